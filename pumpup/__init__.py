@@ -1,0 +1,33 @@
+"""pumpup: physically plausible reflectance models, their albedo, and the albedo pumping-up operator.
+
+See DESIGN.md for the conventions (N = (0, 0, 1), wi towards the light, wo towards the
+viewer, f_r without the cosine factor, mu = cos(theta_i)).
+"""
+
+from ._version import __version__
+from .core import (
+    BRDF,
+    Lobe,
+    Param,
+    ReciprocityResult,
+    SpecError,
+    check_reciprocity,
+    from_function,
+    load,
+    register,
+    registry,
+)
+
+__all__ = [
+    "__version__",
+    "BRDF",
+    "Lobe",
+    "Param",
+    "ReciprocityResult",
+    "SpecError",
+    "check_reciprocity",
+    "from_function",
+    "load",
+    "register",
+    "registry",
+]

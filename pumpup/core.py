@@ -1,0 +1,549 @@
+"""The BRDF interface, the model registry, specs, user functions and the reciprocity check.
+
+Conventions (DESIGN.md; every model in pumpup follows them)
+------------------------------------------------------------
+* Local shading frame: the surface normal is N = (0, 0, 1).  Directions are unit
+  3-vectors on the last axis of an array; every function broadcasts over the
+  leading axes.
+* ``wi`` points from the surface towards the light (the papers' L, Lewis's S);
+  ``wo`` points towards the viewer (V).
+* ``BRDF.eval(wi, wo)`` returns f_r in 1/sr **without** the cosine factor (pbrt's
+  convention).  It is 0 where either direction is at or below the horizon.
+* ``mu`` is cos(theta_i).  Directional albedo
+  a(mu) = integral over the hemisphere of f_r(wi, wo) cos(theta_o) d omega_o
+  (000 eq. 2; 002 eq. 15).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, ClassVar
+
+import numpy as np
+
+__all__ = [
+    "BRDF",
+    "Lobe",
+    "Param",
+    "register",
+    "registry",
+    "load",
+    "from_function",
+    "check_reciprocity",
+    "ReciprocityResult",
+    "SpecError",
+]
+
+#: Largest deviation of |w| from 1 that ``eval`` accepts for a direction.
+UNIT_TOL = 1e-6
+
+
+class SpecError(ValueError):
+    """A model spec or parameter is invalid; the message names the parameter and its range."""
+
+
+# ----------------------------------------------------------------------------------------
+# Parameters
+# ----------------------------------------------------------------------------------------
+
+REQUIRED = object()
+
+
+@dataclass(frozen=True)
+class Param:
+    """Declaration of one model parameter: default and allowed range.
+
+    ``default`` may be a value, ``REQUIRED``, or a callable of the other (already
+    resolved) parameters, e.g. ``lambda p: (p["n"] + 2) / (2 * pi)``.
+    ``lo``/``hi`` bound the value; ``lo_open``/``hi_open`` make the bound strict.
+    ``kind`` is "float", "int", "str", "floats" (a list of floats) or "spec".
+    """
+
+    default: Any = REQUIRED
+    lo: float = -math.inf
+    hi: float = math.inf
+    lo_open: bool = False
+    hi_open: bool = False
+    kind: str = "float"
+    choices: tuple = ()
+    doc: str = ""
+
+    def range_text(self) -> str:
+        if self.choices:
+            return "one of " + ", ".join(repr(c) for c in self.choices)
+        left = "(" if self.lo_open else "["
+        right = ")" if self.hi_open else "]"
+        lo = "-inf" if self.lo == -math.inf else f"{self.lo:g}"
+        hi = "inf" if self.hi == math.inf else f"{self.hi:g}"
+        if self.lo == -math.inf:
+            left = "("
+        if self.hi == math.inf:
+            right = ")"
+        return f"{left}{lo}, {hi}{right}"
+
+    def check_number(self, model: str, name: str, value: Any) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise SpecError(f"{model}: parameter {name!r} must be a number in {self.range_text()}, got {value!r}")
+        v = float(value)
+        if not math.isfinite(v):
+            raise SpecError(f"{model}: parameter {name!r} must be finite, in {self.range_text()}; got {value!r}")
+        bad_lo = v <= self.lo if self.lo_open else v < self.lo
+        bad_hi = v >= self.hi if self.hi_open else v > self.hi
+        if bad_lo or bad_hi:
+            raise SpecError(f"{model}: parameter {name!r} = {v:g} is outside its allowed range {self.range_text()}")
+        return v
+
+    def check(self, model: str, name: str, value: Any) -> Any:
+        if self.kind == "float":
+            return self.check_number(model, name, value)
+        if self.kind == "int":
+            v = self.check_number(model, name, value)
+            if v != int(v):
+                raise SpecError(f"{model}: parameter {name!r} must be an integer in {self.range_text()}, got {value!r}")
+            return int(v)
+        if self.kind == "str":
+            if not isinstance(value, str) or (self.choices and value not in self.choices):
+                raise SpecError(f"{model}: parameter {name!r} must be {self.range_text()}, got {value!r}")
+            return value
+        if self.kind == "floats":
+            if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool):
+                value = [value]
+            if not isinstance(value, (list, tuple, np.ndarray)) or len(value) == 0:
+                raise SpecError(f"{model}: parameter {name!r} must be a non-empty list of numbers in {self.range_text()}, got {value!r}")
+            return [self.check_number(model, f"{name}[{i}]", v) for i, v in enumerate(value)]
+        if self.kind == "spec":
+            if isinstance(value, BRDF):
+                return value
+            if not isinstance(value, dict):
+                raise SpecError(f"{model}: parameter {name!r} must be a model spec (a dict with a 'type'), got {value!r}")
+            return load(value)
+        raise AssertionError(self.kind)
+
+
+# ----------------------------------------------------------------------------------------
+# Quadrature hints
+# ----------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Lobe:
+    """A quadrature hint: where a BRDF's lobe is and how sharp it is (see ``pumpup.albedo``).
+
+    The albedo engine integrates over directions d = A cos(alpha) + sin(alpha) (e1 cos(beta)
+    + e2 sin(beta)) around an axis A, with the polar angle alpha reached through a radial
+    map x -> alpha that absorbs the lobe's peak, so the integrand is smooth in x.
+
+    Parameters
+    ----------
+    axis : {"normal", "mirror", "retro", "half"}
+        A = N; A = R, the mirror direction of wi (000 eq. 8); A = wi; or d is the half
+        vector h around N and wo = 2 (wi.h) h - wi, with d omega_o = 4 (wo.h) d omega_h.
+    radial : {"cosine", "power", "beckmann", "ggx", "gaussian"}
+        "cosine": sin^2(alpha) = x (exact for a Lambertian integrand around N).
+        "power": cos(alpha) = x^(1/(n+1)) for a cos^n lobe (000 eq. 20).
+        "beckmann": tan^2(alpha) = -m^2 ln x for exp(-tan^2/m^2).
+        "ggx": tan^2(alpha) = r x / (1 - x) for r / (1 - (1 - r) cos^2)^2 (000 eq. 36).
+        "gaussian": alpha = sqrt(-ln x) / c for exp(-(c alpha)^2) (002 D2).
+    sharpness : float
+        n, m, r or c of the radial map.
+    levels : tuple of float
+        Values u of N.wo = wo_z where the integrand has a kink (max(N.L, N.V) gives u = mu).
+    kinks : callable or None
+        ``kinks(mu, s, cos_a, sin_a) -> list of (a, b)``: further kinks where
+        a + b cos(beta) = 0 (e.g. the Cook-Torrance geometry factor).
+    symmetric : bool
+        The integrand is even in beta (true for isotropic models and for anisotropy
+        aligned with the x and y axes), so only beta in [0, pi] is integrated.
+    """
+
+    axis: str = "normal"
+    radial: str = "cosine"
+    sharpness: float = 0.0
+    levels: tuple = ()
+    kinks: Callable | None = None
+    symmetric: bool = True
+    # terms of the same lobe family added linearly are handled by BRDF.albedo_terms
+
+
+# ----------------------------------------------------------------------------------------
+# The BRDF base class and the registry
+# ----------------------------------------------------------------------------------------
+
+_REGISTRY: dict[str, type["BRDF"]] = {}
+
+
+def register(name: str):
+    """Class decorator: make a BRDF class loadable as ``{"type": name, ...}``."""
+
+    def deco(cls):
+        if name in _REGISTRY:
+            raise ValueError(f"model type {name!r} is registered twice")
+        cls.type = name
+        _REGISTRY[name] = cls
+        return cls
+
+    return deco
+
+
+def registry() -> dict[str, type["BRDF"]]:
+    """The registered model types, name -> class (a copy), in registration order."""
+    _ensure_models()
+    return dict(_REGISTRY)
+
+
+def _ensure_models() -> None:
+    from . import models  # noqa: F401  (registers the built-in models)
+
+
+def as_directions(w: Any, name: str) -> np.ndarray:
+    """Check that ``w`` holds unit 3-vectors on its last axis; return it as float64."""
+    try:
+        a = np.asarray(w, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be an array of unit 3-vectors: {exc}") from None
+    if a.ndim == 0 or a.shape[-1] != 3:
+        raise ValueError(f"{name} must have 3 components on its last axis, got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        i = np.argwhere(~np.isfinite(a))[0][:-1]
+        raise ValueError(f"{name} contains non-finite values (first at index {tuple(i)})")
+    norm = np.sqrt(np.einsum("...k,...k->...", a, a))
+    bad = np.abs(norm - 1.0) > UNIT_TOL
+    if np.any(bad):
+        i = tuple(np.argwhere(bad)[0])
+        raise ValueError(f"{name} must be unit vectors (|w| = 1 within {UNIT_TOL:g}); |{name}{list(i)}| = {norm[i]:.9g}")
+    return a
+
+
+class BRDF:
+    """A bidirectional reflectance distribution function f_r(wi, wo) in 1/sr.
+
+    Subclasses declare ``params`` (name -> :class:`Param`), set ``reciprocal`` and
+    implement ``_eval`` (usually a compiled numba kernel, with the plain numpy
+    ``reference`` beside it).  They may give the albedo engine a :class:`Lobe` hint.
+
+    Conventions: N = (0, 0, 1); ``wi`` towards the light, ``wo`` towards the viewer;
+    f_r excludes the cosine factor and is 0 below the horizon; ``mu`` = cos(theta_i).
+    """
+
+    type: ClassVar[str] = "?"
+    params: ClassVar[dict[str, Param]] = {}
+    reciprocal: ClassVar[bool] = True
+    #: name of the scalar constant that multiplies the whole BRDF (for max_constant), or None
+    constant: ClassVar[str | None] = "c"
+
+    def __init__(self, **kwargs: Any) -> None:
+        model = self.type
+        unknown = sorted(set(kwargs) - set(self.params))
+        if unknown:
+            raise SpecError(
+                f"{model}: unknown parameter(s) {', '.join(map(repr, unknown))}; "
+                f"allowed: {', '.join(self.params) or 'none'}"
+            )
+        values: dict[str, Any] = {}
+        for name, p in self.params.items():
+            if name in kwargs and kwargs[name] is not None:
+                values[name] = p.check(model, name, kwargs[name])
+        for name, p in self.params.items():
+            if name in values:
+                continue
+            if p.default is REQUIRED:
+                raise SpecError(f"{model}: missing required parameter {name!r} (allowed range {p.range_text()})")
+            if p.default is None:
+                values[name] = None
+                continue
+            d = p.default(values) if callable(p.default) else p.default
+            values[name] = p.check(model, name, d)
+        self.p = values
+        self._validate()
+
+    def _validate(self) -> None:
+        """Cross-parameter checks (override); raise SpecError."""
+
+    # --- spec -------------------------------------------------------------------------
+    @property
+    def spec(self) -> dict:
+        """The model as a plain-JSON dict; ``pumpup.load(f.spec)`` rebuilds it exactly."""
+        out: dict[str, Any] = {"type": self.type}
+        for k, v in self.p.items():
+            if v is None:
+                continue
+            out[k] = v.spec if isinstance(v, BRDF) else v
+        return out
+
+    def with_params(self, **changes: Any) -> "BRDF":
+        """A copy of this model with some parameters changed."""
+        s = self.spec
+        s.update(changes)
+        return load(s)
+
+    def __repr__(self) -> str:
+        return f"pumpup.load({json.dumps(self.spec)})"
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, BRDF) and self.spec == other.spec
+
+    def __hash__(self) -> int:
+        return hash(json.dumps(self.spec, sort_keys=True))
+
+    # --- evaluation -------------------------------------------------------------------
+    def eval(self, wi: Any, wo: Any) -> np.ndarray:
+        """f_r(wi, wo) in 1/sr (no cosine factor), broadcast over the leading axes.
+
+        Parameters
+        ----------
+        wi, wo : array_like, shape (..., 3)
+            Unit vectors towards the light and towards the viewer, N = (0, 0, 1).
+
+        Returns
+        -------
+        ndarray
+            Shape: the broadcast of the leading axes.  0 where wi or wo is at or below
+            the horizon.
+        """
+        wi = as_directions(wi, "wi")
+        wo = as_directions(wo, "wo")
+        return self._eval(wi, wo)
+
+    def _eval(self, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
+        """Evaluate without input checks (the albedo engine calls this)."""
+        return self.kernel(*split(wi), *split(wo), *self.kernel_args())
+
+    def kernel_args(self) -> tuple:
+        """Scalar parameters passed to the compiled kernel after the 6 direction components."""
+        return tuple(self.p[k] for k in self.params)
+
+    def reference(self, wi: Any, wo: Any) -> np.ndarray:
+        """The plain numpy implementation, the readable reference for the kernel."""
+        wi = np.asarray(wi, dtype=np.float64)
+        wo = np.asarray(wo, dtype=np.float64)
+        return self.reference_fn(wi, wo, *self.kernel_args())
+
+    # --- hints for the albedo engine ---------------------------------------------------
+    def lobe(self, mu: float) -> Lobe:
+        """Quadrature hint for incidence cos(theta_i) = mu (default: no knowledge)."""
+        return Lobe(axis="normal", radial="cosine", symmetric=False)
+
+    def albedo_terms(self) -> list[tuple[float, "BRDF"]]:
+        """Linear decomposition f = sum w_k f_k used by the engine (default: itself)."""
+        return [(1.0, self)]
+
+
+def split(w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The x, y, z components of an array of 3-vectors (views, no copy)."""
+    return w[..., 0], w[..., 1], w[..., 2]
+
+
+def load(spec: Any) -> BRDF:
+    """Build a BRDF from a spec: a dict ``{"type": name, param: value, ...}`` or its JSON text.
+
+    Nested specs compose (``{"type": "pumped", "base": {...}}``).  A spec is data: it
+    never imports or evaluates code.
+
+    Examples
+    --------
+    >>> import pumpup
+    >>> f = pumpup.load({"type": "phong", "n": 20})
+    >>> pumpup.load(f.spec) == f
+    True
+    """
+    _ensure_models()
+    if isinstance(spec, BRDF):
+        return spec
+    if isinstance(spec, str):
+        try:
+            spec = json.loads(spec)
+        except json.JSONDecodeError as exc:
+            raise SpecError(f"a spec string must be JSON: {exc}") from None
+    if not isinstance(spec, dict):
+        raise SpecError(f"a spec must be a dict with a 'type' key, got {type(spec).__name__}")
+    if "type" not in spec:
+        raise SpecError(f"a spec needs a 'type' key; known types: {', '.join(_REGISTRY)}")
+    name = spec["type"]
+    if name not in _REGISTRY:
+        raise SpecError(f"unknown model type {name!r}; known types: {', '.join(_REGISTRY)}")
+    kwargs = {k: v for k, v in spec.items() if k != "type"}
+    return _REGISTRY[name](**kwargs)
+
+
+# ----------------------------------------------------------------------------------------
+# User functions
+# ----------------------------------------------------------------------------------------
+
+_USER_FUNCTIONS: dict[str, Callable] = {}
+
+
+@register("function")
+class FunctionBRDF(BRDF):
+    """Any callable ``fn(wi, wo) -> f_r`` as a BRDF (see :func:`from_function`).
+
+    The spec ``{"type": "function", "name": name}`` refers to a function registered in
+    this Python session by ``from_function``; a spec never carries code.
+    """
+
+    params = {"name": Param(kind="str", doc="name the function was registered under")}
+    constant = None
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        name = self.p["name"]
+        if name not in _USER_FUNCTIONS:
+            raise SpecError(
+                f"function: no function named {name!r} is registered in this session; "
+                "call pumpup.from_function(fn, name=...) first"
+            )
+        self.fn, self.reciprocal = _USER_FUNCTIONS[name]
+
+    def _eval(self, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
+        shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
+        out = self.fn(wi, wo)
+        try:
+            out = np.broadcast_to(np.asarray(out, dtype=np.float64), shape)
+        except ValueError:
+            raise ValueError(
+                f"function {self.p['name']!r} returned shape {np.shape(out)}; expected {shape} "
+                "(the broadcast of the leading axes of wi and wo)"
+            ) from None
+        bad = ~np.isfinite(out) | (out < 0)
+        if np.any(bad):
+            i = tuple(np.argwhere(bad)[0])
+            wib = np.broadcast_to(wi, shape + (3,))[i]
+            wob = np.broadcast_to(wo, shape + (3,))[i]
+            raise ValueError(
+                f"function {self.p['name']!r} returned {out[i]!r} at wi={wib.tolist()}, wo={wob.tolist()}: "
+                "a BRDF must be finite and non-negative"
+            )
+        return np.where((wi[..., 2] > 0) & (wo[..., 2] > 0), out, 0.0)
+
+    reference = BRDF.eval
+
+    def kernel_args(self) -> tuple:
+        return ()
+
+
+def from_function(fn: Callable, name: str = "function", reciprocal: bool = True) -> BRDF:
+    """Wrap a callable ``fn(wi, wo) -> f_r`` (numpy, broadcasting) as a BRDF.
+
+    Parameters
+    ----------
+    fn : callable
+        Takes arrays of unit vectors of shape (..., 3) and returns f_r in 1/sr, without
+        the cosine factor.  Values below the horizon are replaced by 0.
+    name : str
+        Registers the function under this name for the session, so that the spec
+        ``{"type": "function", "name": name}`` loads it again.
+    reciprocal : bool
+        What the caller claims; :func:`check_reciprocity` measures it.
+
+    Examples
+    --------
+    >>> import numpy as np, pumpup
+    >>> f = pumpup.from_function(lambda wi, wo: np.full(np.broadcast_shapes(wi.shape, wo.shape)[:-1], 0.5 / np.pi), name="half_white")
+    >>> float(f.eval([0, 0, 1], [0.6, 0, 0.8])) * np.pi
+    0.5
+    """
+    if not callable(fn):
+        raise TypeError(f"from_function needs a callable fn(wi, wo), got {type(fn).__name__}")
+    if not isinstance(name, str) or not name:
+        raise SpecError("from_function: 'name' must be a non-empty string")
+    _USER_FUNCTIONS[name] = (fn, bool(reciprocal))
+    return FunctionBRDF(name=name)
+
+
+# ----------------------------------------------------------------------------------------
+# Reciprocity
+# ----------------------------------------------------------------------------------------
+
+
+@dataclass
+class ReciprocityResult:
+    """Measured asymmetry max |f(wi, wo) - f(wo, wi)| / scale over a set of direction pairs.
+
+    ``scale`` is max(|f(wi, wo)|, |f(wo, wi)|) per pair (pairs where both vanish are
+    skipped).  ``reciprocal`` is ``max_rel_error <= tol``.
+    """
+
+    max_rel_error: float
+    worst_wi: np.ndarray
+    worst_wo: np.ndarray
+    f_forward: float
+    f_backward: float
+    pairs: int
+    tol: float
+    reciprocal: bool = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.reciprocal = bool(self.max_rel_error <= self.tol)
+
+    def __bool__(self) -> bool:
+        return self.reciprocal
+
+    def __str__(self) -> str:
+        verdict = "reciprocal" if self.reciprocal else "NOT reciprocal"
+        return (
+            f"{verdict}: max relative asymmetry {self.max_rel_error:.3g} (tol {self.tol:g}) over {self.pairs} pairs; "
+            f"worst at wi={np.round(self.worst_wi, 6).tolist()}, wo={np.round(self.worst_wo, 6).tolist()}: "
+            f"f(wi,wo)={self.f_forward:.6g}, f(wo,wi)={self.f_backward:.6g}"
+        )
+
+
+def direction_set(n_mu: int = 24, n_phi: int = 24) -> np.ndarray:
+    """A well-spread set of upper-hemisphere directions, including near-grazing ones.
+
+    mu = cos(theta) runs over a grid uniform in theta plus mu = 1e-3, 1e-6, 1e-8; phi
+    is uniform and staggered per ring.  Returns shape (n, 3).
+    """
+    theta = (np.arange(n_mu) + 0.5) / n_mu * (np.pi / 2)
+    mu = np.concatenate([np.cos(theta), [1.0, 1e-3, 1e-6, 1e-8]])
+    dirs = []
+    for k, m in enumerate(mu):
+        phi = (np.arange(n_phi) + 0.5 * (k % 2)) / n_phi * 2 * np.pi
+        s = math.sqrt((1 - m) * (1 + m))
+        dirs.append(np.stack([s * np.cos(phi), s * np.sin(phi), np.full_like(phi, m)], axis=-1))
+    return np.concatenate(dirs)
+
+
+def check_reciprocity(brdf: BRDF, tol: float = 1e-12, n_mu: int = 24, n_phi: int = 24) -> ReciprocityResult:
+    """Measure the asymmetry of ``brdf`` on all pairs of a well-spread direction set.
+
+    Parameters
+    ----------
+    brdf : BRDF
+    tol : float
+        Relative asymmetry allowed for a reciprocal verdict (rounding error).
+    n_mu, n_phi : int
+        Size of the direction set (:func:`direction_set`); the check uses every pair.
+
+    Returns
+    -------
+    ReciprocityResult
+        With the worst pair; truthy when reciprocal.
+
+    Examples
+    --------
+    >>> import pumpup
+    >>> pumpup.check_reciprocity(pumpup.load({"type": "phong", "n": 20})).reciprocal
+    True
+    """
+    d = direction_set(n_mu, n_phi)
+    wi = d[:, None, :]
+    wo = d[None, :, :]
+    fwd = np.asarray(brdf._eval(wi, wo), dtype=np.float64)
+    bwd = np.asarray(brdf._eval(wo, wi), dtype=np.float64)
+    scale = np.maximum(np.abs(fwd), np.abs(bwd))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rel = np.where(scale > 0, np.abs(fwd - bwd) / scale, 0.0)
+    if fwd.ndim > 2:  # multi-channel models: worst channel
+        rel = rel.max(axis=tuple(range(2, rel.ndim)))
+        fwd, bwd = fwd[..., 0], bwd[..., 0]
+    i, j = np.unravel_index(np.argmax(rel), rel.shape)
+    return ReciprocityResult(
+        max_rel_error=float(rel[i, j]),
+        worst_wi=d[i],
+        worst_wo=d[j],
+        f_forward=float(fwd[i, j]),
+        f_backward=float(bwd[i, j]),
+        pairs=int(rel.size),
+        tol=tol,
+    )

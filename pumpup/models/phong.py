@@ -1,0 +1,246 @@
+"""The Phong family: reciprocal Phong, stretched Phong / p-model, retro-reflective, and
+Phong's original (non-reciprocal) shader as a BRDF.
+
+All lobes are powers of cos(alpha) = (R.V)_+ (or (L.V)_+ for the retro-reflective model),
+with R = 2 (N.L) N - L the mirror direction of L (000 eq. 8) and, by 000 eq. 9,
+R.V = 2 (N.L)(N.V) - L.V.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import vectorize
+
+from ..core import BRDF, Lobe, Param, register
+
+
+def _phong_c(p):
+    return (p["n"] + 2.0) / (2.0 * math.pi)  # 000 eq. 6, the largest energy-conserving c
+
+
+def _cos_alpha(wi, wo):
+    """(R.V) = 2 (N.L)(N.V) - (L.V), 000 eq. 9."""
+    return 2.0 * wi[..., 2] * wo[..., 2] - np.einsum("...k,...k->...", wi, wo)
+
+
+def _up(wi, wo):
+    return (wi[..., 2] > 0) & (wo[..., 2] > 0)
+
+
+# --- reciprocal Phong ---------------------------------------------------------------------
+
+
+@vectorize(cache=True)
+def _phong_kernel(lx, ly, lz, vx, vy, vz, n, c):  # pragma: no cover - compiled
+    if lz <= 0.0 or vz <= 0.0:
+        return 0.0
+    rv = 2.0 * lz * vz - (lx * vx + ly * vy + lz * vz)  # 000 eq. 9
+    if rv <= 0.0:
+        return 0.0
+    return c * rv**n  # 000 eq. 5
+
+
+def _phong_reference(wi, wo, n, c):
+    rv = np.maximum(_cos_alpha(wi, wo), 0.0)
+    return np.where(_up(wi, wo) & (rv > 0), c * rv**n, 0.0)  # 000 eq. 5
+
+
+@register("phong")
+class Phong(BRDF):
+    """Reciprocal Phong, f_r = c (R.V)_+^n [1/sr] (000 eq. 5; Lewis 002 removes 1/(N.L)).
+
+    Parameters
+    ----------
+    n : float, >= 0
+        Phong exponent.
+    c : float, >= 0, default (n + 2) / (2 pi)
+        Scale; (n + 2) / (2 pi) is the largest that conserves energy (000 eq. 6), and
+        gives albedo exactly 1 at normal incidence.
+
+    Examples
+    --------
+    >>> import pumpup
+    >>> f = pumpup.load({"type": "phong", "n": 20})
+    >>> float(f.eval([0, 0, 1], [0, 0, 1])) == 22 / (2 * 3.141592653589793)
+    True
+    """
+
+    params = {
+        "n": Param(lo=0.0, doc="exponent"),
+        "c": Param(_phong_c, lo=0.0, doc="scale [1/sr]"),
+    }
+    kernel = staticmethod(_phong_kernel)
+    reference_fn = staticmethod(_phong_reference)
+
+    def lobe(self, mu):
+        return Lobe(axis="mirror", radial="power", sharpness=self.p["n"])
+
+
+# --- stretched Phong / p-model ------------------------------------------------------------
+
+
+@vectorize(cache=True)
+def _stretched_kernel(lx, ly, lz, vx, vy, vz, n, p, c):  # pragma: no cover - compiled
+    if lz <= 0.0 or vz <= 0.0:
+        return 0.0
+    rv = 2.0 * lz * vz - (lx * vx + ly * vy + lz * vz)  # 000 eq. 9
+    if rv <= 0.0:
+        return 0.0
+    return c * rv**n / max(lz, vz) ** p  # 000 eq. 10, 12
+
+
+def _stretched_reference(wi, wo, n, p, c):
+    rv = np.maximum(_cos_alpha(wi, wo), 0.0)
+    mx = np.maximum(wi[..., 2], wo[..., 2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f = c * rv**n / mx**p  # 000 eq. 10, 12
+    return np.where(_up(wi, wo) & (rv > 0), f, 0.0)
+
+
+@register("stretched_phong")
+class StretchedPhong(BRDF):
+    """Stretched Phong and the p-model, f_r = c (R.V)_+^n / max(N.L, N.V)^p [1/sr].
+
+    000 eq. 7 and 10 (p = 1, the metallic "stretched" model) and eq. 12 (the p-model,
+    a transition from reciprocal Phong at p = 0).
+
+    Parameters
+    ----------
+    n : float, >= 0
+        Phong exponent.
+    p : float, in [0, 1], default 1
+        Stretch power.
+    c : float, >= 0, default (n + 2) / (2 pi)
+        Scale (000 eq. 6 holds for n >= 1 and any p, 000 sec. 2.3).
+
+    Examples
+    --------
+    >>> import pumpup
+    >>> f = pumpup.load({"type": "stretched_phong", "n": 20})
+    >>> mu = 0.5  # mirror direction at 60 degrees: f = c / mu
+    >>> wi = [3**0.5 / 2, 0, mu]; wo = [-3**0.5 / 2, 0, mu]
+    >>> round(float(f.eval(wi, wo)) * mu / (22 / (2 * 3.141592653589793)), 12)
+    1.0
+    """
+
+    params = {
+        "n": Param(lo=0.0, doc="exponent"),
+        "p": Param(1.0, lo=0.0, hi=1.0, doc="stretch power"),
+        "c": Param(_phong_c, lo=0.0, doc="scale [1/sr]"),
+    }
+    kernel = staticmethod(_stretched_kernel)
+    reference_fn = staticmethod(_stretched_reference)
+
+    def lobe(self, mu):
+        levels = (mu,) if self.p["p"] > 0 else ()
+        return Lobe(axis="mirror", radial="power", sharpness=self.p["n"], levels=levels)
+
+
+# --- retro-reflective ---------------------------------------------------------------------
+
+
+@vectorize(cache=True)
+def _retro_kernel(lx, ly, lz, vx, vy, vz, n, p, c):  # pragma: no cover - compiled
+    if lz <= 0.0 or vz <= 0.0:
+        return 0.0
+    lv = lx * vx + ly * vy + lz * vz
+    if lv <= 0.0:
+        return 0.0
+    return c * lv**n / max(lz, vz) ** p  # 000 eq. 13
+
+
+def _retro_reference(wi, wo, n, p, c):
+    lv = np.maximum(np.einsum("...k,...k->...", wi, wo), 0.0)
+    mx = np.maximum(wi[..., 2], wo[..., 2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f = c * lv**n / mx**p  # 000 eq. 13
+    return np.where(_up(wi, wo) & (lv > 0), f, 0.0)
+
+
+@register("retro")
+class Retro(BRDF):
+    """Retro-reflective stretched Phong, f_r = c (L.V)_+^n / max(N.L, N.V)^p [1/sr] (000 eq. 13).
+
+    The mirror direction R of the stretched model is replaced by L itself, so the lobe
+    peaks back towards the light.
+
+    Parameters
+    ----------
+    n : float, >= 0
+    p : float, in [0, 1], default 1 (000 eq. 13 has p = 1)
+    c : float, >= 0, default (n + 2) / (2 pi) (000 sec. 3.1)
+    """
+
+    params = {
+        "n": Param(lo=0.0, doc="exponent"),
+        "p": Param(1.0, lo=0.0, hi=1.0, doc="stretch power"),
+        "c": Param(_phong_c, lo=0.0, doc="scale [1/sr]"),
+    }
+    kernel = staticmethod(_retro_kernel)
+    reference_fn = staticmethod(_retro_reference)
+
+    def lobe(self, mu):
+        levels = (mu,) if self.p["p"] > 0 else ()
+        return Lobe(axis="retro", radial="power", sharpness=self.p["n"], levels=levels)
+
+
+# --- Phong's original shader as a BRDF (not reciprocal) ------------------------------------
+
+
+@vectorize(cache=True)
+def _shader_kernel(lx, ly, lz, vx, vy, vz, n, ks, kd):  # pragma: no cover - compiled
+    if lz <= 0.0 or vz <= 0.0:
+        return 0.0
+    rv = 2.0 * lz * vz - (lx * vx + ly * vy + lz * vz)
+    spec = ks * rv**n / lz if rv > 0.0 else 0.0  # 002 eq. 5, 8
+    return kd + spec
+
+
+def _shader_reference(wi, wo, n, ks, kd):
+    rv = np.maximum(_cos_alpha(wi, wo), 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        spec = np.where(rv > 0, ks * rv**n / wi[..., 2], 0.0)  # 002 eq. 5, 8
+    return np.where(_up(wi, wo), kd + spec, 0.0)
+
+
+@register("phong_shader")
+class PhongShader(BRDF):
+    """Phong's original shader as a BRDF, f_r = k_d + k_s (R.V)_+^n / (N.L) [1/sr].
+
+    002 eq. 8 with F_s of 002 eq. 5.  Not reciprocal (002 sec. 5.1) and its albedo
+    diverges at grazing incidence (002 sec. 4.1).
+
+    Parameters
+    ----------
+    n : float, >= 0
+    ks : float, >= 0, default (n + 2) / (2 pi)
+        Specular coefficient [1/sr].
+    kd : float, in [0, 1/pi], default 0
+        Diffuse coefficient [1/sr] (k_d of 002 eq. 8 is already divided by pi).
+    """
+
+    params = {
+        "n": Param(lo=0.0, doc="exponent"),
+        "ks": Param(_phong_c, lo=0.0, doc="specular coefficient [1/sr]"),
+        "kd": Param(0.0, lo=0.0, hi=1.0 / math.pi, doc="diffuse coefficient [1/sr]"),
+    }
+    reciprocal = False
+    constant = "ks"
+    kernel = staticmethod(_shader_kernel)
+    reference_fn = staticmethod(_shader_reference)
+
+    def albedo_terms(self):
+        if self.p["kd"] == 0:
+            return [(1.0, self)]
+        return [(1.0, self.with_params(kd=0.0)), (math.pi * self.p["kd"], load_lambert())]
+
+    def lobe(self, mu):
+        return Lobe(axis="mirror", radial="power", sharpness=self.p["n"])
+
+
+def load_lambert():
+    from ..core import load
+
+    return load({"type": "lambert", "albedo": 1.0})
