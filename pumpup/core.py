@@ -232,6 +232,8 @@ class BRDF:
     reciprocal: ClassVar[bool] = True
     #: name of the scalar constant that multiplies the whole BRDF (for max_constant), or None
     constant: ClassVar[str | None] = "c"
+    #: a few specs (without "type") that the common model tests run through every invariant
+    examples: ClassVar[list[dict]] = []
 
     def __init__(self, **kwargs: Any) -> None:
         model = self.type

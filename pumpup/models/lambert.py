@@ -40,6 +40,7 @@ class Lambert(BRDF):
 
     params = {"albedo": Param(1.0, lo=0.0, hi=1.0, doc="directional albedo")}
     constant = "albedo"
+    examples = [{}, {"albedo": 0.3}]
     kernel = staticmethod(_kernel)
     reference_fn = staticmethod(_reference)
 

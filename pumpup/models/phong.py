@@ -71,6 +71,7 @@ class Phong(BRDF):
         "n": Param(lo=0.0, doc="exponent"),
         "c": Param(_phong_c, lo=0.0, doc="scale [1/sr]"),
     }
+    examples = [{"n": 0}, {"n": 1}, {"n": 20}, {"n": 5000}, {"n": 10.5, "c": 1.0}]
     kernel = staticmethod(_phong_kernel)
     reference_fn = staticmethod(_phong_reference)
 
@@ -130,6 +131,7 @@ class StretchedPhong(BRDF):
         "p": Param(1.0, lo=0.0, hi=1.0, doc="stretch power"),
         "c": Param(_phong_c, lo=0.0, doc="scale [1/sr]"),
     }
+    examples = [{"n": 1}, {"n": 20}, {"n": 5000}, {"n": 8, "p": 0.5}, {"n": 3, "p": 0.0}]
     kernel = staticmethod(_stretched_kernel)
     reference_fn = staticmethod(_stretched_reference)
 
@@ -178,6 +180,7 @@ class Retro(BRDF):
         "p": Param(1.0, lo=0.0, hi=1.0, doc="stretch power"),
         "c": Param(_phong_c, lo=0.0, doc="scale [1/sr]"),
     }
+    examples = [{"n": 10}, {"n": 100, "p": 0.5}]
     kernel = staticmethod(_retro_kernel)
     reference_fn = staticmethod(_retro_reference)
 
@@ -228,6 +231,7 @@ class PhongShader(BRDF):
     }
     reciprocal = False
     constant = "ks"
+    examples = [{"n": 20}, {"n": 5, "kd": 0.1}]
     kernel = staticmethod(_shader_kernel)
     reference_fn = staticmethod(_shader_reference)
 
