@@ -5,6 +5,7 @@ viewer, f_r without the cosine factor, mu = cos(theta_i)).
 """
 
 from ._version import __version__
+from .albedo import albedo
 from .core import (
     BRDF,
     Lobe,
@@ -20,6 +21,7 @@ from .core import (
 
 __all__ = [
     "__version__",
+    "albedo",
     "BRDF",
     "Lobe",
     "Param",
