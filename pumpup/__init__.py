@@ -6,6 +6,7 @@ viewer, f_r without the cosine factor, mu = cos(theta_i)).
 
 from ._version import __version__
 from .albedo import albedo
+from .tables import AlbedoTable, max_albedo, max_constant, mean_albedo, open_table, tabulate, write_table
 from .core import (
     BRDF,
     Lobe,
@@ -22,6 +23,13 @@ from .core import (
 __all__ = [
     "__version__",
     "albedo",
+    "AlbedoTable",
+    "max_albedo",
+    "max_constant",
+    "mean_albedo",
+    "open_table",
+    "tabulate",
+    "write_table",
     "BRDF",
     "Lobe",
     "Param",

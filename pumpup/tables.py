@@ -1,0 +1,412 @@
+"""Albedo tables: tabulation on an adaptive grid, interpolation with a stated error, netCDF
+files, mean albedo and maximum constants.
+
+A table is an ``xarray.Dataset`` with the data variables ``albedo`` and ``albedo_error``
+over the coordinate ``mu`` = cos(theta_i) (with ``theta`` in degrees beside it) and
+attributes that make the file self-describing: the model spec as JSON, the method and
+tolerances, the interpolation error, and the pumpup version.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+import tempfile
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._version import __version__
+from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
+from .core import BRDF, load
+
+__all__ = [
+    "tabulate",
+    "AlbedoTable",
+    "write_table",
+    "open_table",
+    "mean_albedo",
+    "max_constant",
+    "max_albedo",
+    "default_grid",
+]
+
+TABLE_KIND = "pumpup albedo table"
+METHOD = "adaptive 15x15 Gauss-Kronrod cubature in a lobe-adapted frame (pumpup.albedo)"
+
+
+def default_grid(n_theta: int = 33, mu_min: float = 1e-8) -> np.ndarray:
+    """Initial grid: uniform in theta from 0 to 90 degrees, plus decades of mu down to mu_min.
+
+    Returns increasing mu in (0, 1].
+    """
+    theta = np.linspace(0.0, np.pi / 2, n_theta)[:-1]
+    mu = np.cos(theta)
+    mu = mu[mu > 0.02]
+    decades = np.logspace(math.log10(0.02), math.log10(mu_min), max(2, int(round(math.log10(0.02 / mu_min))) * 2 + 1))
+    return np.unique(np.concatenate([mu, decades, [1.0]]))
+
+
+def _progress(total: int, desc: str, progress: bool | None):
+    """A tqdm bar on a terminal, silent otherwise (or as forced by ``progress``)."""
+    from tqdm.auto import tqdm
+
+    show = sys.stderr.isatty() if progress is None else progress
+    return tqdm(total=total, desc=desc, disable=not show, unit="mu", leave=False)
+
+
+class AlbedoTable:
+    """a(mu) anywhere in (0, 1], interpolated from a table, with a stated error.
+
+    Interpolation is monotone piecewise-cubic Hermite (PCHIP) in log(mu), which never
+    overshoots the data.  Below the smallest tabulated mu the table extrapolates the
+    power law through its last two nodes (linear in log a versus log mu).
+
+    ``interp_error`` is the largest difference between the interpolant and the computed
+    albedo at the midpoints of the intervals, measured when the grid was built (or 0 if
+    the grid was given and not checked).  :meth:`upper` is an upper bound of the true
+    albedo: interpolant + interpolation error + the largest quadrature error of the two
+    neighbouring nodes.
+    """
+
+    def __init__(self, mu, value, error, interp_error: float = 0.0, spec: dict | None = None):
+        from scipy.interpolate import PchipInterpolator
+
+        mu = np.asarray(mu, dtype=np.float64)
+        order = np.argsort(mu)
+        self.mu = mu[order]
+        self.value = np.asarray(value, dtype=np.float64)[order]
+        self.error = np.asarray(error, dtype=np.float64)[order]
+        self.interp_error = float(interp_error)
+        self.spec = spec
+        if len(self.mu) < 2:
+            raise ValueError("an albedo table needs at least two values of mu")
+        self._pchip = PchipInterpolator(np.log(self.mu), self.value, extrapolate=True)
+        self._err = PchipInterpolator(np.log(self.mu), self.error, extrapolate=True)
+
+    @classmethod
+    def from_dataset(cls, ds) -> "AlbedoTable":
+        return cls(ds["mu"].values, ds["albedo"].values, ds["albedo_error"].values,
+                   float(ds.attrs.get("interpolation_error", 0.0)), json.loads(ds.attrs["spec"]))
+
+    def __call__(self, mu) -> np.ndarray:
+        m = check_mu(mu)
+        lm = np.log(m)
+        out = self._pchip(lm)
+        lo = m < self.mu[0]
+        if np.any(lo):
+            a0, a1 = self.value[0], self.value[1]
+            if a0 > 0 and a1 > 0:
+                slope = (math.log(a1) - math.log(a0)) / (math.log(self.mu[1]) - math.log(self.mu[0]))
+                out = np.where(lo, a0 * np.exp(slope * (lm - math.log(self.mu[0]))), out)
+            else:
+                out = np.where(lo, a0, out)
+        return out
+
+    def node_error(self, mu) -> np.ndarray:
+        """Quadrature error of the nearest nodes (the larger of the two neighbours)."""
+        m = check_mu(mu)
+        i = np.clip(np.searchsorted(self.mu, m), 1, len(self.mu) - 1)
+        return np.maximum(self.error[i - 1], self.error[i])
+
+    def upper(self, mu) -> np.ndarray:
+        """An upper bound of the true albedo: interpolant + interpolation error + quadrature error."""
+        return self(mu) + self.interp_error + self.node_error(mu)
+
+
+def _midpoints(mu: np.ndarray) -> np.ndarray:
+    """Midpoints of consecutive nodes in log(mu)."""
+    return np.sqrt(mu[:-1] * mu[1:])
+
+
+def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
+             interp_tol: float = 1e-7, mu_min: float = 1e-8, max_points: int = 2049, progress: bool | None = None):
+    """Tabulate the directional albedo of ``brdf``.
+
+    Parameters
+    ----------
+    brdf : BRDF
+    mu : array_like, optional
+        The grid of cos(theta_i) in (0, 1].  If omitted, the grid adapts: it starts from
+        :func:`default_grid` (down to ``mu_min``) and bisects (in log mu) every interval
+        where the interpolant misses the computed albedo at the midpoint by more than
+        ``interp_tol``; the largest miss found is stored as ``interpolation_error``.
+    rtol, atol : float
+        Quadrature tolerance of every value (see :func:`pumpup.albedo`).
+    interp_tol : float
+        Absolute interpolation tolerance of the adaptive grid.
+    mu_min : float
+        Smallest mu of the adaptive grid.
+    max_points : int
+        Upper limit on the adaptive grid.
+    progress : bool, optional
+        Show a progress bar (default: when stderr is a terminal).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``albedo`` and ``albedo_error`` over ``mu``, coordinate ``theta`` [deg], and
+        attributes ``spec`` (JSON), ``method``, ``rtol``, ``atol``,
+        ``interpolation_error``, ``pumpup_version``.
+
+    Examples
+    --------
+    >>> import pumpup
+    >>> ds = pumpup.tabulate(pumpup.load({"type": "lambert", "albedo": 0.5}), mu=[0.1, 0.5, 1.0])
+    >>> ds["albedo"].values.round(12).tolist()
+    [0.5, 0.5, 0.5]
+    """
+    if mu is not None:
+        grid = np.unique(check_mu(np.atleast_1d(mu)).ravel())
+        with _progress(len(grid), f"albedo {brdf.type}", progress) as bar:
+            val, err = _chunked(brdf, grid, rtol, atol, bar)
+        return _dataset(brdf, grid, val, err, rtol, atol, 0.0, "given")
+    check_mu(mu_min)
+    grid = default_grid(mu_min=mu_min)
+    with _progress(len(grid), f"albedo {brdf.type}", progress) as bar:
+        val, err = _chunked(brdf, grid, rtol, atol, bar)
+        interp_error = 0.0
+        todo = np.ones(len(grid) - 1, bool)  # intervals not yet checked
+        while todo.any() and len(grid) < max_points:
+            mids = _midpoints(grid)[todo]
+            bar.total += len(mids)
+            mval, merr = _chunked(brdf, mids, rtol, atol, bar)
+            table = AlbedoTable(grid, val, err)
+            miss = np.abs(table(mids) - mval)
+            bad = miss > interp_tol
+            interp_error = max(interp_error, float(miss[~bad].max(initial=0.0)))
+            # accept the good intervals; add the bad midpoints as nodes
+            new_mu = np.concatenate([grid, mids[bad]])
+            order = np.argsort(new_mu)
+            grid = new_mu[order]
+            val = np.concatenate([val, mval[bad]])[order]
+            err = np.concatenate([err, merr[bad]])[order]
+            # intervals next to a new node must be checked again
+            is_new = np.concatenate([np.zeros(len(order) - bad.sum(), bool), np.ones(bad.sum(), bool)])[order]
+            todo = is_new[:-1] | is_new[1:]
+        if todo.any():
+            interp_error = max(interp_error, float(miss.max()))
+    return _dataset(brdf, grid, val, err, rtol, atol, interp_error, "adaptive")
+
+
+def _chunked(brdf, mu, rtol, atol, bar, chunk: int = 32):
+    val = np.empty_like(mu)
+    err = np.empty_like(mu)
+    for a in range(0, len(mu), chunk):
+        sl = slice(a, a + chunk)
+        val[sl], err[sl] = albedo(brdf, mu[sl], return_error=True, rtol=rtol, atol=atol)
+        bar.update(len(mu[sl]))
+    return val, err
+
+
+def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind):
+    import xarray as xr
+
+    theta = np.degrees(np.arccos(mu))
+    ds = xr.Dataset(
+        {
+            "albedo": ("mu", val, {"long_name": "directional albedo a(mu)", "units": "1",
+                                   "definition": "integral of f_r(wi, wo) cos(theta_o) d omega_o (000 eq. 2)"}),
+            "albedo_error": ("mu", err, {"long_name": "estimated absolute quadrature error of albedo", "units": "1"}),
+        },
+        coords={
+            "mu": ("mu", mu, {"long_name": "cosine of the incidence angle, cos(theta_i)", "units": "1"}),
+            "theta": ("mu", theta, {"long_name": "incidence angle theta_i", "units": "degree"}),
+        },
+        attrs={
+            "title": f"Directional albedo of {brdf.type}",
+            "pumpup_kind": TABLE_KIND,
+            "spec": json.dumps(brdf.spec, sort_keys=True),
+            "model": brdf.type,
+            "method": METHOD,
+            "rtol": float(rtol),
+            "atol": float(atol),
+            "grid": grid_kind,
+            "interpolation": "PCHIP in log(mu); power-law extrapolation below the smallest mu",
+            "interpolation_error": float(interp_error),
+            "pumpup_version": __version__,
+        },
+    )
+    return ds
+
+
+def write_table(ds, path) -> str:
+    """Write a Dataset to netCDF atomically (a temporary file renamed into place)."""
+    path = os.fspath(path)
+    directory = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(directory):
+        raise OSError(f"cannot write {path!r}: directory {directory!r} does not exist")
+    if not os.access(directory, os.W_OK):
+        raise OSError(f"cannot write {path!r}: directory {directory!r} is not writable")
+    fd, tmp = tempfile.mkstemp(suffix=".nc.tmp", dir=directory)
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def open_table(path, group: str | None = None):
+    """Open a netCDF table written by pumpup, fully loaded into memory.
+
+    Raises
+    ------
+    FileNotFoundError
+        If there is no such file.
+    ValueError
+        If the file is damaged, not netCDF, or not a pumpup table.
+    """
+    import xarray as xr
+
+    path = os.fspath(path)
+    if not os.path.exists(path):
+        raise FileNotFoundError(f"no such table: {path!r}")
+    try:
+        with xr.open_dataset(path, engine="netcdf4", group=group) as ds:
+            ds = ds.load()
+    except (OSError, ValueError, RuntimeError, KeyError) as exc:
+        raise ValueError(f"{path!r} is not a readable netCDF file (damaged or another format): {exc}") from None
+    if not str(ds.attrs.get("pumpup_kind", "")).startswith("pumpup"):
+        raise ValueError(f"{path!r} is a netCDF file but not a pumpup table (no 'pumpup_kind' attribute)")
+    return ds
+
+
+# --------------------------------------------------------------------------------------------
+# Mean albedo and maximum constants
+# --------------------------------------------------------------------------------------------
+
+
+def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False, max_intervals: int = 400):
+    """Mean albedo 2 * integral_0^1 a(mu) mu dmu (000 eq. 33): the albedo under uniform sky light.
+
+    Computed by adaptive Gauss-Kronrod (7/15) quadrature over mu with the smoothing
+    substitution mu = tau^2 (3 - 2 tau); every a(mu) comes from :func:`pumpup.albedo` at
+    a tolerance 10 times tighter.  The error estimate adds the outer |K - G| and the
+    propagated albedo errors.
+
+    Examples
+    --------
+    >>> import pumpup
+    >>> round(pumpup.mean_albedo(pumpup.load({"type": "lambert", "albedo": 0.25})), 12)
+    0.25
+    """
+    from .albedo import NODES, WG, WK
+
+    def rule(a, b):
+        tau = a[:, None] + (b - a)[:, None] * NODES[None, :]
+        mu = tau * tau * (3 - 2 * tau)
+        w = 6 * tau * (1 - tau) * (b - a)[:, None]
+        v, e = albedo(brdf, mu, return_error=True, rtol=rtol / 10, atol=1e-15)
+        fv = 2 * v * mu * w
+        fe = 2 * e * mu * w
+        k = fv @ WK
+        return k, np.abs(k - fv @ WG), fe @ WK
+
+    edges = np.linspace(0, 1, 9)
+    a, b = edges[:-1], edges[1:]
+    k, qe, pe = rule(a, b)
+    while True:
+        total = k.sum()
+        err = qe.sum() + pe.sum()
+        if qe.sum() <= rtol * abs(total) / 2 or len(a) >= max_intervals:
+            break
+        pick = qe > 0.25 * qe.sum() / len(a)
+        pick[np.argmax(qe)] = True
+        m = 0.5 * (a[pick] + b[pick])
+        na = np.concatenate([a[pick], m])
+        nb = np.concatenate([m, b[pick]])
+        nk, nqe, npe = rule(na, nb)
+        a = np.concatenate([a[~pick], na])
+        b = np.concatenate([b[~pick], nb])
+        k, qe, pe = np.concatenate([k[~pick], nk]), np.concatenate([qe[~pick], nqe]), np.concatenate([pe[~pick], npe])
+    total = float(total)
+    err = float(err + 50 * np.finfo(float).eps * abs(total))
+    return (total, err) if return_error else total
+
+
+@dataclass
+class AlbedoMaximum:
+    """Where the albedo of a model (with its constant set to 1) peaks."""
+
+    albedo: float  #: maximum albedo with the constant set to 1
+    error: float  #: its estimated error
+    mu: float  #: cos(theta_i) at the maximum
+    theta_deg: float  #: theta_i at the maximum [deg]
+    constant: float  #: 1 / albedo, the largest energy-conserving constant
+    constant_error: float  #: propagated error of the constant
+    at_boundary: bool  #: the maximum is at the end of the scanned range (mu = 1 or mu = mu_min)
+
+
+def _unit_constant(brdf: BRDF) -> BRDF:
+    if brdf.constant is None or brdf.constant not in brdf.p:
+        return brdf
+    return brdf.with_params(**{brdf.constant: 1.0})
+
+
+def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: float = 1e-11) -> AlbedoMaximum:
+    """Locate the maximum of a(mu) over [mu_min, 1] with the model's constant set to 1.
+
+    A scan uniform in theta (plus decades of mu down to ``mu_min``) finds the best node;
+    a bounded Brent search (scipy ``minimize_scalar``) between its neighbours refines it.
+    """
+    from scipy.optimize import minimize_scalar
+
+    f = _unit_constant(brdf)
+    theta = np.linspace(0, math.acos(mu_min), n_scan)
+    mu = np.unique(np.concatenate([np.cos(theta), np.logspace(-1, math.log10(mu_min), 6), [1.0, mu_min]]))
+    mu = mu[(mu >= mu_min) & (mu <= 1)]
+    a, e = albedo(f, mu, return_error=True, rtol=rtol)
+    i = int(np.argmax(a))
+    best_mu, best_a, best_e = float(mu[i]), float(a[i]), float(e[i])
+    if 0 < i < len(mu) - 1:
+        lo, hi = float(mu[i - 1]), float(mu[i + 1])
+
+        def neg(m):
+            return -float(albedo(f, m, rtol=rtol))
+
+        res = minimize_scalar(neg, bounds=(lo, hi), method="bounded", options={"xatol": 1e-9 * hi})
+        if -res.fun > best_a:
+            best_mu = float(res.x)
+            best_a, best_e = (float(v) for v in albedo(f, best_mu, return_error=True, rtol=rtol))
+    at_boundary = i in (0, len(mu) - 1)
+    return AlbedoMaximum(
+        albedo=best_a,
+        error=best_e,
+        mu=best_mu,
+        theta_deg=math.degrees(math.acos(best_mu)),
+        constant=1.0 / best_a,
+        constant_error=best_e / best_a**2,
+        at_boundary=at_boundary,
+    )
+
+
+def max_constant(brdf: BRDF, **kw) -> tuple[float, float]:
+    """The maximum constant of a model and the angle of its albedo maximum.
+
+    The constant is 1 / max over mu of the albedo computed with the model's constant
+    (``c``; ``albedo`` for Lambert) set to 1 (000 Tables 2 and 4).
+
+    Returns
+    -------
+    (constant, theta_deg)
+
+    Examples
+    --------
+    >>> import pumpup
+    >>> c, theta = pumpup.max_constant(pumpup.load({"type": "lambert"}))
+    >>> round(c, 12)
+    1.0
+    """
+    m = max_albedo(brdf, **kw)
+    return m.constant, m.theta_deg
+
+
+def table_for(brdf: BRDF | dict, **kw) -> AlbedoTable:
+    """Tabulate ``brdf`` on the adaptive grid and return the interpolating table."""
+    return AlbedoTable.from_dataset(tabulate(load(brdf), **kw))
