@@ -1,0 +1,209 @@
+"""The Ward family: isotropic Ward, anisotropic Ward, and the modified Ward model.
+
+delta is the angle between N and the halfway vector H = (L + V) / |L + V|.  With the
+unnormalised S = L + V (S_z > 0 above the horizon), tan^2 delta = (S_x / S_z)^2 + (S_y / S_z)^2,
+and the anisotropic terms are tan^2 delta cos^2 phi_h = (h_x / h_z)^2 = (S_x / S_z)^2 (likewise
+for y); this avoids the cancellation in 1 - (N.H)^2 near the highlight.  sqrt(N.L) sqrt(N.V)
+stands for sqrt((N.L)(N.V)) so that the product cannot underflow.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import vectorize
+
+from ..core import BRDF, Lobe, Param, register
+
+
+def _tan2_delta(wi, wo):
+    """tan^2 delta = (S_x / S_z)^2 + (S_y / S_z)^2 with S = L + V."""
+    s = wi + wo
+    qx = s[..., 0] / s[..., 2]
+    qy = s[..., 1] / s[..., 2]
+    return qx * qx + qy * qy
+
+
+def _up(wi, wo):
+    return (wi[..., 2] > 0) & (wo[..., 2] > 0)
+
+
+# --- isotropic Ward -------------------------------------------------------------------------
+
+
+@vectorize(cache=True)
+def _ward_kernel(lx, ly, lz, vx, vy, vz, m, c):  # pragma: no cover - compiled
+    if lz <= 0.0 or vz <= 0.0:
+        return 0.0
+    sz = lz + vz
+    qx = (lx + vx) / sz  # h_x / h_z
+    qy = (ly + vy) / sz  # h_y / h_z
+    t2 = qx * qx + qy * qy  # tan^2 delta
+    den = 4.0 * math.pi * m * m * (math.sqrt(lz) * math.sqrt(vz))
+    return c * math.exp(-t2 / (m * m)) / den  # 000 eq. 34, 001 eq. 8
+
+
+def _ward_reference(wi, wo, m, c):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        t2 = _tan2_delta(wi, wo)
+        den = 4.0 * np.pi * m * m * (np.sqrt(wi[..., 2]) * np.sqrt(wo[..., 2]))
+        f = c * np.exp(-t2 / (m * m)) / den  # 000 eq. 34, 001 eq. 8
+    return np.where(_up(wi, wo), f, 0.0)
+
+
+@register("ward")
+class Ward(BRDF):
+    """Isotropic Ward, f_r = c exp(-tan^2 delta / m^2) / (4 pi m^2 sqrt((N.L)(N.V))) [1/sr].
+
+    000 eq. 34 (with C_max = c) and 001 eq. 8; delta = arccos(N.H).  Its albedo
+    diverges at grazing incidence (001 sec. 2.1), so it is not physically plausible.
+
+    Parameters
+    ----------
+    m : float, in (0, inf)
+        RMS surface slope (dimensionless).
+    c : float, >= 0, default 1
+        Scale (dimensionless); Ward's value is 1, energy conserving below 89 degrees
+        for m < 0.2 (000 sec. 6.2).
+
+    Examples
+    --------
+    >>> import math, pumpup
+    >>> f = pumpup.load({"type": "ward", "m": 0.1})
+    >>> round(float(f.eval([0, 0, 1], [0, 0, 1])) * 4 * math.pi * 0.1**2, 12)
+    1.0
+    """
+
+    params = {
+        "m": Param(lo=0.0, lo_open=True, doc="RMS slope"),
+        "c": Param(1.0, lo=0.0, doc="scale"),
+    }
+    examples = [{"m": 0.1}, {"m": 0.2}, {"m": 0.02}, {"m": 0.4, "c": 0.6}]
+    kernel = staticmethod(_ward_kernel)
+    reference_fn = staticmethod(_ward_reference)
+
+    def lobe(self, mu):
+        return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"])
+
+
+# --- anisotropic Ward -----------------------------------------------------------------------
+
+
+@vectorize(cache=True)
+def _aniso_kernel(lx, ly, lz, vx, vy, vz, ax, ay, c):  # pragma: no cover - compiled
+    if lz <= 0.0 or vz <= 0.0:
+        return 0.0
+    sz = lz + vz
+    qx = (lx + vx) / sz  # h_x / h_z: tan^2 delta cos^2 phi_h = qx^2
+    qy = (ly + vy) / sz  # h_y / h_z: tan^2 delta sin^2 phi_h = qy^2
+    e = (qx / ax) ** 2 + (qy / ay) ** 2
+    den = 4.0 * math.pi * ax * ay * (math.sqrt(lz) * math.sqrt(vz))
+    return c * math.exp(-e) / den  # Ward 1992 anisotropic (isotropic case: 000 eq. 34)
+
+
+def _aniso_reference(wi, wo, ax, ay, c):
+    s = wi + wo
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        qx = s[..., 0] / s[..., 2]
+        qy = s[..., 1] / s[..., 2]
+        e = (qx / ax) ** 2 + (qy / ay) ** 2
+        den = 4.0 * np.pi * ax * ay * (np.sqrt(wi[..., 2]) * np.sqrt(wo[..., 2]))
+        f = c * np.exp(-e) / den  # Ward 1992 anisotropic (isotropic case: 000 eq. 34)
+    return np.where(_up(wi, wo), f, 0.0)
+
+
+@register("ward_aniso")
+class WardAniso(BRDF):
+    """Anisotropic Ward [1/sr] (Ward 1992; the isotropic case is 000 eq. 34).
+
+    f_r = c exp(-tan^2 delta (cos^2 phi_h / a_x^2 + sin^2 phi_h / a_y^2))
+    / (4 pi a_x a_y sqrt((N.L)(N.V))), with phi_h the azimuth of H measured from the
+    tangent x axis; tan^2 delta cos^2 phi_h = (h_x / h_z)^2 and
+    tan^2 delta sin^2 phi_h = (h_y / h_z)^2.  ax = ay = m gives ``ward``.
+
+    Parameters
+    ----------
+    ax, ay : float, in (0, inf)
+        RMS slopes along the tangent x and y axes (dimensionless).
+    c : float, >= 0, default 1
+        Scale (dimensionless).
+
+    Examples
+    --------
+    >>> import math, pumpup
+    >>> f = pumpup.load({"type": "ward_aniso", "ax": 0.1, "ay": 0.3})
+    >>> round(float(f.eval([0, 0, 1], [0, 0, 1])) * 4 * math.pi * 0.1 * 0.3, 12)
+    1.0
+    """
+
+    params = {
+        "ax": Param(lo=0.0, lo_open=True, doc="RMS slope along x"),
+        "ay": Param(lo=0.0, lo_open=True, doc="RMS slope along y"),
+        "c": Param(1.0, lo=0.0, doc="scale"),
+    }
+    examples = [{"ax": 0.1, "ay": 0.3}, {"ax": 0.05, "ay": 0.05}, {"ax": 0.4, "ay": 0.02, "c": 0.8}]
+    kernel = staticmethod(_aniso_kernel)
+    reference_fn = staticmethod(_aniso_reference)
+
+    def lobe(self, mu):
+        return Lobe(axis="half", radial="beckmann", sharpness=min(self.p["ax"], self.p["ay"]), symmetric=True)
+
+
+# --- modified Ward --------------------------------------------------------------------------
+
+
+@vectorize(cache=True)
+def _modified_kernel(lx, ly, lz, vx, vy, vz, m, c):  # pragma: no cover - compiled
+    if lz <= 0.0 or vz <= 0.0:
+        return 0.0
+    sz = lz + vz
+    qx = (lx + vx) / sz  # h_x / h_z
+    qy = (ly + vy) / sz  # h_y / h_z
+    t2 = qx * qx + qy * qy  # tan^2 delta
+    return c * math.exp(-t2 / (m * m)) / (4.0 * math.pi * m * m * max(lz, vz))  # 000 eq. 35
+
+
+def _modified_reference(wi, wo, m, c):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        t2 = _tan2_delta(wi, wo)
+        mx = np.maximum(wi[..., 2], wo[..., 2])
+        f = c * np.exp(-t2 / (m * m)) / (4.0 * np.pi * m * m * mx)  # 000 eq. 35
+    return np.where(_up(wi, wo), f, 0.0)
+
+
+@register("modified_ward")
+class ModifiedWard(BRDF):
+    """Modified Ward, f_r = c exp(-tan^2 delta / m^2) / (4 pi m^2 max(N.L, N.V)) [1/sr].
+
+    000 eq. 35: the isotropic Ward model with max(N.L, N.V) in place of
+    sqrt((N.L)(N.V)), which bounds its albedo at grazing angles.
+
+    Parameters
+    ----------
+    m : float, in (0, inf)
+        RMS surface slope (dimensionless).
+    c : float, >= 0, default 1
+        Scale (dimensionless); 000 Table 4 gives the largest energy-conserving values
+        (1.63 for m = 0.4, 1.04 for m = 0.1, about 1 for m < 0.05).
+
+    Examples
+    --------
+    >>> import math, pumpup
+    >>> f = pumpup.load({"type": "modified_ward", "m": 0.1})
+    >>> mu = 0.5  # mirror direction at 60 degrees: H = N, f = c / (4 pi m^2 mu)
+    >>> wi = [3**0.5 / 2, 0, mu]; wo = [-3**0.5 / 2, 0, mu]
+    >>> round(float(f.eval(wi, wo)) * 4 * math.pi * 0.1**2 * mu, 12)
+    1.0
+    """
+
+    params = {
+        "m": Param(lo=0.0, lo_open=True, doc="RMS slope"),
+        "c": Param(1.0, lo=0.0, doc="scale"),
+    }
+    examples = [{"m": 0.1}, {"m": 0.2, "c": 1.16}, {"m": 0.02}, {"m": 0.4, "c": 1.63}]
+    kernel = staticmethod(_modified_kernel)
+    reference_fn = staticmethod(_modified_reference)
+
+    def lobe(self, mu):
+        return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"], levels=(mu,))
