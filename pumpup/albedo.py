@@ -91,8 +91,9 @@ def check_mu(mu) -> np.ndarray:
         raise ValueError(f"mu must be a number or an array of numbers in (0, 1], got {mu!r}") from None
     bad = ~np.isfinite(m) | (m <= 0) | (m > 1)
     if np.any(bad):
-        i = tuple(np.argwhere(bad)[0]) if m.ndim else ()
-        raise ValueError(f"mu = cos(theta_i) must be in (0, 1]; mu{list(i) if i else ''} = {m[i]!r}")
+        i = tuple(int(k) for k in np.argwhere(bad)[0]) if m.ndim else ()
+        where = f"mu[{', '.join(map(str, i))}]" if i else "mu"
+        raise ValueError(f"mu = cos(theta_i) must be in (0, 1]; {where} = {float(m[i])!r}")
     return m
 
 
@@ -115,10 +116,10 @@ def _radial(kind: str, k: float, x: np.ndarray, xc: np.ndarray):
             jac = ca / ((k + 1.0) * x)
         return ca, sa, jac
     if kind == "beckmann":  # tan^2 alpha = -m^2 ln x
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore"):
             t2 = -(k * k) * np.log1p(-xc)
             ca = 1.0 / np.sqrt(1.0 + t2)
-            sa = np.sqrt(t2) * ca
+            sa = np.where(np.isinf(t2), 1.0, np.sqrt(t2) * ca)
             jac = (k * k) * ca**3 / (2.0 * x)
         return ca, sa, jac
     if kind == "ggx":  # tan^2 alpha = r x / (1 - x)
@@ -257,6 +258,18 @@ def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
     return out.T
 
 
+def _rounding(lobe: Lobe) -> float:
+    """Relative rounding error of the integrand values.
+
+    A lobe cos^n(alpha) computed from directions that carry a relative rounding error of
+    a few eps has a relative error of about n eps (measured: 3 n eps for n = 1e4 at
+    grazing incidence), so the term grows with the exponent.
+    """
+    eps = np.finfo(float).eps
+    n = lobe.sharpness if lobe.radial == "power" else 0.0
+    return 16.0 * eps * (4.0 + n)
+
+
 def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_regions: int):
     P = len(g.mu)
     n_pieces = 1 + g.levels.shape[1] + (len(g.lobe.kinks(np.array([0.5]), np.array([0.5]), np.array([0.5]), np.array([0.5]))) if g.lobe.kinks else 0)
@@ -275,13 +288,13 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
     t0 = np.tile(gt[it], P * n_pieces)
     t1 = np.tile(gt[it + 1], P * n_pieces)
     val, err, ex, et = _rule(brdf, g, prob, piece, x0, x1, t0, t1)
-    eps = np.finfo(float).eps
+    rounding = _rounding(g.lobe)
     converged = np.zeros(P, bool)
     while True:
         I = np.bincount(prob, val, minlength=P)
         E = np.bincount(prob, err, minlength=P)
         A = np.bincount(prob, np.abs(val), minlength=P)
-        E = E + 50 * eps * A
+        E = E + rounding * A
         tol = np.maximum(rtol * np.abs(I), atol)
         converged = E <= tol
         count = np.bincount(prob, minlength=P)

@@ -337,6 +337,11 @@ def split(w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return w[..., 0], w[..., 1], w[..., 2]
 
 
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a . b over the last axis, summed x + y + z in the same order as the numba kernels."""
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
+
+
 def load(spec: Any) -> BRDF:
     """Build a BRDF from a spec: a dict ``{"type": name, param: value, ...}`` or its JSON text.
 

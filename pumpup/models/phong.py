@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import vectorize
 
-from ..core import BRDF, Lobe, Param, register
+from ..core import BRDF, Lobe, Param, dot, register
 
 
 def _phong_c(p):
@@ -22,7 +22,7 @@ def _phong_c(p):
 
 def _cos_alpha(wi, wo):
     """(R.V) = 2 (N.L)(N.V) - (L.V), 000 eq. 9."""
-    return 2.0 * wi[..., 2] * wo[..., 2] - np.einsum("...k,...k->...", wi, wo)
+    return 2.0 * wi[..., 2] * wo[..., 2] - dot(wi, wo)
 
 
 def _up(wi, wo):
@@ -154,7 +154,7 @@ def _retro_kernel(lx, ly, lz, vx, vy, vz, n, p, c):  # pragma: no cover - compil
 
 
 def _retro_reference(wi, wo, n, p, c):
-    lv = np.maximum(np.einsum("...k,...k->...", wi, wo), 0.0)
+    lv = np.maximum(dot(wi, wo), 0.0)
     mx = np.maximum(wi[..., 2], wo[..., 2])
     with np.errstate(divide="ignore", invalid="ignore"):
         f = c * lv**n / mx**p  # 000 eq. 13

@@ -1,0 +1,128 @@
+"""The ``pumpup`` command line.  Heavy imports happen inside the commands, so ``--help`` is fast."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+
+def parse_spec(text: str) -> dict:
+    """A model spec from JSON (``'{"type": "phong", "n": 20}'``) or the short form ``phong:n=20,c=1``."""
+    text = text.strip()
+    if text.startswith("{"):
+        try:
+            return json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise SystemExit(f"pumpup: the spec is not valid JSON: {exc}") from None
+    name, _, rest = text.partition(":")
+    spec: dict = {"type": name}
+    for item in filter(None, rest.split(",")):
+        key, eq, value = item.partition("=")
+        if not eq:
+            raise SystemExit(f"pumpup: spec parameter {item!r} must look like name=value")
+        try:
+            spec[key.strip()] = json.loads(value)
+        except json.JSONDecodeError:
+            spec[key.strip()] = value.strip()
+    return spec
+
+
+def _load(text: str):
+    import pumpup
+
+    try:
+        return pumpup.load(parse_spec(text))
+    except pumpup.SpecError as exc:
+        raise SystemExit(f"pumpup: {exc}") from None
+
+
+def cmd_models(args) -> int:
+    import pumpup
+
+    for name, cls in pumpup.registry().items():
+        doc = (cls.__doc__ or "").strip().splitlines()[0] if cls.__doc__ else ""
+        params = ", ".join(cls.params)
+        print(f"{name:18s} {params:28s} {doc}")
+    return 0
+
+
+def cmd_albedo(args) -> int:
+    import numpy as np
+
+    import pumpup
+
+    f = _load(args.spec)
+    if args.theta is not None:
+        mu = np.cos(np.radians(np.asarray(args.theta, dtype=float)))
+    else:
+        mu = np.asarray(args.mu if args.mu else [1.0, 0.5, 0.1, 0.01], dtype=float)
+    try:
+        a, e = pumpup.albedo(f, mu, return_error=True, rtol=args.rtol)
+    except ValueError as exc:
+        raise SystemExit(f"pumpup: {exc}") from None
+    print(f"# {json.dumps(f.spec)}")
+    print(f"{'mu':>14s} {'theta [deg]':>14s} {'albedo':>20s} {'error':>10s}")
+    for m, v, err in zip(mu, a, e):
+        print(f"{m:14.8g} {np.degrees(np.arccos(m)):14.8f} {v:20.15f} {err:10.2g}")
+    return 0
+
+
+def cmd_table(args) -> int:
+    import pumpup
+
+    f = _load(args.spec)
+    ds = pumpup.tabulate(f, rtol=args.rtol)
+    pumpup.write_table(ds, args.out)
+    print(f"wrote {args.out}: {ds.sizes['mu']} values of mu, interpolation error {ds.attrs['interpolation_error']:.2g}")
+    return 0
+
+
+def cmd_check(args) -> int:
+    import pumpup
+
+    f = _load(args.spec)
+    r = pumpup.check_reciprocity(f)
+    print(r)
+    m = pumpup.max_albedo(f)
+    print(f"max albedo (constant set to 1): {m.albedo:.12g} +- {m.error:.2g} at theta = {m.theta_deg:.6f} deg;"
+          f" maximum constant {m.constant:.12g}")
+    return 0 if r.reciprocal else 1
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="pumpup",
+        description="Physically plausible BRDFs: accurate albedo, the albedo pumping-up operator, "
+        "and the tables of Neumann, Neumann and Szirmay-Kalos.",
+        epilog="A SPEC is JSON ('{\"type\": \"phong\", \"n\": 20}') or short ('phong:n=20'). "
+        "'pumpup models' lists the types.",
+    )
+    sub = p.add_subparsers(dest="command", required=True)
+    s = sub.add_parser("models", help="list the registered model types and their parameters")
+    s.set_defaults(func=cmd_models)
+    s = sub.add_parser("albedo", help="directional albedo of a model, with error estimates")
+    s.add_argument("spec")
+    g = s.add_mutually_exclusive_group()
+    g.add_argument("--mu", type=float, nargs="+", help="cos(theta_i) values in (0, 1]")
+    g.add_argument("--theta", type=float, nargs="+", help="incidence angles in degrees")
+    s.add_argument("--rtol", type=float, default=1e-10)
+    s.set_defaults(func=cmd_albedo)
+    s = sub.add_parser("table", help="tabulate the albedo on an adaptive grid into a netCDF file")
+    s.add_argument("spec")
+    s.add_argument("--out", required=True)
+    s.add_argument("--rtol", type=float, default=1e-10)
+    s.set_defaults(func=cmd_table)
+    s = sub.add_parser("check", help="reciprocity and maximum albedo of a model")
+    s.add_argument("spec")
+    s.set_defaults(func=cmd_check)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,145 @@
+"""The albedo engine against closed forms and an independent 1-D method; error honesty; bad input."""
+
+import warnings
+
+import numpy as np
+import pytest
+from scipy.special import expn
+
+import pumpup
+from helpers import phong_albedo_1d
+
+MU = np.array([1.0, 0.999, 0.9, 0.7, 0.5, 0.3, 0.1, 0.03, 1e-2, 1e-3, 1e-5, 1e-8])
+
+
+def test_lambert_is_exact():
+    for alb in (1.0, 0.3):
+        a, e = pumpup.albedo(pumpup.load({"type": "lambert", "albedo": alb}), MU, return_error=True)
+        np.testing.assert_allclose(a, alb, rtol=0, atol=1e-12)
+        assert np.all(np.abs(a - alb) <= e)
+
+
+@pytest.mark.parametrize("n", [0, 1, 2.5, 20, 150, 5000, 1e4])
+@pytest.mark.parametrize("kind", ["phong", "stretched_phong"])
+def test_phong_normal_incidence_is_one(kind, n):
+    # c = (n+2)/(2 pi): integral of cos^n(alpha) cos(alpha) d omega = 2 pi / (n + 2)
+    a, e = pumpup.albedo(pumpup.load({"type": kind, "n": n}), 1.0, return_error=True)
+    assert abs(a - 1.0) < 1e-10
+    assert abs(a - 1.0) <= e
+
+
+@pytest.mark.parametrize("n", [1, 2, 8, 20, 5000])
+def test_stretched_phong_grazing_limit(n):
+    # 000 eq. 26: a(90 deg) = (n + 2) / (2 (n + 1)); the approach is O(mu)
+    a, e = pumpup.albedo(pumpup.load({"type": "stretched_phong", "n": n}), 1e-10, return_error=True)
+    assert abs(a - (n + 2) / (2 * (n + 1))) < 1e-8
+
+
+@pytest.mark.parametrize("n", [1, 8, 20, 100, 1000, 5000, 1e4])
+@pytest.mark.parametrize("stretched", [False, True])
+def test_phong_family_against_independent_1d_method(n, stretched):
+    f = pumpup.load({"type": "stretched_phong" if stretched else "phong", "n": n})
+    a, e = pumpup.albedo(f, MU, return_error=True)
+    for m, v, err in zip(MU, a, e):
+        ref, ref_err = phong_albedo_1d(n, m, stretched=stretched)
+        diff = abs(v - ref)
+        assert diff <= err + ref_err + 4e-16, (m, v, ref, err)  # the estimate bounds the true error
+        tol = 1e-8 if n <= 100 else 1e-6  # issue 3: smooth cases 1e-8, hard ones 1e-6 (relative)
+        assert diff <= tol * abs(ref), (m, v, ref)
+
+
+def test_error_estimate_is_small_but_honest():
+    f = pumpup.load({"type": "stretched_phong", "n": 20})
+    a, e = pumpup.albedo(f, MU, return_error=True, rtol=1e-6)
+    ref = np.array([phong_albedo_1d(20, m, stretched=True)[0] for m in MU])
+    assert np.all(np.abs(a - ref) <= e)
+    assert np.all(e <= 1e-6 * a + 1e-14)
+
+
+def test_p_model_interpolates_between_phong_and_stretched():
+    mu = np.array([0.9, 0.5, 0.1])
+    a0 = pumpup.albedo(pumpup.load({"type": "stretched_phong", "n": 8, "p": 0.0}), mu)
+    ap = pumpup.albedo(pumpup.load({"type": "stretched_phong", "n": 8, "p": 0.5}), mu)
+    a1 = pumpup.albedo(pumpup.load({"type": "stretched_phong", "n": 8, "p": 1.0}), mu)
+    np.testing.assert_allclose(a0, pumpup.albedo(pumpup.load({"type": "phong", "n": 8}), mu), rtol=1e-12)
+    assert np.all(a0 < ap) and np.all(ap < a1)
+
+
+def test_user_function_generic_method_agrees_with_builtin():
+    def phong20(wi, wo):
+        rv = 2 * wi[..., 2] * wo[..., 2] - np.sum(wi * wo, axis=-1)
+        return 22 / (2 * np.pi) * np.maximum(rv, 0) ** 20
+
+    user = pumpup.from_function(phong20, name="phong20")
+    mu = np.array([1.0, 0.8, 0.4, 0.1, 0.01])
+    a, e = pumpup.albedo(user, mu, return_error=True, rtol=1e-8)
+    ref = np.array([phong_albedo_1d(20, m)[0] for m in mu])
+    assert np.all(np.abs(a - ref) <= e + 1e-15)
+    assert np.all(np.abs(a - ref) <= 1e-8 * ref)
+
+
+def test_user_function_closed_form_lacquer():
+    # Neumann-Neumann lacquer c exp(-s (1/mu_i + 1/mu_o)), written by hand:
+    # a(mu) = 2 pi c exp(-s/mu) E_3(s)
+    s, c = 0.2, 0.4
+
+    def lacquer(wi, wo):
+        with np.errstate(divide="ignore"):
+            return c * np.exp(-s * (1 / wi[..., 2] + 1 / wo[..., 2]))
+
+    f = pumpup.from_function(lacquer, name="lacquer-by-hand")
+    mu = np.array([1.0, 0.5, 0.2, 0.05])
+    a, e = pumpup.albedo(f, mu, return_error=True, rtol=1e-10)
+    exact = 2 * np.pi * c * np.exp(-s / mu) * expn(3, s)
+    assert np.all(np.abs(a - exact) <= e)
+    np.testing.assert_allclose(a, exact, rtol=1e-9)
+
+
+def test_mean_albedo_matches_table_3_of_000():
+    # 000 Table 3, three digits
+    for kind, n, published in [("phong", 1, 0.737), ("phong", 8, 0.676),
+                               ("stretched_phong", 1, 0.934), ("stretched_phong", 8, 0.888)]:
+        m, e = pumpup.mean_albedo(pumpup.load({"type": kind, "n": n}), return_error=True)
+        assert round(m, 3) == published, (kind, n, m)
+        assert e < 1e-8
+
+
+def test_mean_albedo_of_phong_n8_closed_form():
+    # far from grazing the Phong lobe loses almost nothing below the horizon, so the mean albedo
+    # is close to 2/3 (the n -> infinity limit of 000 Table 3 is 2 integral mu^2 = 2/3, not 0.5)
+    m = pumpup.mean_albedo(pumpup.load({"type": "phong", "n": 1000}))
+    assert abs(m - 2 / 3) < 1e-3
+
+
+def test_stretched_phong_n1_overshoot_matches_000_sec_2_2():
+    # "if n = 1, then the maximum c_n constant would result in 0.0003 maximum overshooting at 13 degrees"
+    m = pumpup.max_albedo(pumpup.load({"type": "stretched_phong", "n": 1}))
+    overshoot = m.albedo * 3 / (2 * np.pi) - 1
+    assert round(overshoot, 4) == 0.0003
+    assert round(m.theta_deg) == 13
+    assert not m.at_boundary
+
+
+@pytest.mark.parametrize("bad", [0.0, -0.1, 1.0000001, np.nan, np.inf])
+def test_bad_mu_is_refused_with_position(bad):
+    f = pumpup.load({"type": "phong", "n": 3})
+    with pytest.raises(ValueError, match=r"mu\[1\]"):
+        pumpup.albedo(f, [0.5, bad])
+
+
+def test_brdf_returning_nan_or_negative_is_refused():
+    f = pumpup.from_function(lambda wi, wo: np.where(wo[..., 2] > 0.5, np.nan, 0.1), name="half-nan")
+    with pytest.raises(ValueError, match="finite"):
+        pumpup.albedo(f, 0.5)
+    with pytest.raises(TypeError):
+        pumpup.albedo(lambda wi, wo: 1.0, 0.5)
+
+
+def test_unmet_tolerance_warns_and_reports_the_larger_error():
+    f = pumpup.load({"type": "stretched_phong", "n": 20})
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        a, e = pumpup.albedo(f, 0.3, return_error=True, rtol=1e-15, atol=0, max_regions=10)
+    assert any(issubclass(x.category, pumpup.albedo_module.AlbedoWarning) for x in w)
+    ref = phong_albedo_1d(20, 0.3, stretched=True)[0]
+    assert abs(a - ref) <= e

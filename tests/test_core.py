@@ -1,0 +1,124 @@
+"""The BRDF interface: specs, registry, input checks, user functions, reciprocity check."""
+
+import numpy as np
+import pytest
+
+import pumpup
+
+
+def test_unknown_type_lists_known_types():
+    with pytest.raises(pumpup.SpecError, match="unknown model type 'nope'.*phong"):
+        pumpup.load({"type": "nope"})
+
+
+def test_spec_must_be_dict_with_type():
+    with pytest.raises(pumpup.SpecError, match="'type'"):
+        pumpup.load({"n": 3})
+    with pytest.raises(pumpup.SpecError):
+        pumpup.load(["phong"])
+    with pytest.raises(pumpup.SpecError, match="JSON"):
+        pumpup.load("{not json")
+
+
+def test_spec_never_evaluates_code():
+    # a string where a number belongs is refused, not evaluated
+    with pytest.raises(pumpup.SpecError, match="'n'"):
+        pumpup.load({"type": "phong", "n": "__import__('os').system('true')"})
+
+
+@pytest.mark.parametrize("bad", [-1, -1e-9, float("inf"), True, None and 0])
+def test_negative_or_nonfinite_exponent(bad):
+    if bad == 0:
+        pumpup.load({"type": "phong", "n": 0})  # n = 0 is allowed
+        return
+    with pytest.raises(pumpup.SpecError, match="'n'"):
+        pumpup.load({"type": "phong", "n": bad})
+
+
+def test_p_range():
+    with pytest.raises(pumpup.SpecError, match=r"'p'.*\[0, 1\]"):
+        pumpup.load({"type": "stretched_phong", "n": 3, "p": 1.5})
+
+
+def test_json_string_spec():
+    f = pumpup.load('{"type": "phong", "n": 4}')
+    assert f.spec["n"] == 4.0
+
+
+def test_eval_rejects_non_unit_and_bad_shapes():
+    f = pumpup.load({"type": "phong", "n": 4})
+    with pytest.raises(ValueError, match="unit"):
+        f.eval([0, 0, 2], [0, 0, 1])
+    with pytest.raises(ValueError, match="3 components"):
+        f.eval([0, 1], [0, 0, 1])
+    with pytest.raises(ValueError, match="non-finite"):
+        f.eval([np.nan, 0, 1], [0, 0, 1])
+
+
+def test_closed_form_values_phong_family():
+    n = 20.0
+    c = (n + 2) / (2 * np.pi)
+    N = np.array([0.0, 0.0, 1.0])
+    phong = pumpup.load({"type": "phong", "n": n})
+    assert phong.eval(N, N) == pytest.approx(c, rel=1e-15)
+    # mirror direction at theta: reciprocal Phong gives c, stretched Phong c / cos(theta)
+    th = np.radians(70.0)
+    wi = np.array([np.sin(th), 0, np.cos(th)])
+    wo = np.array([-np.sin(th), 0, np.cos(th)])
+    assert phong.eval(wi, wo) == pytest.approx(c, rel=1e-13)
+    sp = pumpup.load({"type": "stretched_phong", "n": n})
+    assert sp.eval(wi, wo) == pytest.approx(c / np.cos(th), rel=1e-13)
+    # p-model: c / cos^p
+    pm = pumpup.load({"type": "stretched_phong", "n": n, "p": 0.5})
+    assert pm.eval(wi, wo) == pytest.approx(c / np.cos(th) ** 0.5, rel=1e-13)
+    # (R.V) = cos(alpha) off the mirror direction, in the plane of incidence
+    a = np.radians(10.0)
+    wo2 = np.array([-np.sin(th - a), 0, np.cos(th - a)])
+    assert phong.eval(wi, wo2) == pytest.approx(c * np.cos(a) ** n, rel=1e-12)
+    assert sp.eval(wi, wo2) == pytest.approx(c * np.cos(a) ** n / np.cos(th - a), rel=1e-12)
+    # retro-reflective peaks back towards the light
+    retro = pumpup.load({"type": "retro", "n": n})
+    assert retro.eval(wi, wi) == pytest.approx(c / np.cos(th), rel=1e-13)
+    # Phong's shader divides by N.L
+    shader = pumpup.load({"type": "phong_shader", "n": n, "kd": 0.1})
+    assert shader.eval(wi, wo) == pytest.approx(0.1 + c / np.cos(th), rel=1e-13)
+
+
+def test_from_function_round_trip_and_checks():
+    f = pumpup.from_function(lambda wi, wo: np.full(np.broadcast_shapes(wi.shape, wo.shape)[:-1], 0.2), name="flat")
+    g = pumpup.load(f.spec)
+    assert g.spec == {"type": "function", "name": "flat"}
+    assert g.eval([0, 0, 1], [0, 0, 1]) == 0.2
+    assert g.eval([0, 0, 1], [0, 0, -1]) == 0.0  # below the horizon
+    bad = pumpup.from_function(lambda wi, wo: -np.ones(np.broadcast_shapes(wi.shape, wo.shape)[:-1]), name="neg")
+    with pytest.raises(ValueError, match="non-negative"):
+        bad.eval([0, 0, 1], [0, 0, 1])
+    nan = pumpup.from_function(lambda wi, wo: wi[..., 0] * np.nan, name="nan")
+    with pytest.raises(ValueError, match="finite"):
+        nan.eval([0, 0, 1], [0, 0, 1])
+    with pytest.raises(pumpup.SpecError, match="no function named"):
+        pumpup.load({"type": "function", "name": "never-registered"})
+    with pytest.raises(TypeError):
+        pumpup.from_function(3)
+
+
+def test_check_reciprocity_finds_asymmetry_and_reports_worst_pair():
+    def lopsided(wi, wo):
+        return 0.1 + 0.05 * wi[..., 2] * (1 - wo[..., 2])
+
+    r = pumpup.check_reciprocity(pumpup.from_function(lopsided, name="lopsided", reciprocal=False))
+    assert not r.reciprocal
+    assert r.max_rel_error > 0.1
+    assert r.worst_wi.shape == (3,) and "NOT reciprocal" in str(r)
+    # the reported pair really is asymmetric by the reported amount
+    fw = lopsided(r.worst_wi, r.worst_wo)
+    bw = lopsided(r.worst_wo, r.worst_wi)
+    assert abs(fw - bw) / max(fw, bw) == pytest.approx(r.max_rel_error, rel=1e-12)
+
+
+def test_direction_set_includes_grazing():
+    from pumpup.core import direction_set
+
+    d = direction_set()
+    assert d[:, 2].min() <= 1e-8 and d[:, 2].max() == 1.0
+    np.testing.assert_allclose(np.linalg.norm(d, axis=-1), 1.0, rtol=1e-15)
