@@ -1,0 +1,325 @@
+"""Metal and plastic BRDFs of Neumann, Neumann and Szirmay-Kalos (000 sec. 5, eq. 27-30).
+
+Both use the stretched Phong lobe cos^n(alpha) / cos(Theta_min) with
+cos(alpha) = (R.V)_+ (000 eq. 8, 9) and cos(Theta_min) = max(N.L, N.V), times the
+Fresnel reflectance F evaluated at Theta_min (000 eq. 28), a symmetric function of L and
+V, so both models are reciprocal.
+
+The models take one scalar refractive index (one wavelength or one colour channel);
+:func:`per_channel` builds one BRDF per channel from lists.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numba import njit, vectorize
+
+from ..core import BRDF, Lobe, Param, SpecError, load, register
+
+__all__ = ["Metal", "Plastic", "fresnel", "per_channel"]
+
+
+# --- Fresnel reflectance -----------------------------------------------------------------
+
+
+def fresnel(cos_i, eta, k=0.0):
+    """Unpolarised Fresnel reflectance of a smooth interface with complex index eta + i k.
+
+    The exact formula with complex arithmetic, as pbrt-v4's ``FrComplex``:
+    cos_t = sqrt(1 - sin^2(theta_i) / eta^2),
+    r_par = (eta cos_i - cos_t) / (eta cos_i + cos_t),
+    r_perp = (cos_i - eta cos_t) / (cos_i + eta cos_t),
+    F = (|r_par|^2 + |r_perp|^2) / 2.
+
+    Parameters
+    ----------
+    cos_i : array_like
+        Cosine of the incidence angle, clipped to [0, 1].
+    eta : float or array_like, > 0
+        Real part of the relative refractive index (dimensionless).
+    k : float or array_like, >= 0
+        Extinction coefficient (imaginary part of the index); 0 for a dielectric.
+
+    Returns
+    -------
+    ndarray
+        F in [0, 1].
+
+    Examples
+    --------
+    >>> round(float(fresnel(1.0, 1.5)), 12)  # ((eta - 1) / (eta + 1))^2
+    0.04
+    """
+    c = np.clip(np.asarray(cos_i, dtype=np.float64), 0.0, 1.0)
+    e = np.asarray(eta, dtype=np.float64) + 1j * np.asarray(k, dtype=np.float64)
+    sin2_i = (1.0 - c) * (1.0 + c)
+    cos_t = np.sqrt(1.0 - sin2_i / (e * e))  # Snell's law, complex angle of refraction
+    r_par = (e * c - cos_t) / (e * c + cos_t)  # Fresnel equations (pbrt-v4 FrComplex)
+    r_perp = (c - e * cos_t) / (c + e * cos_t)
+    return 0.5 * (np.abs(r_par) ** 2 + np.abs(r_perp) ** 2)
+
+
+@njit(cache=True)
+def _fresnel_real(c, eta, k):  # pragma: no cover - compiled
+    """``fresnel`` in real arithmetic, free of cancellation (for the numba kernels).
+
+    With a + i b = sqrt((eta + i k)^2 - sin^2) (a >= 0), the classic real form
+    (e.g. pbrt-v3 FrConductor) becomes a ratio of sums of squares:
+    R_s = ((a - c)^2 + b^2) / ((a + c)^2 + b^2),
+    R_p = R_s ((a c - s^2)^2 + b^2 c^2) / ((a c + s^2)^2 + b^2 c^2), F = (R_s + R_p) / 2.
+    """
+    s2 = (1.0 - c) * (1.0 + c)
+    t0 = eta * eta - k * k - s2
+    big = math.hypot(t0, 2.0 * eta * k)  # a^2 + b^2
+    if big == 0.0:
+        a = 0.0
+        b = 0.0
+    elif t0 >= 0.0:
+        a = math.sqrt(0.5 * (big + t0))
+        b = eta * k / a
+    else:
+        b = math.sqrt(0.5 * (big - t0))
+        a = eta * k / b
+    rs = ((a - c) ** 2 + b * b) / ((a + c) ** 2 + b * b)
+    rp = rs * ((a * c - s2) ** 2 + b * b * c * c) / ((a * c + s2) ** 2 + b * b * c * c)
+    return 0.5 * (rs + rp)
+
+
+def _phong_c(q):
+    return (q["n"] + 2.0) / (2.0 * math.pi)  # 000 eq. 6
+
+
+def _cos_alpha(wi, wo):
+    # 000 eq. 9, summed in the kernel's order
+    lv = wi[..., 0] * wo[..., 0] + wi[..., 1] * wo[..., 1] + wi[..., 2] * wo[..., 2]
+    return 2.0 * wi[..., 2] * wo[..., 2] - lv
+
+
+def _up(wi, wo):
+    return (wi[..., 2] > 0) & (wo[..., 2] > 0)
+
+
+# --- metal ----------------------------------------------------------------------------------
+
+
+@vectorize(cache=True)
+def _metal_kernel(lx, ly, lz, vx, vy, vz, n, eta, k, c):  # pragma: no cover - compiled
+    if lz <= 0.0 or vz <= 0.0:
+        return 0.0
+    rv = 2.0 * lz * vz - (lx * vx + ly * vy + lz * vz)  # cos(alpha), 000 eq. 9
+    if rv <= 0.0:
+        return 0.0
+    mx = max(lz, vz)  # cos(Theta_min)
+    return c * rv**n / mx * _fresnel_real(mx, eta, k)  # 000 eq. 28
+
+
+def _metal_reference(wi, wo, n, eta, k, c):
+    rv = np.maximum(_cos_alpha(wi, wo), 0.0)
+    mx = np.maximum(wi[..., 2], wo[..., 2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f = c * rv**n / mx * fresnel(mx, eta, k)  # 000 eq. 28
+    return np.where(_up(wi, wo) & (rv > 0), f, 0.0)
+
+
+@register("metal")
+class Metal(BRDF):
+    """Metallic BRDF, f_r = c cos^n(alpha) / cos(Theta_min) F(eta + i k, Theta_min) [1/sr].
+
+    000 eq. 28 (eq. 27 with Theta = Theta_min): cos(alpha) = (R.V)_+,
+    cos(Theta_min) = max(N.L, N.V), F the exact unpolarised Fresnel reflectance of
+    a conductor (:func:`fresnel`).  Reciprocal.  One wavelength or colour channel per
+    model; see :func:`per_channel`.
+
+    Parameters
+    ----------
+    n : float, >= 0
+        Phong exponent.
+    eta : float, > 0
+        Real part of the complex refractive index at this wavelength.
+    k : float, >= 0, default 0
+        Extinction coefficient (imaginary part of the index).
+    c : float, >= 0, default (n + 2) / (2 pi)
+        Scale [1/sr] (000 eq. 6, 28).
+
+    Examples
+    --------
+    >>> import math, pumpup
+    >>> f = pumpup.load({"type": "metal", "n": 100, "eta": 0.2, "k": 3.0})
+    >>> F0 = ((0.2 - 1) ** 2 + 9) / ((0.2 + 1) ** 2 + 9)  # Fresnel at normal incidence
+    >>> round(float(f.eval([0, 0, 1], [0, 0, 1])) / (102 / (2 * math.pi) * F0), 12)
+    1.0
+    """
+
+    params = {
+        "n": Param(lo=0.0, doc="exponent"),
+        "eta": Param(lo=0.0, lo_open=True, doc="refractive index, real part"),
+        "k": Param(0.0, lo=0.0, doc="extinction coefficient"),
+        "c": Param(_phong_c, lo=0.0, doc="scale [1/sr]"),
+    }
+    examples = [
+        {"n": 20, "eta": 0.2, "k": 3.0},
+        {"n": 1, "eta": 1.5},
+        {"n": 500, "eta": 1.1, "k": 6.0},
+        {"n": 7.5, "eta": 0.6, "k": 0.3, "c": 0.5},
+    ]
+    kernel = staticmethod(_metal_kernel)
+    reference_fn = staticmethod(_metal_reference)
+
+    def lobe(self, mu):
+        return Lobe(axis="mirror", radial="power", sharpness=self.p["n"], levels=(mu,))
+
+
+# --- plastic --------------------------------------------------------------------------------
+
+
+@vectorize(cache=True)
+def _plastic_kernel(lx, ly, lz, vx, vy, vz, n, ad, a_s, eta):  # pragma: no cover - compiled
+    if lz <= 0.0 or vz <= 0.0:
+        return 0.0
+    f = ad / math.pi
+    rv = 2.0 * lz * vz - (lx * vx + ly * vy + lz * vz)  # cos(alpha), 000 eq. 9
+    if rv > 0.0:
+        mx = max(lz, vz)  # cos(Theta_min)
+        fr = _fresnel_real(mx, eta, 0.0) if eta > 0.0 else 1.0  # eta <= 0 stands for "no Fresnel", 000 eq. 30
+        f += a_s * (n + 2.0) / (2.0 * math.pi) * rv**n / mx * fr  # 000 eq. 29
+    return f
+
+
+def _plastic_reference(wi, wo, n, ad, a_s, eta):
+    rv = np.maximum(_cos_alpha(wi, wo), 0.0)
+    mx = np.maximum(wi[..., 2], wo[..., 2])
+    fr = fresnel(mx, eta) if eta is not None and eta > 0 else 1.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        spec = np.where(rv > 0, a_s * (n + 2.0) / (2.0 * np.pi) * rv**n / mx * fr, 0.0)  # 000 eq. 29, 30
+    return np.where(_up(wi, wo), ad / np.pi + spec, 0.0)
+
+
+@register("plastic")
+class Plastic(BRDF):
+    """Plastic / ceramic BRDF, a Lambertian base plus the metallic lobe [1/sr].
+
+    f_r = ad / pi + a_s (n + 2) / (2 pi) cos^n(alpha) / cos(Theta_min) F(eta, Theta_min)
+    (000 eq. 29), with a real (dielectric) index eta; without eta, F = 1 (000 eq. 30).
+    Reciprocal.
+
+    Parameters
+    ----------
+    n : float, >= 0
+        Phong exponent.
+    ad : float, in [0, 1], default 0.5
+        Albedo of the diffuse component (one channel).
+    a_s : float, in [0, 1], default 0.5
+        Weight of the specular component; ad + a_s <= 1 (000 sec. 5.2).
+    eta : float, > 0, optional
+        Real refractive index of the dielectric; omitted means F = 1 (000 eq. 30).
+
+    Examples
+    --------
+    >>> import math, pumpup
+    >>> f = pumpup.load({"type": "plastic", "n": 50, "ad": 0.3, "a_s": 0.6, "eta": 1.5})
+    >>> value = 0.3 / math.pi + 0.6 * 52 / (2 * math.pi) * 0.04  # at wi = wo = N
+    >>> round(float(f.eval([0, 0, 1], [0, 0, 1])) / value, 12)
+    1.0
+    """
+
+    params = {
+        "n": Param(lo=0.0, doc="exponent"),
+        "ad": Param(0.5, lo=0.0, hi=1.0, doc="diffuse albedo"),
+        "a_s": Param(0.5, lo=0.0, hi=1.0, doc="specular weight"),
+        "eta": Param(None, lo=0.0, lo_open=True, doc="refractive index (omitted: F = 1)"),
+    }
+    constant = None  # f is not a constant times a fixed shape
+    examples = [
+        {"n": 20},
+        {"n": 100, "ad": 0.3, "a_s": 0.6, "eta": 1.5},
+        {"n": 2, "ad": 0.0, "a_s": 1.0, "eta": 1.33},
+        {"n": 1000, "ad": 0.8, "a_s": 0.2},
+    ]
+    kernel = staticmethod(_plastic_kernel)
+    reference_fn = staticmethod(_plastic_reference)
+
+    def _validate(self) -> None:
+        if self.p["a_s"] + self.p["ad"] > 1.0 + 1e-12:
+            raise SpecError(
+                f"{self.type}: parameters 'a_s' + 'ad' must not exceed 1 (energy conservation, 000 sec. 5.2); "
+                f"got a_s = {self.p['a_s']:g}, ad = {self.p['ad']:g}"
+            )
+
+    def kernel_args(self) -> tuple:
+        q = self.p
+        return (q["n"], q["ad"], q["a_s"], 0.0 if q["eta"] is None else q["eta"])
+
+    def reference(self, wi, wo) -> np.ndarray:
+        q = self.p
+        wi = np.asarray(wi, dtype=np.float64)
+        wo = np.asarray(wo, dtype=np.float64)
+        return _plastic_reference(wi, wo, q["n"], q["ad"], q["a_s"], q["eta"])
+
+    def albedo_terms(self):
+        if self.p["ad"] == 0:
+            return [(1.0, self)]
+        return [(1.0, self.with_params(ad=0.0)), (self.p["ad"], load({"type": "lambert", "albedo": 1.0}))]
+
+    def lobe(self, mu):
+        return Lobe(axis="mirror", radial="power", sharpness=self.p["n"], levels=(mu,))
+
+
+# --- one model per channel -------------------------------------------------------------------
+
+
+def per_channel(kind: str, n: Any, eta: Any, k: Any = None, **kw: Any) -> list[BRDF]:
+    """One metal or plastic BRDF per wavelength or colour channel.
+
+    Parameters
+    ----------
+    kind : {"metal", "plastic"}
+    n, eta, k : float or list of float
+        Exponent, real index and extinction coefficient; a list gives one value per
+        channel, a scalar is shared by all channels.  ``k`` must be omitted (or 0) for
+        "plastic", whose index is real; ``eta`` may be None for "plastic" (F = 1).
+    **kw : float or list of float
+        Further parameters of the model (``c`` for metal; ``ad``, ``a_s`` for plastic),
+        scalars or per-channel lists.
+
+    Returns
+    -------
+    list of BRDF
+        One model per channel, in order.
+
+    Examples
+    --------
+    Gold-like RGB values (illustrative round numbers near published data for about
+    650, 550 and 450 nm, not measured data):
+
+    >>> from pumpup.models.metal import per_channel
+    >>> gold = per_channel("metal", n=200, eta=[0.18, 0.42, 1.37], k=[3.42, 2.35, 1.77])
+    >>> [f.p["eta"] for f in gold]
+    [0.18, 0.42, 1.37]
+    >>> [round(float(fresnel(1.0, f.p["eta"], f.p["k"])), 3) for f in gold]  # F at normal incidence
+    [0.945, 0.777, 0.374]
+    """
+    if kind not in ("metal", "plastic"):
+        raise SpecError(f"per_channel: 'kind' must be 'metal' or 'plastic', got {kind!r}")
+    args = {"n": n, "eta": eta, **kw}
+    if kind == "metal":
+        args["k"] = 0.0 if k is None else k
+    elif k is not None and np.any(np.asarray(k, dtype=float) != 0):
+        raise SpecError("per_channel: parameter 'k' must be omitted or 0 for 'plastic' (a dielectric has a real index)")
+    lengths = {name: len(v) for name, v in args.items() if isinstance(v, (list, tuple, np.ndarray))}
+    if len(set(lengths.values())) > 1:
+        text = ", ".join(f"{name!r} has {m}" for name, m in lengths.items())
+        raise SpecError(f"per_channel: the per-channel lists must have equal length; {text}")
+    m = next(iter(lengths.values()), 1)
+    if m == 0:
+        raise SpecError(f"per_channel: empty per-channel list(s) {', '.join(map(repr, lengths))}")
+    out = []
+    for i in range(m):
+        spec: dict[str, Any] = {"type": kind}
+        for name, v in args.items():
+            val = v[i] if name in lengths else v
+            spec[name] = val.item() if isinstance(val, np.generic) else val
+        out.append(load(spec))
+    return out

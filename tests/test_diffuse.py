@@ -1,0 +1,196 @@
+"""Diffuse models: minnaert (002 sec. 3.4), lacquer (002 sec. 3.3), oren_nayar (Oren & Nayar 1994)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+import pumpup
+
+MODELS = ["minnaert", "lacquer", "oren_nayar"]
+CASES = [(name, ex) for name in MODELS for ex in pumpup.registry()[name].examples]
+IDS = [f"{name}-{json.dumps(ex, sort_keys=True)}" for name, ex in CASES]
+N = np.array([0.0, 0.0, 1.0])
+
+
+@pytest.fixture
+def rng():
+    """A fixed random generator for this module."""
+    return np.random.default_rng(20261128)
+
+
+def random_directions(rng, n, below=0.1, grazing=0.05):
+    """Unit vectors: mostly upper hemisphere, a fraction below it and a fraction near grazing."""
+    v = rng.normal(size=(n, 3))
+    v /= np.linalg.norm(v, axis=-1, keepdims=True)
+    v[:, 2] = np.abs(v[:, 2])
+    k = int(n * below)
+    v[:k, 2] *= -1
+    g = int(n * grazing)
+    mu = 10.0 ** rng.uniform(-8, -2, g)
+    phi = rng.uniform(0, 2 * np.pi, g)
+    s = np.sqrt(1 - mu**2)
+    v[k : k + g] = np.stack([s * np.cos(phi), s * np.sin(phi), mu], axis=-1)
+    return v
+
+
+def direction_pairs(rng, n=10_000):
+    """~n pairs: random (10% below the horizon, 5% near grazing), exact mirror pairs, and
+    pairs with wi or wo at mu = 1e-8 exactly."""
+    wi = random_directions(rng, n)
+    wo = random_directions(rng, n)[::-1].copy()
+    wo[:500] = wi[:500] * np.array([-1, -1, 1])  # mirror pairs
+    for k, sl in enumerate([slice(500, 700), slice(700, 900)]):
+        phi = rng.uniform(0, 2 * np.pi, 200)
+        s = np.sqrt(1 - 1e-16)
+        w = np.stack([s * np.cos(phi), s * np.sin(phi), np.full(200, 1e-8)], axis=-1)
+        (wi if k == 0 else wo)[sl] = w
+    return wi, wo
+
+
+def polar(theta, phi=0.0):
+    """Unit vector at polar angle theta and azimuth phi [rad]."""
+    return np.array([math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi), math.cos(theta)])
+
+
+@pytest.mark.parametrize("name,params", CASES, ids=IDS)
+def test_kernel_matches_reference(name, params, rng):
+    f = pumpup.load({"type": name, **params})
+    wi, wo = direction_pairs(rng)
+    fast = f.eval(wi, wo)
+    ref = f.reference(wi, wo)
+    assert np.all(np.isfinite(fast)) and np.all(fast >= 0)
+    np.testing.assert_allclose(fast, ref, rtol=1e-12, atol=0)
+    assert np.all(fast[(wi[:, 2] <= 0) | (wo[:, 2] <= 0)] == 0)
+
+
+@pytest.mark.parametrize("name,params", CASES, ids=IDS)
+def test_reciprocal(name, params):
+    f = pumpup.load({"type": name, **params})
+    r = pumpup.check_reciprocity(f)
+    assert r.reciprocal, str(r)
+
+
+@pytest.mark.parametrize("name,params", CASES, ids=IDS)
+def test_spec_round_trip(name, params):
+    f = pumpup.load({"type": name, **params})
+    assert pumpup.load(json.loads(json.dumps(f.spec))) == f
+
+
+# --- Minnaert -------------------------------------------------------------------------------
+
+
+def test_minnaert_values():
+    for k in [0.5, 1.0, 2.0, 3.7]:
+        f = pumpup.load({"type": "minnaert", "k": k})
+        b = (k + 1) / (2 * math.pi)
+        assert f.p["b"] == pytest.approx(b, rel=1e-15)
+        assert f.eval(N, N) == pytest.approx(b, rel=1e-15)  # wi = wo = N
+        wi, wo = polar(math.radians(40), 0.3), polar(math.radians(75), 2.0)
+        expected = b * (math.cos(math.radians(40)) * math.cos(math.radians(75))) ** (k - 1)
+        assert f.eval(wi, wo) == pytest.approx(expected, rel=1e-14)
+    # k = 1 is Lambert with albedo pi b
+    f = pumpup.load({"type": "minnaert", "k": 1, "b": 0.2})
+    g = pumpup.load({"type": "lambert", "albedo": 0.2 * math.pi})
+    d = np.array([polar(0.1), polar(1.5, 1.0), polar(0.9, 4.0)])
+    np.testing.assert_allclose(f.eval(d[:, None], d[None]), g.eval(d[:, None], d[None]), rtol=1e-15)
+
+
+@pytest.mark.parametrize("k", [1.0, 1.8, 4.0])
+@pytest.mark.parametrize("mu", [1.0, 0.5, 0.05])
+def test_minnaert_albedo_closed_form(k, mu):
+    """a(mu) = b 2 pi / (k + 1) mu^(k-1) (002 sec. 4.3), by quadrature over N.V."""
+    f = pumpup.load({"type": "minnaert", "k": k})
+    wi = np.array([math.sqrt(1 - mu * mu), 0.0, mu])
+
+    def integrand(m):
+        wo = np.array([0.0, math.sqrt(1 - m * m), m])
+        return float(f.eval(wi, wo)) * m
+
+    a = 2 * math.pi * quad(integrand, 0, 1, epsabs=0, epsrel=1e-12)[0]
+    assert a == pytest.approx(mu ** (k - 1), rel=1e-10)
+
+
+# --- lacquer --------------------------------------------------------------------------------
+
+
+def test_lacquer_values():
+    for c, s in [(1 / math.pi, 0.1), (0.4, 0.0), (0.2, 2.5)]:
+        f = pumpup.load({"type": "lacquer", "c": c, "s": s})
+        assert f.eval(N, N) == pytest.approx(c * math.exp(-2 * s), rel=1e-15)  # wi = wo = N
+        wi, wo = polar(math.radians(60)), polar(math.radians(30), 1.0)
+        expected = c * math.exp(-s * (2 + 2 / math.sqrt(3)))
+        assert f.eval(wi, wo) == pytest.approx(expected, rel=1e-14)
+    f = pumpup.load({"type": "lacquer"})
+    assert f.p == {"c": 1 / math.pi, "s": 0.1}
+    # grazing: exp(-s / 1e-8) underflows to exactly 0, no NaN
+    g = np.array([math.sqrt(1 - 1e-16), 0.0, 1e-8])
+    assert f.eval(g, N) == 0.0 and f.eval(N, g) == 0.0
+    # s = 0 is Lambert with albedo pi c, also at grazing
+    h = pumpup.load({"type": "lacquer", "c": 0.25, "s": 0.0})
+    assert h.eval(g, g) == 0.25 and h.eval(N, g) == 0.25
+
+
+# --- Oren-Nayar -----------------------------------------------------------------------------
+
+
+def test_oren_nayar_sigma_zero_is_lambert(rng):
+    wi, wo = direction_pairs(rng, 3000)
+    for albedo in [1.0, 0.3]:
+        f = pumpup.load({"type": "oren_nayar", "albedo": albedo, "sigma": 0.0})
+        g = pumpup.load({"type": "lambert", "albedo": albedo})
+        np.testing.assert_array_equal(f.eval(wi, wo), g.eval(wi, wo))
+
+
+def test_oren_nayar_hand_values():
+    albedo, sigma = 0.8, 0.5
+    f = pumpup.load({"type": "oren_nayar", "albedo": albedo, "sigma": sigma})
+    s2 = sigma**2
+    A = 1 - 0.5 * s2 / (s2 + 0.33)
+    B = 0.45 * s2 / (s2 + 0.09)
+    t60, t30 = math.radians(60), math.radians(30)
+    # same azimuth: cos(dphi) = 1, alpha = 60, beta = 30: sin 60 tan 30 = 1/2
+    assert f.eval(polar(t60, 0.4), polar(t30, 0.4)) == pytest.approx(albedo / math.pi * (A + B / 2), rel=1e-14)
+    assert f.eval(polar(t30, 0.4), polar(t60, 0.4)) == pytest.approx(albedo / math.pi * (A + B / 2), rel=1e-14)
+    # azimuths 60 deg apart: cos(dphi) = 1/2
+    assert f.eval(polar(t60, 0.0), polar(t30, math.pi / 3)) == pytest.approx(albedo / math.pi * (A + B / 4), rel=1e-14)
+    # opposite azimuths, or either direction at the normal: the B term vanishes
+    assert f.eval(polar(t60, 0.0), polar(t30, math.pi)) == pytest.approx(albedo / math.pi * A, rel=1e-14)
+    assert f.eval(N, polar(t60, 1.0)) == pytest.approx(albedo / math.pi * A, rel=1e-14)
+    assert f.eval(polar(t60, 1.0), N) == pytest.approx(albedo / math.pi * A, rel=1e-14)
+    assert f.eval(N, N) == pytest.approx(albedo / math.pi * A, rel=1e-14)
+    # both near grazing in the same azimuth: sin(alpha) tan(beta) -> 1 / 1e-8
+    g = np.array([math.sqrt(1 - 1e-16), 0.0, 1e-8])
+    assert f.eval(g, g) == pytest.approx(albedo / math.pi * (A + B * (1 - 1e-16) / 1e-8), rel=1e-12)
+
+
+def test_hints_and_constants():
+    for name, const in [("minnaert", "b"), ("lacquer", "c"), ("oren_nayar", "albedo")]:
+        cls = pumpup.registry()[name]
+        assert cls.constant == const and cls.reciprocal
+    assert pumpup.load({"type": "minnaert", "k": 2}).lobe(0.4) == pumpup.Lobe(axis="normal", radial="cosine",
+                                                                             symmetric=True)
+    assert pumpup.load({"type": "lacquer"}).lobe(0.4) == pumpup.Lobe(axis="normal", radial="cosine", symmetric=True)
+    assert pumpup.load({"type": "oren_nayar"}).lobe(0.4).levels == (0.4,)
+
+
+def test_bad_input_names_the_parameter():
+    bad = [
+        ({"type": "minnaert", "k": 0}, "'k'"),
+        ({"type": "minnaert", "k": -1}, "'k'"),
+        ({"type": "minnaert"}, "'k'"),
+        ({"type": "minnaert", "k": 2, "b": -0.1}, "'b'"),
+        ({"type": "minnaert", "k": float("nan")}, "'k'"),
+        ({"type": "lacquer", "s": -0.1}, "'s'"),
+        ({"type": "lacquer", "c": float("nan")}, "'c'"),
+        ({"type": "lacquer", "thickness": 1}, "'thickness'"),
+        ({"type": "oren_nayar", "albedo": 1.2}, "'albedo'"),
+        ({"type": "oren_nayar", "sigma": -0.2}, "'sigma'"),
+        ({"type": "oren_nayar", "sigma": float("inf")}, "'sigma'"),
+        ({"type": "oren_nayar", "roughness": 0.2}, "'roughness'"),
+    ]
+    for spec, name in bad:
+        with pytest.raises(pumpup.SpecError, match=name):
+            pumpup.load(spec)

@@ -1,0 +1,171 @@
+"""Lafortune lobes: lafortune (000 eq. 14, 15) and lafortune_sum (000 eq. 16)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import pumpup
+from pumpup.models.lafortune import Lafortune
+
+MODELS = ["lafortune", "lafortune_sum"]
+CASES = [(name, ex) for name in MODELS for ex in pumpup.registry()[name].examples]
+IDS = [f"{name}-{json.dumps(ex, sort_keys=True)}" for name, ex in CASES]
+N = np.array([0.0, 0.0, 1.0])
+
+
+@pytest.fixture
+def rng():
+    """A fixed random generator for this module."""
+    return np.random.default_rng(20261127)
+
+
+def random_directions(rng, n, below=0.1, grazing=0.05):
+    """Unit vectors: mostly upper hemisphere, a fraction below it and a fraction near grazing."""
+    v = rng.normal(size=(n, 3))
+    v /= np.linalg.norm(v, axis=-1, keepdims=True)
+    v[:, 2] = np.abs(v[:, 2])
+    k = int(n * below)
+    v[:k, 2] *= -1
+    g = int(n * grazing)
+    mu = 10.0 ** rng.uniform(-8, -2, g)
+    phi = rng.uniform(0, 2 * np.pi, g)
+    s = np.sqrt(1 - mu**2)
+    v[k : k + g] = np.stack([s * np.cos(phi), s * np.sin(phi), mu], axis=-1)
+    return v
+
+
+def direction_pairs(rng, n=10_000):
+    """~n pairs: random (10% below the horizon, 5% near grazing), exact mirror pairs, and
+    pairs with wi or wo at mu = 1e-8 exactly."""
+    wi = random_directions(rng, n)
+    wo = random_directions(rng, n)[::-1].copy()
+    wo[:500] = wi[:500] * np.array([-1, -1, 1])  # mirror pairs
+    for k, sl in enumerate([slice(500, 700), slice(700, 900)]):
+        phi = rng.uniform(0, 2 * np.pi, 200)
+        s = np.sqrt(1 - 1e-16)
+        w = np.stack([s * np.cos(phi), s * np.sin(phi), np.full(200, 1e-8)], axis=-1)
+        (wi if k == 0 else wo)[sl] = w
+    return wi, wo
+
+
+def polar(theta, phi=0.0):
+    """Unit vector at polar angle theta and azimuth phi [rad]."""
+    return np.array([math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi), math.cos(theta)])
+
+
+@pytest.mark.parametrize("name,params", CASES, ids=IDS)
+def test_kernel_matches_reference(name, params, rng):
+    f = pumpup.load({"type": name, **params})
+    wi, wo = direction_pairs(rng)
+    fast = f.eval(wi, wo)
+    ref = f.reference(wi, wo)
+    assert np.all(np.isfinite(fast)) and np.all(fast >= 0)
+    np.testing.assert_allclose(fast, ref, rtol=1e-12, atol=0)
+    assert np.all(fast[(wi[:, 2] <= 0) | (wo[:, 2] <= 0)] == 0)
+
+
+@pytest.mark.parametrize("name,params", CASES, ids=IDS)
+def test_reciprocal(name, params):
+    f = pumpup.load({"type": name, **params})
+    r = pumpup.check_reciprocity(f)
+    assert r.reciprocal, str(r)
+
+
+@pytest.mark.parametrize("name,params", CASES, ids=IDS)
+def test_spec_round_trip(name, params):
+    f = pumpup.load({"type": name, **params})
+    text = json.dumps(f.spec)
+    assert pumpup.load(json.loads(text)) == f
+    assert pumpup.load(f.spec) == f
+
+
+def test_isotropic_lobe_is_phong_and_stretched_phong(rng):
+    wi, wo = direction_pairs(rng, 2000)
+    for n, c in [(0.0, 0.7), (1.0, 1.0), (20.0, 3.5), (1000.0, 2.0)]:
+        lf = pumpup.load({"type": "lafortune", "n": n, "c": c})
+        ph = pumpup.load({"type": "phong", "n": n, "c": c})
+        # the two formulas round differently; rv^n amplifies that where rv is small, so the
+        # absolute tolerance is relative to the peak value c
+        np.testing.assert_allclose(lf.eval(wi, wo), ph.eval(wi, wo), rtol=1e-12, atol=1e-14 * c)
+        lf1 = pumpup.load({"type": "lafortune", "n": n, "c": c, "p": 1.0})
+        sp = pumpup.load({"type": "stretched_phong", "n": n, "c": c, "p": 1.0})
+        np.testing.assert_allclose(lf1.eval(wi, wo), sp.eval(wi, wo), rtol=1e-12, atol=1e-14 * c)
+
+
+def test_hand_values():
+    f = pumpup.load({"type": "lafortune", "n": 10, "cx": 0.8, "cy": 1.2, "cz": 1.1, "c": 0.5})
+    # wi = wo = N: (R.V)_M = cz
+    assert f.eval(N, N) == pytest.approx(0.5 * 1.1**10, rel=1e-14)
+    # mirror pair at theta = 50 deg, phi = 30 deg: R = wo, so (R.V)_M = cx wx^2 + cy wy^2 + cz wz^2
+    wi = polar(math.radians(50), math.radians(30))
+    wo = wi * np.array([-1, -1, 1])
+    rv = 0.8 * wi[0] ** 2 + 1.2 * wi[1] ** 2 + 1.1 * wi[2] ** 2
+    assert f.eval(wi, wo) == pytest.approx(0.5 * rv**10, rel=1e-13)
+    # stretched (p = 1): divide by max(N.L, N.V); at the mirror pair that is cos(50 deg)
+    g = f.with_params(p=1.0)
+    assert g.eval(wi, wo) == pytest.approx(0.5 * rv**10 / math.cos(math.radians(50)), rel=1e-13)
+    # p = 0.5, wi at 60 deg, wo = N: R.V_M = cz cos(60) = 0.55, max = 1
+    h = f.with_params(p=0.5)
+    assert h.eval(polar(math.radians(60)), N) == pytest.approx(0.5 * 0.55**10, rel=1e-13)
+    # negative cx = cy: a retro-reflective lobe, (R.V)_M = L.V at cx = cy = -1, cz = 1
+    r = pumpup.load({"type": "lafortune", "n": 7, "cx": -1, "cy": -1, "cz": 1})
+    wi = polar(0.7, 0.2)
+    assert r.eval(wi, wi) == pytest.approx(1.0, rel=1e-14)
+    assert r.eval(wi, wi * np.array([-1, -1, 1])) == pytest.approx(max(0, 1 - 2 * math.sin(0.7) ** 2) ** 7, rel=1e-13)
+
+
+def test_sum_is_sum_of_lobes(rng):
+    spec = pumpup.registry()["lafortune_sum"].examples[1]
+    f = pumpup.load({"type": "lafortune_sum", **spec})
+    lobes = f.lobes()
+    assert len(lobes) == 3 and all(isinstance(g, Lafortune) for g in lobes)
+    wi, wo = direction_pairs(rng, 3000)
+    total = sum(g.eval(wi, wo) for g in lobes)
+    np.testing.assert_allclose(f.eval(wi, wo), total, rtol=1e-13, atol=0)
+    assert [w for w, _ in f.albedo_terms()] == [1.0, 1.0, 1.0]
+    # defaults broadcast to the number of lobes; a scalar is a one-lobe list
+    g = pumpup.load({"type": "lafortune_sum", "n": [3, 30]})
+    assert g.p == {"n": [3.0, 30.0], "cx": [1.0, 1.0], "cy": [1.0, 1.0], "cz": [1.0, 1.0], "p": [0.0, 0.0],
+                   "c": [1.0, 1.0]}
+    one = pumpup.load({"type": "lafortune_sum", "n": 12, "c": 2.0})
+    assert one.p["n"] == [12.0]
+    np.testing.assert_allclose(one.eval(wi, wo), pumpup.load({"type": "lafortune", "n": 12, "c": 2.0}).eval(wi, wo),
+                               rtol=1e-14, atol=0)
+    # broadcasting of the leading axes
+    out = f.eval(wi[:40, None, :], wo[None, :7, :])
+    assert out.shape == (40, 7)
+    np.testing.assert_allclose(out[:, 3], f.eval(wi[:40], np.broadcast_to(wo[3], (40, 3))), rtol=1e-15)
+
+
+def test_lobe_hints():
+    f = pumpup.load({"type": "lafortune", "n": 40, "c": 2})
+    assert f.lobe(0.3) == pumpup.Lobe(axis="mirror", radial="power", sharpness=40.0, symmetric=True)
+    g = pumpup.load({"type": "lafortune", "n": 40, "p": 0.5})
+    assert g.lobe(0.3).levels == (0.3,) and g.lobe(0.3).axis == "mirror"
+    a = pumpup.load({"type": "lafortune", "n": 40, "cx": 0.9})
+    assert a.lobe(0.3) == pumpup.Lobe(axis="normal", radial="cosine", symmetric=True)
+
+
+def test_bad_input_names_the_parameter():
+    with pytest.raises(pumpup.SpecError, match="'n'"):
+        pumpup.load({"type": "lafortune", "n": -1})
+    with pytest.raises(pumpup.SpecError, match="'n'"):
+        pumpup.load({"type": "lafortune"})
+    with pytest.raises(pumpup.SpecError, match="'p'"):
+        pumpup.load({"type": "lafortune", "n": 3, "p": 1.5})
+    with pytest.raises(pumpup.SpecError, match="'c'"):
+        pumpup.load({"type": "lafortune", "n": 3, "c": -0.1})
+    with pytest.raises(pumpup.SpecError, match="'cx'"):
+        pumpup.load({"type": "lafortune", "n": 3, "cx": float("nan")})
+    with pytest.raises(pumpup.SpecError, match="'shininess'"):
+        pumpup.load({"type": "lafortune", "n": 3, "shininess": 2})
+    with pytest.raises(pumpup.SpecError, match=r"'cy' has 3"):
+        pumpup.load({"type": "lafortune_sum", "n": [1, 2], "cy": [1, 1, 1]})
+    with pytest.raises(pumpup.SpecError, match=r"'n\[1\]'"):
+        pumpup.load({"type": "lafortune_sum", "n": [1, -2]})
+    with pytest.raises(pumpup.SpecError, match=r"'c\[0\]'"):
+        pumpup.load({"type": "lafortune_sum", "n": [1, 2], "c": [float("nan"), 1]})
+    with pytest.raises(pumpup.SpecError, match="'p'"):
+        pumpup.load({"type": "lafortune_sum", "n": [1, 2], "p": []})
