@@ -43,6 +43,7 @@ __all__ = ["albedo", "check_mu", "AlbedoWarning"]
 
 DEFAULT_RTOL = 1e-10
 DEFAULT_ATOL = 1e-14
+NX_INIT = 8  # initial subdivisions of the radial variable
 
 
 class AlbedoWarning(UserWarning):
@@ -107,17 +108,27 @@ def _radial(kind: str, k: float, x: np.ndarray, xc: np.ndarray):
         with np.errstate(divide="ignore"):
             jac = 0.5 / ca
         return ca, sa, jac
-    if kind == "power":  # cos alpha = x^(1/(n+1)) (000 eq. 20)
-        with np.errstate(divide="ignore"):
-            lx = np.log(x) / (k + 1.0)
-            ca = np.exp(lx)
-            one_minus = -np.expm1(lx)
-            sa = np.sqrt(one_minus * (1.0 + ca))
-            jac = ca / ((k + 1.0) * x)
+    if kind == "power":
+        # two pieces: for x < 1/2, cos(alpha) = 2 x u_s runs linearly over the tail [0, u_s];
+        # for x >= 1/2, y = y_s + (1 - y_s)(2 x - 1) and cos(alpha) = y^(1/(n+1)) absorbs the
+        # cos^n peak (000 eq. 20).  A single power map would be singular at alpha = 90 deg.
+        us = 0.5
+        ys = us ** (k + 1.0)
+        tail = x < 0.5
+        with np.errstate(divide="ignore", invalid="ignore"):
+            y = 1.0 - 2.0 * (1.0 - ys) * xc  # = ys + (1 - ys)(2 x - 1), kept exact near y = 1
+            ly = np.log1p(-2.0 * (1.0 - ys) * xc) / (k + 1.0)
+            ca_peak = np.exp(ly)
+            sa_peak = np.sqrt(-np.expm1(ly) * (1.0 + ca_peak))
+            jac_peak = 2.0 * (1.0 - ys) * ca_peak / ((k + 1.0) * y)
+        ca_tail = 2.0 * us * x
+        ca = np.where(tail, ca_tail, ca_peak)
+        sa = np.where(tail, np.sqrt((1.0 - ca_tail) * (1.0 + ca_tail)), sa_peak)
+        jac = np.where(tail, 2.0 * us, jac_peak)
         return ca, sa, jac
     if kind == "beckmann":  # tan^2 alpha = -m^2 ln x
         with np.errstate(divide="ignore", invalid="ignore"):
-            t2 = -(k * k) * np.log1p(-xc)
+            t2 = -(k * k) * np.where(x < 0.5, np.log(x), np.log1p(-xc))
             ca = 1.0 / np.sqrt(1.0 + t2)
             sa = np.where(np.isinf(t2), 1.0, np.sqrt(t2) * ca)
             jac = (k * k) * ca**3 / (2.0 * x)
@@ -258,6 +269,139 @@ def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
     return out.T
 
 
+def _radial_inverse(kind: str, k: float, alpha: float) -> tuple[float, float]:
+    """The map variable x of the polar angle alpha, and 1 - x, both to full precision
+    (inverse of :func:`_radial`)."""
+    ta = math.tan(alpha)
+    if kind == "cosine":
+        return math.sin(alpha) ** 2, math.cos(alpha) ** 2
+    if kind == "power":
+        us, ys = 0.5, 0.5 ** (k + 1.0)
+        ca = math.cos(alpha)
+        if ca < us:
+            x = ca / (2 * us)
+            return x, 1.0 - x
+        one_minus_y = -math.expm1((k + 1.0) * math.log1p(-2.0 * math.sin(alpha / 2) ** 2))
+        xc = one_minus_y / (2.0 * (1.0 - ys))
+        return 1.0 - xc, xc
+    if kind == "beckmann":
+        q = ta * ta / (k * k)
+        return math.exp(-q), -math.expm1(-q)
+    if kind == "ggx":
+        return ta * ta / (k + ta * ta), k / (k + ta * ta)
+    if kind == "gaussian":
+        y0 = math.exp(-((k * math.pi / 2) ** 2))
+        q = (k * alpha) ** 2
+        return (math.exp(-q) - y0) / (1.0 - y0), -math.expm1(-q) / (1.0 - y0)
+    raise ValueError(kind)
+
+
+def _smooth_inverse(x: float, xc: float) -> float:
+    """tau with tau^2 (3 - 2 tau) = x, precise at both ends (the map is symmetric about 1/2)."""
+    small = min(x, xc)
+    tau = 0.5 - math.sin(math.asin(1.0 - 2.0 * small) / 3.0)
+    for _ in range(3):  # Newton on the small side, where the residual keeps its digits
+        d = 6.0 * tau * (1.0 - tau)
+        if d <= 0:
+            tau = math.sqrt(small / 3.0)
+            continue
+        tau -= (tau * tau * (3.0 - 2.0 * tau) - small) / d
+    return tau if x <= xc else 1.0 - tau
+
+
+def _horizon_breaks(lobe: Lobe, mu: float) -> np.ndarray:
+    """Values of tau_x where the visible arc starts to shrink and where it vanishes.
+
+    N.wo = a(alpha) + b(alpha) cos(beta) in every frame; the arc is complete while a >= b
+    and empty once a <= -b.  At normal incidence (b = 0) the second is a jump of the
+    integrand, which must sit on a rectangle edge.
+    """
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    theta = math.atan2(s, mu)
+    if lobe.axis in ("mirror", "retro"):
+        alphas = [math.pi / 2 - theta]  # mu cos(alpha) = s sin(alpha); a <= -b only beyond 90 deg
+    elif lobe.axis == "half":
+        alphas = [math.pi / 4 - theta / 2, math.pi / 4 + theta / 2]  # mu cos 2a = +-s sin 2a
+    else:
+        alphas = []
+    out = []
+    for a in alphas:
+        if 0 < a < math.pi / 2:
+            x, xc = _radial_inverse(lobe.radial, lobe.sharpness, a)
+            if x > 0 and xc > 0:
+                out.append(_smooth_inverse(x, xc))
+    return np.array(out)
+
+
+_TAU_SCAN = np.unique(np.concatenate([
+    np.linspace(0.0, 1.0, 2001),
+    np.logspace(-13, math.log10(0.5), 200),
+    1.0 - np.logspace(-13, math.log10(0.5), 200),
+]))
+
+
+def _kink_breaks(lobe: Lobe, mu: float, levels: np.ndarray) -> np.ndarray:
+    """Values of tau_x where a kink of the integrand enters or leaves the arc of beta.
+
+    A kink a + b cos(beta) = 0 (a level N.wo = u, or a model's own kink) lies on the arc
+    only while |a| <= |b|; where a = +-b it appears or vanishes with a square-root
+    behaviour in x (and at normal incidence, where b = 0, it becomes a circle: a jump in
+    the derivative along x).  Roots of a -+ b are found on a graded scan and refined by
+    brentq.
+    """
+    from scipy.optimize import brentq
+
+    if not len(levels) and lobe.kinks is None:
+        return np.array([])
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+
+    def coeffs(tau):
+        tau = np.atleast_1d(np.asarray(tau, dtype=float))
+        x, xc, _ = _smooth(tau)
+        ca, sa, _ = _radial(lobe.radial, lobe.sharpness, x, xc)
+        if lobe.axis == "normal":
+            a0, b0 = ca, np.zeros_like(ca)
+        elif lobe.axis in ("mirror", "retro"):
+            a0, b0 = mu * ca, s * sa
+        else:
+            a0, b0 = mu * (ca * ca - sa * sa), 2.0 * s * sa * ca
+        pairs = [(a0 - u, b0) for u in levels]
+        if lobe.kinks is not None:
+            m = np.full_like(ca, mu)
+            pairs += list(lobe.kinks(m, np.full_like(ca, s), ca, sa))
+        return [(np.asarray(a, float), np.asarray(b, float)) for a, b in pairs]
+
+    out = []
+    vals = coeffs(_TAU_SCAN)
+    for j, (a, b) in enumerate(vals):
+        for sign in (1.0, -1.0):
+            h = a - sign * b
+            ok = np.isfinite(h)
+            change = np.nonzero(ok[:-1] & ok[1:] & (np.sign(h[:-1]) * np.sign(h[1:]) < 0))[0]
+            for i in change:
+                def fun(t, j=j, sign=sign):
+                    aa, bb = coeffs(t)[j]
+                    return float(aa[0] - sign * bb[0])
+                try:
+                    out.append(brentq(fun, _TAU_SCAN[i], _TAU_SCAN[i + 1], xtol=1e-16, rtol=4 * np.finfo(float).eps))
+                except ValueError:
+                    pass
+    return np.array(out)
+
+
+def _graded(points: np.ndarray) -> np.ndarray:
+    """Breakpoints with a grid graded geometrically towards each (see _horizon_breaks)."""
+    out = list(points)
+    for t in points:
+        d = min(t, 1.0 - t)
+        for k in range(1, 60):
+            step = d * 2.0**k
+            if step > 0.25:
+                break
+            out.extend(v for v in (t - step, t + step) if 0 < v < 1)
+    return np.array(out)
+
+
 def _rounding(lobe: Lobe) -> float:
     """Relative rounding error of the integrand values.
 
@@ -274,19 +418,24 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
     P = len(g.mu)
     n_pieces = 1 + g.levels.shape[1] + (len(g.lobe.kinks(np.array([0.5]), np.array([0.5]), np.array([0.5]), np.array([0.5]))) if g.lobe.kinks else 0)
     generic = g.lobe.axis == "normal" and g.lobe.radial == "cosine" and not g.lobe.symmetric
-    nx = 4 if not generic else 8
+    nx = NX_INIT if not generic else 8
     nt = 2 if not generic else 8
-    # initial rectangles: nx x nt per piece per problem
-    gx = np.linspace(0, 1, nx + 1)
+    # initial rectangles: nx x nt per piece per problem, with the x grid also split where
+    # the horizon starts to cut the lobe and where it hides it completely
     gt = np.linspace(0, 1, nt + 1)
-    ix, it = np.meshgrid(np.arange(nx), np.arange(nt), indexing="ij")
-    ix, it = ix.ravel(), it.ravel()
-    prob = np.repeat(np.arange(P), n_pieces * len(ix))
-    piece = np.tile(np.repeat(np.arange(n_pieces), len(ix)), P)
-    x0 = np.tile(gx[ix], P * n_pieces)
-    x1 = np.tile(gx[ix + 1], P * n_pieces)
-    t0 = np.tile(gt[it], P * n_pieces)
-    t1 = np.tile(gt[it + 1], P * n_pieces)
+    cols = []
+    for p_ in range(P):
+        # the arc changes on the scale of the distance from a break to the nearer end (near
+        # grazing incidence the horizon break sits within 1e-5 of an end): the grid is graded
+        # geometrically towards every break, so that no first rectangle straddles it unseen
+        breaks = np.concatenate([_horizon_breaks(g.lobe, float(g.mu[p_])),
+                                 _kink_breaks(g.lobe, float(g.mu[p_]), g.levels[p_])])
+        gx = np.unique(np.concatenate([np.linspace(0, 1, nx + 1), _graded(breaks)]))
+        for k in range(n_pieces):
+            X0, T0 = np.meshgrid(gx[:-1], gt[:-1], indexing="ij")
+            X1, T1 = np.meshgrid(gx[1:], gt[1:], indexing="ij")
+            cols.append((np.full(X0.size, p_), np.full(X0.size, k), X0.ravel(), X1.ravel(), T0.ravel(), T1.ravel()))
+    prob, piece, x0, x1, t0, t1 = (np.concatenate(c) for c in zip(*cols))
     val, err, ex, et = _rule(brdf, g, prob, piece, x0, x1, t0, t1)
     rounding = _rounding(g.lobe)
     converged = np.zeros(P, bool)
