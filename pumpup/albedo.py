@@ -36,6 +36,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from .core import BRDF, Lobe
 
@@ -100,6 +101,11 @@ def check_mu(mu) -> np.ndarray:
 
 # --- radial maps: x (with xc = 1 - x) -> cos(alpha), sin(alpha), J = |d cos(alpha) / dx| ------
 
+def _power_split(k: float) -> tuple[float, float]:
+    """(u_s, y_s) of the two-piece power map: the tail cos(alpha) in [0, u_s = 1/2] is
+    integrated in cos(alpha) itself, the peak y = cos^(n+1)(alpha) in [y_s, 1]."""
+    return 0.5, 0.5 ** (k + 1.0)
+
 
 def _radial(kind: str, k: float, x: np.ndarray, xc: np.ndarray):
     if kind == "cosine":  # sin^2 alpha = x
@@ -112,8 +118,7 @@ def _radial(kind: str, k: float, x: np.ndarray, xc: np.ndarray):
         # two pieces: for x < 1/2, cos(alpha) = 2 x u_s runs linearly over the tail [0, u_s];
         # for x >= 1/2, y = y_s + (1 - y_s)(2 x - 1) and cos(alpha) = y^(1/(n+1)) absorbs the
         # cos^n peak (000 eq. 20).  A single power map would be singular at alpha = 90 deg.
-        us = 0.5
-        ys = us ** (k + 1.0)
+        us, ys = _power_split(k)
         tail = x < 0.5
         with np.errstate(divide="ignore", invalid="ignore"):
             y = 1.0 - 2.0 * (1.0 - ys) * xc  # = ys + (1 - ys)(2 x - 1), kept exact near y = 1
@@ -172,10 +177,30 @@ def _smooth(tau):
     return x, xc, 6.0 * tau * (1.0 - tau)
 
 
-def _integrand(brdf: BRDF, g: _Group, prob: np.ndarray, piece: np.ndarray, tx: np.ndarray, tt: np.ndarray):
-    """Integrand values at points (tau_x, tau_t) of piece ``piece`` of problem ``prob``."""
-    lobe = g.lobe
-    mu = g.mu[prob]
+_AXIS_CODE = {"normal": 0, "mirror": 1, "retro": 2, "half": 3}
+_RADIAL_CODE = {"cosine": 0, "power": 1, "beckmann": 2, "ggx": 3, "gaussian": 4}
+
+
+def _kink_coefficients(lobe: Lobe, mu: np.ndarray, x: np.ndarray, xc: np.ndarray):
+    """(a, b) arrays of shape (N, K) of the model's own kinks a + b cos(beta) = 0."""
+    if lobe.kinks is None:
+        z = np.zeros((len(mu), 0))
+        return z, z
+    s = np.sqrt((1.0 - mu) * (1.0 + mu))
+    ca, sa, _ = _radial(lobe.radial, lobe.sharpness, x, xc)
+    pairs = list(lobe.kinks(mu, s, ca, sa))
+    a = np.stack([np.broadcast_to(np.asarray(p[0], float), mu.shape) for p in pairs], axis=-1)
+    b = np.stack([np.broadcast_to(np.asarray(p[1], float), mu.shape) for p in pairs], axis=-1)
+    return np.ascontiguousarray(a), np.ascontiguousarray(b)
+
+
+def _geometry_reference(lobe: Lobe, mu, levels, ka, kb, piece, tx, tt):
+    """Plain numpy geometry: (wi, wo, weight) of every point (tau_x, tau_t) of a piece.
+
+    ``weight`` is d omega_o per d tau_x d tau_t (with the half-vector Jacobian and the
+    width of the beta piece), for one sign of beta; ``levels`` (N, L) and ``ka``, ``kb``
+    (N, K) give the kinks.  The compiled :func:`_geometry_kernel` does the same.
+    """
     s = np.sqrt((1.0 - mu) * (1.0 + mu))
     x, xc, dx = _smooth(tx)
     t, _, dt = _smooth(tt)
@@ -189,13 +214,10 @@ def _integrand(brdf: BRDF, g: _Group, prob: np.ndarray, piece: np.ndarray, tx: n
         a0, b0 = mu * (ca * ca - sa * sa), 2.0 * s * sa * ca
     with np.errstate(divide="ignore", invalid="ignore"):
         beta0 = np.where(b0 > 0, np.arccos(np.clip(-a0 / b0, -1.0, 1.0)), np.where(a0 > 0, np.pi, 0.0))
-        cuts = []
-        for j in range(g.levels.shape[1]):
-            u = g.levels[prob, j]
-            cuts.append(np.where(b0 > 0, np.arccos(np.clip((u - a0) / b0, -1.0, 1.0)), 0.0))
-        if lobe.kinks is not None:
-            for a, b in lobe.kinks(mu, s, ca, sa):
-                cuts.append(np.where(np.abs(b) > 0, np.arccos(np.clip(-a / b, -1.0, 1.0)), 0.0))
+        cuts = [np.where(b0 > 0, np.arccos(np.clip((levels[:, j] - a0) / b0, -1.0, 1.0)), 0.0)
+                for j in range(levels.shape[1])]
+        cuts += [np.where(np.abs(kb[:, j]) > 0, np.arccos(np.clip(-ka[:, j] / kb[:, j], -1.0, 1.0)), 0.0)
+                 for j in range(ka.shape[1])]
     if cuts:
         edges = np.sort(np.minimum(np.stack(cuts, axis=-1), beta0[:, None]), axis=-1)
         edges = np.concatenate([np.zeros_like(beta0)[:, None], edges, beta0[:, None]], axis=-1)
@@ -207,24 +229,150 @@ def _integrand(brdf: BRDF, g: _Group, prob: np.ndarray, piece: np.ndarray, tx: n
     beta = lo + t * width
     cb, sb = np.cos(beta), np.sin(beta)
     wi = np.stack([s, np.zeros_like(s), mu], axis=-1)
-    total = np.zeros_like(mu)
-    signs = (1.0,) if lobe.symmetric else (1.0, -1.0)
-    for sign in signs:
-        # d = A cos(alpha) + sin(alpha) (e1 cos(beta) + e2 sin(beta))
-        if axis in ("normal", "half"):
-            d = np.stack([sa * cb, sign * sa * sb, ca], axis=-1)
-        elif axis == "mirror":  # A = R = (-s, 0, mu), e1 = (mu, 0, s)
-            d = np.stack([-s * ca + mu * sa * cb, sign * sa * sb, mu * ca + s * sa * cb], axis=-1)
-        else:  # retro: A = wi = (s, 0, mu), e1 = (-mu, 0, s)
-            d = np.stack([s * ca - mu * sa * cb, sign * sa * sb, mu * ca + s * sa * cb], axis=-1)
-        if axis == "half":
-            ih = np.einsum("...k,...k->...", wi, d)
-            wo = 2.0 * ih[:, None] * d - wi
+    # d = A cos(alpha) + sin(alpha) (e1 cos(beta) + e2 sin(beta))
+    if axis in ("normal", "half"):
+        d = np.stack([sa * cb, sa * sb, ca], axis=-1)
+    elif axis == "mirror":  # A = R = (-s, 0, mu), e1 = (mu, 0, s)
+        d = np.stack([-s * ca + mu * sa * cb, sa * sb, mu * ca + s * sa * cb], axis=-1)
+    else:  # retro: A = wi = (s, 0, mu), e1 = (-mu, 0, s)
+        d = np.stack([s * ca - mu * sa * cb, sa * sb, mu * ca + s * sa * cb], axis=-1)
+    if axis == "half":
+        ih = s * d[:, 0] + mu * d[:, 2]
+        wo = 2.0 * ih[:, None] * d - wi
+        extra = 4.0 * ih  # d omega_o = 4 (wo.h) d omega_h
+    else:
+        wo = d
+        extra = 1.0
+    return wi, wo, jac * extra * width * dx * dt
+
+
+@njit(cache=True)
+def _radial_scalar(kind, k, x, xc):  # pragma: no cover - compiled; see _radial
+    if kind == 0:
+        ca = math.sqrt(xc)
+        return ca, math.sqrt(x), (0.5 / ca if ca > 0 else math.inf)
+    if kind == 1:
+        us = 0.5  # as in _power_split
+        ys = us ** (k + 1.0)
+        if x < 0.5:
+            c = 2.0 * us * x
+            return c, math.sqrt((1.0 - c) * (1.0 + c)), 2.0 * us
+        y = 1.0 - 2.0 * (1.0 - ys) * xc
+        ly = math.log1p(-2.0 * (1.0 - ys) * xc) / (k + 1.0)
+        c = math.exp(ly)
+        sa = math.sqrt(-math.expm1(ly) * (1.0 + c))
+        jac = 2.0 * (1.0 - ys) * c / ((k + 1.0) * y) if y > 0 else math.inf
+        return c, sa, jac
+    if kind == 2:
+        lg = math.log(x) if x < 0.5 else math.log1p(-xc)
+        if x <= 0.0:
+            return 0.0, 1.0, math.inf
+        t2 = -(k * k) * lg
+        c = 1.0 / math.sqrt(1.0 + t2)
+        return c, math.sqrt(t2) * c, (k * k) * c * c * c / (2.0 * x)
+    if kind == 3:
+        d = xc + k * x
+        c = math.sqrt(xc / d)
+        return c, math.sqrt(k * x / d), (k / (2.0 * c * d * d) if c > 0 else math.inf)
+    y0 = math.exp(-((k * math.pi / 2) ** 2))
+    y = y0 + (1.0 - y0) * x
+    a = math.sqrt(max(-math.log1p(-(1.0 - y0) * xc), 0.0)) / k
+    sinc = math.sin(a) / a if a > 0 else 1.0
+    return math.cos(a), math.sin(a), (1.0 - y0) * sinc / (2.0 * k * k * y)
+
+
+@njit(cache=True)
+def _geometry_kernel(axis, radial, k, mu, levels, ka, kb, piece, tx, tt, wo, weight):  # pragma: no cover
+    """Compiled twin of :func:`_geometry_reference`; fills ``wo`` (N, 3) and ``weight`` (N)."""
+    L = levels.shape[1]
+    K = ka.shape[1]
+    edges = np.empty(L + K + 2)
+    for i in range(tx.shape[0]):
+        m = mu[i]
+        s = math.sqrt((1.0 - m) * (1.0 + m))
+        # smoothing substitution x = tau^2 (3 - 2 tau)
+        u = tx[i]
+        x = u * u * (3.0 - 2.0 * u)
+        xc = (1.0 - u) ** 2 * (1.0 + 2.0 * u)
+        dx = 6.0 * u * (1.0 - u)
+        v = tt[i]
+        t = v * v * (3.0 - 2.0 * v)
+        dt = 6.0 * v * (1.0 - v)
+        ca, sa, jac = _radial_scalar(radial, k, x, xc)
+        if axis == 0:
+            a0, b0 = ca, 0.0
+        elif axis == 3:
+            a0, b0 = m * (ca * ca - sa * sa), 2.0 * s * sa * ca
+        else:
+            a0, b0 = m * ca, s * sa
+        if b0 > 0:
+            beta0 = math.acos(min(1.0, max(-1.0, -a0 / b0)))
+        else:
+            beta0 = math.pi if a0 > 0 else 0.0
+        n = 0
+        edges[n] = 0.0
+        n += 1
+        for j in range(L):
+            c = math.acos(min(1.0, max(-1.0, (levels[i, j] - a0) / b0))) if b0 > 0 else 0.0
+            edges[n] = min(c, beta0)
+            n += 1
+        for j in range(K):
+            c = math.acos(min(1.0, max(-1.0, -ka[i, j] / kb[i, j]))) if kb[i, j] != 0 else 0.0
+            edges[n] = min(c, beta0)
+            n += 1
+        edges[n] = beta0
+        n += 1
+        # insertion sort of the interior cuts
+        for a in range(2, n - 1):
+            val = edges[a]
+            b = a - 1
+            while b >= 1 and edges[b] > val:
+                edges[b + 1] = edges[b]
+                b -= 1
+            edges[b + 1] = val
+        lo = edges[piece[i]]
+        hi = edges[piece[i] + 1]
+        width = hi - lo
+        beta = lo + t * width
+        cb, sb = math.cos(beta), math.sin(beta)
+        if axis == 0 or axis == 3:
+            d0, d1, d2 = sa * cb, sa * sb, ca
+        elif axis == 1:
+            d0, d1, d2 = -s * ca + m * sa * cb, sa * sb, m * ca + s * sa * cb
+        else:
+            d0, d1, d2 = s * ca - m * sa * cb, sa * sb, m * ca + s * sa * cb
+        if axis == 3:
+            ih = s * d0 + m * d2
+            wo[i, 0] = 2.0 * ih * d0 - s
+            wo[i, 1] = 2.0 * ih * d1
+            wo[i, 2] = 2.0 * ih * d2 - m
             extra = 4.0 * ih
         else:
-            wo = d
+            wo[i, 0] = d0
+            wo[i, 1] = d1
+            wo[i, 2] = d2
             extra = 1.0
-        cos_o = wo[:, 2]
+        w = jac * extra * width * dx * dt
+        weight[i] = w if width > 0 else 0.0
+
+
+def _integrand(brdf: BRDF, g: _Group, prob: np.ndarray, piece: np.ndarray, tx: np.ndarray, tt: np.ndarray):
+    """Integrand values at points (tau_x, tau_t) of piece ``piece`` of problem ``prob``."""
+    lobe = g.lobe
+    mu = np.ascontiguousarray(g.mu[prob])
+    levels = np.ascontiguousarray(g.levels[prob])
+    x, xc, _ = _smooth(tx) if lobe.kinks is not None else (None, None, None)
+    ka, kb = _kink_coefficients(lobe, mu, x, xc) if lobe.kinks is not None else _kink_coefficients(lobe, mu, mu, mu)
+    wo = np.empty((len(mu), 3))
+    weight = np.empty(len(mu))
+    _geometry_kernel(_AXIS_CODE[lobe.axis], _RADIAL_CODE[lobe.radial], float(lobe.sharpness), mu, levels, ka, kb,
+                     np.ascontiguousarray(piece), np.ascontiguousarray(tx, dtype=np.float64),
+                     np.ascontiguousarray(tt, dtype=np.float64), wo, weight)
+    wi = np.stack([np.sqrt((1.0 - mu) * (1.0 + mu)), np.zeros_like(mu), mu], axis=-1)
+    total = np.zeros_like(mu)
+    for sign in (1.0,) if lobe.symmetric else (1.0, -1.0):
+        if sign < 0:
+            wo[:, 1] *= -1.0  # beta -> -beta flips wo_y in every frame (wi_y = 0)
         f = np.asarray(brdf._eval(wi, wo), dtype=np.float64)
         bad = ~np.isfinite(f) | (f < 0)
         if np.any(bad):
@@ -234,11 +382,8 @@ def _integrand(brdf: BRDF, g: _Group, prob: np.ndarray, piece: np.ndarray, tx: n
                 "a BRDF must be finite and non-negative above the horizon"
             )
         with np.errstate(invalid="ignore", over="ignore"):
-            val = np.where((f > 0) & (cos_o > 0), f * cos_o * jac * extra, 0.0)
-        total = total + val
-    if lobe.symmetric:
-        total = 2.0 * total
-    return total * width * dx * dt
+            total += np.where((f > 0) & (wo[:, 2] > 0) & (weight > 0), f * wo[:, 2] * weight, 0.0)
+    return 2.0 * total if lobe.symmetric else total
 
 
 def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
@@ -276,7 +421,7 @@ def _radial_inverse(kind: str, k: float, alpha: float) -> tuple[float, float]:
     if kind == "cosine":
         return math.sin(alpha) ** 2, math.cos(alpha) ** 2
     if kind == "power":
-        us, ys = 0.5, 0.5 ** (k + 1.0)
+        us, ys = _power_split(k)
         ca = math.cos(alpha)
         if ca < us:
             x = ca / (2 * us)
@@ -394,8 +539,8 @@ def _graded(points: np.ndarray) -> np.ndarray:
     out = list(points)
     for t in points:
         d = min(t, 1.0 - t)
-        for k in range(1, 60):
-            step = d * 2.0**k
+        for k in range(1, 30):
+            step = d * 4.0**k
             if step > 0.25:
                 break
             out.extend(v for v in (t - step, t + step) if 0 < v < 1)
