@@ -103,6 +103,10 @@ class Param:
             if v != int(v):
                 raise SpecError(f"{model}: parameter {name!r} must be an integer in {self.range_text()}, got {value!r}")
             return int(v)
+        if self.kind == "bool":
+            if not isinstance(value, (bool, np.bool_)):
+                raise SpecError(f"{model}: parameter {name!r} must be true or false, got {value!r}")
+            return bool(value)
         if self.kind == "str":
             if not isinstance(value, str) or (self.choices and value not in self.choices):
                 raise SpecError(f"{model}: parameter {name!r} must be {self.range_text()}, got {value!r}")

@@ -1,0 +1,403 @@
+"""The albedo pumping-up operator (001 sec. 3).
+
+    f*(wi, wo) = f(wi, wo) / g(wi, wo)                                   (001 eq. 16)
+    g1 = max(a(wi), a(wo))                                               (001 eq. 20)
+    g2 = max(a(wi), a(wo), N.wi, N.wo)          (controlled pumping-up,   001 eq. 21)
+
+with a the directional albedo of f.  If f is symmetric, f* is symmetric, and since
+max(a(L), a(V)) <= g <= 1 (001 eq. 17), its albedo satisfies a(L) <= a*(L) <= 1
+(001 eq. 18-19).  The proof needs g >= the *true* albedo: pumpup divides by an upper bound
+of the tabulated albedo (interpolant + measured interpolation error + quadrature error),
+never by a value that could dip below it.  A pumped BRDF is an ordinary BRDF: it
+evaluates, tabulates, pumps again and round-trips through its spec.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+
+import numpy as np
+from numba import njit
+
+from .core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register
+
+__all__ = ["pump", "Pumped", "save_pumped", "load_pumped", "base_table"]
+
+#: accuracy of the albedo tables that pumped BRDFs divide by
+TABLE_RTOL = 1e-10
+TABLE_INTERP_TOL = 1e-8
+
+_TABLES: dict[str, object] = {}  # JSON spec of a base -> AlbedoTable (computed once per session)
+
+
+def _key(brdf: BRDF) -> str:
+    """Cache key of a base: its spec (and, for a user function, which function object)."""
+    key = json.dumps(brdf.spec, sort_keys=True)
+    fn = getattr(brdf, "fn", None)
+    return key if fn is None else f"{key}#{id(fn)}"
+
+
+def base_table(base: BRDF, progress: bool | None = None):
+    """The albedo table of ``base`` used by the pumping operator (cached per session)."""
+    from .tables import AlbedoTable, tabulate
+
+    key = _key(base)
+    if key not in _TABLES:
+        ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress)
+        _TABLES[key] = AlbedoTable.from_dataset(ds)
+        _TABLES[key].dataset = ds
+    return _TABLES[key]
+
+
+# --- the compiled look-up: upper bound of a(mu) from the spline pieces ---------------------
+
+
+@njit(cache=True)
+def _upper_scalar(mu, logx, coef, v0, slope0, margin_lo, margin, node_err, cap):  # pragma: no cover - compiled
+    """Upper bound of a(mu): the table's cubic in log(mu) (power law below the first node) + margin,
+    at most ``cap``."""
+    lm = math.log(mu)
+    n = logx.shape[0]
+    if lm <= logx[0]:
+        return min(cap, v0 * math.exp(slope0 * (lm - logx[0])) + margin_lo)
+    lo, hi = 0, n - 1
+    while hi - lo > 1:  # binary search for the interval
+        mid = (lo + hi) // 2
+        if logx[mid] <= lm:
+            lo = mid
+        else:
+            hi = mid
+    d = lm - logx[lo]
+    val = ((coef[0, lo] * d + coef[1, lo]) * d + coef[2, lo]) * d + coef[3, lo]
+    return min(cap, val + margin + max(node_err[lo], node_err[lo + 1]))
+
+
+@njit(cache=True)
+def _pumped_kernel(fbase, mu_i, mu_o, logx, coef, v0, slope0, margin_lo, margin, node_err, cap, controlled, out):  # pragma: no cover
+    for k in range(fbase.shape[0]):
+        f = fbase[k]
+        if f == 0.0 or mu_i[k] <= 0.0 or mu_o[k] <= 0.0:
+            out[k] = 0.0
+            continue
+        gi = _upper_scalar(mu_i[k], logx, coef, v0, slope0, margin_lo, margin, node_err, cap)
+        go = _upper_scalar(mu_o[k], logx, coef, v0, slope0, margin_lo, margin, node_err, cap)
+        g = max(gi, go)  # 001 eq. 20
+        if controlled:
+            g = max(g, mu_i[k], mu_o[k])  # 001 eq. 21
+        out[k] = f / g  # 001 eq. 16
+
+
+def _pumped_reference(fbase, mu_i, mu_o, upper, controlled):
+    """Plain numpy version of the kernel (the readable reference)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        g = np.maximum(upper(np.clip(mu_i, 1e-300, 1)), upper(np.clip(mu_o, 1e-300, 1)))  # 001 eq. 20
+        if controlled:
+            g = np.maximum(g, np.maximum(mu_i, mu_o))  # 001 eq. 21
+        out = fbase / g  # 001 eq. 16
+    return np.where((fbase > 0) & (mu_i > 0) & (mu_o > 0), out, 0.0)
+
+
+class _Lookup:
+    """The table's upper bound in the flat form the compiled kernel takes."""
+
+    def __init__(self, table):
+        t = table
+        self.logx = np.log(t.mu)
+        self.coef = np.ascontiguousarray(t._spline.c)
+        self.node_err = np.ascontiguousarray(t.error)
+        self.margin = t.SAFETY * float(t.interp_error)  # as in AlbedoTable.upper
+        a0, a1 = t.value[0], t.value[1]
+        self.v0 = float(a0)
+        self.slope0 = (math.log(a1) - math.log(a0)) / (self.logx[1] - self.logx[0]) if a0 > 0 and a1 > 0 else 0.0
+        # below the first node the power-law extrapolation is a guess: add the full spread of
+        # the first interval as margin
+        self.margin_lo = self.margin + float(t.error[0]) + abs(float(a1) - float(a0))
+        # 001 eq. 17 asks max(a(L), a(V)) <= g <= 1.  The upper bound can exceed 1 by its
+        # margin where a = 1, which would lower the albedo there (a* < a): cap g at 1 when the
+        # table says the base conserves energy.  A base that reflects more than it receives
+        # (a > 1 beyond its error) cannot meet both sides; then g stays >= a so that the first
+        # pumping makes it plausible (001, after eq. 17).
+        self.cap = 1.0 if float(np.max(t.value - t.error)) <= 1.0 else math.inf
+        self.table = t
+
+    def args(self):
+        return self.logx, self.coef, self.v0, self.slope0, self.margin_lo, self.margin, self.node_err, self.cap
+
+    def upper(self, mu):
+        mu = np.asarray(mu, dtype=np.float64)
+        out = np.empty(mu.size)
+        flat = mu.ravel()
+        for i in range(flat.size):
+            out[i] = _upper_scalar(flat[i], *self.args())
+        return out.reshape(mu.shape)
+
+
+@register("pumped")
+class Pumped(BRDF):
+    """One level of albedo pumping-up, f*(wi, wo) = f(wi, wo) / g(wi, wo) (001 eq. 16).
+
+    Parameters
+    ----------
+    base : spec
+        The BRDF to pump; it must be reciprocal (checked with :func:`check_reciprocity`)
+        unless ``force`` is true.
+    g : {"g1", "g2"}
+        g1 = max(a(wi), a(wo)) (001 eq. 20); g2 = max(a(wi), a(wo), N.wi, N.wo), the
+        controlled pumping-up (001 eq. 21).
+    levels : int, >= 1
+        ``levels`` > 1 builds nested levels (each pumping the one below); the object and
+        its spec are then nested with one level each.
+    force : bool
+        Pump a base that ``check_reciprocity`` finds non-reciprocal.
+
+    Notes
+    -----
+    a is the base's albedo table (:func:`base_table`), computed once per session or
+    loaded with :func:`load_pumped`; g uses its upper bound, so the pumped albedo is at
+    most 1.
+    """
+
+    params = {
+        "base": Param(kind="spec", doc="the BRDF to pump"),
+        "g": Param("g1", kind="str", choices=("g1", "g2")),
+        "levels": Param(1, lo=1, kind="int"),
+        "force": Param(False, kind="bool"),
+    }
+    constant = None
+
+    def __init__(self, **kwargs):
+        levels = kwargs.get("levels", 1)
+        if isinstance(levels, (int, float)) and not isinstance(levels, bool) and levels > 1 and levels == int(levels):
+            inner = dict(kwargs, levels=int(levels) - 1)
+            kwargs = dict(kwargs, levels=1, base=Pumped(**inner))
+        super().__init__(**kwargs)
+        base = self.p["base"]
+        if isinstance(base, Pumped):  # reciprocal by construction (or forced below)
+            self.reciprocal = base.reciprocal
+        else:
+            r = check_reciprocity(base, n_mu=16, n_phi=16)
+            self.reciprocal = bool(r.reciprocal and base.reciprocal)
+            if not self.reciprocal and not self.p["force"]:
+                raise SpecError(
+                    f"pumped: the base {base.type!r} is not reciprocal ({r}); pumping needs a symmetric "
+                    "BRDF (001 sec. 3). Pass force=True to pump it anyway."
+                )
+        self._lookup = None
+
+    @property
+    def base(self) -> BRDF:
+        return self.p["base"]
+
+    @property
+    def controlled(self) -> bool:
+        return self.p["g"] == "g2"
+
+    @property
+    def spec(self) -> dict:
+        out = {"type": "pumped", "base": self.base.spec, "g": self.p["g"]}
+        if self.p["force"]:
+            out["force"] = True
+        return out
+
+    @property
+    def depth(self) -> int:
+        """Number of pumping levels from the first non-pumped base."""
+        return 1 + (self.base.depth if isinstance(self.base, Pumped) else 0)
+
+    def table(self, progress: bool | None = None):
+        """The albedo table of the base (the a in g)."""
+        return base_table(self.base, progress=progress)
+
+    def lookup(self) -> _Lookup:
+        if self._lookup is None:
+            self._lookup = _Lookup(self.table())
+        return self._lookup
+
+    def g(self, mu_i, mu_o) -> np.ndarray:
+        """g(wi, wo) as a function of mu_i = N.wi and mu_o = N.wo (001 eq. 20, 21)."""
+        up = self.lookup().upper
+        g = np.maximum(up(mu_i), up(mu_o))
+        if self.controlled:
+            g = np.maximum(g, np.maximum(mu_i, mu_o))
+        return g
+
+    def _eval(self, wi, wo):
+        fb = np.asarray(self.base._eval(wi, wo), dtype=np.float64)
+        shape = fb.shape
+        mi = np.broadcast_to(wi[..., 2], shape).ravel()
+        mo = np.broadcast_to(wo[..., 2], shape).ravel()
+        out = np.empty(fb.size)
+        _pumped_kernel(np.ascontiguousarray(fb.ravel()), np.ascontiguousarray(mi), np.ascontiguousarray(mo),
+                       *self.lookup().args(), self.controlled, out)
+        return out.reshape(shape)
+
+    def reference(self, wi, wo):
+        wi = np.asarray(wi, dtype=np.float64)
+        wo = np.asarray(wo, dtype=np.float64)
+        fb = np.asarray(self.base.reference(wi, wo), dtype=np.float64)
+        mi = np.broadcast_to(wi[..., 2], fb.shape)
+        mo = np.broadcast_to(wo[..., 2], fb.shape)
+        return _pumped_reference(fb, mi, mo, self.lookup().upper, self.controlled)
+
+    # --- hints for the albedo engine: the base's lobe plus the kinks of g ------------------
+    def kink_levels(self, mu: float) -> tuple:
+        """Values u of N.wo where g(mu, u) has a kink (roots on the tabulated albedo)."""
+        from scipy.optimize import brentq
+
+        up = self.lookup().upper
+        t = self.lookup().table
+        am = float(up(mu))
+        grid = np.unique(np.concatenate([t.mu, np.sqrt(t.mu[:-1] * t.mu[1:]), [1.0]]))
+        au = up(grid)
+        funcs = [lambda u: float(up(u)) - am]
+        if self.controlled:
+            funcs += [lambda u: float(up(u)) - u, lambda u: float(up(u)) - mu]
+        out = [mu]
+        if self.controlled:
+            out.append(am)
+        for k, fn in enumerate(funcs):
+            vals = au - am if k == 0 else (au - grid if k == 1 else au - mu)
+            idx = np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]
+            for i in idx:
+                out.append(brentq(fn, grid[i], grid[i + 1], xtol=1e-15))
+        levels = []
+        for u in sorted(out):  # one level per kink: roots that agree to 1e-12 are the same kink
+            if 0 < u < 1 and (not levels or u - levels[-1] > 1e-12 * u):
+                levels.append(u)
+        return tuple(levels)
+
+    def lobe(self, mu: float) -> Lobe:
+        b = self.base.lobe(mu)
+        return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
+                    levels=tuple(sorted(set(b.levels) | set(self.kink_levels(mu)))),
+                    kinks=b.kinks, symmetric=b.symmetric)
+
+    def albedo_terms(self):
+        terms = self.base.albedo_terms()
+        if len(terms) == 1 and terms[0][1] is self.base:
+            return [(1.0, self)]
+        return [(w, _Divided(t, self)) for w, t in terms]
+
+
+class _Divided(BRDF):
+    """One linear term of a pumped sum, f_k / g (the albedo engine integrates it alone)."""
+
+    type = "pumped-term"
+    params = {}
+
+    def __init__(self, term: BRDF, pumped: Pumped):
+        self.p = {}
+        self.term, self.pumped = term, pumped
+        self.reciprocal = term.reciprocal
+
+    @property
+    def spec(self):
+        return {"type": "pumped-term", "term": self.term.spec, "of": self.pumped.spec}
+
+    def _eval(self, wi, wo):
+        fb = np.asarray(self.term._eval(wi, wo), dtype=np.float64)
+        mi = np.broadcast_to(wi[..., 2], fb.shape)
+        mo = np.broadcast_to(wo[..., 2], fb.shape)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(fb > 0, fb / self.pumped.g(np.clip(mi, 1e-300, 1), np.clip(mo, 1e-300, 1)), 0.0)
+
+    def lobe(self, mu):
+        b = self.term.lobe(mu)
+        return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
+                    levels=tuple(sorted(set(b.levels) | set(self.pumped.kink_levels(mu)))),
+                    kinks=b.kinks, symmetric=b.symmetric)
+
+
+def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False) -> Pumped:
+    """Pump up the albedo of a symmetric BRDF (001 sec. 3), ``levels`` times.
+
+    Parameters
+    ----------
+    brdf : BRDF or spec
+        Reciprocal (checked); any symmetric function will do, even one that does not
+        conserve energy: the first pumping makes it plausible (001, after eq. 17).
+    g : {"g1", "g2"}
+        The correction term: g1 (001 eq. 20) or the controlled g2 (001 eq. 21).
+    levels : int
+        Number of nested pumpings; each uses the albedo of the level below.
+    force : bool
+        Accept a base that :func:`pumpup.check_reciprocity` finds non-reciprocal.
+
+    Returns
+    -------
+    Pumped
+        A BRDF: ``pump(pump(f))`` works and ``pumped.spec`` is a nested spec.
+
+    Examples
+    --------
+    >>> import pumpup
+    >>> f = pumpup.pump(pumpup.load({"type": "phong", "n": 20}), g="g2", levels=2)
+    >>> f.spec["base"]["type"], f.depth
+    ('pumped', 2)
+    """
+    if g not in ("g1", "g2"):
+        raise SpecError(f"pump: g must be 'g1' or 'g2', got {g!r}")
+    if isinstance(levels, bool) or not isinstance(levels, (int, np.integer)) or levels < 1:
+        raise SpecError(f"pump: levels must be an integer >= 1, got {levels!r}")
+    base = load(brdf)
+    return Pumped(base=base, g=g, levels=int(levels), force=force)
+
+
+# --- saving and loading: one netCDF file, a group per level -----------------------------------
+
+
+def save_pumped(f: Pumped, path) -> str:
+    """Write a pumped BRDF and the albedo tables of all its levels to one netCDF file.
+
+    Group ``level1`` holds the table of the innermost base, ``level2`` that of the first
+    pumped level, and so on; the root attributes hold the spec.  Written atomically.
+    """
+    import tempfile
+
+    import xarray as xr
+
+    from ._version import __version__
+
+    if not isinstance(f, Pumped):
+        raise TypeError("save_pumped needs a pumped BRDF (pumpup.pump)")
+    chain = []
+    cur = f
+    while isinstance(cur, Pumped):
+        chain.append(cur)
+        cur = cur.base
+    chain.reverse()  # innermost first
+    path = os.fspath(path)
+    directory = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(suffix=".nc.tmp", dir=directory)
+    os.close(fd)
+    try:
+        root = xr.Dataset(attrs={"pumpup_kind": "pumpup pumped BRDF", "spec": json.dumps(f.spec, sort_keys=True),
+                                 "levels": len(chain), "pumpup_version": __version__})
+        root.to_netcdf(tmp, mode="w", engine="netcdf4")
+        for i, level in enumerate(chain, start=1):
+            base_table(level.base)
+            ds = _TABLES[_key(level.base)].dataset
+            ds.to_netcdf(tmp, mode="a", group=f"level{i}", engine="netcdf4")
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
+
+
+def load_pumped(path) -> Pumped:
+    """Load a pumped BRDF saved by :func:`save_pumped`, without recomputing its tables."""
+    from .tables import AlbedoTable, open_table
+
+    root = open_table(path)
+    if root.attrs.get("pumpup_kind") != "pumpup pumped BRDF":
+        raise ValueError(f"{os.fspath(path)!r} is a pumpup table, not a saved pumped BRDF")
+    for i in range(1, int(root.attrs["levels"]) + 1):
+        ds = open_table(path, group=f"level{i}")
+        t = AlbedoTable.from_dataset(ds)
+        t.dataset = ds
+        _TABLES[_key(load(json.loads(ds.attrs["spec"])))] = t
+    return load(json.loads(root.attrs["spec"]))

@@ -1,0 +1,169 @@
+"""The albedo pumping-up operator (001 sec. 3): reciprocity, energy balance, monotone albedo,
+controlled radiance, saving and loading, bad input."""
+
+import json
+import sys
+
+import numpy as np
+import pytest
+
+import pumpup
+from pumpup.pump import Pumped, _TABLES
+from helpers import random_directions
+
+MU = np.array([1.0, 0.95, 0.8, 0.6, 0.4, 0.2, 0.1, 0.03, 1e-2, 1e-3, 1e-5, 1e-8])
+# between the nodes of every table: the interpolant must not let the pumped albedo exceed 1 there
+RNG_MU = np.sort(10 ** np.random.default_rng(7).uniform(-8, 0, 12))
+
+BASES = {
+    "phong": {"type": "phong", "n": 20},
+    "blinn": {"type": "blinn", "n": 20, "c": 0.9},
+    "ward0.1": {"type": "ward", "m": 0.1},
+    "ward0.3": {"type": "ward", "m": 0.3},
+    "cook_torrance": {"type": "cook_torrance", "m": 0.2},
+}
+
+
+def levels_of(f):
+    out = [f]
+    while isinstance(out[-1], Pumped):
+        out.append(out[-1].base)
+    return out[::-1]  # base first
+
+
+def check_chain(top, mus):
+    """Every level: reciprocal, albedo <= 1 within its error (levels >= 1), monotone in the level.
+
+    001 eq. 19 (a <= a*) needs a base that conserves energy: where a base reflects more than
+    it receives (Ward and Cook-Torrance at grazing incidence), the first pumping brings the
+    albedo down to at most 1 instead, so the monotonicity is checked from the first level
+    whose base is plausible.
+    """
+    prev = None
+    for k, f in enumerate(levels_of(top)):
+        if k > 0:
+            assert pumpup.check_reciprocity(f, n_mu=12, n_phi=12).reciprocal
+        a, e = pumpup.albedo(f, mus, return_error=True, rtol=1e-9)
+        if k > 0:
+            assert np.all(a - e <= 1.0), (k, a.max())
+        if prev is not None and np.all(prev - prev_e <= 1.0):
+            assert np.all(a >= prev - e - prev_e), k  # 001 eq. 19: a <= a*
+        prev, prev_e = a, e
+    return prev
+
+
+@pytest.mark.parametrize("g", ["g1", "g2"])
+def test_phong_three_levels(g):
+    f = pumpup.pump(pumpup.load(BASES["phong"]), g=g, levels=3)
+    assert f.depth == 3
+    a = check_chain(f, np.concatenate([MU, RNG_MU]))
+    if g == "g1":
+        assert a[0] > 0.9999 and a[-1] > 0.85  # g1 tends to the ideal energy mirror (001 sec. 3.1)
+
+
+@pytest.mark.parametrize("name", ["blinn", "ward0.1", "ward0.3", "cook_torrance"])
+@pytest.mark.parametrize("g", ["g1", "g2"])
+def test_other_bases_one_level(name, g):
+    check_chain(pumpup.pump(pumpup.load(BASES[name]), g=g, levels=1), np.concatenate([MU, RNG_MU[::3]]))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(BASES))
+@pytest.mark.parametrize("g", ["g1", "g2"])
+def test_five_levels(name, g):
+    """Issue 4's full matrix: levels 1 to 5 on every base (slow: run with -m slow)."""
+    check_chain(pumpup.pump(pumpup.load(BASES[name]), g=g, levels=5), np.concatenate([MU, RNG_MU]))
+
+
+def test_energy_creating_symmetric_function_becomes_plausible():
+    # a constant 2/pi reflects twice what it receives; one pumping makes it exactly Lambertian
+    f = pumpup.from_function(lambda wi, wo: np.full(np.broadcast_shapes(wi.shape, wo.shape)[:-1], 2 / np.pi),
+                             name="twice-lambert")
+    assert np.allclose(pumpup.albedo(f, MU), 2.0)
+    p = pumpup.pump(f, g="g1", levels=3)
+    for level in levels_of(p)[1:]:
+        a, e = pumpup.albedo(level, MU, return_error=True)
+        assert np.all(a - e <= 1.0)
+        np.testing.assert_allclose(a, 1.0, atol=1e-7)
+
+
+def test_user_function_base_two_levels():
+    def phong8(wi, wo):
+        rv = 2 * wi[..., 2] * wo[..., 2] - np.sum(wi * wo, axis=-1)
+        return 10 / (2 * np.pi) * np.maximum(rv, 0) ** 8
+
+    f = pumpup.pump(pumpup.from_function(phong8, name="phong8"), g="g2", levels=2)
+    check_chain(f, MU[::2])
+
+
+def test_kernel_matches_reference_and_radiance_is_controlled(rng):
+    base = pumpup.load(BASES["phong"])
+    f = pumpup.pump(base, g="g2", levels=3)
+    wi = random_directions(rng, 3000)
+    wo = random_directions(rng, 3000)[::-1]
+    wo[:300] = wi[:300] * np.array([-1, -1, 1])
+    np.testing.assert_allclose(f.eval(wi, wo), f.reference(wi, wo), rtol=1e-13, atol=1e-300)
+    # controlled pumping (001 sec. 3.2): g2 >= N.L, so the radiance under a point light of
+    # power 4 pi at distance 1, f* cos(theta_L), never exceeds the base f, and so never exceeds
+    # the base's radiance at normal incidence in the mirror direction, c = (n + 2) / (2 pi)
+    up = (wi[:, 2] > 0) & (wo[:, 2] > 0)
+    radiance = f.eval(wi, wo) * np.maximum(wi[:, 2], 0)
+    assert np.all(radiance[up] <= base.eval(wi, wo)[up] * (1 + 1e-12))
+    assert radiance.max() <= 22 / (2 * np.pi) * (1 + 1e-12)
+
+
+def test_g1_radiance_can_exceed_the_input():
+    # without control, pumped Phong is a "super-metal" at grazing angles (001 sec. 3.1)
+    f = pumpup.pump(pumpup.load(BASES["phong"]), g="g1", levels=3)
+    th = np.radians(85.0)
+    wi = np.array([np.sin(th), 0, np.cos(th)])
+    wo = np.array([-np.sin(th), 0, np.cos(th)])
+    assert f.eval(wi, wo) * np.cos(th) > 22 / (2 * np.pi)
+
+
+def test_spec_round_trip_and_nesting():
+    f = pumpup.pump({"type": "phong", "n": 20}, g="g2", levels=2)
+    spec = json.loads(json.dumps(f.spec))
+    assert spec["base"]["type"] == "pumped" and spec["base"]["base"]["type"] == "phong"
+    g = pumpup.load(spec)
+    assert g == f
+    h = pumpup.load({"type": "pumped", "base": {"type": "phong", "n": 20}, "g": "g2", "levels": 2})
+    assert h == f
+    assert pumpup.pump(pumpup.pump({"type": "phong", "n": 20}, g="g2"), g="g2") == f
+
+
+def test_save_and_load_without_recomputation(tmp_path, monkeypatch):
+    f = pumpup.pump({"type": "phong", "n": 20}, g="g1", levels=2)
+    d = random_directions(np.random.default_rng(3), 500, below=0)
+    before = f.eval(d, d[::-1])
+    path = pumpup.save_pumped(f, tmp_path / "pumped.nc")
+    _TABLES.clear()
+
+    def refuse(*a, **k):
+        raise AssertionError("load_pumped recomputed a table")
+
+    monkeypatch.setattr(sys.modules["pumpup.tables"], "tabulate", refuse)
+    g = pumpup.load_pumped(path)
+    assert g == f
+    np.testing.assert_array_equal(g.eval(d, d[::-1]), before)
+    with pytest.raises(ValueError, match="pumped"):
+        pumpup.load_pumped(pumpup.write_table(_table_of_lambert(), tmp_path / "plain.nc"))
+
+
+def _table_of_lambert():
+    return pumpup.tabulate(pumpup.load({"type": "lambert"}), mu=[0.5, 1.0])
+
+
+def test_bad_input():
+    shader = pumpup.load({"type": "phong_shader", "n": 10})
+    with pytest.raises(pumpup.SpecError, match="not reciprocal.*force=True"):
+        pumpup.pump(shader)
+    forced = pumpup.pump(shader, force=True)
+    assert not forced.reciprocal and forced.spec["force"] is True
+    with pytest.raises(pumpup.SpecError, match="'g1' or 'g2'"):
+        pumpup.pump({"type": "phong", "n": 3}, g="g3")
+    for bad in (0, -1, 1.5, True):
+        with pytest.raises(pumpup.SpecError, match="levels"):
+            pumpup.pump({"type": "phong", "n": 3}, levels=bad)
+    with pytest.raises(pumpup.SpecError, match="'g'"):
+        pumpup.load({"type": "pumped", "base": {"type": "phong", "n": 3}, "g": "g9"})
