@@ -89,7 +89,9 @@ def _stretched_kernel(lx, ly, lz, vx, vy, vz, n, p, c):  # pragma: no cover - co
     rv = 2.0 * lz * vz - (lx * vx + ly * vy + lz * vz)  # 000 eq. 9
     if rv <= 0.0:
         return 0.0
-    return c * rv**n / max(lz, vz) ** p  # 000 eq. 10, 12
+    mx = max(lz, vz)
+    den = mx if p == 1.0 else (1.0 if p == 0.0 else mx**p)  # pow only for a true p-model
+    return c * rv**n / den  # 000 eq. 10, 12
 
 
 def _stretched_reference(wi, wo, n, p, c):

@@ -1,0 +1,72 @@
+"""Evaluations per second of every built-in model, and the cost relative to reciprocal Phong.
+
+In the spirit of 000 Table 1 / Table 5 (the paper found stretched Phong only 8 % dearer than
+Phong).  One core, 2e6 random direction pairs in the upper hemisphere, best of 5 runs after
+a warm-up call (so numba compilation is not timed).  The baseline (reciprocal Phong) is
+measured in the same run.
+
+    python scripts/bench_eval.py [--pumped]
+
+``--pumped`` also builds a 3-level pumped Phong (its tables take a while) and reports its
+evaluation cost relative to the base.
+"""
+
+import sys
+import time
+
+import numpy as np
+
+import pumpup
+
+N = 2_000_000
+
+
+def directions(rng, n):
+    v = rng.normal(size=(n, 3))
+    v /= np.linalg.norm(v, axis=-1, keepdims=True)
+    v[:, 2] = np.abs(v[:, 2])
+    return v
+
+
+def rate(f, wi, wo, repeat=5):
+    f._eval(wi[:10], wo[:10])  # compile / load the cached kernel
+    best = np.inf
+    for _ in range(repeat):
+        t = time.perf_counter()
+        f._eval(wi, wo)
+        best = min(best, time.perf_counter() - t)
+    return len(wi) / best
+
+
+def main():
+    rng = np.random.default_rng(1)
+    wi, wo = directions(rng, N), directions(rng, N)
+    cases = [(name, {"type": name, **cls.examples[0]}) for name, cls in pumpup.registry().items() if cls.examples]
+    base = rate(pumpup.load({"type": "phong", "n": 20}), wi, wo)
+    print(f"{'model':18s} {'spec':58s} {'evals/s':>10s} {'cost vs phong':>14s}")
+    print(f"{'phong (baseline)':18s} {str({'n': 20}):58s} {base:10.3g} {1.0:14.2f}")
+    for name, spec in cases:
+        r = rate(pumpup.load(spec), wi, wo)
+        shown = {k: v for k, v in spec.items() if k != "type"}
+        print(f"{name:18s} {str(shown)[:58]:58s} {r:10.3g} {base / r:14.2f}")
+    print("\nThe pairs of 000 Table 5, at the same parameters:")
+    for a, b in [({"type": "phong", "n": 20}, {"type": "stretched_phong", "n": 20}),
+                 ({"type": "blinn", "n": 20}, {"type": "stretched_blinn", "n": 20}),
+                 ({"type": "ward", "m": 0.1}, {"type": "modified_ward", "m": 0.1})]:
+        ra, rb = rate(pumpup.load(a), wi, wo), rate(pumpup.load(b), wi, wo)
+        print(f"  {b['type']:16s} costs {ra / rb:5.2f} x {a['type']} ({rb:.3g} vs {ra:.3g} evals/s)")
+    if "--pumped" in sys.argv:
+        t = time.perf_counter()
+        f = pumpup.pump({"type": "phong", "n": 20}, g="g2", levels=3)
+        lev = f
+        while isinstance(lev, pumpup.Pumped):
+            lev.lookup()
+            lev = lev.base
+        build = time.perf_counter() - t
+        r = rate(f, wi, wo)
+        print(f"\n3-level pumped Phong (g2): {r:.3g} evals/s, {base / r:.2f} x the base Phong; "
+              f"its 3 albedo tables took {build:.1f} s to build")
+
+
+if __name__ == "__main__":
+    main()
