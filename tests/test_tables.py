@@ -1,0 +1,115 @@
+"""Albedo tables: adaptive grid, metadata, exact netCDF round trip, atomic writing, clear errors,
+interpolation error between the nodes, mean albedo and maximum constants."""
+
+import json
+import os
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import pumpup
+
+
+@pytest.fixture(scope="module")
+def phong_table():
+    return pumpup.tabulate(pumpup.load({"type": "phong", "n": 20}), interp_tol=1e-8)
+
+
+def test_dataset_layout_and_metadata(phong_table):
+    ds = phong_table
+    assert set(ds.data_vars) == {"albedo", "albedo_error"}
+    assert ds["mu"].attrs["units"] == "1" and ds["theta"].attrs["units"] == "degree"
+    np.testing.assert_allclose(ds["theta"], np.degrees(np.arccos(ds["mu"])))
+    assert json.loads(ds.attrs["spec"]) == pumpup.load({"type": "phong", "n": 20}).spec
+    assert ds.attrs["pumpup_version"] == pumpup.__version__
+    assert ds.attrs["rtol"] > 0 and "Gauss-Kronrod" in ds.attrs["method"]
+    assert ds["mu"].min() <= 1e-8 and ds["mu"].max() == 1.0
+    assert np.all(np.diff(ds["mu"]) > 0)
+
+
+def test_adaptive_grid_interpolation_error_is_honest_between_nodes(phong_table):
+    table = pumpup.AlbedoTable.from_dataset(phong_table)
+    f = pumpup.load({"type": "phong", "n": 20})
+    mu = np.sort(10 ** np.random.default_rng(5).uniform(-8, 0, 300))
+    miss = np.abs(table(mu) - pumpup.albedo(f, mu))
+    assert table.interp_error <= 1e-8
+    assert miss.max() <= table.SAFETY * table.interp_error
+    assert np.all(table.upper(mu) >= pumpup.albedo(f, mu))
+
+
+def test_netcdf_round_trip_is_exact(phong_table, tmp_path):
+    path = pumpup.write_table(phong_table, tmp_path / "t.nc")
+    back = pumpup.open_table(path)
+    xr.testing.assert_identical(back, phong_table)
+
+
+def test_writing_is_atomic(tmp_path, monkeypatch):
+    ds = pumpup.tabulate(pumpup.load({"type": "lambert"}), mu=[0.5, 1.0])
+    target = tmp_path / "t.nc"
+    pumpup.write_table(ds, target)
+    before = target.read_bytes()
+
+    def broken(self, path, *a, **k):
+        with open(path, "wb") as fh:
+            fh.write(b"half a table")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", broken)
+    with pytest.raises(KeyboardInterrupt):
+        pumpup.write_table(ds, target)
+    assert target.read_bytes() == before  # the old file is untouched
+    assert sorted(os.listdir(tmp_path)) == ["t.nc"]  # and no temporary file is left
+
+
+def test_open_table_errors(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        pumpup.open_table(tmp_path / "missing.nc")
+    junk = tmp_path / "junk.nc"
+    junk.write_bytes(b"this is not netCDF")
+    with pytest.raises(ValueError, match="not a readable netCDF"):
+        pumpup.open_table(junk)
+    other = tmp_path / "other.nc"
+    xr.Dataset({"x": ("i", [1.0, 2.0])}).to_netcdf(other)
+    with pytest.raises(ValueError, match="not a pumpup table"):
+        pumpup.open_table(other)
+    good = pumpup.write_table(pumpup.tabulate(pumpup.load({"type": "lambert"}), mu=[0.5, 1.0]), tmp_path / "g.nc")
+    data = bytearray(open(good, "rb").read())
+    damaged = tmp_path / "damaged.nc"
+    damaged.write_bytes(bytes(data[: len(data) // 3]))
+    with pytest.raises(ValueError, match="not a readable netCDF"):
+        pumpup.open_table(damaged)
+
+
+def test_write_to_missing_directory_is_a_clear_error(tmp_path):
+    ds = pumpup.tabulate(pumpup.load({"type": "lambert"}), mu=[1.0, 0.5])
+    with pytest.raises(OSError, match="does not exist"):
+        pumpup.write_table(ds, tmp_path / "nope" / "t.nc")
+
+
+def test_given_grid_and_bad_grid():
+    ds = pumpup.tabulate(pumpup.load({"type": "lambert", "albedo": 0.7}), mu=[1.0, 0.3, 0.3, 1e-6])
+    assert ds.sizes["mu"] == 3  # sorted, duplicates dropped
+    with pytest.raises(ValueError, match="mu"):
+        pumpup.tabulate(pumpup.load({"type": "lambert"}), mu=[0.5, 2.0])
+
+
+def test_mean_albedo_closed_forms():
+    assert pumpup.mean_albedo(pumpup.load({"type": "lambert", "albedo": 0.4})) == pytest.approx(0.4, abs=1e-12)
+    # Minnaert with b = (k+1)/(2 pi): a(mu) = mu^(k-1), so the mean albedo is 2/(k+1)
+    m, e = pumpup.mean_albedo(pumpup.load({"type": "minnaert", "k": 2.0}), return_error=True)
+    assert abs(m - 2 / 3) <= e and e < 1e-9
+
+
+def test_max_constant_uses_the_unit_constant():
+    c, theta = pumpup.max_constant(pumpup.load({"type": "lambert", "albedo": 0.2}))
+    assert c == pytest.approx(1.0, abs=1e-12)
+    # reciprocal Phong with c = 1: the albedo peaks at normal incidence at 2 pi / (n + 2)
+    c, theta = pumpup.max_constant(pumpup.load({"type": "phong", "n": 8, "c": 5.0}))
+    assert c == pytest.approx(10 / (2 * np.pi), rel=1e-9) and theta == pytest.approx(0.0, abs=1e-6)
+
+
+def test_blinn_max_constant_matches_table_2_of_000():
+    for n, published in [(1, 0.350), (16, 0.895)]:
+        c, _ = pumpup.max_constant(pumpup.load({"type": "blinn", "n": n}))
+        assert round(c, 3) == published
