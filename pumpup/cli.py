@@ -90,6 +90,38 @@ def cmd_check(args) -> int:
     return 0 if r.reciprocal else 1
 
 
+def cmd_pump(args) -> int:
+    import numpy as np
+
+    import pumpup
+
+    f = _load(args.spec)
+    try:
+        p = pumpup.pump(f, g=args.g, levels=args.levels, force=args.force)
+    except pumpup.SpecError as exc:
+        raise SystemExit(f"pumpup: {exc}") from None
+    mu = np.array([1.0, 0.5, 0.1, 0.01, 1e-4])
+    print(f"{'mu':>8s} " + " ".join(f"{'level ' + str(k):>12s}" for k in range(args.levels + 1)))
+    chain = [p]
+    while isinstance(chain[-1], pumpup.Pumped):
+        chain.append(chain[-1].base)
+    values = [pumpup.albedo(lev, mu) for lev in chain[::-1]]
+    for i, m in enumerate(mu):
+        print(f"{m:8.2g} " + " ".join(f"{v[i]:12.9f}" for v in values))
+    if args.out:
+        pumpup.save_pumped(p, args.out)
+        print(f"wrote {args.out}")
+    return 0
+
+
+def cmd_figures(args) -> int:
+    from .figures import make_figures
+
+    for path in make_figures(args.tables, args.figures):
+        print("wrote", path)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="pumpup",
@@ -113,6 +145,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", required=True)
     s.add_argument("--rtol", type=float, default=1e-10)
     s.set_defaults(func=cmd_table)
+    s = sub.add_parser("pump", help="pump up a model's albedo (001 sec. 3) and print the albedo of every level")
+    s.add_argument("spec")
+    s.add_argument("--g", choices=("g1", "g2"), default="g1")
+    s.add_argument("--levels", type=int, default=1)
+    s.add_argument("--force", action="store_true", help="pump a base that is not reciprocal")
+    s.add_argument("--out", help="save the pumped BRDF and its tables to this netCDF file")
+    s.set_defaults(func=cmd_pump)
+    s = sub.add_parser("figures", help="data and plots of 001 Figs. 3-7 and 000 Fig. 3 (takes minutes)")
+    s.add_argument("--tables", default="tables")
+    s.add_argument("--figures", default="figures")
+    s.set_defaults(func=cmd_figures)
     s = sub.add_parser("check", help="reciprocity and maximum albedo of a model")
     s.add_argument("spec")
     s.set_defaults(func=cmd_check)

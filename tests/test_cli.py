@@ -1,0 +1,44 @@
+"""The command line: a few real runs and clear errors."""
+
+import subprocess
+import sys
+
+import pytest
+
+from pumpup.cli import main, parse_spec
+
+
+def test_parse_spec_short_and_json():
+    assert parse_spec("phong:n=20,c=1") == {"type": "phong", "n": 20, "c": 1}
+    assert parse_spec('{"type": "ward", "m": 0.1}') == {"type": "ward", "m": 0.1}
+    with pytest.raises(SystemExit):
+        parse_spec("phong:n")
+
+
+def test_albedo_command(capsys):
+    assert main(["albedo", "lambert:albedo=0.5", "--mu", "1", "0.25"]) == 0
+    out = capsys.readouterr().out
+    assert out.count("0.500000000000000") == 2
+
+
+def test_models_lists_the_registry(capsys):
+    main(["models"])
+    out = capsys.readouterr().out
+    for name in ("phong", "stretched_phong", "ward", "cook_torrance", "pumped"):
+        assert name in out
+
+
+def test_bad_spec_and_mu_are_clear_errors():
+    with pytest.raises(SystemExit, match="unknown model type"):
+        main(["albedo", "nope:n=1"])
+    with pytest.raises(SystemExit, match=r"'n'.*\[0, inf\)"):
+        main(["albedo", "phong:n=-1"])
+    with pytest.raises(SystemExit, match="mu"):
+        main(["albedo", "phong:n=1", "--mu", "0"])
+    with pytest.raises(SystemExit, match="not reciprocal"):
+        main(["pump", "phong_shader:n=3"])
+
+
+def test_help_is_fast_and_works():
+    r = subprocess.run([sys.executable, "-m", "pumpup.cli", "--help"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0 and "albedo" in r.stdout
