@@ -45,6 +45,7 @@ __all__ = ["albedo", "check_mu", "AlbedoWarning"]
 DEFAULT_RTOL = 1e-10
 DEFAULT_ATOL = 1e-14
 NX_INIT = 8  # initial subdivisions of the radial variable
+NT_INIT = 2  # initial subdivisions of each piece of the azimuth
 
 
 class AlbedoWarning(UserWarning):
@@ -564,7 +565,7 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
     n_pieces = 1 + g.levels.shape[1] + (len(g.lobe.kinks(np.array([0.5]), np.array([0.5]), np.array([0.5]), np.array([0.5]))) if g.lobe.kinks else 0)
     generic = g.lobe.axis == "normal" and g.lobe.radial == "cosine" and not g.lobe.symmetric
     nx = NX_INIT if not generic else 8
-    nt = 2 if not generic else 8
+    nt = NT_INIT if not generic else 8
     # initial rectangles: nx x nt per piece per problem, with the x grid also split where
     # the horizon starts to cut the lobe and where it hides it completely
     gt = np.linspace(0, 1, nt + 1)
