@@ -1,5 +1,7 @@
 """Shared helpers for the tests (importable: tests/ is on pytest's pythonpath)."""
 
+import math
+
 import numpy as np
 
 
@@ -16,6 +18,39 @@ def random_directions(rng, n, below=0.1, grazing=0.05):
     s = np.sqrt(1 - mu**2)
     v[k : k + g] = np.stack([s * np.cos(phi), s * np.sin(phi), mu], axis=-1)
     return v
+
+
+def direction_pairs(rng, n=10_000):
+    """~n pairs: random (some below the horizon, some near grazing), exact mirror pairs,
+    pairs at mu = 1e-8 exactly, and grazing pairs with wi nearly opposite wo.
+
+    The special pairs fill rows 0-1100; for n < 1100 they are cut to fit."""
+    wi = random_directions(rng, n)
+    wo = random_directions(rng, n)[::-1].copy()
+    wo[:500] = wi[:500] * np.array([-1, -1, 1])  # mirror pairs: H = N
+    for k, sl in enumerate([slice(500, 700), slice(700, 900)]):
+        phi = rng.uniform(0, 2 * np.pi, 200)
+        w = np.stack([np.cos(phi), np.sin(phi), np.full(200, 1e-8)], axis=-1)
+        target = wi if k == 0 else wo
+        target[sl] = w[: len(target[sl])]
+    phi = rng.uniform(0, 2 * np.pi, 200)
+    mu = 10.0 ** rng.uniform(-8, -3, (2, 200))
+    s = np.sqrt(1 - mu**2)
+    m = len(wi[900:1100])
+    wi[900:1100] = np.stack([s[0] * np.cos(phi), s[0] * np.sin(phi), mu[0]], axis=-1)[:m]
+    wo[900:1100] = np.stack([-s[1] * np.cos(phi + 1e-6), -s[1] * np.sin(phi + 1e-6), mu[1]], axis=-1)[:m]
+    return wi, wo
+
+
+def polar(theta, phi=0.0):
+    """Unit vector at polar angle theta and azimuth phi [rad]."""
+    return np.array([math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi), math.cos(theta)])
+
+
+def at_mu(mu, phi=0.0):
+    """The direction with N.w = mu exactly (no round trip through an angle)."""
+    s = math.sqrt((1 - mu) * (1 + mu))
+    return np.array([s * math.cos(phi), s * math.sin(phi), mu])
 
 
 def phong_albedo_1d(n, mu, stretched=False):

@@ -1,6 +1,5 @@
 """The Blinn family: blinn (000 eq. 31), stretched_blinn (000 eq. 32), phong_blinn (002 eq. 24)."""
 
-import json
 import math
 
 import numpy as np
@@ -8,87 +7,7 @@ import pytest
 
 import pumpup
 
-MODELS = ["blinn", "stretched_blinn", "phong_blinn"]
-CASES = [(name, ex) for name in MODELS for ex in pumpup.registry()[name].examples]
-IDS = [f"{name}-{json.dumps(ex, sort_keys=True)}" for name, ex in CASES]
-
-
-@pytest.fixture
-def rng():
-    """A fixed random generator for this module."""
-    return np.random.default_rng(20261126)
-
-
-def random_directions(rng, n, below=0.1, grazing=0.05):
-    """Unit vectors: mostly upper hemisphere, a fraction below it and a fraction near grazing."""
-    v = rng.normal(size=(n, 3))
-    v /= np.linalg.norm(v, axis=-1, keepdims=True)
-    v[:, 2] = np.abs(v[:, 2])
-    k = int(n * below)
-    v[:k, 2] *= -1
-    g = int(n * grazing)
-    mu = 10.0 ** rng.uniform(-8, -2, g)
-    phi = rng.uniform(0, 2 * np.pi, g)
-    s = np.sqrt(1 - mu**2)
-    v[k : k + g] = np.stack([s * np.cos(phi), s * np.sin(phi), mu], axis=-1)
-    return v
-
-
-def direction_pairs(rng, n=10_000):
-    """~n pairs: random (some below the horizon, some near grazing), exact mirror pairs,
-    pairs at mu = 1e-8 exactly, and grazing pairs with wi nearly opposite wo."""
-    wi = random_directions(rng, n)
-    wo = random_directions(rng, n)[::-1].copy()
-    wo[:500] = wi[:500] * np.array([-1, -1, 1])  # mirror pairs: H = N
-    for k, sl in enumerate([slice(500, 700), slice(700, 900)]):
-        phi = rng.uniform(0, 2 * np.pi, 200)
-        w = np.stack([np.cos(phi), np.sin(phi), np.full(200, 1e-8)], axis=-1)
-        w[:, :2] *= math.sqrt(1 - 1e-16)
-        (wi if k == 0 else wo)[sl] = w
-    phi = rng.uniform(0, 2 * np.pi, 200)
-    mu = 10.0 ** rng.uniform(-8, -3, (2, 200))
-    s = np.sqrt(1 - mu**2)
-    wi[900:1100] = np.stack([s[0] * np.cos(phi), s[0] * np.sin(phi), mu[0]], axis=-1)
-    wo[900:1100] = np.stack([-s[1] * np.cos(phi + 1e-6), -s[1] * np.sin(phi + 1e-6), mu[1]], axis=-1)
-    return wi, wo
-
-
-def polar(theta, phi=0.0):
-    return np.array([math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi), math.cos(theta)])
-
-
-def at_mu(mu, phi=0.0):
-    """The direction with N.w = mu exactly (no round trip through an angle)."""
-    s = math.sqrt((1 - mu) * (1 + mu))
-    return np.array([s * math.cos(phi), s * math.sin(phi), mu])
-
-
-@pytest.mark.parametrize("name,params", CASES, ids=IDS)
-def test_kernel_matches_reference(name, params, rng):
-    f = pumpup.load({"type": name, **params})
-    wi, wo = direction_pairs(rng)
-    fast = f.eval(wi, wo)
-    ref = f.reference(wi, wo)
-    assert np.all(np.isfinite(fast)) and np.all(fast >= 0)
-    np.testing.assert_allclose(fast, ref, rtol=1e-12, atol=0)
-    below = (wi[:, 2] <= 0) | (wo[:, 2] <= 0)
-    assert below.any() and np.all(fast[below] == 0)
-
-
-@pytest.mark.parametrize("name,params", CASES, ids=IDS)
-def test_reciprocal(name, params):
-    f = pumpup.load({"type": name, **params})
-    r = pumpup.check_reciprocity(f)
-    assert r.reciprocal is True, str(r)
-
-
-@pytest.mark.parametrize("name,params", CASES, ids=IDS)
-def test_spec_round_trip(name, params):
-    f = pumpup.load({"type": name, **params})
-    text = json.dumps(f.spec)
-    assert pumpup.load(json.loads(text)) == f
-    assert pumpup.load(f.spec) == f
-
+from helpers import at_mu, polar
 
 N = np.array([0.0, 0.0, 1.0])
 

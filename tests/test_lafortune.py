@@ -1,6 +1,5 @@
 """Lafortune lobes: lafortune (000 eq. 14, 15) and lafortune_sum (000 eq. 16)."""
 
-import json
 import math
 
 import numpy as np
@@ -9,76 +8,9 @@ import pytest
 import pumpup
 from pumpup.models.lafortune import Lafortune
 
-MODELS = ["lafortune", "lafortune_sum"]
-CASES = [(name, ex) for name in MODELS for ex in pumpup.registry()[name].examples]
-IDS = [f"{name}-{json.dumps(ex, sort_keys=True)}" for name, ex in CASES]
+from helpers import direction_pairs, polar
+
 N = np.array([0.0, 0.0, 1.0])
-
-
-@pytest.fixture
-def rng():
-    """A fixed random generator for this module."""
-    return np.random.default_rng(20261127)
-
-
-def random_directions(rng, n, below=0.1, grazing=0.05):
-    """Unit vectors: mostly upper hemisphere, a fraction below it and a fraction near grazing."""
-    v = rng.normal(size=(n, 3))
-    v /= np.linalg.norm(v, axis=-1, keepdims=True)
-    v[:, 2] = np.abs(v[:, 2])
-    k = int(n * below)
-    v[:k, 2] *= -1
-    g = int(n * grazing)
-    mu = 10.0 ** rng.uniform(-8, -2, g)
-    phi = rng.uniform(0, 2 * np.pi, g)
-    s = np.sqrt(1 - mu**2)
-    v[k : k + g] = np.stack([s * np.cos(phi), s * np.sin(phi), mu], axis=-1)
-    return v
-
-
-def direction_pairs(rng, n=10_000):
-    """~n pairs: random (10% below the horizon, 5% near grazing), exact mirror pairs, and
-    pairs with wi or wo at mu = 1e-8 exactly."""
-    wi = random_directions(rng, n)
-    wo = random_directions(rng, n)[::-1].copy()
-    wo[:500] = wi[:500] * np.array([-1, -1, 1])  # mirror pairs
-    for k, sl in enumerate([slice(500, 700), slice(700, 900)]):
-        phi = rng.uniform(0, 2 * np.pi, 200)
-        s = np.sqrt(1 - 1e-16)
-        w = np.stack([s * np.cos(phi), s * np.sin(phi), np.full(200, 1e-8)], axis=-1)
-        (wi if k == 0 else wo)[sl] = w
-    return wi, wo
-
-
-def polar(theta, phi=0.0):
-    """Unit vector at polar angle theta and azimuth phi [rad]."""
-    return np.array([math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi), math.cos(theta)])
-
-
-@pytest.mark.parametrize("name,params", CASES, ids=IDS)
-def test_kernel_matches_reference(name, params, rng):
-    f = pumpup.load({"type": name, **params})
-    wi, wo = direction_pairs(rng)
-    fast = f.eval(wi, wo)
-    ref = f.reference(wi, wo)
-    assert np.all(np.isfinite(fast)) and np.all(fast >= 0)
-    np.testing.assert_allclose(fast, ref, rtol=1e-12, atol=0)
-    assert np.all(fast[(wi[:, 2] <= 0) | (wo[:, 2] <= 0)] == 0)
-
-
-@pytest.mark.parametrize("name,params", CASES, ids=IDS)
-def test_reciprocal(name, params):
-    f = pumpup.load({"type": name, **params})
-    r = pumpup.check_reciprocity(f)
-    assert r.reciprocal, str(r)
-
-
-@pytest.mark.parametrize("name,params", CASES, ids=IDS)
-def test_spec_round_trip(name, params):
-    f = pumpup.load({"type": name, **params})
-    text = json.dumps(f.spec)
-    assert pumpup.load(json.loads(text)) == f
-    assert pumpup.load(f.spec) == f
 
 
 def test_isotropic_lobe_is_phong_and_stretched_phong(rng):
