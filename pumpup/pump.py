@@ -75,6 +75,12 @@ def _upper_scalar(mu, logx, coef, v0, slope0, margin_lo, margin, node_err, cap):
 
 
 @njit(cache=True)
+def _upper_array(mu, logx, coef, v0, slope0, margin_lo, margin, node_err, cap, out):  # pragma: no cover - compiled
+    for k in range(mu.shape[0]):
+        out[k] = _upper_scalar(mu[k], logx, coef, v0, slope0, margin_lo, margin, node_err, cap)
+
+
+@njit(cache=True)
 def _pumped_kernel(fbase, mu_i, mu_o, logx, coef, v0, slope0, margin_lo, margin, node_err, cap, controlled, out):  # pragma: no cover
     for k in range(fbase.shape[0]):
         f = fbase[k]
@@ -126,11 +132,10 @@ class _Lookup:
         return self.logx, self.coef, self.v0, self.slope0, self.margin_lo, self.margin, self.node_err, self.cap
 
     def upper(self, mu):
+        """Upper bound of the base's albedo at ``mu`` (any shape), as the kernel sees it."""
         mu = np.asarray(mu, dtype=np.float64)
         out = np.empty(mu.size)
-        flat = mu.ravel()
-        for i in range(flat.size):
-            out[i] = _upper_scalar(flat[i], *self.args())
+        _upper_array(np.ascontiguousarray(mu.ravel()), *self.args(), out)
         return out.reshape(mu.shape)
 
 
