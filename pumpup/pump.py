@@ -359,8 +359,6 @@ def save_pumped(f: Pumped, path) -> str:
     Group ``level1`` holds the table of the innermost base, ``level2`` that of the first
     pumped level, and so on; the root attributes hold the spec.  Written atomically.
     """
-    import tempfile
-
     import xarray as xr
 
     from ._version import __version__
@@ -373,11 +371,9 @@ def save_pumped(f: Pumped, path) -> str:
         chain.append(cur)
         cur = cur.base
     chain.reverse()  # innermost first
-    path = os.fspath(path)
-    directory = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(suffix=".nc.tmp", dir=directory)
-    os.close(fd)
-    try:
+    from .tables import atomic_path
+
+    with atomic_path(path) as tmp:
         root = xr.Dataset(attrs={"pumpup_kind": "pumpup pumped BRDF", "spec": json.dumps(f.spec, sort_keys=True),
                                  "levels": len(chain), "pumpup_version": __version__})
         root.to_netcdf(tmp, mode="w", engine="netcdf4")
@@ -385,12 +381,7 @@ def save_pumped(f: Pumped, path) -> str:
             base_table(level.base)
             ds = _TABLES[_key(level.base)].dataset
             ds.to_netcdf(tmp, mode="a", group=f"level{i}", engine="netcdf4")
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
+    return os.fspath(path)
 
 
 def load_pumped(path) -> Pumped:

@@ -9,6 +9,7 @@ tolerances, the interpolation error, and the pumpup version.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -240,8 +241,12 @@ def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind):
     return ds
 
 
-def write_table(ds, path) -> str:
-    """Write a Dataset to netCDF atomically (a temporary file renamed into place)."""
+@contextlib.contextmanager
+def atomic_path(path):
+    """Yield a temporary file beside ``path``; rename it into place only if the block succeeds.
+
+    An interrupted write never leaves a half file at ``path`` (nor a temporary one).
+    """
     path = os.fspath(path)
     directory = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(directory):
@@ -251,13 +256,19 @@ def write_table(ds, path) -> str:
     fd, tmp = tempfile.mkstemp(suffix=".nc.tmp", dir=directory)
     os.close(fd)
     try:
-        ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
+        yield tmp
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
-    return path
+
+
+def write_table(ds, path) -> str:
+    """Write a Dataset to netCDF atomically (a temporary file renamed into place)."""
+    with atomic_path(path) as tmp:
+        ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
+    return os.fspath(path)
 
 
 def open_table(path, group: str | None = None):
