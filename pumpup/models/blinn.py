@@ -13,6 +13,7 @@ import math
 import numpy as np
 from numba import vectorize
 
+from ._half import tan2_half
 from ..core import BRDF, Lobe, Param, load, register
 
 
@@ -36,10 +37,7 @@ def _up(wi, wo):
 def _blinn_kernel(lx, ly, lz, vx, vy, vz, n, c):  # pragma: no cover - compiled
     if lz <= 0.0 or vz <= 0.0:
         return 0.0
-    sz = lz + vz
-    qx = (lx + vx) / sz  # h_x / h_z
-    qy = (ly + vy) / sz  # h_y / h_z
-    cos2 = 1.0 / (1.0 + (qx * qx + qy * qy))  # (N.H)^2 = 1 / (1 + tan^2 delta)
+    cos2 = 1.0 / (1.0 + tan2_half(lx, ly, lz, vx, vy, vz))  # (N.H)^2 = 1 / (1 + tan^2 delta)
     return c * cos2 ** (0.5 * n)  # 000 eq. 31: c (N.H)^n
 
 
@@ -91,10 +89,7 @@ class Blinn(BRDF):
 def _stretched_kernel(lx, ly, lz, vx, vy, vz, n, c):  # pragma: no cover - compiled
     if lz <= 0.0 or vz <= 0.0:
         return 0.0
-    sz = lz + vz
-    qx = (lx + vx) / sz  # h_x / h_z
-    qy = (ly + vy) / sz  # h_y / h_z
-    cos2 = 1.0 / (1.0 + (qx * qx + qy * qy))  # (N.H)^2 = 1 / (1 + tan^2 delta)
+    cos2 = 1.0 / (1.0 + tan2_half(lx, ly, lz, vx, vy, vz))  # (N.H)^2 = 1 / (1 + tan^2 delta)
     return c * cos2 ** (0.5 * n) / max(lz, vz)  # 000 eq. 32
 
 
@@ -149,10 +144,7 @@ class StretchedBlinn(BRDF):
 def _phong_blinn_kernel(lx, ly, lz, vx, vy, vz, n, ks, kd):  # pragma: no cover - compiled
     if lz <= 0.0 or vz <= 0.0:
         return 0.0
-    sz = lz + vz
-    qx = (lx + vx) / sz  # h_x / h_z
-    qy = (ly + vy) / sz  # h_y / h_z
-    cos2 = 1.0 / (1.0 + (qx * qx + qy * qy))  # (N.H)^2 = 1 / (1 + tan^2 delta)
+    cos2 = 1.0 / (1.0 + tan2_half(lx, ly, lz, vx, vy, vz))  # (N.H)^2 = 1 / (1 + tan^2 delta)
     return kd + ks * cos2 ** (0.5 * n)  # 002 eq. 24 with F_s^B of 002 eq. 6
 
 

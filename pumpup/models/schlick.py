@@ -14,6 +14,7 @@ import math
 import numpy as np
 from numba import vectorize
 
+from ._half import tan2_half
 from ..core import BRDF, Lobe, Param, register
 
 
@@ -21,10 +22,7 @@ from ..core import BRDF, Lobe, Param, register
 def _kernel(lx, ly, lz, vx, vy, vz, r, c):  # pragma: no cover - compiled
     if lz <= 0.0 or vz <= 0.0:
         return 0.0
-    sz = lz + vz
-    qx = (lx + vx) / sz  # h_x / h_z
-    qy = (ly + vy) / sz  # h_y / h_z
-    t = qx * qx + qy * qy  # tan^2 delta
+    t = tan2_half(lx, ly, lz, vx, vy, vz)  # tan^2 delta
     cos2 = 1.0 / (1.0 + t)
     sin2 = t * cos2 if t <= 1.0 else 1.0 - cos2
     d = r + (1.0 - r) * sin2  # 1 - (1 - r)(N.H)^2

@@ -14,6 +14,7 @@ import math
 import numpy as np
 from numba import vectorize
 
+from ._half import tan2_half
 from ..core import BRDF, Lobe, Param, register
 
 
@@ -36,10 +37,7 @@ def _up(wi, wo):
 def _ward_kernel(lx, ly, lz, vx, vy, vz, m, c):  # pragma: no cover - compiled
     if lz <= 0.0 or vz <= 0.0:
         return 0.0
-    sz = lz + vz
-    qx = (lx + vx) / sz  # h_x / h_z
-    qy = (ly + vy) / sz  # h_y / h_z
-    t2 = qx * qx + qy * qy  # tan^2 delta
+    t2 = tan2_half(lx, ly, lz, vx, vy, vz)  # tan^2 delta
     den = 4.0 * math.pi * m * m * (math.sqrt(lz) * math.sqrt(vz))
     return c * math.exp(-t2 / (m * m)) / den  # 000 eq. 34, 001 eq. 8
 
@@ -157,10 +155,7 @@ class WardAniso(BRDF):
 def _modified_kernel(lx, ly, lz, vx, vy, vz, m, c):  # pragma: no cover - compiled
     if lz <= 0.0 or vz <= 0.0:
         return 0.0
-    sz = lz + vz
-    qx = (lx + vx) / sz  # h_x / h_z
-    qy = (ly + vy) / sz  # h_y / h_z
-    t2 = qx * qx + qy * qy  # tan^2 delta
+    t2 = tan2_half(lx, ly, lz, vx, vy, vz)  # tan^2 delta
     return c * math.exp(-t2 / (m * m)) / (4.0 * math.pi * m * m * max(lz, vz))  # 000 eq. 35
 
 
