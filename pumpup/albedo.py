@@ -184,9 +184,6 @@ _RADIAL_CODE = {"cosine": 0, "power": 1, "beckmann": 2, "ggx": 3, "gaussian": 4}
 
 def _kink_coefficients(lobe: Lobe, mu: np.ndarray, x: np.ndarray, xc: np.ndarray):
     """(a, b) arrays of shape (N, K) of the model's own kinks a + b cos(beta) = 0."""
-    if lobe.kinks is None:
-        z = np.zeros((len(mu), 0))
-        return z, z
     s = np.sqrt((1.0 - mu) * (1.0 + mu))
     ca, sa, _ = _radial(lobe.radial, lobe.sharpness, x, xc)
     pairs = list(lobe.kinks(mu, s, ca, sa))
@@ -362,8 +359,11 @@ def _integrand(brdf: BRDF, g: _Group, prob: np.ndarray, piece: np.ndarray, tx: n
     lobe = g.lobe
     mu = np.ascontiguousarray(g.mu[prob])
     levels = np.ascontiguousarray(g.levels[prob])
-    x, xc, _ = _smooth(tx) if lobe.kinks is not None else (None, None, None)
-    ka, kb = _kink_coefficients(lobe, mu, x, xc) if lobe.kinks is not None else _kink_coefficients(lobe, mu, mu, mu)
+    if lobe.kinks is not None:
+        x, xc, _ = _smooth(tx)
+        ka, kb = _kink_coefficients(lobe, mu, x, xc)
+    else:
+        ka = kb = np.zeros((len(mu), 0))
     wo = np.empty((len(mu), 3))
     weight = np.empty(len(mu))
     _geometry_kernel(_AXIS_CODE[lobe.axis], _RADIAL_CODE[lobe.radial], float(lobe.sharpness), mu, levels, ka, kb,
