@@ -589,9 +589,12 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
         I = np.bincount(prob, val, minlength=P)
         E = np.bincount(prob, err, minlength=P)
         A = np.bincount(prob, np.abs(val), minlength=P)
-        E = E + rounding * A
+        R = rounding * A
         tol = np.maximum(rtol * np.abs(I), atol)
-        converged = E <= tol
+        # done when the cubature error meets the tolerance, or is already below the rounding
+        # error of the integrand (refining further cannot help); the reported error is both
+        converged = E <= np.maximum(tol, R)
+        E = E + R
         count = np.bincount(prob, minlength=P)
         active = ~converged & (count < max_regions)
         if not active.any():

@@ -122,6 +122,23 @@ def cmd_figures(args) -> int:
     return 0
 
 
+def cmd_reproduce(args) -> int:
+    from .reproduce import reproduce
+
+    try:
+        out = reproduce(args.out, args.only)
+    except (ValueError, OSError) as exc:
+        raise SystemExit(f"pumpup: {exc}") from None
+    seconds = out.pop("_seconds")
+    total = sum(ds.sizes["entry"] for ds in out.values())
+    agree = sum(int(ds["agrees"].sum()) for ds in out.values())
+    with open(f"{args.out}/report.md") as fh:
+        print(fh.read())
+    print(f"{agree} of {total} published values reproduced to their printed digits; "
+          f"{len(out)} tables and report.md written to {args.out}/ in {seconds:.0f} s")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="pumpup",
@@ -131,6 +148,10 @@ def build_parser() -> argparse.ArgumentParser:
         "'pumpup models' lists the types.",
     )
     sub = p.add_subparsers(dest="command", required=True)
+    s = sub.add_parser("reproduce", help="regenerate the papers' tables and compare them with the published values")
+    s.add_argument("--out", default="tables", help="output directory (default: tables)")
+    s.add_argument("--only", nargs="+", metavar="NAME", help="only these tables: table2 table3 table4 text")
+    s.set_defaults(func=cmd_reproduce)
     s = sub.add_parser("models", help="list the registered model types and their parameters")
     s.set_defaults(func=cmd_models)
     s = sub.add_parser("albedo", help="directional albedo of a model, with error estimates")
