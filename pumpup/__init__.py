@@ -7,6 +7,7 @@ viewer, f_r without the cosine factor, mu = cos(theta_i)).
 from ._version import __version__
 from . import albedo as albedo_module
 from .albedo import albedo
+from . import reproduce
 from .pump import Pumped, load_pumped, pump, save_pumped
 from .tables import AlbedoTable, max_albedo, max_constant, mean_albedo, open_table, tabulate, write_table
 from .core import (
