@@ -8,6 +8,7 @@ from ._version import __version__
 from . import albedo as albedo_module
 from .albedo import albedo
 from . import reproduce
+from .divergence import divergence
 from .pump import Pumped, load_pumped, pump, save_pumped
 from .tables import AlbedoTable, max_albedo, max_constant, mean_albedo, open_table, tabulate, write_table
 from .core import (
@@ -26,6 +27,7 @@ from .core import (
 __all__ = [
     "__version__",
     "albedo",
+    "divergence",
     "Pumped",
     "pump",
     "save_pumped",

@@ -139,6 +139,26 @@ def cmd_reproduce(args) -> int:
     return 0
 
 
+def cmd_divergence(args) -> int:
+    from .divergence import analysis_dataset, divergence, plot
+    from .tables import write_table
+
+    if args.spec == "all":
+        ds = analysis_dataset()
+        write_table(ds, f"{args.tables}/divergence.nc")
+        plot(ds, f"{args.figures}/divergence.png")
+        for i, name in enumerate(ds.model.values):
+            print(f"{name:24s} {ds.verdict.values[i]:10s} k = {float(ds.k[i]):.5f} +- {float(ds.k_error[i]):.1g}")
+        print(f"wrote {args.tables}/divergence.nc and {args.figures}/divergence.png")
+        return 0
+    r = divergence(parse_spec(args.spec), mu_min=args.mu_min)
+    print(f"{'mu':>12s} {'albedo':>20s} {'error':>9s}")
+    for m, a, e in zip(r.mu, r.albedo, r.albedo_error):
+        print(f"{m:12.4g} {a:20.12g} {e:9.2g}")
+    print(r)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="pumpup",
@@ -177,6 +197,13 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--tables", default="tables")
     s.add_argument("--figures", default="figures")
     s.set_defaults(func=cmd_figures)
+    s = sub.add_parser("divergence", help="albedo down to mu = 1e-8 and the fit a ~ K mu^-k (001 sec. 2.1); "
+                                          "SPEC 'all' runs the whole analysis into tables/ and figures/")
+    s.add_argument("spec")
+    s.add_argument("--mu-min", type=float, default=1e-8)
+    s.add_argument("--tables", default="tables")
+    s.add_argument("--figures", default="figures")
+    s.set_defaults(func=cmd_divergence)
     s = sub.add_parser("check", help="reciprocity and maximum albedo of a model")
     s.add_argument("spec")
     s.set_defaults(func=cmd_check)

@@ -119,7 +119,9 @@ def _text(cache, bar):
         col = p.column
         if col == "schlick C_max":
             r = float(p.row.split("=")[1])
-            m = cache.max_albedo({"type": "schlick", "r": r}, mu_min=1e-8)
+            # the albedo rises towards grazing incidence: its supremum is the limit mu -> 0, which
+            # mu = 1e-12 resolves to 1e-8 (docs/notes_on_published_tables.md)
+            m = cache.max_albedo({"type": "schlick", "r": r}, mu_min=1e-12)
             row = Row(p, p.source, p.row, col, m.constant, m.constant_error, {"theta_deg": m.theta_deg})
         elif col.startswith("stretched_phong overshoot"):
             m = cache.max_albedo({"type": "stretched_phong", "n": 1.0})
