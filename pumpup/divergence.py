@@ -279,8 +279,10 @@ def plot(ds, path):
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(9, 6), constrained_layout=True)
+    colors = plt.get_cmap("tab20").colors[::2] + plt.get_cmap("tab20").colors[1::2]
     for i, name in enumerate(ds.model.values):
-        line, = ax.loglog(ds.mu, ds.albedo[i], label=f"{name}: {ds.verdict.values[i]}, k = {float(ds.k[i]):.3f}")
+        line, = ax.loglog(ds.mu, ds.albedo[i], color=colors[i % len(colors)],
+                          label=f"{name}: {ds.verdict.values[i]}, k = {abs(float(ds.k[i])):.3f}")
         if np.isfinite(ds.lower_bound[i]).any():
             ax.loglog(ds.mu, ds.lower_bound[i], "--", color=line.get_color(), lw=1)
     ax.set(xlabel="mu = cos(theta_i)", ylabel="albedo", title="Albedo near grazing incidence (dashed: 001 eq. 14/15 bounds)",
