@@ -58,7 +58,12 @@ def base_table(base: BRDF, progress: bool | None = None):
 def _upper_scalar(mu, logx, coef, v0, slope0, margin_lo, margin, node_err, cap):  # pragma: no cover - compiled
     """Upper bound of a(mu): the table's cubic in log(mu) (power law below the first node) + margin,
     at most ``cap``."""
-    lm = math.log(mu)
+    return _upper_log(math.log(mu), logx, coef, v0, slope0, margin_lo, margin, node_err, cap)
+
+
+@njit(cache=True)
+def _upper_log(lm, logx, coef, v0, slope0, margin_lo, margin, node_err, cap):  # pragma: no cover - compiled
+    """:func:`_upper_scalar` of mu = exp(lm)."""
     n = logx.shape[0]
     if lm <= logx[0]:
         return min(cap, v0 * math.exp(slope0 * (lm - logx[0])) + margin_lo)
@@ -81,18 +86,29 @@ def _upper_array(mu, logx, coef, v0, slope0, margin_lo, margin, node_err, cap, o
 
 
 @njit(cache=True)
-def _pumped_kernel(fbase, mu_i, mu_o, logx, coef, v0, slope0, margin_lo, margin, node_err, cap, controlled, out):  # pragma: no cover
-    for k in range(fbase.shape[0]):
-        f = fbase[k]
-        if f == 0.0 or mu_i[k] <= 0.0 or mu_o[k] <= 0.0:
-            out[k] = 0.0
+def _chain_kernel(f, mu_i, mu_o, offsets, logx, coef, node_err, v0, slope0, margin_lo, margin, cap, controlled):  # pragma: no cover
+    """All levels of a pumped chain in one pass: f /= g_1, then g_2, ... (001 eq. 16).
+
+    The tables of the levels are concatenated (level j owns offsets[j]:offsets[j+1]); the
+    logarithms of mu_i and mu_o are taken once for all levels.  Tested against the plain
+    numpy reference, :meth:`Pumped.reference`, which pumps level by level.
+    """
+    for k in range(f.shape[0]):
+        if f[k] == 0.0 or mu_i[k] <= 0.0 or mu_o[k] <= 0.0:
+            f[k] = 0.0
             continue
-        gi = _upper_scalar(mu_i[k], logx, coef, v0, slope0, margin_lo, margin, node_err, cap)
-        go = _upper_scalar(mu_o[k], logx, coef, v0, slope0, margin_lo, margin, node_err, cap)
-        g = max(gi, go)  # 001 eq. 20
-        if controlled:
-            g = max(g, mu_i[k], mu_o[k])  # 001 eq. 21
-        out[k] = f / g  # 001 eq. 16
+        li = math.log(mu_i[k])
+        lo = math.log(mu_o[k])
+        for j in range(offsets.shape[0] - 1):
+            a, b = offsets[j], offsets[j + 1]
+            gi = _upper_log(li, logx[a:b], coef[:, a:b - 1], v0[j], slope0[j], margin_lo[j], margin[j],
+                            node_err[a:b], cap[j])
+            go = _upper_log(lo, logx[a:b], coef[:, a:b - 1], v0[j], slope0[j], margin_lo[j], margin[j],
+                            node_err[a:b], cap[j])
+            g = max(gi, go)  # 001 eq. 20
+            if controlled[j]:
+                g = max(g, mu_i[k], mu_o[k])  # 001 eq. 21
+            f[k] = f[k] / g  # 001 eq. 16
 
 
 def _pumped_reference(fbase, mu_i, mu_o, upper, controlled):
@@ -228,15 +244,40 @@ class Pumped(BRDF):
             g = np.maximum(g, np.maximum(mu_i, mu_o))
         return g
 
+    def chain(self) -> list["Pumped"]:
+        """The pumped levels from the innermost (level 1) to this one."""
+        levels = [self]
+        while isinstance(levels[-1].base, Pumped):
+            levels.append(levels[-1].base)
+        return levels[::-1]
+
+    def _chain_args(self):
+        """The tables of all levels, concatenated for :func:`_chain_kernel` (built once)."""
+        if getattr(self, "_chain_cache", None) is None:
+            looks = [lev.lookup() for lev in self.chain()]
+            sizes = [len(lk.logx) for lk in looks]
+            offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+            coef = np.zeros((4, offsets[-1]))
+            for lk, a in zip(looks, offsets[:-1]):
+                coef[:, a:a + lk.coef.shape[1]] = lk.coef
+            self._chain_cache = (
+                offsets, np.concatenate([lk.logx for lk in looks]), coef,
+                np.concatenate([lk.node_err for lk in looks]),
+                *(np.array([getattr(lk, name) for lk in looks], dtype=float)
+                  for name in ("v0", "slope0", "margin_lo", "margin", "cap")),
+                np.array([lev.controlled for lev in self.chain()]),
+            )
+        return self._chain_cache
+
     def _eval(self, wi, wo):
-        fb = np.asarray(self.base._eval(wi, wo), dtype=np.float64)
-        shape = fb.shape
-        mi = np.broadcast_to(wi[..., 2], shape).ravel()
-        mo = np.broadcast_to(wo[..., 2], shape).ravel()
-        out = np.empty(fb.size)
-        _pumped_kernel(np.ascontiguousarray(fb.ravel()), np.ascontiguousarray(mi), np.ascontiguousarray(mo),
-                       *self.lookup().args(), self.controlled, out)
-        return out.reshape(shape)
+        levels = self.chain()
+        f = np.array(levels[0].base._eval(wi, wo), dtype=np.float64)  # the innermost base, once
+        shape = f.shape
+        mi = np.ascontiguousarray(np.broadcast_to(wi[..., 2], shape).ravel())
+        mo = np.ascontiguousarray(np.broadcast_to(wo[..., 2], shape).ravel())
+        flat = np.ascontiguousarray(f.ravel())
+        _chain_kernel(flat, mi, mo, *self._chain_args())
+        return flat.reshape(shape)
 
     def reference(self, wi, wo):
         wi = np.asarray(wi, dtype=np.float64)
