@@ -85,27 +85,41 @@ def _upper_array(mu, logx, coef, v0, slope0, margin_lo, margin, node_err, cap, o
         out[k] = _upper_scalar(mu[k], logx, coef, v0, slope0, margin_lo, margin, node_err, cap)
 
 
+#: cells of the uniform index over log(mu) that the chain kernel uses to find a table interval
+_INDEX_CELLS = 4096
+
+
 @njit(cache=True)
-def _chain_kernel(f, mu_i, mu_o, offsets, logx, coef, node_err, v0, slope0, margin_lo, margin, cap, controlled):  # pragma: no cover
+def _chain_kernel(f, mu_i, mu_o, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
+                  index, index_lo, index_h):  # pragma: no cover - compiled
     """All levels of a pumped chain in one pass: f /= g_1, then g_2, ... (001 eq. 16).
 
-    The tables of the levels are concatenated (level j owns offsets[j]:offsets[j+1]); the
-    logarithms of mu_i and mu_o are taken once for all levels.  Tested against the plain
-    numpy reference, :meth:`Pumped.reference`, which pumps level by level.
+    The tables of the levels are concatenated (level j owns nodes offsets[j]:offsets[j+1]);
+    ``coef`` already holds the upper bound (spline + margin + node error, as in
+    :func:`_upper_scalar`), and a uniform index over log(mu) finds the interval in O(1).
+    The logarithms of mu_i and mu_o are taken once for all levels.  Tested against the
+    plain numpy reference, :meth:`Pumped.reference`, which pumps level by level.
     """
+    ncell = index.shape[1]
     for k in range(f.shape[0]):
         if f[k] == 0.0 or mu_i[k] <= 0.0 or mu_o[k] <= 0.0:
             f[k] = 0.0
             continue
-        li = math.log(mu_i[k])
-        lo = math.log(mu_o[k])
+        lms = (math.log(mu_i[k]), math.log(mu_o[k]))
         for j in range(offsets.shape[0] - 1):
             a, b = offsets[j], offsets[j + 1]
-            gi = _upper_log(li, logx[a:b], coef[:, a:b - 1], v0[j], slope0[j], margin_lo[j], margin[j],
-                            node_err[a:b], cap[j])
-            go = _upper_log(lo, logx[a:b], coef[:, a:b - 1], v0[j], slope0[j], margin_lo[j], margin[j],
-                            node_err[a:b], cap[j])
-            g = max(gi, go)  # 001 eq. 20
+            g = 0.0
+            for lm in lms:
+                if lm <= logx[a]:
+                    u = v0[j] * math.exp(slope0[j] * (lm - logx[a])) + margin_lo[j]
+                else:
+                    c = int((lm - index_lo[j]) / index_h[j])
+                    i = index[j, min(max(c, 0), ncell - 1)]
+                    while i < b - 2 and logx[i + 1] <= lm:
+                        i += 1
+                    d = lm - logx[i]
+                    u = ((coef[0, i] * d + coef[1, i]) * d + coef[2, i]) * d + coef[3, i]
+                g = max(g, min(cap[j], u))  # 001 eq. 20
             if controlled[j]:
                 g = max(g, mu_i[k], mu_o[k])  # 001 eq. 21
             f[k] = f[k] / g  # 001 eq. 16
@@ -252,20 +266,27 @@ class Pumped(BRDF):
         return levels[::-1]
 
     def _chain_args(self):
-        """The tables of all levels, concatenated for :func:`_chain_kernel` (built once)."""
+        """The upper bounds of all levels, concatenated for :func:`_chain_kernel` (built once)."""
         if getattr(self, "_chain_cache", None) is None:
             looks = [lev.lookup() for lev in self.chain()]
             sizes = [len(lk.logx) for lk in looks]
             offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
             coef = np.zeros((4, offsets[-1]))
-            for lk, a in zip(looks, offsets[:-1]):
-                coef[:, a:a + lk.coef.shape[1]] = lk.coef
+            index = np.zeros((len(looks), _INDEX_CELLS), dtype=np.int64)
+            lo = np.array([lk.logx[0] for lk in looks])
+            h = np.array([(lk.logx[-1] - lk.logx[0]) / _INDEX_CELLS for lk in looks])
+            for j, (lk, a) in enumerate(zip(looks, offsets[:-1])):
+                n = lk.coef.shape[1]
+                coef[:, a:a + n] = lk.coef
+                # the same upper bound as _upper_scalar: + margin + the larger neighbouring node error
+                coef[3, a:a + n] += lk.margin + np.maximum(lk.node_err[:-1], lk.node_err[1:])
+                starts = lo[j] + h[j] * np.arange(_INDEX_CELLS)
+                index[j] = a + np.clip(np.searchsorted(lk.logx, starts, side="right") - 1, 0, n - 1)
             self._chain_cache = (
                 offsets, np.concatenate([lk.logx for lk in looks]), coef,
-                np.concatenate([lk.node_err for lk in looks]),
                 *(np.array([getattr(lk, name) for lk in looks], dtype=float)
-                  for name in ("v0", "slope0", "margin_lo", "margin", "cap")),
-                np.array([lev.controlled for lev in self.chain()]),
+                  for name in ("v0", "slope0", "margin_lo", "cap")),
+                np.array([lev.controlled for lev in self.chain()]), index, lo, h,
             )
         return self._chain_cache
 
