@@ -285,52 +285,57 @@ def _geometry_kernel(axis, radial, k, mu, levels, ka, kb, piece, tx, tt, wo, wei
     L = levels.shape[1]
     K = ka.shape[1]
     edges = np.empty(L + K + 2)
+    # the points come as 15 values of tau_t per value of tau_x: everything that depends on x
+    # (the radial map, the visible arc, the cuts) is computed once per x and reused
+    prev_tx, prev_mu, prev_piece = -1.0, -1.0, -1
+    m = s = ca = sa = jac = dx = lo = width = 0.0
     for i in range(tx.shape[0]):
-        m = mu[i]
-        s = math.sqrt((1.0 - m) * (1.0 + m))
-        # smoothing substitution x = tau^2 (3 - 2 tau)
-        u = tx[i]
-        x = u * u * (3.0 - 2.0 * u)
-        xc = (1.0 - u) ** 2 * (1.0 + 2.0 * u)
-        dx = 6.0 * u * (1.0 - u)
+        if tx[i] != prev_tx or mu[i] != prev_mu or piece[i] != prev_piece:
+            prev_tx, prev_mu, prev_piece = tx[i], mu[i], piece[i]
+            m = mu[i]
+            s = math.sqrt((1.0 - m) * (1.0 + m))
+            # smoothing substitution x = tau^2 (3 - 2 tau)
+            u = tx[i]
+            x = u * u * (3.0 - 2.0 * u)
+            xc = (1.0 - u) ** 2 * (1.0 + 2.0 * u)
+            dx = 6.0 * u * (1.0 - u)
+            ca, sa, jac = _radial_scalar(radial, k, x, xc)
+            if axis == 0:
+                a0, b0 = ca, 0.0
+            elif axis == 3:
+                a0, b0 = m * (ca * ca - sa * sa), 2.0 * s * sa * ca
+            else:
+                a0, b0 = m * ca, s * sa
+            if b0 > 0:
+                beta0 = math.acos(min(1.0, max(-1.0, -a0 / b0)))
+            else:
+                beta0 = math.pi if a0 > 0 else 0.0
+            n = 0
+            edges[n] = 0.0
+            n += 1
+            for j in range(L):
+                c = math.acos(min(1.0, max(-1.0, (levels[i, j] - a0) / b0))) if b0 > 0 else 0.0
+                edges[n] = min(c, beta0)
+                n += 1
+            for j in range(K):
+                c = math.acos(min(1.0, max(-1.0, -ka[i, j] / kb[i, j]))) if kb[i, j] != 0 else 0.0
+                edges[n] = min(c, beta0)
+                n += 1
+            edges[n] = beta0
+            n += 1
+            # insertion sort of the interior cuts
+            for a in range(2, n - 1):
+                val = edges[a]
+                b = a - 1
+                while b >= 1 and edges[b] > val:
+                    edges[b + 1] = edges[b]
+                    b -= 1
+                edges[b + 1] = val
+            lo = edges[piece[i]]
+            width = edges[piece[i] + 1] - lo
         v = tt[i]
         t = v * v * (3.0 - 2.0 * v)
         dt = 6.0 * v * (1.0 - v)
-        ca, sa, jac = _radial_scalar(radial, k, x, xc)
-        if axis == 0:
-            a0, b0 = ca, 0.0
-        elif axis == 3:
-            a0, b0 = m * (ca * ca - sa * sa), 2.0 * s * sa * ca
-        else:
-            a0, b0 = m * ca, s * sa
-        if b0 > 0:
-            beta0 = math.acos(min(1.0, max(-1.0, -a0 / b0)))
-        else:
-            beta0 = math.pi if a0 > 0 else 0.0
-        n = 0
-        edges[n] = 0.0
-        n += 1
-        for j in range(L):
-            c = math.acos(min(1.0, max(-1.0, (levels[i, j] - a0) / b0))) if b0 > 0 else 0.0
-            edges[n] = min(c, beta0)
-            n += 1
-        for j in range(K):
-            c = math.acos(min(1.0, max(-1.0, -ka[i, j] / kb[i, j]))) if kb[i, j] != 0 else 0.0
-            edges[n] = min(c, beta0)
-            n += 1
-        edges[n] = beta0
-        n += 1
-        # insertion sort of the interior cuts
-        for a in range(2, n - 1):
-            val = edges[a]
-            b = a - 1
-            while b >= 1 and edges[b] > val:
-                edges[b + 1] = edges[b]
-                b -= 1
-            edges[b + 1] = val
-        lo = edges[piece[i]]
-        hi = edges[piece[i] + 1]
-        width = hi - lo
         beta = lo + t * width
         cb, sb = math.cos(beta), math.sin(beta)
         if axis == 0 or axis == 3:
