@@ -374,22 +374,35 @@ def _integrand(brdf: BRDF, g: _Group, prob: np.ndarray, piece: np.ndarray, tx: n
     _geometry_kernel(_AXIS_CODE[lobe.axis], _RADIAL_CODE[lobe.radial], float(lobe.sharpness), mu, levels, ka, kb,
                      np.ascontiguousarray(piece), np.ascontiguousarray(tx, dtype=np.float64),
                      np.ascontiguousarray(tt, dtype=np.float64), wo, weight)
-    wi = np.stack([np.sqrt((1.0 - mu) * (1.0 + mu)), np.zeros_like(mu), mu], axis=-1)
+    wi = np.empty_like(wo)
+    wi[:, 0] = np.sqrt((1.0 - mu) * (1.0 + mu))
+    wi[:, 1] = 0.0
+    wi[:, 2] = mu
     total = np.zeros_like(mu)
     for sign in (1.0,) if lobe.symmetric else (1.0, -1.0):
         if sign < 0:
             wo[:, 1] *= -1.0  # beta -> -beta flips wo_y in every frame (wi_y = 0)
-        f = np.asarray(brdf._eval(wi, wo), dtype=np.float64)
-        bad = ~np.isfinite(f) | (f < 0)
-        if np.any(bad):
-            i = int(np.argmax(bad))
+        f = np.ascontiguousarray(brdf._eval(wi, wo), dtype=np.float64)
+        i = _accumulate(f, wo[:, 2], weight, total)
+        if i >= 0:
             raise ValueError(
                 f"{brdf!r} returned {f[i]!r} at wi={wi[i].tolist()}, wo={wo[i].tolist()}: "
                 "a BRDF must be finite and non-negative above the horizon"
             )
-        with np.errstate(invalid="ignore", over="ignore"):
-            total += np.where((f > 0) & (wo[:, 2] > 0) & (weight > 0), f * wo[:, 2] * weight, 0.0)
     return 2.0 * total if lobe.symmetric else total
+
+
+@njit(cache=True)
+def _accumulate(f, cos_o, weight, total):  # pragma: no cover - compiled
+    """total += f cos(theta_o) weight where all are positive; the index of the first value of f
+    that is negative or not finite (or -1)."""
+    for i in range(f.shape[0]):
+        v = f[i]
+        if not (v >= 0.0 and v < math.inf):
+            return i
+        if v > 0.0 and cos_o[i] > 0.0 and weight[i] > 0.0:
+            total[i] += v * cos_o[i] * weight[i]
+    return -1
 
 
 def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
