@@ -498,9 +498,9 @@ def _horizon_breaks(lobe: Lobe, mu: float) -> np.ndarray:
 
 
 _TAU_SCAN = np.unique(np.concatenate([
-    np.linspace(0.0, 1.0, 2001),
-    np.logspace(-13, math.log10(0.5), 200),
-    1.0 - np.logspace(-13, math.log10(0.5), 200),
+    np.linspace(0.0, 1.0, 401),
+    np.logspace(-13, math.log10(0.5), 120),
+    1.0 - np.logspace(-13, math.log10(0.5), 120),
 ]))
 
 
