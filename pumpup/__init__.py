@@ -26,6 +26,8 @@ from .core import (
 
 __all__ = [
     "__version__",
+    "albedo_module",
+    "reproduce",
     "albedo",
     "divergence",
     "Pumped",

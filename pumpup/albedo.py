@@ -604,11 +604,11 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
     rounding = _rounding(g.lobe)
     converged = np.zeros(P, bool)
     while True:
-        I = np.bincount(prob, val, minlength=P)
+        total = np.bincount(prob, val, minlength=P)
         E = np.bincount(prob, err, minlength=P)
         A = np.bincount(prob, np.abs(val), minlength=P)
         R = rounding * A
-        tol = np.maximum(rtol * np.abs(I), atol)
+        tol = np.maximum(rtol * np.abs(total), atol)
         # done when the cubature error meets the tolerance, or is already below the rounding
         # error of the integrand (refining further cannot help); the reported error is both
         converged = E <= np.maximum(tol, R)
@@ -645,7 +645,7 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
         t0, t1 = np.concatenate([t0[keep], ct0]), np.concatenate([t1[keep], ct1])
         val, err = np.concatenate([val[keep], cv]), np.concatenate([err[keep], ce])
         ex, et = np.concatenate([ex[keep], cex]), np.concatenate([et[keep], cet])
-    return I, E, converged
+    return total, E, converged
 
 
 def _groups(brdf: BRDF, mu: np.ndarray):

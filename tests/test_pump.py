@@ -39,7 +39,7 @@ def check_chain(top, mus):
     albedo down to at most 1 instead, so the monotonicity is checked from the first level
     whose base is plausible.
     """
-    prev = None
+    prev = prev_e = None
     for k, f in enumerate(levels_of(top)):
         if k > 0:
             assert pumpup.check_reciprocity(f, n_mu=12, n_phi=12).reciprocal

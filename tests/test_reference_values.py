@@ -5,7 +5,6 @@ pumpup; tests/data/independent_reference.json holds its output)."""
 import json
 import pathlib
 
-import numpy as np
 import pytest
 
 import pumpup

@@ -1,4 +1,4 @@
-"""A compiled helper shared by the (N.H) models (Blinn, Ward, Schlick)."""
+"""A compiled helper shared by the (N.H) models (Blinn, Ward, Schlick, Cook-Torrance)."""
 
 from numba import njit
 

@@ -23,6 +23,7 @@ import math
 import numpy as np
 from numba import njit, vectorize
 
+from ._half import tan2_half
 from ..core import BRDF, Lobe, Param, SpecError, register
 
 # ----------------------------------------------------------------------------------------
@@ -134,9 +135,7 @@ def _ct_kernel(lx, ly, lz, vx, vy, vz, m, ior):  # pragma: no cover - compiled
     sx = lx + vx
     sy = ly + vy
     sz = lz + vz
-    qx = sx / sz  # h_x / h_z
-    qy = sy / sz  # h_y / h_z
-    t = qx * qx + qy * qy  # tan^2 delta
+    t = tan2_half(lx, ly, lz, vx, vy, vz)  # tan^2 delta
     e = math.exp(-t / (m * m))
     if e == 0.0:
         return 0.0
@@ -211,9 +210,7 @@ def _ts_kernel(lx, ly, lz, vx, vy, vz, d, s, b, ior):  # pragma: no cover - comp
     sx = lx + vx
     sy = ly + vy
     sz = lz + vz
-    qx = sx / sz  # h_x / h_z
-    qy = sy / sz  # h_y / h_z
-    t = qx * qx + qy * qy  # tan^2 alpha
+    t = tan2_half(lx, ly, lz, vx, vy, vz)  # tan^2 alpha
     cos2 = 1.0 / (1.0 + t)  # cos^2 alpha = (N.H)^2
     if d == 1:
         dist = b * cos2 ** (0.5 * s)  # D1 = b cos^e alpha, 002 sec. 3.2
