@@ -504,53 +504,64 @@ _TAU_SCAN = np.unique(np.concatenate([
 ]))
 
 
-def _kink_breaks(lobe: Lobe, mu: float, levels: np.ndarray) -> np.ndarray:
-    """Values of tau_x where a kink of the integrand enters or leaves the arc of beta.
+def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray) -> list[np.ndarray]:
+    """Values of tau_x where a kink of the integrand enters or leaves the arc of beta, for
+    every problem (mu (P,), levels (P, L)); a list of P arrays.
 
     A kink a + b cos(beta) = 0 (a level N.wo = u, or a model's own kink) lies on the arc
     only while |a| <= |b|; where a = +-b it appears or vanishes with a square-root
     behaviour in x (and at normal incidence, where b = 0, it becomes a circle: a jump in
     the derivative along x).  Roots of a -+ b are found on a graded scan and refined by
-    brentq.
+    bisection to full precision, all problems at once.
     """
-    from scipy.optimize import brentq
+    P = len(mu)
+    if not levels.shape[1] and lobe.kinks is None:
+        return [np.array([]) for _ in range(P)]
 
-    if not len(levels) and lobe.kinks is None:
-        return np.array([])
-    s = math.sqrt((1.0 - mu) * (1.0 + mu))
-
-    def coeffs(tau):
-        tau = np.atleast_1d(np.asarray(tau, dtype=float))
+    def coeffs(m, tau, lev):
+        s = np.sqrt((1.0 - m) * (1.0 + m))
         x, xc, _ = _smooth(tau)
         ca, sa, _ = _radial(lobe.radial, lobe.sharpness, x, xc)
         if lobe.axis == "normal":
             a0, b0 = ca, np.zeros_like(ca)
         elif lobe.axis in ("mirror", "retro"):
-            a0, b0 = mu * ca, s * sa
+            a0, b0 = m * ca, s * sa
         else:
-            a0, b0 = mu * (ca * ca - sa * sa), 2.0 * s * sa * ca
-        pairs = [(a0 - u, b0) for u in levels]
+            a0, b0 = m * (ca * ca - sa * sa), 2.0 * s * sa * ca
+        pairs = [(a0 - lev[:, j], b0) for j in range(lev.shape[1])]
         if lobe.kinks is not None:
-            m = np.full_like(ca, mu)
-            pairs += list(lobe.kinks(m, np.full_like(ca, s), ca, sa))
-        return [(np.asarray(a, float), np.asarray(b, float)) for a, b in pairs]
+            pairs += list(lobe.kinks(m, s, ca, sa))
+        return ([np.broadcast_to(np.asarray(a, float), m.shape) for a, _ in pairs],
+                [np.broadcast_to(np.asarray(b, float), m.shape) for _, b in pairs])
 
-    out = []
-    vals = coeffs(_TAU_SCAN)
-    for j, (a, b) in enumerate(vals):
+    G = len(_TAU_SCAN)
+    m_all = np.repeat(mu, G)
+    lev_all = np.repeat(levels, G, axis=0)
+    with np.errstate(all="ignore"):
+        A, B = coeffs(m_all, np.tile(_TAU_SCAN, P), lev_all)
+    out = [[] for _ in range(P)]
+    for j in range(len(A)):
         for sign in (1.0, -1.0):
-            h = a - sign * b
+            h = (A[j] - sign * B[j]).reshape(P, G)
             ok = np.isfinite(h)
-            change = np.nonzero(ok[:-1] & ok[1:] & (np.sign(h[:-1]) * np.sign(h[1:]) < 0))[0]
-            for i in change:
-                def fun(t, j=j, sign=sign):
-                    aa, bb = coeffs(t)[j]
-                    return float(aa[0] - sign * bb[0])
-                try:
-                    out.append(brentq(fun, _TAU_SCAN[i], _TAU_SCAN[i + 1], xtol=1e-16, rtol=4 * np.finfo(float).eps))
-                except ValueError:
-                    pass
-    return np.array(out)
+            p_idx, i_idx = np.nonzero(ok[:, :-1] & ok[:, 1:] & (np.sign(h[:, :-1]) * np.sign(h[:, 1:]) < 0))
+            if not len(p_idx):
+                continue
+            lo, hi = _TAU_SCAN[i_idx].copy(), _TAU_SCAN[i_idx + 1].copy()
+            h_lo = h[p_idx, i_idx]
+            m, lev = mu[p_idx], levels[p_idx]
+            for _ in range(64):  # bisection: the cells are at least 1e-13 wide
+                mid = 0.5 * (lo + hi)
+                with np.errstate(all="ignore"):
+                    a_, b_ = coeffs(m, mid, lev)
+                h_mid = a_[j] - sign * b_[j]
+                left = np.sign(h_mid) == np.sign(h_lo)
+                lo = np.where(left, mid, lo)
+                h_lo = np.where(left, h_mid, h_lo)
+                hi = np.where(left, hi, mid)
+            for p_, t in zip(p_idx, 0.5 * (lo + hi)):
+                out[p_].append(t)
+    return [np.array(o) for o in out]
 
 
 def _graded(points: np.ndarray) -> np.ndarray:
@@ -588,12 +599,13 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
     # the horizon starts to cut the lobe and where it hides it completely
     gt = np.linspace(0, 1, nt + 1)
     cols = []
+    kink_breaks = _kink_breaks(g.lobe, g.mu, g.levels)
     for p_ in range(P):
         # the arc changes on the scale of the distance from a break to the nearer end (near
         # grazing incidence the horizon break sits within 1e-5 of an end): the grid is graded
         # geometrically towards every break, so that no first rectangle straddles it unseen
         breaks = np.concatenate([_horizon_breaks(g.lobe, float(g.mu[p_])),
-                                 _kink_breaks(g.lobe, float(g.mu[p_]), g.levels[p_])])
+                                 kink_breaks[p_]])
         gx = np.unique(np.concatenate([np.linspace(0, 1, nx + 1), _graded(breaks)]))
         for k in range(n_pieces):
             X0, T0 = np.meshgrid(gx[:-1], gt[:-1], indexing="ij")
