@@ -280,9 +280,12 @@ def _radial_scalar(kind, k, x, xc):  # pragma: no cover - compiled; see _radial
 
 
 @njit(cache=True)
-def _geometry_kernel(axis, radial, k, mu, levels, ka, kb, piece, tx, tt, wo, weight):  # pragma: no cover
-    """Compiled twin of :func:`_geometry_reference`; fills ``wo`` (N, 3) and ``weight`` (N)."""
-    L = levels.shape[1]
+def _geometry_kernel(axis, radial, k, mu_p, levels_p, prob, ka, kb, piece, tx, tt, wi, wo, weight):  # pragma: no cover
+    """Compiled twin of :func:`_geometry_reference`; fills ``wi``, ``wo`` (N, 3) and ``weight`` (N).
+
+    Point i belongs to problem prob[i], with mu = mu_p[prob[i]] and levels levels_p[prob[i]].
+    """
+    L = levels_p.shape[1]
     K = ka.shape[1]
     edges = np.empty(L + K + 2)
     # the points come as 15 values of tau_t per value of tau_x: everything that depends on x
@@ -290,9 +293,10 @@ def _geometry_kernel(axis, radial, k, mu, levels, ka, kb, piece, tx, tt, wo, wei
     prev_tx, prev_mu, prev_piece = -1.0, -1.0, -1
     m = s = ca = sa = jac = dx = lo = width = 0.0
     for i in range(tx.shape[0]):
-        if tx[i] != prev_tx or mu[i] != prev_mu or piece[i] != prev_piece:
-            prev_tx, prev_mu, prev_piece = tx[i], mu[i], piece[i]
-            m = mu[i]
+        p = prob[i]
+        if tx[i] != prev_tx or mu_p[p] != prev_mu or piece[i] != prev_piece:
+            prev_tx, prev_mu, prev_piece = tx[i], mu_p[p], piece[i]
+            m = mu_p[p]
             s = math.sqrt((1.0 - m) * (1.0 + m))
             # smoothing substitution x = tau^2 (3 - 2 tau)
             u = tx[i]
@@ -314,7 +318,7 @@ def _geometry_kernel(axis, radial, k, mu, levels, ka, kb, piece, tx, tt, wo, wei
             edges[n] = 0.0
             n += 1
             for j in range(L):
-                c = math.acos(min(1.0, max(-1.0, (levels[i, j] - a0) / b0))) if b0 > 0 else 0.0
+                c = math.acos(min(1.0, max(-1.0, (levels_p[p, j] - a0) / b0))) if b0 > 0 else 0.0
                 edges[n] = min(c, beta0)
                 n += 1
             for j in range(K):
@@ -333,6 +337,9 @@ def _geometry_kernel(axis, radial, k, mu, levels, ka, kb, piece, tx, tt, wo, wei
                 edges[b + 1] = val
             lo = edges[piece[i]]
             width = edges[piece[i] + 1] - lo
+        wi[i, 0] = s
+        wi[i, 1] = 0.0
+        wi[i, 2] = m
         v = tt[i]
         t = v * v * (3.0 - 2.0 * v)
         dt = 6.0 * v * (1.0 - v)
@@ -362,23 +369,18 @@ def _geometry_kernel(axis, radial, k, mu, levels, ka, kb, piece, tx, tt, wo, wei
 def _integrand(brdf: BRDF, g: _Group, prob: np.ndarray, piece: np.ndarray, tx: np.ndarray, tt: np.ndarray):
     """Integrand values at points (tau_x, tau_t) of piece ``piece`` of problem ``prob``."""
     lobe = g.lobe
-    mu = np.ascontiguousarray(g.mu[prob])
-    levels = np.ascontiguousarray(g.levels[prob])
+    n = len(tx)
     if lobe.kinks is not None:
         x, xc, _ = _smooth(tx)
-        ka, kb = _kink_coefficients(lobe, mu, x, xc)
+        ka, kb = _kink_coefficients(lobe, g.mu[prob], x, xc)
     else:
-        ka = kb = np.zeros((len(mu), 0))
-    wo = np.empty((len(mu), 3))
-    weight = np.empty(len(mu))
-    _geometry_kernel(_AXIS_CODE[lobe.axis], _RADIAL_CODE[lobe.radial], float(lobe.sharpness), mu, levels, ka, kb,
-                     np.ascontiguousarray(piece), np.ascontiguousarray(tx, dtype=np.float64),
-                     np.ascontiguousarray(tt, dtype=np.float64), wo, weight)
-    wi = np.empty_like(wo)
-    wi[:, 0] = np.sqrt((1.0 - mu) * (1.0 + mu))
-    wi[:, 1] = 0.0
-    wi[:, 2] = mu
-    total = np.zeros_like(mu)
+        ka = kb = np.zeros((n, 0))
+    wi = np.empty((n, 3))
+    wo = np.empty((n, 3))
+    weight = np.empty(n)
+    _geometry_kernel(_AXIS_CODE[lobe.axis], _RADIAL_CODE[lobe.radial], float(lobe.sharpness), g.mu, g.levels, prob,
+                     ka, kb, piece, tx, tt, wi, wo, weight)
+    total = np.zeros(n)
     for sign in (1.0,) if lobe.symmetric else (1.0, -1.0):
         if sign < 0:
             wo[:, 1] *= -1.0  # beta -> -beta flips wo_y in every frame (wi_y = 0)
@@ -420,7 +422,8 @@ def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
         X, T = np.broadcast_arrays(X, T)
         P = np.broadcast_to(prob[sl][:, None, None], X.shape)
         K = np.broadcast_to(piece[sl][:, None, None], X.shape)
-        v = _integrand(brdf, g, P.ravel(), K.ravel(), X.ravel(), T.ravel()).reshape(n, 15, 15)
+        v = _integrand(brdf, g, np.ascontiguousarray(P.ravel()), np.ascontiguousarray(K.ravel()),
+                       np.ascontiguousarray(X.ravel()), np.ascontiguousarray(T.ravel())).reshape(n, 15, 15)
         area = (hx * ht)[:, 0, 0]
         kk = np.einsum("rij,i,j->r", v, WK, WK) * area
         gg = np.einsum("rij,i,j->r", v, WG, WG) * area

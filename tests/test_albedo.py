@@ -170,10 +170,12 @@ def test_compiled_geometry_matches_numpy_reference(spec, rng):
     pieces = 1 + levels.shape[1] + ka.shape[1]
     piece = rng.integers(0, pieces, n)
     wi, wo_ref, w_ref = A._geometry_reference(lobe, mu, levels, ka, kb, piece, tx, tt)
+    wi_k = np.empty((n, 3))
     wo = np.empty((n, 3))
     w = np.empty(n)
     A._geometry_kernel(A._AXIS_CODE[lobe.axis], A._RADIAL_CODE[lobe.radial], float(lobe.sharpness), mu,
-                       np.ascontiguousarray(levels), ka, kb, piece, tx, tt, wo, w)
+                       np.ascontiguousarray(levels), np.arange(n), ka, kb, piece, tx, tt, wi_k, wo, w)
+    np.testing.assert_allclose(wi_k, wi, rtol=1e-15)
     # where a piece has zero width the kernel returns weight 0 (the reference may give 0 * inf)
     w_ref = np.where(np.isfinite(w_ref), w_ref, 0.0)
     np.testing.assert_allclose(wo, wo_ref, rtol=1e-9, atol=1e-12)
