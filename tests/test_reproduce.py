@@ -40,6 +40,11 @@ def _stored(name):
 def test_stored_tables_are_what_the_command_produces(name):
     fresh = compute(name, progress=False)
     stored = _stored(name)
+    # where a maximum lies is determined only to about sqrt(albedo error): a flat maximum moves
+    # by 1e-7 of its angle when the albedo moves by 1e-14, so the angle is compared to 1e-4 deg
+    if "theta_deg" in fresh:
+        np.testing.assert_allclose(fresh["theta_deg"], stored["theta_deg"], rtol=0, atol=1e-4)
+        fresh, stored = fresh.drop_vars("theta_deg"), stored.drop_vars("theta_deg")
     xr.testing.assert_allclose(fresh, stored, rtol=1e-8, atol=1e-13)
     assert {k: v for k, v in fresh.attrs.items() if k != "pumpup_version"} == \
            {k: v for k, v in stored.attrs.items() if k != "pumpup_version"}
