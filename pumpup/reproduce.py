@@ -234,12 +234,32 @@ def report(datasets: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: the analysis of 001 sec. 2.1 (pumpup.divergence), written as divergence.nc with its plot
+DIVERGENCE = "divergence"
+
+
+def _divergence_report(ds) -> str:
+    lines = ["## Divergence at grazing incidence (001 sec. 2.1; fit a ~ K mu^-k for mu in [1e-8, 1e-5])", "",
+             "| model | verdict | k | a(mu = 1e-8) |", "|---|---|---|---|"]
+    for i, name in enumerate(ds.model.values):
+        lines.append(f"| {name} | {ds.verdict.values[i]} | {float(ds.k[i]):.5f} ± {float(ds.k_error[i]):.1g} | "
+                     f"{float(ds.albedo[i, -1]):.6g} |")
+    lines += ["", "001 claims that Ward and Cook-Torrance diverge; see the README for why Cook-Torrance does not.", ""]
+    return "\n".join(lines)
+
+
 def reproduce(out: str = "tables", only: list[str] | None = None, progress: bool | None = None) -> dict:
-    """Compute the tables, write ``<out>/<name>.nc`` and ``<out>/report.md``, return the datasets."""
-    names = list(only) if only else list(TABLES)
-    unknown = [n for n in names if n not in TABLES]
+    """Compute the tables, write ``<out>/<name>.nc`` and ``<out>/report.md``, return the datasets.
+
+    Besides :data:`TABLES`, ``divergence`` runs the divergence analysis
+    (:func:`pumpup.divergence.analysis_dataset`) into ``<out>/divergence.nc`` and
+    ``<out>/divergence.png``.
+    """
+    choices = list(TABLES) + [DIVERGENCE]
+    names = list(only) if only else choices
+    unknown = [n for n in names if n not in choices]
     if unknown:
-        raise ValueError(f"unknown table(s) {', '.join(map(repr, unknown))}; choose from {', '.join(TABLES)}")
+        raise ValueError(f"unknown table(s) {', '.join(map(repr, unknown))}; choose from {', '.join(choices)}")
     try:
         os.makedirs(out, exist_ok=True)
     except OSError as exc:
@@ -248,11 +268,19 @@ def reproduce(out: str = "tables", only: list[str] | None = None, progress: bool
         raise OSError(f"the output directory {out!r} is not writable")
     cache = _Cache()
     t0 = time.perf_counter()
-    datasets = {n: compute(n, progress=progress, cache=cache) for n in names}
+    datasets = {n: compute(n, progress=progress, cache=cache) for n in names if n != DIVERGENCE}
+    extra = ""
+    if DIVERGENCE in names:
+        from .divergence import analysis_dataset, plot
+
+        div = analysis_dataset(progress=progress)
+        write_table(div, os.path.join(out, "divergence.nc"))
+        plot(div, os.path.join(out, "divergence.png"))
+        extra = _divergence_report(div)
     for n, ds in datasets.items():
         write_table(ds, os.path.join(out, f"{n}.nc"))
     with atomic_path(os.path.join(out, "report.md")) as tmp:
         with open(tmp, "w") as fh:
-            fh.write(report(datasets))
+            fh.write(report(datasets) + ("\n" + extra if extra else ""))
     datasets["_seconds"] = time.perf_counter() - t0
     return datasets

@@ -102,3 +102,13 @@ def test_bad_arguments_are_clear_and_leave_no_files(tmp_path):
 
 def test_every_table_has_a_name():
     assert set(TABLES) == {"table2", "table3", "table4", "text"}
+
+
+@pytest.mark.slow
+def test_stored_divergence_analysis_is_what_the_command_produces():
+    from pumpup.divergence import analysis_dataset
+
+    fresh, stored = analysis_dataset(progress=False), _stored("divergence")
+    xr.testing.assert_allclose(fresh.drop_vars(["verdict", "spec"]), stored.drop_vars(["verdict", "spec"]),
+                               rtol=1e-7, atol=1e-12)
+    assert list(fresh.verdict.values) == list(stored.verdict.values)
