@@ -54,7 +54,7 @@ def cmd_albedo(args) -> int:
 
     f = _load(args.spec)
     if args.theta is not None:
-        mu = np.cos(np.radians(np.asarray(args.theta, dtype=float)))
+        mu = np.sin(np.radians(90.0 - np.asarray(args.theta, dtype=float)))  # keeps its digits near 90 deg
     else:
         mu = np.asarray(args.mu if args.mu else [1.0, 0.5, 0.1, 0.01], dtype=float)
     try:
