@@ -127,16 +127,6 @@ def _chain_kernel(f, mu_i, mu_o, offsets, logx, coef, v0, slope0, margin_lo, cap
             f[k] = f[k] / g  # 001 eq. 16
 
 
-def _pumped_reference(fbase, mu_i, mu_o, upper, controlled):
-    """Plain numpy version of the kernel (the readable reference)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        g = np.maximum(upper(np.clip(mu_i, 1e-300, 1)), upper(np.clip(mu_o, 1e-300, 1)))  # 001 eq. 20
-        if controlled:
-            g = np.maximum(g, np.maximum(mu_i, mu_o))  # 001 eq. 21
-        out = fbase / g  # 001 eq. 16
-    return np.where((fbase > 0) & (mu_i > 0) & (mu_o > 0), out, 0.0)
-
-
 class _Lookup:
     """The table's upper bound in the flat form the compiled kernel takes."""
 
@@ -145,13 +135,8 @@ class _Lookup:
         self.logx = np.log(t.mu)
         self.coef = np.ascontiguousarray(t._spline.c)
         self.node_err = np.ascontiguousarray(t.error)
-        self.margin = t.SAFETY * float(t.interp_error)  # as in AlbedoTable.upper
-        a0, a1 = t.value[0], t.value[1]
-        self.v0 = float(a0)
-        self.slope0 = (math.log(a1) - math.log(a0)) / (self.logx[1] - self.logx[0]) if a0 > 0 and a1 > 0 else 0.0
-        # below the first node the power-law extrapolation is a guess: add the full spread of
-        # the first interval as margin
-        self.margin_lo = self.margin + float(t.error[0]) + abs(float(a1) - float(a0))
+        self.margin, self.margin_lo = t.margin, t.margin_below  # as in AlbedoTable.upper
+        self.v0, self.slope0 = float(t.value[0]), t.slope_below
         # 001 eq. 17 asks max(a(L), a(V)) <= g <= 1.  The upper bound can exceed 1 by its
         # margin where a = 1, which would lower the albedo there (a* < a): cap g at 1 when the
         # table says the base conserves energy.  A base that reflects more than it receives
@@ -255,10 +240,19 @@ class Pumped(BRDF):
     def g(self, mu_i, mu_o) -> np.ndarray:
         """g(wi, wo) as a function of mu_i = N.wi and mu_o = N.wo (001 eq. 20, 21)."""
         up = self.lookup().upper
-        g = np.maximum(up(mu_i), up(mu_o))
+        g = np.maximum(up(mu_i), up(mu_o))  # 001 eq. 20
         if self.controlled:
-            g = np.maximum(g, np.maximum(mu_i, mu_o))
+            g = np.maximum(g, np.maximum(mu_i, mu_o))  # 001 eq. 21
         return g
+
+    def divide(self, fbase, wi, wo) -> np.ndarray:
+        """f / g (001 eq. 16) in plain numpy: the readable reference for :func:`_chain_kernel`."""
+        mi = np.broadcast_to(wi[..., 2], fbase.shape)
+        mo = np.broadcast_to(wo[..., 2], fbase.shape)
+        up = (fbase > 0) & (mi > 0) & (mo > 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out = fbase / self.g(np.clip(mi, 1e-300, 1), np.clip(mo, 1e-300, 1))
+        return np.where(up, out, 0.0)
 
     def chain(self) -> list["Pumped"]:
         """The pumped levels from the innermost (level 1) to this one."""
@@ -305,10 +299,7 @@ class Pumped(BRDF):
     def reference(self, wi, wo):
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
-        fb = np.asarray(self.base.reference(wi, wo), dtype=np.float64)
-        mi = np.broadcast_to(wi[..., 2], fb.shape)
-        mo = np.broadcast_to(wo[..., 2], fb.shape)
-        return _pumped_reference(fb, mi, mo, self.lookup().upper, self.controlled)
+        return self.divide(np.asarray(self.base.reference(wi, wo), dtype=np.float64), wi, wo)
 
     # --- hints for the albedo engine: the base's lobe plus the kinks of g ------------------
     def kink_levels(self, mu: float) -> tuple:
@@ -366,11 +357,7 @@ class _Divided(BRDF):
         return {"type": "pumped-term", "term": self.term.spec, "of": self.pumped.spec}
 
     def _eval(self, wi, wo):
-        fb = np.asarray(self.term._eval(wi, wo), dtype=np.float64)
-        mi = np.broadcast_to(wi[..., 2], fb.shape)
-        mo = np.broadcast_to(wo[..., 2], fb.shape)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(fb > 0, fb / self.pumped.g(np.clip(mi, 1e-300, 1), np.clip(mo, 1e-300, 1)), 0.0)
+        return self.pumped.divide(np.asarray(self.term._eval(wi, wo), dtype=np.float64), wi, wo)
 
     def lobe(self, mu):
         b = self.term.lobe(mu)

@@ -198,7 +198,7 @@ def compute(name: str, progress: bool | None = None, cache: _Cache | None = None
 
     if name not in TABLES:
         raise ValueError(f"unknown table {name!r}; choose from {', '.join(TABLES)}")
-    title, entries, fn = TABLES[name]
+    _, entries, fn = TABLES[name]
     with _progress(len(entries), name, progress) as bar:
         bar.unit = "value"
         rows = fn(cache or _Cache(), bar)

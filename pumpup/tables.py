@@ -21,7 +21,7 @@ import numpy as np
 
 from ._version import __version__
 from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
-from .core import BRDF, load
+from .core import BRDF
 
 __all__ = [
     "tabulate",
@@ -85,6 +85,15 @@ class AlbedoTable:
         if len(self.mu) < 2:
             raise ValueError("an albedo table needs at least two values of mu")
         self._spline = CubicSpline(np.log(self.mu), self.value, bc_type="not-a-knot", extrapolate=True)
+        a0, a1 = self.value[0], self.value[1]
+        #: slope of the power law below the first node (0: constant extrapolation)
+        self.slope_below = ((math.log(a1) - math.log(a0)) / (math.log(self.mu[1]) - math.log(self.mu[0]))
+                            if a0 > 0 and a1 > 0 else 0.0)
+        #: added to the interpolant in :meth:`upper`
+        self.margin = self.SAFETY * self.interp_error
+        #: added below the first node, where the extrapolation is a guess: also the spread of the
+        #: first interval and the first node's quadrature error
+        self.margin_below = self.margin + float(self.error[0]) + abs(float(a1) - float(a0))
 
     @classmethod
     def from_dataset(cls, ds) -> "AlbedoTable":
@@ -97,12 +106,7 @@ class AlbedoTable:
         out = self._spline(lm)
         lo = m < self.mu[0]
         if np.any(lo):
-            a0, a1 = self.value[0], self.value[1]
-            if a0 > 0 and a1 > 0:
-                slope = (math.log(a1) - math.log(a0)) / (math.log(self.mu[1]) - math.log(self.mu[0]))
-                out = np.where(lo, a0 * np.exp(slope * (lm - math.log(self.mu[0]))), out)
-            else:
-                out = np.where(lo, a0, out)
+            out = np.where(lo, self.value[0] * np.exp(self.slope_below * (lm - math.log(self.mu[0]))), out)
         return out
 
     def node_error(self, mu) -> np.ndarray:
@@ -116,8 +120,11 @@ class AlbedoTable:
     SAFETY = 2.0
 
     def upper(self, mu) -> np.ndarray:
-        """An upper bound of the true albedo: interpolant + 2 x interpolation error + quadrature error."""
-        return self(mu) + self.SAFETY * self.interp_error + self.node_error(mu)
+        """An upper bound of the true albedo: interpolant + 2 x interpolation error + quadrature error
+        (``margin_below`` below the first node).  The pumping operator's compiled look-up uses
+        the same margins."""
+        m = check_mu(mu)
+        return self(m) + np.where(m < self.mu[0], self.margin_below, self.margin + self.node_error(m))
 
 
 def _midpoints(mu: np.ndarray) -> np.ndarray:
@@ -424,8 +431,3 @@ def max_constant(brdf: BRDF, **kw) -> tuple[float, float]:
     """
     m = max_albedo(brdf, **kw)
     return m.constant, m.theta_deg
-
-
-def table_for(brdf: BRDF | dict, **kw) -> AlbedoTable:
-    """Tabulate ``brdf`` on the adaptive grid and return the interpolating table."""
-    return AlbedoTable.from_dataset(tabulate(load(brdf), **kw))

@@ -113,3 +113,14 @@ def test_blinn_max_constant_matches_table_2_of_000():
     for n, published in [(1, 0.350), (16, 0.895)]:
         c, _ = pumpup.max_constant(pumpup.load({"type": "blinn", "n": n}))
         assert round(c, 3) == published
+
+
+def test_compiled_upper_bound_is_the_tables_upper_bound(phong_table):
+    # the pumping operator's look-up and AlbedoTable.upper are one definition (capped at 1)
+    from pumpup.pump import _Lookup
+
+    table = pumpup.AlbedoTable.from_dataset(phong_table)
+    lookup = _Lookup(table)
+    mu = np.concatenate([10 ** np.random.default_rng(9).uniform(-10, 0, 200), [1.0, 1e-12]])
+    np.testing.assert_allclose(lookup.upper(mu), np.minimum(lookup.cap, table.upper(mu)), rtol=1e-12, atol=1e-15)
+    assert np.any(mu < table.mu[0])
