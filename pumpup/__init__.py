@@ -10,6 +10,8 @@ from .albedo import albedo
 from . import reproduce
 from .divergence import divergence
 from .pump import Pumped, load_pumped, pump, save_pumped
+from . import sampling
+from .sampling import mc_albedo, mc_radiance, sample
 from .tables import AlbedoTable, max_albedo, max_constant, mean_albedo, open_table, tabulate, write_table
 from .core import (
     BRDF,
@@ -30,6 +32,10 @@ __all__ = [
     "reproduce",
     "albedo",
     "divergence",
+    "sampling",
+    "sample",
+    "mc_albedo",
+    "mc_radiance",
     "Pumped",
     "pump",
     "save_pumped",

@@ -150,7 +150,9 @@ def _radial(kind: str, k: float, x: np.ndarray, xc: np.ndarray):
         y0 = math.exp(-((k * math.pi / 2) ** 2))
         y = y0 + (1.0 - y0) * x
         with np.errstate(divide="ignore", invalid="ignore"):
-            a = np.sqrt(np.maximum(-np.log1p(-(1.0 - y0) * xc), 0.0)) / k
+            # ln y: directly where y is small (1 - y0 may round to 1), via log1p near y = 1
+            ln_y = np.where(x < 0.5, np.log(y), np.log1p(-(1.0 - y0) * xc))
+            a = np.minimum(np.sqrt(np.maximum(-ln_y, 0.0)) / k, 0.5 * np.pi)  # y0 may underflow to 0
             ca = np.cos(a)
             sa = np.sin(a)
             sinc = np.where(a > 0, sa / np.where(a > 0, a, 1.0), 1.0)
@@ -274,9 +276,10 @@ def _radial_scalar(kind, k, x, xc):  # pragma: no cover - compiled; see _radial
         return c, math.sqrt(k * x / d), (k / (2.0 * c * d * d) if c > 0 else math.inf)
     y0 = math.exp(-((k * math.pi / 2) ** 2))
     y = y0 + (1.0 - y0) * x
-    a = math.sqrt(max(-math.log1p(-(1.0 - y0) * xc), 0.0)) / k
+    ln_y = (math.log(y) if y > 0.0 else 0.0) if x < 0.5 else math.log1p(-(1.0 - y0) * xc)  # as in _radial
+    a = min(math.sqrt(max(-ln_y, 0.0)) / k, 0.5 * math.pi) if y > 0.0 else 0.5 * math.pi
     sinc = math.sin(a) / a if a > 0 else 1.0
-    return math.cos(a), math.sin(a), (1.0 - y0) * sinc / (2.0 * k * k * y)
+    return math.cos(a), math.sin(a), ((1.0 - y0) * sinc / (2.0 * k * k * y) if y > 0.0 else math.inf)
 
 
 @njit(cache=True)

@@ -331,6 +331,14 @@ class BRDF:
         """Quadrature hint for incidence cos(theta_i) = mu (default: no knowledge)."""
         return Lobe(axis="normal", radial="cosine", symmetric=False)
 
+    def sampling_lobe(self, mu: float) -> Lobe:
+        """Hint for importance sampling (``pumpup.sampling``), default :meth:`lobe`.
+
+        Override where the quadrature hint's lobe has lighter tails than f (the weights
+        f cos / p would then grow without bound): the sampling density must not fall off
+        faster than f."""
+        return self.lobe(mu)
+
     def albedo_terms(self) -> list[tuple[float, "BRDF"]]:
         """Linear decomposition f = sum w_k f_k used by the engine (default: itself)."""
         return [(1.0, self)]

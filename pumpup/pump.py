@@ -334,6 +334,9 @@ class Pumped(BRDF):
                     levels=tuple(sorted(set(b.levels) | set(self.kink_levels(mu)))),
                     kinks=b.kinks, symmetric=b.symmetric)
 
+    def sampling_lobe(self, mu: float) -> Lobe:
+        return self.base.sampling_lobe(mu)  # f / g has the lobe of f; g only rescales it
+
     def albedo_terms(self):
         terms = self.base.albedo_terms()
         if len(terms) == 1 and terms[0][1] is self.base:
@@ -358,6 +361,9 @@ class _Divided(BRDF):
 
     def _eval(self, wi, wo):
         return self.pumped.divide(np.asarray(self.term._eval(wi, wo), dtype=np.float64), wi, wo)
+
+    def sampling_lobe(self, mu):
+        return self.term.sampling_lobe(mu)
 
     def lobe(self, mu):
         b = self.term.lobe(mu)

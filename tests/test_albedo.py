@@ -181,3 +181,23 @@ def test_compiled_geometry_matches_numpy_reference(spec, rng):
     np.testing.assert_allclose(wo, wo_ref, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(w, w_ref, rtol=1e-9, atol=1e-300)
     np.testing.assert_allclose(np.linalg.norm(wo, axis=-1), 1.0, rtol=1e-12)
+
+
+def test_radial_maps_are_finite_at_the_ends():
+    """Every radial map gives finite directions at x = 0, x = 1 and x within 1e-300 of them
+    (the Gaussian map once produced NaN for c = 5, where 1 - exp(-(c pi/2)^2) rounds to 1)."""
+    A = pumpup.albedo_module
+    x = np.array([0.0, 1e-300, 1e-20, 1e-10, 0.5, 1 - 1e-10, 1.0])
+    xc = np.array([1.0, 1.0, 1.0, 1 - 1e-10, 0.5, 1e-10, 0.0])
+    for kind, k in [("cosine", 0.0), ("power", 20.0), ("power", 1e4), ("beckmann", 0.1), ("ggx", 1e-3),
+                    ("gaussian", 0.5), ("gaussian", 5.0), ("gaussian", 40.0)]:
+        ca, sa, _ = A._radial(kind, k, x, xc)
+        assert np.all(np.isfinite(ca)) and np.all(np.isfinite(sa)), (kind, k, ca, sa)
+        np.testing.assert_allclose(ca * ca + sa * sa, 1.0, atol=1e-15)
+        code = A._RADIAL_CODE[kind]
+        for xi, xci, c, s in zip(x, xc, ca, sa):
+            cs, ss, _ = A._radial_scalar(code, k, xi, xci)
+            assert abs(cs - c) <= 1e-15 and abs(ss - s) <= 1e-15, (kind, k, xi)
+    f = pumpup.load({"type": "torrance_sparrow", "d": "D2", "s": 5.0, "ior": 1.5})
+    a, err = pumpup.albedo(f, np.array([0.5, 0.1]), return_error=True)
+    assert np.all(np.isfinite(a)) and np.all(err < 1e-9 * a)

@@ -147,6 +147,11 @@ class WardAniso(BRDF):
     def lobe(self, mu):
         return Lobe(axis="half", radial="beckmann", sharpness=min(self.p["ax"], self.p["ay"]), symmetric=True)
 
+    def sampling_lobe(self, mu):
+        # the wider of the two slopes: a Beckmann density with the narrower one falls off faster
+        # than f across the wide axis, and the weights f cos / p would be unbounded
+        return Lobe(axis="half", radial="beckmann", sharpness=max(self.p["ax"], self.p["ay"]), symmetric=True)
+
 
 # --- modified Ward --------------------------------------------------------------------------
 
