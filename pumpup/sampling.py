@@ -49,7 +49,8 @@ from numba import njit, vectorize
 from .albedo import check_mu
 from .core import BRDF, Lobe, as_directions
 
-__all__ = ["Strategy", "strategy", "sample", "pdf", "mc_albedo", "mc_radiance", "second_moment"]
+__all__ = ["Strategy", "acceptance", "efficiency_dataset", "mc_albedo", "mc_radiance", "pdf", "plot_efficiency", "sample",
+           "second_moment", "strategy"]
 
 # component kinds (ints for the compiled kernels)
 COSINE, MIRROR, RETRO, HALF_POWER, HALF_BECKMANN, HALF_GGX = range(6)
@@ -605,3 +606,152 @@ def second_moment(brdf: BRDF, mu, *, kind: str = "lobe", rtol: float = 1e-9, ret
 
     f = _check_brdf(brdf)
     return albedo(_SecondMomentIntegrand(f, kind), mu, return_error=return_error, rtol=rtol)
+
+
+class _DensityIntegrand(BRDF):
+    """h(c, x) = p(x | c) / cos(theta_x): its albedo at c is the probability that a draw is accepted."""
+
+    type = "acceptance"
+    params = {}
+    constant = None
+
+    def __init__(self, f: BRDF, kind: str):
+        self.p = {}
+        self.f = f
+        self.kind = kind
+        self.reciprocal = False
+
+    @property
+    def spec(self):  # not a user model: never saved
+        return {"type": self.type, "of": self.f.spec, "kind": self.kind}
+
+    def _eval(self, c, x):
+        c, x = np.broadcast_arrays(c, x)
+        shape = c.shape[:-1]
+        a, b = c.reshape(-1, 3), x.reshape(-1, 3)
+        out = np.zeros(a.shape[0])
+        for m in np.unique(a[:, 2]):
+            sel = a[:, 2] == m
+            p = strategy(self.f, float(m), self.kind).pdf(b[sel], a[sel])
+            z = b[sel, 2]
+            out[sel] = np.where(z > 0, p / np.where(z > 0, z, 1.0), 0.0)
+        return out.reshape(shape)
+
+    def lobe(self, mu):
+        return self.f.lobe(mu)
+
+
+def acceptance(brdf: BRDF, mu, *, kind: str = "lobe", rtol: float = 1e-9, return_error: bool = False):
+    """Probability that a draw of :func:`sample` around a direction with cos(theta) = mu is
+    accepted (not below the horizon): the integral of the density over the hemisphere,
+    computed by the albedo engine.
+
+    Examples
+    --------
+    >>> import pumpup
+    >>> f = pumpup.load({"type": "phong", "n": 20})
+    >>> round(float(pumpup.sampling.acceptance(f, 1e-9)), 6)   # half the lobe is below the horizon
+    0.5
+    """
+    from .albedo import albedo
+
+    f = _check_brdf(brdf)
+    return albedo(_DensityIntegrand(f, kind), mu, return_error=return_error, rtol=rtol)
+
+
+# ----------------------------------------------------------------------------------------
+# the efficiency study of 000 sec. 4.2
+# ----------------------------------------------------------------------------------------
+
+#: the exponents and viewing angles of the stored study (tables/sampling_efficiency.nc)
+EFFICIENCY_N = (1.0, 5.0, 20.0, 100.0, 1000.0)
+EFFICIENCY_THETA = (0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 75.0, 80.0, 85.0, 88.0, 89.0, 89.9, 89.99)
+
+
+def efficiency_dataset(ns=EFFICIENCY_N, theta_deg=EFFICIENCY_THETA, mu_grazing: float = 1e-8, rtol: float = 1e-9):
+    """Variance per sample of the Phong-lobe estimator (000 eq. 23-25) for reciprocal Phong and
+    stretched Phong, against the viewing angle (000 sec. 4.2), as an xarray.Dataset.
+
+    For each model, exponent n and viewing direction V (cos(theta_V) = mu): the albedo a (the
+    estimator's mean, L_in = 1), the second moment E[w^2] of one weight w = f cos / p and the
+    acceptance probability, all three by the albedo engine (no sampling); the variance per
+    sample E[w^2] - a^2 and the relative variance (variance / a^2: the number of samples
+    needed for a relative standard error of 1 is this number).  The last angle is
+    mu = ``mu_grazing``, where 000 eq. 26 gives a = (n+2)/(2(n+1)) for the stretched model.
+    """
+    import xarray as xr
+
+    from ._version import __version__
+    from .albedo import albedo
+    from .core import load
+
+    mu = np.concatenate([np.cos(np.radians(np.asarray(theta_deg, dtype=np.float64))), [mu_grazing]])
+    mu = np.where(np.asarray(list(theta_deg) + [90.0]) == 0.0, 1.0, mu)
+    models = ("phong", "stretched_phong")
+    shape = (len(models), len(ns), len(mu))
+    out = {k: np.empty(shape) for k in ("albedo", "albedo_error", "second_moment", "second_moment_error",
+                                        "acceptance", "acceptance_error")}
+    for i, model in enumerate(models):
+        for j, n in enumerate(ns):
+            f = load({"type": model, "n": float(n)})
+            out["albedo"][i, j], out["albedo_error"][i, j] = albedo(f, mu, return_error=True, rtol=rtol)
+            out["second_moment"][i, j], out["second_moment_error"][i, j] = second_moment(f, mu, return_error=True,
+                                                                                      rtol=rtol)
+            out["acceptance"][i, j], out["acceptance_error"][i, j] = acceptance(f, mu, return_error=True, rtol=rtol)
+    var = out["second_moment"] - out["albedo"] ** 2
+    var_err = out["second_moment_error"] + 2 * out["albedo"] * out["albedo_error"]
+    theta = np.degrees(np.arccos(mu))
+    dims = ("model", "n", "mu")
+    coords = {"model": list(models), "n": ("n", np.asarray(ns, dtype=np.float64), {"long_name": "Phong exponent"}),
+              "mu": ("mu", mu, {"long_name": "cos(theta_V), the viewing direction", "units": "1"}),
+              "theta": ("mu", theta, {"long_name": "viewing angle theta_V", "units": "degree"})}
+    ds = xr.Dataset(
+        {
+            "albedo": (dims, out["albedo"], {"long_name": "albedo a(V), the estimator's mean (L_in = 1)", "units": "1"}),
+            "albedo_error": (dims, out["albedo_error"], {"long_name": "quadrature error estimate of albedo"}),
+            "second_moment": (dims, out["second_moment"], {"long_name": "E[w^2], w = f cos(theta_L) / p(L)"}),
+            "second_moment_error": (dims, out["second_moment_error"], {"long_name": "quadrature error of E[w^2]"}),
+            "variance": (dims, var, {"long_name": "variance per sample, E[w^2] - a^2"}),
+            "variance_error": (dims, var_err, {"long_name": "error bound of variance"}),
+            "relative_variance": (dims, var / out["albedo"] ** 2,
+                                  {"long_name": "variance / a^2 (samples per unit relative standard error squared)"}),
+            "acceptance": (dims, out["acceptance"], {"long_name": "probability that a draw is above the horizon"}),
+            "acceptance_error": (dims, out["acceptance_error"], {"long_name": "quadrature error of acceptance"}),
+        },
+        coords=coords,
+        attrs={"pumpup_kind": "pumpup sampling efficiency", "title": "Importance sampling efficiency of the Phong lobe (000 sec. 4.2)",
+               "method": "pumpup albedo engine on E[w], E[w^2] and the density (no Monte Carlo)",
+               "rtol": rtol, "sampler": "000 eq. 19-22: R around V with density (n+1)/(2 pi) cos^n, L = mirror of R",
+               "pumpup_version": __version__},
+    )
+    return ds
+
+
+def plot_efficiency(ds, path):
+    """Relative variance per sample against the viewing angle (000 sec. 4.2), both models."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.5), constrained_layout=True)
+    colors = plt.get_cmap("viridis")(np.linspace(0, 0.9, ds.sizes["n"]))
+    theta = ds.theta.values
+    for j, n in enumerate(ds.n.values):
+        for model, style in (("phong", "--"), ("stretched_phong", "-")):
+            rv = ds.relative_variance.sel(model=model).values[j]
+            ax.semilogy(theta, rv, style, color=colors[j], label=f"{model} n={n:g}")
+        ratio = (ds.relative_variance.sel(model="phong").values[j]
+                 / ds.relative_variance.sel(model="stretched_phong").values[j])
+        bx.plot(theta, ratio, "-o", ms=3, color=colors[j], label=f"n={n:g}")
+    ax.set(xlabel="viewing angle theta_V [deg]", ylabel="variance per sample / albedo^2",
+           title="Phong-lobe sampling, dashed: Phong, solid: stretched")
+    bx.set(xlabel="viewing angle theta_V [deg]", ylabel="relative variance, Phong / stretched Phong",
+           title="Phong samples needed per stretched-Phong sample")
+    for a in (ax, bx):
+        a.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7, ncol=2)
+    bx.legend(fontsize=7)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path

@@ -275,3 +275,62 @@ def test_bad_input():
         pumpup.mc_albedo(f, 1.5, 10, 0)
     with pytest.raises(ValueError, match="strategy"):
         pumpup.sample(f, [0.0, 0.0, 1.0], 10, 0, kind="magic")
+
+
+@pytest.fixture(scope="module")
+def efficiency():
+    return S.efficiency_dataset()
+
+
+def test_efficiency_table_regression(efficiency):
+    """The stored study (scripts/sampling_efficiency.py) equals a fresh computation within the
+    quadrature error estimates."""
+    import os
+
+    import xarray as xr
+
+    stored = pumpup.open_table(os.path.join(os.path.dirname(__file__), "..", "tables", "sampling_efficiency.nc"))
+    xr.testing.assert_equal(stored.mu, efficiency.mu)
+    for v in ("albedo", "second_moment", "acceptance"):
+        diff = np.abs(stored[v] - efficiency[v])
+        assert float((diff - stored[v + "_error"] - efficiency[v + "_error"]).max()) <= 1e-15, v
+
+
+def test_efficiency_against_monte_carlo(efficiency, rng):
+    """The table's variance per sample and acceptance agree with what the sampler does
+    (sample variance within 5 sigma of its own sampling distribution)."""
+    N = 400_000
+    for model in ("phong", "stretched_phong"):
+        for n in (5.0, 100.0):
+            f = pumpup.load({"type": model, "n": n})
+            for i in (0, 6, 11, 15):
+                mu = float(efficiency.mu[i])
+                row = efficiency.sel(model=model, n=n).isel(mu=i)
+                w = np.array([math.sqrt((1 - mu) * (1 + mu)), 0.0, mu])
+                wi, p = pumpup.sample(f, w, N, rng)
+                x = np.zeros(N)
+                ok = p > 0
+                x[ok] = f.eval(w, wi[ok]) * wi[ok, 2] / p[ok]
+                var = float(row.variance)
+                # sd of the sample variance: sqrt((mu4 - var^2) / N), mu4 estimated from the draws
+                mu4 = np.mean((x - x.mean()) ** 4)
+                assert abs(x.var() - var) < 5 * math.sqrt(max(mu4 - var * var, 0) / N) + 1e-12, (model, n, mu)
+                acc = float(row.acceptance)
+                assert abs(ok.mean() - acc) < 5 * math.sqrt(acc * (1 - acc) / N) + 1e-12
+
+
+def test_efficiency_claims_of_000_sec_4_2(efficiency):
+    """000 sec. 4.2: the stretched model samples at least as well as Phong at every angle, equally at
+    normal view ('the worst case ... at zero degree'), better towards grazing; eq. 26 at 90 degrees;
+    half the draws rejected at grazing."""
+    rv = efficiency.relative_variance
+    p, s = rv.sel(model="phong"), rv.sel(model="stretched_phong")
+    assert bool((s <= p * (1 + 1e-9)).all())
+    np.testing.assert_allclose(p.isel(mu=0), s.isel(mu=0), rtol=1e-9)
+    assert bool((p.isel(mu=-1) / s.isel(mu=-1) > 1.7).all())
+    n = efficiency.n
+    np.testing.assert_allclose(efficiency.albedo.sel(model="stretched_phong").isel(mu=-1), (n + 2) / (2 * (n + 1)),
+                               rtol=1e-6)  # 000 eq. 26, at mu = 1e-8
+    np.testing.assert_allclose(efficiency.acceptance.isel(mu=-1), 0.5, rtol=1e-6)
+    # at grazing every accepted stretched weight is (n+2)/(n+1): relative variance 1 (Bernoulli 1/2)
+    np.testing.assert_allclose(s.isel(mu=-1), 1.0, rtol=1e-6)
