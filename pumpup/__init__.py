@@ -8,6 +8,7 @@ from ._version import __version__
 from . import albedo as albedo_module
 from .albedo import albedo
 from . import reproduce
+from . import testing
 from .divergence import divergence
 from .pump import Pumped, load_pumped, pump, save_pumped
 from . import sampling
