@@ -14,6 +14,7 @@ from .pump import Pumped, load_pumped, pump, save_pumped
 from . import sampling
 from .sampling import mc_albedo, mc_radiance, sample
 from .tables import AlbedoTable, max_albedo, max_constant, mean_albedo, open_table, tabulate, write_table
+from .sweep import sweep
 from .core import (
     BRDF,
     Lobe,
@@ -47,6 +48,7 @@ __all__ = [
     "mean_albedo",
     "open_table",
     "tabulate",
+    "sweep",
     "write_table",
     "BRDF",
     "Lobe",

@@ -159,6 +159,74 @@ def cmd_divergence(args) -> int:
     return 0
 
 
+def parse_values(text: str) -> tuple[str, list]:
+    """``name=v1,v2,...`` (JSON numbers, else strings), ``name=lin:a:b:k`` or ``name=geom:a:b:k``."""
+    name, eq, rest = text.partition("=")
+    name = name.strip()
+    if not eq or not name:
+        raise SystemExit(f"pumpup: --param {text!r} must look like name=v1,v2,... (or name=lin:a:b:k, name=geom:a:b:k)")
+    kind, _, rng = rest.partition(":")
+    if kind in ("lin", "geom") and rng:
+        import numpy as np
+
+        try:
+            a, b, k = rng.split(":")
+            a, b, k = float(a), float(b), int(k)
+            if k < 1 or (kind == "geom" and (a <= 0 or b <= 0)):
+                raise ValueError
+        except ValueError:
+            raise SystemExit(f"pumpup: --param {text!r}: {kind}:a:b:k needs numbers a, b (> 0 for geom) and a "
+                             "count k >= 1") from None
+        return name, (np.linspace(a, b, k) if kind == "lin" else np.geomspace(a, b, k)).tolist()
+    values = []
+    for item in rest.split(","):
+        item = item.strip()
+        if not item:
+            continue
+        try:
+            values.append(json.loads(item))
+        except json.JSONDecodeError:
+            values.append(item)
+    return name, values
+
+
+def cmd_sweep(args) -> int:
+    import time
+
+    import pumpup
+    from pumpup.sweep import default_mu
+
+    spec = parse_spec(args.spec)
+    params: dict = {}
+    for text in args.param:
+        name, values = parse_values(text)
+        if name in params:
+            raise SystemExit(f"pumpup: --param {name!r} is given twice")
+        params[name] = values
+    pump = None
+    if args.pump:
+        g, _, levels = args.pump.partition(":")
+        try:
+            pump = {"g": g, "levels": int(levels) if levels else 1}
+        except ValueError:
+            raise SystemExit(f"pumpup: --pump {args.pump!r} must look like g2 or g2:LEVELS") from None
+    if args.mu is None and args.n_mu < 2:
+        raise SystemExit("pumpup: --n-mu must be at least 2")
+    mu = args.mu if args.mu is not None else default_mu(args.n_mu)
+    if args.scheduler and args.local:
+        raise SystemExit("pumpup: give --scheduler ADDRESS or one of --threads/--processes/--serial, not both")
+    t0 = time.perf_counter()
+    try:
+        ds = pumpup.sweep(spec, params, mu=mu, pump=pump, scheduler=args.scheduler or args.local,
+                          workers=args.workers, chunks=args.chunk, out=args.out, rtol=args.rtol,
+                          mean=not args.no_mean, maximum=not args.no_maximum)
+    except (ValueError, OSError, TypeError) as exc:  # SpecError is a ValueError
+        raise SystemExit(f"pumpup: {exc}") from None
+    shape = " x ".join(f"{d} {n}" for d, n in ds["albedo"].sizes.items())
+    print(f"wrote {args.out}: {shape} in {time.perf_counter() - t0:.1f} s")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="pumpup",
@@ -207,6 +275,28 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("check", help="reciprocity and maximum albedo of a model")
     s.add_argument("spec")
     s.set_defaults(func=cmd_check)
+    s = sub.add_parser("sweep", help="albedo tables over a grid of model parameters, in chunks on dask "
+                                     "(resumable; a dask.distributed cluster with --scheduler)")
+    s.add_argument("spec")
+    s.add_argument("--param", action="append", required=True, metavar="NAME=VALUES",
+                   help="a swept parameter: n=1,2,4 or n=geom:1:1000:64 or p=lin:0:1:64 (repeat for more)")
+    g = s.add_mutually_exclusive_group()
+    g.add_argument("--mu", type=float, nargs="+", help="cos(theta_i) values in (0, 1]")
+    g.add_argument("--n-mu", type=int, default=257, help="else this many mu, theta uniform in [0, 90) deg (default 257)")
+    s.add_argument("--pump", metavar="G[:LEVELS]", help="pump each cell's model first, e.g. g2:2")
+    s.add_argument("--out", required=True, help="netCDF file, or a zarr store if it ends in .zarr; "
+                                                "finished chunks wait in OUT.parts/ so a rerun resumes")
+    s.add_argument("--scheduler", metavar="ADDRESS", help="a dask.distributed scheduler, e.g. tcp://host:8786")
+    g = s.add_mutually_exclusive_group()
+    g.add_argument("--threads", dest="local", action="store_const", const="threads", help="local threads (default)")
+    g.add_argument("--processes", dest="local", action="store_const", const="processes", help="local processes")
+    g.add_argument("--serial", dest="local", action="store_const", const="synchronous", help="one cell at a time")
+    s.add_argument("--workers", type=int, help="local threads or processes (default: one per core)")
+    s.add_argument("--chunk", type=int, help="cells per chunk along the last parameter (default 8)")
+    s.add_argument("--rtol", type=float, default=1e-10)
+    s.add_argument("--no-mean", action="store_true", help="skip the mean albedo")
+    s.add_argument("--no-maximum", action="store_true", help="skip the maximum constant")
+    s.set_defaults(func=cmd_sweep)
     return p
 
 

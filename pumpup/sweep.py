@@ -1,0 +1,594 @@
+"""Parameter sweeps: albedo tables over a grid of model parameters, run in chunks on dask.
+
+``pumpup.sweep(spec, {"n": [...], "p": [...]}, mu=...)`` tabulates, for every cell of the
+parameter grid, the directional albedo a(mu) (000 eq. 2) with its error, the mean albedo
+(000 eq. 33) and the maximum constant (000 Tables 2 and 4), optionally after pumping the
+cell's model up (001 sec. 3).  Each cell is one pure, deterministic computation: exactly
+:func:`pumpup.tabulate`, :func:`pumpup.mean_albedo` and :func:`pumpup.max_albedo` of the
+cell's model, whatever scheduler runs it and however the grid is chunked.
+
+Chunks run through dask: the local threaded, multiprocessing or synchronous scheduler, or a
+``dask.distributed`` cluster (``client=`` or ``scheduler="tcp://host:8786"``).  With
+``out=``, every finished chunk is saved at once, atomically, as a part file in the
+directory ``<out>.parts/`` beside a manifest of the sweep's definition; a sweep started
+again with the same definition loads the finished parts and computes only the rest.  When
+all chunks are done the parts are merged into ``out`` (netCDF, or a zarr store if ``out``
+ends in ``.zarr``), written atomically, and the parts directory is removed.
+
+dask is imported inside the functions, so ``import pumpup`` stays fast.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+import os
+import shutil
+import sys
+import tempfile
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from ._version import __version__
+from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
+from .core import BRDF, SpecError, load
+
+__all__ = ["SWEEP_KIND", "default_mu", "dimension_name", "sweep"]
+
+SWEEP_KIND = "pumpup albedo sweep"
+#: scheduler names that select dask's local schedulers (anything else is a cluster address)
+LOCAL_SCHEDULERS = ("threads", "processes", "synchronous")
+#: keyword arguments of :func:`pumpup.pump` that ``pump=`` may hold
+PUMP_KEYS = ("g", "levels", "force")
+#: tolerances of the per-cell mean albedo and albedo maximum (the defaults of those functions)
+MEAN_RTOL = 1e-9
+MAX_RTOL = 1e-11
+MAX_MU_MIN = 1e-6
+#: default number of cells of a chunk along the last swept parameter
+DEFAULT_CHUNK = 8
+_PART_VARS = ("albedo", "albedo_error", "mean_albedo", "mean_albedo_error", "max_constant",
+              "max_constant_error", "max_albedo_theta", "max_albedo_mu")
+
+
+def default_mu(n: int = 257) -> np.ndarray:
+    """``n`` values of mu = cos(theta_i), theta_i uniform in [0, 90) degrees, increasing.
+
+    theta_k = k 90 / n degrees for k = 0 ... n - 1; mu is computed as sin(90 deg - theta_k)
+    so that it keeps its digits near grazing incidence.
+
+    Examples
+    --------
+    >>> mu = default_mu(4)
+    >>> mu.round(6).tolist()
+    [0.382683, 0.707107, 0.92388, 1.0]
+    """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
+        raise ValueError(f"default_mu: n must be an integer >= 2, got {n!r}")
+    k = np.arange(1, n + 1)
+    return np.sin(k * (np.pi / 2) / n)
+
+
+# --------------------------------------------------------------------------------------------
+# Input checks
+# --------------------------------------------------------------------------------------------
+
+
+def _plain(value: Any) -> Any:
+    """A numpy scalar as the Python number (specs are plain JSON)."""
+    return value.item() if isinstance(value, np.generic) else value
+
+
+def _check_params(spec: dict, params: Mapping[str, Sequence]) -> dict[str, list]:
+    if not isinstance(params, Mapping) or len(params) == 0:
+        raise SpecError("sweep: params must be a non-empty dict {parameter name: list of values}")
+    from .core import _REGISTRY, _ensure_models
+
+    _ensure_models()
+
+    name = spec.get("type")
+    if name not in _REGISTRY:
+        raise SpecError(f"unknown model type {name!r}; known types: {', '.join(_REGISTRY)}")
+    cls = _REGISTRY[name]
+    out: dict[str, list] = {}
+    for key, values in params.items():
+        if key not in cls.params:
+            raise SpecError(f"sweep: {name} has no parameter {key!r}; its parameters: {', '.join(cls.params)}")
+        if cls.params[key].kind == "spec":
+            raise SpecError(f"sweep: {name} parameter {key!r} is a nested model spec and cannot be swept")
+        if isinstance(values, (str, bytes)) or not isinstance(values, (Sequence, np.ndarray)):
+            raise SpecError(f"sweep: the values of {key!r} must be a list, got {values!r}")
+        values = [_plain(v) for v in np.asarray(values, dtype=object).ravel()] if len(values) else []
+        if len(values) == 0:
+            raise SpecError(f"sweep: the list of values of {key!r} is empty")
+        if len(set(map(repr, values))) != len(values):
+            raise SpecError(f"sweep: the values of {key!r} repeat: {values!r}")
+        for v in values:  # the model's own Param check: names the parameter and its range
+            cls.params[key].check(name, key, v)
+        out[key] = values
+    return out
+
+
+def _check_pump(pump: Mapping | None) -> dict | None:
+    if pump is None:
+        return None
+    if not isinstance(pump, Mapping):
+        raise SpecError(f"sweep: pump must be a dict like {{'g': 'g2', 'levels': 2}} or None, got {pump!r}")
+    unknown = sorted(set(pump) - set(PUMP_KEYS))
+    if unknown:
+        raise SpecError(f"sweep: unknown pump option(s) {', '.join(map(repr, unknown))}; allowed: {', '.join(PUMP_KEYS)}")
+    out = {"g": "g1", "levels": 1, **{k: _plain(v) for k, v in pump.items()}}
+    if out["g"] not in ("g1", "g2"):
+        raise SpecError(f"sweep: pump g must be 'g1' or 'g2', got {out['g']!r}")
+    lv = out["levels"]
+    if isinstance(lv, bool) or not isinstance(lv, int) or lv < 1:
+        raise SpecError(f"sweep: pump levels must be an integer >= 1, got {lv!r}")
+    return out
+
+
+def _chunk_shape(names: list[str], shape: tuple[int, ...], chunks) -> tuple[int, ...]:
+    if chunks is None:
+        return (1,) * (len(shape) - 1) + (min(shape[-1], DEFAULT_CHUNK),)
+    if isinstance(chunks, (int, np.integer)) and not isinstance(chunks, bool):
+        chunks = {names[-1]: int(chunks)}
+    if not isinstance(chunks, Mapping):
+        raise TypeError(f"sweep: chunks must be None, an int or a dict {{parameter: cells}}, got {chunks!r}")
+    unknown = sorted(set(chunks) - set(names))
+    if unknown:
+        raise ValueError(f"sweep: chunks names {', '.join(map(repr, unknown))}, which are not swept ({', '.join(names)})")
+    out = []
+    for name, n in zip(names, shape):
+        c = chunks.get(name, 1 if name != names[-1] else min(n, DEFAULT_CHUNK))
+        if isinstance(c, bool) or not isinstance(c, (int, np.integer)) or c < 1:
+            raise ValueError(f"sweep: chunks[{name!r}] must be an integer >= 1, got {c!r}")
+        out.append(min(int(c), n))
+    return tuple(out)
+
+
+# --------------------------------------------------------------------------------------------
+# One cell, one chunk (these run on the workers)
+# --------------------------------------------------------------------------------------------
+
+
+def cell_model(spec: dict, pump: dict | None) -> BRDF:
+    """The model of one cell: ``load(spec)``, pumped with ``pump`` if given."""
+    f = load(spec)
+    if pump:
+        from .pump import pump as pump_fn
+
+        f = pump_fn(f, **pump)
+    return f
+
+
+def _cell(spec: dict, pump: dict | None, mu: np.ndarray, opts: dict) -> dict[str, Any]:
+    """Everything the sweep stores for one cell: a pure function of its arguments."""
+    from .pump import _TABLES, Pumped, _key
+    from .tables import max_albedo, mean_albedo, tabulate
+
+    f = cell_model(spec, pump)
+    ds = tabulate(f, mu=mu, rtol=opts["rtol"], atol=opts["atol"], progress=False)
+    out: dict[str, Any] = {"albedo": ds["albedo"].values, "albedo_error": ds["albedo_error"].values}
+    if opts["mean"]:
+        out["mean_albedo"], out["mean_albedo_error"] = mean_albedo(f, rtol=MEAN_RTOL, return_error=True)
+    if opts["maximum"]:
+        m = max_albedo(f, mu_min=MAX_MU_MIN, rtol=MAX_RTOL)
+        out.update(max_constant=m.constant, max_constant_error=m.constant_error,
+                   max_albedo_theta=m.theta_deg, max_albedo_mu=m.mu)
+    # the pumping operator caches the albedo table of every base for the session; no other
+    # cell has this cell's bases, so drop them (a long sweep would otherwise grow in memory;
+    # the levels of f keep their own references while f lives)
+    cur = f
+    while isinstance(cur, Pumped):
+        _TABLES.pop(_key(cur.base), None)
+        cur = cur.base
+    return out
+
+
+def _run_chunk(specs: list[dict], pump: dict | None, mu: np.ndarray, opts: dict) -> dict[str, np.ndarray]:
+    """The cells of one chunk, one after the other; arrays with a leading cell axis."""
+    cells = [_cell(s, pump, mu, opts) for s in specs]
+    return {k: np.array([c[k] for c in cells], dtype=np.float64) for k in cells[0]}
+
+
+# --------------------------------------------------------------------------------------------
+# Part files: one per finished chunk, written atomically
+# --------------------------------------------------------------------------------------------
+
+
+def _part_name(block: tuple[int, ...]) -> str:
+    return "chunk-" + "-".join(map(str, block)) + ".npz"
+
+
+def _write_atomic(directory: str, name: str, write) -> None:
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix="-" + name, dir=directory)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            write(fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, os.path.join(directory, name))
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _save_part(directory: str, block: tuple[int, ...], arrays: dict[str, np.ndarray]) -> None:
+    _write_atomic(directory, _part_name(block), lambda fh: np.savez(fh, **arrays))
+
+
+def _load_part(directory: str, block: tuple[int, ...], n_cells: int) -> dict[str, np.ndarray] | None:
+    """A finished chunk's arrays, or None if it is missing or unreadable (then it is recomputed)."""
+    path = os.path.join(directory, _part_name(block))
+    if not os.path.exists(path):
+        return None
+    try:
+        with np.load(path) as z:
+            arrays = {k: z[k] for k in z.files}
+    except (OSError, ValueError, EOFError):
+        return None
+    if not arrays or any(a.shape[0] != n_cells for a in arrays.values()):
+        return None
+    return arrays
+
+
+def _open_parts(out: str, definition: dict) -> str:
+    """The parts directory of ``out``, created with its manifest or checked against it."""
+    directory = os.fspath(out) + ".parts"
+    parent = os.path.dirname(os.path.abspath(directory))
+    if not os.path.isdir(parent):
+        raise OSError(f"cannot write {out!r}: directory {parent!r} does not exist")
+    manifest = os.path.join(directory, "sweep.json")
+    text = json.dumps(definition, sort_keys=True, indent=1)
+    if os.path.isdir(directory) and os.path.exists(manifest):
+        with open(manifest) as fh:
+            old = fh.read()
+        if old != text:
+            raise ValueError(
+                f"{directory!r} holds the parts of a different sweep (its manifest sweep.json differs from "
+                "this one's spec, parameters, mu, pump or options); delete that directory to start afresh, "
+                "or write this sweep to another file"
+            )
+        return directory
+    os.makedirs(directory, exist_ok=True)
+    _write_atomic(directory, "sweep.json", lambda fh: fh.write(text.encode()))
+    return directory
+
+
+# --------------------------------------------------------------------------------------------
+# Running the chunks
+# --------------------------------------------------------------------------------------------
+
+
+def _progress_bar(total: int, progress: bool | None):
+    from tqdm.auto import tqdm
+
+    show = sys.stderr.isatty() if progress is None else progress
+    return tqdm(total=total, desc="sweep", unit="cell", disable=not show)
+
+
+def _run_local(tasks, scheduler: str, workers: int | None, on_done) -> None:
+    """Run the chunks with a local dask scheduler; ``on_done`` sees each result in this process."""
+    import dask
+    from dask.callbacks import Callback
+
+    keys = {}
+    delayed = []
+    for k, (block, args) in enumerate(tasks):
+        key = f"pumpup-sweep-chunk-{k}"
+        keys[key] = block
+        delayed.append(dask.delayed(_run_chunk, pure=True)(*args, dask_key_name=key))
+
+    class Saver(Callback):
+        def _posttask(self, key, result, dsk, state, worker_id):
+            if key in keys:
+                on_done(keys[key], result)
+
+    kw = {} if scheduler == "synchronous" or workers is None else {"num_workers": workers}
+    with Saver():
+        # each result is placed (and saved) as it arrives
+        dask.compute(*delayed, scheduler=scheduler, **kw)
+
+
+def _run_distributed(tasks, client, address: str | None, on_done) -> None:
+    """Run the chunks on a dask.distributed cluster; results are saved here as they complete."""
+    from distributed import Client, as_completed
+
+    own = client is None
+    if own:
+        try:
+            client = Client(address, timeout="20s")
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise OSError(f"sweep: cannot reach the dask scheduler at {address!r}: {exc}") from None
+    futures = {}
+    try:
+        for block, args in tasks:
+            futures[client.submit(_run_chunk, *args, pure=False)] = block
+        for fut in as_completed(list(futures)):
+            result = fut.result()  # raises the worker's exception here
+            on_done(futures.pop(fut), result)
+            fut.release()
+    finally:
+        if futures:
+            client.cancel(list(futures))
+        if own:
+            client.close()
+
+
+# --------------------------------------------------------------------------------------------
+# The public function
+# --------------------------------------------------------------------------------------------
+
+
+def sweep(spec: dict | str, params: Mapping[str, Sequence], mu=None, *, pump: Mapping | None = None,
+          client=None, scheduler: str | None = None, workers: int | None = None, chunks=None,
+          out: str | os.PathLike | None = None, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
+          mean: bool = True, maximum: bool = True, progress: bool | None = None):
+    """Albedo tables over a grid of model parameters, computed in chunks through dask.
+
+    Cell (v_1, ..., v_k) of the grid is the model ``pumpup.load(spec | {p_1: v_1, ...})``
+    (pumped with ``pumpup.pump(model, **pump)`` if ``pump`` is given).  For each cell the
+    sweep stores exactly what :func:`pumpup.tabulate` (on the grid ``mu``),
+    :func:`pumpup.mean_albedo` and :func:`pumpup.max_albedo` return for that model: the
+    values do not depend on the scheduler, the number of workers or the chunking.
+
+    Parameters
+    ----------
+    spec : dict or str
+        The base model spec (or its JSON).  Parameters not given take the model's defaults
+        *per cell*: sweeping ``n`` of ``stretched_phong`` without a ``c`` gives each cell
+        its own c = (n + 2) / (2 pi).
+    params : dict
+        ``{name: list of values}``, one grid dimension per entry, in this order.  Names must
+        be parameters of ``spec["type"]``; values are checked by the model's own parameter
+        ranges before anything runs.  Swept values replace those in ``spec``.
+    mu : array_like, optional
+        cos(theta_i) in (0, 1]; sorted and made unique as by :func:`pumpup.tabulate`.
+        Default: :func:`default_mu` (257 values, theta uniform in [0, 90) degrees).
+    pump : dict, optional
+        Options of :func:`pumpup.pump`, e.g. ``{"g": "g2", "levels": 2}``: each cell's model
+        is pumped up first (001 sec. 3).
+    client : dask.distributed.Client, optional
+        Run on this cluster (left open afterwards).
+    scheduler : str, optional
+        ``"threads"`` (default), ``"processes"`` or ``"synchronous"`` for dask's local
+        schedulers, or the address of a ``dask.distributed`` scheduler
+        (``"tcp://host:8786"``), to which the sweep connects and which it leaves running.
+    workers : int, optional
+        Threads or processes of the local scheduler (default: dask's, one per core).
+    chunks : int or dict, optional
+        Cells of a chunk along each swept parameter, ``{name: count}`` (missing names: 1,
+        except the last parameter: 8); an int is the count along the last parameter.
+        A chunk is the unit of work, of saving and of resuming.
+    out : path, optional
+        Write the result here (netCDF; a zarr store if the name ends in ``.zarr``) and keep
+        finished chunks in ``<out>.parts/`` until the end, so that an interrupted sweep run
+        again with the same arguments resumes where it stopped.  The parts directory
+        remembers the sweep's definition; a different sweep is refused, not mixed in.
+    rtol, atol : float
+        Quadrature tolerances of the albedo values (see :func:`pumpup.albedo`).
+    mean : bool
+        Compute the mean albedo of every cell (000 eq. 33; rtol 1e-9).  For pumped models
+        this is the dearest part of a cell.
+    maximum : bool
+        Compute the maximum constant and the angle of the albedo maximum of every cell
+        (000 Tables 2 and 4; scanned down to mu = 1e-6, rtol 1e-11).
+    progress : bool, optional
+        Show a progress bar over cells (default: when stderr is a terminal).
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions: the swept parameters, in order, then ``mu`` (a parameter named like a data
+        variable, Lambert's ``albedo``, gets the dimension ``lambert_albedo``).  Data variables:
+        ``albedo`` and ``albedo_error`` (params..., mu); if ``mean``, ``mean_albedo`` and
+        ``mean_albedo_error``; if ``maximum``, ``max_constant``, ``max_constant_error``,
+        ``max_albedo_theta`` [degree] and ``max_albedo_mu``.  Coordinates: the swept values,
+        ``mu`` and ``theta`` [degree].  Attributes: ``spec`` (JSON of the base spec without
+        the swept parameters), ``swept_parameters`` (JSON list), ``pump`` (JSON),
+        ``method``, ``rtol``, ``atol``, ``mean_albedo_rtol``, ``max_albedo_rtol``,
+        ``pumpup_version``.
+
+    Raises
+    ------
+    SpecError
+        An unknown model or parameter name, a value outside the parameter's range, an empty
+        or repeating list of values, or bad pump options.
+    ValueError
+        mu outside (0, 1], bad chunks, or parts of a different sweep at ``out``.
+
+    References
+    ----------
+    000: L. Neumann, A. Neumann, L. Szirmay-Kalos, Compact Metallic Reflectance Models (1999).
+    001: the same authors, Analysis and Pumping of the Albedo Function (1998).
+
+    Examples
+    --------
+    >>> import pumpup
+    >>> ds = pumpup.sweep({"type": "lambert"}, {"albedo": [0.25, 0.5]}, mu=[0.5, 1.0],
+    ...                   scheduler="synchronous", maximum=False)
+    >>> ds["albedo"].dims, ds["albedo"].values.round(12).tolist()
+    (('lambert_albedo', 'mu'), [[0.25, 0.25], [0.5, 0.5]])
+    """
+    if isinstance(spec, str):
+        try:
+            spec = json.loads(spec)
+        except json.JSONDecodeError as exc:
+            raise SpecError(f"sweep: a spec string must be JSON: {exc}") from None
+    if not isinstance(spec, Mapping) or "type" not in spec:
+        raise SpecError(f"sweep: spec must be a dict with a 'type' key, got {spec!r}")
+    spec = {k: _plain(v) for k, v in spec.items()}
+    values = _check_params(spec, params)
+    names = list(values)
+    pump = _check_pump(pump)
+    grid = np.unique(check_mu(np.atleast_1d(default_mu() if mu is None else mu)).ravel())
+    if grid.size == 0:
+        raise ValueError("sweep: mu is empty; give at least one value in (0, 1]")
+    if client is not None and scheduler is not None:
+        raise ValueError("sweep: give client= or scheduler=, not both")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise ValueError(f"sweep: workers must be an integer >= 1, got {workers!r}")
+    shape = tuple(len(values[n]) for n in names)
+    cshape = _chunk_shape(names, shape, chunks)
+    base = {k: v for k, v in spec.items() if k not in values}
+
+    # every cell's spec, checked up front (cross-parameter checks too) so no worker fails on input
+    def cell_spec(index):
+        return {**spec, **{n: values[n][i] for n, i in zip(names, index)}}
+
+    for index in itertools.product(*(range(s) for s in shape)):
+        load(cell_spec(index))
+    first = cell_spec((0,) * len(shape))
+    if pump:
+        cell_model(first, pump)  # pump's own checks (e.g. a non-reciprocal base) before anything runs
+
+    opts = {"rtol": float(rtol), "atol": float(atol), "mean": bool(mean), "maximum": bool(maximum)}
+    blocks = list(itertools.product(*(range(math.ceil(s / c)) for s, c in zip(shape, cshape))))
+
+    def block_slices(block):
+        return tuple(slice(b * c, min((b + 1) * c, s)) for b, c, s in zip(block, cshape, shape))
+
+    def block_cells(block):
+        return list(itertools.product(*(range(sl.start, sl.stop) for sl in block_slices(block))))
+
+    n_mu = grid.size
+    arrays = {k: np.full(shape + ((n_mu,) if k.startswith("albedo") else ()), np.nan) for k in _PART_VARS}
+
+    def place(block, result):
+        sl = block_slices(block)
+        bshape = tuple(s.stop - s.start for s in sl)
+        for k, v in result.items():
+            arrays[k][sl] = v.reshape(bshape + v.shape[1:])
+
+    definition = {"spec": spec, "params": values, "mu": [float(m) for m in grid], "pump": pump,
+                  "options": opts, "chunks": list(cshape), "pumpup_version": __version__}
+    parts = None
+    todo = list(blocks)
+    if out is not None:
+        parts = _open_parts(out, definition)
+        todo = []
+        for block in blocks:
+            res = _load_part(parts, block, len(block_cells(block)))
+            if res is None:
+                todo.append(block)
+            else:
+                place(block, res)
+
+    tasks = [(block, ([cell_spec(i) for i in block_cells(block)], pump, grid, opts)) for block in todo]
+    with _progress_bar(sum(len(block_cells(b)) for b in todo), progress) as bar:
+        def on_done(block, result):
+            if parts is not None:
+                _save_part(parts, block, result)
+            place(block, result)
+            bar.update(len(block_cells(block)))
+
+        if tasks:
+            if client is not None or (scheduler is not None and scheduler not in LOCAL_SCHEDULERS):
+                _run_distributed(tasks, client, scheduler, on_done)
+            else:
+                _run_local(tasks, scheduler or "threads", workers, on_done)
+
+    ds = _dataset(spec, base, names, values, grid, pump, opts, arrays)
+    if out is not None:
+        _write_output(ds, out)
+        shutil.rmtree(parts, ignore_errors=True)
+    return ds
+
+
+def dimension_name(model: str, name: str) -> str:
+    """The dimension of a swept parameter: its name, or ``model_name`` where that is also the
+    name of a data variable (Lambert's ``albedo`` becomes ``lambert_albedo``).
+
+    Examples
+    --------
+    >>> dimension_name("phong", "n"), dimension_name("lambert", "albedo")
+    ('n', 'lambert_albedo')
+    """
+    return f"{model}_{name}" if name in _PART_VARS or name in ("mu", "theta") else name
+
+
+def _dataset(spec, base, names, values, grid, pump, opts, arrays):
+    import xarray as xr
+
+    from .core import _REGISTRY
+    from .tables import METHOD
+
+    cls = _REGISTRY[spec["type"]]
+    dims = tuple(dimension_name(spec["type"], n) for n in names)
+    adims = dims + ("mu",)
+    data = {
+        "albedo": (adims, arrays["albedo"], {
+            "long_name": "directional albedo a(mu)", "units": "1",
+            "definition": "integral of f_r(wi, wo) cos(theta_o) d omega_o (000 eq. 2)"}),
+        "albedo_error": (adims, arrays["albedo_error"], {
+            "long_name": "estimated absolute quadrature error of albedo", "units": "1"}),
+    }
+    if opts["mean"]:
+        data["mean_albedo"] = (dims, arrays["mean_albedo"], {
+            "long_name": "mean albedo 2 * integral_0^1 a(mu) mu dmu (000 eq. 33)", "units": "1"})
+        data["mean_albedo_error"] = (dims, arrays["mean_albedo_error"], {
+            "long_name": "estimated absolute error of mean_albedo", "units": "1"})
+    if opts["maximum"]:
+        data["max_constant"] = (dims, arrays["max_constant"], {
+            "long_name": "maximum constant: 1 / max over mu of the albedo with the model's constant set to 1 "
+                         "(000 Tables 2 and 4)", "units": "1"})
+        data["max_constant_error"] = (dims, arrays["max_constant_error"], {
+            "long_name": "propagated error of max_constant", "units": "1"})
+        data["max_albedo_theta"] = (dims, arrays["max_albedo_theta"], {
+            "long_name": "incidence angle theta_i of the albedo maximum", "units": "degree"})
+        data["max_albedo_mu"] = (dims, arrays["max_albedo_mu"], {
+            "long_name": "cos(theta_i) of the albedo maximum", "units": "1"})
+    coords = {
+        "mu": ("mu", grid, {"long_name": "cosine of the incidence angle, cos(theta_i)", "units": "1"}),
+        "theta": ("mu", np.degrees(np.arccos(grid)), {"long_name": "incidence angle theta_i", "units": "degree"}),
+    }
+    for n, d in zip(names, dims):
+        p = cls.params[n]
+        coords[d] = (d, np.asarray(values[n]), {"parameter": n, "long_name": f"{spec['type']} parameter {n}" + (f": {p.doc}" if p.doc else ""),
+                                                "valid_range": p.range_text()})
+    return xr.Dataset(data, coords=coords, attrs={
+        "title": f"Directional albedo of {spec['type']} over {', '.join(names)}"
+                 + (f", pumped ({pump['g']}, {pump['levels']} levels)" if pump else ""),
+        "pumpup_kind": SWEEP_KIND,
+        "spec": json.dumps(base, sort_keys=True),
+        "model": spec["type"],
+        "swept_parameters": json.dumps(names),
+        "swept_dimensions": json.dumps(list(dims)),
+        "cell_spec": "spec with the swept parameters set to the cell's coordinates; model defaults per cell",
+        "pump": json.dumps(pump, sort_keys=True),
+        "method": METHOD,
+        "rtol": opts["rtol"],
+        "atol": opts["atol"],
+        "mean_albedo_rtol": MEAN_RTOL if opts["mean"] else "not computed",
+        "max_albedo_rtol": MAX_RTOL if opts["maximum"] else "not computed",
+        "max_albedo_mu_min": MAX_MU_MIN if opts["maximum"] else "not computed",
+        "grid": "given",
+        "pumpup_version": __version__,
+    })
+
+
+def _write_output(ds, out) -> None:
+    """netCDF (atomic rename of a temporary file) or a zarr store (atomic rename of a temporary directory)."""
+    from .tables import write_table
+
+    out = os.fspath(out)
+    if not out.rstrip("/").endswith(".zarr"):
+        write_table(ds, out)
+        return
+    out = out.rstrip("/")
+    parent = os.path.dirname(os.path.abspath(out))
+    tmp = tempfile.mkdtemp(prefix=".tmp-", suffix=".zarr", dir=parent)
+    try:
+        ds.to_zarr(tmp, mode="w", zarr_format=2, consolidated=True)  # format 2: every zarr and xarray reads it
+        if os.path.exists(out):
+            old = tempfile.mkdtemp(prefix=".old-", dir=parent)
+            os.replace(out, os.path.join(old, "store"))
+            os.replace(tmp, out)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
