@@ -271,13 +271,16 @@ def _progress_bar(total: int, progress: bool | None):
 
 def _run_local(tasks, scheduler: str, workers: int | None, on_done) -> None:
     """Run the chunks with a local dask scheduler; ``on_done`` sees each result in this process."""
-    import dask
-    from dask.callbacks import Callback
+    import uuid
 
+    import dask
+    from dask.callbacks import Callback, normalize_callback
+
+    run = uuid.uuid4().hex  # keys of this run only, even beside other dask work in this process
     keys = {}
     delayed = []
     for k, (block, args) in enumerate(tasks):
-        key = f"pumpup-sweep-chunk-{k}"
+        key = f"pumpup-sweep-{run}-chunk-{k}"
         keys[key] = block
         delayed.append(dask.delayed(_run_chunk, pure=True)(*args, dask_key_name=key))
 
@@ -287,9 +290,8 @@ def _run_local(tasks, scheduler: str, workers: int | None, on_done) -> None:
                 on_done(keys[key], result)
 
     kw = {} if scheduler == "synchronous" or workers is None else {"num_workers": workers}
-    with Saver():
-        # each result is placed (and saved) as it arrives
-        dask.compute(*delayed, scheduler=scheduler, **kw)
+    # each result is placed (and saved) as it arrives; the callback is local to this computation
+    dask.compute(*delayed, scheduler=scheduler, callbacks=[normalize_callback(Saver())], **kw)
 
 
 def _run_distributed(tasks, client, address: str | None, on_done) -> None:
@@ -428,6 +430,10 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu=None, *, pump: Ma
         raise ValueError("sweep: mu is empty; give at least one value in (0, 1]")
     if client is not None and scheduler is not None:
         raise ValueError("sweep: give client= or scheduler=, not both")
+    if scheduler is not None and (not isinstance(scheduler, str)
+                                  or (scheduler not in LOCAL_SCHEDULERS and ":" not in scheduler)):
+        raise ValueError(f"sweep: scheduler must be one of {', '.join(map(repr, LOCAL_SCHEDULERS))} or the address "
+                         f"of a dask.distributed scheduler such as 'tcp://host:8786', got {scheduler!r}")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ValueError(f"sweep: workers must be an integer >= 1, got {workers!r}")
     shape = tuple(len(values[n]) for n in names)

@@ -6,7 +6,9 @@ sweep pumped with g2 at 2 levels (001 eq. 21).  Each grid size k x k samples the
 parameter ranges, so the mean cost of a cell does not depend on k and the time should be
 linear in the number of cells: t = t0 + b * cells.  Every size runs in a fresh process
 (``--one``) so that its peak memory is its own: the peak of the summed resident set size of
-the process and its dask worker processes, sampled every 0.2 s.
+the process and its dask worker processes, sampled every 0.2 s.  The CPU time (user +
+system, of the process and its workers) is reported beside the wall time: on a shared
+machine it is the steadier measure of the cost per cell.
 
 Usage::
 
@@ -56,9 +58,16 @@ def _peak_rss(stop: threading.Event, out: list) -> None:
 
 def run_one(k: int, pumped: bool, n_mu: int, scheduler: str, workers: int) -> dict:
     """One sweep of a k x k grid in this process; its wall time and peak memory."""
+    import resource
+
     import pumpup
     from pumpup.sweep import default_mu
 
+    def cpu() -> float:  # user + system seconds of this process and its finished (reaped) workers
+        return sum(r.ru_utime + r.ru_stime for r in (resource.getrusage(resource.RUSAGE_SELF),
+                                                     resource.getrusage(resource.RUSAGE_CHILDREN)))
+
+    cpu0 = cpu()
     stop, peak = threading.Event(), []
     sampler = threading.Thread(target=_peak_rss, args=(stop, peak), daemon=True)
     sampler.start()
@@ -69,12 +78,14 @@ def run_one(k: int, pumped: bool, n_mu: int, scheduler: str, workers: int) -> di
                           pump={"g": "g2", "levels": 2} if pumped else None,
                           scheduler=scheduler, workers=workers, out=out, progress=False)
         seconds = time.perf_counter() - t0
+        cpu_seconds = cpu() - cpu0
+        load = os.getloadavg()[1]
         size = os.path.getsize(out)
     stop.set()
     sampler.join()
     assert bool(np.isfinite(ds["albedo"]).all())
     return {"k": k, "cells": k * k, "n_mu": n_mu, "pumped": pumped, "scheduler": scheduler, "workers": workers,
-            "seconds": seconds, "peak_rss_mb": peak[0] / 2**20, "file_mb": size / 2**20,
+            "seconds": seconds, "cpu_seconds": cpu_seconds, "load_5min": load, "peak_rss_mb": peak[0] / 2**20, "file_mb": size / 2**20,
             "max_albedo": float(ds["albedo"].max())}
 
 
@@ -103,11 +114,14 @@ def report(path: str) -> str:
             continue
         name = "stretched Phong, pumped g2 x 2" if pumped else "stretched Phong"
         lines.append(f"## {name} (n_mu = {sub[0]['n_mu']}, {sub[0]['scheduler']}, {sub[0]['workers']} workers)")
-        lines.append("| grid | cells | wall time [s] (measured) | s / cell | peak memory [MB] (measured) | file [MB] |")
-        lines.append("|---|---|---|---|---|---|")
+        lines.append("| grid | cells | wall time [s] | wall s / cell | CPU s / cell | peak memory [MB] | file [MB] "
+                     "| load (5 min) |")
+        lines.append("|---|---|---|---|---|---|---|---|")
         for r in sub:
+            cpu = f"{r['cpu_seconds'] / r['cells']:.2f}" if "cpu_seconds" in r else "-"
+            load = f"{r['load_5min']:.1f}" if "load_5min" in r else "-"
             lines.append(f"| {r['k']} x {r['k']} | {r['cells']} | {r['seconds']:.1f} | {r['seconds'] / r['cells']:.2f}"
-                         f" | {r['peak_rss_mb']:.0f} | {r['file_mb']:.2f} |")
+                         f" | {cpu} | {r['peak_rss_mb']:.0f} | {r['file_mb']:.2f} | {load} |")
         f = fit(sub)
         if f:
             measured = any(r["k"] == FULL for r in sub)

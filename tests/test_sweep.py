@@ -254,6 +254,8 @@ def test_other_bad_input():
         pumpup.sweep({"type": "phong_shader"}, {"n": [1]}, mu=[1.0], pump={"g": "g2"})
     with pytest.raises(ValueError, match="client= or scheduler="):
         pumpup.sweep(SPEC, {"n": [1]}, mu=[1.0], client=object(), scheduler="threads")
+    with pytest.raises(ValueError, match="scheduler must be one of 'threads', 'processes', 'synchronous' or"):
+        pumpup.sweep(SPEC, {"n": [1]}, mu=[1.0], scheduler="thread")
     with pytest.raises(ValueError, match="chunks names 'q'"):
         pumpup.sweep(SPEC, {"n": [1]}, mu=[1.0], chunks={"q": 2})
 
