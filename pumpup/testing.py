@@ -557,10 +557,16 @@ def chi2_test(
     samples (rejected ones included) fall in cells whose expected count is 0; fewer than
     two cells remain after pooling.
 
-    The quadrature is accurate when the pdf is smooth inside each bin.  The horizon is a
-    bin edge; other discontinuities are handled by refinement, up to ``max_depth``.  A
-    lobe much narrower than a bin needs more bins or a larger ``ires``; a bin that holds
-    samples where the quadrature saw only zeros is refined before it is declared empty.
+    The quadrature is accurate when the pdf is continuous inside each bin (measured: the
+    Phong-lobe pdf with rejection integrates to within 2e-10 of an independent 1-D
+    quadrature, and pumpup's own samplers to within their reported error).  The horizon is
+    a bin edge.  A pdf with a jump inside bins (say, uniform in a cone) is refined along
+    the jump only down to ``max_depth``, and thin slivers that no node hits are lost: for a
+    12-degree cone about 2e-5 of the mass goes missing, which biases the rejected cell at
+    1e6 samples; the result then carries a note when the error estimate is large beside
+    the rejected cell's noise.  A lobe much narrower than a bin needs more bins or a larger
+    ``ires``; a bin that holds samples where the quadrature saw only zeros is refined
+    before it is declared empty.
 
     References
     ----------
