@@ -467,3 +467,14 @@ def test_albedo_matches_mitsuba_monte_carlo(mi, dist):
         a = float(pumpup.albedo(_like_mitsuba(dist, alpha), mu))
         assert abs(est - a) <= 4 * se, (dist, alpha, mu, a, est, se)
         assert se < 0.005
+
+
+def test_pumped_ggx_reflects_more_and_at_most_one():
+    # 001 eq. 16-20: pumping a microfacet model raises its albedo towards 1 and never above it
+    base = pumpup.load({"type": "ggx", "alpha": 0.5})
+    pumped = pumpup.pump(base, g="g1")
+    mu = np.array([1.0, 0.5, 0.1, 1e-3])
+    a, e = pumpup.albedo(pumped, mu, return_error=True)
+    b = pumpup.albedo(base, mu)
+    assert np.all(a > b + 0.1) and np.all(a - e <= 1.0)
+    assert pumpup.check_reciprocity(pumped).reciprocal
