@@ -433,10 +433,17 @@ def sample(brdf: BRDF, wo, n: int, rng=None, *, kind: str = "lobe") -> tuple[np.
 
 
 def pdf(brdf: BRDF, wi, wo, *, kind: str = "lobe") -> np.ndarray:
-    """The density [1/sr] with which :func:`sample` draws wi given wo (wo of shape (3,))."""
+    """The density [1/sr] with which :func:`sample` draws wi given wo (wo of shape (3,)).
+
+    ``wi`` may hold the zero vectors of rejected draws (their density is 0), so
+    ``pdf(f, sample(f, wo, n, rng)[0], wo)`` equals the second output of :func:`sample`.
+    """
     f = _check_brdf(brdf)
     w = _check_wo(wo)
-    return strategy(f, float(w[2]), kind).pdf(as_directions(wi, "wi"), w)
+    a = np.asarray(wi, dtype=np.float64)
+    rejected = np.all(a == 0.0, axis=-1, keepdims=True)
+    a = as_directions(np.where(rejected, np.array([0.0, 0.0, -1.0]), a), "wi")  # below the horizon: p = 0
+    return strategy(f, float(w[2]), kind).pdf(a, w)
 
 
 def _weights(f: BRDF, strat: Strategy, w: np.ndarray, n: int, rng, radiance=None, chunk: int = 1 << 20):

@@ -247,6 +247,14 @@ def test_strategy_from_hints():
     assert S.strategy(pumped, 0.3).components == ((1.0, S.HALF_POWER, 20.0),)
 
 
+def test_pdf_function_matches_the_sampled_density(rng):
+    for spec in ({"type": "phong", "n": 20}, {"type": "ward", "m": 0.2}, {"type": "plastic", "n": 20}):
+        f = pumpup.load(spec)
+        wi, p = pumpup.sample(f, VIEWS[2], 10_000, rng)
+        assert np.any(p == 0)  # rejected draws are in there
+        np.testing.assert_allclose(pumpup.sampling.pdf(f, wi, VIEWS[2]), p, rtol=1e-9, atol=0)
+
+
 def test_same_seed_same_samples():
     f = pumpup.load({"type": "ward", "m": 0.2})
     a = pumpup.sample(f, VIEWS[1], 1000, np.random.default_rng(3))
@@ -334,3 +342,56 @@ def test_efficiency_claims_of_000_sec_4_2(efficiency):
     np.testing.assert_allclose(efficiency.acceptance.isel(mu=-1), 0.5, rtol=1e-6)
     # at grazing every accepted stretched weight is (n+2)/(n+1): relative variance 1 (Bernoulli 1/2)
     np.testing.assert_allclose(s.isel(mu=-1), 1.0, rtol=1e-6)
+
+
+# ----------------------------------------------------------------------------------------
+# chi-square goodness of fit of every sampler (pumpup.testing, in the manner of pbrt-v4 and Mitsuba 3)
+# ----------------------------------------------------------------------------------------
+
+CHI2_VIEWS = np.array([[0.0, 0.0, 1.0], [0.6, 0.0, 0.8], [0.8 * math.sqrt(1 - 0.1**2), 0.6 * math.sqrt(1 - 0.1**2), 0.1]])
+
+CHI2_MODELS = [
+    {"type": "phong", "n": 20},
+    {"type": "stretched_phong", "n": 5},
+    {"type": "retro", "n": 10},
+    {"type": "blinn", "n": 20},
+    {"type": "ward", "m": 0.2},
+    {"type": "ward_aniso", "ax": 0.1, "ay": 0.3},
+    {"type": "cook_torrance", "m": 0.3},
+    {"type": "torrance_sparrow", "d": "D2", "s": 5.0},
+    {"type": "schlick", "r": 0.1},
+    {"type": "ggx", "alpha": 0.3},
+    {"type": "beckmann", "alpha": 0.2},
+    {"type": "lambert"},
+    {"type": "plastic", "n": 20, "eta": 1.5, "ad": 0.5},
+    {"type": "pumped", "base": {"type": "blinn", "n": 10}, "g": "g2"},
+]
+
+
+@pytest.mark.parametrize("spec", CHI2_MODELS, ids=lambda s: s["type"])
+def test_chi2_every_sampler(spec):
+    """1e6 draws per view direction, three views, Sidak-corrected significance 0.01."""
+    from pumpup.testing import chi2_test
+
+    try:
+        f = pumpup.load(spec)
+    except pumpup.SpecError as e:  # a parameter name changed: fail loudly rather than skip
+        raise AssertionError(f"test spec out of date: {e}") from e
+    res = chi2_test(lambda wo, n, rng: pumpup.sample(f, wo, n, rng), lambda wi, wo: pumpup.sampling.pdf(f, wi, wo),
+                    CHI2_VIEWS, n_samples=1_000_000, seed=11)
+    assert res.passed, str(res)
+
+
+def test_chi2_catches_a_wrong_phong_pdf():
+    """The sampler of n = 20 reported with the density of n = 21 (consistently, so only the
+    histogram can tell): the test must fail."""
+    from pumpup.testing import chi2_test
+
+    f, wrong = pumpup.load({"type": "phong", "n": 20}), pumpup.load({"type": "phong", "n": 21})
+
+    def sample(wo, n, rng):
+        wi, _ = pumpup.sample(f, wo, n, rng)
+        return wi, pumpup.sampling.pdf(wrong, wi, wo)
+
+    res = chi2_test(sample, lambda wi, wo: pumpup.sampling.pdf(wrong, wi, wo), CHI2_VIEWS, n_samples=1_000_000, seed=11)
+    assert not res.passed
