@@ -290,8 +290,10 @@ def _run_local(tasks, scheduler: str, workers: int | None, on_done) -> None:
                 on_done(keys[key], result)
 
     kw = {} if scheduler == "synchronous" or workers is None else {"num_workers": workers}
-    # each result is placed (and saved) as it arrives; the callback is local to this computation
-    dask.compute(*delayed, scheduler=scheduler, callbacks=[normalize_callback(Saver())], **kw)
+    # each result is placed (and saved) as it arrives; the callback is local to this computation.
+    # chunksize=1: one chunk per dispatch (dask's process scheduler batches 6 ready tasks per
+    # worker by default, which ran a sweep of two chunks on one process)
+    dask.compute(*delayed, scheduler=scheduler, callbacks=[normalize_callback(Saver())], chunksize=1, **kw)
 
 
 def _run_distributed(tasks, client, address: str | None, on_done) -> None:

@@ -89,12 +89,13 @@ def run_one(k: int, pumped: bool, n_mu: int, scheduler: str, workers: int) -> di
             "max_albedo": float(ds["albedo"].max())}
 
 
-def fit(rows: list[dict]) -> dict | None:
-    """Least-squares t = t0 + b * cells, with the largest relative residual."""
+def fit(rows: list[dict], key: str = "seconds") -> dict | None:
+    """Least-squares t = t0 + b * cells of ``key`` (wall or CPU seconds), with the largest relative residual."""
+    rows = [r for r in rows if key in r]
     if len({r["cells"] for r in rows}) < 2:
         return None
     c = np.array([r["cells"] for r in rows], float)
-    t = np.array([r["seconds"] for r in rows], float)
+    t = np.array([r[key] for r in rows], float)
     b, t0 = np.polyfit(c, t, 1)
     resid = np.max(np.abs(t0 + b * c - t) / t)
     # the exponent of a power law t ~ cells^e through the two largest grids (1 = linear)
@@ -107,6 +108,7 @@ def fit(rows: list[dict]) -> dict | None:
 def report(path: str) -> str:
     with open(path) as fh:
         rows = [json.loads(line) for line in fh if line.strip()]
+    rows = list({(r["k"], r["pumped"]): r for r in rows}.values())  # the latest run of each grid
     lines = []
     for pumped in (False, True):
         sub = sorted((r for r in rows if r["pumped"] == pumped), key=lambda r: r["cells"])
@@ -122,12 +124,14 @@ def report(path: str) -> str:
             load = f"{r['load_5min']:.1f}" if "load_5min" in r else "-"
             lines.append(f"| {r['k']} x {r['k']} | {r['cells']} | {r['seconds']:.1f} | {r['seconds'] / r['cells']:.2f}"
                          f" | {cpu} | {r['peak_rss_mb']:.0f} | {r['file_mb']:.2f} | {load} |")
-        f = fit(sub)
-        if f:
-            measured = any(r["k"] == FULL for r in sub)
-            lines.append(f"fit t = {f['t0']:.1f} s + {f['per_cell']:.3f} s x cells (largest relative residual "
+        measured = any(r["k"] == FULL for r in sub)
+        for key, what in (("seconds", "wall"), ("cpu_seconds", "CPU")):
+            f = fit(sub, key)
+            if not f:
+                continue
+            lines.append(f"{what}: fit t = {f['t0']:.1f} s + {f['per_cell']:.3f} s x cells (largest relative residual "
                          f"{f['max_rel_residual']:.2f}; exponent between the two largest grids {f['exponent_last_two']:.2f})")
-            lines.append(f"{FULL} x {FULL}: {f['full_seconds']:.0f} s = {f['full_seconds'] / 3600:.2f} h "
+            lines.append(f"{what}: {FULL} x {FULL}: {f['full_seconds']:.0f} s = {f['full_seconds'] / 3600:.2f} h "
                          + ("(fit; also measured above)" if measured else "(EXTRAPOLATED from the fit, not measured)"))
         lines.append("")
     return "\n".join(lines)
