@@ -68,8 +68,8 @@ class AlbedoTable:
     ``interp_error`` is the largest difference between the interpolant and the computed
     albedo at the midpoints of the intervals, measured when the grid was built (or 0 if
     the grid was given and not checked).  :meth:`upper` is an upper bound of the true
-    albedo: interpolant + SAFETY x interpolation error + the larger quadrature error of
-    the two neighbouring nodes.
+    albedo: interpolant + SAFETY x interpolation error + the largest quadrature error of
+    the table (one constant, so that the bound is as smooth and as monotone as the spline).
     """
 
     def __init__(self, mu, value, error, interp_error: float = 0.0, spec: dict | None = None):
@@ -90,7 +90,7 @@ class AlbedoTable:
         self.slope_below = ((math.log(a1) - math.log(a0)) / (math.log(self.mu[1]) - math.log(self.mu[0]))
                             if a0 > 0 and a1 > 0 else 0.0)
         #: added to the interpolant in :meth:`upper`
-        self.margin = self.SAFETY * self.interp_error
+        self.margin = self.SAFETY * self.interp_error + float(np.max(self.error))
         #: added below the first node, where the extrapolation is a guess: also the spread of the
         #: first interval and the first node's quadrature error
         self.margin_below = self.margin + float(self.error[0]) + abs(float(a1) - float(a0))
@@ -109,22 +109,30 @@ class AlbedoTable:
             out = np.where(lo, self.value[0] * np.exp(self.slope_below * (lm - math.log(self.mu[0]))), out)
         return out
 
-    def node_error(self, mu) -> np.ndarray:
-        """Quadrature error of the nearest nodes (the larger of the two neighbours)."""
-        m = check_mu(mu)
-        i = np.clip(np.searchsorted(self.mu, m), 1, len(self.mu) - 1)
-        return np.maximum(self.error[i - 1], self.error[i])
-
     #: the measured interpolation error is multiplied by this in :meth:`upper` (the largest
     #: miss between nodes found by the tests is within 1 % of the one measured at midpoints)
     SAFETY = 2.0
 
     def upper(self, mu) -> np.ndarray:
-        """An upper bound of the true albedo: interpolant + 2 x interpolation error + quadrature error
-        (``margin_below`` below the first node).  The pumping operator's compiled look-up uses
-        the same margins."""
+        """An upper bound of the true albedo: interpolant + ``margin`` (2 x interpolation error +
+        the largest quadrature error), ``margin_below`` below the first node.  The pumping
+        operator's compiled look-up uses the same margins."""
         m = check_mu(mu)
-        return self(m) + np.where(m < self.mu[0], self.margin_below, self.margin + self.node_error(m))
+        return self(m) + np.where(m < self.mu[0], self.margin_below, self.margin)
+
+    def is_increasing(self) -> bool:
+        """True if the spline is non-decreasing on [mu_0, mu_last] (checked exactly: the minimum of
+        each piece's derivative, a quadratic in log mu, is >= 0).  Then so is :meth:`upper` there,
+        and max(upper(x), upper(y)) = upper(max(x, y)) for x, y >= mu_0."""
+        c = self._spline.c  # piece i: c0 d^3 + c1 d^2 + c2 d + c3, d in [0, h_i]
+        h = np.diff(self._spline.x)
+        q2, q1, q0 = 3 * c[0], 2 * c[1], c[2]  # derivative q2 d^2 + q1 d + q0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dv = np.where(q2 != 0, -q1 / (2 * q2), 0.0)
+        inside = (dv > 0) & (dv < h)
+        lowest = np.minimum(q0, q2 * h * h + q1 * h + q0)
+        lowest = np.where(inside, np.minimum(lowest, q2 * dv * dv + q1 * dv + q0), lowest)
+        return bool(np.all(lowest >= 0))
 
 
 def _midpoints(mu: np.ndarray) -> np.ndarray:

@@ -114,6 +114,26 @@ def test_kernel_matches_reference_and_radiance_is_controlled(rng):
     assert (f.base.base.eval(wi, wo) * cos_l).max() <= 22 / (2 * np.pi) * (1 + 1e-12)
 
 
+def test_kernel_both_look_up_paths_and_broadcasting(rng):
+    """The kernel takes one look-up per level where the level's bound increases (Phong) and two
+    where it does not (Ward, whose albedo grows towards grazing): both agree with the reference,
+    also for broadcast shapes and non-contiguous direction arrays."""
+    phong = pumpup.pump(pumpup.load(BASES["phong"]), g="g2", levels=2)
+    ward = pumpup.pump(pumpup.load({"type": "ward", "m": 0.3}), g="g1", levels=1)
+    assert all(lev.lookup().increasing for lev in phong.chain())
+    assert not ward.lookup().increasing
+    wi = random_directions(rng, 2000)
+    wo = random_directions(rng, 2000)[::-1]
+    for f in (phong, ward):
+        np.testing.assert_allclose(f.eval(wi, wo), f.reference(wi, wo), rtol=1e-13, atol=1e-300)
+        a, b = wi[:40, None, :], wo[None, :50, :]
+        np.testing.assert_allclose(f.eval(a, b), f.reference(a, b), rtol=1e-13, atol=1e-300)
+        strided = np.concatenate([wi, wo], axis=-1)[:, :3]  # a view with row stride 6
+        assert not strided.flags.c_contiguous
+        np.testing.assert_array_equal(f.eval(strided, wo), f.eval(np.ascontiguousarray(strided), wo))
+        np.testing.assert_allclose(f.eval(wi[0], wo), f.reference(wi[0], wo), rtol=1e-13, atol=1e-300)
+
+
 def test_repeated_controlled_pumping_can_exceed_the_input_radiance():
     # The bound above holds one level at a time (f_k cos <= f_(k-1)), not against the original:
     # level 2 divides by g2 = max(a(L), a(V), N.L, N.V) of level 1, which near grazing is well

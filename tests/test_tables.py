@@ -124,3 +124,19 @@ def test_compiled_upper_bound_is_the_tables_upper_bound(phong_table):
     mu = np.concatenate([10 ** np.random.default_rng(9).uniform(-10, 0, 200), [1.0, 1e-12]])
     np.testing.assert_allclose(lookup.upper(mu), np.minimum(lookup.cap, table.upper(mu)), rtol=1e-12, atol=1e-15)
     assert np.any(mu < table.mu[0])
+
+
+def test_is_increasing_is_exact(phong_table):
+    """AlbedoTable.is_increasing agrees with a dense check of the spline, and says False for a
+    table that goes down (the pumping kernel takes one look-up per level only when it is True)."""
+    table = pumpup.AlbedoTable.from_dataset(phong_table)
+    mu = np.clip(np.exp(np.linspace(np.log(table.mu[0]), 0.0, 200_001)), table.mu[0], 1.0)  # on the spline
+    dense = bool(np.all(np.diff(table.upper(mu)) >= -1e-15))
+    assert table.is_increasing() and dense
+    down = pumpup.AlbedoTable(table.mu, table.value[::-1], table.error, table.interp_error)
+    assert not down.is_increasing()
+    # a single dip between two nodes, invisible at the nodes, is found
+    v = table.value.copy()
+    x = np.log(table.mu)
+    bump = pumpup.AlbedoTable(table.mu, v + 1e-3 * np.sin(40 * x), table.error, table.interp_error)
+    assert bump.is_increasing() == bool(np.all(np.diff(bump(mu)) >= 0))
