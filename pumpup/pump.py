@@ -312,7 +312,7 @@ class Pumped(BRDF):
         if not own or f.shape != shape:
             f = np.array(np.broadcast_to(f, shape), dtype=np.float64)  # a copy we own
         if wi.shape[:-1] != shape or wo.shape[:-1] != shape:
-            wi, wo = np.broadcast_arrays(wi, wo)
+            wi, wo = np.broadcast_to(wi, shape + (3,)), np.broadcast_to(wo, shape + (3,))  # read-only views
         # (n, 3) views of the directions when their strides allow it (the engine's do): no copies
         _chain_kernel(f.reshape(-1), wi.reshape(-1, 3), wo.reshape(-1, 3), *self._chain_args())
         return f
