@@ -227,6 +227,41 @@ def cmd_sweep(args) -> int:
     return 0
 
 
+def cmd_mc(args) -> int:
+    import numpy as np
+
+    import pumpup
+
+    f = _load(args.spec)
+    mu = np.asarray(args.mu if args.mu else [1.0, 0.5, 0.1, 0.01], dtype=float)
+    if args.n < 1:
+        raise SystemExit(f"pumpup: --n must be >= 1, got {args.n}")
+    rng = np.random.default_rng(args.seed)
+    try:
+        est, se = pumpup.mc_albedo(f, mu, args.n, rng, kind=args.strategy)
+        a, e = pumpup.albedo(f, mu, return_error=True)
+    except ValueError as exc:
+        raise SystemExit(f"pumpup: {exc}") from None
+    print(f"# {json.dumps(f.spec)}: {pumpup.sampling.strategy(f, float(mu[0]), args.strategy)}, "
+          f"{args.n} samples per mu, seed {args.seed}")
+    print(f"{'mu':>10s} {'Monte Carlo':>14s} {'std error':>10s} {'quadrature':>18s} {'(MC - q) / se':>14s}")
+    worst = 0.0
+    for m, v, s_, q in zip(mu, est, se, a):
+        z = (v - q) / s_ if s_ > 0 else (0.0 if v == q else np.inf)
+        worst = max(worst, abs(z))
+        print(f"{m:10.6g} {v:14.8f} {s_:10.2g} {q:18.12f} {z:14.2f}")
+    if args.chi2:
+        from pumpup.testing import chi2_test
+
+        views = np.stack([np.sqrt((1 - mu) * (1 + mu)), np.zeros_like(mu), mu], axis=-1)
+        res = chi2_test(lambda wo, n, r: pumpup.sample(f, wo, n, r, kind=args.strategy),
+                        lambda wi, wo: pumpup.sampling.pdf(f, wi, wo, kind=args.strategy), views, seed=args.seed)
+        print(res)
+        if not res.passed:
+            return 1
+    return 0 if worst < 4 else 1
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="pumpup",
@@ -272,6 +307,15 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--tables", default="tables")
     s.add_argument("--figures", default="tables")
     s.set_defaults(func=cmd_divergence)
+    s = sub.add_parser("mc", help="Monte Carlo albedo by importance sampling (000 sec. 4) beside the quadrature; "
+                                  "exit status 1 if they differ by 4 standard errors or more")
+    s.add_argument("spec")
+    s.add_argument("--mu", type=float, nargs="+", help="cos(theta_i) values in (0, 1]")
+    s.add_argument("--n", type=int, default=1_000_000, help="samples per mu (default 1e6)")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--strategy", choices=("lobe", "cosine"), default="lobe")
+    s.add_argument("--chi2", action="store_true", help="also run the chi-square test of the sampler at these mu")
+    s.set_defaults(func=cmd_mc)
     s = sub.add_parser("check", help="reciprocity and maximum albedo of a model")
     s.add_argument("spec")
     s.set_defaults(func=cmd_check)

@@ -42,3 +42,15 @@ def test_bad_spec_and_mu_are_clear_errors():
 def test_help_is_fast_and_works():
     r = subprocess.run([sys.executable, "-m", "pumpup.cli", "--help"], capture_output=True, text=True, timeout=60)
     assert r.returncode == 0 and "albedo" in r.stdout
+
+
+def test_mc_command(capsys):
+    """Monte Carlo beside quadrature; exit 0 when they agree within 4 standard errors, clear errors."""
+    assert main(["mc", "stretched_phong:n=20", "--mu", "1", "0.05", "--n", "50000", "--seed", "3"]) == 0
+    out = capsys.readouterr().out
+    assert "phong lobe (mirror)(20)" in out and "(MC - q) / se" in out
+    assert len(out.strip().splitlines()) == 4
+    with pytest.raises(SystemExit, match="mu"):
+        main(["mc", "phong:n=20", "--mu", "0"])
+    with pytest.raises(SystemExit, match="--n"):
+        main(["mc", "phong:n=20", "--n", "0"])
