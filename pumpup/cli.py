@@ -239,7 +239,7 @@ def cmd_mc(args) -> int:
     rng = np.random.default_rng(args.seed)
     try:
         est, se = pumpup.mc_albedo(f, mu, args.n, rng, kind=args.strategy)
-        a, e = pumpup.albedo(f, mu, return_error=True)
+        a = pumpup.albedo(f, mu)
     except ValueError as exc:
         raise SystemExit(f"pumpup: {exc}") from None
     print(f"# {json.dumps(f.spec)}: {pumpup.sampling.strategy(f, float(mu[0]), args.strategy)}, "

@@ -559,36 +559,42 @@ class _SwappedRoles:
 # ----------------------------------------------------------------------------------------
 
 
-class _SecondMomentIntegrand(BRDF):
-    """h(wi, wo) = f(wi, wo)^2 cos(theta_o) / p(wo | wi): its albedo is E[w^2] of mc_albedo."""
+class _MomentIntegrand(BRDF):
+    """An integrand h(c, x) whose albedo at c (the engine integrates h cos(theta_x) over x) is a
+    moment of the sampling of x around c (x drawn with density p(x | c) of ``strategy``):
 
-    type = "second-moment"
+    * ``what = "second"``: h = f(c, x)^2 cos(theta_x) / p(x | c), albedo E[w^2] of mc_albedo;
+    * ``what = "density"``: h = p(x | c) / cos(theta_x), albedo the acceptance probability.
+    """
+
+    type = "sampling-moment"
     params = {}
     constant = None
 
-    def __init__(self, f: BRDF, kind: str):
+    def __init__(self, f: BRDF, kind: str, what: str):
         self.p = {}
-        self.f = f
-        self.kind = kind
+        self.f, self.kind, self.what = f, kind, what
         self.reciprocal = False
 
     @property
     def spec(self):  # not a user model: never saved
-        return {"type": self.type, "of": self.f.spec, "kind": self.kind}
+        return {"type": self.type, "of": self.f.spec, "kind": self.kind, "what": self.what}
 
-    def _eval(self, wi, wo):
-        wi, wo = np.broadcast_arrays(wi, wo)
-        shape = wi.shape[:-1]
-        a, b = wi.reshape(-1, 3), wo.reshape(-1, 3)
+    def _eval(self, c, x):
+        c, x = np.broadcast_arrays(c, x)
+        shape = c.shape[:-1]
+        a, b = c.reshape(-1, 3), x.reshape(-1, 3)
         out = np.zeros(a.shape[0])
-        fv = self.f._eval(a, b)
-        mu = np.unique(a[:, 2])
-        for m in mu:  # the engine integrates one incidence direction at a time, in groups
+        fv = self.f._eval(a, b) if self.what == "second" else None
+        for m in np.unique(a[:, 2]):  # the engine integrates a few incidence directions at a time
             sel = a[:, 2] == m
-            st = strategy(self.f, float(m), self.kind)
-            p = st.pdf(b[sel], a[sel])
+            p = strategy(self.f, float(m), self.kind).pdf(b[sel], a[sel])
+            z = b[sel, 2]
             with np.errstate(divide="ignore", invalid="ignore"):
-                out[sel] = np.where(fv[sel] > 0, fv[sel] ** 2 * np.maximum(b[sel, 2], 0) / p, 0.0)
+                if self.what == "second":
+                    out[sel] = np.where(fv[sel] > 0, fv[sel] ** 2 * np.maximum(z, 0) / p, 0.0)
+                else:
+                    out[sel] = np.where(z > 0, p / np.where(z > 0, z, 1.0), 0.0)
         return out.reshape(shape)
 
     def lobe(self, mu):
@@ -612,40 +618,7 @@ def second_moment(brdf: BRDF, mu, *, kind: str = "lobe", rtol: float = 1e-9, ret
     from .albedo import albedo
 
     f = _check_brdf(brdf)
-    return albedo(_SecondMomentIntegrand(f, kind), mu, return_error=return_error, rtol=rtol)
-
-
-class _DensityIntegrand(BRDF):
-    """h(c, x) = p(x | c) / cos(theta_x): its albedo at c is the probability that a draw is accepted."""
-
-    type = "acceptance"
-    params = {}
-    constant = None
-
-    def __init__(self, f: BRDF, kind: str):
-        self.p = {}
-        self.f = f
-        self.kind = kind
-        self.reciprocal = False
-
-    @property
-    def spec(self):  # not a user model: never saved
-        return {"type": self.type, "of": self.f.spec, "kind": self.kind}
-
-    def _eval(self, c, x):
-        c, x = np.broadcast_arrays(c, x)
-        shape = c.shape[:-1]
-        a, b = c.reshape(-1, 3), x.reshape(-1, 3)
-        out = np.zeros(a.shape[0])
-        for m in np.unique(a[:, 2]):
-            sel = a[:, 2] == m
-            p = strategy(self.f, float(m), self.kind).pdf(b[sel], a[sel])
-            z = b[sel, 2]
-            out[sel] = np.where(z > 0, p / np.where(z > 0, z, 1.0), 0.0)
-        return out.reshape(shape)
-
-    def lobe(self, mu):
-        return self.f.lobe(mu)
+    return albedo(_MomentIntegrand(f, kind, "second"), mu, return_error=return_error, rtol=rtol)
 
 
 def acceptance(brdf: BRDF, mu, *, kind: str = "lobe", rtol: float = 1e-9, return_error: bool = False):
@@ -663,7 +636,7 @@ def acceptance(brdf: BRDF, mu, *, kind: str = "lobe", rtol: float = 1e-9, return
     from .albedo import albedo
 
     f = _check_brdf(brdf)
-    return albedo(_DensityIntegrand(f, kind), mu, return_error=return_error, rtol=rtol)
+    return albedo(_MomentIntegrand(f, kind, "density"), mu, return_error=return_error, rtol=rtol)
 
 
 # ----------------------------------------------------------------------------------------
