@@ -326,7 +326,14 @@ class Pumped(BRDF):
 
     # --- hints for the albedo engine: the base's lobe plus the kinks of g ------------------
     def kink_levels(self, mu: float) -> tuple:
-        """Values u of N.wo where g(mu, u) has a kink (roots on the tabulated albedo)."""
+        """Values v of N.wo where g(mu, v) has a kink (roots on the tabulated albedo).
+
+        g is the max of U = u(mu), u(v) and, for g2, mu and v (u the upper bound of the base's
+        albedo).  A kink is where the two largest terms cross: a crossing of two terms that lie
+        below a third is no kink, and is dropped (for Phong, whose albedo is above mu, g2 has
+        the kinks of g1 only; two spurious levels within 5e-4 of v = mu once made the cubature
+        refine to rectangles of width 1e-16 there).
+        """
         from scipy.optimize import brentq
 
         up = self.lookup().upper
@@ -337,14 +344,20 @@ class Pumped(BRDF):
         funcs = [lambda u: float(up(u)) - am]
         if self.controlled:
             funcs += [lambda u: float(up(u)) - u, lambda u: float(up(u)) - mu]
-        out = [mu]
-        if self.controlled:
-            out.append(am)
+        out = [mu]  # u(v) = U at v = mu, or (g2) v = mu against U: a kink either way
+        if self.controlled and float(up(am)) <= am * (1 + 1e-12) and am >= mu * (1 - 1e-12):
+            out.append(am)  # v = U, where v and U are the two largest
         for k, fn in enumerate(funcs):
             vals = au - am if k == 0 else (au - grid if k == 1 else au - mu)
             idx = np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]
             for i in idx:
-                out.append(brentq(fn, grid[i], grid[i + 1], xtol=1e-15))
+                v = brentq(fn, grid[i], grid[i + 1], xtol=1e-15)
+                if self.controlled:
+                    # the crossing value c and the terms that are not crossing there
+                    c, others = [(am, (mu, v)), (v, (am, mu)), (mu, (am, v))][k]
+                    if c < max(others) * (1 - 1e-12):
+                        continue  # both crossing terms are below a third: g has no kink here
+                out.append(v)
         levels = []
         for u in sorted(out):  # one level per kink: roots that agree to 1e-12 are the same kink
             if 0 < u < 1 and (not levels or u - levels[-1] > 1e-12 * u):
