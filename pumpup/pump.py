@@ -60,7 +60,7 @@ def base_table(base: BRDF, progress: bool | None = None):
 
 @njit(cache=True)
 def _upper_scalar(mu, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
-    """Upper bound of a(mu): the table's cubic in log(mu) (power law below the first node) + margin,
+    """Upper bound of a(mu): the table's spline piece in log(mu) (power law below the first node) + margin,
     at most ``cap``."""
     return _upper_log(math.log(mu), logx, coef, v0, slope0, margin_lo, margin, cap)
 
@@ -79,7 +79,9 @@ def _upper_log(lm, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: n
         else:
             hi = mid
     d = lm - logx[lo]
-    val = ((coef[0, lo] * d + coef[1, lo]) * d + coef[2, lo]) * d + coef[3, lo]
+    val = coef[0, lo]
+    for r in range(1, coef.shape[0]):  # Horner: the spline piece in d = log(mu) - logx[lo]
+        val = val * d + coef[r, lo]
     return min(cap, val + margin)
 
 
@@ -136,7 +138,13 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
                     while i < b - 2 and logx[i + 1] <= lm:
                         i += 1
                     d = lm - logx[i]
-                    u = ((coef[0, i] * d + coef[1, i]) * d + coef[2, i]) * d + coef[3, i]
+                    if coef.shape[0] == 6:  # the quintic, written out (Horner)
+                        u = ((((coef[0, i] * d + coef[1, i]) * d + coef[2, i]) * d + coef[3, i]) * d
+                             + coef[4, i]) * d + coef[5, i]
+                    else:
+                        u = coef[0, i]
+                        for r in range(1, coef.shape[0]):  # Horner
+                            u = u * d + coef[r, i]
                 g = max(g, min(cap[j], u))  # 001 eq. 20
             if controlled[j]:
                 g = max(g, mmax)  # 001 eq. 21
@@ -149,7 +157,7 @@ class _Lookup:
 
     def __init__(self, table):
         t = table
-        self.logx = np.log(t.mu)
+        self.logx = np.ascontiguousarray(t._spline.x)  # the breakpoints of the spline pieces, in log(mu)
         self.coef = np.ascontiguousarray(t._spline.c)
         self.margin, self.margin_lo = t.margin, t.margin_below  # as in AlbedoTable.upper
         self.increasing = t.is_increasing()
@@ -285,14 +293,14 @@ class Pumped(BRDF):
             looks = [lev.lookup() for lev in self.chain()]
             sizes = [len(lk.logx) for lk in looks]
             offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-            coef = np.zeros((4, offsets[-1]))
+            coef = np.zeros((looks[0].coef.shape[0], offsets[-1]))
             index = np.zeros((len(looks), _INDEX_CELLS), dtype=np.int64)
             lo = np.array([lk.logx[0] for lk in looks])
             h = np.array([(lk.logx[-1] - lk.logx[0]) / _INDEX_CELLS for lk in looks])
             for j, (lk, a) in enumerate(zip(looks, offsets[:-1])):
                 n = lk.coef.shape[1]
                 coef[:, a:a + n] = lk.coef
-                coef[3, a:a + n] += lk.margin  # the same upper bound as _upper_scalar
+                coef[-1, a:a + n] += lk.margin  # the same upper bound as _upper_scalar
                 starts = lo[j] + h[j] * np.arange(_INDEX_CELLS)
                 index[j] = a + np.clip(np.searchsorted(lk.logx, starts, side="right") - 1, 0, n - 1)
             self._chain_cache = (

@@ -61,9 +61,14 @@ def _progress(total: int, desc: str, progress: bool | None):
 class AlbedoTable:
     """a(mu) anywhere in (0, 1], interpolated from a table, with a stated error.
 
-    Interpolation is a not-a-knot cubic spline in log(mu) (C2, fourth order, so the adaptive
-    grid needs few nodes and the pumped integrands stay smooth).  Below the smallest tabulated mu the table extrapolates the
-    power law through its last two nodes (linear in log a versus log mu).
+    Interpolation is an interpolating spline in log(mu) of odd degree ``degree`` with
+    not-a-knot ends: quintic by default (C4, sixth order), so the adaptive grid needs few
+    nodes (measured on pumped Phong: 55-66 instead of the cubic's 88-114) and a pumped
+    integrand f / g, which carries the spline's pieces, stays smooth enough for the cubature;
+    cubic (C2) for tables of fewer than 6 nodes and for files written before the quintic
+    (their ``interpolation_degree`` attribute is missing).  Below the smallest tabulated mu
+    the table extrapolates the power law through its last two nodes (linear in log a versus
+    log mu).
 
     ``interp_error`` is the largest difference between the interpolant and the computed
     albedo at the midpoints of the intervals, measured when the grid was built (or 0 if
@@ -72,8 +77,12 @@ class AlbedoTable:
     the table (one constant, so that the bound is as smooth and as monotone as the spline).
     """
 
-    def __init__(self, mu, value, error, interp_error: float = 0.0, spec: dict | None = None):
-        from scipy.interpolate import CubicSpline
+    #: the default degree of the interpolating spline
+    DEGREE = 5
+
+    def __init__(self, mu, value, error, interp_error: float = 0.0, spec: dict | None = None,
+                 degree: int | None = None):
+        from scipy.interpolate import CubicSpline, PPoly, make_interp_spline
 
         mu = np.asarray(mu, dtype=np.float64)
         order = np.argsort(mu)
@@ -84,7 +93,15 @@ class AlbedoTable:
         self.spec = spec
         if len(self.mu) < 2:
             raise ValueError("an albedo table needs at least two values of mu")
-        self._spline = CubicSpline(np.log(self.mu), self.value, bc_type="not-a-knot", extrapolate=True)
+        degree = self.DEGREE if degree is None else int(degree)
+        if degree not in (3, 5):
+            raise ValueError(f"an albedo table interpolates with degree 3 or 5, got {degree}")
+        self.degree = 5 if degree == 5 and len(self.mu) >= 6 else 3
+        lx = np.log(self.mu)
+        if self.degree == 5:  # a piecewise polynomial in log(mu), breakpoints at the inner knots
+            self._spline = PPoly.from_spline(make_interp_spline(lx, self.value, k=5), extrapolate=True)
+        else:
+            self._spline = CubicSpline(lx, self.value, bc_type="not-a-knot", extrapolate=True)
         a0, a1 = self.value[0], self.value[1]
         #: slope of the power law below the first node (0: constant extrapolation)
         self.slope_below = ((math.log(a1) - math.log(a0)) / (math.log(self.mu[1]) - math.log(self.mu[0]))
@@ -98,7 +115,8 @@ class AlbedoTable:
     @classmethod
     def from_dataset(cls, ds) -> "AlbedoTable":
         return cls(ds["mu"].values, ds["albedo"].values, ds["albedo_error"].values,
-                   float(ds.attrs.get("interpolation_error", 0.0)), json.loads(ds.attrs["spec"]))
+                   float(ds.attrs.get("interpolation_error", 0.0)), json.loads(ds.attrs["spec"]),
+                   degree=int(ds.attrs.get("interpolation_degree", 3)))  # files from before the quintic: cubic
 
     def __call__(self, mu) -> np.ndarray:
         m = check_mu(mu)
@@ -121,18 +139,13 @@ class AlbedoTable:
         return self(m) + np.where(m < self.mu[0], self.margin_below, self.margin)
 
     def is_increasing(self) -> bool:
-        """True if the spline is non-decreasing on [mu_0, mu_last] (checked exactly: the minimum of
-        each piece's derivative, a quadratic in log mu, is >= 0).  Then so is :meth:`upper` there,
-        and max(upper(x), upper(y)) = upper(max(x, y)) for x, y >= mu_0."""
-        c = self._spline.c  # piece i: c0 d^3 + c1 d^2 + c2 d + c3, d in [0, h_i]
-        h = np.diff(self._spline.x)
-        q2, q1, q0 = 3 * c[0], 2 * c[1], c[2]  # derivative q2 d^2 + q1 d + q0
-        with np.errstate(divide="ignore", invalid="ignore"):
-            dv = np.where(q2 != 0, -q1 / (2 * q2), 0.0)
-        inside = (dv > 0) & (dv < h)
-        lowest = np.minimum(q0, q2 * h * h + q1 * h + q0)
-        lowest = np.where(inside, np.minimum(lowest, q2 * dv * dv + q1 * dv + q0), lowest)
-        return bool(np.all(lowest >= 0))
+        """True if the spline is non-decreasing on [mu_0, mu_last] (checked exactly: its derivative is
+        >= 0 at every breakpoint and at every root of the second derivative).  Then so is
+        :meth:`upper` there, and max(upper(x), upper(y)) = upper(max(x, y)) for x, y >= mu_0."""
+        d1 = self._spline.derivative()
+        crit = d1.derivative().roots(extrapolate=False)
+        pts = np.concatenate([self._spline.x, crit[np.isfinite(crit)]])
+        return bool(np.all(d1(pts) >= 0))
 
 
 def _midpoints(mu: np.ndarray) -> np.ndarray:
@@ -228,6 +241,8 @@ def _chunked(brdf, mu, rtol, atol, bar, chunk: int = 32):
 def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind):
     import xarray as xr
 
+    degree = AlbedoTable.DEGREE if len(mu) >= 6 else 3  # as AlbedoTable chooses
+
     theta = np.degrees(np.arccos(mu))
     ds = xr.Dataset(
         {
@@ -248,7 +263,9 @@ def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind):
             "rtol": float(rtol),
             "atol": float(atol),
             "grid": grid_kind,
-            "interpolation": "not-a-knot cubic spline in log(mu); power-law extrapolation below the smallest mu",
+            "interpolation": (f"interpolating spline of degree {degree} in log(mu), not-a-knot ends; "
+                              "power-law extrapolation below the smallest mu"),
+            "interpolation_degree": int(degree),
             "interpolation_error": float(interp_error),
             "pumpup_version": __version__,
         },
