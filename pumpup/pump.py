@@ -357,6 +357,7 @@ class Pumped(BRDF):
             out.append(am)  # v = U, where v and U are the two largest
         for k, fn in enumerate(funcs):
             vals = au - am if k == 0 else (au - grid if k == 1 else au - mu)
+            vals = np.where(np.abs(vals) < 1e-13 * max(1.0, am), 0.0, vals)  # rounding of a flat spline: no root
             idx = np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]
             for i in idx:
                 v = brentq(fn, grid[i], grid[i + 1], xtol=1e-15)
