@@ -360,6 +360,10 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu=None, *, pump: Ma
         ``"threads"`` (default), ``"processes"`` or ``"synchronous"`` for dask's local
         schedulers, or the address of a ``dask.distributed`` scheduler
         (``"tcp://host:8786"``), to which the sweep connects and which it leaves running.
+        pumpup's compiled kernels hold the GIL, so threads mostly take turns: use
+        ``"processes"`` (from a script, under ``if __name__ == "__main__":``, since the
+        workers are spawned) or a cluster for large sweeps.  Cluster workers need pumpup
+        installed; results come back to this process, which writes the parts and ``out``.
     workers : int, optional
         Threads or processes of the local scheduler (default: dask's, one per core).
     chunks : int or dict, optional

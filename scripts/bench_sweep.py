@@ -84,7 +84,12 @@ def run_one(k: int, pumped: bool, n_mu: int, scheduler: str, workers: int) -> di
     stop.set()
     sampler.join()
     assert bool(np.isfinite(ds["albedo"]).all())
-    return {"k": k, "cells": k * k, "n_mu": n_mu, "pumped": pumped, "scheduler": scheduler, "workers": workers,
+    try:  # which pumpup was measured (other work may land between runs)
+        commit = subprocess.run(["git", "-C", os.path.dirname(os.path.abspath(__file__)), "describe", "--always",
+                                 "--dirty"], check=False, capture_output=True, text=True).stdout.strip()
+    except OSError:
+        commit = ""
+    return {"k": k, "cells": k * k, "commit": commit, "n_mu": n_mu, "pumped": pumped, "scheduler": scheduler, "workers": workers,
             "seconds": seconds, "cpu_seconds": cpu_seconds, "load_5min": load, "peak_rss_mb": peak[0] / 2**20, "file_mb": size / 2**20,
             "max_albedo": float(ds["albedo"].max())}
 
@@ -125,6 +130,12 @@ def report(path: str) -> str:
             lines.append(f"| {r['k']} x {r['k']} | {r['cells']} | {r['seconds']:.1f} | {r['seconds'] / r['cells']:.2f}"
                          f" | {cpu} | {r['peak_rss_mb']:.0f} | {r['file_mb']:.2f} | {load} |")
         measured = any(r["k"] == FULL for r in sub)
+        big = sub[-1]
+        if "cpu_seconds" in big:  # the cost of a cell on the finest measured grid, on every worker
+            t = big["cpu_seconds"] / big["cells"] * FULL * FULL / big["workers"]
+            lines.append(f"CPU per cell of the {big['k']} x {big['k']} grid x {FULL * FULL} cells / {big['workers']} "
+                         f"workers: {t:.0f} s = {t / 3600:.2f} h for {FULL} x {FULL} "
+                         + ("(measured grid)" if measured else "(EXTRAPOLATED, not measured)"))
         for key, what in (("seconds", "wall"), ("cpu_seconds", "CPU")):
             f = fit(sub, key)
             if not f:
