@@ -127,8 +127,9 @@ class AlbedoTable:
             out = np.where(lo, self.value[0] * np.exp(self.slope_below * (lm - math.log(self.mu[0]))), out)
         return out
 
-    #: the measured interpolation error is multiplied by this in :meth:`upper` (the largest
-    #: miss between nodes found by the tests is within 1 % of the one measured at midpoints)
+    #: the measured interpolation error is multiplied by this in :meth:`upper` (the largest miss
+    #: between nodes found against 400 random mu, quintic tables of Phong, Blinn, Ward, Cook-Torrance
+    #: and a pumped Phong level: 0.62-0.97 x the one measured at the midpoints)
     SAFETY = 2.0
 
     def upper(self, mu) -> np.ndarray:

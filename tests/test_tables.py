@@ -38,6 +38,18 @@ def test_adaptive_grid_interpolation_error_is_honest_between_nodes(phong_table):
     assert np.all(table.upper(mu) >= pumpup.albedo(f, mu))
 
 
+def test_interpolation_error_is_honest_between_nodes_for_a_diverging_albedo():
+    """Ward's albedo grows like mu^(-1/2) at grazing: the quintic's miss between the nodes stays
+    within the bound that upper() adds."""
+    f = pumpup.load({"type": "ward", "m": 0.1})
+    table = pumpup.AlbedoTable.from_dataset(pumpup.tabulate(f, rtol=1e-9, progress=False))
+    assert table.degree == 5
+    mu = np.sort(10 ** np.random.default_rng(6).uniform(-8, 0, 60))
+    a = pumpup.albedo(f, mu, rtol=1e-10)
+    assert np.abs(table(mu) - a).max() <= table.SAFETY * table.interp_error
+    assert np.all(table.upper(mu) >= a)
+
+
 def test_netcdf_round_trip_is_exact(phong_table, tmp_path):
     path = pumpup.write_table(phong_table, tmp_path / "t.nc")
     back = pumpup.open_table(path)
