@@ -98,27 +98,20 @@ def test_density_integrates_to_the_acceptance_rate(kind, k, rng):
         np.testing.assert_allclose(total[0], 1.0, rtol=1e-9)  # nothing is rejected at normal view
 
 
-def test_phong_weight_is_eq_24(rng):
-    """For reciprocal Phong the weight of an accepted sample is (n+2)/(n+1) cos(theta_L) (000 eq. 24)."""
+@pytest.mark.parametrize("model,view,expect", [
+    # reciprocal Phong: an accepted weight is (n+2)/(n+1) cos(theta_L) (000 eq. 24)
+    ("phong", 1, lambda n, cl, cv: (n + 2) / (n + 1) * cl),
+    # stretched Phong: (n+2)/(n+1) where theta_L <= theta_V, else times cos L / cos V (000 eq. 25)
+    ("stretched_phong", 2, lambda n, cl, cv: (n + 2) / (n + 1) * np.where(cl >= cv, 1.0, cl / cv)),
+])
+def test_weights_are_eq_24_and_25(model, view, expect, rng):
     n = 20
-    f = pumpup.load({"type": "phong", "n": n})
-    wo = VIEWS[1]
+    f = pumpup.load({"type": model, "n": n})
+    wo = VIEWS[view]
     wi, p = pumpup.sample(f, wo, 10_000, rng)
     ok = p > 0
     w = f.eval(wi[ok], wo) * wi[ok, 2] / p[ok]
-    np.testing.assert_allclose(w, (n + 2) / (n + 1) * wi[ok, 2], rtol=1e-9)
-
-
-def test_stretched_weight_is_eq_25(rng):
-    """Stretched Phong: weight (n+2)/(n+1) where theta_L <= theta_V, else times cos L / cos V (000 eq. 25)."""
-    n = 20
-    f = pumpup.load({"type": "stretched_phong", "n": n})
-    wo = VIEWS[2]
-    wi, p = pumpup.sample(f, wo, 10_000, rng)
-    ok = p > 0
-    w = f.eval(wi[ok], wo) * wi[ok, 2] / p[ok]
-    expect = (n + 2) / (n + 1) * np.where(wi[ok, 2] >= wo[2], 1.0, wi[ok, 2] / wo[2])
-    np.testing.assert_allclose(w, expect, rtol=1e-9)
+    np.testing.assert_allclose(w, expect(n, wi[ok, 2], wo[2]), rtol=1e-9)
 
 
 def test_eq_26_grazing_limit(rng):
