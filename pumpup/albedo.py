@@ -510,6 +510,10 @@ _TAU_SCAN = np.unique(np.concatenate([
 ]))
 
 
+#: kink breaks closer than this to an end of the radial range are the end itself (_kink_breaks)
+_END_GAP = 1e-10
+
+
 def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray) -> list[np.ndarray]:
     """Values of tau_x where a kink of the integrand enters or leaves the arc of beta, for
     every problem (mu (P,), levels (P, L)); a list of P arrays.
@@ -572,9 +576,6 @@ def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray) -> list[np.ndar
                 if _END_GAP < t < 1.0 - _END_GAP:
                     out[p_].append(t)
     return [np.array(o) for o in out]
-
-
-_END_GAP = 1e-10
 
 
 def _graded(points: np.ndarray) -> np.ndarray:

@@ -666,7 +666,6 @@ def efficiency_dataset(ns=EFFICIENCY_N, theta_deg=EFFICIENCY_THETA, mu_grazing: 
     from .core import load
 
     mu = np.concatenate([np.cos(np.radians(np.asarray(theta_deg, dtype=np.float64))), [mu_grazing]])
-    mu = np.where(np.asarray(list(theta_deg) + [90.0]) == 0.0, 1.0, mu)
     models = ("phong", "stretched_phong")
     shape = (len(models), len(ns), len(mu))
     out = {k: np.empty(shape) for k in ("albedo", "albedo_error", "second_moment", "second_moment_error",

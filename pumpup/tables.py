@@ -93,10 +93,7 @@ class AlbedoTable:
         self.spec = spec
         if len(self.mu) < 2:
             raise ValueError("an albedo table needs at least two values of mu")
-        degree = self.DEGREE if degree is None else int(degree)
-        if degree not in (3, 5):
-            raise ValueError(f"an albedo table interpolates with degree 3 or 5, got {degree}")
-        self.degree = 5 if degree == 5 and len(self.mu) >= 6 else 3
+        self.degree = self.degree_for(len(self.mu), degree)
         lx = np.log(self.mu)
         if self.degree == 5:  # a piecewise polynomial in log(mu), breakpoints at the inner knots
             self._spline = PPoly.from_spline(make_interp_spline(lx, self.value, k=5), extrapolate=True)
@@ -111,6 +108,14 @@ class AlbedoTable:
         #: added below the first node, where the extrapolation is a guess: also the spread of the
         #: first interval and the first node's quadrature error
         self.margin_below = self.margin + float(self.error[0]) + abs(float(a1) - float(a0))
+
+    @classmethod
+    def degree_for(cls, n: int, degree: int | None = None) -> int:
+        """The spline degree a table of n nodes uses: ``degree`` (default :attr:`DEGREE`), 3 below 6 nodes."""
+        degree = cls.DEGREE if degree is None else int(degree)
+        if degree not in (3, 5):
+            raise ValueError(f"an albedo table interpolates with degree 3 or 5, got {degree}")
+        return 5 if degree == 5 and n >= 6 else 3
 
     @classmethod
     def from_dataset(cls, ds) -> "AlbedoTable":
@@ -242,7 +247,7 @@ def _chunked(brdf, mu, rtol, atol, bar, chunk: int = 32):
 def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind):
     import xarray as xr
 
-    degree = AlbedoTable.DEGREE if len(mu) >= 6 else 3  # as AlbedoTable chooses
+    degree = AlbedoTable.degree_for(len(mu))
 
     theta = np.degrees(np.arccos(mu))
     ds = xr.Dataset(

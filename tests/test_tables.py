@@ -147,8 +147,8 @@ def test_is_increasing_is_exact(phong_table):
     assert table.is_increasing() and dense
     down = pumpup.AlbedoTable(table.mu, table.value[::-1], table.error, table.interp_error)
     assert not down.is_increasing()
-    # a single dip between two nodes, invisible at the nodes, is found
-    v = table.value.copy()
+    # a wiggle on the increasing values is found, as the dense check finds it
     x = np.log(table.mu)
-    bump = pumpup.AlbedoTable(table.mu, v + 1e-3 * np.sin(40 * x), table.error, table.interp_error)
-    assert bump.is_increasing() == bool(np.all(np.diff(bump(mu)) >= 0))
+    bump = pumpup.AlbedoTable(table.mu, table.value + 1e-3 * np.sin(40 * x), table.error, table.interp_error)
+    assert not bool(np.all(np.diff(bump(mu)) >= 0))
+    assert not bump.is_increasing()
