@@ -246,7 +246,7 @@ def _geometry_reference(lobe: Lobe, mu, levels, ka, kb, piece, tx, tt):
     return wi, wo, jac * extra * width * dx * dt
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _radial_scalar(kind, k, x, xc):  # pragma: no cover - compiled; see _radial
     if kind == 0:
         ca = math.sqrt(xc)
@@ -282,7 +282,7 @@ def _radial_scalar(kind, k, x, xc):  # pragma: no cover - compiled; see _radial
     return math.cos(a), math.sin(a), ((1.0 - y0) * sinc / (2.0 * k * k * y) if y > 0.0 else math.inf)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _geometry_kernel(axis, radial, k, mu_p, levels_p, prob, ka, kb, piece, tx, tt, wi, wo, weight):  # pragma: no cover
     """Compiled twin of :func:`_geometry_reference`; fills ``wi``, ``wo`` (N, 3) and ``weight`` (N).
 
@@ -397,7 +397,7 @@ def _integrand(brdf: BRDF, g: _Group, prob: np.ndarray, piece: np.ndarray, tx: n
     return 2.0 * total if lobe.symmetric else total
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _accumulate(f, cos_o, weight, total):  # pragma: no cover - compiled
     """total += f cos(theta_o) weight where all are positive; the index of the first value of f
     that is negative or not finite (or -1)."""

@@ -148,10 +148,16 @@ class AlbedoTable:
         """True if the spline is non-decreasing on [mu_0, mu_last] (checked exactly: its derivative is
         >= 0 at every breakpoint and at every root of the second derivative).  Then so is
         :meth:`upper` there, and max(upper(x), upper(y)) = upper(max(x, y)) for x, y >= mu_0."""
-        d1 = self._spline.derivative()
-        crit = d1.derivative().roots(extrapolate=False)
-        pts = np.concatenate([self._spline.x, crit[np.isfinite(crit)]])
-        return bool(np.all(d1(pts) >= 0))
+        return nondecreasing(self._spline)
+
+
+def nondecreasing(spline) -> bool:
+    """True if a scipy PPoly is non-decreasing between its first and last breakpoints (exact: its
+    derivative is >= 0 at every breakpoint and at every root of the second derivative)."""
+    d1 = spline.derivative()
+    crit = d1.derivative().roots(extrapolate=False)
+    pts = np.concatenate([spline.x, crit[np.isfinite(crit)]])
+    return bool(np.all(d1(pts) >= 0))
 
 
 def _midpoints(mu: np.ndarray) -> np.ndarray:
@@ -234,13 +240,34 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     return _dataset(brdf, grid, val, err, rtol, atol, interp_error, "adaptive")
 
 
+#: threads that compute the albedos of a table (None: one per core).  The compiled kernels
+#: release the GIL; a value of mu does not depend on the others computed with it, so the table is
+#: the same for any number of threads (tested).  3-level pumped Phong: 1.04 -> 0.7 s on 2 cores.
+THREADS: int | None = None
+
+
 def _chunked(brdf, mu, rtol, atol, bar, chunk: int = 32):
+    """Albedo and error at every mu, in chunks, on :data:`THREADS` threads (every k-th mu to
+    thread k: grazing values, the dear ones, are spread over all)."""
     val = np.empty_like(mu)
     err = np.empty_like(mu)
-    for a in range(0, len(mu), chunk):
-        sl = slice(a, a + chunk)
-        val[sl], err[sl] = albedo(brdf, mu[sl], return_error=True, rtol=rtol, atol=atol)
-        bar.update(len(mu[sl]))
+    threads = max(1, min(THREADS or os.cpu_count() or 1, len(mu)))
+
+    def work(idx):
+        for a in range(0, len(idx), chunk):
+            part = idx[a:a + chunk]
+            val[part], err[part] = albedo(brdf, mu[part], return_error=True, rtol=rtol, atol=atol)
+            bar.update(len(part))
+
+    parts = [np.arange(k, len(mu), threads) for k in range(threads)]
+    if threads == 1:
+        work(parts[0])
+    else:
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(threads) as pool:
+            for done in [pool.submit(work, p) for p in parts]:
+                done.result()
     return val, err
 
 
