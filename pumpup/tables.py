@@ -259,15 +259,17 @@ def _chunked(brdf, mu, rtol, atol, bar, chunk: int = 32):
             val[part], err[part] = albedo(brdf, mu[part], return_error=True, rtol=rtol, atol=atol)
             bar.update(len(part))
 
-    parts = [np.arange(k, len(mu), threads) for k in range(threads)]
     if threads == 1:
-        work(parts[0])
-    else:
-        from concurrent.futures import ThreadPoolExecutor
+        work(np.arange(len(mu)))
+        return val, err
+    from concurrent.futures import ThreadPoolExecutor
 
-        with ThreadPoolExecutor(threads) as pool:
-            for done in [pool.submit(work, p) for p in parts]:
-                done.result()
+    # the first value on this thread: it compiles whatever the BRDF's kernels still need (two
+    # threads compiling one numba ufunc at once race; numba warns), then the rest on the pool
+    work(np.arange(1))
+    with ThreadPoolExecutor(threads) as pool:
+        for done in [pool.submit(work, np.arange(1 + k, len(mu), threads)) for k in range(threads)]:
+            done.result()
     return val, err
 
 

@@ -203,3 +203,71 @@ def test_bad_input():
             pumpup.pump({"type": "phong", "n": 3}, levels=bad)
     with pytest.raises(pumpup.SpecError, match="'g'"):
         pumpup.load({"type": "pumped", "base": {"type": "phong", "n": 3}, "g": "g9"})
+
+
+@pytest.mark.parametrize("spec, g", [(BASES["phong"], "g2"), (BASES["blinn"], "g1")])
+def test_product_table_of_a_monotone_chain(rng, spec, g):
+    """The kernel's fast path divides by G(m), one function of m = max(N.wi, N.wo) for all
+    levels: never below the product of the levels' g, above it by at most twice its epsilon (checked
+    at 2e5 random m and at every piece's ends), and the kernel evaluates exactly that G."""
+    from pumpup.pump import _bits
+
+    f = pumpup.pump(pumpup.load(spec), g=g, levels=3)
+    p = f.product()
+    assert p is not None and 0 < p.epsilon < 1e-13
+    m = np.concatenate([np.exp(rng.uniform(np.log(p.mlo), 0, 200_000)), p.lo[1:-1], np.nextafter(p.lo[1:-1], 0), [1.0]])
+    m = m[m > p.mlo]
+    ratio = p(m) / p.exact(m)
+    assert ratio.min() >= 1.0 and ratio.max() <= 1.0 + 2 * p.epsilon
+    # the cells: numbered by the float's bits, monotone in m
+    assert np.all(np.diff(_bits(np.sort(m)) >> 48) >= 0)
+    # the kernel: pairs with both cosines above mlo take the fast path, G(max)
+    wi = random_directions(rng, 5000)
+    wo = random_directions(rng, 5000)[::-1]
+    up = (wi[:, 2] > p.mlo) & (wo[:, 2] > p.mlo)
+    expect = f.chain()[0].base.eval(wi[up], wo[up]) / p(np.maximum(wi[up, 2], wo[up, 2]))
+    np.testing.assert_allclose(f.eval(wi[up], wo[up]), expect, rtol=1e-15, atol=0)
+    # and the level-by-level reference agrees to 2 epsilon (the fast path is never larger)
+    ref = f.reference(wi[up], wo[up])
+    assert np.all(f.eval(wi[up], wo[up]) <= ref * (1 + 1e-15))
+    np.testing.assert_allclose(f.eval(wi[up], wo[up]), ref, rtol=2.5 * p.epsilon, atol=1e-300)
+
+
+def test_no_product_table_where_a_level_decreases():
+    ward = pumpup.pump(pumpup.load({"type": "ward", "m": 0.3}), g="g1", levels=2)
+    assert ward.product() is None
+    assert not ward.lookup().envelope  # Ward's albedo falls by far more than the table's margin
+
+
+def test_running_maximum_of_a_table_that_dips_within_its_margin():
+    """A table that falls by less than its margin is replaced by its running maximum: an upper
+    bound that is non-decreasing and exceeds the spline by at most the margin; a larger dip is
+    refused.  The third level of pumped Phong (n = 20, g2) dips by 1.9e-7 near mu = 1."""
+    from scipy.interpolate import PPoly, make_interp_spline
+
+    from pumpup.pump import _monotone_envelope
+    from pumpup.tables import nondecreasing
+
+    x = np.linspace(-3, 0, 12)
+    y = np.minimum(1.0, 0.6 + 0.1 * np.arange(12))  # rises, then a plateau: the spline wiggles there
+    s = PPoly.from_spline(make_interp_spline(x, y, k=5))
+    assert not nondecreasing(s)
+    t = np.linspace(x[0], x[-1], 200001)
+    dip = float(np.max(np.maximum.accumulate(s(t)) - s(t)))  # the running maximum, sampled
+    assert dip > 1e-4
+    assert _monotone_envelope(s, margin=0.5 * dip) is None
+    ex, ec = _monotone_envelope(s, margin=2 * dip)
+    env = PPoly(ec, ex)
+    assert nondecreasing(env)
+    sampled = np.maximum.accumulate(s(t))  # misses the peaks between samples by ~3e-11
+    assert np.all(env(t) >= sampled - 1e-15) and np.all(env(t) - sampled <= 1e-9)
+    rising = t < x[3]
+    np.testing.assert_allclose(env(t[rising]), s(t[rising]), rtol=1e-14)  # the same spline where it rises
+
+    f = pumpup.pump(pumpup.load(BASES["phong"]), g="g2", levels=3)
+    lk = f.lookup()
+    assert lk.envelope and lk.increasing and not lk.table.is_increasing()
+    mu = np.exp(np.linspace(np.log(lk.mu0 * 1.01), 0, 40001))
+    u, raw = lk.upper(mu, capped=False), lk.table.upper(mu)
+    assert np.all(u >= raw - 1e-15) and np.all(u - raw <= lk.margin)
+    assert np.all(np.diff(u) >= 0)

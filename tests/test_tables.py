@@ -152,3 +152,20 @@ def test_is_increasing_is_exact(phong_table):
     bump = pumpup.AlbedoTable(table.mu, table.value + 1e-3 * np.sin(40 * x), table.error, table.interp_error)
     assert not bool(np.all(np.diff(bump(mu)) >= 0))
     assert not bump.is_increasing()
+
+
+@pytest.mark.parametrize("threads", [1, 3])
+def test_table_is_the_same_on_any_number_of_threads(monkeypatch, threads):
+    """tabulate spreads its albedos over THREADS threads; a value of mu does not depend on the
+    others, so the adaptive grid, the values, the errors and the interpolation error are equal."""
+    import sys
+
+    mod = sys.modules["pumpup.tables"]
+    f = pumpup.load({"type": "ward", "m": 0.2})
+    monkeypatch.setattr(mod, "THREADS", 2)
+    two = pumpup.tabulate(f, rtol=1e-9, interp_tol=1e-5)
+    monkeypatch.setattr(mod, "THREADS", threads)
+    other = pumpup.tabulate(f, rtol=1e-9, interp_tol=1e-5)
+    for name in ("mu", "albedo", "albedo_error"):
+        np.testing.assert_array_equal(other[name].values, two[name].values)
+    assert other.attrs["interpolation_error"] == two.attrs["interpolation_error"]
