@@ -567,7 +567,7 @@ class Pumped(BRDF):
         return p.mlo, p.cbase, p.cstart, p.lo, p.rows
 
     #: pairs per pass when many are evaluated at once: the base's values and the directions are
-    #: still in the cache when the chain kernel reads them (2e6 pairs, 3-level Phong: 26 -> 19 ns
+    #: still in the cache when the chain kernel reads them (2e6 pairs, 3-level Phong: 26 -> 21 ns
     #: per pair, measured with scripts/bench_eval.py)
     BLOCK = 8192
 
