@@ -231,6 +231,13 @@ def test_product_table_of_a_monotone_chain(rng, spec, g):
     ref = f.reference(wi[up], wo[up])
     assert np.all(f.eval(wi[up], wo[up]) <= ref * (1 + 1e-15))
     np.testing.assert_allclose(f.eval(wi[up], wo[up]), ref, rtol=2.5 * p.epsilon, atol=1e-300)
+    # at the ends of pieces and cells, and at normal incidence (m = 1, the last cell)
+    z = np.concatenate([p.lo[1:-1:7], np.nextafter(p.lo[1:-1:7], 0), [1.0]])
+    li = np.stack([np.sqrt(1 - z**2), np.zeros_like(z), z], axis=-1)
+    lo = li * np.array([-1.0, 1.0, 1.0])  # the mirror direction: f is at its peak
+    expect = f.chain()[0].base.eval(li, lo) / p(z)
+    assert np.all(expect > 0)
+    np.testing.assert_allclose(f.eval(li, lo), expect, rtol=1e-15, atol=0)
 
 
 def test_no_product_table_where_a_level_decreases():
