@@ -266,6 +266,10 @@ def _horner(coef, t):
     return v + coef[-1]
 
 
+class _ProductError(RuntimeError):
+    """The product table cannot reach its tolerance (the kernel then looks up level by level)."""
+
+
 class _Product:
     """g_1 g_2 ... g_k of a chain whose levels' bounds all increase, as one function of
     m = max(N.wi, N.wo): the chain kernel's fast path.
@@ -322,12 +326,12 @@ class _Product:
             if not bad.any():
                 break
             if len(lo) + bad.sum() > 100_000:
-                raise RuntimeError(f"pumped chain: the product table needs more than 100000 pieces to reach {self.TOL:g}")
+                raise _ProductError(f"the product table needs more than 100000 pieces to reach {self.TOL:g}")
             mid = 0.5 * (lo[bad] + hi[bad])
             lo = np.sort(np.concatenate([lo, mid]))
             hi = np.sort(np.concatenate([hi, mid]))
         else:
-            raise RuntimeError(f"pumped chain: the product table did not reach {self.TOL:g} (worst {worst.max():.3g})")
+            raise _ProductError(f"the product table did not reach {self.TOL:g} (worst {worst.max():.3g})")
         self.epsilon = 2.0 * float(worst.max()) + 4 * np.finfo(float).eps
         self.coef = np.ascontiguousarray(coef * (1.0 + self.epsilon))
         self.center, self.ihalf = center, 1.0 / half
@@ -555,10 +559,16 @@ class Pumped(BRDF):
 
     def product(self) -> "_Product | None":
         """The fast path's table of the product of all levels' g (None unless every level's bound
-        increases)."""
-        if getattr(self, "_product", None) is None and all(lev.lookup().increasing for lev in self.chain()):
-            self._product = _Product([lev.lookup() for lev in self.chain()], [lev.controlled for lev in self.chain()])
-        return getattr(self, "_product", None)
+        increases and the table reaches its tolerance; the kernel then looks up level by level)."""
+        if not hasattr(self, "_product"):
+            self._product = None
+            if all(lev.lookup().increasing for lev in self.chain()):
+                try:
+                    self._product = _Product([lev.lookup() for lev in self.chain()],
+                                             [lev.controlled for lev in self.chain()])
+                except _ProductError:
+                    pass
+        return self._product
 
     def _product_args(self, looks):
         p = self.product()

@@ -278,3 +278,13 @@ def test_running_maximum_of_a_table_that_dips_within_its_margin():
     u, raw = lk.upper(mu, capped=False), lk.table.upper(mu)
     assert np.all(u >= raw - 1e-15) and np.all(u - raw <= lk.margin)
     assert np.all(np.diff(u) >= 0)
+
+
+def test_product_table_that_cannot_reach_its_tolerance_falls_back(monkeypatch, rng):
+    from pumpup.pump import _Product
+
+    monkeypatch.setattr(_Product, "TOL", 0.0)  # unreachable: bisects until 1e5 pieces, then gives up
+    f = pumpup.pump(pumpup.load(BASES["phong"]), g="g2", levels=1)
+    assert f.lookup().increasing and f.product() is None
+    wi, wo = random_directions(rng, 2000), random_directions(rng, 2000)[::-1]
+    np.testing.assert_allclose(f.eval(wi, wo), f.reference(wi, wo), rtol=1e-13, atol=1e-300)
