@@ -164,8 +164,14 @@ def test_table_is_the_same_on_any_number_of_threads(monkeypatch, threads):
     f = pumpup.load({"type": "ward", "m": 0.2})
     monkeypatch.setattr(mod, "THREADS", 2)
     two = pumpup.tabulate(f, rtol=1e-9, interp_tol=1e-5)
-    monkeypatch.setattr(mod, "THREADS", threads)
-    other = pumpup.tabulate(f, rtol=1e-9, interp_tol=1e-5)
+    monkeypatch.setattr(mod, "THREADS", None)
+    other = pumpup.tabulate(f, rtol=1e-9, interp_tol=1e-5, threads=threads)
     for name in ("mu", "albedo", "albedo_error"):
         np.testing.assert_array_equal(other[name].values, two[name].values)
     assert other.attrs["interpolation_error"] == two.attrs["interpolation_error"]
+
+
+@pytest.mark.parametrize("threads", [0, -1, 1.5, True, "2"])
+def test_tabulate_bad_threads(threads):
+    with pytest.raises(ValueError, match="threads must be an integer >= 1"):
+        pumpup.tabulate(pumpup.load({"type": "lambert"}), mu=[0.5], threads=threads)
