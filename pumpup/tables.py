@@ -252,12 +252,20 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
 THREADS: int | None = None
 
 
+def _cores() -> int:
+    """The cores this process may run on (its CPU affinity where the system tells it)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
 def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int = 32):
     """Albedo and error at every mu, in chunks, on ``threads`` threads (default :data:`THREADS`;
     every k-th mu to thread k: grazing values, the dear ones, are spread over all)."""
     val = np.empty_like(mu)
     err = np.empty_like(mu)
-    threads = max(1, min(threads or THREADS or os.cpu_count() or 1, len(mu)))
+    threads = max(1, min(threads or THREADS or _cores(), len(mu)))
 
     def work(idx):
         for a in range(0, len(idx), chunk):
