@@ -206,8 +206,9 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
 
 
 def _monotone_envelope(spline, margin: float):
-    """The running maximum of a PPoly spline over its breakpoints' range, as (x, c) of a PPoly,
-    or None when the spline falls anywhere more than ``margin`` below its running maximum.
+    """The running maximum of a PPoly spline over its breakpoints' range, as (x, c) of a PPoly
+    and the list of its flat pieces (start, end, value), or None when the spline falls anywhere
+    more than ``margin`` below its running maximum.
 
     An albedo table that is flat near mu = 1 (a pumped level there is 1 - 1e-7) can wiggle
     down by less than its own error margin; its running maximum is then an upper bound of the
@@ -242,7 +243,7 @@ def _monotone_envelope(spline, margin: float):
             return None
         flats.append((float(p), q, v))
     if not flats:
-        return x, c
+        return x, c, []
     nx = np.unique(np.concatenate([x, [b for fl in flats for b in fl[:2]]]))
     nc = np.empty((c.shape[0], len(nx) - 1))
     for i, (a, b) in enumerate(zip(nx[:-1], nx[1:])):
@@ -255,7 +256,7 @@ def _monotone_envelope(spline, margin: float):
             shifted = Polynomial(c[::-1, j])(Polynomial([a - x[j], 1.0])).coef
             nc[:, i] = 0.0
             nc[-len(shifted):, i] = shifted[::-1]
-    return nx, nc
+    return nx, nc, flats
 
 
 def _horner(coef, t):
@@ -396,11 +397,14 @@ class _Lookup:
         x, c = t._spline.x, t._spline.c  # the breakpoints of the spline pieces, in log(mu)
         self.increasing = t.is_increasing()
         self.envelope = False
+        self.flats = []
         if not self.increasing:  # a dip within the table's margin: use the running maximum
             env = _monotone_envelope(t._spline, self.margin)
             if env is not None and nondecreasing(PPoly(env[1], env[0])):
-                x, c = env
+                x, c, flats = env
                 self.increasing = self.envelope = True
+                #: the flat pieces in mu, with the bound there (g has a kink where one ends)
+                self.flats = [(math.exp(p), math.exp(q), v + self.margin) for p, q, v in flats]
         self.logx = np.ascontiguousarray(x)
         self.coef = np.ascontiguousarray(c)
         self.mu0 = float(t.mu[0])
@@ -646,6 +650,10 @@ class Pumped(BRDF):
                     if c < max(others) * (1 - 1e-12):
                         continue  # both crossing terms are below a third: g has no kink here
                 out.append(v)
+        lk = self.lookup()
+        for p, q, value in lk.flats:  # mu on a flat piece of the bound: u(v) = U up to its end q
+            if p <= mu <= q and value < lk.cap:
+                out.append(q)
         levels = []
         for u in sorted(out):  # one level per kink: roots that agree to 1e-12 are the same kink
             if 0 < u < 1 and (not levels or u - levels[-1] > 1e-12 * u):

@@ -263,7 +263,8 @@ def test_running_maximum_of_a_table_that_dips_within_its_margin():
     dip = float(np.max(np.maximum.accumulate(s(t)) - s(t)))  # the running maximum, sampled
     assert dip > 1e-4
     assert _monotone_envelope(s, margin=0.5 * dip) is None
-    ex, ec = _monotone_envelope(s, margin=2 * dip)
+    ex, ec, flats = _monotone_envelope(s, margin=2 * dip)
+    assert len(flats) == 1 and flats[0][1] == x[-1]  # one flat piece, from the overshoot to the end
     env = PPoly(ec, ex)
     assert nondecreasing(env)
     sampled = np.maximum.accumulate(s(t))  # misses the peaks between samples by ~3e-11
@@ -274,6 +275,9 @@ def test_running_maximum_of_a_table_that_dips_within_its_margin():
     f = pumpup.pump(pumpup.load(BASES["phong"]), g="g2", levels=3)
     lk = f.lookup()
     assert lk.envelope and lk.increasing and not lk.table.is_increasing()
+    (p, q, value), = lk.flats  # one flat piece; for mu on it, g(mu, v) bends where v leaves it
+    assert p < q < 1 and value < lk.cap
+    assert q in f.kink_levels(0.5 * (p + q)) and q not in f.kink_levels(0.5)
     mu = np.exp(np.linspace(np.log(lk.mu0 * 1.01), 0, 40001))
     u, raw = lk.upper(mu, capped=False), lk.table.upper(mu)
     assert np.all(u >= raw - 1e-15) and np.all(u - raw <= lk.margin)
