@@ -15,6 +15,7 @@ import math
 import os
 import sys
 import tempfile
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -252,6 +253,10 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
 THREADS: int | None = None
 
 
+#: the BRDF objects whose kernels have run in this process (see :func:`_chunked`)
+_WARM: "weakref.WeakSet" = weakref.WeakSet()
+
+
 def _cores() -> int:
     """The cores this process may run on (its CPU affinity where the system tells it)."""
     try:
@@ -273,16 +278,22 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
             val[part], err[part] = albedo(brdf, mu[part], return_error=True, rtol=rtol, atol=atol)
             bar.update(len(part))
 
-    if threads == 1:
-        work(np.arange(len(mu)))
+    todo = np.arange(len(mu))
+    if threads > 1 and brdf not in _WARM:
+        # the first value for a BRDF on this thread (the largest mu, usually the cheapest): it
+        # compiles whatever its kernels still need (two threads compiling one numba ufunc at
+        # once race; numba warns), then the rest on the pool
+        first = int(np.argmax(mu))
+        work(np.array([first]))
+        _WARM.add(brdf)
+        todo = np.delete(todo, first)
+    if threads == 1 or len(todo) < 2:
+        work(todo)
         return val, err
     from concurrent.futures import ThreadPoolExecutor
 
-    # the first value on this thread: it compiles whatever the BRDF's kernels still need (two
-    # threads compiling one numba ufunc at once race; numba warns), then the rest on the pool
-    work(np.arange(1))
     with ThreadPoolExecutor(threads) as pool:
-        for done in [pool.submit(work, np.arange(1 + k, len(mu), threads)) for k in range(threads)]:
+        for done in [pool.submit(work, todo[k::threads]) for k in range(threads)]:
             done.result()
     return val, err
 
