@@ -371,16 +371,22 @@ class _Product:
                     out.append(brentq(lambda m: float(fn(np.array([m]))[0]), grid[i], grid[i + 1], xtol=1e-300, rtol=1e-15))
         return np.array(out)
 
-    def __call__(self, m):
-        """The kernel's G(m) in plain numpy (m > mlo): the reference of the fast path."""
+    def piece(self, m):
+        """The piece that holds m (> mlo), found as the kernel finds it: the cell from the bits of
+        m, then forward."""
         m = np.asarray(m, dtype=np.float64)
         c = np.minimum((_bits(m) >> _CELL_SHIFT) - self.cbase, len(self.cstart) - 1)
         s = self.cstart[c]
-        while True:  # forward to the piece that holds m
+        while True:
             step = m >= self.lo[s + 1]
             if not np.any(step):
-                break
+                return s
             s = s + step
+
+    def __call__(self, m):
+        """The kernel's G(m) in plain numpy (m > mlo): the reference of the fast path."""
+        m = np.asarray(m, dtype=np.float64)
+        s = self.piece(m)
         return _horner(self.coef[:, s], (m - self.center[s]) * self.ihalf[s])
 
 
@@ -396,13 +402,12 @@ class _Lookup:
         self.margin, self.margin_lo = t.margin, t.margin_below  # as in AlbedoTable.upper
         x, c = t._spline.x, t._spline.c  # the breakpoints of the spline pieces, in log(mu)
         self.increasing = t.is_increasing()
-        self.envelope = False
         self.flats = []
         if not self.increasing:  # a dip within the table's margin: use the running maximum
             env = _monotone_envelope(t._spline, self.margin)
             if env is not None and nondecreasing(PPoly(env[1], env[0])):
                 x, c, flats = env
-                self.increasing = self.envelope = True
+                self.increasing = True
                 #: the flat pieces in mu, with the bound there (g has a kink where one ends)
                 self.flats = [(math.exp(p), math.exp(q), v + self.margin) for p, q, v in flats]
         self.logx = np.ascontiguousarray(x)
@@ -416,6 +421,11 @@ class _Lookup:
         # pumping makes it plausible (001, after eq. 17).
         self.cap = 1.0 if float(np.max(t.value - t.error)) <= 1.0 else math.inf
         self.table = t
+
+    @property
+    def envelope(self) -> bool:
+        """True if the bound is the running maximum of the table (it has flat pieces)."""
+        return bool(self.flats)
 
     def args(self):
         return self.logx, self.coef, self.v0, self.slope0, self.margin_lo, self.margin, self.cap

@@ -201,3 +201,18 @@ def test_radial_maps_are_finite_at_the_ends():
     f = pumpup.load({"type": "torrance_sparrow", "d": "D2", "s": 5.0, "ior": 1.5})
     a, err = pumpup.albedo(f, np.array([0.5, 0.1]), return_error=True)
     assert np.all(np.isfinite(a)) and np.all(err < 1e-9 * a)
+
+
+def test_max_regions_counts_the_refinement_beyond_the_first_grid():
+    """Phong's first grid at mu = 0.5 has more than 10 rectangles; max_regions = 10 still lets
+    the engine refine (a lobe with many kinks, such as a pumped Cook-Torrance with g2, starts
+    with more rectangles than the default 20000), max_regions = 0 does not."""
+    f = pumpup.load({"type": "phong", "n": 20})
+    exact, exact_err = phong_albedo_1d(20, 0.5)
+    out = {}
+    for mr in (0, 10):
+        with pytest.warns(pumpup.albedo_module.AlbedoWarning):
+            out[mr] = pumpup.albedo(f, 0.5, return_error=True, rtol=1e-12, max_regions=mr)
+    assert out[10][1] < out[0][1]
+    for a, e in out.values():
+        assert abs(a - exact) <= e + exact_err  # an honest error estimate either way

@@ -210,7 +210,7 @@ def test_product_table_of_a_monotone_chain(rng, spec, g):
     """The kernel's fast path divides by G(m), one function of m = max(N.wi, N.wo) for all
     levels: never below the product of the levels' g, above it by at most twice its epsilon (checked
     at 2e5 random m and at every piece's ends), and the kernel evaluates exactly that G."""
-    from pumpup.pump import _bits
+    from pumpup.pump import _CELL_SHIFT, _bits
 
     f = pumpup.pump(pumpup.load(spec), g=g, levels=3)
     p = f.product()
@@ -219,8 +219,10 @@ def test_product_table_of_a_monotone_chain(rng, spec, g):
     m = m[m > p.mlo]
     ratio = p(m) / p.exact(m)
     assert ratio.min() >= 1.0 and ratio.max() <= 1.0 + 2 * p.epsilon
-    # the cells: numbered by the float's bits, monotone in m
-    assert np.all(np.diff(_bits(np.sort(m)) >> 48) >= 0)
+    # the look-up: the cell from the float's bits, then forward, lands on the piece that holds m
+    s = p.piece(m)
+    assert np.all((p.lo[s] <= m) & (m < p.lo[s + 1]))
+    assert np.all(p.cstart[np.minimum((_bits(m) >> _CELL_SHIFT) - p.cbase, len(p.cstart) - 1)] <= s)  # forward only
     # the kernel: pairs with both cosines above mlo take the fast path, G(max)
     wi = random_directions(rng, 5000)
     wo = random_directions(rng, 5000)[::-1]
