@@ -360,7 +360,8 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu=None, *, pump: Ma
         ``"threads"`` (default), ``"processes"`` or ``"synchronous"`` for dask's local
         schedulers, or the address of a ``dask.distributed`` scheduler
         (``"tcp://host:8786"``), to which the sweep connects and which it leaves running.
-        pumpup's compiled kernels hold the GIL, so threads mostly take turns: use
+        The engine's compiled kernels release the GIL but its Python between them does not,
+        and each cell's table already runs on ``pumpup.tables.THREADS`` threads: use
         ``"processes"`` (from a script, under ``if __name__ == "__main__":``, since the
         workers are spawned) or a cluster for large sweeps.  Cluster workers need pumpup
         installed; results come back to this process, which writes the parts and ``out``.
