@@ -343,9 +343,8 @@ class _Product:
         self.cstart = np.clip(np.searchsorted(lo, bounds, side="right") - 1, 0, len(lo) - 1).astype(np.int32)
 
     def _g(self, j, m):
-        lk = self.looks[j]
-        g = np.minimum(lk.cap, lk.upper(m))
-        return np.maximum(g, m) if self.controlled[j] else g
+        g = self.looks[j].upper(m)  # already at most the cap
+        return np.maximum(g, m) if self.controlled[j] else g  # 001 eq. 21
 
     def exact(self, m):
         """G(m): the product of the levels' g at mu_i = mu_o = m, from the levels' look-ups."""
@@ -567,7 +566,7 @@ class Pumped(BRDF):
                   for name in ("v0", "slope0", "margin_lo", "cap")),
                 np.array([lev.controlled for lev in self.chain()]),
                 np.array([lk.increasing for lk in looks]), np.array([lk.mu0 for lk in looks]),
-                index, lo, 1.0 / h, *self._product_args(looks),
+                index, lo, 1.0 / h, *self._product_args(),
             )
         return self._chain_cache
 
@@ -584,7 +583,7 @@ class Pumped(BRDF):
                     pass
         return self._product
 
-    def _product_args(self, looks):
+    def _product_args(self):
         p = self.product()
         if p is None:  # off: pmlo = inf
             return math.inf, 0, np.zeros(1, np.int32), np.full(2, math.inf), np.zeros((1, _PRODUCT_DEGREE + 3))
