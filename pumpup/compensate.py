@@ -259,7 +259,14 @@ class _Compensated(BRDF):
         if np.ndim(base._eval(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0]))) != 0:
             raise SpecError(f"{self.type}: the base must have one channel (a spectral or RGB base is not supported)")
         self._white = white
+        self.reciprocal = self._check_reciprocal(self.type, self._why) and type(self).reciprocal
+        self._precheck()
         self.bound = _bounds(white)
+
+    _why = ""
+
+    def _precheck(self) -> None:
+        """Checks before the table is built (override)."""
 
     @property
     def base(self) -> BRDF:
@@ -353,18 +360,30 @@ class KullaConty(_Compensated):
         "force": Param(False, kind="bool"),
     }
     examples = [{"base": {"type": "phong", "n": 5}}, {"base": {"type": "lambert", "albedo": 0.5}, "f_avg": 0.8}]
+    _why = "the Kulla-Conty lobe compensates a symmetric BRDF"
 
-    def __init__(self, **kwargs):
-        super().__init__(**kwargs)
-        self.reciprocal = self._check_reciprocal("kulla_conty", "the Kulla-Conty lobe compensates a symmetric BRDF")
-        t = self.table()
-        over = t.value - t.error
+    #: where :meth:`_precheck` looks for an albedo above 1 before the table is built
+    PROBE_MU = (1.0, 0.5, 0.1, 1e-2, 1e-4, 1e-6, 1e-8)
+
+    def _precheck(self) -> None:
+        from .albedo import albedo
+
+        a, e = albedo(self.white, np.array(self.PROBE_MU), return_error=True, rtol=1e-6, atol=1e-12)
+        self._refuse_above_one(np.array(self.PROBE_MU), a, e)
+
+    def _refuse_above_one(self, mu, value, error) -> None:
+        over = value - error
         if float(np.max(over)) > 1.0:
             i = int(np.argmax(over))
             raise SpecError(
-                f"kulla_conty: the albedo of the base {white.type!r} exceeds 1 (E = {t.value[i]:.9g} +- {t.error[i]:.2g} "
-                f"at mu = {t.mu[i]:.3g}, theta = {math.degrees(math.acos(t.mu[i])):.4f} deg), so 1 - E < 0 would make "
+                f"kulla_conty: the albedo of the base {self.white.type!r} exceeds 1 (E = {value[i]:.9g} +- {error[i]:.2g} "
+                f"at mu = {mu[i]:.3g}, theta = {math.degrees(math.acos(mu[i])):.4f} deg), so 1 - E < 0 would make "
                 "the lobe f_ms negative; use method 'g1' or 'g2' (pumping), which handles such a base")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        t = self.table()
+        self._refuse_above_one(t.mu, t.value, t.error)
         i_hi = self.bound.deficit_integral
         self.e_avg = 1.0 - i_hi  # a lower bound of the E_avg of the table's bound
         fa = self.p["f_avg"]
@@ -500,10 +519,10 @@ class Scaled(_Compensated):
     }
     reciprocal = False
     examples = [{"base": {"type": "phong", "n": 5}}, {"base": {"type": "phong", "n": 5}, "f0": 0.5}]
+    _why = "its albedo table is then not the albedo toward wo that 1/E(mu_o) needs"
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self._check_reciprocal("scaled", "its albedo table is then not the albedo toward wo that 1/E(mu_o) needs")
 
     @property
     def spec(self) -> dict:
