@@ -791,5 +791,6 @@ def load_compensated(path) -> BRDF:
         ds = ds.copy()
         del ds.attrs["cache"]
         t.dataset = ds
-        (_TABLES if kind == "compensate" else PUMP_TABLES)[_key(load(json.loads(ds.attrs["spec"])))] = t
+        key = json.dumps(json.loads(ds.attrs["spec"]), sort_keys=True)  # = _key of its BRDF, without building it
+        (_TABLES if kind == "compensate" else PUMP_TABLES)[key] = t
     return load(spec)
