@@ -257,6 +257,7 @@ def plot(ds, path):
             if model in ds.model.values:
                 ax[1].plot(ds.theta_i, ds.mirror_ratio.sel({"model": model, "method": method}), ls, color=colors[method],
                            marker=".", label=f"{method} ({model})")
+    ax[1].set_yscale("log")
     ax[1].set_xlabel("theta_i [deg]")
     ax[1].set_ylabel("f_c(wi, R) / f(wi, R)")
     ax[1].set_title("point light, mirror direction, against the base")
@@ -278,20 +279,44 @@ def plot(ds, path):
 
 
 def markdown(ds) -> str:
-    """The README's table."""
-    lines = ["| model | method | max \\|1 - a\\| | min a | asymmetry | mirror 60° | mirror 89° | peak 85° | shape | cost |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+    """The README's table: one row per model, the four methods as kulla_conty / scale / g1 / g2."""
+    meth = [m for m in ds.method.values if m != "base"]
     i60, i89 = list(ds.theta_i.values).index(60.0), list(ds.theta_i.values).index(89.0)
+
+    def cells(model, fn):
+        out = []
+        for m in meth:
+            s = ds.sel({"model": model, "method": m})
+            out.append("refused" if str(s.refused.values) else fn(s))
+        return " / ".join(out)
+
+    lines = ["| model | base min a | max \\|1 - a\\| | min a | asymmetry | mirror 60° | mirror 89° | peak 85° | "
+             "shape | cost |", "|---|---|---|---|---|---|---|---|---|---|"]
     for model in ds.model.values:
-        for method in ds.method.values:
-            s = ds.sel({"model": model, "method": method})
-            if str(s.refused.values):
-                lines.append(f"| {model} | {method} | refused (E > 1) | | | | | | | |")
-                continue
-            lines.append(
-                f"| {model} | {method} | {float(s.furnace_residual):.1e} | {float(s.min_albedo):.6f} | "
-                f"{float(s.asymmetry):.2g} | {float(s.mirror_ratio[i60]):.4f} | {float(s.mirror_ratio[i89]):.4f} | "
-                f"{float(s.peak_ratio):.3f} | {float(s.shape_change):.3g} | {float(s.cost_ratio):.2f} |")
+        b = ds.sel({"model": model, "method": "base"})
+        lines.append("| " + " | ".join([
+            model, f"{float(b.min_albedo):.3f}",
+            cells(model, lambda s: f"{float(s.furnace_residual):.1e}"),
+            cells(model, lambda s: f"{float(s.min_albedo):.6f}"),
+            cells(model, lambda s: f"{float(s.asymmetry):.2g}"),
+            cells(model, lambda s: f"{float(s.mirror_ratio[i60]):.3f}"),
+            cells(model, lambda s: f"{float(s.mirror_ratio[i89]):.3f}"),
+            cells(model, lambda s: f"{float(s.peak_ratio):.3g}"),
+            cells(model, lambda s: f"{float(s.shape_change):.2g}"),
+            cells(model, lambda s: f"{float(s.cost_ratio):.1f}")]) + " |")
+    return "\n".join(lines)
+
+
+def metal_markdown(ds) -> str:
+    """The metalness furnace: max over mu and m of |1 - a|, per method and arrangement."""
+    lines = ["| GGX alpha | applied to | " + " | ".join(ds.method.values) + " |",
+             "|---|---|" + "---|" * len(ds.method)]
+    for a in ds.alpha.values:
+        for arr in ds.arrangement.values:
+            r = ds.metal_residual.sel({"alpha": a, "arrangement": arr})
+            lines.append(f"| {a:g} | {arr} | " + " | ".join(
+                f"{float(r.sel({'method': m}).max()):.1e}" + (" ✓" if float(r.sel({"method": m}).max()) <= 1e-6 else "")
+                for m in ds.method.values) + " |")
     return "\n".join(lines)
 
 
@@ -300,7 +325,14 @@ def main(argv=None):
     ap.add_argument("--out", default="tables")
     ap.add_argument("--figures", default="figures")
     ap.add_argument("--quick", action="store_true", help="two models only (a smoke test)")
+    ap.add_argument("--replot", action="store_true", help="redraw the figure and tables from the stored file")
     a = ap.parse_args(argv)
+    if a.replot:
+        ds = pumpup.open_table(os.path.join(a.out, "compensation.nc"))
+        print(plot(ds, os.path.join(a.figures, "compensation.png")))
+        print(markdown(ds))
+        print(metal_markdown(ds))
+        return
     os.makedirs(a.out, exist_ok=True)
     os.makedirs(a.figures, exist_ok=True)
     t0 = time.perf_counter()
@@ -309,6 +341,7 @@ def main(argv=None):
     path = pumpup.write_table(ds, os.path.join(a.out, "compensation.nc"))
     fig = plot(ds, os.path.join(a.figures, "compensation.png"))
     print(markdown(ds))
+    print(metal_markdown(ds))
     print(f"wrote {path} and {fig} in {ds.attrs['seconds']:.0f} s")
 
 
