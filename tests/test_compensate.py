@@ -299,3 +299,23 @@ def test_cli_compensate_and_check(tmp_path, capsys):
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "--f0" in r.stderr
     main(["check", '{"type": "scaled", "base": {"type": "lambert", "albedo": 0.5}, "f0": 0.5}'])
     assert "scaled: f (1 + F0 (1/E(mu_o) - 1)), F0 = 0.5" in capsys.readouterr().out
+
+
+def test_study_rows_match_the_stored_table():
+    """scripts/compensation_study.py's own function on two rows of tables/compensation.nc (no timing);
+    and the stored refusal of Ward by Kulla-Conty."""
+    from pathlib import Path
+
+    import compensation_study as cs
+
+    ds = pumpup.open_table(Path(__file__).resolve().parents[1] / "tables" / "compensation.nc")
+    specs = json.loads(ds.attrs["specs"])
+    assert "exceeds 1" in str(ds.refused.sel({"model": "ward m=0.1", "method": "kulla_conty"}).values)
+    for method in ("kulla_conty", "scale"):
+        row = ds.sel({"model": "ggx alpha=0.3", "method": method})
+        f, why = cs.build(specs["ggx alpha=0.3"], method)
+        r = cs.measure(f, pumpup.load(specs["ggx alpha=0.3"]), timing=False)
+        np.testing.assert_allclose(r["furnace"], row.furnace.values, rtol=0, atol=1e-10)
+        np.testing.assert_allclose(r["mirror_ratio"], row.mirror_ratio.values, rtol=1e-12)
+        for k in ("asymmetry", "peak_ratio", "shape_change"):
+            assert r[k] == pytest.approx(float(row[k]), rel=1e-9, abs=1e-15), k
