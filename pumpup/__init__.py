@@ -11,6 +11,7 @@ from . import reproduce
 from . import testing
 from .divergence import divergence
 from .pump import Pumped, load_pumped, pump, save_pumped
+from .compensate import KullaConty, Scaled, compensate, furnace, load_compensated, save_compensated
 from . import sampling
 from .sampling import mc_albedo, mc_radiance, sample
 from .tables import AlbedoTable, max_albedo, max_constant, mean_albedo, open_table, tabulate, write_table
@@ -42,6 +43,12 @@ __all__ = [
     "pump",
     "save_pumped",
     "load_pumped",
+    "compensate",
+    "furnace",
+    "KullaConty",
+    "Scaled",
+    "save_compensated",
+    "load_compensated",
     "AlbedoTable",
     "max_albedo",
     "max_constant",

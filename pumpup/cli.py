@@ -84,6 +84,8 @@ def cmd_check(args) -> int:
     f = _load(args.spec)
     r = pumpup.check_reciprocity(f)
     print(r)
+    if hasattr(f, "report"):  # a compensated BRDF (pumpup.compensate): its E table and bounds
+        print(f.report())
     m = pumpup.max_albedo(f)
     print(f"max albedo (constant set to 1): {m.albedo:.12g} +- {m.error:.2g} at theta = {m.theta_deg:.6f} deg;"
           f" maximum constant {m.constant:.12g}")
@@ -262,6 +264,58 @@ def cmd_mc(args) -> int:
     return 0 if worst < 4 else 1
 
 
+def cmd_compensate(args) -> int:
+    import os
+
+    import numpy as np
+
+    import pumpup
+
+    def die(msg):  # a user error: one line on stderr, exit status 2
+        print(f"pumpup: {msg}", file=sys.stderr)
+        raise SystemExit(2)
+
+    try:
+        f = pumpup.load(parse_spec(args.spec))
+    except SystemExit as exc:  # parse_spec's message
+        die(str(exc.code).removeprefix("pumpup: "))
+    except pumpup.SpecError as exc:
+        die(str(exc))
+    for name, v in (("--f0", args.f0), ("--f-avg", args.f_avg)):
+        if v is not None and not 0.0 <= v <= 1.0:
+            die(f"{name} must be in [0, 1], got {v:g}")
+    if args.method in ("g1", "g2") and (args.f0 is not None or args.f_avg is not None):
+        die(f"--method {args.method} (pumping) takes no --f0 or --f-avg")
+    if args.method == "scale" and args.f_avg is not None:
+        die("--f-avg belongs to --method kulla_conty; --method scale takes --f0")
+    if args.out:
+        d = os.path.dirname(os.path.abspath(args.out))
+        if not os.path.isdir(d):
+            die(f"cannot write {args.out!r}: directory {d!r} does not exist")
+    kw = {}
+    if args.f0 is not None:
+        kw["f0"] = args.f0
+    if args.f_avg is not None:
+        kw["f_avg"] = args.f_avg
+    try:
+        c = pumpup.compensate(f, method=args.method, force=args.force, **kw)
+    except pumpup.SpecError as exc:
+        die(str(exc))
+    print(f"# {json.dumps(c.spec)}")
+    if hasattr(c, "report"):
+        print(f"# {c.report()}")
+    mu = np.array([1.0, 0.5, 0.1, 0.01, 1e-4])
+    a0 = pumpup.albedo(f, mu)
+    a1, e1 = pumpup.furnace(c, mu, return_error=True)
+    print(f"{'mu':>8s} {'base albedo':>14s} {'compensated':>14s} {'error':>9s}   (furnace toward wo = mu)")
+    for i, m in enumerate(mu):
+        print(f"{m:8.2g} {a0[i]:14.10f} {a1[i]:14.10f} {e1[i]:9.2g}")
+    if args.out:
+        pumpup.save_compensated(c, args.out)
+        print(f"wrote {args.out}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="pumpup",
@@ -341,6 +395,15 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--no-mean", action="store_true", help="skip the mean albedo")
     s.add_argument("--no-maximum", action="store_true", help="skip the maximum constant")
     s.set_defaults(func=cmd_sweep)
+    s = sub.add_parser("compensate", help="energy compensation: Kulla-Conty lobe, 1/E scaling (not reciprocal), or "
+                                          "pumping g1/g2; prints the furnace and saves the BRDF with its tables")
+    s.add_argument("spec")
+    s.add_argument("--method", choices=("kulla_conty", "scale", "g1", "g2"), default="kulla_conty")
+    s.add_argument("--f0", type=float, help="Fresnel F0 in [0, 1] (scale: Turquin's F0; kulla_conty: Schlick F_avg)")
+    s.add_argument("--f-avg", type=float, help="kulla_conty: the Fresnel average F_avg in [0, 1]")
+    s.add_argument("--force", action="store_true", help="accept a base that is not reciprocal")
+    s.add_argument("--out", help="save the compensated BRDF and its tables to this netCDF file")
+    s.set_defaults(func=cmd_compensate)
     return p
 
 

@@ -351,7 +351,8 @@ def strategy(brdf: BRDF, mu: float = 1.0, kind: str = "lobe") -> Strategy:
         return Strategy(((1.0, COSINE, 0.0),))
     if kind != "lobe":
         raise ValueError(f"sampling strategy must be 'lobe' or 'cosine', got {kind!r}")
-    terms = brdf.albedo_terms()
+    by_mu = getattr(brdf, "sampling_terms", None)  # terms weighted for this mu (the Kulla-Conty mixture)
+    terms = by_mu(float(mu)) if by_mu is not None else brdf.albedo_terms()
     weights = np.array([abs(w) for w, _ in terms], dtype=np.float64)
     if not np.all(np.isfinite(weights)) or weights.sum() <= 0:
         weights = np.ones(len(terms))
