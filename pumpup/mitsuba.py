@@ -615,7 +615,9 @@ def _spec_from_props(props) -> Any:
                 return json.loads(s)
             except json.JSONDecodeError as exc:
                 raise SpecError(f"pumpup plugin: 'spec' is not valid JSON: {exc}") from None
-        return s
+        from .cli import parse_spec
+
+        return parse_spec(s)  # the short form, phong:n=20
     if "model" in keys:
         spec = {"type": props["model"]}
         for k in keys:
