@@ -48,8 +48,9 @@ The BSDF
     the result rounded once to Mitsuba's float32), so in ``llvm_*`` variants it is traced into
     Mitsuba's kernels; in ``scalar_*`` variants the same code runs on Python floats.  A pumped
     model divides by the same upper bounds of the albedo tables as pumpup's compiled kernel
-    (spline + margin, capped at 1; :class:`pumpup.pump._Lookup`), evaluated level by level with
-    ``dr.gather`` on the tables, and its value is rounded down before the cast to float32
+    (spline + margin, capped at 1; :class:`pumpup.pump._Lookup`): through pumpup's product table G(m)
+    of all levels where it has one (:class:`pumpup.pump._Product`, piece found from the float64 bits
+    of m = max(N.wi, N.wo)), else level by level, with ``dr.gather`` on the tables; its value is rounded down before the cast to float32
     (x (1 - 2^-23)), so the exported BSDF is pointwise at most the double-precision one and
     keeps its proof of energy conservation (001 eq. 18).
 ``from_mitsuba(bsdf_dict, channel=0, variant=None) -> pumpup BRDF``
@@ -471,6 +472,48 @@ class _Level:
         return g
 
 
+class _ProductG:
+    """The chain kernel's fast path in Dr.Jit: G(m) = g_1 ... g_k as one piecewise quintic in
+    m = max(N.wi, N.wo) (:class:`pumpup.pump._Product`, the same pieces and coefficients, already scaled
+    up by 1 + epsilon), the piece found from the float64 bits of m, for min(N.wi, N.wo) > ``mlo``."""
+
+    def __init__(self, prod):
+        from .pump import _CELL_SHIFT, _bits
+
+        self.mlo, self.cbase, self.shift = float(prod.mlo), int(prod.cbase), _CELL_SHIFT
+        self.ncell = len(prod.cstart)
+        self.deg = prod.rows.shape[1] - 3
+        self.width = prod.rows.shape[1]
+        self.rows = _Table(prod.rows)  # piece s: coefficients (highest power first), centre, 1 / half-width
+        self.lo = _Table(prod.lo)  # piece starts, with an inf sentinel
+        self.cstart_np = np.asarray(prod.cstart, dtype=np.int64)
+        self.cstart = mi.UInt32(self.cstart_np.astype(np.uint32)) if _jit() else None
+        # the most pieces that start inside one cell: the kernel's forward steps, unrolled here
+        bounds = (np.arange(self.cbase, self.cbase + self.ncell + 1, dtype=np.int64) << self.shift).view(np.float64)
+        ends = np.searchsorted(prod.lo[:-1], bounds[1:], side="left") - 1
+        self.steps = int(max(0, np.max(ends - self.cstart_np))) + 1
+        self._bits = _bits
+
+    def __call__(self, m):
+        if _jit():
+            bits = dr.reinterpret_array(mi.UInt64, m) >> self.shift
+            c = mi.UInt32(dr.minimum(dr.maximum(bits, self.cbase) - self.cbase, self.ncell - 1))
+            s = dr.gather(mi.UInt32, self.cstart, c)
+            for _ in range(self.steps):  # forward to the piece that holds m (pumpup.pump._Product.piece)
+                s = dr.select(m >= self.lo[s + 1], s + 1, s)
+        else:
+            c = min(max((int(self._bits(m)) >> self.shift) - self.cbase, 0), self.ncell - 1)
+            s = int(self.cstart_np[c])
+            while m >= self.lo[s + 1]:
+                s += 1
+        w, d = self.width, self.deg
+        t = (m - self.rows[s * w + d + 1]) * self.rows[s * w + d + 2]
+        g = self.rows[s * w] * t
+        for r in range(1, d):  # Horner, in the order of pumpup.pump._horner
+            g = (g + self.rows[s * w + r]) * t
+        return g + self.rows[s * w + d]
+
+
 class _DrModel:
     """A pumpup BRDF translated to Dr.Jit: ``f(l, v)`` in Float64, and its sampling strategy."""
 
@@ -483,6 +526,8 @@ class _DrModel:
         base = brdf
         from .pump import Pumped
 
+        prod = brdf.product() if isinstance(brdf, Pumped) else None
+        self.product = _ProductG(prod) if prod is not None else None
         while isinstance(base, Pumped):
             self.levels.append(_Level(base.lookup(), base.controlled))
             base = base.base
@@ -500,12 +545,25 @@ class _DrModel:
                                 "angle, which the plugin does not support")
         self.components = strat.components
 
+    def g(self, mi_, mo):
+        """The product of all levels' g at cosines (mi_, mo) > 0, as pumpup's chain kernel computes it."""
+        def by_levels(mi_, mo):
+            g = 1.0
+            for lev in self.levels:
+                g = g * lev.g(mi_, mo)
+            return g
+
+        if self.product is None:
+            return by_levels(mi_, mo)
+        fast = dr.minimum(mi_, mo) > self.product.mlo  # both cosines where the product table holds
+        if not _jit():
+            return self.product(dr.maximum(mi_, mo)) if fast else by_levels(mi_, mo)
+        return dr.if_stmt((mi_, mo), fast, lambda a, b: self.product(dr.maximum(a, b)), by_levels)
+
     def f(self, l, v):
         val = self.kernel(l, v, *self.args)
         if self.levels:
-            g = 1.0
-            for lev in self.levels:
-                g = g * lev.g(dr.maximum(l[2], 1e-300), dr.maximum(v[2], 1e-300))
+            g = self.g(dr.maximum(l[2], 1e-300), dr.maximum(v[2], 1e-300))
             val = _div(val, g) * self.ROUND_DOWN  # 001 eq. 16, all levels
         return dr.select((l[2] > 0) & (v[2] > 0), val, 0.0)
 

@@ -98,7 +98,8 @@ def _ids(specs):
 
 
 def _pairs(n, rng):
-    """Random pairs above the horizon plus grazing ones (cosines down to 1e-6), float32-exact."""
+    """Random pairs above the horizon plus grazing ones (cosines down to 1e-9, below the 1e-8 where pumped
+    chains leave their product table), float32-exact."""
     def dirs(m, zmin=None):
         x = rng.normal(size=(m, 3))
         x[:, 2] = np.abs(x[:, 2])
@@ -113,8 +114,8 @@ def _pairs(n, rng):
     m = v * np.array([-1.0, -1.0, 1.0]) + 0.02 * rng.normal(size=v.shape)
     m[:, 2] = np.abs(m[:, 2])
     m = (m / np.linalg.norm(m, axis=1)[:, None]).astype(np.float32).astype(np.float64)
-    wi = np.concatenate([dirs(n), m, dirs(n // 4, 1e-6), dirs(n // 4)])
-    wo = np.concatenate([dirs(n), v, dirs(n // 4), dirs(n // 4, 1e-6)])
+    wi = np.concatenate([dirs(n), m, dirs(n // 4, 1e-9), dirs(n // 4)])
+    wo = np.concatenate([dirs(n), v, dirs(n // 4), dirs(n // 4, 1e-9)])
     return wi, wo
 
 
