@@ -12,7 +12,6 @@ difference to pumpup's double-precision model where there is one).
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import time
 

@@ -29,23 +29,6 @@ def _run(code, env=None, timeout=300):
                           timeout=timeout)
 
 
-# --- without mitsuba (no import of mitsuba needed here) ---------------------------------------
-
-
-def test_import_pumpup_does_not_import_mitsuba():
-    r = _run("import sys, pumpup; print('mitsuba' in sys.modules, 'drjit' in sys.modules)")
-    assert r.returncode == 0, r.stderr
-    assert r.stdout.split() == ["False", "False"]
-
-
-def test_missing_mitsuba_gives_an_import_error_naming_the_extra():
-    r = _run("import sys; sys.modules['mitsuba'] = None; sys.modules['drjit'] = None\n"
-             "import pumpup\n"
-             "try:\n    import pumpup.mitsuba\nexcept ImportError as e:\n    print('IMPORTERROR', e)\n")
-    assert r.returncode == 0, r.stderr
-    assert "IMPORTERROR" in r.stdout and 'pip install -e ".[render]"' in r.stdout
-
-
 mi = pytest.importorskip("mitsuba")
 dr = pytest.importorskip("drjit")
 pm = pytest.importorskip("pumpup.mitsuba")
