@@ -871,7 +871,8 @@ def from_mitsuba(bsdf: Any, channel: int = 0, variant: str | None = None, name: 
     channel : int, in [0, channels)
         Which channel of Mitsuba's spectrum to return (R, G, B = 0, 1, 2 in rgb variants).
     variant : str or None
-        As :func:`register` (None keeps the current variant, or prefers a probed ``llvm_ad_rgb``).
+        As :func:`register` (None keeps the current variant, or prefers a probed ``llvm_ad_rgb``); rgb or
+        mono variants only.
     name : str, optional
         The BRDF's name (default: the dict's type).
 
@@ -882,6 +883,9 @@ def from_mitsuba(bsdf: Any, channel: int = 0, variant: str | None = None, name: 
         Mitsuba evaluates in float32 (relative rounding about 1e-7 per value).
     """
     variant = register(variant)
+    if mi.is_spectral:
+        raise ValueError(f"from_mitsuba needs an rgb or mono variant (channel = an RGB channel), got {variant}; "
+                         "a chosen wavelength of a spectral variant is not supported")
     if isinstance(bsdf, dict):
         label = name or f"mitsuba {json.dumps(bsdf, sort_keys=True, default=str)} channel {channel}"
         obj = mi.load_dict(_convert(bsdf))
