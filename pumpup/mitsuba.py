@@ -1,0 +1,928 @@
+"""Mitsuba 3 bridge: pumpup's BRDFs as a Mitsuba BSDF plugin, and Mitsuba's BSDFs as pumpup BRDFs.
+
+Imported only explicitly (``import pumpup.mitsuba``); ``import pumpup`` never imports Mitsuba.
+Needs the ``render`` extra: ``pip install -e ".[render]"`` (mitsuba >= 3.5 with drjit).
+
+Plugin API (a contract for scripts and renderers that use it)
+-------------------------------------------------------------
+``variant = register(variant=None)``
+    Choose a Mitsuba variant, ``mi.set_variant`` it, and register the BSDF plugin ``"pumpup"``
+    for that variant (call it again after switching variants).  ``variant=None`` keeps the
+    variant already set, else prefers ``llvm_ad_rgb``.  A JIT (``llvm_*``) variant is first
+    *probed in a subprocess* (:func:`probe`): with a libLLVM older than 17, Dr.Jit 1.5 aborts
+    the process (SIGABRT, "Cannot select: fmaximum") at the first kernel, which no Python code
+    can catch; if the probe fails, ``scalar_rgb`` is used instead and one line on stderr says
+    why and how to get the fast variant (``apt-get install libllvm19``, or
+    ``DRJIT_LIBLLVM_PATH``).  Returns the variant in use.
+``mi.load_dict({"type": "pumpup", "spec": SPEC})``
+    SPEC is a pumpup spec as a JSON string (``json.dumps(spec)``, or :func:`bsdf_dict`), a
+    short spec (``"phong:n=20"``), or a JSON list of three specs (one per RGB channel, rgb
+    variants only: e.g. ``metal`` with per-channel indices).  Mitsuba's ``load_dict`` reads
+    a nested dict with a ``"type"`` as a Mitsuba object, so a *dict* spec is passed through
+    :func:`bsdf_dict` / :func:`load_dict`, which turn it into JSON.  Flat parameters work too:
+    ``{"type": "pumpup", "model": "phong", "n": 20}``.  A spec the plugin cannot translate
+    raises ``SpecError`` naming the type (Mitsuba wraps it in a RuntimeError).
+``bsdf_dict(spec) -> dict``, ``load_dict(scene_dict)``
+    ``{"type": "pumpup", "spec": "<json>"}``; ``mi.load_dict`` of a scene dict in which every
+    ``{"type": "pumpup", "spec": {...}}`` has been converted that way.
+The BSDF
+    Front side only (0 where either cosine <= 0), one component, flags ``GlossyReflection``
+    (``DiffuseReflection`` for ``lambert``).  Directions are in Mitsuba's local shading frame
+    (z = normal, x = the frame's tangent ``si.sh_frame.s``, which is the x axis of anisotropic
+    models such as ``ward_aniso``).  Mitsuba's ``si.wi`` points to the viewer (pumpup's ``wo``)
+    and its ``wo`` to the light (pumpup's ``wi``):
+
+    * ``eval(ctx, si, wo)`` = f_r(wi=wo, wo=si.wi) * cos(theta) of Mitsuba's wo (Mitsuba's
+      convention: the cosine is included), per channel;
+    * ``pdf(ctx, si, wo)`` = pumpup's sampling density (:func:`pumpup.sampling.pdf`);
+    * ``sample(ctx, si, s1, s2)`` draws with pumpup's strategy (:func:`pumpup.sampling.strategy`:
+      the Phong lobe of 000 eq. 19-22 around the mirror direction, half-vector lobes for Blinn
+      (cos^n), Beckmann and GGX, the cosine-weighted hemisphere otherwise, and mixtures for sums,
+      the component chosen with ``s1``); a lobe direction below the horizon is a rejected draw:
+      weight 0, ``pdf`` 0 (000 after eq. 22), which keeps estimators unbiased.  The returned
+      weight is eval / pdf at the returned (float32) direction, and ``bs.pdf`` equals
+      ``pdf(ctx, si, bs.wo)``;
+    * ``eval_pdf`` returns (eval, pdf).
+
+    Everything is computed in Dr.Jit operations on Float64 (the float32 inputs converted exactly,
+    the result rounded once to Mitsuba's float32), so in ``llvm_*`` variants it is traced into
+    Mitsuba's kernels; in ``scalar_*`` variants the same code runs on Python floats.  A pumped
+    model divides by the same upper bounds of the albedo tables as pumpup's compiled kernel
+    (spline + margin, capped at 1; :class:`pumpup.pump._Lookup`): through pumpup's product table G(m)
+    of all levels where it has one (:class:`pumpup.pump._Product`, piece found from the float64 bits
+    of m = max(N.wi, N.wo)), else level by level, with ``dr.gather`` on the tables; its value is rounded down before the cast to float32
+    (x (1 - 2^-23)), so the exported BSDF is pointwise at most the double-precision one and
+    keeps its proof of energy conservation (001 eq. 18).
+``from_mitsuba(bsdf_dict, channel=0, variant=None) -> pumpup BRDF``
+    A Mitsuba BSDF as a pumpup BRDF: f_r(wi, wo) = eval(si.wi = wo, wo = wi)[channel] / N.wi,
+    front side, so that ``albedo``, ``tabulate``, ``check_reciprocity``, ``pump`` and
+    ``compensate`` work on it.  Evaluated by Mitsuba in float32: its relative accuracy is about
+    1e-7 per value (see the README for what this limits).
+
+Supported pumpup types: lambert, phong, stretched_phong, retro, phong_shader, blinn,
+stretched_blinn, phong_blinn, ward, modified_ward, ward_aniso, schlick, cook_torrance,
+beckmann, ggx (with ``ior`` or ``eta``/``k`` Fresnel, separable or correlated Smith, exact or
+Walter G1), metal, plastic, and ``pumped`` over any of them (g1 or g2, any number of levels).
+
+Examples
+--------
+>>> import pumpup.mitsuba as pm
+>>> variant = pm.register("scalar_rgb")
+>>> import mitsuba as mi
+>>> b = pm.load_dict({"type": "pumpup", "spec": {"type": "lambert", "albedo": 0.5}})
+>>> si = mi.SurfaceInteraction3f(); si.wi = mi.Vector3f(0, 0, 1)
+>>> round(b.eval(mi.BSDFContext(), si, mi.Vector3f(0, 0.6, 0.8))[0] * 3.141592653589793 / 0.4, 6)
+1.0
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+from typing import Any
+
+try:
+    import drjit as dr
+    import mitsuba as mi
+except ImportError as _exc:  # pragma: no cover - exercised in a subprocess without mitsuba
+    raise ImportError(
+        "pumpup.mitsuba needs Mitsuba 3 and Dr.Jit (mitsuba>=3.5): install the render extra, "
+        "pip install -e \".[render]\" (or pip install \"pumpup[render]\")"
+    ) from _exc
+
+import numpy as np
+
+from . import sampling as _sampling
+from .core import BRDF, SpecError, from_function, load
+
+__all__ = ["register", "probe", "choose_variant", "bsdf_dict", "load_dict", "from_mitsuba", "SUPPORTED",
+           "DEFAULT_VARIANT", "FALLBACK_VARIANT"]
+
+DEFAULT_VARIANT = "llvm_ad_rgb"
+FALLBACK_VARIANT = "scalar_rgb"
+
+_INV_PI = 1.0 / math.pi
+_INV_2PI = 0.5 / math.pi
+_SQRT_PI = math.sqrt(math.pi)
+
+# ----------------------------------------------------------------------------------------
+# The subprocess probe of a JIT variant
+# ----------------------------------------------------------------------------------------
+
+#: the probe: set the variant, run a BSDF kernel with fmaximum (the instruction libLLVM 15
+#: cannot select) and a Float64 kernel, print a marker
+_PROBE_CODE = r"""
+import sys
+import drjit as dr, mitsuba as mi
+mi.set_variant(sys.argv[1])
+b = mi.load_dict({"type": "roughconductor", "alpha": 0.2})
+si = dr.zeros(mi.SurfaceInteraction3f, 16)
+si.wi = mi.Vector3f(0.0, 0.6, 0.8)
+v = b.eval(mi.BSDFContext(), si, mi.Vector3f(0.0, -0.6, 0.8))
+x = dr.maximum(mi.Float64(v[0]), dr.sqrt(mi.Float64(dr.arange(mi.Float, 16))))
+dr.eval(v, x)
+print("pumpup-probe-ok", float(dr.sum(x)[0]) > 0)
+"""
+
+_PROBES: dict[tuple, tuple[bool, str]] = {}
+
+
+def probe(variant: str = DEFAULT_VARIANT, timeout: float = 180.0) -> tuple[bool, str]:
+    """Test in a subprocess whether ``variant`` runs a BSDF kernel here without aborting.
+
+    Parameters
+    ----------
+    variant : str
+        A Mitsuba variant name (``mi.variants()``).
+    timeout : float
+        Seconds before the probe counts as failed.
+
+    Returns
+    -------
+    (ok, reason)
+        ``reason`` is "" when ok, else one line (the signal, the exit status or the last line
+        of the probe's stderr).  Cached per (variant, DRJIT_LIBLLVM_PATH) for the session.
+    """
+    key = (variant, os.environ.get("DRJIT_LIBLLVM_PATH"))
+    if key in _PROBES:
+        return _PROBES[key]
+    if variant not in mi.variants():
+        res = (False, f"this Mitsuba build has no variant {variant!r} (it has {', '.join(mi.variants())})")
+    elif variant.startswith("scalar"):
+        res = (True, "")
+    else:
+        try:
+            r = subprocess.run([sys.executable, "-c", _PROBE_CODE, variant], capture_output=True, text=True,
+                               timeout=timeout, env=dict(os.environ))
+        except subprocess.TimeoutExpired:
+            res = (False, f"the probe of {variant} did not finish in {timeout:g} s")
+        else:
+            if r.returncode == 0 and "pumpup-probe-ok True" in r.stdout:
+                res = (True, "")
+            else:
+                lines = [ln for ln in (r.stderr or "").strip().splitlines() if ln.strip()]
+                tail = lines[-1].strip()[:160] if lines else "no message"
+                if r.returncode < 0:
+                    try:
+                        sig = signal.Signals(-r.returncode).name
+                    except ValueError:
+                        sig = f"signal {-r.returncode}"
+                    res = (False, f"the probe process was killed by {sig} ({tail})")
+                else:
+                    res = (False, f"the probe exited with status {r.returncode} ({tail})")
+    _PROBES[key] = res
+    return res
+
+
+def choose_variant(prefer: str = DEFAULT_VARIANT, quiet: bool = False) -> str:
+    """``prefer`` if :func:`probe` passes, else ``scalar_rgb`` (with one line on stderr)."""
+    ok, reason = probe(prefer)
+    if ok:
+        return prefer
+    if not quiet:
+        print(f"pumpup.mitsuba: {prefer} is unusable here ({reason}); using {FALLBACK_VARIANT} (slow). "
+              "For the fast variant install libLLVM >= 17 (Debian: apt-get install libllvm19) or point "
+              "DRJIT_LIBLLVM_PATH at one.", file=sys.stderr)
+    return FALLBACK_VARIANT
+
+
+# ----------------------------------------------------------------------------------------
+# Array helpers: the same code runs on Dr.Jit arrays (JIT variants) and Python floats (scalar)
+# ----------------------------------------------------------------------------------------
+
+
+def _jit() -> bool:
+    return dr.is_jit_v(mi.Float)
+
+
+def _f64(x):
+    """An exact Float64 copy of a Mitsuba Float (float32 in JIT variants; a Python float in scalar)."""
+    return mi.Float64(x) if _jit() else float(x)
+
+
+def _div(a, b):
+    """a / b that never raises (Python floats raise on / 0; lanes with b = 0 are masked by the caller)."""
+    return a * dr.rcp(b)
+
+
+class _Table:
+    """A float64 table for ``dr.gather`` (a Float64 array in JIT variants, a numpy array in scalar)."""
+
+    def __init__(self, values):
+        self.np = np.ascontiguousarray(np.asarray(values, dtype=np.float64).ravel())
+        self.dr = mi.Float64(self.np) if _jit() else None
+
+    def __getitem__(self, idx):
+        if self.dr is None:
+            return float(self.np[int(idx)])
+        return dr.gather(mi.Float64, self.dr, idx)
+
+
+def _int(v):
+    return mi.UInt32(v) if _jit() else int(v)
+
+
+# ----------------------------------------------------------------------------------------
+# Dr.Jit versions of the models: k(l, v, *brdf.kernel_args()) with l = wi, v = wo as
+# (x, y, z) tuples of Float64, beside the numba kernels they mirror (same formulas, same order)
+# ----------------------------------------------------------------------------------------
+
+
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _tan2_half(l, v):
+    """tan^2 delta from S = L + V (pumpup.models._half.tan2_half)."""
+    sz = l[2] + v[2]
+    qx = _div(l[0] + v[0], sz)
+    qy = _div(l[1] + v[1], sz)
+    return qx * qx + qy * qy
+
+
+def _pow_pos(x, n):
+    """x^n for x > 0 (0 elsewhere: every caller masks x <= 0)."""
+    return dr.select(x > 0, dr.power(dr.maximum(x, 1e-300), n), 0.0)
+
+
+def _fresnel_dielectric(c, n):
+    """pumpup.models.cook_torrance._fresnel (002 sec. 3.2); callers use it only for n > 0."""
+    g = dr.sqrt(dr.maximum(n * n + c * c - 1.0, 0.0))
+    a = _div(g - c, g + c)
+    q = _div(c * (g + c) - 1.0, c * (g - c) + 1.0)
+    return 0.5 * a * a * (1.0 + q * q)
+
+
+def _fresnel_conductor(c, eta, k):
+    """pumpup.models.metal._fresnel_real: the exact conductor Fresnel factor without cancellation."""
+    s2 = (1.0 - c) * (1.0 + c)
+    t0 = eta * eta - k * k - s2
+    big = dr.sqrt(t0 * t0 + (2.0 * eta * k) ** 2)  # a^2 + b^2
+    ra = dr.sqrt(dr.maximum(0.5 * (big + t0), 0.0))
+    rb = dr.sqrt(dr.maximum(0.5 * (big - t0), 0.0))
+    pos = t0 >= 0.0
+    a = dr.select(pos, ra, _div(eta * k, dr.maximum(rb, 1e-300)))
+    b = dr.select(pos, _div(eta * k, dr.maximum(ra, 1e-300)), rb)
+    a = dr.select(big == 0.0, 0.0, a)
+    b = dr.select(big == 0.0, 0.0, b)
+    rs = _div((a - c) ** 2 + b * b, (a + c) ** 2 + b * b)
+    rp = rs * _div((a * c - s2) ** 2 + b * b * c * c, (a * c + s2) ** 2 + b * b * c * c)
+    return 0.5 * (rs + rp)
+
+
+def _dr_lambert(l, v, albedo):
+    return albedo * _INV_PI + 0.0 * l[2]
+
+
+def _dr_phong(l, v, n, c):
+    rv = 2.0 * l[2] * v[2] - _dot(l, v)  # 000 eq. 9
+    return dr.select(rv > 0, c * _pow_pos(rv, n), 0.0)  # 000 eq. 5
+
+
+def _den_p(mx, p):
+    return mx if p == 1.0 else (1.0 + 0.0 * mx if p == 0.0 else dr.power(mx, p))
+
+
+def _dr_stretched_phong(l, v, n, p, c):
+    rv = 2.0 * l[2] * v[2] - _dot(l, v)  # 000 eq. 9
+    mx = dr.maximum(l[2], v[2])
+    return dr.select(rv > 0, _div(c * _pow_pos(rv, n), _den_p(mx, p)), 0.0)  # 000 eq. 10, 12
+
+
+def _dr_retro(l, v, n, p, c):
+    lv = _dot(l, v)
+    mx = dr.maximum(l[2], v[2])
+    return dr.select(lv > 0, _div(c * _pow_pos(lv, n), dr.power(mx, p)), 0.0)  # 000 eq. 13
+
+
+def _dr_phong_shader(l, v, n, ks, kd):
+    rv = 2.0 * l[2] * v[2] - _dot(l, v)
+    return kd + dr.select(rv > 0, _div(ks * _pow_pos(rv, n), l[2]), 0.0)  # 002 eq. 5, 8
+
+
+def _dr_blinn(l, v, n, c):
+    cos2 = dr.rcp(1.0 + _tan2_half(l, v))  # (N.H)^2
+    return c * _pow_pos(cos2, 0.5 * n)  # 000 eq. 31
+
+
+def _dr_stretched_blinn(l, v, n, c):
+    cos2 = dr.rcp(1.0 + _tan2_half(l, v))
+    return _div(c * _pow_pos(cos2, 0.5 * n), dr.maximum(l[2], v[2]))  # 000 eq. 32
+
+
+def _dr_phong_blinn(l, v, n, ks, kd):
+    cos2 = dr.rcp(1.0 + _tan2_half(l, v))
+    return kd + ks * _pow_pos(cos2, 0.5 * n)  # 002 eq. 24, 6
+
+
+def _dr_ward(l, v, m, c):
+    t2 = _tan2_half(l, v)
+    den = 4.0 * math.pi * m * m * (dr.sqrt(dr.maximum(l[2], 0.0)) * dr.sqrt(dr.maximum(v[2], 0.0)))
+    return _div(c * dr.exp(-t2 / (m * m)), den)  # 000 eq. 34, 001 eq. 8
+
+
+def _dr_modified_ward(l, v, m, c):
+    t2 = _tan2_half(l, v)
+    return _div(c * dr.exp(-t2 / (m * m)), 4.0 * math.pi * m * m * dr.maximum(l[2], v[2]))  # 000 eq. 35
+
+
+def _dr_ward_aniso(l, v, ax, ay, c):
+    sz = l[2] + v[2]
+    qx = _div(l[0] + v[0], sz)  # h_x / h_z
+    qy = _div(l[1] + v[1], sz)  # h_y / h_z
+    e = (qx / ax) ** 2 + (qy / ay) ** 2
+    den = 4.0 * math.pi * ax * ay * (dr.sqrt(dr.maximum(l[2], 0.0)) * dr.sqrt(dr.maximum(v[2], 0.0)))
+    return _div(c * dr.exp(-e), den)  # Ward 1992 (isotropic: 000 eq. 34)
+
+
+def _dr_schlick(l, v, r, c):
+    t = _tan2_half(l, v)
+    cos2 = dr.rcp(1.0 + t)
+    sin2 = dr.select(t <= 1.0, t * cos2, 1.0 - cos2)
+    d = r + (1.0 - r) * sin2  # 1 - (1 - r)(N.H)^2
+    gl = r + (1.0 - r) * l[2]
+    gv = r + (1.0 - r) * v[2]
+    return c / (4.0 * math.pi) * _div(_div(r, d * d), gl * gv)  # 000 eq. 36
+
+
+def _dr_cook_torrance(l, v, m, ior):
+    s = (l[0] + v[0], l[1] + v[1], l[2] + v[2])
+    t = _tan2_half(l, v)
+    e = dr.exp(-t / (m * m))
+    d = e * ((1.0 + t) * (1.0 + t)) / (4.0 * math.pi * m * m)  # 001 eq. 9
+    g = dr.minimum(1.0, _div(4.0 * dr.minimum(l[2], v[2]), s[2] * (1.0 + t)))  # 001 eq. 10
+    c = 0.5 * dr.sqrt(_dot(s, s))  # V.H
+    f = _fresnel_dielectric(c, ior) if ior > 0 else 1.0
+    return _div(f * d * g, l[2] * v[2])  # 001 eq. 9
+
+
+def _projected(w, dist, g1, alpha):
+    """pumpup.models.microfacet._projected: P = z (1 + Lambda) = z / G1 (Walter et al. 2007)."""
+    x, y, z = w
+    s = dr.sqrt(x * x + y * y)
+    if dist == 1:
+        return 0.5 * (z + dr.sqrt(z * z + (alpha * s) ** 2))  # Walter eq. 34
+    a = _div(z, alpha * s)
+    if g1 == 0:
+        p = 0.5 * (z * (1.0 + dr.erf(a)) + alpha * s * dr.exp(-a * a) / _SQRT_PI)  # Walter eq. 27 (exact)
+    else:
+        p = dr.select(a >= 1.6, z, _div(alpha * s * (1.0 + 2.276 * a + 2.577 * a * a), 3.535 + 2.181 * a))
+    return dr.select(s == 0.0, z, p)
+
+
+def _dr_microfacet(l, v, dist, alpha, shadowing, g1, ior, eta, k):
+    s = (l[0] + v[0], l[1] + v[1], l[2] + v[2])
+    t = _tan2_half(l, v)
+    a2 = alpha * alpha
+    if dist == 0:
+        d = dr.exp(-t / a2) * ((1.0 + t) * (1.0 + t)) / (math.pi * a2)  # Walter eq. 25
+    else:
+        cos2 = dr.rcp(1.0 + t)
+        sin2 = dr.select(t <= 1.0, t * cos2, 1.0 - cos2)
+        q = a2 * cos2 + sin2
+        d = _div(a2, math.pi * q * q)  # Walter eq. 33
+    c = 0.5 * dr.sqrt(_dot(s, s))  # wi.h
+    if eta > 0.0:
+        f = _fresnel_conductor(c, eta, k)
+    elif ior > 0.0:
+        f = _fresnel_dielectric(c, ior)
+    else:
+        f = 1.0
+    pl = _projected(l, dist, g1, alpha)
+    pv = _projected(v, dist, g1, alpha)
+    if shadowing == 0:
+        return _div(d * f, 4.0 * pl * pv)  # Walter eq. 20, separable Smith
+    return _div(d * f, 4.0 * (v[2] * pl + l[2] * pv - l[2] * v[2]))  # Heitz 2014, height-correlated
+
+
+def _dr_metal(l, v, n, eta, k, c):
+    rv = 2.0 * l[2] * v[2] - _dot(l, v)  # 000 eq. 9
+    mx = dr.maximum(l[2], v[2])
+    return dr.select(rv > 0, _div(c * _pow_pos(rv, n), mx) * _fresnel_conductor(mx, eta, k), 0.0)  # 000 eq. 28
+
+
+def _dr_plastic(l, v, n, ad, a_s, eta):
+    rv = 2.0 * l[2] * v[2] - _dot(l, v)
+    mx = dr.maximum(l[2], v[2])
+    fr = _fresnel_conductor(mx, eta, 0.0) if eta > 0.0 else 1.0  # 000 eq. 30
+    spec = _div(a_s * (n + 2.0) / (2.0 * math.pi) * _pow_pos(rv, n), mx) * fr  # 000 eq. 29
+    return ad / math.pi + dr.select(rv > 0, spec, 0.0)
+
+
+_KERNELS = {
+    "lambert": _dr_lambert, "phong": _dr_phong, "stretched_phong": _dr_stretched_phong, "retro": _dr_retro,
+    "phong_shader": _dr_phong_shader, "blinn": _dr_blinn, "stretched_blinn": _dr_stretched_blinn,
+    "phong_blinn": _dr_phong_blinn, "ward": _dr_ward, "modified_ward": _dr_modified_ward,
+    "ward_aniso": _dr_ward_aniso, "schlick": _dr_schlick, "cook_torrance": _dr_cook_torrance,
+    "beckmann": _dr_microfacet, "ggx": _dr_microfacet, "metal": _dr_metal, "plastic": _dr_plastic,
+}
+
+#: the pumpup model types the plugin translates
+SUPPORTED = tuple(sorted(set(_KERNELS) | {"pumped"}))
+
+
+class _Level:
+    """One pumping level in Dr.Jit: the upper bound u(mu) of :func:`pumpup.pump._upper_scalar` on
+    the same arrays (:class:`pumpup.pump._Lookup`), found by a binary search of fixed length."""
+
+    def __init__(self, lookup, controlled: bool):
+        lk = lookup
+        self.logx = _Table(lk.logx)
+        self.n = len(lk.logx)
+        self.deg = lk.coef.shape[0]
+        self.coef = _Table(lk.coef)  # row r at r * (n - 1) + i
+        self.logx0 = float(lk.logx[0])
+        self.v0, self.slope0 = float(lk.v0), float(lk.slope0)
+        self.margin_lo, self.margin, self.cap = float(lk.margin_lo), float(lk.margin), float(lk.cap)
+        self.controlled = controlled
+        self.steps = []
+        s = 1
+        while s < self.n:
+            s *= 2
+        while s >= 1:
+            self.steps.append(s)
+            s //= 2
+
+    def upper(self, mu):
+        lm = dr.log(mu)
+        lo = _int(0)
+        for step in self.steps:  # the largest lo in [0, n - 2] with logx[lo] <= lm
+            cand = lo + step
+            ok = cand <= self.n - 2
+            safe = dr.select(ok, cand, lo) if _jit() else (cand if ok else lo)
+            take = ok & (self.logx[safe] <= lm)
+            lo = dr.select(take, safe, lo) if _jit() else (safe if take else lo)
+        d = lm - self.logx[lo]
+        m1 = self.n - 1
+        val = self.coef[lo]
+        for r in range(1, self.deg):  # Horner: the spline piece in d = log(mu) - logx[lo]
+            val = val * d + self.coef[lo + r * m1]
+        below = self.v0 * dr.exp(self.slope0 * (lm - self.logx0)) + self.margin_lo  # power law below the table
+        u = dr.select(lm <= self.logx0, below, val + self.margin)
+        return dr.minimum(u, self.cap) if math.isfinite(self.cap) else u
+
+    def g(self, mi_, mo):
+        g = dr.maximum(self.upper(mi_), self.upper(mo))  # 001 eq. 20
+        if self.controlled:
+            g = dr.maximum(g, dr.maximum(mi_, mo))  # 001 eq. 21
+        return g
+
+
+class _ProductG:
+    """The chain kernel's fast path in Dr.Jit: G(m) = g_1 ... g_k as one piecewise quintic in
+    m = max(N.wi, N.wo) (:class:`pumpup.pump._Product`, the same pieces and coefficients, already scaled
+    up by 1 + epsilon), the piece found from the float64 bits of m, for min(N.wi, N.wo) > ``mlo``."""
+
+    def __init__(self, prod):
+        from .pump import _CELL_SHIFT, _bits
+
+        self.mlo, self.cbase, self.shift = float(prod.mlo), int(prod.cbase), _CELL_SHIFT
+        self.ncell = len(prod.cstart)
+        self.deg = prod.rows.shape[1] - 3
+        self.width = prod.rows.shape[1]
+        self.rows = _Table(prod.rows)  # piece s: coefficients (highest power first), centre, 1 / half-width
+        self.lo = _Table(prod.lo)  # piece starts, with an inf sentinel
+        self.cstart_np = np.asarray(prod.cstart, dtype=np.int64)
+        self.cstart = mi.UInt32(self.cstart_np.astype(np.uint32)) if _jit() else None
+        # the most pieces that start inside one cell: the kernel's forward steps, unrolled here
+        bounds = (np.arange(self.cbase, self.cbase + self.ncell + 1, dtype=np.int64) << self.shift).view(np.float64)
+        ends = np.searchsorted(prod.lo[:-1], bounds[1:], side="left") - 1
+        self.steps = int(max(0, np.max(ends - self.cstart_np))) + 1
+        self._bits = _bits
+
+    def __call__(self, m):
+        if _jit():
+            bits = dr.reinterpret_array(mi.UInt64, m) >> self.shift
+            c = mi.UInt32(dr.minimum(dr.maximum(bits, self.cbase) - self.cbase, self.ncell - 1))
+            s = dr.gather(mi.UInt32, self.cstart, c)
+            for _ in range(self.steps):  # forward to the piece that holds m (pumpup.pump._Product.piece)
+                s = dr.select(m >= self.lo[s + 1], s + 1, s)
+        else:
+            c = min(max((int(self._bits(m)) >> self.shift) - self.cbase, 0), self.ncell - 1)
+            s = int(self.cstart_np[c])
+            while m >= self.lo[s + 1]:
+                s += 1
+        w, d = self.width, self.deg
+        t = (m - self.rows[s * w + d + 1]) * self.rows[s * w + d + 2]
+        g = self.rows[s * w] * t
+        for r in range(1, d):  # Horner, in the order of pumpup.pump._horner
+            g = (g + self.rows[s * w + r]) * t
+        return g + self.rows[s * w + d]
+
+
+class _DrModel:
+    """A pumpup BRDF translated to Dr.Jit: ``f(l, v)`` in Float64, and its sampling strategy."""
+
+    #: pumped values are multiplied by this before the cast to float32 (rounded down)
+    ROUND_DOWN = 1.0 - 2.0**-23
+
+    def __init__(self, brdf: BRDF):
+        self.brdf = brdf
+        self.levels: list[_Level] = []
+        base = brdf
+        from .pump import Pumped
+
+        prod = brdf.product() if isinstance(brdf, Pumped) else None
+        self.product = _ProductG(prod) if prod is not None else None
+        while isinstance(base, Pumped):
+            self.levels.append(_Level(base.lookup(), base.controlled))
+            base = base.base
+        self.levels.reverse()
+        if base.type not in _KERNELS:
+            raise SpecError(f"pumpup.mitsuba: model type {base.type!r} has no Dr.Jit translation; the plugin supports "
+                            f"{', '.join(SUPPORTED)}")
+        self.base = base
+        self.kernel = _KERNELS[base.type]
+        self.args = base.kernel_args()
+        strat = _sampling.strategy(brdf, 1.0)
+        for mu in (0.5, 1e-3):
+            if _sampling.strategy(brdf, mu) != strat:
+                raise SpecError(f"pumpup.mitsuba: the sampling strategy of {brdf.type!r} depends on the incidence "
+                                "angle, which the plugin does not support")
+        self.components = strat.components
+
+    def g(self, mi_, mo):
+        """The product of all levels' g at cosines (mi_, mo) > 0, as pumpup's chain kernel computes it."""
+        def by_levels(mi_, mo):
+            g = 1.0
+            for lev in self.levels:
+                g = g * lev.g(mi_, mo)
+            return g
+
+        if self.product is None:
+            return by_levels(mi_, mo)
+        fast = dr.minimum(mi_, mo) > self.product.mlo  # both cosines where the product table holds
+        if not _jit():
+            return self.product(dr.maximum(mi_, mo)) if fast else by_levels(mi_, mo)
+        return dr.if_stmt((mi_, mo), fast, lambda a, b: self.product(dr.maximum(a, b)), by_levels)
+
+    def f(self, l, v):
+        val = self.kernel(l, v, *self.args)
+        if self.levels:
+            g = self.g(dr.maximum(l[2], 1e-300), dr.maximum(v[2], 1e-300))
+            val = _div(val, g) * self.ROUND_DOWN  # 001 eq. 16, all levels
+        return dr.select((l[2] > 0) & (v[2] > 0), val, 0.0)
+
+
+# ----------------------------------------------------------------------------------------
+# Sampling in Dr.Jit (pumpup.sampling's components)
+# ----------------------------------------------------------------------------------------
+
+
+def _frame(a):
+    """pumpup.sampling._frame: an orthonormal basis perpendicular to a (Duff et al. 2017)."""
+    ax, ay, az = a
+    sign = dr.select(az >= 0.0, 1.0, -1.0)
+    c = -dr.rcp(sign + az)
+    b = ax * ay * c
+    return (1.0 + sign * ax * ax * c, sign * b, -sign * ax), (b, sign + ay * ay * c, -ay)
+
+
+def _comp_sample(kind, k, v, u1, u2):
+    """One component of pumpup.sampling._sample_kernel: (wi (x, y, z), ok)."""
+    C = _sampling
+    phi = 2.0 * math.pi * u2
+    sp, cp = dr.sincos(phi)
+    if kind == C.COSINE:
+        r = dr.sqrt(u1)
+        z = dr.sqrt(dr.maximum(1.0 - u1, 0.0))
+        return (r * cp, r * sp, z), z > 0.0
+    if kind in (C.MIRROR, C.RETRO):
+        t = _div(dr.log(u1), k + 1.0)
+        ca = dr.exp(t)  # 000 eq. 20
+        sa = dr.sqrt(dr.maximum((1.0 - ca) * (1.0 + ca), 0.0))
+        e1, e2 = _frame(v)
+        r = tuple(ca * v[i] + sa * (cp * e1[i] + sp * e2[i]) for i in range(3))  # 000 eq. 22
+        ok = (r[2] > 0.0) & (u1 > 0.0)
+        if kind == C.MIRROR:
+            r = (-r[0], -r[1], r[2])  # L = 2 (N.R) N - R (000 after eq. 22)
+        return r, ok
+    if kind == C.HALF_POWER:
+        t = _div(dr.log(u1), k + 1.0)
+        ch = dr.exp(t)
+        sh = dr.sqrt(dr.maximum((1.0 - ch) * (1.0 + ch), 0.0))
+    else:
+        if kind == C.HALF_BECKMANN:
+            t2 = -k * k * dr.log(dr.maximum(1.0 - u1, 1e-300))  # tan^2 = -m^2 ln(1 - u)
+        else:
+            t2 = _div(k * u1, dr.maximum(1.0 - u1, 1e-300))  # tan^2 = r u / (1 - u)
+        ch = dr.rsqrt(1.0 + t2)
+        sh = dr.sqrt(t2) * ch
+    h = (sh * cp, sh * sp, ch)
+    d = _dot(v, h)
+    w = (2.0 * d * h[0] - v[0], 2.0 * d * h[1] - v[1], 2.0 * d * h[2] - v[2])
+    return w, (d > 0.0) & (w[2] > 0.0) & (u1 > 0.0)
+
+
+def _comp_pdf(kind, k, l, v):
+    """pumpup.sampling._pdf_kernel: density [1/sr] of wi = l given wo = v for one component."""
+    C = _sampling
+    if kind == C.COSINE:
+        p = l[2] * _INV_PI
+    elif kind in (C.MIRROR, C.RETRO):
+        rx, ry = (-l[0], -l[1]) if kind == C.MIRROR else (l[0], l[1])
+        dx, dy, dz = rx - v[0], ry - v[1], l[2] - v[2]
+        h = 0.5 * (dx * dx + dy * dy + dz * dz)  # 1 - R.V without cancellation
+        p = dr.select(h < 1.0, (k + 1.0) * _INV_2PI * dr.exp(k * dr.log(dr.maximum(1.0 - h, 1e-300))), 0.0)
+    else:
+        s = (l[0] + v[0], l[1] + v[1], l[2] + v[2])
+        n = dr.sqrt(_dot(s, s))
+        t2 = _div(s[0] * s[0] + s[1] * s[1], s[2] * s[2])
+        ch = _div(s[2], n)
+        if kind == C.HALF_POWER:
+            ph = (k + 1.0) * _INV_2PI * _pow_pos(ch, k) if k > 0 else _INV_2PI + 0.0 * ch
+        elif kind == C.HALF_BECKMANN:
+            ph = _div(dr.exp(-t2 / (k * k)), math.pi * k * k * ch * ch * ch)
+        else:
+            q = k + t2
+            ph = _div(k, math.pi * ch * ch * ch * q * q)
+        p = dr.select(n > 0.0, _div(ph, 2.0 * n), 0.0)
+    return dr.select((l[2] > 0.0) & (v[2] > 0.0), p, 0.0)
+
+
+def _mixture_pdf(components, l, v):
+    out = 0.0
+    for w, kind, k in components:
+        out = out + w * _comp_pdf(kind, k, l, v)
+    return out
+
+
+# ----------------------------------------------------------------------------------------
+# The plugin
+# ----------------------------------------------------------------------------------------
+
+
+def _spec_from_props(props) -> Any:
+    keys = list(props.keys())
+    if "spec" in keys:
+        extra = [k for k in keys if k != "spec"]
+        if extra:
+            raise SpecError(f"pumpup plugin: give either 'spec' or 'model' with flat parameters, not 'spec' and "
+                            f"{', '.join(map(repr, extra))}")
+        s = props["spec"]
+        if not isinstance(s, str):
+            raise SpecError(f"pumpup plugin: 'spec' must be a JSON string (use pumpup.mitsuba.bsdf_dict), got "
+                            f"{type(s).__name__}")
+        s = s.strip()
+        if s.startswith("{") or s.startswith("["):
+            try:
+                return json.loads(s)
+            except json.JSONDecodeError as exc:
+                raise SpecError(f"pumpup plugin: 'spec' is not valid JSON: {exc}") from None
+        from .cli import parse_spec
+
+        return parse_spec(s)  # the short form, phong:n=20
+    if "model" in keys:
+        spec = {"type": props["model"]}
+        for k in keys:
+            if k != "model":
+                spec[k] = props[k]
+        return spec
+    raise SpecError("pumpup plugin: needs a 'spec' (a JSON string of a pumpup spec) or a 'model' with flat parameters")
+
+
+_CLASSES: dict[str, type] = {}
+
+
+def _plugin_class():
+    """The BSDF class for the current variant (mi.BSDF exists only once a variant is set)."""
+    variant = mi.variant()
+    if variant in _CLASSES:
+        return _CLASSES[variant]
+
+    class PumpupBSDF(mi.BSDF):
+        """A pumpup BRDF as a Mitsuba BSDF (see the pumpup.mitsuba docstring)."""
+
+        def __init__(self, props):
+            mi.BSDF.__init__(self, props)
+            spec = _spec_from_props(props)
+            if isinstance(spec, list):
+                if len(spec) != 3 or not mi.is_rgb:
+                    raise SpecError("pumpup plugin: a list spec needs 3 entries (R, G, B) and an rgb variant, got "
+                                    f"{len(spec)} in {mi.variant()}")
+                self.brdfs = [load(s) for s in spec]
+            else:
+                self.brdfs = [load(spec)]
+            self.models = [_DrModel(b) for b in self.brdfs]
+            self.components = self.models[len(self.models) // 2].components  # sample with the middle (green) one
+            inner = self.models[0].base.type
+            lobe = mi.BSDFFlags.DiffuseReflection if (inner == "lambert" and not self.models[0].levels) \
+                else mi.BSDFFlags.GlossyReflection
+            self.m_flags = lobe | mi.BSDFFlags.FrontSide
+            self.m_components = [self.m_flags]
+            self.spec = spec
+
+        # l: pumpup's wi (Mitsuba's wo, towards the light); v: pumpup's wo (Mitsuba's si.wi)
+        def _values(self, l, v):
+            vals = [m.f(l, v) for m in self.models]
+            return vals
+
+        def _color(self, vals, cos):
+            if len(vals) == 1:
+                return mi.Spectrum(mi.Float(vals[0] * cos))
+            return mi.Color3f(*(mi.Float(x * cos) for x in vals))
+
+        @staticmethod
+        def _dirs(si_wi, wo):
+            v = (_f64(si_wi.x), _f64(si_wi.y), _f64(si_wi.z))
+            l = (_f64(wo.x), _f64(wo.y), _f64(wo.z))
+            return l, v
+
+        def eval(self, ctx, si, wo, active=True):
+            l, v = self._dirs(si.wi, wo)
+            up = (l[2] > 0) & (v[2] > 0)
+            vals = [dr.select(up, x, 0.0) for x in self._values(l, v)]
+            out = self._color(vals, dr.maximum(l[2], 0.0))  # Mitsuba's eval includes cos(theta_o)
+            if not ctx.is_enabled(mi.BSDFFlags.GlossyReflection) and not ctx.is_enabled(mi.BSDFFlags.DiffuseReflection):
+                return mi.Spectrum(0.0)
+            return dr.select(active, out, 0.0) if _jit() else (out if active else mi.Spectrum(0.0))
+
+        def pdf(self, ctx, si, wo, active=True):
+            l, v = self._dirs(si.wi, wo)
+            p = mi.Float(_mixture_pdf(self.components, l, v))
+            return dr.select(active, p, 0.0) if _jit() else (p if active else 0.0)
+
+        def eval_pdf(self, ctx, si, wo, active=True):
+            return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
+
+        def sample(self, ctx, si, sample1, sample2, active=True):
+            v = (_f64(si.wi.x), _f64(si.wi.y), _f64(si.wi.z))
+            u0, u1, u2 = _f64(sample1), _f64(sample2.x), _f64(sample2.y)
+            wx, wy, wz, ok = 0.0, 0.0, 0.0, False
+            acc = 0.0
+            for idx, (w, kind, k) in enumerate(self.components):
+                d, good = _comp_sample(kind, k, v, u1, u2)
+                last = idx == len(self.components) - 1
+                pick = (u0 >= acc) if last else ((u0 >= acc) & (u0 < acc + w))
+                acc += w
+                if _jit():
+                    wx, wy, wz = dr.select(pick, d[0], wx), dr.select(pick, d[1], wy), dr.select(pick, d[2], wz)
+                    ok = dr.select(pick, good, ok)
+                elif pick:
+                    wx, wy, wz, ok = d[0], d[1], d[2], good
+            ok = ok & (v[2] > 0.0)
+            bs = dr.zeros(mi.BSDFSample3f)
+            wo = mi.Vector3f(mi.Float(wx), mi.Float(wy), mi.Float(wz))
+            if _jit():
+                wo = dr.select(ok, dr.normalize(wo), mi.Vector3f(0.0, 0.0, 1.0))
+            else:
+                wo = dr.normalize(wo) if ok else mi.Vector3f(0.0, 0.0, 1.0)
+            l = (_f64(wo.x), _f64(wo.y), _f64(wo.z))
+            ok = ok & (l[2] > 0.0)
+            p = _mixture_pdf(self.components, l, v)
+            ok = ok & (p > 0.0)
+            vals = self._values(l, v)
+            weight = self._color([dr.select(ok, _div(x, dr.maximum(p, 1e-300)), 0.0) for x in vals], l[2])
+            bs.wo = wo
+            bs.pdf = mi.Float(dr.select(ok, p, 0.0))
+            bs.eta = 1.0
+            bs.sampled_type = mi.UInt32(+self.m_flags & ~int(mi.BSDFFlags.FrontSide))
+            bs.sampled_component = mi.UInt32(0)
+            if _jit():
+                keep = active & ok
+                return bs, dr.select(keep, weight, 0.0)
+            return bs, (weight if (active and ok) else mi.Spectrum(0.0))
+
+        def to_string(self):
+            return f"PumpupBSDF[spec = {json.dumps(self.spec)}]"
+
+        def traverse(self, callback):
+            pass
+
+    _CLASSES[variant] = PumpupBSDF
+    return PumpupBSDF
+
+
+def register(variant: str | None = None) -> str:
+    """Set a usable Mitsuba variant and register the BSDF plugin ``"pumpup"`` for it.
+
+    Parameters
+    ----------
+    variant : str or None
+        The variant to use; None keeps the one already set (``mi.variant()``), or prefers
+        ``llvm_ad_rgb``.  A JIT variant is probed in a subprocess first (:func:`probe`); if it
+        would abort, ``scalar_rgb`` is used and one line on stderr says so.
+
+    Returns
+    -------
+    str
+        The variant in use.
+    """
+    if variant is None:
+        variant = mi.variant() or DEFAULT_VARIANT
+    if variant not in mi.variants():
+        raise ValueError(f"variant must be one of {', '.join(mi.variants())}; got {variant!r}")
+    if not variant.startswith("scalar"):
+        ok, _ = probe(variant)
+        if not ok:
+            variant = choose_variant(variant)
+    mi.set_variant(variant)
+    cls = _plugin_class()
+    mi.register_bsdf("pumpup", lambda props: cls(props))
+    return variant
+
+
+def bsdf_dict(spec: Any) -> dict:
+    """``{"type": "pumpup", "spec": "<JSON>"}`` for ``mi.load_dict`` (spec: a dict, a BRDF, a list of
+    three per-channel specs, or a string)."""
+    if isinstance(spec, BRDF):
+        spec = spec.spec
+    if isinstance(spec, list):
+        spec = [s.spec if isinstance(s, BRDF) else s for s in spec]
+    if isinstance(spec, (dict, list)):
+        return {"type": "pumpup", "spec": json.dumps(spec)}
+    if isinstance(spec, str):
+        return {"type": "pumpup", "spec": spec}
+    raise TypeError(f"spec must be a dict, a list of specs, a JSON or short string or a pumpup BRDF, got "
+                    f"{type(spec).__name__}")
+
+
+def _convert(d):
+    if isinstance(d, dict):
+        if d.get("type") == "pumpup" and isinstance(d.get("spec"), (dict, list, BRDF)):
+            out = bsdf_dict(d["spec"])
+            out.update({k: v for k, v in d.items() if k not in ("type", "spec")})
+            return out
+        return {k: _convert(v) for k, v in d.items()}
+    return d
+
+
+def load_dict(scene: dict):
+    """``mi.load_dict`` after turning every ``{"type": "pumpup", "spec": {...}}`` into JSON (:func:`bsdf_dict`)."""
+    return mi.load_dict(_convert(scene))
+
+
+# ----------------------------------------------------------------------------------------
+# Mitsuba's BSDFs as pumpup BRDFs
+# ----------------------------------------------------------------------------------------
+
+
+def from_mitsuba(bsdf: Any, channel: int = 0, variant: str | None = None, name: str | None = None) -> BRDF:
+    """A Mitsuba BSDF as a pumpup BRDF (front side, the cosine divided out, one channel).
+
+    Parameters
+    ----------
+    bsdf : dict or mitsuba.BSDF
+        A ``mi.load_dict`` dict (e.g. ``{"type": "roughconductor", "alpha": 0.2}``) or a loaded BSDF.
+    channel : int, in [0, channels)
+        Which channel of Mitsuba's spectrum to return (R, G, B = 0, 1, 2 in rgb variants).
+    variant : str or None
+        As :func:`register` (None keeps the current variant, or prefers a probed ``llvm_ad_rgb``); rgb or
+        mono variants only.
+    name : str, optional
+        The BRDF's name (default: the dict's type).
+
+    Returns
+    -------
+    BRDF
+        f_r(wi, wo) = eval(si.wi = wo, wo = wi)[channel] / N.wi in 1/sr, 0 below the horizon;
+        Mitsuba evaluates in float32 (relative rounding about 1e-7 per value).
+    """
+    variant = register(variant)
+    if mi.is_spectral:
+        raise ValueError(f"from_mitsuba needs an rgb or mono variant (channel = an RGB channel), got {variant}; "
+                         "a chosen wavelength of a spectral variant is not supported")
+    if isinstance(bsdf, dict):
+        label = name or f"mitsuba {json.dumps(bsdf, sort_keys=True, default=str)} channel {channel}"
+        obj = mi.load_dict(_convert(bsdf))
+    else:
+        label = name or f"mitsuba {obj} channel {channel}"
+        obj = bsdf
+    if isinstance(channel, bool) or not isinstance(channel, (int, np.integer)):
+        raise TypeError(f"channel must be an integer, got {channel!r}")
+    nch = 3 if mi.is_rgb else 1
+    if not 0 <= channel < nch:
+        raise ValueError(f"channel must be in [0, {nch}) for variant {variant}, got {channel}")
+    ctx = mi.BSDFContext()
+    jit = _jit()
+
+    def fn(wi, wo):
+        wi = np.asarray(wi, dtype=np.float64)
+        wo = np.asarray(wo, dtype=np.float64)
+        shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
+        a = np.broadcast_to(wi, shape + (3,)).reshape(-1, 3)
+        b = np.broadcast_to(wo, shape + (3,)).reshape(-1, 3)
+        up = (a[:, 2] > 0) & (b[:, 2] > 0)
+        out = np.zeros(a.shape[0])
+        idx = np.nonzero(up)[0]
+        if idx.size:
+            if jit:
+                si = dr.zeros(mi.SurfaceInteraction3f, idx.size)
+                si.wi = mi.Vector3f(*(mi.Float(b[idx, i].astype(np.float32)) for i in range(3)))
+                w = mi.Vector3f(*(mi.Float(a[idx, i].astype(np.float32)) for i in range(3)))
+                val = np.asarray(obj.eval(ctx, si, w)[channel] if nch > 1 else obj.eval(ctx, si, w)[0], dtype=np.float64)
+                cos = a[idx, 2].astype(np.float32).astype(np.float64)
+                out[idx] = val / cos
+            else:
+                si = mi.SurfaceInteraction3f()
+                for j in idx:
+                    si.wi = mi.Vector3f(*b[j])
+                    w = mi.Vector3f(*a[j])
+                    out[j] = float(obj.eval(ctx, si, w)[channel]) / float(np.float32(a[j, 2]))
+        return out.reshape(shape)
+
+    return from_function(fn, name=label)
