@@ -97,7 +97,7 @@ __all__ = [
 MIN_SIZE = 8
 #: display colour of clipped pixels (radiance x 2^exposure > 1), and of the background, in sRGB [0, 1]
 CLIP_COLOUR = (1.0, 0.0, 1.0)
-BACKGROUND = (0.06, 0.08, 0.16)
+BACKGROUND = (0.20, 0.24, 0.36)
 
 
 # --------------------------------------------------------------------------------------------
@@ -618,3 +618,63 @@ def _default_tile_text(im: Image, clipped) -> str:
     if im.kind == "furnace":
         return f"max {peak:.4f}\nrim {float(vals.min()):.3f}"
     return f"max {peak:.3g}" + (f"\n{int(clipped.sum())} clipped" if clipped.any() else "")
+
+
+# --------------------------------------------------------------------------------------------
+# Batches (the command line's ``pumpup render sphere`` and ``pumpup render furnace``)
+# --------------------------------------------------------------------------------------------
+
+
+def _stem(k: int, f) -> str:
+    return f"{k:02d}_{f.type}"
+
+
+def render_spheres(models, lights, size: int, out: str, *, exposure: float = 0.0, irradiance: float = 1.0,
+                   report=print) -> list[str]:
+    """Render every model at every light angle into ``out``: EXR + PNG per image and a labelled grid.
+
+    ``models`` are loaded BRDFs (or specs), ``lights`` Phi_L in degrees.  Files:
+    ``sphere_KK_TYPE_L{Phi_L}.exr/.png`` and ``sphere_grid.png`` (rows: models, columns: Phi_L).
+    Returns the paths written.
+    """
+    lights = [check_light(v) for v in lights]
+    size = check_size(size)
+    models = [_load(m) for m in models]
+    written, rows = [], []
+    for k, f in enumerate(models):
+        row = []
+        for phi in lights:
+            im = sphere(f, phi, size, irradiance=irradiance)
+            stem = os.path.join(out, f"sphere_{_stem(k, f)}_L{phi:g}")
+            written += [write_exr(stem + ".exr", im), write_png(stem + ".png", im, exposure)]
+            clipped = int(tone_map(im, exposure)[1].sum())
+            report(f"{label(f.spec)}, Phi_L = {phi:g} deg: max radiance {float(im.radiance.max()):.6g}, "
+                   f"{clipped} clipped pixels -> {stem}.exr/.png")
+            row.append(im)
+        rows.append(row)
+    grid = os.path.join(out, "sphere_grid.png")
+    written.append(grid_figure(rows, grid, row_labels=[label(f.spec) for f in models],
+                               col_labels=[f"Phi_L = {v:g} deg" for v in lights], exposure=exposure,
+                               title=f"directional light (002 Fig. 2), irradiance {irradiance:g}"))
+    report(f"wrote {grid}")
+    return written
+
+
+def render_furnaces(models, size: int, out: str, *, exposure: float = 0.0, report=print) -> list[str]:
+    """Furnace images of every model into ``out``: EXR + PNG each (``furnace_KK_TYPE``) and ``furnace_grid.png``."""
+    size = check_size(size)
+    models = [_load(m) for m in models]
+    written, ims = [], []
+    for k, f in enumerate(models):
+        im = furnace(f, size)
+        stem = os.path.join(out, f"furnace_{_stem(k, f)}")
+        written += [write_exr(stem + ".exr", im), write_png(stem + ".png", im, exposure)]
+        vals = im.radiance[im.mask]
+        report(f"{label(f.spec)}: a(mu_V) from {float(vals.min()):.6g} (rim) to {float(vals.max()):.6g}, "
+               f"error bound {im.error:.2g} -> {stem}.exr/.png")
+        ims.append(im)
+    grid = os.path.join(out, "furnace_grid.png")
+    written.append(grid_figure([ims], grid, col_labels=[label(f.spec) for f in models], exposure=exposure,
+                               title="white furnace: pixel = albedo a(mu_V)"))
+    report(f"wrote {grid}")
+    return written
