@@ -302,6 +302,10 @@ def cmd_render(args) -> int:
             if a > render.ISOTROPY_TOL:
                 return fail(f"SPEC {text!r} is anisotropic (f changes by {a:.2g} under a rotation about N): "
                             "its furnace radiance depends on the azimuth of V")
+    try:
+        render._openexr()
+    except ImportError as exc:
+        return fail(str(exc))
     if os.path.exists(args.out) and not os.path.isdir(args.out):
         return fail(f"--out {args.out!r} exists and is not a directory")
     try:

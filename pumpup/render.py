@@ -463,14 +463,21 @@ def _atomic(path):
     return atomic_path(path)
 
 
+def _openexr():
+    try:
+        import OpenEXR
+    except ImportError:
+        raise ImportError("EXR images need the 'openexr' package (a dependency of pumpup): pip install openexr") from None
+    return OpenEXR
+
+
 def write_exr(path, image: Image) -> str:
     """Write linear radiance as 32-bit float OpenEXR (channel ``Y``, or ``R``, ``G``, ``B``; mask in ``A``).
 
     The header holds ``pumpup_spec``, ``pumpup_params``, ``pumpup_kind`` and, for a furnace,
     ``pumpup_error_bound``.  Written atomically.  Needs the ``openexr`` package.
     """
-    import OpenEXR
-
+    OpenEXR = _openexr()
     rad = np.asarray(image.radiance)
     if rad.ndim == 2:
         channels = {"Y": rad.astype(np.float32)}
@@ -494,8 +501,7 @@ def read_exr(path) -> tuple[np.ndarray, np.ndarray, dict]:
     Raises ValueError if the file is not an OpenEXR image, has no ``Y`` (or ``R, G, B``) and
     ``A`` channels, or holds non-finite or negative radiance.
     """
-    import OpenEXR
-
+    OpenEXR = _openexr()
     path = os.fspath(path)
     if not os.path.exists(path):
         raise FileNotFoundError(f"no such image: {path!r}")
@@ -522,8 +528,9 @@ def srgb(v: np.ndarray) -> np.ndarray:
 def tone_map(image: Image, exposure: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """Display RGB in [0, 1] and the clipped mask: v = radiance x 2^exposure, sRGB transfer.
 
-    Pixels with v > 1 (any channel) are painted :data:`CLIP_COLOUR` (magenta) and flagged in the
-    returned mask; pixels off the sphere are :data:`BACKGROUND`.  Grey images become grey RGB.
+    Pixels with v > 1 (any channel; for a furnace image v > 1 + its error bound x 2^exposure) are
+    painted :data:`CLIP_COLOUR` (magenta) and flagged in the returned mask; pixels off the sphere are
+    :data:`BACKGROUND`.  Grey images become grey RGB.
     """
     if not math.isfinite(float(exposure)):
         raise ValueError(f"exposure must be a finite number of stops, got {exposure!r}")
@@ -534,7 +541,9 @@ def tone_map(image: Image, exposure: float = 0.0) -> tuple[np.ndarray, np.ndarra
         v = np.repeat(v, 3, axis=2)
     if v.shape[2] != 3:
         raise ValueError(f"tone_map: radiance must have 1 or 3 channels, got {v.shape[2]}")
-    clipped = image.mask & np.any(v > 1.0, axis=2)
+    # a furnace image may exceed 1 by its own error bound without reflecting more than it receives
+    tol = float(image.error or 0.0) * 2.0 ** float(exposure)
+    clipped = image.mask & np.any(v > 1.0 + tol, axis=2)
     rgb = srgb(v)
     rgb[clipped] = CLIP_COLOUR
     rgb[~image.mask] = BACKGROUND
