@@ -467,7 +467,7 @@ def _openexr():
     try:
         import OpenEXR
     except ImportError:
-        raise ImportError("EXR images need the 'openexr' package (a dependency of pumpup): pip install openexr") from None
+        raise ImportError("EXR images need the 'openexr' package (a pumpup dependency): pip install openexr") from None
     return OpenEXR
 
 
@@ -581,15 +581,12 @@ def grid_figure(images, path, *, row_labels=None, col_labels=None, exposure: flo
     stated under the grid.  ``tile_text(image) -> str`` writes a line on each tile (default:
     Phi_L for sphere images, the maximum and the error bound for furnace images).
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure  # no pyplot: the caller's backend and figures are left alone
 
     rows = [list(r) for r in images]
     n_rows, n_cols = len(rows), max(len(r) for r in rows)
-    fig, axes = plt.subplots(n_rows, n_cols, figsize=(tile_inches * n_cols + 1.9, tile_inches * n_rows + 0.9),
-                             squeeze=False)
+    fig = Figure(figsize=(tile_inches * n_cols + 1.9, tile_inches * n_rows + 0.9))
+    axes = fig.subplots(n_rows, n_cols, squeeze=False)
     for i, row in enumerate(rows):
         for j in range(n_cols):
             ax = axes[i][j]
@@ -605,7 +602,8 @@ def grid_figure(images, path, *, row_labels=None, col_labels=None, exposure: flo
             ax.imshow(rgb, interpolation="nearest")
             text = tile_text(im) if tile_text else _default_tile_text(im, clipped)
             if text:
-                ax.text(0.03, 0.97, text, transform=ax.transAxes, va="top", ha="left", fontsize=6.5, color="white")
+                ax.text(0.02, 0.98, text, transform=ax.transAxes, va="top", ha="left", fontsize=6.5, color="white",
+                        bbox={"facecolor": "black", "alpha": 0.55, "pad": 1.5, "linewidth": 0})
             if i == 0 and col_labels:
                 ax.set_title(col_labels[j], fontsize=8)
             if j == 0 and row_labels:
@@ -617,7 +615,6 @@ def grid_figure(images, path, *, row_labels=None, col_labels=None, exposure: flo
     path = os.fspath(path)
     with _atomic(path) as tmp:
         fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
     return path
 
 

@@ -20,8 +20,6 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # this checkout's pumpup
 
-import numpy as np  # noqa: E402
-
 import pumpup  # noqa: E402
 import pumpup.render as R  # noqa: E402
 
@@ -57,7 +55,8 @@ def main(argv=None) -> int:
     t_geo = best(lambda: (R._GEOMETRY.clear(), R.geometry(args.size)), 3)
     print(f"{'(geometry of a new size, once)':38s} {t_geo:9.4f}")
 
-    print(f"\n{'furnace':38s} {'time [s]':>9s} {'look-up [s]':>12s} {'nodes':>6s} {'one albedo [s]':>15s} {'ratio':>6s}")
+    print(f"\n{'furnace':38s} {'time [s]':>9s} {'look-up [s]':>12s} {'nodes':>6s} {'one albedo [s]':>15s} "
+          f"{'ratio':>6s}")
     for spec in ({"type": "lambert", "albedo": 0.8}, {"type": "phong", "n": 20}, {"type": "stretched_phong", "n": 20},
                  {"type": "ggx", "alpha": 0.3}):
         f = pumpup.load(spec)

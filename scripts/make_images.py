@@ -135,8 +135,9 @@ def furnace(size, out):
         for im in row:
             v = im.radiance[im.mask]
             c = im.radiance[size // 2, size // 2]
+            note = "  (integrated over wi: not reciprocal)" if im.params["transposed"] else ""
             print(f"  {R.label(im.spec):40s} {float(v.min()):.4f} / {float(c):.6f} / {float(v.max()):.6f}"
-                  f"  bound {im.error:.2g}{'  (integrated over wi: not reciprocal)' if im.params['transposed'] else ''}")
+                  f"  bound {im.error:.2g}{note}")
 
     def text(im):
         v = im.radiance[im.mask]

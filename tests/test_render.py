@@ -263,3 +263,14 @@ def test_cli_bad_input_one_line_status_2_nothing_written(tmp_path, capsys, argv,
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and re.search(match, err), err
     assert not out.exists()
+
+
+def test_furnace_clipping_allows_the_error_bound():
+    mask = np.ones((8, 8), bool)
+    rad = np.full((8, 8), 1.0 + 5e-8)
+    rad[0, 0] = 1.0 + 3e-7
+    im = R.Image(rad, mask, "furnace", {"type": "lambert"}, error=1e-7)
+    _, clipped = R.tone_map(im)
+    assert clipped.sum() == 1 and clipped[0, 0]  # above 1 + bound: more reflected than received
+    im.error = None
+    assert R.tone_map(im)[1].all()
