@@ -45,9 +45,10 @@ Furnace
 Under a uniform white sky of radiance 1 a convex object sees only the sky, so its
 radiance towards V is integral f_r(L, V) (N.L) d omega_L over the hemisphere: for a
 reciprocal BRDF exactly the directional albedo a(mu_V) at mu_V = N.V (000 eq. 2), which
-pumpup's engine computes.  :func:`furnace` tabulates a(mu) once (``pumpup.tabulate``,
-adaptive grid down to the smallest mu_V of the image) and looks every pixel up in the
-table; ``Image.error`` is the table's stated bound (twice the measured interpolation
+pumpup's engine computes.  :func:`furnace` tabulates a(mu) once per session
+(``pumpup.tabulate``, adaptive grid down to mu = 1e-8; for a reciprocal model at the default
+tolerances it is the pumping operator's own table, ``pumpup.pump.base_table``) and looks
+every pixel up in the table; ``Image.error`` is the table's stated bound (twice the measured interpolation
 error plus the largest quadrature error, as in ``AlbedoTable.upper``).  A non-reciprocal
 model is integrated over the incidence direction instead (its albedo with the roles of
 wi and wo exchanged); an anisotropic one is refused (its furnace radiance depends on the
@@ -350,34 +351,69 @@ def _anisotropy(f) -> float:
 ISOTROPY_TOL = 1e-9
 
 
-def furnace_table(f, mu_min: float, *, rtol: float = 1e-9, interp_tol: float = 1e-7):
+#: furnace tables that the pumping operator's cache does not hold: key -> AlbedoTable
+_TABLES: dict = {}
+#: model key -> whether its furnace integrates f(wo, wi) (measured once: not reciprocal)
+_TRANSPOSED: dict = {}
+
+
+def _pump_module():
+    """The module pumpup.pump (the package attribute ``pumpup.pump`` is the function)."""
+    import sys
+
+    from . import pump as _  # noqa: F401  (imports the module)
+
+    return sys.modules[__package__ + ".pump"]
+
+
+def furnace_table(f, mu_min: float = 1e-8, *, rtol: float | None = None, interp_tol: float | None = None):
     """The albedo table a furnace image looks up: (AlbedoTable, bound, transposed).
 
-    ``bound`` is the table's stated error bound (``AlbedoTable.margin``); ``transposed`` is True
-    when f is not reciprocal and the table holds the albedo of f(wo, wi).
+    With the default tolerances (None: ``pumpup.pump.TABLE_RTOL`` and ``TABLE_INTERP_TOL``, 1e-9
+    and 1e-7) the table of a reciprocal model is the pumping operator's (``pumpup.pump.base_table``,
+    down to mu = 1e-8, computed once per session and shared: the furnace of a pumped level is the
+    table the next level divides by); other tables are cached here per spec and tolerances.
+    ``mu_min`` is the smallest mu the table must reach without extrapolation.  ``bound`` is the
+    table's stated error bound (``AlbedoTable.margin``); ``transposed`` is True when f is not
+    reciprocal and the table holds the albedo of f(wo, wi).
     """
     from .core import SpecError, check_reciprocity
     from .tables import AlbedoTable, tabulate
 
+    pump = _pump_module()
+
     f = _load(f)
-    probe = np.asarray(f._eval(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0])))
-    if probe.ndim:
-        raise SpecError(f"furnace: {f.type} has {probe.shape} channels; the albedo engine integrates one channel")
-    aniso = _anisotropy(f)
-    if aniso > ISOTROPY_TOL:
-        raise SpecError(f"furnace: {f.type} is anisotropic (f changes by {aniso:.2g} relative under a rotation "
-                        "about N), so its furnace radiance depends on the azimuth of V; one table in mu cannot give it")
-    transposed = not (f.reciprocal and check_reciprocity(f).reciprocal)
-    g = Transposed(f) if transposed else f
-    # a hair below the image's smallest mu: the grid's last decade is 10^log10(mu_min), which may round up
-    ds = tabulate(g, rtol=rtol, interp_tol=interp_tol, mu_min=min(float(mu_min) * (1.0 - 1e-9), 0.02), progress=False)
-    table = AlbedoTable.from_dataset(ds)
-    if table.mu[0] > mu_min:  # never: tabulate's grid starts below mu_min
+    fkey = pump._key(f)
+    if fkey not in _TRANSPOSED:
+        probe = np.asarray(f._eval(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0])))
+        if probe.ndim:
+            raise SpecError(f"furnace: {f.type} has {probe.shape} channels; the albedo engine integrates one channel")
+        aniso = _anisotropy(f)
+        if aniso > ISOTROPY_TOL:
+            raise SpecError(f"furnace: {f.type} is anisotropic (f changes by {aniso:.2g} relative under a rotation "
+                            "about N), so its furnace radiance depends on the azimuth of V; one table in mu cannot "
+                            "give it")
+        _TRANSPOSED[fkey] = not (f.reciprocal and check_reciprocity(f).reciprocal)
+    transposed = _TRANSPOSED[fkey]
+    rtol = pump.TABLE_RTOL if rtol is None else float(rtol)
+    interp_tol = pump.TABLE_INTERP_TOL if interp_tol is None else float(interp_tol)
+    # a hair below mu_min: the grid's last decade is 10^log10(mu_min), which may round up
+    low = min(float(mu_min) * (1.0 - 1e-9), 1e-8)
+    if not transposed and (rtol, interp_tol) == (pump.TABLE_RTOL, pump.TABLE_INTERP_TOL) and low >= 1e-8 * (1 - 1e-9):
+        table = pump.base_table(f, progress=False)
+    else:
+        key = (("transposed " if transposed else "") + fkey, rtol, interp_tol, low)
+        if key not in _TABLES:
+            g = Transposed(f) if transposed else f
+            ds = tabulate(g, rtol=rtol, interp_tol=interp_tol, mu_min=low, progress=False)
+            _TABLES[key] = AlbedoTable.from_dataset(ds)
+        table = _TABLES[key]
+    if table.mu[0] > mu_min:  # never: the grids start at or below mu_min
         raise AssertionError("furnace table does not reach the smallest mu of the image")
     return table, float(table.margin), transposed
 
 
-def furnace(f, size: int = 256, *, rtol: float = 1e-9, interp_tol: float = 1e-7) -> Image:
+def furnace(f, size: int = 256, *, rtol: float | None = None, interp_tol: float | None = None) -> Image:
     """The sphere in a white furnace (uniform sky of radiance 1): pixel = a(mu_V), mu_V = N.V.
 
     Parameters
@@ -387,14 +423,16 @@ def furnace(f, size: int = 256, *, rtol: float = 1e-9, interp_tol: float = 1e-7)
         incidence direction: the radiance it sends towards V).
     size : int, >= 8
         Pixels per side.
-    rtol, interp_tol : float
-        Quadrature and interpolation tolerances of the albedo table (``pumpup.tabulate``).
+    rtol, interp_tol : float, optional
+        Quadrature and interpolation tolerances of the albedo table (``pumpup.tabulate``); by default
+        those of the pumping operator's tables (1e-9, 1e-7), whose cache it shares
+        (:func:`furnace_table`).
 
     Returns
     -------
     Image
-        ``radiance`` = a(mu_V) from one adaptive albedo table (down to the smallest mu_V of the
-        image) and a look-up per pixel; ``error`` is the table's stated bound, so
+        ``radiance`` = a(mu_V) from one adaptive albedo table (down to mu = 1e-8, computed once per
+        session) and a look-up per pixel; ``error`` is the table's stated bound, so
         |radiance - exact| <= error at every pixel.  Lambert with albedo rho gives rho.
 
     Examples
@@ -410,8 +448,11 @@ def furnace(f, size: int = 256, *, rtol: float = 1e-9, interp_tol: float = 1e-7)
     mu = g.view[:, 2]  # N.V
     table, bound, transposed = furnace_table(f, float(mu.min()), rtol=rtol, interp_tol=interp_tol)
     rad = table(mu)  # 000 eq. 2 (for f(wo, wi) when transposed), one look-up per pixel
+    pump = _pump_module()
     return Image(_scatter(rad, g.mask), g.mask, "furnace", f.spec, bound,
-                 {"size": size, "rtol": rtol, "interp_tol": interp_tol, "table_nodes": int(len(table.mu)),
+                 {"size": size, "rtol": pump.TABLE_RTOL if rtol is None else float(rtol),
+                  "interp_tol": pump.TABLE_INTERP_TOL if interp_tol is None else float(interp_tol),
+                  "table_nodes": int(len(table.mu)),
                   "transposed": bool(transposed)})
 
 

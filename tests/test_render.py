@@ -112,6 +112,8 @@ def test_lambert_furnace_is_rho_everywhere():
         assert vals.size == np.count_nonzero(im.mask) > 700
         assert np.abs(vals - rho).max() <= 1e-12
         assert im.error <= 1e-12 and np.all(im.radiance[~im.mask] == 0)
+    own = R.furnace({"type": "lambert", "albedo": 0.37}, size=9, rtol=1e-8, interp_tol=1e-6)  # not pump's table
+    assert own.params["rtol"] == 1e-8 and np.abs(own.radiance[own.mask] - 0.37).max() <= 1e-12
 
 
 def test_phong_furnace_pixels_are_the_albedo_within_the_stated_bound():
