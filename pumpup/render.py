@@ -60,7 +60,7 @@ Output
 ``A``) with the model and geometry in the header; :func:`tone_map` and :func:`write_png`
 make a display image with a stated tone map: radiance x 2^exposure, the sRGB transfer
 function (IEC 61966-2-1), values above 1 clipped and **marked magenta**, the background
-dark blue.  :func:`grid_figure` assembles labelled grids (matplotlib).
+slate blue.  :func:`grid_figure` assembles labelled grids (matplotlib).
 """
 
 from __future__ import annotations
@@ -92,10 +92,12 @@ __all__ = [
     "check_size",
     "check_light",
     "MIN_SIZE",
+    "MAX_SIZE",
 ]
 
-#: smallest image accepted (pixels per side)
+#: smallest and largest image accepted (pixels per side; 4096^2 pixels take about 2 GB of geometry)
 MIN_SIZE = 8
+MAX_SIZE = 4096
 #: display colour of clipped pixels (radiance x 2^exposure > 1), and of the background, in sRGB [0, 1]
 CLIP_COLOUR = (1.0, 0.0, 1.0)
 BACKGROUND = (0.20, 0.24, 0.36)
@@ -107,12 +109,12 @@ BACKGROUND = (0.20, 0.24, 0.36)
 
 
 def check_size(size) -> int:
-    """``size`` as an int >= :data:`MIN_SIZE`, or a ValueError naming it."""
+    """``size`` as an int in [:data:`MIN_SIZE`, :data:`MAX_SIZE`], or a ValueError naming it."""
     if isinstance(size, bool) or not isinstance(size, (int, np.integer)) and not (
             isinstance(size, (float, np.floating)) and float(size).is_integer()):
         raise ValueError(f"size must be an integer number of pixels >= {MIN_SIZE}, got {size!r}")
-    if int(size) < MIN_SIZE:
-        raise ValueError(f"size must be an integer number of pixels >= {MIN_SIZE}, got {int(size)}")
+    if not MIN_SIZE <= int(size) <= MAX_SIZE:
+        raise ValueError(f"size must be an integer number of pixels >= {MIN_SIZE} and <= {MAX_SIZE}, got {int(size)}")
     return int(size)
 
 
@@ -195,6 +197,8 @@ def light_direction(light_deg: float, azimuth_deg: float = 0.0) -> np.ndarray:
     image, 90 above it.
     """
     p = math.radians(check_light(light_deg))
+    if not math.isfinite(float(azimuth_deg)):
+        raise ValueError(f"light azimuth must be a finite number of degrees, got {azimuth_deg!r}")
     a = math.radians(float(azimuth_deg))
     return np.array([math.sin(p) * math.cos(a), math.sin(p) * math.sin(a), math.cos(p)])
 

@@ -172,7 +172,8 @@ def test_furnace_refuses_anisotropic_models():
 
 @pytest.mark.parametrize("kw, match", [
     ({"light_deg": 180}, r"\[0, 180\)"), ({"light_deg": -1e-9}, r"\[0, 180\)"), ({"light_deg": float("nan")}, "180"),
-    ({"size": 7}, ">= 8"), ({"size": 8.5}, ">= 8"), ({"size": True}, ">= 8"), ({"irradiance": 0.0}, "irradiance"),
+    ({"size": 7}, ">= 8"), ({"size": 8.5}, ">= 8"), ({"size": True}, ">= 8"), ({"size": 10**6}, "<= 4096"),
+    ({"irradiance": 0.0}, "irradiance"), ({"azimuth_deg": float("inf")}, "azimuth"),
 ])
 def test_bad_input_is_one_clear_error(kw, match):
     args = {"light_deg": 0.0, "size": 16, **kw}
