@@ -573,7 +573,7 @@ def srgb(v: np.ndarray) -> np.ndarray:
 def tone_map(image: Image, exposure: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """Display RGB in [0, 1] and the clipped mask: v = radiance x 2^exposure, sRGB transfer.
 
-    Pixels with v > 1 (any channel; for a furnace image v > 1 + its error bound x 2^exposure) are
+    Pixels with v > 1 + 1e-9 (any channel; for a furnace image v > 1 + 1e-9 + its error bound x 2^exposure) are
     painted :data:`CLIP_COLOUR` (magenta) and flagged in the returned mask; pixels off the sphere are
     :data:`BACKGROUND`.  Grey images become grey RGB.
     """
@@ -586,8 +586,9 @@ def tone_map(image: Image, exposure: float = 0.0) -> tuple[np.ndarray, np.ndarra
         v = np.repeat(v, 3, axis=2)
     if v.shape[2] != 3:
         raise ValueError(f"tone_map: radiance must have 1 or 3 channels, got {v.shape[2]}")
-    # a furnace image may exceed 1 by its own error bound without reflecting more than it receives
-    tol = float(image.error or 0.0) * 2.0 ** float(exposure)
+    # a furnace image may exceed 1 by its own error bound without reflecting more than it receives;
+    # 1e-9: a light scaled to make the peak 1 gives 1 + 2e-16, which is not clipping
+    tol = float(image.error or 0.0) * 2.0 ** float(exposure) + 1e-9
     clipped = image.mask & np.any(v > 1.0 + tol, axis=2)
     rgb = srgb(v)
     rgb[clipped] = CLIP_COLOUR

@@ -88,6 +88,26 @@ def lewis_fig10(size, out):
                          title="reciprocal Phong-Blinn (002 eq. 24): [(1 - k_s) + k_s (N.H)^n] (N.S), L_d = 1")
 
 
+def lobes(size, out):
+    """Phong, stretched Phong and once-pumped Phong at Lewis's half-angles beta = 10 and 30 degrees, each row lit
+    so that its peak at Phi_L = 0 is 1 (Lewis's normalisation of his Fig. 4)."""
+    specs, labels = [], []
+    for beta in (10.0, 30.0):
+        n = R.lewis_exponent(beta)
+        base = {"type": "phong", "n": n}
+        for s in (base, {"type": "stretched_phong", "n": n}, pumpup.pump(base, g="g1").spec):
+            specs.append(s)
+            labels.append(f"{R.label(s).replace(f'n={n:.4g}', 'n=' + format(n, '.3g'))}\nbeta={beta:g} deg")
+    ims = []
+    for s in specs:
+        e = 1.0 / float(R.sphere(s, 0.0, size).radiance.max())
+        ims.append(_row_of_lights(s, LIGHTS, size, e))
+    _print_peaks("lobes (peak at Phi_L = 0 scaled to 1)", ims, labels, LIGHTS)
+    return R.grid_figure(ims, os.path.join(out, "render_lobes.png"), row_labels=labels,
+                         col_labels=[f"Phi_L = {v:g} deg" for v in LIGHTS],
+                         title="Phong, stretched Phong (000 eq. 7), pumped Phong (001 eq. 20); light scaled per row")
+
+
 def _blinn_spec():
     c, _ = pumpup.max_constant(pumpup.load({"type": "blinn", "n": N_PUMP}))
     return {"type": "blinn", "n": N_PUMP, "c": c}
@@ -149,7 +169,7 @@ def furnace(size, out):
 
 
 MAKERS = {"lewis_fig3": lewis_fig3, "lewis_fig6": lewis_fig6, "lewis_fig10": lewis_fig10,
-          "phong_pumped": phong_stretched_pumped, "blinn_pumped": blinn_pumped, "furnace": furnace}
+          "lobes": lobes, "phong_pumped": phong_stretched_pumped, "blinn_pumped": blinn_pumped, "furnace": furnace}
 
 
 def main(argv=None) -> int:

@@ -277,3 +277,5 @@ def test_furnace_clipping_allows_the_error_bound():
     assert clipped.sum() == 1 and clipped[0, 0]  # above 1 + bound: more reflected than received
     im.error = None
     assert R.tone_map(im)[1].all()
+    im.radiance[:] = 1.0 + 2e-16  # a light scaled so that the peak is 1, to rounding: not clipped
+    assert not R.tone_map(im)[1].any()
