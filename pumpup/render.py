@@ -285,7 +285,7 @@ def sphere(f, light_deg: float = 0.0, size: int = 256, *, irradiance: float = 1.
     --------
     >>> import pumpup.render as R
     >>> im = R.sphere({"type": "lambert", "albedo": 1.0}, light_deg=0, size=8)
-    >>> round(float(im.radiance.max()) * 3.141592653589793, 3)   # (N.L) / pi at the centre pixels
+    >>> round(float(im.radiance.max()) * 3.141592653589793, 3)   # pi x radiance = N.L next to the centre
     0.984
     """
     light_deg = check_light(light_deg)
