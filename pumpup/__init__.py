@@ -9,6 +9,7 @@ from . import albedo as albedo_module
 from .albedo import albedo
 from . import reproduce
 from . import testing
+from . import render
 from .divergence import divergence
 from .pump import Pumped, load_pumped, pump, save_pumped
 from .compensate import KullaConty, Scaled, compensate, furnace, load_compensated, save_compensated
@@ -33,6 +34,7 @@ __all__ = [
     "__version__",
     "albedo_module",
     "reproduce",
+    "render",
     "albedo",
     "divergence",
     "sampling",

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 
 
@@ -316,6 +317,65 @@ def cmd_compensate(args) -> int:
     return 0
 
 
+def cmd_render(args) -> int:
+    """``pumpup render sphere|furnace``: every argument is checked (one line, status 2) before rendering."""
+    import os
+
+    import pumpup
+    from pumpup import render
+
+    def fail(msg: str) -> int:
+        print(f"pumpup render {args.what}: {msg}", file=sys.stderr)
+        return 2
+
+    try:
+        size = render.check_size(int(args.size) if args.size.strip().lstrip("+-").isdigit() else args.size)
+        lights = [render.check_light(v) for v in args.light.split(",")] if args.what == "sphere" else []
+        exposure = float(args.exposure)
+        if not math.isfinite(exposure):
+            raise ValueError(f"--exposure must be a finite number of stops, got {args.exposure!r}")
+        irradiance = float(getattr(args, "irradiance", "1"))
+        if not (math.isfinite(irradiance) and irradiance > 0):
+            raise ValueError(f"--irradiance must be a finite number > 0, got {args.irradiance!r}")
+    except ValueError as exc:
+        msg = str(exc)
+        if msg.startswith("could not convert"):
+            msg = f"--exposure and --irradiance must be numbers: {msg}"
+        return fail(msg.replace("size must", "--size must").replace("light angle", "--light angle"))
+    models = []
+    for text in args.spec:
+        try:
+            models.append(pumpup.load(parse_spec(text)))
+        except SystemExit as exc:  # parse_spec's own message
+            return fail(f"SPEC {text!r}: {str(exc.code).removeprefix('pumpup: ')}")
+        except (pumpup.SpecError, ValueError, TypeError) as exc:
+            return fail(f"SPEC {text!r} does not load: {exc}")
+    if args.what == "furnace":
+        for f, text in zip(models, args.spec):
+            a = render._anisotropy(f)
+            if a > render.ISOTROPY_TOL:
+                return fail(f"SPEC {text!r} is anisotropic (f changes by {a:.2g} under a rotation about N): "
+                            "its furnace radiance depends on the azimuth of V")
+    try:
+        render._openexr()
+    except ImportError as exc:
+        return fail(str(exc))
+    if os.path.exists(args.out) and not os.path.isdir(args.out):
+        return fail(f"--out {args.out!r} exists and is not a directory")
+    try:
+        os.makedirs(args.out, exist_ok=True)
+    except OSError as exc:
+        return fail(f"--out {args.out!r}: {exc}")
+    try:
+        if args.what == "sphere":
+            render.render_spheres(models, lights, size, args.out, exposure=exposure, irradiance=irradiance)
+        else:
+            render.render_furnaces(models, size, args.out, exposure=exposure)
+    except (ValueError, OSError) as exc:  # SpecError is a ValueError
+        return fail(str(exc))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="pumpup",
@@ -404,6 +464,26 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--force", action="store_true", help="accept a base that is not reciprocal")
     s.add_argument("--out", help="save the compensated BRDF and its tables to this netCDF file")
     s.set_defaults(func=cmd_compensate)
+    s = sub.add_parser("render", help="exact images of a sphere: Lewis's directional-light test (002 Fig. 2) "
+                                      "and the white furnace (pixel = albedo)")
+    render_sub = s.add_subparsers(dest="what", required=True)
+    r = render_sub.add_parser("sphere", help="orthographic unit sphere under one directional light at Phi_L "
+                                             "from the view: radiance = E f_r(L, V) cos(theta_L)")
+    r.add_argument("spec", nargs="+", help="one or more model specs (one row of the grid each)")
+    r.add_argument("--light", default="0,30,60,80", help="Phi_L values in [0, 180) degrees, comma-separated "
+                                                        "(default 0,30,60,80)")
+    r.add_argument("--irradiance", default="1", help="E, irradiance on a surface facing the light (default 1)")
+    r.add_argument("--size", default="256", help="pixels per side, >= 8 (default 256)")
+    r.add_argument("--exposure", default="0", help="PNG tone map: radiance x 2^EXPOSURE, sRGB; default 0")
+    r.add_argument("--out", required=True, help="directory for the EXR and PNG files and sphere_grid.png")
+    r.set_defaults(func=cmd_render)
+    r = render_sub.add_parser("furnace", help="the sphere in a white furnace: pixel = albedo a(mu_V) "
+                                              "(one albedo table per model, its error bound reported)")
+    r.add_argument("spec", nargs="+", help="one or more isotropic model specs")
+    r.add_argument("--size", default="256", help="pixels per side, >= 8 (default 256)")
+    r.add_argument("--exposure", default="0", help="PNG tone map: radiance x 2^EXPOSURE, sRGB; default 0")
+    r.add_argument("--out", required=True, help="directory for the EXR and PNG files and furnace_grid.png")
+    r.set_defaults(func=cmd_render)
     return p
 
 
