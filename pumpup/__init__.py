@@ -15,6 +15,8 @@ from . import sampling
 from .sampling import mc_albedo, mc_radiance, sample
 from .tables import AlbedoTable, max_albedo, max_constant, mean_albedo, open_table, tabulate, write_table
 from .sweep import sweep
+from . import luts as lut_module
+from .luts import audit, lut
 from .core import (
     BRDF,
     Lobe,
@@ -49,6 +51,9 @@ __all__ = [
     "open_table",
     "tabulate",
     "sweep",
+    "lut",
+    "audit",
+    "lut_module",
     "write_table",
     "BRDF",
     "Lobe",
