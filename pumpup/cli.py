@@ -421,7 +421,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--preset", required=True, help="cycles, filament, filament-centred, appleseed, bsdl, mitsuba, "
                                                   "netcdf, exr")
     s.add_argument("--out", required=True, help="the table file (.h for C arrays, .inc, .npy, .nc, .exr)")
-    s.add_argument("--rtol", type=float, default=1e-8)
+    s.add_argument("--rtol", type=float, help="quadrature tolerance of the nodes (default 1e-8; 1e-6 for half floats)")
     s.add_argument("--max-lookup-error", type=float, help="fail (status 1, saying where) above this look-up error")
     s.add_argument("--no-lookup-check", action="store_true", help="skip the look-up error between the nodes")
     s.add_argument("--no-eavg", action="store_true", help="skip E_avg")

@@ -79,6 +79,8 @@ class Preset:
     lookup_mu_min: float = 1e-4
     lookup_rough_min: float = 1e-2
     source: str = ""
+    #: default quadrature tolerance of the nodes: 1e-8, or 1e-6 for half floats (whose rounding is 2.4e-4)
+    rtol: float = 1e-8
 
     @property
     def mu_lookup(self) -> str:
@@ -97,7 +99,7 @@ PRESETS: dict[str, Preset] = {p.name: p for p in [
                   "data[y*32 + x] printed by std::to_string (%f of the float) after saturatef; table_ggx_Eavg "
                   "over the same rough axis; verified against the shipped numbers (pumpup.audit)"),
     Preset("filament", "Google Filament", 128, 128, "texel", "filament", 0.0, 0.0, "correlated", "half", "E", False,
-           True, "filament", ("DFG_LUT",), lookup_rough_min=0.045,
+           True, "filament", ("DFG_LUT",), lookup_rough_min=0.045, rtol=1e-6,
            source="Filament libs/ibl/src/CubemapIBL.cpp CubemapIBL::DFG with DFV_Multiscatter (cmgen "
                   "--ibl-dfg-multiscatter, as filament/CMakeLists.txt builds dfg.inc): NoV = (x + 0.5)/128, "
                   "coord = saturate((128 - y + 0.5)/128) for image row y, a = coord^2 is GGX alpha, height-"
@@ -106,7 +108,7 @@ PRESETS: dict[str, Preset] = {p.name: p for p in [
                   "textureLod(dfg, vec2(NoV, perceptualRoughness)), so GL row t holds roughness (t + 1.5)/128 "
                   "where it is read at (t + 0.5)/128; lookup_rough_min = Filament's MIN_PERCEPTUAL_ROUGHNESS"),
     Preset("filament-centred", "Google Filament (texel-centred rows)", 128, 128, "texel", "texel", 0.0, 0.0,
-           "correlated", "half", "E", False, True, "filament", ("DFG_LUT",), lookup_rough_min=0.045,
+           "correlated", "half", "E", False, True, "filament", ("DFG_LUT",), lookup_rough_min=0.045, rtol=1e-6,
            source="as 'filament', with each row computed at the texel centre the shader reads, (t + 0.5)/128"),
     Preset("appleseed", "appleseed", 32, 32, "node", "node", 1e-4, 1e-4, "separable", "float32", "E", True, False,
            "c", ("ggx_albedo_table", "ggx_avg_albedo"),
@@ -279,12 +281,12 @@ def _brdf(spec: dict, param: str, rough: float) -> BRDF:
     return load({**spec, param: float(rough) ** 2})  # alpha = r^2 (every preset)
 
 
-def _albedo(f: BRDF, mu, rtol: float, max_regions: int):
+def _albedo(f: BRDF, mu, rtol: float, max_regions: int, atol: float = 1e-14):
     from .albedo import AlbedoWarning, albedo
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", AlbedoWarning)  # the error estimate says it; counted by the caller
-        return albedo(f, mu, return_error=True, rtol=rtol, atol=1e-14, max_regions=max_regions)
+        return albedo(f, mu, return_error=True, rtol=rtol, atol=atol, max_regions=max_regions)
 
 
 def _map_columns(fn, n: int, threads: int | None):
@@ -323,7 +325,8 @@ def truth_grid(spec: dict, param: str, mu, rough, *, rtol: float = 1e-8, split: 
         e, ee = _albedo(f, mu, rtol, max_regions)
         if not split:
             return e, ee
-        b, be = _albedo(_SchlickWeighted(f), mu, rtol, max_regions)
+        # B is small where Fc is (near normal incidence): its tolerance is relative to E, not to B
+        b, be = _albedo(_SchlickWeighted(f), mu, rtol, max_regions, atol=rtol * float(np.min(e)))
         return e, ee, b, be
 
     cols = _map_columns(column, len(rough), threads)
@@ -342,8 +345,8 @@ def mean_albedo_grid(spec: dict, param: str, rough, *, rtol: float = 1e-8, max_r
     """E_avg(rough) = 2 integral_0^1 E(mu) mu dmu (000 eq. 33), with its error, for each rough.
 
     Adaptive Gauss-Kronrod (7/15) over tau with mu = tau^2 (3 - 2 tau) (as
-    :func:`pumpup.mean_albedo`), starting from 4 panels; the error adds |K - G| and the
-    propagated albedo errors.
+    :func:`pumpup.mean_albedo`), starting from 6 panels graded towards grazing; the error adds
+    |K - G| and the propagated albedo errors.
     """
     from .albedo import NODES, WG, WK
 
@@ -351,8 +354,8 @@ def mean_albedo_grid(spec: dict, param: str, rough, *, rtol: float = 1e-8, max_r
 
     def one(j):
         f = _brdf(spec, param, rough[j])
-        a = np.linspace(0.0, 1.0, 5)[:-1]
-        b = a + 0.25
+        edges = np.array([0.0, 1 / 32, 1 / 8, 1 / 4, 1 / 2, 3 / 4, 1.0])  # graded towards grazing
+        a, b = edges[:-1], edges[1:]
         total = 0.0
         err = 0.0
         est = None
@@ -360,7 +363,7 @@ def mean_albedo_grid(spec: dict, param: str, rough, *, rtol: float = 1e-8, max_r
             tau = a[:, None] + (b - a)[:, None] * NODES[None, :]
             m = tau * tau * (3 - 2 * tau)
             w = 6 * tau * (1 - tau) * (b - a)[:, None]
-            v, e = _albedo(f, np.maximum(m, 1e-300).ravel(), rtol / 4, max_regions)
+            v, e = _albedo(f, np.maximum(m, 1e-300).ravel(), rtol / 2, max_regions)
             v = v.reshape(m.shape)
             e = e.reshape(m.shape)
             fv = 2 * v * m * w
@@ -481,7 +484,7 @@ def lookup_error(table, spec: dict, param: str, preset, *, per_cell: int = 1, st
 # --------------------------------------------------------------------------------------------
 
 
-def lut(model="ggx", preset: str = "cycles", *, rtol: float = 1e-8, eavg: bool | None = None,
+def lut(model="ggx", preset: str = "cycles", *, rtol: float | None = None, eavg: bool | None = None,
         split: bool | None = None, lookup_check: bool = True, per_cell: int | None = None,
         stride: int | None = None, max_lookup_error: float | None = None, threads: int | None = None,
         max_regions: int = 400):
@@ -497,8 +500,9 @@ def lut(model="ggx", preset: str = "cycles", *, rtol: float = 1e-8, eavg: bool |
     preset : str
         A key of :data:`PRESETS` (cycles, filament, filament-centred, appleseed, bsdl, mitsuba,
         netcdf, exr).
-    rtol : float
-        Relative tolerance of every node (and of E_avg).
+    rtol : float, optional
+        Relative tolerance of every node (and of E_avg); default the preset's (1e-8; 1e-6 for
+        half-float tables, whose storage rounds by up to 2.4e-4).
     eavg, split : bool, optional
         Compute E_avg(rough) / the split-sum pair A, B (default: what the preset stores).
     lookup_check : bool
@@ -532,6 +536,7 @@ def lut(model="ggx", preset: str = "cycles", *, rtol: float = 1e-8, eavg: bool |
     from ._version import __version__
 
     p = _preset(preset)
+    rtol = p.rtol if rtol is None else rtol
     if not (isinstance(rtol, float | int) and 1e-13 <= rtol <= 1e-2):
         raise SpecError(f"rtol must be in [1e-13, 1e-2], got {rtol!r}")
     if max_lookup_error is not None and not max_lookup_error > 0:
@@ -967,3 +972,47 @@ def error_map_png(res: AuditResult, path) -> str:
         fig.savefig(tmp, format="png", dpi=100)
     plt.close(fig)
     return os.fspath(path)
+
+
+# --------------------------------------------------------------------------------------------
+# Better tables for the same budget: axis warps
+# --------------------------------------------------------------------------------------------
+
+
+def warp_search(model="ggx", preset="cycles", p_grid=(1.0, 1.5, 2.0, 3.0, 4.0), q_grid=(1.0, 1.5, 2.0, 3.0), *,
+                rtol: float = 1e-7, per_cell: int = 1, refine: int = 2, threads: int | None = None,
+                max_regions: int = 400) -> list[dict]:
+    """The worst look-up error of power-warped node axes for the preset's budget and bilinear look-up.
+
+    Each candidate puts the nodes at mu = (i / (n - 1))^p and rough = (j / (n - 1))^q (the preset's
+    floors applied) and is read by the same bilinear interpolation in the warped coordinate
+    (index = mu^(1/p) (n - 1); BSDL's mu axis is p = 2).  Its nodes are exact (float64) and its
+    worst look-up error over the preset's look-up domain is measured by :func:`lookup_error`.
+    p = q = 1 is the uniform grid the renderers use.
+
+    Returns
+    -------
+    list of dict
+        One per (p, q), sorted by ``max_abs``: ``p``, ``q``, ``max_abs``, ``where``, ``rms``.
+    """
+    base = _preset(preset)
+    if base.mu_lookup == "texel" or base.rough_lookup == "texel":
+        raise SpecError("warp_search needs a preset with node axes (cycles, appleseed, bsdl, netcdf, exr)")
+    spec, param = model_spec(model, base)
+    out = []
+    for p in p_grid:
+        for q in q_grid:
+            cand = _dc_replace(base, name=f"{base.name}-warp", mu_axis=f"power:{p:g}", rough_axis=f"power:{q:g}")
+            mu, rough = nodes(cand)
+            table = truth_grid(spec, param, mu, rough, rtol=rtol, threads=threads, max_regions=max_regions)["E"]
+            le = lookup_error(table, spec, param, cand, per_cell=per_cell, refine=refine, rtol=rtol, threads=threads,
+                              max_regions=max_regions)
+            out.append({"p": float(p), "q": float(q), "max_abs": le["max_abs"], "where": le["where"], "rms": le["rms"],
+                        "truth_error": le["truth_error"]})
+    return sorted(out, key=lambda d: d["max_abs"])
+
+
+def _dc_replace(obj, **kw):
+    import dataclasses
+
+    return dataclasses.replace(obj, **kw)
