@@ -315,3 +315,16 @@ def test_cli_audit_exit_status(tmp_path):
              "--no-eavg", "--rtol", "1e-5")
     assert r.returncode == 1 and "node error" in r.stderr and "at mu =" in r.stderr
     assert p.n_mu == 32
+
+
+@pytest.mark.slow
+def test_cli_lut_then_audit(tmp_path):
+    out = str(tmp_path / "t.npy")
+    r = _cli("lut", "ggx", "--preset", "mitsuba", "--out", out, "--no-eavg", "--max-lookup-error", "1e-6")
+    assert r.returncode == 1 and "exceeds max_lookup_error=1e-06 at mu = " in r.stderr and not os.path.exists(out)
+    r = _cli("lut", "ggx", "--preset", "mitsuba", "--out", out, "--no-eavg", "--no-lookup-check")
+    assert r.returncode == 0, r.stderr
+    assert "storage (float32) rounds by" in r.stdout
+    r = _cli("audit", out, "--preset", "mitsuba", "--no-lookup-check", "--tol", "1e-6")
+    assert r.returncode == 0, r.stderr
+    assert "max |table - E| = " in r.stdout
