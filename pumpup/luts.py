@@ -675,6 +675,9 @@ def write_lut(ds, path, preset=None) -> str:
             header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage,
                       "pumpup_spec": ds.attrs["spec"], "pumpup_preset": p.name,
                       "pumpup_conventions": "x = mu node i/(n-1) (floor 1e-4), y = rough node, alpha = rough^2"}
+            for k in ("quadrature_error", "quantisation_error", "lookup_error", "lookup_error_mu", "lookup_error_rough"):
+                if k in ds.attrs:
+                    header["pumpup_" + k] = f"{float(ds.attrs[k]):.6g}"
             with OpenEXR.File(header, {k: np.ascontiguousarray(v) for k, v in chans.items()}) as f:
                 f.write(tmp)
         else:  # pragma: no cover - every preset has a writer
