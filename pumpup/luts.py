@@ -309,7 +309,7 @@ def _map_columns(fn, n: int, threads: int | None):
 
 
 def truth_grid(spec: dict, param: str, mu, rough, *, rtol: float = 1e-8, split: bool = False,
-               max_regions: int = 400, threads: int | None = None) -> dict:
+               max_regions: int = 200, threads: int | None = None) -> dict:
     """E (and with ``split`` A, B) on the product grid mu x rough, each with its error estimate.
 
     Returns a dict of arrays of shape (len(mu), len(rough)): ``E``, ``E_error`` (and ``A``,
@@ -340,7 +340,7 @@ def truth_grid(spec: dict, param: str, mu, rough, *, rtol: float = 1e-8, split: 
     return out
 
 
-def mean_albedo_grid(spec: dict, param: str, rough, *, rtol: float = 1e-8, max_regions: int = 400,
+def mean_albedo_grid(spec: dict, param: str, rough, *, rtol: float = 1e-8, max_regions: int = 200,
                      threads: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """E_avg(rough) = 2 integral_0^1 E(mu) mu dmu (000 eq. 33), with its error, for each rough.
 
@@ -427,7 +427,7 @@ def _dense_axis(kind: str, n: int, lo: float, per_cell: int, stride: int) -> np.
 
 
 def lookup_error(table, spec: dict, param: str, preset, *, per_cell: int = 1, stride: int = 1,
-                 rtol: float = 1e-7, refine: int = 3, threads: int | None = None, max_regions: int = 400) -> dict:
+                 rtol: float = 1e-7, refine: int = 3, threads: int | None = None, max_regions: int = 200) -> dict:
     """Error of the renderer's look-up of ``table`` against the true E between the nodes.
 
     The truth is computed on a dense grid (``per_cell`` points per cell and axis, cell
@@ -487,7 +487,7 @@ def lookup_error(table, spec: dict, param: str, preset, *, per_cell: int = 1, st
 def lut(model="ggx", preset: str = "cycles", *, rtol: float | None = None, eavg: bool | None = None,
         split: bool | None = None, lookup_check: bool = True, per_cell: int | None = None,
         stride: int | None = None, max_lookup_error: float | None = None, threads: int | None = None,
-        max_regions: int = 400):
+        max_regions: int = 200):
     """A renderer's albedo table of ``model``, computed exactly, with its errors.
 
     Parameters
@@ -897,7 +897,7 @@ def _monotonicity(table: np.ndarray, truth: np.ndarray, slack: float, mu, rough)
 
 def audit(path, preset: str = "cycles", model="ggx", *, rtol: float = 1e-7, lookup_check: bool = True, eavg: bool = True,
           per_cell: int = 1, stride: int | None = None, png: str | None = None, threads: int | None = None,
-          max_regions: int = 400) -> AuditResult:
+          max_regions: int = 200) -> AuditResult:
     """Grade a shipped table against pumpup's truth, in the preset's conventions.
 
     Reads ``path`` (:func:`read_table`), recomputes every node with ``model`` (default GGX with
@@ -984,7 +984,7 @@ def error_map_png(res: AuditResult, path) -> str:
 
 def warp_search(model="ggx", preset="cycles", p_grid=(1.0, 1.5, 2.0, 3.0, 4.0), q_grid=(1.0, 1.5, 2.0, 3.0), *,
                 rtol: float = 1e-7, per_cell: int = 1, refine: int = 2, threads: int | None = None,
-                max_regions: int = 400) -> list[dict]:
+                max_regions: int = 200) -> list[dict]:
     """The worst look-up error of power-warped node axes for the preset's budget and bilinear look-up.
 
     Each candidate puts the nodes at mu = (i / (n - 1))^p and rough = (j / (n - 1))^q (the preset's

@@ -13,6 +13,7 @@ Prints every candidate and the gain of the best over the uniform grid.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import sys
 import time
@@ -29,15 +30,21 @@ def main() -> int:
     ap.add_argument("--p", default="1,1.5,2,3,4", help="exponents of the mu axis")
     ap.add_argument("--q", default="1,1.5,2,3", help="exponents of the roughness axis")
     ap.add_argument("--rtol", type=float, default=1e-7)
+    ap.add_argument("--mu-min", type=float, help="smallest mu of the look-up domain (default the preset's, 1e-4)")
+    ap.add_argument("--rough-min", type=float, help="smallest roughness of the look-up domain (default 0.01)")
     args = ap.parse_args()
     ps = [float(v) for v in args.p.split(",")]
     qs = [float(v) for v in args.q.split(",")]
     if 1.0 not in ps or 1.0 not in qs:
         print("the grids must contain 1 (the uniform axis) to report the gain", file=sys.stderr)
         return 2
-    t = time.perf_counter()
-    res = luts.warp_search(args.model, args.preset, ps, qs, rtol=args.rtol)
     p = luts.PRESETS[args.preset]
+    if args.mu_min is not None:
+        p = dataclasses.replace(p, lookup_mu_min=args.mu_min)
+    if args.rough_min is not None:
+        p = dataclasses.replace(p, lookup_rough_min=args.rough_min)
+    t = time.perf_counter()
+    res = luts.warp_search(args.model, p, ps, qs, rtol=args.rtol)
     print(f"{args.model}, {p.n_mu} x {p.n_rough} entries, bilinear; look-up domain mu in [{p.lookup_mu_min:g}, 1], "
           f"rough in [{p.lookup_rough_min:g}, 1] ({time.perf_counter() - t:.0f} s, load {os.getloadavg()[0]:.1f})")
     print(f"{'p (mu)':>7s} {'q (rough)':>9s} {'worst error':>12s} {'at mu':>10s} {'rough':>8s} {'rms':>9s}")
