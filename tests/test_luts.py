@@ -204,6 +204,14 @@ def test_lookup_node_matches_scipy():
     b = small("bsdl", 7, 6)  # BSDL's mu axis: index sqrt(mu) (n - 1)
     assert np.allclose(luts.lookup(table, mu, r, b), RegularGridInterpolator(
         (np.linspace(0, 1, 7), np.linspace(0, 1, 6)), table)(np.stack([np.sqrt(mu), r], -1)), atol=1e-12)
+    w = small("cycles", 7, 6, mu_axis="power:3", rough_axis="power:2")  # the warped axes of warp_search
+    assert np.allclose(luts.lookup(table, mu, r, w), RegularGridInterpolator(
+        (np.linspace(0, 1, 7), np.linspace(0, 1, 6)), table)(np.stack([np.cbrt(mu), np.sqrt(r)], -1)), atol=1e-12)
+    assert luts.nodes(w)[0][1] == pytest.approx((1 / 6) ** 3)
+    with pytest.raises(pumpup.SpecError, match="exponent must be a number in"):
+        luts.axis_values("power:x", 4)
+    with pytest.raises(pumpup.SpecError, match="needs a preset with node axes"):
+        luts.warp_search("ggx", "mitsuba")
 
 
 def test_lookup_texel_matches_mitsuba_texture():
