@@ -22,7 +22,6 @@ renderer's "perceptual" roughness, alpha = r^2.
 from __future__ import annotations
 
 import json
-import math
 import os
 import re
 import warnings
