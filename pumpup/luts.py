@@ -80,6 +80,14 @@ class Preset:
     source: str = ""
     #: default quadrature tolerance of the nodes: 1e-8, or 1e-6 for half floats (whose rounding is 2.4e-4)
     rtol: float = 1e-8
+    #: which axis the rows of a C array run over ("mu": data[i_mu * n_rough + j]; "rough": data[j * n_mu + i])
+    rows: str = "mu"
+    #: the renderer defines E = 1 at the nodes with mu = 0 or rough = 0 (appleseed's special cases)
+    edge_one: bool = False
+    #: E_avg follows E in the same C array (appleseed)
+    eavg_in_array: bool = False
+    #: values per line of a C array (0: one table row per line)
+    per_line: int = 0
 
     @property
     def mu_lookup(self) -> str:
@@ -109,10 +117,15 @@ PRESETS: dict[str, Preset] = {p.name: p for p in [
     Preset("filament-centred", "Google Filament (texel-centred rows)", 128, 128, "texel", "texel", 0.0, 0.0,
            "correlated", "half", "E", False, True, "filament", ("DFG_LUT",), lookup_rough_min=0.045, rtol=1e-6,
            source="as 'filament', with each row computed at the texel centre the shader reads, (t + 0.5)/128"),
-    Preset("appleseed", "appleseed", 32, 32, "node", "node", 1e-4, 1e-4, "separable", "float32", "E", True, False,
-           "c", ("ggx_albedo_table", "ggx_avg_albedo"),
-           source="32 x 32 plus an E_avg row, node axes; the floors, the separable Smith G and the array names are "
-                  "pumpup's choice (not checked against appleseed's source; override shadowing= if needed)"),
+    Preset("appleseed", "appleseed", 32, 32, "node", "node", 1e-4, 1e-4, "separable", "text6", "E", True, False,
+           "c", ("g_glossy_ggx_albedo_table",), rows="rough", edge_one=True, eavg_in_array=True, per_line=4,
+           source="appleseed src/appleseed/renderer/modeling/bsdf/microfacethelper.cpp MDFAlbedoTable and "
+                  "energycompensation.cpp AlbedoTable2D: row y -> roughness y/31, alpha = roughness^2, column x -> "
+                  "cos_theta x/31, data[y*32 + x], E = 1 where cos_theta = 0 or alpha = 0 (special cases), 512 "
+                  "Hammersley samples, min(E, 1); E_avg (appleseed: min(2 sum_i E_i cos_i / 32, 1)) follows in the "
+                  "same 1056-float array g_glossy_ggx_albedo_table, printed std::fixed with 6 decimals, 4 per line; "
+                  "look-up x = cos_theta 31, y = roughness 31, bilinear; the separable Smith G is not checked "
+                  "against appleseed's MDF code"),
     Preset("bsdl", "OSL BSDL", 16, 16, "square", "node", 1e-6, 1e-4, "correlated", "float32", "1-E", False, False,
            "c", ("ggx_one_minus_E",),
            source="16 x 16, mu = (i/15)^2 floored at 1e-6, stores 1 - E (issue 16); roughness floor, Smith G and "
@@ -179,6 +192,19 @@ def nodes(preset) -> tuple[np.ndarray, np.ndarray]:
     mu = np.maximum(axis_values(p.mu_axis, p.n_mu), p.mu_floor)
     rough = np.maximum(axis_values(p.rough_axis, p.n_rough), p.rough_floor)
     return np.minimum(mu, 1.0), np.minimum(rough, 1.0)
+
+
+def _edge_rule(tr: dict, p: Preset) -> dict:
+    """Apply a renderer's definition E = 1 at the mu = 0 and rough = 0 nodes (``edge_one``)."""
+    if not p.edge_one:
+        return tr
+    edge = (axis_values(p.mu_axis, p.n_mu) == 0)[:, None] | (axis_values(p.rough_axis, p.n_rough) == 0)[None, :]
+    tr["E"] = np.where(edge, 1.0, tr["E"])
+    tr["E_error"] = np.where(edge, 0.0, tr["E_error"])
+    for k in ("A", "B"):
+        if k in tr:
+            tr[k] = np.where(edge, np.nan, tr[k])
+    return tr
 
 
 # --------------------------------------------------------------------------------------------
@@ -544,7 +570,8 @@ def lut(model="ggx", preset: str = "cycles", *, rtol: float | None = None, eavg:
     eavg = p.eavg if eavg is None else bool(eavg)
     split = p.split if split is None else bool(split)
     mu, rough = nodes(p)
-    tr = truth_grid(spec, param, mu, rough, rtol=rtol, split=split, threads=threads, max_regions=max_regions)
+    tr = _edge_rule(truth_grid(spec, param, mu, rough, rtol=rtol, split=split, threads=threads,
+                               max_regions=max_regions), p)
     stored = quantise(tr["E"] if p.stores == "E" else 1.0 - tr["E"], p.storage)
     stored_E = stored if p.stores == "E" else 1.0 - stored
     qerr = float(np.max(np.abs(stored_E - tr["E"])))
@@ -610,7 +637,7 @@ def lut(model="ggx", preset: str = "cycles", *, rtol: float | None = None, eavg:
 # --------------------------------------------------------------------------------------------
 
 
-def _c_array(name: str, values: np.ndarray, storage: str, per_line: int) -> str:
+def _c_array(name: str, values: np.ndarray, storage: str, per_line: int, qualifier: str = "static") -> str:
     flat = np.asarray(values, dtype=np.float64).ravel()
     if storage == "text6":
         items = ["%ff" % float(np.float32(x)) for x in np.clip(flat, 0, 1)]
@@ -619,7 +646,7 @@ def _c_array(name: str, values: np.ndarray, storage: str, per_line: int) -> str:
     lines = []
     for a in range(0, len(items), per_line):
         lines.append("  " + ", ".join(items[a:a + per_line]))
-    return f"static const float {name}[{len(items)}] = {{\n" + ",\n".join(lines) + "\n};\n"
+    return f"{qualifier} const float {name}[{len(items)}] = {{\n" + ",\n".join(lines) + "\n};\n"
 
 
 def write_lut(ds, path, preset=None) -> str:
@@ -634,13 +661,21 @@ def write_lut(ds, path, preset=None) -> str:
     with atomic_path(path) as tmp:
         if p.fmt == "c":
             head = (f"/* {p.renderer} albedo table written by pumpup {ds.attrs['pumpup_version']} from "
-                    f"{ds.attrs['spec']}; preset {p.name}: {p.source}.  Rows: mu, columns: rough.  Quadrature error "
+                    f"{ds.attrs['spec']}; preset {p.name}: {p.source}.  Rows: {p.rows}.  Quadrature error "
                     f"{ds.attrs['quadrature_error']:.2g}, quantisation error {ds.attrs['quantisation_error']:.2g}"
                     + (f", look-up error {ds.attrs['lookup_error']:.3g}" if "lookup_error" in ds.attrs else "")
                     + ". */\n\n")
-            text = head + _c_array(p.names[0], raw, p.storage, p.n_rough)
-            if "E_avg" in ds and len(p.names) > 1:
-                text += "\n" + _c_array(p.names[1], ds["E_avg"].values, p.storage, p.n_rough)
+            grid = raw if p.rows == "mu" else raw.T  # C order: rows of the preset's row axis
+            per = p.per_line or grid.shape[1]
+            if p.eavg_in_array:
+                if "E_avg" not in ds:
+                    raise LutError(f"preset {p.name} stores E_avg in the same array: lut(..., eavg=True)")
+                text = head + _c_array(p.names[0], np.concatenate([grid.ravel(), ds["E_avg"].values]), p.storage,
+                                       per, "extern")
+            else:
+                text = head + _c_array(p.names[0], grid, p.storage, per)
+                if "E_avg" in ds and len(p.names) > 1:
+                    text += "\n" + _c_array(p.names[1], ds["E_avg"].values, p.storage, per)
             with open(tmp, "w") as fh:
                 fh.write(text)
         elif p.fmt == "filament":
@@ -684,7 +719,7 @@ def write_lut(ds, path, preset=None) -> str:
     return os.fspath(path)
 
 
-_C_ARRAY = re.compile(r"static\s+const\s+float\s+(\w+)\s*\[\s*(\d+)\s*\]\s*=\s*\{([^}]*)\}", re.S)
+_C_ARRAY = re.compile(r"(?:static\s+|extern\s+)?const\s+float\s+(\w+)\s*\[\s*(\d+)\s*\]\s*=\s*\{([^}]*)\}", re.S)
 
 
 def _read_c(path: str, p: Preset) -> dict:
@@ -695,8 +730,8 @@ def _read_c(path: str, p: Preset) -> dict:
         known = ", ".join(arrays) or "none"
         raise LutError(f"{path!r}: no array named {p.names[0]!r} for preset {p.name} (arrays found: {known})")
     out = {}
-    for key, name, size in (("E", p.names[0], p.n_mu * p.n_rough), ("E_avg", p.names[1] if len(p.names) > 1 else None,
-                                                                      p.n_rough)):
+    n_e = p.n_mu * p.n_rough + (p.n_rough if p.eavg_in_array else 0)
+    for key, name, size in (("E", p.names[0], n_e), ("E_avg", p.names[1] if len(p.names) > 1 else None, p.n_rough)):
         if name is None or name not in arrays:
             continue
         declared, body = arrays[name]
@@ -708,7 +743,13 @@ def _read_c(path: str, p: Preset) -> dict:
             raise LutError(f"{path!r}: array {name} has {len(vals)} values (declared {declared}); preset {p.name} "
                            f"needs {size}")
         out[key] = vals.astype(np.float32).astype(np.float64)
-    out["E"] = out["E"].reshape(p.n_mu, p.n_rough)  # data[y * nx + x]: rows mu, columns rough
+    if p.eavg_in_array:
+        out["E_avg"] = out["E"][p.n_mu * p.n_rough:]
+        out["E"] = out["E"][:p.n_mu * p.n_rough]
+    if p.rows == "mu":
+        out["E"] = out["E"].reshape(p.n_mu, p.n_rough)  # Cycles: data[y * nx + x], rows mu, columns rough
+    else:
+        out["E"] = out["E"].reshape(p.n_rough, p.n_mu).T  # appleseed: data[y * 32 + x], y roughness, x cos_theta
     if p.stores == "1-E":
         out["E"] = 1.0 - out["E"]
     return out
@@ -918,7 +959,7 @@ def audit(path, preset: str = "cycles", model="ggx", *, rtol: float = 1e-7, look
     tab = read_table(path, p)
     spec, param = model_spec(model, p)
     mu, rough = nodes(p)
-    tr = truth_grid(spec, param, mu, rough, rtol=rtol, threads=threads, max_regions=max_regions)
+    tr = _edge_rule(truth_grid(spec, param, mu, rough, rtol=rtol, threads=threads, max_regions=max_regions), p)
     E = tab["E"]
     diff = E - tr["E"]
     i, j = np.unravel_index(np.argmax(np.abs(diff)), diff.shape)

@@ -336,3 +336,22 @@ def test_cli_lut_then_audit(tmp_path):
     r = _cli("audit", out, "--preset", "mitsuba", "--no-lookup-check", "--tol", "1e-6")
     assert r.returncode == 0, r.stderr
     assert "max |table - E| = " in r.stdout
+
+
+def test_appleseed_layout_rows_are_roughness(tmp_path):
+    """appleseed: one array, data[y * n + x] with y the roughness and x the cosine, E_avg appended;
+    E = 1 by definition where cos_theta = 0 or roughness = 0."""
+    p = small("appleseed", 4, 3)
+    vals = np.array([[10 * y + x for x in range(4)] for y in range(3)]) / 100.0  # y: rough, x: mu
+    avg = np.array([0.9, 0.8, 0.7])
+    path = tmp_path / "a.cpp"
+    items = ", ".join("%ff" % v for v in np.concatenate([vals.ravel(), avg]))
+    path.write_text(f"extern const float g_glossy_ggx_albedo_table[15] =\n{{\n    {items}\n}};\n")
+    tab = luts.read_table(path, p)
+    assert tab["E"].shape == (4, 3) and tab["E"][3, 1] == pytest.approx(0.13)  # mu index 3, rough index 1
+    assert tab["E_avg"].tolist() == pytest.approx(avg.tolist())
+    ds = pumpup.lut("ggx", preset=p, lookup_check=False, rtol=1e-7)
+    assert np.all(ds["E"].values[0, :] == 1.0) and np.all(ds["E"].values[:, 0] == 1.0)
+    luts.write_lut(ds, tmp_path / "b.cpp", preset=p)
+    assert "extern const float g_glossy_ggx_albedo_table[15]" in (tmp_path / "b.cpp").read_text()
+    assert luts.read_table(tmp_path / "b.cpp", p)["E"] == pytest.approx(ds["E"].values, abs=6e-7)
