@@ -17,6 +17,8 @@ from . import sampling
 from .sampling import mc_albedo, mc_radiance, sample
 from .tables import AlbedoTable, max_albedo, max_constant, mean_albedo, open_table, tabulate, write_table
 from .sweep import sweep
+from . import luts as lut_module
+from .luts import audit, lut
 from .core import (
     BRDF,
     Lobe,
@@ -58,6 +60,9 @@ __all__ = [
     "open_table",
     "tabulate",
     "sweep",
+    "lut",
+    "audit",
+    "lut_module",
     "write_table",
     "BRDF",
     "Lobe",

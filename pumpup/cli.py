@@ -376,6 +376,79 @@ def cmd_render(args) -> int:
     return 0
 
 
+def _lut_fail(msg: str) -> int:
+    print(f"pumpup: {msg}", file=sys.stderr)
+    return 2
+
+
+def cmd_lut(args) -> int:
+    import pumpup
+    from pumpup import luts
+
+    if args.preset not in luts.PRESETS:
+        return _lut_fail(f"--preset must be one of {', '.join(luts.PRESETS)}; got {args.preset!r}")
+    p = luts.PRESETS[args.preset]
+    want = {"c": (".h", ".c", ".tables", ".inc", ".txt"), "filament": (".inc", ".h", ".txt"), "npy": (".npy",),
+            "netcdf": (".nc",), "exr": (".exr",)}[p.fmt]
+    if not args.out.endswith(want):
+        return _lut_fail(f"--out for preset {p.name} must end in {' or '.join(want)}; got {args.out!r}")
+    try:
+        ds = pumpup.lut(args.model, preset=args.preset, rtol=args.rtol, lookup_check=not args.no_lookup_check,
+                        max_lookup_error=args.max_lookup_error, eavg=False if args.no_eavg else None)
+    except luts.LutError as exc:
+        print(f"pumpup: {exc}", file=sys.stderr)
+        return 1
+    except (pumpup.SpecError, ValueError, TypeError) as exc:
+        return _lut_fail(str(exc))
+    try:
+        luts.write_lut(ds, args.out)
+    except OSError as exc:
+        return _lut_fail(str(exc))
+    a = ds.attrs
+    print(f"wrote {args.out}: {p.renderer} {ds.sizes['mu']} x {ds.sizes['rough']} table of {a['spec']}")
+    print(f"  quadrature error at the nodes <= {a['quadrature_error']:.2g} ({a['nodes_over_tolerance']} node(s) "
+          f"above rtol); storage ({a['storage']}) rounds by {a['quantisation_error']:.2g} (bound "
+          f"{a['quantisation_bound']:.2g})")
+    if "E_avg_error" in a:
+        print(f"  E_avg error <= {a['E_avg_error']:.2g}")
+    if "lookup_error" in a:
+        print(f"  the renderer's look-up: max error {a['lookup_error']:.3g} at mu = {a['lookup_error_mu']:.6g}, "
+              f"rough = {a['lookup_error_rough']:.6g} (rms {a['lookup_error_rms']:.2g}; {a['lookup_domain']})")
+    return 0
+
+
+def cmd_audit(args) -> int:
+    import pumpup
+    from pumpup import luts
+
+    if args.preset not in luts.PRESETS:
+        return _lut_fail(f"--preset must be one of {', '.join(luts.PRESETS)}; got {args.preset!r}")
+    for name in ("tol", "max_lookup_error"):
+        v = getattr(args, name)
+        if v is not None and not v > 0:
+            return _lut_fail(f"--{name.replace('_', '-')} must be > 0, got {v}")
+    try:
+        res = pumpup.audit(args.file, preset=args.preset, model=args.model, rtol=args.rtol,
+                           lookup_check=not args.no_lookup_check, png=args.png, eavg=not args.no_eavg)
+    except (luts.LutError, pumpup.SpecError, ValueError, TypeError, OSError) as exc:
+        return _lut_fail(str(exc))
+    print(res.report())
+    if args.png:
+        print(f"  error map: {args.png}")
+    if not res.ok(args.tol, args.max_lookup_error):
+        what = []
+        if args.tol is not None and res.max_abs > args.tol:
+            what.append(f"node error {res.max_abs:.3g} > --tol {args.tol:g} at mu = {res.where_abs[0]:.6g}, "
+                        f"rough = {res.where_abs[1]:.6g}")
+        if args.max_lookup_error is not None and res.lookup and res.lookup["max_abs"] > args.max_lookup_error:
+            lk = res.lookup
+            what.append(f"look-up error {lk['max_abs']:.3g} > --max-lookup-error {args.max_lookup_error:g} at "
+                        f"mu = {lk['where'][0]:.6g}, rough = {lk['where'][1]:.6g}")
+        print("pumpup: table fails: " + "; ".join(what), file=sys.stderr)
+        return 1
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="pumpup",
@@ -484,6 +557,30 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--exposure", default="0", help="PNG tone map: radiance x 2^EXPOSURE, sRGB; default 0")
     r.add_argument("--out", required=True, help="directory for the EXR and PNG files and furnace_grid.png")
     r.set_defaults(func=cmd_render)
+    s = sub.add_parser("lut", help="a renderer's albedo look-up table, computed exactly, with its node, storage and "
+                                   "look-up errors")
+    s.add_argument("model", nargs="?", default="ggx", help="ggx (default), beckmann, or a spec such as "
+                                                           "ggx:shadowing=separable")
+    s.add_argument("--preset", required=True, help="cycles, filament, filament-centred, appleseed, bsdl, mitsuba, "
+                                                  "netcdf, exr")
+    s.add_argument("--out", required=True, help="the table file (.h for C arrays, .inc, .npy, .nc, .exr)")
+    s.add_argument("--rtol", type=float, help="quadrature tolerance of the nodes (default 1e-8; 1e-6 for half floats)")
+    s.add_argument("--max-lookup-error", type=float, help="fail (status 1, saying where) above this look-up error")
+    s.add_argument("--no-lookup-check", action="store_true", help="skip the look-up error between the nodes")
+    s.add_argument("--no-eavg", action="store_true", help="skip E_avg")
+    s.set_defaults(func=cmd_lut)
+    s = sub.add_parser("audit", help="grade a shipped albedo table against pumpup's truth (status 1 beyond --tol)")
+    s.add_argument("file")
+    s.add_argument("--preset", required=True, help="cycles, filament, filament-centred, appleseed, bsdl, mitsuba, "
+                                                  "netcdf, exr")
+    s.add_argument("--model", default="ggx", help="the model the table claims (default ggx with the preset's Smith)")
+    s.add_argument("--tol", type=float, help="fail (status 1) if a node is off by more than this")
+    s.add_argument("--max-lookup-error", type=float, help="fail (status 1) if the look-up error exceeds this")
+    s.add_argument("--rtol", type=float, default=1e-7, help="quadrature tolerance of the truth (default 1e-7)")
+    s.add_argument("--png", help="write an error map here")
+    s.add_argument("--no-lookup-check", action="store_true", help="skip the look-up error between the nodes")
+    s.add_argument("--no-eavg", action="store_true", help="skip the E_avg checks")
+    s.set_defaults(func=cmd_audit)
     return p
 
 
