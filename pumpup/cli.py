@@ -8,24 +8,15 @@ import sys
 
 
 def parse_spec(text: str) -> dict:
-    """A model spec from JSON (``'{"type": "phong", "n": 20}'``) or the short form ``phong:n=20,c=1``."""
-    text = text.strip()
-    if text.startswith("{"):
-        try:
-            return json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise SystemExit(f"pumpup: the spec is not valid JSON: {exc}") from None
-    name, _, rest = text.partition(":")
-    spec: dict = {"type": name}
-    for item in filter(None, rest.split(",")):
-        key, eq, value = item.partition("=")
-        if not eq:
-            raise SystemExit(f"pumpup: spec parameter {item!r} must look like name=value")
-        try:
-            spec[key.strip()] = json.loads(value)
-        except json.JSONDecodeError:
-            spec[key.strip()] = value.strip()
-    return spec
+    """A model spec from JSON (``'{"type": "phong", "n": 20}'``) or the short form ``phong:n=20,c=1``
+    (:func:`pumpup.core.parse_spec`; a bad one exits with its one-line message)."""
+    from pumpup.core import SpecError
+    from pumpup.core import parse_spec as _parse
+
+    try:
+        return _parse(text)
+    except SpecError as exc:
+        raise SystemExit(f"pumpup: {exc}") from None
 
 
 def _load(text: str):

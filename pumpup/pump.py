@@ -33,6 +33,9 @@ __all__ = ["pump", "Pumped", "save_pumped", "load_pumped", "base_table"]
 #: (1e-8 with 1e-7: 6 x slower, measured)
 TABLE_RTOL = 1e-9
 TABLE_INTERP_TOL = 1e-7
+#: the most nested pumping levels accepted (each level's table costs about a second; the spec
+#: nests one dict per level)
+MAX_LEVELS = 64
 
 _TABLES: dict[str, object] = {}  # JSON spec of a base -> AlbedoTable (computed once per session)
 
@@ -466,14 +469,16 @@ class Pumped(BRDF):
 
     params = {
         "base": Param(kind="spec", doc="the BRDF to pump"),
-        "g": Param("g1", kind="str", choices=("g1", "g2")),
-        "levels": Param(1, lo=1, kind="int"),
-        "force": Param(False, kind="bool"),
+        "g": Param("g1", kind="str", choices=("g1", "g2"), doc="g1 = max(a(wi), a(wo)) (001 eq. 20) or g2, also max with N.wi, N.wo (001 eq. 21)"),
+        "levels": Param(1, lo=1, hi=MAX_LEVELS, kind="int", doc="nested pumpings, each dividing by g of the level below"),
+        "force": Param(False, kind="bool", doc="pump a base that is not reciprocal"),
     }
     constant = None
 
     def __init__(self, **kwargs):
         levels = kwargs.get("levels", 1)
+        if "levels" in kwargs:  # checked before nesting (levels = 1e5 would recurse 1e5 deep)
+            levels = self.params["levels"].check("pumped", "levels", levels)
         if isinstance(levels, (int, float)) and not isinstance(levels, bool) and levels > 1 and levels == int(levels):
             inner = dict(kwargs, levels=int(levels) - 1)
             kwargs = dict(kwargs, levels=1, base=Pumped(**inner))
@@ -742,8 +747,10 @@ def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False)
     """
     if g not in ("g1", "g2"):
         raise SpecError(f"pump: g must be 'g1' or 'g2', got {g!r}")
-    if isinstance(levels, bool) or not isinstance(levels, (int, np.integer)) or levels < 1:
-        raise SpecError(f"pump: levels must be an integer >= 1, got {levels!r}")
+    if isinstance(levels, bool) or not isinstance(levels, (int, np.integer)) or not 1 <= levels <= MAX_LEVELS:
+        raise SpecError(f"pump: levels must be an integer in [1, {MAX_LEVELS}], got {levels!r}")
+    if not isinstance(force, (bool, np.bool_)):
+        raise SpecError(f"pump: force must be true or false, got {force!r}")
     base = load(brdf)
     return Pumped(base=base, g=g, levels=int(levels), force=force)
 

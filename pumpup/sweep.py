@@ -89,7 +89,7 @@ def _check_params(spec: dict, params: Mapping[str, Sequence]) -> dict[str, list]
     _ensure_models()
 
     name = spec.get("type")
-    if name not in _REGISTRY:
+    if not isinstance(name, str) or name not in _REGISTRY:
         raise SpecError(f"unknown model type {name!r}; known types: {', '.join(_REGISTRY)}")
     cls = _REGISTRY[name]
     out: dict[str, list] = {}
@@ -421,14 +421,15 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu=None, *, pump: Ma
     >>> ds["albedo"].dims, ds["albedo"].values.round(12).tolist()
     (('lambert_albedo', 'mu'), [[0.25, 0.25], [0.5, 0.5]])
     """
-    if isinstance(spec, str):
-        try:
-            spec = json.loads(spec)
-        except json.JSONDecodeError as exc:
-            raise SpecError(f"sweep: a spec string must be JSON: {exc}") from None
+    from .core import check_tolerance, parse_spec
+
+    if isinstance(spec, str):  # JSON or the short form "stretched_phong:p=0.5" (or just a type name)
+        spec = parse_spec(spec)
     if not isinstance(spec, Mapping) or "type" not in spec:
         raise SpecError(f"sweep: spec must be a dict with a 'type' key, got {spec!r}")
     spec = {k: _plain(v) for k, v in spec.items()}
+    rtol = check_tolerance("sweep", "rtol", rtol)
+    atol = check_tolerance("sweep", "atol", atol, hi=math.inf)
     values = _check_params(spec, params)
     names = list(values)
     pump = _check_pump(pump)

@@ -22,7 +22,7 @@ import numpy as np
 
 from ._version import __version__
 from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
-from .core import BRDF
+from .core import BRDF, SpecError, check_count, check_open_unit, check_tolerance
 
 __all__ = [
     "tabulate",
@@ -36,6 +36,13 @@ __all__ = [
 ]
 
 TABLE_KIND = "pumpup albedo table"
+#: the largest ``max_points`` of an adaptive table
+MAX_POINTS_LIMIT = 1_000_000
+
+
+def _check_brdf(func: str, brdf) -> None:
+    if not isinstance(brdf, BRDF):
+        raise TypeError(f"{func} needs a pumpup BRDF (pumpup.load(spec)), got {type(brdf).__name__}")
 METHOD = "adaptive 15x15 Gauss-Kronrod cubature in a lobe-adapted frame (pumpup.albedo)"
 
 
@@ -209,6 +216,12 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     """
     if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1):
         raise ValueError(f"tabulate: threads must be an integer >= 1, got {threads!r}")
+    _check_brdf("tabulate", brdf)
+    rtol = check_tolerance("tabulate", "rtol", rtol)
+    atol = check_tolerance("tabulate", "atol", atol, hi=math.inf)
+    interp_tol = check_tolerance("tabulate", "interp_tol", interp_tol, hi=math.inf)
+    mu_min = check_open_unit("tabulate", "mu_min", mu_min)
+    max_points = check_count("tabulate", "max_points", max_points, 2, MAX_POINTS_LIMIT)
     if mu is not None:
         grid = np.unique(check_mu(np.atleast_1d(mu)).ravel())
         with _progress(len(grid), f"albedo {brdf.type}", progress) as bar:
@@ -409,6 +422,10 @@ def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False, m
     """
     from .albedo import NODES, WG, WK
 
+    _check_brdf("mean_albedo", brdf)
+    rtol = check_tolerance("mean_albedo", "rtol", rtol)
+    max_intervals = check_count("mean_albedo", "max_intervals", max_intervals, 8, 10**6)
+
     def rule(a, b):
         tau = a[:, None] + (b - a)[:, None] * NODES[None, :]
         mu = tau * tau * (3 - 2 * tau)
@@ -468,6 +485,10 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
     """
     from scipy.optimize import minimize_scalar
 
+    _check_brdf("max_albedo", brdf)
+    mu_min = check_open_unit("max_albedo", "mu_min", mu_min)
+    n_scan = check_count("max_albedo", "n_scan", n_scan, 3, 10**6)
+    rtol = check_tolerance("max_albedo", "rtol", rtol)
     f = _unit_constant(brdf)
     theta = np.linspace(0, math.acos(mu_min), n_scan)
     mu = np.unique(np.concatenate([np.cos(theta), np.logspace(-1, math.log10(mu_min), 6), [1.0, mu_min]]))
