@@ -285,8 +285,14 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
     err = np.empty_like(mu)
     threads = max(1, min(threads or THREADS or _cores(), len(mu)))
 
+    import threading
+
+    stop = threading.Event()  # set when the caller is interrupted (Ctrl-C): the threads end soon
+
     def work(idx):
         for a in range(0, len(idx), chunk):
+            if stop.is_set():
+                return
             part = idx[a:a + chunk]
             val[part], err[part] = albedo(brdf, mu[part], return_error=True, rtol=rtol, atol=atol)
             bar.update(len(part))
@@ -306,8 +312,12 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
     from concurrent.futures import ThreadPoolExecutor
 
     with ThreadPoolExecutor(threads) as pool:
-        for done in [pool.submit(work, todo[k::threads]) for k in range(threads)]:
-            done.result()
+        try:
+            for done in [pool.submit(work, todo[k::threads]) for k in range(threads)]:
+                done.result()
+        except BaseException:
+            stop.set()
+            raise
     return val, err
 
 
