@@ -269,6 +269,26 @@ def _progress_bar(total: int, progress: bool | None):
     return tqdm(total=total, desc="sweep", unit="cell", disable=not show)
 
 
+def warm_kernels(f: BRDF) -> None:
+    """Compile (or load from numba's cache) the kernels that the cells of a threaded sweep use, on
+    this thread, before the threads start: numba's lazily compiled ufuncs, asked for the same
+    signature by two threads at once, compile it twice and warn ("Compilation requested for
+    previously compiled argument types"), once per sweep.  One value of the innermost base's
+    albedo runs every kernel of the engine and the model (a pumped chain's own kernel compiles
+    under numba's lock)."""
+    from .albedo import albedo
+    from .pump import Pumped
+
+    base = f
+    while isinstance(base, Pumped):
+        base = base.base
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a warm-up value: its accuracy does not matter
+        albedo(base, 1.0, rtol=1e-3, atol=1e-3)
+
+
 def _run_local(tasks, scheduler: str, workers: int | None, on_done) -> None:
     """Run the chunks with a local dask scheduler; ``on_done`` sees each result in this process."""
     import uuid
@@ -502,6 +522,8 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu=None, *, pump: Ma
             if client is not None or (scheduler is not None and scheduler not in LOCAL_SCHEDULERS):
                 _run_distributed(tasks, client, scheduler, on_done)
             else:
+                if (scheduler or "threads") == "threads":
+                    warm_kernels(cell_model(first, pump))
                 _run_local(tasks, scheduler or "threads", workers, on_done)
 
     ds = _dataset(spec, base, names, values, grid, pump, opts, arrays)
