@@ -331,7 +331,7 @@ def cmd_sweep(args) -> int:
     try:
         ds = pumpup.sweep(spec, params, mu=mu, pump=pump, scheduler=args.scheduler or args.local,
                           workers=args.workers, chunks=args.chunk, out=args.out, rtol=args.rtol,
-                          mean=not args.no_mean, maximum=not args.no_maximum)
+                          mean=not args.no_mean, maximum=not args.no_maximum, overwrite=args.overwrite)
     except (ValueError, OSError, TypeError) as exc:  # SpecError is a ValueError
         raise SystemExit(f"pumpup: {exc}") from None
     shape = " x ".join(f"{d} {n}" for d, n in ds["albedo"].sizes.items())
@@ -465,6 +465,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of the albedo values (default: 1e-10)")
     s.add_argument("--no-mean", action="store_true", help="skip the mean albedo (default: computed)")
     s.add_argument("--no-maximum", action="store_true", help="skip the maximum constant (default: computed)")
+    s.add_argument("--overwrite", action="store_true", help="replace OUT (and discard OUT.parts/) when they hold "
+                                                            "a different sweep (default: refuse)")
     s.set_defaults(func=cmd_sweep)
     return p
 
