@@ -209,22 +209,61 @@ def _ensure_models() -> None:
     from . import models  # noqa: F401  (registers the built-in models)
 
 
+#: directions checked at a time by :func:`as_directions` (its temporaries stay near 1 MB)
+CHECK_BLOCK = 1 << 15
+
+
+def slabs(shape: tuple, block: int):
+    """Index tuples that cut an array of ``shape`` into pieces of about ``block`` elements or fewer
+    along its leading axes (a whole trailing axis longer than ``block`` is cut too): indexing a
+    broadcast view with one of them gives a view whose copy costs at most a block."""
+    if not shape:
+        yield ()
+        return
+    inner = math.prod(shape[1:])
+    if inner <= block:
+        step = max(1, block // max(inner, 1))
+        for a in range(0, shape[0], step):
+            yield (slice(a, min(a + step, shape[0])),)
+        return
+    for a in range(shape[0]):
+        for rest in slabs(shape[1:], block):
+            yield (a,) + rest
+
+
 def as_directions(w: Any, name: str) -> np.ndarray:
-    """Check that ``w`` holds unit 3-vectors on its last axis; return it as float64."""
+    """Check that ``w`` holds unit 3-vectors on its last axis; return it as float64.
+
+    The check runs in blocks of :data:`CHECK_BLOCK` directions, so its temporaries do not grow
+    with the array (1e8 directions once allocated 1.5 GB of them)."""
     try:
         a = np.asarray(w, dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{name} must be an array of unit 3-vectors: {exc}") from None
     if a.ndim == 0 or a.shape[-1] != 3:
         raise ValueError(f"{name} must have 3 components on its last axis, got shape {a.shape}")
-    if not np.all(np.isfinite(a)):
-        i = np.argwhere(~np.isfinite(a))[0][:-1]
-        raise ValueError(f"{name} contains non-finite values (first at index {tuple(i)})")
-    norm = np.sqrt(np.einsum("...k,...k->...", a, a))
-    bad = np.abs(norm - 1.0) > UNIT_TOL
-    if np.any(bad):
-        i = tuple(np.argwhere(bad)[0])
-        raise ValueError(f"{name} must be unit vectors (|w| = 1 within {UNIT_TOL:g}); |{name}{list(i)}| = {norm[i]:.9g}")
+    for idx in slabs(a.shape[:-1], CHECK_BLOCK):
+        part = a[idx]
+        finite = np.isfinite(part).all(axis=-1)
+        norm = np.sqrt(np.einsum("...k,...k->...", part, part))
+        bad_finite = ~finite
+        bad = finite & (np.abs(norm - 1.0) > UNIT_TOL)
+        if bad_finite.any() or bad.any():
+            local = np.argwhere(bad_finite if bad_finite.any() else bad)[0]
+            glob = []
+            k = 0
+            for ix in idx:
+                if isinstance(ix, slice):
+                    glob.append(ix.start + int(local[k]))
+                    k += 1
+                else:
+                    glob.append(ix)
+            glob += [int(v) for v in local[k:]]
+            i = tuple(glob)
+            if bad_finite.any():
+                raise ValueError(f"{name} contains non-finite values (first at index {i})")
+            raise ValueError(f"{name} must be unit vectors (|w| = 1 within {UNIT_TOL:g}); "
+                             f"|{name}{list(i)}| = {float(norm[tuple(local)]):.9g}")
     return a
 
 
