@@ -244,7 +244,7 @@ def cmd_reproduce(args) -> int:
 
 def cmd_divergence(args) -> int:
     from .divergence import analysis_dataset, divergence, plot
-    from .tables import write_table
+    from .provenance import write_generated
 
     from pumpup.core import check_open_unit
 
@@ -256,7 +256,7 @@ def cmd_divergence(args) -> int:
         check_dir(args.tables, "--tables")
         check_dir(args.figures, "--figures")
         ds = analysis_dataset()
-        write_table(ds, f"{args.tables}/divergence.nc")
+        write_generated(ds, f"{args.tables}/divergence.nc")
         plot(ds, f"{args.figures}/divergence.png")
         for i, name in enumerate(ds.model.values):
             print(f"{name:24s} {ds.verdict.values[i]:10s} k = {float(ds.k[i]):.5f} +- {float(ds.k_error[i]):.1g}")
