@@ -80,11 +80,23 @@ def test_errors_of_a_real_process_and_ctrl_c(tmp_path):
     # Ctrl-C in the middle of a long computation: one line, status 130
     p = subprocess.Popen([sys.executable, "-m", "pumpup.cli", "divergence", "all", "--tables", ".", "--figures", "."],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path, env=env)
-    time.sleep(6)
+    deadline = time.time() + 120
+    while time.time() < deadline and p.poll() is None and _cpu_seconds(p.pid) < 4.0:
+        time.sleep(0.2)  # until it is computing (imports take about 1 s of CPU)
     p.send_signal(signal.SIGINT)
     out, err = p.communicate(timeout=120)
     assert p.returncode == 130, err
     assert err.strip() == "pumpup: interrupted", err
+
+
+def _cpu_seconds(pid):
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            fields = fh.read().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        time.sleep(6)
+        return 1e9
 
 
 def _actions(parser):
