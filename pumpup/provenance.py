@@ -62,7 +62,8 @@ def same_data(a, b) -> bool:
 
 def write_generated(ds, path) -> bool:
     """Write generated data with its provenance (:func:`pumpup.write_table`), unless ``path``
-    already holds the same data (:func:`same_data`): then the file is left as it is.
+    already holds the same data (:func:`same_data`) made from committed code: then the file is
+    left as it is.
 
     Returns True if the file was written.
     """
@@ -75,7 +76,10 @@ def write_generated(ds, path) -> bool:
             old = open_table(path)
         except (ValueError, OSError):
             old = None
-        if old is not None and same_data(old, ds):
+        # kept only if it holds the same data and already says where it came from (a file of an
+        # older pumpup, without pumpup_commit or its checksums, is rewritten once)
+        if (old is not None and same_data(old, ds) and isinstance(old.attrs.get("pumpup_commit"), str)
+                and not old.attrs["pumpup_commit"].endswith("-dirty") and old.attrs["pumpup_commit"] != "unknown"):
             return False
     write_table(ds, path)
     return True
