@@ -223,12 +223,7 @@ def cmd_figures(args) -> int:
 def cmd_reproduce(args) -> int:
     from .reproduce import reproduce
 
-    import os
-
-    if os.path.exists(args.out) and not os.path.isdir(args.out):
-        raise SystemExit(f"pumpup: --out {args.out}: exists and is not a directory")
-    check_out(os.path.join(args.out, "report.md") if os.path.isdir(args.out) else args.out)
-    try:
+    try:  # reproduce checks (and creates) its output directory before any work
         out = reproduce(args.out, args.only)
     except (ValueError, OSError) as exc:
         raise SystemExit(f"pumpup: {exc}") from None
