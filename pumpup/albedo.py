@@ -744,8 +744,8 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     from .core import check_count, check_tolerance
 
     rtol = check_tolerance("albedo", "rtol", rtol)
-    atol = check_tolerance("albedo", "atol", atol, hi=math.inf)
-    max_regions = check_count("albedo", "max_regions", max_regions, 1, MAX_REGIONS_LIMIT)
+    atol = check_tolerance("albedo", "atol", atol, hi=math.inf, zero=True)  # 0: relative only
+    max_regions = check_count("albedo", "max_regions", max_regions, 0, MAX_REGIONS_LIMIT)  # 0: the first grid
     m = check_mu(mu)
     flat = m.ravel()
     value = np.zeros_like(flat)

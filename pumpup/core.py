@@ -501,11 +501,12 @@ def _as_real(func: str, name: str, value: Any, what: str) -> float:
     return v
 
 
-def check_tolerance(func: str, name: str, value: Any, hi: float = 1.0) -> float:
-    """A tolerance (``rtol``, ``atol``, ...): a finite number in (0, hi]; else a SpecError naming it."""
-    what = f"a finite number in (0, {hi:g}]"
+def check_tolerance(func: str, name: str, value: Any, hi: float = 1.0, zero: bool = False) -> float:
+    """A tolerance (``rtol``, ``atol``, ...): a finite number in (0, hi] (``zero``: [0, hi], for an
+    absolute tolerance that may be switched off); else a SpecError naming it."""
+    what = f"a finite number in {'[' if zero else '('}0, {hi:g}]"
     v = _as_real(func, name, value, what)
-    if not 0 < v <= hi:
+    if not (0 <= v if zero else 0 < v) or not v <= hi:
         raise SpecError(f"{func}: {name} must be {what}, got {_show(value)}")
     return v
 

@@ -580,7 +580,7 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu=None, *, pump: Ma
         raise SpecError(f"sweep: spec must be a dict with a 'type' key, got {spec!r}")
     spec = {k: _plain(v) for k, v in spec.items()}
     rtol = check_tolerance("sweep", "rtol", rtol)
-    atol = check_tolerance("sweep", "atol", atol, hi=math.inf)
+    atol = check_tolerance("sweep", "atol", atol, hi=math.inf, zero=True)
     values = _check_params(spec, params)
     names = list(values)
     pump = _check_pump(pump)

@@ -218,7 +218,7 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
         raise ValueError(f"tabulate: threads must be an integer >= 1, got {threads!r}")
     _check_brdf("tabulate", brdf)
     rtol = check_tolerance("tabulate", "rtol", rtol)
-    atol = check_tolerance("tabulate", "atol", atol, hi=math.inf)
+    atol = check_tolerance("tabulate", "atol", atol, hi=math.inf, zero=True)
     interp_tol = check_tolerance("tabulate", "interp_tol", interp_tol, hi=math.inf)
     mu_min = check_open_unit("tabulate", "mu_min", mu_min)
     max_points = check_count("tabulate", "max_points", max_points, 2, MAX_POINTS_LIMIT)

@@ -13,8 +13,8 @@ PHONG = pumpup.load({"type": "phong", "n": 20})
 @pytest.mark.parametrize("kw, name", [
     ({"rtol": 0}, "rtol"), ({"rtol": -1e-9}, "rtol"), ({"rtol": float("nan")}, "rtol"),
     ({"rtol": None}, "rtol"), ({"rtol": "1e-9"}, "rtol"), ({"rtol": float("inf")}, "rtol"),
-    ({"atol": 0}, "atol"), ({"atol": float("nan")}, "atol"), ({"atol": [1e-9]}, "atol"),
-    ({"max_regions": 0}, "max_regions"), ({"max_regions": float("inf")}, "max_regions"),
+    ({"atol": -1e-9}, "atol"), ({"atol": float("nan")}, "atol"), ({"atol": [1e-9]}, "atol"),
+    ({"max_regions": -1}, "max_regions"), ({"max_regions": float("inf")}, "max_regions"),
     ({"max_regions": 2.5}, "max_regions"), ({"max_regions": 10**400}, "max_regions"),
     ({"max_regions": True}, "max_regions"),
 ])
@@ -24,7 +24,7 @@ def test_albedo_engine_arguments(kw, name):
 
 
 @pytest.mark.parametrize("kw, name", [
-    ({"rtol": 0}, "rtol"), ({"atol": None}, "atol"), ({"interp_tol": 0}, "interp_tol"),
+    ({"rtol": 0}, "rtol"), ({"atol": None}, "atol"), ({"atol": -1.0}, "atol"), ({"interp_tol": 0}, "interp_tol"),
     ({"mu_min": 0}, "mu_min"), ({"mu_min": 1}, "mu_min"), ({"mu_min": float("nan")}, "mu_min"),
     ({"max_points": 1}, "max_points"), ({"max_points": float("inf")}, "max_points"),
     ({"max_points": 10**400}, "max_points"),
