@@ -44,6 +44,8 @@ __all__ = ["albedo", "check_mu", "AlbedoWarning"]
 
 DEFAULT_RTOL = 1e-10
 DEFAULT_ATOL = 1e-14
+#: the largest ``max_regions`` accepted (each rectangle costs 225 evaluations and about 100 bytes)
+MAX_REGIONS_LIMIT = 10**7
 NX_INIT = 8  # initial subdivisions of the radial variable
 NT_INIT = 2  # initial subdivisions of each piece of the azimuth
 
@@ -739,6 +741,11 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     """
     if not isinstance(brdf, BRDF):
         raise TypeError(f"albedo needs a pumpup BRDF, got {type(brdf).__name__}; wrap functions with pumpup.from_function")
+    from .core import check_count, check_tolerance
+
+    rtol = check_tolerance("albedo", "rtol", rtol)
+    atol = check_tolerance("albedo", "atol", atol, hi=math.inf, zero=True)  # 0: relative only
+    max_regions = check_count("albedo", "max_regions", max_regions, 0, MAX_REGIONS_LIMIT)  # 0: the first grid
     m = check_mu(mu)
     flat = m.ravel()
     value = np.zeros_like(flat)

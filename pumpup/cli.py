@@ -9,24 +9,15 @@ import sys
 
 
 def parse_spec(text: str) -> dict:
-    """A model spec from JSON (``'{"type": "phong", "n": 20}'``) or the short form ``phong:n=20,c=1``."""
-    text = text.strip()
-    if text.startswith("{"):
-        try:
-            return json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise SystemExit(f"pumpup: the spec is not valid JSON: {exc}") from None
-    name, _, rest = text.partition(":")
-    spec: dict = {"type": name}
-    for item in filter(None, rest.split(",")):
-        key, eq, value = item.partition("=")
-        if not eq:
-            raise SystemExit(f"pumpup: spec parameter {item!r} must look like name=value")
-        try:
-            spec[key.strip()] = json.loads(value)
-        except json.JSONDecodeError:
-            spec[key.strip()] = value.strip()
-    return spec
+    """A model spec from JSON (``'{"type": "phong", "n": 20}'``) or the short form ``phong:n=20,c=1``
+    (:func:`pumpup.core.parse_spec`; a bad one exits with its one-line message)."""
+    from pumpup.core import SpecError
+    from pumpup.core import parse_spec as _parse
+
+    try:
+        return _parse(text)
+    except SpecError as exc:
+        raise SystemExit(f"pumpup: {exc}") from None
 
 
 def _load(text: str):
@@ -38,13 +29,107 @@ def _load(text: str):
         raise SystemExit(f"pumpup: {exc}") from None
 
 
+class UsageError(SystemExit):
+    """A user error (or an interruption): its one line is already on stderr; the exit status is
+    ``code`` (2, or 130 after Ctrl-C).  ``str()`` gives the message."""
+
+    def __init__(self, message: str, code: int = 2):
+        super().__init__(code)
+        self.message = message
+
+    def __str__(self) -> str:
+        return self.message
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def check_out(path: str, option: str = "--out") -> None:
+    """Exit with one line unless ``path`` can be written: its directory exists and is writable,
+    and it is not itself a directory (checked before any work)."""
+    import os
+
+    directory = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(directory):
+        raise SystemExit(f"pumpup: {option} {path}: directory {directory!r} does not exist")
+    if not os.access(directory, os.W_OK):
+        raise SystemExit(f"pumpup: {option} {path}: directory {directory!r} is not writable")
+    if os.path.isdir(path) and not path.rstrip("/").endswith(".zarr"):
+        raise SystemExit(f"pumpup: {option} {path}: is a directory")
+
+
+def check_dir(path: str, option: str) -> None:
+    """Exit with one line unless ``path`` is a writable directory."""
+    import os
+
+    if not os.path.isdir(path):
+        raise SystemExit(f"pumpup: {option} {path}: directory does not exist (create it, or give {option} DIR)")
+    if not os.access(path, os.W_OK):
+        raise SystemExit(f"pumpup: {option} {path}: directory is not writable")
+
+
+def _plain_text(text: str) -> str:
+    """A docstring line without reST markup: ``x`` -> x, :func:`~a.b` -> b, *x* -> x."""
+    import re
+
+    text = re.sub(r":[a-z]+:`~?([^`]*)`", lambda m: m.group(1).rsplit(".", 1)[-1] if "~" in m.group(0) else m.group(1), text)
+    text = re.sub(r"``([^`]*)``", r"\1", text)
+    text = re.sub(r"(?<![\w*])\*([^*\s][^*]*)\*(?![\w*])", r"\1", text)
+    return text
+
+
+def default_text(param) -> str:
+    """A Param's default for people: the value, 'required', 'none', or the formula of a computed one."""
+    import inspect
+    import re
+
+    from pumpup.core import REQUIRED
+
+    d = param.default
+    if d is REQUIRED:
+        return "required"
+    if d is None:
+        return "none"
+    if callable(d):
+        doc = (getattr(d, "__doc__", None) or "").strip()
+        if doc:
+            return _plain_text(doc.splitlines()[0])
+        try:
+            src = inspect.getsource(d)
+        except (OSError, TypeError):
+            return "computed"
+        m = re.search(r"return\s+(.*?)(\s+#.*)?$", src.strip(), re.S) or re.search(r"lambda\s+\w+\s*:\s*(.*?)[,)]*$", src)
+        if not m:
+            return "computed"
+        expr = m.group(1).strip().splitlines()[0]
+        expr = re.sub(r"\w+\[[\"']([A-Za-z_]\w*)[\"']\]", r"\1", expr)  # p["n"] -> n
+        expr = re.sub(r"\bmath\.|\bnp\.", "", expr)
+        expr = re.sub(r"(\d)\.0\b", r"\1", expr)
+        expr = re.sub(r"\[(.+?)\] \* len\((\w+)\)", r"\1 for each of \2", expr).replace(" * ", " ")
+        return expr
+    if isinstance(d, bool):
+        return str(d).lower()
+    if isinstance(d, float):
+        return f"{d:g}"
+    return str(d)
+
+
 def cmd_models(args) -> int:
     import pumpup
 
+    rows = []
     for name, cls in pumpup.registry().items():
-        doc = (cls.__doc__ or "").strip().splitlines()[0] if cls.__doc__ else ""
-        params = ", ".join(cls.params)
-        print(f"{name:18s} {params:28s} {doc}")
+        doc = _plain_text((cls.__doc__ or "").strip().splitlines()[0]) if cls.__doc__ else ""
+        params = [(k, p.range_text() if p.kind in ("float", "int", "floats") or p.choices else p.kind,
+                   default_text(p), _plain_text(p.doc)) for k, p in cls.params.items()]
+        rows.append((name, doc, params))
+    w = [max([len(r[c]) for _, _, ps in rows for r in ps] + [len(h)]) for c, h in enumerate(("name", "range", "default"))]
+    print(f"    {'parameter':{w[0]}s}  {'range':{w[1]}s}  {'default':{w[2]}s}  meaning")
+    for name, doc, params in rows:
+        print(f"{name}: {doc}")
+        for k, rng, dflt, meaning in params:
+            print(f"    {k:{w[0]}s}  {rng:{w[1]}s}  {dflt:{w[2]}s}  {meaning}".rstrip())
     return 0
 
 
@@ -53,6 +138,10 @@ def cmd_albedo(args) -> int:
 
     import pumpup
 
+    if args.theta is not None:
+        bad = [t for t in args.theta if not 0 <= t < 90]
+        if bad:
+            raise SystemExit(f"pumpup: --theta {bad[0]:g}: the incidence angle theta must be in [0, 90) degrees")
     f = _load(args.spec)
     if args.theta is not None:
         mu = np.sin(np.radians(90.0 - np.asarray(args.theta, dtype=float)))  # keeps its digits near 90 deg
@@ -72,6 +161,7 @@ def cmd_albedo(args) -> int:
 def cmd_table(args) -> int:
     import pumpup
 
+    check_out(args.out)
     f = _load(args.spec)
     ds = pumpup.tabulate(f, rtol=args.rtol)
     pumpup.write_table(ds, args.out)
@@ -98,6 +188,12 @@ def cmd_pump(args) -> int:
 
     import pumpup
 
+    from pumpup.pump import MAX_LEVELS
+
+    if not 1 <= args.levels <= MAX_LEVELS:
+        raise SystemExit(f"pumpup: --levels: levels must be an integer in [1, {MAX_LEVELS}], got {args.levels}")
+    if args.out:
+        check_out(args.out)
     f = _load(args.spec)
     try:
         p = pumpup.pump(f, g=args.g, levels=args.levels, force=args.force)
@@ -120,6 +216,8 @@ def cmd_pump(args) -> int:
 def cmd_figures(args) -> int:
     from .figures import make_figures
 
+    check_out(args.tables.rstrip("/") + "/x", "--tables")
+    check_out(args.figures.rstrip("/") + "/x", "--figures")
     for path in make_figures(args.tables, args.figures):
         print("wrote", path)
     return 0
@@ -128,7 +226,7 @@ def cmd_figures(args) -> int:
 def cmd_reproduce(args) -> int:
     from .reproduce import reproduce
 
-    try:
+    try:  # reproduce checks (and creates) its output directory before any work
         out = reproduce(args.out, args.only)
     except (ValueError, OSError) as exc:
         raise SystemExit(f"pumpup: {exc}") from None
@@ -144,17 +242,25 @@ def cmd_reproduce(args) -> int:
 
 def cmd_divergence(args) -> int:
     from .divergence import analysis_dataset, divergence, plot
-    from .tables import write_table
+    from .provenance import write_generated
 
+    from pumpup.core import check_open_unit
+
+    try:
+        check_open_unit("divergence", "--mu-min", args.mu_min)
+    except ValueError as exc:
+        raise SystemExit(f"pumpup: {exc}") from None
     if args.spec == "all":
+        check_dir(args.tables, "--tables")
+        check_dir(args.figures, "--figures")
         ds = analysis_dataset()
-        write_table(ds, f"{args.tables}/divergence.nc")
+        write_generated(ds, f"{args.tables}/divergence.nc")
         plot(ds, f"{args.figures}/divergence.png")
         for i, name in enumerate(ds.model.values):
             print(f"{name:24s} {ds.verdict.values[i]:10s} k = {float(ds.k[i]):.5f} +- {float(ds.k_error[i]):.1g}")
         print(f"wrote {args.tables}/divergence.nc and {args.figures}/divergence.png")
         return 0
-    r = divergence(parse_spec(args.spec), mu_min=args.mu_min)
+    r = divergence(_load(args.spec), mu_min=args.mu_min)
     print(f"{'mu':>12s} {'albedo':>20s} {'error':>9s}")
     for m, a, e in zip(r.mu, r.albedo, r.albedo_error):
         print(f"{m:12.4g} {a:20.12g} {e:9.2g}")
@@ -200,6 +306,7 @@ def cmd_sweep(args) -> int:
     from pumpup.sweep import default_mu
 
     spec = parse_spec(args.spec)
+    check_out(args.out)
     params: dict = {}
     for text in args.param:
         name, values = parse_values(text)
@@ -222,7 +329,7 @@ def cmd_sweep(args) -> int:
     try:
         ds = pumpup.sweep(spec, params, mu=mu, pump=pump, scheduler=args.scheduler or args.local,
                           workers=args.workers, chunks=args.chunk, out=args.out, rtol=args.rtol,
-                          mean=not args.no_mean, maximum=not args.no_maximum)
+                          mean=not args.no_mean, maximum=not args.no_maximum, overwrite=args.overwrite)
     except (ValueError, OSError, TypeError) as exc:  # SpecError is a ValueError
         raise SystemExit(f"pumpup: {exc}") from None
     shape = " x ".join(f"{d} {n}" for d, n in ds["albedo"].sizes.items())
@@ -449,8 +556,15 @@ def cmd_audit(args) -> int:
     return 0
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (the usage is one ``--help`` away); exit status 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {_one_line(message)} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="pumpup",
         description="Physically plausible BRDFs: accurate albedo, the albedo pumping-up operator, "
         "and the tables of Neumann, Neumann and Szirmay-Kalos.",
@@ -460,73 +574,81 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
     s = sub.add_parser("reproduce", help="regenerate the papers' tables and compare them with the published values")
     s.add_argument("--out", default="tables", help="output directory (default: tables)")
-    s.add_argument("--only", nargs="+", metavar="NAME", help="only these: table2 table3 table4 text divergence")
+    s.add_argument("--only", nargs="+", metavar="NAME", help="only these: table2 table3 table4 text divergence "
+                                                            "(default: all)")
     s.set_defaults(func=cmd_reproduce)
     s = sub.add_parser("models", help="list the registered model types and their parameters")
     s.set_defaults(func=cmd_models)
     s = sub.add_parser("albedo", help="directional albedo of a model, with error estimates")
-    s.add_argument("spec")
+    s.add_argument("spec", help="a model SPEC: JSON or short, e.g. phong:n=20")
     g = s.add_mutually_exclusive_group()
-    g.add_argument("--mu", type=float, nargs="+", help="cos(theta_i) values in (0, 1]")
-    g.add_argument("--theta", type=float, nargs="+", help="incidence angles in degrees")
-    s.add_argument("--rtol", type=float, default=1e-10)
+    g.add_argument("--mu", type=float, nargs="+", help="cos(theta_i) values in (0, 1] (default: 1 0.5 0.1 0.01)")
+    g.add_argument("--theta", type=float, nargs="+", help="incidence angles in degrees, in [0, 90) (default: use --mu)")
+    s.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of the cubature (default: 1e-10)")
     s.set_defaults(func=cmd_albedo)
     s = sub.add_parser("table", help="tabulate the albedo on an adaptive grid into a netCDF file")
-    s.add_argument("spec")
-    s.add_argument("--out", required=True)
-    s.add_argument("--rtol", type=float, default=1e-10)
+    s.add_argument("spec", help="a model SPEC: JSON or short, e.g. phong:n=20")
+    s.add_argument("--out", required=True, help="the netCDF file to write (required; its directory must exist)")
+    s.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of every value (default: 1e-10)")
     s.set_defaults(func=cmd_table)
     s = sub.add_parser("pump", help="pump up a model's albedo (001 sec. 3) and print the albedo of every level")
-    s.add_argument("spec")
-    s.add_argument("--g", choices=("g1", "g2"), default="g1")
-    s.add_argument("--levels", type=int, default=1)
-    s.add_argument("--force", action="store_true", help="pump a base that is not reciprocal")
-    s.add_argument("--out", help="save the pumped BRDF and its tables to this netCDF file")
+    s.add_argument("spec", help="a model SPEC: JSON or short, e.g. phong:n=20")
+    s.add_argument("--g", choices=("g1", "g2"), default="g1",
+                   help="g1 = max(a(wi), a(wo)) (001 eq. 20) or the controlled g2 (001 eq. 21) (default: g1)")
+    s.add_argument("--levels", type=int, default=1, help="nested pumpings, 1 to 64 (default: 1)")
+    s.add_argument("--force", action="store_true", help="pump a base that is not reciprocal (default: refuse)")
+    s.add_argument("--out", help="save the pumped BRDF and its tables to this netCDF file (default: not saved)")
     s.set_defaults(func=cmd_pump)
     s = sub.add_parser("figures", help="data and plots of 001 Figs. 3-7 and 000 Fig. 3 (takes minutes)")
-    s.add_argument("--tables", default="tables")
-    s.add_argument("--figures", default="figures")
+    s.add_argument("--tables", default="tables", help="directory of the figure data, netCDF (default: tables)")
+    s.add_argument("--figures", default="figures", help="directory of the plots, PNG (default: figures)")
     s.set_defaults(func=cmd_figures)
     s = sub.add_parser("divergence", help="albedo down to mu = 1e-8 and the fit a ~ K mu^-k (001 sec. 2.1); "
-                                          "SPEC 'all' runs the whole analysis into tables/ and figures/")
-    s.add_argument("spec")
-    s.add_argument("--mu-min", type=float, default=1e-8)
-    s.add_argument("--tables", default="tables")
-    s.add_argument("--figures", default="tables")
+                                          "SPEC 'all' runs the whole analysis into tables/divergence.nc and "
+                                          "tables/divergence.png")
+    s.add_argument("spec", help="a model SPEC, or 'all' for the analysis of 001 sec. 2.1")
+    s.add_argument("--mu-min", type=float, default=1e-8, help="smallest mu, in (0, 1) (default: 1e-8)")
+    s.add_argument("--tables", default="tables", help="with 'all': directory of divergence.nc (default: tables)")
+    s.add_argument("--figures", default="tables", help="with 'all': directory of divergence.png (default: tables)")
     s.set_defaults(func=cmd_divergence)
     s = sub.add_parser("mc", help="Monte Carlo albedo by importance sampling (000 sec. 4) beside the quadrature; "
                                   "exit status 1 if they differ by 4 standard errors or more")
-    s.add_argument("spec")
-    s.add_argument("--mu", type=float, nargs="+", help="cos(theta_i) values in (0, 1]")
-    s.add_argument("--n", type=int, default=1_000_000, help="samples per mu (default 1e6)")
-    s.add_argument("--seed", type=int, default=0)
-    s.add_argument("--strategy", choices=("lobe", "cosine"), default="lobe")
-    s.add_argument("--chi2", action="store_true", help="also run the chi-square test of the sampler at these mu")
+    s.add_argument("spec", help="a model SPEC: JSON or short, e.g. phong:n=20")
+    s.add_argument("--mu", type=float, nargs="+", help="cos(theta_i) values in (0, 1] (default: 1 0.5 0.1 0.01)")
+    s.add_argument("--n", type=int, default=1_000_000, help="samples per mu (default: 1000000)")
+    s.add_argument("--seed", type=int, default=0, help="seed of the random generator (default: 0)")
+    s.add_argument("--strategy", choices=("lobe", "cosine"), default="lobe",
+                   help="sample the model's lobe or the cosine-weighted hemisphere (default: lobe)")
+    s.add_argument("--chi2", action="store_true", help="also run the chi-square test of the sampler at these mu "
+                                                       "(default: off)")
     s.set_defaults(func=cmd_mc)
     s = sub.add_parser("check", help="reciprocity and maximum albedo of a model")
-    s.add_argument("spec")
+    s.add_argument("spec", help="a model SPEC")
     s.set_defaults(func=cmd_check)
     s = sub.add_parser("sweep", help="albedo tables over a grid of model parameters, in chunks on dask "
                                      "(resumable; a dask.distributed cluster with --scheduler)")
-    s.add_argument("spec")
+    s.add_argument("spec", help="a model SPEC: JSON or short, e.g. phong:n=20")
     s.add_argument("--param", action="append", required=True, metavar="NAME=VALUES",
-                   help="a swept parameter: n=1,2,4 or n=geom:1:1000:64 or p=lin:0:1:64 (repeat for more)")
+                   help="a swept parameter: n=1,2,4 or n=geom:1:1000:64 or p=lin:0:1:64 (required; repeat for more)")
     g = s.add_mutually_exclusive_group()
-    g.add_argument("--mu", type=float, nargs="+", help="cos(theta_i) values in (0, 1]")
+    g.add_argument("--mu", type=float, nargs="+", help="cos(theta_i) values in (0, 1] (default: use --n-mu)")
     g.add_argument("--n-mu", type=int, default=257, help="else this many mu, theta uniform in [0, 90) deg (default 257)")
-    s.add_argument("--pump", metavar="G[:LEVELS]", help="pump each cell's model first, e.g. g2:2")
+    s.add_argument("--pump", metavar="G[:LEVELS]", help="pump each cell's model first, e.g. g2:2 (default: no pumping)")
     s.add_argument("--out", required=True, help="netCDF file, or a zarr store if it ends in .zarr; "
-                                                "finished chunks wait in OUT.parts/ so a rerun resumes")
-    s.add_argument("--scheduler", metavar="ADDRESS", help="a dask.distributed scheduler, e.g. tcp://host:8786")
+                                                "finished chunks wait in OUT.parts/ so a rerun resumes (required)")
+    s.add_argument("--scheduler", metavar="ADDRESS", help="a dask.distributed scheduler, e.g. tcp://host:8786 "
+                                                          "(default: local threads)")
     g = s.add_mutually_exclusive_group()
     g.add_argument("--threads", dest="local", action="store_const", const="threads", help="local threads (default)")
-    g.add_argument("--processes", dest="local", action="store_const", const="processes", help="local processes")
-    g.add_argument("--serial", dest="local", action="store_const", const="synchronous", help="one cell at a time")
+    g.add_argument("--processes", dest="local", action="store_const", const="processes", help="local processes (default: threads)")
+    g.add_argument("--serial", dest="local", action="store_const", const="synchronous", help="one cell at a time (default: threads)")
     s.add_argument("--workers", type=int, help="local threads or processes (default: one per core)")
     s.add_argument("--chunk", type=int, help="cells per chunk along the last parameter (default 8)")
-    s.add_argument("--rtol", type=float, default=1e-10)
-    s.add_argument("--no-mean", action="store_true", help="skip the mean albedo")
-    s.add_argument("--no-maximum", action="store_true", help="skip the maximum constant")
+    s.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of the albedo values (default: 1e-10)")
+    s.add_argument("--no-mean", action="store_true", help="skip the mean albedo (default: computed)")
+    s.add_argument("--no-maximum", action="store_true", help="skip the maximum constant (default: computed)")
+    s.add_argument("--overwrite", action="store_true", help="replace OUT (and discard OUT.parts/) when they hold "
+                                                            "a different sweep (default: refuse)")
     s.set_defaults(func=cmd_sweep)
     s = sub.add_parser("compensate", help="energy compensation: Kulla-Conty lobe, 1/E scaling (not reciprocal), or "
                                           "pumping g1/g2; prints the furnace and saves the BRDF with its tables")
@@ -585,8 +707,32 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one command.  A user error prints one line on stderr and exits with status 2 (raised as
+    :class:`UsageError`, a SystemExit); Ctrl-C prints one line and exits with 130.  Set
+    PUMPUP_TRACEBACK=1 to see the traceback of an error instead."""
+    import os
+
+    from pumpup.core import SpecError
+
     args = build_parser().parse_args(argv)
-    return args.func(args)
+    debug = bool(os.environ.get("PUMPUP_TRACEBACK"))
+    try:
+        return args.func(args)
+    except UsageError:
+        raise
+    except SystemExit as exc:
+        if not isinstance(exc.code, str):
+            raise
+        message = _one_line(exc.code)
+    except KeyboardInterrupt:
+        print("pumpup: interrupted", file=sys.stderr)
+        raise UsageError("pumpup: interrupted", 130) from None
+    except (SpecError, ValueError, TypeError, OSError) as exc:
+        if debug:
+            raise
+        message = _one_line(f"pumpup: {exc}")
+    print(message, file=sys.stderr)
+    raise UsageError(message) from None
 
 
 if __name__ == "__main__":

@@ -34,6 +34,10 @@ __all__ = [
     "check_reciprocity",
     "ReciprocityResult",
     "SpecError",
+    "parse_spec",
+    "check_tolerance",
+    "check_count",
+    "check_open_unit",
 ]
 
 #: Largest deviation of |w| from 1 that ``eval`` accepts for a direction.
@@ -86,7 +90,11 @@ class Param:
     def check_number(self, model: str, name: str, value: Any) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
             raise SpecError(f"{model}: parameter {name!r} must be a number in {self.range_text()}, got {value!r}")
-        v = float(value)
+        try:
+            v = float(value)
+        except OverflowError:  # a Python int beyond the float range (c = 10**400)
+            raise SpecError(f"{model}: parameter {name!r} is too large for a float (about {len(str(abs(value)))} "
+                            f"digits); allowed range {self.range_text()}") from None
         if not math.isfinite(v):
             raise SpecError(f"{model}: parameter {name!r} must be finite, in {self.range_text()}; got {value!r}")
         bad_lo = v <= self.lo if self.lo_open else v < self.lo
@@ -201,22 +209,61 @@ def _ensure_models() -> None:
     from . import models  # noqa: F401  (registers the built-in models)
 
 
+#: directions checked at a time by :func:`as_directions` (its temporaries stay near 1 MB)
+CHECK_BLOCK = 1 << 15
+
+
+def slabs(shape: tuple, block: int):
+    """Index tuples that cut an array of ``shape`` into pieces of about ``block`` elements or fewer
+    along its leading axes (a whole trailing axis longer than ``block`` is cut too): indexing a
+    broadcast view with one of them gives a view whose copy costs at most a block."""
+    if not shape:
+        yield ()
+        return
+    inner = math.prod(shape[1:])
+    if inner <= block:
+        step = max(1, block // max(inner, 1))
+        for a in range(0, shape[0], step):
+            yield (slice(a, min(a + step, shape[0])),)
+        return
+    for a in range(shape[0]):
+        for rest in slabs(shape[1:], block):
+            yield (a,) + rest
+
+
 def as_directions(w: Any, name: str) -> np.ndarray:
-    """Check that ``w`` holds unit 3-vectors on its last axis; return it as float64."""
+    """Check that ``w`` holds unit 3-vectors on its last axis; return it as float64.
+
+    The check runs in blocks of :data:`CHECK_BLOCK` directions, so its temporaries do not grow
+    with the array (1e8 directions once allocated 1.5 GB of them)."""
     try:
         a = np.asarray(w, dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{name} must be an array of unit 3-vectors: {exc}") from None
     if a.ndim == 0 or a.shape[-1] != 3:
         raise ValueError(f"{name} must have 3 components on its last axis, got shape {a.shape}")
-    if not np.all(np.isfinite(a)):
-        i = np.argwhere(~np.isfinite(a))[0][:-1]
-        raise ValueError(f"{name} contains non-finite values (first at index {tuple(i)})")
-    norm = np.sqrt(np.einsum("...k,...k->...", a, a))
-    bad = np.abs(norm - 1.0) > UNIT_TOL
-    if np.any(bad):
-        i = tuple(np.argwhere(bad)[0])
-        raise ValueError(f"{name} must be unit vectors (|w| = 1 within {UNIT_TOL:g}); |{name}{list(i)}| = {norm[i]:.9g}")
+    for idx in slabs(a.shape[:-1], CHECK_BLOCK):
+        part = a[idx]
+        finite = np.isfinite(part).all(axis=-1)
+        norm = np.sqrt(np.einsum("...k,...k->...", part, part))
+        bad_finite = ~finite
+        bad = finite & (np.abs(norm - 1.0) > UNIT_TOL)
+        if bad_finite.any() or bad.any():
+            local = np.argwhere(bad_finite if bad_finite.any() else bad)[0]
+            glob = []
+            k = 0
+            for ix in idx:
+                if isinstance(ix, slice):
+                    glob.append(ix.start + int(local[k]))
+                    k += 1
+                else:
+                    glob.append(ix)
+            glob += [int(v) for v in local[k:]]
+            i = tuple(glob)
+            if bad_finite.any():
+                raise ValueError(f"{name} contains non-finite values (first at index {i})")
+            raise ValueError(f"{name} must be unit vectors (|w| = 1 within {UNIT_TOL:g}); "
+                             f"|{name}{list(i)}| = {float(norm[tuple(local)]):.9g}")
     return a
 
 
@@ -310,6 +357,7 @@ class BRDF:
         """
         wi = as_directions(wi, "wi")
         wo = as_directions(wo, "wo")
+        check_pair(wi, wo)
         return self._eval(wi, wo)
 
     def _eval(self, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
@@ -355,7 +403,8 @@ def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def load(spec: Any) -> BRDF:
-    """Build a BRDF from a spec: a dict ``{"type": name, param: value, ...}`` or its JSON text.
+    """Build a BRDF from a spec: a dict ``{"type": name, param: value, ...}``, its JSON text, or
+    the short form of the command line, ``"phong:n=20,c=1"`` (:func:`parse_spec`).
 
     Nested specs compose (``{"type": "pumped", "base": {...}}``).  A spec is data: it
     never imports or evaluates code.
@@ -371,19 +420,126 @@ def load(spec: Any) -> BRDF:
     if isinstance(spec, BRDF):
         return spec
     if isinstance(spec, str):
-        try:
-            spec = json.loads(spec)
-        except json.JSONDecodeError as exc:
-            raise SpecError(f"a spec string must be JSON: {exc}") from None
+        spec = parse_spec(spec)
     if not isinstance(spec, dict):
         raise SpecError(f"a spec must be a dict with a 'type' key, got {type(spec).__name__}")
     if "type" not in spec:
         raise SpecError(f"a spec needs a 'type' key; known types: {', '.join(_REGISTRY)}")
+    bad_keys = [k for k in spec if not isinstance(k, str)]
+    if bad_keys:
+        raise SpecError(f"spec keys must be parameter names (strings), got {bad_keys[0]!r}")
     name = spec["type"]
+    if not isinstance(name, str):
+        raise SpecError(f"a spec's 'type' must be a model name (a string), got {name!r}; "
+                        f"known types: {', '.join(_REGISTRY)}")
     if name not in _REGISTRY:
         raise SpecError(f"unknown model type {name!r}; known types: {', '.join(_REGISTRY)}")
     kwargs = {k: v for k, v in spec.items() if k != "type"}
     return _REGISTRY[name](**kwargs)
+
+
+def parse_spec(text: str) -> dict:
+    """A model spec from its text: JSON (``'{"type": "phong", "n": 20}'``) or the short form
+    ``"phong:n=20,c=1"`` (values are JSON numbers, ``true``/``false``, or else strings).
+
+    Raises
+    ------
+    SpecError
+        Invalid JSON, or a short-form item that is not ``name=value``.
+
+    Examples
+    --------
+    >>> parse_spec("phong:n=20,c=1")
+    {'type': 'phong', 'n': 20, 'c': 1}
+    """
+    if not isinstance(text, str):
+        raise SpecError(f"a spec text must be a string, got {type(text).__name__}")
+    text = text.strip()
+    if text.startswith("{"):
+        try:
+            spec = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise SpecError(f"the spec is not valid JSON: {exc}") from None
+        if not isinstance(spec, dict):
+            raise SpecError(f"a spec must be a JSON object with a 'type' key, got {text!r}")
+        return spec
+    name, _, rest = text.partition(":")
+    if not name.strip():
+        raise SpecError(f"a spec needs a model type before ':' (e.g. 'phong:n=20'), got {text!r}")
+    spec: dict = {"type": name.strip()}
+    for item in filter(None, (i.strip() for i in rest.split(","))):
+        key, eq, value = item.partition("=")
+        if not eq or not key.strip():
+            raise SpecError(f"spec parameter {item!r} must look like name=value (e.g. 'phong:n=20')")
+        try:
+            spec[key.strip()] = json.loads(value)
+        except json.JSONDecodeError:
+            spec[key.strip()] = value.strip()
+    return spec
+
+
+# ----------------------------------------------------------------------------------------
+# Checks of engine and table arguments (the same style as the model parameters)
+# ----------------------------------------------------------------------------------------
+
+
+def _show(value: Any) -> str:
+    """repr of a value, shortened to about 40 characters (an int of 400 digits names its length)."""
+    r = repr(value)
+    return r if len(r) <= 40 else f"{r[:20]}... ({len(r)} characters)"
+
+
+def _as_real(func: str, name: str, value: Any, what: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise SpecError(f"{func}: {name} must be {what}, got {_show(value)}")
+    try:
+        v = float(value)
+    except OverflowError:
+        raise SpecError(f"{func}: {name} must be {what}, got an integer too large for a float") from None
+    if not math.isfinite(v):
+        raise SpecError(f"{func}: {name} must be {what}, got {_show(value)}")
+    return v
+
+
+def check_tolerance(func: str, name: str, value: Any, hi: float = 1.0, zero: bool = False) -> float:
+    """A tolerance (``rtol``, ``atol``, ...): a finite number in (0, hi] (``zero``: [0, hi], for an
+    absolute tolerance that may be switched off); else a SpecError naming it."""
+    what = f"a finite number in {'[' if zero else '('}0, {hi:g}]"
+    v = _as_real(func, name, value, what)
+    if not (0 <= v if zero else 0 < v) or not v <= hi:
+        raise SpecError(f"{func}: {name} must be {what}, got {_show(value)}")
+    return v
+
+
+def check_count(func: str, name: str, value: Any, lo: int = 1, hi: int = 10**9) -> int:
+    """An integer count in [lo, hi] (``max_regions``, ``max_points``, ``levels``...); else a SpecError."""
+    what = f"an integer in [{lo}, {hi}]"
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer, float, np.floating)):
+        raise SpecError(f"{func}: {name} must be {what}, got {_show(value)}")
+    if isinstance(value, (float, np.floating)) and not (math.isfinite(value) and value == int(value)):
+        raise SpecError(f"{func}: {name} must be {what}, got {_show(value)}")
+    v = int(value)
+    if not lo <= v <= hi:
+        raise SpecError(f"{func}: {name} must be {what}, got {_show(value)}")
+    return v
+
+
+def check_open_unit(func: str, name: str, value: Any) -> float:
+    """A number strictly inside (0, 1) (``mu_min``); else a SpecError naming it."""
+    what = "a number in (0, 1)"
+    v = _as_real(func, name, value, what)
+    if not 0 < v < 1:
+        raise SpecError(f"{func}: {name} must be {what}, got {_show(value)}")
+    return v
+
+
+def check_pair(wi: np.ndarray, wo: np.ndarray) -> tuple:
+    """The broadcast shape of the leading axes of wi and wo, or a ValueError naming both."""
+    try:
+        return np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
+    except ValueError:
+        raise ValueError(f"wi and wo must broadcast against each other: wi has shape {wi.shape}, "
+                         f"wo has shape {wo.shape} (leading axes {wi.shape[:-1]} and {wo.shape[:-1]})") from None
 
 
 # ----------------------------------------------------------------------------------------

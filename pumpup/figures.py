@@ -16,7 +16,7 @@ import numpy as np
 from .albedo import albedo
 from .core import load
 from .pump import Pumped, pump
-from .tables import max_constant, write_table
+from .tables import max_constant
 
 THETA = np.linspace(0.0, 89.9, 300)  # incidence angles of the albedo and mirror-radiance curves [deg]
 THETA_IN = np.array([0.0, 30.0, 60.0, 80.0])  # incidence angles of the in-plane radiance curves [deg]
@@ -177,7 +177,9 @@ def make_figures(table_dir="tables", figure_dir="figures"):
     os.makedirs(table_dir, exist_ok=True)
     os.makedirs(figure_dir, exist_ok=True)
     ds = pumping_dataset()
-    write_table(ds, os.path.join(table_dir, "pumping_figures.nc"))
+    from .provenance import write_generated
+
+    write_generated(ds, os.path.join(table_dir, "pumping_figures.nc"))
     st = stretched_dataset()
-    write_table(st, os.path.join(table_dir, "stretched_phong_albedo.nc"))
+    write_generated(st, os.path.join(table_dir, "stretched_phong_albedo.nc"))
     return plot_all(ds, st, figure_dir)

@@ -17,6 +17,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import threading
 
 import numpy as np
 from numba import njit, types
@@ -33,6 +34,9 @@ __all__ = ["pump", "Pumped", "save_pumped", "load_pumped", "base_table"]
 #: (1e-8 with 1e-7: 6 x slower, measured)
 TABLE_RTOL = 1e-9
 TABLE_INTERP_TOL = 1e-7
+#: the most nested pumping levels accepted (each level's table costs about a second; the spec
+#: nests one dict per level)
+MAX_LEVELS = 64
 
 _TABLES: dict[str, object] = {}  # JSON spec of a base -> AlbedoTable (computed once per session)
 
@@ -48,12 +52,42 @@ def base_table(base: BRDF, progress: bool | None = None):
     """The albedo table of ``base`` used by the pumping operator (cached per session)."""
     from .tables import AlbedoTable, tabulate
 
+    if _uses_file_tables(base):  # computed from a file's tables: serves this object only
+        with _lock_for(f"derived#{id(base)}"):
+            if getattr(base, "_derived_table", None) is None:
+                ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress)
+                base._derived_table = AlbedoTable.from_dataset(ds)
+                base._derived_table.dataset = ds
+        return base._derived_table
     key = _key(base)
     if key not in _TABLES:
-        ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress)
-        _TABLES[key] = AlbedoTable.from_dataset(ds)
-        _TABLES[key].dataset = ds
+        with _lock_for(key):  # one thread computes a base's table; the others wait for it
+            if key not in _TABLES:
+                ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress)
+                t = AlbedoTable.from_dataset(ds)
+                t.dataset = ds
+                _TABLES[key] = t
     return _TABLES[key]
+
+
+_LOCKS: dict[str, threading.Lock] = {}
+_LOCKS_LOCK = threading.Lock()
+
+
+def _lock_for(key: str) -> threading.Lock:
+    with _LOCKS_LOCK:
+        return _LOCKS.setdefault(key, threading.Lock())
+
+
+def _uses_file_tables(brdf: BRDF) -> bool:
+    """True if ``brdf`` is a pumped chain with a level whose table came from a file (load_pumped):
+    what is computed from it must not enter the shared cache."""
+    cur = brdf
+    while isinstance(cur, Pumped):
+        if cur._own_table is not None:
+            return True
+        cur = cur.base
+    return False
 
 
 # --- the compiled look-up: upper bound of a(mu) from the spline pieces ---------------------
@@ -466,14 +500,16 @@ class Pumped(BRDF):
 
     params = {
         "base": Param(kind="spec", doc="the BRDF to pump"),
-        "g": Param("g1", kind="str", choices=("g1", "g2")),
-        "levels": Param(1, lo=1, kind="int"),
-        "force": Param(False, kind="bool"),
+        "g": Param("g1", kind="str", choices=("g1", "g2"), doc="g1 = max(a(wi), a(wo)) (001 eq. 20) or g2, also max with N.wi, N.wo (001 eq. 21)"),
+        "levels": Param(1, lo=1, hi=MAX_LEVELS, kind="int", doc="nested pumpings, each dividing by g of the level below"),
+        "force": Param(False, kind="bool", doc="pump a base that is not reciprocal"),
     }
     constant = None
 
     def __init__(self, **kwargs):
         levels = kwargs.get("levels", 1)
+        if "levels" in kwargs:  # checked before nesting (levels = 1e5 would recurse 1e5 deep)
+            levels = self.params["levels"].check("pumped", "levels", levels)
         if isinstance(levels, (int, float)) and not isinstance(levels, bool) and levels > 1 and levels == int(levels):
             inner = dict(kwargs, levels=int(levels) - 1)
             kwargs = dict(kwargs, levels=1, base=Pumped(**inner))
@@ -490,6 +526,17 @@ class Pumped(BRDF):
                     "BRDF (001 sec. 3). Pass force=True to pump it anyway."
                 )
         self._lookup = None
+        self._own_table = None  # a table loaded from a file serves this object only (load_pumped)
+        self._init_lock = threading.RLock()
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state.pop("_init_lock", None)  # a lock does not pickle
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._init_lock = threading.RLock()
 
     @property
     def base(self) -> BRDF:
@@ -512,12 +559,16 @@ class Pumped(BRDF):
         return 1 + (self.base.depth if isinstance(self.base, Pumped) else 0)
 
     def table(self, progress: bool | None = None):
-        """The albedo table of the base (the a in g)."""
-        return base_table(self.base, progress=progress)
+        """The albedo table of the base (the a in g): its own if it was loaded from a file
+        (:func:`load_pumped`), else the session's shared one (:func:`base_table`)."""
+        own = getattr(self, "_own_table", None)
+        return own if own is not None else base_table(self.base, progress=progress)
 
     def lookup(self) -> _Lookup:
         if self._lookup is None:
-            self._lookup = _Lookup(self.table())
+            with self._init_lock:  # threads that evaluate a fresh object build it once
+                if self._lookup is None:
+                    self._lookup = _Lookup(self.table())
         return self._lookup
 
     def g(self, mu_i, mu_o) -> np.ndarray:
@@ -546,41 +597,52 @@ class Pumped(BRDF):
 
     def _chain_args(self):
         """The upper bounds of all levels, concatenated for :func:`_chain_kernel` (built once)."""
-        if getattr(self, "_chain_cache", None) is None:
-            looks = [lev.lookup() for lev in self.chain()]
-            sizes = [len(lk.logx) for lk in looks]
-            offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-            coef = np.zeros((looks[0].coef.shape[0], offsets[-1]))
-            index = np.zeros((len(looks), _INDEX_CELLS), dtype=np.int64)
-            lo = np.array([lk.logx[0] for lk in looks])
-            h = np.array([(lk.logx[-1] - lk.logx[0]) / _INDEX_CELLS for lk in looks])
-            for j, (lk, a) in enumerate(zip(looks, offsets[:-1])):
-                n = lk.coef.shape[1]
-                coef[:, a:a + n] = lk.coef
-                coef[-1, a:a + n] += lk.margin  # the same upper bound as _upper_scalar
-                starts = lo[j] + h[j] * np.arange(_INDEX_CELLS)
-                index[j] = a + np.clip(np.searchsorted(lk.logx, starts, side="right") - 1, 0, n - 1)
-            self._chain_cache = (
-                offsets, np.concatenate([lk.logx for lk in looks]), coef,
-                *(np.array([getattr(lk, name) for lk in looks], dtype=float)
-                  for name in ("v0", "slope0", "margin_lo", "cap")),
-                np.array([lev.controlled for lev in self.chain()]),
-                np.array([lk.increasing for lk in looks]), np.array([lk.mu0 for lk in looks]),
-                index, lo, 1.0 / h, *self._product_args(),
-            )
+        cache = getattr(self, "_chain_cache", None)
+        if cache is not None:
+            return cache
+        with self._init_lock:  # built once, whole, before any thread sees it
+            if getattr(self, "_chain_cache", None) is None:
+                self._chain_cache = self._build_chain_args()
         return self._chain_cache
+
+    def _build_chain_args(self):
+        """:meth:`_chain_args`, computed."""
+        looks = [lev.lookup() for lev in self.chain()]
+        sizes = [len(lk.logx) for lk in looks]
+        offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+        coef = np.zeros((looks[0].coef.shape[0], offsets[-1]))
+        index = np.zeros((len(looks), _INDEX_CELLS), dtype=np.int64)
+        lo = np.array([lk.logx[0] for lk in looks])
+        h = np.array([(lk.logx[-1] - lk.logx[0]) / _INDEX_CELLS for lk in looks])
+        for j, (lk, a) in enumerate(zip(looks, offsets[:-1])):
+            n = lk.coef.shape[1]
+            coef[:, a:a + n] = lk.coef
+            coef[-1, a:a + n] += lk.margin  # the same upper bound as _upper_scalar
+            starts = lo[j] + h[j] * np.arange(_INDEX_CELLS)
+            index[j] = a + np.clip(np.searchsorted(lk.logx, starts, side="right") - 1, 0, n - 1)
+        return (
+            offsets, np.concatenate([lk.logx for lk in looks]), coef,
+            *(np.array([getattr(lk, name) for lk in looks], dtype=float)
+              for name in ("v0", "slope0", "margin_lo", "cap")),
+            np.array([lev.controlled for lev in self.chain()]),
+            np.array([lk.increasing for lk in looks]), np.array([lk.mu0 for lk in looks]),
+            index, lo, 1.0 / h, *self._product_args(),
+        )
 
     def product(self) -> "_Product | None":
         """The fast path's table of the product of all levels' g (None unless every level's bound
         increases and the table reaches its tolerance; the kernel then looks up level by level)."""
         if not hasattr(self, "_product"):
-            self._product = None
-            if all(lev.lookup().increasing for lev in self.chain()):
-                try:
-                    self._product = _Product([lev.lookup() for lev in self.chain()],
-                                             [lev.controlled for lev in self.chain()])
-                except _ProductError:
-                    pass
+            with self._init_lock:  # another thread must not see a half-decided None (a race once
+                if not hasattr(self, "_product"):  # made threaded values differ by 3e-14)
+                    product = None
+                    if all(lev.lookup().increasing for lev in self.chain()):
+                        try:
+                            product = _Product([lev.lookup() for lev in self.chain()],
+                                               [lev.controlled for lev in self.chain()])
+                        except _ProductError:
+                            pass
+                    self._product = product
         return self._product
 
     def _product_args(self):
@@ -595,15 +657,26 @@ class Pumped(BRDF):
     BLOCK = 8192
 
     def _eval(self, wi, wo):
+        from .core import slabs
+
         shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
         n = math.prod(shape)
-        if n <= 2 * self.BLOCK or wi.shape != wo.shape:
+        if n <= 2 * self.BLOCK:
             return self._eval_block(wi, wo)
-        a, b = wi.reshape(-1, 3), wo.reshape(-1, 3)  # views when the strides allow it
-        out = np.empty(n)
-        for s in range(0, n, self.BLOCK):
-            out[s:s + self.BLOCK] = self._eval_block(a[s:s + self.BLOCK], b[s:s + self.BLOCK])
-        return out.reshape(shape)
+        if wi.shape == wo.shape and wi.flags.c_contiguous and wo.flags.c_contiguous:
+            a, b = wi.reshape(-1, 3), wo.reshape(-1, 3)  # views
+            out = np.empty(n)
+            for s in range(0, n, self.BLOCK):
+                out[s:s + self.BLOCK] = self._eval_block(a[s:s + self.BLOCK], b[s:s + self.BLOCK])
+            return out.reshape(shape)
+        # broadcast (or strided) inputs: read-only views of the full shape, cut into slabs of about
+        # BLOCK pairs along the leading axes; only a slab's directions are ever copied (a copy of
+        # both arrays cost 4.6 GB for 1e8 pairs)
+        a, b = np.broadcast_to(wi, shape + (3,)), np.broadcast_to(wo, shape + (3,))
+        out = np.empty(shape)
+        for idx in slabs(shape, self.BLOCK):
+            out[idx] = self._eval_block(a[idx], b[idx])
+        return out
 
     def _eval_block(self, wi, wo):
         base = self.chain()[0].base
@@ -742,8 +815,10 @@ def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False)
     """
     if g not in ("g1", "g2"):
         raise SpecError(f"pump: g must be 'g1' or 'g2', got {g!r}")
-    if isinstance(levels, bool) or not isinstance(levels, (int, np.integer)) or levels < 1:
-        raise SpecError(f"pump: levels must be an integer >= 1, got {levels!r}")
+    if isinstance(levels, bool) or not isinstance(levels, (int, np.integer)) or not 1 <= levels <= MAX_LEVELS:
+        raise SpecError(f"pump: levels must be an integer in [1, {MAX_LEVELS}], got {levels!r}")
+    if not isinstance(force, (bool, np.bool_)):
+        raise SpecError(f"pump: force must be true or false, got {force!r}")
     base = load(brdf)
     return Pumped(base=base, g=g, levels=int(levels), force=force)
 
@@ -770,28 +845,69 @@ def save_pumped(f: Pumped, path) -> str:
         cur = cur.base
     chain.reverse()  # innermost first
     from .tables import atomic_path
+    from .validate import DIGEST_ATTR, checksum_encoding, content_digest
+
+    def digested(ds):
+        ds = ds.copy()
+        ds.attrs.pop(DIGEST_ATTR, None)
+        ds.attrs[DIGEST_ATTR] = content_digest(ds)
+        return ds
 
     with atomic_path(path) as tmp:
         root = xr.Dataset(attrs={"pumpup_kind": "pumpup pumped BRDF", "spec": json.dumps(f.spec, sort_keys=True),
                                  "levels": len(chain), "pumpup_version": __version__})
-        root.to_netcdf(tmp, mode="w", engine="netcdf4")
+        digested(root).to_netcdf(tmp, mode="w", engine="netcdf4")
         for i, level in enumerate(chain, start=1):
-            base_table(level.base)
-            ds = _TABLES[_key(level.base)].dataset
-            ds.to_netcdf(tmp, mode="a", group=f"level{i}", engine="netcdf4")
+            ds = digested(level.table().dataset)
+            ds.to_netcdf(tmp, mode="a", group=f"level{i}", engine="netcdf4", encoding=checksum_encoding(ds))
     return os.fspath(path)
 
 
 def load_pumped(path) -> Pumped:
-    """Load a pumped BRDF saved by :func:`save_pumped`, without recomputing its tables."""
-    from .tables import AlbedoTable, open_table
+    """Load a pumped BRDF saved by :func:`save_pumped`, without recomputing its tables.
 
+    The file is validated (:func:`pumpup.open_table` for the root and every level's group; the
+    levels' specs must be the chain of the root's spec).  Its tables serve only the returned
+    object: they never enter the session's shared cache, so an edited file cannot change what
+    later ``pump()`` calls on the same base compute.
+
+    Raises
+    ------
+    pumpup.validate.TableError (a ValueError)
+        If the file is damaged, edited, or not a saved pumped BRDF (the message says what).
+    """
+    from .tables import AlbedoTable, open_table
+    from .validate import TableError, spec_attribute
+
+    where = os.fspath(path)
     root = open_table(path)
     if root.attrs.get("pumpup_kind") != "pumpup pumped BRDF":
-        raise ValueError(f"{os.fspath(path)!r} is a pumpup table, not a saved pumped BRDF")
-    for i in range(1, int(root.attrs["levels"]) + 1):
-        ds = open_table(path, group=f"level{i}")
-        t = AlbedoTable.from_dataset(ds)
+        raise TableError(f"{where!r} is a pumpup table, not a saved pumped BRDF")
+    spec = spec_attribute(where, root)
+    try:
+        f = load(spec)
+    except (SpecError, ValueError, TypeError) as exc:
+        raise TableError(f"{where!r}: its spec does not load: {exc}") from None
+    if not isinstance(f, Pumped):
+        raise TableError(f"{where!r}: its spec is a {spec.get('type')!r}, not a pumped BRDF")
+    chain = f.chain()  # innermost first, as the groups level1, level2, ...
+    levels = int(np.asarray(root.attrs["levels"]).item())
+    if levels != len(chain):
+        raise TableError(f"{where!r}: attribute 'levels' = {levels} but its spec has {len(chain)} levels")
+    for i, level in enumerate(chain, start=1):
+        try:
+            ds = open_table(path, group=f"level{i}")
+        except OSError as exc:  # a missing group
+            raise TableError(f"{where!r}: group 'level{i}' is missing or unreadable: {exc}") from None
+        if ds.attrs.get("pumpup_kind") != "pumpup albedo table":
+            raise TableError(f"{where!r}: group 'level{i}' is not an albedo table")
+        if json.loads(ds.attrs["spec"]) != level.base.spec:
+            raise TableError(f"{where!r}: group 'level{i}' holds the table of {ds.attrs['spec']}, but level {i} of "
+                             f"the spec pumps {json.dumps(level.base.spec, sort_keys=True)}")
+        try:
+            t = AlbedoTable.from_dataset(ds)
+        except (ValueError, KeyError, TypeError) as exc:
+            raise TableError(f"{where!r}: group 'level{i}': {exc}") from None
         t.dataset = ds
-        _TABLES[_key(load(json.loads(ds.attrs["spec"])))] = t
-    return load(json.loads(root.attrs["spec"]))
+        level._own_table = t  # this object's own table: never the shared cache
+    return f

@@ -19,7 +19,7 @@ import numpy as np
 from .albedo import albedo
 from .core import load
 from .published import TABLE2, TABLE3, TABLE4, TEXT, Published, agrees
-from .tables import atomic_path, max_albedo, mean_albedo, write_table
+from .tables import atomic_path, max_albedo, mean_albedo
 
 __all__ = ["TABLES", "compute", "reproduce", "LIMITS"]
 
@@ -266,6 +266,8 @@ def reproduce(out: str = "tables", only: list[str] | None = None, progress: bool
         raise OSError(f"cannot create the output directory {out!r}: {exc}") from None
     if not os.access(out, os.W_OK):
         raise OSError(f"the output directory {out!r} is not writable")
+    from .provenance import write_generated
+
     cache = _Cache()
     t0 = time.perf_counter()
     datasets = {n: compute(n, progress=progress, cache=cache) for n in names if n != DIVERGENCE}
@@ -274,11 +276,11 @@ def reproduce(out: str = "tables", only: list[str] | None = None, progress: bool
         from .divergence import analysis_dataset, plot
 
         div = analysis_dataset(progress=progress)
-        write_table(div, os.path.join(out, "divergence.nc"))
+        write_generated(div, os.path.join(out, "divergence.nc"))
         plot(div, os.path.join(out, "divergence.png"))
         extra = _divergence_report(div)
     for n, ds in datasets.items():
-        write_table(ds, os.path.join(out, f"{n}.nc"))
+        write_generated(ds, os.path.join(out, f"{n}.nc"))
     with atomic_path(os.path.join(out, "report.md")) as tmp:
         with open(tmp, "w") as fh:
             fh.write(report(datasets) + ("\n" + extra if extra else ""))

@@ -89,7 +89,7 @@ def _check_params(spec: dict, params: Mapping[str, Sequence]) -> dict[str, list]
     _ensure_models()
 
     name = spec.get("type")
-    if name not in _REGISTRY:
+    if not isinstance(name, str) or name not in _REGISTRY:
         raise SpecError(f"unknown model type {name!r}; known types: {', '.join(_REGISTRY)}")
     cls = _REGISTRY[name]
     out: dict[str, list] = {}
@@ -234,27 +234,114 @@ def _load_part(directory: str, block: tuple[int, ...], n_cells: int) -> dict[str
     return arrays
 
 
-def _open_parts(out: str, definition: dict) -> str:
-    """The parts directory of ``out``, created with its manifest or checked against it."""
-    directory = os.fspath(out) + ".parts"
-    parent = os.path.dirname(os.path.abspath(directory))
-    if not os.path.isdir(parent):
-        raise OSError(f"cannot write {out!r}: directory {parent!r} does not exist")
-    manifest = os.path.join(directory, "sweep.json")
-    text = json.dumps(definition, sort_keys=True, indent=1)
-    if os.path.isdir(directory) and os.path.exists(manifest):
-        with open(manifest) as fh:
-            old = fh.read()
-        if old != text:
-            raise ValueError(
-                f"{directory!r} holds the parts of a different sweep (its manifest sweep.json differs from "
-                "this one's spec, parameters, mu, pump or options); delete that directory to start afresh, "
-                "or write this sweep to another file"
-            )
-        return directory
-    os.makedirs(directory, exist_ok=True)
-    _write_atomic(directory, "sweep.json", lambda fh: fh.write(text.encode()))
-    return directory
+class SweepError(ValueError):
+    """A sweep cannot write its output: another sweep is running into it, or it holds another sweep."""
+
+
+class _Parts:
+    """The parts directory ``<out>.parts/`` of a sweep, locked (flock on the directory itself) for as
+    long as the sweep runs, so that two sweeps to one ``out`` never run at once.  The manifest
+    ``sweep.json`` is written with the first finished chunk (a sweep that never started, say its
+    scheduler was unreachable, leaves nothing behind); an existing manifest must match."""
+
+    def __init__(self, out: str, definition: dict, overwrite: bool = False):
+        import fcntl
+
+        self.directory = directory = os.fspath(out) + ".parts"
+        parent = os.path.dirname(os.path.abspath(directory))
+        if not os.path.isdir(parent):
+            raise OSError(f"cannot write {out!r}: directory {parent!r} does not exist")
+        self.text = json.dumps(definition, sort_keys=True, indent=1)
+        self.created = not os.path.isdir(directory)
+        os.makedirs(directory, exist_ok=True)
+        self.fd = os.open(directory, os.O_RDONLY)
+        try:
+            fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(self.fd)
+            raise SweepError(f"another sweep is running into {os.fspath(out)!r} (its parts directory "
+                             f"{directory!r} is locked); wait for it, or write to another file") from None
+        if not os.path.isdir(directory) or not os.path.samestat(os.fstat(self.fd), os.stat(directory)):
+            self.close()  # the sweep that held it finished and removed it meanwhile: start afresh
+            return self.__init__(out, definition, overwrite)
+        self.manifest = os.path.join(directory, "sweep.json")
+        self.saved = 0
+        if os.path.exists(self.manifest):
+            with open(self.manifest) as fh:
+                old = fh.read()
+            if old != self.text:
+                if not overwrite:
+                    self.close()
+                    raise ValueError(
+                        f"{directory!r} holds the parts of a different sweep (its manifest sweep.json differs from "
+                        "this one's spec, parameters, mu, pump or options); delete that directory to start afresh, "
+                        "write this sweep to another file, or pass overwrite=True (--overwrite)"
+                    )
+                for name in os.listdir(directory):  # overwrite: that sweep's parts go
+                    os.unlink(os.path.join(directory, name))
+
+    def save(self, block, arrays) -> None:
+        if self.saved == 0 and not os.path.exists(self.manifest):
+            _write_atomic(self.directory, "sweep.json", lambda fh: fh.write(self.text.encode()))
+        _save_part(self.directory, block, arrays)
+        self.saved += 1
+
+    def close(self, remove: bool = False) -> None:
+        if remove:
+            shutil.rmtree(self.directory, ignore_errors=True)
+        if self.fd is not None:
+            os.close(self.fd)  # releases the lock
+            self.fd = None
+
+    def abandon(self) -> None:
+        """After a failure: release the lock; remove the directory if this sweep made it and
+        saved nothing into it."""
+        empty = self.created and self.saved == 0 and not any(n.startswith("chunk-") for n in os.listdir(self.directory))
+        self.close(remove=empty)
+
+
+def definition_digest(definition: dict) -> str:
+    """SHA-256 of what defines a sweep's result (spec, parameters, mu, pump, options): stored in
+    the result's attribute ``sweep_definition_sha256``."""
+    import hashlib
+
+    def canon(v):  # 1 and 1.0 are the same parameter value
+        if isinstance(v, dict):
+            return {k: canon(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [canon(x) for x in v]
+        if isinstance(v, (int, float)) and not isinstance(v, bool):
+            return float(v)
+        return v
+
+    keys = ("spec", "params", "mu", "pump", "options")
+    text = json.dumps({k: canon(definition[k]) for k in keys}, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _check_existing_output(out: str, digest: str, overwrite: bool) -> None:
+    """Refuse to replace a result of a different sweep (or a file that is not one) unless ``overwrite``."""
+    out = os.fspath(out)
+    if not os.path.exists(out) or overwrite:
+        return
+    try:
+        if out.rstrip("/").endswith(".zarr"):
+            import xarray as xr
+
+            with xr.open_zarr(out) as ds:
+                attrs = dict(ds.attrs)
+        else:
+            from .tables import open_table
+
+            attrs = open_table(out).attrs
+    except Exception:  # unreadable: not ours to replace silently
+        attrs = {}
+    if attrs.get("sweep_definition_sha256") == digest:
+        return
+    what = ("the result of a different sweep" if attrs.get("pumpup_kind") == SWEEP_KIND
+            else "something that is not a result of this sweep")
+    raise SweepError(f"{out!r} exists and holds {what}; pass overwrite=True (--overwrite) to replace it, "
+                     "or write to another file")
 
 
 # --------------------------------------------------------------------------------------------
@@ -267,6 +354,26 @@ def _progress_bar(total: int, progress: bool | None):
 
     show = sys.stderr.isatty() if progress is None else progress
     return tqdm(total=total, desc="sweep", unit="cell", disable=not show)
+
+
+def warm_kernels(f: BRDF) -> None:
+    """Compile (or load from numba's cache) the kernels that the cells of a threaded sweep use, on
+    this thread, before the threads start: numba's lazily compiled ufuncs, asked for the same
+    signature by two threads at once, compile it twice and warn ("Compilation requested for
+    previously compiled argument types"), once per sweep.  One value of the innermost base's
+    albedo runs every kernel of the engine and the model (a pumped chain's own kernel compiles
+    under numba's lock)."""
+    from .albedo import albedo
+    from .pump import Pumped
+
+    base = f
+    while isinstance(base, Pumped):
+        base = base.base
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a warm-up value: its accuracy does not matter
+        albedo(base, 1.0, rtol=1e-3, atol=1e-3)
 
 
 def _run_local(tasks, scheduler: str, workers: int | None, on_done) -> None:
@@ -293,7 +400,47 @@ def _run_local(tasks, scheduler: str, workers: int | None, on_done) -> None:
     # each result is placed (and saved) as it arrives; the callback is local to this computation.
     # chunksize=1: one chunk per dispatch (dask's process scheduler batches 6 ready tasks per
     # worker by default, which ran a sweep of two chunks on one process)
-    dask.compute(*delayed, scheduler=scheduler, callbacks=[normalize_callback(Saver())], chunksize=1, **kw)
+    if scheduler != "processes":
+        dask.compute(*delayed, scheduler=scheduler, callbacks=[normalize_callback(Saver())], chunksize=1, **kw)
+        return
+    # our own pool of worker processes, so that they end with the sweep: terminated if it fails or
+    # is interrupted, and (Linux) sent SIGTERM by the kernel if this process is killed
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    pool = ProcessPoolExecutor(workers or os.cpu_count() or 1, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_worker_init, initargs=(os.getpid(),))
+    try:
+        dask.compute(*delayed, scheduler="processes", pool=pool, callbacks=[normalize_callback(Saver())],
+                     chunksize=1)
+    except BaseException:
+        procs = list(getattr(pool, "_processes", {}).values())
+        pool.shutdown(wait=False, cancel_futures=True)
+        for proc in procs:
+            if proc.is_alive():
+                proc.terminate()
+        for proc in procs:
+            proc.join(5)
+        raise
+    pool.shutdown(wait=True)
+
+
+def _worker_init(parent: int) -> None:  # pragma: no cover - runs in the workers
+    """In each worker process: ask the kernel (Linux prctl PR_SET_PDEATHSIG) for SIGTERM when the
+    sweep's process dies, so that a killed sweep leaves no workers behind; ignore SIGINT (Ctrl-C
+    goes to the sweep, which ends the workers)."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGTERM, 0, 0, 0)  # PR_SET_PDEATHSIG = 1
+    except (OSError, AttributeError):
+        return
+    if os.getppid() != parent:  # the sweep died before prctl took effect
+        os._exit(1)
 
 
 def _run_distributed(tasks, client, address: str | None, on_done) -> None:
@@ -329,7 +476,7 @@ def _run_distributed(tasks, client, address: str | None, on_done) -> None:
 def sweep(spec: dict | str, params: Mapping[str, Sequence], mu=None, *, pump: Mapping | None = None,
           client=None, scheduler: str | None = None, workers: int | None = None, chunks=None,
           out: str | os.PathLike | None = None, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
-          mean: bool = True, maximum: bool = True, progress: bool | None = None):
+          mean: bool = True, maximum: bool = True, progress: bool | None = None, overwrite: bool = False):
     """Albedo tables over a grid of model parameters, computed in chunks through dask.
 
     Cell (v_1, ..., v_k) of the grid is the model ``pumpup.load(spec | {p_1: v_1, ...})``
@@ -386,6 +533,10 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu=None, *, pump: Ma
         (000 Tables 2 and 4; scanned down to mu = 1e-6, rtol 1e-11).
     progress : bool, optional
         Show a progress bar over cells (default: when stderr is a terminal).
+    overwrite : bool
+        Replace ``out`` (and discard the parts in ``<out>.parts/``) when they belong to a different
+        sweep; without it such a sweep is refused before it computes.  A result of the same sweep
+        is always replaced (by the same numbers).
 
     Returns
     -------
@@ -421,14 +572,15 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu=None, *, pump: Ma
     >>> ds["albedo"].dims, ds["albedo"].values.round(12).tolist()
     (('lambert_albedo', 'mu'), [[0.25, 0.25], [0.5, 0.5]])
     """
-    if isinstance(spec, str):
-        try:
-            spec = json.loads(spec)
-        except json.JSONDecodeError as exc:
-            raise SpecError(f"sweep: a spec string must be JSON: {exc}") from None
+    from .core import check_tolerance, parse_spec
+
+    if isinstance(spec, str):  # JSON or the short form "stretched_phong:p=0.5" (or just a type name)
+        spec = parse_spec(spec)
     if not isinstance(spec, Mapping) or "type" not in spec:
         raise SpecError(f"sweep: spec must be a dict with a 'type' key, got {spec!r}")
     spec = {k: _plain(v) for k, v in spec.items()}
+    rtol = check_tolerance("sweep", "rtol", rtol)
+    atol = check_tolerance("sweep", "atol", atol, hi=math.inf, zero=True)
     values = _check_params(spec, params)
     names = list(values)
     pump = _check_pump(pump)
@@ -477,36 +629,47 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu=None, *, pump: Ma
 
     definition = {"spec": spec, "params": values, "mu": [float(m) for m in grid], "pump": pump,
                   "options": opts, "chunks": list(cshape), "pumpup_version": __version__}
+    digest = definition_digest(definition)
     parts = None
     todo = list(blocks)
     if out is not None:
-        parts = _open_parts(out, definition)
+        _check_existing_output(out, digest, overwrite)
+        parts = _Parts(out, definition, overwrite)
         todo = []
         for block in blocks:
-            res = _load_part(parts, block, len(block_cells(block)))
+            res = _load_part(parts.directory, block, len(block_cells(block)))
             if res is None:
                 todo.append(block)
             else:
                 place(block, res)
 
-    tasks = [(block, ([cell_spec(i) for i in block_cells(block)], pump, grid, opts)) for block in todo]
-    with _progress_bar(sum(len(block_cells(b)) for b in todo), progress) as bar:
-        def on_done(block, result):
-            if parts is not None:
-                _save_part(parts, block, result)
-            place(block, result)
-            bar.update(len(block_cells(block)))
+    try:
+        tasks = [(block, ([cell_spec(i) for i in block_cells(block)], pump, grid, opts)) for block in todo]
+        with _progress_bar(sum(len(block_cells(b)) for b in todo), progress) as bar:
+            def on_done(block, result):
+                if parts is not None:
+                    parts.save(block, result)
+                place(block, result)
+                bar.update(len(block_cells(block)))
 
-        if tasks:
-            if client is not None or (scheduler is not None and scheduler not in LOCAL_SCHEDULERS):
-                _run_distributed(tasks, client, scheduler, on_done)
-            else:
-                _run_local(tasks, scheduler or "threads", workers, on_done)
+            if tasks:
+                if client is not None or (scheduler is not None and scheduler not in LOCAL_SCHEDULERS):
+                    _run_distributed(tasks, client, scheduler, on_done)
+                else:
+                    if (scheduler or "threads") == "threads":
+                        warm_kernels(cell_model(first, pump))
+                    _run_local(tasks, scheduler or "threads", workers, on_done)
 
-    ds = _dataset(spec, base, names, values, grid, pump, opts, arrays)
-    if out is not None:
-        _write_output(ds, out)
-        shutil.rmtree(parts, ignore_errors=True)
+        ds = _dataset(spec, base, names, values, grid, pump, opts, arrays)
+        ds.attrs["sweep_definition_sha256"] = digest
+        if out is not None:
+            _write_output(ds, out)
+    except BaseException:
+        if parts is not None:
+            parts.abandon()
+        raise
+    if parts is not None:
+        parts.close(remove=True)
     return ds
 
 

@@ -22,7 +22,7 @@ import numpy as np
 
 from ._version import __version__
 from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
-from .core import BRDF
+from .core import BRDF, SpecError, check_count, check_open_unit, check_tolerance
 
 __all__ = [
     "tabulate",
@@ -36,6 +36,13 @@ __all__ = [
 ]
 
 TABLE_KIND = "pumpup albedo table"
+#: the largest ``max_points`` of an adaptive table
+MAX_POINTS_LIMIT = 1_000_000
+
+
+def _check_brdf(func: str, brdf) -> None:
+    if not isinstance(brdf, BRDF):
+        raise TypeError(f"{func} needs a pumpup BRDF (pumpup.load(spec)), got {type(brdf).__name__}")
 METHOD = "adaptive 15x15 Gauss-Kronrod cubature in a lobe-adapted frame (pumpup.albedo)"
 
 
@@ -209,6 +216,12 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     """
     if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1):
         raise ValueError(f"tabulate: threads must be an integer >= 1, got {threads!r}")
+    _check_brdf("tabulate", brdf)
+    rtol = check_tolerance("tabulate", "rtol", rtol)
+    atol = check_tolerance("tabulate", "atol", atol, hi=math.inf, zero=True)
+    interp_tol = check_tolerance("tabulate", "interp_tol", interp_tol, hi=math.inf)
+    mu_min = check_open_unit("tabulate", "mu_min", mu_min)
+    max_points = check_count("tabulate", "max_points", max_points, 2, MAX_POINTS_LIMIT)
     if mu is not None:
         grid = np.unique(check_mu(np.atleast_1d(mu)).ravel())
         with _progress(len(grid), f"albedo {brdf.type}", progress) as bar:
@@ -272,8 +285,14 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
     err = np.empty_like(mu)
     threads = max(1, min(threads or THREADS or _cores(), len(mu)))
 
+    import threading
+
+    stop = threading.Event()  # set when the caller is interrupted (Ctrl-C): the threads end soon
+
     def work(idx):
         for a in range(0, len(idx), chunk):
+            if stop.is_set():
+                return
             part = idx[a:a + chunk]
             val[part], err[part] = albedo(brdf, mu[part], return_error=True, rtol=rtol, atol=atol)
             bar.update(len(part))
@@ -293,8 +312,12 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
     from concurrent.futures import ThreadPoolExecutor
 
     with ThreadPoolExecutor(threads) as pool:
-        for done in [pool.submit(work, todo[k::threads]) for k in range(threads)]:
-            done.result()
+        try:
+            for done in [pool.submit(work, todo[k::threads]) for k in range(threads)]:
+                done.result()
+        except BaseException:
+            stop.set()
+            raise
     return val, err
 
 
@@ -333,11 +356,75 @@ def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind):
     return ds
 
 
+def _umask() -> int:
+    """The process's umask, read without changing it where the system tells it (Linux), else by
+    setting and restoring it."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError):
+        return True  # it exists (another user's) or we cannot tell: leave its file alone
+    return True
+
+
+#: the temporary files of a target ``NAME`` are ``.NAME.<pid>.<random>.pumpup-tmp`` beside it
+_TMP_SUFFIX = ".pumpup-tmp"
+
+
+def stale_temporaries(path) -> list[str]:
+    """Temporary files of ``path`` left by writes that were killed (their process is gone)."""
+    path = os.fspath(path)
+    directory = os.path.dirname(os.path.abspath(path))
+    prefix = "." + os.path.basename(path) + "."
+    out = []
+    try:
+        names = os.listdir(directory)
+    except OSError:
+        return out
+    for name in names:
+        if not (name.startswith(prefix) and name.endswith(_TMP_SUFFIX)):
+            continue
+        pid = name[len(prefix):-len(_TMP_SUFFIX)].split(".")[0]
+        if pid.isdigit() and not _pid_alive(int(pid)):
+            out.append(os.path.join(directory, name))
+    return out
+
+
+def _fsync_path(path: str, directory: bool = False) -> None:
+    try:
+        fd = os.open(path, os.O_RDONLY | (getattr(os, "O_DIRECTORY", 0) if directory else 0))
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
 @contextlib.contextmanager
 def atomic_path(path):
     """Yield a temporary file beside ``path``; rename it into place only if the block succeeds.
 
-    An interrupted write never leaves a half file at ``path`` (nor a temporary one).
+    An interrupted write never leaves a half file at ``path`` (nor a temporary one; one left by a
+    process that was killed is removed by the next write of the same target).  The file gets the
+    permissions the user's umask gives a new file (0666 & ~umask), also when it replaces one, and
+    its data reach the disk (fsync) before the rename.
     """
     path = os.fspath(path)
     directory = os.path.dirname(os.path.abspath(path))
@@ -345,11 +432,19 @@ def atomic_path(path):
         raise OSError(f"cannot write {path!r}: directory {directory!r} does not exist")
     if not os.access(directory, os.W_OK):
         raise OSError(f"cannot write {path!r}: directory {directory!r} is not writable")
-    fd, tmp = tempfile.mkstemp(suffix=".nc.tmp", dir=directory)
+    if os.path.isdir(path):
+        raise OSError(f"cannot write {path!r}: it is a directory")
+    for stale in stale_temporaries(path):
+        with contextlib.suppress(OSError):
+            os.unlink(stale)
+    fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(path)}.{os.getpid()}.", suffix=_TMP_SUFFIX, dir=directory)
     os.close(fd)
     try:
         yield tmp
+        os.chmod(tmp, 0o666 & ~_umask())
+        _fsync_path(tmp)
         os.replace(tmp, path)
+        _fsync_path(directory, directory=True)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
@@ -357,34 +452,53 @@ def atomic_path(path):
 
 
 def write_table(ds, path) -> str:
-    """Write a Dataset to netCDF atomically (a temporary file renamed into place)."""
+    """Write a Dataset to netCDF atomically (a temporary file renamed into place), with a
+    Fletcher-32 checksum on every numeric variable (:func:`pumpup.validate.checksum_encoding`) and
+    a digest of the whole content in the attribute ``pumpup_digest``, which :func:`open_table`
+    checks (:func:`pumpup.validate.content_digest`)."""
+    from .validate import DIGEST_ATTR, checksum_encoding, content_digest
+
+    ds = ds.copy()  # shallow: the caller's attributes stay as they are
+    ds.attrs.pop(DIGEST_ATTR, None)
+    ds.attrs[DIGEST_ATTR] = content_digest(ds)
     with atomic_path(path) as tmp:
-        ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4")
+        ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=checksum_encoding(ds))
     return os.fspath(path)
 
 
 def open_table(path, group: str | None = None):
-    """Open a netCDF table written by pumpup, fully loaded into memory.
+    """Open a netCDF table written by pumpup, fully loaded into memory, and validate it
+    (:func:`pumpup.validate.validate_dataset`: variables, coordinates, shapes, finite values,
+    mu in (0, 1] strictly increasing, albedo >= 0, a loadable spec; checksums).
 
     Raises
     ------
     FileNotFoundError
         If there is no such file.
-    ValueError
-        If the file is damaged, not netCDF, or not a pumpup table.
+    pumpup.validate.TableError (a ValueError)
+        If the file is damaged, not netCDF, not a pumpup table, or fails a check; the message
+        names the file and what is wrong.
     """
     import xarray as xr
+
+    from .validate import TableError, validate_dataset
 
     path = os.fspath(path)
     if not os.path.exists(path):
         raise FileNotFoundError(f"no such table: {path!r}")
+    where = path if group is None else f"{path}, group {group!r}"
     try:
         with xr.open_dataset(path, engine="netcdf4", group=group) as ds:
             ds = ds.load()
-    except (OSError, ValueError, RuntimeError, KeyError) as exc:
-        raise ValueError(f"{path!r} is not a readable netCDF file (damaged or another format): {exc}") from None
-    if not str(ds.attrs.get("pumpup_kind", "")).startswith("pumpup"):
-        raise ValueError(f"{path!r} is a netCDF file but not a pumpup table (no 'pumpup_kind' attribute)")
+    except MemoryError:
+        raise
+    except Exception as exc:  # netCDF/HDF5 raise OSError, RuntimeError, KeyError, AttributeError, ... on damage
+        raise TableError(f"{where!r} is not a readable netCDF file (damaged or another format): "
+                         f"{type(exc).__name__}: {exc}") from None
+    validate_dataset(ds, where)
+    from .validate import DIGEST_ATTR
+
+    ds.attrs.pop(DIGEST_ATTR, None)  # verified; the Dataset is what was written
     return ds
 
 
@@ -408,6 +522,10 @@ def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False, m
     0.25
     """
     from .albedo import NODES, WG, WK
+
+    _check_brdf("mean_albedo", brdf)
+    rtol = check_tolerance("mean_albedo", "rtol", rtol)
+    max_intervals = check_count("mean_albedo", "max_intervals", max_intervals, 8, 10**6)
 
     def rule(a, b):
         tau = a[:, None] + (b - a)[:, None] * NODES[None, :]
@@ -468,6 +586,10 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
     """
     from scipy.optimize import minimize_scalar
 
+    _check_brdf("max_albedo", brdf)
+    mu_min = check_open_unit("max_albedo", "mu_min", mu_min)
+    n_scan = check_count("max_albedo", "n_scan", n_scan, 3, 10**6)
+    rtol = check_tolerance("max_albedo", "rtol", rtol)
     f = _unit_constant(brdf)
     theta = np.linspace(0, math.acos(mu_min), n_scan)
     mu = np.unique(np.concatenate([np.cos(theta), np.logspace(-1, math.log10(mu_min), 6), [1.0, mu_min]]))

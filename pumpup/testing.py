@@ -173,6 +173,14 @@ class Chi2Result:
     def __bool__(self) -> bool:
         return bool(self.passed)
 
+    def __repr__(self) -> str:
+        """The verdict and the family-wise p-value, not the histograms (they are attributes)."""
+        k = len(self.p_values)
+        return (f"<Chi2Result {'passed' if self.passed else 'FAILED'}: p = {self.p_value:.4g} "
+                f"(Sidak-adjusted, {k} direction{'s' if k > 1 else ''}, alpha = {self.alpha:g}), "
+                f"statistic {self.statistic:.4g} on {self.dof} dof, {self.n_samples} samples each, "
+                f"{self.n_theta} x {self.n_phi} bins>")
+
     @property
     def worst(self) -> int:
         """Index of the direction with the smallest p-value (NaN counts as smallest)."""

@@ -13,7 +13,7 @@ import argparse
 import os
 
 from pumpup.sampling import efficiency_dataset, plot_efficiency
-from pumpup.tables import write_table
+from pumpup.provenance import write_generated
 
 
 def main(argv=None):
@@ -24,7 +24,8 @@ def main(argv=None):
     ds = efficiency_dataset()
     os.makedirs(a.out, exist_ok=True)
     os.makedirs(a.figures, exist_ok=True)
-    path = write_table(ds, os.path.join(a.out, "sampling_efficiency.nc"))
+    path = os.path.join(a.out, "sampling_efficiency.nc")
+    write_generated(ds, path)
     fig = plot_efficiency(ds, os.path.join(a.figures, "sampling_efficiency.png"))
     print(f"wrote {path} and {fig}")
     print(f"000 eq. 26, stretched Phong at mu = {float(ds.mu[-1]):.0e}:")
