@@ -379,7 +379,7 @@ class KullaConty(_Compensated):
         "base": Param(kind="spec", doc="the BRDF to compensate"),
         "white": Param(None, kind="spec", doc="the Fresnel-1 BRDF whose albedo is E (default: base)"),
         "f_avg": Param(1.0, lo=0.0, hi=1.0, doc="hemispherical average of the Fresnel factor"),
-        "force": Param(False, kind="bool"),
+        "force": Param(False, kind="bool", doc="accept a base that is not reciprocal"),
     }
     examples = [{"base": {"type": "phong", "n": 5}}, {"base": {"type": "lambert", "albedo": 0.5}, "f_avg": 0.8}]
     _why = "the Kulla-Conty lobe compensates a symmetric BRDF"
@@ -537,7 +537,7 @@ class Scaled(_Compensated):
         "base": Param(kind="spec", doc="the BRDF to scale"),
         "white": Param(None, kind="spec", doc="the Fresnel-1 BRDF whose albedo is E (default: base)"),
         "f0": Param(1.0, lo=0.0, hi=1.0, doc="Fresnel reflectance at normal incidence"),
-        "force": Param(False, kind="bool"),
+        "force": Param(False, kind="bool", doc="accept a base that is not reciprocal"),
     }
     reciprocal = False
     examples = [{"base": {"type": "phong", "n": 5}}, {"base": {"type": "phong", "n": 5}, "f0": 0.5}]
