@@ -343,6 +343,11 @@ class BRDF:
         """Linear decomposition f = sum w_k f_k used by the engine (default: itself)."""
         return [(1.0, self)]
 
+    def polar(self):
+        """A :class:`pumpup._polar.Polar` hint when the azimuth of the albedo integral is closed-form
+        (the engine then integrates one dimension, ``pumpup._polar``), else None (the default)."""
+        return None
+
 
 def split(w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The x, y, z components of an array of 3-vectors (views, no copy)."""
