@@ -209,14 +209,17 @@ def as_directions(w: Any, name: str) -> np.ndarray:
         raise ValueError(f"{name} must be an array of unit 3-vectors: {exc}") from None
     if a.ndim == 0 or a.shape[-1] != 3:
         raise ValueError(f"{name} must have 3 components on its last axis, got shape {a.shape}")
-    if not np.all(np.isfinite(a)):
-        i = np.argwhere(~np.isfinite(a))[0][:-1]
-        raise ValueError(f"{name} contains non-finite values (first at index {tuple(i)})")
-    norm = np.sqrt(np.einsum("...k,...k->...", a, a))
-    bad = np.abs(norm - 1.0) > UNIT_TOL
-    if np.any(bad):
-        i = tuple(np.argwhere(bad)[0])
-        raise ValueError(f"{name} must be unit vectors (|w| = 1 within {UNIT_TOL:g}); |{name}{list(i)}| = {norm[i]:.9g}")
+    from ._checks import first_bad  # finiteness and unit length in one compiled pass
+
+    lead = a.shape[:-1]
+    bad_value, bad_norm = first_bad(a, UNIT_TOL)
+    if bad_value >= 0:
+        i = np.unravel_index(bad_value, lead) if lead else ()
+        raise ValueError(f"{name} contains non-finite values (first at index {tuple(int(k) for k in i)})")
+    if bad_norm >= 0:
+        i = tuple(int(k) for k in np.unravel_index(bad_norm, lead)) if lead else ()
+        norm = float(np.sqrt(np.sum(a[i] * a[i])))
+        raise ValueError(f"{name} must be unit vectors (|w| = 1 within {UNIT_TOL:g}); |{name}{list(i)}| = {norm:.9g}")
     return a
 
 
