@@ -18,6 +18,7 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
 
     python scripts/bench_albedo.py            # the family table and the cells
     python scripts/bench_albedo.py --all      # also the three measurements above
+    python scripts/bench_albedo.py --cells    # only the sweep cells and the pumped tables
 """
 
 import signal
@@ -162,7 +163,7 @@ def families(rtol=1e-10):
 
 
 def cells():
-    from pumpup import _polar
+    from pumpup import _polar, _reuse
     from pumpup.pump import _TABLES
     from pumpup.sweep import default_mu
 
@@ -188,8 +189,13 @@ def cells():
                  {"type": "blinn", "n": 16}]:
         cell(spec)
         new = min(cell(spec) for _ in range(3))
-        with _polar.two_d_only():
-            old = cell(spec)
+        recall = _reuse.recall
+        _reuse.recall = lambda brdf: None  # the previous engine: no reuse of the table either
+        try:
+            with _polar.two_d_only():
+                old = cell(spec)
+        finally:
+            _reuse.recall = recall
         print(f"sweep cell (257 mu + mean albedo + maximum constant, one thread) {spec}: {new * 1e3:.1f} ms, "
               f"previous engine {old * 1e3:.1f} ms, ratio {old / new:.1f}", flush=True)
     pumped(21)  # the first build in the process loads the compiled kernels
@@ -205,7 +211,8 @@ def main():
 
     print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f} "
           f"on {os.cpu_count()} cores")
-    families()
+    if "--cells" not in sys.argv:
+        families()
     cells()
     if "--all" in sys.argv:
         legacy()
