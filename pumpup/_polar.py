@@ -26,11 +26,15 @@ cancellation, and b (sin beta0 - sin beta1) as mu^2 (1 - 2u) / (b sin beta0 + b 
 
 This leaves a(mu) = c * integral_0^1 u^n K(u) du.  Its kinks are where the arc starts to be
 cut by the horizon (u = s) and where the level N.wo = mu leaves the circle (u = cos 2 theta_i,
-p = 1 only): these, and u = 1/2, are breakpoints.  On [0, 1/2] the variable is u itself; on
-[1/2, 1] it is y = u^(n+1), which absorbs the u^n peak exactly (u^n du = dy / (n + 1); the
-engine's "power" map, 000 eq. 20).  Every piece is integrated by globally adaptive 7/15
-Gauss-Kronrod quadrature with the smoothing substitution x = tau^2 (3 - 2 tau), which turns
-the square-root behaviour at the breakpoints into smooth functions.  The reported error is
+p = 1 only): these, and u = 1/2, are breakpoints.  On [0, 1/2] the variable is u itself; above
+it is z = -(n + 1) ln u, i.e. y = u^(n+1) = e^-z, which absorbs the u^n peak exactly
+(u^n du = e^-z dz / (n + 1); the engine's "power" map, 000 eq. 20, graded logarithmically); z
+stops at Z_MAX = 40, the rest is bounded and added to the error.  Above the horizon break z_s
+the arc shrinks on the scale of z_s itself (tiny near grazing), so that piece is cut at
+z_s (1 + 4^i).  Every piece is integrated by globally adaptive 10/21 Gauss-Kronrod quadrature
+(QUADPACK's qk21; ``RULE = "gk15"`` selects the engine's 7/15 rule) with a one-sided smoothing
+substitution (x = tau^2 at a square-root end, tau^2 (3 - 2 tau) at two), which turns the
+square-root behaviour at the breakpoints into smooth functions.  The reported error is
 the sum of |K - G| over the intervals plus a rounding term; on these smooth integrands it
 overestimates the true error by orders of magnitude (tested against mpmath and the
 independent references of ``tests/data``).
@@ -217,6 +221,8 @@ WG21 = np.zeros(21)
 WG21[1:10:2] = 0.5 * _WG10
 WG21[11::2] = 0.5 * _WG10[::-1]
 from .albedo import NODES as _NODES, WG as _WG, WK as _WK  # noqa: E402  (the engine's 7/15 rule)
+#: the rule of the 1-D path (measured and tested with "gk21": 90-190 evaluations per mu for the
+#: Phong family at rtol 1e-10)
 RULE = "gk21"
 
 
@@ -249,7 +255,6 @@ def _pieces(n, p, mu, s):  # pragma: no cover - compiled
     n1 = n + 1.0
     uz = math.exp(-Z_MAX / n1)
     skip = uz > 0.5
-    u_split = uz if skip else 0.5
     z_split = Z_MAX if skip else n1 * math.log(2.0)
     # breakpoints in u, and their z = -(n + 1) ln u to full precision
     ub = np.empty(2)
@@ -338,7 +343,8 @@ def _pieces(n, p, mu, s):  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True)
 def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, val, err, conv, evals):  # pragma: no cover
-    """Adaptive 7/15 Gauss-Kronrod of c * integral u^n K(u) du for every mu (without the scale)."""
+    """Adaptive Gauss-Kronrod (the rule ``nodes``, ``wk``, ``wg``) of integral u^n K(u) du for
+    every mu (without the scale)."""
     cap = max_intervals + 64
     pk = np.empty(cap, np.int64)
     t0 = np.empty(cap)
