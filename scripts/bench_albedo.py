@@ -19,6 +19,7 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
     python scripts/bench_albedo.py            # the family table and the cells
     python scripts/bench_albedo.py --all      # also the three measurements above
     python scripts/bench_albedo.py --cells    # only the sweep cells and the pumped tables
+    python scripts/bench_albedo.py --eval     # only BRDF.eval's overhead (the input checks)
 """
 
 import signal
@@ -206,14 +207,46 @@ def cells():
           f"previous engine {old * 1e3:.0f} ms, ratio {old / new:.2f}")
 
 
+def eval_overhead(n=1_000_000, repeat=9):
+    """BRDF.eval of Phong n = 20 (with the input checks) against its kernel (_eval) and against a plain
+    fused numpy expression of the same formula, on 1e6 pairs; best of ``repeat``."""
+    rng = np.random.default_rng(1)
+
+    def directions():
+        v = rng.normal(size=(n, 3))
+        v /= np.linalg.norm(v, axis=-1, keepdims=True)
+        v[:, 2] = np.abs(v[:, 2])
+        return v
+
+    wi, wo = directions(), directions()
+    f = pumpup.load({"type": "phong", "n": 20})
+    c, e = f.p["c"], f.p["n"]
+    f.eval(wi[:10], wo[:10])
+
+    def numpy_fused():
+        rv = 2 * wi[:, 2] * wo[:, 2] - (wi[:, 0] * wo[:, 0] + wi[:, 1] * wo[:, 1] + wi[:, 2] * wo[:, 2])
+        return np.where((wi[:, 2] > 0) & (wo[:, 2] > 0) & (rv > 0), c * np.maximum(rv, 0) ** e, 0.0)
+
+    _, t_eval = _best(lambda: f.eval(wi, wo), repeat)
+    _, t_kernel = _best(lambda: f._eval(wi, wo), repeat)
+    _, t_numpy = _best(numpy_fused, repeat)
+    print(f"Phong n = 20 on 1e6 pairs: eval {t_eval * 1e3:.1f} ms, _eval {t_kernel * 1e3:.1f} ms "
+          f"(eval / _eval = {t_eval / t_kernel:.2f}), fused numpy {t_numpy * 1e3:.1f} ms "
+          f"(numpy / eval = {t_numpy / t_eval:.2f})")
+
+
 def main():
     import os
 
     print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f} "
           f"on {os.cpu_count()} cores")
+    if "--eval" in sys.argv:
+        eval_overhead()
+        return
     if "--cells" not in sys.argv:
         families()
     cells()
+    eval_overhead()
     if "--all" in sys.argv:
         legacy()
 
