@@ -7,6 +7,7 @@ viewer, f_r without the cosine factor, mu = cos(theta_i)).
 from ._version import __version__
 from . import albedo as albedo_module
 from .albedo import albedo
+from . import _polar  # noqa: F401  (the 1-D albedo path; pumpup._polar.two_d_only() for the 2-D reference)
 from . import reproduce
 from . import testing
 from . import render

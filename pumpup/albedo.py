@@ -751,7 +751,15 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     value = np.zeros_like(flat)
     error = np.zeros_like(flat)
     ok = np.ones(flat.shape, bool)
+    from . import _polar
+
     for w, term in brdf.albedo_terms():
+        fast = _polar.albedo_1d(term, flat, rtol, atol, max_regions)  # closed-form azimuth, or None
+        if fast is not None:
+            value += w * fast[0]
+            error += abs(w) * fast[1]
+            ok &= fast[2]
+            continue
         for idx, g in _groups(term, flat):
             v, e, conv = _integrate_group(term, g, rtol, atol, max_regions)
             value[idx] += w * v

@@ -234,36 +234,25 @@ def slabs(shape: tuple, block: int):
 def as_directions(w: Any, name: str) -> np.ndarray:
     """Check that ``w`` holds unit 3-vectors on its last axis; return it as float64.
 
-    The check runs in blocks of :data:`CHECK_BLOCK` directions, so its temporaries do not grow
-    with the array (1e8 directions once allocated 1.5 GB of them)."""
+    The check is one compiled pass (``pumpup._checks.first_bad``) with no temporaries, so its memory
+    does not grow with the array (the numpy check once allocated 1.5 GB for 1e8 directions)."""
     try:
         a = np.asarray(w, dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{name} must be an array of unit 3-vectors: {exc}") from None
     if a.ndim == 0 or a.shape[-1] != 3:
         raise ValueError(f"{name} must have 3 components on its last axis, got shape {a.shape}")
-    for idx in slabs(a.shape[:-1], CHECK_BLOCK):
-        part = a[idx]
-        finite = np.isfinite(part).all(axis=-1)
-        norm = np.sqrt(np.einsum("...k,...k->...", part, part))
-        bad_finite = ~finite
-        bad = finite & (np.abs(norm - 1.0) > UNIT_TOL)
-        if bad_finite.any() or bad.any():
-            local = np.argwhere(bad_finite if bad_finite.any() else bad)[0]
-            glob = []
-            k = 0
-            for ix in idx:
-                if isinstance(ix, slice):
-                    glob.append(ix.start + int(local[k]))
-                    k += 1
-                else:
-                    glob.append(ix)
-            glob += [int(v) for v in local[k:]]
-            i = tuple(glob)
-            if bad_finite.any():
-                raise ValueError(f"{name} contains non-finite values (first at index {i})")
-            raise ValueError(f"{name} must be unit vectors (|w| = 1 within {UNIT_TOL:g}); "
-                             f"|{name}{list(i)}| = {float(norm[tuple(local)]):.9g}")
+    from ._checks import first_bad  # finiteness and unit length in one compiled pass
+
+    lead = a.shape[:-1]
+    bad_value, bad_norm = first_bad(a, UNIT_TOL)
+    if bad_value >= 0:
+        i = np.unravel_index(bad_value, lead) if lead else ()
+        raise ValueError(f"{name} contains non-finite values (first at index {tuple(int(k) for k in i)})")
+    if bad_norm >= 0:
+        i = tuple(int(k) for k in np.unravel_index(bad_norm, lead)) if lead else ()
+        norm = float(np.sqrt(np.sum(a[i] * a[i])))
+        raise ValueError(f"{name} must be unit vectors (|w| = 1 within {UNIT_TOL:g}); |{name}{list(i)}| = {norm:.9g}")
     return a
 
 
@@ -390,6 +379,11 @@ class BRDF:
     def albedo_terms(self) -> list[tuple[float, "BRDF"]]:
         """Linear decomposition f = sum w_k f_k used by the engine (default: itself)."""
         return [(1.0, self)]
+
+    def polar(self):
+        """A :class:`pumpup._polar.Polar` hint when the azimuth of the albedo integral is closed-form
+        (the engine then integrates one dimension, ``pumpup._polar``), else None (the default)."""
+        return None
 
 
 def split(w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._version import __version__
+from . import _reuse
 from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
 from .core import BRDF, SpecError, check_count, check_open_unit, check_tolerance
 
@@ -226,6 +227,7 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
         grid = np.unique(check_mu(np.atleast_1d(mu)).ravel())
         with _progress(len(grid), f"albedo {brdf.type}", progress) as bar:
             val, err = _chunked(brdf, grid, rtol, atol, bar, threads)
+        _reuse.remember(brdf, grid, val, err, rtol)  # for mean_albedo and max_albedo of this object
         return _dataset(brdf, grid, val, err, rtol, atol, 0.0, "given")
     check_mu(mu_min)
     grid = default_grid(mu_min=mu_min)
@@ -257,6 +259,7 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
             todo = near[:-1] | near[1:]
         if todo.any():
             interp_error = max(interp_error, float(miss.max()))
+    _reuse.remember(brdf, grid, val, err, rtol)
     return _dataset(brdf, grid, val, err, rtol, atol, interp_error, "adaptive")
 
 
@@ -526,6 +529,11 @@ def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False, m
     _check_brdf("mean_albedo", brdf)
     rtol = check_tolerance("mean_albedo", "rtol", rtol)
     max_intervals = check_count("mean_albedo", "max_intervals", max_intervals, 8, 10**6)
+    # a table of this object just computed: its values, the part below its smallest mu afresh
+    reused = _reuse.mean_from_table(
+        brdf, rtol, lambda mu_min, scale: _reuse.fresh_low(brdf, mu_min, 0.25 * rtol * scale, rtol / 10))
+    if reused is not None:
+        return reused if return_error else reused[0]
 
     def rule(a, b):
         tau = a[:, None] + (b - a)[:, None] * NODES[None, :]
@@ -594,7 +602,12 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
     theta = np.linspace(0, math.acos(mu_min), n_scan)
     mu = np.unique(np.concatenate([np.cos(theta), np.logspace(-1, math.log10(mu_min), 6), [1.0, mu_min]]))
     mu = mu[(mu >= mu_min) & (mu <= 1)]
-    a, e = albedo(f, mu, return_error=True, rtol=rtol)
+    # a table of this object just computed stands for the scan (fresh values below its smallest mu)
+    scan = _reuse.scan_from_table(brdf, f, mu, mu_min, lambda m: albedo(f, m, return_error=True, rtol=rtol))
+    if scan is not None:
+        mu, a, e = scan
+    else:
+        a, e = albedo(f, mu, return_error=True, rtol=rtol)
     i = int(np.argmax(a))
     best_mu, best_a, best_e = float(mu[i]), float(a[i]), float(e[i])
     if 0 < i < len(mu) - 1:
@@ -607,6 +620,10 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
         if -res.fun > best_a:
             best_mu = float(res.x)
             best_a, best_e = (float(v) for v in albedo(f, best_mu, return_error=True, rtol=rtol))
+        elif scan is not None:  # the table's value was computed at its own tolerance
+            best_a, best_e = (float(v) for v in albedo(f, best_mu, return_error=True, rtol=rtol))
+    elif scan is not None:
+        best_a, best_e = (float(v) for v in albedo(f, best_mu, return_error=True, rtol=rtol))
     at_boundary = i in (0, len(mu) - 1)
     return AlbedoMaximum(
         albedo=best_a,

@@ -7,9 +7,23 @@ Measures, on this machine:
 3. a generic ``from_function`` BRDF (a hand-written Phong n = 20) tabulated on 257 points
    to rtol 1e-6 by the generic adaptive cubature.
 
-    python scripts/bench_albedo.py
+First, for every built-in model family (issue 14): the time of a 257-point table (mu uniform in
+theta) at rtol 1e-10 on one thread (``pumpup.albedo`` on the 257 values, and ``pumpup.tabulate``
+with ``threads=1``), the integrand evaluations per value of mu, the path the engine takes (1-D:
+the closed-form azimuth of ``pumpup._polar``; 2-D: the cubature), and for the 1-D families the
+previous engine (the 2-D cubature, ``pumpup._polar.two_d_only()``) measured in the same run, with
+the ratio; then scipy ``dblquad`` at mu = 0.5 and epsrel 1e-10 per value (stopped after 60 s), and
+the sweep cell (257 mu + mean albedo + maximum constant) and the three tables of a 3-level g2
+pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs after a warm-up.
+
+    python scripts/bench_albedo.py            # the family table and the cells
+    python scripts/bench_albedo.py --all      # also the three measurements above
+    python scripts/bench_albedo.py --cells    # only the sweep cells and the pumped tables
+    python scripts/bench_albedo.py --eval     # only BRDF.eval's overhead (the input checks)
 """
 
+import signal
+import sys
 import time
 
 import numpy as np
@@ -31,7 +45,213 @@ def dblquad_albedo(f, mu, epsrel):
     return v, e
 
 
+FAMILIES = [
+    {"type": "phong", "n": 20},
+    {"type": "stretched_phong", "n": 20},
+    {"type": "stretched_phong", "n": 20, "p": 0.0},
+    {"type": "stretched_phong", "n": 5000},
+    {"type": "retro", "n": 10},
+    {"type": "phong_shader", "n": 20},
+    {"type": "lewis_phong", "n": 20},
+    {"type": "lafortune", "n": 20, "cx": 1.1, "cy": 1.1, "cz": 1.1, "p": 1.0},
+    {"type": "lafortune_sum", "n": [5.0, 50.0], "c": [0.2, 3.0]},
+    {"type": "lambert"},
+    {"type": "stretched_phong", "n": 20, "p": 0.5},
+    {"type": "blinn", "n": 16},
+    {"type": "stretched_blinn", "n": 8},
+    {"type": "phong_blinn", "n": 20},
+    {"type": "ward", "m": 0.1},
+    {"type": "modified_ward", "m": 0.1},
+    {"type": "ward_aniso", "ax": 0.1, "ay": 0.3},
+    {"type": "cook_torrance", "m": 0.3},
+    {"type": "torrance_sparrow", "d": "D1", "s": 20},
+    {"type": "schlick", "r": 0.2},
+    {"type": "beckmann", "alpha": 0.1},
+    {"type": "ggx", "alpha": 0.1},
+    {"type": "minnaert", "k": 1.0},
+    {"type": "oren_nayar"},
+    {"type": "lacquer"},
+    {"type": "plastic", "n": 20},
+]
+
+
+def _best(fn, repeat):
+    out, best = None, np.inf
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t)
+    return out, best
+
+
+def evaluations(f, mu, rtol):
+    """Integrand evaluations of pumpup.albedo(f, mu): the 1-D path's own count, the 2-D engine's
+    points counted at its accumulation step (once per sign of beta)."""
+    from pumpup import _polar
+
+    A = pumpup.albedo_module
+    count = [0]
+    orig = A._accumulate
+
+    def counting(fv, cos_o, weight, total):
+        count[0] += fv.shape[0]
+        return orig(fv, cos_o, weight, total)
+
+    A._accumulate = counting
+    try:
+        for _, term in f.albedo_terms():
+            fast = _polar.albedo_1d(term, mu, rtol, 1e-14, 20000)
+            if fast is not None:
+                count[0] += int(fast[3].sum())
+            else:
+                pumpup.albedo(term, mu, rtol=rtol)
+    finally:
+        A._accumulate = orig
+    return count[0] / len(mu)
+
+
+class _Timeout(Exception):
+    pass
+
+
+def _alarm(signum, frame):
+    raise _Timeout
+
+
+def dblquad_seconds(f, mu, epsrel, limit=60):
+    """Seconds of one dblquad albedo (None after ``limit`` seconds)."""
+    signal.signal(signal.SIGALRM, _alarm)
+    signal.alarm(limit)
+    t = time.perf_counter()
+    try:
+        dblquad_albedo(f, mu, epsrel)
+    except _Timeout:
+        return None
+    finally:
+        signal.alarm(0)
+    return time.perf_counter() - t
+
+
+def families(rtol=1e-10):
+    from pumpup import _polar
+
+    mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
+    print(f"257-point tables at rtol {rtol:g}, one thread (ms); evaluations per mu; previous = the 2-D engine")
+    print(f"{'model':58s} {'path':4s} {'albedo':>9s} {'tabulate':>9s} {'evals/mu':>9s} "
+          f"{'previous':>9s} {'evals/mu':>9s} {'ratio':>7s} {'dblquad/value':>14s} {'x per value':>11s}")
+    for spec in FAMILIES:
+        f = pumpup.load(spec)
+        one_d = all(t.polar() is not None for _, t in f.albedo_terms())
+        repeat = 3 if one_d else 1
+        pumpup.albedo(f, [0.5, 1e-3])  # compile / load the kernels
+        _, t_new = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), repeat)
+        _, t_tab = _best(lambda: pumpup.tabulate(f, mu=mu, rtol=rtol, threads=1, progress=False), repeat)
+        ev = evaluations(f, mu, rtol)
+        if one_d:
+            with _polar.two_d_only():
+                pumpup.albedo(f, [0.5, 1e-3])
+                _, t_old = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), 1)
+                ev_old = evaluations(f, mu, rtol)
+            old = f"{t_old * 1e3:9.1f} {ev_old:9.0f} {t_old / t_new:7.0f}"
+        else:
+            old = f"{'(same)':>9s} {'':9s} {1.0:7.0f}"
+        td = dblquad_seconds(f, 0.5, rtol) if spec["type"] not in ("lafortune_sum",) else None
+        per_value = t_new / len(mu)
+        dq = f"{td:14.3f} {td / per_value:11.0f}" if td is not None else f"{'> 60 s':>14s} {'':11s}"
+        shown = {k: v for k, v in spec.items()}
+        print(f"{str(shown)[:58]:58s} {'1-D' if one_d else '2-D':4s} {t_new * 1e3:9.1f} {t_tab * 1e3:9.1f} "
+              f"{ev:9.0f} {old} {dq}", flush=True)
+
+
+def cells():
+    from pumpup import _polar, _reuse
+    from pumpup.pump import _TABLES
+    from pumpup.sweep import default_mu
+
+    mu = default_mu(257)
+
+    def cell(spec):
+        f = pumpup.load(spec)
+        t = time.perf_counter()
+        pumpup.tabulate(f, mu=mu, threads=1, progress=False)
+        pumpup.mean_albedo(f)
+        pumpup.max_albedo(f)
+        return time.perf_counter() - t
+
+    def pumped(n):
+        _TABLES.clear()
+        t = time.perf_counter()
+        g = pumpup.pump({"type": "phong", "n": n}, g="g2", levels=3)
+        for lev in g.chain():
+            lev.lookup()
+        return time.perf_counter() - t
+
+    for spec in [{"type": "stretched_phong", "n": 20}, {"type": "stretched_phong", "n": 20, "p": 0.5},
+                 {"type": "blinn", "n": 16}]:
+        cell(spec)
+        new = min(cell(spec) for _ in range(3))
+        recall = _reuse.recall
+        _reuse.recall = lambda brdf: None  # the previous engine: no reuse of the table either
+        try:
+            with _polar.two_d_only():
+                old = cell(spec)
+        finally:
+            _reuse.recall = recall
+        print(f"sweep cell (257 mu + mean albedo + maximum constant, one thread) {spec}: {new * 1e3:.1f} ms, "
+              f"previous engine {old * 1e3:.1f} ms, ratio {old / new:.1f}", flush=True)
+    pumped(21)  # the first build in the process loads the compiled kernels
+    new = min(pumped(20) for _ in range(2))
+    with _polar.two_d_only():
+        old = pumped(20)
+    print(f"3-level g2 pumped Phong n = 20, its three tables (tabulate's threads): {new * 1e3:.0f} ms, "
+          f"previous engine {old * 1e3:.0f} ms, ratio {old / new:.2f}")
+
+
+def eval_overhead(n=1_000_000, repeat=9):
+    """BRDF.eval of Phong n = 20 (with the input checks) against its kernel (_eval) and against a plain
+    fused numpy expression of the same formula, on 1e6 pairs; best of ``repeat``."""
+    rng = np.random.default_rng(1)
+
+    def directions():
+        v = rng.normal(size=(n, 3))
+        v /= np.linalg.norm(v, axis=-1, keepdims=True)
+        v[:, 2] = np.abs(v[:, 2])
+        return v
+
+    wi, wo = directions(), directions()
+    f = pumpup.load({"type": "phong", "n": 20})
+    c, e = f.p["c"], f.p["n"]
+    f.eval(wi[:10], wo[:10])
+
+    def numpy_fused():
+        rv = 2 * wi[:, 2] * wo[:, 2] - (wi[:, 0] * wo[:, 0] + wi[:, 1] * wo[:, 1] + wi[:, 2] * wo[:, 2])
+        return np.where((wi[:, 2] > 0) & (wo[:, 2] > 0) & (rv > 0), c * np.maximum(rv, 0) ** e, 0.0)
+
+    _, t_eval = _best(lambda: f.eval(wi, wo), repeat)
+    _, t_kernel = _best(lambda: f._eval(wi, wo), repeat)
+    _, t_numpy = _best(numpy_fused, repeat)
+    print(f"Phong n = 20 on 1e6 pairs: eval {t_eval * 1e3:.1f} ms, _eval {t_kernel * 1e3:.1f} ms "
+          f"(eval / _eval = {t_eval / t_kernel:.2f}), fused numpy {t_numpy * 1e3:.1f} ms "
+          f"(numpy / eval = {t_numpy / t_eval:.2f})")
+
+
 def main():
+    import os
+
+    print(f"load average {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f} "
+          f"on {os.cpu_count()} cores")
+    if "--eval" in sys.argv:
+        eval_overhead()
+        return
+    if "--cells" not in sys.argv:
+        families()
+    cells()
+    eval_overhead()
+    if "--all" in sys.argv:
+        legacy()
+
+
+def legacy():
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     f = pumpup.load({"type": "stretched_phong", "n": 5000})
     pumpup.albedo(f, 0.5)  # load the compiled kernels

@@ -46,3 +46,9 @@ class Lambert(BRDF):
 
     def lobe(self, mu):
         return Lobe(axis="normal", radial="cosine")
+
+    def polar(self):
+        from .._polar import Polar
+
+        a = self.p["albedo"]
+        return Polar(kind="constant", scale=lambda mu: np.full(np.shape(mu), a))  # albedo / pi * pi

@@ -78,6 +78,21 @@ class Phong(BRDF):
     def lobe(self, mu):
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"])
 
+    def polar(self):
+        return _polar_hint(self.p["n"], 0.0, self.p["c"])
+
+
+def _polar_hint(n, p, c, per_mu=None):
+    """The closed-form-azimuth hint (pumpup._polar) of a lobe c u^n / max(N.L, N.V)^p with p in
+    {0, 1}; ``per_mu(mu)`` multiplies c (Phong's shader: 1 / mu).  None for other p."""
+    from .._polar import Polar
+
+    if p not in (0.0, 1.0):
+        return None
+    if per_mu is None:
+        return Polar(n=n, p=int(p), scale=lambda mu: np.full(np.shape(mu), c))
+    return Polar(n=n, p=int(p), scale=lambda mu: c * per_mu(mu))
+
 
 # --- stretched Phong / p-model ------------------------------------------------------------
 
@@ -141,6 +156,9 @@ class StretchedPhong(BRDF):
         levels = (mu,) if self.p["p"] > 0 else ()
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"], levels=levels)
 
+    def polar(self):
+        return _polar_hint(self.p["n"], self.p["p"], self.p["c"])  # 000 eq. 7, 12 with p in {0, 1}
+
 
 # --- retro-reflective ---------------------------------------------------------------------
 
@@ -189,6 +207,10 @@ class Retro(BRDF):
     def lobe(self, mu):
         levels = (mu,) if self.p["p"] > 0 else ()
         return Lobe(axis="retro", radial="power", sharpness=self.p["n"], levels=levels)
+
+    def polar(self):
+        # around wi, N.wo = mu u + s sqrt(1 - u^2) cos(beta) as around R: the same 1-D integral
+        return _polar_hint(self.p["n"], self.p["p"], self.p["c"])  # 000 eq. 13
 
 
 # --- Phong's original shader as a BRDF (not reciprocal) ------------------------------------
@@ -244,6 +266,11 @@ class PhongShader(BRDF):
 
     def lobe(self, mu):
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"])
+
+    def polar(self):
+        if self.p["kd"] != 0:
+            return None  # albedo_terms splits off the diffuse part
+        return _polar_hint(self.p["n"], 0.0, self.p["ks"], per_mu=lambda mu: 1.0 / mu)  # 002 eq. 5, 8
 
 
 def load_lambert():

@@ -1,0 +1,49 @@
+"""Input checks of directions in one compiled pass (used by :func:`pumpup.core.as_directions`).
+
+The plain numpy version, :func:`first_bad_reference`, is the readable twin of the kernel; the
+tests check that the two find the same rows.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, nogil=True)
+def _first_bad(a, tol):  # pragma: no cover - compiled; see first_bad_reference
+    """(row of the first non-finite component or -1, row of the first |w| off 1 by more than tol or
+    -1; -1 when a row is not finite) of an (N, 3) array, in one pass."""
+    bad_norm = -1
+    lo2 = (1.0 - tol) * (1.0 - tol)  # |w| in [1 - tol, 1 + tol]  <=>  |w|^2 in [lo2, hi2]
+    hi2 = (1.0 + tol) * (1.0 + tol)
+    for i in range(a.shape[0]):
+        x, y, z = a[i, 0], a[i, 1], a[i, 2]
+        n2 = x * x + y * y + z * z
+        if not (lo2 <= n2 <= hi2):  # also every row with a NaN or an infinity
+            if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+                return i, -1
+            if bad_norm < 0:
+                bad_norm = i
+    return -1, bad_norm
+
+
+def first_bad_reference(a: np.ndarray, tol: float) -> tuple[int, int]:
+    """The same as the kernel, in numpy: (first non-finite row or -1, first non-unit row or -1)."""
+    fin = np.all(np.isfinite(a), axis=-1)
+    if not fin.all():
+        return int(np.argmin(fin)), -1
+    bad = np.abs(np.sqrt(np.einsum("...k,...k->...", a, a)) - 1.0) > tol
+    return -1, (int(np.argmax(bad)) if bad.any() else -1)
+
+
+def first_bad(a: np.ndarray, tol: float) -> tuple[int, int]:
+    """(first non-finite row, first non-unit row), -1 where none, of the rows of ``a`` (..., 3),
+    counted in C order over the leading axes."""
+    flat = a.reshape(-1, 3)
+    if not flat.flags.c_contiguous:
+        flat = np.ascontiguousarray(flat)
+    i, j = _first_bad(flat, tol)
+    return int(i), int(j)

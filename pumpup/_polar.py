@@ -1,0 +1,435 @@
+"""One-dimensional albedo where the azimuth integrates in closed form (the Phong family).
+
+Method
+------
+For a lobe that is a power of cos(alpha) = u around the mirror direction R (reciprocal Phong,
+stretched Phong / the p-model with p in {0, 1}, Phong's original shader, Lewis's Phong,
+isotropic Lafortune lobes) or around wi itself (the retro-reflective model, Lafortune with
+cx = cy = -cz), write the outgoing direction in the lobe frame,
+wo = A u + sqrt(1 - u^2) (e1 cos(beta) + e2 sin(beta)).  In both frames
+
+    N.wo = a + b cos(beta),   a = mu u,   b = s sqrt(1 - u^2),   s = sqrt(1 - mu^2)
+
+(the frame the 2-D engine uses, ``pumpup.albedo``).  The integrand f_r cos(theta_o) depends on
+beta only through N.wo, so for every u the integral over the visible arc |beta| < beta0
+(N.wo > 0) is elementary:
+
+* p = 0, f = c u^n:  integral (a + b cos beta) d beta = 2 (a beta0 + b sin beta0);
+* p = 1, f = c u^n / max(mu, N.wo) (000 eq. 7, 10, 13): the arc |beta| < beta1 where
+  N.wo >= mu contributes its length, the rest N.wo / mu:
+  2 [beta1 + (a (beta0 - beta1) + b (sin beta0 - sin beta1)) / mu]
+
+(the same closed form as Lewis's H_s, 002 sec. 4.1, and as ``phong_1d`` of
+``scripts/independent_reference.py``).  With b^2 - a^2 = sin^2(alpha) - mu^2 and
+b^2 - (mu - a)^2 = (1 - u)(u - cos 2 theta_i) the sines and angles are computed without
+cancellation, and b (sin beta0 - sin beta1) as mu^2 (1 - 2u) / (b sin beta0 + b sin beta1).
+
+This leaves a(mu) = c * integral_0^1 u^n K(u) du.  Its kinks are where the arc starts to be
+cut by the horizon (u = s) and where the level N.wo = mu leaves the circle (u = cos 2 theta_i,
+p = 1 only): these, and u = 1/2, are breakpoints.  On [0, 1/2] the variable is u itself; above
+it is z = -(n + 1) ln u, i.e. y = u^(n+1) = e^-z, which absorbs the u^n peak exactly
+(u^n du = e^-z dz / (n + 1); the engine's "power" map, 000 eq. 20, graded logarithmically); z
+stops at Z_MAX = 40, the rest is bounded and added to the error.  Above the horizon break z_s
+the arc shrinks on the scale of z_s itself (tiny near grazing), so that piece is cut at
+z_s (1 + 4^i).  Every piece is integrated by globally adaptive 10/21 Gauss-Kronrod quadrature
+(QUADPACK's qk21; ``RULE = "gk15"`` selects the engine's 7/15 rule) with a one-sided smoothing
+substitution (x = tau^2 at a square-root end, tau^2 (3 - 2 tau) at two), which turns the
+square-root behaviour at the breakpoints into smooth functions.  The reported error is
+the sum of |K - G| over the intervals plus a rounding term; on these smooth integrands it
+overestimates the true error by orders of magnitude (tested against mpmath and the
+independent references of ``tests/data``).
+
+A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
+:class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D
+engine stays the reference: :func:`two_d_only` switches the 1-D path off.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+__all__ = ["Polar", "albedo_1d", "two_d_only", "integrand_reference"]
+
+#: the 1-D path is used when a model offers it (``two_d_only`` switches it off)
+ENABLED = True
+
+#: relative rounding error of the 1-D quadrature (per unit of sum |K|): the integrand is a few
+#: elementary functions of u, accurate to a few ulp, summed over a few hundred nodes
+ROUNDING = 64.0 * np.finfo(float).eps
+
+#: initial subintervals of every piece
+N_INIT = 2
+
+
+@dataclass(frozen=True)
+class Polar:
+    """A model's closed-form-azimuth hint for :func:`albedo_1d`.
+
+    a(mu) = scale(mu) * integral over the hemisphere of u^n / max(mu, N.wo)^p cos(theta_o)
+    d omega_o, u = (A.wo)_+ with A the mirror direction of wi or wi itself (the integral is the
+    same for both), or, for ``kind="constant"``, a(mu) = scale(mu) exactly.
+
+    Parameters
+    ----------
+    n : float, >= 0
+        Exponent of the lobe.
+    p : {0, 1}
+        Power of max(N.L, N.V) in the denominator.
+    scale : callable
+        ``scale(mu) -> ndarray`` of the same shape: the constant of the model (c, c C^n for a
+        Lafortune lobe, k_s / mu for Phong's shader, k_rho / H_s(mu) for Lewis's Phong).
+    kind : {"lobe", "constant"}
+    """
+
+    n: float = 0.0
+    p: int = 0
+    scale: object = None
+    kind: str = "lobe"
+
+
+@contextlib.contextmanager
+def two_d_only():
+    """Within the block, ``pumpup.albedo`` ignores the 1-D path and uses the 2-D engine (the
+    reference; the benchmark and the tests use it).  Not meant for concurrent toggling."""
+    global ENABLED
+    old = ENABLED
+    ENABLED = False
+    try:
+        yield
+    finally:
+        ENABLED = old
+
+
+# --- the integrand ----------------------------------------------------------------------------
+
+
+@njit(cache=True, nogil=True)
+def _k_of_u(p, mu, c2, u, um, sa):  # pragma: no cover - compiled; see integrand_reference
+    """K(u): the integral over the visible arc of N.wo / max(mu, N.wo)^p (p in {0, 1}), for
+    u = cos(alpha), um = 1 - u, sa = sin(alpha); c2 = cos(2 theta_i)."""
+    a = mu * u
+    d0 = (sa - mu) * (sa + mu)  # b^2 - a^2 = sin^2(alpha) - mu^2
+    if d0 > 0.0:
+        bs0 = math.sqrt(d0)  # b sin(beta0)
+        beta0 = math.atan2(bs0, -a)  # cos(beta0) = -a / b
+    else:
+        bs0 = 0.0
+        beta0 = math.pi
+    if p == 0:
+        return 2.0 * (a * beta0 + bs0)  # 2 (a beta0 + b sin beta0)
+    d1 = um * (u - c2)  # b^2 - (mu - a)^2
+    if d1 > 0.0:
+        bs1 = math.sqrt(d1)
+        beta1 = math.atan2(bs1, mu * um)  # cos(beta1) = (mu - a) / b
+    else:
+        bs1 = 0.0
+        beta1 = 0.0
+    if bs0 > 0.0 and bs1 > 0.0:
+        diff = mu * mu * (1.0 - 2.0 * u) / (bs0 + bs1)  # b sin(beta0) - b sin(beta1), no cancellation
+    else:
+        diff = bs0 - bs1
+    return 2.0 * (beta1 + (a * (beta0 - beta1) + diff) / mu)  # 000 eq. 7: N.wo / max(mu, N.wo)
+
+
+def integrand_reference(n: float, p: int, mu: float, u: np.ndarray) -> np.ndarray:
+    """Plain numpy u^n K(u), straight from the arccos form (the readable twin of the kernel).
+
+    K(u) = J(a, b) for p = 0 and (J(a, b) - J(a - mu, b)) / mu for p = 1, with
+    J(a, b) = integral over beta of (a + b cos beta)_+ = 2 (a acos(-a/b) + b sin(acos(-a/b))),
+    a = mu u, b = s sqrt(1 - u^2).
+    """
+    u = np.asarray(u, dtype=np.float64)
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    b = s * np.sqrt((1.0 - u) * (1.0 + u))
+
+    def J(a):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            al = np.arccos(np.clip(-a / b, -1.0, 1.0))
+        out = 2.0 * (a * al + b * np.sin(al))
+        return np.where(a >= b, 2.0 * np.pi * a, np.where(a <= -b, 0.0, out))
+
+    a = mu * u
+    k = J(a) if p == 0 else (J(a) - J(a - mu)) / mu
+    return u**n * k
+
+
+@njit(cache=True, nogil=True)
+def _smoothing(sm, tau):  # pragma: no cover - compiled
+    """(x, 1 - x, dx/dtau) of the smoothing substitution on [0, 1]: sm = 0 none, 1 at the left
+    end (x = tau^2), 2 at the right end (1 - x = (1 - tau)^2), 3 at both (x = tau^2 (3 - 2 tau))."""
+    tc = 1.0 - tau
+    if sm == 0:
+        return tau, tc, 1.0
+    if sm == 1:
+        return tau * tau, tc * (1.0 + tau), 2.0 * tau
+    if sm == 2:
+        return tau * (1.0 + tc), tc * tc, 2.0 * tc
+    return tau * tau * (3.0 - 2.0 * tau), tc * tc * (1.0 + 2.0 * tau), 6.0 * tau * tc
+
+
+@njit(cache=True, nogil=True)
+def _point(kind, sm, n, p, mu, c2, v0, w, cv1, tau):  # pragma: no cover - compiled
+    """Integrand per d tau at tau in [0, 1] of a piece.
+
+    kind 0: u = v0 + w X in [0, 1/2], value u^n K(u) w dX;
+    kind 1: y = u^(n+1) in [v0, v0 + w], 1 - y = cv1 + w (1 - X), value K(u) w dX / (n + 1);
+    X(tau) is the smoothing substitution ``sm`` (:func:`_smoothing`) at the ends where K has a
+    square-root behaviour.
+    """
+    x, xc, dx = _smoothing(sm, tau)
+    if kind == 0:
+        u = v0 + w * x
+        um = 1.0 - u
+        sa = math.sqrt(um * (1.0 + u))
+        un = u**n if n > 0.0 else 1.0
+        return un * _k_of_u(p, mu, c2, u, um, sa) * w * dx
+    z = v0 + w * x if x < 0.5 else cv1 - w * xc  # z = -(n + 1) ln u, from the nearer end
+    lu = -z / (n + 1.0)
+    u = math.exp(lu)
+    um = -math.expm1(lu)
+    sa = math.sqrt(um * (1.0 + u))
+    return math.exp(-z) * _k_of_u(p, mu, c2, u, um, sa) * w * dx / (n + 1.0)  # u^n du = e^-z dz / (n + 1)
+
+
+# Gauss-Kronrod 10/21 on [-1, 1] (QUADPACK qk21): Kronrod nodes, their weights, and the weights of
+# the embedded 10-point Gauss rule on the odd nodes
+_XGK21 = np.array([
+    0.995657163025808080735527280689003, 0.973906528517171720077964012084452,
+    0.930157491355708226001207180059508, 0.865063366688984510732096688423493,
+    0.780817726586416897063717578345042, 0.679409568299024406234327365114874,
+    0.562757134668604683339000099272694, 0.433395394129247190799265943165784,
+    0.294392862701460198131126603103866, 0.148874338981631210884826001129720, 0.0])
+_WGK21 = np.array([
+    0.011694638867371874278064396062192, 0.032558162307964727478818972459390,
+    0.054755896574351996031381300244580, 0.075039674810919952767043140916190,
+    0.093125454583697605535065465083366, 0.109387158802297641899210590325805,
+    0.123491976262065851077482296703034, 0.134709217311473325928054001771707,
+    0.142775938577060080797094273138717, 0.147739104901338491374841515972068,
+    0.149445554002916905664936468389821])
+_WG10 = np.array([0.066671344308688137593568809893332, 0.149451349150580593145776339657697,
+                  0.219086362515982043995534934228163, 0.269266719309996355091226921569469,
+                  0.295524224714752870173892994651338])
+#: the 21-point rule on [0, 1]
+NODES21 = 0.5 * (1.0 + np.concatenate([-_XGK21[:-1], _XGK21[::-1]]))
+WK21 = 0.5 * np.concatenate([_WGK21[:-1], _WGK21[::-1]])
+WG21 = np.zeros(21)
+WG21[1:10:2] = 0.5 * _WG10
+WG21[11::2] = 0.5 * _WG10[::-1]
+from .albedo import NODES as _NODES, WG as _WG, WK as _WK  # noqa: E402  (the engine's 7/15 rule)
+#: the rule of the 1-D path (measured and tested with "gk21": 90-190 evaluations per mu for the
+#: Phong family at rtol 1e-10)
+RULE = "gk21"
+
+
+@njit(cache=True, nogil=True)
+def _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg):  # pragma: no cover - compiled
+    h = t1 - t0
+    k = 0.0
+    g = 0.0
+    for j in range(nodes.shape[0]):
+        f = _point(kind, sm, n, p, mu, c2, v0, w, cv1, t0 + h * nodes[j])
+        k += wk[j] * f
+        g += wg[j] * f
+    return k * h, abs(k - g) * h
+
+
+#: the peak variable z = -(n + 1) ln u runs at most to Z_MAX: below u = exp(-Z_MAX / (n + 1)) the
+#: integral of u^n K(u) is at most 2 pi e^-Z_MAX / (n + 1) (K <= 2 pi), added to the error
+Z_MAX = 40.0
+
+
+@njit(cache=True, nogil=True)
+def _pieces(n, p, mu, s):  # pragma: no cover - compiled
+    """The pieces between the breakpoints u = 0, 1/2, s, cos 2 theta_i, 1: (kind, smoothing, v0, w,
+    v1) each, c2 = cos 2 theta_i and a bound of the part left out.
+
+    kind 0: u in [v0, v1 = v0 + w] (u <= 1/2); kind 1: z = -(n + 1) ln u in [v0, v1].  Where
+    exp(-Z_MAX / (n + 1)) > 1/2 the range of u below it is left out (its bound is returned).
+    """
+    c2 = (mu - s) * (mu + s)
+    n1 = n + 1.0
+    uz = math.exp(-Z_MAX / n1)
+    skip = uz > 0.5
+    z_split = Z_MAX if skip else n1 * math.log(2.0)
+    # breakpoints in u, and their z = -(n + 1) ln u to full precision
+    ub = np.empty(2)
+    zb = np.empty(2)
+    kb = np.empty(2, np.int64)  # 0: horizon (sqrt below), 1: level mu (sqrt above)
+    m = 0
+    if 0.0 < s < 1.0:
+        ub[m] = s
+        zb[m] = -0.5 * n1 * math.log1p(-mu * mu)
+        kb[m] = 0
+        m += 1
+    if p == 1 and 0.0 < c2 < 1.0:
+        ub[m] = c2
+        zb[m] = -n1 * math.log1p(-2.0 * s * s)
+        kb[m] = 1
+        m += 1
+    # tail pieces (increasing u) then peak pieces (increasing z = decreasing u)
+    size = 64
+    kinds = np.empty(size, np.int64)
+    sms = np.empty(size, np.int64)
+    v0 = np.empty(size)
+    w = np.empty(size)
+    v1 = np.empty(size)
+    k = 0
+    if not skip:
+        cuts = [0.0]
+        kc = [-1]
+        for j in range(m):
+            if ub[j] < 0.5:
+                cuts.append(ub[j])
+                kc.append(kb[j])
+        cuts.append(0.5)
+        kc.append(-1)
+        order = np.argsort(np.array(cuts))
+        for j in range(len(cuts) - 1):
+            lo, hi = cuts[order[j]], cuts[order[j + 1]]
+            if hi > lo:
+                left = p == 1 and kc[order[j]] == 1
+                right = kc[order[j + 1]] == 0
+                kinds[k] = 0
+                sms[k] = (1 if left else 0) + (2 if right else 0)
+                v0[k] = lo
+                w[k] = hi - lo
+                v1[k] = hi
+                k += 1
+    cuts = [0.0]
+    kc = [-2]  # z = 0: u = 1, a square-root end for p = 1
+    for j in range(m):
+        if zb[j] < z_split:
+            cuts.append(zb[j])
+            kc.append(kb[j])
+    cuts.append(z_split)
+    kc.append(-1)
+    order = np.argsort(np.array(cuts))
+    for j in range(len(cuts) - 1):
+        lo, hi = cuts[order[j]], cuts[order[j + 1]]
+        if hi > lo:
+            # in z the horizon's square root lies above z_s, the level's below z_c
+            left = kc[order[j]] == 0 or (p == 1 and kc[order[j]] == -2)
+            right = p == 1 and kc[order[j + 1]] == 1
+            # above the horizon break z_s the arc shrinks from the full circle to half of it on
+            # the scale of z_s itself (sin(alpha) ~ mu): near grazing z_s is tiny, and the piece
+            # is cut at z_s (1 + 4^i) so that no first interval hides that feature
+            a = lo
+            if kc[order[j]] == 0:
+                step = lo
+                while a + step < hi - step and k < kinds.shape[0] - 1:
+                    kinds[k] = 1
+                    sms[k] = 1 if a == lo else 0
+                    v0[k] = a
+                    w[k] = step
+                    v1[k] = a + step
+                    k += 1
+                    a = a + step
+                    step = 3.0 * a - 3.0 * lo  # cuts at lo (1 + 4^i)
+                left = a == lo
+            kinds[k] = 1
+            sms[k] = (1 if left else 0) + (2 if right else 0)
+            v0[k] = a
+            w[k] = hi - a
+            v1[k] = hi
+            k += 1
+    left_out = 2.0 * math.pi * math.exp(-Z_MAX) / n1 if skip else 0.0
+    return kinds[:k], sms[:k], v0[:k], w[:k], v1[:k], c2, left_out
+
+
+@njit(cache=True, nogil=True)
+def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, val, err, conv, evals):  # pragma: no cover
+    """Adaptive Gauss-Kronrod (the rule ``nodes``, ``wk``, ``wg``) of integral u^n K(u) du for
+    every mu (without the scale)."""
+    cap = max_intervals + 64
+    pk = np.empty(cap, np.int64)
+    t0 = np.empty(cap)
+    t1 = np.empty(cap)
+    kv = np.empty(cap)
+    ke = np.empty(cap)
+    for q in range(mu_arr.shape[0]):
+        mu = mu_arr[q]
+        s = math.sqrt((1.0 - mu) * (1.0 + mu))
+        kinds, sms, v0, w, cv1, c2, left_out = _pieces(n, p, mu, s)
+        m = 0
+        for i in range(kinds.shape[0]):
+            if w[i] <= 0.0:
+                continue
+            for j in range(N_INIT):
+                pk[m] = i
+                t0[m] = j / N_INIT
+                t1[m] = (j + 1.0) / N_INIT
+                kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg)
+                m += 1
+        start = m
+        ok = False
+        while True:
+            tot = 0.0
+            e = left_out
+            ab = 0.0
+            worst = 0
+            for j in range(m):
+                tot += kv[j]
+                e += ke[j]
+                ab += abs(kv[j])
+                if ke[j] > ke[worst]:
+                    worst = j
+            r = rounding * ab
+            if e <= max(rtol * abs(tot), atol_arr[q]):
+                ok = True
+                break
+            if e <= r:  # below the rounding error of the integrand: refining cannot help
+                ok = True
+                break
+            if m - start >= max_intervals or m >= cap:
+                break
+            i = pk[worst]
+            a_, b_ = t0[worst], t1[worst]
+            mid = 0.5 * (a_ + b_)
+            t1[worst] = mid
+            kv[worst], ke[worst] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg)
+            pk[m] = i
+            t0[m] = mid
+            t1[m] = b_
+            kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg)
+            m += 1
+        val[q] = tot
+        err[q] = e + r
+        conv[q] = ok
+        evals[q] = nodes.shape[0] * (m + (m - start))  # every split evaluates two halves
+
+
+_RULES = {"gk15": (_NODES, _WK, _WG), "gk21": (NODES21, WK21, WG21)}
+
+
+def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
+    """(value, error, converged, evaluations) of the albedo of ``brdf`` at every mu (a 1-D float
+    array), or None when the model has no :class:`Polar` hint (or the 1-D path is off)."""
+    if not ENABLED:
+        return None
+    polar = getattr(brdf, "polar", None)
+    hint = polar() if polar is not None else None
+    if hint is None:
+        return None
+    mu = np.ascontiguousarray(mu, dtype=np.float64)
+    scale = np.broadcast_to(np.asarray(hint.scale(mu), dtype=np.float64), mu.shape)
+    if not np.all(np.isfinite(scale)):
+        return None  # (an overflowing constant) the 2-D engine reports what the model returns
+    if hint.kind == "constant":
+        return scale.copy(), 4.0 * np.finfo(float).eps * np.abs(scale), np.ones(mu.shape, bool), np.zeros(mu.shape, np.int64)
+    if hint.p not in (0, 1):
+        raise ValueError(f"{brdf!r}: a Polar hint needs p in {{0, 1}}, got {hint.p!r}")
+    val = np.empty(mu.shape)
+    err = np.empty(mu.shape)
+    conv = np.empty(mu.shape, bool)
+    evals = np.empty(mu.shape, np.int64)
+    # atol applies to the scaled albedo: per mu, atol / scale for the unscaled integral
+    with np.errstate(divide="ignore"):
+        atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
+    _integrate(float(hint.n), int(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
+               *(_RULES[RULE]), val, err, conv, evals)
+    return scale * val, np.abs(scale) * err, conv, evals

@@ -1,0 +1,149 @@
+"""The 1-D albedo path (closed-form azimuth, pumpup/_polar.py) against its numpy reference, the
+independent 1-D mpmath quadrature, the 2-D engine, and closed forms; its error estimate bounds the
+true error at every tolerance tested."""
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+from helpers import phong_albedo_1d
+
+import pumpup
+from pumpup import _polar
+
+# grazing, the breakpoints' special cases (mu = 1/2: s = cos 30 deg; 1/sqrt(2): cos 2 theta = 0;
+# sqrt(3)/2: s = 1/2, the split of the tail), and ordinary angles
+MU = [1.0, 0.99, 0.9, math.sqrt(3) / 2, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8]
+
+
+class _Lobe:
+    """A bare lobe c u^n / max(mu, N.wo)^p with c = (n + 2) / (2 pi), as the mpmath reference has it."""
+
+    def __init__(self, n, p):
+        self.n, self.p = n, p
+
+    def polar(self):
+        c = (self.n + 2) / (2 * math.pi)
+        return _polar.Polar(n=self.n, p=self.p, scale=lambda mu: np.full(np.shape(mu), c))
+
+
+def test_kernel_integrand_matches_numpy_reference(rng):
+    for n in (0.0, 1.0, 20.0, 5000.0):
+        for p in (0, 1):
+            for mu in (1.0, 0.9, 0.5, 0.1, 1e-4, 1e-8):
+                s = math.sqrt((1 - mu) * (1 + mu))
+                c2 = (mu - s) * (mu + s)
+                u = np.concatenate([rng.uniform(0, 1, 200), [0.0, 0.5, 1.0, s, max(c2, 0.0)]])
+                ref = _polar.integrand_reference(n, p, mu, u)
+                got = np.array([(v**n if n else 1.0) * _polar._k_of_u(p, mu, c2, v, 1.0 - v, math.sqrt((1 - v) * (1 + v)))
+                                for v in u])
+                # the reference's arccos form loses digits near the arc's ends (and p = 1 divides by mu)
+                np.testing.assert_allclose(got, ref, rtol=1e-9, atol=1e-9 * max(1.0, 1.0 / mu) * np.max(np.abs(ref)))
+
+
+@pytest.mark.parametrize("n,p", [(0, 0), (1, 1), (20, 0), (20, 1), (5000, 1), (1e5, 0)])
+def test_against_mpmath_with_honest_error(n, p):
+    mu = np.array(MU)
+    for rtol in (1e-10, 1e-6):
+        a, e, conv, evals = _polar.albedo_1d(_Lobe(n, p), mu, rtol, 1e-14, 20000)
+        assert conv.all()
+        for m, v, err in zip(MU, a, e):
+            ref, ref_err = phong_albedo_1d(n, m, stretched=bool(p))
+            assert abs(v - ref) <= err + ref_err, (n, p, m, rtol, v, ref, err)  # the estimate bounds the truth
+            assert err <= max(rtol * abs(v), 1e-14) * 1.0001 or err <= 64 * 2.3e-16 * abs(v) * 4
+            if rtol == 1e-10:
+                assert abs(v - ref) <= 1e-10 * ref
+
+
+def test_evaluations_per_mu_are_a_few_hundred():
+    mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
+    for n, p in [(20, 0), (20, 1), (5000, 1), (1, 0)]:
+        _, _, conv, evals = _polar.albedo_1d(_Lobe(n, p), mu, 1e-10, 1e-14, 20000)
+        assert conv.all() and evals.mean() < 300 and evals.max() < 1000, (n, p, evals.mean(), evals.max())
+
+
+SPECS = [
+    {"type": "phong", "n": 20},
+    {"type": "stretched_phong", "n": 20},
+    {"type": "stretched_phong", "n": 3, "p": 0.0},
+    {"type": "retro", "n": 10},
+    {"type": "phong_shader", "n": 5, "kd": 0.1},
+    {"type": "lewis_phong", "n": 20},
+    {"type": "lewis_phong", "n": 1, "k_rho": 0.8, "k_sigma": 0.5},
+    {"type": "lafortune", "n": 20, "cx": 1.1, "cy": 1.1, "cz": 1.1, "p": 1.0},
+    {"type": "lafortune", "n": 4.5, "cx": -1.0, "cy": -1.0, "cz": 1.0, "p": 1.0, "c": 0.3},
+    {"type": "lafortune_sum", "n": [5.0, 50.0], "c": [0.2, 3.0]},
+    {"type": "lambert", "albedo": 0.3},
+]
+
+
+@pytest.mark.parametrize("spec", SPECS, ids=[s["type"] for s in SPECS])
+def test_one_d_agrees_with_the_two_d_engine(spec):
+    f = pumpup.load(spec)
+    assert all(t.polar() is not None for _, t in f.albedo_terms())  # the 1-D path is taken
+    mu = np.array([1.0, 0.7, 0.3, 1e-3, 1e-7])
+    a, e = pumpup.albedo(f, mu, return_error=True)
+    with _polar.two_d_only():
+        b, eb = pumpup.albedo(f, mu, return_error=True)
+    assert np.all(np.abs(a - b) <= e + eb), (a, b, e, eb)
+    assert np.all(e <= 1e-10 * a + 1e-14)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("spec", [dict(type=m.type, **ex) for m in pumpup.registry().values() for ex in m.examples
+                                  if m(**ex).polar() is not None or m.type in ("lafortune_sum", "lewis_phong", "phong_shader")],
+                         ids=lambda s: s["type"])
+def test_one_d_agrees_with_the_two_d_engine_on_every_example(spec):
+    f = pumpup.load(spec)
+    mu = np.array(MU)
+    a, e = pumpup.albedo(f, mu, return_error=True)
+    with _polar.two_d_only():
+        b, eb = pumpup.albedo(f, mu, return_error=True)
+    assert np.all(np.abs(a - b) <= e + eb), (a, b, e, eb)
+
+
+def test_models_without_a_closed_azimuth_decline():
+    for spec in [{"type": "stretched_phong", "n": 8, "p": 0.5}, {"type": "lafortune", "n": 10, "cx": 0.8, "cy": 1.2},
+                 {"type": "blinn", "n": 16}, {"type": "cook_torrance", "m": 0.3}, {"type": "phong_shader", "n": 5, "kd": 0.1}]:
+        assert pumpup.load(spec).polar() is None, spec
+    user = pumpup.from_function(lambda wi, wo: np.full(np.broadcast_shapes(wi.shape, wo.shape)[:-1], 0.5 / np.pi),
+                                name="half-grey-polar")
+    assert user.polar() is None
+    assert abs(float(pumpup.albedo(user, 0.4)) - 0.5) < 1e-9  # the generic 2-D cubature, as before
+
+
+def test_closed_forms():
+    # Lewis's Phong conserves energy exactly (002 eq. 22); Phong's shader is Phong / mu (002 eq. 8)
+    mu = np.array([1.0, 0.5, 0.01, 1e-6])
+    a, e = pumpup.albedo(pumpup.load({"type": "lewis_phong", "n": 20, "k_rho": 0.9}), mu, return_error=True)
+    assert np.all(np.abs(a - 0.9) <= e + 1e-14)
+    ph, ph_e = pumpup.albedo(pumpup.load({"type": "phong", "n": 7, "c": 2.0}), mu, return_error=True)
+    sh, sh_e = pumpup.albedo(pumpup.load({"type": "phong_shader", "n": 7, "ks": 2.0}), mu, return_error=True)
+    np.testing.assert_allclose(sh, ph / mu, rtol=1e-13)
+    a, e = pumpup.albedo(pumpup.load({"type": "phong", "n": 20}), 1.0, return_error=True)
+    assert abs(a - 1.0) <= e and e < 1e-10  # 000 eq. 6
+    assert float(pumpup.albedo(pumpup.load({"type": "lambert", "albedo": 0.3}), 0.2)) == 0.3
+    # Lafortune with cx = cy = -cz is the retro-reflective lobe times cz^n
+    r = pumpup.albedo(pumpup.load({"type": "retro", "n": 6, "c": 1.0}), mu)
+    la = pumpup.albedo(pumpup.load({"type": "lafortune", "n": 6, "cx": -1.5, "cy": -1.5, "cz": 1.5, "p": 1.0}), mu)
+    np.testing.assert_allclose(la, 1.5**6 * r, rtol=1e-14)
+
+
+def test_budget_warns_and_keeps_an_honest_error():
+    f = pumpup.load({"type": "stretched_phong", "n": 5000})
+    ref, ref_err = phong_albedo_1d(5000, 0.5, stretched=True)
+    for budget in (0, 1):  # no refinement beyond the first intervals, then one split
+        with warnings.catch_warnings(record=True) as w:
+            warnings.simplefilter("always")
+            a, e = pumpup.albedo(f, 0.5, return_error=True, rtol=1e-13, atol=0, max_regions=budget)
+        assert any(issubclass(x.category, pumpup.albedo_module.AlbedoWarning) for x in w)
+        assert abs(a - ref) <= e + ref_err and e > 1e-13 * a
+
+
+def test_two_d_only_restores_the_switch():
+    assert _polar.ENABLED
+    with pytest.raises(RuntimeError), _polar.two_d_only():
+        assert not _polar.ENABLED
+        raise RuntimeError
+    assert _polar.ENABLED

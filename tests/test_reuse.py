@@ -1,0 +1,79 @@
+"""mean_albedo and max_albedo reuse the table just computed for the same BRDF object (pumpup/_reuse.py):
+the same numbers within the stated errors, the independent references, and a fall-back where the
+table cannot meet the tolerance."""
+
+import json
+import pathlib
+
+import numpy as np
+import pytest
+
+import pumpup
+from pumpup import _reuse
+from pumpup.sweep import default_mu
+
+DATA = json.loads((pathlib.Path(__file__).parent / "data" / "independent_reference.json").read_text())
+MEAN = [e for e in DATA["entries"] if e["quantity"] == "mean_albedo"]
+MU = default_mu(257)  # the sweep's grid
+
+
+def _fresh_low(f, rtol):
+    return lambda mu_min, scale: _reuse.fresh_low(f, mu_min, 0.25 * rtol * scale, rtol / 10)
+
+
+@pytest.mark.parametrize("entry", MEAN, ids=[f"{e['model']}-{e['params']}" for e in MEAN])
+def test_mean_from_the_table_against_independent_reference(entry):
+    f = pumpup.load({"type": entry["model"], **entry["params"]})
+    pumpup.tabulate(f, mu=MU, progress=False)
+    assert _reuse.mean_from_table(f, 1e-9, _fresh_low(f, 1e-9)) is not None  # the table is used
+    m, e = pumpup.mean_albedo(f, return_error=True)
+    assert abs(m - entry["value"]) <= e + entry["abs_err_estimate"]  # honest
+    assert e <= 1e-9 * m
+
+
+@pytest.mark.parametrize("spec", [{"type": "stretched_phong", "n": 20}, {"type": "retro", "n": 10},
+                                  {"type": "stretched_phong", "n": 300}, {"type": "lewis_phong", "n": 5}])
+def test_reuse_agrees_with_fresh(spec):
+    fresh = pumpup.load(spec)
+    m0, e0 = pumpup.mean_albedo(fresh, return_error=True)
+    x0 = pumpup.max_albedo(fresh)
+    f = pumpup.load(spec)
+    pumpup.tabulate(f, mu=MU, progress=False)
+    m1, e1 = pumpup.mean_albedo(f, return_error=True)
+    assert abs(m1 - m0) <= e0 + e1 and e1 <= 1e-9 * m1
+    x1 = pumpup.max_albedo(f)
+    assert abs(x1.albedo - x0.albedo) <= x0.error + x1.error + 1e-12 * x0.albedo  # Brent's bracket may differ
+    assert x1.at_boundary == x0.at_boundary
+
+
+def test_an_unresolved_table_falls_back():
+    f = pumpup.load({"type": "stretched_phong", "n": 3000})  # the lobe is narrower than the grid near grazing
+    pumpup.tabulate(f, mu=MU, progress=False)
+    assert _reuse.mean_from_table(f, 1e-9, _fresh_low(f, 1e-9)) is None
+    m, e = pumpup.mean_albedo(f, return_error=True)
+    g = pumpup.load(f.spec)  # no table: the fresh computation
+    assert (m, e) == tuple(pumpup.mean_albedo(g, return_error=True))
+
+
+def test_only_the_tabulated_object_and_a_proportional_unit_model():
+    f = pumpup.load({"type": "phong", "n": 20})
+    pumpup.tabulate(f, mu=MU, progress=False)
+    assert _reuse.recall(f) is not None and _reuse.recall(pumpup.load(f.spec)) is None
+    k = _reuse.proportional_factor(f, f.with_params(c=1.0))
+    assert abs(k - 2 * np.pi / 22) < 1e-13
+    shader = pumpup.load({"type": "phong_shader", "n": 5, "kd": 0.1})  # kd is not scaled with ks
+    assert _reuse.proportional_factor(shader, shader.with_params(ks=1.0)) is None
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("spec", [{"type": "blinn", "n": 16}, {"type": "ward", "m": 0.3}, {"type": "cook_torrance", "m": 0.3}])
+def test_reuse_agrees_with_fresh_two_d_models(spec):
+    fresh = pumpup.load(spec)
+    m0, e0 = pumpup.mean_albedo(fresh, return_error=True)
+    x0 = pumpup.max_albedo(fresh)
+    f = pumpup.load(spec)
+    pumpup.tabulate(f, mu=MU, progress=False)
+    m1, e1 = pumpup.mean_albedo(f, return_error=True)
+    assert abs(m1 - m0) <= e0 + e1
+    x1 = pumpup.max_albedo(f)
+    assert abs(x1.albedo - x0.albedo) <= x0.error + x1.error + 1e-12 * x0.albedo
