@@ -276,7 +276,7 @@ def _scene_dict(name, mats, size, spp):
             d[f"s{i}"] = sphere(mats[f"s{i}"], -1.5 + 1.0 * i, 0.4 * (i % 2), 0.45)
     else:
         d["tank"] = cube(mats["tank"], 0.0, -0.6, 0.6, 20)
-        for i, (x, z) in enumerate(((-1.7, 0.8), (-0.6, 1.3), (0.6, 1.3), (1.7, 0.8))):
+        for i, (x, z) in enumerate(((-1.45, 0.9), (-0.5, 1.5), (0.5, 1.5), (1.45, 0.9))):
             d[f"p{i}"] = cube(mats[f"p{i}"], x, z, 0.3, 45)
     return d
 
@@ -350,8 +350,9 @@ def render_scene(name, spp=64, size=256, variant="auto", *, progress=True, out=s
     return v, rows, times
 
 
-def write_scene(name, rows, out_dir, *, exposure=0.0, variant="", spp=0):
-    """Write each panel as linear EXR (R, G, B) and the side-by-side PNG ``NAME.png``; returns the paths."""
+def write_scene(name, rows, out_dir, *, exposure=0.0, variant="", spp=0, exr=True):
+    """Write each panel as linear EXR (R, G, B; unless ``exr`` is False) and the side-by-side PNG ``NAME.png``
+    (radiance x 2^exposure, sRGB transfer, clipped at 1); returns the paths."""
     from matplotlib.figure import Figure
 
     from .render import _atomic, srgb
@@ -360,7 +361,7 @@ def write_scene(name, rows, out_dir, *, exposure=0.0, variant="", spp=0):
     paths = []
     import OpenEXR
 
-    for i, row in enumerate(rows):
+    for i, row in enumerate(rows if exr else []):
         for j, (label, img) in enumerate(row):
             p = os.path.join(out_dir, f"{name}_{i}{j}.exr")
             ch = {k: np.ascontiguousarray(img[..., c], dtype=np.float32) for c, k in enumerate("RGB")}
