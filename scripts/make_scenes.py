@@ -39,7 +39,9 @@ def main(argv=None) -> int:
         for r in rows:
             for label, im in r:
                 y = im @ np.array([0.2126, 0.7152, 0.0722])  # linear sRGB luminance
-                print(f"  {label:36s} mean {y.mean():.4f}, 99th percentile {np.percentile(y, 99):.3f}")
+                lo = y[int(0.85 * y.shape[0]):]  # the bottom 15 % of the rows: the plate only
+                print(f"  {label:36s} mean {y.mean():.4f}, 99th percentile {np.percentile(y, 99):.3f}, "
+                      f"plate (bottom 15 % of rows) {lo.mean():.4f}")
         paths = S.write_scene(name, rows, args.out, variant=v, spp=args.spp, exr=False)
         print(f"wrote {paths[-1]} in {time.perf_counter() - t:.1f} s", flush=True)
     return 0
