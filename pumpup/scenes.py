@@ -153,7 +153,11 @@ def _mitsuba(variant="auto"):
     except ImportError:
         raise ImportError("path-traced scenes need Mitsuba 3: install the render extra, "
                           "pip install -e \".[render]\" (or pip install \"pumpup[render]\")") from None
+    if variant not in (None, "auto") and not str(variant).endswith("_rgb"):
+        raise ValueError(f"variant must be 'auto' or an RGB Mitsuba variant (scalar_rgb, llvm_ad_rgb, ...), got {variant!r}")
     v = pm.register(None if variant in (None, "auto") else variant)
+    if not v.endswith("_rgb"):  # an earlier mi.set_variant of a mono or spectral variant
+        v = pm.register("llvm_ad_rgb")
     _register_mix(pm)
     return pm, v
 
