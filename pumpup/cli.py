@@ -563,6 +563,55 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {_one_line(message)} (see {self.prog} --help)\n")
 
 
+def cmd_render_scene(args) -> int:
+    """``pumpup render scene NAME``: the papers' scenes path-traced by Mitsuba 3 (pumpup.scenes); every
+    argument is checked (one line, status 2) before rendering; without mitsuba, the ``render`` extra is named."""
+    import os
+
+    from pumpup import scenes
+
+    def fail(msg: str) -> int:
+        print(f"pumpup render scene: {msg}", file=sys.stderr)
+        return 2
+
+    try:
+        scenes.check_scene(args.name)
+        spp = int(args.spp) if args.spp.strip().isdigit() else None
+        if spp is None:
+            raise ValueError(f"spp must be an integer number of samples per pixel >= 1, got {args.spp!r}")
+        size = int(args.size) if args.size.strip().isdigit() else args.size
+        exposure = float(args.exposure)
+        if not math.isfinite(exposure):
+            raise ValueError(f"--exposure must be a finite number of stops, got {args.exposure!r}")
+        scenes.check_args(args.name, spp, size, args.variant)
+    except ValueError as exc:
+        msg = str(exc)
+        if msg.startswith("could not convert"):
+            msg = f"--exposure must be a number: {msg}"
+        return fail(msg.replace("size must", "--size must").replace("spp must", "--spp must"))
+    if os.path.exists(args.out) and not os.path.isdir(args.out):
+        return fail(f"--out {args.out!r} exists and is not a directory")
+    try:
+        import mitsuba as mi
+    except ImportError:
+        return fail("needs Mitsuba 3: install the render extra, pip install -e \".[render]\" "
+                    "(or pip install \"pumpup[render]\")")
+    rgb = [v for v in mi.variants() if v.endswith("_rgb")]  # the scenes' colours are RGB
+    if args.variant != "auto" and args.variant not in rgb:
+        return fail(f"--variant must be auto or one of {', '.join(rgb)}; got {args.variant!r}")
+    try:
+        os.makedirs(args.out, exist_ok=True)
+        variant, rows, times = scenes.render_scene(args.name, spp, size, args.variant, progress=not args.quiet)
+        paths = scenes.write_scene(args.name, rows, args.out, exposure=exposure, variant=variant, spp=spp)
+    except (ValueError, OSError, ImportError) as exc:
+        return fail(str(exc))
+    print(f"variant {variant}; {len(times)} panels in {sum(times):.1f} s ("
+          + ", ".join(f"{t:.1f}" for t in times) + " s each)")
+    for p in paths:
+        print(f"wrote {p}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(
         prog="pumpup",
@@ -704,6 +753,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--no-lookup-check", action="store_true", help="skip the look-up error between the nodes (default: measured)")
     s.add_argument("--no-eavg", action="store_true", help="skip the E_avg checks (default: checked)")
     s.set_defaults(func=cmd_audit)
+    r = render_sub.add_parser("scene", help="the papers' scenes path-traced by Mitsuba 3 with the pumpup plugin, "
+                                            "original and stretched or pumped side by side (needs the render extra)")
+    r.add_argument("name", help="000-fig8, 000-fig9 or 001-fig8")
+    r.add_argument("--spp", default="64", help="samples per pixel (default 64)")
+    r.add_argument("--size", default="256", help="pixels per side, >= 8 (default 256)")
+    r.add_argument("--variant", default="auto", help="Mitsuba variant, or auto: llvm_ad_rgb if it runs here, "
+                                                     "else scalar_rgb (default auto)")
+    r.add_argument("--exposure", default="0", help="PNG tone map: radiance x 2^EXPOSURE, sRGB (default: 0)")
+    r.add_argument("--out", default="scenes", help="directory for NAME.png and the panels' EXR (default scenes)")
+    r.add_argument("--quiet", action="store_true", help="no progress lines (default: progress shown)")
+    r.set_defaults(func=cmd_render_scene)
     return p
 
 

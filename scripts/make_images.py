@@ -148,6 +148,9 @@ def furnace(size, out):
         [blinn] + [pumpup.pump(blinn, g=g, levels=k).spec for g in ("g1", "g2") for k in (1, 3)],
         [{"type": "lambert", "albedo": 0.8}, {"type": "ggx", "alpha": 0.3}, {"type": "cook_torrance", "m": 0.3},
          {"type": "phong_shader", "n": N_PUMP}, {"type": "stretched_phong", "n": 5000}],
+        # energy compensation (pumpup.compensate): Kulla-Conty's added lobe and the 1/E(wo) scaling
+        [pumpup.compensate(pumpup.load(b), method=m) for b in (phong, {"type": "ggx", "alpha": 0.3})
+         for m in ("kulla_conty", "scale")],
     ]
     ims = [[R.furnace(s, size) for s in row] for row in rows]
     print("furnace: a(mu_V) at the rim pixel / centre / maximum, error bound")
@@ -164,7 +167,7 @@ def furnace(size, out):
         return f"{R.label(im.spec)}\nrim {float(v.min()):.3f}, max {float(v.max()):.4f}"
 
     return R.grid_figure(ims, os.path.join(out, "render_furnace.png"), tile_text=text, tile_inches=1.9,
-                         row_labels=["Phong n=20", "Blinn n=20", "others"],
+                         row_labels=["Phong n=20", "Blinn n=20", "others", "compensated"],
                          title="white furnace (sky radiance 1): pixel = albedo a(mu_V)")
 
 

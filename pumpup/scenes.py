@@ -1,0 +1,397 @@
+"""Path-traced scenes of the papers in Mitsuba 3, through the ``pumpup`` plugin (issue 18, item 2).
+
+Each scene renders the same geometry, lights and samples twice (or four times) with the original
+model and with its stretched or pumped version, side by side:
+
+``000-fig8``
+    000 Fig. 8, left: "a golden Beethoven (n = 4) with a copper sphere (n = 40) and a copper
+    pyramid (n = 150) on a silver mirror (n = 5000)".  Here a gold sphere (n = 4) stands for the
+    head and a cube for the pyramid.  Original: reciprocal Phong (000 eq. 5); new: stretched Phong
+    (000 eq. 7), both times the metal's colour.
+``000-fig9``
+    000 Fig. 9: plastic spheres of one hue and different lightness and saturation, with
+    (a_s, n) = (0.04, 169), (0.065, 64), (0.09, 9), (0.13, 3), on a plastic plate.  Original:
+    Lambert + a_s x reciprocal Phong; new: 000 eq. 30 (``plastic``: Lambert + a_s x stretched
+    Phong, Fresnel 1).
+``001-fig8``
+    001 Fig. 8: "a golden tank with aluminum, silver, copper and golden pyramids", reciprocal
+    Phong (top) against Phong pumped up once (bottom), n = 20 (left) and n = 5000 (right).  Here
+    a gold cube with four small cubes (turned 45 degrees) on a grey Lambert plate.
+
+Metals: the papers use the spectral Fresnel factor (000 eq. 28, 8 wavelengths); here the colour is
+the normal-incidence reflectance F0 in linear RGB (Hoffman, "Physics and math of shading",
+SIGGRAPH 2010 course; also Real-Time Rendering, 3rd ed., Table 7.3), constant over angle, applied
+as a factor outside the lobe.  The factor commutes with g1 pumping (g1 divides by the albedo, so
+pumping F0 x Phong would undo the colour): a pumped metal is F0 x pump(Phong).  Both halves of a
+comparison use the same F0, so the difference is the stretching or pumping alone.
+
+Lights: a constant sky (Mitsuba ``constant`` emitter; the papers' "sky-light") plus point lights,
+path tracing (``path``, max_depth 6) with Mitsuba's MIS; the plugin samples each lobe with
+pumpup's strategies.  A colour factor or a sum of pumpup models (Lambert + Phong lobe) is the
+small BSDF plugin ``pumpup_mix`` defined here: f = sum_i w_i f_i (w_i RGB), sampled by choosing
+component i with probability proportional to the mean of w_i and evaluating the mixture pdf.
+
+Imports Mitsuba only inside functions: ``import pumpup.scenes`` works without it, and
+:func:`render_scene` then raises ImportError naming the ``render`` extra.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+__all__ = ["SCENES", "F0", "check_scene", "panels", "render_scene", "render_panel", "write_scene"]
+
+#: normal-incidence reflectance of metals, linear RGB (Hoffman 2010 / Real-Time Rendering 3rd ed., Table 7.3)
+F0 = {
+    "gold": (1.000, 0.766, 0.336),
+    "silver": (0.972, 0.960, 0.915),
+    "copper": (0.955, 0.638, 0.538),
+    "aluminium": (0.913, 0.922, 0.924),
+}
+
+SCENES = {
+    "000-fig8": "000 Fig. 8 (left): gold, copper sphere and cube on a silver near-mirror plate (n = 5000); "
+                "reciprocal Phong | stretched Phong",
+    "000-fig9": "000 Fig. 9: plastic spheres (a_s, n) = (0.04, 169), (0.065, 64), (0.09, 9), (0.13, 3); "
+                "Lambert + Phong lobe | 000 eq. 30",
+    "001-fig8": "001 Fig. 8: gold cube with aluminium, silver, copper, gold cubes; reciprocal Phong | pumped once, "
+                "n = 20 and 5000",
+}
+
+#: the plastic spheres of 000 Fig. 9: (a_s, n) and a diffuse colour of one hue (orange), different lightness
+#: and saturation, each with max(r, g, b) <= 1 - a_s (000 after eq. 30)
+PLASTICS = [
+    ((0.04, 169.0), (0.80, 0.42, 0.12)),
+    ((0.065, 64.0), (0.60, 0.40, 0.25)),
+    ((0.09, 9.0), (0.45, 0.22, 0.05)),
+    ((0.13, 3.0), (0.75, 0.55, 0.38)),
+]
+
+
+def check_scene(name) -> str:
+    """``name`` if it is a known scene, else a ValueError listing them (one line)."""
+    if name not in SCENES:
+        raise ValueError(f"unknown scene {name!r}; choose one of {', '.join(SCENES)}")
+    return name
+
+
+# --------------------------------------------------------------------------------------------
+# Materials as pumpup specs (plain data: no Mitsuba needed)
+# --------------------------------------------------------------------------------------------
+
+
+def _phong(n, c=None):
+    s = {"type": "phong", "n": float(n)}
+    if c is not None:
+        s["c"] = float(c)
+    return s
+
+
+def metal(colour, n, kind):
+    """A metal of colour ``F0[colour]`` and exponent n: ``kind`` "phong" (000 eq. 5), "stretched" (000 eq. 7)
+    or "pumped" (001 eq. 20, one level of g1 over Phong).  A ``pumpup_mix`` material: [(rgb, spec)]."""
+    base = _phong(n)
+    spec = {"phong": base, "stretched": {"type": "stretched_phong", "n": float(n)},
+            "pumped": {"type": "pumped", "base": base, "g": "g1", "levels": 1}}[kind]
+    return [(F0[colour], spec)]
+
+
+def plastic(rgb, a_s, n, kind):
+    """000 Fig. 9's plastic: "phong" = Lambert(rgb) + a_s x reciprocal Phong; "stretched" = 000 eq. 30."""
+    if kind == "phong":  # c = a_s (n + 2) / (2 pi): the normalised reciprocal Phong lobe scaled by a_s
+        return [(tuple(rgb), {"type": "lambert", "albedo": 1.0}),
+                ((1.0, 1.0, 1.0), _phong(n, a_s * (n + 2.0) / (2.0 * math.pi)))]
+    return [((1.0, 1.0, 1.0), [{"type": "plastic", "n": float(n), "ad": float(c), "a_s": float(a_s)} for c in rgb])]
+
+
+def panels(name) -> list:
+    """The panels of a scene: a list of rows, each a list of (label, {object name: material}).
+
+    A material is a list of (rgb weight, pumpup spec or list of 3 specs) for ``pumpup_mix``.
+    """
+    check_scene(name)
+    if name == "000-fig8":
+        out = []
+        for kind, lab in (("phong", "reciprocal Phong (000 eq. 5)"), ("stretched", "stretched Phong (000 eq. 7)")):
+            out.append((lab, {"head": metal("gold", 4, kind), "sphere": metal("copper", 40, kind),
+                              "cube": metal("copper", 150, kind), "plate": metal("silver", 5000, kind)}))
+        return [out]
+    if name == "000-fig9":
+        out = []
+        for kind, lab in (("phong", "Lambert + a_s Phong (000 eq. 5)"), ("stretched", "plastic, 000 eq. 30")):
+            mats = {f"s{i}": plastic(rgb, a_s, n, kind) for i, ((a_s, n), rgb) in enumerate(PLASTICS)}
+            mats["plate"] = plastic((0.45, 0.45, 0.50), 0.04, 20.0, kind)
+            out.append((lab, mats))
+        return [out]
+    rows = []
+    for kind, lab in (("phong", "reciprocal Phong"), ("pumped", "pumped once (g1)")):
+        row = []
+        for n in (20, 5000):
+            row.append((f"{lab}, n = {n}", {
+                "tank": metal("gold", n, kind), "p0": metal("aluminium", n, kind), "p1": metal("silver", n, kind),
+                "p2": metal("copper", n, kind), "p3": metal("gold", n, kind),
+                "plate": [((0.5, 0.5, 0.5), {"type": "lambert", "albedo": 1.0})]}))
+        rows.append(row)
+    return rows
+
+
+# --------------------------------------------------------------------------------------------
+# Mitsuba (imported only here)
+# --------------------------------------------------------------------------------------------
+
+
+def _mitsuba(variant="auto"):
+    """Import pumpup.mitsuba and register the plugins for ``variant`` ("auto": llvm if its probe passes)."""
+    try:
+        import pumpup.mitsuba as pm
+    except ImportError:
+        raise ImportError("path-traced scenes need Mitsuba 3: install the render extra, "
+                          "pip install -e \".[render]\" (or pip install \"pumpup[render]\")") from None
+    if variant not in (None, "auto") and not str(variant).endswith("_rgb"):
+        raise ValueError(f"variant must be 'auto' or an RGB Mitsuba variant (scalar_rgb, llvm_ad_rgb, ...), got {variant!r}")
+    v = pm.register(None if variant in (None, "auto") else variant)
+    if not v.endswith("_rgb"):  # an earlier mi.set_variant of a mono or spectral variant
+        v = pm.register("llvm_ad_rgb")
+    _register_mix(pm)
+    return pm, v
+
+
+_MIX: dict = {}
+
+
+def _register_mix(pm):
+    import drjit as dr
+    import mitsuba as mi
+
+    variant = mi.variant()
+    if variant not in _MIX:
+        jit = not variant.startswith("scalar")
+
+        class PumpupMix(mi.BSDF):
+            """f = sum_i w_i f_i for pumpup BSDFs f_i and RGB weights w_i (see the module docstring)."""
+
+            def __init__(self, props):
+                mi.BSDF.__init__(self, props)
+                comps = json.loads(props["components"])
+                if not comps:
+                    raise ValueError("pumpup_mix: needs at least one component")
+                self.weights = [mi.Color3f(*[float(x) for x in w]) for w, _ in comps]
+                self.bsdfs = [mi.load_dict(pm.bsdf_dict(s)) for _, s in comps]
+                m = np.array([max(float(np.mean(w)), 1e-6) for w, _ in comps])
+                self.prob = [float(x) for x in m / m.sum()]  # Python floats: numpy scalars would force evaluation
+                flags = 0
+                for b in self.bsdfs:
+                    flags |= int(b.flags())
+                self.m_flags = flags
+                self.m_components = [flags]
+                self.desc = props["components"]
+
+            def _eval_pdf(self, ctx, si, wo, active):
+                val, pdf = mi.Color3f(0.0), mi.Float(0.0)
+                for w, p, b in zip(self.weights, self.prob, self.bsdfs):
+                    e, q = b.eval_pdf(ctx, si, wo, active)
+                    val = val + w * e
+                    pdf = pdf + p * q
+                return val, pdf
+
+            def eval(self, ctx, si, wo, active=True):
+                return self._eval_pdf(ctx, si, wo, active)[0]
+
+            def pdf(self, ctx, si, wo, active=True):
+                return self._eval_pdf(ctx, si, wo, active)[1]
+
+            def eval_pdf(self, ctx, si, wo, active=True):
+                return self._eval_pdf(ctx, si, wo, active)
+
+            def sample(self, ctx, si, sample1, sample2, active=True):
+                if len(self.bsdfs) == 1:
+                    bs, wt = self.bsdfs[0].sample(ctx, si, sample1, sample2, active)
+                    return bs, wt * self.weights[0]
+                acc, bs = 0.0, None
+                for i, (p, b) in enumerate(zip(self.prob, self.bsdfs)):
+                    last = i == len(self.bsdfs) - 1
+                    pick = (sample1 >= acc) if last else ((sample1 >= acc) & (sample1 < acc + p))
+                    u = dr.clip((sample1 - acc) / p, 0.0, 0.99999994)  # reuse the selection sample
+                    bi, _ = b.sample(ctx, si, u, sample2, active)
+                    if bs is None:
+                        bs = bi
+                    elif jit:
+                        bs = dr.select(pick, bi, bs)
+                    elif pick:
+                        bs = bi
+                    acc += p
+                val, pdf = self._eval_pdf(ctx, si, bs.wo, active)
+                ok = (pdf > 0.0) & active & (bs.pdf > 0.0)
+                wt = val / dr.maximum(pdf, 1e-30)
+                bs.pdf = dr.select(ok, pdf, 0.0) if jit else (pdf if ok else mi.Float(0.0))
+                return bs, (dr.select(ok, wt, 0.0) if jit else (wt if ok else mi.Color3f(0.0)))
+
+            def to_string(self):
+                return f"PumpupMix[{self.desc}]"
+
+            def traverse(self, callback):
+                pass
+
+        _MIX[variant] = PumpupMix
+    cls = _MIX[variant]
+    mi.register_bsdf("pumpup_mix", lambda props: cls(props))
+
+
+def _bsdf(material) -> dict:
+    return {"type": "pumpup_mix", "components": json.dumps([[list(w), s] for w, s in material])}
+
+
+def _scene_dict(name, mats, size, spp):
+    import mitsuba as mi
+
+    T = mi.ScalarTransform4f
+
+    def sphere(mat, x, z, r):
+        return {"type": "sphere", "center": [x, r, z], "radius": r, "bsdf": _bsdf(mat)}
+
+    def cube(mat, x, z, h, turn):
+        return {"type": "cube", "bsdf": _bsdf(mat),
+                "to_world": T().translate([x, h, z]) @ T().rotate([0, 1, 0], turn) @ T().scale(h)}
+
+    d = {"type": "scene",
+         "integrator": {"type": "path", "max_depth": 6},
+         "sensor": {"type": "perspective", "fov": 32,
+                    "to_world": T().look_at(origin=[0, 2.4, 7.0], target=[0, 0.45, 0], up=[0, 1, 0]),
+                    "film": {"type": "hdrfilm", "width": size, "height": size, "pixel_format": "rgb",
+                             "rfilter": {"type": "box"}},
+                    "sampler": {"type": "independent", "sample_count": spp}},
+         "sky": {"type": "constant", "radiance": {"type": "rgb", "value": [0.55, 0.62, 0.75]}},
+         "key": {"type": "point", "position": [3.0, 5.0, 4.0], "intensity": {"type": "rgb", "value": 40.0}},
+         "fill": {"type": "point", "position": [-4.0, 3.5, 1.5], "intensity": {"type": "rgb", "value": 14.0}},
+         "plate": {"type": "rectangle", "bsdf": _bsdf(mats["plate"]),
+                   "to_world": T().rotate([1, 0, 0], -90) @ T().scale(3.2)}}
+    if name == "000-fig8":
+        d["head"] = sphere(mats["head"], -0.9, -0.3, 0.75)
+        d["sphere"] = sphere(mats["sphere"], 1.3, 0.9, 0.45)
+        d["cube"] = cube(mats["cube"], 0.5, -1.3, 0.42, 30)
+    elif name == "000-fig9":
+        for i in range(4):
+            d[f"s{i}"] = sphere(mats[f"s{i}"], -1.5 + 1.0 * i, 0.4 * (i % 2), 0.45)
+    else:
+        d["tank"] = cube(mats["tank"], 0.0, -0.6, 0.6, 20)
+        for i, (x, z) in enumerate(((-1.45, 0.9), (-0.5, 1.5), (0.5, 1.5), (1.45, 0.9))):
+            d[f"p{i}"] = cube(mats[f"p{i}"], x, z, 0.3, 45)
+    return d
+
+
+def check_args(name, spp, size, variant):
+    """Check every argument before any work (one-line ValueError naming it)."""
+    from .render import check_size
+
+    check_scene(name)
+    if isinstance(spp, bool) or not isinstance(spp, (int, np.integer)) or not 1 <= int(spp) <= 1 << 20:
+        raise ValueError(f"spp must be an integer number of samples per pixel in [1, {1 << 20}], got {spp!r}")
+    size = check_size(size)
+    if variant not in ("auto", None) and not isinstance(variant, str):
+        raise ValueError(f"variant must be 'auto' or a Mitsuba variant name, got {variant!r}")
+    return name, int(spp), size
+
+
+def render_panel(name, mats, size, spp, *, passes=4, seed=0, report=None):
+    """One panel: (size, size, 3) linear RGB radiance, the mean of ``passes`` renders with different seeds."""
+    import mitsuba as mi
+
+    passes = max(1, min(int(passes), spp))
+    scene = _load(name, mats, size, spp // passes)
+    acc = None
+    for k in range(passes):
+        img = np.array(mi.render(scene, seed=seed + k), dtype=np.float64)[..., :3]
+        acc = img if acc is None else acc + img
+        if report:
+            report(k + 1, passes)
+    extra = spp - passes * (spp // passes)
+    if extra:  # samples per pixel not divisible by the passes: one more pass with the rest, weighted
+        scene = _load(name, mats, size, extra)
+        img = np.array(mi.render(scene, seed=seed + passes), dtype=np.float64)[..., :3]
+        return (acc * (spp // passes) + img * extra) / spp
+    return acc / passes
+
+
+def _load(name, mats, size, spp):
+    import mitsuba as mi
+
+    return mi.load_dict(_scene_dict(name, mats, size, spp))
+
+
+def render_scene(name, spp=64, size=256, variant="auto", *, progress=True, out=sys.stderr):
+    """Render every panel of a scene: (variant, rows of (label, image), seconds per panel).
+
+    Same geometry, lights, seed and samples in every panel.  Prints the variant and progress on ``out``.
+    """
+    name, spp, size = check_args(name, spp, size, variant)
+    pm, v = _mitsuba(variant)
+    print(f"pumpup render scene {name}: Mitsuba variant {v}, {size} x {size}, {spp} spp", file=out, flush=True)
+    rows, times = [], []
+    layout = panels(name)
+    total = sum(len(r) for r in layout)
+    done = 0
+    for row in layout:
+        r = []
+        for label, mats in row:
+            t = time.perf_counter()
+
+            def report(k, n, label=label, t=t, done=done):
+                if progress:
+                    print(f"  panel {done + 1}/{total} ({label}): pass {k}/{n}, {time.perf_counter() - t:.1f} s",
+                          file=out, flush=True)
+
+            img = render_panel(name, mats, size, spp, report=report)
+            times.append(time.perf_counter() - t)
+            r.append((label, img))
+            done += 1
+        rows.append(r)
+    return v, rows, times
+
+
+def write_scene(name, rows, out_dir, *, exposure=0.0, variant="", spp=0, exr=True):
+    """Write each panel as linear EXR (R, G, B; unless ``exr`` is False) and the side-by-side PNG ``NAME.png``
+    (radiance x 2^exposure, sRGB transfer, clipped at 1); returns the paths."""
+    from matplotlib.figure import Figure
+
+    from .render import _atomic, srgb
+
+    os.makedirs(out_dir, exist_ok=True)
+    paths = []
+    import OpenEXR
+
+    for i, row in enumerate(rows if exr else []):
+        for j, (label, img) in enumerate(row):
+            p = os.path.join(out_dir, f"{name}_{i}{j}.exr")
+            ch = {k: np.ascontiguousarray(img[..., c], dtype=np.float32) for c, k in enumerate("RGB")}
+            header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage,
+                      "pumpup_scene": name, "pumpup_panel": label, "pumpup_variant": variant,
+                      "pumpup_spp": str(spp)}
+            with _atomic(p) as tmp:
+                with OpenEXR.File(header, ch) as f:
+                    f.write(tmp)
+            paths.append(p)
+    n_rows, n_cols = len(rows), max(len(r) for r in rows)
+    fig = Figure(figsize=(3.2 * n_cols, 3.2 * n_rows + 0.5))
+    axes = fig.subplots(n_rows, n_cols, squeeze=False)
+    for i, row in enumerate(rows):
+        for j, (label, img) in enumerate(row):
+            ax = axes[i][j]
+            ax.imshow(srgb(img * 2.0 ** exposure), interpolation="nearest")
+            ax.set_xticks([])
+            ax.set_yticks([])
+            ax.set_title(label, fontsize=8)
+    fig.suptitle(SCENES[name], fontsize=7.5)
+    fig.text(0.5, 0.005, f"Mitsuba 3 {variant}, {spp} spp; tone map: radiance x 2^{exposure:g}, sRGB transfer, "
+             "clipped at 1", ha="center", va="bottom", fontsize=6.5)
+    fig.tight_layout(rect=(0, 0.03, 1, 0.95))
+    p = os.path.join(out_dir, f"{name}.png")
+    with _atomic(p) as tmp:
+        fig.savefig(tmp, dpi=100, format="png")
+    paths.append(p)
+    return paths
