@@ -58,7 +58,7 @@ import numpy as np
 from numba import njit
 
 from .core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register
-from .pump import _CELL_SHIFT, Pumped, _float_bits, _key, _Lookup, _Product, _ProductError, _upper_scalar
+from .pump import _CELL_SHIFT, Pumped, _float_bits, _key, _Lookup, _Product, _ProductError, _upper_scalar, file_tables, from_file
 
 __all__ = ["compensate", "KullaConty", "Scaled", "save_compensated", "load_compensated", "furnace",
            "compensation_table", "METHODS", "fresnel_average"]
@@ -80,6 +80,9 @@ def compensation_table(white: BRDF, progress: bool | None = None):
     from .tables import AlbedoTable, tabulate
 
     key = _key(white)
+    own = from_file("compensate", key)  # a file being loaded: its table serves only its objects
+    if own is not None:
+        return own
     if key not in _TABLES:
         ds = tabulate(white, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress)
         t = AlbedoTable.from_dataset(ds)
@@ -792,7 +795,6 @@ def save_compensated(f: BRDF, path) -> str:
 
 def load_compensated(path) -> BRDF:
     """Load a BRDF saved by :func:`save_compensated`, without recomputing its tables."""
-    from .pump import _TABLES as PUMP_TABLES
     from .tables import AlbedoTable, open_table
 
     root = open_table(path)
@@ -804,15 +806,37 @@ def load_compensated(path) -> BRDF:
         spec = json.loads(root.attrs["spec"])
     except (KeyError, ValueError) as exc:
         raise ValueError(f"{os.fspath(path)!r}: damaged compensated-BRDF file ({exc})") from None
-    for i in range(1, n + 1):
-        ds = open_table(path, group=f"table{i}")
-        kind = ds.attrs.get("cache")
-        if kind not in ("compensate", "pump") or "albedo" not in ds or "albedo_error" not in ds:
-            raise ValueError(f"{os.fspath(path)!r}: group table{i} is not a compensation or pumping table")
-        t = AlbedoTable.from_dataset(ds)
-        ds = ds.copy()
-        del ds.attrs["cache"]
-        t.dataset = ds
-        key = json.dumps(json.loads(ds.attrs["spec"]), sort_keys=True)  # = _key of its BRDF, without building it
-        (_TABLES if kind == "compensate" else PUMP_TABLES)[key] = t
-    return load(spec)
+    tables = {}
+    # innermost first (the groups were saved outermost first): a group's spec is validated by
+    # building it, which needs the tables of the BRDFs nested in it, taken from this file
+    with file_tables(tables):
+        for i in range(n, 0, -1):
+            ds = open_table(path, group=f"table{i}")
+            kind = ds.attrs.get("cache")
+            if kind not in ("compensate", "pump") or "albedo" not in ds or "albedo_error" not in ds:
+                raise ValueError(f"{os.fspath(path)!r}: group table{i} is not a compensation or pumping table")
+            t = AlbedoTable.from_dataset(ds)
+            ds = ds.copy()
+            del ds.attrs["cache"]
+            t.dataset = ds
+            key = json.dumps(json.loads(ds.attrs["spec"]), sort_keys=True)  # = _key of its BRDF, without building it
+            tables[(kind, key)] = t
+    # the file's tables serve only the objects built from it: never the session's caches (issue 13 item 5)
+    with file_tables(tables):
+        f = load(spec)
+        for node in _nodes(f):
+            if isinstance(node, Pumped):
+                t = tables.get(("pump", _key(node.base)))
+                if t is None:
+                    raise ValueError(f"{os.fspath(path)!r}: no table for the pumped level of {node.base.spec}")
+                node._own_table = t
+                node.lookup()  # built now, from the file's table
+    return f
+
+
+def _nodes(f: BRDF):
+    """f and every BRDF nested in its parameters."""
+    yield f
+    for v in f.p.values():
+        if isinstance(v, BRDF):
+            yield from _nodes(v)

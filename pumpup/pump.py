@@ -48,10 +48,41 @@ def _key(brdf: BRDF) -> str:
     return key if fn is None else f"{key}#{id(fn)}"
 
 
+#: tables read from a file while that file's BRDF is being built (``file_tables``): (kind, key) -> AlbedoTable
+_FILE = threading.local()
+
+
+class file_tables:
+    """Within this context (one thread), :func:`base_table` and the compensation tables come from
+    ``tables`` ({(kind, key): AlbedoTable}, kind "pump" or "compensate") and never enter the session's
+    shared caches: a file's tables serve only the objects built from that file (issue 13 item 5)."""
+
+    def __init__(self, tables: dict):
+        self.tables = tables
+
+    def __enter__(self):
+        self.saved = getattr(_FILE, "tables", None)
+        _FILE.tables = self.tables
+        return self
+
+    def __exit__(self, *exc):
+        _FILE.tables = self.saved
+        return False
+
+
+def from_file(kind: str, key: str):
+    """The table a file being loaded provides for (kind, key), or None."""
+    tables = getattr(_FILE, "tables", None)
+    return None if tables is None else tables.get((kind, key))
+
+
 def base_table(base: BRDF, progress: bool | None = None):
     """The albedo table of ``base`` used by the pumping operator (cached per session)."""
     from .tables import AlbedoTable, tabulate
 
+    own = from_file("pump", _key(base))
+    if own is not None:
+        return own
     if _uses_file_tables(base):  # computed from a file's tables: serves this object only
         with _lock_for(f"derived#{id(base)}"):
             if getattr(base, "_derived_table", None) is None:

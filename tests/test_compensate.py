@@ -205,6 +205,8 @@ def test_save_and_load_without_recomputing(tmp_path, monkeypatch):
         g = pumpup.load_compensated(p)
         assert g == f
         np.testing.assert_array_equal(g.eval(wi, wo), v)
+    # the file's tables served only the loaded objects: the session's caches are still empty (issue 13 item 5)
+    assert not comp._TABLES and not sys.modules["pumpup.pump"]._TABLES
     with pytest.raises(ValueError, match="not a saved compensated BRDF"):
         pumpup.write_table(c.table().dataset, tmp_path / "t.nc")
         pumpup.load_compensated(tmp_path / "t.nc")
