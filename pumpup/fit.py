@@ -1,0 +1,738 @@
+"""Perceptual fitting: fit a compact model to a target BRDF under point light and sky light (001 sec. 1.1).
+
+001 sec. 1.1: under a point light of power 4 pi at distance 1 in direction L the observer
+at V sees L_out(V) = f_r(L, V) cos(theta_L) (001 eq. 3); under uniform sky light of radiance
+1 it sees L_out(V) = integral of f_r(L, V) cos(theta_L) d omega_L = a(V) (001 eq. 4, the
+albedo of a reciprocal BRDF).  "In perceptual based fitting the albedo should also be
+considered, and the maximal relative errors of both the weighted BRDF and of the albedo
+should be minimized simultaneously."  :func:`fit` does that:
+
+    minimise  E = max(w_f e_f, w_a e_a)
+    e_f = max over (L, V) in D of |f(L, V) cos(theta_L) / f_t(L, V) cos(theta_L) - 1|
+    e_a = max over mu in M of |a(mu) / a_t(mu) - 1|
+
+where f_t is the target, D the lobe region of the target (below) and M a set of mu down
+to ``mu_min``.  ``method="least_squares"`` instead minimises the classical L2 distance of
+the point-light radiance alone (the "so far" of 001 sec. 1.1),
+
+    sum over views V of integral over L of (f(L, V) - f_t(L, V))^2 cos^2(theta_L) d omega_L,
+
+on the same direction grid (solid-angle weights), over all L with f_t > 0, not only the lobe.
+
+The lobe region (default)
+-------------------------
+Relative error is meaningful only where the target is not negligible.  Views V lie in the
+xz-plane with theta_V uniform in [0, arccos(mu_min)]; for each view, the lights L lie on a
+log-polar grid around the mirror direction of V (polar offsets 0 and 1e-3 ... pi rad,
+geometric; azimuths uniform over the full circle), and D keeps the pairs where
+f_t(L, V) cos(theta_L) >= ``lobe_fraction`` (default 0.1) times its maximum over L for that
+view.  The fit uses a coarse grid; the reported e_f is the maximum over a denser grid of the
+same construction (``FitResult.eval_pairs`` pairs).
+
+Scale
+-----
+If the family has a multiplicative constant (``BRDF.constant``, "c") among the free
+parameters and nothing is pumped, it is not searched: the model is evaluated at c = 1 and
+the optimal c within its bounds is exact (the min-max of four lines for the perceptual
+objective, the clipped normal equation for least squares).
+
+Cost
+----
+The albedo of each candidate is the cost.  During the search it is computed with
+``search_rtol`` (default 1e-5) on ``n_mu_search`` values of mu; the errors reported in the
+result are recomputed afterwards at ``final_rtol`` (default 1e-9) on ``n_mu`` values, with
+the bound of that recomputation (``albedo_error_bound``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .core import BRDF, SpecError, load, registry
+
+__all__ = ["fit", "FitResult", "FitData", "lobe_grid", "relative_errors", "DEFAULT_LOBE_FRACTION", "DEFAULT_MU_MIN"]
+
+#: default lobe region: f_t cos(theta_L) at least this fraction of its maximum over L for the view
+DEFAULT_LOBE_FRACTION = 0.1
+#: default smallest mu = cos(theta) of the albedo set and of the views (theta = 87.13 degrees)
+DEFAULT_MU_MIN = 0.05
+#: smallest polar offset of the log-polar light grid around the mirror direction [rad]
+ALPHA_MIN = 1e-3
+#: (views, polar offsets, azimuths) of the search grid and of the denser evaluation grid
+SEARCH_GRID = (10, 36, 16)
+EVAL_GRID = (25, 90, 48)
+METHODS = ("perceptual", "least_squares")
+
+
+class FitError(SpecError):
+    """Bad input to :func:`fit`; the message names the argument and its allowed range."""
+
+
+# ----------------------------------------------------------------------------------------
+# Direction sets
+# ----------------------------------------------------------------------------------------
+
+
+def view_mus(n_views: int, mu_min: float) -> np.ndarray:
+    """mu of the views: theta uniform in [0, arccos(mu_min)], normal view first."""
+    return np.cos(np.linspace(0.0, math.acos(mu_min), n_views))
+
+
+def lobe_grid(n_views: int, n_alpha: int, n_beta: int, mu_min: float = DEFAULT_MU_MIN):
+    """Light-view pairs on log-polar grids around the mirror direction of each view.
+
+    Parameters
+    ----------
+    n_views : int
+        Views V = (sin theta_V, 0, cos theta_V), theta_V uniform in [0, arccos(mu_min)].
+    n_alpha : int
+        Polar offsets from the mirror direction R_V: 0 and ``n_alpha`` values geometric in
+        [1e-3, pi] rad.
+    n_beta : int
+        Azimuths around R_V, uniform over [0, 2 pi).
+    mu_min : float
+        Smallest cos(theta_V).
+
+    Returns
+    -------
+    wi, wo : ndarray, shape (n, 3)
+        Light and view directions of the pairs with the light above the horizon.
+    view : ndarray of int, shape (n,)
+        Index of the view of each pair.
+    weight : ndarray, shape (n,)
+        Solid angle of each light direction's cell [sr] (for the least-squares integral).
+    """
+    alpha = np.concatenate([[0.0], np.geomspace(ALPHA_MIN, math.pi, n_alpha)])
+    # cell edges in alpha: midpoints, [0, a_1 / 2] for the centre
+    edges = np.concatenate([[0.0], 0.5 * (alpha[1:] + alpha[:-1]), [math.pi]])
+    band = 2.0 * math.pi * (np.cos(edges[:-1]) - np.cos(edges[1:]))  # solid angle of each ring
+    beta = np.arange(n_beta) * (2.0 * math.pi / n_beta)
+    a = np.concatenate([[0.0], np.repeat(alpha[1:], n_beta)])
+    b = np.concatenate([[0.0], np.tile(beta, n_alpha)])
+    w = np.concatenate([[band[0]], np.repeat(band[1:] / n_beta, n_beta)])
+    wis, wos, views, weights = [], [], [], []
+    for k, mv in enumerate(view_mus(n_views, mu_min)):
+        sv = math.sqrt(max(0.0, (1.0 - mv) * (1.0 + mv)))
+        v = np.array([sv, 0.0, mv])
+        r = np.array([-sv, 0.0, mv])  # mirror of V about N
+        e1 = np.array([mv, 0.0, sv])  # in the plane of incidence, perpendicular to R
+        e2 = np.array([0.0, 1.0, 0.0])
+        d = (np.cos(a)[:, None] * r + np.sin(a)[:, None] * (np.cos(b)[:, None] * e1 + np.sin(b)[:, None] * e2))
+        d /= np.linalg.norm(d, axis=-1, keepdims=True)
+        up = d[:, 2] > 1e-12
+        wis.append(d[up])
+        wos.append(np.broadcast_to(v, (int(up.sum()), 3)))
+        views.append(np.full(int(up.sum()), k))
+        weights.append(w[up])
+    return np.concatenate(wis), np.concatenate(wos), np.concatenate(views), np.concatenate(weights)
+
+
+@dataclass
+class FitData:
+    """What the objective compares: the target on a direction set and on a set of mu.
+
+    ``region`` marks the pairs of the lobe region (used by the perceptual errors);
+    ``t`` is f_t cos(theta_L) on all pairs, ``a_t`` the target albedo at ``mu``.
+    """
+
+    wi: np.ndarray
+    wo: np.ndarray
+    view: np.ndarray
+    weight: np.ndarray
+    cos_l: np.ndarray
+    t: np.ndarray
+    region: np.ndarray
+    mu: np.ndarray
+    a_t: np.ndarray
+    a_t_err: np.ndarray
+    lobe_fraction: float | None
+
+    @classmethod
+    def build(cls, target: BRDF, pairs, mu, lobe_fraction, rtol):
+        from .albedo import albedo
+
+        wi, wo, view, weight = pairs
+        cos_l = wi[:, 2]
+        t = np.asarray(target._eval(wi, wo), dtype=np.float64) * cos_l  # 001 eq. 3
+        if t.ndim != 1:
+            raise FitError(f"fit: the target must be a single-channel BRDF; its values have shape {t.shape}")
+        if not np.all(np.isfinite(t)):
+            raise FitError("fit: the target is not finite on the direction set")
+        if lobe_fraction is None:
+            region = t > 0
+        else:
+            peak = np.zeros(int(view.max()) + 1)
+            np.maximum.at(peak, view, t)
+            region = (t > 0) & (t >= lobe_fraction * peak[view])
+        if not region.any():
+            raise FitError("fit: the target is zero on every direction pair; nothing to fit")
+        a_t, a_err = albedo(target, mu, return_error=True, rtol=rtol)
+        if np.any(a_t <= 0):
+            i = int(np.argmin(a_t))
+            raise FitError(f"fit: the target's albedo is {a_t[i]:g} at mu = {mu[i]:g}; relative albedo error needs a > 0")
+        return cls(wi, wo, view, weight, cos_l, t, region, np.asarray(mu, float), a_t, a_err, lobe_fraction)
+
+
+def relative_errors(brdf: BRDF, data: FitData, rtol: float, scale: float = 1.0, return_albedo: bool = False):
+    """(e_f, e_a, bound of e_a from the albedo error estimates) of ``scale * brdf`` on ``data``.
+
+    With ``return_albedo``, also the albedo of ``scale * brdf`` at ``data.mu``."""
+    from .albedo import albedo
+
+    m = np.asarray(brdf._eval(data.wi[data.region], data.wo[data.region]), dtype=np.float64) * data.cos_l[data.region]
+    e_f = float(np.max(np.abs(scale * m / data.t[data.region] - 1.0)))  # 001 eq. 3, relative
+    a, a_err = albedo(brdf, data.mu, return_error=True, rtol=rtol)
+    q = scale * a / data.a_t
+    e_a = float(np.max(np.abs(q - 1.0)))  # 001 eq. 4, relative
+    bound = float(np.max(scale * a_err / data.a_t + q * data.a_t_err / data.a_t))
+    if return_albedo:
+        return e_f, e_a, bound, scale * a
+    return e_f, e_a, bound
+
+
+# ----------------------------------------------------------------------------------------
+# The result
+# ----------------------------------------------------------------------------------------
+
+
+@dataclass
+class FitResult:
+    """The outcome of :func:`fit`.
+
+    Attributes
+    ----------
+    spec : dict
+        The fitted model; ``pumpup.load(spec)`` (``brdf``) rebuilds it.
+    brdf : BRDF
+    params : dict
+        The fitted values of the free parameters (for a pumped family: of its base).
+    brdf_error : float
+        e_f, max relative error of f cos(theta_L) over the lobe region of the evaluation grid.
+    albedo_error : float
+        e_a, max relative error of the albedo over ``mu`` (computed at ``final_rtol``).
+    albedo_error_bound : float
+        How far ``albedo_error`` may be off because of the albedo quadrature (both albedos'
+        error estimates).
+    objective : float
+        max(w_f e_f, w_a e_a) at the result.
+    lsq : float
+        Root of the least-squares objective (the L2 distance of f cos theta_L, summed over
+        the views) on the search grid.
+    """
+
+    target: dict
+    family: str
+    method: str
+    spec: dict
+    brdf: BRDF
+    params: dict
+    bounds: dict
+    brdf_error: float
+    albedo_error: float
+    albedo_error_bound: float
+    objective: float
+    weights: tuple
+    lsq: float
+    mu: np.ndarray
+    lobe_fraction: float | None
+    eval_pairs: int
+    eval_views: int
+    max_albedo: float
+    evaluations: int
+    albedo_evaluations: int
+    n_mu_search: int
+    seconds: float
+    final_rtol: float
+    search_rtol: float
+    notes: list = field(default_factory=list)
+
+    @property
+    def mu_min(self) -> float:
+        return float(np.min(self.mu))
+
+    def __repr__(self) -> str:
+        free = ", ".join(f"{k} = {v:.6g} in [{self.bounds[k][0]:g}, {self.bounds[k][1]:g}]" for k, v in self.params.items())
+        region = ("f_t cos >= %g x its peak per view" % self.lobe_fraction) if self.lobe_fraction is not None else "given pairs"
+        lines = [
+            f"FitResult({self.method}: {self.family} fitted to {json.dumps(self.target)})",
+            f"  fitted spec    {json.dumps(self.spec)}",
+            f"  free params    {free or 'none'}",
+            f"  point light    max rel. error of f cos(theta_L) = {self.brdf_error:.4g} "
+            f"({self.eval_pairs} pairs of the lobe region: {region}; {self.eval_views} views, mu_V >= {self.mu_min:g})",
+            f"  sky light      max rel. error of albedo         = {self.albedo_error:.4g} "
+            f"(+- {self.albedo_error_bound:.1g}; {self.mu.size} mu in [{self.mu_min:g}, 1], rtol {self.final_rtol:g})",
+            f"  objective      max({self.weights[0]:g} e_f, {self.weights[1]:g} e_a) = {self.objective:.4g}; "
+            f"L2 distance {self.lsq:.4g}",
+            f"  max albedo     {self.max_albedo:.6g} on those mu" + ("  (> 1: not energy conserving)" if self.max_albedo > 1 else ""),
+            f"  cost           {self.evaluations} evaluations, {self.albedo_evaluations} with the albedo "
+            f"(rtol {self.search_rtol:g}, {self.n_mu_search} mu), {self.seconds:.2f} s",
+        ]
+        lines += [f"  note           {n}" for n in self.notes]
+        return "\n".join(lines)
+
+    __str__ = __repr__
+
+    def summary(self) -> dict:
+        """The result as plain JSON-able values."""
+        return {
+            "target": self.target, "family": self.family, "method": self.method, "spec": self.spec,
+            "params": self.params, "brdf_error": self.brdf_error, "albedo_error": self.albedo_error,
+            "albedo_error_bound": self.albedo_error_bound, "objective": self.objective, "lsq": self.lsq,
+            "max_albedo": self.max_albedo, "seconds": self.seconds, "evaluations": self.evaluations,
+            "mu_min": self.mu_min, "lobe_fraction": self.lobe_fraction,
+        }
+
+
+# ----------------------------------------------------------------------------------------
+# Checking the input (all before any optimisation)
+# ----------------------------------------------------------------------------------------
+
+
+def _load_target(target: Any) -> BRDF:
+    if isinstance(target, BRDF):
+        return target
+    if isinstance(target, str):
+        from .cli import parse_spec
+
+        try:
+            target = parse_spec(target)
+        except SystemExit as exc:
+            raise FitError(f"fit: target {target!r} does not load: {str(exc).removeprefix('pumpup: ')}") from None
+    if not isinstance(target, dict):
+        raise TypeError(f"fit: target must be a pumpup BRDF, a spec dict or a spec string, got {type(target).__name__}")
+    try:
+        return load(target)
+    except SpecError as exc:
+        raise FitError(f"fit: target does not load: {exc}") from None
+
+
+def _check_pump(pump: Any):
+    if pump is None:
+        return None
+    if not isinstance(pump, dict) or set(pump) - {"g", "levels"} or "g" not in pump:
+        raise FitError(f"fit: pump must be None or a dict {{'g': 'g1' or 'g2', 'levels': k >= 1}}, got {pump!r}")
+    g = pump["g"]
+    levels = pump.get("levels", 1)
+    if g not in ("g1", "g2"):
+        raise FitError(f"fit: pump['g'] must be 'g1' or 'g2', got {g!r}")
+    if isinstance(levels, bool) or not isinstance(levels, (int, np.integer)) or levels < 1:
+        raise FitError(f"fit: pump['levels'] must be an integer >= 1, got {levels!r}")
+    return {"g": g, "levels": int(levels)}
+
+
+def _check_params(cls, family: str, params: Any, fixed: dict, ties: dict):
+    if not isinstance(params, dict) or not params:
+        raise FitError(f"fit: params must be a non-empty dict name -> (lo, hi); {family} has {', '.join(cls.params)}")
+    out = {}
+    for name, rng in params.items():
+        if name not in cls.params:
+            raise FitError(f"fit: {family} has no parameter {name!r}; its parameters are {', '.join(cls.params)}")
+        p = cls.params[name]
+        if p.kind not in ("float", "int"):
+            raise FitError(f"fit: parameter {name!r} of {family} is of kind {p.kind!r}; only numbers can be fitted")
+        if name in fixed:
+            raise FitError(f"fit: parameter {name!r} is both free (params) and fixed")
+        if name in ties:
+            raise FitError(f"fit: parameter {name!r} is both free (params) and tied to {ties[name]!r}")
+        try:
+            lo, hi = (float(v) for v in rng)
+        except (TypeError, ValueError):
+            raise FitError(f"fit: params[{name!r}] must be a range (lo, hi) of two numbers, got {rng!r}") from None
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            raise FitError(f"fit: params[{name!r}] = ({lo:g}, {hi:g}) must be finite")
+        if not lo < hi:
+            raise FitError(f"fit: params[{name!r}] = ({lo:g}, {hi:g}) is an empty or inverted range; need lo < hi")
+        for v in (lo, hi):
+            try:
+                p.check_number(family, name, v)
+            except SpecError as exc:
+                raise FitError(f"fit: params[{name!r}] = ({lo:g}, {hi:g}): {exc}") from None
+        out[name] = (lo, hi)
+    return out
+
+
+def _check_weights(weights: Any):
+    try:
+        w = tuple(float(x) for x in weights)
+    except (TypeError, ValueError):
+        raise FitError(f"fit: weights must be two numbers (w_brdf, w_albedo) >= 0, got {weights!r}") from None
+    if len(w) != 2 or not all(math.isfinite(x) and x >= 0 for x in w) or w == (0.0, 0.0):
+        raise FitError(f"fit: weights must be two finite numbers (w_brdf, w_albedo) >= 0, not both 0; got {weights!r}")
+    return w
+
+
+def _log_scaled(lo: float, hi: float) -> bool:
+    return lo > 0 and hi / lo >= 10.0
+
+
+# ----------------------------------------------------------------------------------------
+# The fit
+# ----------------------------------------------------------------------------------------
+
+
+def _best_scale(pairs_q, lo, hi):
+    """argmin over c in [lo, hi] of max_k w_k max_i |c q_ki - 1|, exact (a max of lines).
+
+    ``pairs_q`` is a list of (w_k, q_min_k, q_max_k); each term is
+    w max(c q_max - 1, 1 - c q_min), so the maximum of 2K lines, convex in c.
+    """
+    ups = [(w * qmax, -w) for w, qmin, qmax in pairs_q if w > 0]  # slope, intercept: w (c qmax - 1)
+    downs = [(-w * qmin, w) for w, qmin, qmax in pairs_q if w > 0]  # w (1 - c qmin)
+    lines = ups + downs
+
+    def value(c):
+        return max(s * c + b for s, b in lines)
+
+    cands = [lo, hi]
+    for s1, b1 in ups:
+        for s2, b2 in downs:
+            if s1 != s2:
+                c = (b2 - b1) / (s1 - s2)
+                if lo <= c <= hi:
+                    cands.append(c)
+    best = min(cands, key=value)
+    return best, value(best)
+
+
+class _Problem:
+    def __init__(self, target, family, cls, bounds, fixed, ties, pump, method, weights, data, search_rtol):
+        self.target, self.family, self.cls = target, family, cls
+        self.bounds, self.fixed, self.ties, self.pump = bounds, fixed, ties, pump
+        self.method, self.weights, self.data, self.search_rtol = method, weights, data, search_rtol
+        const = cls.constant
+        self.profile = const if (const in bounds and pump is None) else None
+        self.names = [k for k in bounds if k != self.profile]
+        self.logs = [_log_scaled(*bounds[k]) for k in self.names]
+        self.cache: dict = {}
+        self.pruned: dict = {}
+        self.best = math.inf
+        self.evaluations = 0
+        self.albedo_evaluations = 0
+
+    # transformed coordinates x <-> parameter values
+    def to_x(self, values):
+        return np.array([math.log(values[k]) if lg else values[k] for k, lg in zip(self.names, self.logs)])
+
+    def from_x(self, x):
+        out = {}
+        for k, lg, xi in zip(self.names, self.logs, x):
+            lo, hi = self.bounds[k]
+            v = math.exp(xi) if lg else float(xi)
+            out[k] = min(max(v, lo), hi)
+        return out
+
+    def x_bounds(self):
+        return [(math.log(self.bounds[k][0]), math.log(self.bounds[k][1])) if lg else self.bounds[k]
+                for k, lg in zip(self.names, self.logs)]
+
+    def spec(self, values, scale=None):
+        s = {"type": self.family, **self.fixed, **values}
+        if self.profile is not None:
+            s[self.profile] = 1.0 if scale is None else scale
+        for k, src in self.ties.items():
+            s[k] = s[src]
+        if self.pump is not None:
+            return {"type": "pumped", "base": s, "g": self.pump["g"], "levels": self.pump["levels"]}
+        return s
+
+    def build(self, values, scale=None) -> BRDF:
+        from .pump import pump
+
+        s = self.spec(values, scale)
+        if self.pump is not None:
+            return pump(s["base"], g=self.pump["g"], levels=self.pump["levels"])
+        return load(s)
+
+    def evaluate(self, values, exact: bool = False):
+        """(objective, scale) at these values of the searched parameters.
+
+        During the search (``exact`` false) a candidate whose albedo-free lower bound of
+        the objective already exceeds the best value found so far returns that bound
+        without computing its albedo (it cannot become the best)."""
+        key = tuple(values[k] for k in self.names)
+        if key in self.cache:
+            return self.cache[key]
+        if not exact and key in self.pruned:
+            return self.pruned[key]
+        self.evaluations += 1
+        d = self.data
+        try:
+            f = self.build(values)
+        except SpecError:
+            self.cache[key] = (math.inf, None)
+            return self.cache[key]
+        with np.errstate(all="ignore"):
+            m = np.asarray(f._eval(d.wi, d.wo), dtype=np.float64) * d.cos_l
+        if not np.all(np.isfinite(m)):
+            self.cache[key] = (math.inf, None)
+            return self.cache[key]
+        if self.method == "least_squares":
+            res = self._lsq(m)
+        else:
+            if not exact:
+                lb = self._lower_bound(m)
+                if lb > self.best:
+                    self.pruned[key] = (lb, None)
+                    return self.pruned[key]
+            self.albedo_evaluations += 1
+            res = self._minmax(f, m)
+        self.best = min(self.best, res[0])
+        self.cache[key] = res
+        return res
+
+    def _lower_bound(self, m):
+        """A lower bound of the perceptual objective from the BRDF term alone (no albedo)."""
+        d = self.data
+        wf = self.weights[0]
+        qf = m[d.region] / d.t[d.region]
+        if self.profile is not None:
+            lo, hi = self.bounds[self.profile]
+            return _best_scale([(wf, qf.min(), qf.max())], lo, hi)[1]
+        return wf * float(np.max(np.abs(qf - 1.0)))
+
+    def _lsq(self, m):
+        d = self.data
+        w = d.weight
+        scale = None
+        if self.profile is not None:
+            lo, hi = self.bounds[self.profile]
+            den = float(np.sum(w * m * m))
+            c = float(np.sum(w * m * d.t)) / den if den > 0 else hi
+            scale = min(max(c, lo), hi)  # a convex quadratic in c: clipping is exact
+            m = scale * m
+        return float(np.sum(w * (m - d.t) ** 2)), scale
+
+    def _minmax(self, f, m):
+        from .albedo import albedo
+
+        d = self.data
+        wf, wa = self.weights
+        qf = m[d.region] / d.t[d.region]
+        if wa > 0:
+            import warnings
+
+            from .albedo import AlbedoWarning
+
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", AlbedoWarning)
+                a = albedo(f, d.mu, rtol=self.search_rtol)
+            if not np.all(np.isfinite(a)):
+                return math.inf, None
+            qa = a / d.a_t
+        else:
+            qa = np.ones(1)
+        if self.profile is not None:
+            lo, hi = self.bounds[self.profile]
+            c, val = _best_scale([(wf, qf.min(), qf.max()), (wa, qa.min(), qa.max())], lo, hi)
+            return val, c
+        val = max(wf * float(np.max(np.abs(qf - 1.0))), wa * float(np.max(np.abs(qa - 1.0))))
+        return val, None
+
+    def objective(self, x):
+        return self.evaluate(self.from_x(x))[0]
+
+
+def _search(prob: _Problem, n_scan: int, seed: int, maxiter: int, xtol: float):
+    from scipy.optimize import differential_evolution, minimize, minimize_scalar
+
+    xb = prob.x_bounds()
+    if not prob.names:
+        return np.zeros(0)
+    if len(prob.names) == 1:
+        lo, hi = xb[0]
+        grid = np.linspace(lo, hi, n_scan)
+        vals = np.array([prob.objective([x]) for x in grid])
+        i = int(np.argmin(vals))
+        a, b = grid[max(i - 1, 0)], grid[min(i + 1, n_scan - 1)]
+        r = minimize_scalar(lambda x: prob.objective([x]), bounds=(a, b), method="bounded",
+                            options={"xatol": xtol * max(1.0, abs(grid[i])), "maxiter": 200})
+        x = np.array([r.x]) if r.fun <= vals[i] else np.array([grid[i]])
+        return x
+    r = differential_evolution(prob.objective, xb, seed=seed, popsize=6, maxiter=maxiter, tol=1e-6,
+                               polish=False, init="sobol")
+    x0 = r.x
+    best = (r.fun, x0)
+    # local min-max refinement: Nelder-Mead on the max, restarted once from its own result
+    for _ in range(2):
+        loc = minimize(prob.objective, best[1], method="Nelder-Mead", bounds=xb,
+                       options={"xatol": xtol, "fatol": 1e-12, "maxfev": 100 * len(xb), "adaptive": True})
+        if loc.fun <= best[0]:
+            best = (loc.fun, loc.x)
+    return np.asarray(best[1])
+
+
+def fit(target, family: str, params: dict | None = None, fixed: dict | None = None, pump: dict | None = None,
+        directions=None, mu=None, weights=(1.0, 1.0), method: str = "perceptual", *, ties: dict | None = None,
+        lobe_fraction: float | None = DEFAULT_LOBE_FRACTION, mu_min: float = DEFAULT_MU_MIN,
+        n_mu: int = 33, n_mu_search: int = 9, search_rtol: float = 1e-5, final_rtol: float = 1e-9,
+        n_scan: int = 16, seed: int = 0, maxiter: int = 20, xtol: float = 1e-9) -> FitResult:
+    """Fit a compact model to ``target`` under point light and sky light (001 sec. 1.1).
+
+    Parameters
+    ----------
+    target : BRDF, spec dict or spec string
+        Any single-channel BRDF: a built-in model, a :func:`pumpup.from_function`, a
+        Mitsuba BSDF through ``pumpup.mitsuba.from_mitsuba``; or its spec
+        (``{"type": "ggx", "alpha": 0.1}`` or ``"ggx:alpha=0.1"``).
+    family : str
+        A registered model type (``pumpup.registry()``), e.g. ``"stretched_phong"``.
+    params : dict name -> (lo, hi)
+        The free parameters and their search ranges (inside each parameter's allowed
+        range).  A range with lo > 0 and hi / lo >= 10 is searched in log scale.  With a
+        pump, the names are the base's parameters.  Default ``{"n": (1, 1e4)}``.
+    fixed : dict, optional
+        Further parameters of the family held at given values (the rest take defaults).
+    pump : None or dict
+        ``{"g": "g1" or "g2", "levels": k}``: fit the family pumped up k times
+        (:func:`pumpup.pump`, 001 eq. 16-21).  Every candidate builds its own albedo
+        tables: seconds per candidate.
+    directions : None or (wi, wo)
+        Light and view directions (arrays of shape (n, 3)) on which f cos(theta_L) is
+        compared; default the lobe region of the module docstring (``lobe_fraction``).
+        Given pairs are used as they are (pairs where the target is 0 dropped), for the
+        search and for the reported error.
+    mu : array_like, optional
+        cos(theta) values of the albedo comparison, in (0, 1].  Default ``n_mu_search``
+        values (search) and ``n_mu`` values (reported error), theta uniform in
+        [0, arccos(mu_min)].
+    weights : (w_f, w_a)
+        The objective is max(w_f e_f, w_a e_a); (1, 0) ignores the albedo.
+    method : {"perceptual", "least_squares"}
+        The min-max relative-error fit of 001 sec. 1.1, or the L2 fit of f cos(theta_L)
+        alone (see the module docstring).  Both report both errors.
+    ties : dict, optional
+        ``{"cy": "cx"}``: a parameter that takes another's value (an isotropic Lafortune lobe).
+    lobe_fraction : float in (0, 1) or None
+        The lobe region: pairs with f_t cos(theta_L) >= this fraction of the maximum over L
+        for the same view (None: every pair where f_t > 0).
+    mu_min : float in (0, 1)
+        Smallest mu of the default albedo set and of the views.
+    search_rtol, final_rtol : float
+        Albedo tolerance during the search and for the reported errors.
+    n_scan, seed, maxiter : int
+        Points of the scan (one searched parameter), seed and generations of the
+        differential evolution (two or more).
+    xtol : float
+        Tolerance of the local refinement in the search coordinates (log of a log-scaled
+        parameter, i.e. relative): Brent's ``xatol``, Nelder-Mead's ``xatol``.
+
+    Returns
+    -------
+    FitResult
+        The fitted spec and BRDF, both maximal relative errors (recomputed on the denser
+        evaluation grid and at ``final_rtol``), the cost.
+
+    Notes
+    -----
+    Search: one parameter, a scan of ``n_scan`` points (log-spaced where the range is)
+    and bounded Brent minimisation around the best; two or more, scipy's
+    differential_evolution then Nelder-Mead on the max.  The scale c is profiled out
+    exactly when it is free (module docstring).
+    """
+    t0 = time.perf_counter()
+    if method not in METHODS:
+        raise FitError(f"fit: method must be one of {', '.join(METHODS)}, got {method!r}")
+    tgt = _load_target(target)
+    reg = registry()
+    if not isinstance(family, str) or family not in reg or family in ("pumped", "function"):
+        raise FitError(f"fit: family must be a registered model type (not 'pumped' or 'function'; use pump=); "
+                       f"got {family!r}; known: {', '.join(k for k in reg if k not in ('pumped', 'function'))}")
+    cls = reg[family]
+    fixed = dict(fixed or {})
+    ties = dict(ties or {})
+    for k in list(fixed) + list(ties) + list(ties.values()):
+        if k not in cls.params:
+            raise FitError(f"fit: {family} has no parameter {k!r}; its parameters are {', '.join(cls.params)}")
+    bounds = _check_params(cls, family, {"n": (1.0, 1e4)} if params is None else params, fixed, ties)
+    for k, src in ties.items():
+        if k in fixed:
+            raise FitError(f"fit: parameter {k!r} is both fixed and tied to {src!r}")
+    pump = _check_pump(pump)
+    weights = _check_weights(weights)
+    if lobe_fraction is not None and not (isinstance(lobe_fraction, (int, float)) and 0 < lobe_fraction < 1):
+        raise FitError(f"fit: lobe_fraction must be in (0, 1) or None, got {lobe_fraction!r}")
+    if not (isinstance(mu_min, (int, float)) and 0 < mu_min < 1):
+        raise FitError(f"fit: mu_min must be in (0, 1), got {mu_min!r}")
+    for name, v, lo in (("search_rtol", search_rtol, 1e-13), ("final_rtol", final_rtol, 1e-13), ("xtol", xtol, 1e-15)):
+        if not (isinstance(v, (int, float)) and lo <= v < 1):
+            raise FitError(f"fit: {name} must be in [{lo:g}, 1), got {v!r}")
+    for name, v, lo in (("n_mu", n_mu, 2), ("n_mu_search", n_mu_search, 2), ("n_scan", n_scan, 3), ("maxiter", maxiter, 1)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
+            raise FitError(f"fit: {name} must be an integer >= {lo}, got {v!r}")
+
+    if mu is None:
+        mu_search = np.cos(np.linspace(0.0, math.acos(mu_min), n_mu_search))
+        mu_final = np.cos(np.linspace(0.0, math.acos(mu_min), n_mu))
+    else:
+        from .albedo import check_mu
+
+        try:
+            mu_search = mu_final = np.unique(check_mu(mu).ravel())[::-1]
+        except ValueError as exc:
+            raise FitError(f"fit: {exc}") from None
+    if directions is None:
+        pairs_search = lobe_grid(*SEARCH_GRID, mu_min=mu_min)
+        pairs_final = lobe_grid(*EVAL_GRID, mu_min=mu_min)
+    else:
+        from .core import as_directions
+
+        try:
+            wi, wo = directions
+        except (TypeError, ValueError):
+            raise FitError("fit: directions must be a pair (wi, wo) of arrays of shape (n, 3)") from None
+        try:
+            wi = as_directions(wi, "directions[0] (wi)").reshape(-1, 3)
+            wo = as_directions(wo, "directions[1] (wo)").reshape(-1, 3)
+        except ValueError as exc:
+            raise FitError(f"fit: {exc}") from None
+        if wi.shape != wo.shape:
+            raise FitError(f"fit: directions: wi and wo must have the same shape, got {wi.shape} and {wo.shape}")
+        view = np.zeros(len(wi), int)
+        pairs_search = pairs_final = (wi, wo, view, np.full(len(wi), 4 * math.pi / len(wi)))
+        lobe_fraction = None
+
+    # a candidate at the middle of the ranges must load (names, fixed values, ties, pump)
+    mid = {k: (math.sqrt(lo * hi) if _log_scaled(lo, hi) else 0.5 * (lo + hi)) for k, (lo, hi) in bounds.items()}
+    trial = {"type": family, **fixed, **mid}
+    for k, src in ties.items():
+        trial[k] = trial[src]
+    try:
+        trial_brdf = load(trial)
+    except SpecError as exc:
+        raise FitError(f"fit: the family with these fixed values does not load: {exc}") from None
+    if pump is not None and not trial_brdf.reciprocal:
+        raise FitError(f"fit: pump needs a reciprocal family; {family} is not")
+
+    data = FitData.build(tgt, pairs_search, mu_search, lobe_fraction, final_rtol)
+    prob = _Problem(tgt, family, cls, bounds, fixed, ties, pump, method, weights, data, search_rtol)
+    x = _search(prob, n_scan, seed, maxiter, xtol)
+    values = prob.from_x(x) if prob.names else {}
+    _, scale = prob.evaluate(values, exact=True)
+    brdf = prob.build(values, scale)
+    m_fit = np.asarray(brdf._eval(data.wi, data.wo), dtype=np.float64) * data.cos_l
+    lsq_search = float(np.sum(data.weight * (m_fit - data.t) ** 2))
+    # the reported errors: the denser grid, the albedo at final_rtol
+    final = FitData.build(tgt, pairs_final, mu_final, lobe_fraction, final_rtol)
+    e_f, e_a, bound, a_fit = relative_errors(brdf, final, final_rtol, return_albedo=True)
+    fitted = dict(values)
+    if prob.profile is not None:
+        fitted[prob.profile] = float(scale)
+    notes = []
+    for k, v in fitted.items():
+        lo, hi = bounds[k]
+        if v <= lo * (1 + 1e-9) + 1e-300 or v >= hi * (1 - 1e-9):
+            notes.append(f"{k} = {v:g} is at the edge of its range [{lo:g}, {hi:g}]")
+    return FitResult(
+        target=tgt.spec, family=family, method=method, spec=brdf.spec, brdf=brdf, params=fitted, bounds=bounds,
+        brdf_error=e_f, albedo_error=e_a, albedo_error_bound=bound, albedo_evaluations=prob.albedo_evaluations, n_mu_search=len(mu_search),
+        objective=max(weights[0] * e_f, weights[1] * e_a), weights=weights, lsq=math.sqrt(lsq_search),
+        mu=final.mu, lobe_fraction=lobe_fraction, eval_pairs=int(final.region.sum()),
+        eval_views=int(final.view.max()) + 1, max_albedo=float(np.max(a_fit)), evaluations=prob.evaluations,
+        seconds=time.perf_counter() - t0, final_rtol=final_rtol, search_rtol=search_rtol, notes=notes,
+    )
