@@ -15,6 +15,7 @@ from . import sampling
 from .sampling import mc_albedo, mc_radiance, sample
 from .tables import AlbedoTable, max_albedo, max_constant, mean_albedo, open_table, tabulate, write_table
 from .sweep import sweep
+from .fit import FitResult, fit
 from .core import (
     BRDF,
     Lobe,
@@ -49,6 +50,8 @@ __all__ = [
     "open_table",
     "tabulate",
     "sweep",
+    "fit",
+    "FitResult",
     "write_table",
     "BRDF",
     "Lobe",

@@ -56,7 +56,8 @@ import numpy as np
 
 from .core import BRDF, SpecError, load, registry
 
-__all__ = ["fit", "FitResult", "FitData", "lobe_grid", "relative_errors", "DEFAULT_LOBE_FRACTION", "DEFAULT_MU_MIN"]
+__all__ = ["fit", "FitResult", "FitData", "FitError", "lobe_grid", "relative_errors", "plot_fits",
+           "DEFAULT_LOBE_FRACTION", "DEFAULT_MU_MIN"]
 
 #: default lobe region: f_t cos(theta_L) at least this fraction of its maximum over L for the view
 DEFAULT_LOBE_FRACTION = 0.1
@@ -227,6 +228,7 @@ class FitResult:
     """
 
     target: dict
+    target_brdf: BRDF
     family: str
     method: str
     spec: dict
@@ -269,7 +271,8 @@ class FitResult:
             f"(+- {self.albedo_error_bound:.1g}; {self.mu.size} mu in [{self.mu_min:g}, 1], rtol {self.final_rtol:g})",
             f"  objective      max({self.weights[0]:g} e_f, {self.weights[1]:g} e_a) = {self.objective:.4g}; "
             f"L2 distance {self.lsq:.4g}",
-            f"  max albedo     {self.max_albedo:.6g} on those mu" + ("  (> 1: not energy conserving)" if self.max_albedo > 1 else ""),
+            f"  max albedo     {self.max_albedo:.9g} on those mu"
+            + ("  (> 1: not energy conserving)" if self.max_albedo > 1 + 10 * self.final_rtol else ""),
             f"  cost           {self.evaluations} evaluations, {self.albedo_evaluations} with the albedo "
             f"(rtol {self.search_rtol:g}, {self.n_mu_search} mu), {self.seconds:.2f} s",
         ]
@@ -729,10 +732,80 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
         if v <= lo * (1 + 1e-9) + 1e-300 or v >= hi * (1 - 1e-9):
             notes.append(f"{k} = {v:g} is at the edge of its range [{lo:g}, {hi:g}]")
     return FitResult(
-        target=tgt.spec, family=family, method=method, spec=brdf.spec, brdf=brdf, params=fitted, bounds=bounds,
+        target=tgt.spec, target_brdf=tgt, family=family, method=method, spec=brdf.spec, brdf=brdf, params=fitted, bounds=bounds,
         brdf_error=e_f, albedo_error=e_a, albedo_error_bound=bound, albedo_evaluations=prob.albedo_evaluations, n_mu_search=len(mu_search),
         objective=max(weights[0] * e_f, weights[1] * e_a), weights=weights, lsq=math.sqrt(lsq_search),
         mu=final.mu, lobe_fraction=lobe_fraction, eval_pairs=int(final.region.sum()),
         eval_views=int(final.view.max()) + 1, max_albedo=float(np.max(a_fit)), evaluations=prob.evaluations,
         seconds=time.perf_counter() - t0, final_rtol=final_rtol, search_rtol=search_rtol, notes=notes,
     )
+
+
+# ----------------------------------------------------------------------------------------
+# The comparison figure
+# ----------------------------------------------------------------------------------------
+
+
+def plot_fits(results, path, views_deg=(0.0, 45.0, 75.0), labels=None, title=None):
+    """Write a PNG: point-light radiance and albedo curves of the target and the fits.
+
+    Top row: f(L, V) cos(theta_L) (001 eq. 3) in the plane of incidence for the views
+    ``views_deg``, against the signed light angle (positive on the mirror side), log
+    scale.  Bottom: the albedo a(mu) (001 eq. 4) against theta = arccos(mu) down to the
+    fits' mu_min, and its relative error.  All results must share one target.
+    Written atomically; returns ``path``.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .albedo import albedo
+    from .tables import atomic_path
+
+    results = list(results)
+    if not results:
+        raise ValueError("plot_fits: no results to plot")
+    tgt = results[0].target_brdf
+    labels = labels or [f"{r.family}{'' if 'base' not in r.spec else ' pumped'} ({r.method}): "
+                        f"e_f {r.brdf_error:.3g}, e_a {r.albedo_error:.3g}" for r in results]
+    nv = len(views_deg)
+    fig, axes = plt.subplots(2, max(nv, 2), figsize=(4.6 * max(nv, 2), 8), constrained_layout=True)
+    th_l = np.linspace(-89.5, 89.5, 719)
+    wl = np.stack([np.sin(np.radians(th_l)) * -1.0, np.zeros_like(th_l), np.cos(np.radians(th_l))], axis=-1)
+    for j, tv in enumerate(views_deg):
+        ax = axes[0, j]
+        v = np.array([math.sin(math.radians(tv)), 0.0, math.cos(math.radians(tv))])
+        ft = tgt.eval(wl, v) * wl[:, 2]  # 001 eq. 3
+        ax.semilogy(th_l, ft, "k", lw=2.2, label="target")
+        for r, lab in zip(results, labels):
+            ax.semilogy(th_l, r.brdf.eval(wl, v) * wl[:, 2], lw=1.2, label=lab)
+        peak = float(np.max(ft))
+        ax.set(ylim=(peak * 1e-3, peak * 3), xlabel="light angle theta_L [deg] (+ = mirror side)",
+               title=f"point light, view theta_V = {tv:g} deg")
+        ax.grid(alpha=0.3)
+    mu_min = min(r.mu_min for r in results)
+    th = np.linspace(0.0, math.degrees(math.acos(mu_min)), 60)
+    mu = np.cos(np.radians(th))
+    a_t = albedo(tgt, mu, rtol=1e-8)
+    axes[1, 0].plot(th, a_t, "k", lw=2.2, label="target")
+    for r, lab in zip(results, labels):
+        a = albedo(r.brdf, mu, rtol=1e-8)
+        axes[1, 0].plot(th, a, lw=1.2, label=lab)
+        axes[1, 1].plot(th, a / a_t - 1.0, lw=1.2, label=lab)
+    axes[1, 0].set(title="sky light: albedo a(theta)", xlabel="theta [deg]")
+    axes[1, 1].set(title="relative albedo error a / a_t - 1", xlabel="theta [deg]")
+    for ax in axes[1, :2]:
+        ax.grid(alpha=0.3)
+    if nv > 2:
+        axes[1, 2].axis("off")
+        axes[1, 2].legend(*axes[0, 0].get_legend_handles_labels(), fontsize=8, loc="center")
+        for ax in axes[1, 3:]:
+            ax.axis("off")
+    else:
+        axes[0, 0].legend(fontsize=7)
+    fig.suptitle(title or f"fits to {json.dumps(results[0].target)}", fontsize=10)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=90, format="png")
+    plt.close(fig)
+    return str(path)
