@@ -72,7 +72,7 @@ DEFAULT_MU_MIN = 0.05
 #: smallest polar offset of the log-polar light grid around the mirror direction [rad]
 ALPHA_MIN = 1e-3
 #: (views, polar offsets, azimuths) of the search grid and of the denser evaluation grid
-SEARCH_GRID = (10, 36, 16)
+SEARCH_GRID = (12, 48, 32)
 EVAL_GRID = (25, 90, 48)
 METHODS = ("perceptual", "least_squares")
 
@@ -189,6 +189,22 @@ class FitData:
         return cls(wi, wo, view, weight, cos_l, t, region, np.asarray(mu, float), a_t, a_err, lobe_fraction)
 
 
+def _add_pairs(self, target: BRDF, wi: np.ndarray, wo: np.ndarray) -> None:
+    """Append pairs to the lobe region (the exchange rounds of :func:`fit`; no least-squares weight)."""
+    t = np.asarray(target._eval(wi, wo), dtype=np.float64) * wi[:, 2]
+    ok = t > 0
+    self.wi = np.concatenate([self.wi, wi[ok]])
+    self.wo = np.concatenate([self.wo, wo[ok]])
+    self.view = np.concatenate([self.view, np.zeros(int(ok.sum()), int)])
+    self.weight = np.concatenate([self.weight, np.zeros(int(ok.sum()))])
+    self.cos_l = np.concatenate([self.cos_l, wi[ok, 2]])
+    self.t = np.concatenate([self.t, t[ok]])
+    self.region = np.concatenate([self.region, np.ones(int(ok.sum()), bool)])
+
+
+FitData.add_pairs = _add_pairs
+
+
 def relative_errors(brdf: BRDF, data: FitData, rtol: float, scale: float = 1.0, return_albedo: bool = False):
     """(e_f, e_a, bound of e_a from the albedo error estimates) of ``scale * brdf`` on ``data``.
 
@@ -258,7 +274,7 @@ def _offsets(wi, wo):
     return np.arccos(ca), np.arctan2(np.einsum("ij,ij->i", wi, e2), np.einsum("ij,ij->i", wi, e1))
 
 
-def sup_brdf_error(target: BRDF, brdf: BRDF, data: FitData, n_start: int = 4):
+def sup_brdf_error(target: BRDF, brdf: BRDF, data: FitData, n_start: int = 4, return_points: bool = False):
     """e_f refined: for each view, the grid maximum of |f cos / f_t cos - 1| over the lobe region,
     then local maximisation over the light direction (shrinking patches around the ``n_start``
     worst grid points), the view's peak refined the same way.  Returns (e_f, worst wi, worst wo).
@@ -276,6 +292,8 @@ def sup_brdf_error(target: BRDF, brdf: BRDF, data: FitData, n_start: int = 4):
     if data.lobe_fraction is None:
         inside = data.t > 0
         j = int(np.argmax(np.where(inside, err, -1.0)))
+        if return_points:
+            return float(err[j]), data.wi[j], data.wo[j], data.wi[j:j + 1], data.wo[j:j + 1], err[j:j + 1]
         return float(err[j]), data.wi[j], data.wo[j]
 
     def tval(wl, vv):
@@ -307,6 +325,8 @@ def sup_brdf_error(target: BRDF, brdf: BRDF, data: FitData, n_start: int = 4):
     i = int(np.argmax(val))
     if val[i] > best[0]:
         best = (float(val[i]), wl[i], sv[i])
+    if return_points:
+        return best + (wl, sv, val)
     return best
 
 
@@ -385,6 +405,8 @@ class FitResult:
     worst_pair: tuple
     worst_mu: float
     objective: float
+    search_objective: float
+    exchanges: int
     weights: tuple
     lsq: float
     mu: np.ndarray
@@ -416,7 +438,8 @@ class FitResult:
             f"  sky light      max rel. error of albedo         = {self.albedo_error:.4g} "
             f"(+- {self.albedo_error_bound:.1g}; {self.mu.size} mu in [{self.mu_min:g}, 1], rtol {self.final_rtol:g})",
             f"  objective      max({self.weights[0]:g} e_f, {self.weights[1]:g} e_a) = {self.objective:.4g}; "
-            f"L2 distance {self.lsq:.4g}",
+            f"L2 distance {self.lsq:.4g}; on the search set {self.search_objective:.4g} "
+            f"({self.exchanges} exchange rounds)",
             f"  max albedo     {self.max_albedo:.9g} on those mu"
             + ("  (> 1: not energy conserving)" if self.max_albedo > 1 + 10 * self.final_rtol else ""),
             f"  cost           {self.evaluations} evaluations, {self.albedo_evaluations} with the albedo "
@@ -433,6 +456,7 @@ class FitResult:
             "target": self.target, "family": self.family, "method": self.method, "spec": self.spec,
             "params": self.params, "brdf_error": self.brdf_error, "albedo_error": self.albedo_error,
             "albedo_error_bound": self.albedo_error_bound, "objective": self.objective, "lsq": self.lsq,
+            "search_objective": self.search_objective,
             "max_albedo": self.max_albedo, "seconds": self.seconds, "evaluations": self.evaluations,
             "mu_min": self.mu_min, "lobe_fraction": self.lobe_fraction,
         }
@@ -564,6 +588,12 @@ class _Problem:
         self.evaluations = 0
         self.albedo_evaluations = 0
 
+    def reset(self) -> None:
+        """Forget the cached values (after the data changed)."""
+        self.cache.clear()
+        self.pruned.clear()
+        self.best = math.inf
+
     # transformed coordinates x <-> parameter values
     def to_x(self, values):
         return np.array([math.log(values[k]) if lg else values[k] for k, lg in zip(self.names, self.logs)])
@@ -687,27 +717,20 @@ class _Problem:
         return self.evaluate(self.from_x(x))[0]
 
 
-def _search(prob: _Problem, n_scan: int, seed: int, maxiter: int, xtol: float):
-    from scipy.optimize import differential_evolution, minimize, minimize_scalar
+def _local(prob: _Problem, x, width: float, xtol: float):
+    """Local min-max refinement from x: bounded Brent on [x - width, x + width] (one parameter) or
+    Nelder-Mead on the max, restarted once from its own result (several)."""
+    from scipy.optimize import minimize, minimize_scalar
 
     xb = prob.x_bounds()
-    if not prob.names:
-        return np.zeros(0)
-    if len(prob.names) == 1:
-        lo, hi = xb[0]
-        grid = np.linspace(lo, hi, n_scan)
-        vals = np.array([prob.objective([x]) for x in grid])
-        i = int(np.argmin(vals))
-        a, b = grid[max(i - 1, 0)], grid[min(i + 1, n_scan - 1)]
-        r = minimize_scalar(lambda x: prob.objective([x]), bounds=(a, b), method="bounded",
-                            options={"xatol": xtol * max(1.0, abs(grid[i])), "maxiter": 200})
-        x = np.array([r.x]) if r.fun <= vals[i] else np.array([grid[i]])
-        return x
-    r = differential_evolution(prob.objective, xb, seed=seed, popsize=6, maxiter=maxiter, tol=1e-6,
-                               polish=False, init="sobol")
-    x0 = r.x
-    best = (r.fun, x0)
-    # local min-max refinement: Nelder-Mead on the max, restarted once from its own result
+    x = np.asarray(x, dtype=np.float64)
+    f0 = prob.objective(x)
+    if len(x) == 1:
+        a, b = max(xb[0][0], x[0] - width), min(xb[0][1], x[0] + width)
+        r = minimize_scalar(lambda y: prob.objective([y]), bounds=(a, b), method="bounded",
+                            options={"xatol": xtol * max(1.0, abs(x[0])), "maxiter": 200})
+        return np.array([r.x]) if r.fun <= f0 else x
+    best = (f0, x)
     for _ in range(2):
         loc = minimize(prob.objective, best[1], method="Nelder-Mead", bounds=xb,
                        options={"xatol": xtol, "fatol": 1e-12, "maxfev": 100 * len(xb), "adaptive": True})
@@ -716,11 +739,32 @@ def _search(prob: _Problem, n_scan: int, seed: int, maxiter: int, xtol: float):
     return np.asarray(best[1])
 
 
+def _search(prob: _Problem, n_scan: int, seed: int, maxiter: int, xtol: float):
+    """Bounded global search (a scan for one parameter, differential evolution for more), then
+    :func:`_local`.  Returns (x, the width of the scan's step)."""
+    from scipy.optimize import differential_evolution
+
+    xb = prob.x_bounds()
+    if not prob.names:
+        return np.zeros(0), 0.0
+    if len(prob.names) == 1:
+        lo, hi = xb[0]
+        grid = np.linspace(lo, hi, n_scan)
+        vals = np.array([prob.objective([x]) for x in grid])
+        i = int(np.argmin(vals))
+        step = grid[1] - grid[0]
+        return _local(prob, [grid[i]], step, xtol), step
+    r = differential_evolution(prob.objective, xb, seed=seed, popsize=6, maxiter=maxiter, tol=1e-6,
+                               polish=False, init="sobol")
+    return _local(prob, r.x, 0.0, xtol), 0.0
+
+
 def fit(target, family: str, params: dict | None = None, fixed: dict | None = None, pump: dict | None = None,
         directions=None, mu=None, weights=(1.0, 1.0), method: str = "perceptual", *, ties: dict | None = None,
         lobe_fraction: float | None = DEFAULT_LOBE_FRACTION, mu_min: float = DEFAULT_MU_MIN,
         n_mu: int = 33, n_mu_search: int = 9, search_rtol: float = 1e-5, final_rtol: float = 1e-9,
-        n_scan: int = 16, seed: int = 0, maxiter: int = 20, xtol: float = 1e-9) -> FitResult:
+        n_scan: int = 16, seed: int = 0, maxiter: int = 20, xtol: float = 1e-9,
+        exchange_rounds: int = 3) -> FitResult:
     """Fit a compact model to ``target`` under point light and sky light (001 sec. 1.1).
 
     Parameters
@@ -767,6 +811,9 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
     n_scan, seed, maxiter : int
         Points of the scan (one searched parameter), seed and generations of the
         differential evolution (two or more).
+    exchange_rounds : int
+        Perceptual fits: at most this many rounds in which the worst points of the dense grid
+        (refined) join the search set and the local search is repeated (Remez's exchange).
     xtol : float
         Tolerance of the local refinement in the search coordinates (log of a log-scaled
         parameter, i.e. relative): Brent's ``xatol``, Nelder-Mead's ``xatol``.
@@ -811,7 +858,8 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
     for name, v, lo in (("search_rtol", search_rtol, 1e-13), ("final_rtol", final_rtol, 1e-13), ("xtol", xtol, 1e-15)):
         if not (isinstance(v, (int, float)) and lo <= v < 1):
             raise FitError(f"fit: {name} must be in [{lo:g}, 1), got {v!r}")
-    for name, v, lo in (("n_mu", n_mu, 2), ("n_mu_search", n_mu_search, 2), ("n_scan", n_scan, 3), ("maxiter", maxiter, 1)):
+    for name, v, lo in (("n_mu", n_mu, 2), ("n_mu_search", n_mu_search, 2), ("n_scan", n_scan, 3), ("maxiter", maxiter, 1),
+                         ("exchange_rounds", exchange_rounds, 0)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
             raise FitError(f"fit: {name} must be an integer >= {lo}, got {v!r}")
 
@@ -860,14 +908,30 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
 
     data = FitData.build(tgt, pairs_search, mu_search, lobe_fraction, final_rtol)
     prob = _Problem(tgt, family, cls, bounds, fixed, ties, pump, method, weights, data, search_rtol)
-    x = _search(prob, n_scan, seed, maxiter, xtol)
+    x, step = _search(prob, n_scan, seed, maxiter, xtol)
     values = prob.from_x(x) if prob.names else {}
-    _, scale = prob.evaluate(values, exact=True)
+    search_objective, scale = prob.evaluate(values, exact=True)
+    final = FitData.build(tgt, pairs_final, mu_final, lobe_fraction, final_rtol)
+    exchanges = 0
+    if method == "perceptual" and directions is None and prob.names:
+        # exchange rounds (as in Remez's algorithm): the worst points of the dense grid, refined,
+        # join the search set and the local search is repeated, until the search set sees the maximum
+        for _ in range(exchange_rounds):
+            brdf = prob.build(values, scale)
+            e_f, _, _, more_wi, more_wo, more_val = sup_brdf_error(tgt, brdf, final, return_points=True)
+            if weights[0] * e_f <= search_objective * (1 + 1e-3):
+                break
+            keep = more_val >= 0.5 * e_f
+            data.add_pairs(tgt, more_wi[keep], more_wo[keep])
+            prob.reset()
+            x = _local(prob, x, 2 * step, xtol)
+            values = prob.from_x(x)
+            search_objective, scale = prob.evaluate(values, exact=True)
+            exchanges += 1
     brdf = prob.build(values, scale)
     m_fit = np.asarray(brdf._eval(data.wi, data.wo), dtype=np.float64) * data.cos_l
     lsq_search = float(np.sum(data.weight * (m_fit - data.t) ** 2))
     # the reported errors: the denser grid, the albedo at final_rtol
-    final = FitData.build(tgt, pairs_final, mu_final, lobe_fraction, final_rtol)
     _, _, bound, a_fit = relative_errors(brdf, final, final_rtol, return_albedo=True)
     if directions is None:
         e_f, worst_wi, worst_wo = sup_brdf_error(tgt, brdf, final)
@@ -885,7 +949,7 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
     return FitResult(
         target=tgt.spec, target_brdf=tgt, family=family, method=method, spec=brdf.spec, brdf=brdf, params=fitted, bounds=bounds,
         brdf_error=e_f, albedo_error=e_a, albedo_error_bound=bound, worst_pair=(worst_wi, worst_wo), worst_mu=worst_mu,
-        albedo_evaluations=prob.albedo_evaluations, n_mu_search=len(mu_search),
+        search_objective=search_objective, exchanges=exchanges, albedo_evaluations=prob.albedo_evaluations, n_mu_search=len(mu_search),
         objective=max(weights[0] * e_f, weights[1] * e_a), weights=weights, lsq=math.sqrt(lsq_search),
         mu=final.mu, lobe_fraction=lobe_fraction, eval_pairs=int(final.region.sum()),
         eval_views=int(final.view.max()) + 1, max_albedo=float(np.max(a_fit)), evaluations=prob.evaluations,
