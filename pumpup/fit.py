@@ -679,13 +679,17 @@ class _Problem:
         d = self.data
         w = d.weight
         scale = None
-        if self.profile is not None:
-            lo, hi = self.bounds[self.profile]
-            den = float(np.sum(w * m * m))
-            c = float(np.sum(w * m * d.t)) / den if den > 0 else hi
-            scale = min(max(c, lo), hi)  # a convex quadratic in c: clipping is exact
-            m = scale * m
-        return float(np.sum(w * (m - d.t) ** 2)), scale
+        with np.errstate(over="ignore", invalid="ignore"):
+            if self.profile is not None:
+                lo, hi = self.bounds[self.profile]
+                den = float(np.sum(w * m * m))
+                c = float(np.sum(w * m * d.t)) / den if den > 0 else hi
+                if not math.isfinite(c):
+                    return math.inf, None
+                scale = min(max(c, lo), hi)  # a convex quadratic in c: clipping is exact
+                m = scale * m
+            val = float(np.sum(w * (m - d.t) ** 2))
+        return (val if math.isfinite(val) else math.inf), scale
 
     def _minmax(self, f, m):
         from .albedo import albedo
@@ -764,7 +768,7 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
         lobe_fraction: float | None = DEFAULT_LOBE_FRACTION, mu_min: float = DEFAULT_MU_MIN,
         n_mu: int = 33, n_mu_search: int = 9, search_rtol: float = 1e-5, final_rtol: float = 1e-9,
         n_scan: int = 16, seed: int = 0, maxiter: int = 20, xtol: float = 1e-9,
-        exchange_rounds: int = 3) -> FitResult:
+        exchange_rounds: int = 3, grid: tuple = SEARCH_GRID, eval_grid: tuple = EVAL_GRID) -> FitResult:
     """Fit a compact model to ``target`` under point light and sky light (001 sec. 1.1).
 
     Parameters
@@ -811,6 +815,10 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
     n_scan, seed, maxiter : int
         Points of the scan (one searched parameter), seed and generations of the
         differential evolution (two or more).
+    grid, eval_grid : (int, int, int)
+        Views, polar offsets and azimuths of the lobe grids (:func:`lobe_grid`) of the search
+        and of the reported errors; default ``SEARCH_GRID`` = (12, 48, 32) and
+        ``EVAL_GRID`` = (25, 90, 48).
     exchange_rounds : int
         Perceptual fits: at most this many rounds in which the worst points of the dense grid
         (refined) join the search set and the local search is repeated (Remez's exchange).
@@ -874,8 +882,12 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
         except ValueError as exc:
             raise FitError(f"fit: {exc}") from None
     if directions is None:
-        pairs_search = lobe_grid(*SEARCH_GRID, mu_min=mu_min)
-        pairs_final = lobe_grid(*EVAL_GRID, mu_min=mu_min)
+        for name, g in (("grid", grid), ("eval_grid", eval_grid)):
+            if (not isinstance(g, (tuple, list)) or len(g) != 3
+                    or not all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) and v >= 2 for v in g)):
+                raise FitError(f"fit: {name} must be three integers >= 2 (views, polar offsets, azimuths), got {g!r}")
+        pairs_search = lobe_grid(*grid, mu_min=mu_min)
+        pairs_final = lobe_grid(*eval_grid, mu_min=mu_min)
     else:
         from .core import as_directions
 

@@ -42,9 +42,11 @@ def _independent_errors(target, fitted, lobe_fraction, mu_min, n_views=37, n_the
 
 # --- a family fitted to a member of itself ------------------------------------------------
 
+SMALL = {"grid": (6, 24, 12), "eval_grid": (9, 36, 16), "n_mu": 9}  # cheaper grids where the grid is not tested
+
 
 def test_recovers_stretched_phong_n():
-    r = pumpup.fit({"type": "stretched_phong", "n": 120}, "stretched_phong", params={"n": (1, 1e4)})
+    r = pumpup.fit({"type": "stretched_phong", "n": 120}, "stretched_phong", params={"n": (1, 1e4)}, **SMALL)
     assert abs(r.params["n"] / 120 - 1) < 1e-4
     assert r.brdf_error < 1e-4 and r.albedo_error < 1e-4
     assert r.spec["type"] == "stretched_phong" and pumpup.load(r.spec) == r.brdf
@@ -54,7 +56,7 @@ def test_recovers_stretched_phong_n():
 @pytest.mark.parametrize("method", pf.METHODS)
 def test_recovers_modified_ward_m_and_scale(method):
     r = pumpup.fit({"type": "modified_ward", "m": 0.15, "c": 0.9}, "modified_ward",
-                   params={"m": (0.01, 1.0), "c": (0.1, 10.0)}, method=method)
+                   params={"m": (0.01, 1.0), "c": (0.1, 10.0)}, method=method, **SMALL)
     assert abs(r.params["m"] / 0.15 - 1) < 1e-4 and abs(r.params["c"] / 0.9 - 1) < 1e-4
     assert r.brdf_error < 1e-4 and r.albedo_error < 1e-4
 
@@ -62,7 +64,7 @@ def test_recovers_modified_ward_m_and_scale(method):
 def test_recovers_two_searched_parameters_least_squares():
     """n and p of a stretched Phong lobe: differential evolution then Nelder-Mead."""
     r = pumpup.fit({"type": "stretched_phong", "n": 80, "p": 0.6}, "stretched_phong",
-                   params={"n": (1, 1e4), "p": (0.0, 1.0)}, method="least_squares")
+                   params={"n": (1, 1e4), "p": (0.0, 1.0)}, method="least_squares", **SMALL)
     assert abs(r.params["n"] / 80 - 1) < 1e-4 and abs(r.params["p"] / 0.6 - 1) < 1e-4
     assert r.brdf_error < 1e-4 and r.albedo_error < 1e-4
 
@@ -113,8 +115,9 @@ def test_reported_errors_recomputed_on_a_denser_set():
 
 def test_perceptual_beats_least_squares_on_its_own_objective():
     target = {"type": "ggx", "alpha": 0.2}
-    rp = pumpup.fit(target, "stretched_phong", params={"n": (1, 1e3), "c": (0.01, 100.0)})
-    rl = pumpup.fit(target, "stretched_phong", params={"n": (1, 1e3), "c": (0.01, 100.0)}, method="least_squares")
+    rp = pumpup.fit(target, "stretched_phong", params={"n": (1, 1e3), "c": (0.01, 100.0)}, **SMALL)
+    rl = pumpup.fit(target, "stretched_phong", params={"n": (1, 1e3), "c": (0.01, 100.0)}, method="least_squares",
+                    **SMALL)
     assert rp.objective < rl.objective
     assert rl.lsq <= rp.lsq * (1 + 1e-6)
 
@@ -162,6 +165,8 @@ BAD = [
     (dict(mu=[0.5, 1.5]), "mu"),
     (dict(lobe_fraction=1.5), "lobe_fraction"),
     (dict(ties={"c": "zz"}), "has no parameter 'zz'"),
+    (dict(grid=(5, 5)), "grid must be three integers"),
+    (dict(directions=([0, 0, 1], [0, 0, 2])), "unit vectors"),
 ]
 
 
