@@ -332,7 +332,9 @@ def sup_brdf_error(target: BRDF, brdf: BRDF, data: FitData, n_start: int = 4, re
 
 def sup_albedo_error(target: BRDF, brdf: BRDF, mu: np.ndarray, a_t: np.ndarray, a: np.ndarray, rtol: float):
     """e_a refined: the grid maximum of |a / a_t - 1| over ``mu``, then bounded Brent
-    maximisation in theta between the neighbours of the worst grid point.  Returns (e_a, mu*)."""
+    maximisation in theta between the neighbours of the worst grid point (when the worst grid
+    point is an end of the range and the midpoint towards its neighbour is lower, the end is
+    taken as the maximum).  Returns (e_a, mu*)."""
     from scipy.optimize import minimize_scalar
 
     from .albedo import albedo
@@ -351,8 +353,12 @@ def sup_albedo_error(target: BRDF, brdf: BRDF, mu: np.ndarray, a_t: np.ndarray, 
         m = math.cos(th)
         return -abs(float(albedo(brdf, m, rtol=rtol)) / float(albedo(target, m, rtol=rtol)) - 1.0)
 
+    if i in (order[0], order[-1]):  # the worst grid point is an end of [mu_min, 1]: is the maximum there?
+        mid = 0.5 * (math.acos(lo) + math.acos(hi))
+        if -neg(mid) <= best[0]:
+            return best
     r = minimize_scalar(neg, bounds=(math.acos(hi), math.acos(lo)), method="bounded",
-                        options={"xatol": 1e-7, "maxiter": 40})
+                        options={"xatol": 1e-6, "maxiter": 30})
     if -r.fun > best[0]:
         best = (float(-r.fun), math.cos(r.x))
     return best
@@ -925,12 +931,15 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
     search_objective, scale = prob.evaluate(values, exact=True)
     final = FitData.build(tgt, pairs_final, mu_final, lobe_fraction, final_rtol)
     exchanges = 0
+    last_sup = (None, None)
     if method == "perceptual" and directions is None and prob.names:
         # exchange rounds (as in Remez's algorithm): the worst points of the dense grid, refined,
         # join the search set and the local search is repeated, until the search set sees the maximum
         for _ in range(exchange_rounds):
             brdf = prob.build(values, scale)
-            e_f, _, _, more_wi, more_wo, more_val = sup_brdf_error(tgt, brdf, final, return_points=True)
+            sup = sup_brdf_error(tgt, brdf, final, return_points=True)
+            e_f, more_wi, more_wo, more_val = sup[0], sup[3], sup[4], sup[5]
+            last_sup = (json.dumps(brdf.spec, sort_keys=True), sup[:3])
             if weights[0] * e_f <= search_objective * (1 + 1e-3):
                 break
             keep = more_val >= 0.5 * e_f
@@ -945,7 +954,9 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
     lsq_search = float(np.sum(data.weight * (m_fit - data.t) ** 2))
     # the reported errors: the denser grid, the albedo at final_rtol
     _, _, bound, a_fit = relative_errors(brdf, final, final_rtol, return_albedo=True)
-    if directions is None:
+    if last_sup[0] == json.dumps(brdf.spec, sort_keys=True):  # the last exchange round measured this model
+        e_f, worst_wi, worst_wo = last_sup[1]
+    elif directions is None:
         e_f, worst_wi, worst_wo = sup_brdf_error(tgt, brdf, final)
     else:
         e_f, worst_wi, worst_wo = sup_brdf_error(tgt, brdf, final, n_start=1)

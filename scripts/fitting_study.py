@@ -85,7 +85,7 @@ def save_records(path, records):
 
 def run(path, part, only_targets=None, only_families=None, mu_min=0.05):
     records = load_records(path)
-    done = {(r["target_name"], r["model"], r["method"], r["mu_min"]) for r in records}
+    done = {(r["target_name"], r["model"], r["method"], round(r["mu_min"], 9)) for r in records}
     models = {"compact": COMPACT, "pumped": PUMPED, "all": {**COMPACT, **PUMPED}}[part]
     for tname, tspec in targets().items():
         if only_targets and tname not in only_targets:
@@ -94,7 +94,7 @@ def run(path, part, only_targets=None, only_families=None, mu_min=0.05):
             if only_families and mname not in only_families:
                 continue
             for method in METHODS:
-                if (tname, mname, method, mu_min) in done:
+                if (tname, mname, method, round(mu_min, 9)) in done:
                     continue
                 t0 = time.perf_counter()
                 r = pumpup.fit(tspec, method=method, mu_min=mu_min, **kw)
@@ -108,25 +108,38 @@ def run(path, part, only_targets=None, only_families=None, mu_min=0.05):
     return records
 
 
+SHORT = {"phong": "Phong", "stretched_phong": "str. Phong", "blinn": "Blinn", "stretched_blinn": "str. Blinn",
+         "modified_ward": "mod. Ward", "lafortune": "Lafortune", "pumped_phong_g2_1": "Phong g2 x1",
+         "pumped_phong_g2_2": "Phong g2 x2", "pumped_phong_g2_3": "Phong g2 x3"}
+
+
 def table(records):
-    """Markdown: one row per target, for each model the perceptual and least-squares errors."""
-    by = {}
-    for r in records:
-        by[(r["target_name"], r["model"], r["method"])] = r
+    """Markdown: for each method, targets x models with "e_f / e_a"; then the fit times per model."""
+    by = {(r["target_name"], r["model"], r["method"]): r for r in records}
     tnames = [t for t in targets() if any(k[0] == t for k in by)]
     models = [m for m in {**COMPACT, **PUMPED} if any(k[1] == m for k in by)]
     lines = []
-    for m in models:
-        lines.append(f"\n**{m}**: max relative error e_f (point light) / e_a (albedo), fit time\n")
-        lines.append("| target | perceptual e_f | e_a | time [s] | least squares e_f | e_a | time [s] |")
-        lines.append("|---|---|---|---|---|---|---|")
+    for method in METHODS:
+        lines.append(f"\n{method}: e_f (point light) / e_a (albedo), maximal relative errors\n")
+        lines.append("| target | " + " | ".join(SHORT[m] for m in models) + " |")
+        lines.append("|---|" + "---|" * len(models))
         for t in tnames:
-            p, q = by.get((t, m, "perceptual")), by.get((t, m, "least_squares"))
-            if p is None and q is None:
-                continue
-            cell = lambda r: ("not run", "", "") if r is None else (f"{r['brdf_error']:.3g}", f"{r['albedo_error']:.3g}",
-                                                                    f"{r['seconds']:.1f}")
-            lines.append(f"| {t} | " + " | ".join(cell(p)) + " | " + " | ".join(cell(q)) + " |")
+            cells = []
+            for m in models:
+                r = by.get((t, m, method))
+                cells.append("-" if r is None else f"{r['brdf_error']:.3g} / {r['albedo_error']:.3g}")
+            lines.append(f"| {t} | " + " | ".join(cells) + " |")
+    lines.append("\nfit time [s] (wall, median and max over the targets; load average during the runs in brackets)\n")
+    lines.append("| model | perceptual | least squares | fits | load |")
+    lines.append("|---|---|---|---|---|")
+    for m in models:
+        row = []
+        loads = [r["load"] for r in records if r["model"] == m]
+        for method in METHODS:
+            ts = [r["seconds"] for r in records if r["model"] == m and r["method"] == method]
+            row.append(f"{np.median(ts):.1f} / {max(ts):.1f}" if ts else "-")
+        n = sum(1 for r in records if r["model"] == m)
+        lines.append(f"| {SHORT[m]} | {row[0]} | {row[1]} | {n} | {min(loads):.0f}-{max(loads):.0f} |")
     return "\n".join(lines)
 
 
@@ -147,16 +160,17 @@ def best(records):
            "|---|---|---|\n" + "\n".join(out)
 
 
-def figure(records, path, target_name="ggx a=0.1 Al"):
+def figure(records, path, target_name="ggx a=0.1 F=1"):
     tspec = targets()[target_name]
     tgt = pumpup.load(tspec)
     res, labels = [], []
+    records = [r for r in records if abs(r["mu_min"] - 0.05) < 1e-9]
     for r in records:
         if r["target_name"] == target_name and r["method"] == "perceptual" and r["model"] in COMPACT:
             res.append(r)
     pick = {}
     for r in records:
-        if r["target_name"] == target_name and r["model"] in ("stretched_phong", "modified_ward", "pumped_phong_g2_1"):
+        if r["target_name"] == target_name and r["model"] in ("stretched_phong", "modified_ward", "pumped_phong_g2_2"):
             pick[(r["model"], r["method"])] = r
     chosen = [r for r in res if r["model"] in ("phong", "blinn", "lafortune")] + list(pick.values())
     from pumpup.fit import plot_fits
@@ -195,9 +209,12 @@ def main():
         run(a.out, a.part, a.targets, a.models, a.mu_min)
     recs = [r for path in [a.out] + (a.read or []) for r in load_records(path)]
     if a.table:
-        print(table(recs))
-        print()
-        print(best(recs))
+        for mu_min in sorted({round(r["mu_min"], 9) for r in recs}):
+            sub = [r for r in recs if round(r["mu_min"], 9) == mu_min]
+            print(f"\n### mu_min = {mu_min:g} (views and albedo down to theta = {math.degrees(math.acos(mu_min)):.1f} deg)")
+            print(table(sub))
+            print()
+            print(best(sub))
     if a.figure:
         print("wrote", figure(recs, a.figure))
 
