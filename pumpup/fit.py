@@ -413,6 +413,7 @@ class FitResult:
     objective: float
     search_objective: float
     exchanges: int
+    plausible: bool
     weights: tuple
     lsq: float
     mu: np.ndarray
@@ -436,7 +437,8 @@ class FitResult:
         free = ", ".join(f"{k} = {v:.6g} in [{self.bounds[k][0]:g}, {self.bounds[k][1]:g}]" for k, v in self.params.items())
         region = ("f_t cos >= %g x its peak per view" % self.lobe_fraction) if self.lobe_fraction is not None else "given pairs"
         lines = [
-            f"FitResult({self.method}: {self.family} fitted to {json.dumps(self.target)})",
+            f"FitResult({self.method}{', albedo <= 1' if self.plausible else ''}: {self.family} fitted to "
+            f"{json.dumps(self.target)})",
             f"  fitted spec    {json.dumps(self.spec)}",
             f"  free params    {free or 'none'}",
             f"  point light    max rel. error of f cos(theta_L) = {self.brdf_error:.4g} "
@@ -444,8 +446,9 @@ class FitResult:
             f"  sky light      max rel. error of albedo         = {self.albedo_error:.4g} "
             f"(+- {self.albedo_error_bound:.1g}; {self.mu.size} mu in [{self.mu_min:g}, 1], rtol {self.final_rtol:g})",
             f"  objective      max({self.weights[0]:g} e_f, {self.weights[1]:g} e_a) = {self.objective:.4g}; "
-            f"L2 distance {self.lsq:.4g}; on the search set {self.search_objective:.4g} "
-            f"({self.exchanges} exchange rounds)",
+            f"L2 distance {self.lsq:.4g}" + (f"; on the search set {self.search_objective:.4g} "
+                                                f"({self.exchanges} exchange rounds)"
+                                                if self.method == "perceptual" else ""),
             f"  max albedo     {self.max_albedo:.9g} on those mu"
             + ("  (> 1: not energy conserving)" if self.max_albedo > 1 + 10 * self.final_rtol else ""),
             f"  cost           {self.evaluations} evaluations, {self.albedo_evaluations} with the albedo "
@@ -462,7 +465,7 @@ class FitResult:
             "target": self.target, "family": self.family, "method": self.method, "spec": self.spec,
             "params": self.params, "brdf_error": self.brdf_error, "albedo_error": self.albedo_error,
             "albedo_error_bound": self.albedo_error_bound, "objective": self.objective, "lsq": self.lsq,
-            "search_objective": self.search_objective,
+            "search_objective": self.search_objective, "plausible": self.plausible,
             "max_albedo": self.max_albedo, "seconds": self.seconds, "evaluations": self.evaluations,
             "mu_min": self.mu_min, "lobe_fraction": self.lobe_fraction,
         }
@@ -580,7 +583,9 @@ def _best_scale(pairs_q, lo, hi):
 
 
 class _Problem:
-    def __init__(self, target, family, cls, bounds, fixed, ties, pump, method, weights, data, search_rtol):
+    def __init__(self, target, family, cls, bounds, fixed, ties, pump, method, weights, data, search_rtol,
+                 plausible=False):
+        self.plausible = plausible
         self.target, self.family, self.cls = target, family, cls
         self.bounds, self.fixed, self.ties, self.pump = bounds, fixed, ties, pump
         self.method, self.weights, self.data, self.search_rtol = method, weights, data, search_rtol
@@ -658,14 +663,13 @@ class _Problem:
             self.cache[key] = (math.inf, None)
             return self.cache[key]
         if self.method == "least_squares":
-            res = self._lsq(m)
+            res = self._lsq(m, f)
         else:
             if not exact:
                 lb = self._lower_bound(m)
                 if lb > self.best:
                     self.pruned[key] = (lb, None)
                     return self.pruned[key]
-            self.albedo_evaluations += 1
             res = self._minmax(f, m)
         self.best = min(self.best, res[0])
         self.cache[key] = res
@@ -681,13 +685,43 @@ class _Problem:
             return _best_scale([(wf, qf.min(), qf.max())], lo, hi)[1]
         return wf * float(np.max(np.abs(qf - 1.0)))
 
-    def _lsq(self, m):
+    def _search_albedo(self, f):
+        """The albedo of f on the search mu (at the search tolerance), or None if not finite."""
+        import warnings
+
+        from .albedo import AlbedoWarning, albedo
+
+        self.albedo_evaluations += 1
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", AlbedoWarning)
+            a = albedo(f, self.data.mu, rtol=self.search_rtol)
+        return a if np.all(np.isfinite(a)) else None
+
+    def _scale_range(self, a):
+        """The range of the profiled scale; with ``plausible``, capped so that c a <= 1 on the search mu
+        (a: the albedo at c = 1).  None if empty."""
+        lo, hi = self.bounds[self.profile]
+        if self.plausible and a is not None and np.max(a) > 0:
+            hi = min(hi, 1.0 / float(np.max(a)))  # energy conservation, 000 eq. 2-3
+        return (lo, hi) if lo <= hi else None
+
+    def _lsq(self, m, f=None):
         d = self.data
         w = d.weight
         scale = None
+        a = None
+        if self.plausible and f is not None:
+            a = self._search_albedo(f)
+            if a is None:
+                return math.inf, None
+            if self.profile is None and np.max(a) > 1.0 + 10 * self.search_rtol:
+                return math.inf, None
         with np.errstate(over="ignore", invalid="ignore"):
             if self.profile is not None:
-                lo, hi = self.bounds[self.profile]
+                rng = self._scale_range(a)
+                if rng is None:
+                    return math.inf, None
+                lo, hi = rng
                 den = float(np.sum(w * m * m))
                 c = float(np.sum(w * m * d.t)) / den if den > 0 else hi
                 if not math.isfinite(c):
@@ -698,28 +732,23 @@ class _Problem:
         return (val if math.isfinite(val) else math.inf), scale
 
     def _minmax(self, f, m):
-        from .albedo import albedo
-
         d = self.data
         wf, wa = self.weights
         qf = m[d.region] / d.t[d.region]
-        if wa > 0:
-            import warnings
-
-            from .albedo import AlbedoWarning
-
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", AlbedoWarning)
-                a = albedo(f, d.mu, rtol=self.search_rtol)
-            if not np.all(np.isfinite(a)):
+        a = None
+        if wa > 0 or self.plausible:
+            a = self._search_albedo(f)
+            if a is None:
                 return math.inf, None
-            qa = a / d.a_t
-        else:
-            qa = np.ones(1)
+        qa = a / d.a_t if wa > 0 else np.ones(1)
         if self.profile is not None:
-            lo, hi = self.bounds[self.profile]
-            c, val = _best_scale([(wf, qf.min(), qf.max()), (wa, qa.min(), qa.max())], lo, hi)
+            rng = self._scale_range(a)
+            if rng is None:
+                return math.inf, None
+            c, val = _best_scale([(wf, qf.min(), qf.max()), (wa, qa.min(), qa.max())], *rng)
             return val, c
+        if self.plausible and np.max(a) > 1.0 + 10 * self.search_rtol:
+            return math.inf, None
         val = max(wf * float(np.max(np.abs(qf - 1.0))), wa * float(np.max(np.abs(qa - 1.0))))
         return val, None
 
@@ -774,7 +803,8 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
         lobe_fraction: float | None = DEFAULT_LOBE_FRACTION, mu_min: float = DEFAULT_MU_MIN,
         n_mu: int = 33, n_mu_search: int = 9, search_rtol: float = 1e-5, final_rtol: float = 1e-9,
         n_scan: int = 16, seed: int = 0, maxiter: int = 20, xtol: float = 1e-9,
-        exchange_rounds: int = 3, grid: tuple = SEARCH_GRID, eval_grid: tuple = EVAL_GRID) -> FitResult:
+        exchange_rounds: int = 3, grid: tuple = SEARCH_GRID, eval_grid: tuple = EVAL_GRID,
+        plausible: bool = False) -> FitResult:
     """Fit a compact model to ``target`` under point light and sky light (001 sec. 1.1).
 
     Parameters
@@ -821,6 +851,12 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
     n_scan, seed, maxiter : int
         Points of the scan (one searched parameter), seed and generations of the
         differential evolution (two or more).
+    plausible : bool
+        Energy conservation as a constraint: the profiled scale is capped so that the albedo
+        is at most 1 on the search mu (and mu = 1 if it is among them); a family without a
+        free scale rejects candidates whose albedo exceeds 1 there.  Pumped families conserve
+        energy by construction.  ``FitResult.max_albedo`` reports the albedo maximum on the
+        final mu set.
     grid, eval_grid : (int, int, int)
         Views, polar offsets and azimuths of the lobe grids (:func:`lobe_grid`) of the search
         and of the reported errors; default ``SEARCH_GRID`` = (12, 48, 32) and
@@ -925,7 +961,7 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
         raise FitError(f"fit: pump needs a reciprocal family; {family} is not")
 
     data = FitData.build(tgt, pairs_search, mu_search, lobe_fraction, final_rtol)
-    prob = _Problem(tgt, family, cls, bounds, fixed, ties, pump, method, weights, data, search_rtol)
+    prob = _Problem(tgt, family, cls, bounds, fixed, ties, pump, method, weights, data, search_rtol, bool(plausible))
     x, step = _search(prob, n_scan, seed, maxiter, xtol)
     values = prob.from_x(x) if prob.names else {}
     search_objective, scale = prob.evaluate(values, exact=True)
@@ -972,7 +1008,7 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
     return FitResult(
         target=tgt.spec, target_brdf=tgt, family=family, method=method, spec=brdf.spec, brdf=brdf, params=fitted, bounds=bounds,
         brdf_error=e_f, albedo_error=e_a, albedo_error_bound=bound, worst_pair=(worst_wi, worst_wo), worst_mu=worst_mu,
-        search_objective=search_objective, exchanges=exchanges, albedo_evaluations=prob.albedo_evaluations, n_mu_search=len(mu_search),
+        search_objective=search_objective, exchanges=exchanges, plausible=bool(plausible), albedo_evaluations=prob.albedo_evaluations, n_mu_search=len(mu_search),
         objective=max(weights[0] * e_f, weights[1] * e_a), weights=weights, lsq=math.sqrt(lsq_search),
         mu=final.mu, lobe_fraction=lobe_fraction, eval_pairs=int(final.region.sum()),
         eval_views=int(final.view.max()) + 1, max_albedo=float(np.max(a_fit)), evaluations=prob.evaluations,

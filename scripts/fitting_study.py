@@ -83,9 +83,10 @@ def save_records(path, records):
             json.dump(records, fh, indent=1)
 
 
-def run(path, part, only_targets=None, only_families=None, mu_min=0.05):
+def run(path, part, only_targets=None, only_families=None, mu_min=0.05, plausible=False):
     records = load_records(path)
-    done = {(r["target_name"], r["model"], r["method"], round(r["mu_min"], 9)) for r in records}
+    done = {(r["target_name"], r["model"], r["method"], round(r["mu_min"], 9), r.get("plausible", False))
+            for r in records}
     models = {"compact": COMPACT, "pumped": PUMPED, "all": {**COMPACT, **PUMPED}}[part]
     for tname, tspec in targets().items():
         if only_targets and tname not in only_targets:
@@ -94,10 +95,10 @@ def run(path, part, only_targets=None, only_families=None, mu_min=0.05):
             if only_families and mname not in only_families:
                 continue
             for method in METHODS:
-                if (tname, mname, method, round(mu_min, 9)) in done:
+                if (tname, mname, method, round(mu_min, 9), plausible) in done:
                     continue
                 t0 = time.perf_counter()
-                r = pumpup.fit(tspec, method=method, mu_min=mu_min, **kw)
+                r = pumpup.fit(tspec, method=method, mu_min=mu_min, plausible=plausible, **kw)
                 rec = r.summary()
                 rec.update(target_name=tname, model=mname, wall=time.perf_counter() - t0,
                            load=os.getloadavg()[0], albedo_evaluations=r.albedo_evaluations)
@@ -164,7 +165,7 @@ def figure(records, path, target_name="ggx a=0.1 F=1"):
     tspec = targets()[target_name]
     tgt = pumpup.load(tspec)
     res, labels = [], []
-    records = [r for r in records if abs(r["mu_min"] - 0.05) < 1e-9]
+    records = [r for r in records if abs(r["mu_min"] - 0.05) < 1e-9 and not r.get("plausible", False)]
     for r in records:
         if r["target_name"] == target_name and r["method"] == "perceptual" and r["model"] in COMPACT:
             res.append(r)
@@ -198,6 +199,7 @@ def main():
     ap.add_argument("--out", default="tables/fitting_study.json")
     ap.add_argument("--part", choices=("compact", "pumped", "all"))
     ap.add_argument("--targets", nargs="+", help="only these target names (quote them)")
+    ap.add_argument("--plausible", action="store_true", help="fit with albedo <= 1 as a constraint")
     ap.add_argument("--mu-min", type=float, default=0.05, help="smallest mu of the views and the albedo (default 0.05)")
     ap.add_argument("--models", nargs="+", help="only these model names")
     ap.add_argument("--read", nargs="+", metavar="JSON", help="further result files for --table and --figure")
@@ -206,12 +208,13 @@ def main():
     a = ap.parse_args()
     if a.part:
         print(f"load average at start: {os.getloadavg()}")
-        run(a.out, a.part, a.targets, a.models, a.mu_min)
+        run(a.out, a.part, a.targets, a.models, a.mu_min, a.plausible)
     recs = [r for path in [a.out] + (a.read or []) for r in load_records(path)]
     if a.table:
-        for mu_min in sorted({round(r["mu_min"], 9) for r in recs}):
-            sub = [r for r in recs if round(r["mu_min"], 9) == mu_min]
-            print(f"\n### mu_min = {mu_min:g} (views and albedo down to theta = {math.degrees(math.acos(mu_min)):.1f} deg)")
+        for mu_min, pl in sorted({(round(r["mu_min"], 9), r.get("plausible", False)) for r in recs}):
+            sub = [r for r in recs if round(r["mu_min"], 9) == mu_min and r.get("plausible", False) == pl]
+            print(f"\n### mu_min = {mu_min:g} (views and albedo down to theta = {math.degrees(math.acos(mu_min)):.1f} deg)"
+                  + (", albedo <= 1 imposed" if pl else ", scale free"))
             print(table(sub))
             print()
             print(best(sub))
