@@ -414,6 +414,8 @@ class FitResult:
     search_objective: float
     exchanges: int
     plausible: bool
+    directions_given: bool
+    view_mu_min: float
     weights: tuple
     lsq: float
     mu: np.ndarray
@@ -435,14 +437,19 @@ class FitResult:
 
     def __repr__(self) -> str:
         free = ", ".join(f"{k} = {v:.6g} in [{self.bounds[k][0]:g}, {self.bounds[k][1]:g}]" for k, v in self.params.items())
-        region = ("f_t cos >= %g x its peak per view" % self.lobe_fraction) if self.lobe_fraction is not None else "given pairs"
+        if self.directions_given:
+            where = f"over the {self.eval_pairs} given pairs where f_t > 0"
+        else:
+            region = (f"f_t cos >= {self.lobe_fraction:g} x its peak per view" if self.lobe_fraction is not None
+                      else "f_t > 0")
+            where = (f"({self.eval_pairs} pairs of the lobe region: {region}; {self.eval_views} views, "
+                     f"mu_V >= {self.view_mu_min:g})")
         lines = [
             f"FitResult({self.method}{', albedo <= 1' if self.plausible else ''}: {self.family} fitted to "
             f"{json.dumps(self.target)})",
             f"  fitted spec    {json.dumps(self.spec)}",
             f"  free params    {free or 'none'}",
-            f"  point light    max rel. error of f cos(theta_L) = {self.brdf_error:.4g} "
-            f"({self.eval_pairs} pairs of the lobe region: {region}; {self.eval_views} views, mu_V >= {self.mu_min:g})",
+            f"  point light    max rel. error of f cos(theta_L) = {self.brdf_error:.4g} {where}",
             f"  sky light      max rel. error of albedo         = {self.albedo_error:.4g} "
             f"(+- {self.albedo_error_bound:.1g}; {self.mu.size} mu in [{self.mu_min:g}, 1], rtol {self.final_rtol:g})",
             f"  objective      max({self.weights[0]:g} e_f, {self.weights[1]:g} e_a) = {self.objective:.4g}; "
@@ -1008,7 +1015,8 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
     return FitResult(
         target=tgt.spec, target_brdf=tgt, family=family, method=method, spec=brdf.spec, brdf=brdf, params=fitted, bounds=bounds,
         brdf_error=e_f, albedo_error=e_a, albedo_error_bound=bound, worst_pair=(worst_wi, worst_wo), worst_mu=worst_mu,
-        search_objective=search_objective, exchanges=exchanges, plausible=bool(plausible), albedo_evaluations=prob.albedo_evaluations, n_mu_search=len(mu_search),
+        search_objective=search_objective, exchanges=exchanges, plausible=bool(plausible),
+        directions_given=directions is not None, view_mu_min=float(np.min(final.wo[:, 2])), albedo_evaluations=prob.albedo_evaluations, n_mu_search=len(mu_search),
         objective=max(weights[0] * e_f, weights[1] * e_a), weights=weights, lsq=math.sqrt(lsq_search),
         mu=final.mu, lobe_fraction=lobe_fraction, eval_pairs=int(final.region.sum()),
         eval_views=int(final.view.max()) + 1, max_albedo=float(np.max(a_fit)), evaluations=prob.evaluations,
