@@ -282,7 +282,7 @@ def sup_brdf_error(target: BRDF, brdf: BRDF, data: FitData, n_start: int = 4, re
     The grid maximum alone underestimates the supremum where the worst point lies on the
     region's boundary (common: the tails differ most)."""
     m = np.asarray(brdf._eval(data.wi, data.wo), dtype=np.float64) * data.cos_l
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # outside the region t may be tiny
         err = np.where(data.t > 0, np.abs(m / np.where(data.t > 0, data.t, 1.0) - 1.0), 0.0)
     nv = int(data.view.max()) + 1
     first = np.array([np.flatnonzero(data.view == k)[0] for k in range(nv)])
