@@ -1068,12 +1068,12 @@ def plot_fits(results, path, views_deg=(0.0, 45.0, 75.0), labels=None, title=Non
                title=f"point light, view theta_V = {tv:g} deg")
         ax.grid(alpha=0.3)
     mu_min = min(r.mu_min for r in results)
-    th = np.linspace(0.0, math.degrees(math.acos(mu_min)), 60)
+    th = np.linspace(0.0, math.degrees(math.acos(mu_min)), 40)
     mu = np.cos(np.radians(th))
-    a_t = albedo(tgt, mu, rtol=1e-8)
+    a_t = albedo(tgt, mu, rtol=1e-6)  # a plot: 1e-6 is far below a line's width
     axes[1, 0].plot(th, a_t, "k", lw=2.2, label="target")
     for r, lab in zip(results, labels):
-        a = albedo(r.brdf, mu, rtol=1e-8)
+        a = albedo(r.brdf, mu, rtol=1e-6)
         axes[1, 0].plot(th, a, lw=1.2, label=lab)
         axes[1, 1].plot(th, a / a_t - 1.0, lw=1.2, label=lab)
     axes[1, 0].set(title="sky light: albedo a(theta)", xlabel="theta [deg]")
