@@ -472,7 +472,7 @@ class FitResult:
             "target": self.target, "family": self.family, "method": self.method, "spec": self.spec,
             "params": self.params, "brdf_error": self.brdf_error, "albedo_error": self.albedo_error,
             "albedo_error_bound": self.albedo_error_bound, "objective": self.objective, "lsq": self.lsq,
-            "search_objective": self.search_objective, "plausible": self.plausible,
+            "search_objective": self.search_objective, "plausible": self.plausible, "notes": list(self.notes),
             "max_albedo": self.max_albedo, "seconds": self.seconds, "evaluations": self.evaluations,
             "mu_min": self.mu_min, "lobe_fraction": self.lobe_fraction,
         }
