@@ -188,21 +188,17 @@ class FitData:
             raise FitError(f"fit: the target's albedo is {a_t[i]:g} at mu = {mu[i]:g}; relative albedo error needs a > 0")
         return cls(wi, wo, view, weight, cos_l, t, region, np.asarray(mu, float), a_t, a_err, lobe_fraction)
 
-
-def _add_pairs(self, target: BRDF, wi: np.ndarray, wo: np.ndarray) -> None:
-    """Append pairs to the lobe region (the exchange rounds of :func:`fit`; no least-squares weight)."""
-    t = np.asarray(target._eval(wi, wo), dtype=np.float64) * wi[:, 2]
-    ok = t > 0
-    self.wi = np.concatenate([self.wi, wi[ok]])
-    self.wo = np.concatenate([self.wo, wo[ok]])
-    self.view = np.concatenate([self.view, np.zeros(int(ok.sum()), int)])
-    self.weight = np.concatenate([self.weight, np.zeros(int(ok.sum()))])
-    self.cos_l = np.concatenate([self.cos_l, wi[ok, 2]])
-    self.t = np.concatenate([self.t, t[ok]])
-    self.region = np.concatenate([self.region, np.ones(int(ok.sum()), bool)])
-
-
-FitData.add_pairs = _add_pairs
+    def add_pairs(self, target: BRDF, wi: np.ndarray, wo: np.ndarray) -> None:
+        """Append pairs to the lobe region (the exchange rounds of :func:`fit`; no least-squares weight)."""
+        t = np.asarray(target._eval(wi, wo), dtype=np.float64) * wi[:, 2]
+        ok = t > 0
+        self.wi = np.concatenate([self.wi, wi[ok]])
+        self.wo = np.concatenate([self.wo, wo[ok]])
+        self.view = np.concatenate([self.view, np.zeros(int(ok.sum()), int)])
+        self.weight = np.concatenate([self.weight, np.zeros(int(ok.sum()))])
+        self.cos_l = np.concatenate([self.cos_l, wi[ok, 2]])
+        self.t = np.concatenate([self.t, t[ok]])
+        self.region = np.concatenate([self.region, np.ones(int(ok.sum()), bool)])
 
 
 def relative_errors(brdf: BRDF, data: FitData, rtol: float, scale: float = 1.0, return_albedo: bool = False):
