@@ -20,6 +20,7 @@ from .tables import AlbedoTable, max_albedo, max_constant, mean_albedo, open_tab
 from .sweep import sweep
 from . import luts as lut_module
 from .luts import audit, lut
+from .fit import FitResult, fit
 from .core import (
     BRDF,
     Lobe,
@@ -64,6 +65,8 @@ __all__ = [
     "lut",
     "audit",
     "lut_module",
+    "fit",
+    "FitResult",
     "write_table",
     "BRDF",
     "Lobe",

@@ -424,6 +424,71 @@ def cmd_compensate(args) -> int:
     return 0
 
 
+def cmd_fit(args) -> int:
+    try:
+        return _fit(args)
+    except SystemExit as exc:  # user errors: one line on stderr, status 2
+        if isinstance(exc.code, str):
+            print(exc.code, file=sys.stderr)
+            raise SystemExit(2) from None
+        raise
+
+
+def _fit(args) -> int:
+    import pumpup
+    from pumpup.fit import plot_fits
+
+    target = _load(args.target)
+    params, fixed = {}, {}
+    for item in args.param:
+        name, eq, rng = item.partition("=")
+        lo, colon, hi = rng.partition(":")
+        try:
+            if not (eq and colon):
+                raise ValueError
+            params[name.strip()] = (float(lo), float(hi))
+        except ValueError:
+            raise SystemExit(f"pumpup: --param {item!r} must look like NAME=LO:HI, e.g. n=1:10000") from None
+    for item in args.fixed or []:
+        name, eq, value = item.partition("=")
+        if not eq:
+            raise SystemExit(f"pumpup: --fixed {item!r} must look like NAME=VALUE, e.g. p=1")
+        try:
+            fixed[name.strip()] = json.loads(value)
+        except json.JSONDecodeError:
+            fixed[name.strip()] = value.strip()
+    ties = {}
+    for item in args.tie or []:
+        name, eq, src = item.partition("=")
+        if not eq:
+            raise SystemExit(f"pumpup: --tie {item!r} must look like NAME=OTHER, e.g. cy=cx")
+        ties[name.strip()] = src.strip()
+    pump = None
+    if args.pump:
+        g, _, levels = args.pump.partition(":")
+        try:
+            pump = {"g": g, "levels": int(levels or 1)}
+        except ValueError:
+            raise SystemExit(f"pumpup: --pump {args.pump!r} must look like G[:LEVELS], e.g. g2:2") from None
+    methods = ("perceptual", "least_squares") if args.method == "both" else (args.method,)
+    results = []
+    for m in methods:
+        try:
+            r = pumpup.fit(target, args.family, params=params, fixed=fixed, pump=pump, ties=ties, method=m,
+                           weights=(args.w_brdf, args.w_albedo), lobe_fraction=args.lobe_fraction, mu_min=args.mu_min)
+        except (pumpup.SpecError, ValueError, TypeError) as exc:
+            raise SystemExit(f"pumpup: {exc}") from None
+        print(r)
+        results.append(r)
+    if args.out:
+        try:
+            plot_fits(results, args.out)
+        except OSError as exc:
+            raise SystemExit(f"pumpup: {exc}") from None
+        print(f"wrote {args.out}")
+    return 0
+
+
 def cmd_render(args) -> int:
     """``pumpup render sphere|furnace``: every argument is checked (one line, status 2) before rendering."""
     import os
@@ -764,6 +829,25 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--out", default="scenes", help="directory for NAME.png and the panels' EXR (default scenes)")
     r.add_argument("--quiet", action="store_true", help="no progress lines (default: progress shown)")
     r.set_defaults(func=cmd_render_scene)
+    s = sub.add_parser("fit", help="fit a model family to a target: max relative error of f cos(theta_L) and of "
+                                   "the albedo (perceptual, 001 sec. 1.1) or least squares")
+    s.add_argument("target", help="the target's SPEC, e.g. ggx:alpha=0.1")
+    s.add_argument("--family", required=True, help="a model type, e.g. stretched_phong (required)")
+    s.add_argument("--param", action="append", required=True, metavar="NAME=LO:HI",
+                   help="a free parameter and its range, e.g. n=1:10000 (required; repeat for more)")
+    s.add_argument("--fixed", action="append", metavar="NAME=VALUE",
+                   help="a parameter held fixed, e.g. p=0.5 (default: the family's defaults)")
+    s.add_argument("--tie", action="append", metavar="NAME=OTHER", help="a parameter equal to another, e.g. cy=cx (default: none)")
+    s.add_argument("--pump", metavar="G[:LEVELS]", help="fit the family pumped up, e.g. g2:2 (default: not pumped)")
+    s.add_argument("--method", choices=("perceptual", "least_squares", "both"), default="perceptual",
+                   help="the objective (default: perceptual)")
+    s.add_argument("--w-brdf", type=float, default=1.0, help="weight of the point-light error (default 1)")
+    s.add_argument("--w-albedo", type=float, default=1.0, help="weight of the albedo error (default 1)")
+    s.add_argument("--lobe-fraction", type=float, default=0.1,
+                   help="lobe region: f_t cos(theta_L) >= this fraction of its peak per view (default 0.1)")
+    s.add_argument("--mu-min", type=float, default=0.05, help="smallest mu of the albedo and the views (default 0.05)")
+    s.add_argument("--out", help="write the comparison figure (PNG) here (default: none)")
+    s.set_defaults(func=cmd_fit)
     return p
 
 
