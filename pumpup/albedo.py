@@ -750,6 +750,10 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
             value[idx] += w * v
             error[idx] += abs(w) * e
             ok[idx] &= conv
+    extra = getattr(brdf, "albedo_extra", None)  # a model's analytic part (e.g. a delta lobe), see he_torrance
+    if extra is not None:
+        add, add_err = extra(flat, value)
+        value, error = value + add, error + add_err
     if not ok.all():
         i = int(np.argmin(ok))
         warnings.warn(
