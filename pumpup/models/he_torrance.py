@@ -59,7 +59,7 @@ P_{m+1} / P_m = g / (m + 1) <= g / (M + 2) < 1 for m > M, so the remainder is
 R_M <= P_{M+1} / ((M + 1) (1 - g / (M + 2))).  The sum stops at the first M with
 R_M <= ``SERIES_RTOL`` * (sum so far), or R_M below 1e-280 (absolute).  The truncated f
 is therefore below the true f by a relative amount of at most SERIES_RTOL; the albedo
-engine adds SERIES_RTOL * a to its error estimate (:meth:`HeTorrance.albedo_extra`).
+engine adds SERIES_RTOL * a to its error estimate (``HeTorrance.eval_rtol``).
 
 References
 ----------
@@ -328,7 +328,8 @@ class HeTorrance(BRDF):
 
     ``eval`` returns the directional-diffuse plus the uniform-diffuse parts; the specular
     part is a delta in the mirror direction whose weight :meth:`specular_weight` gives,
-    and which :func:`pumpup.albedo` adds analytically (through :meth:`albedo_extra`).
+    and which :func:`pumpup.albedo` and :func:`pumpup.mc_albedo` add analytically
+    (through :meth:`delta_albedo`).
     The equations, and which line implements which, are in the module docstring.
 
     Parameters
@@ -371,6 +372,8 @@ class HeTorrance(BRDF):
     ]
     kernel = staticmethod(_ht_kernel)
     reference_fn = staticmethod(_ht_reference)
+    #: relative truncation bound of eval (the series), added to the albedo error
+    eval_rtol = SERIES_RTOL
 
     def _validate(self):
         p = self.p
@@ -406,14 +409,15 @@ class HeTorrance(BRDF):
         f = fresnel_unpolarised(mu, p["n"], p["k"])
         return f * np.exp(-g) * shadowing(mu, m0) ** 2
 
-    def albedo_extra(self, mu, integrated):
-        """What :func:`pumpup.albedo` adds to the cubature of ``eval``: (value, error).
+    def delta_albedo(self, mu):
+        """The delta lobe's share of the albedo, :meth:`specular_weight`.
 
-        The value is :meth:`specular_weight`; the error adds its rounding (1e-15 of it)
-        and the series truncation, at most ``SERIES_RTOL`` of the integrated part.
+        :func:`pumpup.albedo` adds it to the cubature of ``eval`` (with a rounding error
+        of 1e-15 of it) and :func:`pumpup.mc_albedo` to its estimate (exactly: the delta
+        is not sampled); ``eval_rtol`` (= ``SERIES_RTOL``) of the cubature is added to the
+        albedo error for the truncation of the series.
         """
-        w = self.specular_weight(mu)
-        return w, 1e-15 * w + SERIES_RTOL * np.abs(integrated)
+        return self.specular_weight(mu)
 
     # --- hints ---------------------------------------------------------------------------
     def lobe(self, mu):
