@@ -236,6 +236,8 @@ def report(datasets: dict) -> str:
 
 #: the analysis of 001 sec. 2.1 (pumpup.divergence), written as divergence.nc with its plot
 DIVERGENCE = "divergence"
+#: 000 Tables 1 and 5 (pumpup.costs): evaluation and sampling cost measured here, in report.md only
+COSTS = "costs"
 
 
 def _divergence_report(ds) -> str:
@@ -253,9 +255,10 @@ def reproduce(out: str = "tables", only: list[str] | None = None, progress: bool
 
     Besides :data:`TABLES`, ``divergence`` runs the divergence analysis
     (:func:`pumpup.divergence.analysis_dataset`) into ``<out>/divergence.nc`` and
-    ``<out>/divergence.png``.
+    ``<out>/divergence.png``. ``costs`` measures 000 Tables 1 and 5 on this machine (:mod:`pumpup.costs`) into a
+    section of ``report.md``.
     """
-    choices = list(TABLES) + [DIVERGENCE]
+    choices = list(TABLES) + [DIVERGENCE, COSTS]
     names = list(only) if only else choices
     unknown = [n for n in names if n not in choices]
     if unknown:
@@ -268,7 +271,7 @@ def reproduce(out: str = "tables", only: list[str] | None = None, progress: bool
         raise OSError(f"the output directory {out!r} is not writable")
     cache = _Cache()
     t0 = time.perf_counter()
-    datasets = {n: compute(n, progress=progress, cache=cache) for n in names if n != DIVERGENCE}
+    datasets = {n: compute(n, progress=progress, cache=cache) for n in names if n not in (DIVERGENCE, COSTS)}
     extra = ""
     if DIVERGENCE in names:
         from .divergence import analysis_dataset, plot
@@ -277,6 +280,10 @@ def reproduce(out: str = "tables", only: list[str] | None = None, progress: bool
         write_table(div, os.path.join(out, "divergence.nc"))
         plot(div, os.path.join(out, "divergence.png"))
         extra = _divergence_report(div)
+    if COSTS in names:
+        from .costs import report as costs_report
+
+        extra += ("\n" if extra else "") + costs_report()  # timings: reported, never asserted
     for n, ds in datasets.items():
         write_table(ds, os.path.join(out, f"{n}.nc"))
     with atomic_path(os.path.join(out, "report.md")) as tmp:
