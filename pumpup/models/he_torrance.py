@@ -50,8 +50,15 @@ the known geometric-optics limit of the Kirchhoff theory.
 
 Where 000 and the original differ: 000 cites the model (ref. 7) and shows its albedo for
 sigma_0 = 0.1, tau = 1.7 with F = 1 (Fig. 5) without a wavelength; HTSG give sigma_0 and
-tau in micrometres.  000 Table 1 calls it physically plausible; the specular part makes
-it a BRDF with a delta, which 000 does not discuss.
+tau in micrometres.  000 Table 1 calls it physically plausible; measured here (README, "He-Torrance"), it is
+reciprocal to the last bit but its albedo with F = 1 exceeds 1 by up to 4 % near 80 degrees
+(1e-4 at normal incidence), so it is not energy-conserving in this unpolarised form.  The
+specular part makes it a BRDF with a delta, which 000 does not discuss.
+
+Pumping (:func:`pumpup.pump`) divides ``eval`` by g built from the full albedo (delta
+included) but the pumped model has no delta of its own: its albedo lacks the delta's share
+w(mu) / g.  Sampling is the cosine fallback; the delta is not sampled (``mc_albedo`` adds
+its weight exactly).
 
 Truncation of the series (provable bound).  With P_m = g^m e^(-g) / m! (Poisson) the
 terms are T_m = P_m exp(-q / m) / m <= P_m / m, q = v_xy^2 tau^2 / 4.  For M + 2 > g,
