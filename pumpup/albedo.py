@@ -765,6 +765,13 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
             value[idx] += w * v
             error[idx] += abs(w) * e
             ok[idx] &= conv
+    # a model's delta lobe (he_torrance's specular part) is added analytically; a model whose eval
+    # is exact to a relative eval_rtol (a truncated series) has that share added to the error
+    error += getattr(brdf, "eval_rtol", 0.0) * value
+    delta = getattr(brdf, "delta_albedo", None)
+    if delta is not None:
+        w = np.asarray(delta(flat), dtype=np.float64)
+        value, error = value + w, error + 1e-15 * w
     if not ok.all():
         i = int(np.argmin(ok))
         warnings.warn(

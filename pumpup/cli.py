@@ -689,7 +689,7 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("reproduce", help="regenerate the papers' tables and compare them with the published values")
     s.add_argument("--out", default="tables", help="output directory (default: tables)")
     s.add_argument("--only", nargs="+", metavar="NAME", help="only these: table2 table3 table4 text divergence "
-                                                            "(default: all)")
+                                                            "costs (default: all but costs)")
     s.set_defaults(func=cmd_reproduce)
     s = sub.add_parser("models", help="list the registered model types and their parameters")
     s.set_defaults(func=cmd_models)

@@ -540,6 +540,9 @@ def mc_albedo(brdf: BRDF, mu, n: int, rng=None, *, kind: str = "lobe"):
     for i, x in enumerate(flat):
         w = np.array([math.sqrt((1.0 - x) * (1.0 + x)), 0.0, x])
         est[i], se[i] = _weights(t, strategy(f, x, kind), w, n, g)
+    delta = getattr(f, "delta_albedo", None)
+    if delta is not None:
+        est += delta(flat)  # a delta lobe (he_torrance's specular part): exact, no variance
     if m.ndim == 0:
         return float(est[0]), float(se[0])
     return est.reshape(m.shape), se.reshape(m.shape)

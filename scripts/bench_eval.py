@@ -52,6 +52,8 @@ def main():
         r = rate(pumpup.load(spec), wi, wo)
         shown = {k: v for k, v in spec.items() if k != "type"}
         print(f"{name:18s} {str(shown)[:58]:58s} {r:10.3g} {base / r:14.2f}")
+    ht = rate(pumpup.load({"type": "he_torrance", "sigma_0": 0.1, "tau": 1.7}), wi, wo)
+    print(f"\nhe_torrance (000 Fig. 5 parameters) costs {base / ht:.1f} x Phong ({ht:.3g} evals/s); 000 Table 1: 320")
     print("\nThe pairs of 000 Table 5, at the same parameters:")
     for a, b in [({"type": "phong", "n": 20}, {"type": "stretched_phong", "n": 20}),
                  ({"type": "blinn", "n": 20}, {"type": "stretched_blinn", "n": 20}),

@@ -1,4 +1,4 @@
 """The built-in models, one module per family; importing this package registers them."""
 
-from . import blinn, cook_torrance, diffuse, lafortune, lambert, lewis, metal, microfacet, phong, schlick, ward  # noqa: F401
+from . import blinn, cook_torrance, diffuse, he_torrance, lafortune, lambert, lewis, metal, microfacet, phong, schlick, ward  # noqa: F401
 from . import mix  # noqa: F401  (after the models it mixes)
