@@ -343,6 +343,13 @@ class BRDF:
         """Linear decomposition f = sum w_k f_k used by the engine (default: itself)."""
         return [(1.0, self)]
 
+    def azimuth_range(self) -> float | None:
+        """None if the albedo does not depend on the azimuth phi of wi (an isotropic model, the
+        default); otherwise the length P of an interval [0, P] of phi on which a(mu, phi) takes
+        all its values: pi / 2 for a model that is symmetric under the reflections y -> -y and
+        x -> -x (anisotropy aligned with the tangent axes), 2 pi when nothing is known."""
+        return None
+
 
 def split(w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The x, y, z components of an array of 3-vectors (views, no copy)."""
@@ -439,6 +446,9 @@ class FunctionBRDF(BRDF):
 
     def kernel_args(self) -> tuple:
         return ()
+
+    def azimuth_range(self) -> float:
+        return 2.0 * math.pi  # nothing is known about a user function's symmetry
 
 
 def from_function(fn: Callable, name: str = "function", reciprocal: bool = True) -> BRDF:

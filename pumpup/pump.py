@@ -678,6 +678,9 @@ class Pumped(BRDF):
     def sampling_lobe(self, mu: float) -> Lobe:
         return self.base.sampling_lobe(mu)  # f / g has the lobe of f; g only rescales it
 
+    def azimuth_range(self):
+        return self.base.azimuth_range()  # g depends on N.wi and N.wo only
+
     def albedo_terms(self):
         terms = self.base.albedo_terms()
         if len(terms) == 1 and terms[0][1] is self.base:
@@ -705,6 +708,9 @@ class _Divided(BRDF):
 
     def sampling_lobe(self, mu):
         return self.term.sampling_lobe(mu)
+
+    def azimuth_range(self):
+        return self.term.azimuth_range()
 
     def lobe(self, mu):
         b = self.term.lobe(mu)

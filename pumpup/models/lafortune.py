@@ -84,8 +84,8 @@ class Lafortune(BRDF):
 
     Notes
     -----
-    An anisotropic lobe's albedo depends on the azimuth of ``wi``, not only on mu; the
-    albedo engine works with ``wi`` in the xz-plane.
+    An anisotropic lobe's albedo depends on the azimuth of ``wi``, not only on mu:
+    ``pumpup.albedo(f, mu, phi=...)`` (phi = 0 puts ``wi`` in the xz-plane).
 
     Examples
     --------
@@ -115,6 +115,10 @@ class Lafortune(BRDF):
     def lobe(self, mu):
         q = self.p
         return _isotropic_lobe(q["n"], q["cx"], q["cy"], q["cz"], q["p"], mu)
+
+    def azimuth_range(self):
+        # (R.V)_M is unchanged by x -> -x and by y -> -y of both L and V: a(phi) = a(-phi) = a(pi - phi)
+        return None if self.p["cx"] == self.p["cy"] else np.pi / 2
 
 
 # --- a sum of lobes -----------------------------------------------------------------------
@@ -226,6 +230,9 @@ class LafortuneSum(BRDF):
 
     def albedo_terms(self):
         return [(1.0, lobe) for lobe in self.lobes()]
+
+    def azimuth_range(self):
+        return None if all(x == y for x, y in zip(self.p["cx"], self.p["cy"])) else np.pi / 2
 
     def lobe(self, mu):
         q = self.p
