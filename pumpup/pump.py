@@ -50,7 +50,10 @@ def base_table(base: BRDF, progress: bool | None = None):
 
     key = _key(base)
     if key not in _TABLES:
-        ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress)
+        # an anisotropic base: the table bounds the supremum over the azimuth of wi (001 eq. 17
+        # needs g >= a(L) for every L, not only for L in the xz-plane; pumpup.azimuth)
+        phi = None if base.azimuth_range() is None else "sup"
+        ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress, phi=phi)
         _TABLES[key] = AlbedoTable.from_dataset(ds)
         _TABLES[key].dataset = ds
     return _TABLES[key]

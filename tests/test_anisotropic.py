@@ -131,3 +131,58 @@ def test_cli_phi_in_degrees(capsys):
     assert "0.18651132" in out and "0.27817825" in out and "phi [deg]" in out
     with pytest.raises(SystemExit):
         main(["albedo", "ward_aniso:ax=0.1,ay=0.3", "--mu", "0.2", "--phi", "nan"])
+
+
+# --- issue 13 item 3: pumping an anisotropic BRDF ---------------------------------------------
+
+
+@pytest.mark.parametrize("mu,n_phi", [([0.3, 0.8], 12), pytest.param([0.02, 0.1], 48, marks=pytest.mark.slow)])
+def test_sup_albedo_bounds_every_azimuth(rng, mu, n_phi):
+    from pumpup.azimuth import sup_albedo
+
+    f = pumpup.load({"type": "ward_aniso", "ax": 0.4, "ay": 0.02, "c": 0.8})
+    mu = np.array(mu)
+    v, e = sup_albedo(f, mu, tol=1e-7)
+    phi = rng.uniform(0, 2 * np.pi, n_phi)
+    a, ea = pumpup.albedo(f, mu[:, None], phi=phi[None, :], return_error=True)
+    assert np.all(a - ea <= (v + e)[:, None])
+    assert np.all(e < 1e-6)  # and the bound is tight: the largest of 24 random azimuths is close
+    assert np.all(v + e - a.max(axis=1) < 0.02)
+
+
+def test_sup_albedo_of_an_isotropic_model_is_its_albedo():
+    from pumpup.azimuth import sup_albedo
+
+    f = pumpup.load({"type": "phong", "n": 20})
+    v, e = sup_albedo(f, [0.3, 1.0])
+    a, ea = pumpup.albedo(f, [0.3, 1.0], return_error=True)
+    assert np.array_equal(v, a) and np.array_equal(e, ea)
+
+
+@pytest.fixture
+def loose_tables(monkeypatch):
+    import sys
+
+    mod = sys.modules["pumpup.pump"]  # pumpup.pump is also the function
+    monkeypatch.setattr(mod, "TABLE_RTOL", 1e-7)
+    monkeypatch.setattr(mod, "TABLE_INTERP_TOL", 1e-5)
+    before = set(mod._TABLES)
+    yield mod
+    for k in set(mod._TABLES) - before:  # loose tables must not serve later tests
+        del mod._TABLES[k]
+
+
+@pytest.mark.parametrize("g", ["g1", pytest.param("g2", marks=pytest.mark.slow)])
+def test_pumped_anisotropic_albedo_at_most_one_at_every_azimuth(loose_tables, g, rng):
+    base = {"type": "ward_aniso", "ax": 0.2, "ay": 0.3, "c": 0.9999}
+    p = pumpup.pump(base, g=g)
+    # g bounds the base's albedo for every azimuth of wi (001 eq. 17), not only for phi = 0
+    mu = np.array([0.01, 0.1, 0.3, 0.6, 0.95])
+    phi = np.concatenate([[0.0, np.pi / 2], rng.uniform(0, 2 * np.pi, 6)])
+    a, e = pumpup.albedo(pumpup.load(base), mu[:, None], phi=phi[None, :], return_error=True)
+    assert np.all(a - e <= p.lookup().upper(mu)[:, None])
+    assert "sup over phi" in p.table().dataset.attrs["azimuth"]
+    # the pumped albedo <= 1 at every azimuth, within its error, and >= the base's
+    pa, pe = pumpup.albedo(p, mu[:, None], phi=phi[None, :], return_error=True, rtol=1e-8)
+    assert np.all(pa - pe <= 1.0)
+    assert np.all(pa + pe >= a - e)
