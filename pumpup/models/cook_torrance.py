@@ -24,7 +24,7 @@ import numpy as np
 from numba import njit, vectorize
 
 from ._half import tan2_half
-from ..core import BRDF, Lobe, Param, SpecError, register
+from ..core import MAX_EXPONENT, MAX_WIDTH, MIN_WIDTH, BRDF, Lobe, Param, SpecError, register
 
 # ----------------------------------------------------------------------------------------
 # Shared pieces: Fresnel, geometry factor, and the kinks of G for the albedo engine
@@ -181,7 +181,7 @@ class CookTorrance(BRDF):
     """
 
     params = {
-        "m": Param(lo=0.0, lo_open=True, doc="RMS slope"),
+        "m": Param(lo=MIN_WIDTH, hi=MAX_WIDTH, doc="RMS slope"),
         "ior": _IOR,
     }
     constant = None
@@ -312,6 +312,12 @@ class TorranceSparrow(BRDF):
             name = {"D2": "c2", "D3": "c3", "D4": "m"}[d]
             raise SpecError(
                 f"torrance_sparrow: parameter 's' ({name} of {d}) = {s:g} is outside its allowed range (0, inf)"
+            )
+        lo, hi = (0.0, MAX_EXPONENT) if d == "D1" else (MIN_WIDTH, MAX_WIDTH) if d == "D4" else (0.0, math.inf)
+        if d in ("D1", "D4") and not lo <= s <= hi:  # the range where the engine is accurate (core.MIN_WIDTH)
+            name = {"D1": "e", "D4": "m"}[d]
+            raise SpecError(
+                f"torrance_sparrow: parameter 's' ({name} of {d}) = {s:g} is outside its allowed range [{lo:g}, {hi:g}]"
             )
         if d == "D4" and self.p["b"] != 1.0:
             raise SpecError(

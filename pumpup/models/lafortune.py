@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, vectorize
 
-from ..core import BRDF, Lobe, Param, SpecError, register
+from ..core import MAX_EXPONENT, BRDF, Lobe, Param, SpecError, register
 
 
 def _rv_m(wi, wo, cx, cy, cz):
@@ -96,7 +96,7 @@ class Lafortune(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "cx": Param(1.0, doc="M_xx (dimensionless)"),
         "cy": Param(1.0, doc="M_yy (dimensionless)"),
         "cz": Param(1.0, doc="M_zz (dimensionless)"),
@@ -185,7 +185,7 @@ class LafortuneSum(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, kind="floats", doc="exponents"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, kind="floats", doc="exponents"),
         "cx": Param(_ones_like_n, kind="floats", doc="M_xx per lobe"),
         "cy": Param(_ones_like_n, kind="floats", doc="M_yy per lobe"),
         "cz": Param(_ones_like_n, kind="floats", doc="M_zz per lobe"),

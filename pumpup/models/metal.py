@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numba import njit, vectorize
 
-from ..core import BRDF, Lobe, Param, SpecError, load, register
+from ..core import MAX_EXPONENT, BRDF, Lobe, Param, SpecError, load, register
 
 __all__ = ["Metal", "Plastic", "fresnel", "per_channel"]
 
@@ -154,7 +154,7 @@ class Metal(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "eta": Param(lo=0.0, lo_open=True, doc="refractive index, real part"),
         "k": Param(0.0, lo=0.0, doc="extinction coefficient"),
         "c": Param(_phong_c, lo=0.0, doc="scale [1/sr]"),
@@ -251,7 +251,7 @@ class Plastic(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "ad": Param(0.5, lo=0.0, hi=1.0, doc="diffuse albedo"),
         "a_s": Param(0.5, lo=0.0, hi=1.0, doc="specular weight"),
         "eta": Param(None, lo=0.0, lo_open=True, doc="refractive index (omitted: F = 1)"),

@@ -15,7 +15,7 @@ import numpy as np
 from numba import vectorize
 
 from ._half import tan2_half
-from ..core import BRDF, Lobe, Param, register
+from ..core import MAX_WIDTH, MIN_WIDTH, BRDF, Lobe, Param, register
 
 
 def _tan2_delta(wi, wo):
@@ -74,7 +74,7 @@ class Ward(BRDF):
     """
 
     params = {
-        "m": Param(lo=0.0, lo_open=True, doc="RMS slope"),
+        "m": Param(lo=MIN_WIDTH, hi=MAX_WIDTH, doc="RMS slope"),
         "c": Param(1.0, lo=0.0, doc="scale"),
     }
     examples = [{"m": 0.1}, {"m": 0.2}, {"m": 0.02}, {"m": 0.4, "c": 0.6}]
@@ -136,8 +136,8 @@ class WardAniso(BRDF):
     """
 
     params = {
-        "ax": Param(lo=0.0, lo_open=True, doc="RMS slope along x"),
-        "ay": Param(lo=0.0, lo_open=True, doc="RMS slope along y"),
+        "ax": Param(lo=MIN_WIDTH, hi=MAX_WIDTH, doc="RMS slope along x"),
+        "ay": Param(lo=MIN_WIDTH, hi=MAX_WIDTH, doc="RMS slope along y"),
         "c": Param(1.0, lo=0.0, doc="scale"),
     }
     examples = [{"ax": 0.1, "ay": 0.3}, {"ax": 0.05, "ay": 0.05}, {"ax": 0.4, "ay": 0.02, "c": 0.8}]
@@ -208,7 +208,7 @@ class ModifiedWard(BRDF):
     """
 
     params = {
-        "m": Param(lo=0.0, lo_open=True, doc="RMS slope"),
+        "m": Param(lo=MIN_WIDTH, hi=MAX_WIDTH, doc="RMS slope"),
         "c": Param(1.0, lo=0.0, doc="scale"),
     }
     examples = [{"m": 0.1}, {"m": 0.2, "c": 1.16}, {"m": 0.02}, {"m": 0.4, "c": 1.63}]
