@@ -12,6 +12,8 @@ which is symmetric in L and V: the models are reciprocal.  Cx = Cy = Cz = 1 give
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit, vectorize
 
@@ -31,6 +33,23 @@ def _up(wi, wo):
 
 
 # --- one lobe ---------------------------------------------------------------------------
+
+#: the largest peak value c max(|cx|, |cy|, |cz|)^n [1/sr] a lobe may have: (R.V)_M <= max |C| for unit
+#: L and V, so f <= c max|C|^n; beyond this the values overflow in the kernel's arithmetic or the
+#: albedo (up to pi x the peak) is not a reflectance any more, and the cubature ran for minutes
+MAX_PEAK = 1e100
+
+
+def _check_peak(model, n, cx, cy, cz, c, where=""):
+    big = max(abs(cx), abs(cy), abs(cz))
+    if c > 0 and big > 0:
+        log_peak = math.log10(c) + n * math.log10(big)
+        if log_peak > math.log10(MAX_PEAK):
+            raise SpecError(
+                f"{model}: the lobe's peak c max(|cx|, |cy|, |cz|)^n{where} = 10^{log_peak:.4g} exceeds {MAX_PEAK:g} "
+                f"[1/sr]; reduce parameter 'c', 'n' or the coefficients 'cx', 'cy', 'cz'"
+            )
+
 
 
 @vectorize(cache=True)
@@ -111,6 +130,10 @@ class Lafortune(BRDF):
     ]
     kernel = staticmethod(_kernel)
     reference_fn = staticmethod(_reference)
+
+    def _validate(self) -> None:
+        q = self.p
+        _check_peak(self.type, q["n"], q["cx"], q["cy"], q["cz"], q["c"])
 
     def lobe(self, mu):
         q = self.p
@@ -206,6 +229,8 @@ class LafortuneSum(BRDF):
             text = ", ".join(f"{k!r} has {m}" for k, m in lengths.items())
             raise SpecError(f"{self.type}: parameters 'n', 'cx', 'cy', 'cz', 'p', 'c' must be lists of equal length "
                             f"(one entry per lobe); {text}")
+        for i, (n, cx, cy, cz, c) in enumerate(zip(*(self.p[k] for k in ("n", "cx", "cy", "cz", "c")))):
+            _check_peak(self.type, n, cx, cy, cz, c, where=f" of lobe {i}")
 
     def kernel_args(self) -> tuple:
         return tuple(np.asarray(self.p[k], dtype=np.float64) for k in self.params)
