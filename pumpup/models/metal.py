@@ -235,9 +235,9 @@ class Plastic(BRDF):
     ad : float, in [0, 1], default 0.5
         Albedo of the diffuse component (one channel).
     a_s : float, in [0, 1], default 0.5
-        Weight of the specular component; ad + a_s max S <= 1, S the albedo of the specular
-        lobe with a_s = 1 (checked; 000 sec. 5.2's ad + a_s <= 1 is this for n >= 2, where
-        max S = 1; max S = 1.0858 at n = 0).
+        Weight of the specular component; ad + a_s <= 1 (000 sec. 5.2) and ad + a_s max S <= 1,
+        S the albedo of the specular lobe with a_s = 1, so that the model conserves energy
+        (both checked; the second matters for n < 2, where max S exceeds 1: 1.0858 at n = 0).
     eta : float, > 0, optional
         Real refractive index of the dielectric; omitted means F = 1 (000 eq. 30).
 
@@ -274,6 +274,11 @@ class Plastic(BRDF):
         # n = 0.5, 1.00028 at n = 1) and exactly 1 at normal incidence for n >= 2 (measured with
         # pumpup.max_albedo, and max S falls with n; tests/test_energy_claims.py); F <= 1 only lowers S.
         ad, a_s, n = self.p["ad"], self.p["a_s"], self.p["n"]
+        if a_s + ad > 1.0 + 1e-12:  # the model's own constraint (000 sec. 5.2), necessary where F = 1
+            raise SpecError(
+                f"{self.type}: parameters 'a_s' + 'ad' must not exceed 1 (energy conservation, 000 sec. 5.2); "
+                f"got a_s = {a_s:g}, ad = {ad:g}"
+            )
         bound = 1.0 if n >= 2.0 else PLASTIC_MAX_S
         if ad + a_s * bound <= 1.0 + 1e-12:
             return
