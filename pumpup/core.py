@@ -49,6 +49,11 @@ UNIT_TOL = 1e-6
 MIN_WIDTH = 1e-6
 MAX_WIDTH = 1e3
 MAX_EXPONENT = 1e6
+#: refractive indices (the real part eta, a dielectric's ior) and extinction coefficients k are taken
+#: in [MIN_INDEX, MAX_INDEX] (k in [0, MAX_INDEX]): real materials lie well inside, and a subnormal eta
+#: divided by zero in the Fresnel kernels
+MIN_INDEX = 1e-3
+MAX_INDEX = 1e3
 
 
 class SpecError(ValueError):

@@ -18,7 +18,10 @@ from pumpup.core import MAX_EXPONENT, MAX_WIDTH, MIN_WIDTH
                                        ({"type": "ward_aniso", "ax": 1e6, "ay": 0.1}, "ax"),
                                        ({"type": "torrance_sparrow", "d": "D4", "s": 1e-9}, "s"),
                                        ({"type": "schlick", "r": 1e-300}, "r"),
-                                       ({"type": "lafortune_sum", "n": [1e7], "c": [1.0]}, "n")])
+                                       ({"type": "lafortune_sum", "n": [1e7], "c": [1.0]}, "n"),
+                                       ({"type": "plastic", "n": 20, "eta": 5e-324}, "eta"),  # ZeroDivisionError
+                                       ({"type": "metal", "n": 20, "eta": 0.2, "k": 1e300}, "k"),
+                                       ({"type": "ggx", "alpha": 0.3, "ior": 1e300}, "ior")])
 def test_confident_nonsense_is_refused(spec, name):
     # these gave 5551 +- 5e-7 (albedo <= 1), 30.8, 15.4 and 8.0 +- 2.8e36; now one line naming the range
     with pytest.raises(pumpup.SpecError, match=f"'{name}(\\[0\\])?'.*range"):
@@ -85,3 +88,10 @@ def test_every_lobe_parameter_has_a_finite_accurate_range():
         if p is not None and p.kind in ("float", "floats"):
             assert p.hi == MAX_EXPONENT, model
     assert math.isfinite(reg["minnaert"].params["k"].hi)
+
+
+@pytest.mark.parametrize("spec", [{"type": "plastic", "n": 20, "eta": 1e-3}, {"type": "metal", "n": 20, "eta": 1e-3, "k": 1e3},
+                                  {"type": "ggx", "alpha": 0.3, "eta": 1e-3, "k": 1e3}, {"type": "beckmann", "alpha": 0.3, "ior": 1e3}])
+def test_index_range_ends_give_finite_values(spec):
+    a, e = pumpup.albedo(pumpup.load(spec), [1.0, 1e-8], return_error=True)
+    assert np.all(np.isfinite(a)) and np.all(e < 1e-9) and np.all(a <= 1.0 + e)

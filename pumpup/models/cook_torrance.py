@@ -24,7 +24,7 @@ import numpy as np
 from numba import njit, vectorize
 
 from ._half import tan2_half
-from ..core import MAX_EXPONENT, MAX_WIDTH, MIN_WIDTH, BRDF, Lobe, Param, SpecError, register
+from ..core import MAX_EXPONENT, MAX_INDEX, MAX_WIDTH, MIN_WIDTH, BRDF, Lobe, Param, SpecError, register
 
 # ----------------------------------------------------------------------------------------
 # Shared pieces: Fresnel, geometry factor, and the kinks of G for the albedo engine
@@ -120,7 +120,7 @@ def _ior_arg(ior):
     return 0.0 if ior is None else float(ior)
 
 
-_IOR = Param(None, lo=1.0, lo_open=True, doc="real index of refraction (None: Fresnel factor 1)")
+_IOR = Param(None, lo=1.0, lo_open=True, hi=MAX_INDEX, doc="real index of refraction (None: Fresnel factor 1)")
 
 
 # ----------------------------------------------------------------------------------------

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numba import njit, vectorize
 
-from ..core import MAX_EXPONENT, BRDF, Lobe, Param, SpecError, load, register
+from ..core import MAX_EXPONENT, MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, SpecError, load, register
 
 __all__ = ["Metal", "Plastic", "fresnel", "per_channel"]
 
@@ -155,8 +155,8 @@ class Metal(BRDF):
 
     params = {
         "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
-        "eta": Param(lo=0.0, lo_open=True, doc="refractive index, real part"),
-        "k": Param(0.0, lo=0.0, doc="extinction coefficient"),
+        "eta": Param(lo=MIN_INDEX, hi=MAX_INDEX, doc="refractive index, real part"),
+        "k": Param(0.0, lo=0.0, hi=MAX_INDEX, doc="extinction coefficient"),
         "c": Param(_phong_c, lo=0.0, doc="scale [1/sr]"),
     }
     examples = [
@@ -254,7 +254,7 @@ class Plastic(BRDF):
         "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "ad": Param(0.5, lo=0.0, hi=1.0, doc="diffuse albedo"),
         "a_s": Param(0.5, lo=0.0, hi=1.0, doc="specular weight"),
-        "eta": Param(None, lo=0.0, lo_open=True, doc="refractive index (omitted: F = 1)"),
+        "eta": Param(None, lo=MIN_INDEX, hi=MAX_INDEX, doc="refractive index (omitted: F = 1)"),
     }
     constant = None  # f is not a constant times a fixed shape
     examples = [
