@@ -186,3 +186,21 @@ def test_pumped_anisotropic_albedo_at_most_one_at_every_azimuth(loose_tables, g,
     pa, pe = pumpup.albedo(p, mu[:, None], phi=phi[None, :], return_error=True, rtol=1e-8)
     assert np.all(pa - pe <= 1.0)
     assert np.all(pa + pe >= a - e)
+
+
+def test_trigonometric_interpolant_is_exact_below_nyquist():
+    from pumpup.azimuth import _period, _trig_up
+
+    # a cos(2 phi) + b cos(4 phi) sampled on [0, pi/2] (J = 4, even extension to a period of pi) is
+    # reproduced exactly at the midpoints and on the dense grid
+    def a(phi):
+        return 0.3 + 0.1 * np.cos(2 * phi) - 0.05 * np.cos(4 * phi)
+    nodes = np.arange(5) * (np.pi / 2) / 4
+    up = _trig_up(_period(a(nodes)[None], True), 8)[0]
+    grid = np.arange(len(up)) * np.pi / len(up)
+    np.testing.assert_allclose(up, a(grid), atol=1e-15)
+    # the generic case: 2 J samples of a full turn
+    nodes = np.arange(8) * 2 * np.pi / 8
+    b = lambda p: 1.0 + 0.2 * np.sin(p) + 0.1 * np.cos(3 * p)  # noqa: E731
+    up = _trig_up(_period(b(nodes)[None], False), 4)[0]
+    np.testing.assert_allclose(up, b(np.arange(32) * 2 * np.pi / 32), atol=1e-15)
