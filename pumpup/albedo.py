@@ -708,6 +708,35 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
     return total, E, converged
 
 
+_TURNED: dict = {}
+
+
+def _turned_lobe(brdf: BRDF, lobe: Lobe, phi: float) -> Lobe:
+    """The hint for wi at azimuth phi: not even in beta, and, where beta is the azimuth about N
+    (the "normal" and "half" frames) and the model's anisotropy is aligned with the tangent axes
+    (``azimuth_range() == pi / 2``), the model's x and y axes as breakpoints of beta: a lobe that is
+    narrow across one axis is a ridge along it, which at phi = 0 lies on the ends of the beta range
+    and otherwise would fall inside a piece unseen (ward_aniso ax = 1000, ay = 1e-6 gave 0 at mu = 1)."""
+    lobe = replace(lobe, symmetric=False)
+    rng = brdf.azimuth_range()
+    if lobe.axis not in ("normal", "half") or rng is None or abs(rng - math.pi / 2) > 1e-15:
+        return lobe
+    key = (lobe.kinks, phi)
+    if key not in _TURNED:
+        # the model's axes at azimuths 0, pi/2, pi, 3 pi/2 are, in the engine's frame (turned by phi),
+        # at beta = -phi + k pi/2; the engine integrates |beta| in [0, pi] (both signs), so the cuts
+        # are the folded angles, as kinks a + b cos(beta) = 0 with a = -cos(angle), b = 1
+        angles = sorted({abs(math.remainder(-phi + k * math.pi / 2, 2 * math.pi)) for k in range(4)})
+        cuts = [c for c in angles if 1e-12 < c < math.pi - 1e-12]
+        base = lobe.kinks
+
+        def kinks(mu, s, ca, sa, base=base, cuts=tuple(cuts)):
+            out = list(base(mu, s, ca, sa)) if base is not None else []
+            return out + [(-math.cos(c), 1.0) for c in cuts]
+        _TURNED[key] = kinks
+    return replace(lobe, kinks=_TURNED[key])
+
+
 def _groups(brdf: BRDF, mu: np.ndarray, phi: np.ndarray | None = None):
     """Group the values of mu by the structure of their Lobe hint (and whether wi leaves the
     xz-plane: ``phi`` != 0, where the hint's symmetry in beta no longer holds)."""
@@ -717,7 +746,10 @@ def _groups(brdf: BRDF, mu: np.ndarray, phi: np.ndarray | None = None):
         if lobe.axis not in _AXES:
             raise ValueError(f"{brdf!r}: Lobe axis must be one of {_AXES}, got {lobe.axis!r}")
         turned = phi is not None and phi[i] != 0.0
-        key = (lobe.axis, lobe.radial, lobe.sharpness, lobe.kinks, lobe.symmetric, len(lobe.levels), turned)
+        if turned:
+            lobe = _turned_lobe(brdf, lobe, float(phi[i]))
+        key = (lobe.axis, lobe.radial, lobe.sharpness, lobe.kinks, lobe.symmetric, len(lobe.levels), turned,
+               float(phi[i]) if turned else 0.0)
         by_key.setdefault(key, (lobe, [], [], turned))
         by_key[key][1].append(i)
         by_key[key][2].append(lobe.levels)
@@ -726,8 +758,8 @@ def _groups(brdf: BRDF, mu: np.ndarray, phi: np.ndarray | None = None):
         lev = np.array(levels, dtype=np.float64).reshape(len(idx), -1)
         if turned:
             # the hint's "even in beta" holds for wi in the xz-plane (Lobe.symmetric); an anisotropic
-            # BRDF seen from wi at azimuth phi is not even in beta: integrate both halves
-            yield idx, _Group(lobe=replace(lobe, symmetric=False), mu=mu[idx], levels=lev, phi=phi[idx])
+            # BRDF seen from wi at azimuth phi is not even in beta: both halves (_turned_lobe)
+            yield idx, _Group(lobe=lobe, mu=mu[idx], levels=lev, phi=phi[idx])
         else:
             yield idx, _Group(lobe=lobe, mu=mu[idx], levels=lev)
 
