@@ -313,9 +313,12 @@ class TorranceSparrow(BRDF):
             raise SpecError(
                 f"torrance_sparrow: parameter 's' ({name} of {d}) = {s:g} is outside its allowed range (0, inf)"
             )
-        lo, hi = (0.0, MAX_EXPONENT) if d == "D1" else (MIN_WIDTH, MAX_WIDTH) if d == "D4" else (0.0, math.inf)
-        if d in ("D1", "D4") and not lo <= s <= hi:  # the range where the engine is accurate (core.MIN_WIDTH)
-            name = {"D1": "e", "D4": "m"}[d]
+        # the range where the engine is accurate (core.MIN_WIDTH): D1's exponent e; D2's c2 is an inverse
+        # width (1/rad; c2 = 5e-324 divided by zero in the radial map, and below 1e-2 the Gaussian map
+        # degenerates: c2 = 1e-6 gave an error estimate of 5.6e-6 at mu = 1e-8); D3's c3 and D4's m are widths
+        lo, hi = {"D1": (0.0, MAX_EXPONENT), "D2": (1e-2, 1.0 / MIN_WIDTH)}.get(d, (MIN_WIDTH, MAX_WIDTH))
+        if not lo <= s <= hi:
+            name = {"D1": "e", "D2": "c2", "D3": "c3", "D4": "m"}[d]
             raise SpecError(
                 f"torrance_sparrow: parameter 's' ({name} of {d}) = {s:g} is outside its allowed range [{lo:g}, {hi:g}]"
             )
