@@ -95,8 +95,10 @@ def test_every_lobe_parameter_has_a_finite_accurate_range():
 @pytest.mark.parametrize("spec", [{"type": "torrance_sparrow", "d": "D2", "s": 1e-2},
                                   {"type": "torrance_sparrow", "d": "D2", "s": 1e6},
                                   {"type": "torrance_sparrow", "d": "D3", "s": 1e-6, "b": 1e-12},
-                                  {"type": "plastic", "n": 20, "eta": 1e-3}, {"type": "metal", "n": 20, "eta": 1e-3, "k": 1e3},
-                                  {"type": "ggx", "alpha": 0.3, "eta": 1e-3, "k": 1e3}, {"type": "beckmann", "alpha": 0.3, "ior": 1e3}])
+                                  {"type": "plastic", "n": 20, "eta": 1e-3},
+                                  {"type": "metal", "n": 20, "eta": 1e-3, "k": 1e3},
+                                  {"type": "ggx", "alpha": 0.3, "eta": 1e-3, "k": 1e3},
+                                  {"type": "beckmann", "alpha": 0.3, "ior": 1e3}])
 def test_index_range_ends_give_finite_values(spec):
     a, e = pumpup.albedo(pumpup.load(spec), [1.0, 1e-8], return_error=True)
     assert np.all(np.isfinite(a)) and np.all(e < 1e-8 * np.maximum(a, 1.0))

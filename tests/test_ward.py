@@ -87,7 +87,7 @@ def test_lobe_hints():
     lobe = pumpup.load({"type": "modified_ward", "m": 0.2}).lobe(0.5)
     assert (lobe.axis, lobe.radial, lobe.sharpness, lobe.levels) == ("half", "beckmann", 0.2, (0.5,))
     lobe = pumpup.load({"type": "ward_aniso", "ax": 0.3, "ay": 0.05}).lobe(0.5)
-    assert (lobe.axis, lobe.radial, lobe.sharpness, lobe.symmetric) == ("half", "beckmann", 0.3, True)  # the wider slope (issue 13)
+    assert (lobe.axis, lobe.radial, lobe.sharpness, lobe.symmetric) == ("half", "beckmann", 0.3, True)  # wider slope
 
 
 @pytest.mark.parametrize(
