@@ -33,14 +33,14 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numba import njit
 
 from .core import BRDF, Lobe
 
-__all__ = ["albedo", "check_mu", "AlbedoWarning"]
+__all__ = ["albedo", "check_mu", "check_phi", "AlbedoWarning"]
 
 DEFAULT_RTOL = 1e-10
 DEFAULT_ATOL = 1e-14
@@ -100,6 +100,20 @@ def check_mu(mu) -> np.ndarray:
         where = f"mu[{', '.join(map(str, i))}]" if i else "mu"
         raise ValueError(f"mu = cos(theta_i) must be in (0, 1]; {where} = {float(m[i])!r}")
     return m
+
+
+def check_phi(phi) -> np.ndarray:
+    """``phi`` (the azimuth of wi, radians) as a float64 array, or a ValueError naming it."""
+    if isinstance(phi, (str, bytes)) or phi is None:
+        raise ValueError(f"phi (the azimuth of wi, in radians) must be a finite number, got {phi!r}")
+    try:
+        p = np.asarray(phi, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"phi (the azimuth of wi, in radians) must be a finite number or an array of them, "
+                         f"got {phi!r}") from None
+    if not np.all(np.isfinite(p)):
+        raise ValueError(f"phi (the azimuth of wi, in radians) must be finite, got {phi!r}")
+    return p
 
 
 # --- radial maps: x (with xc = 1 - x) -> cos(alpha), sin(alpha), J = |d cos(alpha) / dx| ------
@@ -173,6 +187,7 @@ class _Group:
     lobe: Lobe
     mu: np.ndarray  # (P,)
     levels: np.ndarray  # (P, L)
+    phi: np.ndarray | None = None  # (P,) azimuths of wi, or None: wi in the xz-plane
 
 
 def _smooth(tau):
@@ -386,17 +401,33 @@ def _integrand(brdf: BRDF, g: _Group, prob: np.ndarray, piece: np.ndarray, tx: n
     _geometry_kernel(_AXIS_CODE[lobe.axis], _RADIAL_CODE[lobe.radial], float(lobe.sharpness), g.mu, g.levels, prob,
                      ka, kb, piece, tx, tt, wi, wo, weight)
     total = np.zeros(n)
+    if g.phi is not None:  # rotate the whole configuration by phi about N: wi gets azimuth phi
+        cp, sp = np.cos(g.phi[prob]), np.sin(g.phi[prob])
+        wi_c, wo_c = wi, wo
     for sign in (1.0,) if lobe.symmetric else (1.0, -1.0):
         if sign < 0:
             wo[:, 1] *= -1.0  # beta -> -beta flips wo_y in every frame (wi_y = 0)
+        if g.phi is not None:
+            wi, wo = _rotate(wi_c, cp, sp), _rotate(wo_c, cp, sp)  # N.wi, N.wo and wi.wo unchanged
         f = np.ascontiguousarray(brdf._eval(wi, wo), dtype=np.float64)
         i = _accumulate(f, wo[:, 2], weight, total)
+        if g.phi is not None:
+            wo = wo_c
         if i >= 0:
             raise ValueError(
                 f"{brdf!r} returned {f[i]!r} at wi={wi[i].tolist()}, wo={wo[i].tolist()}: "
                 "a BRDF must be finite and non-negative above the horizon"
             )
     return 2.0 * total if lobe.symmetric else total
+
+
+def _rotate(w, c, s):
+    """w rotated about N = (0, 0, 1) by the angle with cosine c and sine s (arrays (n,))."""
+    out = np.empty_like(w)
+    out[:, 0] = c * w[:, 0] - s * w[:, 1]
+    out[:, 1] = s * w[:, 0] + c * w[:, 1]
+    out[:, 2] = w[:, 2]
+    return out
 
 
 @njit(cache=True, nogil=True)
@@ -679,29 +710,68 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
     return total, E, converged
 
 
-def _groups(brdf: BRDF, mu: np.ndarray):
-    """Group the values of mu by the structure of their Lobe hint."""
+_TURNED: dict = {}
+
+
+def _turned_lobe(brdf: BRDF, lobe: Lobe, phi: float) -> Lobe:
+    """The hint for wi at azimuth phi: not even in beta, and, where beta is the azimuth about N
+    (the "normal" and "half" frames) and the model's anisotropy is aligned with the tangent axes
+    (``azimuth_range() == pi / 2``), the model's x and y axes as breakpoints of beta: a lobe that is
+    narrow across one axis is a ridge along it, which at phi = 0 lies on the ends of the beta range
+    and otherwise would fall inside a piece unseen (ward_aniso ax = 1000, ay = 1e-6 gave 0 at mu = 1)."""
+    lobe = replace(lobe, symmetric=False)
+    rng = brdf.azimuth_range()
+    if lobe.axis not in ("normal", "half") or rng is None or abs(rng - math.pi / 2) > 1e-15:
+        return lobe
+    key = (lobe.kinks, phi)
+    if key not in _TURNED:
+        # the model's axes at azimuths 0, pi/2, pi, 3 pi/2 are, in the engine's frame (turned by phi),
+        # at beta = -phi + k pi/2; the engine integrates |beta| in [0, pi] (both signs), so the cuts
+        # are the folded angles, as kinks a + b cos(beta) = 0 with a = -cos(angle), b = 1
+        angles = sorted({abs(math.remainder(-phi + k * math.pi / 2, 2 * math.pi)) for k in range(4)})
+        cuts = [c for c in angles if 1e-12 < c < math.pi - 1e-12]
+        base = lobe.kinks
+
+        def kinks(mu, s, ca, sa, base=base, cuts=tuple(cuts)):
+            out = list(base(mu, s, ca, sa)) if base is not None else []
+            return out + [(-math.cos(c), 1.0) for c in cuts]
+        _TURNED[key] = kinks
+    return replace(lobe, kinks=_TURNED[key])
+
+
+def _groups(brdf: BRDF, mu: np.ndarray, phi: np.ndarray | None = None):
+    """Group the values of mu by the structure of their Lobe hint (and whether wi leaves the
+    xz-plane: ``phi`` != 0, where the hint's symmetry in beta no longer holds)."""
     by_key: dict = {}
     for i, m in enumerate(mu):
         lobe = brdf.lobe(float(m))
         if lobe.axis not in _AXES:
             raise ValueError(f"{brdf!r}: Lobe axis must be one of {_AXES}, got {lobe.axis!r}")
-        key = (lobe.axis, lobe.radial, lobe.sharpness, lobe.kinks, lobe.symmetric, len(lobe.levels))
-        by_key.setdefault(key, (lobe, [], []))
+        turned = phi is not None and phi[i] != 0.0
+        if turned:
+            lobe = _turned_lobe(brdf, lobe, float(phi[i]))
+        key = (lobe.axis, lobe.radial, lobe.sharpness, lobe.kinks, lobe.symmetric, len(lobe.levels), turned,
+               float(phi[i]) if turned else 0.0)
+        by_key.setdefault(key, (lobe, [], [], turned))
         by_key[key][1].append(i)
         by_key[key][2].append(lobe.levels)
-    for lobe, idx, levels in by_key.values():
+    for lobe, idx, levels, turned in by_key.values():
         idx = np.array(idx)
         lev = np.array(levels, dtype=np.float64).reshape(len(idx), -1)
-        yield idx, _Group(lobe=lobe, mu=mu[idx], levels=lev)
+        if turned:
+            # the hint's "even in beta" holds for wi in the xz-plane (Lobe.symmetric); an anisotropic
+            # BRDF seen from wi at azimuth phi is not even in beta: both halves (_turned_lobe)
+            yield idx, _Group(lobe=lobe, mu=mu[idx], levels=lev, phi=phi[idx])
+        else:
+            yield idx, _Group(lobe=lobe, mu=mu[idx], levels=lev)
 
 
 def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
-           max_regions: int = 20000):
+           max_regions: int = 20000, phi=0.0):
     """Directional albedo a(mu) of ``brdf`` (000 eq. 2; Lewis's k_rho, 002 eq. 15).
 
-    a(mu) = integral over the hemisphere of f_r(wi, wo) cos(theta_o) d omega_o, with
-    wi = (sqrt(1 - mu^2), 0, mu).  Dimensionless.
+    a(mu, phi) = integral over the hemisphere of f_r(wi, wo) cos(theta_o) d omega_o, with
+    wi = (sqrt(1 - mu^2) cos(phi), sqrt(1 - mu^2) sin(phi), mu).  Dimensionless.
 
     Parameters
     ----------
@@ -719,11 +789,17 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
         Rectangles that refinement may add per value of mu (beyond the first grid, which
         grows with the lobe's kinks); if the tolerance is not met by then, an
         :class:`AlbedoWarning` is issued and the (larger) error estimate is returned.
+    phi : float or array_like, default 0
+        Azimuth of wi in radians, measured from the tangent x axis towards y; broadcast
+        against ``mu``.  An anisotropic BRDF's albedo depends on it (``ward_aniso``,
+        ``lafortune`` with cx != cy, a user function); for a model whose
+        :meth:`~pumpup.core.BRDF.azimuth_range` is None (isotropic) it is ignored.
 
     Returns
     -------
     ndarray, or (ndarray, ndarray)
-        The albedo with the shape of ``mu`` (and the estimated absolute error).
+        The albedo with the broadcast shape of ``mu`` and ``phi`` (and the estimated
+        absolute error).
 
     Notes
     -----
@@ -747,20 +823,30 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     atol = check_tolerance("albedo", "atol", atol, hi=math.inf, zero=True)  # 0: relative only
     max_regions = check_count("albedo", "max_regions", max_regions, 0, MAX_REGIONS_LIMIT)  # 0: the first grid
     m = check_mu(mu)
-    flat = m.ravel()
+    ph = check_phi(phi)
+    try:
+        m, ph = np.broadcast_arrays(m, ph)
+    except ValueError:
+        raise ValueError(f"phi (shape {ph.shape}) does not broadcast against mu (shape {m.shape})") from None
+    flat = np.array(m, dtype=np.float64).ravel()
+    phflat = np.array(ph, dtype=np.float64).ravel()
     value = np.zeros_like(flat)
     error = np.zeros_like(flat)
     ok = np.ones(flat.shape, bool)
     from . import _polar
 
     for w, term in brdf.albedo_terms():
-        fast = _polar.albedo_1d(term, flat, rtol, atol, max_regions)  # closed-form azimuth, or None
+        turn = None
+        if np.any(phflat != 0.0) and term.azimuth_range() is not None:
+            turn = phflat
+        # closed-form azimuth (isotropic models only, where phi does not matter), or None
+        fast = _polar.albedo_1d(term, flat, rtol, atol, max_regions) if turn is None else None
         if fast is not None:
             value += w * fast[0]
             error += abs(w) * fast[1]
             ok &= fast[2]
             continue
-        for idx, g in _groups(term, flat):
+        for idx, g in _groups(term, flat, turn):
             v, e, conv = _integrate_group(term, g, rtol, atol, max_regions)
             value[idx] += w * v
             error[idx] += abs(w) * e

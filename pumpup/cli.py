@@ -147,6 +147,8 @@ def cmd_albedo(args) -> int:
         mu = np.sin(np.radians(90.0 - np.asarray(args.theta, dtype=float)))  # keeps its digits near 90 deg
     else:
         mu = np.asarray(args.mu if args.mu else [1.0, 0.5, 0.1, 0.01], dtype=float)
+    if getattr(args, "phi", None) is not None:  # azimuths of the light in degrees: every mu at every phi
+        return _albedo_phi(f, mu, args)
     try:
         a, e = pumpup.albedo(f, mu, return_error=True, rtol=args.rtol)
     except ValueError as exc:
@@ -158,14 +160,47 @@ def cmd_albedo(args) -> int:
     return 0
 
 
+def _albedo_phi(f, mu, args) -> int:
+    """``pumpup albedo --phi DEG...``: the albedo at every (mu, phi), phi in degrees."""
+    import numpy as np
+
+    import pumpup
+
+    phi = np.asarray(args.phi, dtype=float)
+    if not np.all(np.isfinite(phi)):
+        raise SystemExit("pumpup: --phi must be finite angles in degrees")
+    try:
+        a, e = pumpup.albedo(f, mu[:, None], phi=np.radians(phi)[None, :], return_error=True, rtol=args.rtol)
+    except ValueError as exc:
+        raise SystemExit(f"pumpup: {exc}") from None
+    print(f"# {json.dumps(f.spec)}" + ("" if f.azimuth_range() is not None else "  (isotropic: phi does not matter)"))
+    print(f"{'mu':>14s} {'theta [deg]':>14s} {'phi [deg]':>10s} {'albedo':>20s} {'error':>10s}")
+    for i, m in enumerate(mu):
+        for j, p in enumerate(phi):
+            print(f"{m:14.8g} {np.degrees(np.arccos(m)):14.8f} {p:10.4f} {a[i, j]:20.15f} {e[i, j]:10.2g}")
+    return 0
+
+
 def cmd_table(args) -> int:
+    import numpy as np
+
     import pumpup
 
     check_out(args.out)
     f = _load(args.spec)
-    ds = pumpup.tabulate(f, rtol=args.rtol)
+    phi = getattr(args, "phi", None)
+    if phi is not None:
+        if not np.all(np.isfinite(phi)):
+            raise SystemExit("pumpup: --phi must be finite angles in degrees")
+        phi = np.radians(np.asarray(phi, dtype=float))
+    try:
+        ds = pumpup.tabulate(f, rtol=args.rtol, phi=phi)
+    except ValueError as exc:
+        raise SystemExit(f"pumpup: {exc}") from None
     pumpup.write_table(ds, args.out)
-    print(f"wrote {args.out}: {ds.sizes['mu']} values of mu, interpolation error {ds.attrs['interpolation_error']:.2g}")
+    extra = f" x {ds.sizes['phi']} values of phi" if "phi" in ds.dims else ""
+    print(f"wrote {args.out}: {ds.sizes['mu']} values of mu{extra}, "
+          f"interpolation error {ds.attrs['interpolation_error']:.2g}")
     return 0
 
 
@@ -699,11 +734,17 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--mu", type=float, nargs="+", help="cos(theta_i) values in (0, 1] (default: 1 0.5 0.1 0.01)")
     g.add_argument("--theta", type=float, nargs="+", help="incidence angles in degrees, in [0, 90) (default: use --mu)")
     s.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of the cubature (default: 1e-10)")
+    s.add_argument("--phi", type=float, nargs="+", metavar="DEG",
+                   help="azimuths of the light in DEGREES from the tangent x axis (default: 0, the xz-plane); "
+                        "anisotropic models depend on it, isotropic ones do not")
     s.set_defaults(func=cmd_albedo)
     s = sub.add_parser("table", help="tabulate the albedo on an adaptive grid into a netCDF file")
     s.add_argument("spec", help="a model SPEC: JSON or short, e.g. phong:n=20")
     s.add_argument("--out", required=True, help="the netCDF file to write (required; its directory must exist)")
     s.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of every value (default: 1e-10)")
+    s.add_argument("--phi", type=float, nargs="+", metavar="DEG",
+                   help="tabulate over (mu, phi) at these azimuths of the light in DEGREES (default: a table over "
+                        "mu at phi = 0)")
     s.set_defaults(func=cmd_table)
     s = sub.add_parser("pump", help="pump up a model's albedo (001 sec. 3) and print the albedo of every level")
     s.add_argument("spec", help="a model SPEC: JSON or short, e.g. phong:n=20")

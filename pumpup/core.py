@@ -43,6 +43,22 @@ __all__ = [
 #: Largest deviation of |w| from 1 that ``eval`` accepts for a direction.
 UNIT_TOL = 1e-6
 
+#: The range of a lobe's width parameter (an RMS slope m, a roughness alpha) and the largest lobe
+#: exponent n where the albedo engine is accurate (issue 13 item 4).  The lobe's angular width is
+#: about m, alpha or 1 / sqrt(n) rad; directions carry rounding errors of ~1e-16, so a lobe 1e-6 wide
+#: is resolved to ~1e-10 relative (ggx alpha = 1e-20 gave 5551 +- 5e-7 at mu = 0.5, beckmann 1e-18
+#: 30.8, phong n = 1e50 8.0 +- 2.8e36; at these ends the values are right: tests/test_extremes.py).
+#: Beyond MAX_WIDTH a microfacet lobe is not a surface any more (and the engine slows: minutes for
+#: pumped ward_aniso with ax = 1e6).  Models refuse values outside with a SpecError.
+MIN_WIDTH = 1e-6
+MAX_WIDTH = 1e3
+MAX_EXPONENT = 1e6
+#: refractive indices (the real part eta, a dielectric's ior) and extinction coefficients k are taken
+#: in [MIN_INDEX, MAX_INDEX] (k in [0, MAX_INDEX]): real materials lie well inside, and a subnormal eta
+#: divided by zero in the Fresnel kernels
+MIN_INDEX = 1e-3
+MAX_INDEX = 1e3
+
 
 class SpecError(ValueError):
     """A model spec or parameter is invalid; the message names the parameter and its range."""
@@ -385,6 +401,13 @@ class BRDF:
         (the engine then integrates one dimension, ``pumpup._polar``), else None (the default)."""
         return None
 
+    def azimuth_range(self) -> float | None:
+        """None if the albedo does not depend on the azimuth phi of wi (an isotropic model, the
+        default); otherwise the length P of an interval [0, P] of phi on which a(mu, phi) takes
+        all its values: pi / 2 for a model that is symmetric under the reflections y -> -y and
+        x -> -x (anisotropy aligned with the tangent axes), 2 pi when nothing is known."""
+        return None
+
 
 def split(w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The x, y, z components of an array of 3-vectors (views, no copy)."""
@@ -589,6 +612,9 @@ class FunctionBRDF(BRDF):
 
     def kernel_args(self) -> tuple:
         return ()
+
+    def azimuth_range(self) -> float:
+        return 2.0 * math.pi  # nothing is known about a user function's symmetry
 
 
 def from_function(fn: Callable, name: str = "function", reciprocal: bool = True) -> BRDF:

@@ -94,7 +94,10 @@ def base_table(base: BRDF, progress: bool | None = None):
     if key not in _TABLES:
         with _lock_for(key):  # one thread computes a base's table; the others wait for it
             if key not in _TABLES:
-                ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress)
+                # an anisotropic base: the table bounds the supremum over the azimuth of wi (001 eq. 17
+                # needs g >= a(L) for every L, not only for L in the xz-plane; pumpup.azimuth)
+                phi = None if base.azimuth_range() is None else "sup"
+                ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress, phi=phi)
                 t = AlbedoTable.from_dataset(ds)
                 t.dataset = ds
                 _TABLES[key] = t
@@ -782,6 +785,9 @@ class Pumped(BRDF):
     def sampling_lobe(self, mu: float) -> Lobe:
         return self.base.sampling_lobe(mu)  # f / g has the lobe of f; g only rescales it
 
+    def azimuth_range(self):
+        return self.base.azimuth_range()  # g depends on N.wi and N.wo only
+
     def albedo_terms(self):
         terms = self.base.albedo_terms()
         if len(terms) == 1 and terms[0][1] is self.base:
@@ -809,6 +815,9 @@ class _Divided(BRDF):
 
     def sampling_lobe(self, mu):
         return self.term.sampling_lobe(mu)
+
+    def azimuth_range(self):
+        return self.term.azimuth_range()
 
     def lobe(self, mu):
         b = self.term.lobe(mu)

@@ -176,7 +176,7 @@ def _midpoints(mu: np.ndarray) -> np.ndarray:
 
 def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
              interp_tol: float = 1e-7, mu_min: float = 1e-8, max_points: int = 2049, progress: bool | None = None,
-             threads: int | None = None):
+             threads: int | None = None, phi=None):
     """Tabulate the directional albedo of ``brdf``.
 
     Parameters
@@ -200,11 +200,19 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     threads : int, optional
         Threads that compute the values (default :data:`THREADS`: one per core).  The table
         does not depend on it.
+    phi : None, float, array_like or "sup", optional
+        Azimuth(s) of wi in radians (see :func:`pumpup.albedo`).  None: phi = 0 (wi in the
+        xz-plane), a table over ``mu``.  A number or an array: a table over (``mu``, ``phi``)
+        (an isotropic model's values are the same in every column, computed once); the
+        adaptive grid in mu then meets ``interp_tol`` in every column.  ``"sup"``: a table
+        over ``mu`` of an upper bound of the supremum over phi of a(mu, phi), what the pumping
+        operator needs of an anisotropic base (:func:`pumpup.azimuth.sup_albedo`; the plain
+        table for an isotropic model).
 
     Returns
     -------
     xarray.Dataset
-        ``albedo`` and ``albedo_error`` over ``mu``, coordinate ``theta`` [deg], and
+        ``albedo`` and ``albedo_error`` over ``mu`` (and ``phi``), coordinate ``theta`` [deg], and
         attributes ``spec`` (JSON), ``method``, ``rtol``, ``atol``,
         ``interpolation_error``, ``pumpup_version``.
 
@@ -223,24 +231,33 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     interp_tol = check_tolerance("tabulate", "interp_tol", interp_tol, hi=math.inf)
     mu_min = check_open_unit("tabulate", "mu_min", mu_min)
     max_points = check_count("tabulate", "max_points", max_points, 2, MAX_POINTS_LIMIT)
+    from .azimuth import table_values
+
+    values, phis, phi_kind = table_values(brdf, phi, rtol, atol, threads, interp_tol)
+    # mean_albedo and max_albedo of this object may reuse a table at phi = 0 (not a supremum, not a grid)
+    reusable = phis is None and phi_kind != "sup"
     if mu is not None:
         grid = np.unique(check_mu(np.atleast_1d(mu)).ravel())
         with _progress(len(grid), f"albedo {brdf.type}", progress) as bar:
-            val, err = _chunked(brdf, grid, rtol, atol, bar, threads)
-        _reuse.remember(brdf, grid, val, err, rtol)  # for mean_albedo and max_albedo of this object
-        return _dataset(brdf, grid, val, err, rtol, atol, 0.0, "given")
+            val, err = values(grid, bar)
+        if reusable:
+            _reuse.remember(brdf, grid, val, err, rtol)
+        return _dataset(brdf, grid, val, err, rtol, atol, 0.0, "given", phis, phi_kind)
     check_mu(mu_min)
     grid = default_grid(mu_min=mu_min)
     with _progress(len(grid), f"albedo {brdf.type}", progress) as bar:
-        val, err = _chunked(brdf, grid, rtol, atol, bar, threads)
+        val, err = values(grid, bar)
         interp_error = 0.0
         todo = np.ones(len(grid) - 1, bool)  # intervals not yet checked
         while todo.any() and len(grid) < max_points:
             mids = _midpoints(grid)[todo]
             bar.total += len(mids)
-            mval, merr = _chunked(brdf, mids, rtol, atol, bar, threads)
-            table = AlbedoTable(grid, val, err)
-            miss = np.abs(table(mids) - mval)
+            mval, merr = values(mids, bar)
+            if val.ndim == 1:
+                miss = np.abs(AlbedoTable(grid, val, err)(mids) - mval)
+            else:  # a table over (mu, phi): the worst column
+                miss = np.max([np.abs(AlbedoTable(grid, val[:, j], err[:, j])(mids) - mval[:, j])
+                               for j in range(val.shape[1])], axis=0)
             bad = miss > interp_tol
             interp_error = max(interp_error, float(miss[~bad].max(initial=0.0)))
             # accept the good intervals; add the bad midpoints as nodes
@@ -259,8 +276,9 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
             todo = near[:-1] | near[1:]
         if todo.any():
             interp_error = max(interp_error, float(miss.max()))
-    _reuse.remember(brdf, grid, val, err, rtol)
-    return _dataset(brdf, grid, val, err, rtol, atol, interp_error, "adaptive")
+    if reusable:
+        _reuse.remember(brdf, grid, val, err, rtol)
+    return _dataset(brdf, grid, val, err, rtol, atol, interp_error, "adaptive", phis, phi_kind)
 
 
 #: threads that compute the albedos of a table (None: one per core).  The compiled kernels
@@ -281,9 +299,9 @@ def _cores() -> int:
         return os.cpu_count() or 1
 
 
-def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int = 32):
-    """Albedo and error at every mu, in chunks, on ``threads`` threads (default :data:`THREADS`;
-    every k-th mu to thread k: grazing values, the dear ones, are spread over all)."""
+def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int = 32, phi: float = 0.0):
+    """Albedo and error at every mu (at the azimuth ``phi`` of wi), in chunks, on ``threads`` threads
+    (default :data:`THREADS`; every k-th mu to thread k: grazing values, the dear ones, are spread over all)."""
     val = np.empty_like(mu)
     err = np.empty_like(mu)
     threads = max(1, min(threads or THREADS or _cores(), len(mu)))
@@ -297,7 +315,7 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
             if stop.is_set():
                 return
             part = idx[a:a + chunk]
-            val[part], err[part] = albedo(brdf, mu[part], return_error=True, rtol=rtol, atol=atol)
+            val[part], err[part] = albedo(brdf, mu[part], return_error=True, rtol=rtol, atol=atol, phi=phi)
             bar.update(len(part))
 
     todo = np.arange(len(mu))
@@ -324,8 +342,14 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
     return val, err
 
 
-def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind):
+def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind, phis=None, phi_kind=None):
     import xarray as xr
+
+    if phis is not None:
+        from .azimuth import phi_dataset
+
+        return phi_dataset(_dataset(brdf, mu, val[:, 0], err[:, 0], rtol, atol, interp_error, grid_kind),
+                           val, err, phis)
 
     degree = AlbedoTable.degree_for(len(mu))
 
@@ -356,6 +380,10 @@ def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind):
             "pumpup_version": __version__,
         },
     )
+    if phi_kind is not None:  # an anisotropic model: say which azimuth of wi the values hold
+        from .azimuth import describe_phi
+
+        describe_phi(ds, brdf, phi_kind)
     return ds
 
 

@@ -80,4 +80,4 @@ def test_bad_input_names_the_parameter(spec, pname):
     with pytest.raises(pumpup.SpecError, match=repr(pname)) as exc:
         pumpup.load(spec)
     if pname == "r" and "r" in spec and not math.isnan(spec["r"]):
-        assert "(0, 1]" in str(exc.value)
+        assert "[1e-12, 1]" in str(exc.value)  # r >= 1e-12: the lobe is sqrt(r) >= 1e-6 wide (issue 13)

@@ -87,7 +87,7 @@ def test_lobe_hints():
     lobe = pumpup.load({"type": "modified_ward", "m": 0.2}).lobe(0.5)
     assert (lobe.axis, lobe.radial, lobe.sharpness, lobe.levels) == ("half", "beckmann", 0.2, (0.5,))
     lobe = pumpup.load({"type": "ward_aniso", "ax": 0.3, "ay": 0.05}).lobe(0.5)
-    assert (lobe.axis, lobe.radial, lobe.sharpness, lobe.symmetric) == ("half", "beckmann", 0.05, True)
+    assert (lobe.axis, lobe.radial, lobe.sharpness, lobe.symmetric) == ("half", "beckmann", 0.3, True)  # wider slope
 
 
 @pytest.mark.parametrize(
@@ -113,4 +113,4 @@ def test_bad_input_names_the_parameter(spec, pname):
     with pytest.raises(pumpup.SpecError, match=repr(pname)) as exc:
         pumpup.load(spec)
     if pname in ("m", "ax", "ay") and spec.get(pname) in (0, -1):
-        assert "(0, inf)" in str(exc.value)
+        assert "[1e-06, 1000]" in str(exc.value)  # the range where the engine is accurate (issue 13)

@@ -14,7 +14,7 @@ import numpy as np
 from numba import vectorize
 
 from ._half import tan2_half
-from ..core import BRDF, Lobe, Param, load, register
+from ..core import MAX_EXPONENT, BRDF, Lobe, Param, load, register
 
 
 def _cos2_delta(wi, wo):
@@ -71,7 +71,7 @@ class Blinn(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "c": Param(1.0, lo=0.0, doc="scale [1/sr]"),
     }
     examples = [{"n": 0}, {"n": 1}, {"n": 20}, {"n": 512, "c": 20.6}, {"n": 10.5, "c": 0.7}]
@@ -126,7 +126,7 @@ class StretchedBlinn(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "c": Param(1.0, lo=0.0, doc="scale [1/sr]"),
     }
     examples = [{"n": 1, "c": 0.293}, {"n": 20}, {"n": 128, "c": 5.34}, {"n": 0}]
@@ -180,7 +180,7 @@ class PhongBlinn(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "ks": Param(1.0, lo=0.0, doc="specular coefficient [1/sr]"),
         "kd": Param(0.0, lo=0.0, hi=1.0 / math.pi, doc="diffuse coefficient [1/sr]"),
     }

@@ -24,7 +24,7 @@ import numpy as np
 from numba import njit, vectorize
 
 from ._half import tan2_half
-from ..core import BRDF, Lobe, Param, SpecError, register
+from ..core import MAX_EXPONENT, MAX_INDEX, MAX_WIDTH, MIN_WIDTH, BRDF, Lobe, Param, SpecError, register
 
 # ----------------------------------------------------------------------------------------
 # Shared pieces: Fresnel, geometry factor, and the kinks of G for the albedo engine
@@ -120,7 +120,7 @@ def _ior_arg(ior):
     return 0.0 if ior is None else float(ior)
 
 
-_IOR = Param(None, lo=1.0, lo_open=True, doc="real index of refraction (None: Fresnel factor 1)")
+_IOR = Param(None, lo=1.0, lo_open=True, hi=MAX_INDEX, doc="real index of refraction (None: Fresnel factor 1)")
 
 
 # ----------------------------------------------------------------------------------------
@@ -181,7 +181,7 @@ class CookTorrance(BRDF):
     """
 
     params = {
-        "m": Param(lo=0.0, lo_open=True, doc="RMS slope"),
+        "m": Param(lo=MIN_WIDTH, hi=MAX_WIDTH, doc="RMS slope"),
         "ior": _IOR,
     }
     constant = None
@@ -312,6 +312,15 @@ class TorranceSparrow(BRDF):
             name = {"D2": "c2", "D3": "c3", "D4": "m"}[d]
             raise SpecError(
                 f"torrance_sparrow: parameter 's' ({name} of {d}) = {s:g} is outside its allowed range (0, inf)"
+            )
+        # the range where the engine is accurate (core.MIN_WIDTH): D1's exponent e; D2's c2 is an inverse
+        # width (1/rad; c2 = 5e-324 divided by zero in the radial map, and below 1e-2 the Gaussian map
+        # degenerates: c2 = 1e-6 gave an error estimate of 5.6e-6 at mu = 1e-8); D3's c3 and D4's m are widths
+        lo, hi = {"D1": (0.0, MAX_EXPONENT), "D2": (1e-2, 1.0 / MIN_WIDTH)}.get(d, (MIN_WIDTH, MAX_WIDTH))
+        if not lo <= s <= hi:
+            name = {"D1": "e", "D2": "c2", "D3": "c3", "D4": "m"}[d]
+            raise SpecError(
+                f"torrance_sparrow: parameter 's' ({name} of {d}) = {s:g} is outside its allowed range [{lo:g}, {hi:g}]"
             )
         if d == "D4" and self.p["b"] != 1.0:
             raise SpecError(

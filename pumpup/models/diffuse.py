@@ -10,7 +10,7 @@ import math
 import numpy as np
 from numba import vectorize
 
-from ..core import BRDF, Lobe, Param, register
+from ..core import MAX_EXPONENT, BRDF, Lobe, Param, register
 
 
 def _up(wi, wo):
@@ -64,7 +64,7 @@ class Minnaert(BRDF):
     """
 
     params = {
-        "k": Param(lo=0.0, lo_open=True, doc="Minnaert exponent"),
+        "k": Param(lo=0.0, hi=MAX_EXPONENT, lo_open=True, doc="Minnaert exponent"),
         "b": Param(_minnaert_b, lo=0.0, doc="scale [1/sr]"),
     }
     constant = "b"

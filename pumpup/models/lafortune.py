@@ -12,10 +12,12 @@ which is symmetric in L and V: the models are reciprocal.  Cx = Cy = Cz = 1 give
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit, vectorize
 
-from ..core import BRDF, Lobe, Param, SpecError, register
+from ..core import MAX_EXPONENT, BRDF, Lobe, Param, SpecError, register
 
 
 def _rv_m(wi, wo, cx, cy, cz):
@@ -31,6 +33,23 @@ def _up(wi, wo):
 
 
 # --- one lobe ---------------------------------------------------------------------------
+
+#: the largest peak value c max(|cx|, |cy|, |cz|)^n [1/sr] a lobe may have: (R.V)_M <= max |C| for unit
+#: L and V, so f <= c max|C|^n; beyond this the values overflow in the kernel's arithmetic or the
+#: albedo (up to pi x the peak) is not a reflectance any more, and the cubature ran for minutes
+MAX_PEAK = 1e100
+
+
+def _check_peak(model, n, cx, cy, cz, c, where=""):
+    big = max(abs(cx), abs(cy), abs(cz))
+    if c > 0 and big > 0:
+        log_peak = math.log10(c) + n * math.log10(big)
+        if log_peak > math.log10(MAX_PEAK):
+            raise SpecError(
+                f"{model}: the lobe's peak c max(|cx|, |cy|, |cz|)^n{where} = 10^{log_peak:.4g} exceeds {MAX_PEAK:g} "
+                f"[1/sr]; reduce parameter 'c', 'n' or the coefficients 'cx', 'cy', 'cz'"
+            )
+
 
 
 @vectorize(cache=True)
@@ -84,8 +103,8 @@ class Lafortune(BRDF):
 
     Notes
     -----
-    An anisotropic lobe's albedo depends on the azimuth of ``wi``, not only on mu; the
-    albedo engine works with ``wi`` in the xz-plane.
+    An anisotropic lobe's albedo depends on the azimuth of ``wi``, not only on mu:
+    ``pumpup.albedo(f, mu, phi=...)`` (phi = 0 puts ``wi`` in the xz-plane).
 
     Examples
     --------
@@ -96,7 +115,7 @@ class Lafortune(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "cx": Param(1.0, doc="M_xx (dimensionless)"),
         "cy": Param(1.0, doc="M_yy (dimensionless)"),
         "cz": Param(1.0, doc="M_zz (dimensionless)"),
@@ -111,6 +130,10 @@ class Lafortune(BRDF):
     ]
     kernel = staticmethod(_kernel)
     reference_fn = staticmethod(_reference)
+
+    def _validate(self) -> None:
+        q = self.p
+        _check_peak(self.type, q["n"], q["cx"], q["cy"], q["cz"], q["c"])
 
     def lobe(self, mu):
         q = self.p
@@ -129,6 +152,10 @@ class Lafortune(BRDF):
         with np.errstate(over="ignore"):
             scale = float(q["c"] * np.float64(C) ** q["n"])
         return Polar(n=q["n"], p=int(q["p"]), scale=lambda mu: np.full(np.shape(mu), scale))
+
+    def azimuth_range(self):
+        # (R.V)_M is unchanged by x -> -x and by y -> -y of both L and V: a(phi) = a(-phi) = a(pi - phi)
+        return None if self.p["cx"] == self.p["cy"] else np.pi / 2
 
 
 # --- a sum of lobes -----------------------------------------------------------------------
@@ -195,7 +222,7 @@ class LafortuneSum(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, kind="floats", doc="exponents"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, kind="floats", doc="exponents"),
         "cx": Param(_ones_like_n, kind="floats", doc="M_xx per lobe"),
         "cy": Param(_ones_like_n, kind="floats", doc="M_yy per lobe"),
         "cz": Param(_ones_like_n, kind="floats", doc="M_zz per lobe"),
@@ -216,6 +243,8 @@ class LafortuneSum(BRDF):
             text = ", ".join(f"{k!r} has {m}" for k, m in lengths.items())
             raise SpecError(f"{self.type}: parameters 'n', 'cx', 'cy', 'cz', 'p', 'c' must be lists of equal length "
                             f"(one entry per lobe); {text}")
+        for i, (n, cx, cy, cz, c) in enumerate(zip(*(self.p[k] for k in ("n", "cx", "cy", "cz", "c")))):
+            _check_peak(self.type, n, cx, cy, cz, c, where=f" of lobe {i}")
 
     def kernel_args(self) -> tuple:
         return tuple(np.asarray(self.p[k], dtype=np.float64) for k in self.params)
@@ -240,6 +269,9 @@ class LafortuneSum(BRDF):
 
     def albedo_terms(self):
         return [(1.0, lobe) for lobe in self.lobes()]
+
+    def azimuth_range(self):
+        return None if all(x == y for x, y in zip(self.p["cx"], self.p["cy"])) else np.pi / 2
 
     def lobe(self, mu):
         q = self.p

@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import vectorize
 
-from ..core import BRDF, Lobe, Param, load, register
+from ..core import MAX_EXPONENT, BRDF, Lobe, Param, load, register
 
 __all__ = ["LewisPhong", "phong_hs"]
 
@@ -159,7 +159,7 @@ class LewisPhong(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "k_rho": Param(1.0, lo=0.0, hi=1.0, doc="directional-hemispherical reflectance"),
         "k_sigma": Param(1.0, lo=0.0, hi=1.0, doc="specular fraction"),
     }

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numba import njit, vectorize
 
-from ..core import BRDF, Lobe, Param, SpecError, load, register
+from ..core import MAX_EXPONENT, MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, SpecError, load, register
 
 __all__ = ["Metal", "Plastic", "fresnel", "per_channel"]
 
@@ -154,9 +154,9 @@ class Metal(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
-        "eta": Param(lo=0.0, lo_open=True, doc="refractive index, real part"),
-        "k": Param(0.0, lo=0.0, doc="extinction coefficient"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
+        "eta": Param(lo=MIN_INDEX, hi=MAX_INDEX, doc="refractive index, real part"),
+        "k": Param(0.0, lo=0.0, hi=MAX_INDEX, doc="extinction coefficient"),
         "c": Param(_phong_c, lo=0.0, doc="scale [1/sr]"),
     }
     examples = [
@@ -197,6 +197,29 @@ def _plastic_reference(wi, wo, n, ad, a_s, eta):
     return np.where(_up(wi, wo), ad / np.pi + spec, 0.0)
 
 
+#: the largest albedo of plastic's specular lobe with a_s = 1 and F = 1, over all n >= 0 and mu
+#: (at n = 0, theta = 45 degrees: 1.0857906, rounded up; see Plastic._validate)
+PLASTIC_MAX_S = 1.0858
+
+
+_MAX_S_CACHE: dict = {}
+
+
+def _plastic_max_s(n: float, eta) -> float:
+    """max over mu of the albedo of plastic's specular lobe with a_s = 1 (plus its error estimate):
+    ``metal`` with k = 0 (the same kernel, 000 eq. 28-29) or stretched Phong without Fresnel."""
+    key = (float(n), eta)
+    if key not in _MAX_S_CACHE:
+        from ..tables import max_albedo
+
+        lobe = load({"type": "stretched_phong", "n": n, "p": 1.0}) if eta is None else \
+            load({"type": "metal", "n": n, "eta": eta, "k": 0.0})
+        m = max_albedo(lobe, rtol=1e-9, mu_min=1e-8)
+        c = (n + 2.0) / (2.0 * math.pi)  # max_albedo sets the constant to 1
+        _MAX_S_CACHE[key] = c * (m.albedo + m.error)
+    return _MAX_S_CACHE[key]
+
+
 @register("plastic")
 class Plastic(BRDF):
     """Plastic / ceramic BRDF, a Lambertian base plus the metallic lobe [1/sr].
@@ -212,7 +235,9 @@ class Plastic(BRDF):
     ad : float, in [0, 1], default 0.5
         Albedo of the diffuse component (one channel).
     a_s : float, in [0, 1], default 0.5
-        Weight of the specular component; ad + a_s <= 1 (000 sec. 5.2).
+        Weight of the specular component; ad + a_s <= 1 (000 sec. 5.2) and ad + a_s max S <= 1,
+        S the albedo of the specular lobe with a_s = 1, so that the model conserves energy
+        (both checked; the second matters for n < 2, where max S exceeds 1: 1.0858 at n = 0).
     eta : float, > 0, optional
         Real refractive index of the dielectric; omitted means F = 1 (000 eq. 30).
 
@@ -226,10 +251,10 @@ class Plastic(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "ad": Param(0.5, lo=0.0, hi=1.0, doc="diffuse albedo"),
         "a_s": Param(0.5, lo=0.0, hi=1.0, doc="specular weight"),
-        "eta": Param(None, lo=0.0, lo_open=True, doc="refractive index (omitted: F = 1)"),
+        "eta": Param(None, lo=MIN_INDEX, hi=MAX_INDEX, doc="refractive index (omitted: F = 1)"),
     }
     constant = None  # f is not a constant times a fixed shape
     examples = [
@@ -242,10 +267,28 @@ class Plastic(BRDF):
     reference_fn = staticmethod(_plastic_reference)
 
     def _validate(self) -> None:
-        if self.p["a_s"] + self.p["ad"] > 1.0 + 1e-12:
+        # energy conservation: the albedo is ad + a_s S(mu), S the albedo of the specular lobe
+        # with a_s = 1, so the condition is ad + a_s max_mu S <= 1.  000 sec. 5.2's a_s + ad <= 1
+        # is it only where max S = 1: the stretched lobe (n + 2)/(2 pi) cos^n / cos(Theta_min)
+        # reflects more than 1 for small n (max S = 1.0858 at n = 0, 45 degrees; 1.0104 at
+        # n = 0.5, 1.00028 at n = 1) and exactly 1 at normal incidence for n >= 2 (measured with
+        # pumpup.max_albedo, and max S falls with n; tests/test_energy_claims.py); F <= 1 only lowers S.
+        ad, a_s, n = self.p["ad"], self.p["a_s"], self.p["n"]
+        if a_s + ad > 1.0 + 1e-12:  # the model's own constraint (000 sec. 5.2), necessary where F = 1
             raise SpecError(
                 f"{self.type}: parameters 'a_s' + 'ad' must not exceed 1 (energy conservation, 000 sec. 5.2); "
-                f"got a_s = {self.p['a_s']:g}, ad = {self.p['ad']:g}"
+                f"got a_s = {a_s:g}, ad = {ad:g}"
+            )
+        bound = 1.0 if n >= 2.0 else PLASTIC_MAX_S
+        if ad + a_s * bound <= 1.0 + 1e-12:
+            return
+        s_max = _plastic_max_s(n, self.p["eta"])  # the bound fails: compute max S itself (cached)
+        if ad + a_s * s_max > 1.0 + 1e-9:
+            limit = (1.0 - ad) / s_max
+            raise SpecError(
+                f"{self.type}: ad + a_s * max S must not exceed 1 (energy conservation; S, the specular lobe's "
+                f"albedo, reaches {s_max:.6f} for n = {n:g}): with ad = {ad:g}, 'a_s' must be at most {limit:.6g}; "
+                f"got a_s = {a_s:g}"
             )
 
     def kernel_args(self) -> tuple:

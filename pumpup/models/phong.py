@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import vectorize
 
-from ..core import BRDF, Lobe, Param, dot, register
+from ..core import MAX_EXPONENT, BRDF, Lobe, Param, dot, register
 
 
 def _phong_c(p):
@@ -68,7 +68,7 @@ class Phong(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "c": Param(_phong_c, lo=0.0, doc="scale [1/sr]"),
     }
     examples = [{"n": 0}, {"n": 1}, {"n": 20}, {"n": 5000}, {"n": 10.5, "c": 1.0}]
@@ -144,7 +144,7 @@ class StretchedPhong(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "p": Param(1.0, lo=0.0, hi=1.0, doc="stretch power"),
         "c": Param(_phong_c, lo=0.0, doc="scale [1/sr]"),
     }
@@ -196,7 +196,7 @@ class Retro(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "p": Param(1.0, lo=0.0, hi=1.0, doc="stretch power"),
         "c": Param(_phong_c, lo=0.0, doc="scale [1/sr]"),
     }
@@ -249,7 +249,7 @@ class PhongShader(BRDF):
     """
 
     params = {
-        "n": Param(lo=0.0, doc="exponent"),
+        "n": Param(lo=0.0, hi=MAX_EXPONENT, doc="exponent"),
         "ks": Param(_phong_c, lo=0.0, doc="specular coefficient [1/sr]"),
         "kd": Param(0.0, lo=0.0, hi=1.0 / math.pi, doc="diffuse coefficient [1/sr]"),
     }

@@ -15,7 +15,7 @@ import numpy as np
 from numba import vectorize
 
 from ._half import tan2_half
-from ..core import BRDF, Lobe, Param, register
+from ..core import MIN_WIDTH, BRDF, Lobe, Param, register
 
 
 @vectorize(cache=True)
@@ -71,7 +71,7 @@ class Schlick(BRDF):
     """
 
     params = {
-        "r": Param(lo=0.0, hi=1.0, lo_open=True, doc="roughness"),
+        "r": Param(lo=MIN_WIDTH**2, hi=1.0, doc="roughness (the lobe is about sqrt(r) wide)"),
         "c": Param(1.0, lo=0.0, doc="scale"),
     }
     examples = [{"r": 1.0}, {"r": 0.5, "c": 2.14}, {"r": 0.1}, {"r": 0.01, "c": 0.21}, {"r": 0.001}]
