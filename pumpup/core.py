@@ -51,6 +51,11 @@ UNIT_TOL = 1e-6
 #: Beyond MAX_WIDTH a microfacet lobe is not a surface any more (and the engine slows: minutes for
 #: pumped ward_aniso with ax = 1e6).  Models refuse values outside with a SpecError.
 MIN_WIDTH = 1e-6
+#: the microfacet roughness alpha of ggx and beckmann goes lower, to 1e-8: renderers clamp roughness at 1e-4
+#: and square it (Blender Cycles' albedo tables, pumpup.luts), and there the engine agrees with the mirror
+#: limit with Smith shadowing, E = G(wi, mirror) (1 - E = O(alpha^2 tan^2)), within its error for mu >= 1e-6
+#: (tests/test_extremes.py)
+MIN_ALPHA = 1e-8
 MAX_WIDTH = 1e3
 MAX_EXPONENT = 1e6
 #: refractive indices (the real part eta, a dielectric's ior) and extinction coefficients k are taken

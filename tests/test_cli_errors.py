@@ -41,7 +41,7 @@ CASES = [
     (["pump", "phong:n=20", "--out", "nodir/x.nc"], "directory .* does not exist"),
     (["sweep", "stretched_phong", "--param", "n=1,2", "--out", "nodir/x.nc"], "directory .* does not exist"),
     (["divergence", "all", "--tables", "nodir"], "--tables nodir: directory does not exist"),
-    (["divergence", "ward:m=-0.1"], r"parameter 'm' = -0.1 is outside its allowed range \(0, inf\)"),
+    (["divergence", "ward:m=-0.1"], r"parameter 'm' = -0.1 is outside its allowed range \[1e-06, 1000\]"),
     (["divergence", "ward:m=0.1", "--mu-min", "0"], r"--mu-min must be a number in \(0, 1\)"),
     (["albedo", "phong:n=20", "--theta", "100"], r"theta must be in \[0, 90\) degrees"),
     (["albedo", "phong:n=20", "--theta", "-30"], r"--theta -30: .*\[0, 90\)"),
@@ -131,7 +131,7 @@ def test_models_shows_ranges_defaults_and_meanings(capsys):
     lines = out.splitlines()
     phong = lines.index(next(ln for ln in lines if ln.startswith("phong:")))
     n, c = lines[phong + 1].split(), lines[phong + 2].split()
-    assert n[:4] == ["n", "[0,", "inf)", "required"] and "exponent" in lines[phong + 1]
+    assert n[:4] == ["n", "[0,", "1e+06]", "required"] and "exponent" in lines[phong + 1]
     assert c[:3] == ["c", "[0,", "inf)"] and "(n + 2) / (2 pi)" in lines[phong + 2]
     assert "scale [1/sr]" in lines[phong + 2]
     # aligned: every parameter line has its range, default and meaning in the same columns

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup.core import MAX_EXPONENT, MAX_WIDTH, MIN_WIDTH
+from pumpup.core import MAX_EXPONENT, MAX_WIDTH, MIN_ALPHA, MIN_WIDTH
 
 
 @pytest.mark.parametrize("spec,name", [({"type": "ggx", "alpha": 1e-20}, "alpha"),
@@ -31,12 +31,22 @@ def test_confident_nonsense_is_refused(spec, name):
 
 
 @pytest.mark.parametrize("spec", [{"type": "ggx", "alpha": MIN_WIDTH}, {"type": "beckmann", "alpha": MIN_WIDTH},
-                                  {"type": "ggx", "alpha": MIN_WIDTH, "shadowing": "correlated"}])
+                                  {"type": "ggx", "alpha": MIN_WIDTH, "shadowing": "correlated"},
+                                  {"type": "ggx", "alpha": MIN_ALPHA}, {"type": "beckmann", "alpha": MIN_ALPHA},
+                                  {"type": "ggx", "alpha": MIN_ALPHA, "shadowing": "correlated"}])
 def test_narrowest_microfacet_lobe_is_a_mirror(spec):
     # alpha -> 0 with Fresnel 1: every microfacet faces N and Smith's G -> 1 (1 - G = O(alpha^2 tan^2)),
     # so the albedo is 1 (a mirror); the engine must agree within its error
     a, e = pumpup.albedo(pumpup.load(spec), [1.0, 0.5], return_error=True)
     assert np.all(np.abs(a - 1.0) <= e + 1e-10), (a, e)
+    if spec["alpha"] == MIN_ALPHA and spec["type"] == "ggx":
+        # near grazing the mirror limit with Smith shadowing: E = G(wi, mirror) to O(lobe width / grazing
+        # angle); separable G = G1^2, correlated 1 / (1 + 2 Lambda), Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2
+        mu = np.array([1e-4, 1e-6])
+        a, e = pumpup.albedo(pumpup.load(spec), mu, return_error=True)
+        lam = (np.sqrt(1 + (spec["alpha"] * np.sqrt(1 - mu**2) / mu) ** 2) - 1) / 2
+        limit = 1 / (1 + 2 * lam) if spec.get("shadowing") == "correlated" else 1 / (1 + lam) ** 2
+        assert np.all(np.abs(a - limit) <= e + 1e-10), (a, limit, e)
 
 
 def test_narrowest_ward_lobe_has_the_mirror_limit():
@@ -84,10 +94,13 @@ def test_every_lobe_parameter_has_a_finite_accurate_range():
     reg = pumpup.registry()
     for model, name in widths:
         p = reg[model].params[name]
-        assert (p.lo, p.hi) == (MIN_WIDTH, MAX_WIDTH), (model, name)
+        lo = MIN_ALPHA if name == "alpha" else MIN_WIDTH  # renderers' clamped roughness (pumpup.core.MIN_ALPHA)
+        assert (p.lo, p.hi) == (lo, MAX_WIDTH), (model, name)
     for model, cls in reg.items():
         p = cls.params.get("n")
-        if p is not None and p.kind in ("float", "floats"):
+        if model == "he_torrance":  # its n is an index of refraction, bounded like eta
+            assert (p.lo, p.hi) == (pumpup.core.MIN_INDEX, pumpup.core.MAX_INDEX)
+        elif p is not None and p.kind in ("float", "floats"):
             assert p.hi == MAX_EXPONENT, model
     assert math.isfinite(reg["minnaert"].params["k"].hi)
 

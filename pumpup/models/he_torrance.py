@@ -94,7 +94,7 @@ import math
 import numpy as np
 from numba import njit, vectorize
 
-from ..core import BRDF, Lobe, Param, SpecError, register
+from ..core import MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, SpecError, register
 
 #: relative bound on the truncation remainder of the directional-diffuse series
 SERIES_RTOL = 1e-13
@@ -378,8 +378,8 @@ class HeTorrance(BRDF):
         "sigma_0": Param(lo=0.0, lo_open=True, doc="RMS roughness [um]"),
         "tau": Param(lo=0.0, lo_open=True, doc="autocorrelation length [um]"),
         "wavelength": Param(0.55, lo=0.0, lo_open=True, doc="wavelength [um]"),
-        "n": Param(None, lo=0.0, lo_open=True, doc="real index of refraction (None: |F|^2 = 1)"),
-        "k": Param(0.0, lo=0.0, doc="extinction coefficient"),
+        "n": Param(None, lo=MIN_INDEX, hi=MAX_INDEX, doc="real index of refraction (None: |F|^2 = 1)"),
+        "k": Param(0.0, lo=0.0, hi=MAX_INDEX, doc="extinction coefficient"),
         "diffuse": Param(0.0, lo=0.0, hi=1.0, doc="albedo of the uniform-diffuse part"),
     }
     constant = None

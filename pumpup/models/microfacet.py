@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 from numba import njit, vectorize
 
-from ..core import MAX_INDEX, MAX_WIDTH, MIN_INDEX, MIN_WIDTH, BRDF, Lobe, Param, SpecError, register
+from ..core import MAX_INDEX, MAX_WIDTH, MIN_ALPHA, MIN_INDEX, MIN_WIDTH, BRDF, Lobe, Param, SpecError, register
 from ._half import tan2_half
 from .cook_torrance import _IOR, _fresnel, _fresnel_reference
 from .metal import _fresnel_real
@@ -282,7 +282,7 @@ def walter_level(alpha: float) -> float:
 # The models
 # ----------------------------------------------------------------------------------------
 
-_ALPHA = Param(lo=MIN_WIDTH, hi=MAX_WIDTH, doc="roughness alpha (Walter et al. 2007; Mitsuba's alpha)")
+_ALPHA = Param(lo=MIN_ALPHA, hi=MAX_WIDTH, doc="roughness alpha (Walter et al. 2007; Mitsuba's alpha)")
 _SHADOW = Param("separable", kind="str", choices=tuple(_SHADOWING), doc="Smith G: G1 G1 or height-correlated")
 _ETA = Param(None, lo=MIN_INDEX, hi=MAX_INDEX, doc="conductor: real part of the complex index (omitted: no conductor)")
 _K = Param(None, lo=0.0, hi=MAX_INDEX, doc="conductor: extinction coefficient (with eta; default 0)")
