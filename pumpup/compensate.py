@@ -283,6 +283,11 @@ class _Compensated(BRDF):
         white = self.p.get("white") or base
         if np.ndim(base._eval(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0]))) != 0:
             raise SpecError(f"{self.type}: the base must have one channel (a spectral or RGB base is not supported)")
+        for name, f in (("base", base), ("white", white)):
+            if f.azimuth_range() is not None:  # E(mu) would depend on the azimuth of the light
+                raise SpecError(f"{self.type}: the {name} {f.type!r} is anisotropic; its albedo depends on the azimuth "
+                                "of the light, and this compensation needs E(mu) alone (use pump(..., g='g1'|'g2'), "
+                                "which bounds the supremum over azimuths)")
         self._white = white
         self.reciprocal = self._check_reciprocal(self.type, self._why) and type(self).reciprocal
         self._precheck()

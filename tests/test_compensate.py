@@ -333,3 +333,10 @@ def test_scale_of_a_mix_scales_each_term():
     assert np.all(a <= 1 + e) and np.all(1 - a <= 2 * s.table().margin_below / 0.8 + e)
     wi, wo = direction_pairs(np.random.default_rng(4), 2000)
     np.testing.assert_allclose(s.eval(wi, wo), s.reference(wi, wo), rtol=1e-12, atol=0)
+
+
+def test_anisotropic_base_refused():
+    """E(mu) of an anisotropic base depends on the light's azimuth: refused with the reason (issue 13)."""
+    for method in ("kulla_conty", "scale"):
+        with pytest.raises(pumpup.SpecError, match="anisotropic"):
+            pumpup.compensate({"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, method=method)
