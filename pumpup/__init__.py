@@ -12,15 +12,15 @@ from . import reproduce
 from . import testing
 from . import render
 from .divergence import divergence
-from .pump import Pumped, load_pumped, pump, save_pumped
+from .pumping import Pumped, load_pumped, pump, save_pumped
 from .compensate import KullaConty, Scaled, compensate, furnace, load_compensated, save_compensated
 from . import sampling
 from .sampling import mc_albedo, mc_radiance, sample
 from .tables import AlbedoTable, max_albedo, max_constant, mean_albedo, open_table, tabulate, write_table
-from .sweep import sweep
+from .sweeps import sweep
 from . import luts as lut_module
 from .luts import audit, lut
-from .fit import FitResult, fit
+from .fitting import FitResult, fit
 from .core import (
     BRDF,
     Lobe,

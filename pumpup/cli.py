@@ -223,7 +223,7 @@ def cmd_pump(args) -> int:
 
     import pumpup
 
-    from pumpup.pump import MAX_LEVELS
+    from pumpup.pumping import MAX_LEVELS
 
     if not 1 <= args.levels <= MAX_LEVELS:
         raise SystemExit(f"pumpup: --levels: levels must be an integer in [1, {MAX_LEVELS}], got {args.levels}")
@@ -338,7 +338,7 @@ def cmd_sweep(args) -> int:
     import time
 
     import pumpup
-    from pumpup.sweep import default_mu
+    from pumpup.sweeps import default_mu
 
     spec = parse_spec(args.spec)
     check_out(args.out)
@@ -471,7 +471,7 @@ def cmd_fit(args) -> int:
 
 def _fit(args) -> int:
     import pumpup
-    from pumpup.fit import plot_fits
+    from pumpup.fitting import plot_fits
 
     target = _load(args.target)
     params, fixed = {}, {}

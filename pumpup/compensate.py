@@ -58,7 +58,7 @@ import numpy as np
 from numba import njit
 
 from .core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register
-from .pump import _CELL_SHIFT, Pumped, _float_bits, _key, _Lookup, _Product, _ProductError, _upper_scalar, file_tables, from_file
+from .pumping import _CELL_SHIFT, Pumped, _float_bits, _key, _Lookup, _Product, _ProductError, _upper_scalar, file_tables, from_file
 
 __all__ = ["compensate", "KullaConty", "Scaled", "save_compensated", "load_compensated", "furnace",
            "compensation_table", "METHODS", "fresnel_average"]
@@ -768,8 +768,8 @@ def save_compensated(f: BRDF, path) -> str:
     import xarray as xr
 
     from ._version import __version__
-    from .pump import _TABLES as PUMP_TABLES
-    from .pump import base_table
+    from .pumping import _TABLES as PUMP_TABLES
+    from .pumping import base_table
     from .tables import atomic_path
 
     if not isinstance(f, BRDF):

@@ -15,7 +15,7 @@ import numpy as np
 
 from .albedo import albedo
 from .core import load
-from .pump import Pumped, pump
+from .pumping import Pumped, pump
 from .tables import max_constant
 
 THETA = np.linspace(0.0, 89.9, 300)  # incidence angles of the albedo and mirror-radiance curves [deg]

@@ -48,8 +48,8 @@ The BSDF
     the result rounded once to Mitsuba's float32), so in ``llvm_*`` variants it is traced into
     Mitsuba's kernels; in ``scalar_*`` variants the same code runs on Python floats.  A pumped
     model divides by the same upper bounds of the albedo tables as pumpup's compiled kernel
-    (spline + margin, capped at 1; :class:`pumpup.pump._Lookup`): through pumpup's product table G(m)
-    of all levels where it has one (:class:`pumpup.pump._Product`, piece found from the float64 bits
+    (spline + margin, capped at 1; :class:`pumpup.pumping._Lookup`): through pumpup's product table G(m)
+    of all levels where it has one (:class:`pumpup.pumping._Product`, piece found from the float64 bits
     of m = max(N.wi, N.wo)), else level by level, with ``dr.gather`` on the tables; its value is rounded down before the cast to float32
     (x (1 - 2^-23)), so the exported BSDF is pointwise at most the double-precision one and
     keeps its proof of energy conservation (001 eq. 18).
@@ -426,8 +426,8 @@ SUPPORTED = tuple(sorted(set(_KERNELS) | {"pumped"}))
 
 
 class _Level:
-    """One pumping level in Dr.Jit: the upper bound u(mu) of :func:`pumpup.pump._upper_scalar` on
-    the same arrays (:class:`pumpup.pump._Lookup`), found by a binary search of fixed length."""
+    """One pumping level in Dr.Jit: the upper bound u(mu) of :func:`pumpup.pumping._upper_scalar` on
+    the same arrays (:class:`pumpup.pumping._Lookup`), found by a binary search of fixed length."""
 
     def __init__(self, lookup, controlled: bool):
         lk = lookup
@@ -474,11 +474,11 @@ class _Level:
 
 class _ProductG:
     """The chain kernel's fast path in Dr.Jit: G(m) = g_1 ... g_k as one piecewise quintic in
-    m = max(N.wi, N.wo) (:class:`pumpup.pump._Product`, the same pieces and coefficients, already scaled
+    m = max(N.wi, N.wo) (:class:`pumpup.pumping._Product`, the same pieces and coefficients, already scaled
     up by 1 + epsilon), the piece found from the float64 bits of m, for min(N.wi, N.wo) > ``mlo``."""
 
     def __init__(self, prod):
-        from .pump import _CELL_SHIFT, _bits
+        from .pumping import _CELL_SHIFT, _bits
 
         self.mlo, self.cbase, self.shift = float(prod.mlo), int(prod.cbase), _CELL_SHIFT
         self.ncell = len(prod.cstart)
@@ -499,7 +499,7 @@ class _ProductG:
             bits = dr.reinterpret_array(mi.UInt64, m) >> self.shift
             c = mi.UInt32(dr.minimum(dr.maximum(bits, self.cbase) - self.cbase, self.ncell - 1))
             s = dr.gather(mi.UInt32, self.cstart, c)
-            for _ in range(self.steps):  # forward to the piece that holds m (pumpup.pump._Product.piece)
+            for _ in range(self.steps):  # forward to the piece that holds m (pumpup.pumping._Product.piece)
                 s = dr.select(m >= self.lo[s + 1], s + 1, s)
         else:
             c = min(max((int(self._bits(m)) >> self.shift) - self.cbase, 0), self.ncell - 1)
@@ -509,7 +509,7 @@ class _ProductG:
         w, d = self.width, self.deg
         t = (m - self.rows[s * w + d + 1]) * self.rows[s * w + d + 2]
         g = self.rows[s * w] * t
-        for r in range(1, d):  # Horner, in the order of pumpup.pump._horner
+        for r in range(1, d):  # Horner, in the order of pumpup.pumping._horner
             g = (g + self.rows[s * w + r]) * t
         return g + self.rows[s * w + d]
 
@@ -524,7 +524,7 @@ class _DrModel:
         self.brdf = brdf
         self.levels: list[_Level] = []
         base = brdf
-        from .pump import Pumped
+        from .pumping import Pumped
 
         prod = brdf.product() if isinstance(brdf, Pumped) else None
         self.product = _ProductG(prod) if prod is not None else None

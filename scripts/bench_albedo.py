@@ -165,8 +165,8 @@ def families(rtol=1e-10):
 
 def cells():
     from pumpup import _polar, _reuse
-    from pumpup.pump import _TABLES
-    from pumpup.sweep import default_mu
+    from pumpup.pumping import _TABLES
+    from pumpup.sweeps import default_mu
 
     mu = default_mu(257)
 

@@ -1,7 +1,7 @@
 """Scale benchmark of :func:`pumpup.sweep` (issue 7, item 4).
 
 A sweep of stretched Phong (000 eq. 7, 12) over n x p x mu, n geometric in [1, 1000], p
-uniform in [0, 1], mu = the 257 values of :func:`pumpup.sweep.default_mu`; and the same
+uniform in [0, 1], mu = the 257 values of :func:`pumpup.sweeps.default_mu`; and the same
 sweep pumped with g2 at 2 levels (001 eq. 21).  Each grid size k x k samples the same
 parameter ranges, so the mean cost of a cell does not depend on k and the time should be
 linear in the number of cells: t = t0 + b * cells.  Every size runs in a fresh process
@@ -61,7 +61,7 @@ def run_one(k: int, pumped: bool, n_mu: int, scheduler: str, workers: int) -> di
     import resource
 
     import pumpup
-    from pumpup.sweep import default_mu
+    from pumpup.sweeps import default_mu
 
     def cpu() -> float:  # user + system seconds of this process and its finished (reaped) workers
         return sum(r.ru_utime + r.ru_stime for r in (resource.getrusage(resource.RUSAGE_SELF),

@@ -174,7 +174,7 @@ def figure(records, path, target_name="ggx a=0.1 F=1"):
         if r["target_name"] == target_name and r["model"] in ("stretched_phong", "modified_ward", "pumped_phong_g2_2"):
             pick[(r["model"], r["method"])] = r
     chosen = [r for r in res if r["model"] in ("phong", "blinn", "lafortune")] + list(pick.values())
-    from pumpup.fit import plot_fits
+    from pumpup.fitting import plot_fits
 
     class _R:  # the fields plot_fits reads, rebuilt from the JSON record
         def __init__(self, rec):

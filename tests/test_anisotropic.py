@@ -163,7 +163,7 @@ def test_sup_albedo_of_an_isotropic_model_is_its_albedo():
 def loose_tables(monkeypatch):
     import sys
 
-    mod = sys.modules["pumpup.pump"]  # pumpup.pump is also the function
+    mod = sys.modules["pumpup.pumping"]  
     monkeypatch.setattr(mod, "TABLE_RTOL", 1e-7)
     monkeypatch.setattr(mod, "TABLE_INTERP_TOL", 1e-5)
     before = set(mod._TABLES)

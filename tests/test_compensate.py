@@ -196,7 +196,7 @@ def test_save_and_load_without_recomputing(tmp_path, monkeypatch):
     before = [f.eval(wi, wo) for f in (c, s, nested)]
     paths = [pumpup.save_compensated(f, tmp_path / f"f{i}.nc") for i, f in enumerate((c, s, nested))]
     comp._TABLES.clear()
-    sys.modules["pumpup.pump"]._TABLES.clear()
+    sys.modules["pumpup.pumping"]._TABLES.clear()
     def no_tables(*a, **k):
         raise AssertionError("a table was recomputed")
 
@@ -206,7 +206,7 @@ def test_save_and_load_without_recomputing(tmp_path, monkeypatch):
         assert g == f
         np.testing.assert_array_equal(g.eval(wi, wo), v)
     # the file's tables served only the loaded objects: the session's caches are still empty (issue 13 item 5)
-    assert not comp._TABLES and not sys.modules["pumpup.pump"]._TABLES
+    assert not comp._TABLES and not sys.modules["pumpup.pumping"]._TABLES
     with pytest.raises(ValueError, match="not a saved compensated BRDF"):
         pumpup.write_table(c.table().dataset, tmp_path / "t.nc")
         pumpup.load_compensated(tmp_path / "t.nc")

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import pumpup
-pf = importlib.import_module("pumpup.fit")  # the module; the attribute pumpup.fit is the function
+pf = importlib.import_module("pumpup.fitting")
 from pumpup.cli import main
 
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup.pump import Pumped, _TABLES
+from pumpup.pumping import Pumped, _TABLES
 from helpers import random_directions
 
 MU = np.array([1.0, 0.95, 0.8, 0.6, 0.4, 0.2, 0.1, 0.03, 1e-2, 1e-3, 1e-5, 1e-8])
@@ -210,7 +210,7 @@ def test_product_table_of_a_monotone_chain(rng, spec, g):
     """The kernel's fast path divides by G(m), one function of m = max(N.wi, N.wo) for all
     levels: never below the product of the levels' g, above it by at most twice its epsilon (checked
     at 2e5 random m and at every piece's ends), and the kernel evaluates exactly that G."""
-    from pumpup.pump import _CELL_SHIFT, _bits
+    from pumpup.pumping import _CELL_SHIFT, _bits
 
     f = pumpup.pump(pumpup.load(spec), g=g, levels=3)
     p = f.product()
@@ -256,7 +256,7 @@ def test_running_maximum_of_a_table_that_dips_within_its_margin(monkeypatch):
     their errors, all three levels increase: the real-model part runs on the 2-D engine's tables)."""
     from scipy.interpolate import PPoly, make_interp_spline
 
-    from pumpup.pump import _monotone_envelope
+    from pumpup.pumping import _monotone_envelope
     from pumpup.tables import nondecreasing
 
     x = np.linspace(-3, 0, 12)
@@ -278,7 +278,7 @@ def test_running_maximum_of_a_table_that_dips_within_its_margin(monkeypatch):
 
     import sys
 
-    monkeypatch.setattr(sys.modules["pumpup.pump"], "_TABLES", {})  # tables of this test only
+    monkeypatch.setattr(sys.modules["pumpup.pumping"], "_TABLES", {})  # tables of this test only
     with pumpup._polar.two_d_only():
         f = pumpup.pump(pumpup.load(BASES["phong"]), g="g2", levels=3)
         lk = f.lookup()
@@ -293,7 +293,7 @@ def test_running_maximum_of_a_table_that_dips_within_its_margin(monkeypatch):
 
 
 def test_product_table_that_cannot_reach_its_tolerance_falls_back(monkeypatch, rng):
-    from pumpup.pump import _Product
+    from pumpup.pumping import _Product
 
     monkeypatch.setattr(_Product, "TOL", 0.0)  # unreachable: bisects until 1e5 pieces, then gives up
     f = pumpup.pump(pumpup.load(BASES["phong"]), g="g2", levels=1)

@@ -10,7 +10,7 @@ import pytest
 
 import pumpup
 from pumpup import _reuse
-from pumpup.sweep import default_mu
+from pumpup.sweeps import default_mu
 
 DATA = json.loads((pathlib.Path(__file__).parent / "data" / "independent_reference.json").read_text())
 MEAN = [e for e in DATA["entries"] if e["quantity"] == "mean_albedo"]

@@ -41,3 +41,16 @@ def test_threaded_sweep_compiles_without_numba_warning(tmp_path):
                         "--threads", "--workers", "2"], capture_output=True, text=True, env=env, timeout=1800)
     assert r.returncode == 0, r.stderr
     assert "NumbaWarning" not in r.stderr and "previously compiled" not in r.stderr, r.stderr
+
+
+def test_modules_are_not_hidden_by_their_functions():
+    """Issue 13 item 16: the modules of pump, sweep and fit have names of their own."""
+    import importlib
+    import types
+
+    import pumpup
+
+    for mod, func in (("pumping", "pump"), ("sweeps", "sweep"), ("fitting", "fit")):
+        m = importlib.import_module(f"pumpup.{mod}")
+        assert isinstance(m, types.ModuleType) and getattr(pumpup, mod) is m
+        assert callable(getattr(pumpup, func)) and getattr(m, func) is getattr(pumpup, func)

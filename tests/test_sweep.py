@@ -13,7 +13,7 @@ import xarray as xr
 import pumpup
 from pumpup.cli import main
 
-sweep_module = importlib.import_module("pumpup.sweep")  # the module (pumpup.sweep is the function)
+sweep_module = importlib.import_module("pumpup.sweeps")
 REAL_CELL = sweep_module._cell
 
 SPEC = {"type": "stretched_phong"}

@@ -12,7 +12,7 @@ import pytest
 
 import pumpup
 
-sw = sys.modules["pumpup.sweep"]  # (pumpup.sweep is also the function's name)
+sw = sys.modules["pumpup.sweeps"]
 A = dict(spec={"type": "lambert"}, params={"albedo": [0.25, 0.5]}, mu=[0.5, 1.0], scheduler="synchronous",
          mean=False, maximum=False, progress=False)
 

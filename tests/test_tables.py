@@ -129,7 +129,7 @@ def test_blinn_max_constant_matches_table_2_of_000():
 
 def test_compiled_upper_bound_is_the_tables_upper_bound(phong_table):
     # the pumping operator's look-up and AlbedoTable.upper are one definition (capped at 1)
-    from pumpup.pump import _Lookup
+    from pumpup.pumping import _Lookup
 
     table = pumpup.AlbedoTable.from_dataset(phong_table)
     lookup = _Lookup(table)

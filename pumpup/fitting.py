@@ -635,7 +635,7 @@ class _Problem:
         return s
 
     def build(self, values, scale=None) -> BRDF:
-        from .pump import pump
+        from .pumping import pump
 
         s = self.spec(values, scale)
         if self.pump is not None:

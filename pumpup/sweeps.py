@@ -156,7 +156,7 @@ def cell_model(spec: dict, pump: dict | None) -> BRDF:
     """The model of one cell: ``load(spec)``, pumped with ``pump`` if given."""
     f = load(spec)
     if pump:
-        from .pump import pump as pump_fn
+        from .pumping import pump as pump_fn
 
         f = pump_fn(f, **pump)
     return f
@@ -164,7 +164,7 @@ def cell_model(spec: dict, pump: dict | None) -> BRDF:
 
 def _cell(spec: dict, pump: dict | None, mu: np.ndarray, opts: dict) -> dict[str, Any]:
     """Everything the sweep stores for one cell: a pure function of its arguments."""
-    from .pump import _TABLES, Pumped, _key
+    from .pumping import _TABLES, Pumped, _key
     from .tables import max_albedo, mean_albedo, tabulate
 
     f = cell_model(spec, pump)
@@ -364,7 +364,7 @@ def warm_kernels(f: BRDF) -> None:
     albedo runs every kernel of the engine and the model (a pumped chain's own kernel compiles
     under numba's lock)."""
     from .albedo import albedo
-    from .pump import Pumped
+    from .pumping import Pumped
 
     base = f
     while isinstance(base, Pumped):
