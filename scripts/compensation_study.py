@@ -338,7 +338,10 @@ def main(argv=None):
     t0 = time.perf_counter()
     ds = study(quick=a.quick)
     ds.attrs["seconds"] = time.perf_counter() - t0
-    path = pumpup.write_table(ds, os.path.join(a.out, "compensation.nc"))
+    from pumpup.provenance import write_generated  # stamps the commit that made it (issue 13 item 15)
+
+    path = os.path.join(a.out, "compensation.nc")
+    write_generated(ds, path)
     fig = plot(ds, os.path.join(a.figures, "compensation.png"))
     print(markdown(ds))
     print(metal_markdown(ds))
