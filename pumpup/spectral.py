@@ -164,6 +164,15 @@ class SpectralMetal:
         e = np.stack(errs, axis=-1)
         return (v, e) if return_error else v
 
+    def mean_albedo(self, return_error: bool = False, **kw):
+        """Mean (cosine-weighted hemispherical) albedo per wavelength, :func:`pumpup.mean_albedo` (000 eq. 33)."""
+        from .tables import mean_albedo
+
+        out = [mean_albedo(m, return_error=True, **kw) for m in self.models]
+        v = np.array([o[0] for o in out])
+        e = np.array([o[1] for o in out])
+        return (v, e) if return_error else v
+
     def tabulate(self, mu=None, **kw):
         """Albedo tables of every wavelength as one xarray.Dataset with dims (``mu``, ``wavelength``).
 
