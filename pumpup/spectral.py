@@ -35,7 +35,7 @@ from . import optical
 from .core import SpecError, load
 from .models.metal import _fresnel_real
 
-__all__ = ["SpectralMetal", "to_xyz", "to_srgb", "RGB_WAVELENGTHS"]
+__all__ = ["Spectral", "SpectralMetal", "SpectralPumped", "to_xyz", "to_srgb", "RGB_WAVELENGTHS"]
 
 #: Three representative wavelengths [nm] of the sRGB primaries' channels (red, green, blue).
 RGB_WAVELENGTHS: tuple[float, float, float] = (630.0, 532.0, 465.0)
@@ -46,7 +46,126 @@ def _fresnel_vec(c, eta, k):  # pragma: no cover - compiled
     return _fresnel_real(c, eta, k)
 
 
-class SpectralMetal:
+class Spectral:
+    """One scalar BRDF per wavelength (``models``, ``wavelengths`` [nm]), stacked on a trailing axis.
+
+    The base of :class:`SpectralMetal` and of its pumped form (:meth:`SpectralMetal.pump`).
+    """
+
+    models: list
+    wavelengths: np.ndarray
+    material: str | None = None
+
+    def eval(self, wi, wo) -> np.ndarray:
+        """f_r(wi, wo) [1/sr] of every wavelength's model: shape broadcast(wi, wo)[:-1] + (len(wavelengths),)."""
+        return np.stack([m.eval(wi, wo) for m in self.models], axis=-1)
+
+    # --- albedo ----------------------------------------------------------------------------
+
+    def albedo(self, mu, return_error: bool = False, **kw):
+        """Directional albedo per wavelength: shape mu.shape + (len(wavelengths),).
+
+        :func:`pumpup.albedo` of each wavelength's model (keyword arguments passed on); with
+        ``return_error`` also its error estimate, same shape.
+        """
+        from .albedo import albedo
+
+        vals, errs = [], []
+        for m in self.models:
+            v, e = albedo(m, mu, return_error=True, **kw)
+            vals.append(np.asarray(v))
+            errs.append(np.asarray(e))
+        v = np.stack(vals, axis=-1)
+        e = np.stack(errs, axis=-1)
+        return (v, e) if return_error else v
+
+    def mean_albedo(self, return_error: bool = False, **kw):
+        """Mean (cosine-weighted hemispherical) albedo per wavelength, :func:`pumpup.mean_albedo` (000 eq. 33)."""
+        from .tables import mean_albedo
+
+        out = [mean_albedo(m, return_error=True, **kw) for m in self.models]
+        v = np.array([o[0] for o in out])
+        e = np.array([o[1] for o in out])
+        return (v, e) if return_error else v
+
+    def tabulate(self, mu=None, **kw):
+        """Albedo tables of every wavelength as one xarray.Dataset with dims (``mu``, ``wavelength``).
+
+        With ``mu`` given, every wavelength is computed on it.  Without, each wavelength's
+        adaptive grid (:func:`pumpup.tabulate`) is computed, and the values missing from the
+        union of those grids are added, so all wavelengths share the union grid (which
+        contains each one's adaptive grid); ``interpolation_error`` (per wavelength) is that
+        of the wavelength's own adaptive grid.
+        """
+        import xarray as xr
+
+        from .albedo import albedo
+        from .tables import tabulate
+
+        kw.setdefault("progress", False)
+        tables = [tabulate(m, mu=mu, **kw) for m in self.models]
+        grid = np.unique(np.concatenate([t["mu"].values for t in tables]))
+        vals = np.empty((grid.size, len(self.models)))
+        errs = np.empty_like(vals)
+        a_kw = {key: kw[key] for key in ("rtol", "atol") if key in kw}
+        for j, (m, t) in enumerate(zip(self.models, tables)):
+            own = t["mu"].values
+            idx = np.searchsorted(grid, own)
+            vals[idx, j] = t["albedo"].values
+            errs[idx, j] = t["albedo_error"].values
+            miss = np.setdiff1d(np.arange(grid.size), idx)
+            if miss.size:
+                v, e = albedo(m, grid[miss], return_error=True, **a_kw)
+                vals[miss, j] = v
+                errs[miss, j] = e
+        import json
+
+        ds = xr.Dataset(
+            {
+                "albedo": (("mu", "wavelength"), vals),
+                "albedo_error": (("mu", "wavelength"), errs),
+                "interpolation_error": ("wavelength", [float(t.attrs["interpolation_error"]) for t in tables]),
+                "eta": ("wavelength", self.eta),
+                "k": ("wavelength", self.k),
+            },
+            coords={"mu": grid, "theta": ("mu", np.degrees(np.arccos(grid))), "wavelength": self.wavelengths},
+            attrs={k: v for k, v in tables[0].attrs.items() if k not in ("spec", "interpolation_error")},
+        )
+        ds["wavelength"].attrs["units"] = "nm"
+        ds["theta"].attrs["units"] = "degree"
+        ds.attrs["spec"] = json.dumps(self.spec, sort_keys=True)
+        ds.attrs["title"] = f"Spectral directional albedo of metal ({self.material or 'explicit index'})"
+        if getattr(self, "material", None) is not None:
+            for key, val in optical.metadata(self.material).items():
+                ds.attrs[f"optical_{key}"] = val
+        return ds
+
+
+
+class SpectralPumped(Spectral):
+    """A spectral BRDF pumped up wavelength by wavelength (001 sec. 3): each wavelength's model is
+    divided by its own correction g (:func:`pumpup.pump` of that wavelength's model)."""
+
+    def __init__(self, base: Spectral, g: str = "g1", levels: int = 1):
+        from .pump import pump
+
+        self.base = base
+        self.material = base.material
+        self.wavelengths = base.wavelengths
+        self.models = [pump(m, g=g, levels=levels) for m in base.models]
+        self.eta, self.k = base.eta, base.k
+        self.g = g
+        self.levels = levels
+
+    @property
+    def spec(self) -> dict:
+        return {"type": "pumped", "base": self.base.spec, "g": self.g, "levels": self.levels}
+
+    def __repr__(self) -> str:
+        return f"SpectralPumped({self.base!r}, g={self.g!r}, levels={self.levels})"
+
+
+class SpectralMetal(Spectral):
     """A metal of 000 eq. 28 at several wavelengths, f_r(wi, wo, lambda) [1/sr].
 
     f_r = c cos^n(alpha) / cos(Theta_min) F(n(lambda) + i k(lambda), Theta_min), 000 eq. 28,
@@ -141,90 +260,13 @@ class SpectralMetal:
         fr = _fresnel_vec(np.where(ok, mx, 1.0)[..., None], self.eta, self.k)  # F(Theta_min), 000 eq. 28
         return lobe[..., None] * fr
 
+    def pump(self, g: str = "g1", levels: int = 1) -> "SpectralPumped":
+        """Pump every wavelength up by its own albedo (:func:`pumpup.pump`, 001 sec. 3)."""
+        return SpectralPumped(self, g=g, levels=levels)
+
     def fresnel_normal(self) -> np.ndarray:
         """F at normal incidence, ((n - 1)^2 + k^2) / ((n + 1)^2 + k^2), per wavelength."""
         return ((self.eta - 1) ** 2 + self.k**2) / ((self.eta + 1) ** 2 + self.k**2)
-
-    # --- albedo ----------------------------------------------------------------------------
-
-    def albedo(self, mu, return_error: bool = False, **kw):
-        """Directional albedo per wavelength: shape mu.shape + (len(wavelengths),).
-
-        :func:`pumpup.albedo` of each wavelength's model (keyword arguments passed on); with
-        ``return_error`` also its error estimate, same shape.
-        """
-        from .albedo import albedo
-
-        vals, errs = [], []
-        for m in self.models:
-            v, e = albedo(m, mu, return_error=True, **kw)
-            vals.append(np.asarray(v))
-            errs.append(np.asarray(e))
-        v = np.stack(vals, axis=-1)
-        e = np.stack(errs, axis=-1)
-        return (v, e) if return_error else v
-
-    def mean_albedo(self, return_error: bool = False, **kw):
-        """Mean (cosine-weighted hemispherical) albedo per wavelength, :func:`pumpup.mean_albedo` (000 eq. 33)."""
-        from .tables import mean_albedo
-
-        out = [mean_albedo(m, return_error=True, **kw) for m in self.models]
-        v = np.array([o[0] for o in out])
-        e = np.array([o[1] for o in out])
-        return (v, e) if return_error else v
-
-    def tabulate(self, mu=None, **kw):
-        """Albedo tables of every wavelength as one xarray.Dataset with dims (``mu``, ``wavelength``).
-
-        With ``mu`` given, every wavelength is computed on it.  Without, each wavelength's
-        adaptive grid (:func:`pumpup.tabulate`) is computed, and the values missing from the
-        union of those grids are added, so all wavelengths share the union grid (which
-        contains each one's adaptive grid); ``interpolation_error`` (per wavelength) is that
-        of the wavelength's own adaptive grid.
-        """
-        import xarray as xr
-
-        from .albedo import albedo
-        from .tables import tabulate
-
-        kw.setdefault("progress", False)
-        tables = [tabulate(m, mu=mu, **kw) for m in self.models]
-        grid = np.unique(np.concatenate([t["mu"].values for t in tables]))
-        vals = np.empty((grid.size, len(self.models)))
-        errs = np.empty_like(vals)
-        a_kw = {key: kw[key] for key in ("rtol", "atol") if key in kw}
-        for j, (m, t) in enumerate(zip(self.models, tables)):
-            own = t["mu"].values
-            idx = np.searchsorted(grid, own)
-            vals[idx, j] = t["albedo"].values
-            errs[idx, j] = t["albedo_error"].values
-            miss = np.setdiff1d(np.arange(grid.size), idx)
-            if miss.size:
-                v, e = albedo(m, grid[miss], return_error=True, **a_kw)
-                vals[miss, j] = v
-                errs[miss, j] = e
-        import json
-
-        ds = xr.Dataset(
-            {
-                "albedo": (("mu", "wavelength"), vals),
-                "albedo_error": (("mu", "wavelength"), errs),
-                "interpolation_error": ("wavelength", [float(t.attrs["interpolation_error"]) for t in tables]),
-                "eta": ("wavelength", self.eta),
-                "k": ("wavelength", self.k),
-            },
-            coords={"mu": grid, "theta": ("mu", np.degrees(np.arccos(grid))), "wavelength": self.wavelengths},
-            attrs={k: v for k, v in tables[0].attrs.items() if k not in ("spec", "interpolation_error")},
-        )
-        ds["wavelength"].attrs["units"] = "nm"
-        ds["theta"].attrs["units"] = "degree"
-        ds.attrs["spec"] = json.dumps(self.spec, sort_keys=True)
-        ds.attrs["title"] = f"Spectral directional albedo of metal ({self.material or 'explicit index'})"
-        if self.material is not None:
-            for key, val in optical.metadata(self.material).items():
-                ds.attrs[f"optical_{key}"] = val
-        return ds
-
 
 # --- colour ---------------------------------------------------------------------------------
 

@@ -101,3 +101,24 @@ def test_colour_sanity():
     np.testing.assert_allclose(xyz, np.broadcast_to(0.5 * spectral.to_xyz(np.ones(8), w), (2, 3)), rtol=1e-12)
     with pytest.raises(SpecError, match="last axis of length 8"):
         spectral.to_xyz(np.ones(3), w)
+
+
+def test_pump_per_wavelength():
+    rng = np.random.default_rng(7)
+    wi, wo = _dirs(rng, 200), _dirs(rng, 200)
+    s = spectral.SpectralMetal("Au", n=20, wavelengths=[450.0, 650.0])
+    p = s.pump()
+    f = p.eval(wi, wo)
+    assert f.shape == (200, 2)
+    n, k = optical.constants("Au", [450.0, 650.0])
+    mu = [1.0, 0.3, 0.02]
+    a, e = p.albedo(mu, return_error=True)
+    for j in range(2):
+        one = pumpup.pump(pumpup.load({"type": "metal", "n": 20, "eta": float(n[j]), "k": float(k[j])}))
+        np.testing.assert_allclose(f[:, j], one.eval(wi, wo), rtol=1e-13, atol=0)
+        np.testing.assert_allclose(a[:, j], pumpup.albedo(one, mu), rtol=1e-12)
+    assert np.all(a - e <= 1.0)
+    # pumping raises every wavelength's albedo (each divided by its own g)
+    assert np.all(a > s.albedo(mu))
+    ds = p.tabulate(mu=mu)
+    assert ds["albedo"].dims == ("mu", "wavelength") and '"pumped"' in ds.attrs["spec"]
