@@ -122,3 +122,21 @@ def test_pump_per_wavelength():
     assert np.all(a > s.albedo(mu))
     ds = p.tabulate(mu=mu)
     assert ds["albedo"].dims == ("mu", "wavelength") and '"pumped"' in ds.attrs["spec"]
+
+
+def test_metals_table_file():
+    """tables/metals.nc (scripts/make_metals_table.py): valid, <= 1 within error, recomputable."""
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parent.parent / "tables" / "metals.nc"
+    ds = pumpup.open_table(path)
+    a, e = ds["albedo"].values, ds["albedo_error"].values
+    assert np.all(a - e <= 1.0) and np.all(e < 1e-7)
+    # pumping raised every value; and one row is recomputed from scratch
+    assert np.all(ds["albedo"].sel(variant="pumped").values >= ds["albedo"].sel(variant="stretched").values)
+    s = spectral.SpectralMetal("Cu", n=20)
+    mu = ds["mu"].values[[0, 10, 20]]
+    np.testing.assert_allclose(ds["albedo"].sel(metal="Cu", exponent=20.0, variant="stretched").values[[0, 10, 20]],
+                               s.albedo(mu), rtol=1e-9)
+    meta = __import__("json").loads(ds.attrs["optical_constants"])
+    assert "Johnson" in meta["Au"]["reference"]
