@@ -32,10 +32,11 @@ import numpy as np
 from numba import vectorize
 
 from . import optical
-from .core import SpecError, load
+from .core import SpecError
+from .core import load as _load_scalar
 from .models.metal import _fresnel_real
 
-__all__ = ["Spectral", "SpectralMetal", "SpectralPumped", "to_xyz", "to_srgb", "RGB_WAVELENGTHS"]
+__all__ = ["load", "Spectral", "SpectralMetal", "SpectralPumped", "to_xyz", "to_srgb", "RGB_WAVELENGTHS"]
 
 #: Three representative wavelengths [nm] of the sRGB primaries' channels (red, green, blue).
 RGB_WAVELENGTHS: tuple[float, float, float] = (630.0, 532.0, 465.0)
@@ -219,7 +220,7 @@ class SpectralMetal(Spectral):
         if c is not None:
             spec["c"] = c
         # one scalar model per wavelength; their validation checks n, c, eta, k
-        self.models = [load({**spec, "eta": float(e), "k": float(kk)}) for e, kk in zip(etas, ks)]
+        self.models = [_load_scalar({**spec, "eta": float(e), "k": float(kk)}) for e, kk in zip(etas, ks)]
         self.eta = np.array([m.p["eta"] for m in self.models])
         self.k = np.array([m.p["k"] for m in self.models])
         self.n = self.models[0].p["n"]
@@ -267,6 +268,43 @@ class SpectralMetal(Spectral):
     def fresnel_normal(self) -> np.ndarray:
         """F at normal incidence, ((n - 1)^2 + k^2) / ((n + 1)^2 + k^2), per wavelength."""
         return ((self.eta - 1) ** 2 + self.k**2) / ((self.eta + 1) ** 2 + self.k**2)
+
+def load(spec: Any) -> Spectral:
+    """A spectral model from the DESIGN.md spec ``{"type": "metal", "material": "Au", "n": 20}``.
+
+    Accepts ``material`` (or per-wavelength ``eta``/``k`` lists) with ``n``, optional ``c`` and
+    ``wavelengths`` (a list of nm or ``"rgb"``), and ``{"type": "pumped", "base": <spectral metal
+    spec>, "g": ..., "levels": ...}``; ``SpectralMetal.spec`` round-trips.  (``pumpup.load`` builds
+    scalar models only; its albedo engine integrates one scalar BRDF.)
+
+    Examples
+    --------
+    >>> from pumpup import spectral
+    >>> f = spectral.load({"type": "metal", "material": "Cu", "n": 20, "wavelengths": "rgb"})
+    >>> f.eval([0, 0, 1], [0, 0, 1]).shape
+    (3,)
+    """
+    if isinstance(spec, Spectral):
+        return spec
+    if not isinstance(spec, dict) or "type" not in spec:
+        raise SpecError(f"spectral.load: a spec must be a dict with a 'type' key, got {spec!r}")
+    kw = {k: v for k, v in spec.items() if k != "type"}
+    if spec["type"] == "pumped":
+        allowed = {"base", "g", "levels"}
+        bad = sorted(set(kw) - allowed)
+        if bad or "base" not in kw:
+            raise SpecError(f"spectral.load: a pumped spec needs 'base' and allows {', '.join(sorted(allowed))}; "
+                            f"got {sorted(kw)}")
+        return SpectralPumped(load(kw["base"]), g=kw.get("g", "g1"), levels=kw.get("levels", 1))
+    if spec["type"] != "metal":
+        raise SpecError(f"spectral.load: 'type' must be 'metal' or 'pumped', got {spec['type']!r}")
+    allowed = {"material", "n", "wavelengths", "eta", "k", "c"}
+    bad = sorted(set(kw) - allowed)
+    if bad:
+        raise SpecError(f"spectral.load: unknown parameter(s) {', '.join(map(repr, bad))}; allowed: "
+                        f"{', '.join(sorted(allowed))}")
+    return SpectralMetal(**kw)
+
 
 # --- colour ---------------------------------------------------------------------------------
 

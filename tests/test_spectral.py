@@ -140,3 +140,16 @@ def test_metals_table_file():
                                s.albedo(mu), rtol=1e-9)
     meta = __import__("json").loads(ds.attrs["optical_constants"])
     assert "Johnson" in meta["Au"]["reference"]
+
+
+def test_spectral_load_round_trip():
+    f = spectral.load({"type": "metal", "material": "Au", "n": 20})
+    g = spectral.load(f.spec)
+    rng = np.random.default_rng(3)
+    wi, wo = _dirs(rng, 50), _dirs(rng, 50)
+    np.testing.assert_array_equal(f.eval(wi, wo), g.eval(wi, wo))
+    assert spectral.load({"type": "pumped", "base": f.spec}).spec["base"] == f.spec
+    with pytest.raises(SpecError, match="unknown parameter"):
+        spectral.load({"type": "metal", "material": "Au", "n": 20, "colour": 1})
+    with pytest.raises(SpecError, match="'type' must be"):
+        spectral.load({"type": "phong", "n": 20})
