@@ -153,3 +153,24 @@ def test_spectral_load_round_trip():
         spectral.load({"type": "metal", "material": "Au", "n": 20, "colour": 1})
     with pytest.raises(SpecError, match="'type' must be"):
         spectral.load({"type": "phong", "n": 20})
+
+
+@pytest.mark.parametrize("material", ["Au", "Fe"])
+def test_tabulated_fresnel_eq28(material):
+    rng = np.random.default_rng(11)
+    wi, wo = _dirs(rng, 3000), _dirs(rng, 3000)
+    wo[:100] = wi[:100] * [-1, -1, 1]
+    wi[-5:] = [0, 0, 1]
+    s = spectral.SpectralMetal(material, n=50)
+    table, err = s.fresnel_table()
+    assert 0 < err < 1e-7
+    fast = s.eval_tabulated(wi, wo)
+    # the numba kernel against its plain numpy twin
+    np.testing.assert_allclose(fast, spectral._eval_table_reference(wi, wo, s.n, s.c, table), rtol=1e-13, atol=1e-300)
+    # against direct Fresnel, within the measured table error times the F = 1 lobe
+    rv = np.maximum(2 * wi[:, 2] * wo[:, 2] - np.sum(wi * wo, axis=1), 0.0)
+    up = (wi[:, 2] > 0) & (wo[:, 2] > 0)
+    lobe = np.where(up, s.c * rv**50 / np.maximum(np.maximum(wi[:, 2], wo[:, 2]), 1e-300), 0.0)  # f_r with F = 1
+    exact = s.eval(wi, wo)
+    assert np.all(np.abs(fast - exact) <= err * lobe[:, None] * (1 + 1e-6) + 1e-300)
+    assert fast.shape == exact.shape and np.any(fast > 0)
