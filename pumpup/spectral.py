@@ -189,7 +189,7 @@ class SpectralPumped(Spectral):
     divided by its own correction g (:func:`pumpup.pump` of that wavelength's model)."""
 
     def __init__(self, base: Spectral, g: str = "g1", levels: int = 1):
-        from .pump import pump
+        from .pumping import pump
 
         self.base = base
         self.material = base.material
