@@ -230,10 +230,6 @@ def _ensure_models() -> None:
     from . import models  # noqa: F401  (registers the built-in models)
 
 
-#: directions checked at a time by :func:`as_directions` (its temporaries stay near 1 MB)
-CHECK_BLOCK = 1 << 15
-
-
 def slabs(shape: tuple, block: int):
     """Index tuples that cut an array of ``shape`` into pieces of about ``block`` elements or fewer
     along its leading axes (a whole trailing axis longer than ``block`` is cut too): indexing a

@@ -884,23 +884,11 @@ def save_pumped(f: Pumped, path) -> str:
         chain.append(cur)
         cur = cur.base
     chain.reverse()  # innermost first
-    from .tables import atomic_path
-    from .validate import DIGEST_ATTR, checksum_encoding, content_digest
+    from .tables import write_groups
 
-    def digested(ds):
-        ds = ds.copy()
-        ds.attrs.pop(DIGEST_ATTR, None)
-        ds.attrs[DIGEST_ATTR] = content_digest(ds)
-        return ds
-
-    with atomic_path(path) as tmp:
-        root = xr.Dataset(attrs={"pumpup_kind": "pumpup pumped BRDF", "spec": json.dumps(f.spec, sort_keys=True),
-                                 "levels": len(chain), "pumpup_version": __version__})
-        digested(root).to_netcdf(tmp, mode="w", engine="netcdf4")
-        for i, level in enumerate(chain, start=1):
-            ds = digested(level.table().dataset)
-            ds.to_netcdf(tmp, mode="a", group=f"level{i}", engine="netcdf4", encoding=checksum_encoding(ds))
-    return os.fspath(path)
+    root = xr.Dataset(attrs={"pumpup_kind": "pumpup pumped BRDF", "spec": json.dumps(f.spec, sort_keys=True),
+                             "levels": len(chain), "pumpup_version": __version__})
+    return write_groups(path, root, [(f"level{i}", level.table().dataset) for i, level in enumerate(chain, start=1)])
 
 
 def load_pumped(path) -> Pumped:

@@ -23,7 +23,7 @@ import numpy as np
 from ._version import __version__
 from . import _reuse
 from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
-from .core import BRDF, SpecError, check_count, check_open_unit, check_tolerance
+from .core import BRDF, check_count, check_open_unit, check_tolerance
 
 __all__ = [
     "tabulate",
@@ -487,13 +487,34 @@ def write_table(ds, path) -> str:
     Fletcher-32 checksum on every numeric variable (:func:`pumpup.validate.checksum_encoding`) and
     a digest of the whole content in the attribute ``pumpup_digest``, which :func:`open_table`
     checks (:func:`pumpup.validate.content_digest`)."""
-    from .validate import DIGEST_ATTR, checksum_encoding, content_digest
+    from .validate import checksum_encoding
 
-    ds = ds.copy()  # shallow: the caller's attributes stay as they are
-    ds.attrs.pop(DIGEST_ATTR, None)
-    ds.attrs[DIGEST_ATTR] = content_digest(ds)
+    ds = _digested(ds)
     with atomic_path(path) as tmp:
         ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=checksum_encoding(ds))
+    return os.fspath(path)
+
+
+def _digested(ds):
+    """A shallow copy of ``ds`` carrying the digest of its content (the caller's attributes stay)."""
+    from .validate import DIGEST_ATTR, content_digest
+
+    ds = ds.copy()
+    ds.attrs.pop(DIGEST_ATTR, None)
+    ds.attrs[DIGEST_ATTR] = content_digest(ds)
+    return ds
+
+
+def write_groups(path, root, groups) -> str:
+    """Write ``root`` and the (name, Dataset) ``groups`` into one netCDF file, atomically, each with
+    its digest and the Fletcher-32 checksums of :func:`write_table` (saved pumped and compensated BRDFs)."""
+    from .validate import checksum_encoding
+
+    with atomic_path(path) as tmp:
+        _digested(root).to_netcdf(tmp, mode="w", engine="netcdf4")
+        for name, ds in groups:
+            ds = _digested(ds)
+            ds.to_netcdf(tmp, mode="a", group=name, engine="netcdf4", encoding=checksum_encoding(ds))
     return os.fspath(path)
 
 

@@ -53,7 +53,7 @@ def main() -> int:
     for arr in (np.abs(d), rel):
         for flat in np.argsort(arr, axis=None)[::-1][:args.worst]:
             cells.append(tuple(int(v) for v in np.unravel_index(flat, d.shape)))
-    print(f"\n  worst cells, recomputed by the independent quadrature (rtol 1e-11):")
+    print("\n  worst cells, recomputed by the independent quadrature (rtol 1e-11):")
     print(f"  {'y':>3s} {'x':>3s} {'mu':>10s} {'rough':>10s} {'shipped':>10s} {'pumpup':>16s} "
           f"{'independent':>16s} {'|pu - ind|':>10s} {'shipped - E':>12s} {'rel':>9s}")
     worst_gap = 0.0

@@ -18,7 +18,6 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import pumpup
-from pumpup.core import REQUIRED
 
 #: "function" needs a registered callable; "pumped" builds tables (seconds each): tests/test_pump.py
 MODELS = {name: cls for name, cls in pumpup.registry().items() if name not in ("function", "pumped") and cls.examples}

@@ -3,8 +3,8 @@
 Checked against an independent source (the paper itself was not available here): Westin's
 reference implementation (heBRDF, Cornell; as reproduced in github.com/bsdfbenchmark/bbm,
 ``unittest/he/bin/he_westin.cpp``), whose functions are labelled by the paper's equations
-(24, 70, 73-84): every formula below matches it, and so do the values (30 direction pairs to the
-limit of Westin's series cut-off, the specular weight to 1e-14; ``tests/data/he_torrance_westin.json``).
+(24, 70, 73-84): every formula below matches it, and so do the values (30 direction pairs to
+1e-13 with Westin's series summed to a relative 1e-17, the specular weight to 1e-14; ``tests/data/he_torrance_westin.json``).
 Two places where sources differ: the shadowing uses the errata's exp(-c^2) factor in Lambda
 (the printed eq. 25 lacks it; bsdfbenchmark's ``he.h`` says so), and D keeps k^2 = (2 pi /
 lambda)^2 in v_xy^2 tau^2 / (4 m) as Westin does (a variant without it is dimensionally

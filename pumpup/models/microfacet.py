@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 from numba import njit, vectorize
 
-from ..core import MAX_INDEX, MAX_WIDTH, MIN_ALPHA, MIN_INDEX, MIN_WIDTH, BRDF, Lobe, Param, SpecError, register
+from ..core import MAX_INDEX, MAX_WIDTH, MIN_ALPHA, MIN_INDEX, BRDF, Lobe, Param, SpecError, register
 from ._half import tan2_half
 from .cook_torrance import _IOR, _fresnel, _fresnel_reference
 from .metal import _fresnel_real
