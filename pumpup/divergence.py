@@ -290,6 +290,9 @@ def plot(ds, path):
     ax.invert_xaxis()
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
-    fig.savefig(path, dpi=90)
+    from .tables import atomic_path
+
+    with atomic_path(path) as tmp:  # an interrupted write leaves no half PNG
+        fig.savefig(tmp, dpi=90, format="png")
     plt.close(fig)
     return path

@@ -16,7 +16,7 @@ import numpy as np
 from .albedo import albedo
 from .core import load
 from .pumping import Pumped, pump
-from .tables import max_constant
+from .tables import atomic_path, max_constant
 
 THETA = np.linspace(0.0, 89.9, 300)  # incidence angles of the albedo and mirror-radiance curves [deg]
 THETA_IN = np.array([0.0, 30.0, 60.0, 80.0])  # incidence angles of the in-plane radiance curves [deg]
@@ -156,7 +156,8 @@ def plot_all(ds, st, outdir):
                 ax.legend(fontsize=8)
                 ax.grid(alpha=0.3)
         path = os.path.join(outdir, f"pumping_{model}.png")
-        fig.savefig(path, dpi=90)
+        with atomic_path(path) as tmp:  # an interrupted write leaves no half PNG
+            fig.savefig(tmp, dpi=90, format="png")
         plt.close(fig)
         paths.append(path)
     fig, ax = plt.subplots(figsize=(7, 5), constrained_layout=True)
@@ -167,7 +168,8 @@ def plot_all(ds, st, outdir):
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     path = os.path.join(outdir, "stretched_phong_albedo.png")
-    fig.savefig(path, dpi=90)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=90, format="png")
     plt.close(fig)
     return paths + [path]
 

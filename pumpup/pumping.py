@@ -622,6 +622,30 @@ class Pumped(BRDF):
             out = fbase / self.g(np.clip(mi, 1e-300, 1), np.clip(mo, 1e-300, 1))
         return np.where(up, out, 0.0)
 
+    @property
+    def delta_albedo(self):
+        """The base's delta lobe pumped, or None if the base has none (he_torrance's specular part).
+
+        A delta in the mirror direction of weight w(mu) (000 eq. 2 then picks wo = the mirror of wi,
+        N.wo = N.wi = mu) is divided by g at that pair like the rest of f: its share of the pumped
+        albedo is w(mu) / g(mu, mu) (001 eq. 16, 20, 21).  The bound still holds: the base's table,
+        and so g >= a(mu), includes the delta, so (integral of f + w) / g <= a(mu) / a(mu) = 1.
+        """
+        base = getattr(self.base, "delta_albedo", None)
+        if base is None:
+            return None
+
+        def delta(mu):
+            mu = np.asarray(mu, dtype=np.float64)
+            return np.asarray(base(mu), dtype=np.float64) / self.g(mu, mu)
+
+        return delta
+
+    @property
+    def eval_rtol(self) -> float:
+        """The base's relative error of eval (a truncated series), unchanged by the division by g."""
+        return getattr(self.base, "eval_rtol", 0.0)
+
     def chain(self) -> list["Pumped"]:
         """The pumped levels from the innermost (level 1) to this one."""
         levels = [self]

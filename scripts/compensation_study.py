@@ -34,6 +34,7 @@ import time
 import numpy as np
 
 import pumpup
+from pumpup.tables import atomic_path
 
 METHODS = ("base", "kulla_conty", "scale", "g1", "g2")
 MU = np.array([1.0, 0.9, 0.7, 0.5, 0.3, 0.1, 0.03, 1e-2, 1e-3, 1e-4, 1e-6])
@@ -273,7 +274,8 @@ def plot(ds, path):
     ax[2].set_title(f"(1 - m) Lambert + m GGX {float(ds.alpha.values[0]):g}")
     ax[2].legend(fontsize=6, ncol=2)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with atomic_path(path) as tmp:  # no half PNG if interrupted
+        fig.savefig(tmp, dpi=110, format="png")
     plt.close(fig)
     return path
 

@@ -72,6 +72,7 @@ def figure(ds, path="figures/metals.png"):
     import matplotlib.pyplot as plt
 
     from pumpup import spectral
+    from pumpup.tables import atomic_path
 
     fig, axes = plt.subplots(2, 4, figsize=(14, 6.5), sharex=True, sharey=True)
     w = ds["wavelength"].values
@@ -98,7 +99,8 @@ def figure(ds, path="figures/metals.png"):
     fig.suptitle("Albedo per wavelength (line colour = wavelength, 400-680 nm): eq. 28 solid, pumped dashed; "
                  "squares: sRGB of the albedo spectrum (lower eq. 28, upper pumped)", fontsize=9)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with atomic_path(path) as tmp:  # no half PNG if interrupted
+        fig.savefig(tmp, dpi=110, format="png")
 
 
 if __name__ == "__main__":

@@ -67,9 +67,9 @@ reciprocal to the last bit but its albedo with F = 1 exceeds 1 by up to 4 % near
 specular part makes it a BRDF with a delta, which 000 does not discuss.
 
 Pumping (:func:`pumpup.pump`) divides ``eval`` by g built from the full albedo (delta
-included) but the pumped model has no delta of its own: its albedo lacks the delta's share
-w(mu) / g.  Sampling is the cosine fallback; the delta is not sampled (``mc_albedo`` adds
-its weight exactly).
+included), and the delta's weight by g at the mirror pair: the pumped model's albedo adds
+w(mu) / g(mu, mu) (``Pumped.delta_albedo``).  Sampling is the cosine fallback; the delta is
+not sampled (``mc_albedo`` adds its weight exactly).
 
 Truncation of the series (provable bound).  With P_m = g^m e^(-g) / m! (Poisson) the
 terms are T_m = P_m exp(-q / m) / m <= P_m / m, q = v_xy^2 tau^2 / 4.  For M + 2 > g,
