@@ -816,6 +816,8 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     True
     """
     if not isinstance(brdf, BRDF):
+        if getattr(brdf, "is_spectral", False):  # pumpup.spectral: one albedo per wavelength, on a trailing axis
+            return brdf.albedo(mu, return_error=return_error, rtol=rtol, atol=atol, max_regions=max_regions, phi=phi)
         raise TypeError(f"albedo needs a pumpup BRDF, got {type(brdf).__name__}; wrap functions with pumpup.from_function")
     from .core import check_count, check_tolerance
 

@@ -860,6 +860,10 @@ def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False)
     if not isinstance(force, (bool, np.bool_)):
         raise SpecError(f"pump: force must be true or false, got {force!r}")
     base = load(brdf)
+    if getattr(base, "is_spectral", False):  # pumpup.spectral: each wavelength divided by its own g
+        from .spectral import SpectralPumped
+
+        return SpectralPumped(base, g=g, levels=int(levels), force=bool(force))
     return Pumped(base=base, g=g, levels=int(levels), force=force)
 
 
@@ -876,6 +880,10 @@ def save_pumped(f: Pumped, path) -> str:
 
     from ._version import __version__
 
+    if getattr(f, "is_spectral", False):  # one file with a wavelength dimension (pumpup.spectral_ops)
+        from .spectral_ops import save_spectral_pumped
+
+        return save_spectral_pumped(f, path)
     if not isinstance(f, Pumped):
         raise TypeError("save_pumped needs a pumped BRDF (pumpup.pump)")
     chain = []
@@ -909,6 +917,10 @@ def load_pumped(path) -> Pumped:
 
     where = os.fspath(path)
     root = open_table(path)
+    if root.attrs.get("pumpup_kind") == "pumpup spectral pumped BRDF":  # save_pumped of a spectral BRDF
+        from .spectral_ops import load_spectral_pumped
+
+        return load_spectral_pumped(path, root)
     if root.attrs.get("pumpup_kind") != "pumpup pumped BRDF":
         raise TableError(f"{where!r} is a pumpup table, not a saved pumped BRDF")
     spec = spec_attribute(where, root)
