@@ -10,6 +10,10 @@ The albedo engine (:func:`pumpup.albedo`, :func:`pumpup.tabulate`) integrates on
 BRDF, so a spectral metal is not a registered model type: :meth:`SpectralMetal.albedo` and
 :meth:`SpectralMetal.tabulate` run the engine once per wavelength and stack the results on a
 trailing ``wavelength`` axis / dimension, each value with its own error estimate.
+:func:`pumpup.load` builds these objects from spectral specs, and :func:`pumpup.albedo`,
+``tabulate``, ``mean_albedo``, ``pump``, ``compensate`` and ``save_pumped`` hand them to their
+methods (the ``is_spectral`` marker); plastics are in :mod:`pumpup.spectral_plastic`, energy
+compensation and saved files in :mod:`pumpup.spectral_ops`.
 
 Colour (:func:`to_xyz`, :func:`to_srgb`) uses colour-science with the CIE 1931 2-degree
 observer and illuminant D65: a spectrum of reflectances or albedos is read as the reflectance
@@ -385,9 +389,11 @@ def load(spec: Any) -> Spectral:
     """A spectral model from the DESIGN.md spec ``{"type": "metal", "material": "Au", "n": 20}``.
 
     Accepts ``material`` (or per-wavelength ``eta``/``k`` lists) with ``n``, optional ``c`` and
-    ``wavelengths`` (a list of nm or ``"rgb"``), and ``{"type": "pumped", "base": <spectral metal
-    spec>, "g": ..., "levels": ...}``; ``SpectralMetal.spec`` round-trips.  (``pumpup.load`` builds
-    scalar models only; its albedo engine integrates one scalar BRDF.)
+    ``wavelengths`` (a list of nm or ``"rgb"``), ``{"type": "plastic", ...}``
+    (:class:`pumpup.spectral_plastic.SpectralPlastic`), ``{"type": "pumped", "base": <spectral
+    spec>, "g": ..., "levels": ...}`` and ``{"type": "kulla_conty" | "scaled", "base": <spectral
+    spec>, ...}`` (:class:`pumpup.spectral_ops.SpectralCompensated`); ``spec`` round-trips.
+    :func:`pumpup.load` calls this for every spectral spec (:func:`pumpup.core.is_spectral_spec`).
 
     Examples
     --------
