@@ -30,9 +30,13 @@ def _load(text: str, spectral: bool = False):
     except pumpup.SpecError as exc:
         raise SystemExit(f"pumpup: {exc}") from None
     if getattr(f, "is_spectral", False) and not spectral:
-        raise SystemExit("pumpup: this command takes a single-channel model; a spectral spec (a 'material', "
-                         "'wavelengths' or per-wavelength lists) works with albedo, table and pump")
+        raise SystemExit(f"pumpup: {SPECTRAL_REFUSED}")
     return f
+
+
+#: the one line of a command that takes single-channel models only, given a spectral spec
+SPECTRAL_REFUSED = ("this command takes a single-channel model; a spectral spec (a 'material', 'wavelengths' or "
+                    "per-wavelength lists) works with albedo, table and pump")
 
 
 class UsageError(SystemExit):
@@ -479,6 +483,8 @@ def cmd_compensate(args) -> int:
         die(str(exc.code).removeprefix("pumpup: "))
     except pumpup.SpecError as exc:
         die(str(exc))
+    if getattr(f, "is_spectral", False):
+        die(SPECTRAL_REFUSED)
     for name, v in (("--f0", args.f0), ("--f-avg", args.f_avg)):
         if v is not None and not 0.0 <= v <= 1.0:
             die(f"{name} must be in [0, 1], got {v:g}")
@@ -612,6 +618,8 @@ def cmd_render(args) -> int:
             return fail(f"SPEC {text!r}: {str(exc.code).removeprefix('pumpup: ')}")
         except (pumpup.SpecError, ValueError, TypeError) as exc:
             return fail(f"SPEC {text!r} does not load: {exc}")
+        if getattr(models[-1], "is_spectral", False):
+            return fail(f"SPEC {text!r}: {SPECTRAL_REFUSED}")
     if args.what == "furnace":
         for f, text in zip(models, args.spec):
             a = render._anisotropy(f)

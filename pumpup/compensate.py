@@ -675,6 +675,10 @@ def furnace(f: BRDF, mu, return_error: bool = False, **kw):
     """
     from .albedo import albedo
 
+    if getattr(f, "is_spectral", False):  # pumpup.spectral: each wavelength's furnace, on a trailing axis
+        out = [furnace(m, mu, return_error=True, **kw) for m in f.models]
+        v, e = np.stack([np.asarray(o[0]) for o in out], axis=-1), np.stack([np.asarray(o[1]) for o in out], axis=-1)
+        return (v, e) if return_error else v
     g = f if f.reciprocal else _Transposed(f)
     return albedo(g, mu, return_error=return_error, **kw)
 

@@ -121,6 +121,12 @@ class Spectral:
             cur = cur.base
         return cur
 
+    def _eval(self, wi, wo):
+        """Refused: the functions that call ``_eval`` (check_reciprocity, render, sample, ...) take a
+        single-channel BRDF; a clear TypeError instead of an AttributeError deep inside them."""
+        raise TypeError(f"{self!r} is spectral: this function takes a single-channel BRDF; use its .eval() "
+                        "(a trailing wavelength axis) or one wavelength's model, .models[j]")
+
     def wavelength_variables(self) -> dict:
         """The per-wavelength parameters of the innermost model (``eta``, ``k``, ``ad``, ``a_s``)
         that :meth:`tabulate` stores beside the albedo, name -> array."""

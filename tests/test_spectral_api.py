@@ -182,6 +182,12 @@ def test_pump_and_compensate_per_wavelength():
     assert np.all(ca - ce <= 1.0) and np.all(ca >= pumpup.albedo(g, mu) - ce)
     s = pumpup.compensate(g, method="scale", f0=0.5)
     assert s.spec["type"] == "scaled" and s.spec["f0"] == 0.5 and pumpup.load(s.spec) == s
+    # 1/E scaling (E of the Fresnel-1 lobe): the furnace toward the viewer, per wavelength, between the
+    # base's albedo and 1
+    sc = pumpup.compensate(g, method="scale")
+    fu, fe = pumpup.furnace(sc, mu, return_error=True)
+    assert fu.shape == (3, 2) and np.all(fu - fe <= 1.0) and np.all(fu + fe >= pumpup.albedo(g, mu) - 1e-9)
+    np.testing.assert_array_equal(fu[:, 1], pumpup.furnace(pumpup.compensate(g.models[1], method="scale"), mu))
     assert isinstance(pumpup.compensate(g, method="g1"), spectral.SpectralPumped)
     with pytest.raises(SpecError, match="takes no f0"):
         pumpup.compensate(g, method="g1", f0=0.5)
@@ -261,12 +267,16 @@ def test_cli_albedo_table_pump_per_wavelength(tmp_path, capsys):
     (["albedo", "metal:material=Au,n=20", "--phi", "30"], "--phi"),
     (["check", "metal:material=Au,n=20"], "single-channel"),
     (["mc", "plastic:material=PMMA,n=20"], "single-channel"),
+    (["compensate", "metal:material=Au,n=20"], "single-channel"),
+    (["render", "sphere", "metal:material=Au,n=20", "--out", "."], "single-channel"),
 ])
 def test_cli_spectral_errors_one_line_status_2(argv, match, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    with pytest.raises(SystemExit) as exc:
-        cli.main(argv)
+    try:
+        code = cli.main(argv)
+    except SystemExit as exc:
+        code = exc.code
     err = capsys.readouterr().err
-    assert exc.value.code == 2
+    assert code == 2
     assert len(err.strip().splitlines()) == 1 and err.startswith("pumpup: ")
     assert __import__("re").search(match, err), err
