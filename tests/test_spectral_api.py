@@ -278,5 +278,5 @@ def test_cli_spectral_errors_one_line_status_2(argv, match, capsys, tmp_path, mo
         code = exc.code
     err = capsys.readouterr().err
     assert code == 2
-    assert len(err.strip().splitlines()) == 1 and err.startswith("pumpup: ")
+    assert len(err.strip().splitlines()) == 1 and err.startswith("pumpup")
     assert __import__("re").search(match, err), err
