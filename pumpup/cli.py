@@ -400,6 +400,10 @@ def cmd_sweep(args) -> int:
     from pumpup.sweeps import default_mu
 
     spec = parse_spec(args.spec)
+    from pumpup.core import is_spectral_spec
+
+    if is_spectral_spec(spec):
+        raise SystemExit(f"pumpup: {SPECTRAL_REFUSED}")
     check_out(args.out)
     params: dict = {}
     for text in args.param:

@@ -268,6 +268,7 @@ def test_cli_albedo_table_pump_per_wavelength(tmp_path, capsys):
     (["check", "metal:material=Au,n=20"], "single-channel"),
     (["mc", "plastic:material=PMMA,n=20"], "single-channel"),
     (["compensate", "metal:material=Au,n=20"], "single-channel"),
+    (["sweep", "metal:material=Au", "--param", "n=10,20", "--out", "s.nc"], "single-channel"),
     (["render", "sphere", "metal:material=Au,n=20", "--out", "."], "single-channel"),
 ])
 def test_cli_spectral_errors_one_line_status_2(argv, match, capsys, tmp_path, monkeypatch):
