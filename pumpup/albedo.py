@@ -777,7 +777,8 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     ----------
     brdf : BRDF
         Any BRDF: a built-in model (which guides the cubature with its Lobe hint) or
-        one from :func:`pumpup.from_function` (generic adaptive cubature).
+        one from :func:`pumpup.from_function` (generic adaptive cubature).  A spectral
+        model (:mod:`pumpup.spectral`) gives one albedo per wavelength on a trailing axis.
     mu : float or array_like
         cos(theta_i), each in (0, 1].  Work in mu near grazing: 89.9995 degrees is
         mu = 8.7e-6.

@@ -693,7 +693,8 @@ def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None 
     Parameters
     ----------
     f : BRDF or spec
-        Any BRDF the engine can tabulate (one channel).
+        Any BRDF the engine can tabulate (one channel), or a spectral model or spec: each
+        wavelength compensated on its own (:class:`pumpup.spectral_ops.SpectralCompensated`).
     method : {"kulla_conty", "scale", "g1", "g2"}
         "kulla_conty": f + F_ms f_ms (:class:`KullaConty`); "scale": f (1 + F0 (1/E(mu_o) - 1))
         (:class:`Scaled`, not reciprocal); "g1", "g2": one level of pumping (001 eq. 20, 21;

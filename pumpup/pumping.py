@@ -833,7 +833,9 @@ def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False)
     ----------
     brdf : BRDF or spec
         Reciprocal (checked); any symmetric function will do, even one that does not
-        conserve energy: the first pumping makes it plausible (001, after eq. 17).
+        conserve energy: the first pumping makes it plausible (001, after eq. 17).  A
+        spectral model or spec gives a :class:`pumpup.spectral.SpectralPumped`, each
+        wavelength divided by its own g.
     g : {"g1", "g2"}
         The correction term: g1 (001 eq. 20) or the controlled g2 (001 eq. 21).
     levels : int

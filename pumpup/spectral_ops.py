@@ -151,6 +151,12 @@ def save_spectral_pumped(f: Spectral, path) -> str:
                              "levels": levels, "pumpup_version": __version__,
                              "layout": "group wavelength{j}/level{i}: albedo table of level i (1 = innermost base) "
                                        "at wavelength[j]"})
+    material = f.innermost().material
+    if material is not None:  # the provenance of the optical constants, as in tabulate's tables
+        from . import optical
+
+        for key, val in optical.metadata(material).items():
+            root.attrs[f"optical_{key}"] = val
     groups = [(_group(j, i), level.table().dataset) for j, chain in enumerate(chains)
               for i, level in enumerate(chain, start=1)]
     return write_groups(path, root, groups)

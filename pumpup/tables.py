@@ -182,6 +182,7 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     Parameters
     ----------
     brdf : BRDF
+        Or a spectral model (:mod:`pumpup.spectral`): a table with dims (``mu``, ``wavelength``).
     mu : array_like, optional
         The grid of cos(theta_i) in (0, 1].  If omitted, the grid adapts: it starts from
         :func:`default_grid` (down to ``mu_min``) and bisects (in log mu) every interval

@@ -202,6 +202,7 @@ def test_save_and_load_pumped_with_a_wavelength_dimension(tmp_path):
     pumpup.save_pumped(p, path)
     root = pumpup.open_table(path)
     assert root["wavelength"].values.tolist() == [500.0, 620.0] and root["eta"].dims == ("wavelength",)
+    assert "Johnson" in root.attrs["optical_reference"]
     q = pumpup.load_pumped(path)
     assert q == p
     wi, wo = _pairs(m=200)
