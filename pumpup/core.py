@@ -152,7 +152,11 @@ class Param:
                 return value
             if not isinstance(value, dict):
                 raise SpecError(f"{model}: parameter {name!r} must be a model spec (a dict with a 'type'), got {value!r}")
-            return load(value)
+            f = load(value)
+            if getattr(f, "is_spectral", False):  # pumped / kulla_conty / scaled over one are spectral themselves
+                raise SpecError(f"{model}: parameter {name!r} must be a single-channel model; a spectral spec (a "
+                                "'material', 'wavelengths' or per-wavelength lists) is not supported here")
+            return f
         raise AssertionError(self.kind)
 
 

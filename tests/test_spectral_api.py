@@ -61,6 +61,8 @@ def test_unknown_material_lists_the_known_ones():
         pumpup.load({"type": "plastic", "material": "Au", "n": 20})
     with pytest.raises(SpecError, match="real"):
         pumpup.load({"type": "plastic", "eta": [1.5, 1.5], "k": [0.1, 0.1], "n": 20, "wavelengths": [500, 600]})
+    with pytest.raises(SpecError, match="mix: parameter 'a' must be a single-channel model"):
+        pumpup.load({"type": "mix", "a": {"type": "metal", "material": "Au", "n": 20}, "b": {"type": "lambert"}})
     with pytest.raises(SpecError, match="outside the range of the PMMA data"):
         pumpup.load({"type": "plastic", "material": "PMMA", "n": 20, "wavelengths": [380.0]})
 
