@@ -777,7 +777,8 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     ----------
     brdf : BRDF
         Any BRDF: a built-in model (which guides the cubature with its Lobe hint) or
-        one from :func:`pumpup.from_function` (generic adaptive cubature).
+        one from :func:`pumpup.from_function` (generic adaptive cubature).  A spectral
+        model (:mod:`pumpup.spectral`) gives one albedo per wavelength on a trailing axis.
     mu : float or array_like
         cos(theta_i), each in (0, 1].  Work in mu near grazing: 89.9995 degrees is
         mu = 8.7e-6.
@@ -816,6 +817,8 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     True
     """
     if not isinstance(brdf, BRDF):
+        if getattr(brdf, "is_spectral", False):  # pumpup.spectral: one albedo per wavelength, on a trailing axis
+            return brdf.albedo(mu, return_error=return_error, rtol=rtol, atol=atol, max_regions=max_regions, phi=phi)
         raise TypeError(f"albedo needs a pumpup BRDF, got {type(brdf).__name__}; wrap functions with pumpup.from_function")
     from .core import check_count, check_tolerance
 

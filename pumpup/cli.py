@@ -20,13 +20,23 @@ def parse_spec(text: str) -> dict:
         raise SystemExit(f"pumpup: {exc}") from None
 
 
-def _load(text: str):
+def _load(text: str, spectral: bool = False):
+    """The model of a SPEC argument; a spectral one (a 'material' or per-wavelength lists, pumpup.spectral)
+    only where the command prints or writes per wavelength (``spectral=True``)."""
     import pumpup
 
     try:
-        return pumpup.load(parse_spec(text))
+        f = pumpup.load(parse_spec(text))
     except pumpup.SpecError as exc:
         raise SystemExit(f"pumpup: {exc}") from None
+    if getattr(f, "is_spectral", False) and not spectral:
+        raise SystemExit(f"pumpup: {SPECTRAL_REFUSED}")
+    return f
+
+
+#: the one line of a command that takes single-channel models only, given a spectral spec
+SPECTRAL_REFUSED = ("this command takes a single-channel model; a spectral spec (a 'material', 'wavelengths' or "
+                    "per-wavelength lists) works with albedo, table and pump")
 
 
 class UsageError(SystemExit):
@@ -142,11 +152,13 @@ def cmd_albedo(args) -> int:
         bad = [t for t in args.theta if not 0 <= t < 90]
         if bad:
             raise SystemExit(f"pumpup: --theta {bad[0]:g}: the incidence angle theta must be in [0, 90) degrees")
-    f = _load(args.spec)
+    f = _load(args.spec, spectral=True)
     if args.theta is not None:
         mu = np.sin(np.radians(90.0 - np.asarray(args.theta, dtype=float)))  # keeps its digits near 90 deg
     else:
         mu = np.asarray(args.mu if args.mu else [1.0, 0.5, 0.1, 0.01], dtype=float)
+    if getattr(f, "is_spectral", False):
+        return _albedo_spectral(f, mu, args)
     if getattr(args, "phi", None) is not None:  # azimuths of the light in degrees: every mu at every phi
         return _albedo_phi(f, mu, args)
     try:
@@ -157,6 +169,30 @@ def cmd_albedo(args) -> int:
     print(f"{'mu':>14s} {'theta [deg]':>14s} {'albedo':>20s} {'error':>10s}")
     for m, v, err in zip(mu, a, e):
         print(f"{m:14.8g} {np.degrees(np.arccos(m)):14.8f} {v:20.15f} {err:10.2g}")
+    return 0
+
+
+def _no_phi(args) -> None:
+    if getattr(args, "phi", None) is not None:
+        raise SystemExit("pumpup: --phi: a spectral metal or plastic is isotropic; its albedo does not depend on phi")
+
+
+def _albedo_spectral(f, mu, args) -> int:
+    """``pumpup albedo`` of a spectral model: one row per (mu, wavelength)."""
+    import numpy as np
+
+    import pumpup
+
+    _no_phi(args)
+    try:
+        a, e = pumpup.albedo(f, mu, return_error=True, rtol=args.rtol)
+    except ValueError as exc:
+        raise SystemExit(f"pumpup: {exc}") from None
+    print(f"# {json.dumps(f.spec)}")
+    print(f"{'mu':>14s} {'theta [deg]':>14s} {'wavelength [nm]':>16s} {'albedo':>20s} {'error':>10s}")
+    for i, m in enumerate(mu):
+        for j, w in enumerate(f.wavelengths):
+            print(f"{m:14.8g} {np.degrees(np.arccos(m)):14.8f} {w:16.6g} {a[i, j]:20.15f} {e[i, j]:10.2g}")
     return 0
 
 
@@ -187,7 +223,17 @@ def cmd_table(args) -> int:
     import pumpup
 
     check_out(args.out)
-    f = _load(args.spec)
+    f = _load(args.spec, spectral=True)
+    if getattr(f, "is_spectral", False):  # one table with dims (mu, wavelength)
+        _no_phi(args)
+        try:
+            ds = pumpup.tabulate(f, rtol=args.rtol)
+        except ValueError as exc:
+            raise SystemExit(f"pumpup: {exc}") from None
+        pumpup.write_table(ds, args.out)
+        print(f"wrote {args.out}: {ds.sizes['mu']} values of mu x {ds.sizes['wavelength']} wavelengths, "
+              f"interpolation error {float(ds['interpolation_error'].max()):.2g} (the largest)")
+        return 0
     phi = getattr(args, "phi", None)
     if phi is not None:
         if not np.all(np.isfinite(phi)):
@@ -229,12 +275,25 @@ def cmd_pump(args) -> int:
         raise SystemExit(f"pumpup: --levels: levels must be an integer in [1, {MAX_LEVELS}], got {args.levels}")
     if args.out:
         check_out(args.out)
-    f = _load(args.spec)
+    f = _load(args.spec, spectral=True)
     try:
         p = pumpup.pump(f, g=args.g, levels=args.levels, force=args.force)
     except pumpup.SpecError as exc:
         raise SystemExit(f"pumpup: {exc}") from None
     mu = np.array([1.0, 0.5, 0.1, 0.01, 1e-4])
+    if getattr(p, "is_spectral", False):  # one row per (mu, wavelength), every level's albedo
+        print(f"{'mu':>8s} {'wavelength':>10s} " + " ".join(f"{'level ' + str(k):>12s}" for k in range(args.levels + 1)))
+        per = []  # per wavelength: the albedo of levels 0..L, each of shape mu.shape
+        for m in p.models:
+            chain = m.chain()  # innermost first
+            per.append([pumpup.albedo(chain[0].base, mu)] + [pumpup.albedo(lev, mu) for lev in chain])
+        for i, mv in enumerate(mu):
+            for j, w in enumerate(p.wavelengths):
+                print(f"{mv:8.2g} {w:10.6g} " + " ".join(f"{v[i]:12.9f}" for v in per[j]))
+        if args.out:
+            pumpup.save_pumped(p, args.out)
+            print(f"wrote {args.out}")
+        return 0
     print(f"{'mu':>8s} " + " ".join(f"{'level ' + str(k):>12s}" for k in range(args.levels + 1)))
     chain = [p]
     while isinstance(chain[-1], pumpup.Pumped):
@@ -341,6 +400,10 @@ def cmd_sweep(args) -> int:
     from pumpup.sweeps import default_mu
 
     spec = parse_spec(args.spec)
+    from pumpup.core import is_spectral_spec
+
+    if is_spectral_spec(spec):
+        raise SystemExit(f"pumpup: {SPECTRAL_REFUSED}")
     check_out(args.out)
     params: dict = {}
     for text in args.param:
@@ -424,6 +487,8 @@ def cmd_compensate(args) -> int:
         die(str(exc.code).removeprefix("pumpup: "))
     except pumpup.SpecError as exc:
         die(str(exc))
+    if getattr(f, "is_spectral", False):
+        die(SPECTRAL_REFUSED)
     for name, v in (("--f0", args.f0), ("--f-avg", args.f_avg)):
         if v is not None and not 0.0 <= v <= 1.0:
             die(f"{name} must be in [0, 1], got {v:g}")
@@ -557,6 +622,8 @@ def cmd_render(args) -> int:
             return fail(f"SPEC {text!r}: {str(exc.code).removeprefix('pumpup: ')}")
         except (pumpup.SpecError, ValueError, TypeError) as exc:
             return fail(f"SPEC {text!r} does not load: {exc}")
+        if getattr(models[-1], "is_spectral", False):
+            return fail(f"SPEC {text!r}: {SPECTRAL_REFUSED}")
     if args.what == "furnace":
         for f, text in zip(models, args.spec):
             a = render._anisotropy(f)

@@ -268,7 +268,9 @@ def _white_of(base: BRDF) -> BRDF | None:
     """The Fresnel-1 version of a microfacet model with a Fresnel factor (None if it has none)."""
     p = base.p
     if ("ior" in p or "eta" in p) and (p.get("ior") is not None or p.get("eta") is not None):
-        return base.with_params(ior=None, eta=None, k=None)
+        if base.type == "metal":  # 000 eq. 28 with F = 1 is the stretched Phong lobe, 000 eq. 12 with p = 1
+            return load({"type": "stretched_phong", "n": p["n"], "p": 1.0, "c": p["c"]})
+        return base.with_params(**{k: None for k in ("ior", "eta", "k") if k in p})  # plastic has no k
     return None
 
 
@@ -673,6 +675,10 @@ def furnace(f: BRDF, mu, return_error: bool = False, **kw):
     """
     from .albedo import albedo
 
+    if getattr(f, "is_spectral", False):  # pumpup.spectral: each wavelength's furnace, on a trailing axis
+        out = [furnace(m, mu, return_error=True, **kw) for m in f.models]
+        v, e = np.stack([np.asarray(o[0]) for o in out], axis=-1), np.stack([np.asarray(o[1]) for o in out], axis=-1)
+        return (v, e) if return_error else v
     g = f if f.reciprocal else _Transposed(f)
     return albedo(g, mu, return_error=return_error, **kw)
 
@@ -687,7 +693,8 @@ def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None 
     Parameters
     ----------
     f : BRDF or spec
-        Any BRDF the engine can tabulate (one channel).
+        Any BRDF the engine can tabulate (one channel), or a spectral model or spec: each
+        wavelength compensated on its own (:class:`pumpup.spectral_ops.SpectralCompensated`).
     method : {"kulla_conty", "scale", "g1", "g2"}
         "kulla_conty": f + F_ms f_ms (:class:`KullaConty`); "scale": f (1 + F0 (1/E(mu_o) - 1))
         (:class:`Scaled`, not reciprocal); "g1", "g2": one level of pumping (001 eq. 20, 21;
@@ -726,6 +733,10 @@ def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None 
     if not isinstance(force, (bool, np.bool_)):
         raise SpecError(f"compensate: force must be true or false, got {force!r}")
     base = load(f)
+    if getattr(base, "is_spectral", False):  # pumpup.spectral: every wavelength compensated on its own
+        from .spectral_ops import compensate_spectral
+
+        return compensate_spectral(base, method, f0=f0, f_avg=f_avg, white=white, force=bool(force))
     if method in ("g1", "g2"):
         if f0 is not None or f_avg is not None or white is not None:
             raise SpecError(f"compensate: method {method!r} (pumping) takes no f0, f_avg or white")

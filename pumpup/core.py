@@ -35,6 +35,7 @@ __all__ = [
     "ReciprocityResult",
     "SpecError",
     "parse_spec",
+    "is_spectral_spec",
     "check_tolerance",
     "check_count",
     "check_open_unit",
@@ -151,7 +152,11 @@ class Param:
                 return value
             if not isinstance(value, dict):
                 raise SpecError(f"{model}: parameter {name!r} must be a model spec (a dict with a 'type'), got {value!r}")
-            return load(value)
+            f = load(value)
+            if getattr(f, "is_spectral", False):  # pumped / kulla_conty / scaled over one are spectral themselves
+                raise SpecError(f"{model}: parameter {name!r} must be a single-channel model; a spectral spec (a "
+                                "'material', 'wavelengths' or per-wavelength lists) is not supported here")
+            return f
         raise AssertionError(self.kind)
 
 
@@ -435,7 +440,7 @@ def load(spec: Any) -> BRDF:
     True
     """
     _ensure_models()
-    if isinstance(spec, BRDF):
+    if isinstance(spec, BRDF) or getattr(spec, "is_spectral", False):
         return spec
     if isinstance(spec, str):
         spec = parse_spec(spec)
@@ -452,8 +457,34 @@ def load(spec: Any) -> BRDF:
                         f"known types: {', '.join(_REGISTRY)}")
     if name not in _REGISTRY:
         raise SpecError(f"unknown model type {name!r}; known types: {', '.join(_REGISTRY)}")
+    if is_spectral_spec(spec):  # a material or per-wavelength lists: pumpup.spectral (imported only then)
+        from . import spectral
+
+        return spectral.load(spec)
     kwargs = {k: v for k, v in spec.items() if k != "type"}
     return _REGISTRY[name](**kwargs)
+
+
+#: the keys whose presence makes a metal or plastic spec spectral, and the parameters that may be per-wavelength lists
+_SPECTRAL_KEYS = ("material", "wavelengths")
+_SPECTRAL_LISTS = ("eta", "k", "ad", "a_s")
+
+
+def is_spectral_spec(spec: Any) -> bool:
+    """True for a spec that :mod:`pumpup.spectral` builds: a ``metal`` or ``plastic`` with a
+    ``material``, ``wavelengths`` or a per-wavelength list (``eta``, ``k``, ``ad``, ``a_s``), or a
+    ``pumped`` / ``kulla_conty`` / ``scaled`` spec whose base is one (or a spectral object)."""
+    if getattr(spec, "is_spectral", False):
+        return True
+    if not isinstance(spec, dict):
+        return False
+    t = spec.get("type")
+    if t in ("metal", "plastic"):
+        return any(k in spec for k in _SPECTRAL_KEYS) or any(
+            isinstance(spec.get(k), (list, tuple, np.ndarray)) for k in _SPECTRAL_LISTS)
+    if t in ("pumped", "kulla_conty", "scaled"):
+        return is_spectral_spec(spec.get("base"))
+    return False
 
 
 def parse_spec(text: str) -> dict:
@@ -485,7 +516,7 @@ def parse_spec(text: str) -> dict:
     if not name.strip():
         raise SpecError(f"a spec needs a model type before ':' (e.g. 'phong:n=20'), got {text!r}")
     spec: dict = {"type": name.strip()}
-    for item in filter(None, (i.strip() for i in rest.split(","))):
+    for item in filter(None, (i.strip() for i in _split_items(rest))):
         key, eq, value = item.partition("=")
         if not eq or not key.strip():
             raise SpecError(f"spec parameter {item!r} must look like name=value (e.g. 'phong:n=20')")
@@ -494,6 +525,22 @@ def parse_spec(text: str) -> dict:
         except json.JSONDecodeError:
             spec[key.strip()] = value.strip()
     return spec
+
+
+def _split_items(text: str) -> list[str]:
+    """``text`` cut at the commas outside brackets, so a short-form value may be a JSON list
+    (``"metal:n=20,eta=[0.2,0.4],k=[3,2],wavelengths=[650,550]"``)."""
+    items, depth, start = [], 0, 0
+    for i, ch in enumerate(text):
+        if ch in "[{":
+            depth += 1
+        elif ch in "]}":
+            depth = max(depth - 1, 0)
+        elif ch == "," and depth == 0:
+            items.append(text[start:i])
+            start = i + 1
+    items.append(text[start:])
+    return items
 
 
 # ----------------------------------------------------------------------------------------

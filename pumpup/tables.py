@@ -182,6 +182,7 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     Parameters
     ----------
     brdf : BRDF
+        Or a spectral model (:mod:`pumpup.spectral`): a table with dims (``mu``, ``wavelength``).
     mu : array_like, optional
         The grid of cos(theta_i) in (0, 1].  If omitted, the grid adapts: it starts from
         :func:`default_grid` (down to ``mu_min``) and bisects (in log mu) every interval
@@ -225,6 +226,9 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     """
     if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1):
         raise ValueError(f"tabulate: threads must be an integer >= 1, got {threads!r}")
+    if getattr(brdf, "is_spectral", False):  # pumpup.spectral: dims (mu, wavelength)
+        return brdf.tabulate(mu=mu, rtol=rtol, atol=atol, interp_tol=interp_tol, mu_min=mu_min, max_points=max_points,
+                             progress=progress, threads=threads, phi=phi)
     _check_brdf("tabulate", brdf)
     rtol = check_tolerance("tabulate", "rtol", rtol)
     atol = check_tolerance("tabulate", "atol", atol, hi=math.inf, zero=True)
@@ -575,6 +579,8 @@ def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False, m
     """
     from .albedo import NODES, WG, WK
 
+    if getattr(brdf, "is_spectral", False):  # pumpup.spectral: one mean albedo per wavelength
+        return brdf.mean_albedo(rtol=rtol, return_error=return_error, max_intervals=max_intervals)
     _check_brdf("mean_albedo", brdf)
     rtol = check_tolerance("mean_albedo", "rtol", rtol)
     max_intervals = check_count("mean_albedo", "max_intervals", max_intervals, 8, 10**6)
