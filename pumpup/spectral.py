@@ -286,20 +286,20 @@ class SpectralMetal(Spectral):
     def eval(self, wi, wo) -> np.ndarray:
         """f_r(wi, wo) [1/sr] at every wavelength: shape broadcast(wi, wo)[:-1] + (len(wavelengths),).
 
-        The geometry (cos(alpha), cos(Theta_min)) is computed once and shared; only the
-        Fresnel factor depends on the wavelength (000 eq. 28).
+        The geometry (cos(alpha), cos(Theta_min), the lobe) is computed once per pair in one
+        compiled pass and only the Fresnel factor F(eta + i k, Theta_min) per wavelength
+        (000 eq. 27, 28; :func:`pumpup._spectral_kernels.metal_eval_kernel`, whose numpy twin is
+        ``metal_eval_reference``).  Equal to the one-wavelength models (``self.models``) to a few
+        ulp; 8 wavelengths cost about 2x one ``Metal.eval`` (``scripts/bench_spectral.py``).
         """
-        wi = np.asarray(wi, dtype=np.float64)
-        wo = np.asarray(wo, dtype=np.float64)
-        self.models[0].eval(wi, wo)  # validates the directions (unit vectors on the last axis)
-        lz, vz = wi[..., 2], wo[..., 2]
-        rv = 2.0 * lz * vz - (wi[..., 0] * wo[..., 0] + wi[..., 1] * wo[..., 1] + lz * vz)  # cos(alpha), 000 eq. 9
-        mx = np.maximum(lz, vz)  # cos(Theta_min)
-        ok = (lz > 0) & (vz > 0) & (rv > 0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            lobe = np.where(ok, self.c * np.where(ok, rv, 0.0) ** self.n / np.where(ok, mx, 1.0), 0.0)
-        fr = _fresnel_vec(np.where(ok, mx, 1.0)[..., None], self.eta, self.k)  # F(Theta_min), 000 eq. 28
-        return lobe[..., None] * fr
+        from ._spectral_kernels import flat_pairs, fresnel_constants, metal_eval_kernel
+
+        a, b, shape = flat_pairs(wi, wo)
+        if getattr(self, "_fconst", None) is None:
+            self._fconst = fresnel_constants(self.eta, self.k)
+        out = np.empty((a.shape[0], self.eta.size))
+        metal_eval_kernel(a, b, float(self.n), float(self.c), *self._fconst, out)
+        return out.reshape(shape + (self.eta.size,))
 
     def fresnel_table(self):
         """The tabulated F(cos Theta_min) per wavelength (000 eq. 28) and its measured error.
@@ -327,13 +327,9 @@ class SpectralMetal(Spectral):
 
         Differs from :meth:`eval` by at most f_r(F = 1) times ``fresnel_table()[1]`` (measured when the table is built; from 9e-9 for Au to 4e-8, the largest over the nine metals at the default wavelengths).
         """
-        wi = np.asarray(wi, dtype=np.float64)
-        wo = np.asarray(wo, dtype=np.float64)
-        self.models[0].eval(wi[..., :1, :] if wi.ndim > 1 else wi, wo[..., :1, :] if wo.ndim > 1 else wo)
-        a, b = np.broadcast_arrays(wi, wo)
-        shape = a.shape[:-1]
-        a2 = np.ascontiguousarray(a.reshape(-1, 3))
-        b2 = np.ascontiguousarray(b.reshape(-1, 3))
+        from ._spectral_kernels import flat_pairs
+
+        a2, b2, shape = flat_pairs(wi, wo)  # every direction checked (unit, finite), as eval
         table, _ = self.fresnel_table()
         out = np.zeros((a2.shape[0], table.shape[0]))
         _eval_table_kernel(a2, b2, float(self.n), float(self.c), table, out)

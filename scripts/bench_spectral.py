@@ -1,12 +1,24 @@
 """Cost of an 8-wavelength metal against one wavelength (issue 19's speed targets: eval <= 3x, tabulate <= 8x).
 
 Baseline and spectral model are timed in the same run (best of several repeats); the ratios are
-what to read, the absolute times depend on the load.
+what to read, the absolute times depend on the load (printed).
 
-    PYTHONPATH=. python scripts/bench_spectral.py
+    PYTHONPATH=. python scripts/bench_spectral.py [--no-tabulate]
+
+eval (2e5 random pairs in the upper hemisphere, input checks included everywhere):
+* one wavelength: the scalar ``metal`` model (``Metal.eval``), the baseline;
+* 000 eq. 27/28 direct: ``SpectralMetal.eval``, one compiled pass, geometry once per pair and
+  F(eta_j + i k_j, Theta_min) computed per wavelength; also the same kernel at one wavelength;
+* 8 separate ``Metal.eval`` calls (what the spectral model did before);
+* 000 eq. 28 tabulated: ``SpectralMetal.eval_tabulated``, F(Theta_min) read from a per-wavelength table;
+* the colour-keeping pumped metal (``SpectralPumpedLobe``: the pumped F = 1 lobe times F) against
+  the pumped one-wavelength metal.
+tabulate (Au, n = 20 and n = 5000, adaptive mu grid, one thread): ``Spectral.tabulate`` of
+8 wavelengths against ``pumpup.tabulate`` of one.
 """
 
 import os
+import sys
 import time
 
 import numpy as np
@@ -24,33 +36,66 @@ def best(fn, repeat=5):
     return min(out)
 
 
-def main():
+def directions(rng, m):
+    w = rng.normal(size=(m, 3))
+    w[:, 2] = np.abs(w[:, 2])
+    return w / np.linalg.norm(w, axis=1, keepdims=True)
+
+
+def bench_eval(m=200_000):
     rng = np.random.default_rng(0)
-    m = 200_000
-    wi = rng.normal(size=(m, 3))
-    wo = rng.normal(size=(m, 3))
-    wi[:, 2] = np.abs(wi[:, 2])
-    wo[:, 2] = np.abs(wo[:, 2])
-    wi /= np.linalg.norm(wi, axis=1, keepdims=True)
-    wo /= np.linalg.norm(wo, axis=1, keepdims=True)
+    wi, wo = directions(rng, m), directions(rng, m)
     s = spectral.SpectralMetal("Au", n=20)
+    s1 = spectral.SpectralMetal("Au", n=20, wavelengths=[520.0])
     one = s.models[3]
-    s.eval(wi[:10], wo[:10]), one.eval(wi[:10], wo[:10])  # compile
+    for f in (s.eval, s1.eval, one.eval, s.eval_tabulated):
+        f(wi[:10], wo[:10])  # compile / load the cached kernels
     t1 = best(lambda: one.eval(wi, wo))
-    t8 = best(lambda: s.eval(wi, wo))
-    t8s = best(lambda: np.stack([f.eval(wi, wo) for f in s.models], -1))
-    s.eval_tabulated(wi[:10], wo[:10])
-    t8t = best(lambda: s.eval_tabulated(wi, wo))
-    print(f"load: {os.getloadavg()[0]:.2f}; eval of {m} pairs")
-    print(f"  one wavelength (Metal.eval):            {t1 * 1e3:8.1f} ms")
-    print(f"  8 wavelengths, shared geometry:         {t8 * 1e3:8.1f} ms  ratio {t8 / t1:.2f}")
-    print(f"  8 wavelengths, 8 separate Metal.eval:   {t8s * 1e3:8.1f} ms  ratio {t8s / t1:.2f}")
-    print(f"  8 wavelengths, tabulated F (eq. 28):    {t8t * 1e3:8.1f} ms  ratio {t8t / t1:.2f}"
-          f"  (max |F error| {s.fresnel_table()[1]:.1e})")
-    mu = np.linspace(0.05, 1.0, 20)
-    ta1 = best(lambda: pumpup.albedo(one, mu), repeat=2)
-    ta8 = best(lambda: s.albedo(mu), repeat=2)
-    print(f"albedo at {mu.size} mu: one wavelength {ta1:.3f} s, 8 wavelengths {ta8:.3f} s, ratio {ta8 / ta1:.2f}")
+    rows = [
+        ("one wavelength (Metal.eval, baseline)", t1),
+        ("one wavelength, spectral kernel", best(lambda: s1.eval(wi, wo))),
+        ("8 wavelengths, eq. 27/28 direct", best(lambda: s.eval(wi, wo))),
+        ("8 wavelengths, 8 separate Metal.eval", best(lambda: np.stack([f.eval(wi, wo) for f in s.models], -1))),
+        ("8 wavelengths, eq. 28 tabulated F", best(lambda: s.eval_tabulated(wi, wo))),
+    ]
+    print(f"eval of {m} pairs, load {os.getloadavg()[0]:.2f}")
+    for name, t in rows:
+        print(f"  {name:42s} {t * 1e3:8.1f} ms  ratio {t / t1:5.2f}")
+    print(f"  (tabulated F: max |F error| {s.fresnel_table()[1]:.1e})")
+    keep = getattr(spectral, "SpectralPumpedLobe", None)
+    if keep is not None:
+        pm = pumpup.pump(one)
+        pk = keep(s)
+        pm.eval(wi[:10], wo[:10]), pk.eval(wi[:10], wo[:10])
+        tp = best(lambda: pm.eval(wi, wo))
+        tk = best(lambda: pk.eval(wi, wo))
+        tw = best(lambda: np.stack([f.eval(wi, wo) for f in s.pump().models], -1), repeat=3)
+        print(f"  {'pumped metal, one wavelength (baseline 2)':42s} {tp * 1e3:8.1f} ms  ratio {tp / t1:5.2f}")
+        print(f"  {'8 wavelengths, colour-keeping pumped':42s} {tk * 1e3:8.1f} ms  ratio {tk / t1:5.2f}"
+              f"  ({tk / tp:.2f} x the pumped one)")
+        print(f"  {'8 wavelengths, pumped per wavelength':42s} {tw * 1e3:8.1f} ms  ratio {tw / t1:5.2f}"
+              f"  ({tw / tp:.2f} x the pumped one)")
+
+
+def bench_tabulate(n):
+    s = spectral.SpectralMetal("Au", n=n)
+    one = s.models[3]
+    pumpup.tabulate(s.models[0], mu=[0.5, 0.01], threads=1, progress=False)  # load the compiled kernels
+    t = time.perf_counter()
+    d1 = pumpup.tabulate(one, threads=1, progress=False)
+    t1 = time.perf_counter() - t
+    t = time.perf_counter()
+    d8 = s.tabulate(threads=1)
+    t8 = time.perf_counter() - t
+    print(f"tabulate Au n = {n:g}, one thread, load {os.getloadavg()[0]:.2f}: one wavelength {t1:.2f} s "
+          f"({d1.sizes['mu']} mu), 8 wavelengths {t8:.2f} s ({d8.sizes['mu']} mu), ratio {t8 / t1:.2f}")
+
+
+def main():
+    bench_eval()
+    if "--no-tabulate" not in sys.argv:
+        for n in (20, 5000):
+            bench_tabulate(n)
 
 
 if __name__ == "__main__":
