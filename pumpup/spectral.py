@@ -34,6 +34,7 @@ from . import optical
 from .core import SpecError
 from .core import load as _load_scalar
 from .models.metal import _fresnel_real
+from .core import BRDF
 
 __all__ = ["load", "Spectral", "SpectralMetal", "SpectralPumped", "to_xyz", "to_srgb", "RGB_WAVELENGTHS"]
 
@@ -429,3 +430,141 @@ def to_srgb(values, wavelengths, encoded: bool = False) -> np.ndarray:
 
     xyz = to_xyz(values, wavelengths)
     return np.asarray(colour.XYZ_to_sRGB(xyz, apply_cctf_encoding=encoded))
+
+
+# --- the colour-keeping pumped metal -----------------------------------------------------------
+
+
+class _FresnelWeighted(BRDF):
+    """One wavelength of :class:`SpectralPumpedLobe`: f_r = f*(wi, wo) F(eta + i k, Theta_min) [1/sr].
+
+    ``lobe`` is the pumped F = 1 lobe (a :class:`pumpup.pumping.Pumped`), shared by all
+    wavelengths; the albedo engine integrates this product with the lobe's quadrature hint
+    (its lobe and the kinks of g; F(max(N.wi, N.wo)) adds the kink N.wo = mu, already a level
+    of the pumped lobe's hint).  Not a registered type: its spec describes it, it does not load.
+    """
+
+    type = "fresnel-weighted"
+    params = {}
+    constant = None
+
+    def __init__(self, lobe: BRDF, eta: float, k: float):
+        self.p = {}
+        self.lobe_brdf = lobe
+        self.eta, self.k = float(eta), float(k)
+        self.reciprocal = lobe.reciprocal
+
+    @property
+    def spec(self) -> dict:
+        return {"type": "fresnel-weighted", "base": self.lobe_brdf.spec, "eta": self.eta, "k": self.k}
+
+    def _eval(self, wi, wo):
+        f = np.asarray(self.lobe_brdf._eval(wi, wo), dtype=np.float64)
+        mx = np.minimum(np.maximum(wi[..., 2], wo[..., 2]), 1.0)  # cos(Theta_min)
+        return np.where(f != 0.0, f * _fresnel_vec(np.maximum(mx, 0.0), self.eta, self.k), 0.0)  # 000 eq. 28
+
+    def reference(self, wi, wo):
+        from .models.metal import fresnel
+
+        wi = np.asarray(wi, dtype=np.float64)
+        wo = np.asarray(wo, dtype=np.float64)
+        f = np.asarray(self.lobe_brdf.reference(wi, wo), dtype=np.float64)
+        return f * fresnel(np.maximum(wi[..., 2], wo[..., 2]), self.eta, self.k)
+
+    def lobe(self, mu):
+        return self.lobe_brdf.lobe(mu)
+
+    def sampling_lobe(self, mu):
+        return self.lobe_brdf.sampling_lobe(mu)
+
+
+class SpectralPumpedLobe(Spectral):
+    """A colour-keeping pumped metal: the F = 1 lobe pumped once, times F(Theta_min) per wavelength.
+
+    f_r(wi, wo, lambda) = f*(wi, wo) F(n(lambda) + i k(lambda), Theta_min) [1/sr], with f* the
+    pumped-up (001 eq. 16, 20 or 21) lobe of 000 eq. 28 without Fresnel,
+    L(wi, wo) = c cos^n(alpha) / max(N.L, N.V) (stretched Phong, 000 eq. 7, 12 with p = 1), and
+    cos(Theta_min) = max(N.L, N.V).  :class:`SpectralPumped` (``SpectralMetal.pump()``, the
+    default, what 001 sec. 3 says) divides every wavelength by its own albedo, which also undoes
+    the metal's absorption: every wavelength reaches albedo 1 at normal incidence and pumped gold
+    is white.  Here only the lobe's geometric loss (the energy cut off by the horizon) is
+    restored; F keeps the colour.
+
+    Plausibility (tested in tests/test_spectral_speed.py):
+
+    * reciprocal: f* is reciprocal (g is symmetric in wi, wo, 001 eq. 20, 21, and L is
+      reciprocal) and F(Theta_min) depends on max(N.L, N.V), symmetric in L and V;
+    * energy: 0 <= F <= 1 for a conductor, so for every wavelength and mu
+      a_lambda(mu) = int f* F cos(theta_o) d omega_o <= int f* cos(theta_o) d omega_o = a*(mu) <= 1,
+      the last because g >= a_L(wi) (001, after eq. 17); so the spectral albedo is bounded by the
+      pumped lobe's, which is the pumping bound of a single BRDF;
+    * one pumping table instead of one per wavelength: g needs the albedo of L only, which does
+      not depend on the wavelength (``pumpup.pumping.base_table`` of L, computed once and shared
+      with every other pumping of the same lobe).
+
+    Parameters
+    ----------
+    base : SpectralMetal
+        The metal (its n, c and per-wavelength index are used).
+    g : {"g1", "g2"}
+        The pumping correction (001 eq. 20 or 21).
+    levels : int, >= 1
+        Nested pumpings of L (:func:`pumpup.pump`).
+
+    Examples
+    --------
+    >>> from pumpup import spectral
+    >>> gold = spectral.SpectralPumpedLobe(spectral.SpectralMetal("Au", n=20, wavelengths="rgb"))
+    >>> f = gold.eval([0, 0, 1], [0, 0, 1])
+    >>> bool(f[0] > f[2])  # red above blue: still gold
+    True
+    """
+
+    def __init__(self, base: "SpectralMetal", g: str = "g1", levels: int = 1):
+        from .pumping import pump
+
+        if not isinstance(base, SpectralMetal):
+            raise TypeError(f"SpectralPumpedLobe: 'base' must be a SpectralMetal, got {type(base).__name__}")
+        self.base = base
+        self.material = base.material
+        self.wavelengths = base.wavelengths
+        self.eta, self.k = base.eta, base.k
+        self.g, self.levels = g, levels
+        #: the F = 1 lobe of 000 eq. 28, c cos^n(alpha) / max(N.L, N.V)
+        self.lobe = _load_scalar({"type": "stretched_phong", "n": base.n, "p": 1.0, "c": base.c})
+        #: the pumped lobe f*, one pumping table for all wavelengths
+        self.pumped_lobe = pump(self.lobe, g=g, levels=levels)
+        self.models = [_FresnelWeighted(self.pumped_lobe, e, kk) for e, kk in zip(self.eta, self.k)]
+        self._fconst = None
+
+    @property
+    def spec(self) -> dict:
+        return {"type": "pumped_lobe", "base": self.base.spec, "g": self.g, "levels": self.levels}
+
+    def __repr__(self) -> str:
+        return f"SpectralPumpedLobe({self.base!r}, g={self.g!r}, levels={self.levels})"
+
+    def eval(self, wi, wo) -> np.ndarray:
+        """f_r [1/sr] at every wavelength, shape broadcast(wi, wo)[:-1] + (len(wavelengths),).
+
+        f* once per pair (the pumped lobe's compiled chain), then F(Theta_min) per wavelength in
+        one compiled pass (:func:`pumpup._spectral_kernels.fresnel_scale_kernel`).
+        """
+        from ._spectral_kernels import flat_pairs, fresnel_constants, fresnel_scale_kernel
+
+        a, b, shape = flat_pairs(wi, wo)
+        if self._fconst is None:
+            self._fconst = fresnel_constants(self.eta, self.k)
+        f = np.ascontiguousarray(self.pumped_lobe._eval(a, b), dtype=np.float64).reshape(-1)
+        out = np.empty((a.shape[0], self.eta.size))
+        fresnel_scale_kernel(f, a, b, *self._fconst, out)
+        return out.reshape(shape + (self.eta.size,))
+
+    def lobe_albedo(self, mu, return_error: bool = False, **kw):
+        """The albedo a*(mu) of the pumped lobe f* (the bound of every wavelength's albedo)."""
+        from .albedo import albedo
+
+        return albedo(self.pumped_lobe, mu, return_error=return_error, **kw)
+
+
+__all__ += ["SpectralPumpedLobe"]
