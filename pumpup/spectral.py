@@ -130,49 +130,129 @@ class Spectral:
         e = np.array([o[1] for o in out])
         return (v, e) if return_error else v
 
-    def tabulate(self, mu=None, **kw):
+    def tabulate(self, mu=None, *, rtol: float | None = None, atol: float | None = None, interp_tol: float = 1e-7,
+                 mu_min: float = 1e-8, max_points: int = 2049, threads: int | None = None, progress=None,
+                 phi=None):
         """Albedo tables of every wavelength as one xarray.Dataset with dims (``mu``, ``wavelength``).
 
-        With ``mu`` given, every wavelength is computed on it.  Without, each wavelength's
-        adaptive grid (:func:`pumpup.tabulate`) is computed, and the values missing from the
-        union of those grids are added, so all wavelengths share the union grid (which
-        contains each one's adaptive grid); ``interpolation_error`` (per wavelength) is that
-        of the wavelength's own adaptive grid.
+        Every value is :func:`pumpup.albedo` of that wavelength's model at that mu, with its own
+        error estimate.  With ``mu`` given, every wavelength is computed on it.  Without, one
+        adaptive grid is shared by all wavelengths (the :func:`pumpup.tabulate` algorithm run
+        on all of them at once): it starts from :func:`pumpup.tables.default_grid` and bisects
+        (in log mu) every interval where the interpolant of any wavelength misses the albedo
+        computed at the midpoint by more than ``interp_tol``; ``interpolation_error`` (per
+        wavelength) is the largest miss of that wavelength over the accepted intervals.  The
+        values of a round (all wavelengths x all new mu) are spread over ``threads`` threads
+        (default :data:`pumpup.tables.THREADS`, one per core), so the short late rounds of the
+        adaptive loop keep every core busy; the table does not depend on ``threads``.
+
+        Parameters as :func:`pumpup.tabulate` (``phi`` must be None: the metals are isotropic;
+        ``progress`` is accepted and ignored).
         """
-        import xarray as xr
-
-        from .albedo import albedo
-        from .tables import tabulate
-
-        kw.setdefault("progress", False)
-        tables = [tabulate(m, mu=mu, **kw) for m in self.models]
-        grid = np.unique(np.concatenate([t["mu"].values for t in tables]))
-        vals = np.empty((grid.size, len(self.models)))
-        errs = np.empty_like(vals)
-        a_kw = {key: kw[key] for key in ("rtol", "atol") if key in kw}
-        for j, (m, t) in enumerate(zip(self.models, tables)):
-            own = t["mu"].values
-            idx = np.searchsorted(grid, own)
-            vals[idx, j] = t["albedo"].values
-            errs[idx, j] = t["albedo_error"].values
-            miss = np.setdiff1d(np.arange(grid.size), idx)
-            if miss.size:
-                v, e = albedo(m, grid[miss], return_error=True, **a_kw)
-                vals[miss, j] = v
-                errs[miss, j] = e
         import json
 
+        import xarray as xr
+
+        from . import _reuse
+        from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
+        from .core import check_count, check_open_unit, check_tolerance
+        from .tables import MAX_POINTS_LIMIT, THREADS, AlbedoTable, _cores, _dataset, _midpoints, default_grid
+
+        if phi is not None:
+            raise SpecError("Spectral.tabulate: parameter 'phi' must be None (the spectral models are isotropic)")
+        if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer))
+                                    or threads < 1):
+            raise ValueError(f"Spectral.tabulate: threads must be an integer >= 1, got {threads!r}")
+        rtol = check_tolerance("tabulate", "rtol", DEFAULT_RTOL if rtol is None else rtol)
+        atol = check_tolerance("tabulate", "atol", DEFAULT_ATOL if atol is None else atol, hi=np.inf, zero=True)
+        interp_tol = check_tolerance("tabulate", "interp_tol", interp_tol, hi=np.inf)
+        mu_min = check_open_unit("tabulate", "mu_min", mu_min)
+        max_points = check_count("tabulate", "max_points", max_points, 2, MAX_POINTS_LIMIT)
+        nw = len(self.models)
+        threads = max(1, threads or THREADS or _cores())
+
+        def values(mus):
+            """(albedo, error) of shape (len(mus), nw), every (wavelength, chunk of mu) a task."""
+            from concurrent.futures import ThreadPoolExecutor
+
+            from .albedo import albedo
+
+            val = np.empty((mus.size, nw))
+            err = np.empty_like(val)
+            chunk = max(1, min(32, -(-mus.size * nw // (4 * threads))))  # >= 4 tasks per thread
+            # dear grazing values spread over the tasks: chunk k takes every n_chunks-th mu
+            n_chunks = -(-mus.size // chunk)
+            tasks = [(j, np.arange(c, mus.size, n_chunks)) for j in range(nw) for c in range(n_chunks)]
+
+            def work(task):
+                j, idx = task
+                val[idx, j], err[idx, j] = albedo(self.models[j], mus[idx], return_error=True, rtol=rtol, atol=atol)
+
+            if threads == 1 or len(tasks) < 2:
+                for t in tasks:
+                    work(t)
+                return val, err
+            if not getattr(self, "_warm", False):  # the first value on this thread: compiles what the
+                first = (0, np.array([int(np.argmax(mus))]))  # kernels still need (two threads compiling
+                work(first)  # one numba ufunc at once race)
+                self._warm = True
+            with ThreadPoolExecutor(min(threads, len(tasks))) as pool:
+                list(pool.map(work, tasks))
+            return val, err
+
+        if mu is not None:
+            grid = np.unique(check_mu(np.atleast_1d(np.asarray(mu, dtype=np.float64))).ravel())
+            vals, errs = values(grid)
+            interp = np.zeros(nw)
+            kind = "given"
+        else:
+            check_mu(mu_min)
+            grid = default_grid(mu_min=mu_min)
+            vals, errs = values(grid)
+            interp = np.zeros(nw)
+            todo = np.ones(len(grid) - 1, bool)  # intervals not yet checked
+            miss = np.zeros((0, nw))
+            while todo.any() and len(grid) < max_points:
+                mids = _midpoints(grid)[todo]
+                mval, merr = values(mids)
+                miss = np.column_stack([np.abs(AlbedoTable(grid, vals[:, j], errs[:, j])(mids) - mval[:, j])
+                                        for j in range(nw)])
+                bad = (miss > interp_tol).any(axis=1)  # an interval fails if any wavelength misses
+                if (~bad).any():
+                    interp = np.maximum(interp, miss[~bad].max(axis=0))
+                new_mu = np.concatenate([grid, mids[bad]])
+                order = np.argsort(new_mu)
+                grid = new_mu[order]
+                vals = np.concatenate([vals, mval[bad]])[order]
+                errs = np.concatenate([errs, merr[bad]])[order]
+                # a new node changes the spline mostly within a few intervals: check again every
+                # interval within three nodes of a new one (as pumpup.tabulate)
+                is_new = np.concatenate([np.zeros(len(order) - bad.sum(), bool), np.ones(bad.sum(), bool)])[order]
+                near = is_new.copy()
+                for shift in (1, 2, 3):
+                    near[shift:] |= is_new[:-shift]
+                    near[:-shift] |= is_new[shift:]
+                todo = near[:-1] | near[1:]
+            if todo.any() and miss.size:  # stopped by max_points: the misses not resolved count
+                interp = np.maximum(interp, miss.max(axis=0))
+            kind = "adaptive"
+        for j, m in enumerate(self.models):  # mean_albedo / max_albedo of a model may reuse its column
+            _reuse.remember(m, grid, vals[:, j], errs[:, j], rtol)
+        template = _dataset(self.models[0], grid, vals[:, 0], errs[:, 0], rtol, atol, 0.0, kind)
         ds = xr.Dataset(
             {
-                "albedo": (("mu", "wavelength"), vals),
-                "albedo_error": (("mu", "wavelength"), errs),
-                "interpolation_error": ("wavelength", [float(t.attrs["interpolation_error"]) for t in tables]),
-                "eta": ("wavelength", self.eta),
-                "k": ("wavelength", self.k),
+                "albedo": (("mu", "wavelength"), vals, template["albedo"].attrs),
+                "albedo_error": (("mu", "wavelength"), errs, template["albedo_error"].attrs),
+                "interpolation_error": ("wavelength", interp, {
+                    "long_name": "largest interpolation miss found at the checked midpoints", "units": "1"}),
+                "eta": ("wavelength", self.eta, {"long_name": "refractive index, real part", "units": "1"}),
+                "k": ("wavelength", self.k, {"long_name": "extinction coefficient", "units": "1"}),
             },
-            coords={"mu": grid, "theta": ("mu", np.degrees(np.arccos(grid))), "wavelength": self.wavelengths},
-            attrs={k: v for k, v in tables[0].attrs.items() if k not in ("spec", "interpolation_error")},
+            coords={"mu": ("mu", grid, template["mu"].attrs), "theta": ("mu", np.degrees(np.arccos(grid))),
+                    "wavelength": self.wavelengths},
+            attrs={k: v for k, v in template.attrs.items() if k not in ("spec", "interpolation_error")},
         )
+        ds.attrs["interp_tol"] = float(interp_tol)
         ds["wavelength"].attrs["units"] = "nm"
         ds["theta"].attrs["units"] = "degree"
         ds.attrs["spec"] = json.dumps(self.spec, sort_keys=True)
@@ -181,7 +261,6 @@ class Spectral:
             for key, val in optical.metadata(self.material).items():
                 ds.attrs[f"optical_{key}"] = val
         return ds
-
 
 
 class SpectralPumped(Spectral):

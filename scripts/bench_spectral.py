@@ -69,7 +69,9 @@ def bench_eval(m=200_000):
         pm.eval(wi[:10], wo[:10]), pk.eval(wi[:10], wo[:10])
         tp = best(lambda: pm.eval(wi, wo))
         tk = best(lambda: pk.eval(wi, wo))
-        tw = best(lambda: np.stack([f.eval(wi, wo) for f in s.pump().models], -1), repeat=3)
+        pw = s.pump()
+        pw.eval(wi[:10], wo[:10])
+        tw = best(lambda: pw.eval(wi, wo), repeat=3)
         print(f"  {'pumped metal, one wavelength (baseline 2)':42s} {tp * 1e3:8.1f} ms  ratio {tp / t1:5.2f}")
         print(f"  {'8 wavelengths, colour-keeping pumped':42s} {tk * 1e3:8.1f} ms  ratio {tk / t1:5.2f}"
               f"  ({tk / tp:.2f} x the pumped one)")
@@ -81,14 +83,25 @@ def bench_tabulate(n):
     s = spectral.SpectralMetal("Au", n=n)
     one = s.models[3]
     pumpup.tabulate(s.models[0], mu=[0.5, 0.01], threads=1, progress=False)  # load the compiled kernels
-    t = time.perf_counter()
-    d1 = pumpup.tabulate(one, threads=1, progress=False)
-    t1 = time.perf_counter() - t
-    t = time.perf_counter()
-    d8 = s.tabulate(threads=1)
-    t8 = time.perf_counter() - t
-    print(f"tabulate Au n = {n:g}, one thread, load {os.getloadavg()[0]:.2f}: one wavelength {t1:.2f} s "
-          f"({d1.sizes['mu']} mu), 8 wavelengths {t8:.2f} s ({d8.sizes['mu']} mu), ratio {t8 / t1:.2f}")
+
+    def timed(fn):
+        t = time.perf_counter()
+        out = fn()
+        return out, time.perf_counter() - t
+
+    d1, t1 = timed(lambda: pumpup.tabulate(one, threads=1, progress=False))
+    sep = [timed(lambda m=m: pumpup.tabulate(m, threads=1, progress=False))[1] for m in s.models]
+    d8, t8 = timed(lambda: s.tabulate(threads=1))
+    _, t1p = timed(lambda: pumpup.tabulate(s.models[2], progress=False))  # default threads (tables.THREADS)
+    _, t8p = timed(lambda: spectral.SpectralMetal("Au", n=n).tabulate())  # a fresh object: nothing reused
+    mean1 = sum(sep) / len(sep)
+    print(f"tabulate Au n = {n:g} (adaptive grid), load {os.getloadavg()[0]:.2f}:")
+    print(f"  one thread: one wavelength (520 nm) {t1:.2f} s ({d1.sizes['mu']} mu); the 8 one at a time "
+          f"{sum(sep):.2f} s (from {min(sep):.2f} to {max(sep):.2f} s each, mean {mean1:.2f} s); "
+          f"Spectral.tabulate {t8:.2f} s ({d8.sizes['mu']} mu, one shared grid): {t8 / t1:.2f} x the 520 nm one, "
+          f"{t8 / mean1:.2f} x the mean one")
+    print(f"  {pumpup.tables._cores()} threads: one wavelength (480 nm) {t1p:.2f} s, Spectral.tabulate {t8p:.2f} s: "
+          f"{t8p / t1p:.2f} x")
 
 
 def main():
