@@ -167,3 +167,21 @@ def test_pumped_lobe_errors():
         spectral.SpectralPumpedLobe(spectral.SpectralMetal("Au", n=20).pump())
     with pytest.raises(pumpup.SpecError, match="g"):
         spectral.SpectralPumpedLobe(spectral.SpectralMetal("Au", n=20), g="g3")
+
+
+def test_tabulate_threads_do_not_change_the_table_and_checks(gold_keep):
+    s, keep = gold_keep.base, gold_keep
+    mu = [1.0, 0.3, 1e-4]
+    d1 = keep.tabulate(mu=mu, threads=1)
+    d2 = keep.tabulate(mu=mu, threads=2)
+    np.testing.assert_array_equal(d1["albedo"].values, d2["albedo"].values)
+    np.testing.assert_array_equal(d1["albedo_error"].values, d2["albedo_error"].values)
+    assert '"pumped_lobe"' in d1.attrs["spec"] and d1.attrs["grid"] == "given"
+    lobe, lerr = keep.lobe_albedo(d1["mu"].values, return_error=True)  # the table's mu increase
+    assert np.all(d1["albedo"].values - d1["albedo_error"].values <= (lobe + lerr)[:, None])
+    with pytest.raises(pumpup.SpecError, match="phi"):
+        s.tabulate(mu=mu, phi=0.3)
+    with pytest.raises(ValueError, match="threads"):
+        s.tabulate(mu=mu, threads=0)
+    with pytest.raises(ValueError, match="interp_tol"):
+        s.tabulate(interp_tol=-1)
