@@ -24,8 +24,8 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["metal_eval_kernel", "metal_eval_reference", "fresnel_scale_kernel", "fresnel_scale_reference",
-           "fresnel_constants"]
+__all__ = ["flat_pairs", "fresnel_constants", "fresnel_scale_kernel", "fresnel_scale_reference", "metal_eval_kernel",
+           "metal_eval_reference"]
 
 
 def fresnel_constants(eta, k):

@@ -31,10 +31,9 @@ import numpy as np
 from numba import njit, vectorize
 
 from . import optical
-from .core import SpecError
+from .core import BRDF, SpecError
 from .core import load as _load_scalar
 from .models.metal import _fresnel_real
-from .core import BRDF
 
 __all__ = ["load", "Spectral", "SpectralMetal", "SpectralPumped", "to_xyz", "to_srgb", "RGB_WAVELENGTHS"]
 
@@ -599,7 +598,7 @@ class SpectralPumpedLobe(Spectral):
     True
     """
 
-    def __init__(self, base: "SpectralMetal", g: str = "g1", levels: int = 1):
+    def __init__(self, base: SpectralMetal, g: str = "g1", levels: int = 1):
         from .pumping import pump
 
         if not isinstance(base, SpectralMetal):
