@@ -103,21 +103,23 @@ class Spectral:
 
     # --- albedo ----------------------------------------------------------------------------
 
-    def albedo(self, mu, return_error: bool = False, **kw):
+    def albedo(self, mu, return_error: bool = False, threads: int | None = None, **kw):
         """Directional albedo per wavelength: shape mu.shape + (len(wavelengths),).
 
         :func:`pumpup.albedo` of each wavelength's model (keyword arguments passed on); with
-        ``return_error`` also its error estimate, same shape.
+        ``return_error`` also its error estimate, same shape.  The (wavelength, chunk of mu)
+        integrals are spread over ``threads`` threads (default :data:`pumpup.tables.THREADS`,
+        one per core); a value does not depend on the others computed with it, so the result
+        does not depend on ``threads``.
         """
-        from .albedo import albedo
+        from .albedo import check_mu
 
-        vals, errs = [], []
-        for m in self.models:
-            v, e = albedo(m, mu, return_error=True, **kw)
-            vals.append(np.asarray(v))
-            errs.append(np.asarray(e))
-        v = np.stack(vals, axis=-1)
-        e = np.stack(errs, axis=-1)
+        m = np.asarray(mu, dtype=np.float64)
+        flat = np.ascontiguousarray(m.reshape(-1))
+        check_mu(flat)  # pumpup.albedo's message, before any thread starts
+        v, e = _spread(self, flat, threads, **kw)
+        v = v.reshape(m.shape + (len(self.models),))
+        e = e.reshape(v.shape)
         return (v, e) if return_error else v
 
     def mean_albedo(self, return_error: bool = False, **kw):
@@ -155,7 +157,7 @@ class Spectral:
         from . import _reuse
         from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
         from .core import check_count, check_open_unit, check_tolerance
-        from .tables import MAX_POINTS_LIMIT, THREADS, AlbedoTable, _cores, _dataset, _midpoints, default_grid
+        from .tables import MAX_POINTS_LIMIT, AlbedoTable, _dataset, _midpoints, default_grid
 
         if phi is not None:
             raise SpecError("Spectral.tabulate: parameter 'phi' must be None (the spectral models are isotropic)")
@@ -168,36 +170,10 @@ class Spectral:
         mu_min = check_open_unit("tabulate", "mu_min", mu_min)
         max_points = check_count("tabulate", "max_points", max_points, 2, MAX_POINTS_LIMIT)
         nw = len(self.models)
-        threads = max(1, threads or THREADS or _cores())
 
         def values(mus):
             """(albedo, error) of shape (len(mus), nw), every (wavelength, chunk of mu) a task."""
-            from concurrent.futures import ThreadPoolExecutor
-
-            from .albedo import albedo
-
-            val = np.empty((mus.size, nw))
-            err = np.empty_like(val)
-            chunk = max(1, min(32, -(-mus.size * nw // (4 * threads))))  # >= 4 tasks per thread
-            # dear grazing values spread over the tasks: chunk k takes every n_chunks-th mu
-            n_chunks = -(-mus.size // chunk)
-            tasks = [(j, np.arange(c, mus.size, n_chunks)) for j in range(nw) for c in range(n_chunks)]
-
-            def work(task):
-                j, idx = task
-                val[idx, j], err[idx, j] = albedo(self.models[j], mus[idx], return_error=True, rtol=rtol, atol=atol)
-
-            if threads == 1 or len(tasks) < 2:
-                for t in tasks:
-                    work(t)
-                return val, err
-            if not getattr(self, "_warm", False):  # the first value on this thread: compiles what the
-                first = (0, np.array([int(np.argmax(mus))]))  # kernels still need (two threads compiling
-                work(first)  # one numba ufunc at once race)
-                self._warm = True
-            with ThreadPoolExecutor(min(threads, len(tasks))) as pool:
-                list(pool.map(work, tasks))
-            return val, err
+            return _spread(self, mus, threads, rtol=rtol, atol=atol)
 
         if mu is not None:
             grid = np.unique(check_mu(np.atleast_1d(np.asarray(mu, dtype=np.float64))).ravel())
@@ -643,6 +619,48 @@ class SpectralPumpedLobe(Spectral):
         from .albedo import albedo
 
         return albedo(self.pumped_lobe, mu, return_error=return_error, **kw)
+
+
+def _spread(spectral: Spectral, mus: np.ndarray, threads: int | None = None, **kw):
+    """:func:`pumpup.albedo` (value, error) of every wavelength's model at ``mus`` (1-D), shape
+    (len(mus), len(models)), with the (wavelength, chunk of mu) integrals spread over ``threads``
+    threads (default :data:`pumpup.tables.THREADS`, one per core).  Chunk k of a wavelength takes
+    every n-th mu, so the dear grazing values are spread over the tasks."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from .albedo import albedo
+    from .tables import THREADS, _cores
+
+    if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1):
+        raise ValueError(f"threads must be an integer >= 1, got {threads!r}")
+    threads = max(1, threads or THREADS or _cores())
+    models = spectral.models
+    nw = len(models)
+    val = np.empty((mus.size, nw))
+    err = np.empty_like(val)
+    if mus.size == 0:
+        return val, err
+    chunk = max(1, min(32, -(-mus.size * nw // (4 * threads))))  # >= 4 tasks per thread where possible
+    n_chunks = -(-mus.size // chunk)
+    tasks = [(j, np.arange(c, mus.size, n_chunks)) for j in range(nw) for c in range(n_chunks)]
+
+    def work(task):
+        j, idx = task
+        val[idx, j], err[idx, j] = albedo(models[j], mus[idx], return_error=True, **kw)
+
+    if threads == 1 or len(tasks) < 2:
+        for t in tasks:
+            work(t)
+        return val, err
+    if not getattr(spectral, "_warm", False):
+        # the first value on this thread: it compiles what the kernels still need (two threads
+        # compiling one numba ufunc at once race; pumpup.tables._chunked does the same)
+        j, idx = tasks[0]
+        work((j, idx[:1]))
+        spectral._warm = True
+    with ThreadPoolExecutor(min(threads, len(tasks))) as pool:
+        list(pool.map(work, tasks))
+    return val, err
 
 
 __all__ += ["SpectralPumpedLobe"]

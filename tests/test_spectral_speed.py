@@ -179,6 +179,14 @@ def test_tabulate_threads_do_not_change_the_table_and_checks(gold_keep):
     assert '"pumped_lobe"' in d1.attrs["spec"] and d1.attrs["grid"] == "given"
     lobe, lerr = keep.lobe_albedo(d1["mu"].values, return_error=True)  # the table's mu increase
     assert np.all(d1["albedo"].values - d1["albedo_error"].values <= (lobe + lerr)[:, None])
+    a1, e1 = s.albedo([[0.2, 1.0], [0.05, 0.7]], return_error=True, threads=1)  # Spectral.albedo's pool too
+    a2, e2 = s.albedo([[0.2, 1.0], [0.05, 0.7]], return_error=True, threads=2)
+    assert a1.shape == (2, 2, 8)
+    np.testing.assert_array_equal(a1, a2)
+    np.testing.assert_array_equal(e1, e2)
+    np.testing.assert_array_equal(a1[1, 0], [pumpup.albedo(m, 0.05) for m in s.models])
+    with pytest.raises(ValueError, match=r"mu\[1\] = 1.5"):
+        s.albedo([0.5, 1.5])
     with pytest.raises(pumpup.SpecError, match="phi"):
         s.tabulate(mu=mu, phi=0.3)
     with pytest.raises(ValueError, match="threads"):
