@@ -138,8 +138,21 @@ def bench_tabulate(n):
           f"{t8p / t1p:.2f} x")
 
 
+def bench_albedo():
+    s = spectral.SpectralMetal("Au", n=20)
+    one = s.models[3]
+    mu = np.linspace(0.05, 1.0, 20)
+    pumpup.albedo(one, mu[:2]), s.albedo(mu[:2], threads=1)
+    ta1 = best(lambda: pumpup.albedo(one, mu), repeat=2)
+    ta8 = best(lambda: s.albedo(mu, threads=1), repeat=2)
+    tap = best(lambda: s.albedo(mu), repeat=2)
+    print(f"albedo at {mu.size} mu, load {os.getloadavg()[0]:.2f}: one wavelength {ta1:.3f} s; 8 wavelengths "
+          f"{ta8:.3f} s on one thread ({ta8 / ta1:.2f} x), {tap:.3f} s on {pumpup.tables._cores()} ({tap / ta1:.2f} x)")
+
+
 def main():
     bench_eval()
+    bench_albedo()
     if "--no-tabulate" not in sys.argv:
         for n in (20, 5000):
             bench_counts(n)
