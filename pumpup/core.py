@@ -455,7 +455,7 @@ def load(spec: Any) -> BRDF:
     if not isinstance(name, str):
         raise SpecError(f"a spec's 'type' must be a model name (a string), got {name!r}; "
                         f"known types: {', '.join(_REGISTRY)}")
-    if name not in _REGISTRY:
+    if name not in _REGISTRY and name != "pumped_lobe":  # pumped_lobe: spectral only (below)
         raise SpecError(f"unknown model type {name!r}; known types: {', '.join(_REGISTRY)}")
     if is_spectral_spec(spec):  # a material or per-wavelength lists: pumpup.spectral (imported only then)
         from . import spectral
@@ -484,7 +484,7 @@ def is_spectral_spec(spec: Any) -> bool:
             isinstance(spec.get(k), (list, tuple, np.ndarray)) for k in _SPECTRAL_LISTS)
     if t in ("pumped", "kulla_conty", "scaled"):
         return is_spectral_spec(spec.get("base"))
-    return False
+    return t == "pumped_lobe"  # the colour-keeping pumped metal, spectral by definition
 
 
 def parse_spec(text: str) -> dict:

@@ -35,7 +35,7 @@ import numpy as np
 from numba import njit, vectorize
 
 from . import optical
-from .core import SpecError
+from .core import BRDF, SpecError
 from .core import load as _load_scalar
 from .models.metal import _fresnel_real
 
@@ -91,6 +91,11 @@ def _eval_table_reference(wi, wo, n, c, table):
     return lobe[..., None] * np.moveaxis(f, 0, -1)
 
 
+#: long names of the per-wavelength parameters :meth:`Spectral.tabulate` stores beside the albedo
+_VARIABLE_NAMES = {"eta": "refractive index, real part", "k": "extinction coefficient",
+                   "ad": "diffuse albedo (000 eq. 29)", "a_s": "specular weight (000 eq. 29)"}
+
+
 class Spectral:
     """One scalar BRDF per wavelength (``models``, ``wavelengths`` [nm]), stacked on a trailing axis.
 
@@ -144,21 +149,23 @@ class Spectral:
 
     # --- albedo ----------------------------------------------------------------------------
 
-    def albedo(self, mu, return_error: bool = False, **kw):
+    def albedo(self, mu, return_error: bool = False, threads: int | None = None, **kw):
         """Directional albedo per wavelength: shape mu.shape + (len(wavelengths),).
 
         :func:`pumpup.albedo` of each wavelength's model (keyword arguments passed on); with
-        ``return_error`` also its error estimate, same shape.
+        ``return_error`` also its error estimate, same shape.  The (wavelength, chunk of mu)
+        integrals are spread over ``threads`` threads (default :data:`pumpup.tables.THREADS`,
+        one per core); a value does not depend on the others computed with it, so the result
+        does not depend on ``threads``.
         """
-        from .albedo import albedo
+        from .albedo import check_mu
 
-        vals, errs = [], []
-        for m in self.models:
-            v, e = albedo(m, mu, return_error=True, **kw)
-            vals.append(np.asarray(v))
-            errs.append(np.asarray(e))
-        v = np.stack(vals, axis=-1)
-        e = np.stack(errs, axis=-1)
+        m = np.asarray(mu, dtype=np.float64)
+        flat = np.ascontiguousarray(m.reshape(-1))
+        check_mu(flat)  # pumpup.albedo's message, before any thread starts
+        v, e = _spread(self, flat, threads, **kw)
+        v = v.reshape(m.shape + (len(self.models),))
+        e = e.reshape(v.shape)
         return (v, e) if return_error else v
 
     def mean_albedo(self, return_error: bool = False, **kw):
@@ -170,48 +177,103 @@ class Spectral:
         e = np.array([o[1] for o in out])
         return (v, e) if return_error else v
 
-    def tabulate(self, mu=None, **kw):
+    def tabulate(self, mu=None, *, rtol: float | None = None, atol: float | None = None, interp_tol: float = 1e-7,
+                 mu_min: float = 1e-8, max_points: int = 2049, threads: int | None = None, progress=None,
+                 phi=None):
         """Albedo tables of every wavelength as one xarray.Dataset with dims (``mu``, ``wavelength``).
 
-        With ``mu`` given, every wavelength is computed on it.  Without, each wavelength's
-        adaptive grid (:func:`pumpup.tabulate`) is computed, and the values missing from the
-        union of those grids are added, so all wavelengths share the union grid (which
-        contains each one's adaptive grid); ``interpolation_error`` (per wavelength) is that
-        of the wavelength's own adaptive grid.
+        Every value is :func:`pumpup.albedo` of that wavelength's model at that mu, with its own
+        error estimate.  With ``mu`` given, every wavelength is computed on it.  Without, one
+        adaptive grid is shared by all wavelengths (the :func:`pumpup.tabulate` algorithm run
+        on all of them at once): it starts from :func:`pumpup.tables.default_grid` and bisects
+        (in log mu) every interval where the interpolant of any wavelength misses the albedo
+        computed at the midpoint by more than ``interp_tol``; ``interpolation_error`` (per
+        wavelength) is the largest miss of that wavelength over the accepted intervals.  The
+        values of a round (all wavelengths x all new mu) are spread over ``threads`` threads
+        (default :data:`pumpup.tables.THREADS`, one per core), so the short late rounds of the
+        adaptive loop keep every core busy; the table does not depend on ``threads``.
+
+        Parameters as :func:`pumpup.tabulate` (``phi`` must be None: the metals are isotropic;
+        ``progress`` is accepted and ignored).
         """
-        import xarray as xr
-
-        from .albedo import albedo
-        from .tables import tabulate
-
-        kw.setdefault("progress", False)
-        tables = [tabulate(m, mu=mu, **kw) for m in self.models]
-        grid = np.unique(np.concatenate([t["mu"].values for t in tables]))
-        vals = np.empty((grid.size, len(self.models)))
-        errs = np.empty_like(vals)
-        a_kw = {key: kw[key] for key in ("rtol", "atol") if key in kw}
-        for j, (m, t) in enumerate(zip(self.models, tables)):
-            own = t["mu"].values
-            idx = np.searchsorted(grid, own)
-            vals[idx, j] = t["albedo"].values
-            errs[idx, j] = t["albedo_error"].values
-            miss = np.setdiff1d(np.arange(grid.size), idx)
-            if miss.size:
-                v, e = albedo(m, grid[miss], return_error=True, **a_kw)
-                vals[miss, j] = v
-                errs[miss, j] = e
         import json
 
+        import xarray as xr
+
+        from . import _reuse
+        from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
+        from .core import check_count, check_open_unit, check_tolerance
+        from .tables import MAX_POINTS_LIMIT, AlbedoTable, _dataset, _midpoints, default_grid
+
+        if phi is not None:
+            raise SpecError("Spectral.tabulate: parameter 'phi' must be None (the spectral models are isotropic)")
+        if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer))
+                                    or threads < 1):
+            raise ValueError(f"Spectral.tabulate: threads must be an integer >= 1, got {threads!r}")
+        rtol = check_tolerance("tabulate", "rtol", DEFAULT_RTOL if rtol is None else rtol)
+        atol = check_tolerance("tabulate", "atol", DEFAULT_ATOL if atol is None else atol, hi=np.inf, zero=True)
+        interp_tol = check_tolerance("tabulate", "interp_tol", interp_tol, hi=np.inf)
+        mu_min = check_open_unit("tabulate", "mu_min", mu_min)
+        max_points = check_count("tabulate", "max_points", max_points, 2, MAX_POINTS_LIMIT)
+        nw = len(self.models)
+
+        def values(mus):
+            """(albedo, error) of shape (len(mus), nw), every (wavelength, chunk of mu) a task."""
+            return _spread(self, mus, threads, rtol=rtol, atol=atol)
+
+        if mu is not None:
+            grid = np.unique(check_mu(np.atleast_1d(np.asarray(mu, dtype=np.float64))).ravel())
+            vals, errs = values(grid)
+            interp = np.zeros(nw)
+            kind = "given"
+        else:
+            check_mu(mu_min)
+            grid = default_grid(mu_min=mu_min)
+            vals, errs = values(grid)
+            interp = np.zeros(nw)
+            todo = np.ones(len(grid) - 1, bool)  # intervals not yet checked
+            miss = np.zeros((0, nw))
+            while todo.any() and len(grid) < max_points:
+                mids = _midpoints(grid)[todo]
+                mval, merr = values(mids)
+                miss = np.column_stack([np.abs(AlbedoTable(grid, vals[:, j], errs[:, j])(mids) - mval[:, j])
+                                        for j in range(nw)])
+                bad = (miss > interp_tol).any(axis=1)  # an interval fails if any wavelength misses
+                if (~bad).any():
+                    interp = np.maximum(interp, miss[~bad].max(axis=0))
+                new_mu = np.concatenate([grid, mids[bad]])
+                order = np.argsort(new_mu)
+                grid = new_mu[order]
+                vals = np.concatenate([vals, mval[bad]])[order]
+                errs = np.concatenate([errs, merr[bad]])[order]
+                # a new node changes the spline mostly within a few intervals: check again every
+                # interval within three nodes of a new one (as pumpup.tabulate)
+                is_new = np.concatenate([np.zeros(len(order) - bad.sum(), bool), np.ones(bad.sum(), bool)])[order]
+                near = is_new.copy()
+                for shift in (1, 2, 3):
+                    near[shift:] |= is_new[:-shift]
+                    near[:-shift] |= is_new[shift:]
+                todo = near[:-1] | near[1:]
+            if todo.any() and miss.size:  # stopped by max_points: the misses not resolved count
+                interp = np.maximum(interp, miss.max(axis=0))
+            kind = "adaptive"
+        for j, m in enumerate(self.models):  # mean_albedo / max_albedo of a model may reuse its column
+            _reuse.remember(m, grid, vals[:, j], errs[:, j], rtol)
+        template = _dataset(self.models[0], grid, vals[:, 0], errs[:, 0], rtol, atol, 0.0, kind)
         ds = xr.Dataset(
             {
-                "albedo": (("mu", "wavelength"), vals),
-                "albedo_error": (("mu", "wavelength"), errs),
-                "interpolation_error": ("wavelength", [float(t.attrs["interpolation_error"]) for t in tables]),
-                **{name: ("wavelength", v) for name, v in self.wavelength_variables().items()},
+                "albedo": (("mu", "wavelength"), vals, template["albedo"].attrs),
+                "albedo_error": (("mu", "wavelength"), errs, template["albedo_error"].attrs),
+                "interpolation_error": ("wavelength", interp, {
+                    "long_name": "largest interpolation miss found at the checked midpoints", "units": "1"}),
+                **{name: ("wavelength", v, {"long_name": _VARIABLE_NAMES[name], "units": "1"})
+                   for name, v in self.wavelength_variables().items()},
             },
-            coords={"mu": grid, "theta": ("mu", np.degrees(np.arccos(grid))), "wavelength": self.wavelengths},
-            attrs={k: v for k, v in tables[0].attrs.items() if k not in ("spec", "interpolation_error")},
+            coords={"mu": ("mu", grid, template["mu"].attrs), "theta": ("mu", np.degrees(np.arccos(grid))),
+                    "wavelength": self.wavelengths},
+            attrs={k: v for k, v in template.attrs.items() if k not in ("spec", "interpolation_error")},
         )
+        ds.attrs["interp_tol"] = float(interp_tol)
         ds["wavelength"].attrs["units"] = "nm"
         ds["theta"].attrs["units"] = "degree"
         ds.attrs["spec"] = json.dumps(self.spec, sort_keys=True)
@@ -220,7 +282,6 @@ class Spectral:
             for key, val in optical.metadata(self.material).items():
                 ds.attrs[f"optical_{key}"] = val
         return ds
-
 
 
 class SpectralPumped(Spectral):
@@ -330,20 +391,20 @@ class SpectralMetal(Spectral):
     def eval(self, wi, wo) -> np.ndarray:
         """f_r(wi, wo) [1/sr] at every wavelength: shape broadcast(wi, wo)[:-1] + (len(wavelengths),).
 
-        The geometry (cos(alpha), cos(Theta_min)) is computed once and shared; only the
-        Fresnel factor depends on the wavelength (000 eq. 28).
+        The geometry (cos(alpha), cos(Theta_min), the lobe) is computed once per pair in one
+        compiled pass and only the Fresnel factor F(eta + i k, Theta_min) per wavelength
+        (000 eq. 27, 28; :func:`pumpup._spectral_kernels.metal_eval_kernel`, whose numpy twin is
+        ``metal_eval_reference``).  Equal to the one-wavelength models (``self.models``) to a few
+        ulp; 8 wavelengths cost about 2x one ``Metal.eval`` (``scripts/bench_spectral.py``).
         """
-        wi = np.asarray(wi, dtype=np.float64)
-        wo = np.asarray(wo, dtype=np.float64)
-        self.models[0].eval(wi, wo)  # validates the directions (unit vectors on the last axis)
-        lz, vz = wi[..., 2], wo[..., 2]
-        rv = 2.0 * lz * vz - (wi[..., 0] * wo[..., 0] + wi[..., 1] * wo[..., 1] + lz * vz)  # cos(alpha), 000 eq. 9
-        mx = np.maximum(lz, vz)  # cos(Theta_min)
-        ok = (lz > 0) & (vz > 0) & (rv > 0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            lobe = np.where(ok, self.c * np.where(ok, rv, 0.0) ** self.n / np.where(ok, mx, 1.0), 0.0)
-        fr = _fresnel_vec(np.where(ok, mx, 1.0)[..., None], self.eta, self.k)  # F(Theta_min), 000 eq. 28
-        return lobe[..., None] * fr
+        from ._spectral_kernels import flat_pairs, fresnel_constants, metal_eval_kernel
+
+        a, b, shape = flat_pairs(wi, wo)
+        if getattr(self, "_fconst", None) is None:
+            self._fconst = fresnel_constants(self.eta, self.k)
+        out = np.empty((a.shape[0], self.eta.size))
+        metal_eval_kernel(a, b, float(self.n), float(self.c), *self._fconst, out)
+        return out.reshape(shape + (self.eta.size,))
 
     def fresnel_table(self):
         """The tabulated F(cos Theta_min) per wavelength (000 eq. 28) and its measured error.
@@ -371,13 +432,9 @@ class SpectralMetal(Spectral):
 
         Differs from :meth:`eval` by at most f_r(F = 1) times ``fresnel_table()[1]`` (measured when the table is built; from 9e-9 for Au to 4e-8, the largest over the nine metals at the default wavelengths).
         """
-        wi = np.asarray(wi, dtype=np.float64)
-        wo = np.asarray(wo, dtype=np.float64)
-        self.models[0].eval(wi[..., :1, :] if wi.ndim > 1 else wi, wo[..., :1, :] if wo.ndim > 1 else wo)
-        a, b = np.broadcast_arrays(wi, wo)
-        shape = a.shape[:-1]
-        a2 = np.ascontiguousarray(a.reshape(-1, 3))
-        b2 = np.ascontiguousarray(b.reshape(-1, 3))
+        from ._spectral_kernels import flat_pairs
+
+        a2, b2, shape = flat_pairs(wi, wo)  # every direction checked (unit, finite), as eval
         table, _ = self.fresnel_table()
         out = np.zeros((a2.shape[0], table.shape[0]))
         _eval_table_kernel(a2, b2, float(self.n), float(self.c), table, out)
@@ -426,6 +483,16 @@ def load(spec: Any) -> Spectral:
         from .pumping import pump
 
         return pump(load(kw["base"]), g=kw.get("g", "g1"), levels=kw.get("levels", 1), force=kw.get("force", False))
+    if spec["type"] == "pumped_lobe":  # the colour-keeping pumped metal (SpectralPumpedLobe)
+        allowed = {"base", "g", "levels"}
+        bad = sorted(set(kw) - allowed)
+        if bad or "base" not in kw:
+            raise SpecError(f"spectral.load: a pumped_lobe spec needs 'base' (a spectral metal) and allows "
+                            f"{', '.join(sorted(allowed))}; got {sorted(kw)}")
+        base = load(kw["base"])
+        if not isinstance(base, SpectralMetal):
+            raise SpecError(f"spectral.load: parameter 'base' of pumped_lobe must be a spectral metal, got {base!r}")
+        return SpectralPumpedLobe(base, g=kw.get("g", "g1"), levels=kw.get("levels", 1))
     if spec["type"] in ("kulla_conty", "scaled"):
         from .spectral_ops import SpectralCompensated
 
@@ -435,7 +502,8 @@ def load(spec: Any) -> Spectral:
 
         return SpectralPlastic.from_spec(spec)
     if spec["type"] != "metal":
-        raise SpecError(f"spectral.load: 'type' must be 'metal', 'plastic', 'pumped', 'kulla_conty' or 'scaled', "
+        raise SpecError(f"spectral.load: 'type' must be 'metal', 'plastic', 'pumped', 'pumped_lobe', 'kulla_conty' or "
+                        f"'scaled', "
                         f"got {spec['type']!r}")
     allowed = {"material", "n", "wavelengths", "eta", "k", "c"}
     bad = sorted(set(kw) - allowed)
@@ -494,3 +562,183 @@ def to_srgb(values, wavelengths, encoded: bool = False) -> np.ndarray:
 
     xyz = to_xyz(values, wavelengths)
     return np.asarray(colour.XYZ_to_sRGB(xyz, apply_cctf_encoding=encoded))
+
+
+# --- the colour-keeping pumped metal -----------------------------------------------------------
+
+
+class _FresnelWeighted(BRDF):
+    """One wavelength of :class:`SpectralPumpedLobe`: f_r = f*(wi, wo) F(eta + i k, Theta_min) [1/sr].
+
+    ``lobe`` is the pumped F = 1 lobe (a :class:`pumpup.pumping.Pumped`), shared by all
+    wavelengths; the albedo engine integrates this product with the lobe's quadrature hint
+    (its lobe and the kinks of g; F(max(N.wi, N.wo)) adds the kink N.wo = mu, already a level
+    of the pumped lobe's hint).  Not a registered type: its spec describes it, it does not load.
+    """
+
+    type = "fresnel-weighted"
+    params = {}
+    constant = None
+
+    def __init__(self, lobe: BRDF, eta: float, k: float):
+        self.p = {}
+        self.lobe_brdf = lobe
+        self.eta, self.k = float(eta), float(k)
+        self.reciprocal = lobe.reciprocal
+
+    @property
+    def spec(self) -> dict:
+        return {"type": "fresnel-weighted", "base": self.lobe_brdf.spec, "eta": self.eta, "k": self.k}
+
+    def _eval(self, wi, wo):
+        f = np.asarray(self.lobe_brdf._eval(wi, wo), dtype=np.float64)
+        mx = np.minimum(np.maximum(wi[..., 2], wo[..., 2]), 1.0)  # cos(Theta_min)
+        return np.where(f != 0.0, f * _fresnel_vec(np.maximum(mx, 0.0), self.eta, self.k), 0.0)  # 000 eq. 28
+
+    def reference(self, wi, wo):
+        from .models.metal import fresnel
+
+        wi = np.asarray(wi, dtype=np.float64)
+        wo = np.asarray(wo, dtype=np.float64)
+        f = np.asarray(self.lobe_brdf.reference(wi, wo), dtype=np.float64)
+        return f * fresnel(np.maximum(wi[..., 2], wo[..., 2]), self.eta, self.k)
+
+    def lobe(self, mu):
+        return self.lobe_brdf.lobe(mu)
+
+    def sampling_lobe(self, mu):
+        return self.lobe_brdf.sampling_lobe(mu)
+
+
+class SpectralPumpedLobe(Spectral):
+    """A colour-keeping pumped metal: the F = 1 lobe pumped once, times F(Theta_min) per wavelength.
+
+    f_r(wi, wo, lambda) = f*(wi, wo) F(n(lambda) + i k(lambda), Theta_min) [1/sr], with f* the
+    pumped-up (001 eq. 16, 20 or 21) lobe of 000 eq. 28 without Fresnel,
+    L(wi, wo) = c cos^n(alpha) / max(N.L, N.V) (stretched Phong, 000 eq. 7, 12 with p = 1), and
+    cos(Theta_min) = max(N.L, N.V).  :class:`SpectralPumped` (``SpectralMetal.pump()``, the
+    default, what 001 sec. 3 says) divides every wavelength by its own albedo, which also undoes
+    the metal's absorption: every wavelength reaches albedo 1 at normal incidence and pumped gold
+    is white.  Here only the lobe's geometric loss (the energy cut off by the horizon) is
+    restored; F keeps the colour.
+
+    Plausibility (tested in tests/test_spectral_speed.py):
+
+    * reciprocal: f* is reciprocal (g is symmetric in wi, wo, 001 eq. 20, 21, and L is
+      reciprocal) and F(Theta_min) depends on max(N.L, N.V), symmetric in L and V;
+    * energy: 0 <= F <= 1 for a conductor, so for every wavelength and mu
+      a_lambda(mu) = int f* F cos(theta_o) d omega_o <= int f* cos(theta_o) d omega_o = a*(mu) <= 1,
+      the last because g >= a_L(wi) (001, after eq. 17); so the spectral albedo is bounded by the
+      pumped lobe's, which is the pumping bound of a single BRDF;
+    * one pumping table instead of one per wavelength: g needs the albedo of L only, which does
+      not depend on the wavelength (``pumpup.pumping.base_table`` of L, computed once and shared
+      with every other pumping of the same lobe).
+
+    Parameters
+    ----------
+    base : SpectralMetal
+        The metal (its n, c and per-wavelength index are used).
+    g : {"g1", "g2"}
+        The pumping correction (001 eq. 20 or 21).
+    levels : int, >= 1
+        Nested pumpings of L (:func:`pumpup.pump`).
+
+    Examples
+    --------
+    >>> from pumpup import spectral
+    >>> gold = spectral.SpectralPumpedLobe(spectral.SpectralMetal("Au", n=20, wavelengths="rgb"))
+    >>> f = gold.eval([0, 0, 1], [0, 0, 1])
+    >>> bool(f[0] > f[2])  # red above blue: still gold
+    True
+    """
+
+    def __init__(self, base: SpectralMetal, g: str = "g1", levels: int = 1):
+        from .pumping import pump
+
+        if not isinstance(base, SpectralMetal):
+            raise TypeError(f"SpectralPumpedLobe: 'base' must be a SpectralMetal, got {type(base).__name__}")
+        self.base = base
+        self.material = base.material
+        self.wavelengths = base.wavelengths
+        self.eta, self.k = base.eta, base.k
+        self.g, self.levels = g, levels
+        #: the F = 1 lobe of 000 eq. 28, c cos^n(alpha) / max(N.L, N.V)
+        self.lobe = _load_scalar({"type": "stretched_phong", "n": base.n, "p": 1.0, "c": base.c})
+        #: the pumped lobe f*, one pumping table for all wavelengths
+        self.pumped_lobe = pump(self.lobe, g=g, levels=levels)
+        self.models = [_FresnelWeighted(self.pumped_lobe, e, kk) for e, kk in zip(self.eta, self.k)]
+        self._fconst = None
+
+    @property
+    def spec(self) -> dict:
+        return {"type": "pumped_lobe", "base": self.base.spec, "g": self.g, "levels": self.levels}
+
+    def __repr__(self) -> str:
+        return f"SpectralPumpedLobe({self.base!r}, g={self.g!r}, levels={self.levels})"
+
+    def eval(self, wi, wo) -> np.ndarray:
+        """f_r [1/sr] at every wavelength, shape broadcast(wi, wo)[:-1] + (len(wavelengths),).
+
+        f* once per pair (the pumped lobe's compiled chain), then F(Theta_min) per wavelength in
+        one compiled pass (:func:`pumpup._spectral_kernels.fresnel_scale_kernel`).
+        """
+        from ._spectral_kernels import flat_pairs, fresnel_constants, fresnel_scale_kernel
+
+        a, b, shape = flat_pairs(wi, wo)
+        if self._fconst is None:
+            self._fconst = fresnel_constants(self.eta, self.k)
+        f = np.ascontiguousarray(self.pumped_lobe._eval(a, b), dtype=np.float64).reshape(-1)
+        out = np.empty((a.shape[0], self.eta.size))
+        fresnel_scale_kernel(f, a, b, *self._fconst, out)
+        return out.reshape(shape + (self.eta.size,))
+
+    def lobe_albedo(self, mu, return_error: bool = False, **kw):
+        """The albedo a*(mu) of the pumped lobe f* (the bound of every wavelength's albedo)."""
+        from .albedo import albedo
+
+        return albedo(self.pumped_lobe, mu, return_error=return_error, **kw)
+
+
+def _spread(spectral: Spectral, mus: np.ndarray, threads: int | None = None, **kw):
+    """:func:`pumpup.albedo` (value, error) of every wavelength's model at ``mus`` (1-D), shape
+    (len(mus), len(models)), with the (wavelength, chunk of mu) integrals spread over ``threads``
+    threads (default :data:`pumpup.tables.THREADS`, one per core).  Chunk k of a wavelength takes
+    every n-th mu, so the dear grazing values are spread over the tasks."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from .albedo import albedo
+    from .tables import THREADS, _cores
+
+    if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1):
+        raise ValueError(f"threads must be an integer >= 1, got {threads!r}")
+    threads = max(1, threads or THREADS or _cores())
+    models = spectral.models
+    nw = len(models)
+    val = np.empty((mus.size, nw))
+    err = np.empty_like(val)
+    if mus.size == 0:
+        return val, err
+    chunk = max(1, min(32, -(-mus.size * nw // (4 * threads))))  # >= 4 tasks per thread where possible
+    n_chunks = -(-mus.size // chunk)
+    tasks = [(j, np.arange(c, mus.size, n_chunks)) for j in range(nw) for c in range(n_chunks)]
+
+    def work(task):
+        j, idx = task
+        val[idx, j], err[idx, j] = albedo(models[j], mus[idx], return_error=True, **kw)
+
+    if threads == 1 or len(tasks) < 2:
+        for t in tasks:
+            work(t)
+        return val, err
+    if not getattr(spectral, "_warm", False):
+        # the first value on this thread: it compiles what the kernels still need (two threads
+        # compiling one numba ufunc at once race; pumpup.tables._chunked does the same)
+        j, idx = tasks[0]
+        work((j, idx[:1]))
+        spectral._warm = True
+    with ThreadPoolExecutor(min(threads, len(tasks))) as pool:
+        list(pool.map(work, tasks))
+    return val, err
+
+
+__all__ += ["SpectralPumpedLobe"]

@@ -5,7 +5,11 @@ Phong).  One core, 2e6 random direction pairs in the upper hemisphere, best of 5
 a warm-up call (so numba compilation is not timed).  The baseline (reciprocal Phong) is
 measured in the same run.
 
-    python scripts/bench_eval.py [--pumped]
+    python scripts/bench_eval.py [--pumped] [--spectral]
+
+``--spectral`` also times the spectral gold of 000 sec. 5 (8 wavelengths, n = 20) against one
+wavelength (the scalar ``metal``), with input checks on both: 000 eq. 27/28 with the Fresnel factor
+evaluated directly per wavelength, and eq. 28 with F(Theta_min) tabulated per wavelength.
 
 ``--pumped`` also builds a 3-level pumped Phong (g2, n = 20) and reports its evaluation cost
 relative to the base and the time to build its three albedo tables (issue 4's targets: at most
@@ -73,6 +77,34 @@ def main():
         r = rate(f, wi, wo)
         print(f"\n3-level pumped Phong n = 20 (g2): {r:.3g} evals/s, {base / r:.2f} x the base Phong; "
               f"its 3 albedo tables took {warm:.2f} s to build ({cold:.2f} s for n = 21, the first in the process)")
+    if "--spectral" in sys.argv:
+        spectral_rows(wi, wo)
+
+
+def spectral_rows(wi, wo, repeat=5):
+    """000 eq. 28 tabulated vs eq. 27/28 direct vs one wavelength, in this run (``--spectral``)."""
+    from pumpup import spectral
+
+    gold = spectral.SpectralMetal("Au", n=20)
+    one = gold.models[3]  # 520 nm
+
+    def secs(fn):
+        fn(wi[:10], wo[:10])
+        best = np.inf
+        for _ in range(repeat):
+            t = time.perf_counter()
+            fn(wi, wo)
+            best = min(best, time.perf_counter() - t)
+        return best
+
+    t1 = secs(one.eval)
+    td = secs(gold.eval)
+    tt = secs(gold.eval_tabulated)
+    print(f"\nspectral gold, n = 20, {len(wi):.0e} pairs (input checks included):")
+    print(f"  one wavelength (metal, 520 nm)               {len(wi) / t1:10.3g} pairs/s  1.00")
+    print(f"  8 wavelengths, eq. 27/28 Fresnel direct      {len(wi) / td:10.3g} pairs/s  {td / t1:.2f} x one")
+    print(f"  8 wavelengths, eq. 28 F(Theta_min) tabulated {len(wi) / tt:10.3g} pairs/s  {tt / t1:.2f} x one"
+          f"  (|F error| <= {gold.fresnel_table()[1]:.1e})")
 
 
 if __name__ == "__main__":
