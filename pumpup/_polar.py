@@ -220,6 +220,7 @@ WK21 = 0.5 * np.concatenate([_WGK21[:-1], _WGK21[::-1]])
 WG21 = np.zeros(21)
 WG21[1:10:2] = 0.5 * _WG10
 WG21[11::2] = 0.5 * _WG10[::-1]
+from ._errors import calibrated, mode_code  # noqa: E402
 from .albedo import NODES as _NODES, WG as _WG, WK as _WK  # noqa: E402  (the engine's 7/15 rule)
 #: the rule of the 1-D path (measured and tested with "gk21": 90-190 evaluations per mu for the
 #: Phong family at rtol 1e-10)
@@ -227,15 +228,24 @@ RULE = "gk21"
 
 
 @njit(cache=True, nogil=True)
-def _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg):  # pragma: no cover - compiled
+def _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf):  # pragma: no cover - compiled
+    """(K, error) of the rule on [t0, t1]; the error is :func:`pumpup._errors.calibrated` of
+    |K - G| (``mode`` 1) or |K - G| itself (0); ``buf`` holds the values (one per node)."""
     h = t1 - t0
     k = 0.0
     g = 0.0
+    ab = 0.0
     for j in range(nodes.shape[0]):
         f = _point(kind, sm, n, p, mu, c2, v0, w, cv1, t0 + h * nodes[j])
+        buf[j] = f
         k += wk[j] * f
         g += wg[j] * f
-    return k * h, abs(k - g) * h
+        ab += wk[j] * abs(f)
+    asc = 0.0
+    if mode != 0:
+        for j in range(nodes.shape[0]):
+            asc += wk[j] * abs(buf[j] - k)  # resasc: the spread of f about its mean
+    return k * h, calibrated(abs(k - g) * h, asc * h, ab * h, mode)
 
 
 #: the peak variable z = -(n + 1) ln u runs at most to Z_MAX: below u = exp(-Z_MAX / (n + 1)) the
@@ -342,7 +352,7 @@ def _pieces(n, p, mu, s):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, val, err, conv, evals):  # pragma: no cover
+def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, val, err, conv, evals):  # pragma: no cover
     """Adaptive Gauss-Kronrod (the rule ``nodes``, ``wk``, ``wg``) of integral u^n K(u) du for
     every mu (without the scale)."""
     cap = max_intervals + 64
@@ -351,6 +361,7 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
     t1 = np.empty(cap)
     kv = np.empty(cap)
     ke = np.empty(cap)
+    buf = np.empty(nodes.shape[0])
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -359,11 +370,11 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
         for i in range(kinds.shape[0]):
             if w[i] <= 0.0:
                 continue
-            for j in range(N_INIT):
+            for j in range(n_init):
                 pk[m] = i
-                t0[m] = j / N_INIT
-                t1[m] = (j + 1.0) / N_INIT
-                kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg)
+                t0[m] = j / n_init
+                t1[m] = (j + 1.0) / n_init
+                kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf)
                 m += 1
         start = m
         ok = False
@@ -391,11 +402,11 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
             a_, b_ = t0[worst], t1[worst]
             mid = 0.5 * (a_ + b_)
             t1[worst] = mid
-            kv[worst], ke[worst] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg)
+            kv[worst], ke[worst] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf)
             pk[m] = i
             t0[m] = mid
             t1[m] = b_
-            kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg)
+            kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf)
             m += 1
         val[q] = tot
         err[q] = e + r
@@ -431,5 +442,5 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     with np.errstate(divide="ignore"):
         atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
     _integrate(float(hint.n), int(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
-               *(_RULES[RULE]), val, err, conv, evals)
+               *(_RULES[RULE]), mode_code(), N_INIT, val, err, conv, evals)
     return scale * val, np.abs(scale) * err, conv, evals
