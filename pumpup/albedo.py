@@ -444,7 +444,14 @@ def _accumulate(f, cos_o, weight, total):  # pragma: no cover - compiled
 
 
 def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
-    """Apply the 15 x 15 Gauss-Kronrod tensor rule to rectangles; return (K, err, ex, et)."""
+    """Apply the 15 x 15 Gauss-Kronrod tensor rule to rectangles; return (K, err, ex, et).
+
+    err is the error estimate of the rectangle (:mod:`pumpup._errors`: QUADPACK's calibration
+    of |K - G|, or the raw |K - G| under ``raw_estimate``); ex and et, the same for the Gauss
+    rule in x only and in t only, choose the direction of the split."""
+    from ._errors import calibrated_array, mode_code
+
+    mode = mode_code()
     R = len(prob)
     out = np.empty((R, 4))
     per = max(1, chunk // 225)
@@ -466,9 +473,20 @@ def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
         gk = np.einsum("rij,i,j->r", v, WG, WK) * area  # Gauss in x: measures the x error
         kg = np.einsum("rij,i,j->r", v, WK, WG) * area
         out[sl, 0] = kk
-        out[sl, 1] = np.abs(kk - gg)
-        out[sl, 2] = np.abs(kk - gk)
-        out[sl, 3] = np.abs(kk - kg)
+        if mode == 0:  # the raw |K - G| (pumpup._errors.raw_estimate)
+            out[sl, 1] = np.abs(kk - gg)
+            out[sl, 2] = np.abs(kk - gk)
+            out[sl, 3] = np.abs(kk - kg)
+            continue
+        # QUADPACK's calibration (pumpup._errors) with the tensor Kronrod rule's resasc (the
+        # integral of |f - mean f|) and resabs; per axis the same resasc, so ex >= et (the split
+        # direction) is the comparison of the raw per-axis differences, as before
+        mean = (kk / area)[:, None, None]
+        resasc = np.einsum("rij,i,j->r", np.abs(v - mean), WK, WK) * area
+        resabs = np.einsum("rij,i,j->r", np.abs(v), WK, WK) * area
+        out[sl, 1] = calibrated_array(np.abs(kk - gg), resasc, resabs, mode)
+        out[sl, 2] = calibrated_array(np.abs(kk - gk), resasc, resabs, mode)
+        out[sl, 3] = calibrated_array(np.abs(kk - kg), resasc, resabs, mode)
     return out.T
 
 
