@@ -34,10 +34,20 @@ the arc shrinks on the scale of z_s itself (tiny near grazing), so that piece is
 z_s (1 + 4^i).  Every piece is integrated by globally adaptive 10/21 Gauss-Kronrod quadrature
 (QUADPACK's qk21; ``RULE = "gk15"`` selects the engine's 7/15 rule) with a one-sided smoothing
 substitution (x = tau^2 at a square-root end, tau^2 (3 - 2 tau) at two), which turns the
-square-root behaviour at the breakpoints into smooth functions.  The reported error is
-the sum of |K - G| over the intervals plus a rounding term; on these smooth integrands it
-overestimates the true error by orders of magnitude (tested against mpmath and the
-independent references of ``tests/data``).
+square-root behaviour at the breakpoints into smooth functions.  Every piece starts as one
+interval (``N_INIT``).
+
+Error estimate (issue 14 item 4): per interval QUADPACK's calibration of |K - G|,
+resasc min(1, (200 |K - G| / resasc)^1.5) with its floor 50 eps resabs
+(:func:`pumpup._errors.calibrated`), summed, plus the rounding term ``ROUNDING`` sum |K| and
+the bound of the part beyond Z_MAX.  Measured by ``scripts/error_calibration.py`` over every
+independent reference of ``tests/`` (30-digit mpmath Phong values n = 0 .. 1e5 from normal to
+grazing incidence, tests/data/independent_reference.json, the closed forms) at rtol 1e-6 ..
+1e-12: true error / estimate at most 0.015 (median 2.5e-4; the raw |K - G| gave at most 0.03),
+no case above 1.  The estimate sits mostly on the rounding term, and the first intervals already
+meet rtol 1e-10 almost everywhere: 98 evaluations per mu for Phong n = 20 on a 257-point table
+(165 before, with two first intervals per piece and the raw estimate), 112 for stretched Phong
+n = 20, 99 for retro n = 10.
 
 A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
 :class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D

@@ -24,9 +24,13 @@ A BRDF without a hint (for example one from :func:`pumpup.from_function`) is int
 around N over the full circle of beta, with x = sin^2(theta_o) (exact for Lambert); the
 adaptive cubature then finds its lobes and kinks by itself, more slowly.
 
-The reported error is the sum of |K - G| over all rectangles plus a rounding term: it is
-pessimistic on smooth integrands by design, and the tests check it against closed forms
-and against an independent quadrature.
+The reported error is the sum over all rectangles of QUADPACK's calibration of |K - G|,
+resasc min(1, (200 |K - G| / resasc)^1.5) (resasc the tensor Kronrod rule's integral of
+|f - mean f|; :mod:`pumpup._errors`; smaller than |K - G| on a well-resolved rectangle, larger
+on a poorly resolved one), plus a rounding term.  ``scripts/error_calibration.py`` measures it on
+every independent reference of ``tests/`` at rtol 1e-6 .. 1e-12: true error / estimate at most
+0.12 (median 4e-4; the raw |K - G| of the engine before issue 14: at most 0.18, median 1.3e-3),
+no case above 1; ``tests/test_error_calibration.py`` asserts that it bounds the true error.
 """
 
 from __future__ import annotations
@@ -823,8 +827,8 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     -----
     The method is described in the module docstring of ``pumpup.albedo``: adaptive
     15 x 15 Gauss-Kronrod cubature in a lobe-adapted frame, the visible arc in closed
-    form, the kinks as breakpoints.  The error estimate is the sum of |Kronrod - Gauss|
-    over the rectangles, plus rounding.
+    form, the kinks as breakpoints.  The error estimate is the sum over the rectangles of
+    QUADPACK's calibration of |Kronrod - Gauss| (:mod:`pumpup._errors`), plus rounding.
 
     Examples
     --------
