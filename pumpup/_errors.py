@@ -54,9 +54,9 @@ EPS = float(np.finfo(float).eps)
 
 def mode_code() -> int:
     """1 for the calibrated estimate, 0 for the raw |K - G| (an argument of the compiled kernels)."""
-    if MODE not in ("quadpack", "raw"):
-        raise ValueError(f"pumpup._errors.MODE must be 'quadpack' or 'raw', got {MODE!r}")
-    return 1 if MODE == "quadpack" else 0
+    if MODE not in ("quadpack", "raw", "min"):
+        raise ValueError(f"pumpup._errors.MODE must be 'quadpack', 'min' or 'raw', got {MODE!r}")
+    return {"raw": 0, "quadpack": 1, "min": 2}[MODE]
 
 
 @contextlib.contextmanager
@@ -92,6 +92,8 @@ def calibrated(diff, resasc, resabs, mode):  # pragma: no cover - compiled; see 
     err = diff
     if resasc != 0.0 and diff != 0.0:
         err = resasc * min(1.0, (200.0 * diff / resasc) ** 1.5)  # QUADPACK qk21 / qk15
+        if mode == 2:
+            err = min(err, diff)
     return max(FLOOR * EPS * resabs, err)
 
 
@@ -102,6 +104,8 @@ def calibrated_reference(diff: float, resasc: float, resabs: float, mode: int = 
     err = diff
     if resasc != 0.0 and diff != 0.0:
         err = resasc * min(1.0, (200.0 * diff / resasc) ** 1.5)
+        if mode == 2:
+            err = min(err, diff)
     return max(FLOOR * EPS * resabs, err)
 
 
@@ -115,6 +119,8 @@ def calibrated_array(diff: np.ndarray, resasc: np.ndarray, resabs: np.ndarray, m
     resasc = np.asarray(resasc, dtype=np.float64)
     with np.errstate(divide="ignore", invalid="ignore"):
         scaled = resasc * np.minimum(1.0, (200.0 * diff / resasc) ** 1.5)
+    if mode == 2:
+        scaled = np.minimum(scaled, diff)
     err = np.where((resasc != 0.0) & (diff != 0.0), scaled, diff)
     return np.maximum(FLOOR * EPS * np.asarray(resabs, dtype=np.float64), err)
 

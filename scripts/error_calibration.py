@@ -30,6 +30,7 @@ one (``pumpup._errors``).  ``tests/test_error_calibration.py`` uses the same fun
     PYTHONPATH=. python scripts/error_calibration.py            # every engine, both estimates
     PYTHONPATH=. python scripts/error_calibration.py --quick    # the default test's subset
     PYTHONPATH=. python scripts/error_calibration.py --worst    # also the four largest ratios of each
+    PYTHONPATH=. python scripts/error_calibration.py --cost     # evaluations per mu, raw against calibrated
 """
 
 from __future__ import annotations
@@ -70,8 +71,20 @@ ENGINES = {
     "2-D": (_two_d, lambda f: True),
 }
 
+@contextlib.contextmanager
+def _min_estimate():
+    from pumpup import _errors
+
+    old, _errors.MODE = _errors.MODE, "min"
+    try:
+        yield
+    finally:
+        _errors.MODE = old
+
+
 ESTIMATES = {
     "calibrated": contextlib.nullcontext,
+    "min": _min_estimate,
     "raw": lambda: __import__("pumpup._errors", fromlist=["raw_estimate"]).raw_estimate(),
 }
 
@@ -155,16 +168,56 @@ def judge(result, rtol):
     return "resolved", true / e if e > 0 else (0.0 if true == 0 else math.inf)
 
 
+COST_SPECS = [{"type": "phong", "n": 20}, {"type": "stretched_phong", "n": 20}, {"type": "retro", "n": 10},
+              {"type": "stretched_phong", "n": 20, "p": 0.5}, {"type": "blinn", "n": 16},
+              {"type": "ward", "m": 0.1}, {"type": "cook_torrance", "m": 0.3}, {"type": "ggx", "alpha": 0.1}]
+
+
+def cost(rtol=1e-10, n_mu=65):
+    """Evaluations per mu and seconds of an n_mu-point table (mu uniform in theta) at ``rtol``, each
+    engine with the raw and the calibrated estimate, measured in the same run."""
+    import pumpup
+    from bench_albedo import evaluations
+
+    mu = np.cos(np.linspace(0, np.pi / 2, n_mu + 1)[:-1])
+    print(f"{n_mu}-point tables at rtol {rtol:g}: evaluations per mu (and ms), raw -> calibrated")
+    for spec in COST_SPECS:
+        f = pumpup.load(spec)
+        row = []
+        for engine, (ctx, applies) in ENGINES.items():
+            if not applies(f):
+                continue
+            out = []
+            for estimate in ESTIMATE_SET:
+                with ctx(), ESTIMATES[estimate]():
+                    pumpup.albedo(f, mu[:2], rtol=rtol)
+                    t = time.perf_counter()
+                    pumpup.albedo(f, mu, rtol=rtol)
+                    dt = time.perf_counter() - t
+                    out.append((evaluations(f, mu, rtol), dt))
+            row.append(f"{engine} " + " -> ".join(f"{e:7.0f}" for e, _ in out) + " ("
+                       + " -> ".join(f"{t * 1e3:7.1f}" for _, t in out) + " ms)")
+        print(f"  {str(spec):52s} " + "   ".join(row), flush=True)
+
+
+ESTIMATE_SET = [e for e in ("raw", "min", "calibrated") if "--min" in sys.argv or e != "min"]
+
+
 def main():
     quick = "--quick" in sys.argv
     import os
+
+    if "--cost" in sys.argv:
+        print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
+        cost()
+        return
 
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     cs = cases(quick)
     print(f"{len(cs)} references, rtol {', '.join(f'{r:g}' for r in RTOLS)}; ratio = true error / estimate")
     worst_rows = []
     for engine in ENGINES:
-        for estimate in ("raw", "calibrated"):
+        for estimate in ESTIMATE_SET:
             t = time.perf_counter()
             ratios, top, counts = [], [], {"skip": 0, "dishonest": 0, "unresolved": 0, "resolved": 0}
             for rtol in RTOLS:
