@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import itertools
 import json
 import math
 import pathlib
@@ -89,7 +90,7 @@ ESTIMATES = {
 }
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _mp_phong(n, p, mu):
     import independent_reference as ref
 
@@ -105,29 +106,29 @@ def cases(quick: bool = False):
             continue
         if quick and e["model"] in ("cook_torrance", "ward", "modified_ward") and e["mu"] < 0.05:
             continue  # (grazing Ward: each takes a few seconds at rtol 1e-12 in the 2-D engine)
-        out.append(dict(id=f"ref-{e['model']}-{json.dumps(e['params'])}-mu{e['mu']:.3g}",
-                        spec={"type": e["model"], **e["params"]}, mu=e["mu"], phi=0.0,
-                        value=e["value"], ref_err=e["abs_err_estimate"]))
+        out.append({"id": f"ref-{e['model']}-{json.dumps(e['params'])}-mu{e['mu']:.3g}",
+                        "spec": {"type": e["model"], **e["params"]}, "mu": e["mu"], "phi": 0.0,
+                        "value": e["value"], "ref_err": e["abs_err_estimate"]})
     for r in json.loads((DATA / "independent_anisotropic.json").read_text())["rows"]:
-        out.append(dict(id=f"aniso-{r['model']}-{json.dumps(r['params'])}-mu{r['mu']}-phi{r['phi']:.3f}",
-                        spec={"type": r["model"], **r["params"]}, mu=r["mu"], phi=r["phi"],
-                        value=r["albedo"], ref_err=r["abs_err_estimate"]))
+        out.append({"id": f"aniso-{r['model']}-{json.dumps(r['params'])}-mu{r['mu']}-phi{r['phi']:.3f}",
+                        "spec": {"type": r["model"], **r["params"]}, "mu": r["mu"], "phi": r["phi"],
+                        "value": r["albedo"], "ref_err": r["abs_err_estimate"]})
     for n, p in MP_LOBES:
         if quick and n == 0:
             continue  # (2.5 s of mpmath: the indicator (R.V)_+^0 has a jump)
         spec = {"type": "stretched_phong", "n": float(n), "p": float(p)} if p else {"type": "phong", "n": float(n)}
         for mu in (MP_MU[::3] if quick else MP_MU):
-            out.append(dict(id=f"mpmath-{spec['type']}-n{n}-mu{mu:.3g}", spec=spec, mu=mu, phi=0.0,
-                            value=functools.partial(_mp_phong, n, p, mu), ref_err=None))
+            out.append({"id": f"mpmath-{spec['type']}-n{n}-mu{mu:.3g}", "spec": spec, "mu": mu, "phi": 0.0,
+                            "value": functools.partial(_mp_phong, n, p, mu), "ref_err": None})
     for n in (0.0, 1.0, 20.0, 1e3, 1e6):
         for t in ("phong", "stretched_phong"):
-            out.append(dict(id=f"closed-{t}-n{n:g}-normal", spec={"type": t, "n": n}, mu=1.0, phi=0.0,
-                            value=1.0, ref_err=0.0))  # 000 eq. 6
+            out.append({"id": f"closed-{t}-n{n:g}-normal", "spec": {"type": t, "n": n}, "mu": 1.0, "phi": 0.0,
+                            "value": 1.0, "ref_err": 0.0})  # 000 eq. 6
     for mu in (1.0, 0.3, 1e-6):
-        out.append(dict(id=f"closed-lambert-mu{mu:g}", spec={"type": "lambert", "albedo": 0.7}, mu=mu, phi=0.0,
-                        value=0.7, ref_err=1e-16))
-        out.append(dict(id=f"closed-lewis_phong-mu{mu:g}", spec={"type": "lewis_phong", "n": 20, "k_rho": 0.9},
-                        mu=mu, phi=0.0, value=0.9, ref_err=1e-16))  # 002 eq. 22
+        out.append({"id": f"closed-lambert-mu{mu:g}", "spec": {"type": "lambert", "albedo": 0.7}, "mu": mu, "phi": 0.0,
+                        "value": 0.7, "ref_err": 1e-16})
+        out.append({"id": f"closed-lewis_phong-mu{mu:g}", "spec": {"type": "lewis_phong", "n": 20, "k_rho": 0.9},
+                        "mu": mu, "phi": 0.0, "value": 0.9, "ref_err": 1e-16})  # 002 eq. 22
     return out
 
 
@@ -176,8 +177,9 @@ COST_SPECS = [{"type": "phong", "n": 20}, {"type": "stretched_phong", "n": 20}, 
 def cost(rtol=1e-10, n_mu=65):
     """Evaluations per mu and seconds of an n_mu-point table (mu uniform in theta) at ``rtol``, each
     engine with the raw and the calibrated estimate, measured in the same run."""
-    import pumpup
     from bench_albedo import evaluations
+
+    import pumpup
 
     mu = np.cos(np.linspace(0, np.pi / 2, n_mu + 1)[:-1])
     print(f"{n_mu}-point tables at rtol {rtol:g}: evaluations per mu (and ms), raw -> calibrated")
@@ -197,7 +199,7 @@ def cost(rtol=1e-10, n_mu=65):
                     out.append((evaluations(f, mu, rtol), dt))
             row.append(f"{engine} " + " -> ".join(f"{e:7.0f}" for e, _ in out) + " ("
                        + " -> ".join(f"{t * 1e3:7.1f}" for _, t in out) + " ms)")
-        print(f"  {str(spec):52s} " + "   ".join(row), flush=True)
+        print(f"  {spec!s:52s} " + "   ".join(row), flush=True)
 
 
 ESTIMATE_SET = [e for e in ("raw", "min", "calibrated") if "--min" in sys.argv or e != "min"]
@@ -238,7 +240,7 @@ def main():
                 qs = np.quantile(q, [0.5, 0.9, 0.99, 1.0])
                 lq = np.log10(np.maximum(q, 1e-300))
                 edges = [-np.inf] + list(range(-6, 1)) + [np.inf]
-                hist = " ".join(f"{np.count_nonzero((lq >= lo) & (lq < hi))}" for lo, hi in zip(edges[:-1], edges[1:]))
+                hist = " ".join(f"{np.count_nonzero((lq >= lo) & (lq < hi))}" for lo, hi in itertools.pairwise(edges))
                 print(f"{engine:5s} {estimate:10s} resolved {counts['resolved']:4d}  unresolved {counts['unresolved']:4d}  "
                       f"skipped {counts['skip']:4d}  dishonest {counts['dishonest']:3d} | ratio median {qs[0]:.2g}, "
                       f"90% {qs[1]:.2g}, 99% {qs[2]:.2g}, max {qs[3]:.2g} | per decade <1e-6, 1e-6.. .. 1e0, >1: {hist}  ({dt:.0f} s)",
