@@ -39,8 +39,13 @@ def test_estimate_shape():
     assert _errors.calibrated_reference(1e-30, 1.0, 1.0) == 50 * np.finfo(float).eps
     assert _errors.calibrated_reference(1e-12, 1.0, 1.0, mode=0) == 1e-12
     with _errors.raw_estimate():
-        assert _errors.mode_code() == 0
-    assert _errors.mode_code() == 1
+        assert _errors.mode_code() == 0 and _errors.mode_code(smooth=False) == 0
+    assert _errors.mode_code() == 1 and _errors.mode_code(smooth=False) == 0
+    with _errors.estimates("quadpack"):
+        assert _errors.mode_code(smooth=False) == 1
+    with pytest.raises(ValueError, match="MODE"), _errors.estimates("exact"):
+        pass
+    assert _errors.MODE == "quadpack"
 
 
 def _check(engine, rtol, quick):
@@ -82,20 +87,38 @@ def test_estimate_bounds_the_true_error_everywhere(engine, rtol):
 
 def test_raw_estimate_is_the_previous_engine():
     # on the same rectangles (the first grid: max_regions=0) the 2-D engine gives the same value under
-    # both estimates; there the lobe is poorly resolved, and the calibrated estimate is the larger
-    # (QUADPACK's scaling exceeds |K - G| once |K - G| > 1.25e-7 resasc); both bound the true error
+    # the raw and the QUADPACK estimate; there the lobe is poorly resolved, and QUADPACK's is the
+    # larger (its scaling exceeds |K - G| once |K - G| > 1.25e-7 resasc); both bound the true error;
+    # the engine's default is the raw one
     import warnings
 
     import pumpup
 
     f = pumpup.load({"type": "phong", "n": 20})
     mu = np.array([0.9, 0.5, 0.1])
+    kw = {"rtol": 1e-13, "atol": 0, "max_regions": 0, "return_error": True}
     with cal.ENGINES["2-D"][0](), warnings.catch_warnings():
         warnings.simplefilter("ignore", pumpup.albedo_module.AlbedoWarning)
-        a, e = pumpup.albedo(f, mu, rtol=1e-13, atol=0, max_regions=0, return_error=True)
+        with _errors.estimates("quadpack"):
+            a, e = pumpup.albedo(f, mu, **kw)
         with _errors.raw_estimate():
-            b, eb = pumpup.albedo(f, mu, rtol=1e-13, atol=0, max_regions=0, return_error=True)
+            b, eb = pumpup.albedo(f, mu, **kw)
+        c, ec = pumpup.albedo(f, mu, **kw)
     ref = np.array([cal._mp_phong(20, 0, m)[0] for m in mu])
     np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(ec, eb)
     assert np.all(np.abs(a - ref) <= e) and np.all(np.abs(b - ref) <= eb)
     assert np.all(e > eb), (e, eb)
+
+
+def test_two_d_engine_keeps_the_raw_estimate_where_kinks_are_unmarked():
+    # a pumped Blinn divides by an interpolated albedo table: kinks at its knots that no hint marks.
+    # QUADPACK's scaling assumes smoothness and was measured 1.12 x (rtol 1e-10) and 1.64 x (1e-11)
+    # below the true error at mu = 1e-3 (pumpup._errors); the default (raw) estimate bounds it
+    case = next(c for c in cal.cases(quick=True) if c["id"].startswith("self-") and "blinn" in c["id"]
+                and c["mu"] == 1e-3)
+    for rtol in (1e-10, 1e-11):
+        verdict, ratio = cal.judge(cal.measure(case, "2-D", rtol), rtol)
+        assert verdict != "dishonest", (rtol, ratio)
+        assert verdict != "skip"
+    assert _errors.MODE_2D == "raw" and _errors.MODE == "quadpack"
