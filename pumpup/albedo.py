@@ -25,8 +25,13 @@ around N over the full circle of beta, with x = sin^2(theta_o) (exact for Lamber
 adaptive cubature then finds its lobes and kinks by itself, more slowly.
 
 The reported error is the sum of |K - G| over all rectangles plus a rounding term: it is
-pessimistic on smooth integrands by design, and the tests check it against closed forms
-and against an independent quadrature.
+pessimistic on smooth integrands by design (true error / estimate at most 0.18, median 1.3e-3
+over every independent reference of ``tests/`` at rtol 1e-6 .. 1e-12,
+``scripts/error_calibration.py``), and the tests check it against closed forms and against
+independent quadratures.  QUADPACK's calibrated estimate (:mod:`pumpup._errors`, used by the
+1-D path) is not used here by default: the integrand of a pumped or compensated BRDF has kinks
+at the knots of its albedo table that no hint marks, and there the calibrated estimate was
+measured below the true error (``pumpup._errors.MODE_2D`` switches it on for measurements).
 """
 
 from __future__ import annotations
@@ -444,7 +449,14 @@ def _accumulate(f, cos_o, weight, total):  # pragma: no cover - compiled
 
 
 def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
-    """Apply the 15 x 15 Gauss-Kronrod tensor rule to rectangles; return (K, err, ex, et)."""
+    """Apply the 15 x 15 Gauss-Kronrod tensor rule to rectangles; return (K, err, ex, et).
+
+    err is the error estimate of the rectangle, |K - G| (or, when ``pumpup._errors.MODE_2D``
+    asks for it, QUADPACK's calibration of it: not the default, see the module docstring);
+    ex and et, the same for the Gauss rule in x only and in t only, choose the split direction."""
+    from ._errors import calibrated_array, mode_code
+
+    mode = mode_code(smooth=False)  # raw |K - G| unless pumpup._errors.MODE_2D says otherwise
     R = len(prob)
     out = np.empty((R, 4))
     per = max(1, chunk // 225)
@@ -466,9 +478,20 @@ def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
         gk = np.einsum("rij,i,j->r", v, WG, WK) * area  # Gauss in x: measures the x error
         kg = np.einsum("rij,i,j->r", v, WK, WG) * area
         out[sl, 0] = kk
-        out[sl, 1] = np.abs(kk - gg)
-        out[sl, 2] = np.abs(kk - gk)
-        out[sl, 3] = np.abs(kk - kg)
+        if mode == 0:  # the raw |K - G| (pumpup._errors.raw_estimate)
+            out[sl, 1] = np.abs(kk - gg)
+            out[sl, 2] = np.abs(kk - gk)
+            out[sl, 3] = np.abs(kk - kg)
+            continue
+        # QUADPACK's calibration (pumpup._errors) with the tensor Kronrod rule's resasc (the
+        # integral of |f - mean f|) and resabs; per axis the same resasc, so ex >= et (the split
+        # direction) is the comparison of the raw per-axis differences, as before
+        mean = (kk / area)[:, None, None]
+        resasc = np.einsum("rij,i,j->r", np.abs(v - mean), WK, WK) * area
+        resabs = np.einsum("rij,i,j->r", np.abs(v), WK, WK) * area
+        out[sl, 1] = calibrated_array(np.abs(kk - gg), resasc, resabs, mode)
+        out[sl, 2] = calibrated_array(np.abs(kk - gk), resasc, resabs, mode)
+        out[sl, 3] = calibrated_array(np.abs(kk - kg), resasc, resabs, mode)
     return out.T
 
 

@@ -20,6 +20,7 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
     python scripts/bench_albedo.py --all      # also the three measurements above
     python scripts/bench_albedo.py --cells    # only the sweep cells and the pumped tables
     python scripts/bench_albedo.py --eval     # only BRDF.eval's overhead (the input checks)
+    python scripts/bench_albedo.py --phong    # only the Phong family's rows (1-D path), no dblquad
 """
 
 import signal
@@ -132,17 +133,22 @@ def dblquad_seconds(f, mu, epsrel, limit=60):
     return time.perf_counter() - t
 
 
-def families(rtol=1e-10):
+#: the Phong family of the issue's 2 ms target (the 1-D path)
+PHONG_FAMILY = [{"type": "phong", "n": 20}, {"type": "stretched_phong", "n": 20},
+                {"type": "stretched_phong", "n": 20, "p": 0.0}, {"type": "retro", "n": 10}]
+
+
+def families(rtol=1e-10, specs=None, dblquad=True):
     from pumpup import _polar
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     print(f"257-point tables at rtol {rtol:g}, one thread (ms); evaluations per mu; previous = the 2-D engine")
     print(f"{'model':58s} {'path':4s} {'albedo':>9s} {'tabulate':>9s} {'evals/mu':>9s} "
           f"{'previous':>9s} {'evals/mu':>9s} {'ratio':>7s} {'dblquad/value':>14s} {'x per value':>11s}")
-    for spec in FAMILIES:
+    for spec in FAMILIES if specs is None else specs:
         f = pumpup.load(spec)
         one_d = all(t.polar() is not None for _, t in f.albedo_terms())
-        repeat = 3 if one_d else 1
+        repeat = (3 if one_d else 1) if dblquad else 20
         pumpup.albedo(f, [0.5, 1e-3])  # compile / load the kernels
         _, t_new = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), repeat)
         _, t_tab = _best(lambda: pumpup.tabulate(f, mu=mu, rtol=rtol, threads=1, progress=False), repeat)
@@ -155,7 +161,7 @@ def families(rtol=1e-10):
             old = f"{t_old * 1e3:9.1f} {ev_old:9.0f} {t_old / t_new:7.0f}"
         else:
             old = f"{'(same)':>9s} {'':9s} {1.0:7.0f}"
-        td = dblquad_seconds(f, 0.5, rtol) if spec["type"] not in ("lafortune_sum",) else None
+        td = dblquad_seconds(f, 0.5, rtol) if spec["type"] not in ("lafortune_sum",) and dblquad else None
         per_value = t_new / len(mu)
         dq = f"{td:14.3f} {td / per_value:11.0f}" if td is not None else f"{'> 60 s':>14s} {'':11s}"
         shown = {k: v for k, v in spec.items()}
@@ -242,6 +248,9 @@ def main():
           f"on {os.cpu_count()} cores")
     if "--eval" in sys.argv:
         eval_overhead()
+        return
+    if "--phong" in sys.argv:
+        families(specs=PHONG_FAMILY, dblquad=False)
         return
     if "--cells" not in sys.argv:
         families()
