@@ -127,7 +127,7 @@ def _text(cache, bar):
             m = cache.max_albedo({"type": "stretched_phong", "n": 1.0})
             c = 3.0 / (2.0 * math.pi)
             if "angle" in col:
-                row = Row(p, p.source, p.row, col, m.theta_deg, 0.0)
+                row = Row(p, p.source, p.row, col, m.theta_deg, m.theta_error)  # located to sqrt(err / curvature)
             else:
                 row = Row(p, p.source, p.row, col, m.albedo * c - 1.0, m.error * c)
         elif col == "stretched_phong a(90 deg)":

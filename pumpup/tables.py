@@ -633,6 +633,9 @@ class AlbedoMaximum:
     constant: float  #: 1 / albedo, the largest energy-conserving constant
     constant_error: float  #: propagated error of the constant
     at_boundary: bool  #: the maximum is at the end of the scanned range (mu = 1 or mu = mu_min)
+    #: half-width [deg] of the theta interval the maximum may lie in: where a(mu) is within the
+    #: albedo errors of the maximum (a flat maximum is located only to about sqrt(error / curvature))
+    theta_error: float = 0.0
 
 
 def _unit_constant(brdf: BRDF) -> BRDF:
@@ -680,6 +683,7 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
     elif scan is not None:
         best_a, best_e = (float(v) for v in albedo(f, best_mu, return_error=True, rtol=rtol))
     at_boundary = i in (0, len(mu) - 1)
+    theta_error = 0.0 if at_boundary else _location_error(f, best_mu, best_a, best_e, rtol, lo, hi)
     return AlbedoMaximum(
         albedo=best_a,
         error=best_e,
@@ -688,7 +692,32 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
         constant=1.0 / best_a,
         constant_error=best_e / best_a**2,
         at_boundary=at_boundary,
+        theta_error=theta_error,
     )
+
+
+def _location_error(f, mu0, a0, e0, rtol, lo, hi) -> float:
+    """Half-width [deg] of the theta interval around an interior maximum at mu0 in which the true
+    maximum may lie.
+
+    With a(mu) ~ a0 - k (mu - mu0)^2 / 2 near the maximum, every mu where a is within the albedo
+    errors of a0 (a drop of 2 e, e the largest error of the three values) could be the maximum:
+    |mu - mu0| <= sqrt(4 e / k).  k comes from a centred second difference at a step h of a
+    twentieth of the bracket [lo, hi] of the scan (its own noise 4 e / h^2 is subtracted: a
+    curvature that noise could explain is treated as zero, and then the whole bracket counts), plus
+    the Brent search's tolerance.  Converted to theta through d theta = d mu / sin(theta).
+    """
+    h = min(0.05 * (hi - lo), mu0 - lo, hi - mu0)
+    if not h > 0:
+        return math.degrees(math.acos(lo) - math.acos(hi)) / 2
+    (am, ap), (em, ep) = albedo(f, np.array([mu0 - h, mu0 + h]), return_error=True, rtol=rtol)
+    e = max(e0, em, ep)
+    k = (2.0 * a0 - am - ap) / (h * h) - 4.0 * e / (h * h)  # the curvature noise could not explain
+    dmu = math.sqrt(4.0 * e / k) if k > 0 else max(hi - mu0, mu0 - lo)
+    dmu = min(dmu, max(hi - mu0, mu0 - lo)) + 1e-9 * hi  # never beyond the bracket; Brent's xatol
+    s = math.sqrt(max((1.0 - mu0) * (1.0 + mu0), 0.0))
+    lo_t, hi_t = math.acos(min(1.0, mu0 + dmu)), math.acos(max(-1.0, mu0 - dmu))
+    return math.degrees(max(math.acos(mu0) - lo_t, hi_t - math.acos(mu0), dmu / s if s > 0 else 0.0))
 
 
 def max_constant(brdf: BRDF, **kw) -> tuple[float, float]:
