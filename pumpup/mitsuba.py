@@ -62,7 +62,8 @@ The BSDF
 Supported pumpup types: lambert, phong, stretched_phong, retro, phong_shader, blinn,
 stretched_blinn, phong_blinn, ward, modified_ward, ward_aniso, schlick, cook_torrance,
 beckmann, ggx (with ``ior`` or ``eta``/``k`` Fresnel, separable or correlated Smith, exact or
-Walter G1), metal, plastic, and ``pumped`` over any of them (g1 or g2, any number of levels).
+Walter G1), metal, plastic, and ``pumped`` over any of them (g1 or g2, any number of levels), and
+``fresnel`` (F(Theta_min) x one of these, pumped or not: the colour-keeping pumped metal's channel).
 
 Examples
 --------
@@ -422,7 +423,7 @@ _KERNELS = {
 }
 
 #: the pumpup model types the plugin translates
-SUPPORTED = tuple(sorted(set(_KERNELS) | {"pumped"}))
+SUPPORTED = tuple(sorted(set(_KERNELS) | {"pumped", "fresnel"}))
 
 
 class _Level:
@@ -523,10 +524,12 @@ class _DrModel:
     def __init__(self, brdf: BRDF):
         self.brdf = brdf
         self.levels: list[_Level] = []
-        base = brdf
+        #: (eta, k) of an outer ``fresnel`` model (base x F(Theta_min), pumpup.models.fresnel), else None
+        self.fresnel = (brdf.p["eta"], brdf.p["k"]) if brdf.type == "fresnel" else None
+        base = brdf.p["base"] if self.fresnel is not None else brdf
         from .pumping import Pumped
 
-        prod = brdf.product() if isinstance(brdf, Pumped) else None
+        prod = base.product() if isinstance(base, Pumped) else None
         self.product = _ProductG(prod) if prod is not None else None
         while isinstance(base, Pumped):
             self.levels.append(_Level(base.lookup(), base.controlled))
@@ -562,6 +565,8 @@ class _DrModel:
 
     def f(self, l, v):
         val = self.kernel(l, v, *self.args)
+        if self.fresnel is not None:  # 000 eq. 28's factor F(Theta_min), before the rounding down below
+            val = val * _fresnel_conductor(dr.maximum(l[2], v[2]), *self.fresnel)
         if self.levels:
             g = self.g(dr.maximum(l[2], 1e-300), dr.maximum(v[2], 1e-300))
             val = _div(val, g) * self.ROUND_DOWN  # 001 eq. 16, all levels

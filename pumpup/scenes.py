@@ -7,7 +7,7 @@ model and with its stretched or pumped version, side by side:
     000 Fig. 8, left: "a golden Beethoven (n = 4) with a copper sphere (n = 40) and a copper
     pyramid (n = 150) on a silver mirror (n = 5000)".  Here a gold sphere (n = 4) stands for the
     head and a cube for the pyramid.  Original: reciprocal Phong (000 eq. 5); new: stretched Phong
-    (000 eq. 7), both times the metal's colour.
+    (000 eq. 7 with Fresnel: 000 eq. 28), both times the measured metal's F(Theta_min) per RGB channel.
 ``000-fig9``
     000 Fig. 9: plastic spheres of one hue and different lightness and saturation, with
     (a_s, n) = (0.04, 169), (0.065, 64), (0.09, 9), (0.13, 3), on a plastic plate.  Original:
@@ -15,15 +15,29 @@ model and with its stretched or pumped version, side by side:
     Phong, Fresnel 1).
 ``001-fig8``
     001 Fig. 8: "a golden tank with aluminum, silver, copper and golden pyramids", reciprocal
-    Phong (top) against Phong pumped up once (bottom), n = 20 (left) and n = 5000 (right).  Here
+    Phong (top) against Phong pumped up once (bottom), n = 20 (left) and n = 5000 (right), both times the
+    measured metal's F(Theta_min) per RGB channel (the pumped one keeps the colour).  Here
     a gold cube with four small cubes (turned 45 degrees) on a grey Lambert plate.
 
-Metals: the papers use the spectral Fresnel factor (000 eq. 28, 8 wavelengths); here the colour is
-the normal-incidence reflectance F0 in linear RGB (Hoffman, "Physics and math of shading",
-SIGGRAPH 2010 course; also Real-Time Rendering, 3rd ed., Table 7.3), constant over angle, applied
-as a factor outside the lobe.  The factor commutes with g1 pumping (g1 divides by the albedo, so
-pumping F0 x Phong would undo the colour): a pumped metal is F0 x pump(Phong).  Both halves of a
-comparison use the same F0, so the difference is the stretching or pumping alone.
+Metals: measured gold, silver, copper and aluminium (:mod:`pumpup.optical`: Johnson & Christy 1972
+for Au, Ag, Cu; Rakic 1995 for Al), one complex index n + i k per RGB channel, the measured one at
+:data:`pumpup.spectral.RGB_WAVELENGTHS` (630, 532, 465 nm), so each channel is a real conductor's
+Fresnel factor F(Theta_min) (000 eq. 28: 0 <= F <= 1, F -> 1 at grazing).  Each panel kind is a
+list of three per-channel specs (the ``pumpup`` plugin's RGB form):
+
+* "stretched": ``metal`` (000 eq. 28, the stretched Phong lobe times F(Theta_min)), equal to
+  ``SpectralMetal(material, n, wavelengths="rgb")`` channel by channel;
+* "phong": ``fresnel`` over reciprocal Phong (000 eq. 5) -- the same F(Theta_min) on the original lobe;
+* "pumped": ``fresnel`` over ``pumped(phong)`` (001 eq. 16, 20, one g1 level): the colour-keeping
+  pumped metal (:class:`pumpup.spectral.SpectralPumpedLobe`'s construction: the F = 1 lobe pumped,
+  then F per channel) with 001 Fig. 8's lobe, reciprocal Phong, so that the two rows of that figure
+  differ by the pumping alone.  Pumping the metal per channel would divide out its colour (g
+  divides by each channel's own albedo: pumped gold is white).
+
+The sRGB of the 8-wavelength spectral F0 (``pumpup.spectral.to_srgb``) is not used as the channel
+value: gold's red is 1.032, outside [0, 1], which no Fresnel factor reaches; the three measured
+indices give F0 = (0.942, 0.704, 0.404) for gold against (1.032, 0.732, 0.362) from the spectrum.
+:data:`F0` (Hoffman 2010) is kept for reference only; the scenes do not use it.
 
 Lights: a constant sky (Mitsuba ``constant`` emitter; the papers' "sky-light") plus point lights,
 path tracing (``path``, max_depth 6) with Mitsuba's MIS; the plugin samples each lobe with
@@ -45,9 +59,10 @@ import time
 
 import numpy as np
 
-__all__ = ["SCENES", "F0", "check_scene", "panels", "render_scene", "render_panel", "write_scene"]
+__all__ = ["SCENES", "F0", "METALS", "metal_index", "check_scene", "panels", "render_scene", "render_panel", "write_scene"]
 
-#: normal-incidence reflectance of metals, linear RGB (Hoffman 2010 / Real-Time Rendering 3rd ed., Table 7.3)
+#: normal-incidence reflectance of metals, linear RGB (Hoffman 2010 / Real-Time Rendering 3rd ed., Table 7.3);
+#: the scenes used it before the measured metals (:data:`METALS`); kept for comparison only
 F0 = {
     "gold": (1.000, 0.766, 0.336),
     "silver": (0.972, 0.960, 0.915),
@@ -93,13 +108,34 @@ def _phong(n, c=None):
     return s
 
 
+#: the scenes' metals: colour name -> :mod:`pumpup.optical` material
+METALS = {"gold": "Au", "silver": "Ag", "copper": "Cu", "aluminium": "Al"}
+
+
+def metal_index(colour) -> tuple[list, list]:
+    """(eta, k) per RGB channel of a scene metal: its measured index at ``spectral.RGB_WAVELENGTHS``."""
+    from . import optical
+    from .spectral import RGB_WAVELENGTHS
+
+    eta, k = optical.constants(METALS[colour], list(RGB_WAVELENGTHS))
+    return [float(x) for x in eta], [float(x) for x in k]
+
+
 def metal(colour, n, kind):
-    """A metal of colour ``F0[colour]`` and exponent n: ``kind`` "phong" (000 eq. 5), "stretched" (000 eq. 7)
-    or "pumped" (001 eq. 20, one level of g1 over Phong).  A ``pumpup_mix`` material: [(rgb, spec)]."""
+    """The measured metal ``colour`` (a :data:`METALS` key) with exponent n, one spec per RGB channel:
+    ``kind`` "phong" (F(Theta_min) x reciprocal Phong, 000 eq. 5), "stretched" (000 eq. 28) or "pumped"
+    (F(Theta_min) x Phong pumped once with g1, 001 eq. 20; the colour-keeping pumped metal).  A
+    ``pumpup_mix`` material: [(rgb weight, [3 specs])]."""
+    if kind not in ("phong", "stretched", "pumped"):
+        raise ValueError(f"kind must be 'phong', 'stretched' or 'pumped', got {kind!r}")
+    eta, k = metal_index(colour)
     base = _phong(n)
-    spec = {"phong": base, "stretched": {"type": "stretched_phong", "n": float(n)},
-            "pumped": {"type": "pumped", "base": base, "g": "g1", "levels": 1}}[kind]
-    return [(F0[colour], spec)]
+    if kind == "stretched":
+        specs = [{"type": "metal", "n": float(n), "eta": e, "k": kk} for e, kk in zip(eta, k)]  # 000 eq. 28
+    else:
+        lobe = base if kind == "phong" else {"type": "pumped", "base": base, "g": "g1", "levels": 1}
+        specs = [{"type": "fresnel", "base": lobe, "eta": e, "k": kk} for e, kk in zip(eta, k)]  # F(Theta_min) x lobe
+    return [((1.0, 1.0, 1.0), specs)]
 
 
 def plastic(rgb, a_s, n, kind):

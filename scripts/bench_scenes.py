@@ -22,9 +22,14 @@ import pumpup.scenes as S  # noqa: E402
 
 
 def _builtin(material):
-    w = [float(x) for x in material[0][0]]
-    return {"type": "roughconductor", "distribution": "ggx", "alpha": 0.1,
-            "specular_reflectance": {"type": "rgb", "value": w}}
+    w, spec = material[0]
+    out = {"type": "roughconductor", "distribution": "ggx", "alpha": 0.1}
+    if isinstance(spec, list) and all("eta" in s for s in spec):  # a measured metal: the same index per channel
+        out["eta"] = {"type": "rgb", "value": [float(s["eta"]) for s in spec]}
+        out["k"] = {"type": "rgb", "value": [float(s["k"]) for s in spec]}
+    else:
+        out["specular_reflectance"] = {"type": "rgb", "value": [float(x) for x in w]}
+    return out
 
 
 def _time(name, mats, size, spp):

@@ -54,11 +54,13 @@ def test_panels_are_the_papers_parameters():
         [(0.04, 169), (0.065, 64), (0.09, 9), (0.13, 3)])
     assert new[1]["s0"][0][1][0]["type"] == "plastic"
     (a, b), = S.panels("000-fig8")
-    assert a[1]["plate"][0][1] == {"type": "phong", "n": 5000.0}
-    assert b[1]["plate"][0][1] == {"type": "stretched_phong", "n": 5000.0}
+    eta, k = S.metal_index("silver")  # the measured silver, one index per RGB channel
+    assert a[1]["plate"][0][1] == [{"type": "fresnel", "base": {"type": "phong", "n": 5000.0}, "eta": e, "k": kk}
+                                   for e, kk in zip(eta, k)]
+    assert b[1]["plate"][0][1] == [{"type": "metal", "n": 5000.0, "eta": e, "k": kk} for e, kk in zip(eta, k)]
     rows = S.panels("001-fig8")
-    assert rows[1][1][1]["tank"][0][1] == {"type": "pumped", "base": {"type": "phong", "n": 5000.0}, "g": "g1",
-                                           "levels": 1}
+    pumped = {"type": "pumped", "base": {"type": "phong", "n": 5000.0}, "g": "g1", "levels": 1}
+    assert [s["base"] for s in rows[1][1][1]["tank"][0][1]] == [pumped] * 3
 
 
 mi = pytest.importorskip("mitsuba")

@@ -140,6 +140,17 @@ def test_metals_table_file():
                                s.albedo(mu), rtol=1e-9)
     meta = __import__("json").loads(ds.attrs["optical_constants"])
     assert "Johnson" in meta["Au"]["reference"]
+    # the colour-keeping variant (SpectralPumpedLobe): at least the eq. 28 metal (g <= 1) within the errors,
+    # it keeps gold's and copper's red above their blue at every mu, and one row is recomputed
+    keep, ek = ds["albedo"].sel(variant="colour_keeping").values, ds["albedo_error"].sel(variant="colour_keeping").values
+    st, es = ds["albedo"].sel(variant="stretched").values, ds["albedo_error"].sel(variant="stretched").values
+    assert np.all(keep + ek + es >= st)
+    w = list(ds["wavelength"].values)
+    for m in ("Au", "Cu"):
+        a = ds["albedo"].sel(metal=m, variant="colour_keeping").values
+        assert np.all(a[..., w.index(640.0)] > a[..., w.index(440.0)])
+    np.testing.assert_allclose(ds["albedo"].sel(metal="Cu", exponent=20.0, variant="colour_keeping").values[[0, 20]],
+                               spectral.SpectralPumpedLobe(s).albedo(mu[[0, 2]]), rtol=1e-9)
 
 
 def test_spectral_load_round_trip():

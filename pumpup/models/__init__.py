@@ -2,3 +2,4 @@
 
 from . import blinn, cook_torrance, diffuse, he_torrance, lafortune, lambert, lewis, metal, microfacet, phong, schlick, ward  # noqa: F401
 from . import mix  # noqa: F401  (after the models it mixes)
+from . import fresnel  # noqa: F401  (a base BRDF x F(Theta_min), 000 eq. 28's factor)
