@@ -146,10 +146,11 @@ def test_kernels_match_their_numpy_twins(spec, mu):
     width = edges[node, piece + 1] - lo
     t0 = np.tile([0.0, 0.25], len(node) // 2)
     t1 = np.tile([0.25, 1.0], len(node) // 2)
-    wi_r, wo_r, w_r = _nested._points_reference(lobe.axis, node, lo, width, t0, t1, mu_n, s_n, ca_n, sa_n, wr_n)
+    sm = np.arange(len(node)) % 4  # every inner substitution
+    wi_r, wo_r, w_r = _nested._points_reference(lobe.axis, node, lo, width, t0, t1, mu_n, s_n, ca_n, sa_n, wr_n, sm)
     S = len(node) * 15
     wi, wo, w = np.empty((S, 3)), np.empty((S, 3)), np.empty(S)
-    _nested._points_kernel(_AXIS_CODE[lobe.axis], node, lo, width, t0, t1, mu_n, s_n, ca_n, sa_n, wr_n, NODES,
+    _nested._points_kernel(_AXIS_CODE[lobe.axis], node, lo, width, t0, t1, sm, mu_n, s_n, ca_n, sa_n, wr_n, NODES,
                            wi, wo, w)
     np.testing.assert_allclose(wi, wi_r, rtol=1e-13, atol=1e-15)
     np.testing.assert_allclose(wo, wo_r, rtol=1e-12, atol=1e-14)
