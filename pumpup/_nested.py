@@ -49,12 +49,12 @@ import numpy as np
 from numba import njit
 
 from .albedo import (
+    _AXIS_CODE,
+    _RADIAL_CODE,
     NODES,
     NX_INIT,
     WG,
     WK,
-    _AXIS_CODE,
-    _RADIAL_CODE,
     _horizon_breaks,
     _kink_breaks,
     _kink_coefficients,
@@ -66,7 +66,7 @@ from .albedo import (
     _smooth_inverse,
 )
 
-__all__ = ["ENABLED", "disabled", "supports", "integrate", "interval_error"]
+__all__ = ["ENABLED", "disabled", "integrate", "interval_error", "supports"]
 
 #: the nested path is used where it applies (``disabled()`` switches it off)
 ENABLED = True
@@ -447,7 +447,7 @@ def _split_breaks(lobe) -> np.ndarray:
     """
     if lobe.radial != "power":
         return np.array([])
-    us, ys = _power_split(float(lobe.sharpness))
+    _, ys = _power_split(float(lobe.sharpness))
     out = []
     y = 4.0 * ys
     while y < 0.25:
@@ -527,7 +527,7 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
     s_t1 = np.tile(grid[1:], nI * n_pieces)
     s_k, s_g, s_e, s_a, evals = _evaluate(brdf, g, i_prob, i_x0, i_x1, s_int, s_piece, s_t0, s_t1)
     # the budget counts outer intervals, an interval with m sub-intervals per piece m times
-    seg_count = lambda: np.bincount(i_prob[s_int], minlength=P) / n_pieces  # noqa: E731
+    seg_count = lambda: np.bincount(i_prob[s_int], minlength=P) / n_pieces
     budget = max_regions + seg_count()
     rounding = _rounding(g.lobe)
     while True:

@@ -176,7 +176,7 @@ def test_nested_integrand_equals_the_2d_geometry():
     # the value at one node, as the outer rule on a tiny interval around it would see it: compare the
     # inner sums with the 2-D engine's integrand summed by the same 15-point rule in tau_t
     h = 1e-12
-    k, gs, inner, absk, _ = _nested._evaluate(f, g, np.array([0]), np.array([tx0]), np.array([tx0 + h]), seg_int,
+    k, *_ = _nested._evaluate(f, g, np.array([0]), np.array([tx0]), np.array([tx0 + h]), seg_int,
                                               np.arange(n_pieces), np.zeros(n_pieces), np.ones(n_pieces))
     tt = NODES
     total = 0.0
