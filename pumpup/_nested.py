@@ -52,7 +52,6 @@ from .albedo import (
     _AXIS_CODE,
     _RADIAL_CODE,
     NODES,
-    NX_INIT,
     WG,
     WK,
     _horizon_breaks,
@@ -66,11 +65,13 @@ from .albedo import (
     _smooth_inverse,
 )
 
-__all__ = ["ENABLED", "disabled", "integrate", "interval_error", "supports"]
+__all__ = ["ENABLED", "disabled", "inner_error", "integrate", "interval_error", "supports"]
 
 #: the nested path is used where it applies (``disabled()`` switches it off)
 ENABLED = True
 
+#: initial intervals of tau_x before the breaks are added (as the 2-D engine's NX_INIT)
+NX_INIT = 8
 #: initial sub-intervals of v on every piece of the arc (the 2-D engine starts with 2 in tau_t)
 M_INIT = 1
 #: largest number of sub-intervals per piece before an interval is bisected instead
@@ -105,6 +106,12 @@ def supports(g) -> bool:
     lobe = g.lobe
     generic = lobe.axis == "normal" and lobe.radial == "cosine" and not lobe.symmetric
     return not generic and lobe.axis in _AXIS_CODE and lobe.radial in _RADIAL_CODE
+
+
+def inner_error(kronrod, gauss):
+    """Error estimate of one inner sub-interval at one outer node: |K - G| of the 15-point Kronrod
+    rule and its embedded 7-point Gauss rule (swappable like :func:`interval_error`)."""
+    return np.abs(kronrod - gauss)
 
 
 def interval_error(kronrod, gauss, inner):
@@ -412,12 +419,14 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1):
     hb = sym * h[loc[seg]]
     kron = np.bincount(seg, hb * WK[r] * Kb, minlength=S)
     gauss = np.bincount(seg, hb * WG[r] * Kb, minlength=S)
-    inner = np.bincount(seg, hb * WK[r] * np.abs(Kb - Gb), minlength=S)
+    inner = np.bincount(seg, hb * WK[r] * inner_error(Kb, Gb), minlength=S)
     absk = np.bincount(seg, hb * WK[r] * np.abs(Kb), minlength=S)
     evals = np.bincount(i_prob[seg_int[seg]], minlength=len(g.mu)) * R * len(signs)
     return kron, gauss, inner, absk, evals
 
 
+#: ratio of the geometric grid above the power map's split (_split_breaks)
+SPLIT_RATIO = 4.0
 #: ratio of the geometric grid towards a break (the 2-D engine's _graded uses 4)
 GRADE_RATIO = 16.0
 
@@ -449,11 +458,11 @@ def _split_breaks(lobe) -> np.ndarray:
         return np.array([])
     _, ys = _power_split(float(lobe.sharpness))
     out = []
-    y = 4.0 * ys
+    y = SPLIT_RATIO * ys
     while y < 0.25:
         xc = 0.5 * (1.0 - y) / (1.0 - ys)  # 1 - x, x = 1/2 + (y - y_s) / (2 (1 - y_s))
         out.append(_smooth_inverse(1.0 - xc, xc))
-        y *= 4.0
+        y *= SPLIT_RATIO
     return np.array(out)
 
 
