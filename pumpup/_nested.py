@@ -80,6 +80,10 @@ M_MAX = 4096
 #: sub-intervals per compiled pass (15 points each): the buffers stay in the cache
 CHUNK = 2048
 
+#: the outer (tau_x) and inner (beta) rules: (nodes, Kronrod weights, embedded Gauss weights) on [0, 1]
+_OUTER = (NODES, WK, WG)
+_INNER = (NODES, WK, WG)
+
 #: evaluation counter: integrand evaluations per problem of the last call (for the benchmark)
 LAST_EVALS: np.ndarray | None = None
 
@@ -347,11 +351,13 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1):
     weights, and the sum of |values| (all including the interval width); and the evaluations per
     problem."""
     lobe = g.lobe
-    R = len(NODES)
+    RO, RI = len(_OUTER[0]), len(_INNER[0])
+    onodes, owk, owg = _OUTER
+    inodes, iwk, iwg = _INNER
     uniq, loc = np.unique(seg_int, return_inverse=True)
     h = i_x1[uniq] - i_x0[uniq]
-    tx = (i_x0[uniq][:, None] + h[:, None] * NODES[None, :]).ravel()
-    pnode = np.repeat(i_prob[uniq], R)
+    tx = (i_x0[uniq][:, None] + h[:, None] * onodes[None, :]).ravel()
+    pnode = np.repeat(i_prob[uniq], RO)
     mu_n = np.ascontiguousarray(g.mu[pnode])
     lev_n = np.ascontiguousarray(g.levels[pnode])
     if lobe.kinks is not None:  # the model's kink coefficients: once per outer node (issue 14 item 3)
@@ -369,16 +375,16 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1):
                   np.ascontiguousarray(ka), np.ascontiguousarray(kb), tx, s_n, ca_n, sa_n, wr_n, edges, lab, dn)
     # blocks: (segment, outer node) pairs where the segment's piece is not empty at that node
     S = len(seg_int)
-    node = (loc[:, None] * R + np.arange(R)[None, :]).ravel()  # (S * R,)
-    piece = np.repeat(seg_piece, R)
+    node = (loc[:, None] * RO + np.arange(RO)[None, :]).ravel()  # (S * R,)
+    piece = np.repeat(seg_piece, RO)
     lo = edges[node, piece]
     width = edges[node, piece + 1] - lo
     live = (width > 0) & (wr_n[node] > 0)
     b_seg = np.nonzero(live)[0]  # block -> segment * R + r
     b_node = node[b_seg]
     b_piece = piece[b_seg]
-    b_t0 = np.repeat(seg_t0, R)[b_seg]
-    b_t1 = np.repeat(seg_t1, R)[b_seg]
+    b_t0 = np.repeat(seg_t0, RO)[b_seg]
+    b_t1 = np.repeat(seg_t1, RO)[b_seg]
     # the inner substitution: square-root behaviour only where the arc ends at the horizon (beta0 < pi;
     # sqrt(N.wo) for Ward); beta = 0, a full arc's end and the cuts are analytic ends of a piece
     hi_edge = edges[b_node, b_piece + 1]
@@ -390,38 +396,38 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1):
     b_lo, b_w = lo[b_seg], width[b_seg]
     # in chunks that stay in the cache, through buffers allocated once
     C = min(B, CHUNK)
-    wi = np.empty((C * R, 3))
-    wo = np.empty((C * R, 3))
-    weight = np.empty(C * R)
+    wi = np.empty((C * RI, 3))
+    wo = np.empty((C * RI, 3))
+    weight = np.empty(C * RI)
     Kb = np.zeros(B)
     Gb = np.zeros(B)
     signs = (1.0,) if lobe.symmetric else (1.0, -1.0)
     axis = _AXIS_CODE[lobe.axis]
     for c0 in range(0, B, CHUNK):
         sl = slice(c0, min(B, c0 + CHUNK))
-        n = (sl.stop - sl.start) * R
+        n = (sl.stop - sl.start) * RI
         wi_, wo_, w_ = wi[:n], wo[:n], weight[:n]
         _points_kernel(axis, b_node[sl], b_lo[sl], b_w[sl], b_t0[sl], b_t1[sl], sm[sl], mu_n, s_n, ca_n, sa_n, wr_n,
-                       NODES, wi_, wo_, w_)
+                       inodes, wi_, wo_, w_)
         for sign in signs:
             if sign < 0:
                 wo_[:, 1] *= -1.0  # beta -> -beta flips wo_y in every frame (wi_y = 0)
             f = np.ascontiguousarray(brdf._eval(wi_, wo_), dtype=np.float64)
-            i = _segment_sums_kernel(f, wo_[:, 2], w_, WK, WG, Kb[sl], Gb[sl])
+            i = _segment_sums_kernel(f, wo_[:, 2], w_, iwk, iwg, Kb[sl], Gb[sl])
             if i >= 0:
                 raise ValueError(
                     f"{brdf!r} returned {f[i]!r} at wi={wi_[i].tolist()}, wo={wo_[i].tolist()}: "
                     "a BRDF must be finite and non-negative above the horizon"
                 )
     sym = 2.0 if lobe.symmetric else 1.0
-    r = b_seg % R
-    seg = b_seg // R
+    r = b_seg % RO
+    seg = b_seg // RO
     hb = sym * h[loc[seg]]
-    kron = np.bincount(seg, hb * WK[r] * Kb, minlength=S)
-    gauss = np.bincount(seg, hb * WG[r] * Kb, minlength=S)
-    inner = np.bincount(seg, hb * WK[r] * inner_error(Kb, Gb), minlength=S)
-    absk = np.bincount(seg, hb * WK[r] * np.abs(Kb), minlength=S)
-    evals = np.bincount(i_prob[seg_int[seg]], minlength=len(g.mu)) * R * len(signs)
+    kron = np.bincount(seg, hb * owk[r] * Kb, minlength=S)
+    gauss = np.bincount(seg, hb * owg[r] * Kb, minlength=S)
+    inner = np.bincount(seg, hb * owk[r] * inner_error(Kb, Gb), minlength=S)
+    absk = np.bincount(seg, hb * owk[r] * np.abs(Kb), minlength=S)
+    evals = np.bincount(i_prob[seg_int[seg]], minlength=len(g.mu)) * RI * len(signs)
     return kron, gauss, inner, absk, evals
 
 
