@@ -11,22 +11,28 @@ the hint already says.  This module integrates the same integrand as a nested qu
 (issue 14, item 2):
 
 * outer: globally adaptive 7/15 Gauss-Kronrod in tau_x on [0, 1] (QUADPACK's qk15), started on
-  the 2-D engine's grid (eight intervals, the horizon breaks, the kink breaks and the grid graded
-  geometrically towards each break: ``_horizon_breaks``, ``_kink_breaks``, ``_graded``), the
-  intervals whose error exceeds their share of the tolerance are bisected;
+  the 2-D engine's breaks (eight intervals, the horizon breaks ``_horizon_breaks``, the kink breaks
+  ``_kink_breaks``), a grid graded geometrically towards each break (ratio 16:
+  :func:`_graded_coarse`) and one above the "power" map's split (:func:`_split_breaks`); the
+  intervals whose error exceeds their share of the tolerance are refined;
 * inner, at each of the 15 outer nodes of an interval: the visible arc of beta cut at the same
   cuts as the 2-D engine (the geometry, the cuts and the Cook-Torrance kink coefficients are
-  computed once per outer node, issue 14 item 3), and on each non-empty piece the smoothing
-  substitution t = v^2 (3 - 2 v) and ``m`` equal sub-intervals of v, each with the fixed 15-point
-  Kronrod rule, whose error is measured by the embedded 7-point Gauss rule;
-* the error of an interval is the outer |K - G| plus the inner errors |K - G| carried through the
+  computed once per outer node, issue 14 item 3), and on each non-empty piece the fixed 15-point
+  Kronrod rule on each of the interval's sub-intervals ("segments") of the piece variable v, its
+  error measured by the embedded 7-point Gauss rule (:func:`inner_error`).  The substitution
+  beta = lo + t(v) width is t = 1 - (1 - v)^2 where the piece ends at the horizon (square-root
+  behaviour, sqrt(N.wo) for Ward) and t = v elsewhere (beta = 0, a full arc's end and the cuts are
+  analytic ends of a piece); a piece end at the cut of a small level is graded (:func:`_end_grading`);
+* the error of an interval is the outer |K - G| plus the inner errors carried through the
   (positive) outer Kronrod weights (:func:`interval_error`; the integral of |I_h - I| over the
   interval is bounded by the latter), plus, for the whole value, the 2-D engine's rounding term
   (``_rounding``);
-* inner adaptivity: an interval whose inner error is the larger part of its error is evaluated
-  again with twice as many sub-intervals ``m`` on every piece (never silently accepted); one
-  whose outer error dominates is bisected.  ``max_regions`` is a budget on the intervals
-  refinement adds, an interval with ``m`` sub-intervals counting ``m`` times.
+* refinement: an interval whose inner error is the larger part of its error has its segments
+  above their share (and its worst one) bisected in v (never silently accepted); one whose
+  outer error dominates is bisected in tau_x, its children inheriting its segments.
+  ``max_regions`` is a budget on what refinement adds per value of mu, counted in segments per
+  piece (an outer interval with its initial segments counts once); when it runs out, the
+  (larger) error estimate is returned with converged = False (``pumpup.albedo`` warns).
 
 The geometry runs in two compiled passes per batch (:func:`_nodes_kernel`: per outer node;
 :func:`_points_kernel`: per point), the model's ``_eval`` once per batch on all points (twice
