@@ -470,7 +470,9 @@ def _split_breaks(lobe) -> np.ndarray:
         return np.array([])
     _, ys = _power_split(float(lobe.sharpness))
     out = []
-    y = SPLIT_RATIO * ys
+    # below y = 1e-16 the rest of the peak piece weighs at most 1e-16 of it (u^n du = dy / (n + 1)); for
+    # n > 1073 y_s underflows to 0, so the grid starts there
+    y = max(SPLIT_RATIO * ys, 1e-16)
     while y < 0.25:
         xc = 0.5 * (1.0 - y) / (1.0 - ys)  # 1 - x, x = 1/2 + (y - y_s) / (2 (1 - y_s))
         out.append(_smooth_inverse(1.0 - xc, xc))

@@ -281,3 +281,15 @@ def test_scaled_phong_against_brute_force_spherical_quadrature():
 
     ref, ref_err = quad(ring, 0, math.pi / 2, epsabs=1e-13, epsrel=1e-12, limit=200)
     assert abs(float(a) - ref) <= float(e) + max(ref_err, 1e-12 * ref)
+
+
+@pytest.mark.parametrize("n", [1073.0, 1074.0, 1e4, 1e5])
+def test_sharp_power_lobes_where_the_split_underflows(n):
+    """y_s = 2^-(n+1) underflows to 0 for n > 1073: the grid above the split must still end (it
+    looped for ever) and the value agree with the 2-D engine."""
+    f = pumpup.load({"type": "blinn", "n": n})
+    mu = np.array([1.0, 0.5, 1e-3])
+    a, e = pumpup.albedo(f, mu, return_error=True)
+    with _nested.disabled():
+        b, eb = pumpup.albedo(f, mu, return_error=True)
+    assert np.all(np.abs(a - b) <= e + eb), (a - b, e, eb)
