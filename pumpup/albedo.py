@@ -859,7 +859,7 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     value = np.zeros_like(flat)
     error = np.zeros_like(flat)
     ok = np.ones(flat.shape, bool)
-    from . import _polar
+    from . import _nested, _polar
 
     for w, term in brdf.albedo_terms():
         turn = None
@@ -873,7 +873,9 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
             ok &= fast[2]
             continue
         for idx, g in _groups(term, flat, turn):
-            v, e, conv = _integrate_group(term, g, rtol, atol, max_regions)
+            # the nested quadrature (pumpup._nested) where it applies, else the 2-D cubature
+            nested = _nested.supports(g)
+            v, e, conv = (_nested.integrate if nested else _integrate_group)(term, g, rtol, atol, max_regions)
             value[idx] += w * v
             error[idx] += abs(w) * e
             ok[idx] &= conv

@@ -10,8 +10,9 @@ Measures, on this machine:
 First, for every built-in model family (issue 14): the time of a 257-point table (mu uniform in
 theta) at rtol 1e-10 on one thread (``pumpup.albedo`` on the 257 values, and ``pumpup.tabulate``
 with ``threads=1``), the integrand evaluations per value of mu, the path the engine takes (1-D:
-the closed-form azimuth of ``pumpup._polar``; 2-D: the cubature), and for the 1-D families the
-previous engine (the 2-D cubature, ``pumpup._polar.two_d_only()``) measured in the same run, with
+the closed-form azimuth of ``pumpup._polar``; nst: the nested quadrature of ``pumpup._nested``;
+2-D: the cubature), and for the 1-D and nested families the previous engine (the 2-D cubature,
+``pumpup._polar.two_d_only()``, which switches off both) measured in the same run, with
 the ratio; then scipy ``dblquad`` at mu = 0.5 and epsrel 1e-10 per value (stopped after 60 s), and
 the sweep cell (257 mu + mean albedo + maximum constant) and the three tables of a 3-level g2
 pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs after a warm-up.
@@ -86,19 +87,27 @@ def _best(fn, repeat):
 
 
 def evaluations(f, mu, rtol):
-    """Integrand evaluations of pumpup.albedo(f, mu): the 1-D path's own count, the 2-D engine's
-    points counted at its accumulation step (once per sign of beta)."""
-    from pumpup import _polar
+    """Integrand evaluations of pumpup.albedo(f, mu): the 1-D path's own count, the nested engine's
+    (``pumpup._nested.LAST_EVALS`` of every call), the 2-D engine's points counted at its
+    accumulation step (once per sign of beta)."""
+    from pumpup import _nested, _polar
 
     A = pumpup.albedo_module
     count = [0]
     orig = A._accumulate
+    orig_nested = _nested.integrate
 
     def counting(fv, cos_o, weight, total):
         count[0] += fv.shape[0]
         return orig(fv, cos_o, weight, total)
 
+    def counting_nested(*args):
+        out = orig_nested(*args)
+        count[0] += int(_nested.LAST_EVALS.sum())
+        return out
+
     A._accumulate = counting
+    _nested.integrate = counting_nested
     try:
         for _, term in f.albedo_terms():
             fast = _polar.albedo_1d(term, mu, rtol, 1e-14, 20000)
@@ -108,7 +117,19 @@ def evaluations(f, mu, rtol):
                 pumpup.albedo(term, mu, rtol=rtol)
     finally:
         A._accumulate = orig
+        _nested.integrate = orig_nested
     return count[0] / len(mu)
+
+
+def path_of(f):
+    """'1-D' (closed-form azimuth), 'nst' (nested quadrature) or '2-D' (cubature) for f at phi = 0."""
+    from pumpup import _nested
+
+    if all(t.polar() is not None for _, t in f.albedo_terms()):
+        return "1-D"
+    A = pumpup.albedo_module
+    ok = all(_nested.supports(g) for _, t in f.albedo_terms() for _, g in A._groups(t, np.array([0.5, 1e-3])))
+    return "nst" if ok else "2-D"
 
 
 class _Timeout(Exception):
@@ -142,30 +163,32 @@ def families(rtol=1e-10, specs=None, dblquad=True):
     from pumpup import _polar
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
-    print(f"257-point tables at rtol {rtol:g}, one thread (ms); evaluations per mu; previous = the 2-D engine")
+    print(f"257-point tables at rtol {rtol:g}, one thread (ms); evaluations per mu; previous = the 2-D engine "
+          f"(paths: 1-D closed-form azimuth, nst nested quadrature, 2-D cubature)")
     print(f"{'model':58s} {'path':4s} {'albedo':>9s} {'tabulate':>9s} {'evals/mu':>9s} "
           f"{'previous':>9s} {'evals/mu':>9s} {'ratio':>7s} {'dblquad/value':>14s} {'x per value':>11s}")
     for spec in FAMILIES if specs is None else specs:
         f = pumpup.load(spec)
-        one_d = all(t.polar() is not None for _, t in f.albedo_terms())
+        path = path_of(f)
+        one_d = path == "1-D"
         repeat = (3 if one_d else 1) if dblquad else 20
         pumpup.albedo(f, [0.5, 1e-3])  # compile / load the kernels
         _, t_new = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), repeat)
         _, t_tab = _best(lambda: pumpup.tabulate(f, mu=mu, rtol=rtol, threads=1, progress=False), repeat)
         ev = evaluations(f, mu, rtol)
-        if one_d:
+        if path != "2-D":
             with _polar.two_d_only():
                 pumpup.albedo(f, [0.5, 1e-3])
                 _, t_old = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), 1)
                 ev_old = evaluations(f, mu, rtol)
-            old = f"{t_old * 1e3:9.1f} {ev_old:9.0f} {t_old / t_new:7.0f}"
+            old = f"{t_old * 1e3:9.1f} {ev_old:9.0f} {t_old / t_new:7.1f}"
         else:
             old = f"{'(same)':>9s} {'':9s} {1.0:7.0f}"
         td = dblquad_seconds(f, 0.5, rtol) if spec["type"] not in ("lafortune_sum",) and dblquad else None
         per_value = t_new / len(mu)
         dq = f"{td:14.3f} {td / per_value:11.0f}" if td is not None else f"{'> 60 s':>14s} {'':11s}"
         shown = {k: v for k, v in spec.items()}
-        print(f"{str(shown)[:58]:58s} {'1-D' if one_d else '2-D':4s} {t_new * 1e3:9.1f} {t_tab * 1e3:9.1f} "
+        print(f"{str(shown)[:58]:58s} {path:4s} {t_new * 1e3:9.1f} {t_tab * 1e3:9.1f} "
               f"{ev:9.0f} {old} {dq}", flush=True)
 
 
