@@ -73,9 +73,23 @@ def _two_d():
     return _polar.two_d_only()
 
 
-#: name -> (context manager factory, applies(brdf) -> bool)
+def _nested_applies(f) -> bool:
+    """The nested quadrature (pumpup._nested) integrates f: no closed-form azimuth, every term
+    with a lobe hint (a from_function BRDF stays on the 2-D engine)."""
+    if _has_polar(f):
+        return False
+    for _, t in f.albedo_terms():
+        lobe = t.lobe(0.5)
+        if lobe.axis == "normal" and lobe.radial == "cosine" and not lobe.symmetric:
+            return False
+    return True
+
+
+#: name -> (context manager factory, applies(brdf) -> bool); "nested" is what pumpup.albedo runs by
+#: default where there is no closed-form azimuth, "2-D" the cubature everywhere (the reference)
 ENGINES = {
     "1-D": (contextlib.nullcontext, _has_polar),
+    "nested": (contextlib.nullcontext, _nested_applies),
     "2-D": (_two_d, lambda f: True),
 }
 
