@@ -456,6 +456,8 @@ def _graded_coarse(points: np.ndarray) -> np.ndarray:
     out = list(points)
     for t in points:
         d = min(t, 1.0 - t)
+        if not d > 0:  # a break on an end of the range is the end itself: nothing to grade (d = 0 never grew)
+            continue
         step = d * GRADE_RATIO
         while step <= 0.25:
             out.extend(v for v in (t - step, t + step) if 0 < v < 1)

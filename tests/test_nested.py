@@ -306,3 +306,12 @@ def test_anisotropic_ridge_at_phi_zero(ax, ay):
         b, eb = pumpup.albedo(f, np.array([1.0, 0.5]), return_error=True)
     assert np.all(np.abs(a - b) <= e + eb), (a, b, e, eb)
     assert abs(a[0] - 1.0) < 2e-6
+
+
+def test_graded_breaks_on_an_end_terminate():
+    """A break exactly on an end of the tau range (found by the property test: GGX at an extreme
+    parameter put one at tau = 1) is the end itself; grading towards it looped forever (d = 0)."""
+    from pumpup._nested import _graded_coarse
+
+    out = _graded_coarse(np.array([0.0, 1.0, 1e-3]))
+    assert set(out) >= {0.0, 1.0, 1e-3} and np.all((out >= 0) & (out <= 1)) and len(out) < 20
