@@ -121,6 +121,17 @@ def wavelength_range(material: str) -> tuple[float, float]:
     return float(lo), float(hi)
 
 
+def _in_range(material: str, wavelengths) -> np.ndarray:
+    """The checked wavelengths [nm], refused with one line if one lies outside the material's data."""
+    w = check_wavelengths(wavelengths)
+    lo, hi = wavelength_range(material)
+    bad = w[(w < lo) | (w > hi)]
+    if bad.size:
+        raise SpecError(f"parameter 'wavelengths': {bad[0]:g} nm is outside the range of the {material} data, "
+                        f"[{lo:g}, {hi:g}] nm")
+    return w
+
+
 def constants(material: str, wavelengths=DEFAULT_WAVELENGTHS) -> tuple[np.ndarray, np.ndarray]:
     """Refractive index n and extinction coefficient k of ``material`` at ``wavelengths``.
 
@@ -138,12 +149,7 @@ def constants(material: str, wavelengths=DEFAULT_WAVELENGTHS) -> tuple[np.ndarra
         Real and imaginary parts of the complex index n + i k (dimensionless), one per wavelength.
     """
     _check_material(material)
-    w = check_wavelengths(wavelengths)
-    lo, hi = wavelength_range(material)
-    bad = w[(w < lo) | (w > hi)]
-    if bad.size:
-        raise SpecError(f"parameter 'wavelengths': {bad[0]:g} nm is outside the range of the {material} data, "
-                        f"[{lo:g}, {hi:g}] nm")
+    w = _in_range(material, wavelengths)
     m = _material(material)
     n = np.asarray(m.get_refractive_index(w, unit="nm"), dtype=np.float64)
     k = np.asarray(m.get_extinction_coefficient(w, unit="nm"), dtype=np.float64)
@@ -218,12 +224,7 @@ def dielectric_index(material: str, wavelengths=DEFAULT_WAVELENGTHS) -> tuple[np
     1.5168
     """
     _check_dielectric(material)
-    w = check_wavelengths(wavelengths)
-    lo, hi = wavelength_range(material)
-    bad = w[(w < lo) | (w > hi)]
-    if bad.size:
-        raise SpecError(f"parameter 'wavelengths': {bad[0]:g} nm is outside the range of the {material} data, "
-                        f"[{lo:g}, {hi:g}] nm")
+    w = _in_range(material, wavelengths)
     m = _material(material)
     n = np.asarray(m.get_refractive_index(w, unit="nm"), dtype=np.float64)
     try:

@@ -203,7 +203,7 @@ class Spectral:
         from . import _reuse
         from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
         from .core import check_count, check_open_unit, check_tolerance
-        from .tables import MAX_POINTS_LIMIT, AlbedoTable, _dataset, _midpoints, default_grid
+        from .tables import MAX_POINTS_LIMIT, AlbedoTable, _dataset, _midpoints, _near_new_nodes, default_grid
 
         if phi is not None:
             raise SpecError("Spectral.tabulate: parameter 'phi' must be None (the spectral models are isotropic)")
@@ -248,12 +248,7 @@ class Spectral:
                 errs = np.concatenate([errs, merr[bad]])[order]
                 # a new node changes the spline mostly within a few intervals: check again every
                 # interval within three nodes of a new one (as pumpup.tabulate)
-                is_new = np.concatenate([np.zeros(len(order) - bad.sum(), bool), np.ones(bad.sum(), bool)])[order]
-                near = is_new.copy()
-                for shift in (1, 2, 3):
-                    near[shift:] |= is_new[:-shift]
-                    near[:-shift] |= is_new[shift:]
-                todo = near[:-1] | near[1:]
+                todo = _near_new_nodes(order, int(bad.sum()))
             if todo.any() and miss.size:  # stopped by max_points: the misses not resolved count
                 interp = np.maximum(interp, miss.max(axis=0))
             kind = "adaptive"

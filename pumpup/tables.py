@@ -169,6 +169,17 @@ def nondecreasing(spline) -> bool:
     return bool(np.all(d1(pts) >= 0))
 
 
+def _near_new_nodes(order: np.ndarray, n_new: int) -> np.ndarray:
+    """The intervals to check again after the last ``n_new`` of the nodes (sorted by ``order``) were
+    added: every interval within three nodes of a new one (a new node changes the spline mostly there)."""
+    is_new = np.concatenate([np.zeros(len(order) - n_new, bool), np.ones(n_new, bool)])[order]
+    near = is_new.copy()
+    for shift in (1, 2, 3):
+        near[shift:] |= is_new[:-shift]
+        near[:-shift] |= is_new[shift:]
+    return near[:-1] | near[1:]
+
+
 def _midpoints(mu: np.ndarray) -> np.ndarray:
     """Midpoints of consecutive nodes in log(mu)."""
     return np.sqrt(mu[:-1] * mu[1:])
@@ -272,12 +283,7 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
             err = np.concatenate([err, merr[bad]])[order]
             # a new node changes the spline everywhere, mostly within a few intervals: check
             # again every interval within three nodes of a new one
-            is_new = np.concatenate([np.zeros(len(order) - bad.sum(), bool), np.ones(bad.sum(), bool)])[order]
-            near = is_new.copy()
-            for shift in (1, 2, 3):
-                near[shift:] |= is_new[:-shift]
-                near[:-shift] |= is_new[shift:]
-            todo = near[:-1] | near[1:]
+            todo = _near_new_nodes(order, int(bad.sum()))
         if todo.any():
             interp_error = max(interp_error, float(miss.max()))
     if reusable:
