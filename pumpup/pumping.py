@@ -938,7 +938,7 @@ def load_pumped(path) -> Pumped:
     pumpup.validate.TableError (a ValueError)
         If the file is damaged, edited, or not a saved pumped BRDF (the message says what).
     """
-    from .tables import AlbedoTable, open_table
+    from .tables import open_table
     from .validate import TableError, spec_attribute
 
     where = os.fspath(path)
@@ -961,19 +961,29 @@ def load_pumped(path) -> Pumped:
     if levels != len(chain):
         raise TableError(f"{where!r}: attribute 'levels' = {levels} but its spec has {len(chain)} levels")
     for i, level in enumerate(chain, start=1):
-        try:
-            ds = open_table(path, group=f"level{i}")
-        except OSError as exc:  # a missing group
-            raise TableError(f"{where!r}: group 'level{i}' is missing or unreadable: {exc}") from None
-        if ds.attrs.get("pumpup_kind") != "pumpup albedo table":
-            raise TableError(f"{where!r}: group 'level{i}' is not an albedo table")
-        if json.loads(ds.attrs["spec"]) != level.base.spec:
-            raise TableError(f"{where!r}: group 'level{i}' holds the table of {ds.attrs['spec']}, but level {i} of "
-                             f"the spec pumps {json.dumps(level.base.spec, sort_keys=True)}")
-        try:
-            t = AlbedoTable.from_dataset(ds)
-        except (ValueError, KeyError, TypeError) as exc:
-            raise TableError(f"{where!r}: group 'level{i}': {exc}") from None
-        t.dataset = ds
-        level._own_table = t  # this object's own table: never the shared cache
+        attach_level_table(path, where, f"level{i}", level, f"level {i} of the spec")
     return f
+
+
+def attach_level_table(path, where: str, group: str, level: "Pumped", what: str) -> None:
+    """Read the albedo table in ``group`` of a saved pumped file, check that it is the table of
+    ``level``'s base (``what`` names the level in the message) and make it that object's own table;
+    every problem is one :class:`TableError` naming the file and the group."""
+    from .tables import AlbedoTable, open_table
+    from .validate import TableError
+
+    try:
+        ds = open_table(path, group=group)
+    except OSError as exc:  # a missing group
+        raise TableError(f"{where!r}: group {group!r} is missing or unreadable: {exc}") from None
+    if ds.attrs.get("pumpup_kind") != "pumpup albedo table":
+        raise TableError(f"{where!r}: group {group!r} is not an albedo table")
+    if json.loads(ds.attrs["spec"]) != level.base.spec:
+        raise TableError(f"{where!r}: group {group!r} holds the table of {ds.attrs['spec']}, but {what} "
+                         f"pumps {json.dumps(level.base.spec, sort_keys=True)}")
+    try:
+        t = AlbedoTable.from_dataset(ds)
+    except (ValueError, KeyError, TypeError) as exc:
+        raise TableError(f"{where!r}: group {group!r}: {exc}") from None
+    t.dataset = ds
+    level._own_table = t  # this object's own table: never the shared cache

@@ -175,7 +175,8 @@ def load_spectral_pumped(path, root=None) -> SpectralPumped:
         If the file is damaged, edited, or not a saved spectral pumped BRDF.
     """
     from .core import load
-    from .tables import AlbedoTable, open_table
+    from .pumping import attach_level_table
+    from .tables import open_table
     from .validate import TableError, spec_attribute
 
     where = os.fspath(path)
@@ -204,20 +205,5 @@ def load_spectral_pumped(path, root=None) -> SpectralPumped:
         if levels != len(chain):
             raise TableError(f"{where!r}: attribute 'levels' = {levels} but its spec has {len(chain)} levels")
         for i, level in enumerate(chain, start=1):
-            g = _group(j, i)
-            try:
-                ds = open_table(path, group=g)
-            except OSError as exc:  # a missing group
-                raise TableError(f"{where!r}: group {g!r} is missing or unreadable: {exc}") from None
-            if ds.attrs.get("pumpup_kind") != "pumpup albedo table":
-                raise TableError(f"{where!r}: group {g!r} is not an albedo table")
-            if json.loads(ds.attrs["spec"]) != level.base.spec:
-                raise TableError(f"{where!r}: group {g!r} holds the table of {ds.attrs['spec']}, but level {i} at "
-                                 f"{f.wavelengths[j]:g} nm pumps {json.dumps(level.base.spec, sort_keys=True)}")
-            try:
-                t = AlbedoTable.from_dataset(ds)
-            except (ValueError, KeyError, TypeError) as exc:
-                raise TableError(f"{where!r}: group {g!r}: {exc}") from None
-            t.dataset = ds
-            level._own_table = t  # this object's own table: never the shared cache
+            attach_level_table(path, where, _group(j, i), level, f"level {i} at {f.wavelengths[j]:g} nm")
     return f
