@@ -63,7 +63,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-__all__ = ["Polar", "albedo_1d", "two_d_only", "integrand_reference"]
+__all__ = ["Polar", "albedo_1d", "two_d_only", "integrand", "integrand_reference"]
 
 #: the 1-D path is used when a model offers it (``two_d_only`` switches it off)
 ENABLED = True
@@ -89,8 +89,9 @@ class Polar:
     ----------
     n : float, >= 0
         Exponent of the lobe.
-    p : {0, 1}
-        Power of max(N.L, N.V) in the denominator.
+    p : float in [0, 1]
+        Power of max(N.L, N.V) in the denominator (0 and 1 in closed form, between them an inner
+        rule on the arc where N.wo >= mu, :func:`_arc_power`).
     scale : callable
         ``scale(mu) -> ndarray`` of the same shape: the constant of the model (c, c C^n for a
         Lafortune lobe, k_s / mu for Phong's shader, k_rho / H_s(mu) for Lewis's Phong).
@@ -98,7 +99,7 @@ class Polar:
     """
 
     n: float = 0.0
-    p: int = 0
+    p: float = 0.0
     scale: object = None
     kind: str = "lobe"
 
@@ -119,10 +120,96 @@ def two_d_only():
 # --- the integrand ----------------------------------------------------------------------------
 
 
+#: the inner rule on the arc where N.wo >= mu (p in (0, 1)) is the engine's 7/15 Gauss-Kronrod pair,
+#: globally adaptive on at most INNER_MAX intervals
+INNER_MAX = 64
+#: the inner rule's relative tolerance is rtol / 8, but not below this (its rounding floor is
+#: QUADPACK's 50 eps of the integral)
+INNER_RTOL_MIN = 1e-14
+
+
 @njit(cache=True, nogil=True)
-def _k_of_u(p, mu, c2, u, um, sa):  # pragma: no cover - compiled; see integrand_reference
-    """K(u): the integral over the visible arc of N.wo / max(mu, N.wo)^p (p in {0, 1}), for
-    u = cos(alpha), um = 1 - u, sa = sin(alpha); c2 = cos(2 theta_i)."""
+def _arc_rule(kind, q, mu, um, a, b, lo, hi, nodes, wk, wg, mode, ibuf):  # pragma: no cover - compiled
+    """(value, error) of the rule on [lo, hi] for one piece of H (see :func:`_arc_power`).
+
+    kind 0: beta in [lo, hi], integrand (a + b cos beta)^q;
+    kind 1: v = ln(N.wo / mu) in [lo, hi], N.wo = t = mu e^v, d beta = t dv / (b sin beta), so the
+    integrand is t^(q + 1) / sqrt((b - c)(b + c)) with c = t - a = mu (expm1(v) + 1 - u): smooth
+    where t^q is not (N.wo -> mu -> 0 near grazing incidence)."""
+    h = hi - lo
+    k = 0.0
+    g = 0.0
+    ab = 0.0
+    for j in range(nodes.shape[0]):
+        x = lo + h * nodes[j]
+        if kind == 0:
+            f = (a + b * math.cos(x)) ** q
+        else:
+            c = mu * (math.expm1(x) + um)
+            f = (mu * math.exp(x)) ** (q + 1.0) / math.sqrt((b - c) * (b + c))
+        ibuf[j] = f
+        k += wk[j] * f
+        g += wg[j] * f
+        ab += wk[j] * abs(f)
+    asc = 0.0
+    if mode != 0:
+        for j in range(nodes.shape[0]):
+            asc += wk[j] * abs(ibuf[j] - k)
+    return k * h, calibrated(abs(k - g) * h, asc * h, ab * h, mode)
+
+
+@njit(cache=True, nogil=True)
+def _arc_power(q, mu, um, a, b, beta1, tol, nodes, wk, wg, mode, ibuf, iwork):  # pragma: no cover - compiled
+    """(H, error) of H = integral_0^beta1 (a + b cos beta)^q d beta, q = 1 - p in (0, 1): the arc
+    where N.wo = a + b cos beta >= mu (000 eq. 12's max(N.L, N.V) = N.wo there).
+
+    Where N.wo runs from mu to more than 4 mu, the arc is cut at beta1 / 2 and its lower end
+    (N.wo -> mu, where (N.wo)^q is close to its branch point when mu is small) is integrated in
+    v = ln(N.wo / mu) (:func:`_arc_rule` kind 1); there cos(beta1) = mu (1 - u) / b <= 1/3, so the
+    Jacobian 1 / (b sin beta) is smooth and computed without cancellation.  Otherwise the whole arc
+    is one piece in beta.  Globally adaptive: each piece starts as one interval of the 7/15 rule and
+    the interval with the largest error is bisected until the summed error (QUADPACK's calibrated
+    estimate: every piece is analytic) is at most ``tol`` or INNER_MAX intervals are used; the error
+    is returned either way.  ``iwork`` (5 x INNER_MAX) holds the intervals.
+    """
+    if beta1 <= 0.0:
+        return 0.0, 0.0
+    kd, lo, hi, val, err = iwork[0], iwork[1], iwork[2], iwork[3], iwork[4]
+    if a + b <= 4.0 * mu:  # N.wo at beta = 0 is a + b
+        kd[0], lo[0], hi[0] = 0.0, 0.0, beta1
+        m = 1
+    else:
+        half = 0.5 * beta1
+        kd[0], lo[0], hi[0] = 0.0, 0.0, half
+        kd[1], lo[1], hi[1] = 1.0, 0.0, math.log((a + b * math.cos(half)) / mu)
+        m = 2
+    for i in range(m):
+        val[i], err[i] = _arc_rule(int(kd[i]), q, mu, um, a, b, lo[i], hi[i], nodes, wk, wg, mode, ibuf)
+    while True:
+        tot = 0.0
+        e = 0.0
+        worst = 0
+        for i in range(m):
+            tot += val[i]
+            e += err[i]
+            if err[i] > err[worst]:
+                worst = i
+        if e <= tol or m >= kd.shape[0]:
+            return tot, e
+        mid = 0.5 * (lo[worst] + hi[worst])
+        kd[m], lo[m], hi[m] = kd[worst], mid, hi[worst]
+        hi[worst] = mid
+        val[worst], err[worst] = _arc_rule(int(kd[worst]), q, mu, um, a, b, lo[worst], mid, nodes, wk, wg, mode, ibuf)
+        val[m], err[m] = _arc_rule(int(kd[m]), q, mu, um, a, b, mid, hi[m], nodes, wk, wg, mode, ibuf)
+        m += 1
+
+
+@njit(cache=True, nogil=True)
+def _k_of_u(p, mu, c2, u, um, sa, itol, nodes, wk, wg, mode, ibuf, iwork):  # pragma: no cover - compiled; see integrand_reference
+    """(K(u), its error): K is the integral over the visible arc of N.wo / max(mu, N.wo)^p, for
+    u = cos(alpha), um = 1 - u, sa = sin(alpha); c2 = cos(2 theta_i).  Closed form for p in
+    {0, 1}; for p in (0, 1) the arc where N.wo >= mu by :func:`_arc_power` (relative error
+    ``itol``), the rest in closed form.  The error is 0 for the closed forms."""
     a = mu * u
     d0 = (sa - mu) * (sa + mu)  # b^2 - a^2 = sin^2(alpha) - mu^2
     if d0 > 0.0:
@@ -131,8 +218,8 @@ def _k_of_u(p, mu, c2, u, um, sa):  # pragma: no cover - compiled; see integrand
     else:
         bs0 = 0.0
         beta0 = math.pi
-    if p == 0:
-        return 2.0 * (a * beta0 + bs0)  # 2 (a beta0 + b sin beta0)
+    if p == 0.0:
+        return 2.0 * (a * beta0 + bs0), 0.0  # 2 (a beta0 + b sin beta0)
     d1 = um * (u - c2)  # b^2 - (mu - a)^2
     if d1 > 0.0:
         bs1 = math.sqrt(d1)
@@ -144,15 +231,24 @@ def _k_of_u(p, mu, c2, u, um, sa):  # pragma: no cover - compiled; see integrand
         diff = mu * mu * (1.0 - 2.0 * u) / (bs0 + bs1)  # b sin(beta0) - b sin(beta1), no cancellation
     else:
         diff = bs0 - bs1
-    return 2.0 * (beta1 + (a * (beta0 - beta1) + diff) / mu)  # 000 eq. 7: N.wo / max(mu, N.wo)
+    below = a * (beta0 - beta1) + diff  # integral of N.wo over the arc where 0 < N.wo < mu
+    if p == 1.0:
+        return 2.0 * (beta1 + below / mu), 0.0  # 000 eq. 7: N.wo / max(mu, N.wo)
+    # 000 eq. 12: N.wo / max(mu, N.wo)^p, (N.wo)^(1 - p) on the arc N.wo >= mu
+    below = below / mu**p
+    b = math.sqrt((1.0 - mu) * (1.0 + mu)) * sa  # s sin(alpha)
+    tol = itol * (below + beta1 * mu ** (1.0 - p))  # relative to K (>= its part below + H's lower bound)
+    h, e = _arc_power(1.0 - p, mu, um, a, b, beta1, tol, nodes, wk, wg, mode, ibuf, iwork)
+    return 2.0 * (h + below), 2.0 * e
 
 
-def integrand_reference(n: float, p: int, mu: float, u: np.ndarray) -> np.ndarray:
+def integrand_reference(n: float, p: float, mu: float, u: np.ndarray) -> np.ndarray:
     """Plain numpy u^n K(u), straight from the arccos form (the readable twin of the kernel).
 
     K(u) = J(a, b) for p = 0 and (J(a, b) - J(a - mu, b)) / mu for p = 1, with
     J(a, b) = integral over beta of (a + b cos beta)_+ = 2 (a acos(-a/b) + b sin(acos(-a/b))),
-    a = mu u, b = s sqrt(1 - u^2).
+    a = mu u, b = s sqrt(1 - u^2).  For p in (0, 1): (J(a, b) - J(a - mu, b)) / mu^p for the arc
+    where N.wo < mu, plus 2 integral_0^beta1 (a + b cos beta)^(1 - p) d beta by scipy's QUADPACK.
     """
     u = np.asarray(u, dtype=np.float64)
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -165,8 +261,38 @@ def integrand_reference(n: float, p: int, mu: float, u: np.ndarray) -> np.ndarra
         return np.where(a >= b, 2.0 * np.pi * a, np.where(a <= -b, 0.0, out))
 
     a = mu * u
-    k = J(a) if p == 0 else (J(a) - J(a - mu)) / mu
+    if p in (0, 1):
+        k = J(a) if p == 0 else (J(a) - J(a - mu)) / mu
+        return u**n * k
+    from scipy.integrate import quad
+
+    with np.errstate(divide="ignore", invalid="ignore"):
+        beta1 = np.arccos(np.clip((mu - a) / b, -1.0, 1.0))
+    beta1 = np.where(b > mu - a, beta1, 0.0)
+    h = np.array([quad(lambda t, ai=ai, bi=bi: (ai + bi * math.cos(t)) ** (1.0 - p), 0.0, b1, epsabs=0, epsrel=1e-12,
+                       limit=200)[0] if b1 > 0 else 0.0 for ai, bi, b1 in zip(a.ravel(), b.ravel(), beta1.ravel())])
+    # the arc where 0 < N.wo < mu: all of it (J(a)) less its part above mu, J(a) - J(a - mu) - mu 2 beta1
+    below = J(a) - J(a - mu) - 2.0 * mu * beta1
+    k = below / mu**p + 2.0 * h.reshape(a.shape)
     return u**n * k
+
+
+def integrand(n: float, p: float, mu: float, u, rtol: float = 1e-13):
+    """(u^n K(u), its error) by the compiled kernel at every u in [0, 1] (for tests and checks;
+    ``rtol`` is the inner rule's relative tolerance for p in (0, 1))."""
+    from .albedo import NODES, WG, WK
+
+    u = np.atleast_1d(np.asarray(u, dtype=np.float64))
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    c2 = (mu - s) * (mu + s)
+    ibuf, iwork = np.empty(NODES.shape[0]), np.empty((5, INNER_MAX))
+    val, err = np.empty(u.shape), np.empty(u.shape)
+    for i, v in enumerate(u):
+        k, e = _k_of_u(float(p), mu, c2, v, 1.0 - v, math.sqrt((1.0 - v) * (1.0 + v)), rtol, NODES, WK, WG, mode_code(),
+                       ibuf, iwork)
+        un = v**n if n else 1.0
+        val[i], err[i] = un * k, un * e
+    return val, err
 
 
 @njit(cache=True, nogil=True)
@@ -184,13 +310,14 @@ def _smoothing(sm, tau):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _point(kind, sm, n, p, mu, c2, v0, w, cv1, tau):  # pragma: no cover - compiled
-    """Integrand per d tau at tau in [0, 1] of a piece.
+def _point(kind, sm, n, p, mu, c2, v0, w, cv1, tau, itol, inodes, iwk, iwg, mode, ibuf, iwork):  # pragma: no cover - compiled
+    """(integrand, its error) per d tau at tau in [0, 1] of a piece.
 
     kind 0: u = v0 + w X in [0, 1/2], value u^n K(u) w dX;
     kind 1: y = u^(n+1) in [v0, v0 + w], 1 - y = cv1 + w (1 - X), value K(u) w dX / (n + 1);
     X(tau) is the smoothing substitution ``sm`` (:func:`_smoothing`) at the ends where K has a
-    square-root behaviour.
+    square-root behaviour.  The error is K's (p in (0, 1): the inner rule ``inodes``, ``iwk``,
+    ``iwg`` at relative tolerance ``itol``; 0 for the closed forms) times the same factors.
     """
     x, xc, dx = _smoothing(sm, tau)
     if kind == 0:
@@ -198,13 +325,17 @@ def _point(kind, sm, n, p, mu, c2, v0, w, cv1, tau):  # pragma: no cover - compi
         um = 1.0 - u
         sa = math.sqrt(um * (1.0 + u))
         un = u**n if n > 0.0 else 1.0
-        return un * _k_of_u(p, mu, c2, u, um, sa) * w * dx
+        k, e = _k_of_u(p, mu, c2, u, um, sa, itol, inodes, iwk, iwg, mode, ibuf, iwork)
+        fac = un * w * dx
+        return k * fac, e * fac
     z = v0 + w * x if x < 0.5 else cv1 - w * xc  # z = -(n + 1) ln u, from the nearer end
     lu = -z / (n + 1.0)
     um = -math.expm1(lu)
     u = 1.0 - um if um < 0.5 else math.exp(lu)  # exact to an ulp either way (one exp saved)
     sa = math.sqrt(um * (1.0 + u))
-    return math.exp(-z) * _k_of_u(p, mu, c2, u, um, sa) * w * dx / (n + 1.0)  # u^n du = e^-z dz / (n + 1)
+    k, e = _k_of_u(p, mu, c2, u, um, sa, itol, inodes, iwk, iwg, mode, ibuf, iwork)
+    fac = math.exp(-z) * w * dx / (n + 1.0)  # u^n du = e^-z dz / (n + 1)
+    return k * fac, e * fac
 
 
 # Gauss-Kronrod 10/21 on [-1, 1] (QUADPACK qk21): Kronrod nodes, their weights, and the weights of
@@ -239,24 +370,27 @@ RULE = "gk21"
 
 
 @njit(cache=True, nogil=True)
-def _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf):  # pragma: no cover - compiled
+def _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork):  # pragma: no cover
     """(K, error) of the rule on [t0, t1]; the error is :func:`pumpup._errors.calibrated` of
-    |K - G| (``mode`` 1) or |K - G| itself (0); ``buf`` holds the values (one per node)."""
+    |K - G| (``mode`` 1) or |K - G| itself (0), plus the inner errors of the integrand's values
+    (p in (0, 1)) summed with the Kronrod weights; ``buf`` holds the values (one per node)."""
     h = t1 - t0
     k = 0.0
     g = 0.0
     ab = 0.0
+    ie = 0.0
     for j in range(nodes.shape[0]):
-        f = _point(kind, sm, n, p, mu, c2, v0, w, cv1, t0 + h * nodes[j])
+        f, fe = _point(kind, sm, n, p, mu, c2, v0, w, cv1, t0 + h * nodes[j], itol, inodes, iwk, iwg, mode, ibuf, iwork)
         buf[j] = f
         k += wk[j] * f
         g += wg[j] * f
         ab += wk[j] * abs(f)
+        ie += wk[j] * fe
     asc = 0.0
     if mode != 0:
         for j in range(nodes.shape[0]):
             asc += wk[j] * abs(buf[j] - k)  # resasc: the spread of f about its mean
-    return k * h, calibrated(abs(k - g) * h, asc * h, ab * h, mode)
+    return k * h, calibrated(abs(k - g) * h, asc * h, ab * h, mode) + ie * h
 
 
 #: the peak variable z = -(n + 1) ln u runs at most to Z_MAX: below u = exp(-Z_MAX / (n + 1)) the
@@ -305,7 +439,7 @@ def _pieces(n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
     if 0.0 < s < 1.0:
         ub0, zb0, kb0 = s, -0.5 * n1 * math.log1p(-mu * mu), 0
         m = 1
-    if p == 1 and 0.0 < c2 < 1.0:
+    if p > 0.0 and 0.0 < c2 < 1.0:
         if m == 0:
             ub0, zb0, kb0 = c2, -n1 * math.log1p(-2.0 * s * s), 1
         else:
@@ -330,7 +464,7 @@ def _pieces(n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
         for j in range(nc - 1):
             lo, hi = cv[j], cv[j + 1]
             if hi > lo:
-                left = p == 1 and cc[j] == 1
+                left = p > 0.0 and cc[j] == 1
                 right = cc[j + 1] == 0
                 kinds[k] = 0
                 sms[k] = (1 if left else 0) + (2 if right else 0)
@@ -354,8 +488,8 @@ def _pieces(n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
         lo, hi = cv[j], cv[j + 1]
         if hi > lo:
             # in z the horizon's square root lies above z_s, the level's below z_c
-            left = cc[j] == 0 or (p == 1 and cc[j] == -2)
-            right = p == 1 and cc[j + 1] == 1
+            left = cc[j] == 0 or (p > 0.0 and cc[j] == -2)
+            right = p > 0.0 and cc[j + 1] == 1
             # above the horizon break z_s the arc shrinks from the full circle to half of it on
             # the scale of z_s itself (sin(alpha) ~ mu): near grazing z_s is tiny, and the piece
             # is cut at z_s (1 + 4^i) so that no first interval hides that feature
@@ -383,7 +517,7 @@ def _pieces(n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, val, err, conv, evals):  # pragma: no cover
+def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, inodes, iwk, iwg, val, err, conv, evals):  # pragma: no cover
     """Adaptive Gauss-Kronrod (the rule ``nodes``, ``wk``, ``wg``) of integral u^n K(u) du for
     every mu (without the scale)."""
     cap = max_intervals + 64
@@ -393,6 +527,9 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
     kv = np.empty(cap)
     ke = np.empty(cap)
     buf = np.empty(nodes.shape[0])
+    ibuf = np.empty(inodes.shape[0])
+    iwork = np.empty((5, INNER_MAX))
+    itol = max(0.125 * rtol, INNER_RTOL_MIN)  # the inner error stays a small part of the total
     kinds = np.empty(MAX_PIECES, np.int64)
     sms = np.empty(MAX_PIECES, np.int64)
     v0 = np.empty(MAX_PIECES)
@@ -410,7 +547,7 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
                 pk[m] = i
                 t0[m] = j / n_init
                 t1[m] = (j + 1.0) / n_init
-                kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf)
+                kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork)
                 m += 1
         start = m
         ok = False
@@ -438,11 +575,11 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
             a_, b_ = t0[worst], t1[worst]
             mid = 0.5 * (a_ + b_)
             t1[worst] = mid
-            kv[worst], ke[worst] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf)
+            kv[worst], ke[worst] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork)
             pk[m] = i
             t0[m] = mid
             t1[m] = b_
-            kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf)
+            kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork)
             m += 1
         val[q] = tot
         err[q] = e + r
@@ -468,8 +605,8 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         return None  # (an overflowing constant) the 2-D engine reports what the model returns
     if hint.kind == "constant":
         return scale.copy(), 4.0 * np.finfo(float).eps * np.abs(scale), np.ones(mu.shape, bool), np.zeros(mu.shape, np.int64)
-    if hint.p not in (0, 1):
-        raise ValueError(f"{brdf!r}: a Polar hint needs p in {{0, 1}}, got {hint.p!r}")
+    if not 0.0 <= hint.p <= 1.0:
+        raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
     val = np.empty(mu.shape)
     err = np.empty(mu.shape)
     conv = np.empty(mu.shape, bool)
@@ -477,6 +614,6 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     # atol applies to the scaled albedo: per mu, atol / scale for the unscaled integral
     with np.errstate(divide="ignore"):
         atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
-    _integrate(float(hint.n), int(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
-               *(_RULES[RULE]), mode_code(), N_INIT, val, err, conv, evals)
+    _integrate(float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
+               *(_RULES[RULE]), mode_code(), N_INIT, *_RULES["gk15"], val, err, conv, evals)
     return scale * val, np.abs(scale) * err, conv, evals
