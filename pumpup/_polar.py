@@ -3,7 +3,7 @@
 Method
 ------
 For a lobe that is a power of cos(alpha) = u around the mirror direction R (reciprocal Phong,
-stretched Phong / the p-model with p in {0, 1}, Phong's original shader, Lewis's Phong,
+stretched Phong / the p-model with p in [0, 1], Phong's original shader, Lewis's Phong,
 isotropic Lafortune lobes) or around wi itself (the retro-reflective model, Lafortune with
 cx = cy = -cz), write the outgoing direction in the lobe frame,
 wo = A u + sqrt(1 - u^2) (e1 cos(beta) + e2 sin(beta)).  In both frames
@@ -17,7 +17,12 @@ beta only through N.wo, so for every u the integral over the visible arc |beta| 
 * p = 0, f = c u^n:  integral (a + b cos beta) d beta = 2 (a beta0 + b sin beta0);
 * p = 1, f = c u^n / max(mu, N.wo) (000 eq. 7, 10, 13): the arc |beta| < beta1 where
   N.wo >= mu contributes its length, the rest N.wo / mu:
-  2 [beta1 + (a (beta0 - beta1) + b (sin beta0 - sin beta1)) / mu]
+  2 [beta1 + (a (beta0 - beta1) + b (sin beta0 - sin beta1)) / mu];
+* 0 < p < 1, f = c u^n / max(mu, N.wo)^p (000 eq. 12): the arc where N.wo < mu in closed form as
+  for p = 1, divided by mu^p, plus H = integral_0^beta1 (a + b cos beta)^(1 - p) d beta, which is
+  not elementary: an inner quadrature per value of u (:func:`_arc_power`: the 7/15 rule in beta,
+  and near grazing incidence a Gauss-Jacobi rule for the weight (N.wo)^(1 - p) at the arc's end
+  where N.wo -> mu -> 0), its error added to the outer estimate through the outer weights
 
 (the same closed form as Lewis's H_s, 002 sec. 4.1, and as ``phong_1d`` of
 ``scripts/independent_reference.py``).  With b^2 - a^2 = sin^2(alpha) - mu^2 and
@@ -26,7 +31,7 @@ cancellation, and b (sin beta0 - sin beta1) as mu^2 (1 - 2u) / (b sin beta0 + b 
 
 This leaves a(mu) = c * integral_0^1 u^n K(u) du.  Its kinks are where the arc starts to be
 cut by the horizon (u = s) and where the level N.wo = mu leaves the circle (u = cos 2 theta_i,
-p = 1 only): these, and u = 1/2, are breakpoints.  On [0, 1/2] the variable is u itself; above
+p > 0 only): these, and u = 1/2, are breakpoints.  On [0, 1/2] the variable is u itself; above
 it is z = -(n + 1) ln u, i.e. y = u^(n+1) = e^-z, which absorbs the u^n peak exactly
 (u^n du = e^-z dz / (n + 1); the engine's "power" map, 000 eq. 20, graded logarithmically); z
 stops at Z_MAX = 40, the rest is bounded and added to the error.  Above the horizon break z_s
