@@ -22,6 +22,7 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
     python scripts/bench_albedo.py --cells    # only the sweep cells and the pumped tables
     python scripts/bench_albedo.py --eval     # only BRDF.eval's overhead (the input checks)
     python scripts/bench_albedo.py --phong    # only the Phong family's rows (1-D path), no dblquad
+    python scripts/bench_albedo.py --p        # only the p-model with p in (0, 1): 1-D path against the nested engine
 """
 
 import signal
@@ -192,6 +193,43 @@ def families(rtol=1e-10, specs=None, dblquad=True):
               f"{ev:9.0f} {old} {dq}", flush=True)
 
 
+def p_model(rtol=1e-10, repeat=3):
+    """The p-model with p in (0, 1) (000 eq. 12; the 1-D path's inner rule since issue 14) against the
+    nested engine it replaces (``pumpup._polar.ENABLED = False``), same run, same rtol: a 257-point
+    table (mu uniform in theta) and a sweep cell (257 mu of ``default_mu`` + mean albedo + maximum
+    constant), one thread, best of ``repeat``."""
+    from pumpup import _polar
+    from pumpup.sweeps import default_mu
+
+    mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
+    cell_mu = default_mu(257)
+
+    def cell(f):
+        pumpup.tabulate(f, mu=cell_mu, threads=1, progress=False)
+        pumpup.mean_albedo(f)
+        pumpup.max_albedo(f)
+
+    print(f"p-model, one thread, ms (best of {repeat}); table: 257 mu at rtol {rtol:g}; cell: sweep cell")
+    print(f"{'model':48s} {'table 1-D':>10s} {'nested':>9s} {'ratio':>6s} {'cell 1-D':>9s} {'nested':>9s} {'ratio':>6s}")
+    for spec in [{"type": "stretched_phong", "n": 20, "p": p} for p in (1.0, 0.25, 0.5, 0.75)] + [
+            {"type": "stretched_phong", "n": 1, "p": 0.5}, {"type": "stretched_phong", "n": 1000, "p": 0.5},
+            {"type": "retro", "n": 10, "p": 0.5}]:
+        out = []
+        for enabled in (True, False):
+            _polar.ENABLED = enabled
+            try:
+                f = pumpup.load(spec)
+                pumpup.albedo(f, [0.5, 1e-3], rtol=rtol)
+                _, t_table = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), repeat if enabled else 1)
+                _, t_cell = _best(lambda: cell(pumpup.load(spec)), repeat if enabled else 1)
+            finally:
+                _polar.ENABLED = True
+            out.append((t_table, t_cell))
+        (a, b), (c, d) = out
+        print(f"{str(spec):48s} {a * 1e3:10.1f} {c * 1e3:9.1f} {c / a:6.1f} {b * 1e3:9.1f} {d * 1e3:9.1f} {d / b:6.1f}",
+              flush=True)
+
+
 def cells():
     from pumpup import _polar, _reuse
     from pumpup.pumping import _TABLES
@@ -274,6 +312,9 @@ def main():
         return
     if "--phong" in sys.argv:
         families(specs=PHONG_FAMILY, dblquad=False)
+        return
+    if "--p" in sys.argv:
+        p_model()
         return
     if "--cells" not in sys.argv:
         families()

@@ -237,7 +237,7 @@ def test_bad_brdf_value_is_reported():
 
 @pytest.mark.parametrize("spec", [{"type": "blinn", "n": 16}, {"type": "cook_torrance", "m": 0.3},
                                   {"type": "stretched_phong", "n": 20, "p": 0.5}])
-def test_evaluation_counts_per_mu(spec, capsys):
+def test_evaluation_counts_per_mu(spec, capsys, no_1d):
     """The nested engine spends fewer evaluations per mu than the 2-D engine (counts printed)."""
     f = pumpup.load(spec)
     mu = np.cos(np.linspace(0, np.pi / 2, 18)[:-1])

@@ -140,18 +140,18 @@ class Lafortune(BRDF):
         return _isotropic_lobe(q["n"], q["cx"], q["cy"], q["cz"], q["p"], mu)
 
     def polar(self):
-        """The closed-form-azimuth hint (pumpup._polar) where the lobe is isotropic and p in {0, 1}:
+        """The closed-form-azimuth hint (pumpup._polar) where the lobe is isotropic:
         cx = cy = cz = C > 0 gives (R.V)_M = C (R.V) (stretched Phong), cx = cy = -cz, cz = C > 0
         gives C (L.V) (the retro-reflective lobe); the scale is c C^n (000 eq. 14, 15)."""
         from .._polar import Polar
 
         q = self.p
         C = q["cz"]
-        if q["p"] not in (0.0, 1.0) or not C > 0 or q["cx"] != q["cy"] or abs(q["cx"]) != C:
+        if not C > 0 or q["cx"] != q["cy"] or abs(q["cx"]) != C:
             return None
         with np.errstate(over="ignore"):
             scale = float(q["c"] * np.float64(C) ** q["n"])
-        return Polar(n=q["n"], p=int(q["p"]), scale=lambda mu: np.full(np.shape(mu), scale))
+        return Polar(n=q["n"], p=float(q["p"]), scale=lambda mu: np.full(np.shape(mu), scale))
 
     def azimuth_range(self):
         # (R.V)_M is unchanged by x -> -x and by y -> -y of both L and V: a(phi) = a(-phi) = a(pi - phi)

@@ -83,15 +83,14 @@ class Phong(BRDF):
 
 
 def _polar_hint(n, p, c, per_mu=None):
-    """The closed-form-azimuth hint (pumpup._polar) of a lobe c u^n / max(N.L, N.V)^p with p in
-    {0, 1}; ``per_mu(mu)`` multiplies c (Phong's shader: 1 / mu).  None for other p."""
+    """The closed-form-azimuth hint (pumpup._polar) of a lobe c u^n / max(N.L, N.V)^p, p in [0, 1]
+    (closed form for p in {0, 1}, an inner rule on one arc between them); ``per_mu(mu)`` multiplies
+    c (Phong's shader: 1 / mu)."""
     from .._polar import Polar
 
-    if p not in (0.0, 1.0):
-        return None
     if per_mu is None:
-        return Polar(n=n, p=int(p), scale=lambda mu: np.full(np.shape(mu), c))
-    return Polar(n=n, p=int(p), scale=lambda mu: c * per_mu(mu))
+        return Polar(n=n, p=float(p), scale=lambda mu: np.full(np.shape(mu), c))
+    return Polar(n=n, p=float(p), scale=lambda mu: c * per_mu(mu))
 
 
 # --- stretched Phong / p-model ------------------------------------------------------------
@@ -157,7 +156,7 @@ class StretchedPhong(BRDF):
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"], levels=levels)
 
     def polar(self):
-        return _polar_hint(self.p["n"], self.p["p"], self.p["c"])  # 000 eq. 7, 12 with p in {0, 1}
+        return _polar_hint(self.p["n"], self.p["p"], self.p["c"])  # 000 eq. 7, 12
 
 
 # --- retro-reflective ---------------------------------------------------------------------
