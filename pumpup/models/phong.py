@@ -36,9 +36,9 @@ def _up(wi, wo):
 @njit(cache=True, nogil=True, inline="always")
 def _power(x, n):  # pragma: no cover - compiled; numpy's x**n is its reference
     """x**n for x >= 0 and 0 <= n <= MAX_EXPONENT.  An integral n (the usual Phong exponent) by
-    binary powering (numba's integer power: log2(n) squarings and no libm pow, about 3 x faster; its
-    rounding error stays below the n ulp that one ulp of x already makes of x**n, tests/test_checks.py),
-    any other n by pow."""
+    numba's integer power: binary powering, log2(n) squarings and no libm pow, about 3 x faster,
+    with a rounding error below the n ulp that one ulp of x already makes of x**n
+    (tests/test_phong.py); numba itself takes pow for n > 2**16 = _POW_CUTOFF, and for any other n."""
     k = int(n)
     if k == n:
         return x**k
@@ -54,6 +54,9 @@ def _phong_kernel(lx, ly, lz, vx, vy, vz, n, c):  # pragma: no cover - compiled
         return 0.0
     return c * _power(rv, n)  # 000 eq. 5
 
+
+#: numba's integer power x**k falls back on pow above this k (numba/cpython/numbers.py, int_power)
+_POW_CUTOFF = 0x10000
 
 #: rows per block of _phong_rows: a (B, 3) block of each argument and the scratch stay in the L1 cache
 _BLOCK = 256
@@ -73,7 +76,7 @@ def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compi
     vectorizing them.)"""
     N = out.shape[0]
     k = int(n)
-    integral = k == n
+    integral = k == n and k <= _POW_CUTOFF  # where numba's x**k multiplies, as in _power
     x = np.empty(_BLOCK)  # R.V where lit, else 0
     base = np.empty(_BLOCK)
     acc = np.empty(_BLOCK)
