@@ -237,14 +237,16 @@ def cells():
 
 
 def eval_overhead(n=1_000_000, repeat=15):
-    """BRDF.eval of Phong (with the input checks) against its kernel (_eval), against the previous
-    eval (two ``as_directions`` passes, then _eval) and against a plain fused numpy expression of the
-    same formula, on 1e6 pairs (issue 14 item 6: numpy / eval >= 2, eval / _eval <= 1.2).
+    """BRDF.eval of Phong (with the input checks) against its kernel (_eval) and against a plain fused
+    numpy expression of the same formula, on 1e6 pairs (issue 14 item 6: numpy / eval >= 2 and
+    eval / _eval <= 1.2); beside them the previous eval, measured in the same run: two
+    ``as_directions`` passes, then the broadcasting ufunc ``kernel`` (the previous _eval).
 
     Everything runs on one thread (numba's parallel is not used; numpy is single-threaded here).
     The candidates are timed round-robin, ``repeat`` rounds, so a burst of load on the machine hits
-    all of them; the ratios are of the best times, the medians are shown beside them."""
-    from pumpup.core import as_directions, check_pair
+    all of them; the ratios are of the best wall times, then of the medians and of the best CPU
+    times of this thread in parentheses (a loaded machine preempts the wall times)."""
+    from pumpup.core import as_directions, check_pair, split
 
     rng = np.random.default_rng(1)
 
@@ -263,28 +265,39 @@ def eval_overhead(n=1_000_000, repeat=15):
             rv = 2 * wi[:, 2] * wo[:, 2] - (wi[:, 0] * wo[:, 0] + wi[:, 1] * wo[:, 1] + wi[:, 2] * wo[:, 2])
             return np.where((wi[:, 2] > 0) & (wo[:, 2] > 0) & (rv > 0), c * np.maximum(rv, 0) ** e, 0.0)
 
-        def previous_eval():  # the checks as separate passes (eval before issue 14 item 6)
+        def ufunc():  # the previous _eval: the broadcasting kernel
+            return f.kernel(*split(wi), *split(wo), *f.kernel_args())
+
+        def previous_eval():  # the checks as separate passes, then the ufunc
             a, b = as_directions(wi, "wi"), as_directions(wo, "wo")
             check_pair(a, b)
-            return f._eval(a, b)
+            return f.kernel(*split(a), *split(b), *f.kernel_args())
 
-        cands = {"eval": lambda: f.eval(wi, wo), "_eval": lambda: f._eval(wi, wo),
-                 "checks+_eval": previous_eval, "numpy": numpy_fused}
+        cands = {"eval": lambda: f.eval(wi, wo), "_eval": lambda: f._eval(wi, wo), "numpy": numpy_fused,
+                 "previous eval": previous_eval, "previous _eval": ufunc}
         for fn in cands.values():
             fn()  # compile / load the cached kernels, touch the memory
-        times = {k: [] for k in cands}
+        assert np.array_equal(f.eval(wi, wo), ufunc()) and np.array_equal(f._eval(wi, wo), ufunc())
+        wall = {k: [] for k in cands}
+        cpu = {k: [] for k in cands}  # this thread's CPU time: what a busy machine's other jobs do not add
         for _ in range(repeat):
             for k, fn in cands.items():
-                t = time.perf_counter()
+                t, u = time.perf_counter(), time.thread_time()
                 fn()
-                times[k].append(time.perf_counter() - t)
-        best = {k: min(v) for k, v in times.items()}
-        med = {k: float(np.median(v)) for k, v in times.items()}
-        print(f"{spec} on {n:.0e} pairs, one thread, best (median) of {repeat}: "
-              + ", ".join(f"{k} {best[k] * 1e3:.1f} ({med[k] * 1e3:.1f}) ms" for k in cands))
-        print(f"    numpy / eval = {best['numpy'] / best['eval']:.2f} ({med['numpy'] / med['eval']:.2f})   "
-              f"eval / _eval = {best['eval'] / best['_eval']:.2f} ({med['eval'] / med['_eval']:.2f})   "
-              f"previous eval / _eval = {best['checks+_eval'] / best['_eval']:.2f}", flush=True)
+                wall[k].append(time.perf_counter() - t)
+                cpu[k].append(time.thread_time() - u)
+        best = {k: min(v) for k, v in wall.items()}
+        med = {k: float(np.median(v)) for k, v in wall.items()}
+        bcpu = {k: min(v) for k, v in cpu.items()}
+
+        def ratio(a, b):
+            return f"{best[a] / best[b]:.2f} ({med[a] / med[b]:.2f}; cpu {bcpu[a] / bcpu[b]:.2f})"
+
+        print(f"{spec} on {n:.0e} pairs, one thread, ms best (median; best cpu) of {repeat}: "
+              + ", ".join(f"{k} {best[k] * 1e3:.1f} ({med[k] * 1e3:.1f}; {bcpu[k] * 1e3:.1f})" for k in cands))
+        print(f"    now:      numpy / eval = {ratio('numpy', 'eval')}   eval / _eval = {ratio('eval', '_eval')}")
+        print(f"    previous: numpy / eval = {ratio('numpy', 'previous eval')}   "
+              f"eval / _eval = {ratio('previous eval', 'previous _eval')}", flush=True)
 
 
 def main():

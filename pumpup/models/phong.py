@@ -33,18 +33,6 @@ def _up(wi, wo):
 # --- reciprocal Phong ---------------------------------------------------------------------
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _power(x, n):  # pragma: no cover - compiled; numpy's x**n is its reference
-    """x**n for x >= 0 and 0 <= n <= MAX_EXPONENT.  An integral n (the usual Phong exponent) by
-    numba's integer power: binary powering, log2(n) squarings and no libm pow, about 3 x faster,
-    with a rounding error below the n ulp that one ulp of x already makes of x**n
-    (tests/test_phong.py); numba itself takes pow for n > 2**16 = _POW_CUTOFF, and for any other n."""
-    k = int(n)
-    if k == n:
-        return x**k
-    return x**n
-
-
 @vectorize(cache=True)
 def _phong_kernel(lx, ly, lz, vx, vy, vz, n, c):  # pragma: no cover - compiled
     if lz <= 0.0 or vz <= 0.0:
@@ -52,11 +40,8 @@ def _phong_kernel(lx, ly, lz, vx, vy, vz, n, c):  # pragma: no cover - compiled
     rv = 2.0 * lz * vz - (lx * vx + ly * vy + lz * vz)  # 000 eq. 9
     if rv <= 0.0:
         return 0.0
-    return c * _power(rv, n)  # 000 eq. 5
+    return c * rv**n  # 000 eq. 5
 
-
-#: numba's integer power x**k falls back on pow above this k (numba/cpython/numbers.py, int_power)
-_POW_CUTOFF = 0x10000
 
 #: rows per block of _phong_rows: a (B, 3) block of each argument and the scratch stay in the L1 cache
 _BLOCK = 256
@@ -68,18 +53,15 @@ def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compi
     with the input check in the same pass when ``check``.  Returns the first row of wi and of wo
     that is off the unit sphere (|w|^2 outside [lo2, hi2]) or not finite, -1 where none.
 
-    Blocks of _BLOCK rows, each in loops without branches or calls that the compiler vectorizes:
-    R.V (0 where not lit) and the check; (R.V)^n by binary powering with the loop over the bits of
-    n outside (the same multiplications, in the same order, as ``_power``, so the values are those
-    of ``_phong_kernel`` bit for bit; pow for a non-integral n); c (R.V)^n where lit.  A NaN gives
-    NaN, as in the kernel.  (Loops index block views from 0: an index s + r kept LLVM from
-    vectorizing them.)"""
+    Blocks of _BLOCK rows.  The first loop has no branch or call, so the compiler vectorizes it:
+    R.V (0 where not lit) and the check, which costs little there.  Then the lit rows are gathered
+    without branches (a third of the pairs are dark, at random: an ``if`` mispredicts) and pow runs
+    on them only.  The values are those of ``_phong_kernel`` bit for bit (the same operations,
+    c * pow(R.V, n); a NaN gives what it gives there).  Loops index block views from 0: an index
+    s + r kept LLVM from vectorizing them."""
     N = out.shape[0]
-    k = int(n)
-    integral = k == n and k <= _POW_CUTOFF  # where numba's x**k multiplies, as in _power
     x = np.empty(_BLOCK)  # R.V where lit, else 0
-    base = np.empty(_BLOCK)
-    acc = np.empty(_BLOCK)
+    lit = np.empty(_BLOCK, dtype=np.int64)  # the lit rows of the block
     bad_i = -1
     bad_o = -1
     for s in range(0, N, _BLOCK):
@@ -91,35 +73,24 @@ def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compi
         for r in range(m):
             lx, ly, lz = a[r, 0], a[r, 1], a[r, 2]
             vx, vy, vz = b[r, 0], b[r, 1], b[r, 2]
-            bad |= off_unit(lx, ly, lz, lo2, hi2) | off_unit(vx, vy, vz, lo2, hi2)  # ~free here
+            bad |= off_unit(lx, ly, lz, lo2, hi2) | off_unit(vx, vy, vz, lo2, hi2)
             rv = 2.0 * lz * vz - (lx * vx + ly * vy + lz * vz)  # 000 eq. 9
-            lit = not ((lz <= 0.0) | (vz <= 0.0) | (rv <= 0.0))  # the kernel's tests: NaN passes
-            x[r] = rv if lit else 0.0
+            up = not ((lz <= 0.0) | (vz <= 0.0) | (rv <= 0.0))  # the kernel's tests: NaN passes
+            x[r] = rv if up else 0.0
+            f[r] = 0.0
         if bad and check:  # rare: the first failing rows of this block
             for r in range(m):
                 if bad_i < 0 and off_unit(a[r, 0], a[r, 1], a[r, 2], lo2, hi2):
                     bad_i = s + r
                 if bad_o < 0 and off_unit(b[r, 0], b[r, 1], b[r, 2], lo2, hi2):
                     bad_o = s + r
-        if integral:  # acc = x**k as numba's integer power: acc *= base for a set bit, then base *= base
-            for r in range(m):
-                acc[r] = 1.0
-                base[r] = x[r]
-            e = k
-            while e:
-                if e & 1:
-                    for r in range(m):
-                        acc[r] *= base[r]
-                e >>= 1
-                if e:
-                    for r in range(m):
-                        base[r] *= base[r]
-        else:
-            for r in range(m):
-                acc[r] = 1.0 if x[r] <= 0.0 else x[r] ** n  # pow only where lit (or NaN)
+        q = 0
         for r in range(m):
-            xr = x[r]
-            f[r] = c * acc[r] if (xr > 0.0) | (xr != xr) else 0.0  # 000 eq. 5
+            lit[q] = r
+            q += (x[r] > 0.0) | (x[r] != x[r])
+        for j in range(q):
+            r = lit[j]
+            f[r] = c * x[r] ** n  # 000 eq. 5
     return bad_i, bad_o
 
 
