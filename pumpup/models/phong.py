@@ -47,6 +47,14 @@ def _phong_kernel(lx, ly, lz, vx, vy, vz, n, c):  # pragma: no cover - compiled
 _BLOCK = 256
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _lit_cos(lx, ly, lz, vx, vy, vz):  # pragma: no cover - compiled
+    """R.V where the pair is lit (both above the horizon and R.V > 0, the kernel's tests, which a
+    NaN passes), else 0."""
+    rv = 2.0 * lz * vz - (lx * vx + ly * vy + lz * vz)  # 000 eq. 9
+    return 0.0 if (lz <= 0.0) | (vz <= 0.0) | (rv <= 0.0) else rv
+
+
 @njit(cache=True, nogil=True)
 def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compiled; see _phong_reference
     """The kernel over the rows of C-contiguous (N, 3) arrays into ``out`` (N,) (``BRDF.rows_kernel``),
@@ -54,7 +62,7 @@ def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compi
     that is off the unit sphere (|w|^2 outside [lo2, hi2]) or not finite, -1 where none.
 
     Blocks of _BLOCK rows.  The first loop has no branch or call, so the compiler vectorizes it:
-    R.V (0 where not lit) and the check, which costs little there.  Then the lit rows are gathered
+    R.V (0 where not lit) and, when ``check``, the check, which costs little there.  Then the lit rows are gathered
     without branches (a third of the pairs are dark, at random: an ``if`` mispredicts) and pow runs
     on them only.  The values are those of ``_phong_kernel`` bit for bit (the same operations,
     c * pow(R.V, n); a NaN gives what it gives there).  Loops index block views from 0: an index
@@ -70,15 +78,18 @@ def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compi
         b = wo[s : s + m]
         f = out[s : s + m]
         bad = False
-        for r in range(m):
-            lx, ly, lz = a[r, 0], a[r, 1], a[r, 2]
-            vx, vy, vz = b[r, 0], b[r, 1], b[r, 2]
-            bad |= off_unit(lx, ly, lz, lo2, hi2) | off_unit(vx, vy, vz, lo2, hi2)
-            rv = 2.0 * lz * vz - (lx * vx + ly * vy + lz * vz)  # 000 eq. 9
-            up = not ((lz <= 0.0) | (vz <= 0.0) | (rv <= 0.0))  # the kernel's tests: NaN passes
-            x[r] = rv if up else 0.0
-            f[r] = 0.0
-        if bad and check:  # rare: the first failing rows of this block
+        if check:
+            for r in range(m):
+                lx, ly, lz = a[r, 0], a[r, 1], a[r, 2]
+                vx, vy, vz = b[r, 0], b[r, 1], b[r, 2]
+                bad |= off_unit(lx, ly, lz, lo2, hi2) | off_unit(vx, vy, vz, lo2, hi2)
+                x[r] = _lit_cos(lx, ly, lz, vx, vy, vz)
+                f[r] = 0.0
+        else:
+            for r in range(m):
+                x[r] = _lit_cos(a[r, 0], a[r, 1], a[r, 2], b[r, 0], b[r, 1], b[r, 2])
+                f[r] = 0.0
+        if bad:  # rare: the first failing rows of this block
             for r in range(m):
                 if bad_i < 0 and off_unit(a[r, 0], a[r, 1], a[r, 2], lo2, hi2):
                     bad_i = s + r
