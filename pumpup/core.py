@@ -378,6 +378,15 @@ class BRDF:
         ndarray
             Shape: the broadcast of the leading axes.  0 where wi or wo is at or below
             the horizon.
+
+        Raises
+        ------
+        ValueError
+            One line naming the argument: not 3 components on the last axis, a non-finite
+            value, a vector off unit length by more than ``UNIT_TOL``, or shapes that do not
+            broadcast (wi's errors first).  A model with a ``rows_kernel`` checks arguments
+            of one shape in the same compiled pass as it evaluates them and raises after
+            that pass (it costs what a separate check would); others check before.
         """
         a = _as_vectors(wi, "wi")
         try:
