@@ -40,7 +40,7 @@ def off_unit(x, y, z, lo2, hi2):  # pragma: no cover - compiled; see off_unit_re
     """True where |(x, y, z)|^2 is outside [lo2, hi2] (|w| off 1 by more than the tolerance), and
     for every row with a NaN or an infinity (the comparisons fail)."""
     n2 = x * x + y * y + z * z
-    return (n2 < lo2) | (n2 > hi2) | (n2 != n2)  # no branch: the loops that call it stay vectorized
+    return not ((lo2 <= n2) & (n2 <= hi2))  # `&`, not `and`: no branch, the calling loops stay vectorized
 
 
 def unit_bounds(tol: float) -> tuple[float, float]:
