@@ -2,6 +2,11 @@
 
 The plain numpy version, :func:`first_bad_reference`, is the readable twin of the kernel; the
 tests check that the two find the same rows.
+
+A model may also check while it evaluates (``BRDF.rows_kernel``, issue 14 item 6): its compiled
+loop calls :func:`off_unit` on every row of both arguments in the same pass as the formula and
+returns the first row of each that fails; ``BRDF.eval`` then runs :func:`first_bad` on a failing
+argument for the message, so the errors are word for word those of ``as_directions``.
 """
 
 from __future__ import annotations
@@ -28,6 +33,27 @@ def _first_bad(a, tol):  # pragma: no cover - compiled; see first_bad_reference
             if bad_norm < 0:
                 bad_norm = i
     return -1, bad_norm
+
+
+@njit(cache=True, nogil=True, inline="always")
+def off_unit(x, y, z, lo2, hi2):  # pragma: no cover - compiled; see off_unit_reference
+    """True where |(x, y, z)|^2 is outside [lo2, hi2] (|w| off 1 by more than the tolerance), and
+    for every row with a NaN or an infinity (the comparisons fail)."""
+    n2 = x * x + y * y + z * z
+    return not ((lo2 <= n2) & (n2 <= hi2))  # `&`, not `and`: no branch, the calling loops stay vectorized
+
+
+def unit_bounds(tol: float) -> tuple[float, float]:
+    """(lo2, hi2): |w| in [1 - tol, 1 + tol]  <=>  |w|^2 in [lo2, hi2] (the bounds of :func:`off_unit`)."""
+    return (1.0 - tol) * (1.0 - tol), (1.0 + tol) * (1.0 + tol)
+
+
+def off_unit_reference(a: np.ndarray, tol: float) -> np.ndarray:
+    """:func:`off_unit` in numpy, on the rows of ``a`` (..., 3): non-finite or |w| off 1 by more than tol."""
+    lo2, hi2 = unit_bounds(tol)
+    with np.errstate(over="ignore", invalid="ignore"):
+        n2 = a[..., 0] * a[..., 0] + a[..., 1] * a[..., 1] + a[..., 2] * a[..., 2]  # the kernel's order
+        return ~((lo2 <= n2) & (n2 <= hi2))
 
 
 def first_bad_reference(a: np.ndarray, tol: float) -> tuple[int, int]:

@@ -258,12 +258,26 @@ def as_directions(w: Any, name: str) -> np.ndarray:
 
     The check is one compiled pass (``pumpup._checks.first_bad``) with no temporaries, so its memory
     does not grow with the array (the numpy check once allocated 1.5 GB for 1e8 directions)."""
+    a = _as_vectors(w, name)
+    check_directions(a, name)
+    return a
+
+
+def _as_vectors(w: Any, name: str) -> np.ndarray:
+    """``w`` as a float64 array of 3-vectors on the last axis (no copy when it already is one); its
+    values are not looked at (:func:`check_directions` does that)."""
     try:
         a = np.asarray(w, dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{name} must be an array of unit 3-vectors: {exc}") from None
     if a.ndim == 0 or a.shape[-1] != 3:
         raise ValueError(f"{name} must have 3 components on its last axis, got shape {a.shape}")
+    return a
+
+
+def check_directions(a: np.ndarray, name: str) -> None:
+    """Raise the ValueError of :func:`as_directions` (naming ``name``) if a row of the float64
+    array ``a`` (..., 3) is not finite or not of unit length within ``UNIT_TOL``."""
     from ._checks import first_bad  # finiteness and unit length in one compiled pass
 
     lead = a.shape[:-1]
@@ -275,7 +289,6 @@ def as_directions(w: Any, name: str) -> np.ndarray:
         i = tuple(int(k) for k in np.unravel_index(bad_norm, lead)) if lead else ()
         norm = float(np.sqrt(np.sum(a[i] * a[i])))
         raise ValueError(f"{name} must be unit vectors (|w| = 1 within {UNIT_TOL:g}); |{name}{list(i)}| = {norm:.9g}")
-    return a
 
 
 class BRDF:
@@ -365,14 +378,70 @@ class BRDF:
         ndarray
             Shape: the broadcast of the leading axes.  0 where wi or wo is at or below
             the horizon.
+
+        Raises
+        ------
+        ValueError
+            One line naming the argument: not 3 components on the last axis, a non-finite
+            value, a vector off unit length by more than ``UNIT_TOL``, or shapes that do not
+            broadcast (wi's errors first).  A model with a ``rows_kernel`` checks arguments
+            of one shape in the same compiled pass as it evaluates them and raises after
+            that pass (it costs what a separate check would); others check before.
         """
-        wi = as_directions(wi, "wi")
-        wo = as_directions(wo, "wo")
-        check_pair(wi, wo)
-        return self._eval(wi, wo)
+        a = _as_vectors(wi, "wi")
+        try:
+            b = _as_vectors(wo, "wo")
+        except ValueError:
+            check_directions(a, "wi")  # the errors come in the order of the arguments
+            raise
+        try:
+            check_pair(a, b)
+        except ValueError:
+            check_directions(a, "wi")
+            check_directions(b, "wo")
+            raise
+        rows = self._rows(a, b)
+        if rows is None:
+            check_directions(a, "wi")
+            check_directions(b, "wo")
+            return self._eval(a, b)
+        # checked while evaluated, in one compiled pass over both arguments (issue 14 item 6)
+        from ._checks import unit_bounds
+
+        out = np.empty(a.shape[:-1])
+        bad_i, bad_o = self.rows_kernel(*rows, out.reshape(-1), True, *unit_bounds(UNIT_TOL), *self.kernel_args())
+        if bad_i >= 0:
+            check_directions(a, "wi")  # raises the message of as_directions
+        if bad_o >= 0:
+            check_directions(b, "wo")
+        return out
+
+    #: optional: a compiled loop ``(wi, wo, out, check, lo2, hi2, *kernel_args) -> (bad_i, bad_o)``
+    #: over the rows of C-contiguous (N, 3) arrays that writes ``kernel``'s values into ``out`` (N,)
+    #: and, when ``check``, returns the first row of wi and of wo where ``pumpup._checks.off_unit``
+    #: holds (-1 where none).  ``eval`` then checks its input in the same pass as it evaluates, and
+    #: ``_eval`` uses it without the check, for arguments of one shape (``_rows``).  Only for a class
+    #: whose ``_eval`` is the kernel's: a subclass that changes ``_eval`` sets it back to None.
+    rows_kernel: ClassVar[Callable | None] = None
+
+    def _rows(self, wi: np.ndarray, wo: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """(wi, wo) as (N, 3) views for ``rows_kernel``, or None to take the broadcasting kernel (no
+        rows kernel, shapes that differ, a single vector, an argument that is not a C-contiguous float64
+        array)."""
+        if self.rows_kernel is None or not (isinstance(wi, np.ndarray) and isinstance(wo, np.ndarray)):
+            return None
+        if (wi.ndim < 2 or wi.shape != wo.shape or not (wi.dtype == np.float64 == wo.dtype)
+                or not (wi.flags.c_contiguous and wo.flags.c_contiguous)):
+            return None
+        return wi.reshape(-1, 3), wo.reshape(-1, 3)
 
     def _eval(self, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
         """Evaluate without input checks (the albedo engine calls this)."""
+        rows = self._rows(wi, wo)
+        if rows is not None:
+            out = np.empty(wi.shape[:-1])
+            self.rows_kernel(*rows, out.reshape(-1), False, 1.0, 1.0, *self.kernel_args())
+            return out
         return self.kernel(*split(wi), *split(wo), *self.kernel_args())
 
     def kernel_args(self) -> tuple:

@@ -7,6 +7,9 @@ measured in the same run.
 
     python scripts/bench_eval.py [--pumped] [--spectral]
 
+(These are the kernels, ``_eval``.  The cost of ``BRDF.eval``'s input checks, and eval against a
+fused numpy expression, is ``python scripts/bench_albedo.py --eval``.)
+
 ``--spectral`` also times the spectral gold of 000 sec. 5 (8 wavelengths, n = 20) against one
 wavelength (the scalar ``metal``), with input checks on both: 000 eq. 27/28 with the Fresnel factor
 evaluated directly per wavelength, and eq. 28 with F(Theta_min) tabulated per wavelength.

@@ -11,8 +11,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import vectorize
+from numba import njit, vectorize
 
+from .._checks import off_unit
 from ..core import MAX_EXPONENT, BRDF, Lobe, Param, dot, register
 
 
@@ -40,6 +41,68 @@ def _phong_kernel(lx, ly, lz, vx, vy, vz, n, c):  # pragma: no cover - compiled
     if rv <= 0.0:
         return 0.0
     return c * rv**n  # 000 eq. 5
+
+
+#: rows per block of _phong_rows: a (B, 3) block of each argument and the scratch stay in the L1 cache
+_BLOCK = 256
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _lit_cos(lx, ly, lz, vx, vy, vz):  # pragma: no cover - compiled
+    """R.V where the pair is lit (both above the horizon and R.V > 0, the kernel's tests, which a
+    NaN passes), else 0."""
+    rv = 2.0 * lz * vz - (lx * vx + ly * vy + lz * vz)  # 000 eq. 9
+    return 0.0 if (lz <= 0.0) | (vz <= 0.0) | (rv <= 0.0) else rv
+
+
+@njit(cache=True, nogil=True)
+def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compiled; see _phong_reference
+    """The kernel over the rows of C-contiguous (N, 3) arrays into ``out`` (N,) (``BRDF.rows_kernel``),
+    with the input check in the same pass when ``check``.  Returns the first row of wi and of wo
+    that is off the unit sphere (|w|^2 outside [lo2, hi2]) or not finite, -1 where none.
+
+    Blocks of _BLOCK rows.  The first loop has no branch or call, so the compiler vectorizes it:
+    R.V (0 where not lit) and, when ``check``, the check, which costs little there.  Then the lit rows are gathered
+    without branches (a third of the pairs are dark, at random: an ``if`` mispredicts) and pow runs
+    on them only.  The values are those of ``_phong_kernel`` bit for bit (the same operations,
+    c * pow(R.V, n); a NaN gives what it gives there).  Loops index block views from 0: an index
+    s + r kept LLVM from vectorizing them."""
+    N = out.shape[0]
+    x = np.empty(_BLOCK)  # R.V where lit, else 0
+    lit = np.empty(_BLOCK, dtype=np.int64)  # the lit rows of the block
+    bad_i = -1
+    bad_o = -1
+    for s in range(0, N, _BLOCK):
+        m = min(N - s, _BLOCK)
+        a = wi[s : s + m]
+        b = wo[s : s + m]
+        f = out[s : s + m]
+        bad = False
+        if check:
+            for r in range(m):
+                lx, ly, lz = a[r, 0], a[r, 1], a[r, 2]
+                vx, vy, vz = b[r, 0], b[r, 1], b[r, 2]
+                bad |= off_unit(lx, ly, lz, lo2, hi2) | off_unit(vx, vy, vz, lo2, hi2)
+                x[r] = _lit_cos(lx, ly, lz, vx, vy, vz)
+                f[r] = 0.0
+        else:
+            for r in range(m):
+                x[r] = _lit_cos(a[r, 0], a[r, 1], a[r, 2], b[r, 0], b[r, 1], b[r, 2])
+                f[r] = 0.0
+        if bad:  # rare: the first failing rows of this block
+            for r in range(m):
+                if bad_i < 0 and off_unit(a[r, 0], a[r, 1], a[r, 2], lo2, hi2):
+                    bad_i = s + r
+                if bad_o < 0 and off_unit(b[r, 0], b[r, 1], b[r, 2], lo2, hi2):
+                    bad_o = s + r
+        q = 0
+        for r in range(m):
+            lit[q] = r
+            q += (x[r] > 0.0) | (x[r] != x[r])
+        for j in range(q):
+            r = lit[j]
+            f[r] = c * x[r] ** n  # 000 eq. 5
+    return bad_i, bad_o
 
 
 def _phong_reference(wi, wo, n, c):
@@ -73,6 +136,7 @@ class Phong(BRDF):
     }
     examples = [{"n": 0}, {"n": 1}, {"n": 20}, {"n": 5000}, {"n": 10.5, "c": 1.0}]
     kernel = staticmethod(_phong_kernel)
+    rows_kernel = staticmethod(_phong_rows)
     reference_fn = staticmethod(_phong_reference)
 
     def lobe(self, mu):
