@@ -420,8 +420,8 @@ class BRDF:
     #: over the rows of C-contiguous (N, 3) arrays that writes ``kernel``'s values into ``out`` (N,)
     #: and, when ``check``, returns the first row of wi and of wo where ``pumpup._checks.off_unit``
     #: holds (-1 where none).  ``eval`` then checks its input in the same pass as it evaluates, and
-    #: ``_eval`` uses it without the check, for arguments of one shape (``_rows``).  Only for a class
-    #: whose ``_eval`` is the kernel's: a subclass that changes ``_eval`` sets it back to None.
+    #: ``_eval`` uses it without the check, for arguments of one shape (``_rows``).  Used only while
+    #: ``_eval`` is BRDF's own: a subclass that overrides ``_eval`` takes the check-then-``_eval`` path.
     rows_kernel: ClassVar[Callable | None] = None
 
     def _rows(self, wi: np.ndarray, wo: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
@@ -429,6 +429,8 @@ class BRDF:
         rows kernel, shapes that differ, a single vector, an argument that is not a C-contiguous float64
         array)."""
         if self.rows_kernel is None or not (isinstance(wi, np.ndarray) and isinstance(wo, np.ndarray)):
+            return None
+        if type(self)._eval is not BRDF._eval:  # a subclass that evaluates otherwise is never bypassed
             return None
         if (wi.ndim < 2 or wi.shape != wo.shape or not (wi.dtype == np.float64 == wo.dtype)
                 or not (wi.flags.c_contiguous and wo.flags.c_contiguous)):

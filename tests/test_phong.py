@@ -87,3 +87,19 @@ def test_eval_uses_the_rows_kernel(rng):
     assert f._rows(wi, wo) is not None
     assert f._rows(wi[::2], wo[::2]) is None and f._rows(wi[:1], wo) is None and f._rows(wi[0], wo[0]) is None
     assert pumpup.load({"type": "stretched_phong", "n": 20})._rows(wi, wo) is None  # Phong only, so far
+
+
+def test_subclass_that_overrides_eval_is_not_bypassed(rng):
+    """A Phong subclass with its own _eval: eval goes through it, not through the rows kernel."""
+    base = pumpup.load({"type": "phong", "n": 20})
+
+    class Doubled(type(base)):
+        def _eval(self, wi, wo):
+            return 2.0 * super()._eval(wi, wo)
+
+    f = Doubled(n=20)
+    v = rng.normal(size=(100, 3))
+    v /= np.linalg.norm(v, axis=-1, keepdims=True)
+    v[:, 2] = np.abs(v[:, 2])
+    w = v[::-1].copy()
+    np.testing.assert_array_equal(f.eval(v, w), 2.0 * base.eval(v, w))
