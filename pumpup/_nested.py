@@ -542,7 +542,9 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
     P = len(g.mu)
     n_pieces = 1 + g.levels.shape[1] + (len(g.lobe.kinks(np.array([0.5]), np.array([0.5]), np.array([0.5]),
                                                          np.array([0.5]))) if g.lobe.kinks else 0)
-    kink_breaks = _kink_breaks(g.lobe, g.mu, g.levels)
+    # the crossings of two cuts are kinks of the 2-D engine's sorted pieces, not of the arc's integral
+    # that the outer rule here sees (the pieces at one outer node add up to it whatever their order)
+    kink_breaks = _kink_breaks(g.lobe, g.mu, g.levels, crossings=False)
     split = _split_breaks(g.lobe)
     cols = []
     for p_ in range(P):

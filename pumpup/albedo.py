@@ -17,6 +17,10 @@ error is larger), in coordinates chosen from the BRDF's :class:`~pumpup.core.Lob
   a + b cos(beta) in all four frames, and the kinks of the integrand (max(N.L, N.V), the
   levels of a pumped BRDF's g, the Cook-Torrance geometry factor) as breakpoints in beta,
   so every piece is smooth;
+* breakpoints in x where a kink enters or leaves the arc (also where it only touches it: two
+  roots in one cell of the scan), and, since the pieces are the cuts in sorted order, where two
+  cuts cross or a cut meets the horizon end of the arc (``_kink_breaks``): inside a rectangle,
+  such a kink in x can make the Kronrod and Gauss rules agree while both are wrong;
 * a smoothing substitution x = tau^2 (3 - 2 tau) on both axes, which removes the
   square-root behaviour at the ends of every piece.
 
@@ -570,7 +574,7 @@ _TAU_SCAN = np.unique(np.concatenate([
 _END_GAP = 1e-10
 
 
-def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray) -> list[np.ndarray]:
+def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool = True) -> list[np.ndarray]:
     """Values of tau_x where a kink of the integrand enters or leaves the arc of beta, for
     every problem (mu (P,), levels (P, L)); a list of P arrays.
 
@@ -579,59 +583,161 @@ def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray) -> list[np.ndar
     behaviour in x (and at normal incidence, where b = 0, it becomes a circle: a jump in
     the derivative along x).  Roots of a -+ b are found on a graded scan and refined by
     bisection to full precision, all problems at once.
+
+    Two roots in one cell of the scan leave no sign change on it: a level u near 1 is on the arc
+    only where the arc's highest point a + |b| = cos(alpha - theta) exceeds u, a window of width
+    2 arccos(u) around the axis (6e-4 rad for u = 1 - 1.9e-7, the cap of ``scaled`` Phong n = 5's
+    table at mu = 0.823, inside one 2.5e-3 cell).  Unseen, the piece above the level had width 0 at
+    every node of every first rectangle: K = G = 0, never refined, and the cap (5.1e-7 of the
+    albedo) was missing with an estimate of 1e-13.  So every interior local minimum of |a -+ b| on
+    the scan is followed by a golden-section search of its two cells for a change of sign
+    (:func:`_touching_pairs`), and both roots are refined like the others.
     """
     P = len(mu)
     if not levels.shape[1] and lobe.kinks is None:
         return [np.array([]) for _ in range(P)]
 
-    def coeffs(m, tau, lev):
-        s = np.sqrt((1.0 - m) * (1.0 + m))
-        x, xc, _ = _smooth(tau)
-        ca, sa, _ = _radial(lobe.radial, lobe.sharpness, x, xc)
-        if lobe.axis == "normal":
-            a0, b0 = ca, np.zeros_like(ca)
-        elif lobe.axis in ("mirror", "retro"):
-            a0, b0 = m * ca, s * sa
-        else:
-            a0, b0 = m * (ca * ca - sa * sa), 2.0 * s * sa * ca
-        pairs = [(a0 - lev[:, j], b0) for j in range(lev.shape[1])]
-        if lobe.kinks is not None:
-            pairs += list(lobe.kinks(m, s, ca, sa))
-        return ([np.broadcast_to(np.asarray(a, float), m.shape) for a, _ in pairs],
-                [np.broadcast_to(np.asarray(b, float), m.shape) for _, b in pairs])
+    def values(p_sel, tau):
+        """(A, B): (n_cuts + 1, n) coefficients a + b cos(beta) of the cuts (the levels N.wo = u, then
+        the model's kinks) and, last, of the horizon N.wo = 0, for problems p_sel at tau."""
+        m, lev = mu[p_sel], levels[p_sel]
+        with np.errstate(all="ignore"):
+            s = np.sqrt((1.0 - m) * (1.0 + m))
+            x, xc, _ = _smooth(tau)
+            ca, sa, _ = _radial(lobe.radial, lobe.sharpness, x, xc)
+            if lobe.axis == "normal":
+                a0, b0 = ca, np.zeros_like(ca)
+            elif lobe.axis in ("mirror", "retro"):
+                a0, b0 = m * ca, s * sa
+            else:
+                a0, b0 = m * (ca * ca - sa * sa), 2.0 * s * sa * ca
+            pairs = [(a0 - lev[:, j], b0) for j in range(lev.shape[1])]
+            if lobe.kinks is not None:
+                pairs += list(lobe.kinks(m, s, ca, sa))
+            pairs.append((a0, b0))
+        return (np.stack([np.broadcast_to(np.asarray(a, float), m.shape) for a, _ in pairs]),
+                np.stack([np.broadcast_to(np.asarray(b, float), m.shape) for _, b in pairs]))
+
+    L = levels.shape[1]
+    n_cuts = L + (len(lobe.kinks(*(np.full(1, 0.5) for _ in range(4)))) if lobe.kinks is not None else 0)
+    # the functions whose roots are breaks, one row each per problem: (kind, j, k, sign) with kind 0,
+    # a_j - sign b_j (the cut j enters or leaves the arc), and kind 1, a_j b_k - a_k b_j (the cuts j
+    # and k cross; k = n_cuts is the horizon end beta0).  The pieces are the cuts in sorted order,
+    # so where two cross, or a cut meets beta0, each piece's ends have a kink in x: Cook-Torrance
+    # m = 0.3, ior 1.5 at mu = 0.3414 has its three geometry-factor cuts meet at tau_x = 0.0022
+    # inside a rectangle whose 15 x 15 and 7 x 7 rules agreed to 1e-15 and were both 1.3e-11 off
+    # (rtol 3e-11); ward_aniso ax = 0.05, ay = 0.5 at mu = 0.1, phi = 0.7 has the hint's constant
+    # cuts at the model's axes meet beta0 (8.2e-10 off, estimate 2.2e-14).  Two levels never cross
+    # (distinct values of N.wo on the same arc), nor a level and beta0 (N.wo = 0).
+    funcs = [(0, j, j, sign) for j in range(n_cuts) for sign in (1.0, -1.0)]
+    if crossings:
+        funcs += [(1, j, k, 0.0) for j in range(L, n_cuts) for k in list(range(j)) + [n_cuts]]
+    kind, fj, fk, fs = (np.array(c) for c in zip(*funcs))
+    F = len(funcs)
+
+    def h_rows(rows, tau):
+        """the function of each row (function rows // P, problem rows % P) at tau"""
+        f_ = rows // P
+        a_, b_ = values(rows % P, tau)
+        i = np.arange(len(rows))
+        aj, bj, ak, bk = a_[fj[f_], i], b_[fj[f_], i], a_[fk[f_], i], b_[fk[f_], i]
+        with np.errstate(all="ignore"):
+            return np.where(kind[f_] == 0, aj - fs[f_] * bj, aj * bk - ak * bj)
 
     G = len(_TAU_SCAN)
-    m_all = np.repeat(mu, G)
-    lev_all = np.repeat(levels, G, axis=0)
+    # on the scan the coefficients are computed once for all functions: (n_cuts + 1, P, G)
+    a_, b_ = values(np.repeat(np.arange(P), G), np.tile(_TAU_SCAN, P))
+    a_, b_ = a_.reshape(-1, P, G), b_.reshape(-1, P, G)
+    aj, bj, ak, bk = a_[fj], b_[fj], a_[fk], b_[fk]  # (F, P, G)
     with np.errstate(all="ignore"):
-        A, B = coeffs(m_all, np.tile(_TAU_SCAN, P), lev_all)
+        h = np.where((kind == 0)[:, None, None], aj - fs[:, None, None] * bj, aj * bk - ak * bj).reshape(F * P, G)
+    r_idx, t = _roots(h, h_rows)
+    # a root within 1e-10 of an end is the end itself (a level through the lobe axis, N.wo = mu on
+    # the mirror axis, touches the arc at alpha = 0): grading the grid towards it cost ~100
+    # rectangles per mu and changed nothing
+    keep = (_END_GAP < t) & (t < 1.0 - _END_GAP)
+    f_ = r_idx // P
+    if np.any(kind[f_] == 1):  # a crossing counts where both cuts are on the arc
+        a_, b_ = values(r_idx % P, t)
+        i = np.arange(len(r_idx))
+        on = (np.abs(a_[fj[f_], i]) <= np.abs(b_[fj[f_], i])) & (np.abs(a_[fk[f_], i]) <= np.abs(b_[fk[f_], i]))
+        keep &= (kind[f_] == 0) | on
     out = [[] for _ in range(P)]
-    for j in range(len(A)):
-        for sign in (1.0, -1.0):
-            h = (A[j] - sign * B[j]).reshape(P, G)
-            ok = np.isfinite(h)
-            p_idx, i_idx = np.nonzero(ok[:, :-1] & ok[:, 1:] & (np.sign(h[:, :-1]) * np.sign(h[:, 1:]) < 0))
-            if not len(p_idx):
-                continue
-            lo, hi = _TAU_SCAN[i_idx].copy(), _TAU_SCAN[i_idx + 1].copy()
-            h_lo = h[p_idx, i_idx]
-            m, lev = mu[p_idx], levels[p_idx]
-            for _ in range(64):  # bisection: the cells are at least 1e-13 wide
-                mid = 0.5 * (lo + hi)
-                with np.errstate(all="ignore"):
-                    a_, b_ = coeffs(m, mid, lev)
-                h_mid = a_[j] - sign * b_[j]
-                left = np.sign(h_mid) == np.sign(h_lo)
-                lo = np.where(left, mid, lo)
-                h_lo = np.where(left, h_mid, h_lo)
-                hi = np.where(left, hi, mid)
-            for p_, t in zip(p_idx, 0.5 * (lo + hi)):
-                # a root within 1e-10 of an end is the end itself (a level through the lobe axis,
-                # N.wo = mu on the mirror axis, touches the arc at alpha = 0): grading the grid
-                # towards it cost ~100 rectangles per mu and changed nothing
-                if _END_GAP < t < 1.0 - _END_GAP:
-                    out[p_].append(t)
+    for p_, t_ in zip(r_idx[keep] % P, t[keep]):
+        out[p_].append(t_)
     return [np.array(o) for o in out]
+
+
+_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
+
+
+def _roots(h: np.ndarray, h_at) -> tuple[np.ndarray, np.ndarray]:
+    """(problem, tau) of the roots of a function sampled as ``h`` (P, G) on ``_TAU_SCAN``, with
+    ``h_at(p, tau)`` to evaluate it: every sign change between scan nodes and every pair of roots
+    around a local minimum of |h| (:func:`_touching_pairs`), refined by bisection."""
+    ok = np.isfinite(h)
+    p_idx, i_idx = np.nonzero(ok[:, :-1] & ok[:, 1:] & (np.sign(h[:, :-1]) * np.sign(h[:, 1:]) < 0))
+    lo, hi = _TAU_SCAN[i_idx].copy(), _TAU_SCAN[i_idx + 1].copy()
+    h_lo = h[p_idx, i_idx]
+    tp, tlo, thi, tmid, th_lo, th_mid = _touching_pairs(h, ok, h_at)
+    p_idx = np.concatenate([p_idx, tp, tp])
+    lo = np.concatenate([lo, tlo, tmid])
+    hi = np.concatenate([hi, tmid, thi])
+    h_lo = np.concatenate([h_lo, th_lo, th_mid])
+    if not len(p_idx):
+        return p_idx, lo
+    for _ in range(64):  # bisection: the cells are at least 1e-13 wide
+        mid = 0.5 * (lo + hi)
+        h_mid = h_at(p_idx, mid)
+        left = np.sign(h_mid) == np.sign(h_lo)
+        lo = np.where(left, mid, lo)
+        h_lo = np.where(left, h_mid, h_lo)
+        hi = np.where(left, hi, mid)
+    return p_idx, 0.5 * (lo + hi)
+
+
+def _touching_pairs(h: np.ndarray, ok: np.ndarray, h_at):
+    """Brackets of root pairs that the scan of :func:`_kink_breaks` shows no sign change for.
+
+    ``h`` (P, G) are the values of one kink function a -+ b on ``_TAU_SCAN`` (``ok`` where finite)
+    and ``h_at(p, tau)`` evaluates it for problems ``p`` at ``tau``.  At every interior node i where
+    |h| has a local minimum and h keeps its sign on the nodes i - 1, i, i + 1, a golden-section search
+    of [tau_{i-1}, tau_{i+1}] minimises sign(h_i) h; where it finds the opposite sign at some t, the
+    cells [tau_{i-1}, t] and [t, tau_{i+1}] each hold a root.  Returns the arrays
+    (problem, tau_{i-1}, tau_{i+1}, t, h(tau_{i-1}), h(t)) of those found.
+    """
+    empty = np.zeros(0, np.int64), *(np.zeros(0) for _ in range(5))
+    if h.shape[1] < 3:
+        return empty
+    ah = np.abs(h)
+    sg = np.sign(h)
+    c = (ok[:, :-2] & ok[:, 1:-1] & ok[:, 2:] & (sg[:, 1:-1] != 0) & (sg[:, :-2] == sg[:, 1:-1])
+         & (sg[:, 2:] == sg[:, 1:-1]) & (ah[:, 1:-1] < ah[:, :-2]) & (ah[:, 1:-1] <= ah[:, 2:]))
+    p_idx, i_idx = np.nonzero(c)
+    if not len(p_idx):
+        return empty
+    i_idx = i_idx + 1
+    s0 = sg[p_idx, i_idx]
+    a, b = _TAU_SCAN[i_idx - 1].copy(), _TAU_SCAN[i_idx + 1].copy()
+    found = np.full(len(p_idx), np.nan)
+    h_found = np.zeros(len(p_idx))
+    for _ in range(48):  # (0.618)^48 ~ 1e-10 of a cell (< 1e-12 in tau)
+        x1 = b - _GOLDEN * (b - a)
+        x2 = a + _GOLDEN * (b - a)
+        q1, q2 = s0 * h_at(p_idx, x1), s0 * h_at(p_idx, x2)
+        for x, q in ((x1, q1), (x2, q2)):
+            new = np.isnan(found) & (q < 0)
+            found = np.where(new, x, found)
+            h_found = np.where(new, s0 * q, h_found)
+        if not np.isnan(found).any():
+            break
+        left = ~(q1 >= q2)  # NaN (outside the map's range) keeps the left part
+        b = np.where(left, x2, b)
+        a = np.where(left, a, x1)
+    hit = ~np.isnan(found)
+    p_idx, i_idx = p_idx[hit], i_idx[hit]
+    return (p_idx, _TAU_SCAN[i_idx - 1].copy(), _TAU_SCAN[i_idx + 1].copy(), found[hit],
+            h[p_idx, i_idx - 1], h_found[hit])
 
 
 def _graded(points: np.ndarray) -> np.ndarray:
