@@ -12,6 +12,8 @@ The references (all computed without pumpup):
 
 * ``tests/data/independent_reference.json``: nested QUADPACK in spherical coordinates about N,
   three methods (the Phong, Blinn, Ward and Cook-Torrance families), relative error ~1e-14;
+* ``tests/data/independent_p.json``: the p-model (stretched Phong, retro) with p in {0, 0.25, 0.5, 0.75, 1},
+  30-digit mpmath about the lobe axis checked by two scipy orders about N (``scripts/independent_p.py``);
 * ``tests/data/independent_anisotropic.json``: ward_aniso and anisotropic Lafortune, two nested
   quadratures (at the azimuths of incidence stored there);
 * 30-digit mpmath 1-D quadratures of reciprocal and stretched Phong (the azimuth about R in
@@ -155,6 +157,14 @@ def cases(quick: bool = False):
         out.append({"id": f"aniso-{r['model']}-{json.dumps(r['params'])}-mu{r['mu']}-phi{r['phi']:.3f}",
                         "spec": {"type": r["model"], **r["params"]}, "mu": r["mu"], "phi": r["phi"],
                         "value": r["albedo"], "ref_err": r["abs_err_estimate"]})
+    # the p-model with p in (0, 1) and its p = 0, 1 checks (scripts/independent_p.py: 30-digit mpmath
+    # about the lobe axis, checked by two scipy orders about N; stretched Phong and retro, equal albedos)
+    for e in json.loads((DATA / "independent_p.json").read_text())["entries"]:
+        if quick and (e["model"] == "retro" or e["p"] in (0.0, 1.0) or e["mu"] in (0.9, 1e-4)):
+            continue
+        out.append({"id": f"p-{e['model']}-n{e['n']:g}-p{e['p']:g}-mu{e['mu']:.3g}",
+                    "spec": {"type": e["model"], "n": float(e["n"]), "p": float(e["p"])}, "mu": e["mu"], "phi": 0.0,
+                    "value": e["value"], "ref_err": e["abs_err_estimate"]})
     for n, p in MP_LOBES:
         if quick and n == 0:
             continue  # (2.5 s of mpmath: the indicator (R.V)_+^0 has a jump)
