@@ -62,6 +62,7 @@ engine stays the reference: :func:`two_d_only` switches the 1-D path off.
 from __future__ import annotations
 
 import contextlib
+import functools
 import math
 from dataclasses import dataclass
 
@@ -223,9 +224,17 @@ def _arc_power(q, mu, a, b, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iwork,
         m += 1
 
 
+#: the unused Gauss-Jacobi argument of the closed forms p in {0, 1} (read-only, as jacobi_rules' arrays:
+#: one compiled signature)
+_NO_JACOBI = np.zeros((4, 1))
+_NO_JACOBI.flags.writeable = False
+
+
+@functools.lru_cache(maxsize=256)
 def jacobi_rules(q: float) -> np.ndarray:
     """Nodes on [0, 1] and weights of the Gauss-Jacobi rules for integral_0^1 t^q g(t) dt, of
-    :data:`JACOBI_ORDERS` (the error estimate, the value): rows t, w of the first, t, w of the second."""
+    :data:`JACOBI_ORDERS` (the error estimate, the value): rows t, w of the first, t, w of the second
+    (read-only, cached per q: scipy computes them in about 0.1 ms)."""
     from scipy.special import roots_jacobi
 
     lo_n, hi_n = JACOBI_ORDERS
@@ -234,6 +243,7 @@ def jacobi_rules(q: float) -> np.ndarray:
         x, w = roots_jacobi(n, 0.0, q)  # weight (1 + x)^q on [-1, 1]
         out[row, :n] = 0.5 * (x + 1.0)
         out[row + 1, :n] = w / 2.0 ** (q + 1.0)  # (the shorter rule is padded: _arc_power reads its first n)
+    out.flags.writeable = False
     return out
 
 
@@ -318,7 +328,7 @@ def integrand(n: float, p: float, mu: float, u, rtol: float = 1e-13):
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     c2 = (mu - s) * (mu + s)
     ibuf, iwork = np.empty(NODES.shape[0]), np.empty((4, INNER_MAX))
-    jac = jacobi_rules(1.0 - p) if 0.0 < p < 1.0 else np.zeros((4, 1))
+    jac = jacobi_rules(1.0 - p) if 0.0 < p < 1.0 else _NO_JACOBI
     val, err = np.empty(u.shape), np.empty(u.shape)
     for i, v in enumerate(u):
         k, e = _k_of_u(float(p), mu, c2, v, 1.0 - v, math.sqrt((1.0 - v) * (1.0 + v)), rtol, NODES, WK, WG, mode_code(),
@@ -640,7 +650,7 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         return scale.copy(), 4.0 * np.finfo(float).eps * np.abs(scale), np.ones(mu.shape, bool), np.zeros(mu.shape, np.int64)
     if not 0.0 <= hint.p <= 1.0:
         raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
-    jac = jacobi_rules(1.0 - hint.p) if 0.0 < hint.p < 1.0 else np.zeros((4, 1))
+    jac = jacobi_rules(1.0 - hint.p) if 0.0 < hint.p < 1.0 else _NO_JACOBI
     val = np.empty(mu.shape)
     err = np.empty(mu.shape)
     conv = np.empty(mu.shape, bool)
