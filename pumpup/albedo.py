@@ -21,6 +21,10 @@ error is larger), in coordinates chosen from the BRDF's :class:`~pumpup.core.Lob
   roots in one cell of the scan), and, since the pieces are the cuts in sorted order, where two
   cuts cross or a cut meets the horizon end of the arc (``_kink_breaks``): inside a rectangle,
   such a kink in x can make the Kronrod and Gauss rules agree while both are wrong;
+* in beta, the first rectangles of a piece that ends at the cut of a small level N.wo = u graded
+  towards that end (``_level_end_scales``): continued past the cut, N.wo reaches 0 within
+  sqrt(u / (3 dn w)) in tau_t, the branch point of a p-model's N.wo^(1 - p), which both rules miss
+  near grazing incidence (u = mu);
 * a smoothing substitution x = tau^2 (3 - 2 tau) on both axes, which removes the
   square-root behaviour at the ends of every piece.
 
@@ -773,8 +777,8 @@ def _level_end_scales(lobe: Lobe, mu: float, levels: np.ndarray, gx: np.ndarray,
     u / (dn w) in t, sqrt(u / (3 dn w)) in tau_t (1 - t ~ 3 (1 - tau_t)^2): there the integrand of a
     p-model, c (R.V)^n N.wo^(1 - p) (000 eq. 12, times the cosine), has its branch point.  Near
     grazing incidence (u = mu) that is far inside the rule's outermost node: with p = 1/2, where the
-    limit u -> 0 of the integrand, (R.V)^n sqrt(3 dn w) (1 - tau_t) near the end, is a polynomial, the
-    15- and 7-point rules agree on the limit and both miss the O(u^(3/2)) difference (stretched Phong
+    limit u -> 0 of the integrand is analytic at the end (N.wo^(1/2) ~ (1 - tau_t) sqrt(3 dn w)), the
+    15 x 15 and 7 x 7 rules agree on the limit and both miss the O(u^(3/2)) difference (stretched Phong
     n = 1, p = 1/2, mu = 1e-7: 0.4576559181133117, |K - G| 7.1e-12, true error 1.7e-11).  The piece
     above the cut (N.wo < u) has no such point near its end: N.wo grows past it.  The engine does not
     know p (nor what a pumped model does at N.wo -> 0), so every level's cut is treated alike.
