@@ -174,3 +174,58 @@ def test_anisotropic_axis_cuts_crossing_the_horizon():
     for rtol in (1e-10, 1e-13):
         a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol, phi=phi)
         assert abs(float(a) - ref) <= float(e) + REF_ERR, (rtol, float(a), ref, float(e))
+
+
+# --- the p-model near grazing incidence: the branch point beyond the cut of the level N.wo = mu -----
+
+def _p_reference(model, n, p, mu):
+    """(value, error) of tests/data/independent_p.json (30-digit mpmath, scripts/independent_p.py)."""
+    import json
+    import pathlib
+
+    data = json.loads((pathlib.Path(__file__).parent / "data" / "independent_p.json").read_text())
+    (e,) = [e for e in data["entries"] if (e["model"], e["n"], e["p"], e["mu"]) == (model, n, p, mu)]
+    return e["value"], e["abs_err_estimate"]
+
+
+@pytest.mark.parametrize("rtol", [1e-6, 1e-10, 1e-12])
+@pytest.mark.parametrize("case", [("stretched_phong", 1, 0.5, 1e-7), ("retro", 1, 0.5, 1e-7),
+                                  ("stretched_phong", 1, 0.25, 1e-7), ("stretched_phong", 20, 0.5, 1e-7),
+                                  ("stretched_phong", 1, 0.5, 1e-4)], ids=str)
+def test_p_model_near_grazing_2d_engine_bounds_its_error(case, rtol):
+    # c (R.V)^n N.wo^(1 - p) above the cut N.wo = mu continues to its branch point N.wo = 0 within
+    # sqrt(mu / 3) of the piece's end in tau_t, far inside the outermost node; with p = 1/2 the limit
+    # mu -> 0 is a polynomial there, and the 15 x 15 and 7 x 7 rules agreed on it: stretched Phong
+    # n = 1 at mu = 1e-7 gave 0.4576559181133117 +- 7.1e-12 with the true error 1.7e-11 (rtol 1e-6 ..
+    # 1e-10); the pieces are now graded towards the cut (A._level_end_scales)
+    model, n, p, mu = case
+    ref, ref_err = _p_reference(model, n, p, mu)
+    f = pumpup.load({"type": model, "n": float(n), "p": p})
+    with _polar.two_d_only():
+        a, e = pumpup.albedo(f, mu, rtol=rtol, atol=0.0, return_error=True)
+    assert abs(float(a) - ref) <= float(e) + ref_err, (float(a), float(e), abs(float(a) - ref))
+    assert float(e) <= max(rtol * ref, 64 * np.finfo(float).eps * ref)
+
+
+def test_level_end_scales():
+    # the scale sqrt(u / (3 dn w)) at the upper end of the piece below a level's cut (N.wo > u), none
+    # at the piece above it (N.wo < u: nothing singular beyond its end) nor around N
+    mu = 1e-7
+    lobe = pumpup.load({"type": "stretched_phong", "n": 1, "p": 0.5}).lobe(mu)
+    gx = np.array([0.3, 0.6])
+    d = A._level_end_scales(lobe, mu, np.array([mu]), gx, 2)
+    assert d.shape == (1, 2) and d[0, 1] == np.inf
+    tx = gx[0] + (gx[1] - gx[0]) * A._SCALE_NODES
+    x, xc, _ = A._smooth(tx)
+    ca, sa, _ = A._radial("power", 1.0, x, xc)
+    s = math.sqrt(1 - mu * mu)
+    cut = np.arccos((mu - mu * ca) / (s * sa))  # N.wo = mu ca + s sa cos(beta) = mu
+    expect = np.sqrt(mu / (3 * s * sa * np.sin(cut) * cut))
+    assert d[0, 0] == pytest.approx(expect.min(), rel=1e-12)
+    assert A._level_end_scales(lobe, 0.5, np.array([0.5]), gx, 2)[0, 0] > A.D_GRADE  # not graded away from grazing
+    normal = pumpup.Lobe(axis="normal", radial="cosine", levels=(mu,))
+    assert np.all(A._level_end_scales(normal, mu, np.array([mu]), gx, 2) == np.inf)
+    # the first intervals of tau_t: the grid, and 1 - d 4^k towards the end where d < D_GRADE
+    row, t0, t1 = A._first_rectangles_t(np.array([1e-3, np.inf]), np.linspace(0, 1, 3))
+    assert np.all(t0[row == 1] == [0.0, 0.5]) and np.all(t1[row == 1] == [0.5, 1.0])
+    assert np.allclose(1 - t0[row == 0][2:], 1e-3 * 4.0 ** np.arange(4)[::-1]) and t1[row == 0][-1] == 1.0

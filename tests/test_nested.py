@@ -76,6 +76,22 @@ def test_error_bounds_the_truth_at_every_rtol(spec, rtol):
     assert np.all(e <= rtol * a + 1e-14 + 64 * np.finfo(float).eps * a)
 
 
+@pytest.mark.parametrize("mu", [1e-7, 1e-8])
+@pytest.mark.parametrize("rtol", [1e-10, 1e-12])
+def test_p_model_near_grazing_bounds_its_error(mu, rtol):
+    """Stretched Phong n = 1, p = 0.5 near grazing: N.wo^(1 - p) above the cut N.wo = mu has its branch
+    point N.wo = 0 just beyond the piece's end (pumpup._nested._end_grading; the 2-D engine's
+    pumpup.albedo._level_end_scales).  Before the grading, at mu = 1e-8 and rtol 1e-12: 0.4576558641015173
+    +- 1.1e-13, true error 5.9e-13.  The truth: the 1-D path at rtol 1e-13 (closed-form azimuth and a
+    Gauss-Jacobi rule at the arc's end, a different method; within 1e-15 of tests/data/independent_p.json),
+    its own error added."""
+    f = pumpup.load({"type": "stretched_phong", "n": 1, "p": 0.5})
+    t, et, *_ = _polar.albedo_1d(f, np.array([mu]), 1e-13, 0.0, 10000)
+    a, e, used = _by_engine(f, mu, nested=True, rtol=rtol)
+    assert all(used)
+    assert abs(a[0] - t[0]) <= e[0] + et[0], (a[0], e[0], a[0] - t[0])
+
+
 PUMPED = [("phong", "g1", 3), ("phong", "g2", 3), ("blinn", "g2", 2), ("cook_torrance", "g1", 1),
           pytest.param("cook_torrance", "g2", 2, marks=pytest.mark.slow)]
 BASES = {"phong": {"type": "phong", "n": 20}, "blinn": {"type": "blinn", "n": 20, "c": 0.9},
