@@ -195,7 +195,8 @@ def families(rtol=1e-10, specs=None, dblquad=True):
 
 def p_model(rtol=1e-10, repeat=3):
     """The p-model with p in (0, 1) (000 eq. 12; the 1-D path's inner rule since issue 14) against the
-    nested engine it replaces (``pumpup._polar.ENABLED = False``), same run, same rtol: a 257-point
+    nested engine it replaces (the 1-D path switched off alone; ``_polar.ENABLED = False`` would
+    switch off the nested engine too), same run, same rtol: a 257-point
     table (mu uniform in theta) and a sweep cell (257 mu of ``default_mu`` + mean albedo + maximum
     constant), one thread, best of ``repeat``."""
     from pumpup import _polar
@@ -215,15 +216,17 @@ def p_model(rtol=1e-10, repeat=3):
             {"type": "stretched_phong", "n": 1, "p": 0.5}, {"type": "stretched_phong", "n": 1000, "p": 0.5},
             {"type": "retro", "n": 10, "p": 0.5}]:
         out = []
+        one_d = _polar.albedo_1d
         for enabled in (True, False):
-            _polar.ENABLED = enabled
+            if not enabled:
+                _polar.albedo_1d = lambda *args, **kw: None  # the nested engine takes the model
             try:
                 f = pumpup.load(spec)
                 pumpup.albedo(f, [0.5, 1e-3], rtol=rtol)
                 _, t_table = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), repeat if enabled else 1)
                 _, t_cell = _best(lambda: cell(pumpup.load(spec)), repeat if enabled else 1)
             finally:
-                _polar.ENABLED = True
+                _polar.albedo_1d = one_d
             out.append((t_table, t_cell))
         (a, b), (c, d) = out
         print(f"{str(spec):48s} {a * 1e3:10.1f} {c * 1e3:9.1f} {c / a:6.1f} {b * 1e3:9.1f} {d * 1e3:9.1f} {d / b:6.1f}",

@@ -111,20 +111,25 @@ def test_one_d_agrees_with_the_two_d_engine_on_every_example(spec):
 
 @pytest.mark.parametrize("n", [1.0, 20.0, 1000.0])
 @pytest.mark.parametrize("p", [0.25, 0.5, 0.75])
-def test_general_p_against_the_nested_engine(n, p, monkeypatch):
+def test_general_p_against_the_other_engines(n, p, monkeypatch):
     """p in (0, 1): the 1-D path (closed form below the level N.wo = mu, the inner rule above it)
-    against the nested engine, which evaluates the BRDF itself on a 2-D grid of smooth arcs."""
+    against the nested engine (which evaluates the BRDF itself on smooth arcs; reached by switching
+    off the 1-D path only) and the 2-D engine (``two_d_only``), both at rtol 1e-12."""
+    from pumpup import _nested
+
     f = pumpup.load({"type": "stretched_phong", "n": n, "p": p})
     mu = np.array(MU)
     a, e, conv, _ = _polar.albedo_1d(f, mu, 1e-10, 0.0, 10000)
     assert conv.all() and np.all(e <= 1e-10 * a)
-    monkeypatch.setattr(_polar, "ENABLED", False)
-    # (at rtol 1e-12 the nested engine was 5.9e-13 off at n = 1, p = 0.5, mu = 1e-8 with an estimate
-    # of 1.0e-13; at 1e-13 it agrees with the 1-D path to 5e-16)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", pumpup.albedo_module.AlbedoWarning)
-        b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-13)
+    with monkeypatch.context() as mp:
+        mp.setattr(_polar, "albedo_1d", lambda *args, **kw: None)
+        mp.setattr(_nested, "LAST_EVALS", None)
+        b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
+        assert _nested.LAST_EVALS is not None  # the nested engine did it
     assert np.all(np.abs(a - b) <= e + eb), (np.abs(a - b) / (e + eb)).max()
+    with _polar.two_d_only():
+        c, ec = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
+    assert np.all(np.abs(a - c) <= e + ec), (np.abs(a - c) / (e + ec)).max()
 
 
 P_DATA = json.loads((pathlib.Path(__file__).parent / "data" / "independent_p.json").read_text())["entries"]
