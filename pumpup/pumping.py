@@ -190,6 +190,72 @@ def _bits(x) -> np.ndarray:
     return np.asarray(x, dtype=np.float64).view(np.int64)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _g_product(mmax, pcbase, pcstart, plo, prow):  # pragma: no cover - compiled
+    """The chain kernel's fast path: g_1 g_2 ... g_k as one function of mmax = max(N.wi, N.wo)
+    (:class:`_Product`; mmax above its ``mlo``): the piece found from the bits of mmax (no logarithm),
+    evaluated by Horner's rule; ``prow[s]`` holds the piece's coefficients, centre and inverse
+    half-width (one cache line).  Inlined where it is called."""
+    last_cell = pcstart.shape[0] - 1
+    deg = prow.shape[1] - 3
+    s = pcstart[min((_float_bits(mmax) >> _CELL_SHIFT) - pcbase, last_cell)]
+    s += mmax >= plo[s + 1]  # most cells hold one or two pieces: a branch-free step,
+    while mmax >= plo[s + 1]:  # then a loop that is rarely entered
+        s += 1
+    t = (mmax - prow[s, deg + 1]) * prow[s, deg + 2]
+    if deg == 5:  # written out (Horner, the order of _horner)
+        return (((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t
+                 + prow[s, 4]) * t + prow[s, 5])
+    g_all = prow[s, 0] * t
+    for r in range(1, deg):
+        g_all = (g_all + prow[s, r]) * t
+    return g_all + prow[s, deg]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _g_levels(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
+              index, index_lo, index_h_inv):  # pragma: no cover - compiled
+    """The product of all levels' g (001 eq. 20, 21) at N.wi, N.wo with max ``mmax`` and min ``mmin``
+    (both > 0), level by level: each level's upper bound looked up (spline piece in log(mu), power
+    law below its first node, at most its cap).  Inlined where it is called (a call per look-up
+    cost 20 x the look-up, measured)."""
+    ncell = index.shape[1]
+    lmax = math.log(mmax)
+    lmin = 1.0  # log(mmin), taken only when needed (it is <= 0)
+    g_all = 1.0
+    for j in range(offsets.shape[0] - 1):
+        a, b = offsets[j], offsets[j + 1]
+        nlook = 1 if (increasing[j] and mmin > mu0[j]) else 2
+        g = 0.0
+        for t in range(nlook):
+            if t == 0:
+                lm = lmax
+            else:
+                if lmin > 0.0:
+                    lmin = math.log(mmin)
+                lm = lmin
+            if lm <= logx[a]:
+                u = v0[j] * math.exp(slope0[j] * (lm - logx[a])) + margin_lo[j]
+            else:
+                c = int((lm - index_lo[j]) * index_h_inv[j])
+                i = index[j, min(max(c, 0), ncell - 1)]
+                while i < b - 2 and logx[i + 1] <= lm:
+                    i += 1
+                d = lm - logx[i]
+                if coef.shape[0] == 6:  # the quintic, written out (Horner)
+                    u = ((((coef[0, i] * d + coef[1, i]) * d + coef[2, i]) * d + coef[3, i]) * d
+                         + coef[4, i]) * d + coef[5, i]
+                else:
+                    u = coef[0, i]
+                    for r in range(1, coef.shape[0]):  # Horner
+                        u = u * d + coef[r, i]
+            g = max(g, min(cap[j], u))  # 001 eq. 20
+        if controlled[j]:
+            g = max(g, mmax)  # 001 eq. 21
+        g_all *= g
+    return g_all
+
+
 @njit(cache=True, nogil=True)
 def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
                   index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow):  # pragma: no cover - compiled
@@ -199,20 +265,14 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
     ``coef`` holds the upper bound (spline + margin, as :func:`_upper_scalar`) and a uniform
     index over log(mu) finds the piece in O(1).  Where a level's bound is non-decreasing
     (``increasing``, :meth:`AlbedoTable.is_increasing`) and both cosines lie on its spline
-    (above ``mu0``), max(u(mu_i), u(mu_o)) = u(max(mu_i, mu_o)): one look-up serves the level.
-    ``wi`` and ``wo`` are (n, 3) arrays of any strides (no copies).  The look-up is written
-    out here rather than called (a call per look-up cost 20 x the look-up, measured).  Tested
+    (above ``mu0``), max(u(mu_i), u(mu_o)) = u(max(mu_i, mu_o)): one look-up serves the level
+    (:func:`_g_levels`).  ``wi`` and ``wo`` are (n, 3) arrays of any strides (no copies).  Tested
     against the plain numpy reference, :meth:`Pumped.reference`, which pumps level by level.
 
     Fast path: where every level's bound increases, the product of all levels' g is one function
-    of mmax (:class:`_Product`, arguments ``pmlo`` ... ``prow``; ``pmlo`` = inf turns it off):
-    its piece is found from the bits of mmax (no logarithm) and evaluated by Horner's rule;
-    ``prow[s]`` holds the piece's coefficients, centre and inverse half-width (one cache line).
-    Tested against :meth:`_Product.__call__` and the reference.
+    of mmax (:class:`_Product`, :func:`_g_product`; ``pmlo`` = inf turns it off).  Tested against
+    :meth:`_Product.__call__` and the reference.
     """
-    ncell = index.shape[1]
-    last_cell = pcstart.shape[0] - 1
-    deg = prow.shape[1] - 3
     for k in range(f.shape[0]):
         mi, mo = wi[k, 2], wo[k, 2]
         if mi <= 0.0 or mo <= 0.0:
@@ -220,57 +280,12 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
             continue
         mmax, mmin = max(mi, mo), min(mi, mo)
         if mmin > pmlo:  # the fast path: one look-up for all levels (no branch on f = 0: 0 / g = 0)
-            s = pcstart[min((_float_bits(mmax) >> _CELL_SHIFT) - pcbase, last_cell)]
-            s += mmax >= plo[s + 1]  # most cells hold one or two pieces: a branch-free step,
-            while mmax >= plo[s + 1]:  # then a loop that is rarely entered
-                s += 1
-            t = (mmax - prow[s, deg + 1]) * prow[s, deg + 2]
-            if deg == 5:  # written out (Horner, the order of _horner)
-                g_all = (((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t
-                          + prow[s, 4]) * t + prow[s, 5])
-            else:
-                g_all = prow[s, 0] * t
-                for r in range(1, deg):
-                    g_all = (g_all + prow[s, r]) * t
-                g_all += prow[s, deg]
-            f[k] = f[k] / g_all  # 001 eq. 16, all levels
+            f[k] = f[k] / _g_product(mmax, pcbase, pcstart, plo, prow)  # 001 eq. 16, all levels
             continue
         if f[k] == 0.0:
             continue
-        lmax = math.log(mmax)
-        lmin = 1.0  # log(mmin), taken only when needed (it is <= 0)
-        g_all = 1.0
-        for j in range(offsets.shape[0] - 1):
-            a, b = offsets[j], offsets[j + 1]
-            nlook = 1 if (increasing[j] and mmin > mu0[j]) else 2
-            g = 0.0
-            for t in range(nlook):
-                if t == 0:
-                    lm = lmax
-                else:
-                    if lmin > 0.0:
-                        lmin = math.log(mmin)
-                    lm = lmin
-                if lm <= logx[a]:
-                    u = v0[j] * math.exp(slope0[j] * (lm - logx[a])) + margin_lo[j]
-                else:
-                    c = int((lm - index_lo[j]) * index_h_inv[j])
-                    i = index[j, min(max(c, 0), ncell - 1)]
-                    while i < b - 2 and logx[i + 1] <= lm:
-                        i += 1
-                    d = lm - logx[i]
-                    if coef.shape[0] == 6:  # the quintic, written out (Horner)
-                        u = ((((coef[0, i] * d + coef[1, i]) * d + coef[2, i]) * d + coef[3, i]) * d
-                             + coef[4, i]) * d + coef[5, i]
-                    else:
-                        u = coef[0, i]
-                        for r in range(1, coef.shape[0]):  # Horner
-                            u = u * d + coef[r, i]
-                g = max(g, min(cap[j], u))  # 001 eq. 20
-            if controlled[j]:
-                g = max(g, mmax)  # 001 eq. 21
-            g_all *= g
-        f[k] = f[k] / g_all  # 001 eq. 16, all levels
+        f[k] = f[k] / _g_levels(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
+                                increasing, mu0, index, index_lo, index_h_inv)  # 001 eq. 16, all levels
 
 
 def _monotone_envelope(spline, margin: float):
@@ -791,6 +806,13 @@ class Pumped(BRDF):
                         continue  # both crossing terms are below a third: g has no kink here
                 out.append(v)
         lk = self.lookup()
+        if math.isfinite(lk.cap) and am < lk.cap * (1 - 1e-12):
+            # u(v) reaches its cap (1 where the base conserves energy): there u(v) is the largest term
+            # (the others are U < cap and mu, v <= 1), so g has a kink (the product table's _kinks
+            # has it too); the capped u is flat beyond it, so the roots above do not see it
+            cross = up(grid, capped=False) - lk.cap
+            for i in np.nonzero(np.sign(cross[:-1]) * np.sign(cross[1:]) < 0)[0]:
+                out.append(brentq(lambda u: float(up(u, capped=False)) - lk.cap, grid[i], grid[i + 1], xtol=1e-15))
         for p, q, value in lk.flats:  # mu on a flat piece of the bound: u(v) = U up to its end q
             if p <= mu <= q and value < lk.cap:
                 out.append(q)
@@ -808,6 +830,18 @@ class Pumped(BRDF):
 
     def sampling_lobe(self, mu: float) -> Lobe:
         return self.base.sampling_lobe(mu)  # f / g has the lobe of f; g only rescales it
+
+    def polar(self):
+        """The 1-D albedo path of a pumped Phong-family lobe (``pumpup._polar``): the base's
+        closed-form-azimuth hint, with the divisor g_1 ... g_k (a function of N.wo for a fixed wi)
+        and its kinks; None for any other base."""
+        from ._polar import Polar
+
+        hint = self.chain()[0].base.polar()
+        if hint is None or hint.kind != "lobe" or hint.chain is not None:
+            return None
+        return Polar(n=hint.n, p=hint.p, scale=hint.scale, chain=self._chain_args(),
+                     levels=lambda mu: self.lobe(mu).levels)
 
     def azimuth_range(self):
         return self.base.azimuth_range()  # g depends on N.wi and N.wo only
