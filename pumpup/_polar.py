@@ -428,7 +428,7 @@ def _arc_chain(p, mu, a, b, lo, hi, chain, nodes, wk, wg, mode, ibuf):  # pragma
 
 
 @njit(cache=True, nogil=True)
-def _k_chain(p, mu, c2, u, um, sa, lev, nlev, gmu, itol, chain, nodes, wk, wg, mode, ibuf, iwork, bcut):  # pragma: no cover - compiled
+def _k_chain(p, mu, c2, u, um, sa, lev, nlev, gmu, itol, katol, chain, nodes, wk, wg, mode, ibuf, iwork, bcut):  # pragma: no cover - compiled
     """(K(u), its error) for a pumped lobe: K = integral over the visible arc of
     N.wo / (max(mu, N.wo)^p g(mu, N.wo)) d beta, u = cos(alpha), um = 1 - u, sa = sin(alpha).
 
@@ -494,7 +494,7 @@ def _k_chain(p, mu, c2, u, um, sa, lev, nlev, gmu, itol, chain, nodes, wk, wg, m
             e += err[i]
             if err[i] > err[worst]:
                 worst = i
-        if e <= itol * (tot - e + 0.5 * closed) or nint >= lo.shape[0]:
+        if e <= itol * (tot - e + 0.5 * closed) or 2.0 * e <= katol or nint >= lo.shape[0]:
             return closed + 2.0 * tot, 16.0 * EPS * closed + 2.0 * e
         mid = 0.5 * (lo[worst] + hi[worst])
         lo[nint], hi[nint] = mid, hi[worst]
@@ -558,7 +558,7 @@ RULE = "gk21"
 
 @njit(cache=True, nogil=True)
 def _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac,
-        lev, nlev, gmu, chain, bcut):  # pragma: no cover
+        lev, nlev, gmu, ka, chain, bcut):  # pragma: no cover
     """(K, error) of the rule on [t0, t1]; the error is :func:`pumpup._errors.calibrated` of
     |K - G| (``mode`` 1) or |K - G| itself (0), plus for p in (0, 1) the inner errors of the
     integrand's values (the inner rule ``inodes``, ``iwk``, ``iwg`` at relative tolerance
@@ -571,7 +571,8 @@ def _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, it
     if chain[0].shape[0] > 1:  # a pumped lobe: the arc by the inner rule (_k_chain)
         for j in range(nodes.shape[0]):
             u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
-            k, e = _k_chain(p, mu, c2, u, um, sa, lev, nlev, gmu, itol, chain, inodes, iwk, iwg, mode, ibuf, iwork, bcut)
+            k, e = _k_chain(p, mu, c2, u, um, sa, lev, nlev, gmu, itol, ka / fac if fac > 0.0 else math.inf, chain, inodes, iwk,
+                            iwg, mode, ibuf, iwork, bcut)
             buf[j] = k * fac
             ie += wk[j] * e * fac
     elif 0.0 < p < 1.0:
@@ -735,7 +736,7 @@ def _pieces(n, p, mu, s, kinds, sms, v0, w, v1, lev, nlev):  # pragma: no cover 
 
 @njit(cache=True, nogil=True)
 def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, inodes, iwk, iwg, jac,
-               lev, nlev, chain, val, err, conv, evals):  # pragma: no cover
+               lev, nlev, chain, lower, val, err, conv, evals):  # pragma: no cover
     """Adaptive Gauss-Kronrod (the rule ``nodes``, ``wk``, ``wg``) of integral u^n K(u) du for
     every mu (without the scale); ``lev[q, :nlev[q]]`` the levels of a pumped lobe (``chain``)
     at mu_arr[q] (:func:`level_rows`)."""
@@ -767,15 +768,24 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
                 if lq[j, 0] < mu * (1.0 - 1e-12):
                     gmu = 0.0
         npieces, c2, left_out = _pieces(n, p, mu, s, kinds, sms, v0, w, cv1, lq, nl)
+        # a pumped lobe's inner rule may also stop at an absolute error ka / (the node's outer weight):
+        # summed over the nodes of the pieces' first intervals, and of every later one, that is at most
+        # itol lower[q], lower[q] a lower bound of the integral (the base's: see albedo_1d)
+        used = 0
+        for i in range(npieces):
+            used += w[i] > 0.0
+        ka = itol * lower[q] / max(used, 1)
         m = 0
         for i in range(npieces):
             if w[i] <= 0.0:
                 continue
-            for j in range(n_init):
+            # (a pumped lobe's piece of z-width below one, where u^(n+1) falls by less than e, starts whole)
+            ni = n_init if kinds[i] == 0 or w[i] > 1.0 else 1
+            for j in range(ni):
                 pk[m] = i
-                t0[m] = j / n_init
-                t1[m] = (j + 1.0) / n_init
-                kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, lq, nl, gmu, chain, bcut)
+                t0[m] = j / ni
+                t1[m] = (j + 1.0) / ni
+                kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, lq, nl, gmu, ka, chain, bcut)
                 m += 1
         start = m
         ok = False
@@ -803,11 +813,11 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
             a_, b_ = t0[worst], t1[worst]
             mid = 0.5 * (a_ + b_)
             t1[worst] = mid
-            kv[worst], ke[worst] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, lq, nl, gmu, chain, bcut)
+            kv[worst], ke[worst] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, lq, nl, gmu, ka, chain, bcut)
             pk[m] = i
             t0[m] = mid
             t1[m] = b_
-            kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, lq, nl, gmu, chain, bcut)
+            kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, lq, nl, gmu, ka, chain, bcut)
             m += 1
         val[q] = tot
         err[q] = e + r
@@ -845,6 +855,7 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     if not 0.0 <= hint.p <= 1.0:
         raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
     jac = jacobi_rules(1.0 - hint.p) if 0.0 < hint.p < 1.0 else _NO_JACOBI
+    lower = np.zeros(len(mu))
     if hint.chain is None:
         chain, lev, nlev = _NO_CHAIN, np.zeros((len(mu), 0, 3)), np.zeros(len(mu), np.int64)
     else:  # a pumped lobe: its levels at every mu
@@ -854,6 +865,13 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         for q, r in enumerate(rows):
             lev[q, :len(r)] = r
         chain = hint.chain
+        if np.all(chain[6] <= 1.0):  # every g <= 1 (capped at 1; g2's N.wi, N.wo <= 1): the pumped lobe's
+            # integral is at least the base lobe's (001 eq. 16), which the closed forms give cheaply
+            bv, be = np.empty(len(mu)), np.empty(len(mu))
+            _integrate(float(hint.n), float(hint.p), mu, 1e-3, np.zeros(len(mu)), 100, ROUNDING, *(_RULES[RULE]), mode_code(),
+                       N_INIT, *_RULES["gk15"], jac, np.zeros((len(mu), 0, 3)), np.zeros(len(mu), np.int64), _NO_CHAIN,
+                       lower, bv, be, np.empty(len(mu), bool), np.empty(len(mu), np.int64))
+            lower = np.maximum(bv - be, 0.0)
     val = np.empty(mu.shape)
     err = np.empty(mu.shape)
     conv = np.empty(mu.shape, bool)
@@ -863,5 +881,5 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
     _integrate(float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
                *(_RULES[RULE]), mode_code(hint.chain is None), N_INIT if hint.chain is None else N_INIT_CHAIN,
-               *_RULES["gk15" if hint.chain is None else CHAIN_RULE], jac, lev, nlev, chain, val, err, conv, evals)
+               *_RULES["gk15" if hint.chain is None else CHAIN_RULE], jac, lev, nlev, chain, lower, val, err, conv, evals)
     return scale * val, np.abs(scale) * err, conv, evals
