@@ -508,31 +508,47 @@ def _end_grading(levels, lab, dn, node, piece, width, t0, t1, sm):
     B = len(node)
     if not levels.shape[1]:
         return np.arange(B), t0, t1
-    cand = [t0[:, None], t1[:, None]]
     kk = 4.0 ** np.arange(K_GRADE)
+    ends = []  # (rows, sign, d) of the ends to grade; only those rows are expanded
     for edge, sign in ((piece + 1, -1.0), (piece, 1.0)):
         j = lab[node, edge]
-        u = np.where(j >= 0, levels[node, np.maximum(j, 0)], 0.0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            d = u / (dn[node, edge] * width)
-            smooth = (sm & (2 if sign < 0 else 1)) > 0  # t ~ 3 v^2 at a smoothed end: the scale is sqrt(d / 3)
-            d = np.where(smooth, np.sqrt(d / 3.0), d)
         end = t1 if sign < 0 else t0
-        need = (j >= 0) & (u > 0) & (d < D_GRADE) & (end == (1.0 if sign < 0 else 0.0))
-        if not need.any():
+        maybe = np.nonzero((j >= 0) & (end == (1.0 if sign < 0 else 0.0)))[0]
+        if not len(maybe):
             continue
+        jm = j[maybe]
+        u = levels[node[maybe], jm]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            d = u / (dn[node[maybe], edge[maybe]] * width[maybe])
+            smooth = (sm[maybe] & (2 if sign < 0 else 1)) > 0  # t ~ 3 v^2 at a smoothed end: the scale is sqrt(d / 3)
+            d = np.where(smooth, np.sqrt(d / 3.0), d)
+        need = (u > 0) & (d < D_GRADE)
+        if need.any():
+            ends.append((maybe[need], sign, d[need]))
+    if not ends:
+        return np.arange(B), t0, t1
+    graded = np.unique(np.concatenate([r for r, _, _ in ends]))
+    pos = np.full(B, -1)
+    pos[graded] = np.arange(len(graded))
+    G = len(graded)
+    cand = [t0[graded, None], t1[graded, None]]
+    for rows, sign, d in ends:
         d = np.maximum(d, 0.25 / kk[-1])
         off = d[:, None] * kk[None, :]
         pts = (1.0 - off) if sign < 0 else off
-        ok = need[:, None] & (off < 0.25) & (pts > t0[:, None]) & (pts < t1[:, None])
-        cand.append(np.where(ok, pts, np.nan))
-    if len(cand) == 2:
-        return np.arange(B), t0, t1
+        ok = (off < 0.25) & (pts > t0[rows, None]) & (pts < t1[rows, None])
+        full = np.full((G, K_GRADE), np.nan)
+        full[pos[rows]] = np.where(ok, pts, np.nan)
+        cand.append(full)
     allp = np.sort(np.concatenate(cand, axis=1), axis=1)  # NaN last
     a, b = allp[:, :-1], allp[:, 1:]
     okp = np.isfinite(a) & np.isfinite(b) & (b > a)
-    row, col = np.nonzero(okp)
-    return row, a[row, col], b[row, col]
+    r, col = np.nonzero(okp)
+    plain = np.ones(B, bool)
+    plain[graded] = False
+    row = np.concatenate([np.nonzero(plain)[0], graded[r]])
+    order = np.argsort(row, kind="stable")  # blocks in their order, sub-intervals in increasing v
+    return row[order], np.concatenate([t0[plain], a[r, col]])[order], np.concatenate([t1[plain], b[r, col]])[order]
 
 
 def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
