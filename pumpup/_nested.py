@@ -88,7 +88,7 @@ __all__ = ["ENABLED", "disabled", "inner_error", "integrate", "interval_error", 
 ENABLED = True
 
 #: initial intervals of tau_x before the breaks are added (as the 2-D engine's NX_INIT)
-NX_INIT = 8
+NX_INIT = 4
 #: initial sub-intervals of v on every piece of the arc (the 2-D engine starts with 2 in tau_t)
 M_INIT = 1
 #: largest number of sub-intervals per piece before an interval is bisected instead
