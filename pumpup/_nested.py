@@ -11,10 +11,21 @@ the hint already says.  This module integrates the same integrand as a nested qu
 (issue 14, item 2):
 
 * outer: globally adaptive 7/15 Gauss-Kronrod in tau_x on [0, 1] (QUADPACK's qk15), started on
-  the 2-D engine's breaks (eight intervals, the horizon breaks ``_horizon_breaks``, the kink breaks
-  ``_kink_breaks``), a grid graded geometrically towards each break (ratio 16:
-  :func:`_graded_coarse`) and one above the "power" map's split (:func:`_split_breaks`); the
-  intervals whose error exceeds their share of the tolerance are refined;
+  the 2-D engine's breaks (eight intervals, :data:`NX_INIT`, the horizon breaks ``_horizon_breaks``, the kink breaks
+  ``_kink_breaks`` including the crossings of two cuts), a grid graded geometrically towards each
+  break (ratio 16: :func:`_graded_coarse`) and one above the "power" map's split
+  (:func:`_split_breaks`); the intervals whose error exceeds their share of the tolerance are
+  refined.  An interval that ends at a break is integrated in v with x = x0 + h v^2 (x1 - h (1 - v)^2,
+  both ends: x0 + h v^2 (3 - 2 v)) towards it (:data:`OUTER_SUB`): where the arc starts to be cut
+  (a horizon or a kink entering the arc) the arc's integral behaves like (x - x_b)^(3/2) on one side,
+  which the substitution makes analytic in v (a 7/15 rule on an interval ending at such a point
+  converges only algebraically: ggx alpha = 0.1 at mu = 0.7 had |K - G| = 4.8e-6 on the first
+  interval ending at the horizon break, the largest of its first grid).
+  The crossings of two cuts are breaks too: the pieces there change order and the arc's integral,
+  while continuous with its derivative, is not analytic (Cook-Torrance m = 0.4 at mu = 0.1, rtol
+  1e-10: the three geometry-factor cuts cross at tau_x = 0.02559 inside an interval whose 7- and
+  15-point values agreed to 2.0e-12 while both were 2.6e-11 off; before the substitution the
+  refinement it spent elsewhere had hidden this);
 * inner, at each of the 15 outer nodes of an interval: the visible arc of beta cut at the same
   cuts as the 2-D engine (the geometry, the cuts and the Cook-Torrance kink coefficients are
   computed once per outer node, issue 14 item 3), and on each non-empty piece the fixed 15-point
@@ -29,15 +40,16 @@ the hint already says.  This module integrates the same integrand as a nested qu
   (``_rounding``);
 * refinement: an interval whose inner error is the larger part of its error has its segments
   above their share (and its worst one) bisected in v (never silently accepted); one whose
-  outer error dominates is bisected in tau_x, its children inheriting its segments.
+  outer error dominates is bisected in tau_x (in v where it has the substitution: at x0 + h / 4,
+  the child at the break keeping it), its children inheriting its segments.
   ``max_regions`` is a budget on what refinement adds per value of mu, counted in segments per
   piece (an outer interval with its initial segments counts once); when it runs out, the
   (larger) error estimate is returned with converged = False (``pumpup.albedo`` warns).
 
 The geometry runs in two compiled passes per batch (:func:`_nodes_kernel`: per outer node;
 :func:`_points_kernel`: per point), the model's ``_eval`` once per batch on all points (twice
-where the hint is not even in beta), and one compiled pass (:func:`_segment_sums_kernel`) forms
-the Kronrod and Gauss sums; each has a plain numpy twin (``*_reference``) that the tests compare
+where the hint is not even in beta), and two compiled passes (:func:`_values_kernel`, :func:`_rule_kernel`)
+form the Kronrod and Gauss sums; each has a plain numpy twin (``*_reference``) that the tests compare
 with it.
 
 Groups with wi turned out of the xz-plane (``phi != 0``) and hint-less BRDFs (a
@@ -76,7 +88,11 @@ __all__ = ["ENABLED", "disabled", "inner_error", "integrate", "interval_error", 
 #: the nested path is used where it applies (``disabled()`` switches it off)
 ENABLED = True
 
-#: initial intervals of tau_x before the breaks are added (as the 2-D engine's NX_INIT)
+#: initial intervals of tau_x before the breaks are added (as the 2-D engine's NX_INIT).  4 saved 5-40 %
+#: of the evaluations per mu and stayed honest on scripts/error_calibration.py (max ratio 0.126), but the
+#: doctest of pumpup.luts.audit then failed: GGX alpha = 1e-8 at mu = 1e-6, which converges at no
+#: budget, gave values 9e-6 apart (within their estimates, 3.5e-4) at rtol 1e-7 and 1e-8 with 200
+#: regions; 2 under-reported (Kulla-Conty lobe of Phong n = 20, mu = 0.3: 2.7 x the estimate)
 NX_INIT = 8
 #: initial sub-intervals of v on every piece of the arc (the 2-D engine starts with 2 in tau_t)
 M_INIT = 1
@@ -120,14 +136,15 @@ def supports(g) -> bool:
 
 def inner_error(kronrod, gauss):
     """Error estimate of one inner sub-interval at one outer node: |K - G| of the 15-point Kronrod
-    rule and its embedded 7-point Gauss rule (swappable like :func:`interval_error`)."""
+    rule and its embedded 7-point Gauss rule.  QUADPACK's calibration of it (``pumpup._errors``)
+    was measured here too and under-reported (modified_ward m = 0.1 at mu = 0.2, rtol 1e-10: true
+    error 2.4 x the estimate), so the raw difference stays."""
     return np.abs(kronrod - gauss)
 
 
 def interval_error(kronrod, gauss, inner):
     """Error estimate of outer intervals: |K - G| of the outer rule plus the inner errors carried
-    through the outer weights (an upper bound of the integral of |I_h - I|).  One function, so a
-    calibrated estimate (issue 14, item 4) can replace it."""
+    through the outer weights (an upper bound of the integral of |I_h - I|)."""
     return np.abs(kronrod - gauss) + inner
 
 
@@ -320,37 +337,47 @@ def _points_kernel(axis, node, lo, width, t0, t1, sm, mu, s_n, ca_n, sa_n, wr_n,
 
 # --- Kronrod and Gauss sums per segment --------------------------------------------------------------
 
-def _segment_sums_reference(f, cos_o, weight, wk, wg):
-    """Plain numpy twin of :func:`_segment_sums_kernel`: (K, G) per segment of 15 points."""
-    v = np.where((f > 0) & (cos_o > 0) & (weight > 0), f * cos_o * weight, 0.0).reshape(-1, len(wk))
+def _values_reference(f, cos_o, weight):
+    """Plain numpy twin of :func:`_values_kernel`: f cos(theta_o) weight where all three are positive."""
+    return np.where((f > 0) & (cos_o > 0) & (weight > 0), f * cos_o * weight, 0.0)
+
+
+@njit(cache=True, nogil=True)
+def _values_kernel(f, cos_o, weight, vals):  # pragma: no cover - compiled
+    """vals += f cos(theta_o) weight (positive terms only); the index of the first f that is negative or
+    not finite (or -1)."""
+    for i in range(f.shape[0]):
+        v = f[i]
+        if not (v >= 0.0 and v < math.inf):
+            return i
+        if v > 0.0 and cos_o[i] > 0.0 and weight[i] > 0.0:
+            vals[i] += v * cos_o[i] * weight[i]
+    return -1
+
+
+def _rule_reference(vals, wk, wg):
+    """Plain numpy twin of :func:`_rule_kernel`: (K, G) per block of len(wk) values."""
+    v = vals.reshape(-1, len(wk))
     return v @ wk, v @ wg
 
 
 @njit(cache=True, nogil=True)
-def _segment_sums_kernel(f, cos_o, weight, wk, wg, K, G):  # pragma: no cover - compiled
-    """K += Kronrod sums, G += Gauss sums of f cos(theta_o) weight per segment of len(wk) points,
-    counting only positive terms; the index of the first f that is negative or not finite (or -1)."""
+def _rule_kernel(vals, wk, wg, K, G):  # pragma: no cover - compiled
+    """Per block of len(wk) values: the Kronrod sum K and the Gauss sum G (the rule on [0, 1])."""
     R = wk.shape[0]
     for q in range(K.shape[0]):
         sk = 0.0
         sg = 0.0
         for r in range(R):
-            i = q * R + r
-            v = f[i]
-            if not (v >= 0.0 and v < math.inf):
-                return i
-            if v > 0.0 and cos_o[i] > 0.0 and weight[i] > 0.0:
-                t = v * cos_o[i] * weight[i]
-                sk += wk[r] * t
-                sg += wg[r] * t
-        K[q] += sk
-        G[q] += sg
-    return -1
+            sk += wk[r] * vals[q * R + r]
+            sg += wg[r] * vals[q * R + r]
+        K[q] = sk
+        G[q] = sg
 
 
 # --- one batch of segments ------------------------------------------------------------------------
 
-def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1):
+def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i_sub=None):
     """The segments (piece ``seg_piece``, sub-interval [t0, t1] of v) of outer intervals ``seg_int``
     (indices into ``i_prob``, ``i_x0``, ``i_x1``) at the 15 outer nodes of their interval: per segment
     its share of the outer Kronrod and Gauss sums, its inner error carried through the outer Kronrod
@@ -362,7 +389,13 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1):
     inodes, iwk, iwg = _INNER
     uniq, loc = np.unique(seg_int, return_inverse=True)
     h = i_x1[uniq] - i_x0[uniq]
-    tx = (i_x0[uniq][:, None] + h[:, None] * onodes[None, :]).ravel()
+    if i_sub is None:
+        tx = (i_x0[uniq][:, None] + h[:, None] * onodes[None, :]).ravel()
+        hw = np.broadcast_to(h[:, None], (len(uniq), RO))
+    else:  # the outer substitution towards a break (OUTER_SUB): x = x0 + h t(v), dx = h t'(v) dv
+        tv, dtv = _end_map(i_sub[uniq], np.broadcast_to(onodes, (len(uniq), RO)))
+        tx = (i_x0[uniq][:, None] + h[:, None] * tv).ravel()
+        hw = h[:, None] * dtv
     pnode = np.repeat(i_prob[uniq], RO)
     mu_n = np.ascontiguousarray(g.mu[pnode])
     lev_n = np.ascontiguousarray(g.levels[pnode])
@@ -412,35 +445,43 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1):
     weight = np.empty(C * RI)
     Kb = np.zeros(B)
     Gb = np.zeros(B)
+    vals = np.empty(C * RI)
     signs = (1.0,) if lobe.symmetric else (1.0, -1.0)
     axis = _AXIS_CODE[lobe.axis]
     for c0 in range(0, B, CHUNK):
         sl = slice(c0, min(B, c0 + CHUNK))
         n = (sl.stop - sl.start) * RI
-        wi_, wo_, w_ = wi[:n], wo[:n], weight[:n]
+        wi_, wo_, w_, v_ = wi[:n], wo[:n], weight[:n], vals[:n]
+        v_[:] = 0.0
         _points_kernel(axis, b_node[sl], b_lo[sl], b_w[sl], b_t0[sl], b_t1[sl], sm[sl], mu_n, s_n, ca_n, sa_n, wr_n,
                        inodes, wi_, wo_, w_)
         for sign in signs:
             if sign < 0:
                 wo_[:, 1] *= -1.0  # beta -> -beta flips wo_y in every frame (wi_y = 0)
             f = np.ascontiguousarray(brdf._eval(wi_, wo_), dtype=np.float64)
-            i = _segment_sums_kernel(f, wo_[:, 2], w_, iwk, iwg, Kb[sl], Gb[sl])
+            i = _values_kernel(f, wo_[:, 2], w_, v_)
             if i >= 0:
                 raise ValueError(
                     f"{brdf!r} returned {f[i]!r} at wi={wi_[i].tolist()}, wo={wo_[i].tolist()}: "
                     "a BRDF must be finite and non-negative above the horizon"
                 )
+        _rule_kernel(v_, iwk, iwg, Kb[sl], Gb[sl])
     sym = 2.0 if lobe.symmetric else 1.0
     r = b_seg % RO
     seg = b_seg // RO
-    hb = sym * h[loc[seg]]
-    kron = np.bincount(seg, hb * owk[r] * Kb, minlength=S)
-    gauss = np.bincount(seg, hb * owg[r] * Kb, minlength=S)
+    hb = sym * hw[loc[seg], r]
+    # per segment and outer node: the arc integral's share (the outer rule's value, in its variable)
+    sv = np.bincount(seg * RO + r, hb * Kb, minlength=S * RO).reshape(S, RO)
     inner = np.bincount(seg, hb * owk[r] * inner_error(Kb, Gb), minlength=S)
     absk = np.bincount(seg, hb * owk[r] * np.abs(Kb), minlength=S)
     evals = np.bincount(i_prob[seg_int[seg]], minlength=len(g.mu)) * RI * len(signs)
-    return kron, gauss, inner, absk, evals
+    return sv, inner, absk, evals
 
+
+#: outer intervals that end at a break integrate in v with x = x0 + h v^2 towards it (module docstring)
+OUTER_SUB = True
+#: the crossings of two cuts are breaks of the outer variable too (module docstring)
+CROSSINGS = True
 
 #: ratio of the geometric grid above the power map's split (_split_breaks)
 SPLIT_RATIO = 4.0
@@ -463,6 +504,17 @@ def _graded_coarse(points: np.ndarray) -> np.ndarray:
             out.extend(v for v in (t - step, t + step) if 0 < v < 1)
             step *= GRADE_RATIO
     return np.array(out)
+
+
+def _merged(breaks: np.ndarray) -> np.ndarray:
+    """The sorted breaks with those within 1e-12 of their distance to the nearer end of [0, 1] of the
+    previous one dropped: three cuts of Cook-Torrance's geometry factor cross at one point (m = 0.4,
+    mu = 0.1: tau_x = 0.0255861562 three times, 1e-17 apart), and each interval costs a full rule."""
+    b = np.sort(breaks)
+    if len(b) < 2:
+        return b
+    keep = np.r_[True, np.diff(b) > 1e-12 * np.minimum(b[1:], 1.0 - b[1:])]
+    return b[keep]
 
 
 def _split_breaks(lobe) -> np.ndarray:
@@ -508,31 +560,47 @@ def _end_grading(levels, lab, dn, node, piece, width, t0, t1, sm):
     B = len(node)
     if not levels.shape[1]:
         return np.arange(B), t0, t1
-    cand = [t0[:, None], t1[:, None]]
     kk = 4.0 ** np.arange(K_GRADE)
+    ends = []  # (rows, sign, d) of the ends to grade; only those rows are expanded
     for edge, sign in ((piece + 1, -1.0), (piece, 1.0)):
         j = lab[node, edge]
-        u = np.where(j >= 0, levels[node, np.maximum(j, 0)], 0.0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            d = u / (dn[node, edge] * width)
-            smooth = (sm & (2 if sign < 0 else 1)) > 0  # t ~ 3 v^2 at a smoothed end: the scale is sqrt(d / 3)
-            d = np.where(smooth, np.sqrt(d / 3.0), d)
         end = t1 if sign < 0 else t0
-        need = (j >= 0) & (u > 0) & (d < D_GRADE) & (end == (1.0 if sign < 0 else 0.0))
-        if not need.any():
+        maybe = np.nonzero((j >= 0) & (end == (1.0 if sign < 0 else 0.0)))[0]
+        if not len(maybe):
             continue
+        jm = j[maybe]
+        u = levels[node[maybe], jm]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            d = u / (dn[node[maybe], edge[maybe]] * width[maybe])
+            smooth = (sm[maybe] & (2 if sign < 0 else 1)) > 0  # t ~ 3 v^2 at a smoothed end: the scale is sqrt(d / 3)
+            d = np.where(smooth, np.sqrt(d / 3.0), d)
+        need = (u > 0) & (d < D_GRADE)
+        if need.any():
+            ends.append((maybe[need], sign, d[need]))
+    if not ends:
+        return np.arange(B), t0, t1
+    graded = np.unique(np.concatenate([r for r, _, _ in ends]))
+    pos = np.full(B, -1)
+    pos[graded] = np.arange(len(graded))
+    G = len(graded)
+    cand = [t0[graded, None], t1[graded, None]]
+    for rows, sign, d in ends:
         d = np.maximum(d, 0.25 / kk[-1])
         off = d[:, None] * kk[None, :]
         pts = (1.0 - off) if sign < 0 else off
-        ok = need[:, None] & (off < 0.25) & (pts > t0[:, None]) & (pts < t1[:, None])
-        cand.append(np.where(ok, pts, np.nan))
-    if len(cand) == 2:
-        return np.arange(B), t0, t1
+        ok = (off < 0.25) & (pts > t0[rows, None]) & (pts < t1[rows, None])
+        full = np.full((G, K_GRADE), np.nan)
+        full[pos[rows]] = np.where(ok, pts, np.nan)
+        cand.append(full)
     allp = np.sort(np.concatenate(cand, axis=1), axis=1)  # NaN last
     a, b = allp[:, :-1], allp[:, 1:]
     okp = np.isfinite(a) & np.isfinite(b) & (b > a)
-    row, col = np.nonzero(okp)
-    return row, a[row, col], b[row, col]
+    r, col = np.nonzero(okp)
+    plain = np.ones(B, bool)
+    plain[graded] = False
+    row = np.concatenate([np.nonzero(plain)[0], graded[r]])
+    order = np.argsort(row, kind="stable")  # blocks in their order, sub-intervals in increasing v
+    return row[order], np.concatenate([t0[plain], a[r, col]])[order], np.concatenate([t1[plain], b[r, col]])[order]
 
 
 def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
@@ -542,17 +610,18 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
     P = len(g.mu)
     n_pieces = 1 + g.levels.shape[1] + (len(g.lobe.kinks(np.array([0.5]), np.array([0.5]), np.array([0.5]),
                                                          np.array([0.5]))) if g.lobe.kinks else 0)
-    # the crossings of two cuts are kinks of the 2-D engine's sorted pieces, not of the arc's integral
-    # that the outer rule here sees (the pieces at one outer node add up to it whatever their order)
-    kink_breaks = _kink_breaks(g.lobe, g.mu, g.levels, crossings=False)
+    # the crossings of two cuts change the order of the pieces; the arc's integral is not analytic there
+    # (module docstring): breaks here too, as in the 2-D engine
+    kink_breaks = _kink_breaks(g.lobe, g.mu, g.levels, crossings=CROSSINGS)
     split = _split_breaks(g.lobe)
     cols = []
     for p_ in range(P):
-        breaks = np.concatenate([_horizon_breaks(g.lobe, float(g.mu[p_])), kink_breaks[p_]])
+        breaks = _merged(np.concatenate([_horizon_breaks(g.lobe, float(g.mu[p_])), kink_breaks[p_]]))
         gx = np.unique(np.concatenate([np.linspace(0, 1, NX_INIT + 1), _graded_coarse(breaks), split]))
-        cols.append((np.full(len(gx) - 1, p_), gx[:-1], gx[1:]))
+        at_break = np.isin(gx, breaks) if OUTER_SUB else np.zeros(len(gx), bool)
+        cols.append((np.full(len(gx) - 1, p_), gx[:-1], gx[1:], at_break[:-1] * 1 + at_break[1:] * 2))
     # intervals (growing arrays; a bisected interval is dead) and their segments
-    i_prob, i_x0, i_x1 = (np.concatenate(c) for c in zip(*cols))
+    i_prob, i_x0, i_x1, i_sub = (np.concatenate(c) for c in zip(*cols))
     alive = np.ones(len(i_prob), bool)
     nI = len(i_prob)
     grid = np.linspace(0.0, 1.0, M_INIT + 1)
@@ -560,15 +629,16 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
     s_piece = np.tile(np.repeat(np.arange(n_pieces), M_INIT), nI)
     s_t0 = np.tile(grid[:-1], nI * n_pieces)
     s_t1 = np.tile(grid[1:], nI * n_pieces)
-    s_k, s_g, s_e, s_a, evals = _evaluate(brdf, g, i_prob, i_x0, i_x1, s_int, s_piece, s_t0, s_t1)
+    s_v, s_e, s_a, evals = _evaluate(brdf, g, i_prob, i_x0, i_x1, s_int, s_piece, s_t0, s_t1, i_sub)
     # the budget counts outer intervals, an interval with m sub-intervals per piece m times
     seg_count = lambda: np.bincount(i_prob[s_int], minlength=P) / n_pieces
     budget = max_regions + seg_count()
     rounding = _rounding(g.lobe)
     while True:
         nI = len(i_prob)
-        kron = np.bincount(s_int, s_k, minlength=nI)
-        gauss = np.bincount(s_int, s_g, minlength=nI)
+        RO = s_v.shape[1]
+        F = np.bincount((s_int[:, None] * RO + np.arange(RO)).ravel(), s_v.ravel(), minlength=nI * RO).reshape(nI, RO)
+        kron, gauss = F @ _OUTER[1], F @ _OUTER[2]
         inner = np.bincount(s_int, s_e, minlength=nI)
         outer = np.abs(kron - gauss)
         err = np.where(alive, interval_error(kron, gauss, inner), 0.0)
@@ -601,7 +671,12 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
         sel[f2[deeper[s_int[f2]]]] = True
         # children of split intervals, with copies of the parent's segments
         sp = np.nonzero(split)[0]
-        xm = 0.5 * (i_x0[sp] + i_x1[sp])
+        # bisected in the interval's own variable v: at x0 + h / 4 (x1 - h / 4) where it is x0 + h v^2
+        # (x1 - h (1 - v)^2); a child keeps the substitution at the parent's break end only
+        hs = i_x1[sp] - i_x0[sp]
+        ss = i_sub[sp]
+        xm = np.where(ss == 1, i_x0[sp] + 0.25 * hs, np.where(ss == 2, i_x1[sp] - 0.25 * hs, 0.5 * (i_x0[sp] + i_x1[sp])))
+        i_sub = np.concatenate([i_sub, ss & 1, ss & 2])
         base = len(i_prob)
         child = np.full(nI, -1)
         child[sp] = base + np.arange(len(sp))  # lower children; upper ones follow at + len(sp)
@@ -616,13 +691,13 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
         new_piece = np.concatenate([s_piece[sel], s_piece[sel], s_piece[moved], s_piece[moved]])
         new_t0 = np.concatenate([s_t0[sel], tm, s_t0[moved], s_t0[moved]])
         new_t1 = np.concatenate([tm, s_t1[sel], s_t1[moved], s_t1[moved]])
-        ck, cg, ce, ca, cev = _evaluate(brdf, g, i_prob, i_x0, i_x1, new_int, new_piece, new_t0, new_t1)
+        cv, ce, ca, cev = _evaluate(brdf, g, i_prob, i_x0, i_x1, new_int, new_piece, new_t0, new_t1, i_sub)
         evals = evals + cev
         keep = ~(sel | moved)
         s_int = np.concatenate([s_int[keep], new_int])
         s_piece = np.concatenate([s_piece[keep], new_piece])
         s_t0, s_t1 = np.concatenate([s_t0[keep], new_t0]), np.concatenate([s_t1[keep], new_t1])
-        s_k, s_g = np.concatenate([s_k[keep], ck]), np.concatenate([s_g[keep], cg])
+        s_v = np.concatenate([s_v[keep], cv])
         s_e, s_a = np.concatenate([s_e[keep], ce]), np.concatenate([s_a[keep], ca])
     LAST_EVALS = evals
     return total, E, converged

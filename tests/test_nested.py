@@ -174,13 +174,15 @@ def test_kernels_match_their_numpy_twins(spec, mu):
     np.testing.assert_allclose(np.linalg.norm(wo[w > 0], axis=1), 1.0, atol=1e-13)
     f = np.abs(rng.normal(size=S))
     f[::5] = 0.0
+    vals = np.zeros(S)
+    assert _nested._values_kernel(f, wo[:, 2], w, vals) == -1
+    np.testing.assert_allclose(vals, _nested._values_reference(f, wo[:, 2], w), rtol=1e-15, atol=1e-300)
     K, G = np.zeros(S // 15), np.zeros(S // 15)
-    assert _nested._segment_sums_kernel(f, wo[:, 2], w, WK, WG, K, G) == -1
-    Kr, Gr = _nested._segment_sums_reference(f, wo[:, 2], w, WK, WG)
-    np.testing.assert_allclose(K, Kr, rtol=1e-13, atol=1e-300)
-    np.testing.assert_allclose(G, Gr, rtol=1e-13, atol=1e-300)
+    _nested._rule_kernel(vals, WK, WG, K, G)
+    for got_, ref_ in zip((K, G), _nested._rule_reference(vals, WK, WG)):
+        np.testing.assert_allclose(got_, ref_, rtol=1e-13, atol=1e-300)
     f[17] = np.nan
-    assert _nested._segment_sums_kernel(f, wo[:, 2], w, WK, WG, K, G) == 17
+    assert _nested._values_kernel(f, wo[:, 2], w, vals) == 17
 
 
 def test_nested_integrand_equals_the_2d_geometry():
@@ -192,8 +194,9 @@ def test_nested_integrand_equals_the_2d_geometry():
     # the value at one node, as the outer rule on a tiny interval around it would see it: compare the
     # inner sums with the 2-D engine's integrand summed by the same 15-point rule in tau_t
     h = 1e-12
-    k, *_ = _nested._evaluate(f, g, np.array([0]), np.array([tx0]), np.array([tx0 + h]), seg_int,
-                                              np.arange(n_pieces), np.zeros(n_pieces), np.ones(n_pieces))
+    sv, *_ = _nested._evaluate(f, g, np.array([0]), np.array([tx0]), np.array([tx0 + h]), seg_int,
+                               np.arange(n_pieces), np.zeros(n_pieces), np.ones(n_pieces))
+    k = sv @ _nested._OUTER[1]  # the outer Kronrod sum of each segment
     tt = NODES
     total = 0.0
     for piece in range(n_pieces):
