@@ -603,6 +603,14 @@ def _end_grading(levels, lab, dn, node, piece, width, t0, t1, sm):
     return row[order], np.concatenate([t0[plain], a[r, col]])[order], np.concatenate([t1[plain], b[r, col]])[order]
 
 
+def _weighted_columns(F: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """sum_r F[:, r] w[r], summed in the order of r for every row (independent of the number of rows)."""
+    out = F[:, 0] * w[0]
+    for r in range(1, F.shape[1]):
+        out += F[:, r] * w[r]
+    return out
+
+
 def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
     """a(mu) of the group ``g`` by nested quadrature: (value, error, converged) per problem, as
     ``pumpup.albedo._integrate_group`` returns them."""
@@ -638,7 +646,10 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
         nI = len(i_prob)
         RO = s_v.shape[1]
         F = np.bincount((s_int[:, None] * RO + np.arange(RO)).ravel(), s_v.ravel(), minlength=nI * RO).reshape(nI, RO)
-        kron, gauss = F @ _OUTER[1], F @ _OUTER[2]
+        # the outer sums column by column, not by a matrix product: BLAS's order of the terms depends on
+        # the matrix's size and alignment, and so did the last bits of the error, with the batch a value
+        # of mu was computed in (a table then depended on the number of threads; tests/test_tables.py)
+        kron, gauss = _weighted_columns(F, _OUTER[1]), _weighted_columns(F, _OUTER[2])
         inner = np.bincount(s_int, s_e, minlength=nI)
         outer = np.abs(kron - gauss)
         err = np.where(alive, interval_error(kron, gauss, inner), 0.0)

@@ -48,6 +48,11 @@ def main():
                 print(f"{name:10s} {var:22s} max new/old {np.nanmax(a / np.where(b > 0, b, np.nan)):.3g}, "
                       f"min {np.nanmin(a / np.where(b > 0, b, np.nan)):.3g}")
                 continue
+            elif var == "theta_deg":
+                # the angle of a maximum: the albedo is flat there, so the angle is determined only to about
+                # sqrt(albedo error / curvature) (stretched Blinn n = 2's moved 1.1e-6 deg in issue 14 with
+                # its maximum the same to 7e-17); the regression test's own tolerance, 1e-4 deg
+                tol = np.full(b.shape, 1e-4)
             else:
                 tol = 1e-8 * np.abs(b) + 1e-13  # derived quantities: the regression test's own tolerance
             d = np.abs(a - b)
