@@ -23,6 +23,7 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
     python scripts/bench_albedo.py --eval     # only BRDF.eval's overhead (the input checks) and numpy
     python scripts/bench_albedo.py --phong    # only the Phong family's rows (1-D path), no dblquad
     python scripts/bench_albedo.py --p        # only the p-model with p in (0, 1): 1-D path against the nested engine
+    python scripts/bench_albedo.py --pumped   # only pumped Phong-family chains: 1-D path against the nested engine
 """
 
 import signal
@@ -233,6 +234,54 @@ def p_model(rtol=1e-10, repeat=3):
               flush=True)
 
 
+def pumped_chains(rtol=1e-10, repeat=3):
+    """Pumped Phong-family BRDFs (001 eq. 16; the 1-D path since issue 14's fourth session) against
+    the nested engine that had them (``Pumped.polar`` switched off: the base's Phong lobe keeps its
+    1-D path), same run: a 257-point table at rtol ``rtol`` (mu uniform in theta, the chain's tables
+    built first), one thread, best of ``repeat``; then the three tables of a 3-level g2 pumped Phong
+    n = 20 as ``pumpup.pump`` builds them (``tabulate``'s threads, rtol 1e-9, adaptive grids)."""
+    from pumpup.pumping import _TABLES, Pumped
+
+    mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
+    polar = Pumped.polar
+    print(f"pumped chains, one thread, ms (best of {repeat}); table: 257 mu at rtol {rtol:g}")
+    print(f"{'chain':52s} {'1-D':>8s} {'nested':>9s} {'ratio':>6s}")
+    for spec, g, levels in [({"type": "phong", "n": 20}, "g2", 1), ({"type": "phong", "n": 20}, "g2", 2),
+                            ({"type": "phong", "n": 20}, "g2", 3), ({"type": "stretched_phong", "n": 20}, "g1", 2),
+                            ({"type": "phong", "n": 200}, "g2", 2)]:
+        f = pumpup.pump(spec, g=g, levels=levels)
+        for lev in f.chain():
+            lev.lookup()
+        out = []
+        for on in (True, False):
+            if not on:
+                Pumped.polar = lambda self: None
+            try:
+                pumpup.albedo(f, [0.5, 1e-3], rtol=rtol)
+                out.append(_best(lambda: pumpup.albedo(f, mu, rtol=rtol), repeat if on else 1)[1])
+            finally:
+                Pumped.polar = polar
+        name = f"{spec['type']} n = {spec['n']}, {g} x {levels}"
+        print(f"{name:52s} {out[0] * 1e3:8.1f} {out[1] * 1e3:9.1f} {out[1] / out[0]:6.1f}", flush=True)
+
+    def build(n):
+        _TABLES.clear()
+        t = time.perf_counter()
+        for lev in pumpup.pump({"type": "phong", "n": n}, g="g2", levels=3).chain():
+            lev.lookup()
+        return time.perf_counter() - t
+
+    build(21)
+    new = min(build(20) for _ in range(repeat))
+    Pumped.polar = lambda self: None
+    try:
+        old = build(20)
+    finally:
+        Pumped.polar = polar
+    print(f"3-level g2 pumped Phong n = 20, its three tables (tabulate's threads): 1-D {new * 1e3:.0f} ms, "
+          f"nested {old * 1e3:.0f} ms, ratio {old / new:.1f}")
+
+
 def cells():
     from pumpup import _polar, _reuse
     from pumpup.pumping import _TABLES
@@ -354,6 +403,9 @@ def main():
         return
     if "--p" in sys.argv:
         p_model()
+        return
+    if "--pumped" in sys.argv:
+        pumped_chains()
         return
     if "--cells" not in sys.argv:
         families()
