@@ -780,6 +780,17 @@ class Pumped(BRDF):
         the kinks of g1 only; two spurious levels within 5e-4 of v = mu once made the cubature
         refine to rectangles of width 1e-16 there).
         """
+        cache = self.lookup().__dict__.setdefault("kink_cache", {})  # tied to the bound they come from
+        hit = cache.get(float(mu))
+        if hit is not None:
+            return hit
+        if len(cache) > 4096:  # (a table of every level asks again at the same mu)
+            cache.clear()
+        out = cache[float(mu)] = self._kink_levels(float(mu))
+        return out
+
+    def _kink_levels(self, mu: float) -> tuple:
+        """:meth:`kink_levels`, computed."""
         from scipy.optimize import brentq
 
         up = self.lookup().upper
