@@ -854,6 +854,9 @@ CHAIN_RULE = "gk21"
 #: interval the raw estimate missed such a piece by 2.7 x once (pumped Phong n = 20, g2, 2 levels,
 #: mu = 0.8495, rtol 1e-10), with two no case of the tests is missed
 N_INIT_CHAIN = 2
+#: a pumped lobe's outer rule: its many short pieces (two per level of g) need fewer nodes with the 7/15
+#: rule (3-level g2 Phong's three tables 13 % faster than with 10/21; the estimates as honest)
+CHAIN_OUTER = "gk15"
 
 
 def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
@@ -899,6 +902,6 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     with np.errstate(divide="ignore"):
         atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
     _integrate(float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
-               *(_RULES[RULE]), mode_code(hint.chain is None), N_INIT if hint.chain is None else N_INIT_CHAIN,
+               *(_RULES[RULE if hint.chain is None else CHAIN_OUTER]), mode_code(hint.chain is None), N_INIT if hint.chain is None else N_INIT_CHAIN,
                *_RULES["gk15" if hint.chain is None else CHAIN_RULE], jac, lev, nlev, chain, lower, val, err, conv, evals)
     return scale * val, np.abs(scale) * err, conv, evals
