@@ -48,7 +48,7 @@ the hint already says.  This module integrates the same integrand as a nested qu
 
 The geometry runs in two compiled passes per batch (:func:`_nodes_kernel`: per outer node;
 :func:`_points_kernel`: per point), the model's ``_eval`` once per batch on all points (twice
-where the hint is not even in beta), and two compiled passes (:func:`_values_kernel`, :func:`_rule_kernel`)
+where the hint is not even in beta), and two compiled passes (:func:`pumpup.albedo._accumulate`, :func:`_rule_kernel`)
 form the Kronrod and Gauss sums; each has a plain numpy twin (``*_reference``) that the tests compare
 with it.
 
@@ -72,6 +72,7 @@ from .albedo import (
     NODES,
     WG,
     WK,
+    _accumulate,
     _horizon_breaks,
     _kink_breaks,
     _kink_coefficients,
@@ -338,21 +339,9 @@ def _points_kernel(axis, node, lo, width, t0, t1, sm, mu, s_n, ca_n, sa_n, wr_n,
 # --- Kronrod and Gauss sums per segment --------------------------------------------------------------
 
 def _values_reference(f, cos_o, weight):
-    """Plain numpy twin of :func:`_values_kernel`: f cos(theta_o) weight where all three are positive."""
+    """Plain numpy twin of :func:`pumpup.albedo._accumulate` as this module uses it (on zeros): f cos(theta_o)
+    weight where all three are positive."""
     return np.where((f > 0) & (cos_o > 0) & (weight > 0), f * cos_o * weight, 0.0)
-
-
-@njit(cache=True, nogil=True)
-def _values_kernel(f, cos_o, weight, vals):  # pragma: no cover - compiled
-    """vals += f cos(theta_o) weight (positive terms only); the index of the first f that is negative or
-    not finite (or -1)."""
-    for i in range(f.shape[0]):
-        v = f[i]
-        if not (v >= 0.0 and v < math.inf):
-            return i
-        if v > 0.0 and cos_o[i] > 0.0 and weight[i] > 0.0:
-            vals[i] += v * cos_o[i] * weight[i]
-    return -1
 
 
 def _rule_reference(vals, wk, wg):
@@ -459,7 +448,7 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
             if sign < 0:
                 wo_[:, 1] *= -1.0  # beta -> -beta flips wo_y in every frame (wi_y = 0)
             f = np.ascontiguousarray(brdf._eval(wi_, wo_), dtype=np.float64)
-            i = _values_kernel(f, wo_[:, 2], w_, v_)
+            i = _accumulate(f, wo_[:, 2], w_, v_)
             if i >= 0:
                 raise ValueError(
                     f"{brdf!r} returned {f[i]!r} at wi={wi_[i].tolist()}, wo={wo_[i].tolist()}: "

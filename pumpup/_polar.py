@@ -490,13 +490,7 @@ def _k_chain(p, mu, c2, u, um, sa, lev, nlev, gmu, itol, katol, chain, nodes, wk
                 m += 1
     bcut[m] = beta0
     m += 1
-    for j in range(2, m - 1):  # insertion sort of the level cuts (a few; no allocation)
-        v = bcut[j]
-        i = j - 1
-        while i >= 1 and bcut[i] > v:
-            bcut[i + 1] = bcut[i]
-            i -= 1
-        bcut[i + 1] = v
+    _sort_interior(bcut, m)  # the level cuts, between 0 and beta0
     lo, hi, val, err = iwork[0], iwork[1], iwork[2], iwork[3]
     nint = 0
     for j in range(m - 1):
@@ -568,7 +562,7 @@ WG21 = np.zeros(21)
 WG21[1:10:2] = 0.5 * _WG10
 WG21[11::2] = 0.5 * _WG10[::-1]
 from ._errors import EPS, calibrated, mode_code, rule_sums  # noqa: E402
-from .albedo import NODES as _NODES, WG as _WG, WK as _WK  # noqa: E402  (the engine's 7/15 rule)
+from .albedo import NODES as _NODES, WG as _WG, WK as _WK, _sort_interior  # noqa: E402  (the engine's 7/15 rule)
 from .pumping import _g_levels, _g_product  # noqa: E402  (g of a pumped chain, as the BRDF divides by it)
 #: the rule of the 1-D path (measured and tested with "gk21": 90-190 evaluations per mu for the
 #: Phong family at rtol 1e-10)

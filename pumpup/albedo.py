@@ -312,6 +312,19 @@ def _radial_scalar(kind, k, x, xc):  # pragma: no cover - compiled; see _radial
     return math.cos(a), math.sin(a), ((1.0 - y0) * sinc / (2.0 * k * k * y) if y > 0.0 else math.inf)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _sort_interior(x, n):  # pragma: no cover - compiled
+    """Insertion sort of x[1:n - 1] in place (the cuts between an arc's two ends x[0] and x[n - 1]: a
+    few, already nearly sorted; no allocation)."""
+    for a in range(2, n - 1):
+        val = x[a]
+        b = a - 1
+        while b >= 1 and x[b] > val:
+            x[b + 1] = x[b]
+            b -= 1
+        x[b + 1] = val
+
+
 @njit(cache=True, nogil=True)
 def _geometry_kernel(axis, radial, k, mu_p, levels_p, prob, ka, kb, piece, tx, tt, wi, wo, weight):  # pragma: no cover
     """Compiled twin of :func:`_geometry_reference`; fills ``wi``, ``wo`` (N, 3) and ``weight`` (N).
@@ -360,14 +373,7 @@ def _geometry_kernel(axis, radial, k, mu_p, levels_p, prob, ka, kb, piece, tx, t
                 n += 1
             edges[n] = beta0
             n += 1
-            # insertion sort of the interior cuts
-            for a in range(2, n - 1):
-                val = edges[a]
-                b = a - 1
-                while b >= 1 and edges[b] > val:
-                    edges[b + 1] = edges[b]
-                    b -= 1
-                edges[b + 1] = val
+            _sort_interior(edges, n)
             lo = edges[piece[i]]
             width = edges[piece[i] + 1] - lo
         wi[i, 0] = s

@@ -175,14 +175,14 @@ def test_kernels_match_their_numpy_twins(spec, mu):
     f = np.abs(rng.normal(size=S))
     f[::5] = 0.0
     vals = np.zeros(S)
-    assert _nested._values_kernel(f, wo[:, 2], w, vals) == -1
+    assert _nested._accumulate(f, wo[:, 2], w, vals) == -1
     np.testing.assert_allclose(vals, _nested._values_reference(f, wo[:, 2], w), rtol=1e-15, atol=1e-300)
     K, G = np.zeros(S // 15), np.zeros(S // 15)
     _nested._rule_kernel(vals, WK, WG, K, G)
     for got_, ref_ in zip((K, G), _nested._rule_reference(vals, WK, WG)):
         np.testing.assert_allclose(got_, ref_, rtol=1e-13, atol=1e-300)
     f[17] = np.nan
-    assert _nested._values_kernel(f, wo[:, 2], w, vals) == 17
+    assert _nested._accumulate(f, wo[:, 2], w, vals) == 17
 
 
 def test_nested_integrand_equals_the_2d_geometry():
