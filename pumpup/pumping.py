@@ -772,7 +772,8 @@ class Pumped(BRDF):
 
     # --- hints for the albedo engine: the base's lobe plus the kinks of g ------------------
     def kink_levels(self, mu: float) -> tuple:
-        """Values v of N.wo where g(mu, v) has a kink (roots on the tabulated albedo).
+        """Values v of N.wo where g(mu, v) has a kink (roots on the tabulated albedo), or a jump (the
+        table's first node, near grazing incidence).
 
         g is the max of U = u(mu), u(v) and, for g2, mu and v (u the upper bound of the base's
         albedo).  A kink is where the two largest terms cross: a crossing of two terms that lie
@@ -824,6 +825,12 @@ class Pumped(BRDF):
             cross = up(grid, capped=False) - lk.cap
             for i in np.nonzero(np.sign(cross[:-1]) * np.sign(cross[1:]) < 0)[0]:
                 out.append(brentq(lambda u: float(up(u, capped=False)) - lk.cap, grid[i], grid[i + 1], xtol=1e-15))
+        if mu < 1e3 * lk.mu0 < 1e3:
+            # below the table's first node the bound is a power law with its own margin: it jumps there
+            # (by margin_lo - margin, ~1e-8 of it), which matters where N.wo that small carries weight, at
+            # incidence within 1e3 of it (the 1-D path was 7.5e-11 off at mu = 1e-8 without the cut,
+            # estimate 5.2e-11: 3-level g1 stretched Phong n = 3); further up its share is below 1e-14
+            out.append(lk.mu0)
         for p, q, value in lk.flats:  # mu on a flat piece of the bound: u(v) = U up to its end q
             if p <= mu <= q and value < lk.cap:
                 out.append(q)
