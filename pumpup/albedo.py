@@ -578,24 +578,14 @@ _TAU_SCAN = np.unique(np.concatenate([
 _END_GAP = 1e-10
 
 
-def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool = True) -> list[np.ndarray]:
-    """Values of tau_x where a kink of the integrand enters or leaves the arc of beta, for
-    every problem (mu (P,), levels (P, L)); a list of P arrays.
+def _kink_breaks_reference(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool = True) -> list[np.ndarray]:
+    """Plain numpy reference of :func:`_kink_breaks`: the same breaks, bit for bit and in the same
+    order (``tests/test_albedo_breaks.py`` checks the two against each other).
 
-    A kink a + b cos(beta) = 0 (a level N.wo = u, or a model's own kink) lies on the arc
-    only while |a| <= |b|; where a = +-b it appears or vanishes with a square-root
-    behaviour in x (and at normal incidence, where b = 0, it becomes a circle: a jump in
-    the derivative along x).  Roots of a -+ b are found on a graded scan and refined by
-    bisection to full precision, all problems at once.
-
-    Two roots in one cell of the scan leave no sign change on it: a level u near 1 is on the arc
-    only where the arc's highest point a + |b| = cos(alpha - theta) exceeds u, a window of width
-    2 arccos(u) around the axis (6e-4 rad for u = 1 - 1.9e-7, the cap of ``scaled`` Phong n = 5's
-    table at mu = 0.823, inside one 2.5e-3 cell).  Unseen, the piece above the level had width 0 at
-    every node of every first rectangle: K = G = 0, never refined, and the cap (5.1e-7 of the
-    albedo) was missing with an estimate of 1e-13.  So every interior local minimum of |a -+ b| on
-    the scan is followed by a golden-section search of its two cells for a change of sign
-    (:func:`_touching_pairs`), and both roots are refined like the others.
+    The functions whose roots are breaks are sampled on ``_TAU_SCAN`` for all problems at once (an
+    (F P, G) array), and every sign change and every touching pair (:func:`_touching_pairs_reference`)
+    is refined with ``h_rows``, which evaluates the cuts' coefficients at the points asked for, one
+    step of the bisection (or of the golden-section search) at a time for all roots together.
     """
     P = len(mu)
     if not levels.shape[1] and lobe.kinks is None:
@@ -655,7 +645,7 @@ def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool
     aj, bj, ak, bk = a_[fj], b_[fj], a_[fk], b_[fk]  # (F, P, G)
     with np.errstate(all="ignore"):
         h = np.where((kind == 0)[:, None, None], aj - fs[:, None, None] * bj, aj * bk - ak * bj).reshape(F * P, G)
-    r_idx, t = _roots(h, h_rows)
+    r_idx, t = _roots_reference(h, h_rows)
     # a root within 1e-10 of an end is the end itself (a level through the lobe axis, N.wo = mu on
     # the mirror axis, touches the arc at alpha = 0): grading the grid towards it cost ~100
     # rectangles per mu and changed nothing
@@ -675,15 +665,15 @@ def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool
 _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
 
-def _roots(h: np.ndarray, h_at) -> tuple[np.ndarray, np.ndarray]:
+def _roots_reference(h: np.ndarray, h_at) -> tuple[np.ndarray, np.ndarray]:
     """(problem, tau) of the roots of a function sampled as ``h`` (P, G) on ``_TAU_SCAN``, with
     ``h_at(p, tau)`` to evaluate it: every sign change between scan nodes and every pair of roots
-    around a local minimum of |h| (:func:`_touching_pairs`), refined by bisection."""
+    around a local minimum of |h| (:func:`_touching_pairs_reference`), refined by bisection."""
     ok = np.isfinite(h)
     p_idx, i_idx = np.nonzero(ok[:, :-1] & ok[:, 1:] & (np.sign(h[:, :-1]) * np.sign(h[:, 1:]) < 0))
     lo, hi = _TAU_SCAN[i_idx].copy(), _TAU_SCAN[i_idx + 1].copy()
     h_lo = h[p_idx, i_idx]
-    tp, tlo, thi, tmid, th_lo, th_mid = _touching_pairs(h, ok, h_at)
+    tp, tlo, thi, tmid, th_lo, th_mid = _touching_pairs_reference(h, ok, h_at)
     p_idx = np.concatenate([p_idx, tp, tp])
     lo = np.concatenate([lo, tlo, tmid])
     hi = np.concatenate([hi, tmid, thi])
@@ -700,7 +690,7 @@ def _roots(h: np.ndarray, h_at) -> tuple[np.ndarray, np.ndarray]:
     return p_idx, 0.5 * (lo + hi)
 
 
-def _touching_pairs(h: np.ndarray, ok: np.ndarray, h_at):
+def _touching_pairs_reference(h: np.ndarray, ok: np.ndarray, h_at):
     """Brackets of root pairs that the scan of :func:`_kink_breaks` shows no sign change for.
 
     ``h`` (P, G) are the values of one kink function a -+ b on ``_TAU_SCAN`` (``ok`` where finite)
@@ -742,6 +732,379 @@ def _touching_pairs(h: np.ndarray, ok: np.ndarray, h_at):
     p_idx, i_idx = p_idx[hit], i_idx[hit]
     return (p_idx, _TAU_SCAN[i_idx - 1].copy(), _TAU_SCAN[i_idx + 1].copy(), found[hit],
             h[p_idx, i_idx - 1], h_found[hit])
+
+
+# --- the breaks of the radial variable: compiled scan and refinement (twin: _kink_breaks_reference) ---
+
+#: points of the kink functions evaluated per round of :func:`_kink_breaks`'s refinement: one call of
+#: the numpy coefficients (:func:`_cut_coefficients`) costs ~0.1 ms whatever its size, so while few
+#: roots are left each gets several steps of its search per call (a tree of the possible steps)
+_ROUND_POINTS = 2048
+#: the deepest such tree (2^8 - 1 points of a bisection)
+_MAX_DEPTH = 8
+_BISECT_STEPS = 64  # bisection: the cells are at least 1e-13 wide
+_GOLDEN_STEPS = 48  # (0.618)^48 ~ 1e-10 of a cell (< 1e-12 in tau)
+#: room for this many roots and touching candidates per kink function and problem in the first pass
+#: of :func:`_scan_kernel` (a second pass if there are more)
+_SCAN_ROOM = 16
+
+
+def _cut_coefficients(lobe: Lobe, m, s, lev, ca, sa):
+    """(A, B), each (n_cuts + 1, n): the coefficients a + b cos(beta) of the cuts (the levels N.wo = u,
+    then the model's kinks) and, last, of the horizon N.wo = 0, at n points with mu ``m``,
+    s = sqrt(1 - mu^2), levels ``lev`` (n, L) and cos(alpha), sin(alpha) ``ca``, ``sa`` (as ``values``
+    in :func:`_kink_breaks_reference`, elementwise the same operations)."""
+    with np.errstate(all="ignore"):
+        if lobe.axis == "normal":
+            a0, b0 = ca, 0.0
+        elif lobe.axis in ("mirror", "retro"):
+            a0, b0 = m * ca, s * sa
+        else:
+            a0, b0 = m * (ca * ca - sa * sa), 2.0 * s * sa * ca
+        kinks = list(lobe.kinks(m, s, ca, sa)) if lobe.kinks is not None else []
+        L = lev.shape[1]
+        A = np.empty((L + len(kinks) + 1, len(m)))
+        B = np.empty_like(A)
+        for j in range(L):
+            A[j] = a0 - lev[:, j]
+            B[j] = b0
+        for q, (a, b) in enumerate(kinks, L):
+            A[q] = a
+            B[q] = b
+        A[-1] = a0
+        B[-1] = b0
+    return A, B
+
+
+@njit(cache=True, nogil=True)
+def _kink_h(A, B, i, f, kind, fj, fk, fs):  # pragma: no cover - compiled
+    """The kink function f at point i: a_j - sign b_j (kind 0) or a_j b_k - a_k b_j (kind 1)."""
+    j = fj[f]
+    if kind[f] == 0:
+        return A[j, i] - fs[f] * B[j, i]
+    k = fk[f]
+    return A[j, i] * B[k, i] - A[k, i] * B[j, i]
+
+
+@njit(cache=True, nogil=True)
+def _kink_h_rows(A, B, f, kind, fj, fk, fs):  # pragma: no cover - compiled
+    """The kink function f[i] at every point i (``h_rows`` of :func:`_kink_breaks_reference`)."""
+    out = np.empty(f.shape[0])
+    for i in range(f.shape[0]):
+        out[i] = _kink_h(A, B, i, f[i], kind, fj, fk, fs)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _same_sign(x, y):  # pragma: no cover - compiled
+    """np.sign(x) == np.sign(y) (False where either is NaN)."""
+    return (x > 0.0 and y > 0.0) or (x < 0.0 and y < 0.0) or (x == 0.0 and y == 0.0)
+
+
+@njit(cache=True, nogil=True)
+def _scan_kernel(A, B, P, G, kind, fj, fk, fs, b_row, b_i, b_h, c_row, c_i, c_s0, c_h):  # pragma: no cover
+    """The brackets of the scan: every kink function (row f P + p) on the G nodes of ``_TAU_SCAN``
+    from the coefficients A, B (C, P G) there; its sign changes (row, cell i, h at node i) and its
+    touching candidates (row, interior node i, sign of h there, h at node i - 1), in the order of
+    ``np.nonzero`` in :func:`_roots_reference` and :func:`_touching_pairs_reference`, as many as
+    the arrays hold.  Returns the two counts (the arrays were too short if they exceed them)."""
+    h = np.empty(G)
+    sign_change = np.zeros(G, np.bool_)
+    touching = np.zeros(G, np.bool_)
+    nb = 0
+    nc = 0
+    inf = math.inf
+    for f in range(kind.shape[0]):
+        j, k, sign = fj[f], fk[f], fs[f]
+        for p in range(P):
+            base = p * G
+            if kind[f] == 0:
+                for g in range(G):
+                    h[g] = A[j, base + g] - sign * B[j, base + g]
+            else:
+                for g in range(G):
+                    h[g] = A[j, base + g] * B[k, base + g] - A[k, base + g] * B[j, base + g]
+            # the conditions of the reference with & and | (no branches: these loops vectorise)
+            for g in range(G - 1):
+                x, y = h[g], h[g + 1]
+                sign_change[g] = ((((x > 0.0) & (y < 0.0)) | ((x < 0.0) & (y > 0.0)))
+                                  & (abs(x) < inf) & (abs(y) < inf))
+            for g in range(1, G - 1):
+                x, y, z = h[g - 1], h[g], h[g + 1]
+                ay = abs(y)
+                touching[g] = ((((y > 0.0) & (x > 0.0) & (z > 0.0)) | ((y < 0.0) & (x < 0.0) & (z < 0.0)))
+                               & (ay < abs(x)) & (ay <= abs(z)) & (abs(x) < inf) & (ay < inf) & (abs(z) < inf))
+            r = f * P + p
+            for g in range(G - 1):
+                if sign_change[g]:
+                    if nb < b_row.shape[0]:
+                        b_row[nb] = r
+                        b_i[nb] = g
+                        b_h[nb] = h[g]
+                    nb += 1
+            for g in range(1, G - 1):
+                if touching[g]:
+                    if nc < c_row.shape[0]:
+                        c_row[nc] = r
+                        c_i[nc] = g
+                        c_s0[nc] = 1.0 if h[g] > 0.0 else -1.0
+                        c_h[nc] = h[g - 1]
+                    nc += 1
+    return nb, nc
+
+
+@njit(cache=True, nogil=True)
+def _bisect_points(lo, hi, pts):  # pragma: no cover - compiled
+    """pts (n, 2^d - 1): the midpoints of the next d bisection steps of every bracket [lo, hi] for
+    either outcome of each step, as a heap (node q's children: 2 q + 1 where the root is above the
+    midpoint, 2 q + 2 where below)."""
+    nn = pts.shape[1]
+    tlo = np.empty(nn)
+    thi = np.empty(nn)
+    for r in range(lo.shape[0]):
+        tlo[0] = lo[r]
+        thi[0] = hi[r]
+        for q in range(nn):
+            mid = 0.5 * (tlo[q] + thi[q])
+            pts[r, q] = mid
+            c = 2 * q + 1
+            if c < nn:
+                tlo[c] = mid
+                thi[c] = thi[q]
+                tlo[c + 1] = tlo[q]
+                thi[c + 1] = mid
+
+
+@njit(cache=True, nogil=True)
+def _bisect_walk(lo, hi, h_lo, rem, pts, hv):  # pragma: no cover - compiled
+    """Up to d steps of bisection of every bracket with the values ``hv`` at the points of
+    :func:`_bisect_points` (as the loop of :func:`_roots_reference`); ``rem`` counts the steps left,
+    and is set to 0 where a step changes nothing (lo and hi adjacent: so would every later step)."""
+    depth = 0
+    while (1 << (depth + 1)) - 1 <= pts.shape[1]:
+        depth += 1
+    for r in range(lo.shape[0]):
+        q = 0
+        for _ in range(depth):
+            if rem[r] == 0:
+                break
+            mid, h_mid = pts[r, q], hv[r, q]
+            if _same_sign(h_mid, h_lo[r]):
+                moved = mid != lo[r]
+                lo[r] = mid
+                h_lo[r] = h_mid
+                q = 2 * q + 1
+            else:
+                moved = mid != hi[r]
+                hi[r] = mid
+                q = 2 * q + 2
+            rem[r] -= 1
+            if not moved:
+                rem[r] = 0
+
+
+@njit(cache=True, nogil=True)
+def _golden_points(a, b, pts):  # pragma: no cover - compiled
+    """pts (n, 2 (2^d - 1)): the points x1, x2 of the next d steps of the golden-section search of
+    every [a, b] for either outcome of each step (a heap as in :func:`_bisect_points`; child 2 q + 1
+    keeps the left part [a, x2], child 2 q + 2 the right part [x1, b])."""
+    nn = pts.shape[1] // 2
+    ta = np.empty(nn)
+    tb = np.empty(nn)
+    for r in range(a.shape[0]):
+        ta[0] = a[r]
+        tb[0] = b[r]
+        for q in range(nn):
+            x1 = tb[q] - _GOLDEN * (tb[q] - ta[q])
+            x2 = ta[q] + _GOLDEN * (tb[q] - ta[q])
+            pts[r, 2 * q] = x1
+            pts[r, 2 * q + 1] = x2
+            c = 2 * q + 1
+            if c < nn:
+                ta[c] = ta[q]
+                tb[c] = x2
+                ta[c + 1] = x1
+                tb[c + 1] = tb[q]
+
+
+@njit(cache=True, nogil=True)
+def _golden_walk(a, b, s0, rem, pts, hv, found, h_found):  # pragma: no cover - compiled
+    """Up to d steps of the golden-section search of every candidate with the values ``hv`` at the
+    points of :func:`_golden_points` (as the loop of :func:`_touching_pairs_reference`): the first
+    point where sign(h_i) h < 0 (x1 before x2) is ``found`` (h there in ``h_found``), and ``rem``, the
+    steps left, is set to 0."""
+    depth = 0
+    while (1 << (depth + 1)) - 1 <= pts.shape[1] // 2:
+        depth += 1
+    for r in range(a.shape[0]):
+        q = 0
+        for _ in range(depth):
+            if rem[r] == 0:
+                break
+            x1, x2 = pts[r, 2 * q], pts[r, 2 * q + 1]
+            q1, q2 = s0[r] * hv[r, 2 * q], s0[r] * hv[r, 2 * q + 1]
+            rem[r] -= 1
+            if q1 < 0:
+                found[r] = x1
+                h_found[r] = s0[r] * q1
+                rem[r] = 0
+            elif q2 < 0:
+                found[r] = x2
+                h_found[r] = s0[r] * q2
+                rem[r] = 0
+            elif q1 >= q2:  # NaN (outside the map's range) keeps the left part
+                a[r] = x1
+                q = 2 * q + 2
+            else:
+                b[r] = x2
+                q = 2 * q + 1
+
+
+def _depth(points_per_task: float, steps_left: int) -> int:
+    """The depth d of the tree of steps a task gets in one round: 2^d - 1 nodes within its share."""
+    d = math.floor(math.log2(max(points_per_task, 1.0) + 1.0))
+    return max(1, min(d, _MAX_DEPTH, int(steps_left)))
+
+
+def _refine(h_at, b_row, b_lo, b_hi, b_h, c_row, c_lo, c_hi, c_s0, c_h):
+    """(rows, tau) of the roots: the brackets (b_row, [b_lo, b_hi], h(b_lo)) refined by bisection,
+    and every touching candidate (c_row, [c_lo, c_hi], sign of h at its node, h(c_lo)) searched by
+    golden section and, where it finds the opposite sign at t, its two brackets [c_lo, t] and
+    [t, c_hi] refined likewise; in the order of :func:`_roots_reference` (the sign changes, then
+    the left roots of the pairs, then the right ones) and to the same bits: every search takes the
+    same steps at the same points.  ``h_at(rows, tau)`` evaluates the kink functions.
+
+    All searches advance together, one call of ``h_at`` per round; a bracket whose step changes
+    nothing (adjacent floats) is done, a candidate is done when found, and its two brackets start
+    at the next round."""
+    nb0, nc = len(b_row), len(c_row)
+    rows, lo, hi, h_lo = b_row.copy(), b_lo.copy(), b_hi.copy(), b_h.copy()
+    rem = np.full(nb0, _BISECT_STEPS, np.int64)
+    key = np.arange(nb0)
+    g_idx = np.arange(nc)
+    ga, gb = c_lo.copy(), c_hi.copy()
+    g_rem = np.full(nc, _GOLDEN_STEPS, np.int64)
+    done_key, done_row, done_t = [], [], []
+    while len(rows) or len(g_idx):
+        nb, ng = len(rows), len(g_idx)
+        share = _ROUND_POINTS / ((nb > 0) + (ng > 0))
+        db = _depth(share / max(nb, 1), rem.max() if nb else 1)
+        dg = _depth(share / max(2 * ng, 1), g_rem.max() if ng else 1)
+        pb = np.empty((nb, (1 << db) - 1))
+        _bisect_points(lo, hi, pb)
+        pg = np.empty((ng, 2 * ((1 << dg) - 1)))
+        _golden_points(ga, gb, pg)
+        hv = h_at(np.concatenate([np.repeat(rows, pb.shape[1]), np.repeat(c_row[g_idx], pg.shape[1])]),
+                  np.concatenate([pb.ravel(), pg.ravel()]))
+        _bisect_walk(lo, hi, h_lo, rem, pb, hv[:pb.size].reshape(pb.shape))
+        found = np.full(ng, np.nan)
+        h_found = np.zeros(ng)
+        _golden_walk(ga, gb, c_s0[g_idx], g_rem, pg, hv[pb.size:].reshape(pg.shape), found, h_found)
+        fin = rem == 0
+        if fin.any():
+            done_key.append(key[fin])
+            done_row.append(rows[fin])
+            done_t.append(0.5 * (lo[fin] + hi[fin]))
+            live = ~fin
+            rows, lo, hi, h_lo, rem, key = rows[live], lo[live], hi[live], h_lo[live], rem[live], key[live]
+        hit = ~np.isnan(found)
+        if hit.any():  # each found pair: [tau_{i-1}, t] and [t, tau_{i+1}]
+            gi = g_idx[hit]
+            rows = np.concatenate([rows, c_row[gi], c_row[gi]])
+            lo = np.concatenate([lo, c_lo[gi], found[hit]])
+            hi = np.concatenate([hi, found[hit], c_hi[gi]])
+            h_lo = np.concatenate([h_lo, c_h[gi], h_found[hit]])
+            rem = np.concatenate([rem, np.full(2 * len(gi), _BISECT_STEPS, np.int64)])
+            key = np.concatenate([key, nb0 + gi, nb0 + nc + gi])
+        live = g_rem > 0
+        if not live.all():
+            g_idx, ga, gb, g_rem = g_idx[live], ga[live], gb[live], g_rem[live]
+    if not done_key:
+        return np.zeros(0, np.int64), np.zeros(0)
+    order = np.argsort(np.concatenate(done_key))
+    return np.concatenate(done_row)[order], np.concatenate(done_t)[order]
+
+
+def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool = True) -> list[np.ndarray]:
+    """Values of tau_x where a kink of the integrand enters or leaves the arc of beta, for
+    every problem (mu (P,), levels (P, L)); a list of P arrays.
+
+    A kink a + b cos(beta) = 0 (a level N.wo = u, or a model's own kink) lies on the arc
+    only while |a| <= |b|; where a = +-b it appears or vanishes with a square-root
+    behaviour in x (and at normal incidence, where b = 0, it becomes a circle: a jump in
+    the derivative along x).  Roots of a -+ b are found on a graded scan and refined by
+    bisection to full precision, all problems at once.
+
+    Two roots in one cell of the scan leave no sign change on it: a level u near 1 is on the arc
+    only where the arc's highest point a + |b| = cos(alpha - theta) exceeds u, a window of width
+    2 arccos(u) around the axis (6e-4 rad for u = 1 - 1.9e-7, the cap of ``scaled`` Phong n = 5's
+    table at mu = 0.823, inside one 2.5e-3 cell).  Unseen, the piece above the level had width 0 at
+    every node of every first rectangle: K = G = 0, never refined, and the cap (5.1e-7 of the
+    albedo) was missing with an estimate of 1e-13.  So every interior local minimum of |a -+ b| on
+    the scan is followed by a golden-section search of its two cells for a change of sign
+    (:func:`_touching_pairs_reference`), and both roots are refined like the others.
+
+    The scan (:func:`_scan_kernel`: the radial map once at its G nodes, the cuts' coefficients once
+    per problem and node) and the steps of the searches (:func:`_refine`: all searches advance
+    together, several steps per call where few are left) are compiled; the coefficients at the
+    points a search asks for stay numpy (:func:`_cut_coefficients`, ``_radial`` and the model's
+    ``Lobe.kinks``), so the breaks are those of :func:`_kink_breaks_reference`, the plain numpy
+    twin, bit for bit and in the same order (``tests/test_albedo_breaks.py``).
+    """
+    P = len(mu)
+    if not levels.shape[1] and lobe.kinks is None:
+        return [np.array([]) for _ in range(P)]
+    L = levels.shape[1]
+    n_cuts = L + (len(lobe.kinks(*(np.full(1, 0.5) for _ in range(4)))) if lobe.kinks is not None else 0)
+    # the kink functions, one row each per problem (rows f P + p), as in _kink_breaks_reference
+    funcs = [(0, j, j, sign) for j in range(n_cuts) for sign in (1.0, -1.0)]
+    if crossings:
+        funcs += [(1, j, k, 0.0) for j in range(L, n_cuts) for k in list(range(j)) + [n_cuts]]
+    kind, fj, fk = (np.array([c[i] for c in funcs], np.int64) for i in range(3))
+    fs = np.array([c[3] for c in funcs], np.float64)
+    with np.errstate(all="ignore"):
+        s_p = np.sqrt((1.0 - mu) * (1.0 + mu))
+
+    def coefficients(p, tau):
+        with np.errstate(all="ignore"):
+            x, xc, _ = _smooth(tau)
+            ca, sa, _ = _radial(lobe.radial, lobe.sharpness, x, xc)
+        return _cut_coefficients(lobe, mu[p], s_p[p], levels[p], ca, sa)
+
+    def h_at(rows, tau):
+        A, B = coefficients(rows % P, tau)
+        return _kink_h_rows(A, B, rows // P, kind, fj, fk, fs)
+
+    G = len(_TAU_SCAN)
+    # the scan: the radial map once at the G nodes, the cuts for every problem
+    with np.errstate(all="ignore"):
+        x, xc, _ = _smooth(_TAU_SCAN)
+        ca, sa, _ = _radial(lobe.radial, lobe.sharpness, x, xc)
+    p_rep = np.repeat(np.arange(P), G)
+    A, B = _cut_coefficients(lobe, mu[p_rep], s_p[p_rep], levels[p_rep], np.tile(ca, P), np.tile(sa, P))
+    nb = nc = _SCAN_ROOM * len(kind) * P  # else a second pass with the counts of the first
+    while True:
+        b_row, b_i, c_row, c_i = (np.empty(n, np.int64) for n in (nb, nb, nc, nc))
+        b_h, c_s0, c_h = np.empty(nb), np.empty(nc), np.empty(nc)
+        nb_, nc_ = _scan_kernel(A, B, P, G, kind, fj, fk, fs, b_row, b_i, b_h, c_row, c_i, c_s0, c_h)
+        if nb_ <= nb and nc_ <= nc:
+            break
+        nb, nc = max(nb, nb_), max(nc, nc_)
+    b_row, b_i, b_h, c_row, c_i, c_s0, c_h = (b_row[:nb_], b_i[:nb_], b_h[:nb_], c_row[:nc_], c_i[:nc_],
+                                              c_s0[:nc_], c_h[:nc_])
+    r_idx, t = _refine(h_at, b_row, _TAU_SCAN[b_i], _TAU_SCAN[b_i + 1], b_h,
+                       c_row, _TAU_SCAN[c_i - 1], _TAU_SCAN[c_i + 1], c_s0, c_h)
+    # a root within 1e-10 of an end is the end itself (_kink_breaks_reference)
+    keep = (_END_GAP < t) & (t < 1.0 - _END_GAP)
+    f_ = r_idx // P
+    if np.any(kind[f_] == 1):  # a crossing counts where both cuts are on the arc
+        A, B = coefficients(r_idx % P, t)
+        i = np.arange(len(r_idx))
+        on = (np.abs(A[fj[f_], i]) <= np.abs(B[fj[f_], i])) & (np.abs(A[fk[f_], i]) <= np.abs(B[fk[f_], i]))
+        keep &= (kind[f_] == 0) | on
+    p_keep, t_keep = r_idx[keep] % P, t[keep]
+    order = np.argsort(p_keep, kind="stable")
+    return np.split(t_keep[order], np.cumsum(np.bincount(p_keep, minlength=P))[:-1])
 
 
 def _graded(points: np.ndarray) -> np.ndarray:
