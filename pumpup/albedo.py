@@ -736,9 +736,9 @@ def _touching_pairs_reference(h: np.ndarray, ok: np.ndarray, h_at):
 
 # --- the breaks of the radial variable: compiled scan and refinement (twin: _kink_breaks_reference) ---
 
-#: points of the kink functions evaluated per round of :func:`_kink_breaks`'s refinement: one call of
-#: the numpy coefficients (:func:`_cut_coefficients`) costs ~0.1 ms whatever its size, so while few
-#: roots are left each gets several steps of its search per call (a tree of the possible steps)
+#: points of the kink functions evaluated per round of :func:`_kink_breaks`'s searches: one evaluation
+#: (the model's ``Lobe.kinks`` and the radial map in numpy) costs ~0.1 ms whatever its size, so while
+#: few searches are left each gets several steps per round (a tree of the possible steps)
 _ROUND_POINTS = 2048
 #: the deepest such tree (2^8 - 1 points of a bisection)
 _MAX_DEPTH = 8
@@ -747,52 +747,127 @@ _GOLDEN_STEPS = 48  # (0.618)^48 ~ 1e-10 of a cell (< 1e-12 in tau)
 #: room for this many roots and touching candidates per kink function and problem in the first pass
 #: of :func:`_scan_kernel` (a second pass if there are more)
 _SCAN_ROOM = 16
+#: the coefficients are evaluated this many points at a time: numpy's temporaries (64 kB) stay below
+#: malloc's mmap threshold and are reused, where larger ones were mapped and faulted in page by page
+#: on every call (measured: filling the kinks of 19 000 points 0.7 ms, against 0.03 ms in place)
+_CHUNK = 8192
 
 
-def _cut_coefficients(lobe: Lobe, m, s, lev, ca, sa):
-    """(A, B), each (n_cuts + 1, n): the coefficients a + b cos(beta) of the cuts (the levels N.wo = u,
-    then the model's kinks) and, last, of the horizon N.wo = 0, at n points with mu ``m``,
-    s = sqrt(1 - mu^2), levels ``lev`` (n, L) and cos(alpha), sin(alpha) ``ca``, ``sa`` (as ``values``
-    in :func:`_kink_breaks_reference`, elementwise the same operations)."""
-    with np.errstate(all="ignore"):
-        if lobe.axis == "normal":
-            a0, b0 = ca, 0.0
-        elif lobe.axis in ("mirror", "retro"):
-            a0, b0 = m * ca, s * sa
+@njit(cache=True, nogil=True)
+def _horizon_ab(axis, m, s, ca, sa):  # pragma: no cover - compiled
+    """(a0, b0): N.wo = a0 + b0 cos(beta) on the arc around the lobe axis (``values`` of
+    :func:`_kink_breaks_reference`, the same operations in the same order)."""
+    if axis == 0:  # normal
+        return ca, 0.0
+    if axis == 1 or axis == 2:  # mirror, retro
+        return m * ca, s * sa
+    return m * (ca * ca - sa * sa), 2.0 * s * sa * ca  # half
+
+
+@njit(cache=True, nogil=True)
+def _cut_ab(c, L, K, a0, b0, lev, KA, KB, i):  # pragma: no cover - compiled
+    """(a, b) of cut c: a level N.wo = lev[c] (c < L), the model's kink c - L (its coefficients in
+    column i of KA, KB), or the horizon (c = L + K)."""
+    if c < L:
+        return a0 - lev[c], b0
+    if c < L + K:
+        return KA[c - L, i], KB[c - L, i]
+    return a0, b0
+
+
+@njit(cache=True, nogil=True)
+def _scan_row(kind, j, k, sign, L, K, a0, b0, lev, KA, KB, base, h):  # pragma: no cover - compiled
+    """The kink function (``kind``, cuts j and k, ``sign``; as :func:`_kink_h`) of one problem at the G
+    nodes of the scan, into h: a0, b0 (G,) its horizon there, lev its levels, the model's kinks in
+    columns base + g of KA, KB; one loop for each kind of cut j (and k), so that every loop vectorises
+    (the cuts of a crossing: j is a kink of the model, k a level, a kink or the horizon)."""
+    G = h.shape[0]
+    if kind == 0:
+        if j < L:
+            u = lev[j]
+            for g in range(G):
+                h[g] = (a0[g] - u) - sign * b0[g]
+        elif j < L + K:
+            ka, kb = KA[j - L, base:base + G], KB[j - L, base:base + G]
+            for g in range(G):
+                h[g] = ka[g] - sign * kb[g]
         else:
-            a0, b0 = m * (ca * ca - sa * sa), 2.0 * s * sa * ca
-        kinks = list(lobe.kinks(m, s, ca, sa)) if lobe.kinks is not None else []
-        L = lev.shape[1]
-        A = np.empty((L + len(kinks) + 1, len(m)))
-        B = np.empty_like(A)
-        for j in range(L):
-            A[j] = a0 - lev[:, j]
-            B[j] = b0
-        for q, (a, b) in enumerate(kinks, L):
-            A[q] = a
-            B[q] = b
-        A[-1] = a0
-        B[-1] = b0
-    return A, B
+            for g in range(G):
+                h[g] = a0[g] - sign * b0[g]
+        return
+    ka, kb = KA[j - L, base:base + G], KB[j - L, base:base + G]
+    if k < L:
+        u = lev[k]
+        for g in range(G):
+            h[g] = ka[g] * b0[g] - (a0[g] - u) * kb[g]
+    elif k < L + K:
+        la, lb = KA[k - L, base:base + G], KB[k - L, base:base + G]
+        for g in range(G):
+            h[g] = ka[g] * lb[g] - la[g] * kb[g]
+    else:
+        for g in range(G):
+            h[g] = ka[g] * b0[g] - a0[g] * kb[g]
 
 
 @njit(cache=True, nogil=True)
-def _kink_h(A, B, i, f, kind, fj, fk, fs):  # pragma: no cover - compiled
-    """The kink function f at point i: a_j - sign b_j (kind 0) or a_j b_k - a_k b_j (kind 1)."""
-    j = fj[f]
-    if kind[f] == 0:
-        return A[j, i] - fs[f] * B[j, i]
-    k = fk[f]
-    return A[j, i] * B[k, i] - A[k, i] * B[j, i]
+def _kink_h(kind, j, k, sign, aj, bj, ak, bk):  # pragma: no cover - compiled
+    """A kink function: a_j - sign b_j (kind 0: cut j enters or leaves the arc) or a_j b_k - a_k b_j
+    (kind 1: cuts j and k cross)."""
+    if kind == 0:
+        return aj - sign * bj
+    return aj * bk - ak * bj
 
 
 @njit(cache=True, nogil=True)
-def _kink_h_rows(A, B, f, kind, fj, fk, fs):  # pragma: no cover - compiled
-    """The kink function f[i] at every point i (``h_rows`` of :func:`_kink_breaks_reference`)."""
-    out = np.empty(f.shape[0])
-    for i in range(f.shape[0]):
-        out[i] = _kink_h(A, B, i, f[i], kind, fj, fk, fs)
-    return out
+def _prepare_points(prob, tau, mu, s_p, radial, k, m, s, x, xc, ca, sa, rest):  # pragma: no cover
+    """For the points (problem ``prob[i]``, tau[i]): m = mu and s = sqrt(1 - mu^2)
+    of the problem, x and 1 - x of :func:`_smooth`, and cos(alpha), sin(alpha) of :func:`_radial`
+    where the map is exact arithmetic and square roots (the cosine and GGX maps, the power map's
+    tail x < 1/2: :func:`_radial_scalar` gives numpy's bits there); ``rest`` marks the others (logs
+    and exponentials, left to numpy).  Returns how many those are."""
+    n_rest = 0
+    for i in range(prob.shape[0]):
+        m[i] = mu[prob[i]]
+        s[i] = s_p[prob[i]]
+        t = tau[i]
+        u = 1.0 - t
+        x[i] = t * t * (3.0 - 2.0 * t)
+        xc[i] = (u * u) * (1.0 + 2.0 * t)
+        if radial == 0 or radial == 3 or (radial == 1 and x[i] < 0.5):
+            c, sn, _ = _radial_scalar(radial, k, x[i], xc[i])
+            ca[i] = c
+            sa[i] = sn
+            rest[i] = False
+        else:
+            rest[i] = True
+            n_rest += 1
+    return n_rest
+
+
+@njit(cache=True, nogil=True)
+def _kink_h_points(func, prob, L, K, axis, m, s, ca, sa, KA, KB, levels, kind, fj, fk, fs, out):  # pragma: no cover
+    """The kink function ``func[i]`` of problem ``prob[i]`` at every point i (``h_rows`` of
+    :func:`_kink_breaks_reference`)."""
+    for i in range(func.shape[0]):
+        f = func[i]
+        lev = levels[prob[i]]
+        a0, b0 = _horizon_ab(axis, m[i], s[i], ca[i], sa[i])
+        aj, bj = _cut_ab(fj[f], L, K, a0, b0, lev, KA, KB, i)
+        ak, bk = _cut_ab(fk[f], L, K, a0, b0, lev, KA, KB, i)
+        out[i] = _kink_h(kind[f], fj[f], fk[f], fs[f], aj, bj, ak, bk)
+
+
+@njit(cache=True, nogil=True)
+def _crossings_on_arc(func, prob, L, K, axis, m, s, ca, sa, KA, KB, levels, fj, fk, out):  # pragma: no cover
+    """Whether both cuts of function ``func[i]`` of problem ``prob[i]`` are on the arc (|a| <= |b|)
+    at point i."""
+    for i in range(func.shape[0]):
+        f = func[i]
+        lev = levels[prob[i]]
+        a0, b0 = _horizon_ab(axis, m[i], s[i], ca[i], sa[i])
+        aj, bj = _cut_ab(fj[f], L, K, a0, b0, lev, KA, KB, i)
+        ak, bk = _cut_ab(fk[f], L, K, a0, b0, lev, KA, KB, i)
+        out[i] = (abs(aj) <= abs(bj)) & (abs(ak) <= abs(bk))
 
 
 @njit(cache=True, nogil=True)
@@ -802,12 +877,21 @@ def _same_sign(x, y):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _scan_kernel(A, B, P, G, kind, fj, fk, fs, b_row, b_i, b_h, c_row, c_i, c_s0, c_h):  # pragma: no cover
-    """The brackets of the scan: every kink function (row f P + p) on the G nodes of ``_TAU_SCAN``
-    from the coefficients A, B (C, P G) there; its sign changes (row, cell i, h at node i) and its
-    touching candidates (row, interior node i, sign of h there, h at node i - 1), in the order of
-    ``np.nonzero`` in :func:`_roots_reference` and :func:`_touching_pairs_reference`, as many as
-    the arrays hold.  Returns the two counts (the arrays were too short if they exceed them)."""
+def _scan_kernel(n_prob, p0, G, L, K, axis, mu, s_p, ca, sa, levels, KA, KB, kind, fj, fk, fs,
+                 b_row, b_i, b_h, c_row, c_i, c_s0, c_h):  # pragma: no cover - compiled
+    """The brackets of the scan of problems p0 + p (p < P = len(mu), of n_prob): every kink function
+    (row f n_prob + p0 + p) on the G nodes of ``_TAU_SCAN`` (``ca``, ``sa`` there; the model's kinks
+    in columns p G + g of KA, KB); its sign changes (row, cell i, h at node i) and its touching
+    candidates (row, interior node i, sign of h there, h at node i - 1), in the order of
+    ``np.nonzero`` in :func:`_roots_reference` and :func:`_touching_pairs_reference` (for all
+    problems at once: after a stable sort by row), as many as the arrays hold.  Returns the two
+    counts (the arrays were too short where they exceed them)."""
+    P = mu.shape[0]
+    A0 = np.empty((P, G))
+    B0 = np.empty((P, G))
+    for p in range(P):
+        for g in range(G):
+            A0[p, g], B0[p, g] = _horizon_ab(axis, mu[p], s_p[p], ca[g], sa[g])
     h = np.empty(G)
     sign_change = np.zeros(G, np.bool_)
     touching = np.zeros(G, np.bool_)
@@ -815,15 +899,8 @@ def _scan_kernel(A, B, P, G, kind, fj, fk, fs, b_row, b_i, b_h, c_row, c_i, c_s0
     nc = 0
     inf = math.inf
     for f in range(kind.shape[0]):
-        j, k, sign = fj[f], fk[f], fs[f]
         for p in range(P):
-            base = p * G
-            if kind[f] == 0:
-                for g in range(G):
-                    h[g] = A[j, base + g] - sign * B[j, base + g]
-            else:
-                for g in range(G):
-                    h[g] = A[j, base + g] * B[k, base + g] - A[k, base + g] * B[j, base + g]
+            _scan_row(kind[f], fj[f], fk[f], fs[f], L, K, A0[p], B0[p], levels[p], KA, KB, p * G, h)
             # the conditions of the reference with & and | (no branches: these loops vectorise)
             for g in range(G - 1):
                 x, y = h[g], h[g + 1]
@@ -834,7 +911,7 @@ def _scan_kernel(A, B, P, G, kind, fj, fk, fs, b_row, b_i, b_h, c_row, c_i, c_s0
                 ay = abs(y)
                 touching[g] = ((((y > 0.0) & (x > 0.0) & (z > 0.0)) | ((y < 0.0) & (x < 0.0) & (z < 0.0)))
                                & (ay < abs(x)) & (ay <= abs(z)) & (abs(x) < inf) & (ay < inf) & (abs(z) < inf))
-            r = f * P + p
+            r = f * n_prob + p0 + p
             for g in range(G - 1):
                 if sign_change[g]:
                     if nb < b_row.shape[0]:
@@ -1047,61 +1124,106 @@ def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool
     The scan (:func:`_scan_kernel`: the radial map once at its G nodes, the cuts' coefficients once
     per problem and node) and the steps of the searches (:func:`_refine`: all searches advance
     together, several steps per call where few are left) are compiled; the coefficients at the
-    points a search asks for stay numpy (:func:`_cut_coefficients`, ``_radial`` and the model's
-    ``Lobe.kinks``), so the breaks are those of :func:`_kink_breaks_reference`, the plain numpy
-    twin, bit for bit and in the same order (``tests/test_albedo_breaks.py``).
+    points a search asks for stay numpy where they are not exact arithmetic (the model's
+    ``Lobe.kinks``, and ``_radial`` where it takes logs or exponentials: :func:`_prepare_points`), so
+    the breaks are those of :func:`_kink_breaks_reference`, the plain numpy twin, bit for bit and in
+    the same order (``tests/test_albedo_breaks.py``).
     """
     P = len(mu)
     if not levels.shape[1] and lobe.kinks is None:
         return [np.array([]) for _ in range(P)]
     L = levels.shape[1]
-    n_cuts = L + (len(lobe.kinks(*(np.full(1, 0.5) for _ in range(4)))) if lobe.kinks is not None else 0)
+    K = len(lobe.kinks(*(np.full(1, 0.5) for _ in range(4)))) if lobe.kinks is not None else 0
+    n_cuts = L + K
     # the kink functions, one row each per problem (rows f P + p), as in _kink_breaks_reference
     funcs = [(0, j, j, sign) for j in range(n_cuts) for sign in (1.0, -1.0)]
     if crossings:
         funcs += [(1, j, k, 0.0) for j in range(L, n_cuts) for k in list(range(j)) + [n_cuts]]
     kind, fj, fk = (np.array([c[i] for c in funcs], np.int64) for i in range(3))
     fs = np.array([c[3] for c in funcs], np.float64)
+    mu = np.ascontiguousarray(mu, dtype=np.float64)
+    levels = np.ascontiguousarray(levels, dtype=np.float64)
+    axis, radial, k = _AXIS_CODE[lobe.axis], _RADIAL_CODE[lobe.radial], float(lobe.sharpness)
     with np.errstate(all="ignore"):
         s_p = np.sqrt((1.0 - mu) * (1.0 + mu))
 
-    def coefficients(p, tau):
-        with np.errstate(all="ignore"):
-            x, xc, _ = _smooth(tau)
-            ca, sa, _ = _radial(lobe.radial, lobe.sharpness, x, xc)
-        return _cut_coefficients(lobe, mu[p], s_p[p], levels[p], ca, sa)
+    def kink_coefficients(m, s, ca, sa, KA, KB):
+        """the model's kinks at the points (numpy: ``Lobe.kinks`` is the model's) into KA, KB (K, n)"""
+        if K:
+            with np.errstate(all="ignore"):
+                for q, (a, b) in enumerate(lobe.kinks(m, s, ca, sa)):
+                    KA[q] = a
+                    KB[q] = b
 
-    def h_at(rows, tau):
-        A, B = coefficients(rows % P, tau)
-        return _kink_h_rows(A, B, rows // P, kind, fj, fk, fs)
-
+    # the scan: the radial map once at the G nodes, the model's kinks at every problem and node, in
+    # chunks of problems (numpy's temporaries of _CHUNK points stay in malloc's heap, and are reused)
     G = len(_TAU_SCAN)
-    # the scan: the radial map once at the G nodes, the cuts for every problem
     with np.errstate(all="ignore"):
         x, xc, _ = _smooth(_TAU_SCAN)
-        ca, sa, _ = _radial(lobe.radial, lobe.sharpness, x, xc)
-    p_rep = np.repeat(np.arange(P), G)
-    A, B = _cut_coefficients(lobe, mu[p_rep], s_p[p_rep], levels[p_rep], np.tile(ca, P), np.tile(sa, P))
-    nb = nc = _SCAN_ROOM * len(kind) * P  # else a second pass with the counts of the first
-    while True:
-        b_row, b_i, c_row, c_i = (np.empty(n, np.int64) for n in (nb, nb, nc, nc))
-        b_h, c_s0, c_h = np.empty(nb), np.empty(nc), np.empty(nc)
-        nb_, nc_ = _scan_kernel(A, B, P, G, kind, fj, fk, fs, b_row, b_i, b_h, c_row, c_i, c_s0, c_h)
-        if nb_ <= nb and nc_ <= nc:
-            break
-        nb, nc = max(nb, nb_), max(nc, nc_)
-    b_row, b_i, b_h, c_row, c_i, c_s0, c_h = (b_row[:nb_], b_i[:nb_], b_h[:nb_], c_row[:nc_], c_i[:nc_],
-                                              c_s0[:nc_], c_h[:nc_])
+        ca_g, sa_g, _ = _radial(lobe.radial, lobe.sharpness, x, xc)
+    step = max(1, _CHUNK // G)
+    scanned = []
+    for p0 in range(0, P, step):
+        sl = slice(p0, min(P, p0 + step))
+        n = sl.stop - sl.start
+        KA, KB = np.empty((K, n * G)), np.empty((K, n * G))
+        kink_coefficients(np.repeat(mu[sl], G), np.repeat(s_p[sl], G), np.tile(ca_g, n), np.tile(sa_g, n), KA, KB)
+        nb = nc = _SCAN_ROOM * len(kind) * n  # else a second pass with the counts of the first
+        while True:
+            b_row, b_i, c_row, c_i = (np.empty(size, np.int64) for size in (nb, nb, nc, nc))
+            b_h, c_s0, c_h = np.empty(nb), np.empty(nc), np.empty(nc)
+            nb_, nc_ = _scan_kernel(P, p0, G, L, K, axis, mu[sl], s_p[sl], ca_g, sa_g, levels[sl], KA, KB, kind, fj,
+                                    fk, fs, b_row, b_i, b_h, c_row, c_i, c_s0, c_h)
+            if nb_ <= nb and nc_ <= nc:
+                break
+            nb, nc = max(nb, nb_), max(nc, nc_)
+        scanned.append((b_row[:nb_], b_i[:nb_], b_h[:nb_], c_row[:nc_], c_i[:nc_], c_s0[:nc_], c_h[:nc_]))
+    b_row, b_i, b_h, c_row, c_i, c_s0, c_h = (np.concatenate(a) for a in zip(*scanned))
+    ob, oc = np.argsort(b_row, kind="stable"), np.argsort(c_row, kind="stable")  # row by row, as np.nonzero
+    b_row, b_i, b_h, c_row, c_i, c_s0, c_h = b_row[ob], b_i[ob], b_h[ob], c_row[oc], c_i[oc], c_s0[oc], c_h[oc]
+
+    # the searches: the coefficients at the points they ask for, _CHUNK points at a time, in buffers
+    # reused round after round
+    n_buf = _CHUNK
+    buf_v = np.empty((6, n_buf))  # mu, s, x, 1 - x, cos(alpha), sin(alpha)
+    buf_rest = np.empty(n_buf, np.bool_)
+    buf_k = np.empty((2, K, n_buf))  # the model's kinks
+
+    def at_points(prob, tau):
+        """(m, s, ca, sa, KA, KB) at the points (problem prob, tau); at most _CHUNK of them"""
+        n = len(prob)
+        m, s, x, xc, ca, sa = buf_v[:, :n]
+        rest = buf_rest[:n]
+        KA, KB = buf_k[:, :, :n]
+        if _prepare_points(prob, tau, mu, s_p, radial, k, m, s, x, xc, ca, sa, rest):
+            idx = np.flatnonzero(rest)
+            with np.errstate(all="ignore"):
+                ca[idx], sa[idx], _ = _radial(lobe.radial, lobe.sharpness, x[idx], xc[idx])
+        kink_coefficients(m, s, ca, sa, KA, KB)
+        return m, s, ca, sa, KA, KB
+
+    def h_at(rows, tau):
+        out = np.empty(len(rows))
+        func, prob = np.divmod(rows, P)
+        for i in range(0, len(rows), n_buf):
+            sl = slice(i, i + n_buf)
+            _kink_h_points(func[sl], prob[sl], L, K, axis, *at_points(prob[sl], tau[sl]), levels, kind, fj, fk, fs,
+                           out[sl])
+        return out
+
     r_idx, t = _refine(h_at, b_row, _TAU_SCAN[b_i], _TAU_SCAN[b_i + 1], b_h,
                        c_row, _TAU_SCAN[c_i - 1], _TAU_SCAN[c_i + 1], c_s0, c_h)
     # a root within 1e-10 of an end is the end itself (_kink_breaks_reference)
     keep = (_END_GAP < t) & (t < 1.0 - _END_GAP)
-    f_ = r_idx // P
-    if np.any(kind[f_] == 1):  # a crossing counts where both cuts are on the arc
-        A, B = coefficients(r_idx % P, t)
-        i = np.arange(len(r_idx))
-        on = (np.abs(A[fj[f_], i]) <= np.abs(B[fj[f_], i])) & (np.abs(A[fk[f_], i]) <= np.abs(B[fk[f_], i]))
-        keep &= (kind[f_] == 0) | on
+    cross = kind[r_idx // P] == 1
+    if cross.any():  # a crossing counts where both cuts are on the arc
+        on = np.empty(int(cross.sum()), np.bool_)
+        func, prob = np.divmod(r_idx[cross], P)
+        tc = t[cross]
+        for i in range(0, len(on), n_buf):
+            sl = slice(i, i + n_buf)
+            _crossings_on_arc(func[sl], prob[sl], L, K, axis, *at_points(prob[sl], tc[sl]), levels, fj, fk, on[sl])
+        keep[cross] &= on
     p_keep, t_keep = r_idx[keep] % P, t[keep]
     order = np.argsort(p_keep, kind="stable")
     return np.split(t_keep[order], np.cumsum(np.bincount(p_keep, minlength=P))[:-1])

@@ -283,8 +283,8 @@ def test_kink_breaks_match_the_reference_bit_for_bit(spec, monkeypatch):
     """_kink_breaks (numba scan, all searches advancing together with several steps per round) gives
     the breaks of _kink_breaks_reference (the plain numpy twin: one step per call) to the last bit and
     in the same order, with and without the crossings, for every depth of the rounds' trees of steps
-    (one step per round as the reference, and as deep as allowed) and with the scan's first pass too
-    short (the second pass)."""
+    (one step per round as the reference, and as deep as allowed), with the scan's first pass too
+    short (the second pass) and with one problem per chunk of the scan."""
     found = 0
     for lobe, mu, levels in _break_groups(spec):
         for crossings in (True, False):
@@ -292,9 +292,10 @@ def test_kink_breaks_match_the_reference_bit_for_bit(spec, monkeypatch):
             found += sum(len(r) for r in ref)
             _assert_same_bits(A._kink_breaks(lobe, mu, levels, crossings=crossings), ref)
             if crossings:
-                for points, room in ((1, 16), (10**6, 0)):
+                for points, room, chunk in ((1, 16, 8192), (10**6, 0, 700)):
                     monkeypatch.setattr(A, "_ROUND_POINTS", points)
                     monkeypatch.setattr(A, "_SCAN_ROOM", room)
+                    monkeypatch.setattr(A, "_CHUNK", chunk)
                     _assert_same_bits(A._kink_breaks(lobe, mu, levels, crossings=crossings), ref)
                 monkeypatch.undo()
     assert found > 0
