@@ -584,24 +584,14 @@ _TAU_SCAN = np.unique(np.concatenate([
 _END_GAP = 1e-10
 
 
-def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool = True) -> list[np.ndarray]:
-    """Values of tau_x where a kink of the integrand enters or leaves the arc of beta, for
-    every problem (mu (P,), levels (P, L)); a list of P arrays.
+def _kink_breaks_reference(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool = True) -> list[np.ndarray]:
+    """Plain numpy reference of :func:`_kink_breaks`: the same breaks, bit for bit and in the same
+    order (``tests/test_albedo_breaks.py`` checks the two against each other).
 
-    A kink a + b cos(beta) = 0 (a level N.wo = u, or a model's own kink) lies on the arc
-    only while |a| <= |b|; where a = +-b it appears or vanishes with a square-root
-    behaviour in x (and at normal incidence, where b = 0, it becomes a circle: a jump in
-    the derivative along x).  Roots of a -+ b are found on a graded scan and refined by
-    bisection to full precision, all problems at once.
-
-    Two roots in one cell of the scan leave no sign change on it: a level u near 1 is on the arc
-    only where the arc's highest point a + |b| = cos(alpha - theta) exceeds u, a window of width
-    2 arccos(u) around the axis (6e-4 rad for u = 1 - 1.9e-7, the cap of ``scaled`` Phong n = 5's
-    table at mu = 0.823, inside one 2.5e-3 cell).  Unseen, the piece above the level had width 0 at
-    every node of every first rectangle: K = G = 0, never refined, and the cap (5.1e-7 of the
-    albedo) was missing with an estimate of 1e-13.  So every interior local minimum of |a -+ b| on
-    the scan is followed by a golden-section search of its two cells for a change of sign
-    (:func:`_touching_pairs`), and both roots are refined like the others.
+    The functions whose roots are breaks are sampled on ``_TAU_SCAN`` for all problems at once (an
+    (F P, G) array), and every sign change and every touching pair (:func:`_touching_pairs_reference`)
+    is refined with ``h_rows``, which evaluates the cuts' coefficients at the points asked for, one
+    step of the bisection (or of the golden-section search) at a time for all roots together.
     """
     P = len(mu)
     if not levels.shape[1] and lobe.kinks is None:
@@ -661,7 +651,7 @@ def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool
     aj, bj, ak, bk = a_[fj], b_[fj], a_[fk], b_[fk]  # (F, P, G)
     with np.errstate(all="ignore"):
         h = np.where((kind == 0)[:, None, None], aj - fs[:, None, None] * bj, aj * bk - ak * bj).reshape(F * P, G)
-    r_idx, t = _roots(h, h_rows)
+    r_idx, t = _roots_reference(h, h_rows)
     # a root within 1e-10 of an end is the end itself (a level through the lobe axis, N.wo = mu on
     # the mirror axis, touches the arc at alpha = 0): grading the grid towards it cost ~100
     # rectangles per mu and changed nothing
@@ -681,15 +671,15 @@ def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool
 _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
 
-def _roots(h: np.ndarray, h_at) -> tuple[np.ndarray, np.ndarray]:
+def _roots_reference(h: np.ndarray, h_at) -> tuple[np.ndarray, np.ndarray]:
     """(problem, tau) of the roots of a function sampled as ``h`` (P, G) on ``_TAU_SCAN``, with
     ``h_at(p, tau)`` to evaluate it: every sign change between scan nodes and every pair of roots
-    around a local minimum of |h| (:func:`_touching_pairs`), refined by bisection."""
+    around a local minimum of |h| (:func:`_touching_pairs_reference`), refined by bisection."""
     ok = np.isfinite(h)
     p_idx, i_idx = np.nonzero(ok[:, :-1] & ok[:, 1:] & (np.sign(h[:, :-1]) * np.sign(h[:, 1:]) < 0))
     lo, hi = _TAU_SCAN[i_idx].copy(), _TAU_SCAN[i_idx + 1].copy()
     h_lo = h[p_idx, i_idx]
-    tp, tlo, thi, tmid, th_lo, th_mid = _touching_pairs(h, ok, h_at)
+    tp, tlo, thi, tmid, th_lo, th_mid = _touching_pairs_reference(h, ok, h_at)
     p_idx = np.concatenate([p_idx, tp, tp])
     lo = np.concatenate([lo, tlo, tmid])
     hi = np.concatenate([hi, tmid, thi])
@@ -706,7 +696,7 @@ def _roots(h: np.ndarray, h_at) -> tuple[np.ndarray, np.ndarray]:
     return p_idx, 0.5 * (lo + hi)
 
 
-def _touching_pairs(h: np.ndarray, ok: np.ndarray, h_at):
+def _touching_pairs_reference(h: np.ndarray, ok: np.ndarray, h_at):
     """Brackets of root pairs that the scan of :func:`_kink_breaks` shows no sign change for.
 
     ``h`` (P, G) are the values of one kink function a -+ b on ``_TAU_SCAN`` (``ok`` where finite)
@@ -748,6 +738,501 @@ def _touching_pairs(h: np.ndarray, ok: np.ndarray, h_at):
     p_idx, i_idx = p_idx[hit], i_idx[hit]
     return (p_idx, _TAU_SCAN[i_idx - 1].copy(), _TAU_SCAN[i_idx + 1].copy(), found[hit],
             h[p_idx, i_idx - 1], h_found[hit])
+
+
+# --- the breaks of the radial variable: compiled scan and refinement (twin: _kink_breaks_reference) ---
+
+#: points of the kink functions evaluated per round of :func:`_kink_breaks`'s searches: one evaluation
+#: (the model's ``Lobe.kinks`` and the radial map in numpy) costs ~0.1 ms whatever its size, so while
+#: few searches are left each gets several steps per round (a tree of the possible steps)
+_ROUND_POINTS = 2048
+#: the deepest such tree (2^8 - 1 points of a bisection)
+_MAX_DEPTH = 8
+_BISECT_STEPS = 64  # bisection: the cells are at least 1e-13 wide
+_GOLDEN_STEPS = 48  # (0.618)^48 ~ 1e-10 of a cell (< 1e-12 in tau)
+#: room for this many roots and touching candidates per kink function and problem in the first pass
+#: of :func:`_scan_kernel` (a second pass if there are more)
+_SCAN_ROOM = 16
+#: the coefficients are evaluated this many points at a time: numpy's temporaries (64 kB) stay below
+#: malloc's mmap threshold and are reused, where larger ones were mapped and faulted in page by page
+#: on every call (measured: filling the kinks of 19 000 points 0.7 ms, against 0.03 ms in place)
+_CHUNK = 8192
+
+
+@njit(cache=True, nogil=True)
+def _horizon_ab(axis, m, s, ca, sa):  # pragma: no cover - compiled
+    """(a0, b0): N.wo = a0 + b0 cos(beta) on the arc around the lobe axis (``values`` of
+    :func:`_kink_breaks_reference`, the same operations in the same order)."""
+    if axis == 0:  # normal
+        return ca, 0.0
+    if axis == 1 or axis == 2:  # mirror, retro
+        return m * ca, s * sa
+    return m * (ca * ca - sa * sa), 2.0 * s * sa * ca  # half
+
+
+@njit(cache=True, nogil=True)
+def _cut_ab(c, L, K, a0, b0, lev, KA, KB, i):  # pragma: no cover - compiled
+    """(a, b) of cut c: a level N.wo = lev[c] (c < L), the model's kink c - L (its coefficients in
+    column i of KA, KB), or the horizon (c = L + K)."""
+    if c < L:
+        return a0 - lev[c], b0
+    if c < L + K:
+        return KA[c - L, i], KB[c - L, i]
+    return a0, b0
+
+
+@njit(cache=True, nogil=True)
+def _scan_row(kind, j, k, sign, L, K, a0, b0, lev, KA, KB, base, h):  # pragma: no cover - compiled
+    """The kink function (``kind``, cuts j and k, ``sign``; as :func:`_kink_h`) of one problem at the G
+    nodes of the scan, into h: a0, b0 (G,) its horizon there, lev its levels, the model's kinks in
+    columns base + g of KA, KB; one loop for each kind of cut j (and k), so that every loop vectorises
+    (the cuts of a crossing: j is a kink of the model, k a level, a kink or the horizon)."""
+    G = h.shape[0]
+    if kind == 0:
+        if j < L:
+            u = lev[j]
+            for g in range(G):
+                h[g] = (a0[g] - u) - sign * b0[g]
+        elif j < L + K:
+            ka, kb = KA[j - L, base:base + G], KB[j - L, base:base + G]
+            for g in range(G):
+                h[g] = ka[g] - sign * kb[g]
+        else:
+            for g in range(G):
+                h[g] = a0[g] - sign * b0[g]
+        return
+    ka, kb = KA[j - L, base:base + G], KB[j - L, base:base + G]
+    if k < L:
+        u = lev[k]
+        for g in range(G):
+            h[g] = ka[g] * b0[g] - (a0[g] - u) * kb[g]
+    elif k < L + K:
+        la, lb = KA[k - L, base:base + G], KB[k - L, base:base + G]
+        for g in range(G):
+            h[g] = ka[g] * lb[g] - la[g] * kb[g]
+    else:
+        for g in range(G):
+            h[g] = ka[g] * b0[g] - a0[g] * kb[g]
+
+
+@njit(cache=True, nogil=True)
+def _kink_h(kind, j, k, sign, aj, bj, ak, bk):  # pragma: no cover - compiled
+    """A kink function: a_j - sign b_j (kind 0: cut j enters or leaves the arc) or a_j b_k - a_k b_j
+    (kind 1: cuts j and k cross)."""
+    if kind == 0:
+        return aj - sign * bj
+    return aj * bk - ak * bj
+
+
+@njit(cache=True, nogil=True)
+def _prepare_points(prob, tau, mu, s_p, radial, k, m, s, x, xc, ca, sa, rest):  # pragma: no cover
+    """For the points (problem ``prob[i]``, tau[i]): m = mu and s = sqrt(1 - mu^2)
+    of the problem, x and 1 - x of :func:`_smooth`, and cos(alpha), sin(alpha) of :func:`_radial`
+    where the map is exact arithmetic and square roots (the cosine and GGX maps, the power map's
+    tail x < 1/2: :func:`_radial_scalar` gives numpy's bits there); ``rest`` marks the others (logs
+    and exponentials, left to numpy).  Returns how many those are."""
+    n_rest = 0
+    for i in range(prob.shape[0]):
+        m[i] = mu[prob[i]]
+        s[i] = s_p[prob[i]]
+        t = tau[i]
+        u = 1.0 - t
+        x[i] = t * t * (3.0 - 2.0 * t)
+        xc[i] = (u * u) * (1.0 + 2.0 * t)
+        if radial == 0 or radial == 3 or (radial == 1 and x[i] < 0.5):
+            c, sn, _ = _radial_scalar(radial, k, x[i], xc[i])
+            ca[i] = c
+            sa[i] = sn
+            rest[i] = False
+        else:
+            rest[i] = True
+            n_rest += 1
+    return n_rest
+
+
+@njit(cache=True, nogil=True)
+def _kink_h_points(func, prob, L, K, axis, m, s, ca, sa, KA, KB, levels, kind, fj, fk, fs, out):  # pragma: no cover
+    """The kink function ``func[i]`` of problem ``prob[i]`` at every point i (``h_rows`` of
+    :func:`_kink_breaks_reference`)."""
+    for i in range(func.shape[0]):
+        f = func[i]
+        lev = levels[prob[i]]
+        a0, b0 = _horizon_ab(axis, m[i], s[i], ca[i], sa[i])
+        aj, bj = _cut_ab(fj[f], L, K, a0, b0, lev, KA, KB, i)
+        ak, bk = _cut_ab(fk[f], L, K, a0, b0, lev, KA, KB, i)
+        out[i] = _kink_h(kind[f], fj[f], fk[f], fs[f], aj, bj, ak, bk)
+
+
+@njit(cache=True, nogil=True)
+def _crossings_on_arc(func, prob, L, K, axis, m, s, ca, sa, KA, KB, levels, fj, fk, out):  # pragma: no cover
+    """Whether both cuts of function ``func[i]`` of problem ``prob[i]`` are on the arc (|a| <= |b|)
+    at point i."""
+    for i in range(func.shape[0]):
+        f = func[i]
+        lev = levels[prob[i]]
+        a0, b0 = _horizon_ab(axis, m[i], s[i], ca[i], sa[i])
+        aj, bj = _cut_ab(fj[f], L, K, a0, b0, lev, KA, KB, i)
+        ak, bk = _cut_ab(fk[f], L, K, a0, b0, lev, KA, KB, i)
+        out[i] = (abs(aj) <= abs(bj)) & (abs(ak) <= abs(bk))
+
+
+@njit(cache=True, nogil=True)
+def _same_sign(x, y):  # pragma: no cover - compiled
+    """np.sign(x) == np.sign(y) (False where either is NaN)."""
+    return (x > 0.0 and y > 0.0) or (x < 0.0 and y < 0.0) or (x == 0.0 and y == 0.0)
+
+
+@njit(cache=True, nogil=True)
+def _scan_kernel(n_prob, p0, G, L, K, axis, mu, s_p, ca, sa, levels, KA, KB, kind, fj, fk, fs,
+                 b_row, b_i, b_h, c_row, c_i, c_s0, c_h):  # pragma: no cover - compiled
+    """The brackets of the scan of problems p0 + p (p < P = len(mu), of n_prob): every kink function
+    (row f n_prob + p0 + p) on the G nodes of ``_TAU_SCAN`` (``ca``, ``sa`` there; the model's kinks
+    in columns p G + g of KA, KB); its sign changes (row, cell i, h at node i) and its touching
+    candidates (row, interior node i, sign of h there, h at node i - 1), in the order of
+    ``np.nonzero`` in :func:`_roots_reference` and :func:`_touching_pairs_reference` (for all
+    problems at once: after a stable sort by row), as many as the arrays hold.  Returns the two
+    counts (the arrays were too short where they exceed them)."""
+    P = mu.shape[0]
+    A0 = np.empty((P, G))
+    B0 = np.empty((P, G))
+    for p in range(P):
+        for g in range(G):
+            A0[p, g], B0[p, g] = _horizon_ab(axis, mu[p], s_p[p], ca[g], sa[g])
+    h = np.empty(G)
+    sign_change = np.zeros(G, np.bool_)
+    touching = np.zeros(G, np.bool_)
+    nb = 0
+    nc = 0
+    inf = math.inf
+    for f in range(kind.shape[0]):
+        for p in range(P):
+            _scan_row(kind[f], fj[f], fk[f], fs[f], L, K, A0[p], B0[p], levels[p], KA, KB, p * G, h)
+            # the conditions of the reference with & and | (no branches: these loops vectorise)
+            for g in range(G - 1):
+                x, y = h[g], h[g + 1]
+                sign_change[g] = ((((x > 0.0) & (y < 0.0)) | ((x < 0.0) & (y > 0.0)))
+                                  & (abs(x) < inf) & (abs(y) < inf))
+            for g in range(1, G - 1):
+                x, y, z = h[g - 1], h[g], h[g + 1]
+                ay = abs(y)
+                touching[g] = ((((y > 0.0) & (x > 0.0) & (z > 0.0)) | ((y < 0.0) & (x < 0.0) & (z < 0.0)))
+                               & (ay < abs(x)) & (ay <= abs(z)) & (abs(x) < inf) & (ay < inf) & (abs(z) < inf))
+            r = f * n_prob + p0 + p
+            for g in range(G - 1):
+                if sign_change[g]:
+                    if nb < b_row.shape[0]:
+                        b_row[nb] = r
+                        b_i[nb] = g
+                        b_h[nb] = h[g]
+                    nb += 1
+            for g in range(1, G - 1):
+                if touching[g]:
+                    if nc < c_row.shape[0]:
+                        c_row[nc] = r
+                        c_i[nc] = g
+                        c_s0[nc] = 1.0 if h[g] > 0.0 else -1.0
+                        c_h[nc] = h[g - 1]
+                    nc += 1
+    return nb, nc
+
+
+@njit(cache=True, nogil=True)
+def _bisect_points(lo, hi, pts):  # pragma: no cover - compiled
+    """pts (n, 2^d - 1): the midpoints of the next d bisection steps of every bracket [lo, hi] for
+    either outcome of each step, as a heap (node q's children: 2 q + 1 where the root is above the
+    midpoint, 2 q + 2 where below)."""
+    nn = pts.shape[1]
+    tlo = np.empty(nn)
+    thi = np.empty(nn)
+    for r in range(lo.shape[0]):
+        tlo[0] = lo[r]
+        thi[0] = hi[r]
+        for q in range(nn):
+            mid = 0.5 * (tlo[q] + thi[q])
+            pts[r, q] = mid
+            c = 2 * q + 1
+            if c < nn:
+                tlo[c] = mid
+                thi[c] = thi[q]
+                tlo[c + 1] = tlo[q]
+                thi[c + 1] = mid
+
+
+@njit(cache=True, nogil=True)
+def _bisect_walk(lo, hi, h_lo, rem, pts, hv):  # pragma: no cover - compiled
+    """Up to d steps of bisection of every bracket with the values ``hv`` at the points of
+    :func:`_bisect_points` (as the loop of :func:`_roots_reference`); ``rem`` counts the steps left,
+    and is set to 0 where a step changes nothing (lo and hi adjacent: so would every later step)."""
+    depth = 0
+    while (1 << (depth + 1)) - 1 <= pts.shape[1]:
+        depth += 1
+    for r in range(lo.shape[0]):
+        q = 0
+        for _ in range(depth):
+            if rem[r] == 0:
+                break
+            mid, h_mid = pts[r, q], hv[r, q]
+            if _same_sign(h_mid, h_lo[r]):
+                moved = mid != lo[r]
+                lo[r] = mid
+                h_lo[r] = h_mid
+                q = 2 * q + 1
+            else:
+                moved = mid != hi[r]
+                hi[r] = mid
+                q = 2 * q + 2
+            rem[r] -= 1
+            if not moved:
+                rem[r] = 0
+
+
+@njit(cache=True, nogil=True)
+def _golden_points(a, b, pts):  # pragma: no cover - compiled
+    """pts (n, 2 (2^d - 1)): the points x1, x2 of the next d steps of the golden-section search of
+    every [a, b] for either outcome of each step (a heap as in :func:`_bisect_points`; child 2 q + 1
+    keeps the left part [a, x2], child 2 q + 2 the right part [x1, b])."""
+    nn = pts.shape[1] // 2
+    ta = np.empty(nn)
+    tb = np.empty(nn)
+    for r in range(a.shape[0]):
+        ta[0] = a[r]
+        tb[0] = b[r]
+        for q in range(nn):
+            x1 = tb[q] - _GOLDEN * (tb[q] - ta[q])
+            x2 = ta[q] + _GOLDEN * (tb[q] - ta[q])
+            pts[r, 2 * q] = x1
+            pts[r, 2 * q + 1] = x2
+            c = 2 * q + 1
+            if c < nn:
+                ta[c] = ta[q]
+                tb[c] = x2
+                ta[c + 1] = x1
+                tb[c + 1] = tb[q]
+
+
+@njit(cache=True, nogil=True)
+def _golden_walk(a, b, s0, rem, pts, hv, found, h_found):  # pragma: no cover - compiled
+    """Up to d steps of the golden-section search of every candidate with the values ``hv`` at the
+    points of :func:`_golden_points` (as the loop of :func:`_touching_pairs_reference`): the first
+    point where sign(h_i) h < 0 (x1 before x2) is ``found`` (h there in ``h_found``), and ``rem``, the
+    steps left, is set to 0."""
+    depth = 0
+    while (1 << (depth + 1)) - 1 <= pts.shape[1] // 2:
+        depth += 1
+    for r in range(a.shape[0]):
+        q = 0
+        for _ in range(depth):
+            if rem[r] == 0:
+                break
+            x1, x2 = pts[r, 2 * q], pts[r, 2 * q + 1]
+            q1, q2 = s0[r] * hv[r, 2 * q], s0[r] * hv[r, 2 * q + 1]
+            rem[r] -= 1
+            if q1 < 0:
+                found[r] = x1
+                h_found[r] = s0[r] * q1
+                rem[r] = 0
+            elif q2 < 0:
+                found[r] = x2
+                h_found[r] = s0[r] * q2
+                rem[r] = 0
+            elif q1 >= q2:  # NaN (outside the map's range) keeps the left part
+                a[r] = x1
+                q = 2 * q + 2
+            else:
+                b[r] = x2
+                q = 2 * q + 1
+
+
+def _depth(points_per_task: float, steps_left: int) -> int:
+    """The depth d of the tree of steps a task gets in one round: 2^d - 1 nodes within its share."""
+    d = math.floor(math.log2(max(points_per_task, 1.0) + 1.0))
+    return max(1, min(d, _MAX_DEPTH, int(steps_left)))
+
+
+def _refine(h_at, b_row, b_lo, b_hi, b_h, c_row, c_lo, c_hi, c_s0, c_h):
+    """(rows, tau) of the roots: the brackets (b_row, [b_lo, b_hi], h(b_lo)) refined by bisection,
+    and every touching candidate (c_row, [c_lo, c_hi], sign of h at its node, h(c_lo)) searched by
+    golden section and, where it finds the opposite sign at t, its two brackets [c_lo, t] and
+    [t, c_hi] refined likewise; in the order of :func:`_roots_reference` (the sign changes, then
+    the left roots of the pairs, then the right ones) and to the same bits: every search takes the
+    same steps at the same points.  ``h_at(rows, tau)`` evaluates the kink functions.
+
+    All searches advance together, one call of ``h_at`` per round; a bracket whose step changes
+    nothing (adjacent floats) is done, a candidate is done when found, and its two brackets start
+    at the next round."""
+    nb0, nc = len(b_row), len(c_row)
+    rows, lo, hi, h_lo = b_row.copy(), b_lo.copy(), b_hi.copy(), b_h.copy()
+    rem = np.full(nb0, _BISECT_STEPS, np.int64)
+    key = np.arange(nb0)
+    g_idx = np.arange(nc)
+    ga, gb = c_lo.copy(), c_hi.copy()
+    g_rem = np.full(nc, _GOLDEN_STEPS, np.int64)
+    done_key, done_row, done_t = [], [], []
+    while len(rows) or len(g_idx):
+        nb, ng = len(rows), len(g_idx)
+        share = _ROUND_POINTS / ((nb > 0) + (ng > 0))
+        db = _depth(share / max(nb, 1), rem.max() if nb else 1)
+        dg = _depth(share / max(2 * ng, 1), g_rem.max() if ng else 1)
+        pb = np.empty((nb, (1 << db) - 1))
+        _bisect_points(lo, hi, pb)
+        pg = np.empty((ng, 2 * ((1 << dg) - 1)))
+        _golden_points(ga, gb, pg)
+        hv = h_at(np.concatenate([np.repeat(rows, pb.shape[1]), np.repeat(c_row[g_idx], pg.shape[1])]),
+                  np.concatenate([pb.ravel(), pg.ravel()]))
+        _bisect_walk(lo, hi, h_lo, rem, pb, hv[:pb.size].reshape(pb.shape))
+        found = np.full(ng, np.nan)
+        h_found = np.zeros(ng)
+        _golden_walk(ga, gb, c_s0[g_idx], g_rem, pg, hv[pb.size:].reshape(pg.shape), found, h_found)
+        fin = rem == 0
+        if fin.any():
+            done_key.append(key[fin])
+            done_row.append(rows[fin])
+            done_t.append(0.5 * (lo[fin] + hi[fin]))
+            live = ~fin
+            rows, lo, hi, h_lo, rem, key = rows[live], lo[live], hi[live], h_lo[live], rem[live], key[live]
+        hit = ~np.isnan(found)
+        if hit.any():  # each found pair: [tau_{i-1}, t] and [t, tau_{i+1}]
+            gi = g_idx[hit]
+            rows = np.concatenate([rows, c_row[gi], c_row[gi]])
+            lo = np.concatenate([lo, c_lo[gi], found[hit]])
+            hi = np.concatenate([hi, found[hit], c_hi[gi]])
+            h_lo = np.concatenate([h_lo, c_h[gi], h_found[hit]])
+            rem = np.concatenate([rem, np.full(2 * len(gi), _BISECT_STEPS, np.int64)])
+            key = np.concatenate([key, nb0 + gi, nb0 + nc + gi])
+        live = g_rem > 0
+        if not live.all():
+            g_idx, ga, gb, g_rem = g_idx[live], ga[live], gb[live], g_rem[live]
+    if not done_key:
+        return np.zeros(0, np.int64), np.zeros(0)
+    order = np.argsort(np.concatenate(done_key))
+    return np.concatenate(done_row)[order], np.concatenate(done_t)[order]
+
+
+def _kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool = True) -> list[np.ndarray]:
+    """Values of tau_x where a kink of the integrand enters or leaves the arc of beta, for
+    every problem (mu (P,), levels (P, L)); a list of P arrays.
+
+    A kink a + b cos(beta) = 0 (a level N.wo = u, or a model's own kink) lies on the arc
+    only while |a| <= |b|; where a = +-b it appears or vanishes with a square-root
+    behaviour in x (and at normal incidence, where b = 0, it becomes a circle: a jump in
+    the derivative along x).  Roots of a -+ b are found on a graded scan and refined by
+    bisection to full precision, all problems at once.
+
+    Two roots in one cell of the scan leave no sign change on it: a level u near 1 is on the arc
+    only where the arc's highest point a + |b| = cos(alpha - theta) exceeds u, a window of width
+    2 arccos(u) around the axis (6e-4 rad for u = 1 - 1.9e-7, the cap of ``scaled`` Phong n = 5's
+    table at mu = 0.823, inside one 2.5e-3 cell).  Unseen, the piece above the level had width 0 at
+    every node of every first rectangle: K = G = 0, never refined, and the cap (5.1e-7 of the
+    albedo) was missing with an estimate of 1e-13.  So every interior local minimum of |a -+ b| on
+    the scan is followed by a golden-section search of its two cells for a change of sign
+    (:func:`_touching_pairs_reference`), and both roots are refined like the others.
+
+    The scan (:func:`_scan_kernel`: the radial map once at its G nodes, the cuts' coefficients once
+    per problem and node) and the steps of the searches (:func:`_refine`: all searches advance
+    together, several steps per call where few are left) are compiled; the coefficients at the
+    points a search asks for stay numpy where they are not exact arithmetic (the model's
+    ``Lobe.kinks``, and ``_radial`` where it takes logs or exponentials: :func:`_prepare_points`), so
+    the breaks are those of :func:`_kink_breaks_reference`, the plain numpy twin, bit for bit and in
+    the same order (``tests/test_albedo_breaks.py``).
+    """
+    P = len(mu)
+    if not levels.shape[1] and lobe.kinks is None:
+        return [np.array([]) for _ in range(P)]
+    L = levels.shape[1]
+    K = len(lobe.kinks(*(np.full(1, 0.5) for _ in range(4)))) if lobe.kinks is not None else 0
+    n_cuts = L + K
+    # the kink functions, one row each per problem (rows f P + p), as in _kink_breaks_reference
+    funcs = [(0, j, j, sign) for j in range(n_cuts) for sign in (1.0, -1.0)]
+    if crossings:
+        funcs += [(1, j, k, 0.0) for j in range(L, n_cuts) for k in list(range(j)) + [n_cuts]]
+    kind, fj, fk = (np.array([c[i] for c in funcs], np.int64) for i in range(3))
+    fs = np.array([c[3] for c in funcs], np.float64)
+    mu = np.ascontiguousarray(mu, dtype=np.float64)
+    levels = np.ascontiguousarray(levels, dtype=np.float64)
+    axis, radial, k = _AXIS_CODE[lobe.axis], _RADIAL_CODE[lobe.radial], float(lobe.sharpness)
+    with np.errstate(all="ignore"):
+        s_p = np.sqrt((1.0 - mu) * (1.0 + mu))
+
+    def kink_coefficients(m, s, ca, sa, KA, KB):
+        """the model's kinks at the points (numpy: ``Lobe.kinks`` is the model's) into KA, KB (K, n)"""
+        if K:
+            with np.errstate(all="ignore"):
+                for q, (a, b) in enumerate(lobe.kinks(m, s, ca, sa)):
+                    KA[q] = a
+                    KB[q] = b
+
+    # the scan: the radial map once at the G nodes, the model's kinks at every problem and node, in
+    # chunks of problems (numpy's temporaries of _CHUNK points stay in malloc's heap, and are reused)
+    G = len(_TAU_SCAN)
+    with np.errstate(all="ignore"):
+        x, xc, _ = _smooth(_TAU_SCAN)
+        ca_g, sa_g, _ = _radial(lobe.radial, lobe.sharpness, x, xc)
+    step = max(1, _CHUNK // G)
+    scanned = []
+    for p0 in range(0, P, step):
+        sl = slice(p0, min(P, p0 + step))
+        n = sl.stop - sl.start
+        KA, KB = np.empty((K, n * G)), np.empty((K, n * G))
+        kink_coefficients(np.repeat(mu[sl], G), np.repeat(s_p[sl], G), np.tile(ca_g, n), np.tile(sa_g, n), KA, KB)
+        nb = nc = _SCAN_ROOM * len(kind) * n  # else a second pass with the counts of the first
+        while True:
+            b_row, b_i, c_row, c_i = (np.empty(size, np.int64) for size in (nb, nb, nc, nc))
+            b_h, c_s0, c_h = np.empty(nb), np.empty(nc), np.empty(nc)
+            nb_, nc_ = _scan_kernel(P, p0, G, L, K, axis, mu[sl], s_p[sl], ca_g, sa_g, levels[sl], KA, KB, kind, fj,
+                                    fk, fs, b_row, b_i, b_h, c_row, c_i, c_s0, c_h)
+            if nb_ <= nb and nc_ <= nc:
+                break
+            nb, nc = max(nb, nb_), max(nc, nc_)
+        scanned.append((b_row[:nb_], b_i[:nb_], b_h[:nb_], c_row[:nc_], c_i[:nc_], c_s0[:nc_], c_h[:nc_]))
+    b_row, b_i, b_h, c_row, c_i, c_s0, c_h = (np.concatenate(a) for a in zip(*scanned))
+    ob, oc = np.argsort(b_row, kind="stable"), np.argsort(c_row, kind="stable")  # row by row, as np.nonzero
+    b_row, b_i, b_h, c_row, c_i, c_s0, c_h = b_row[ob], b_i[ob], b_h[ob], c_row[oc], c_i[oc], c_s0[oc], c_h[oc]
+
+    # the searches: the coefficients at the points they ask for, _CHUNK points at a time, in buffers
+    # reused round after round
+    n_buf = _CHUNK
+    buf_v = np.empty((6, n_buf))  # mu, s, x, 1 - x, cos(alpha), sin(alpha)
+    buf_rest = np.empty(n_buf, np.bool_)
+    buf_k = np.empty((2, K, n_buf))  # the model's kinks
+
+    def at_points(prob, tau):
+        """(m, s, ca, sa, KA, KB) at the points (problem prob, tau); at most _CHUNK of them"""
+        n = len(prob)
+        m, s, x, xc, ca, sa = buf_v[:, :n]
+        rest = buf_rest[:n]
+        KA, KB = buf_k[:, :, :n]
+        if _prepare_points(prob, tau, mu, s_p, radial, k, m, s, x, xc, ca, sa, rest):
+            idx = np.flatnonzero(rest)
+            with np.errstate(all="ignore"):
+                ca[idx], sa[idx], _ = _radial(lobe.radial, lobe.sharpness, x[idx], xc[idx])
+        kink_coefficients(m, s, ca, sa, KA, KB)
+        return m, s, ca, sa, KA, KB
+
+    def h_at(rows, tau):
+        out = np.empty(len(rows))
+        func, prob = np.divmod(rows, P)
+        for i in range(0, len(rows), n_buf):
+            sl = slice(i, i + n_buf)
+            _kink_h_points(func[sl], prob[sl], L, K, axis, *at_points(prob[sl], tau[sl]), levels, kind, fj, fk, fs,
+                           out[sl])
+        return out
+
+    r_idx, t = _refine(h_at, b_row, _TAU_SCAN[b_i], _TAU_SCAN[b_i + 1], b_h,
+                       c_row, _TAU_SCAN[c_i - 1], _TAU_SCAN[c_i + 1], c_s0, c_h)
+    # a root within 1e-10 of an end is the end itself (_kink_breaks_reference)
+    keep = (_END_GAP < t) & (t < 1.0 - _END_GAP)
+    cross = kind[r_idx // P] == 1
+    if cross.any():  # a crossing counts where both cuts are on the arc
+        on = np.empty(int(cross.sum()), np.bool_)
+        func, prob = np.divmod(r_idx[cross], P)
+        tc = t[cross]
+        for i in range(0, len(on), n_buf):
+            sl = slice(i, i + n_buf)
+            _crossings_on_arc(func[sl], prob[sl], L, K, axis, *at_points(prob[sl], tc[sl]), levels, fj, fk, on[sl])
+        keep[cross] &= on
+    p_keep, t_keep = r_idx[keep] % P, t[keep]
+    order = np.argsort(p_keep, kind="stable")
+    return np.split(t_keep[order], np.cumsum(np.bincount(p_keep, minlength=P))[:-1])
 
 
 def _graded(points: np.ndarray) -> np.ndarray:

@@ -24,6 +24,8 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
     python scripts/bench_albedo.py --phong    # only the Phong family's rows (1-D path), no dblquad
     python scripts/bench_albedo.py --p        # only the p-model with p in (0, 1): 1-D path against the nested engine
     python scripts/bench_albedo.py --pumped   # only pumped Phong-family chains: 1-D path against the nested engine
+    python scripts/bench_albedo.py --breaks   # only the nested families with kinks or levels: the compiled break
+                                              # finding against its numpy reference (issue 14 item 3)
 """
 
 import signal
@@ -282,6 +284,70 @@ def pumped_chains(rtol=1e-10, repeat=3):
           f"nested {old * 1e3:.0f} ms, ratio {old / new:.1f}")
 
 
+#: the nested engine's families (FAMILIES) whose hints have levels or kinks, a pumped one, and three
+#: without (their break finding is empty) for comparison
+BREAK_FAMILIES = [
+    {"type": "stretched_blinn", "n": 8}, {"type": "modified_ward", "m": 0.1}, {"type": "ward_aniso", "ax": 0.1, "ay": 0.3},
+    {"type": "cook_torrance", "m": 0.3}, {"type": "torrance_sparrow", "d": "D1", "s": 20}, {"type": "oren_nayar"},
+    {"type": "plastic", "n": 20}, {"type": "pumped", "base": {"type": "blinn", "n": 16}, "g": "g2", "levels": 2},
+    {"type": "ggx", "alpha": 0.1}, {"type": "blinn", "n": 16}, {"type": "ward", "m": 0.1},
+]
+
+
+def breaks(rtol=1e-10, repeat=7):
+    """A 257-point table (mu uniform in theta) at rtol ``rtol``, one thread, with the compiled break finding
+    (``albedo._kink_breaks``) and with its plain numpy reference (``albedo._kink_breaks_reference``, the
+    previous code) in the same run, round robin, best of ``repeat``; beside each, the time of the break
+    finding alone (its calls during the table).  The two give the same breaks bit for bit, so the same
+    tables: the script checks the values and errors are identical."""
+    from pumpup import _nested
+
+    A = pumpup.albedo_module
+    mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
+    impl = {"compiled": A._kink_breaks, "reference": A._kink_breaks_reference}
+
+    def use(fn):
+        A._kink_breaks = fn
+        _nested._kink_breaks = fn
+
+    print(f"257-point tables at rtol {rtol:g}, one thread, ms (best of {repeat}, round robin); breaks: the "
+          f"break finding's share")
+    print(f"{'model':72s} {'reference':>9s} {'compiled':>9s} {'ratio':>6s} {'breaks ref':>10s} {'compiled':>9s} "
+          f"{'ratio':>6s}")
+    try:
+        for spec in BREAK_FAMILIES:
+            f = pumpup.load(spec)
+            pumpup.albedo(f, mu[:3], rtol=rtol)  # the pumped model's tables, the compiled kernels
+            best = {k: np.inf for k in impl}
+            best_breaks = {k: np.inf for k in impl}
+            out = {}
+            for _ in range(repeat):
+                for name, fn in impl.items():
+                    spent = [0.0]
+
+                    def timed(*args, fn=fn, spent=spent, **kw):
+                        t = time.perf_counter()
+                        r = fn(*args, **kw)
+                        spent[0] += time.perf_counter() - t
+                        return r
+
+                    use(timed)
+                    t = time.perf_counter()
+                    out[name] = pumpup.albedo(f, mu, rtol=rtol, return_error=True)
+                    t = time.perf_counter() - t
+                    use(impl["compiled"])
+                    best[name] = min(best[name], t)
+                    best_breaks[name] = min(best_breaks[name], spent[0])
+            same = all(np.array_equal(a, b) for a, b in zip(out["compiled"], out["reference"]))
+            r, c = best["reference"], best["compiled"]
+            br, bc = best_breaks["reference"], best_breaks["compiled"]
+            ratio = f"{br / bc:6.1f}" if bc > 1e-4 else f"{'':6s}"
+            print(f"{str(spec)[:72]:72s} {r * 1e3:9.1f} {c * 1e3:9.1f} {r / c:6.2f} {br * 1e3:10.1f} {bc * 1e3:9.1f} "
+                  f"{ratio} {'same values' if same else 'VALUES DIFFER'}", flush=True)
+    finally:
+        use(impl["compiled"])
+
+
 def cells():
     from pumpup import _polar, _reuse
     from pumpup.pumping import _TABLES
@@ -406,6 +472,9 @@ def main():
         return
     if "--pumped" in sys.argv:
         pumped_chains()
+        return
+    if "--breaks" in sys.argv:
+        breaks()
         return
     if "--cells" not in sys.argv:
         families()

@@ -229,3 +229,84 @@ def test_level_end_scales():
     row, t0, t1 = A._first_rectangles_t(np.array([1e-3, np.inf]), np.linspace(0, 1, 3))
     assert np.all(t0[row == 1] == [0.0, 0.5]) and np.all(t1[row == 1] == [0.5, 1.0])
     assert np.allclose(1 - t0[row == 0][2:], 1e-3 * 4.0 ** np.arange(4)[::-1]) and t1[row == 0][-1] == 1.0
+
+
+# --- the compiled break finding against its plain numpy reference, bit for bit -------------------
+
+#: every built-in family of scripts/bench_albedo.py's FAMILIES whose hint has levels or kinks, the
+#: other distributions and radial maps of the microfacet models, and compositions (pumped: levels of
+#: g; scaled and Kulla-Conty: the kinks of their tables)
+BREAK_MODELS = [
+    {"type": "stretched_phong", "n": 20}, {"type": "stretched_phong", "n": 5000}, {"type": "retro", "n": 10},
+    {"type": "lafortune", "n": 20, "cx": 1.1, "cy": 1.1, "cz": 1.1, "p": 1.0},
+    {"type": "stretched_phong", "n": 20, "p": 0.5}, {"type": "stretched_blinn", "n": 8},
+    {"type": "modified_ward", "m": 0.1}, {"type": "ward_aniso", "ax": 0.1, "ay": 0.3},
+    {"type": "cook_torrance", "m": 0.3}, {"type": "cook_torrance", "m": 0.3, "ior": 1.5},
+    {"type": "torrance_sparrow", "d": "D1", "s": 20}, {"type": "torrance_sparrow", "d": "D2", "s": 10.0},
+    {"type": "torrance_sparrow", "d": "D3", "s": 0.3}, {"type": "torrance_sparrow", "d": "D4", "s": 0.2},
+    {"type": "oren_nayar"}, {"type": "plastic", "n": 20},
+    {"type": "pumped", "base": {"type": "blinn", "n": 16}, "g": "g2", "levels": 2},
+    {"type": "pumped", "base": {"type": "phong", "n": 20}, "g": "g1"},
+    {"type": "pumped", "base": {"type": "cook_torrance", "m": 0.3}, "g": "g2"},
+    SCALED, {"type": "kulla_conty", "base": {"type": "cook_torrance", "m": 0.3}},
+]
+#: mu uniform in theta (as the tables), grazing, normal, and the cases above
+BREAK_MU = np.unique(np.concatenate([np.cos(np.linspace(0, np.pi / 2, 258)[:-1]),
+                                     [1e-8, 1e-6, 1e-3, MU_CT, 0.5, MU_SCALED, 1 - 1e-9, 1.0]]))
+
+
+def _break_groups(spec):
+    """(lobe, mu, levels) of every group of mu with levels or kinks, for every term of the model;
+    an anisotropic model also with wi out of the xz-plane (phi != 0: the turned hint's axis cuts)."""
+    f = pumpup.load(spec)
+    phis = [None] + ([np.full(len(BREAK_MU), 0.7), np.linspace(-3.0, 3.0, len(BREAK_MU))]
+                     if f.azimuth_range() is not None else [])
+    out = []
+    for _, term in f.albedo_terms():
+        for phi in phis:
+            for _, g in A._groups(term, BREAK_MU, phi):
+                if g.levels.shape[1] or g.lobe.kinks is not None:
+                    out.append((g.lobe, g.mu, g.levels))
+    assert out, spec
+    return out
+
+
+def _assert_same_bits(new, ref):
+    assert len(new) == len(ref)
+    for p, (a, b) in enumerate(zip(new, ref)):
+        a, b = np.asarray(a, np.float64), np.asarray(b, np.float64)
+        assert a.shape == b.shape and np.array_equal(a.view(np.int64), b.view(np.int64)), (p, a, b)
+
+
+@pytest.mark.parametrize("spec", BREAK_MODELS, ids=str)
+def test_kink_breaks_match_the_reference_bit_for_bit(spec, monkeypatch):
+    """_kink_breaks (numba scan, all searches advancing together with several steps per round) gives
+    the breaks of _kink_breaks_reference (the plain numpy twin: one step per call) to the last bit and
+    in the same order, with and without the crossings, for every depth of the rounds' trees of steps
+    (one step per round as the reference, and as deep as allowed), with the scan's first pass too
+    short (the second pass) and with one problem per chunk of the scan."""
+    found = 0
+    for lobe, mu, levels in _break_groups(spec):
+        for crossings in (True, False):
+            ref = A._kink_breaks_reference(lobe, mu, levels, crossings=crossings)
+            found += sum(len(r) for r in ref)
+            _assert_same_bits(A._kink_breaks(lobe, mu, levels, crossings=crossings), ref)
+            if crossings:
+                for points, room, chunk in ((1, 16, 8192), (10**6, 0, 700)):
+                    monkeypatch.setattr(A, "_ROUND_POINTS", points)
+                    monkeypatch.setattr(A, "_SCAN_ROOM", room)
+                    monkeypatch.setattr(A, "_CHUNK", chunk)
+                    _assert_same_bits(A._kink_breaks(lobe, mu, levels, crossings=crossings), ref)
+                monkeypatch.undo()
+    assert found > 0
+
+
+def test_kink_breaks_touching_pairs_match_the_reference():
+    """The touching pair of scaled Phong (both roots in one cell of the scan, found by the golden-section
+    search) among other problems: the same roots in the same order."""
+    f = pumpup.load(SCALED)
+    mu = np.array([0.3, MU_SCALED, 0.9, MU_SCALED])
+    (_, g), = [(i, g) for i, g in A._groups(f, mu) if len(g.mu) == len(mu)]
+    ref = A._kink_breaks_reference(g.lobe, g.mu, g.levels)
+    assert len(ref[1]) >= 2
+    _assert_same_bits(A._kink_breaks(g.lobe, g.mu, g.levels), ref)
