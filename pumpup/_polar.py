@@ -570,25 +570,17 @@ RULE = "gk21"
 
 
 @njit(cache=True, nogil=True)
-def _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac,
-        lev, nlev, gmu, ka, chain, bcut):  # pragma: no cover
+def _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac):  # pragma: no cover
     """(K, error) of the rule on [t0, t1]; the error is :func:`pumpup._errors.calibrated` of
     |K - G| (``mode`` 1) or |K - G| itself (0), plus for p in (0, 1) the inner errors of the
     integrand's values (the inner rule ``inodes``, ``iwk``, ``iwg`` at relative tolerance
-    ``itol``) summed with the Kronrod weights (also for a pumped lobe, ``chain``: :func:`_k_chain` on the levels
-    ``lev[:nlev]``); ``buf`` holds the values (one per node).  The
+    ``itol``) summed with the Kronrod weights; ``buf`` holds the values (one per node).  The
     closed forms p in {0, 1} have a loop of their own, with no call in it (a loop that may call
-    :func:`_arc_power` ran 2.5 x slower for them)."""
+    :func:`_arc_power` ran 2.5 x slower for them; a pumped lobe has a function of its own,
+    :func:`_gk_chain`: a third loop here did not change their time, measured)."""
     h = t1 - t0
     ie = 0.0
-    if chain[0].shape[0] > 1:  # a pumped lobe: the arc by the inner rule (_k_chain)
-        for j in range(nodes.shape[0]):
-            u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
-            k, e = _k_chain(p, mu, c2, u, um, sa, lev, nlev, gmu, itol, ka / fac if fac > 0.0 else math.inf, chain, inodes, iwk,
-                            iwg, mode, ibuf, iwork, bcut)
-            buf[j] = k * fac
-            ie += wk[j] * e * fac
-    elif 0.0 < p < 1.0:
+    if 0.0 < p < 1.0:
         for j in range(nodes.shape[0]):
             u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
             k, e = _k_of_u(p, mu, c2, u, um, sa, itol, inodes, iwk, iwg, mode, ibuf, iwork, jac)
@@ -600,6 +592,34 @@ def _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, it
             buf[j] = _k_closed(p, mu, c2, u, um, sa)[0] * fac
     k, diff, asc, ab = rule_sums(buf, wk, wg)
     return k * h, calibrated(diff * h, asc * h, ab * h, mode) + ie * h
+
+
+@njit(cache=True, nogil=True)
+def _gk_chain(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork,
+              lev, nlev, gmu, ka, chain, bcut):  # pragma: no cover
+    """:func:`_gk` for a pumped lobe (``chain``): K(u) by :func:`_k_chain` on the levels ``lev[:nlev]``
+    at every node, its inner error (relative ``itol``, or absolute ``ka`` / the node's weight)
+    summed with the Kronrod weights."""
+    h = t1 - t0
+    ie = 0.0
+    for j in range(nodes.shape[0]):
+        u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
+        k, e = _k_chain(p, mu, c2, u, um, sa, lev, nlev, gmu, itol, ka / fac if fac > 0.0 else math.inf, chain, inodes,
+                        iwk, iwg, mode, ibuf, iwork, bcut)
+        buf[j] = k * fac
+        ie += wk[j] * e * fac
+    k, diff, asc, ab = rule_sums(buf, wk, wg)
+    return k * h, calibrated(diff * h, asc * h, ab * h, mode) + ie * h
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _piece_rule(chained, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg,
+                ibuf, iwork, jac, lev, nlev, gmu, ka, chain, bcut):  # pragma: no cover
+    """:func:`_gk_chain` for a pumped lobe, else :func:`_gk`."""
+    if chained:
+        return _gk_chain(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf,
+                         iwork, lev, nlev, gmu, ka, chain, bcut)
+    return _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac)
 
 
 #: the peak variable z = -(n + 1) ln u runs at most to Z_MAX: below u = exp(-Z_MAX / (n + 1)) the
@@ -763,6 +783,18 @@ def _pieces(n, p, mu, s, kinds, sms, v0, w, v1, lev, nlev):  # pragma: no cover 
 
 
 @njit(cache=True, nogil=True)
+def _g_below(mu, lev, nlev, chain):  # pragma: no cover - compiled
+    """g(mu, N.wo) for N.wo <= mu where it is one constant (every level's bound increases and no level
+    lies below mu: the product table's value at mu, see :func:`_k_chain`), else 0."""
+    if nlev == 0 or mu <= chain[13]:
+        return 0.0
+    for j in range(nlev):
+        if lev[j, 0] < mu * (1.0 - 1e-12):
+            return 0.0
+    return _g_product(mu, chain[14], chain[15], chain[16], chain[17])
+
+
+@njit(cache=True, nogil=True)
 def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, inodes, iwk, iwg, jac,
                lev, nlev, chain, lower, val, err, conv, evals):  # pragma: no cover
     """Adaptive Gauss-Kronrod (the rule ``nodes``, ``wk``, ``wg``) of integral u^n K(u) du for
@@ -778,6 +810,7 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
     ibuf = np.empty(inodes.shape[0])
     iwork = np.empty((4, INNER_MAX))
     itol = max(0.125 * rtol, INNER_RTOL_MIN)  # the inner error stays a small part of the total
+    chained = chain[0].shape[0] > 1  # a pumped lobe (_gk_chain)
     npc = MAX_PIECES + 2 * lev.shape[1]
     kinds = np.empty(npc, np.int64)
     sms = np.empty(npc, np.int64)
@@ -789,20 +822,17 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
         lq, nl = lev[q], nlev[q]
-        gmu = 0.0  # g(mu, N.wo) for N.wo <= mu where it is one constant (see _k_chain), else 0
-        if nl > 0 and mu > chain[13]:
-            gmu = _g_product(mu, chain[14], chain[15], chain[16], chain[17])
-            for j in range(nl):
-                if lq[j, 0] < mu * (1.0 - 1e-12):
-                    gmu = 0.0
+        gmu = _g_below(mu, lq, nl, chain) if chained else 0.0
         npieces, c2, left_out = _pieces(n, p, mu, s, kinds, sms, v0, w, cv1, lq, nl)
         # a pumped lobe's inner rule may also stop at an absolute error ka / (the node's outer weight):
         # summed over the nodes of the pieces' first intervals, and of every later one, that is at most
         # itol lower[q], lower[q] a lower bound of the integral (the base's: see albedo_1d)
-        used = 0
-        for i in range(npieces):
-            used += w[i] > 0.0
-        ka = itol * lower[q] / max(used, 1)
+        ka = 0.0
+        if chained:
+            used = 0
+            for i in range(npieces):
+                used += w[i] > 0.0
+            ka = itol * lower[q] / max(used, 1)
         m = 0
         for i in range(npieces):
             if w[i] <= 0.0:
@@ -813,7 +843,7 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
                 pk[m] = i
                 t0[m] = j / ni
                 t1[m] = (j + 1.0) / ni
-                kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, lq, nl, gmu, ka, chain, bcut)
+                kv[m], ke[m] = _piece_rule(chained, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, lq, nl, gmu, ka, chain, bcut)
                 m += 1
         start = m
         ok = False
@@ -841,11 +871,11 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
             a_, b_ = t0[worst], t1[worst]
             mid = 0.5 * (a_ + b_)
             t1[worst] = mid
-            kv[worst], ke[worst] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, lq, nl, gmu, ka, chain, bcut)
+            kv[worst], ke[worst] = _piece_rule(chained, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, lq, nl, gmu, ka, chain, bcut)
             pk[m] = i
             t0[m] = mid
             t1[m] = b_
-            kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, lq, nl, gmu, ka, chain, bcut)
+            kv[m], ke[m] = _piece_rule(chained, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, lq, nl, gmu, ka, chain, bcut)
             m += 1
         val[q] = tot
         err[q] = e + r
