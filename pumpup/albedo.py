@@ -850,16 +850,23 @@ def _prepare_points(prob, tau, mu, s_p, radial, k, m, s, x, xc, ca, sa, rest):  
     return n_rest
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _cut_pair(f, p_, i, L, K, axis, m, s, ca, sa, KA, KB, levels, fj, fk):  # pragma: no cover - compiled
+    """(a_j, b_j, a_k, b_k): the coefficients of the two cuts of kink function f, problem p_, at point i."""
+    lev = levels[p_]
+    a0, b0 = _horizon_ab(axis, m[i], s[i], ca[i], sa[i])
+    aj, bj = _cut_ab(fj[f], L, K, a0, b0, lev, KA, KB, i)
+    ak, bk = _cut_ab(fk[f], L, K, a0, b0, lev, KA, KB, i)
+    return aj, bj, ak, bk
+
+
 @njit(cache=True, nogil=True)
 def _kink_h_points(func, prob, L, K, axis, m, s, ca, sa, KA, KB, levels, kind, fj, fk, fs, out):  # pragma: no cover
     """The kink function ``func[i]`` of problem ``prob[i]`` at every point i (``h_rows`` of
     :func:`_kink_breaks_reference`)."""
     for i in range(func.shape[0]):
         f = func[i]
-        lev = levels[prob[i]]
-        a0, b0 = _horizon_ab(axis, m[i], s[i], ca[i], sa[i])
-        aj, bj = _cut_ab(fj[f], L, K, a0, b0, lev, KA, KB, i)
-        ak, bk = _cut_ab(fk[f], L, K, a0, b0, lev, KA, KB, i)
+        aj, bj, ak, bk = _cut_pair(f, prob[i], i, L, K, axis, m, s, ca, sa, KA, KB, levels, fj, fk)
         out[i] = _kink_h(kind[f], fj[f], fk[f], fs[f], aj, bj, ak, bk)
 
 
@@ -868,11 +875,7 @@ def _crossings_on_arc(func, prob, L, K, axis, m, s, ca, sa, KA, KB, levels, fj, 
     """Whether both cuts of function ``func[i]`` of problem ``prob[i]`` are on the arc (|a| <= |b|)
     at point i."""
     for i in range(func.shape[0]):
-        f = func[i]
-        lev = levels[prob[i]]
-        a0, b0 = _horizon_ab(axis, m[i], s[i], ca[i], sa[i])
-        aj, bj = _cut_ab(fj[f], L, K, a0, b0, lev, KA, KB, i)
-        ak, bk = _cut_ab(fk[f], L, K, a0, b0, lev, KA, KB, i)
+        aj, bj, ak, bk = _cut_pair(func[i], prob[i], i, L, K, axis, m, s, ca, sa, KA, KB, levels, fj, fk)
         out[i] = (abs(aj) <= abs(bj)) & (abs(ak) <= abs(bk))
 
 
