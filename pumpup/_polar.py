@@ -776,20 +776,52 @@ def _g_below(mu, lev, nlev, chain):  # pragma: no cover - compiled
     return _g_product(mu, chain[14], chain[15], chain[16], chain[17])
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _buffers(max_intervals, nodes, inodes, rtol):  # pragma: no cover - compiled
+    """The work arrays of the adaptive loop (intervals: piece, ends, value, error; rule values; the
+    inner rule's) and the inner rule's relative tolerance, a small part of the total (rtol / 8)."""
+    cap = max_intervals + 64
+    return (cap, np.empty(cap, np.int64), np.empty(cap), np.empty(cap), np.empty(cap), np.empty(cap),
+            np.empty(nodes.shape[0]), np.empty(inodes.shape[0]), np.empty((4, INNER_MAX)),
+            max(0.125 * rtol, INNER_RTOL_MIN))
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _status(kv, ke, m, left_out, rounding, rtol, atol):  # pragma: no cover - compiled
+    """(value, error, rounding error, the interval with the largest error, done) of the first m
+    intervals: done when the error meets the tolerance or is below the rounding error of the
+    integrand (refining cannot help there)."""
+    tot = 0.0
+    e = left_out
+    ab = 0.0
+    worst = 0
+    for j in range(m):
+        tot += kv[j]
+        e += ke[j]
+        ab += abs(kv[j])
+        if ke[j] > ke[worst]:
+            worst = j
+    r = rounding * ab
+    return tot, e, r, worst, e <= max(rtol * abs(tot), atol) or e <= r
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _bisect(pk, t0, t1, worst, m):  # pragma: no cover - compiled
+    """Bisect interval ``worst``: it keeps the lower half, interval m (new) takes the upper; returns
+    (piece, lower end, midpoint, upper end)."""
+    i = pk[worst]
+    a_, b_ = t0[worst], t1[worst]
+    mid = 0.5 * (a_ + b_)
+    t1[worst] = mid
+    pk[m], t0[m], t1[m] = i, mid, b_
+    return i, a_, mid, b_
+
+
 @njit(cache=True, nogil=True)
 def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, inodes, iwk, iwg, jac, val, err, conv, evals):  # pragma: no cover
     """Adaptive Gauss-Kronrod (the rule ``nodes``, ``wk``, ``wg``) of integral u^n K(u) du for
     every mu (without the scale)."""
-    cap = max_intervals + 64
-    pk = np.empty(cap, np.int64)
-    t0 = np.empty(cap)
-    t1 = np.empty(cap)
-    kv = np.empty(cap)
-    ke = np.empty(cap)
-    buf = np.empty(nodes.shape[0])
-    ibuf = np.empty(inodes.shape[0])
-    iwork = np.empty((4, INNER_MAX))
-    itol = max(0.125 * rtol, INNER_RTOL_MIN)  # the inner error stays a small part of the total
+    cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals, nodes, inodes, rtol)
     kinds = np.empty(MAX_PIECES, np.int64)
     sms = np.empty(MAX_PIECES, np.int64)
     v0 = np.empty(MAX_PIECES)
@@ -811,35 +843,12 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
                 kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac)
                 m += 1
         start = m
-        ok = False
         while True:
-            tot = 0.0
-            e = left_out
-            ab = 0.0
-            worst = 0
-            for j in range(m):
-                tot += kv[j]
-                e += ke[j]
-                ab += abs(kv[j])
-                if ke[j] > ke[worst]:
-                    worst = j
-            r = rounding * ab
-            if e <= max(rtol * abs(tot), atol_arr[q]):
-                ok = True
+            tot, e, r, worst, ok = _status(kv, ke, m, left_out, rounding, rtol, atol_arr[q])
+            if ok or m - start >= max_intervals or m >= cap:
                 break
-            if e <= r:  # below the rounding error of the integrand: refining cannot help
-                ok = True
-                break
-            if m - start >= max_intervals or m >= cap:
-                break
-            i = pk[worst]
-            a_, b_ = t0[worst], t1[worst]
-            mid = 0.5 * (a_ + b_)
-            t1[worst] = mid
+            i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
             kv[worst], ke[worst] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac)
-            pk[m] = i
-            t0[m] = mid
-            t1[m] = b_
             kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac)
             m += 1
         val[q] = tot
@@ -855,16 +864,7 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
     levels at mu_arr[q] (:func:`level_rows`), ``lower[q]`` a lower bound of the integral.  A function of
     its own: with both rules in one function the closed forms' tables ran 1.45 x slower (0.82 -> 1.18 ms
     for Phong n = 20, measured), as the p-model's loop once made them."""
-    cap = max_intervals + 64
-    pk = np.empty(cap, np.int64)
-    t0 = np.empty(cap)
-    t1 = np.empty(cap)
-    kv = np.empty(cap)
-    ke = np.empty(cap)
-    buf = np.empty(nodes.shape[0])
-    ibuf = np.empty(inodes.shape[0])
-    iwork = np.empty((4, INNER_MAX))
-    itol = max(0.125 * rtol, INNER_RTOL_MIN)  # the inner error stays a small part of the total
+    cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals, nodes, inodes, rtol)
     npc = MAX_PIECES + 2 * lev.shape[1]
     kinds = np.empty(npc, np.int64)
     sms = np.empty(npc, np.int64)
@@ -898,35 +898,12 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
                 kv[m], ke[m] = _gk_chain(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, lq, nl, gmu, ka, chain, bcut)
                 m += 1
         start = m
-        ok = False
         while True:
-            tot = 0.0
-            e = left_out
-            ab = 0.0
-            worst = 0
-            for j in range(m):
-                tot += kv[j]
-                e += ke[j]
-                ab += abs(kv[j])
-                if ke[j] > ke[worst]:
-                    worst = j
-            r = rounding * ab
-            if e <= max(rtol * abs(tot), atol_arr[q]):
-                ok = True
+            tot, e, r, worst, ok = _status(kv, ke, m, left_out, rounding, rtol, atol_arr[q])
+            if ok or m - start >= max_intervals or m >= cap:
                 break
-            if e <= r:  # below the rounding error of the integrand: refining cannot help
-                ok = True
-                break
-            if m - start >= max_intervals or m >= cap:
-                break
-            i = pk[worst]
-            a_, b_ = t0[worst], t1[worst]
-            mid = 0.5 * (a_ + b_)
-            t1[worst] = mid
+            i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
             kv[worst], ke[worst] = _gk_chain(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, lq, nl, gmu, ka, chain, bcut)
-            pk[m] = i
-            t0[m] = mid
-            t1[m] = b_
             kv[m], ke[m] = _gk_chain(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, lq, nl, gmu, ka, chain, bcut)
             m += 1
         val[q] = tot
