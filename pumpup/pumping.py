@@ -825,7 +825,7 @@ class Pumped(BRDF):
             cross = up(grid, capped=False) - lk.cap
             for i in np.nonzero(np.sign(cross[:-1]) * np.sign(cross[1:]) < 0)[0]:
                 out.append(brentq(lambda u: float(up(u, capped=False)) - lk.cap, grid[i], grid[i + 1], xtol=1e-15))
-        if mu < 1e3 * lk.mu0 < 1e3:
+        if lk.mu0 < 1.0 and mu < 1e3 * lk.mu0:
             # below the table's first node the bound is a power law with its own margin: it jumps there
             # (by margin_lo - margin, ~1e-8 of it), which matters where N.wo that small carries weight, at
             # incidence within 1e3 of it (the 1-D path was 7.5e-11 off at mu = 1e-8 without the cut,
