@@ -790,41 +790,67 @@ class Pumped(BRDF):
         out = cache[float(mu)] = self._kink_levels(float(mu))
         return out
 
-    def _kink_levels(self, mu: float) -> tuple:
-        """:meth:`kink_levels`, computed."""
+    def _kink_fixed(self):
+        """What :meth:`_kink_levels` needs at every mu, computed once per bound: the grid of the
+        root search (the table's nodes and their midpoints), the bound on it, and the kinks that do not
+        depend on mu: v where u(v) = v (g2) and where u(v) reaches its cap."""
         from scipy.optimize import brentq
 
-        up = self.lookup().upper
-        t = self.lookup().table
-        am = float(up(mu))
+        lk = self.lookup()
+        hit = lk.__dict__.get("kink_fixed")
+        if hit is not None:
+            return hit
+        up = lk.upper
+        t = lk.table
         grid = np.unique(np.concatenate([t.mu, np.sqrt(t.mu[:-1] * t.mu[1:]), [1.0]]))
         au = up(grid)
-        funcs = [lambda u: float(up(u)) - am]
+
+        def roots(vals, fn):
+            idx = np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]
+            return [brentq(fn, grid[i], grid[i + 1], xtol=1e-15) for i in idx]
+
+        diag = []
         if self.controlled:
-            funcs += [lambda u: float(up(u)) - u, lambda u: float(up(u)) - mu]
+            vals = au - grid
+            diag = roots(np.where(np.abs(vals) < 1e-13, 0.0, vals), lambda u: float(up(u)) - u)
+        caps = []
+        if math.isfinite(lk.cap):
+            caps = roots(up(grid, capped=False) - lk.cap, lambda u: float(up(u, capped=False)) - lk.cap)
+        lk.kink_fixed = out = (grid, au, diag, caps)
+        return out
+
+    def _kink_levels(self, mu: float) -> tuple:
+        """:meth:`kink_levels`, computed (the parts that do not depend on mu once, :meth:`_kink_fixed`)."""
+        from scipy.optimize import brentq
+
+        lk = self.lookup()
+        up = lk.upper
+        grid, au, diag, caps = self._kink_fixed()
+        am = float(up(mu))
         out = [mu]  # u(v) = U at v = mu, or (g2) v = mu against U: a kink either way
         if self.controlled and float(up(am)) <= am * (1 + 1e-12) and am >= mu * (1 - 1e-12):
             out.append(am)  # v = U, where v and U are the two largest
-        for k, fn in enumerate(funcs):
-            vals = au - am if k == 0 else (au - grid if k == 1 else au - mu)
-            vals = np.where(np.abs(vals) < 1e-13 * max(1.0, am), 0.0, vals)  # rounding of a flat spline: no root
-            idx = np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]
-            for i in idx:
-                v = brentq(fn, grid[i], grid[i + 1], xtol=1e-15)
+        for k in ((0, 1, 2) if self.controlled else (0,)):
+            if k == 1:
+                found = diag  # u(v) = v
+            else:
+                vals = au - (am if k == 0 else mu)
+                vals = np.where(np.abs(vals) < 1e-13 * max(1.0, am), 0.0, vals)  # rounding of a flat spline: no root
+                c = am if k == 0 else mu
+                found = [brentq(lambda u: float(up(u)) - c, grid[i], grid[i + 1], xtol=1e-15)
+                         for i in np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]]
+            for v in found:
                 if self.controlled:
                     # the crossing value c and the terms that are not crossing there
                     c, others = [(am, (mu, v)), (v, (am, mu)), (mu, (am, v))][k]
                     if c < max(others) * (1 - 1e-12):
                         continue  # both crossing terms are below a third: g has no kink here
                 out.append(v)
-        lk = self.lookup()
         if math.isfinite(lk.cap) and am < lk.cap * (1 - 1e-12):
             # u(v) reaches its cap (1 where the base conserves energy): there u(v) is the largest term
             # (the others are U < cap and mu, v <= 1), so g has a kink (the product table's _kinks
             # has it too); the capped u is flat beyond it, so the roots above do not see it
-            cross = up(grid, capped=False) - lk.cap
-            for i in np.nonzero(np.sign(cross[:-1]) * np.sign(cross[1:]) < 0)[0]:
-                out.append(brentq(lambda u: float(up(u, capped=False)) - lk.cap, grid[i], grid[i + 1], xtol=1e-15))
+            out += caps
         if lk.mu0 < 1.0 and mu < 1e3 * lk.mu0:
             # below the table's first node the bound is a power law with its own margin: it jumps there
             # (by margin_lo - margin, ~1e-8 of it), which matters where N.wo that small carries weight, at

@@ -127,52 +127,61 @@ def test_levels_of_g_include_where_a_bound_reaches_its_cap():
         assert min(abs(lv - c) for lv in levels) < 1e-4, (c, levels)
 
 
-def test_level_rows_and_the_arc_cut():
-    """(L, 1 - u_A, 1 - u_B): the circle of the lobe crosses N.wo = L exactly for u in (u_A, u_B), and
-    (u_B - u)(u - u_A) = b^2 - (L - a)^2 (the cut's b sin(beta_L), without cancellation)."""
-    rng = np.random.default_rng(3)
-    for mu in (0.9, 0.5, 0.05):
-        s = math.sqrt(1 - mu * mu)
-        levels = np.concatenate([[mu], rng.uniform(0.01, 0.999, 6)])
-        rows = _polar.level_rows(levels, mu)
-        for L, uma, umb in rows:
-            ua, ub = 1 - uma, 1 - umb
-            for u in rng.uniform(0, 1, 50):
-                a, b = mu * u, s * math.sqrt(1 - u * u)
-                assert math.isclose((ub - u) * (u - ua), b * b - (L - a) ** 2, abs_tol=1e-13)
-                crosses = a - b < L < a + b
-                assert crosses == (ua < u < ub) or min(abs(u - ua), abs(u - ub)) < 1e-12
+def _v_reference(n, kappa):
+    """V(kappa) = integral over phi in (-pi, pi] of (1 - kappa sin^2(phi / 2))_+^n, independently: for
+    kappa <= 1 and integer n the finite sum 2 pi sum_k C(n, k) (-kappa)^k (2k)! / (4^k k!^2) (the mean of
+    sin^2k(phi / 2) over the circle; n <= 30) in 40-digit mpmath, otherwise mpmath's tanh-sinh quadrature (which
+    takes the end where the lobe vanishes, (phi0 - phi)^n, in its stride)."""
+    mpmath = pytest.importorskip("mpmath")
+    with mpmath.workdps(40):
+        k = mpmath.mpf(kappa)
+        if k <= 1 and float(n).is_integer() and n <= 30:  # (beyond, the alternating sum cancels)
+            return float(2 * mpmath.pi * mpmath.fsum(mpmath.binomial(int(n), j) * (-k) ** j * mpmath.factorial(2 * j)
+                                                    / (4 ** j * mpmath.factorial(j) ** 2) for j in range(int(n) + 1)))
+        phi0 = mpmath.pi if k <= 1 else 2 * mpmath.asin(1 / mpmath.sqrt(k))
+        peak = min(phi0, 4 * mpmath.sqrt(2 / (n * k))) if k > 0 else phi0
+        return float(2 * mpmath.quad(lambda ph: max(0, 1 - k * mpmath.sin(ph / 2) ** 2) ** n, [0, peak, phi0]))
 
 
-def test_pieces_cut_at_every_level():
-    """The outer pieces tile u in [0, 1]; each level's u_A, u_B is a piece end, smoothed on the side
-    where the level cuts the circle (its square-root end)."""
-    n, mu = 20.0, 0.6
+@pytest.mark.parametrize("n", [0.5, 1.0, 3.0, 20.0, 1000.0])
+def test_ring_table_against_mpmath(n):
+    """The lobe u^n on a circle N.wo = t is (A + B)^n V(kappa): the ring table's V (Chebyshev pieces, or the
+    quadrature where a piece next to kappa = 1 could not be fitted) against 40-digit references, within
+    its own error and 1e-13; the table covers [0, 2] without gaps."""
+    kb, kc, keps = _polar.ring_table(n)
+    assert kb[0] == 0.0 and kb[-1] == 2.0 and np.all(np.diff(kb) > 0)
+    nodes, wk, wg = _polar._RULES["gk21"]
+    ibuf, iwork = np.empty(21), np.empty((5, _polar.INNER_MAX))
+    rng = np.random.default_rng(int(n * 10))
+    kappas = np.concatenate([[0.0, 1e-9, 0.3, 1.0 - 1e-7, 1.0, 1.0 + 1e-7, 1.5, 2.0], rng.uniform(0, 2, 12),
+                             1.0 + rng.uniform(-1e-5, 1e-5, 4)])
+    for kappa in kappas:
+        v, e = _polar._ring_at(kappa, kb, kc, keps)
+        if e < 0:  # a piece left to quadrature
+            v, e = _polar._ring_quad(n, kappa, 1e-15, nodes, wk, wg, ibuf, iwork)
+        ref = _v_reference(n, kappa)
+        assert abs(v - ref) <= e + 1e-15 * ref, (n, kappa, v, ref, e)
+        assert e <= 1e-13 * ref, (n, kappa, e)
+
+
+def test_chain_cuts():
+    """The elevation's cuts: the ends, every level of g, N.wo = mu and s, the peak's theta_i +- 3 and 8
+    over sqrt(n) where they fall inside, N.wo = 1/2, 1/8, ... (g's tables are splines in ln N.wo), and for
+    small n a grading towards x_s; sorted, no duplicates."""
+    mu, n = 0.3, 200.0
     s = math.sqrt(1 - mu * mu)
-    lev = _polar.level_rows([mu, 0.3, 0.95, 0.9999], mu)
-    size = _polar.MAX_PIECES + 2 * len(lev)
-    kinds, sms = np.empty(size, np.int64), np.empty(size, np.int64)
-    v0, w, v1 = np.empty(size), np.empty(size), np.empty(size)
-    k, _, _ = _polar._pieces(n, 0.0, mu, s, kinds, sms, v0, w, v1, lev, len(lev))
-
-    def u_of(kind, v):
-        return v if kind == 0 else math.exp(-v / (n + 1))
-
-    ends = []  # (u at the piece's lower end in u, u at its upper end, smoothed there?)
-    for i in range(k):
-        a, b = u_of(kinds[i], v0[i]), u_of(kinds[i], v1[i])
-        left, right = bool(sms[i] & 1), bool(sms[i] & 2)
-        if kinds[i] == 1:  # z runs against u
-            a, b, left, right = b, a, right, left
-        ends.append((a, b, left, right))
-    ends.sort()
-    assert ends[0][0] == 0.0 and abs(ends[-1][1] - 1.0) < 1e-15
-    assert all(abs(p[1] - q[0]) < 1e-12 for p, q in zip(ends, ends[1:]))  # a tiling
-    for _, uma, umb in lev:
-        for u, inside_above in ((1 - uma, True), (1 - umb, False)):
-            if not 0 < u < 1:
-                continue
-            at = [e for e in ends if abs(e[0] - u) < 1e-12 or abs(e[1] - u) < 1e-12]
-            assert at, u
-            # smoothing on the side where the level cuts the circle: above u_A, below u_B
-            assert any((abs(e[0] - u) < 1e-12 and e[2]) if inside_above else (abs(e[1] - u) < 1e-12 and e[3]) for e in at), (u, at)
+    levels = (mu, 0.95, 0.999)
+    x = _polar.chain_cuts(levels, n, mu)
+    assert x[0] == 0.0 and x[-1] == 0.5 * math.pi and np.all(np.diff(x) > 0)
+    xmu = math.atan2(mu, s)
+    want = [math.asin(v) for v in levels] + [xmu, math.atan2(s, mu), math.asin(0.5), math.asin(0.125)]
+    want += [xmu + k / math.sqrt(n) for k in (-3, 3, -8, 8) if 0 < xmu + k / math.sqrt(n) < 0.5 * math.pi]
+    for w in want:
+        assert np.min(np.abs(x - w)) < 1e-14, w
+    assert np.min(np.abs(x - math.asin(0.25 * 0.125))) > 1e-3  # no grading below a quarter of mu
+    few = _polar.chain_cuts(levels, 2.0, mu)  # small n: graded towards x_s on both sides
+    xs = math.atan2(s, mu)
+    for d in (0.125, 0.5 * 0.25 ** 5):
+        assert np.min(np.abs(few - (xs - d))) < 1e-14 and np.min(np.abs(few - (xs + d))) < 1e-14
+    assert np.min(np.abs(few - (xs - 0.5))) < 1e-14 and few[-1] == 0.5 * math.pi  # (xs + 0.5 is beyond pi / 2)
+    assert np.min(np.abs(x - (xs - 0.125))) > 1e-3  # n = 200: no grading
