@@ -459,9 +459,9 @@ def _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, it
     integrand's values (the inner rule ``inodes``, ``iwk``, ``iwg`` at relative tolerance
     ``itol``) summed with the Kronrod weights; ``buf`` holds the values (one per node).  The
     closed forms p in {0, 1} have a loop of their own, with no call in it (a loop that may call
-    :func:`_arc_power` ran 2.5 x slower for them; a pumped lobe has functions of its own,
-    :func:`_gk_chain` and :func:`_integrate_chain`: one integration loop that could call either rule
-    ran 1.45 x slower for them)."""
+    :func:`_arc_power` ran 2.5 x slower for them; a pumped lobe has a loop of its own,
+    :func:`_integrate_chain`: one integration loop that could call either rule ran 1.45 x slower for
+    them)."""
     h = t1 - t0
     ie = 0.0
     if 0.0 < p < 1.0:
@@ -793,6 +793,8 @@ def ring_table(n: float) -> tuple:
     kernel to compute V there by quadrature.  Cached per n."""
     n = float(n)
     deg = RING_DEGREE
+    if n == 0.0:  # (V = 2 phi0 in closed form, :func:`_x_rule`: no table)
+        return np.array([0.0, 2.0]), np.zeros((1, deg + 1)), np.zeros(1)
     br = [2.0]
     k = 1.0
     while k > 1.0 / (8.0 * max(n, 1e-300)) and k > 1e-300:
@@ -917,23 +919,25 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
 def chain_cuts(levels, n: float, mu: float) -> np.ndarray:
     """The breakpoints in the elevation x of wo (N.wo = sin x) of a pumped lobe at incidence mu:
     0, pi/2, the levels of g (``levels``), N.wo = mu (max(mu, N.wo)), N.wo = s (u > 0 on the whole
-    circle above it), and the lobe's peak theta_o = theta_i +- k / sqrt(n), k = 3, 8 (u^n ~
-    exp(-n alpha^2 / 2)); x = atan2(L, sqrt(1 - L^2)) keeps levels near 1 to full precision."""
+    circle above it), the lobe's peak theta_o = theta_i +- k / sqrt(n), k = 3, 8 (u^n ~
+    exp(-n alpha^2 / 2)), N.wo = 2^-(1 + 2k) (:data:`GRADE`), and for n < :data:`RING_SMOOTH_N` a grading
+    towards x_s; x = atan2(L, sqrt(1 - L^2)) keeps levels near 1 to full precision."""
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     L = np.asarray(levels, dtype=np.float64).reshape(-1)
     L = L[(L > 0.0) & (L < 1.0)]
-    x = [0.0, 0.5 * math.pi, math.atan2(mu, s), math.atan2(s, mu)]
+    x_mu, x_s = math.atan2(mu, s), math.atan2(s, mu)
+    x = [0.0, 0.5 * math.pi, x_mu, x_s]
     x.extend(np.arctan2(L, np.sqrt((1.0 - L) * (1.0 + L))))
     if n > 0.0:
         for k in (3.0, 8.0):
-            x.extend([x[2] - k / math.sqrt(n), x[2] + k / math.sqrt(n)])
+            x.extend([x_mu - k / math.sqrt(n), x_mu + k / math.sqrt(n)])
     if 0.0 < n < RING_SMOOTH_N:
         # W has a term |x - x_s|^(n + 1/2) at x_s (the ring table's kappa = 1): for small n the pieces
         # near it are graded towards it, so that none lies within a fraction of its width of it (stretched
         # Phong n = 0.5 at mu = 0.5, rtol 1e-8: a piece ending 0.002 short of it was 1.8e-8 off, estimate 3.4e-9)
         d = 0.5
         while d > 1e-9:
-            x.extend([x[3] - d, x[3] + d])
+            x.extend([x_s - d, x_s + d])
             d *= 0.25
     # g's tables are splines in ln(N.wo): N.wo = 2^-(1 + 2 k) down to a quarter of mu or of the lowest level
     floor = max(0.25 * min(mu, L.min(initial=1.0)), GRADE_FLOOR)
@@ -992,7 +996,7 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     if hint.chain is None:
         _integrate(float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
                    *(_RULES[RULE]), mode_code(), N_INIT, *_RULES["gk15"], jac, val, err, conv, evals)
-    else:  # a pumped lobe, about N (the raw estimate: g's splines have breakpoints that no cut marks)
+    else:  # a pumped lobe, about N
         cuts = [chain_cuts(hint.levels(float(m)), float(hint.n), float(m)) for m in mu]
         ncut = np.array([len(c) for c in cuts], np.int64)
         cut = np.zeros((len(mu), int(ncut.max(initial=2))))
