@@ -166,8 +166,8 @@ def test_ring_table_against_mpmath(n):
 
 def test_chain_cuts():
     """The elevation's cuts: the ends, every level of g, N.wo = mu and s, the peak's theta_i +- 3 and 8
-    over sqrt(n) where they fall inside, N.wo = 1/2, 1/8, ... (g's tables are splines in ln N.wo), and for
-    small n a grading towards x_s; sorted, no duplicates."""
+    over sqrt(n) where they fall inside, N.wo = 1/2, 1/8, ... (g's tables are splines in ln N.wo), every
+    pi / 16, and for small n a grading towards x_s; sorted, no duplicates."""
     mu, n = 0.3, 200.0
     s = math.sqrt(1 - mu * mu)
     levels = (mu, 0.95, 0.999)
@@ -176,6 +176,7 @@ def test_chain_cuts():
     xmu = math.atan2(mu, s)
     want = [math.asin(v) for v in levels] + [xmu, math.atan2(s, mu), math.asin(0.5), math.asin(0.125)]
     want += [xmu + k / math.sqrt(n) for k in (-3, 3, -8, 8) if 0 < xmu + k / math.sqrt(n) < 0.5 * math.pi]
+    want += [k * math.pi / 16 for k in range(1, 8)]
     for w in want:
         assert np.min(np.abs(x - w)) < 1e-14, w
     assert np.min(np.abs(x - math.asin(0.25 * 0.125))) > 1e-3  # no grading below a quarter of mu
