@@ -69,7 +69,7 @@ term |kappa - 1|^(n + 1/2), computed by quadrature when they cannot be fitted), 
 keeps (A + B)^n = exp(n log1p(-2 sin^2((x - x_mu) / 2))) accurate for any n (a plain power of A + B cos(phi)
 lost n ulp: 2.2e-13 for n = 2000, measured).  The x integral (:func:`_integrate_chain`, adaptive 10/21) is cut
 at the levels of g (``Pumped.lobe(mu).levels``), at N.wo = mu and s (V's kappa = 1), around the lobe's peak
-theta_i +- 3 and 8 / sqrt(n), at N.wo = 2^-(1 + 2k) (g's tables are splines in ln N.wo), every pi / 16, and
+theta_i +- 3, 8 and 13 / sqrt(n), at N.wo = 2^-(1 + 2k) (g's tables are splines in ln N.wo), every pi / 16, and
 for n < 8 graded towards x_s (:func:`chain_cuts`).  g's splines have breakpoints no cut marks, so the estimate
 per interval is ``CHAIN_SAFETY`` (3) times the raw |K - G| (measured: true error at most 0.48 of it over 15
 chains, 351 mu from 1e-10 to 1, rtol 1e-6 ... 1e-12).  Before this (issue 14, fifth session) the lobe frame served pumped
@@ -702,24 +702,40 @@ def _w_rule(n, d1, c2, lo, hi, nodes, wk, wg, ibuf):  # pragma: no cover - compi
 @njit(cache=True, nogil=True)
 def _ring_quad(n, kappa, itol, nodes, wk, wg, ibuf, iwork):  # pragma: no cover - compiled
     """(V, its error): V(kappa) = integral over phi in (-pi, pi] of (1 - kappa sin^2(phi / 2))_+^n,
-    kappa in [0, 2], by the 10/21 rule, globally adaptive, to the relative error ``itol``.  The
-    integrand peaks at phi = 0 with a width ~ sqrt(2 / (n kappa)): the half-arc [0, phi0] (phi0 = pi,
-    or where 1 - kappa sin^2(phi / 2) = 0) is cut at 4 widths to start."""
+    kappa in [0, 2], by the 10/21 rule, globally adaptive, to the relative error ``itol``.
+
+    The integrand f decreases on the half-arc [0, phi0] (phi0 = pi, or where 1 - kappa sin^2(phi / 2)
+    = 0) from its peak f(0) = 1, of width sigma = sqrt(2 / (n kappa)) (f ~ exp(-(phi / sigma)^2 / 2)).
+    The half-arc is cut at sigma (1, 2, 3, 4, 6, 8, 11, 15, ...) until the rest is at most
+    (phi0 - c) f(c) <= 1e-18 sigma f(sigma) (f decreases: a bound, added to the error, its value left
+    out): a rule on a piece that starts several widths out sees zeros at its nodes (n = 1e6,
+    kappa = 0.95, with one piece beyond 4 sigma: 6.3e-5 off, estimate 2.6e-15)."""
     phi0 = math.pi if kappa <= 1.0 else 2.0 * math.asin(1.0 / math.sqrt(kappa))
     if n == 0.0:
         return 2.0 * phi0, 8.0 * EPS * phi0
     lo, hi, val, err = iwork[0], iwork[1], iwork[2], iwork[3]
-    c = min(phi0, 4.0 * math.sqrt(2.0 / (n * kappa))) if kappa > 0.0 else phi0
-    lo[0], hi[0] = 0.0, c
-    val[0], err[0] = _w_rule(n, 0.0, kappa, 0.0, c, nodes, wk, wg, ibuf)
-    nint = 1
-    if c < phi0:
-        lo[1], hi[1] = c, phi0
-        val[1], err[1] = _w_rule(n, 0.0, kappa, c, phi0, nodes, wk, wg, ibuf)
-        nint = 2
+    sig = math.sqrt(2.0 / (n * kappa)) if kappa > 0.0 else math.inf
+    floor = 1e-18 * min(sig, phi0) * _ring_f(n, kappa, min(sig, phi0))
+    nint = 0
+    a = 0.0
+    k = 1.0
+    tail = 0.0
+    while True:
+        b = min(phi0, k * sig)
+        lo[nint], hi[nint] = a, b
+        val[nint], err[nint] = _w_rule(n, 0.0, kappa, a, b, nodes, wk, wg, ibuf)
+        nint += 1
+        if b >= phi0:
+            break
+        fb = _ring_f(n, kappa, b)
+        if (phi0 - b) * fb <= floor or nint >= lo.shape[0] // 2:
+            tail = (phi0 - b) * fb  # f decreases beyond b
+            break
+        a = b
+        k = k + 1.0 if k < 4.0 else math.floor(1.35 * k)
     while True:
         tot = 0.0
-        e = 0.0
+        e = tail
         worst = 0
         for i in range(nint):
             tot += val[i]
@@ -734,6 +750,14 @@ def _ring_quad(n, kappa, itol, nodes, wk, wg, ibuf, iwork):  # pragma: no cover 
         val[worst], err[worst] = _w_rule(n, 0.0, kappa, lo[worst], mid, nodes, wk, wg, ibuf)
         val[nint], err[nint] = _w_rule(n, 0.0, kappa, mid, hi[nint], nodes, wk, wg, ibuf)
         nint += 1
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _ring_f(n, kappa, phi):  # pragma: no cover - compiled
+    """(1 - kappa sin^2(phi / 2))_+^n, as :func:`_w_rule` computes it."""
+    sp = math.sin(0.5 * phi)
+    omu = kappa * sp * sp
+    return math.exp(n * math.log1p(-omu)) if omu < 1.0 else 0.0
 
 
 @njit(cache=True)
@@ -919,7 +943,7 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
 def chain_cuts(levels, n: float, mu: float) -> np.ndarray:
     """The breakpoints in the elevation x of wo (N.wo = sin x) of a pumped lobe at incidence mu:
     0, pi/2, the levels of g (``levels``), N.wo = mu (max(mu, N.wo)), N.wo = s (u > 0 on the whole
-    circle above it), the lobe's peak theta_o = theta_i +- k / sqrt(n), k = 3, 8 (u^n ~
+    circle above it), the lobe's peak theta_o = theta_i +- k / sqrt(n), k = 3, 8, 13 (u^n ~
     exp(-n alpha^2 / 2)), N.wo = 2^-(1 + 2k) (:data:`GRADE`), every pi / 16 (:data:`X_PIECES`), and for
     n < :data:`RING_SMOOTH_N` a grading towards x_s; x = atan2(L, sqrt(1 - L^2)) keeps levels near 1 to full
     precision."""
@@ -930,7 +954,9 @@ def chain_cuts(levels, n: float, mu: float) -> np.ndarray:
     x = [0.0, 0.5 * math.pi, x_mu, x_s]
     x.extend(np.arctan2(L, np.sqrt((1.0 - L) * (1.0 + L))))
     if n > 0.0:
-        for k in (3.0, 8.0):
+        # (beyond 13 / sqrt(n), (A + B)^n = cos^n(x - x_mu) <= exp(-84.5): no rule there sees zeros where
+        # the lobe is not negligible)
+        for k in (3.0, 8.0, 13.0):
             x.extend([x_mu - k / math.sqrt(n), x_mu + k / math.sqrt(n)])
     if 0.0 < n < RING_SMOOTH_N:
         # W has a term |x - x_s|^(n + 1/2) at x_s (the ring table's kappa = 1): for small n the pieces
