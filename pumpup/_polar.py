@@ -71,7 +71,7 @@ lost n ulp: 2.2e-13 for n = 2000, measured).  The x integral (:func:`_integrate_
 at the levels of g (``Pumped.lobe(mu).levels``), at N.wo = mu and s (V's kappa = 1), around the lobe's peak
 theta_i +- 3, 8 and 13 / sqrt(n), at N.wo = 2^-(1 + 2k) (g's tables are splines in ln N.wo), every pi / 16, and
 for n < 8 graded towards x_s (:func:`chain_cuts`).  g's splines have breakpoints no cut marks, so the estimate
-per interval is ``CHAIN_SAFETY`` (3) times the raw |K - G| (measured: true error at most 0.48 of it over 15
+per interval is ``CHAIN_SAFETY`` (3) times the raw |K - G| (measured: true error at most 0.49 of it over 15
 chains, 351 mu from 1e-10 to 1, rtol 1e-6 ... 1e-12).  Before this (issue 14, fifth session) the lobe frame served pumped
 lobes too, with an adaptive rule on the arc for every outer node: g was looked up ~50 000 times per mu instead
 of ~400, and the three tables of 3-level g2 pumped Phong n = 20 took 180-230 ms instead of ~60.
@@ -985,7 +985,7 @@ _RULES = {"gk15": (_NODES, _WK, _WG), "gk21": (NODES21, WK21, WG21)}
 #: right to 1e-17).  So the elevation is also cut every pi / 16 (X_PIECES), where such errors (~ width^6)
 #: are far below the rounding term, and the estimate is 3 |K - G|.  Measured over 15 chains (g1 and g2,
 #: 1-4 levels, n from 0.5 to 5000, p in {0, 0.5, 1}, retro), 351 mu from 1e-10 to 1 and rtol 1e-6 ...
-#: 1e-12, against the lobe frame's engine at 1e-13 on the same BRDFs: the worst true error was 0.48 of
+#: 1e-12, against the lobe frame's engine at 1e-13 on the same BRDFs: the worst true error was 0.49 of
 #: the estimate (one case excepted, where the lobe frame was the one off: retro n = 10 at mu = 0.3705,
 #: 9e-13, by the nested engine and this one at 1e-13); with the raw |K - G| it was 1.41, without the
 #: pi / 16 cuts 4.19.
