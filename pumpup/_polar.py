@@ -201,6 +201,19 @@ def _jacobi_sum(q, top, low, c, jt, jw):  # pragma: no cover - compiled
     return c ** (q + 1.0) * s
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _tally(val, err, m, tot, e):  # pragma: no cover - compiled
+    """(value, error, the interval with the largest error) of an adaptive rule's first m intervals, the
+    sums starting from ``tot`` and ``e``."""
+    worst = 0
+    for i in range(m):
+        tot += val[i]
+        e += err[i]
+        if err[i] > err[worst]:
+            worst = i
+    return tot, e, worst
+
+
 @njit(cache=True, nogil=True)
 def _arc_power(q, mu, a, b, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iwork, jac):  # pragma: no cover - compiled
     """(H, error) of H = integral_0^beta1 (a + b cos beta)^q d beta, q = 1 - p in (0, 1): the arc
@@ -240,14 +253,7 @@ def _arc_power(q, mu, a, b, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iwork,
     val[0], err[0] = _arc_rule(q, a, b, 0.0, end, nodes, wk, wg, mode, ibuf)
     m = 1
     while True:
-        tot = fixed
-        e = fixed_err
-        worst = 0
-        for i in range(m):
-            tot += val[i]
-            e += err[i]
-            if err[i] > err[worst]:
-                worst = i
+        tot, e, worst = _tally(val, err, m, fixed, fixed_err)
         if e <= rtol * (rest + max(tot - e, beta1 * mu**q)) or m >= lo.shape[0]:
             return tot, e
         mid = 0.5 * (lo[worst] + hi[worst])
@@ -734,14 +740,7 @@ def _ring_quad(n, kappa, itol, nodes, wk, wg, ibuf, iwork):  # pragma: no cover 
         a = b
         k = k + 1.0 if k < 4.0 else math.floor(1.35 * k)
     while True:
-        tot = 0.0
-        e = tail
-        worst = 0
-        for i in range(nint):
-            tot += val[i]
-            e += err[i]
-            if err[i] > err[worst]:
-                worst = i
+        tot, e, worst = _tally(val, err, nint, 0.0, tail)
         if e <= itol * tot or nint >= lo.shape[0]:
             return 2.0 * tot, 2.0 * e + 16.0 * EPS * tot
         mid = 0.5 * (lo[worst] + hi[worst])
