@@ -810,7 +810,7 @@ class Pumped(BRDF):
             return [brentq(fn, grid[i], grid[i + 1], xtol=1e-15) for i in idx]
 
         diag = []
-        if self.controlled:
+        if self.controlled:  # (:meth:`_kink_levels` uses these where U(mu) <= 1, as the threshold assumes)
             vals = au - grid
             diag = roots(np.where(np.abs(vals) < 1e-13, 0.0, vals), lambda u: float(up(u)) - u)
         caps = []
@@ -831,14 +831,13 @@ class Pumped(BRDF):
         if self.controlled and float(up(am)) <= am * (1 + 1e-12) and am >= mu * (1 - 1e-12):
             out.append(am)  # v = U, where v and U are the two largest
         for k in ((0, 1, 2) if self.controlled else (0,)):
-            if k == 1:
-                found = diag  # u(v) = v
+            if k == 1 and am <= 1.0:
+                found = diag  # u(v) = v, found once (with the threshold below at am <= 1)
             else:
-                vals = au - (am if k == 0 else mu)
+                vals = au - (am if k == 0 else (grid if k == 1 else mu))
                 vals = np.where(np.abs(vals) < 1e-13 * max(1.0, am), 0.0, vals)  # rounding of a flat spline: no root
-                c = am if k == 0 else mu
-                found = [brentq(lambda u: float(up(u)) - c, grid[i], grid[i + 1], xtol=1e-15)
-                         for i in np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]]
+                fn = [lambda u: float(up(u)) - am, lambda u: float(up(u)) - u, lambda u: float(up(u)) - mu][k]
+                found = [brentq(fn, grid[i], grid[i + 1], xtol=1e-15) for i in np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]]
             for v in found:
                 if self.controlled:
                     # the crossing value c and the terms that are not crossing there
