@@ -691,16 +691,21 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
 # --- pumped Phong-family BRDFs: the frame of N -------------------------------------------------
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _ring_f(n, kappa, phi):  # pragma: no cover - compiled
+    """(1 - kappa sin^2(phi / 2))_+^n as exp(n log1p(-kappa sin^2(phi / 2))): accurate for any n (a power
+    of A + B cos(phi) lost n ulp, 2.2e-13 for n = 2000, measured)."""
+    sp = math.sin(0.5 * phi)
+    omu = kappa * sp * sp
+    return math.exp(n * math.log1p(-omu)) if omu < 1.0 else 0.0
+
+
 @njit(cache=True, nogil=True)
-def _w_rule(n, d1, c2, lo, hi, nodes, wk, wg, ibuf):  # pragma: no cover - compiled
-    """(value, |K - G|) of the rule on phi in [lo, hi] for u_+^n, u = 1 - d1 - c2 sin^2(phi / 2) (the lobe on
-    the circle of :func:`_w_of_t`; 1 - u to a few ulp, so that u^n = exp(n log1p(-(1 - u))) is accurate
-    for any n: a power of A + B cos(phi) lost n ulp, 2.2e-13 for n = 2000, measured)."""
+def _ring_rule(n, kappa, lo, hi, nodes, wk, wg, ibuf):  # pragma: no cover - compiled
+    """(value, |K - G|) of the rule on phi in [lo, hi] for :func:`_ring_f`."""
     h = hi - lo
     for j in range(nodes.shape[0]):
-        sp = math.sin(0.5 * (lo + h * nodes[j]))
-        omu = d1 + c2 * sp * sp
-        ibuf[j] = math.exp(n * math.log1p(-omu)) if omu < 1.0 else 0.0
+        ibuf[j] = _ring_f(n, kappa, lo + h * nodes[j])
     k, diff, asc, ab = rule_sums(ibuf, wk, wg)
     return k * h, diff * h
 
@@ -729,7 +734,7 @@ def _ring_quad(n, kappa, itol, nodes, wk, wg, ibuf, iwork):  # pragma: no cover 
     while True:
         b = min(phi0, k * sig)
         lo[nint], hi[nint] = a, b
-        val[nint], err[nint] = _w_rule(n, 0.0, kappa, a, b, nodes, wk, wg, ibuf)
+        val[nint], err[nint] = _ring_rule(n, kappa, a, b, nodes, wk, wg, ibuf)
         nint += 1
         if b >= phi0:
             break
@@ -746,17 +751,9 @@ def _ring_quad(n, kappa, itol, nodes, wk, wg, ibuf, iwork):  # pragma: no cover 
         mid = 0.5 * (lo[worst] + hi[worst])
         lo[nint], hi[nint] = mid, hi[worst]
         hi[worst] = mid
-        val[worst], err[worst] = _w_rule(n, 0.0, kappa, lo[worst], mid, nodes, wk, wg, ibuf)
-        val[nint], err[nint] = _w_rule(n, 0.0, kappa, mid, hi[nint], nodes, wk, wg, ibuf)
+        val[worst], err[worst] = _ring_rule(n, kappa, lo[worst], mid, nodes, wk, wg, ibuf)
+        val[nint], err[nint] = _ring_rule(n, kappa, mid, hi[nint], nodes, wk, wg, ibuf)
         nint += 1
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _ring_f(n, kappa, phi):  # pragma: no cover - compiled
-    """(1 - kappa sin^2(phi / 2))_+^n, as :func:`_w_rule` computes it."""
-    sp = math.sin(0.5 * phi)
-    omu = kappa * sp * sp
-    return math.exp(n * math.log1p(-omu)) if omu < 1.0 else 0.0
 
 
 @njit(cache=True)
