@@ -1001,6 +1001,12 @@ X_PIECES = 8
 N_INIT_CHAIN = 1
 
 
+def takes_1d_path(brdf) -> bool:
+    """Whether :func:`albedo_1d` takes ``brdf`` (it has a :class:`Polar` hint and the path is on)."""
+    polar = getattr(brdf, "polar", None) if ENABLED else None
+    return polar is not None and polar() is not None
+
+
 def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     """(value, error, converged, evaluations) of the albedo of ``brdf`` at every mu (a 1-D float
     array), or None when the model has no :class:`Polar` hint (or the 1-D path is off)."""

@@ -210,8 +210,8 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     progress : bool, optional
         Show a progress bar (default: when stderr is a terminal).
     threads : int, optional
-        Threads that compute the values (default :data:`THREADS`: one per core).  The table
-        does not depend on it.
+        Threads that compute the values (default :data:`THREADS`: one per core, one for a BRDF on
+        the 1-D path).  The table does not depend on it.
     phi : None, float, array_like or "sup", optional
         Azimuth(s) of wi in radians (see :func:`pumpup.albedo`).  None: phi = 0 (wi in the
         xz-plane), a table over ``mu``.  A number or an array: a table over (``mu``, ``phi``)
@@ -291,9 +291,12 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     return _dataset(brdf, grid, val, err, rtol, atol, interp_error, "adaptive", phis, phi_kind)
 
 
-#: threads that compute the albedos of a table (None: one per core).  The compiled kernels
-#: release the GIL; a value of mu does not depend on the others computed with it, so the table is
-#: the same for any number of threads (tested).  3-level pumped Phong: 1.04 -> 0.8 s on 2 cores.
+#: threads that compute the albedos of a table (None: one per core, or one for a BRDF on the 1-D path,
+#: ``pumpup._polar``).  The compiled kernels release the GIL; a value of mu does not depend on the
+#: others computed with it, so the table is the same for any number of threads (tested).  The nested
+#: engine gains (Blinn n = 16: 74 -> 64 ms on 2 cores); the 1-D path's values cost microseconds, and
+#: the Python around them (a pumped lobe's levels and cuts per mu) holds the GIL, so there a second
+#: thread only adds its cost (3-level g2 pumped Phong's three tables 40 -> 52 ms, Phong n = 20 2.7 -> 5 ms).
 THREADS: int | None = None
 
 
@@ -314,6 +317,10 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
     (default :data:`THREADS`; every k-th mu to thread k: grazing values, the dear ones, are spread over all)."""
     val = np.empty_like(mu)
     err = np.empty_like(mu)
+    from . import _polar
+
+    if threads is None and THREADS is None and _polar.takes_1d_path(brdf):
+        threads = 1
     threads = max(1, min(threads or THREADS or _cores(), len(mu)))
 
     import threading
