@@ -796,6 +796,8 @@ RING_TOL = 1e-14
 #: a piece of the ring table narrower than this that misses RING_TOL is computed by quadrature
 #: wherever it is needed (near kappa = 1 for small n)
 RING_MIN_WIDTH = 1e-6
+#: the relative tolerance of V by quadrature (:func:`_ring_quad`): the table's values, and the pieces left to it
+RING_QUAD_RTOL = 1e-15
 
 
 @functools.lru_cache(maxsize=64)
@@ -807,7 +809,7 @@ def ring_table(n: float) -> tuple:
     Pieces: the octaves of kappa from 2 down to about 1 / (8 n), and [0, that]; on each a Chebyshev
     interpolant of degree :data:`RING_DEGREE` at the Chebyshev points, bisected until it matches V
     to :data:`RING_TOL` (relative) at 2 (degree + 1) + 1 test points.  The relative error of a piece:
-    twice its largest miss, plus the values' own quadrature error (relative 1e-15), plus 4 ulp.  Near
+    twice its largest miss, plus the values' own quadrature error (:data:`RING_QUAD_RTOL`), plus 4 ulp.  Near
     kappa = 1, where the arc stops being the whole circle, V has a term |kappa - 1|^(n + 1/2): a
     piece narrower than :data:`RING_MIN_WIDTH` that still misses gets the error -1, which tells the
     kernel to compute V there by quadrature.  Cached per n."""
@@ -832,7 +834,7 @@ def ring_table(n: float) -> tuple:
         hi = np.array([b for _, b in todo])
         center, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
         x = np.concatenate([xk, tt])
-        v, e = _ring_values(n, (center[:, None] + half[:, None] * x[None, :]).ravel(), 1e-15, nodes, wk, wg)
+        v, e = _ring_values(n, (center[:, None] + half[:, None] * x[None, :]).ravel(), RING_QUAD_RTOL, nodes, wk, wg)
         v, e = v.reshape(len(lo), -1), e.reshape(len(lo), -1)
         todo = []
         for i in range(len(lo)):
@@ -887,7 +889,7 @@ def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, 
         else:
             v, ve = _ring_at(kappa, kb, kc, keps)
             if ve < 0.0:  # (a piece the table leaves to quadrature)
-                v, ve = _ring_quad(n, kappa, 1e-15, nodes, wk, wg, ibuf, iwork)
+                v, ve = _ring_quad(n, kappa, RING_QUAD_RTOL, nodes, wk, wg, ibuf, iwork)
             an = math.exp(n * math.log1p(-d1))
             v *= an
             ve *= an
