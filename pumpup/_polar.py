@@ -1,4 +1,4 @@
-"""One-dimensional albedo where the azimuth integrates in closed form (the Phong family).
+"""One-dimensional albedo where the azimuth integrates in closed form (the Phong and Blinn families).
 
 Method
 ------
@@ -79,6 +79,22 @@ Checked in ``tests/test_polar_pumped.py`` against an independent quadrature abou
 level-by-level reference), the nested engine at rtol 1e-13 and the 2-D engine, and the ring table against
 40-digit mpmath.
 
+The Blinn family (reciprocal Blinn c (N.H)^n, 000 eq. 31; stretched Blinn c (N.H)^n / max(N.L, N.V),
+eq. 32; Lewis's Phong-Blinn, 002 eq. 24) takes the same path in the frame of N for the half vector h
+(``Polar(kind="half")``): with h at u = N.h = cos(alpha) and azimuth beta, d omega_o = 4 (wo.h) d omega_h,
+wo.h = wi.h = c = mu u + s sin(alpha) cos(beta) (the form N.wo has about R) and N.wo = 2 c u - mu, so the
+integrand 4 c N.wo / max(mu, N.wo)^p is a polynomial of degree 2 in cos(beta) on the arc where N.wo > 0 (and
+on the parts where N.wo >= mu and < mu for p = 1): :func:`_k_half` integrates it in closed form, with the
+ends of the arcs exact in the angles (psi = pi/2 - theta_i kept exact near grazing incidence), the moments
+of d = c - c0 >= 0 instead of those of c (no cancellation) and their series below an arc of 1 rad (where
+the closed forms cancel to the 5th order; :func:`_trig_tail`).  Its breakpoints (:func:`_pieces`, frame 1)
+are u = cos(pi/4 - theta_i/2) (the horizon starts to cut h's circle), cos(theta_i) (p = 1: N.wo = mu
+leaves it) and u_lo = cos(pi/4 + theta_i/2), below which no h sends wo above the horizon; near grazing
+incidence the pieces above u_lo ~ mu / 2 and above the level u = mu are cut at lo (1 + 4^i), since the
+arc's end c0 = mu / (2u) changes on the scale of u there (found by the comparison with the nested engine:
+stretched Blinn n = 0 at mu = 1e-8 was 2.5e-8 off without them).  Pumped Blinn BRDFs stay on the nested
+engine (``Pumped.polar`` takes lobes about R only).
+
 A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
 :class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D
 engine stays the reference: :func:`two_d_only` switches the 1-D path off.
@@ -126,7 +142,10 @@ class Polar:
     scale : callable
         ``scale(mu) -> ndarray`` of the same shape: the constant of the model (c, c C^n for a
         Lafortune lobe, k_s / mu for Phong's shader, k_rho / H_s(mu) for Lewis's Phong).
-    kind : {"lobe", "constant"}
+    kind : {"lobe", "constant", "half"}
+        "half": u is N.h, h the half vector of wi and wo (the Blinn family, 000 eq. 31, 32; 002
+        eq. 24), p in {0, 1}: a(mu) = scale(mu) * integral_0^1 u^n K(u) du with the azimuth of h
+        about N in closed form (:func:`_k_half`).
     chain : tuple, optional
         A pumped BRDF's divisor (:meth:`pumpup.pumping.Pumped._chain_args`): the integrand is then
         divided by g_1 ... g_k (mu, N.wo) (001 eq. 16), a function of N.wo only for a fixed wi,
@@ -334,6 +353,160 @@ def _k_of_u(p, mu, c2, u, um, sa, itol, nodes, wk, wg, mode, ibuf, iwork, jac): 
     return 2.0 * (h + below), 2.0 * e
 
 
+# --- the Blinn family: the half vector's azimuth about N in closed form ----------------------------
+
+
+@njit(cache=True, nogil=True)
+def _trig_tail(x, which):  # pragma: no cover - compiled; see half_moments_reference
+    """Integrals of trigonometric polynomials that cancel to high order at small x, by their series
+    below x = 1 and in closed form above (where at most a digit cancels):
+
+    which 0: x - sin(x);  1: F1 = integral_0^x (cos(t) - cos(x)) dt = sin(x) - x cos(x);
+    2: F2 = integral_0^x (cos(t) - cos(x))^2 dt;  3: R2 = integral_0^x (1 - cos(t))^2 dt.
+    """
+    if x >= 1.0:
+        if which == 0:
+            return x - math.sin(x)
+        if which == 1:
+            return math.sin(x) - x * math.cos(x)
+        if which == 2:
+            c = math.cos(x)
+            return x * (0.5 + c * c) - 1.5 * math.sin(x) * c
+        return 1.5 * x - 2.0 * math.sin(x) + 0.25 * math.sin(2.0 * x)
+    # the series sum_k coef(k) y^(2k+1) / (2k+1)!, y = 2x for F2 (then / 4), x otherwise
+    y = 2.0 * x if which == 2 else x
+    y2 = y * y
+    term = y  # y^(2k+1) / (2k+1)! at k = 0
+    total = 0.0
+    for k in range(1, 30):
+        term *= y2 / ((2.0 * k) * (2.0 * k + 1.0))
+        sign = 1.0 if k % 2 == 0 else -1.0
+        if which == 0:
+            coef = -sign  # (-1)^(k+1)
+        elif which == 1:
+            coef = -sign * 2.0 * k  # (-1)^(k+1) 2k
+        elif which == 2:
+            coef = sign * (2.0 * k - 2.0)  # (-1)^k (2k - 2)
+        else:
+            coef = sign * (2.0 ** (2 * k - 1) - 2.0)  # (-1)^k (2^(2k-1) - 2)
+        total += coef * term
+        if term < 1e-18 * abs(total):
+            break
+    return 0.25 * total if which == 2 else total
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _arc_moments(e, sb, b, beta):  # pragma: no cover - compiled; see half_moments_reference
+    """(J1, J2) = integral_0^beta (d, d^2) d beta' for d = c - c_e = e + b cos(beta') >= 0 on the arc, where
+    cos(beta) = -e / b, sb = b sin(beta) (sb = 0 and beta = pi for a full circle): J1 = sb + beta e,
+    J2 = beta (e^2 + b^2 / 2) + 3/2 e sb, by their series b F1(beta), b^2 F2(beta) below beta = 1 (where
+    e is near -b and the closed forms cancel)."""
+    if beta < 1.0:
+        return b * _trig_tail(beta, 1), b * b * _trig_tail(beta, 2)
+    return sb + beta * e, beta * (e * e + 0.5 * b * b) + 1.5 * e * sb
+
+
+@njit(cache=True, nogil=True)
+def _k_half(p, mu, s, psi, u, sa):  # pragma: no cover - compiled; see integrand_reference
+    """K(u) of the half-vector frame, p in {0, 1}: the integral over the azimuth beta of h about N of
+    4 (wi.h) N.wo / max(mu, N.wo)^p where N.wo > 0, for h at u = N.h = cos(alpha), sa = sin(alpha);
+    s = sin(theta_i), psi = pi / 2 - theta_i = atan2(mu, s) (exact near grazing incidence, where the
+    arc's ends depend on 2 alpha - psi).
+
+    d omega_o = 4 (wo.h) d omega_h and wo.h = wi.h = c = a + b cos(beta), a = mu u, b = s sa (the
+    form of N.wo about R, pumpup._polar's lobe frame); N.wo = 2 c u - mu, so N.wo > 0 where
+    c > c0 = mu / (2 u), and N.wo >= mu where c >= c1 = 2 c0.  On the arc |beta| < beta0 (c > c0),
+    with d = c - c0 >= 0: p = 0 integrates 4 c 2 u d = 8 u (c0 d + d^2); p = 1 that on the part
+    |beta| > beta1 (c < c1), divided by mu = 2 u c0, and 4 c on |beta| < beta1.  The arc's ends are
+    exact: b^2 - (a - c0)^2 = sin(2 alpha + psi) sin(2 alpha - psi) / (4 u^2), each sine with its angle
+    written as a difference of small exact angles near its zero (with alpha' = pi/2 - alpha) and b^2 - (a - c1)^2 =
+    sa^2 (u - mu)(u + mu) / u^2; the part between beta1 and beta0
+    is integrated in delta = beta0 - beta (no cancellation when it is thin, near grazing incidence).
+    """
+    if u <= 0.0:
+        return 0.0
+    al = math.atan2(sa, u)
+    alc = math.atan2(u, sa)  # pi/2 - alpha, exact where u is small
+    b = s * sa
+    c0 = 0.5 * mu / u
+    if 2.0 * alc <= psi:  # 2 alpha + psi >= pi: the whole circle of h sends wo below the horizon
+        return 0.0
+    e0 = 0.5 * mu * (u - sa) * (u + sa) / u  # a - c0 = mu cos(2 alpha) / (2 u)
+    if 2.0 * al <= psi:  # the whole circle sends wo above it
+        sb0, beta0 = 0.0, math.pi
+        dpi = 0.5 * math.sin(psi - 2.0 * al) / u  # d at beta = pi: a - b - c0
+    else:
+        dpi = 0.0
+        # b sin(beta0) = sqrt(sin(2 alpha + psi) sin(2 alpha - psi)) / (2 u); a sine whose angle nears pi is taken
+        # as the sine of pi less it (2 alpha' -+ psi), where that difference is exact
+        f1 = math.sin(2.0 * alc - psi) if 2.0 * al + psi > 0.5 * math.pi else math.sin(2.0 * al + psi)
+        f2 = math.sin(2.0 * alc + psi) if 2.0 * al - psi > 0.5 * math.pi else math.sin(2.0 * al - psi)
+        sb0 = 0.5 * math.sqrt(max(0.0, f1 * f2)) / u
+        beta0 = math.atan2(sb0, -e0)
+    j1, j2 = _arc_moments(e0, sb0, b, beta0)
+    if p == 0.0:
+        return 16.0 * u * (c0 * j1 + j2)  # 2 (both signs of beta) 8 u (c0 J1 + J2)
+    # p = 1 (000 eq. 32's max(N.L, N.V)): |beta| < beta1 where N.wo >= mu, non-empty for alpha < theta_i
+    if u <= mu or b == 0.0:
+        return 8.0 * (j1 + j2 / c0)  # (8 u / mu) (c0 J1 + J2) on the whole arc
+    e1 = -mu * sa * sa / u  # a - c1
+    sb1 = sa * math.sqrt((u - mu) * (u + mu)) / u  # b sin(beta1)
+    beta1 = math.atan2(sb1, -e1)
+    k1, _ = _arc_moments(e1, sb1, b, beta1)
+    # beta1 < beta < beta0: d = D + X, X = P sin(delta) + Q (cos(delta) - 1) >= 0, with D = d(beta0) (0 on
+    # a partial arc), P = b sin(beta0), Q = b cos(beta0) (-e0 on a partial arc, -b on the full circle)
+    dl = beta0 - beta1
+    hs = math.sin(0.5 * dl)
+    P = sb0
+    Q = -b if beta0 == math.pi else -e0
+    ix = 2.0 * P * hs * hs - Q * _trig_tail(dl, 0)
+    ix2 = P * P * 0.25 * _trig_tail(2.0 * dl, 0) - 4.0 * P * Q * hs ** 4 + Q * Q * _trig_tail(dl, 3)
+    i1 = dpi * dl + ix
+    i2 = dpi * dpi * dl + 2.0 * dpi * ix + ix2
+    return 8.0 * (2.0 * c0 * beta1 + k1 + i1 + i2 / c0)  # 2 [4 (c1 beta1 + J1(c1)) + (4 / c0)(c0 I1 + I2)]
+
+
+def half_moments_reference(x):
+    """Plain numpy twins of :func:`_trig_tail`'s four functions, in closed form (exact in exact arithmetic;
+    the tests compare them with the series at x >= 1e-2, where these lose at most ~10 digits of 16)."""
+    x = np.asarray(x, dtype=np.float64)
+    return (x - np.sin(x), np.sin(x) - x * np.cos(x), x * (0.5 + np.cos(x) ** 2) - 1.5 * np.sin(x) * np.cos(x),
+            1.5 * x - 2.0 * np.sin(x) + 0.25 * np.sin(2.0 * x))
+
+
+def half_integrand_reference(p: float, mu: float, u: np.ndarray) -> np.ndarray:
+    """Plain numpy K(u) of the half-vector frame (the readable twin of :func:`_k_half`), from the
+    antiderivatives in beta of c and c^2 with beta from arccos:
+    integral_0^beta (a + b cos t)^k dt = a beta + b sin(beta) (k = 1),
+    a^2 beta + 2 a b sin(beta) + b^2 (beta / 2 + sin(2 beta) / 4) (k = 2)."""
+    u = np.asarray(u, dtype=np.float64)
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    a = mu * u
+    b = s * np.sqrt((1.0 - u) * (1.0 + u))
+
+    def ends(cv):  # beta where c = cv (0: none of the arc, pi: all of it)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(a - b >= cv, np.pi, np.where(a + b <= cv, 0.0, np.arccos(np.clip((cv - a) / b, -1, 1))))
+
+    def i1(t):
+        return a * t + b * np.sin(t)
+
+    def i2(t):
+        return a * a * t + 2 * a * b * np.sin(t) + b * b * (t / 2 + np.sin(2 * t) / 4)
+
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c0 = np.where(u > 0, mu / (2 * u), np.inf)
+        t0 = ends(c0)
+        # 2 integral_0^beta0 4 c (2 c u - mu)
+        k0 = 8 * (2 * u * i2(t0) - mu * i1(t0))
+        if p == 0:
+            return np.where(u > 0, k0, 0.0)
+        t1 = ends(2 * c0)
+        # N.wo / max(mu, N.wo): 4 c where N.wo >= mu, 4 c N.wo / mu elsewhere
+        k1 = 8 * i1(t1) + 8 * ((2 * u * (i2(t0) - i2(t1)) - mu * (i1(t0) - i1(t1))) / mu)
+        return np.where(u > 0, k1, 0.0)
+
+
 def integrand_reference(n: float, p: float, mu: float, u: np.ndarray) -> np.ndarray:
     """Plain numpy u^n K(u), straight from the arccos form (the readable twin of the kernel).
 
@@ -459,7 +632,7 @@ RULE = "gk21"
 
 
 @njit(cache=True, nogil=True)
-def _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac):  # pragma: no cover
+def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac):  # pragma: no cover
     """(K, error) of the rule on [t0, t1]; the error is :func:`pumpup._errors.calibrated` of
     |K - G| (``mode`` 1) or |K - G| itself (0), plus for p in (0, 1) the inner errors of the
     integrand's values (the inner rule ``inodes``, ``iwk``, ``iwg`` at relative tolerance
@@ -476,10 +649,16 @@ def _gk(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, it
             k, e = _k_of_u(p, mu, c2, u, um, sa, itol, inodes, iwk, iwg, mode, ibuf, iwork, jac)
             buf[j] = k * fac
             ie += wk[j] * e * fac
-    else:
+    elif frame == 0:
         for j in range(nodes.shape[0]):
             u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
             buf[j] = _k_closed(p, mu, c2, u, um, sa)[0] * fac
+    else:  # the half-vector frame (the Blinn family), p in {0, 1}
+        s = math.sqrt((1.0 - mu) * (1.0 + mu))
+        psi = math.atan2(mu, s)
+        for j in range(nodes.shape[0]):
+            u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
+            buf[j] = _k_half(p, mu, s, psi, u, sa) * fac
     k, diff, asc, ab = rule_sums(buf, wk, wg)
     return k * h, calibrated(diff * h, asc * h, ab * h, mode) + ie * h
 
@@ -508,13 +687,18 @@ def _sorted_cuts(cv, cc, m):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _pieces(n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
-    """The pieces between the breakpoints u = 0, 1/2, s, cos 2 theta_i, 1, written into
-    ``kinds``, ``sms`` (the smoothing), ``v0``, ``w``, ``v1`` (arrays of :data:`MAX_PIECES`);
-    returns (their number, c2 = cos 2 theta_i, a bound of the part left out).
+def _pieces(frame, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
+    """The pieces between the breakpoints, written into ``kinds``, ``sms`` (the smoothing), ``v0``,
+    ``w``, ``v1`` (arrays of :data:`MAX_PIECES`); returns (their number, c2 = cos 2 theta_i, a bound of
+    the part left out).
 
-    kind 0: u in [v0, v1 = v0 + w] (u <= 1/2); kind 1: z = -(n + 1) ln u in [v0, v1].  Where
-    exp(-Z_MAX / (n + 1)) > 1/2 the range of u below it is left out (its bound is returned).
+    Breakpoints: u = 0, 1/2, 1 and, in the lobe frame (``frame`` 0), u = s (the horizon starts to cut
+    the arc) and cos 2 theta_i (the level mu leaves it, p > 0); in the half-vector frame (1,
+    :func:`_k_half`), u = cos(pi/4 - theta_i/2) (the horizon starts to cut h's circle), cos(theta_i)
+    (the level mu leaves it, p > 0) and u_lo = cos(pi/4 + theta_i/2), below which no h sends wo above
+    the horizon (the range starts there).  kind 0: u in [v0, v1 = v0 + w] (u <= 1/2); kind 1:
+    z = -(n + 1) ln u in [v0, v1].  Where exp(-Z_MAX / (n + 1)) > 1/2 the range of u below it is left
+    out (its bound is returned).
     """
     c2 = (mu - s) * (mu + s)
     n1 = n + 1.0
@@ -523,30 +707,42 @@ def _pieces(n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
     z_split = Z_MAX if skip else n1 * math.log(2.0)
     # breakpoints in u, and their z = -(n + 1) ln u to full precision; codes 0: horizon (sqrt
     # below), 1: level mu (sqrt above)
-    ub0 = ub1 = zb0 = zb1 = 0.0
-    kb0 = kb1 = -9
+    ub = np.empty(2)
+    zb = np.empty(2)
+    kb = np.empty(2, np.int64)
     m = 0
-    if 0.0 < s < 1.0:
-        ub0, zb0, kb0 = s, -0.5 * n1 * math.log1p(-mu * mu), 0
-        m = 1
-    if p > 0.0 and 0.0 < c2 < 1.0:
-        if m == 0:
-            ub0, zb0, kb0 = c2, -n1 * math.log1p(-2.0 * s * s), 1
-        else:
-            ub1, zb1, kb1 = c2, -n1 * math.log1p(-2.0 * s * s), 1
+    u_min, z_end, k_end = 0.0, z_split, -1  # the range: u >= u_min, z <= z_end (code of that end)
+    if frame == 0:
+        if 0.0 < s < 1.0:
+            ub[m], zb[m], kb[m] = s, -0.5 * n1 * math.log1p(-mu * mu), 0
+            m += 1
+        if p > 0.0 and 0.0 < c2 < 1.0:
+            ub[m], zb[m], kb[m] = c2, -n1 * math.log1p(-2.0 * s * s), 1
+            m += 1
+    else:
+        psi = math.atan2(mu, s)  # pi / 2 - theta_i, exact near grazing incidence
+        hf = 0.25 * psi  # u_f = cos(pi/4 - theta_i/2) = cos(2 hf) = 1 - 2 sin^2(hf)
+        ub[m], zb[m], kb[m] = math.cos(2.0 * hf), -n1 * math.log1p(-2.0 * math.sin(hf) ** 2), 0
         m += 1
+        if p > 0.0 and 0.0 < mu < 1.0:
+            ub[m], zb[m], kb[m] = mu, -n1 * math.log(mu), 1
+            m += 1
+        u_min = math.sin(0.5 * psi)  # cos(pi/4 + theta_i/2)
+        if u_min > 0.0:
+            z_lo = -n1 * math.log(u_min)
+            if z_lo < z_end:
+                z_end, k_end = z_lo, 1
     cv = np.empty(4)
     cc = np.empty(4, np.int64)
     k = 0
     # tail pieces (increasing u)
-    if not skip:
+    if not skip and u_min < 0.5:
         nc = 0
-        cv[nc], cc[nc] = 0.0, -1
+        cv[nc], cc[nc] = u_min, (1 if u_min > 0.0 else -1)
         nc += 1
         for j in range(m):
-            ub, kb = (ub0, kb0) if j == 0 else (ub1, kb1)
-            if ub < 0.5:
-                cv[nc], cc[nc] = ub, kb
+            if u_min < ub[j] < 0.5:
+                cv[nc], cc[nc] = ub[j], kb[j]
                 nc += 1
         cv[nc], cc[nc] = 0.5, -1
         nc += 1
@@ -554,12 +750,28 @@ def _pieces(n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
         for j in range(nc - 1):
             lo, hi = cv[j], cv[j + 1]
             if hi > lo:
-                left = cc[j] == 1  # (code 1 only where p > 0)
+                left = cc[j] == 1  # (code 1 only where p > 0, or the half frame's u_lo)
                 right = cc[j + 1] == 0
+                a = lo
+                if frame == 1 and lo > 0.0:
+                    # the half frame near grazing incidence: above u_lo ~ mu / 2 and the level u = mu the
+                    # arc's end c0 = mu / (2 u) changes on the scale of u itself, so the piece is cut at
+                    # lo (1 + 4^i) (as above z_s below): one first interval on [mu / 2, 1/2] hid it
+                    step = lo
+                    while a + step < hi - step and k < kinds.shape[0] - 8:
+                        kinds[k] = 0
+                        sms[k] = (1 if left else 0) if a == lo else 0
+                        v0[k] = a
+                        w[k] = step
+                        v1[k] = a + step
+                        k += 1
+                        a = a + step
+                        step = 3.0 * a - 3.0 * lo
+                    left = left and a == lo
                 kinds[k] = 0
                 sms[k] = (1 if left else 0) + (2 if right else 0)
-                v0[k] = lo
-                w[k] = hi - lo
+                v0[k] = a
+                w[k] = hi - a
                 v1[k] = hi
                 k += 1
     # peak pieces (increasing z = decreasing u)
@@ -567,12 +779,11 @@ def _pieces(n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
     cv[nc], cc[nc] = 0.0, -2  # z = 0: u = 1, a square-root end for p = 1
     nc += 1
     for j in range(m):
-        zb, kb = (zb0, kb0) if j == 0 else (zb1, kb1)
-        if zb < z_split:
-            cv[nc], cc[nc] = zb, kb
+        if zb[j] < z_end:
+            cv[nc], cc[nc] = zb[j], kb[j]
             nc += 1
-    top = p > 0.0  # u = 1 (z = 0) is a square-root end: the level mu passes through R
-    cv[nc], cc[nc] = z_split, -1
+    top = p > 0.0  # u = 1 (z = 0) is a square-root end: the level mu passes through R (through h = N)
+    cv[nc], cc[nc] = z_end, k_end
     nc += 1
     _sorted_cuts(cv, cc, nc)
     for j in range(nc - 1):
@@ -604,7 +815,8 @@ def _pieces(n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
             w[k] = hi - a
             v1[k] = hi
             k += 1
-    left_out = 2.0 * math.pi * math.exp(-Z_MAX) / n1 if skip else 0.0
+    # beyond Z_MAX: K <= 2 pi in the lobe frame, <= 8 pi in the half-vector frame (4 (wi.h) N.wo / max^p <= 4)
+    left_out = (2.0 if frame == 0 else 8.0) * math.pi * math.exp(-Z_MAX) / n1 if skip and k_end == -1 else 0.0
     return k, c2, left_out
 
 
@@ -650,7 +862,7 @@ def _bisect(pk, t0, t1, worst, m):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, inodes, iwk, iwg, jac, val, err, conv, evals):  # pragma: no cover
+def _integrate(frame, n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, inodes, iwk, iwg, jac, val, err, conv, evals):  # pragma: no cover
     """Adaptive Gauss-Kronrod (the rule ``nodes``, ``wk``, ``wg``) of integral u^n K(u) du for
     every mu (without the scale)."""
     cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals, nodes, inodes, rtol)
@@ -662,7 +874,7 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
-        npieces, c2, left_out = _pieces(n, p, mu, s, kinds, sms, v0, w, cv1)
+        npieces, c2, left_out = _pieces(frame, n, p, mu, s, kinds, sms, v0, w, cv1)
         m = 0
         for i in range(npieces):
             if w[i] <= 0.0:
@@ -671,7 +883,7 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
                 pk[m] = i
                 t0[m] = j / n_init
                 t1[m] = (j + 1.0) / n_init
-                kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac)
+                kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac)
                 m += 1
         start = m
         while True:
@@ -679,8 +891,8 @@ def _integrate(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
             if ok or m - start >= max_intervals or m >= cap:
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
-            kv[worst], ke[worst] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac)
-            kv[m], ke[m] = _gk(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac)
+            kv[worst], ke[worst] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac)
+            kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac)
             m += 1
         val[q] = tot
         err[q] = e + r
@@ -1003,16 +1215,34 @@ X_PIECES = 8
 N_INIT_CHAIN = 1
 
 
+#: the 1-D path itself (``without_1d`` switches it off and leaves the nested engine on)
+ONE_D = True
+
+
+@contextlib.contextmanager
+def without_1d():
+    """Within the block, ``pumpup.albedo`` ignores the 1-D path only: the models that have it go to the
+    nested engine (``pumpup._nested``), as before they had it (the tests' and the calibration's
+    second engine for them).  Not meant for concurrent toggling."""
+    global ONE_D
+    old = ONE_D
+    ONE_D = False
+    try:
+        yield
+    finally:
+        ONE_D = old
+
+
 def takes_1d_path(brdf) -> bool:
     """Whether :func:`albedo_1d` takes ``brdf`` (it has a :class:`Polar` hint and the path is on)."""
-    polar = getattr(brdf, "polar", None) if ENABLED else None
+    polar = getattr(brdf, "polar", None) if ENABLED and ONE_D else None
     return polar is not None and polar() is not None
 
 
 def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     """(value, error, converged, evaluations) of the albedo of ``brdf`` at every mu (a 1-D float
     array), or None when the model has no :class:`Polar` hint (or the 1-D path is off)."""
-    if not ENABLED:
+    if not (ENABLED and ONE_D):
         return None
     polar = getattr(brdf, "polar", None)
     hint = polar() if polar is not None else None
@@ -1026,6 +1256,8 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         return scale.copy(), 4.0 * np.finfo(float).eps * np.abs(scale), np.ones(mu.shape, bool), np.zeros(mu.shape, np.int64)
     if not 0.0 <= hint.p <= 1.0:
         raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
+    if hint.kind == "half" and (hint.p not in (0.0, 1.0) or hint.chain is not None):
+        raise ValueError(f"{brdf!r}: a half-vector Polar hint needs p in {{0, 1}} and no chain, got p={hint.p!r}")
     jac = jacobi_rules(1.0 - hint.p) if 0.0 < hint.p < 1.0 else _NO_JACOBI
     val = np.empty(mu.shape)
     err = np.empty(mu.shape)
@@ -1035,7 +1267,7 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     with np.errstate(divide="ignore"):
         atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
     if hint.chain is None:
-        _integrate(float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
+        _integrate(1 if hint.kind == "half" else 0, float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
                    *(_RULES[RULE]), mode_code(), N_INIT, *_RULES["gk15"], jac, val, err, conv, evals)
     else:  # a pumped lobe, about N
         cuts = [chain_cuts(hint.levels(float(m)), float(hint.n), float(m)) for m in mu]

@@ -75,12 +75,21 @@ def _two_d():
     return _polar.two_d_only()
 
 
+def _without_1d():
+    from pumpup import _polar
+
+    return _polar.without_1d()
+
+
 def _nested_applies(f) -> bool:
-    """The nested quadrature (pumpup._nested) integrates f: no closed-form azimuth, every term
-    with a lobe hint (a from_function BRDF stays on the 2-D engine)."""
-    if _has_polar(f):
+    """The nested quadrature (pumpup._nested) integrates f: every term with a lobe hint (a
+    from_function BRDF stays on the 2-D engine) and no closed-form azimuth about R (the Phong
+    family's); the Blinn family, whose azimuth about N is closed-form since issue 14's sixth
+    session, is judged here with the 1-D path off, as before it had that path."""
+    terms = [t for _, t in f.albedo_terms()]
+    if any(t.polar() is not None and t.polar().kind != "half" for t in terms):
         return False
-    for _, t in f.albedo_terms():
+    for t in terms:
         lobe = t.lobe(0.5)
         if lobe.axis == "normal" and lobe.radial == "cosine" and not lobe.symmetric:
             return False
@@ -91,7 +100,7 @@ def _nested_applies(f) -> bool:
 #: default where there is no closed-form azimuth, "2-D" the cubature everywhere (the reference)
 ENGINES = {
     "1-D": (contextlib.nullcontext, _has_polar),
-    "nested": (contextlib.nullcontext, _nested_applies),
+    "nested": (_without_1d, _nested_applies),
     "2-D": (_two_d, lambda f: True),
 }
 

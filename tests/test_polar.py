@@ -181,7 +181,8 @@ def test_general_p_evaluations():
 
 def test_models_without_a_closed_azimuth_decline():
     for spec in [{"type": "lafortune", "n": 10, "cx": 0.8, "cy": 1.2},
-                 {"type": "blinn", "n": 16}, {"type": "cook_torrance", "m": 0.3}, {"type": "phong_shader", "n": 5, "kd": 0.1}]:
+                 {"type": "ggx", "alpha": 0.1}, {"type": "cook_torrance", "m": 0.3}, {"type": "phong_shader", "n": 5, "kd": 0.1},
+                 {"type": "phong_blinn", "n": 5, "kd": 0.1}]:
         assert pumpup.load(spec).polar() is None, spec
     user = pumpup.from_function(lambda wi, wo: np.full(np.broadcast_shapes(wi.shape, wo.shape)[:-1], 0.5 / np.pi),
                                 name="half-grey-polar")
@@ -223,3 +224,108 @@ def test_two_d_only_restores_the_switch():
         assert not _polar.ENABLED
         raise RuntimeError
     assert _polar.ENABLED
+
+
+# --- the Blinn family: the half vector's azimuth about N in closed form (kind "half") -----------------
+
+
+def _k_half_by_quad(p, mu, u):
+    """K(u) of the half-vector frame straight from the geometry, by scipy quad over the azimuth of h:
+    wo = 2 (wi.h) h - wi, integrand 4 (wi.h) N.wo / max(mu, N.wo)^p where N.wo > 0 (split at the arcs' ends)."""
+    from scipy.integrate import quad
+
+    s, sa = math.sqrt((1 - mu) * (1 + mu)), math.sqrt((1 - u) * (1 + u))
+    wi = np.array([s, 0.0, mu])
+
+    def g(beta):
+        h = np.array([sa * math.cos(beta), sa * math.sin(beta), u])
+        c = float(wi @ h)
+        nwo = 2 * c * u - mu
+        return 4 * c * nwo / max(mu, nwo) ** p if c > 0 and nwo > 0 else 0.0
+
+    b, a = s * sa, mu * u
+    pts = [math.acos((cv - a) / b) for cv in (mu / (2 * u), mu / u) if b > 0 and abs((cv - a) / b) < 1]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return 2 * quad(g, 0, math.pi, points=pts or None, epsabs=1e-15, epsrel=1e-13, limit=200)[0]
+
+
+@pytest.mark.parametrize("p", [0.0, 1.0])
+def test_half_kernel_against_the_geometry_and_its_numpy_twin(rng, p):
+    """_k_half against an independent quadrature of the integrand built from wi, h and wo, and its numpy twin
+    (arccos and the antiderivatives of c and c^2), at random u and at both sides of every breakpoint."""
+    for mu in (1.0, 0.99, 0.9, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6):
+        s = math.sqrt((1 - mu) * (1 + mu))
+        psi, th = math.atan2(mu, s), math.atan2(s, mu)
+        edges = [math.cos(math.pi / 4 + th / 2), math.cos(math.pi / 4 - th / 2), mu]
+        us = np.concatenate([rng.uniform(0, 1, 12), [1.0, 1 - 1e-12], [e * (1 + d) for e in edges for d in (-1e-6, 1e-6)]])
+        for u in us[(us > 0) & (us <= 1)]:
+            k = _polar._k_half(p, mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
+            q = _k_half_by_quad(p, mu, float(u))
+            twin = _polar.half_integrand_reference(p, mu, np.array([u]))[0]
+            assert abs(k - q) <= 1e-11 * max(abs(q), 1.0), (p, mu, u, k, q)  # K is at most 8 pi
+            # (the twin's differences of antiderivatives cancel, by ~1 / mu for p = 1: the kernel avoids them)
+            assert abs(k - twin) <= 1e-11 * max(abs(twin), 1.0) + 1e-15 * mu**-p, (p, mu, u, k, twin)
+
+
+def test_trig_tails_against_mpmath():
+    """The four functions that cancel at small arcs (series below 1 rad, closed form above) to 1e-15 relative,
+    against 50-digit mpmath quadratures of their definitions; and the numpy twin where it does not cancel."""
+    mp = pytest.importorskip("mpmath")
+    mp.mp.dps = 50
+    defs = [lambda x: mp.quad(lambda t: 1 - mp.cos(t), [0, x]), lambda x: mp.quad(lambda t: mp.cos(t) - mp.cos(x), [0, x]),
+            lambda x: mp.quad(lambda t: (mp.cos(t) - mp.cos(x)) ** 2, [0, x]), lambda x: mp.quad(lambda t: (1 - mp.cos(t)) ** 2, [0, x])]
+    for x in (1e-9, 1e-4, 0.01, 0.3, 0.7, 0.999, 1.0, 1.5, 2.5, math.pi):
+        twin = _polar.half_moments_reference(x)
+        for which, f in enumerate(defs):
+            ref = float(f(mp.mpf(x)))
+            assert abs(_polar._trig_tail(x, which) - ref) <= 2e-15 * ref, (x, which)
+            if x >= 1.0:
+                assert abs(twin[which] - ref) <= 1e-14 * ref, (x, which)
+
+
+HALF_SPECS = [{"type": "blinn", "n": 16}, {"type": "blinn", "n": 0.5}, {"type": "blinn", "n": 512, "c": 20.6},
+              {"type": "blinn", "n": 1e5}, {"type": "stretched_blinn", "n": 8}, {"type": "stretched_blinn", "n": 1},
+              {"type": "stretched_blinn", "n": 128, "c": 5.34}, {"type": "phong_blinn", "n": 20},
+              {"type": "phong_blinn", "n": 5, "ks": 0.5, "kd": 0.1}]
+
+
+@pytest.mark.parametrize("spec", HALF_SPECS, ids=[f"{s['type']}-{s['n']}" for s in HALF_SPECS])
+def test_blinn_family_against_the_nested_and_two_d_engines(spec):
+    """The 1-D path (kind "half") against the nested engine at rtol 1e-12 (the engine these models had before,
+    reached by switching off the 1-D path alone) and the 2-D engine, from normal to grazing incidence; at
+    rtol 1e-6 and 1e-10 the estimate bounds the difference, and at 1e-10 it meets the tolerance."""
+    f = pumpup.load(spec)
+    assert all(t.polar() is not None and t.polar().kind == "half" for _, t in f.albedo_terms() if t.type != "lambert")
+    mu = np.array(MU)
+    with _polar.without_1d():
+        b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
+    for rtol in (1e-6, 1e-10):
+        a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
+        assert np.all(np.abs(a - b) <= e + eb), (rtol, (np.abs(a - b) / (e + eb)).max())
+        assert np.all(e <= rtol * a * 1.0001 + 1e-14)
+    with _polar.two_d_only():
+        c, ec = pumpup.albedo(f, mu[[0, 5, 7, 9]], return_error=True, rtol=1e-10)
+    assert np.all(np.abs(a[[0, 5, 7, 9]] - c) <= e[[0, 5, 7, 9]] + ec)
+
+
+def test_blinn_family_closed_forms():
+    """Blinn n = 0 is the constant c (albedo c pi at every mu); stretched Blinn n = 0 is c / max(N.L, N.V):
+    its albedo is c (2 pi (1 - mu) + pi mu) = c pi (2 - mu) (the solid angle where N.wo >= mu, plus
+    integral N.wo / mu where N.wo < mu)."""
+    mu = np.array(MU)
+    a, e = pumpup.albedo(pumpup.load({"type": "blinn", "n": 0, "c": 0.3}), mu, return_error=True, rtol=1e-12)
+    assert np.all(np.abs(a - 0.3 * math.pi) <= e) and np.all(e <= 1e-12 * a)
+    a, e = pumpup.albedo(pumpup.load({"type": "stretched_blinn", "n": 0, "c": 0.7}), mu, return_error=True, rtol=1e-12)
+    assert np.all(np.abs(a - 0.7 * math.pi * (2 - mu)) <= e) and np.all(e <= 1e-12 * a)
+
+
+def test_blinn_family_evaluations_and_refusals():
+    mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
+    for spec in ({"type": "blinn", "n": 16}, {"type": "stretched_blinn", "n": 8}):
+        _, _, conv, evals = _polar.albedo_1d(pumpup.load(spec), mu, 1e-10, 1e-14, 20000)
+        assert conv.all() and evals.mean() < 300 and evals.max() < 1000, (spec, evals.mean(), evals.max())
+    bad = type("HalfP", (), {"polar": lambda self: _polar.Polar(n=5.0, p=0.5, scale=lambda m: np.ones(np.shape(m)), kind="half")})()
+    with pytest.raises(ValueError, match="p in"):
+        _polar.albedo_1d(bad, mu[:3], 1e-8, 0.0, 100)
+    assert pumpup.pump({"type": "stretched_blinn", "n": 8}, g="g1").polar() is None  # pumped: the nested engine
