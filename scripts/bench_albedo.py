@@ -23,11 +23,13 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
     python scripts/bench_albedo.py --eval     # only BRDF.eval's overhead (the input checks) and numpy
     python scripts/bench_albedo.py --phong    # only the Phong family's rows (1-D path), no dblquad
     python scripts/bench_albedo.py --p        # only the p-model with p in (0, 1): 1-D path against the nested engine
+    python scripts/bench_albedo.py --blinn    # only the Blinn family: 1-D path (half vector) against the nested engine
     python scripts/bench_albedo.py --pumped   # only pumped Phong-family chains: 1-D path against the nested engine
     python scripts/bench_albedo.py --breaks   # only the nested families with kinks or levels: the compiled break
                                               # finding against its numpy reference (issue 14 item 3)
 """
 
+import contextlib
 import signal
 import sys
 import time
@@ -196,11 +198,10 @@ def families(rtol=1e-10, specs=None, dblquad=True):
               f"{ev:9.0f} {old} {dq}", flush=True)
 
 
-def p_model(rtol=1e-10, repeat=3):
-    """The p-model with p in (0, 1) (000 eq. 12; the 1-D path's inner rule since issue 14) against the
-    nested engine it replaces (the 1-D path switched off alone; ``_polar.ENABLED = False`` would
-    switch off the nested engine too), same run, same rtol: a 257-point
-    table (mu uniform in theta) and a sweep cell (257 mu of ``default_mu`` + mean albedo + maximum
+def against_nested(specs, label, rtol=1e-10, repeat=3):
+    """Models on the 1-D path against the nested engine they had before (the 1-D path switched off alone,
+    ``_polar.without_1d``; ``two_d_only`` would switch off the nested engine too), same run, same rtol: a
+    257-point table (mu uniform in theta) and a sweep cell (257 mu of ``default_mu`` + mean albedo + maximum
     constant), one thread, best of ``repeat``."""
     from pumpup import _polar
     from pumpup.sweeps import default_mu
@@ -213,27 +214,37 @@ def p_model(rtol=1e-10, repeat=3):
         pumpup.mean_albedo(f)
         pumpup.max_albedo(f)
 
-    print(f"p-model, one thread, ms (best of {repeat}); table: 257 mu at rtol {rtol:g}; cell: sweep cell")
+    print(f"{label}, one thread, ms (best of {repeat}); table: 257 mu at rtol {rtol:g}; cell: sweep cell")
     print(f"{'model':48s} {'table 1-D':>10s} {'nested':>9s} {'ratio':>6s} {'cell 1-D':>9s} {'nested':>9s} {'ratio':>6s}")
-    for spec in [{"type": "stretched_phong", "n": 20, "p": p} for p in (1.0, 0.25, 0.5, 0.75)] + [
-            {"type": "stretched_phong", "n": 1, "p": 0.5}, {"type": "stretched_phong", "n": 1000, "p": 0.5},
-            {"type": "retro", "n": 10, "p": 0.5}]:
+    for spec in specs:
         out = []
-        one_d = _polar.albedo_1d
-        for enabled in (True, False):
-            if not enabled:
-                _polar.albedo_1d = lambda *args, **kw: None  # the nested engine takes the model
-            try:
+        for one_d in (True, False):
+            with contextlib.nullcontext() if one_d else _polar.without_1d():
                 f = pumpup.load(spec)
                 pumpup.albedo(f, [0.5, 1e-3], rtol=rtol)
-                _, t_table = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), repeat if enabled else 1)
-                _, t_cell = _best(lambda: cell(pumpup.load(spec)), repeat if enabled else 1)
-            finally:
-                _polar.albedo_1d = one_d
+                _, t_table = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), repeat if one_d else 1)
+                _, t_cell = _best(lambda: cell(pumpup.load(spec)), repeat if one_d else 1)
             out.append((t_table, t_cell))
         (a, b), (c, d) = out
         print(f"{str(spec):48s} {a * 1e3:10.1f} {c * 1e3:9.1f} {c / a:6.1f} {b * 1e3:9.1f} {d * 1e3:9.1f} {d / b:6.1f}",
               flush=True)
+
+
+def p_model(rtol=1e-10, repeat=3):
+    """The p-model with p in (0, 1) (000 eq. 12; the 1-D path's inner rule since issue 14) against the
+    nested engine it replaces (:func:`against_nested`)."""
+    against_nested([{"type": "stretched_phong", "n": 20, "p": p} for p in (1.0, 0.25, 0.5, 0.75)] + [
+        {"type": "stretched_phong", "n": 1, "p": 0.5}, {"type": "stretched_phong", "n": 1000, "p": 0.5},
+        {"type": "retro", "n": 10, "p": 0.5}], "p-model", rtol, repeat)
+
+
+def blinn_family(rtol=1e-10, repeat=3):
+    """The Blinn family (000 eq. 31, 32; 002 eq. 24; the half vector's azimuth in closed form since issue 14's
+    sixth session) against the nested engine it replaces (:func:`against_nested`)."""
+    against_nested([{"type": "blinn", "n": 16}, {"type": "blinn", "n": 1}, {"type": "blinn", "n": 512, "c": 20.6},
+                    {"type": "stretched_blinn", "n": 8}, {"type": "stretched_blinn", "n": 128, "c": 5.34},
+                    {"type": "phong_blinn", "n": 20}, {"type": "phong_blinn", "n": 5, "ks": 0.5, "kd": 0.1}],
+                   "Blinn family", rtol, repeat)
 
 
 def pumped_chains(rtol=1e-10, repeat=3):
@@ -466,6 +477,9 @@ def main():
         return
     if "--phong" in sys.argv:
         families(specs=PHONG_FAMILY, dblquad=False)
+        return
+    if "--blinn" in sys.argv:
+        blinn_family()
         return
     if "--p" in sys.argv:
         p_model()
