@@ -1,4 +1,4 @@
-"""One-dimensional albedo where the azimuth integrates in closed form (the Phong and Blinn families).
+"""One-dimensional albedo where the azimuth integrates in closed form (the Phong and Blinn families, modified Ward).
 
 Method
 ------
@@ -92,8 +92,11 @@ are u = cos(pi/4 - theta_i/2) (the horizon starts to cut h's circle), cos(theta_
 leaves it) and u_lo = cos(pi/4 + theta_i/2), below which no h sends wo above the horizon; near grazing
 incidence the pieces above u_lo ~ mu / 2 and above the level u = mu are cut at lo (1 + 4^i), since the
 arc's end c0 = mu / (2u) changes on the scale of u there (found by the comparison with the nested engine:
-stretched Blinn n = 0 at mu = 1e-8 was 2.5e-8 off without them).  Pumped Blinn BRDFs stay on the nested
-engine (``Pumped.polar`` takes lobes about R only).
+stretched Blinn n = 0 at mu = 1e-8 was 2.5e-8 off without them).  The modified Ward model (000 eq. 35,
+c exp(-tan^2(alpha) / m^2) / (4 pi m^2 max(N.L, N.V))) is stretched Blinn's azimuth under the Beckmann weight:
+``Polar(radial="beckmann")`` integrates it in t = tan^2(alpha) / m^2 (weight e^-t, :func:`_u_at` kind 2) up to
+Z_MAX or the break of u_lo, cut at the same breaks.  Pumped Blinn BRDFs stay on the nested engine
+(``Pumped.polar`` takes lobes about R only).
 
 A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
 :class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D
@@ -153,6 +156,9 @@ class Polar:
     levels : callable, optional
         With ``chain``: ``levels(mu)`` -> the values of N.wo where g has a kink
         (:meth:`pumpup.pumping.Pumped.kink_levels` of every level, and the base's level mu).
+    radial : {"power", "beckmann"}
+        The lobe's radial factor: u^n ("power"), or, with kind "half", the Beckmann weight
+        exp(-tan^2(alpha) / m^2) with m = ``n`` (the modified Ward model, 000 eq. 35).
     """
 
     n: float = 0.0
@@ -161,6 +167,7 @@ class Polar:
     kind: str = "lobe"
     chain: tuple | None = None
     levels: object = None
+    radial: str = "power"
 
 
 @contextlib.contextmanager
@@ -583,6 +590,8 @@ def _u_at(kind, sm, n, v0, w, cv1, tau):  # pragma: no cover - compiled
     kind 0: u = v0 + w X in [0, 1/2], factor u^n w dX;
     kind 1: z = -(n + 1) ln u in [v0, v0 + w] (y = u^(n+1)), 1 - y = cv1 + w (1 - X), factor
     e^-z w dX / (n + 1) (u^n du = e^-z dz / (n + 1));
+    kind 2 (the half frame's Beckmann weight exp(-tan^2(alpha) / m^2), ``n`` = m): t = tan^2(alpha) / m^2 in
+    [v0, v0 + w], u = 1 / sqrt(1 + m^2 t), factor e^-t (m^2 / 2) u^3 w dX (du = -(m^2 / 2) u^3 dt);
     X(tau) is the smoothing substitution ``sm`` (:func:`_smoothing`) at the ends where K has a
     square-root behaviour.
     """
@@ -592,6 +601,12 @@ def _u_at(kind, sm, n, v0, w, cv1, tau):  # pragma: no cover - compiled
         um = 1.0 - u
         un = u**n if n > 0.0 else 1.0
         return u, um, math.sqrt(um * (1.0 + u)), un * w * dx
+    if kind == 2:
+        t = v0 + w * x if x < 0.5 else cv1 - w * xc  # t = tan^2(alpha) / m^2, from the nearer end
+        q = n * n * t  # tan^2(alpha)
+        r = math.sqrt(1.0 + q)
+        u = 1.0 / r
+        return u, q / (r * (r + 1.0)), math.sqrt(q) / r, math.exp(-t) * 0.5 * n * n * u * u * u * w * dx
     z = v0 + w * x if x < 0.5 else cv1 - w * xc  # z = -(n + 1) ln u, from the nearer end
     lu = -z / (n + 1.0)
     um = -math.expm1(lu)
@@ -687,7 +702,7 @@ def _sorted_cuts(cv, cc, m):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _pieces(frame, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
+def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
     """The pieces between the breakpoints, written into ``kinds``, ``sms`` (the smoothing), ``v0``,
     ``w``, ``v1`` (arrays of :data:`MAX_PIECES`); returns (their number, c2 = cos 2 theta_i, a bound of
     the part left out).
@@ -698,7 +713,8 @@ def _pieces(frame, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - co
     (the level mu leaves it, p > 0) and u_lo = cos(pi/4 + theta_i/2), below which no h sends wo above
     the horizon (the range starts there).  kind 0: u in [v0, v1 = v0 + w] (u <= 1/2); kind 1:
     z = -(n + 1) ln u in [v0, v1].  Where exp(-Z_MAX / (n + 1)) > 1/2 the range of u below it is left
-    out (its bound is returned).
+    out (its bound is returned).  With ``radial`` 1 (the half frame's Beckmann weight, ``n`` = m) the
+    whole range is kind 2, t = tan^2(alpha) / m^2 in [0, Z_MAX] (:func:`_u_at`), cut at the same breaks.
     """
     c2 = (mu - s) * (mu + s)
     n1 = n + 1.0
@@ -712,6 +728,9 @@ def _pieces(frame, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - co
     kb = np.empty(2, np.int64)
     m = 0
     u_min, z_end, k_end = 0.0, z_split, -1  # the range: u >= u_min, z <= z_end (code of that end)
+    peak = 1  # the kind of the peak's pieces
+    if radial == 1:  # t = tan^2(alpha) / m^2 everywhere (half frame only)
+        skip, z_end, peak = True, Z_MAX, 2
     if frame == 0:
         if 0.0 < s < 1.0:
             ub[m], zb[m], kb[m] = s, -0.5 * n1 * math.log1p(-mu * mu), 0
@@ -722,14 +741,17 @@ def _pieces(frame, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - co
     else:
         psi = math.atan2(mu, s)  # pi / 2 - theta_i, exact near grazing incidence
         hf = 0.25 * psi  # u_f = cos(pi/4 - theta_i/2) = cos(2 hf) = 1 - 2 sin^2(hf)
-        ub[m], zb[m], kb[m] = math.cos(2.0 * hf), -n1 * math.log1p(-2.0 * math.sin(hf) ** 2), 0
+        tf = math.tan(2.0 * hf)  # tan(alpha_f); alpha_lo = pi/2 - alpha_f
+        ub[m], kb[m] = math.cos(2.0 * hf), 0
+        zb[m] = (tf / n) ** 2 if radial == 1 else -n1 * math.log1p(-2.0 * math.sin(hf) ** 2)
         m += 1
         if p > 0.0 and 0.0 < mu < 1.0:
-            ub[m], zb[m], kb[m] = mu, -n1 * math.log(mu), 1
+            ub[m], kb[m] = mu, 1
+            zb[m] = (s / (mu * n)) ** 2 if radial == 1 else -n1 * math.log(mu)  # tan(theta_i) = s / mu
             m += 1
         u_min = math.sin(0.5 * psi)  # cos(pi/4 + theta_i/2)
         if u_min > 0.0:
-            z_lo = -n1 * math.log(u_min)
+            z_lo = 1.0 / (tf * n) ** 2 if radial == 1 else -n1 * math.log(u_min)
             if z_lo < z_end:
                 z_end, k_end = z_lo, 1
     cv = np.empty(4)
@@ -800,7 +822,7 @@ def _pieces(frame, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - co
                 zs = lo
                 step = lo  # the first cut at 2 z_s
                 while a + step < hi - step and k < kinds.shape[0] - 4:
-                    kinds[k] = 1
+                    kinds[k] = peak
                     sms[k] = (1 if left else 0) if a == lo else 0
                     v0[k] = a
                     w[k] = step
@@ -809,14 +831,18 @@ def _pieces(frame, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - co
                     a = a + step
                     step = 3.0 * a - 3.0 * zs  # cuts at z_s (1 + 4^i)
                 left = left and a == lo
-            kinds[k] = 1
+            kinds[k] = peak
             sms[k] = (1 if left else 0) + (2 if right else 0)
             v0[k] = a
             w[k] = hi - a
             v1[k] = hi
             k += 1
-    # beyond Z_MAX: K <= 2 pi in the lobe frame, <= 8 pi in the half-vector frame (4 (wi.h) N.wo / max^p <= 4)
-    left_out = (2.0 if frame == 0 else 8.0) * math.pi * math.exp(-Z_MAX) / n1 if skip and k_end == -1 else 0.0
+    # beyond Z_MAX: K <= 2 pi in the lobe frame, <= 8 pi in the half-vector frame (4 (wi.h) N.wo / max^p <= 4);
+    # with the Beckmann weight, integral_Z^inf e^-t 8 pi (m^2 / 2) u^3 dt, u^3 <= (1 + m^2 Z)^(-3/2) there
+    if radial == 1:
+        left_out = 4.0 * math.pi * n * n * math.exp(-Z_MAX) / (1.0 + n * n * Z_MAX) ** 1.5 if k_end == -1 else 0.0
+    else:
+        left_out = (2.0 if frame == 0 else 8.0) * math.pi * math.exp(-Z_MAX) / n1 if skip and k_end == -1 else 0.0
     return k, c2, left_out
 
 
@@ -862,7 +888,7 @@ def _bisect(pk, t0, t1, worst, m):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _integrate(frame, n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, inodes, iwk, iwg, jac, val, err, conv, evals):  # pragma: no cover
+def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, inodes, iwk, iwg, jac, val, err, conv, evals):  # pragma: no cover
     """Adaptive Gauss-Kronrod (the rule ``nodes``, ``wk``, ``wg``) of integral u^n K(u) du for
     every mu (without the scale)."""
     cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals, nodes, inodes, rtol)
@@ -874,7 +900,7 @@ def _integrate(frame, n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nod
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
-        npieces, c2, left_out = _pieces(frame, n, p, mu, s, kinds, sms, v0, w, cv1)
+        npieces, c2, left_out = _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, cv1)
         m = 0
         for i in range(npieces):
             if w[i] <= 0.0:
@@ -1258,6 +1284,9 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
     if hint.kind == "half" and (hint.p not in (0.0, 1.0) or hint.chain is not None):
         raise ValueError(f"{brdf!r}: a half-vector Polar hint needs p in {{0, 1}} and no chain, got p={hint.p!r}")
+    if hint.radial not in ("power", "beckmann") or (hint.radial == "beckmann" and (hint.kind != "half" or not hint.n > 0)):
+        raise ValueError(f"{brdf!r}: a Polar hint's radial is 'power', or 'beckmann' with kind 'half' and n = m > 0, "
+                         f"got {hint.radial!r} (kind {hint.kind!r}, n {hint.n!r})")
     jac = jacobi_rules(1.0 - hint.p) if 0.0 < hint.p < 1.0 else _NO_JACOBI
     val = np.empty(mu.shape)
     err = np.empty(mu.shape)
@@ -1267,7 +1296,7 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     with np.errstate(divide="ignore"):
         atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
     if hint.chain is None:
-        _integrate(1 if hint.kind == "half" else 0, float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
+        _integrate(1 if hint.kind == "half" else 0, 1 if hint.radial == "beckmann" else 0, float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
                    *(_RULES[RULE]), mode_code(), N_INIT, *_RULES["gk15"], jac, val, err, conv, evals)
     else:  # a pumped lobe, about N
         cuts = [chain_cuts(hint.levels(float(m)), float(hint.n), float(m)) for m in mu]

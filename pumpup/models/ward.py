@@ -241,3 +241,12 @@ class ModifiedWard(BRDF):
 
     def lobe(self, mu):
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"], levels=(mu,))
+
+    def polar(self):
+        from .._polar import Polar
+
+        m, c = self.p["m"], self.p["c"]
+        # 000 eq. 35: c / (4 pi m^2) times exp(-tan^2(alpha) / m^2) / max(N.L, N.V), the half vector's azimuth
+        # in closed form (stretched Blinn's, p = 1) and the Beckmann weight in t = tan^2(alpha) / m^2
+        return Polar(n=m, p=1.0, scale=lambda mu: np.full(np.shape(mu), c / (4.0 * math.pi * m * m)), kind="half",
+                     radial="beckmann")
