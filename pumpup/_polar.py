@@ -1,4 +1,4 @@
-"""One-dimensional albedo where the azimuth integrates in closed form (the Phong and Blinn families, modified Ward).
+"""One-dimensional albedo where the azimuth integrates in closed form (the Phong and Blinn families, Ward).
 
 Method
 ------
@@ -95,8 +95,11 @@ arc's end c0 = mu / (2u) changes on the scale of u there (found by the compariso
 stretched Blinn n = 0 at mu = 1e-8 was 2.5e-8 off without them).  The modified Ward model (000 eq. 35,
 c exp(-tan^2(alpha) / m^2) / (4 pi m^2 max(N.L, N.V))) is stretched Blinn's azimuth under the Beckmann weight:
 ``Polar(radial="beckmann")`` integrates it in t = tan^2(alpha) / m^2 (weight e^-t, :func:`_u_at` kind 2) up to
-Z_MAX or the break of u_lo, cut at the same breaks.  Pumped Blinn BRDFs stay on the nested engine
-(``Pumped.polar`` takes lobes about R only).
+Z_MAX or the break of u_lo, cut at the same breaks.  Ward's model (000 eq. 34, sqrt(N.L N.V) in the
+denominator; ``Polar(sqrt_cos=True)``) has 4 (wi.h) sqrt(N.wo) on the arc instead: complete elliptic integrals
+(:func:`_k_ward`, Carlson's R_F and R_D), with 1 / sqrt(mu) in the scale; its K has a logarithmic term where
+h's circle starts to be cut, so Ward keeps the raw |K - G| (QUADPACK's calibration measured 4.4 x below the
+true error there).  Pumped Blinn BRDFs stay on the nested engine (``Pumped.polar`` takes lobes about R only).
 
 A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
 :class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D
@@ -159,6 +162,9 @@ class Polar:
     radial : {"power", "beckmann"}
         The lobe's radial factor: u^n ("power"), or, with kind "half", the Beckmann weight
         exp(-tan^2(alpha) / m^2) with m = ``n`` (the modified Ward model, 000 eq. 35).
+    sqrt_cos : bool
+        With kind "half" and p = 0: the lobe is divided by sqrt(N.wo) (Ward, 000 eq. 34: sqrt(N.L N.V), its
+        1 / sqrt(N.L) in ``scale``; :func:`_k_ward`).
     """
 
     n: float = 0.0
@@ -168,6 +174,7 @@ class Polar:
     chain: tuple | None = None
     levels: object = None
     radial: str = "power"
+    sqrt_cos: bool = False
 
 
 @contextlib.contextmanager
@@ -473,6 +480,130 @@ def _k_half(p, mu, s, psi, u, sa):  # pragma: no cover - compiled; see integrand
     return 8.0 * (2.0 * c0 * beta1 + k1 + i1 + i2 / c0)  # 2 [4 (c1 beta1 + J1(c1)) + (4 / c0)(c0 I1 + I2)]
 
 
+@njit(cache=True, nogil=True)
+def _carlson_rf(x, y, z):  # pragma: no cover - compiled; tested against scipy.special.elliprf
+    """Carlson's R_F(x, y, z) = 1/2 integral_0^inf dt / sqrt((t + x)(t + y)(t + z)) for x, y, z >= 0, at most
+    one of them 0, by the duplication theorem (Carlson 1995, Numer. Algorithms 10, 13-26, algorithm 1;
+    DLMF 19.36.1), to a relative error ~ eps."""
+    a0 = (x + y + z) / 3.0
+    dx, dy = a0 - x, a0 - y
+    q = max(abs(dx), abs(dy), abs(a0 - z)) * (3.0 * EPS) ** (-1.0 / 6.0)
+    a, p4 = a0, 1.0
+    while p4 * q >= abs(a):
+        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
+        lam = sx * sy + sy * sz + sz * sx
+        x, y, z, a = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam), 0.25 * (a + lam)
+        p4 *= 0.25
+    X, Y = dx * p4 / a, dy * p4 / a
+    Z = -(X + Y)
+    e2 = X * Y - Z * Z
+    e3 = X * Y * Z
+    return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / math.sqrt(a)
+
+
+@njit(cache=True, nogil=True)
+def _carlson_rd(x, y, z):  # pragma: no cover - compiled; tested against scipy.special.elliprd
+    """Carlson's R_D(x, y, z) = 3/2 integral_0^inf dt / ((t + z)^(3/2) sqrt((t + x)(t + y))) for x, y >= 0, at
+    most one of them 0, z > 0 (Carlson 1995, algorithm 4; DLMF 19.36.2), to a relative error ~ eps."""
+    a0 = (x + y + 3.0 * z) / 5.0
+    dx, dy = a0 - x, a0 - y
+    q = max(abs(dx), abs(dy), abs(a0 - z)) * (0.25 * EPS) ** (-1.0 / 6.0)
+    a, p4, tail = a0, 1.0, 0.0
+    while p4 * q >= abs(a):
+        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
+        lam = sx * sy + sy * sz + sz * sx
+        tail += p4 / (sz * (z + lam))
+        x, y, z, a = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam), 0.25 * (a + lam)
+        p4 *= 0.25
+    X, Y = dx * p4 / a, dy * p4 / a
+    Z = -(X + Y) / 3.0
+    xy = X * Y
+    e2 = xy - 6.0 * Z * Z
+    e3 = (3.0 * xy - 8.0 * Z * Z) * Z
+    e4 = 3.0 * (xy - Z * Z) * Z * Z
+    e5 = xy * Z * Z * Z
+    poly = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0 - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0
+    return p4 * poly / (a * math.sqrt(a)) + 3.0 * tail
+
+
+@njit(cache=True, nogil=True)
+def _k_ward(mu, s, psi, u, sa):  # pragma: no cover - compiled; see ward_integrand_reference
+    """K(u) of Ward's model (000 eq. 34) in the half-vector frame: the integral over the azimuth beta of h
+    about N of 4 (wi.h) sqrt(N.wo) where N.wo > 0 (its 1 / sqrt(N.L) goes into the scale), for h at
+    u = N.h, sa = sin(alpha); s = sin(theta_i), psi = pi/2 - theta_i.
+
+    As in :func:`_k_half`, c = wi.h = c0 + d, N.wo = 2 u d, d = e0 + b cos(beta) >= 0 on the arc |beta| <
+    beta0: K = 8 sqrt(2 u) (c0 I_1/2 + I_3/2), I_q = integral_0^beta0 d^q d beta, complete elliptic integrals
+    (Carlson's R_F, R_D): with x = sin(beta / 2), d = T - 2 b x^2, T = d(0), on a partial arc (T < 2 b,
+    M = T / (2 b)) I_1/2 = 2 T / sqrt(2 b) (R_F - R_D / 3), I_-1/2 = 2 R_F / sqrt(2 b), the R at (0, 1 - M, 1);
+    on the full circle (k^2 = 2 b / T <= 1) I_1/2 = 2 sqrt(T) E(k^2) = 2 sqrt(T) (R_F - k^2 R_D / 3),
+    I_-1/2 = 2 R_F / sqrt(T) at (0, 1 - k^2, 1); and 3 I_3/2 = 4 e0 I_1/2 + (b^2 - e0^2) I_-1/2 (the
+    recurrence (q + 1) I_(q+1) = (2q + 1) e0 I_q + q (b^2 - e0^2) I_(q-1), from d/d beta (d^q sin(beta)),
+    whose boundary terms vanish).  T, 1 - M and 1 - k^2 come from the same exact angle forms as _k_half's.
+    """
+    if u <= 0.0:
+        return 0.0
+    al = math.atan2(sa, u)
+    alc = math.atan2(u, sa)
+    if 2.0 * alc <= psi:
+        return 0.0
+    b = s * sa
+    c0 = 0.5 * mu / u
+    e0 = 0.5 * mu * (u - sa) * (u + sa) / u
+    if 2.0 * al <= psi or b == 0.0:  # the full circle: d(pi) = a - b - c0 >= 0 (b = 0: mu = 1, or h = N)
+        low = 0.5 * math.sin(psi - 2.0 * al) / u
+        top = low + 2.0 * b
+        if top <= 0.0:  # (mu = 1 and 2 alpha = pi/2 to rounding: nothing above the horizon)
+            return 0.0
+        if b == 0.0:
+            ih, imh = math.pi * math.sqrt(top), math.pi / math.sqrt(top)
+        else:
+            k2 = 2.0 * b / top
+            rf = _carlson_rf(0.0, low / top, 1.0)
+            ih = 2.0 * math.sqrt(top) * (rf - k2 * _carlson_rd(0.0, low / top, 1.0) / 3.0)
+            imh = 2.0 * rf / math.sqrt(top)
+        bb = -low * top  # b^2 - e0^2 = (b - e0)(b + e0)
+    else:
+        f1 = math.sin(2.0 * alc - psi) if 2.0 * al + psi > 0.5 * math.pi else math.sin(2.0 * al + psi)
+        f2 = math.sin(2.0 * alc + psi) if 2.0 * al - psi > 0.5 * math.pi else math.sin(2.0 * al - psi)
+        top = 0.5 * f1 / u  # T = a + b - c0
+        gap = 0.5 * f2 / u  # 2 b - T = b - e0
+        rf = _carlson_rf(0.0, gap / (2.0 * b), 1.0)
+        rd = _carlson_rd(0.0, gap / (2.0 * b), 1.0)
+        sb2 = math.sqrt(2.0 * b)
+        ih = 2.0 * top / sb2 * (rf - rd / 3.0)
+        imh = 2.0 * rf / sb2
+        bb = gap * top
+    i3h = (4.0 * e0 * ih + bb * imh) / 3.0
+    return 8.0 * math.sqrt(2.0 * u) * (c0 * ih + i3h)
+
+
+def ward_integrand_reference(mu: float, u: np.ndarray) -> np.ndarray:
+    """Plain numpy K(u) of :func:`_k_ward`: the arc integrals I_q = integral_0^beta0 (e0 + b cos(beta))^q
+    d beta by scipy's QUADPACK (beta0 from arccos), K = 8 sqrt(2 u) (c0 I_1/2 + I_3/2)."""
+    import warnings
+
+    from scipy.integrate import quad
+
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+
+    def one(uu):
+        if uu <= 0:
+            return 0.0
+        b, c0 = s * math.sqrt((1.0 - uu) * (1.0 + uu)), 0.5 * mu / uu
+        e0 = mu * uu - c0
+        beta0 = math.pi if e0 - b >= 0 else (0.0 if e0 + b <= 0 else math.acos(-e0 / b))
+        if beta0 == 0.0:
+            return 0.0
+        ih, i3 = (quad(lambda t, q=q: max(e0 + b * math.cos(t), 0.0) ** q, 0.0, beta0, epsabs=0, epsrel=1e-13, limit=200)[0]
+                  for q in (0.5, 1.5))
+        return 8.0 * math.sqrt(2.0 * uu) * (c0 * ih + i3)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # (QUADPACK's roundoff notes at 1e-13 on these smooth arcs)
+        return np.array([one(uu) for uu in np.atleast_1d(np.asarray(u, dtype=np.float64))])
+
+
 def half_moments_reference(x):
     """Plain numpy twins of :func:`_trig_tail`'s four functions, in closed form (exact in exact arithmetic;
     the tests compare them with the series at x >= 1e-2, where these lose at most ~10 digits of 16)."""
@@ -668,12 +799,12 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
         for j in range(nodes.shape[0]):
             u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
             buf[j] = _k_closed(p, mu, c2, u, um, sa)[0] * fac
-    else:  # the half-vector frame (the Blinn family), p in {0, 1}
+    else:  # the half-vector frame: the Blinn family and modified Ward, p in {0, 1} (frame 1); Ward (frame 2)
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
         psi = math.atan2(mu, s)
         for j in range(nodes.shape[0]):
             u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
-            buf[j] = _k_half(p, mu, s, psi, u, sa) * fac
+            buf[j] = (_k_half(p, mu, s, psi, u, sa) if frame == 1 else _k_ward(mu, s, psi, u, sa)) * fac
     k, diff, asc, ab = rule_sums(buf, wk, wg)
     return k * h, calibrated(diff * h, asc * h, ab * h, mode) + ie * h
 
@@ -709,7 +840,7 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
 
     Breakpoints: u = 0, 1/2, 1 and, in the lobe frame (``frame`` 0), u = s (the horizon starts to cut
     the arc) and cos 2 theta_i (the level mu leaves it, p > 0); in the half-vector frame (1,
-    :func:`_k_half`), u = cos(pi/4 - theta_i/2) (the horizon starts to cut h's circle), cos(theta_i)
+    :func:`_k_half`; 2, :func:`_k_ward`), u = cos(pi/4 - theta_i/2) (the horizon starts to cut h's circle), cos(theta_i)
     (the level mu leaves it, p > 0) and u_lo = cos(pi/4 + theta_i/2), below which no h sends wo above
     the horizon (the range starts there).  kind 0: u in [v0, v1 = v0 + w] (u <= 1/2); kind 1:
     z = -(n + 1) ln u in [v0, v1].  Where exp(-Z_MAX / (n + 1)) > 1/2 the range of u below it is left
@@ -775,7 +906,7 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
                 left = cc[j] == 1  # (code 1 only where p > 0, or the half frame's u_lo)
                 right = cc[j + 1] == 0
                 a = lo
-                if frame == 1 and lo > 0.0:
+                if frame != 0 and lo > 0.0:
                     # the half frame near grazing incidence: above u_lo ~ mu / 2 and the level u = mu the
                     # arc's end c0 = mu / (2 u) changes on the scale of u itself, so the piece is cut at
                     # lo (1 + 4^i) (as above z_s below): one first interval on [mu / 2, 1/2] hid it
@@ -1284,6 +1415,8 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
     if hint.kind == "half" and (hint.p not in (0.0, 1.0) or hint.chain is not None):
         raise ValueError(f"{brdf!r}: a half-vector Polar hint needs p in {{0, 1}} and no chain, got p={hint.p!r}")
+    if hint.sqrt_cos and (hint.kind != "half" or hint.p != 0.0):
+        raise ValueError(f"{brdf!r}: a Polar hint with sqrt_cos needs kind 'half' and p = 0, got {hint.kind!r}, p={hint.p!r}")
     if hint.radial not in ("power", "beckmann") or (hint.radial == "beckmann" and (hint.kind != "half" or not hint.n > 0)):
         raise ValueError(f"{brdf!r}: a Polar hint's radial is 'power', or 'beckmann' with kind 'half' and n = m > 0, "
                          f"got {hint.radial!r} (kind {hint.kind!r}, n {hint.n!r})")
@@ -1296,8 +1429,13 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     with np.errstate(divide="ignore"):
         atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
     if hint.chain is None:
-        _integrate(1 if hint.kind == "half" else 0, 1 if hint.radial == "beckmann" else 0, float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
-                   *(_RULES[RULE]), mode_code(), N_INIT, *_RULES["gk15"], jac, val, err, conv, evals)
+        # Ward's K (elliptic integrals) has a logarithmic term where h's circle starts to be cut (E(k^2) near
+        # k^2 = 1), which no substitution here makes analytic: QUADPACK's calibration measured 4.4 x below the
+        # true error there (m = 0.1, mu = 0.6088: 7.1e-13 against 1.5e-13, at every rtol), the raw |K - G| at most
+        # 0.11 of it (7 m x 63 mu x rtol 1e-6 .. 1e-12 against the nested engine at 1e-13): Ward keeps the raw one
+        mode = 0 if hint.sqrt_cos else mode_code()
+        _integrate((2 if hint.sqrt_cos else 1) if hint.kind == "half" else 0, 1 if hint.radial == "beckmann" else 0, float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
+                   *(_RULES[RULE]), mode, N_INIT, *_RULES["gk15"], jac, val, err, conv, evals)
     else:  # a pumped lobe, about N
         cuts = [chain_cuts(hint.levels(float(m)), float(hint.n), float(m)) for m in mu]
         ncut = np.array([len(c) for c in cuts], np.int64)

@@ -229,9 +229,10 @@ def test_two_d_only_restores_the_switch():
 # --- the Blinn family: the half vector's azimuth about N in closed form (kind "half") -----------------
 
 
-def _k_half_by_quad(p, mu, u):
+def _k_half_by_quad(p, mu, u, root=False):
     """K(u) of the half-vector frame straight from the geometry, by scipy quad over the azimuth of h:
-    wo = 2 (wi.h) h - wi, integrand 4 (wi.h) N.wo / max(mu, N.wo)^p where N.wo > 0 (split at the arcs' ends)."""
+    wo = 2 (wi.h) h - wi, integrand 4 (wi.h) N.wo / max(mu, N.wo)^p where N.wo > 0 (split at the arcs' ends);
+    with ``root``, 4 (wi.h) sqrt(N.wo) (Ward's, its 1 / sqrt(N.L) left out)."""
     from scipy.integrate import quad
 
     s, sa = math.sqrt((1 - mu) * (1 + mu)), math.sqrt((1 - u) * (1 + u))
@@ -241,7 +242,9 @@ def _k_half_by_quad(p, mu, u):
         h = np.array([sa * math.cos(beta), sa * math.sin(beta), u])
         c = float(wi @ h)
         nwo = 2 * c * u - mu
-        return 4 * c * nwo / max(mu, nwo) ** p if c > 0 and nwo > 0 else 0.0
+        if not (c > 0 and nwo > 0):
+            return 0.0
+        return 4 * c * math.sqrt(nwo) if root else 4 * c * nwo / max(mu, nwo) ** p
 
     b, a = s * sa, mu * u
     pts = [math.acos((cv - a) / b) for cv in (mu / (2 * u), mu / u) if b > 0 and abs((cv - a) / b) < 1]
@@ -268,6 +271,28 @@ def test_half_kernel_against_the_geometry_and_its_numpy_twin(rng, p):
             assert abs(k - twin) <= 1e-11 * max(abs(twin), 1.0) + 1e-15 * mu**-p, (p, mu, u, k, twin)
 
 
+def test_ward_kernel_against_the_geometry_and_its_twin(rng):
+    """_k_ward (complete elliptic integrals by Carlson's R_F and R_D) against an independent quadrature of
+    4 (wi.h) sqrt(N.wo) built from wi, h and wo, and its twin (scipy quad of the arc integrals), at random u
+    and on both sides of the arc's breaks; and the compiled R_F, R_D against scipy's."""
+    from scipy.special import elliprd, elliprf
+
+    for mu in (1.0, 0.99, 0.9, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6):
+        s = math.sqrt((1 - mu) * (1 + mu))
+        psi, th = math.atan2(mu, s), math.atan2(s, mu)
+        edges = [math.cos(math.pi / 4 + th / 2), math.cos(math.pi / 4 - th / 2)]
+        us = np.concatenate([rng.uniform(0, 1, 10), [1.0, 1 - 1e-12], [e * (1 + d) for e in edges for d in (-1e-6, 1e-6)]])
+        for u in us[(us > 0) & (us <= 1)]:
+            k = _polar._k_ward(mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
+            q = _k_half_by_quad(0.0, mu, float(u), root=True)
+            assert abs(k - q) <= 1e-12 * max(abs(q), 1.0), (mu, u, k, q)
+            assert abs(k - _polar.ward_integrand_reference(mu, u)[0]) <= 1e-11 * max(abs(q), 1.0), (mu, u)
+    for args in rng.uniform(0, 3, (300, 3)) * 10.0 ** rng.integers(-12, 4, (300, 3)):
+        for x, y, z in (args, (0.0, args[1], args[2]), (0.0, min(args[1], 1.0), 1.0)):
+            assert abs(_polar._carlson_rf(x, y, z) - elliprf(x, y, z)) <= 2e-15 * elliprf(x, y, z)
+            assert abs(_polar._carlson_rd(x, y, z) - elliprd(x, y, z)) <= 2e-15 * elliprd(x, y, z)
+
+
 def test_trig_tails_against_mpmath():
     """The four functions that cancel at small arcs (series below 1 rad, closed form above) to 1e-15 relative,
     against 50-digit mpmath quadratures of their definitions; and the numpy twin where it does not cancel."""
@@ -291,7 +316,10 @@ HALF_SPECS = [{"type": "blinn", "n": 16}, {"type": "blinn", "n": 0.5}, {"type": 
               # the modified Ward model: stretched Blinn's azimuth, the Beckmann weight in t = tan^2(alpha) / m^2
               {"type": "modified_ward", "m": 0.1}, {"type": "modified_ward", "m": 0.02},
               {"type": "modified_ward", "m": 0.4, "c": 1.63}, {"type": "modified_ward", "m": 1e-4},
-              {"type": "modified_ward", "m": 5.0}, {"type": "modified_ward", "m": 100.0}]
+              {"type": "modified_ward", "m": 5.0}, {"type": "modified_ward", "m": 100.0},
+              # Ward: the azimuth by complete elliptic integrals, 1 / sqrt(N.L) in the scale (its albedo diverges)
+              {"type": "ward", "m": 0.1}, {"type": "ward", "m": 0.02}, {"type": "ward", "m": 0.2},
+              {"type": "ward", "m": 0.4, "c": 0.6}, {"type": "ward", "m": 1e-4}, {"type": "ward", "m": 5.0}]
 
 
 @pytest.mark.parametrize("spec", HALF_SPECS, ids=[f"{s['type']}-{s.get('n', s.get('m'))}" for s in HALF_SPECS])
@@ -327,11 +355,13 @@ def test_blinn_family_closed_forms():
 
 def test_blinn_family_evaluations_and_refusals():
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
-    for spec in ({"type": "blinn", "n": 16}, {"type": "stretched_blinn", "n": 8}, {"type": "modified_ward", "m": 0.1}):
+    for spec in ({"type": "blinn", "n": 16}, {"type": "stretched_blinn", "n": 8}, {"type": "modified_ward", "m": 0.1},
+                 {"type": "ward", "m": 0.1}):
         _, _, conv, evals = _polar.albedo_1d(pumpup.load(spec), mu, 1e-10, 1e-14, 20000)
         assert conv.all() and evals.mean() < 300 and evals.max() < 1000, (spec, evals.mean(), evals.max())
     for hint, match in [({"n": 5.0, "p": 0.5, "kind": "half"}, "p in"), ({"n": 0.1, "p": 1.0, "radial": "beckmann"}, "radial"),
-                        ({"n": 0.1, "p": 1.0, "kind": "half", "radial": "ggx"}, "radial")]:
+                        ({"n": 0.1, "p": 1.0, "kind": "half", "radial": "ggx"}, "radial"),
+                        ({"n": 0.1, "p": 1.0, "kind": "half", "radial": "beckmann", "sqrt_cos": True}, "sqrt_cos")]:
         bad = type("Bad", (), {"polar": lambda self, h=hint: _polar.Polar(scale=lambda m: np.ones(np.shape(m)), **h)})()
         with pytest.raises(ValueError, match=match):
             _polar.albedo_1d(bad, mu[:3], 1e-8, 0.0, 100)

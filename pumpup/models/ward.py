@@ -84,6 +84,15 @@ class Ward(BRDF):
     def lobe(self, mu):
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"])
 
+    def polar(self):
+        from .._polar import Polar
+
+        m, c = self.p["m"], self.p["c"]
+        # 000 eq. 34: c / (4 pi m^2 sqrt(mu)) times exp(-tan^2(alpha) / m^2) / sqrt(N.wo); the half vector's azimuth
+        # by complete elliptic integrals (pumpup._polar._k_ward), the Beckmann weight in t = tan^2(alpha) / m^2
+        return Polar(n=m, p=0.0, scale=lambda mu: c / (4.0 * math.pi * m * m * np.sqrt(mu)), kind="half",
+                     radial="beckmann", sqrt_cos=True)
+
 
 # --- anisotropic Ward -----------------------------------------------------------------------
 
