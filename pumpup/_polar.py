@@ -162,6 +162,9 @@ class Polar:
     radial : {"power", "beckmann"}
         The lobe's radial factor: u^n ("power"), or, with kind "half", the Beckmann weight
         exp(-tan^2(alpha) / m^2) with m = ``n`` (the modified Ward model, 000 eq. 35).
+    ulps : float or callable
+        With kind "constant": the relative error of ``scale`` in units of eps (or ``ulps(mu)``), as bounded
+        and measured for each closed form.
     sqrt_cos : bool
         With kind "half" and p = 0: the lobe is divided by sqrt(N.wo) (Ward, 000 eq. 34: sqrt(N.L N.V), its
         1 / sqrt(N.L) in ``scale``; :func:`_k_ward`).
@@ -175,6 +178,7 @@ class Polar:
     levels: object = None
     radial: str = "power"
     sqrt_cos: bool = False
+    ulps: object = 4.0
 
 
 @contextlib.contextmanager
@@ -1410,7 +1414,9 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     if not np.all(np.isfinite(scale)):
         return None  # (an overflowing constant) the 2-D engine reports what the model returns
     if hint.kind == "constant":
-        return scale.copy(), 4.0 * np.finfo(float).eps * np.abs(scale), np.ones(mu.shape, bool), np.zeros(mu.shape, np.int64)
+        ulps = hint.ulps(mu) if callable(hint.ulps) else hint.ulps
+        return (scale.copy(), ulps * np.finfo(float).eps * np.abs(scale), np.ones(mu.shape, bool),
+                np.zeros(mu.shape, np.int64))
     if not 0.0 <= hint.p <= 1.0:
         raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
     if hint.kind == "half" and (hint.p not in (0.0, 1.0) or hint.chain is not None):

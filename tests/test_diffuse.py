@@ -128,3 +128,64 @@ def test_bad_input_names_the_parameter():
     for spec, name in bad:
         with pytest.raises(pumpup.SpecError, match=name):
             pumpup.load(spec)
+
+
+def test_oren_nayar_albedo_in_closed_form():
+    """The qualitative Oren-Nayar albedo in closed form (pumpup.models.diffuse.oren_nayar_albedo, the model's
+    Polar "constant" hint) against a 40-digit mpmath quadrature of its 1-D integral over N.wo, and against
+    the nested engine (the 1-D path switched off) on the BRDF itself."""
+    import warnings
+
+    mp = pytest.importorskip("mpmath")
+    from pumpup import _polar
+    from pumpup.models.diffuse import oren_nayar_albedo
+
+    mp.mp.dps = 40
+    for sigma in (0.0, 0.3, 0.5, 1.2):
+        s2 = mp.mpf(sigma) ** 2
+        a_, b_ = 1 - s2 / 2 / (s2 + mp.mpf("0.33")), mp.mpf("0.45") * s2 / (s2 + mp.mpf("0.09"))
+        for mu in (1.0, 0.999999, 0.99, 0.5, 0.2, 1e-3, 1e-8, 1e-300):
+            m = mp.mpf(mu)
+            inner = mp.quad(lambda t, m=m: t * mp.sqrt(1 - t * t) / max(m, t), [0, m, 1])
+            ref = 0.7 * (a_ + 2 * b_ * mp.sqrt(1 - m * m) / mp.pi * inner)
+            assert abs(float(oren_nayar_albedo(mu, 0.7, sigma)) - ref) <= 2.3e-16 * ref, (sigma, mu)
+    mu = np.array([1.0, 0.9, 0.5, 0.2, 1e-3, 1e-8])
+    for spec in ({"type": "oren_nayar"}, {"type": "oren_nayar", "albedo": 0.7, "sigma": 0.5},
+                 {"type": "oren_nayar", "sigma": 1.2}):
+        f = pumpup.load(spec)
+        a, e = pumpup.albedo(f, mu, return_error=True)
+        with _polar.without_1d(), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
+        assert np.all(np.abs(a - b) <= e + eb) and np.all(e <= 1e-15 * a)
+
+
+def test_minnaert_and_lacquer_albedos_in_closed_form():
+    """Minnaert, 2 pi b mu^(k-1) / (k + 1) (002 sec. 4.3), and the lacquer, 2 pi c e^(-s/mu) E_3(s), are the
+    models' Polar "constant" hints: against 30-digit mpmath (its own E_3 and powers) within their stated
+    errors, and against the nested engine on the BRDFs themselves."""
+    import warnings
+
+    mp = pytest.importorskip("mpmath")
+    from pumpup import _polar
+
+    mp.mp.dps = 30
+    mu = np.array([1.0, 0.9, 0.5, 0.2, 0.05, 1e-2, 1e-3])
+    for spec in ({"type": "lacquer", "s": s, "c": 0.3} for s in (0.0, 1e-6, 0.02, 0.1, 1.5, 30.0, 300.0)):
+        a, e = pumpup.albedo(pumpup.load(spec), mu, return_error=True)
+        s = spec["s"]
+        for m, x, ex in zip(mu, a, e):
+            ref = 2 * mp.pi * 0.3 * mp.exp(-mp.mpf(s) / mp.mpf(m)) * (mp.expint(3, s) if s > 0 else mp.mpf(0.5))
+            assert abs(x - float(ref)) <= ex, (spec, m, x, ex)  # (in doubles: e^(-1500) is 0 there)
+    for spec in ({"type": "minnaert", "k": k, "b": 0.2} for k in (0.5, 1.0, 1.37, 2.0, 50.0)):
+        a, e = pumpup.albedo(pumpup.load(spec), mu, return_error=True)
+        for m, x, ex in zip(mu, a, e):
+            ref = 2 * mp.pi * 0.2 * mp.mpf(m) ** (spec["k"] - 1) / (spec["k"] + 1)
+            assert abs(x - ref) <= ex, (spec, m, x, ex)
+    for spec in ({"type": "lacquer"}, {"type": "lacquer", "s": 1.5}, {"type": "minnaert", "k": 0.8}, {"type": "minnaert", "k": 2.0}):
+        f = pumpup.load(spec)
+        a, e = pumpup.albedo(f, mu, return_error=True)
+        with _polar.without_1d(), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
+        assert np.all(np.abs(a - b) <= e + eb), spec
