@@ -81,6 +81,10 @@ SPECS = [
     {"type": "stretched_phong", "n": 8, "p": 0.5},  # p in (0, 1): the inner rule on one arc
     {"type": "retro", "n": 10, "p": 0.3},
     {"type": "lafortune", "n": 20, "cx": 1.1, "cy": 1.1, "cz": 1.1, "p": 0.7},
+    # issue 14's sixth session: 000 eq. 30's plastic (stretched Phong's lobe), and closed forms
+    {"type": "plastic", "n": 20}, {"type": "plastic", "n": 5, "ad": 0.2, "a_s": 0.7},
+    {"type": "oren_nayar", "albedo": 0.7, "sigma": 0.5}, {"type": "minnaert", "k": 1.37, "b": 0.1},
+    {"type": "lacquer", "s": 0.3},
 ]
 
 

@@ -309,6 +309,15 @@ class Plastic(BRDF):
     def lobe(self, mu):
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"], levels=(mu,))
 
+    def polar(self):
+        q = self.p
+        if q["eta"] is not None or q["ad"] != 0:
+            return None  # F(Theta_min) varies along the arc; the diffuse part is split off by albedo_terms
+        from .._polar import Polar
+
+        c = q["a_s"] * (q["n"] + 2.0) / (2.0 * math.pi)  # 000 eq. 30: stretched Phong's lobe (p = 1) times a_s
+        return Polar(n=q["n"], p=1.0, scale=lambda mu: np.full(np.shape(mu), c))
+
 
 # --- one model per channel -------------------------------------------------------------------
 
