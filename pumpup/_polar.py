@@ -1,4 +1,4 @@
-"""One-dimensional albedo where the azimuth integrates in closed form (the Phong and Blinn families, Ward).
+"""One-dimensional albedo where the azimuth integrates in closed form (Phong, Blinn, Ward, Cook-Torrance families).
 
 Method
 ------
@@ -99,7 +99,13 @@ Z_MAX or the break of u_lo, cut at the same breaks.  Ward's model (000 eq. 34, s
 denominator; ``Polar(sqrt_cos=True)``) has 4 (wi.h) sqrt(N.wo) on the arc instead: complete elliptic integrals
 (:func:`_k_ward`, Carlson's R_F and R_D), with 1 / sqrt(mu) in the scale; its K has a logarithmic term where
 h's circle starts to be cut, so Ward keeps the raw |K - G| (QUADPACK's calibration measured 4.4 x below the
-true error there).  Pumped Blinn BRDFs stay on the nested engine (``Pumped.polar`` takes lobes about R only).
+true error there).  The V-cavity microfacet models with F = 1 (Cook-Torrance, 001 eq. 9-10; Torrance-Sparrow
+with D1 or D4, 002 eq. 10; ``Polar(vcavity=True)``) integrate 4 c G = 4 min(c, 2 u mu, 2 u N.wo) on the arc: a
+minimum of three lines in c, so each range of c between their crossings contributes its arc length and its
+integral of c (:func:`_k_vcavity`, with cancellation-free differences: near grazing incidence the integrand lives
+on arcs of width ~mu), and the pieces' changes in u are breaks (:func:`_vcavity_breaks`).  With a Fresnel factor
+(``ior``) they stay on the nested engine.  Pumped Blinn BRDFs stay on the nested engine too (``Pumped.polar``
+takes lobes about R only).
 
 A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
 :class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D
@@ -162,6 +168,10 @@ class Polar:
     radial : {"power", "beckmann"}
         The lobe's radial factor: u^n ("power"), or, with kind "half", the Beckmann weight
         exp(-tan^2(alpha) / m^2) with m = ``n`` (the modified Ward model, 000 eq. 35).
+    vcavity : bool
+        With kind "half" and p = 0: the lobe is the V-cavity microfacet model's D G / (N.L N.V) with F = 1
+        (Cook-Torrance, 001 eq. 9-10; Torrance-Sparrow, 002 eq. 10; :func:`_k_vcavity`), D the radial factor
+        (u^n, or with the Beckmann weight D's 1 / cos^4), 1 / N.L in ``scale``.
     ulps : float or callable
         With kind "constant": the relative error of ``scale`` in units of eps (or ``ulps(mu)``), as bounded
         and measured for each closed form.
@@ -179,6 +189,7 @@ class Polar:
     radial: str = "power"
     sqrt_cos: bool = False
     ulps: object = 4.0
+    vcavity: bool = False
 
 
 @contextlib.contextmanager
@@ -582,6 +593,117 @@ def _k_ward(mu, s, psi, u, sa):  # pragma: no cover - compiled; see ward_integra
     return 8.0 * math.sqrt(2.0 * u) * (c0 * ih + i3h)
 
 
+@njit(cache=True, nogil=True)
+def _k_vcavity(mu, s, psi, u, sa):  # pragma: no cover - compiled; see vcavity_integrand_reference
+    """K(u) of the V-cavity microfacet models with F = 1 (Cook-Torrance, 001 eq. 9-10; Torrance-Sparrow, 002
+    eq. 10) in the half-vector frame, without their D(u): the integral over the azimuth beta of h about N of
+    4 (wi.h) G N.wo / N.wo = 4 c G where N.wo > 0, G = min(1, 2 u min(mu, N.wo) / c) (001 eq. 10; the
+    1 / (N.L) goes into the scale), i.e. 4 min(c, 2 u mu, 4 u^2 c - 2 u mu) with c = wi.h = a + b cos(beta)
+    (N.wo = 2 u c - mu, as in :func:`_k_half`).  A minimum of three lines in c: on each range of c between
+    their crossings (c = 2 u mu, mu / u, 2 u mu / (4 u^2 - 1)) and the arc's end c0 = mu / (2 u) the integral is
+    p J0 + q J1, J0 = integral d beta and J1 = integral c d beta over {beta: c(beta) in the range}.  The arc's
+    end (c0, b sin(beta0)) comes from the exact forms of _k_half; at the interior crossings X = c - a and
+    S = b sin(beta) = sqrt((b - X)(b + X)) are consistent, so their rounding moves a kink of the (continuous)
+    minimum and changes the integral only to second order.
+    """
+    if u <= 0.0:
+        return 0.0
+    al = math.atan2(sa, u)
+    alc = math.atan2(u, sa)
+    if 2.0 * alc <= psi:
+        return 0.0
+    a = mu * u
+    b = s * sa
+    c0 = 0.5 * mu / u
+    e0 = 0.5 * mu * (u - sa) * (u + sa) / u
+    sb0 = 0.0  # b sin(beta0) at the arc's end (0 on the full circle)
+    if not (2.0 * al <= psi or b == 0.0):
+        f1 = math.sin(2.0 * alc - psi) if 2.0 * al + psi > 0.5 * math.pi else math.sin(2.0 * al + psi)
+        f2 = math.sin(2.0 * alc + psi) if 2.0 * al - psi > 0.5 * math.pi else math.sin(2.0 * al - psi)
+        sb0 = 0.5 * math.sqrt(max(0.0, f1 * f2)) / u
+    lo = max(c0, a - b)  # the range of c on the arc
+    hi = a + b
+    if b == 0.0:  # c = a on the whole circle (mu = 1 or h = N)
+        g = min(a, 2.0 * u * mu, 4.0 * u * u * a - 2.0 * u * mu)
+        return 8.0 * math.pi * g if a > c0 else 0.0
+    cuts = np.empty(5)
+    n = 0
+    cuts[n] = lo
+    n += 1
+    for cv in (2.0 * u * mu, mu / u, 2.0 * u * mu / (4.0 * u * u - 1.0) if 4.0 * u * u > 1.0 else -1.0):
+        if lo < cv < hi:
+            cuts[n] = cv
+            n += 1
+    cuts[n] = hi
+    n += 1
+    _sorted_cuts(cuts, np.zeros(5, np.int64), n)
+    total = 0.0
+    for j in range(n - 1):
+        c_lo, c_hi = cuts[j], cuts[j + 1]
+        if not c_hi > c_lo:
+            continue
+        # X = c - a = b cos(beta) and S = b sin(beta) at both ends (c decreases with beta): the arc's end exactly
+        # (X = -e0, S = b sin(beta0)), the circle's bottom and top (X = -+b, S = 0), the rest S = sqrt((b - X)(b + X))
+        if j == 0 and c_lo == c0:
+            x_lo, s_lo = -e0, sb0
+        elif j == 0:
+            x_lo, s_lo = -b, 0.0
+        else:
+            x_lo = c_lo - a
+            s_lo = math.sqrt(max(0.0, (b - x_lo) * (b + x_lo)))
+        if j == n - 2:
+            x_hi, s_hi = b, 0.0
+        else:
+            x_hi = c_hi - a
+            s_hi = math.sqrt(max(0.0, (b - x_hi) * (b + x_hi)))
+        # J0 = beta_lo - beta_hi and J1 = a J0 + S_lo - S_hi without cancellation: b^2 sin(J0) and S_lo - S_hi
+        # from X_hi^2 - X_lo^2 = (c_hi - c_lo)(X_hi + X_lo) (thin pieces near grazing incidence, where the
+        # integrand lives on arcs of width ~mu: the plain differences lost 8 digits at mu = 1e-8)
+        dc, xs = c_hi - c_lo, x_hi + x_lo
+        if x_lo * x_hi > 0.0:
+            sin_b2 = b * b * dc * xs / (s_lo * x_hi + x_lo * s_hi)
+        else:
+            sin_b2 = s_lo * x_hi - x_lo * s_hi
+        j0 = math.atan2(sin_b2, x_lo * x_hi + s_lo * s_hi)
+        j1 = a * j0 + (dc * xs / (s_lo + s_hi) if s_lo + s_hi > 0.0 else 0.0)
+        cm = 0.5 * (c_lo + c_hi)
+        l1, l2, l3 = cm, 2.0 * u * mu, 4.0 * u * u * cm - 2.0 * u * mu
+        if l1 <= l2 and l1 <= l3:
+            total += j1  # G = 1: c
+        elif l2 <= l3:
+            total += 2.0 * u * mu * j0  # G = 2 u mu / c
+        else:
+            total += 4.0 * u * u * j1 - 2.0 * u * mu * j0  # G = 2 u N.wo / c
+    return 8.0 * total  # 2 (both signs of beta) 4 c G
+
+
+def vcavity_integrand_reference(mu: float, u) -> np.ndarray:
+    """Plain twin of :func:`_k_vcavity` by scipy's QUADPACK over beta of 4 min(c, 2 u mu, 4 u^2 c - 2 u mu)
+    where c > mu / (2 u) (split at the lines' crossings)."""
+    import warnings
+
+    from scipy.integrate import quad
+
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+
+    def one(uu):
+        if uu <= 0:
+            return 0.0
+        b, a = s * math.sqrt((1.0 - uu) * (1.0 + uu)), mu * uu
+
+        def g(t):
+            c = a + b * math.cos(t)
+            return 4.0 * min(c, 2 * uu * mu, 4 * uu * uu * c - 2 * uu * mu) if c > 0.5 * mu / uu else 0.0
+
+        pts = [math.acos((cv - a) / b) for cv in (0.5 * mu / uu, 2 * uu * mu, mu / uu, 2 * uu * mu / (4 * uu * uu - 1) if 4 * uu * uu != 1 else -9.0)
+               if b > 0 and abs((cv - a) / b) < 1]
+        return 2.0 * quad(g, 0.0, math.pi, points=pts or None, epsabs=0, epsrel=1e-13, limit=200)[0]
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return np.array([one(uu) for uu in np.atleast_1d(np.asarray(u, dtype=np.float64))])
+
+
 def ward_integrand_reference(mu: float, u: np.ndarray) -> np.ndarray:
     """Plain numpy K(u) of :func:`_k_ward`: the arc integrals I_q = integral_0^beta0 (e0 + b cos(beta))^q
     d beta by scipy's QUADPACK (beta0 from arccos), K = 8 sqrt(2 u) (c0 I_1/2 + I_3/2)."""
@@ -808,7 +930,13 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
         psi = math.atan2(mu, s)
         for j in range(nodes.shape[0]):
             u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
-            buf[j] = (_k_half(p, mu, s, psi, u, sa) if frame == 1 else _k_ward(mu, s, psi, u, sa)) * fac
+            if frame == 1:
+                k = _k_half(p, mu, s, psi, u, sa)
+            elif frame == 2:
+                k = _k_ward(mu, s, psi, u, sa)
+            else:  # 3: V-cavity G, F = 1; under the Beckmann weight D carries 1 / u^4 (001 eq. 9)
+                k = _k_vcavity(mu, s, psi, u, sa) / (u * u * u * u if kind == 2 else 1.0)
+            buf[j] = k * fac
     k, diff, asc, ab = rule_sums(buf, wk, wg)
     return k * h, calibrated(diff * h, asc * h, ab * h, mode) + ie * h
 
@@ -837,6 +965,34 @@ def _sorted_cuts(cv, cc, m):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
+def _vcavity_breaks(mu, s, psi):  # pragma: no cover - compiled
+    """The angles alpha of h from N where :func:`_k_vcavity`'s pieces change (0 for none): where a crossing of
+    its lines reaches the top of h's circle (c = 2 u mu at alpha = pi/2 - theta_i = psi; c = mu / u at
+    alpha = theta_i) or the top or bottom (c = 2 u mu / (4 u^2 - 1): cos(theta_i -+ alpha) sin(3 alpha) =
+    sin(2 alpha) mu, by bisection on (0, pi/3), where it changes sign), and where the crossings meet
+    (alpha = pi/4) or one meets the arc's end mu / (2 u) (alpha = pi/3)."""
+    th = 0.5 * math.pi - psi
+    out = np.zeros(6)
+    out[0], out[1], out[2], out[3] = psi, th, 0.25 * math.pi, math.pi / 3.0
+    for k in range(2):
+        sg = 1.0 if k == 0 else -1.0
+        lo, hi = 1e-9, math.pi / 3.0 - 1e-9
+        flo = (mu * math.cos(lo) + sg * s * math.sin(lo)) * math.sin(3.0 * lo) - math.sin(2.0 * lo) * mu
+        fhi = (mu * math.cos(hi) + sg * s * math.sin(hi)) * math.sin(3.0 * hi) - math.sin(2.0 * hi) * mu
+        if flo * fhi >= 0.0:
+            continue
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            fm = (mu * math.cos(mid) + sg * s * math.sin(mid)) * math.sin(3.0 * mid) - math.sin(2.0 * mid) * mu
+            if (fm < 0.0) == (flo < 0.0):
+                lo, flo = mid, fm
+            else:
+                hi = mid
+        out[4 + k] = 0.5 * (lo + hi)
+    return out
+
+
+@njit(cache=True, nogil=True)
 def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
     """The pieces between the breakpoints, written into ``kinds``, ``sms`` (the smoothing), ``v0``,
     ``w``, ``v1`` (arrays of :data:`MAX_PIECES`); returns (their number, c2 = cos 2 theta_i, a bound of
@@ -858,9 +1014,9 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
     z_split = Z_MAX if skip else n1 * math.log(2.0)
     # breakpoints in u, and their z = -(n + 1) ln u to full precision; codes 0: horizon (sqrt
     # below), 1: level mu (sqrt above)
-    ub = np.empty(2)
-    zb = np.empty(2)
-    kb = np.empty(2, np.int64)
+    ub = np.empty(8)
+    zb = np.empty(8)
+    kb = np.empty(8, np.int64)
     m = 0
     u_min, z_end, k_end = 0.0, z_split, -1  # the range: u >= u_min, z <= z_end (code of that end)
     peak = 1  # the kind of the peak's pieces
@@ -889,8 +1045,14 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
             z_lo = 1.0 / (tf * n) ** 2 if radial == 1 else -n1 * math.log(u_min)
             if z_lo < z_end:
                 z_end, k_end = z_lo, 1
-    cv = np.empty(4)
-    cc = np.empty(4, np.int64)
+        if frame == 3:  # the V-cavity G's kinks (:func:`_vcavity_breaks`), smoothed on both sides (code 2)
+            for ab in _vcavity_breaks(mu, s, psi):
+                if ab > 0.0:
+                    ub[m], kb[m] = math.cos(ab), 2
+                    zb[m] = (math.tan(ab) / n) ** 2 if radial == 1 else -n1 * math.log1p(-2.0 * math.sin(0.5 * ab) ** 2)
+                    m += 1
+    cv = np.empty(12)
+    cc = np.empty(12, np.int64)
     k = 0
     # tail pieces (increasing u)
     if not skip and u_min < 0.5:
@@ -907,8 +1069,8 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
         for j in range(nc - 1):
             lo, hi = cv[j], cv[j + 1]
             if hi > lo:
-                left = cc[j] == 1  # (code 1 only where p > 0, or the half frame's u_lo)
-                right = cc[j + 1] == 0
+                left = cc[j] == 1 or cc[j] == 2  # (code 1 only where p > 0, or the half frame's u_lo)
+                right = cc[j + 1] == 0 or cc[j + 1] == 2
                 a = lo
                 if frame != 0 and lo > 0.0:
                     # the half frame near grazing incidence: above u_lo ~ mu / 2 and the level u = mu the
@@ -947,13 +1109,13 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
         lo, hi = cv[j], cv[j + 1]
         if hi > lo:
             # in z the horizon's square root lies above z_s, the level's below z_c
-            left = cc[j] == 0 or (top and cc[j] == -2)
-            right = cc[j + 1] == 1
+            left = cc[j] == 0 or cc[j] == 2 or (top and cc[j] == -2)
+            right = cc[j + 1] == 1 or cc[j + 1] == 2
             # above the horizon break z_s the arc shrinks from the full circle to half of it on
             # the scale of z_s itself (sin(alpha) ~ mu): near grazing z_s is tiny, and the piece
             # is cut at z_s (1 + 4^i) so that no first interval hides that feature
             a = lo
-            if cc[j] == 0:
+            if cc[j] == 0 or cc[j] == 2:
                 zs = lo
                 step = lo  # the first cut at 2 z_s
                 while a + step < hi - step and k < kinds.shape[0] - 4:
@@ -974,7 +1136,13 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
             k += 1
     # beyond Z_MAX: K <= 2 pi in the lobe frame, <= 8 pi in the half-vector frame (4 (wi.h) N.wo / max^p <= 4);
     # with the Beckmann weight, integral_Z^inf e^-t 8 pi (m^2 / 2) u^3 dt, u^3 <= (1 + m^2 Z)^(-3/2) there
-    if radial == 1:
+    # the V-cavity's K <= 16 pi u mu (c G <= 2 u mu): under the Beckmann weight e^-t (m^2 / 2) u^3 K / u^4 <= 8 pi m^2 mu
+    # e^-t; under u^n, integral_0^uz u^(n+1) 16 pi mu du
+    if radial == 1 and frame == 3:
+        left_out = 8.0 * math.pi * n * n * mu * math.exp(-Z_MAX) if k_end == -1 else 0.0
+    elif frame == 3:
+        left_out = 16.0 * math.pi * mu * math.exp(-Z_MAX * (n + 2.0) / n1) / (n + 2.0) if skip and k_end == -1 else 0.0
+    elif radial == 1:
         left_out = 4.0 * math.pi * n * n * math.exp(-Z_MAX) / (1.0 + n * n * Z_MAX) ** 1.5 if k_end == -1 else 0.0
     else:
         left_out = (2.0 if frame == 0 else 8.0) * math.pi * math.exp(-Z_MAX) / n1 if skip and k_end == -1 else 0.0
@@ -1421,6 +1589,8 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
     if hint.kind == "half" and (hint.p not in (0.0, 1.0) or hint.chain is not None):
         raise ValueError(f"{brdf!r}: a half-vector Polar hint needs p in {{0, 1}} and no chain, got p={hint.p!r}")
+    if hint.vcavity and (hint.kind != "half" or hint.p != 0.0 or hint.sqrt_cos):
+        raise ValueError(f"{brdf!r}: a Polar hint with vcavity needs kind 'half', p = 0 and no sqrt_cos")
     if hint.sqrt_cos and (hint.kind != "half" or hint.p != 0.0):
         raise ValueError(f"{brdf!r}: a Polar hint with sqrt_cos needs kind 'half' and p = 0, got {hint.kind!r}, p={hint.p!r}")
     if hint.radial not in ("power", "beckmann") or (hint.radial == "beckmann" and (hint.kind != "half" or not hint.n > 0)):
@@ -1440,7 +1610,7 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         # true error there (m = 0.1, mu = 0.6088: 7.1e-13 against 1.5e-13, at every rtol), the raw |K - G| at most
         # 0.11 of it (7 m x 63 mu x rtol 1e-6 .. 1e-12 against the nested engine at 1e-13): Ward keeps the raw one
         mode = 0 if hint.sqrt_cos else mode_code()
-        _integrate((2 if hint.sqrt_cos else 1) if hint.kind == "half" else 0, 1 if hint.radial == "beckmann" else 0, float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
+        _integrate((3 if hint.vcavity else 2 if hint.sqrt_cos else 1) if hint.kind == "half" else 0, 1 if hint.radial == "beckmann" else 0, float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
                    *(_RULES[RULE]), mode, N_INIT, *_RULES["gk15"], jac, val, err, conv, evals)
     else:  # a pumped lobe, about N
         cuts = [chain_cuts(hint.levels(float(m)), float(hint.n), float(m)) for m in mu]

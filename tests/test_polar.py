@@ -185,7 +185,8 @@ def test_general_p_evaluations():
 
 def test_models_without_a_closed_azimuth_decline():
     for spec in [{"type": "lafortune", "n": 10, "cx": 0.8, "cy": 1.2},
-                 {"type": "ggx", "alpha": 0.1}, {"type": "cook_torrance", "m": 0.3}, {"type": "phong_shader", "n": 5, "kd": 0.1},
+                 {"type": "ggx", "alpha": 0.1}, {"type": "cook_torrance", "m": 0.3, "ior": 1.5},
+                 {"type": "torrance_sparrow", "d": "D2", "s": 5}, {"type": "phong_shader", "n": 5, "kd": 0.1},
                  {"type": "phong_blinn", "n": 5, "kd": 0.1}]:
         assert pumpup.load(spec).polar() is None, spec
     user = pumpup.from_function(lambda wi, wo: np.full(np.broadcast_shapes(wi.shape, wo.shape)[:-1], 0.5 / np.pi),
@@ -297,6 +298,44 @@ def test_ward_kernel_against_the_geometry_and_its_twin(rng):
             assert abs(_polar._carlson_rd(x, y, z) - elliprd(x, y, z)) <= 2e-15 * elliprd(x, y, z)
 
 
+def test_vcavity_kernel_against_the_geometry_and_its_twin(rng):
+    """_k_vcavity (Cook-Torrance's G with F = 1, the azimuth of h in closed form) against an independent
+    quadrature of 4 (wi.h) G built from wi, h, wo and 001 eq. 10's G itself, and its twin, at random u, at the
+    pieces' breaks (u = 1/2, 1/sqrt(2), mu, cos of _vcavity_breaks' angles) and near grazing incidence, where the
+    integrand lives on arcs of width ~mu (the plain differences of arccos lost 8 digits there)."""
+    from scipy.integrate import quad
+
+    def by_geometry(mu, u):
+        s, sa = math.sqrt((1 - mu) * (1 + mu)), math.sqrt((1 - u) * (1 + u))
+        wi = np.array([s, 0.0, mu])
+
+        def g(beta):
+            h = np.array([sa * math.cos(beta), sa * math.sin(beta), u])
+            c = float(wi @ h)
+            wo = 2 * c * h - wi
+            return 4 * c * min(1.0, 2 * h[2] * wo[2] / c, 2 * h[2] * wi[2] / c) if c > 0 and wo[2] > 0 else 0.0
+
+        b, a = s * sa, mu * u
+        pts = [math.acos((cv - a) / b) for cv in (mu / (2 * u), 2 * u * mu, mu / u, 2 * u * mu / (4 * u * u - 1) if u != 0.5 else -9.0)
+               if b > 0 and abs((cv - a) / b) < 1]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return 2 * quad(g, 0, math.pi, points=pts or None, epsabs=0, epsrel=1e-13, limit=400)[0]
+
+    for mu in (1.0, 0.99, 0.9, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8):
+        s = math.sqrt((1 - mu) * (1 + mu))
+        psi = math.atan2(mu, s)
+        brk = [math.cos(x) for x in _polar._vcavity_breaks(mu, s, psi) if x > 0]
+        us = np.concatenate([rng.uniform(0, 1, 8), np.geomspace(mu, 1, 6), [0.5, 1 / math.sqrt(2), mu, 1.0],
+                             [b * (1 + d) for b in brk for d in (-1e-7, 1e-7)]])
+        for u in us[(us > 0) & (us <= 1)]:
+            k = _polar._k_vcavity(mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
+            q = by_geometry(mu, float(u))
+            # relative, with a floor of 1e-14 mu (K <= 16 pi u mu, and the albedo is K / mu)
+            assert abs(k - q) <= 1e-12 * abs(q) + 1e-14 * mu, (mu, u, k, q)
+            assert abs(k - _polar.vcavity_integrand_reference(mu, u)[0]) <= 1e-11 * abs(q) + 1e-14 * mu, (mu, u)
+
+
 def test_trig_tails_against_mpmath():
     """The four functions that cancel at small arcs (series below 1 rad, closed form above) to 1e-15 relative,
     against 50-digit mpmath quadratures of their definitions; and the numpy twin where it does not cancel."""
@@ -323,10 +362,14 @@ HALF_SPECS = [{"type": "blinn", "n": 16}, {"type": "blinn", "n": 0.5}, {"type": 
               {"type": "modified_ward", "m": 5.0}, {"type": "modified_ward", "m": 100.0},
               # Ward: the azimuth by complete elliptic integrals, 1 / sqrt(N.L) in the scale (its albedo diverges)
               {"type": "ward", "m": 0.1}, {"type": "ward", "m": 0.02}, {"type": "ward", "m": 0.2},
-              {"type": "ward", "m": 0.4, "c": 0.6}, {"type": "ward", "m": 1e-4}, {"type": "ward", "m": 5.0}]
+              {"type": "ward", "m": 0.4, "c": 0.6}, {"type": "ward", "m": 1e-4}, {"type": "ward", "m": 5.0},
+              # the V-cavity G with F = 1: the azimuth in closed form (a minimum of three lines in wi.h)
+              {"type": "cook_torrance", "m": 0.3}, {"type": "cook_torrance", "m": 0.02}, {"type": "cook_torrance", "m": 2.0},
+              {"type": "torrance_sparrow", "d": "D1", "s": 20}, {"type": "torrance_sparrow", "d": "D1", "s": 0},
+              {"type": "torrance_sparrow", "d": "D1", "s": 200, "b": 3.0}, {"type": "torrance_sparrow", "d": "D4", "s": 0.1}]
 
 
-@pytest.mark.parametrize("spec", HALF_SPECS, ids=[f"{s['type']}-{s.get('n', s.get('m'))}" for s in HALF_SPECS])
+@pytest.mark.parametrize("spec", HALF_SPECS, ids=[f"{s['type']}-{s.get('n', s.get('m', s.get('s')))}" for s in HALF_SPECS])
 def test_blinn_family_against_the_nested_and_two_d_engines(spec):
     """The 1-D path (kind "half") against the nested engine at rtol 1e-12 (the engine these models had before,
     reached by switching off the 1-D path alone) and the 2-D engine, from normal to grazing incidence; at
@@ -360,12 +403,13 @@ def test_blinn_family_closed_forms():
 def test_blinn_family_evaluations_and_refusals():
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     for spec in ({"type": "blinn", "n": 16}, {"type": "stretched_blinn", "n": 8}, {"type": "modified_ward", "m": 0.1},
-                 {"type": "ward", "m": 0.1}):
+                 {"type": "ward", "m": 0.1}, {"type": "cook_torrance", "m": 0.3}, {"type": "torrance_sparrow", "d": "D1", "s": 20}):
         _, _, conv, evals = _polar.albedo_1d(pumpup.load(spec), mu, 1e-10, 1e-14, 20000)
         assert conv.all() and evals.mean() < 300 and evals.max() < 1000, (spec, evals.mean(), evals.max())
     for hint, match in [({"n": 5.0, "p": 0.5, "kind": "half"}, "p in"), ({"n": 0.1, "p": 1.0, "radial": "beckmann"}, "radial"),
                         ({"n": 0.1, "p": 1.0, "kind": "half", "radial": "ggx"}, "radial"),
-                        ({"n": 0.1, "p": 1.0, "kind": "half", "radial": "beckmann", "sqrt_cos": True}, "sqrt_cos")]:
+                        ({"n": 0.1, "p": 1.0, "kind": "half", "radial": "beckmann", "sqrt_cos": True}, "sqrt_cos"),
+                        ({"n": 0.1, "p": 1.0, "kind": "half", "vcavity": True}, "vcavity")]:
         bad = type("Bad", (), {"polar": lambda self, h=hint: _polar.Polar(scale=lambda m: np.ones(np.shape(m)), **h)})()
         with pytest.raises(ValueError, match=match):
             _polar.albedo_1d(bad, mu[:3], 1e-8, 0.0, 100)

@@ -195,6 +195,17 @@ class CookTorrance(BRDF):
     def lobe(self, mu):
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"], kinks=_g_kinks)
 
+    def polar(self):
+        if self.p["ior"] is not None:
+            return None  # F(wi.h) varies along the arc of h: the nested engine
+        from .._polar import Polar
+
+        m = self.p["m"]
+        # 001 eq. 9 with F = 1: exp(-tan^2 / m^2) / (4 pi m^2 cos^4) G / (N.L N.V); the azimuth of h in closed form
+        # (G's minimum of three lines in wi.h), the Beckmann weight in t = tan^2(alpha) / m^2
+        return Polar(n=m, scale=lambda mu: 1.0 / (4.0 * math.pi * m * m * np.asarray(mu, float)), kind="half",
+                     radial="beckmann", vcavity=True)
+
 
 # ----------------------------------------------------------------------------------------
 # Torrance-Sparrow shaders with Lewis's facet distributions D1-D4
@@ -342,3 +353,16 @@ class TorranceSparrow(BRDF):
             # grazing half vectors, where r = 1 (uniform in sin^2 alpha) is the neutral map
             return Lobe(axis="half", radial="ggx", sharpness=min(s * s, 1.0), kinks=_g_kinks)
         return Lobe(axis="half", radial="beckmann", sharpness=s, kinks=_g_kinks)
+
+    def polar(self):
+        d, e, b = self.p["d"], self.p["s"], self.p["b"]
+        if self.p["ior"] is not None or d not in ("D1", "D4"):
+            return None  # F(wi.h) varies along the arc of h; D2, D3 have no weight of the 1-D path: the nested engine
+        from .._polar import Polar
+
+        # 002 eq. 10 with F = 1: G D / (pi (N.S)(N.V)); the azimuth of h in closed form (pumpup._polar._k_vcavity)
+        if d == "D1":  # D = b cos^e(alpha): the power weight u^e
+            return Polar(n=e, scale=lambda mu: b / (math.pi * np.asarray(mu, float)), kind="half", vcavity=True)
+        # D4 = exp(-tan^2 / m^2) / (4 m^2 cos^4): Cook-Torrance's
+        return Polar(n=e, scale=lambda mu: 1.0 / (4.0 * math.pi * e * e * np.asarray(mu, float)), kind="half",
+                     radial="beckmann", vcavity=True)
