@@ -1544,6 +1544,10 @@ X_PIECES = 8
 N_INIT_CHAIN = 1
 
 
+#: the half-vector frame takes mu >= this (below it mu / (2 u), tan^2(psi / 2) m^2 and their kin underflow; the nested
+#: engine takes such batches, as before the half frame)
+HALF_MU_MIN = 1e-100
+
 #: the 1-D path itself (``without_1d`` switches it off and leaves the nested engine on)
 ONE_D = True
 
@@ -1583,10 +1587,13 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         return None  # (an overflowing constant) the 2-D engine reports what the model returns
     if hint.kind == "constant":
         ulps = hint.ulps(mu) if callable(hint.ulps) else hint.ulps
-        return (scale.copy(), ulps * np.finfo(float).eps * np.abs(scale), np.ones(mu.shape, bool),
-                np.zeros(mu.shape, np.int64))
+        with np.errstate(invalid="ignore"):  # (inf ulps of a scale that underflowed to 0: e^(-s/mu) at mu = 5e-324)
+            err = np.where(scale == 0.0, 0.0, ulps * np.finfo(float).eps * np.abs(scale))
+        return scale.copy(), err, np.ones(mu.shape, bool), np.zeros(mu.shape, np.int64)
     if not 0.0 <= hint.p <= 1.0:
         raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
+    if hint.kind == "half" and mu.size and mu.min() < HALF_MU_MIN:
+        return None  # (the half frame's breaks and arcs underflow there: the nested engine, as before)
     if hint.kind == "half" and (hint.p not in (0.0, 1.0) or hint.chain is not None):
         raise ValueError(f"{brdf!r}: a half-vector Polar hint needs p in {{0, 1}} and no chain, got p={hint.p!r}")
     if hint.vcavity and (hint.kind != "half" or hint.p != 0.0 or hint.sqrt_cos):

@@ -23,7 +23,8 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
     python scripts/bench_albedo.py --eval     # only BRDF.eval's overhead (the input checks) and numpy
     python scripts/bench_albedo.py --phong    # only the Phong family's rows (1-D path), no dblquad
     python scripts/bench_albedo.py --p        # only the p-model with p in (0, 1): 1-D path against the nested engine
-    python scripts/bench_albedo.py --blinn    # only the Blinn family: 1-D path (half vector) against the nested engine
+    python scripts/bench_albedo.py --half     # only the models put on the 1-D path in issue 14's sixth session
+                                              # (half vector, closed forms) against the nested engine
     python scripts/bench_albedo.py --pumped   # only pumped Phong-family chains: 1-D path against the nested engine
     python scripts/bench_albedo.py --breaks   # only the nested families with kinks or levels: the compiled break
                                               # finding against its numpy reference (issue 14 item 3)
@@ -238,13 +239,17 @@ def p_model(rtol=1e-10, repeat=3):
         {"type": "retro", "n": 10, "p": 0.5}], "p-model", rtol, repeat)
 
 
-def blinn_family(rtol=1e-10, repeat=3):
-    """The Blinn family (000 eq. 31, 32; 002 eq. 24; the half vector's azimuth in closed form since issue 14's
-    sixth session) against the nested engine it replaces (:func:`against_nested`)."""
-    against_nested([{"type": "blinn", "n": 16}, {"type": "blinn", "n": 1}, {"type": "blinn", "n": 512, "c": 20.6},
-                    {"type": "stretched_blinn", "n": 8}, {"type": "stretched_blinn", "n": 128, "c": 5.34},
-                    {"type": "phong_blinn", "n": 20}, {"type": "phong_blinn", "n": 5, "ks": 0.5, "kd": 0.1}],
-                   "Blinn family", rtol, repeat)
+def half_and_closed(rtol=1e-10, repeat=3):
+    """The models issue 14's sixth session put on the 1-D path (the half vector's azimuth about N in closed form:
+    the Blinn family, 000 eq. 31, 32 and 002 eq. 24; Ward and modified Ward, 000 eq. 34, 35; Cook-Torrance and
+    Torrance-Sparrow with F = 1, 001 eq. 9-10 and 002 eq. 10; plastic without Fresnel, 000 eq. 30; and the closed
+    forms of Oren-Nayar, Minnaert and the lacquer) against the nested engine they had before (:func:`against_nested`)."""
+    against_nested([{"type": "blinn", "n": 16}, {"type": "blinn", "n": 512, "c": 20.6}, {"type": "stretched_blinn", "n": 8},
+                    {"type": "phong_blinn", "n": 20}, {"type": "ward", "m": 0.1}, {"type": "ward", "m": 0.4},
+                    {"type": "modified_ward", "m": 0.1}, {"type": "cook_torrance", "m": 0.3},
+                    {"type": "cook_torrance", "m": 0.05}, {"type": "torrance_sparrow", "d": "D1", "s": 20},
+                    {"type": "plastic", "n": 20}, {"type": "oren_nayar"}, {"type": "minnaert", "k": 1.0},
+                    {"type": "lacquer"}], "1-D since issue 14's sixth session", rtol, repeat)
 
 
 def pumped_chains(rtol=1e-10, repeat=3):
@@ -478,8 +483,8 @@ def main():
     if "--phong" in sys.argv:
         families(specs=PHONG_FAMILY, dblquad=False)
         return
-    if "--blinn" in sys.argv:
-        blinn_family()
+    if "--half" in sys.argv:
+        half_and_closed()
         return
     if "--p" in sys.argv:
         p_model()
