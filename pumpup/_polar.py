@@ -435,6 +435,31 @@ def _arc_moments(e, sb, b, beta):  # pragma: no cover - compiled; see half_momen
     return sb + beta * e, beta * (e * e + 0.5 * b * b) + 1.5 * e * sb
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _half_arc(mu, s, psi, u, sa):  # pragma: no cover - compiled; see the kernels' twins
+    """The arc of h's azimuth where N.wo > 0, for h at u = N.h, sa = sin(alpha) (s = sin(theta_i),
+    psi = pi/2 - theta_i): (live, b, c0, e0, sb0, beta0, low).  live is False where no h on the circle
+    sends wo above the horizon; b = s sa, c0 = mu / (2 u) (wi.h there), e0 = a - c0 = mu cos(2 alpha) / (2 u);
+    on the full circle (2 alpha <= psi, or b = 0) sb0 = 0, beta0 = pi and low = d(pi) = a - b - c0, else
+    sb0 = b sin(beta0) = sqrt(sin(2 alpha + psi) sin(2 alpha - psi)) / (2 u), each sine with its angle written
+    as a difference of small exact angles near its zero (alpha' = pi/2 - alpha), and low = 0; and those two
+    sines, f1 = 2 u T with T = d(0) = a + b - c0 and f2 = 2 u (b - e0) (0 on the full circle)."""
+    al = math.atan2(sa, u)
+    alc = math.atan2(u, sa)  # pi/2 - alpha, exact where u is small
+    if u <= 0.0 or 2.0 * alc <= psi:  # 2 alpha + psi >= pi: the whole circle of h sends wo below the horizon
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    b = s * sa
+    c0 = 0.5 * mu / u
+    e0 = 0.5 * mu * (u - sa) * (u + sa) / u
+    if 2.0 * al <= psi or b == 0.0:  # the whole circle sends wo above it (b = 0: mu = 1, or h = N)
+        low = 0.5 * math.sin(psi - 2.0 * al) / u
+        return low + 2.0 * b > 0.0, b, c0, e0, 0.0, math.pi, low, 0.0, 0.0
+    f1 = math.sin(2.0 * alc - psi) if 2.0 * al + psi > 0.5 * math.pi else math.sin(2.0 * al + psi)
+    f2 = math.sin(2.0 * alc + psi) if 2.0 * al - psi > 0.5 * math.pi else math.sin(2.0 * al - psi)
+    sb0 = 0.5 * math.sqrt(max(0.0, f1 * f2)) / u
+    return True, b, c0, e0, sb0, math.atan2(sb0, -e0), 0.0, f1, f2
+
+
 @njit(cache=True, nogil=True)
 def _k_half(p, mu, s, psi, u, sa):  # pragma: no cover - compiled; see integrand_reference
     """K(u) of the half-vector frame, p in {0, 1}: the integral over the azimuth beta of h about N of
@@ -452,26 +477,9 @@ def _k_half(p, mu, s, psi, u, sa):  # pragma: no cover - compiled; see integrand
     sa^2 (u - mu)(u + mu) / u^2; the part between beta1 and beta0
     is integrated in delta = beta0 - beta (no cancellation when it is thin, near grazing incidence).
     """
-    if u <= 0.0:
+    live, b, c0, e0, sb0, beta0, dpi, _, _ = _half_arc(mu, s, psi, u, sa)
+    if not live:
         return 0.0
-    al = math.atan2(sa, u)
-    alc = math.atan2(u, sa)  # pi/2 - alpha, exact where u is small
-    b = s * sa
-    c0 = 0.5 * mu / u
-    if 2.0 * alc <= psi:  # 2 alpha + psi >= pi: the whole circle of h sends wo below the horizon
-        return 0.0
-    e0 = 0.5 * mu * (u - sa) * (u + sa) / u  # a - c0 = mu cos(2 alpha) / (2 u)
-    if 2.0 * al <= psi:  # the whole circle sends wo above it
-        sb0, beta0 = 0.0, math.pi
-        dpi = 0.5 * math.sin(psi - 2.0 * al) / u  # d at beta = pi: a - b - c0
-    else:
-        dpi = 0.0
-        # b sin(beta0) = sqrt(sin(2 alpha + psi) sin(2 alpha - psi)) / (2 u); a sine whose angle nears pi is taken
-        # as the sine of pi less it (2 alpha' -+ psi), where that difference is exact
-        f1 = math.sin(2.0 * alc - psi) if 2.0 * al + psi > 0.5 * math.pi else math.sin(2.0 * al + psi)
-        f2 = math.sin(2.0 * alc + psi) if 2.0 * al - psi > 0.5 * math.pi else math.sin(2.0 * al - psi)
-        sb0 = 0.5 * math.sqrt(max(0.0, f1 * f2)) / u
-        beta0 = math.atan2(sb0, -e0)
     j1, j2 = _arc_moments(e0, sb0, b, beta0)
     if p == 0.0:
         return 16.0 * u * (c0 * j1 + j2)  # 2 (both signs of beta) 8 u (c0 J1 + J2)
@@ -556,20 +564,11 @@ def _k_ward(mu, s, psi, u, sa):  # pragma: no cover - compiled; see ward_integra
     recurrence (q + 1) I_(q+1) = (2q + 1) e0 I_q + q (b^2 - e0^2) I_(q-1), from d/d beta (d^q sin(beta)),
     whose boundary terms vanish).  T, 1 - M and 1 - k^2 come from the same exact angle forms as _k_half's.
     """
-    if u <= 0.0:
+    live, b, c0, e0, _, beta0, low, f1, f2 = _half_arc(mu, s, psi, u, sa)
+    if not live:
         return 0.0
-    al = math.atan2(sa, u)
-    alc = math.atan2(u, sa)
-    if 2.0 * alc <= psi:
-        return 0.0
-    b = s * sa
-    c0 = 0.5 * mu / u
-    e0 = 0.5 * mu * (u - sa) * (u + sa) / u
-    if 2.0 * al <= psi or b == 0.0:  # the full circle: d(pi) = a - b - c0 >= 0 (b = 0: mu = 1, or h = N)
-        low = 0.5 * math.sin(psi - 2.0 * al) / u
+    if beta0 == math.pi:  # the full circle: d(pi) = low >= 0, d(0) = T = low + 2 b
         top = low + 2.0 * b
-        if top <= 0.0:  # (mu = 1 and 2 alpha = pi/2 to rounding: nothing above the horizon)
-            return 0.0
         if b == 0.0:
             ih, imh = math.pi * math.sqrt(top), math.pi / math.sqrt(top)
         else:
@@ -579,8 +578,6 @@ def _k_ward(mu, s, psi, u, sa):  # pragma: no cover - compiled; see ward_integra
             imh = 2.0 * rf / math.sqrt(top)
         bb = -low * top  # b^2 - e0^2 = (b - e0)(b + e0)
     else:
-        f1 = math.sin(2.0 * alc - psi) if 2.0 * al + psi > 0.5 * math.pi else math.sin(2.0 * al + psi)
-        f2 = math.sin(2.0 * alc + psi) if 2.0 * al - psi > 0.5 * math.pi else math.sin(2.0 * al - psi)
         top = 0.5 * f1 / u  # T = a + b - c0
         gap = 0.5 * f2 / u  # 2 b - T = b - e0
         rf = _carlson_rf(0.0, gap / (2.0 * b), 1.0)
@@ -606,21 +603,10 @@ def _k_vcavity(mu, s, psi, u, sa):  # pragma: no cover - compiled; see vcavity_i
     S = b sin(beta) = sqrt((b - X)(b + X)) are consistent, so their rounding moves a kink of the (continuous)
     minimum and changes the integral only to second order.
     """
-    if u <= 0.0:
-        return 0.0
-    al = math.atan2(sa, u)
-    alc = math.atan2(u, sa)
-    if 2.0 * alc <= psi:
+    live, b, c0, e0, sb0, _, _, _, _ = _half_arc(mu, s, psi, u, sa)
+    if not live:
         return 0.0
     a = mu * u
-    b = s * sa
-    c0 = 0.5 * mu / u
-    e0 = 0.5 * mu * (u - sa) * (u + sa) / u
-    sb0 = 0.0  # b sin(beta0) at the arc's end (0 on the full circle)
-    if not (2.0 * al <= psi or b == 0.0):
-        f1 = math.sin(2.0 * alc - psi) if 2.0 * al + psi > 0.5 * math.pi else math.sin(2.0 * al + psi)
-        f2 = math.sin(2.0 * alc + psi) if 2.0 * al - psi > 0.5 * math.pi else math.sin(2.0 * al - psi)
-        sb0 = 0.5 * math.sqrt(max(0.0, f1 * f2)) / u
     lo = max(c0, a - b)  # the range of c on the arc
     hi = a + b
     if b == 0.0:  # c = a on the whole circle (mu = 1 or h = N)
@@ -964,6 +950,25 @@ def _sorted_cuts(cv, cc, m):  # pragma: no cover - compiled
         cc[b + 1] = c
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _graded_cuts(kind, lo, hi, left, k, margin, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
+    """Pieces of ``kind`` from lo cut at lo (1 + 4^i) while they fit below hi (and the arrays keep ``margin``
+    slots), written from slot k; the first keeps the left smoothing ``left``.  Returns (where the rest of
+    [lo, hi] starts, the next slot, the rest's left smoothing)."""
+    a = lo
+    step = lo  # the first cut at 2 lo
+    while a + step < hi - step and k < kinds.shape[0] - margin:
+        kinds[k] = kind
+        sms[k] = (1 if left else 0) if a == lo else 0
+        v0[k] = a
+        w[k] = step
+        v1[k] = a + step
+        k += 1
+        a = a + step
+        step = 3.0 * a - 3.0 * lo  # cuts at lo (1 + 4^i)
+    return a, k, left and a == lo
+
+
 @njit(cache=True, nogil=True)
 def _vcavity_breaks(mu, s, psi):  # pragma: no cover - compiled
     """The angles alpha of h from N where :func:`_k_vcavity`'s pieces change (0 for none): where a crossing of
@@ -1076,17 +1081,7 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
                     # the half frame near grazing incidence: above u_lo ~ mu / 2 and the level u = mu the
                     # arc's end c0 = mu / (2 u) changes on the scale of u itself, so the piece is cut at
                     # lo (1 + 4^i) (as above z_s below): one first interval on [mu / 2, 1/2] hid it
-                    step = lo
-                    while a + step < hi - step and k < kinds.shape[0] - 8:
-                        kinds[k] = 0
-                        sms[k] = (1 if left else 0) if a == lo else 0
-                        v0[k] = a
-                        w[k] = step
-                        v1[k] = a + step
-                        k += 1
-                        a = a + step
-                        step = 3.0 * a - 3.0 * lo
-                    left = left and a == lo
+                    a, k, left = _graded_cuts(0, lo, hi, left, k, 8, kinds, sms, v0, w, v1)
                 kinds[k] = 0
                 sms[k] = (1 if left else 0) + (2 if right else 0)
                 v0[k] = a
@@ -1116,18 +1111,7 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
             # is cut at z_s (1 + 4^i) so that no first interval hides that feature
             a = lo
             if cc[j] == 0 or cc[j] == 2:
-                zs = lo
-                step = lo  # the first cut at 2 z_s
-                while a + step < hi - step and k < kinds.shape[0] - 4:
-                    kinds[k] = peak
-                    sms[k] = (1 if left else 0) if a == lo else 0
-                    v0[k] = a
-                    w[k] = step
-                    v1[k] = a + step
-                    k += 1
-                    a = a + step
-                    step = 3.0 * a - 3.0 * zs  # cuts at z_s (1 + 4^i)
-                left = left and a == lo
+                a, k, left = _graded_cuts(peak, lo, hi, left, k, 4, kinds, sms, v0, w, v1)
             kinds[k] = peak
             sms[k] = (1 if left else 0) + (2 if right else 0)
             v0[k] = a

@@ -234,10 +234,11 @@ def test_two_d_only_restores_the_switch():
 # --- the Blinn family: the half vector's azimuth about N in closed form (kind "half") -----------------
 
 
-def _k_half_by_quad(p, mu, u, root=False):
+def _k_half_by_quad(p, mu, u, kind="max"):
     """K(u) of the half-vector frame straight from the geometry, by scipy quad over the azimuth of h:
     wo = 2 (wi.h) h - wi, integrand 4 (wi.h) N.wo / max(mu, N.wo)^p where N.wo > 0 (split at the arcs' ends);
-    with ``root``, 4 (wi.h) sqrt(N.wo) (Ward's, its 1 / sqrt(N.L) left out)."""
+    kind "root": 4 (wi.h) sqrt(N.wo) (Ward's, its 1 / sqrt(N.L) left out); "vcavity": 4 (wi.h) G with 001 eq. 10's
+    G = min(1, 2 (N.h)(N.wo) / (wo.h), 2 (N.h)(N.wi) / (wo.h)) (Cook-Torrance's, F = 1), split at its kinks too."""
     from scipy.integrate import quad
 
     s, sa = math.sqrt((1 - mu) * (1 + mu)), math.sqrt((1 - u) * (1 + u))
@@ -249,13 +250,17 @@ def _k_half_by_quad(p, mu, u, root=False):
         nwo = 2 * c * u - mu
         if not (c > 0 and nwo > 0):
             return 0.0
-        return 4 * c * math.sqrt(nwo) if root else 4 * c * nwo / max(mu, nwo) ** p
+        if kind == "vcavity":
+            return 4 * c * min(1.0, 2 * u * nwo / c, 2 * u * mu / c)
+        return 4 * c * math.sqrt(nwo) if kind == "root" else 4 * c * nwo / max(mu, nwo) ** p
 
     b, a = s * sa, mu * u
-    pts = [math.acos((cv - a) / b) for cv in (mu / (2 * u), mu / u) if b > 0 and abs((cv - a) / b) < 1]
+    cuts = (mu / (2 * u), mu / u) + ((2 * u * mu, 2 * u * mu / (4 * u * u - 1) if u != 0.5 else -9.0) if kind == "vcavity" else ())
+    pts = [math.acos((cv - a) / b) for cv in cuts if b > 0 and abs((cv - a) / b) < 1]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return 2 * quad(g, 0, math.pi, points=pts or None, epsabs=1e-15, epsrel=1e-13, limit=200)[0]
+        return 2 * quad(g, 0, math.pi, points=pts or None, epsabs=1e-15 if kind != "vcavity" else 0, epsrel=1e-13,
+                        limit=400)[0]
 
 
 @pytest.mark.parametrize("p", [0.0, 1.0])
@@ -289,7 +294,7 @@ def test_ward_kernel_against_the_geometry_and_its_twin(rng):
         us = np.concatenate([rng.uniform(0, 1, 10), [1.0, 1 - 1e-12], [e * (1 + d) for e in edges for d in (-1e-6, 1e-6)]])
         for u in us[(us > 0) & (us <= 1)]:
             k = _polar._k_ward(mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
-            q = _k_half_by_quad(0.0, mu, float(u), root=True)
+            q = _k_half_by_quad(0.0, mu, float(u), kind="root")
             assert abs(k - q) <= 1e-12 * max(abs(q), 1.0), (mu, u, k, q)
             assert abs(k - _polar.ward_integrand_reference(mu, u)[0]) <= 1e-11 * max(abs(q), 1.0), (mu, u)
     for args in rng.uniform(0, 3, (300, 3)) * 10.0 ** rng.integers(-12, 4, (300, 3)):
@@ -303,25 +308,6 @@ def test_vcavity_kernel_against_the_geometry_and_its_twin(rng):
     quadrature of 4 (wi.h) G built from wi, h, wo and 001 eq. 10's G itself, and its twin, at random u, at the
     pieces' breaks (u = 1/2, 1/sqrt(2), mu, cos of _vcavity_breaks' angles) and near grazing incidence, where the
     integrand lives on arcs of width ~mu (the plain differences of arccos lost 8 digits there)."""
-    from scipy.integrate import quad
-
-    def by_geometry(mu, u):
-        s, sa = math.sqrt((1 - mu) * (1 + mu)), math.sqrt((1 - u) * (1 + u))
-        wi = np.array([s, 0.0, mu])
-
-        def g(beta):
-            h = np.array([sa * math.cos(beta), sa * math.sin(beta), u])
-            c = float(wi @ h)
-            wo = 2 * c * h - wi
-            return 4 * c * min(1.0, 2 * h[2] * wo[2] / c, 2 * h[2] * wi[2] / c) if c > 0 and wo[2] > 0 else 0.0
-
-        b, a = s * sa, mu * u
-        pts = [math.acos((cv - a) / b) for cv in (mu / (2 * u), 2 * u * mu, mu / u, 2 * u * mu / (4 * u * u - 1) if u != 0.5 else -9.0)
-               if b > 0 and abs((cv - a) / b) < 1]
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            return 2 * quad(g, 0, math.pi, points=pts or None, epsabs=0, epsrel=1e-13, limit=400)[0]
-
     for mu in (1.0, 0.99, 0.9, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8):
         s = math.sqrt((1 - mu) * (1 + mu))
         psi = math.atan2(mu, s)
@@ -330,7 +316,7 @@ def test_vcavity_kernel_against_the_geometry_and_its_twin(rng):
                              [b * (1 + d) for b in brk for d in (-1e-7, 1e-7)]])
         for u in us[(us > 0) & (us <= 1)]:
             k = _polar._k_vcavity(mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
-            q = by_geometry(mu, float(u))
+            q = _k_half_by_quad(0.0, mu, float(u), kind="vcavity")
             # relative, with a floor of 1e-14 mu (K <= 16 pi u mu, and the albedo is K / mu)
             assert abs(k - q) <= 1e-12 * abs(q) + 1e-14 * mu, (mu, u, k, q)
             assert abs(k - _polar.vcavity_integrand_reference(mu, u)[0]) <= 1e-11 * abs(q) + 1e-14 * mu, (mu, u)
