@@ -231,3 +231,11 @@ def test_agrees_with_westins_reference_implementation():
         for s in case["specular"]:
             assert abs(float(f.specular_weight(s["mu"])) - s["weight"]) <= 1e-12 * s["weight"] + 1e-300, (case["spec"], s)
     assert n >= 20
+
+
+def test_tiny_wavelength_is_refused_in_one_line():
+    """g = (4 pi sigma_0 / lambda)^2 overflowed for lambda = 3.4e-181 (found by the slow property test): the
+    ratio is compared before squaring, and the refusal names both parameters and the allowed range."""
+    for wl in (3.3692610298414625e-181, 1e-300):
+        with pytest.raises(pumpup.SpecError, match=r"'sigma_0' / 'wavelength' = .* outside its allowed range"):
+            pumpup.load({"type": "he_torrance", "sigma_0": 0.1, "tau": 1.7, "wavelength": wl})

@@ -397,9 +397,9 @@ class HeTorrance(BRDF):
         p = self.p
         if p["n"] is None and p["k"] != 0.0:
             raise SpecError("he_torrance: parameter 'k' = %g needs the real index 'n' as well" % p["k"])
-        g0 = (4.0 * math.pi * p["sigma_0"] / p["wavelength"]) ** 2
-        if g0 > G_MAX:
-            lim = math.sqrt(G_MAX) / (4 * math.pi)
+        ratio = p["sigma_0"] / p["wavelength"]  # (compared before squaring: a wavelength of 1e-181 overflowed g)
+        lim = math.sqrt(G_MAX) / (4 * math.pi)
+        if not ratio <= lim:
             raise SpecError(
                 f"he_torrance: parameter 'sigma_0' / 'wavelength' = {p['sigma_0'] / p['wavelength']:g} is outside "
                 f"its allowed range (0, {lim:.4g}] (g = (4 pi sigma_0 / lambda)^2 <= {G_MAX:g}; rougher surfaces "
