@@ -1347,7 +1347,7 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
     two first grids, (8, 8) and ``GENERIC_GRID2``: the value is the second's, the error the larger estimate
     plus the difference of the two (a kink missed by one grid and not by the other shows there: stretched
     Phong n = 1 at mu = 0.01 gave 1.9e-7 and 7e-12 off on the two grids), and it is converged only if both
-    are and the sum meets the tolerance.  This costs the generic path about twice the evaluations.
+    are and their difference meets the tolerance.  This costs the generic path about twice the evaluations.
     """
     generic = g.lobe.axis == "normal" and g.lobe.radial == "cosine" and not g.lobe.symmetric
     if generic and GENERIC_CHECK and grid is None:

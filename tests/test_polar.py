@@ -400,3 +400,18 @@ def test_blinn_family_evaluations_and_refusals():
         with pytest.raises(ValueError, match=match):
             _polar.albedo_1d(bad, mu[:3], 1e-8, 0.0, 100)
     assert pumpup.pump({"type": "stretched_blinn", "n": 8}, g="g1").polar() is None  # pumped: the nested engine
+
+
+def test_pumped_plastic_takes_the_chain_path():
+    """Plastic without Fresnel (000 eq. 30) has stretched Phong's lobe, so its pumped levels take the 1-D
+    path about N (pumpup._polar._integrate_chain); against the nested engine on the same BRDFs (their tables
+    built first) at rtol 1e-12."""
+    mu = np.array([1.0, 0.7, 0.3, 0.05, 1e-3])
+    for g in ("g1", "g2"):
+        f = pumpup.pump({"type": "plastic", "n": 20, "ad": 0.0, "a_s": 0.9}, g=g, levels=2)
+        assert f.polar() is not None and f.polar().chain is not None
+        a, e = pumpup.albedo(f, mu, return_error=True)
+        with _polar.without_1d(), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
+        assert np.all(np.abs(a - b) <= e + eb), (g, (np.abs(a - b) / (e + eb)).max())
