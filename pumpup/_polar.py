@@ -1177,7 +1177,9 @@ def _bisect(pk, t0, t1, worst, m):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True)
 def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, inodes, iwk, iwg, jac, val, err, conv, evals):  # pragma: no cover
     """Adaptive Gauss-Kronrod (the rule ``nodes``, ``wk``, ``wg``) of integral u^n K(u) du for
-    every mu (without the scale)."""
+    every mu (without the scale); ``frame`` 0 the lobe frame (:func:`_k_closed`, :func:`_k_of_u`), 1-3 the
+    half vector's (:func:`_k_half`, :func:`_k_ward`, :func:`_k_vcavity`), ``radial`` 1 the Beckmann weight
+    in place of u^n (:func:`_pieces`)."""
     cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals, nodes, inodes, rtol)
     kinds = np.empty(MAX_PIECES, np.int64)
     sms = np.empty(MAX_PIECES, np.int64)
