@@ -156,8 +156,9 @@ class Polar:
         Lafortune lobe, k_s / mu for Phong's shader, k_rho / H_s(mu) for Lewis's Phong).
     kind : {"lobe", "constant", "half"}
         "half": u is N.h, h the half vector of wi and wo (the Blinn family, 000 eq. 31, 32; 002
-        eq. 24), p in {0, 1}: a(mu) = scale(mu) * integral_0^1 u^n K(u) du with the azimuth of h
-        about N in closed form (:func:`_k_half`).
+        eq. 24; with ``radial``, ``sqrt_cos``, ``vcavity`` below also modified Ward, Ward, Cook-Torrance and
+        Torrance-Sparrow), p in {0, 1}: a(mu) = scale(mu) * integral_0^1 u^n K(u) du with the azimuth of h
+        about N in closed form (:func:`_k_half`, :func:`_k_ward`, :func:`_k_vcavity`).
     chain : tuple, optional
         A pumped BRDF's divisor (:meth:`pumpup.pumping.Pumped._chain_args`): the integrand is then
         divided by g_1 ... g_k (mu, N.wo) (001 eq. 16), a function of N.wo only for a fixed wi,
@@ -438,12 +439,12 @@ def _arc_moments(e, sb, b, beta):  # pragma: no cover - compiled; see half_momen
 @njit(cache=True, nogil=True, inline="always")
 def _half_arc(mu, s, psi, u, sa):  # pragma: no cover - compiled; see the kernels' twins
     """The arc of h's azimuth where N.wo > 0, for h at u = N.h, sa = sin(alpha) (s = sin(theta_i),
-    psi = pi/2 - theta_i): (live, b, c0, e0, sb0, beta0, low).  live is False where no h on the circle
+    psi = pi/2 - theta_i): (live, b, c0, e0, sb0, beta0, low, f1, f2).  live is False where no h on the circle
     sends wo above the horizon; b = s sa, c0 = mu / (2 u) (wi.h there), e0 = a - c0 = mu cos(2 alpha) / (2 u);
     on the full circle (2 alpha <= psi, or b = 0) sb0 = 0, beta0 = pi and low = d(pi) = a - b - c0, else
     sb0 = b sin(beta0) = sqrt(sin(2 alpha + psi) sin(2 alpha - psi)) / (2 u), each sine with its angle written
     as a difference of small exact angles near its zero (alpha' = pi/2 - alpha), and low = 0; and those two
-    sines, f1 = 2 u T with T = d(0) = a + b - c0 and f2 = 2 u (b - e0) (0 on the full circle)."""
+    sines, f1 = 2 u T with T = d(0) = a + b - c0 and f2 = 2 u (b - e0) (0 on the full circle): nine values."""
     al = math.atan2(sa, u)
     alc = math.atan2(u, sa)  # pi/2 - alpha, exact where u is small
     if u <= 0.0 or 2.0 * alc <= psi:  # 2 alpha + psi >= pi: the whole circle of h sends wo below the horizon
@@ -461,7 +462,7 @@ def _half_arc(mu, s, psi, u, sa):  # pragma: no cover - compiled; see the kernel
 
 
 @njit(cache=True, nogil=True)
-def _k_half(p, mu, s, psi, u, sa):  # pragma: no cover - compiled; see integrand_reference
+def _k_half(p, mu, s, psi, u, sa):  # pragma: no cover - compiled; see half_integrand_reference
     """K(u) of the half-vector frame, p in {0, 1}: the integral over the azimuth beta of h about N of
     4 (wi.h) N.wo / max(mu, N.wo)^p where N.wo > 0, for h at u = N.h = cos(alpha), sa = sin(alpha);
     s = sin(theta_i), psi = pi / 2 - theta_i = atan2(mu, s) (exact near grazing incidence, where the
@@ -471,11 +472,10 @@ def _k_half(p, mu, s, psi, u, sa):  # pragma: no cover - compiled; see integrand
     form of N.wo about R, pumpup._polar's lobe frame); N.wo = 2 c u - mu, so N.wo > 0 where
     c > c0 = mu / (2 u), and N.wo >= mu where c >= c1 = 2 c0.  On the arc |beta| < beta0 (c > c0),
     with d = c - c0 >= 0: p = 0 integrates 4 c 2 u d = 8 u (c0 d + d^2); p = 1 that on the part
-    |beta| > beta1 (c < c1), divided by mu = 2 u c0, and 4 c on |beta| < beta1.  The arc's ends are
-    exact: b^2 - (a - c0)^2 = sin(2 alpha + psi) sin(2 alpha - psi) / (4 u^2), each sine with its angle
-    written as a difference of small exact angles near its zero (with alpha' = pi/2 - alpha) and b^2 - (a - c1)^2 =
-    sa^2 (u - mu)(u + mu) / u^2; the part between beta1 and beta0
-    is integrated in delta = beta0 - beta (no cancellation when it is thin, near grazing incidence).
+    |beta| > beta1 (c < c1), divided by mu = 2 u c0, and 4 c on |beta| < beta1.  The arc's end beta0 comes
+    exact from :func:`_half_arc`, beta1 from b^2 - (a - c1)^2 = sa^2 (u - mu)(u + mu) / u^2; the part between
+    beta1 and beta0 is integrated in delta = beta0 - beta (no cancellation when it is thin, near grazing
+    incidence).
     """
     live, b, c0, e0, sb0, beta0, dpi, _, _ = _half_arc(mu, s, psi, u, sa)
     if not live:
@@ -562,7 +562,7 @@ def _k_ward(mu, s, psi, u, sa):  # pragma: no cover - compiled; see ward_integra
     on the full circle (k^2 = 2 b / T <= 1) I_1/2 = 2 sqrt(T) E(k^2) = 2 sqrt(T) (R_F - k^2 R_D / 3),
     I_-1/2 = 2 R_F / sqrt(T) at (0, 1 - k^2, 1); and 3 I_3/2 = 4 e0 I_1/2 + (b^2 - e0^2) I_-1/2 (the
     recurrence (q + 1) I_(q+1) = (2q + 1) e0 I_q + q (b^2 - e0^2) I_(q-1), from d/d beta (d^q sin(beta)),
-    whose boundary terms vanish).  T, 1 - M and 1 - k^2 come from the same exact angle forms as _k_half's.
+    whose boundary terms vanish).  T, 1 - M and 1 - k^2 come from :func:`_half_arc`'s exact angle forms.
     """
     live, b, c0, e0, _, beta0, low, f1, f2 = _half_arc(mu, s, psi, u, sa)
     if not live:
@@ -612,20 +612,18 @@ def _k_vcavity(mu, s, psi, u, sa):  # pragma: no cover - compiled; see vcavity_i
     if b == 0.0:  # c = a on the whole circle (mu = 1 or h = N)
         g = min(a, 2.0 * u * mu, 4.0 * u * u * a - 2.0 * u * mu)
         return 8.0 * math.pi * g if a > c0 else 0.0
-    cuts = np.empty(5)
-    n = 0
-    cuts[n] = lo
-    n += 1
-    for cv in (2.0 * u * mu, mu / u, 2.0 * u * mu / (4.0 * u * u - 1.0) if 4.0 * u * u > 1.0 else -1.0):
-        if lo < cv < hi:
-            cuts[n] = cv
-            n += 1
-    cuts[n] = hi
-    n += 1
-    _sorted_cuts(cuts, np.zeros(5, np.int64), n)
+    # the lines' crossings inside (lo, hi), sorted (those outside stand at hi: their pieces are empty); scalars,
+    # not an array: this runs at every node
+    x1, x2 = 2.0 * u * mu, mu / u
+    x3 = 2.0 * u * mu / (4.0 * u * u - 1.0) if 4.0 * u * u > 1.0 else hi
+    x1, x2, x3 = (x1 if lo < x1 < hi else hi), (x2 if lo < x2 < hi else hi), (x3 if lo < x3 < hi else hi)
+    x1, x2 = min(x1, x2), max(x1, x2)
+    x2, x3 = min(x2, x3), max(x2, x3)
+    x1, x2 = min(x1, x2), max(x1, x2)
     total = 0.0
-    for j in range(n - 1):
-        c_lo, c_hi = cuts[j], cuts[j + 1]
+    for j in range(4):
+        c_lo = lo if j == 0 else (x1 if j == 1 else (x2 if j == 2 else x3))
+        c_hi = x1 if j == 0 else (x2 if j == 1 else (x3 if j == 2 else hi))
         if not c_hi > c_lo:
             continue
         # X = c - a = b cos(beta) and S = b sin(beta) at both ends (c decreases with beta): the arc's end exactly
@@ -637,7 +635,7 @@ def _k_vcavity(mu, s, psi, u, sa):  # pragma: no cover - compiled; see vcavity_i
         else:
             x_lo = c_lo - a
             s_lo = math.sqrt(max(0.0, (b - x_lo) * (b + x_lo)))
-        if j == n - 2:
+        if c_hi == hi:
             x_hi, s_hi = b, 0.0
         else:
             x_hi = c_hi - a
@@ -1005,9 +1003,9 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
 
     Breakpoints: u = 0, 1/2, 1 and, in the lobe frame (``frame`` 0), u = s (the horizon starts to cut
     the arc) and cos 2 theta_i (the level mu leaves it, p > 0); in the half-vector frame (1,
-    :func:`_k_half`; 2, :func:`_k_ward`), u = cos(pi/4 - theta_i/2) (the horizon starts to cut h's circle), cos(theta_i)
-    (the level mu leaves it, p > 0) and u_lo = cos(pi/4 + theta_i/2), below which no h sends wo above
-    the horizon (the range starts there).  kind 0: u in [v0, v1 = v0 + w] (u <= 1/2); kind 1:
+    :func:`_k_half`; 2, :func:`_k_ward`; 3, :func:`_k_vcavity`), u = cos(pi/4 - theta_i/2) (the horizon starts
+    to cut h's circle), cos(theta_i) (the level mu leaves it, p > 0), u_lo = cos(pi/4 + theta_i/2), below which
+    no h sends wo above the horizon (the range starts there), and for frame 3 :func:`_vcavity_breaks`.  kind 0: u in [v0, v1 = v0 + w] (u <= 1/2); kind 1:
     z = -(n + 1) ln u in [v0, v1].  Where exp(-Z_MAX / (n + 1)) > 1/2 the range of u below it is left
     out (its bound is returned).  With ``radial`` 1 (the half frame's Beckmann weight, ``n`` = m) the
     whole range is kind 2, t = tan^2(alpha) / m^2 in [0, Z_MAX] (:func:`_u_at`), cut at the same breaks.
@@ -1017,8 +1015,8 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
     uz = math.exp(-Z_MAX / n1)
     skip = uz > 0.5
     z_split = Z_MAX if skip else n1 * math.log(2.0)
-    # breakpoints in u, and their z = -(n + 1) ln u to full precision; codes 0: horizon (sqrt
-    # below), 1: level mu (sqrt above)
+    # breakpoints in u, and their z = -(n + 1) ln u (or t) to full precision; codes 0: horizon (sqrt
+    # below), 1: level mu (sqrt above), 2: a kink smoothed on both sides
     ub = np.empty(8)
     zb = np.empty(8)
     kb = np.empty(8, np.int64)

@@ -276,7 +276,7 @@ def test_half_kernel_against_the_geometry_and_its_numpy_twin(rng, p):
             k = _polar._k_half(p, mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
             q = _k_half_by_quad(p, mu, float(u))
             twin = _polar.half_integrand_reference(p, mu, np.array([u]))[0]
-            assert abs(k - q) <= 1e-11 * max(abs(q), 1.0), (p, mu, u, k, q)  # K is at most 8 pi
+            assert abs(k - q) <= 1e-13 * max(abs(q), 1.0), (p, mu, u, k, q)  # K is at most 8 pi (measured: 1.3e-15)
             # (the twin's differences of antiderivatives cancel, by ~1 / mu for p = 1: the kernel avoids them)
             assert abs(k - twin) <= 1e-11 * max(abs(twin), 1.0) + 1e-15 * mu**-p, (p, mu, u, k, twin)
 
@@ -295,7 +295,7 @@ def test_ward_kernel_against_the_geometry_and_its_twin(rng):
         for u in us[(us > 0) & (us <= 1)]:
             k = _polar._k_ward(mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
             q = _k_half_by_quad(0.0, mu, float(u), kind="root")
-            assert abs(k - q) <= 1e-12 * max(abs(q), 1.0), (mu, u, k, q)
+            assert abs(k - q) <= 1e-13 * max(abs(q), 1.0), (mu, u, k, q)  # (measured: 1.7e-14)
             assert abs(k - _polar.ward_integrand_reference(mu, u)[0]) <= 1e-11 * max(abs(q), 1.0), (mu, u)
     for args in rng.uniform(0, 3, (300, 3)) * 10.0 ** rng.integers(-12, 4, (300, 3)):
         for x, y, z in (args, (0.0, args[1], args[2]), (0.0, min(args[1], 1.0), 1.0)):
