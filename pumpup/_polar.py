@@ -1,4 +1,5 @@
-"""One-dimensional albedo where the azimuth integrates in closed form (Phong, Blinn, Ward, Cook-Torrance families).
+"""One-dimensional albedo where the azimuth integrates in closed form (Phong, Blinn, Ward, Cook-Torrance families) or by
+a rule on known arcs (GGX, Beckmann, Schlick, Fresnel factors).
 
 Method
 ------
@@ -103,9 +104,27 @@ true error there).  The V-cavity microfacet models with F = 1 (Cook-Torrance, 00
 with D1 or D4, 002 eq. 10; ``Polar(vcavity=True)``) integrate 4 c G = 4 min(c, 2 u mu, 2 u N.wo) on the arc: a
 minimum of three lines in c, so each range of c between their crossings contributes its arc length and its
 integral of c (:func:`_k_vcavity`, with cancellation-free differences: near grazing incidence the integrand lives
-on arcs of width ~mu), and the pieces' changes in u are breaks (:func:`_vcavity_breaks`).  With a Fresnel factor
-(``ior``) they stay on the nested engine.  Pumped Blinn BRDFs stay on the nested engine too (``Pumped.polar``
-takes lobes about R only).
+on arcs of width ~mu), and the pieces' changes in u are breaks (:func:`_vcavity_breaks`); Torrance-Sparrow's D3 = b / (cos^4 (1 + tan^2 /
+c3^2)^2) is the same azimuth under the GGX weight (``Polar(radial="ggx")``: z = ln(1 + tan^2(alpha) / m^2), weight
+e^-z dz, :func:`_u_at` kind 3).  Pumped Blinn BRDFs stay on the nested engine (``Pumped.polar`` takes lobes about R
+only).
+
+Where the integrand over beta is a function of c alone but has no elementary integral (frame 4, :func:`_k_numeric`)
+the arc is integrated by a rule: the Smith microfacet models (GGX, Beckmann, alpha <= 1: 4 c F(c) G / mu with
+G = G1(mu) G1(N.wo) or the height-correlated form, Walter et al. 2007 eq. 20; ``Polar(smith=...)``), the V-cavity
+models with a Fresnel factor (4 F(c) min(c, 2 u mu, 2 u N.wo); ``Polar(vcavity=True, fresnel=...)``) and Schlick's
+model (4 c N.wo / (r + (1 - r) N.wo), 000 eq. 36, under the GGX weight with alpha = sqrt(r); ``Polar(schlick=r)``).
+The rule is globally adaptive 7/15 Gauss-Kronrod in delta = beta0 - beta from the arc's end (where d = c - c0 =
+2 e0 sin^2(delta / 2) + b sin(beta0) sin(delta), no cancellation), cut at the kinks and jumps (the V-cavity's
+crossings, Walter's G1 switch) and, where a factor has a singularity near the arc's small end (P(N.wo) at N.wo ~ +-i
+alpha, Schlick's pole at -r / (1 - r), the Fresnel factor at c ~ +-i sqrt(|1 - index^2|)), at N.wo or c = scale 3^k,
+so that each piece lies its own length from it.  The outer variable is cut at the same scale where K(u) turns (around
+the horizon break and the range's end, :func:`_pieces`).  Each K carries its error (relative ``itol``, or an absolute
+share of the integral's lower bound so far), added to the outer estimate through the Kronrod weights and into |K - G|
+before its calibration.  GGX alpha = 0.001 showed why the cuts are needed: without the outer ones the first version was
+1.6e-10 off at rtol 1e-12 with an estimate of 6e-13 (30-digit mpmath, ``scripts/half_mpmath_reference.py``, and the
+nested engine agree).  alpha > 1 (P then has a singularity near N.wo = 1, which is not graded) and Torrance-Sparrow's
+D2 stay on the nested engine.
 
 A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
 :class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D
@@ -166,9 +185,10 @@ class Polar:
     levels : callable, optional
         With ``chain``: ``levels(mu)`` -> the values of N.wo where g has a kink
         (:meth:`pumpup.pumping.Pumped.kink_levels` of every level, and the base's level mu).
-    radial : {"power", "beckmann"}
+    radial : {"power", "beckmann", "ggx"}
         The lobe's radial factor: u^n ("power"), or, with kind "half", the Beckmann weight
-        exp(-tan^2(alpha) / m^2) with m = ``n`` (the modified Ward model, 000 eq. 35).
+        exp(-tan^2(alpha) / m^2) with m = ``n`` (the modified Ward model, 000 eq. 35), or the GGX weight
+        1 / (1 + tan^2(alpha) / m^2)^2 (GGX, Walter et al. 2007 eq. 33; Torrance-Sparrow's D3, 002 sec. 3.2).
     vcavity : bool
         With kind "half" and p = 0: the lobe is the V-cavity microfacet model's D G / (N.L N.V) with F = 1
         (Cook-Torrance, 001 eq. 9-10; Torrance-Sparrow, 002 eq. 10; :func:`_k_vcavity`), D the radial factor
@@ -179,6 +199,17 @@ class Polar:
     sqrt_cos : bool
         With kind "half" and p = 0: the lobe is divided by sqrt(N.wo) (Ward, 000 eq. 34: sqrt(N.L N.V), its
         1 / sqrt(N.L) in ``scale``; :func:`_k_ward`).
+    smith : tuple, optional
+        With kind "half", p = 0 and the Beckmann or GGX weight: the lobe is a Smith microfacet model's
+        D F G / (4 N.L N.V) (Walter et al. 2007 eq. 20), given as (distribution: 0 Beckmann, 1 GGX; G1: 0 exact, 1
+        Walter's fit; shadowing: 0 separable, 1 height-correlated; alpha); its azimuth by a rule on h's arc
+        (:func:`_k_numeric`), D's 1 / (pi alpha^2) and the 1 / 4 in ``scale``.
+    fresnel : tuple
+        (ior, eta, k): the Fresnel factor at wi.h of a Smith or V-cavity lobe, dielectric (ior > 0) or conductor
+        (eta > 0), or none (all 0); a V-cavity lobe with one takes the rule on h's arc too.
+    schlick : float, optional
+        With kind "half", p = 0 and the GGX weight (n = sqrt(r)): Schlick's model (000 eq. 36) with this r, whose
+        1 / (r + (1 - r) N.V) the rule on h's arc integrates (:func:`_k_numeric`); 1 / (r + (1 - r) N.L) in ``scale``.
     """
 
     n: float = 0.0
@@ -191,6 +222,9 @@ class Polar:
     sqrt_cos: bool = False
     ulps: object = 4.0
     vcavity: bool = False
+    smith: tuple | None = None
+    fresnel: tuple = (0.0, 0.0, 0.0)
+    schlick: float | None = None
 
 
 @contextlib.contextmanager
@@ -661,6 +695,168 @@ def _k_vcavity(mu, s, psi, u, sa):  # pragma: no cover - compiled; see vcavity_i
     return 8.0 * total  # 2 (both signs of beta) 4 c G
 
 
+# --- frame 4: the half vector's azimuth by a rule on its arc (Smith microfacet models, Fresnel factors) ------
+
+
+#: frame 4's models (``mp[0]``): the Smith microfacet models (Beckmann, GGX; :class:`Polar` ``smith``), the
+#: V-cavity models with a Fresnel factor (Cook-Torrance, Torrance-Sparrow with ``ior``) and Schlick's model
+#: (``Polar.schlick``)
+SMITH, VCAVITY_F, SCHLICK = 0, 1, 2
+#: the slots of frame 4's parameter array ``mp`` (float64): model, Smith's distribution (0 Beckmann, 1 GGX), G1 (0
+#: exact, 1 Walter's fit), shadowing (0 separable, 1 height-correlated), alpha, ior, eta, k, P(mu) (set per mu by
+#: :func:`_integrate`), the level N.wo of Walter's G1 switch (-1 for none), the scale c_F of the Fresnel factor's
+#: feature at small wi.h (sqrt(|1 - (eta + i k)^2|), sqrt(ior^2 - 1); inf for none: :func:`fresnel_scale`), the scale
+#: z_s of the integrand's feature at small N.wo (alpha for the Smith models, Schlick's r / (1 - r); inf for none)
+MP_SIZE = 12
+
+
+def fresnel_scale(ior: float, eta: float, k: float) -> float:
+    """c_F: the Fresnel factor F(c) has its singularities where c^2 = 1 - index^2, |c| = c_F = sqrt(|1 - index^2|)
+    (a dielectric's real ior, or a conductor's eta + i k), which near an index of 1 come close to the arc's small c;
+    :func:`_k_numeric` cuts the arc at c = c_F 3^k there.  inf without a Fresnel factor."""
+    if eta > 0.0:
+        return math.sqrt(abs(1.0 - complex(eta, k) ** 2))
+    return math.sqrt((ior - 1.0) * (ior + 1.0)) if ior > 0.0 else math.inf
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _phi_numeric(mp, mu, u, c0, d):  # pragma: no cover - compiled; see numeric_integrand_reference
+    """Frame 4's integrand 4 c F(c) Gamma at d = c - c0 >= 0 (c = wi.h, N.wo = z = 2 u d): Gamma = G / mu for the
+    Smith models (G = G1(mu) G1(z) = mu z / (P(mu) P(z)), Walter et al. 2007 eq. 20; or the height-correlated
+    mu z / (z P(mu) + mu P(z) - mu z), Heitz 2014; P(w) = N.w / G1(w), pumpup.models.microfacet), Gamma = G =
+    min(1, 2 u mu / c, 2 u z / c) for the V-cavity (001 eq. 10); F the dielectric (ior, 002 sec. 3.2) or conductor
+    (eta, k) Fresnel factor at c, or 1."""
+    c = c0 + d
+    z = 2.0 * u * d
+    if mp[6] > 0.0:
+        f = _fresnel_real(c, mp[6], mp[7])  # conductor (metal.py)
+    else:
+        f = _fresnel(c, mp[5])  # dielectric, 1 when ior <= 0 (cook_torrance.py)
+    if mp[0] == VCAVITY_F:
+        return 4.0 * f * min(c, 2.0 * u * mu, 2.0 * u * z)  # 4 c G, 001 eq. 10
+    if mp[0] == SCHLICK:
+        return 4.0 * c * z / (mp[4] + (1.0 - mp[4]) * z)  # 000 eq. 36's 1 / (r + (1 - r) N.V), times N.V
+    if mp[1] == 1.0:  # GGX: P = (z + sqrt(z^2 + alpha^2 sin^2)) / 2, Walter eq. 34 (microfacet._projected, one sqrt)
+        pz = 0.5 * (z + math.sqrt(z * z + mp[4] * mp[4] * ((1.0 - z) * (1.0 + z))))
+    else:
+        pz = _projected(math.sqrt((1.0 - z) * (1.0 + z)), 0.0, z, 0, int(mp[2]), mp[4])
+    if mp[3] == 0.0:
+        return 4.0 * c * f * z / (mp[8] * pz)  # G1(mu) G1(z) / mu, Walter eq. 20
+    return 4.0 * c * f * z / (z * mp[8] + mu * pz - mu * z)  # 1 / (mu (1 + Lambda_i + Lambda_o)), Heitz 2014
+
+
+@njit(cache=True, nogil=True)
+def _delta_rule(mp, mu, u, c0, low, sb0, q, lo, hi, nodes, wk, wg, mode, ibuf):  # pragma: no cover - compiled
+    """(value, error) of the rule on delta in [lo, hi] for :func:`_phi_numeric` at d = low + sb0 sin(delta) +
+    2 q sin^2(delta / 2) (:func:`_k_numeric`)."""
+    h = hi - lo
+    for j in range(nodes.shape[0]):
+        x = 0.5 * (lo + h * nodes[j])
+        sh = math.sin(x)
+        d = low + 2.0 * sh * (sb0 * math.cos(x) + q * sh)
+        ibuf[j] = _phi_numeric(mp, mu, u, c0, max(d, 0.0))
+    k, diff, asc, ab = rule_sums(ibuf, wk, wg)
+    return k * h, calibrated(diff * h, asc * h, ab * h, mode)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _delta_at(c, a, b, beta0):  # pragma: no cover - compiled
+    """delta = beta0 - beta where wi.h = a + b cos(beta) = c (at most beta0)."""
+    x = c - a
+    return min(beta0 - math.atan2(math.sqrt(max(0.0, (b - x) * (b + x))), x), beta0)
+
+
+@njit(cache=True, nogil=True)
+def _k_numeric(mp, mu, s, psi, u, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, iwork):  # pragma: no cover - compiled; see numeric_integrand_reference
+    """(K(u), its error) of frame 4: the integral over the azimuth beta of h about N, where N.wo > 0, of
+    :func:`_phi_numeric` (4 c F(c) Gamma, which depends on beta through c = wi.h only, as in :func:`_k_half`), by a
+    globally adaptive rule (``nodes``, ``wk``, ``wg``: the 7/15 rule) on the arc.
+
+    The arc comes exact from :func:`_half_arc`, in delta = beta0 - beta measured from its end: d = c - c0 =
+    2 e0 sin^2(delta / 2) + b sin(beta0) sin(delta) on a partial arc (N.wo = 0 at delta = 0), low + 2 b
+    sin^2(delta / 2) on the full circle (beta0 = pi), no cancellation either way.  The arc is cut where the
+    integrand has a kink or a jump: Walter's G1 switch (N.wo = ``mp[9]``), the crossings of the V-cavity's three
+    lines (c = 2 u mu, mu / u, 2 u mu / (4 u^2 - 1), as :func:`_k_vcavity`); for the Smith models, where N.wo =
+    z_c 3^k (below).  The interval with the largest error
+    is bisected until the summed error (QUADPACK's calibration: the integrand is analytic on every piece) is at most
+    max(``itol`` |K|, ``tol_abs``) or INNER_MAX intervals are used; the error is returned either way.  Both signs of beta: 2 x."""
+    live, b, c0, e0, sb0, beta0, low, _, _ = _half_arc(mu, s, psi, u, sa)
+    if not live:
+        return 0.0, 0.0
+    q = b if beta0 == math.pi else e0
+    lo, hi, val, err = iwork[0], iwork[1], iwork[2], iwork[3]
+    a = mu * u
+    c_lo, c_hi = c0 + low, a + b  # the range of c on the arc (delta = 0 and beta0)
+    # the cuts in c, as delta = beta0 - beta(c), sorted (at most three; scalars, not an array: this runs at every
+    # node; those outside (0, beta0) stand at beta0, their pieces are empty)
+    x1, x2, x3 = beta0, beta0, beta0
+    if b > 0.0:
+        for j in range(3):
+            if mp[0] == VCAVITY_F:
+                cb = 2.0 * u * mu if j == 0 else (mu / u if j == 1 else (2.0 * u * mu / (4.0 * u * u - 1.0) if 4.0 * u * u > 1.0 else -1.0))
+            else:
+                cb = 0.5 * (mu + mp[9]) / u if j == 0 and mp[9] > 0.0 else -1.0
+            if c_lo < cb < c_hi:
+                dl = _delta_at(cb, a, b, beta0)
+                if 0.0 < dl < beta0:
+                    if j == 0:
+                        x1 = dl
+                    elif j == 1:
+                        x2 = dl
+                    else:
+                        x3 = dl
+    x1, x2 = min(x1, x2), max(x1, x2)
+    x2, x3 = min(x2, x3), max(x2, x3)
+    x1, x2 = min(x1, x2), max(x1, x2)
+    # graded cuts where a factor has a singularity near the arc's small end: P(N.wo) of the Smith models at
+    # N.wo ~ +-i alpha (GGX's at +-i alpha / sqrt(1 - alpha^2); Beckmann's erf and exp turn on the scale
+    # a = N.wo / (alpha sin) ~ 1), the Fresnel factor at c ~ +-i c_F (:func:`fresnel_scale`).  Where the arc runs from
+    # below that scale to far above it, a rule on the whole arc does not see the feature at its end (GGX
+    # alpha = 0.001 was 1.6e-10 off at rtol 1e-12 with an estimate of 6e-13), so it is cut at N.wo = z_c 3^k,
+    # z_c = max(alpha, 3 N.wo_min), and at c = c_c 3^k, c_c = max(c_F, 3 c_min): each piece then lies at least its own
+    # length from the singularity
+    z_lo, z_hi = 2.0 * u * low, 2.0 * u * (c_hi - c0)
+    zc = 3.0 * z_lo if z_lo >= mp[11] else mp[11]
+    cc = 3.0 * c_lo if c_lo >= mp[10] else mp[10]
+    da = _delta_at(c0 + 0.5 * zc / u, a, b, beta0) if zc < z_hi / 1.5 else beta0
+    db = _delta_at(cc, a, b, beta0) if cc < c_hi / 1.5 else beta0
+    m = 0
+    start = 0.0
+    f = 0
+    while True:
+        fx = x1 if f == 0 else (x2 if f == 1 else (x3 if f == 2 else beta0))
+        end = min(da, db, fx)
+        if end > start:
+            lo[m], hi[m] = start, end
+            val[m], err[m] = _delta_rule(mp, mu, u, c0, low, sb0, q, start, end, nodes, wk, wg, mode, ibuf)
+            m += 1
+            start = end
+        if end >= beta0:
+            break
+        if m >= lo.shape[0] - 8:  # (keeps room to bisect)
+            da, db, f = beta0, beta0, 3
+            continue
+        if da <= end:
+            zc *= 3.0
+            da = _delta_at(c0 + 0.5 * zc / u, a, b, beta0) if zc < z_hi / 1.5 else beta0
+        if db <= end:
+            cc *= 3.0
+            db = _delta_at(cc, a, b, beta0) if cc < c_hi / 1.5 else beta0
+        if fx <= end:
+            f += 1
+    while True:
+        tot, e, worst = _tally(val, err, m, 0.0, 0.0)
+        if 2.0 * e <= max(2.0 * itol * abs(tot), tol_abs) or m >= lo.shape[0]:
+            return 2.0 * tot, 2.0 * e
+        mid = 0.5 * (lo[worst] + hi[worst])
+        lo[m], hi[m] = mid, hi[worst]
+        hi[worst] = mid
+        val[worst], err[worst] = _delta_rule(mp, mu, u, c0, low, sb0, q, lo[worst], mid, nodes, wk, wg, mode, ibuf)
+        val[m], err[m] = _delta_rule(mp, mu, u, c0, low, sb0, q, mid, hi[m], nodes, wk, wg, mode, ibuf)
+        m += 1
+
+
+
 def vcavity_integrand_reference(mu: float, u) -> np.ndarray:
     """Plain twin of :func:`_k_vcavity` by scipy's QUADPACK over beta of 4 min(c, 2 u mu, 4 u^2 c - 2 u mu)
     where c > mu / (2 u) (split at the lines' crossings)."""
@@ -833,6 +1029,8 @@ def _u_at(kind, sm, n, v0, w, cv1, tau):  # pragma: no cover - compiled
     e^-z w dX / (n + 1) (u^n du = e^-z dz / (n + 1));
     kind 2 (the half frame's Beckmann weight exp(-tan^2(alpha) / m^2), ``n`` = m): t = tan^2(alpha) / m^2 in
     [v0, v0 + w], u = 1 / sqrt(1 + m^2 t), factor e^-t (m^2 / 2) u^3 w dX (du = -(m^2 / 2) u^3 dt);
+    kind 3 (the half frame's GGX weight 1 / (1 + t)^2, ``n`` = alpha): z = ln(1 + t) in [v0, v0 + w],
+    t = e^z - 1, factor e^-z (m^2 / 2) u^3 w dX (dt / (1 + t)^2 = e^-z dz);
     X(tau) is the smoothing substitution ``sm`` (:func:`_smoothing`) at the ends where K has a
     square-root behaviour.
     """
@@ -848,6 +1046,12 @@ def _u_at(kind, sm, n, v0, w, cv1, tau):  # pragma: no cover - compiled
         r = math.sqrt(1.0 + q)
         u = 1.0 / r
         return u, q / (r * (r + 1.0)), math.sqrt(q) / r, math.exp(-t) * 0.5 * n * n * u * u * u * w * dx
+    if kind == 3:
+        z = v0 + w * x if x < 0.5 else cv1 - w * xc  # z = ln(1 + tan^2(alpha) / alpha^2), from the nearer end
+        q = n * n * math.expm1(z)  # tan^2(alpha)
+        r = math.sqrt(1.0 + q)
+        u = 1.0 / r
+        return u, q / (r * (r + 1.0)), math.sqrt(q) / r, math.exp(-z) * 0.5 * n * n * u * u * u * w * dx
     z = v0 + w * x if x < 0.5 else cv1 - w * xc  # z = -(n + 1) ln u, from the nearer end
     lu = -z / (n + 1.0)
     um = -math.expm1(lu)
@@ -882,23 +1086,28 @@ WG21[11::2] = 0.5 * _WG10[::-1]
 from ._errors import EPS, calibrated, mode_code, rule_sums  # noqa: E402
 from .albedo import NODES as _NODES, WG as _WG, WK as _WK  # noqa: E402  (the engine's 7/15 rule)
 from .pumping import _g_levels, _g_product  # noqa: E402  (g of a pumped chain, as the BRDF divides by it)
+from .models.cook_torrance import _fresnel  # noqa: E402  (frame 4's factors, as the models' kernels compute them)
+from .models.metal import _fresnel_real  # noqa: E402
+from .models.microfacet import _projected  # noqa: E402
 #: the rule of the 1-D path (measured and tested with "gk21": 90-190 evaluations per mu for the
 #: Phong family at rtol 1e-10)
 RULE = "gk21"
 
 
 @njit(cache=True, nogil=True)
-def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac):  # pragma: no cover
+def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc):  # pragma: no cover
     """(K, error) of the rule on [t0, t1]; the error is :func:`pumpup._errors.calibrated` of
-    |K - G| (``mode`` 1) or |K - G| itself (0), plus for p in (0, 1) the inner errors of the
+    |K - G| (``mode`` 1) or |K - G| itself (0), plus for p in (0, 1) and frame 4 the inner errors of the
     integrand's values (the inner rule ``inodes``, ``iwk``, ``iwg`` at relative tolerance
-    ``itol``) summed with the Kronrod weights; ``buf`` holds the values (one per node).  The
+    ``itol``; frame 4 also at absolute tolerance ``iacc`` / the node's factor, :func:`_integrate`) summed with
+    the Kronrod weights (frame 4: and |K - G| raised by what they can hide of it before its calibration); ``buf`` holds the values (one per node).  The
     closed forms p in {0, 1} have a loop of their own, with no call in it (a loop that may call
     :func:`_arc_power` ran 2.5 x slower for them; a pumped lobe has a loop of its own,
     :func:`_integrate_chain`: one integration loop that could call either rule ran 1.45 x slower for
     them)."""
     h = t1 - t0
     ie = 0.0
+    noise = 0.0
     if 0.0 < p < 1.0:
         for j in range(nodes.shape[0]):
             u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
@@ -909,6 +1118,22 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
         for j in range(nodes.shape[0]):
             u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
             buf[j] = _k_closed(p, mu, c2, u, um, sa)[0] * fac
+    elif frame == 4:  # the rule on h's arc (:func:`_k_numeric`); D's 1 / u^4 under the Beckmann and GGX weights
+        s = math.sqrt((1.0 - mu) * (1.0 + mu))
+        psi = math.atan2(mu, s)
+        for j in range(nodes.shape[0]):
+            u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
+            if kind >= 2:
+                fac /= u * u * u * u
+            if fac == 0.0:
+                buf[j] = 0.0
+                continue
+            # K's error may be itol |K| or iacc / fac: the second's share of the sum is at most itol times the
+            # integral's lower bound so far (iacc, :func:`_integrate`)
+            k, e = _k_numeric(mp, mu, s, psi, u, sa, itol, iacc / fac, inodes, iwk, iwg, mode, ibuf, iwork)
+            buf[j] = k * fac
+            ie += wk[j] * e * fac
+            noise += (wk[j] + wg[j]) * e * fac  # what the values' errors can hide of |K - G|
     else:  # the half-vector frame: the Blinn family and modified Ward, p in {0, 1} (frame 1); Ward (frame 2)
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
         psi = math.atan2(mu, s)
@@ -918,11 +1143,11 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
                 k = _k_half(p, mu, s, psi, u, sa)
             elif frame == 2:
                 k = _k_ward(mu, s, psi, u, sa)
-            else:  # 3: V-cavity G, F = 1; under the Beckmann weight D carries 1 / u^4 (001 eq. 9)
-                k = _k_vcavity(mu, s, psi, u, sa) / (u * u * u * u if kind == 2 else 1.0)
+            else:  # 3: V-cavity G, F = 1; under the Beckmann and GGX weights D carries 1 / u^4 (001 eq. 9)
+                k = _k_vcavity(mu, s, psi, u, sa) / (u * u * u * u if kind >= 2 else 1.0)
             buf[j] = k * fac
     k, diff, asc, ab = rule_sums(buf, wk, wg)
-    return k * h, calibrated(diff * h, asc * h, ab * h, mode) + ie * h
+    return k * h, calibrated((diff + noise) * h, asc * h, ab * h, mode) + ie * h
 
 
 #: the peak variable z = -(n + 1) ln u runs at most to Z_MAX: below u = exp(-Z_MAX / (n + 1)) the
@@ -930,8 +1155,11 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
 Z_MAX = 40.0
 
 
-#: the most pieces :func:`_pieces` makes (4 tail, the graded cuts above the horizon break, 3 peak)
-MAX_PIECES = 64
+#: the most breakpoints :func:`_pieces` takes (8, and frame 4's Smith models' graded cuts, 3 x 16)
+MAX_BREAKS = 56
+
+#: the most pieces :func:`_pieces` makes (4 tail, the graded cuts above the horizon break, 3 peak; frame 4's cuts)
+MAX_PIECES = 128
 
 
 @njit(cache=True, nogil=True)
@@ -995,8 +1223,16 @@ def _vcavity_breaks(mu, s, psi):  # pragma: no cover - compiled
     return out
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _zr(radial, tb, n):  # pragma: no cover - compiled
+    """The peak variable at tan(alpha) = tb under the half frame's Beckmann weight (radial 1: t = tan^2(alpha) / m^2)
+    or GGX weight (radial 2: ln(1 + t))."""
+    t = (tb / n) ** 2
+    return t if radial == 1 else math.log1p(t)
+
+
 @njit(cache=True, nogil=True)
-def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
+def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: no cover - compiled
     """The pieces between the breakpoints, written into ``kinds``, ``sms`` (the smoothing), ``v0``,
     ``w``, ``v1`` (arrays of :data:`MAX_PIECES`); returns (their number, c2 = cos 2 theta_i, a bound of
     the part left out).
@@ -1008,7 +1244,11 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
     no h sends wo above the horizon (the range starts there), and for frame 3 :func:`_vcavity_breaks`.  kind 0: u in [v0, v1 = v0 + w] (u <= 1/2); kind 1:
     z = -(n + 1) ln u in [v0, v1].  Where exp(-Z_MAX / (n + 1)) > 1/2 the range of u below it is left
     out (its bound is returned).  With ``radial`` 1 (the half frame's Beckmann weight, ``n`` = m) the
-    whole range is kind 2, t = tan^2(alpha) / m^2 in [0, Z_MAX] (:func:`_u_at`), cut at the same breaks.
+    whole range is kind 2, t = tan^2(alpha) / m^2 in [0, Z_MAX] (:func:`_u_at`), cut at the same breaks; with
+    ``radial`` 2 (the GGX weight, ``n`` = alpha) kind 3, z = ln(1 + t) up to u_lo (the weight e^-z dz leaves no
+    tail to cut).  Frame 4 (:func:`_k_numeric`, parameters ``mp``) has the V-cavity's breaks for its V-cavity model,
+    and for Walter's G1 the angles |arccos(z_w) -+ theta_i| / 2 where its switch level N.wo = z_w leaves h's
+    circle (at its top and bottom, N.wo = cos(2 alpha -+ theta_i)).
     """
     c2 = (mu - s) * (mu + s)
     n1 = n + 1.0
@@ -1017,14 +1257,16 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
     z_split = Z_MAX if skip else n1 * math.log(2.0)
     # breakpoints in u, and their z = -(n + 1) ln u (or t) to full precision; codes 0: horizon (sqrt
     # below), 1: level mu (sqrt above), 2: a kink smoothed on both sides
-    ub = np.empty(8)
-    zb = np.empty(8)
-    kb = np.empty(8, np.int64)
+    ub = np.empty(MAX_BREAKS)
+    zb = np.empty(MAX_BREAKS)
+    kb = np.empty(MAX_BREAKS, np.int64)
     m = 0
     u_min, z_end, k_end = 0.0, z_split, -1  # the range: u >= u_min, z <= z_end (code of that end)
     peak = 1  # the kind of the peak's pieces
     if radial == 1:  # t = tan^2(alpha) / m^2 everywhere (half frame only)
         skip, z_end, peak = True, Z_MAX, 2
+    elif radial == 2:  # ln(1 + t) everywhere, up to u_lo (half frame only)
+        skip, z_end, peak = True, math.inf, 3
     if frame == 0:
         if 0.0 < s < 1.0:
             ub[m], zb[m], kb[m] = s, -0.5 * n1 * math.log1p(-mu * mu), 0
@@ -1037,25 +1279,57 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
         hf = 0.25 * psi  # u_f = cos(pi/4 - theta_i/2) = cos(2 hf) = 1 - 2 sin^2(hf)
         tf = math.tan(2.0 * hf)  # tan(alpha_f); alpha_lo = pi/2 - alpha_f
         ub[m], kb[m] = math.cos(2.0 * hf), 0
-        zb[m] = (tf / n) ** 2 if radial == 1 else -n1 * math.log1p(-2.0 * math.sin(hf) ** 2)
+        zb[m] = _zr(radial, tf, n) if radial else -n1 * math.log1p(-2.0 * math.sin(hf) ** 2)
         m += 1
         if p > 0.0 and 0.0 < mu < 1.0:
             ub[m], kb[m] = mu, 1
-            zb[m] = (s / (mu * n)) ** 2 if radial == 1 else -n1 * math.log(mu)  # tan(theta_i) = s / mu
+            zb[m] = _zr(radial, s / mu, n) if radial else -n1 * math.log(mu)  # tan(theta_i) = s / mu
             m += 1
         u_min = math.sin(0.5 * psi)  # cos(pi/4 + theta_i/2)
         if u_min > 0.0:
-            z_lo = 1.0 / (tf * n) ** 2 if radial == 1 else -n1 * math.log(u_min)
+            if radial == 1:
+                z_lo = 1.0 / (tf * n) ** 2
+            elif radial == 2:
+                z_lo = math.log1p((tf * n) ** 2) - 2.0 * math.log(tf * n)  # ln(1 + 1 / (tf n)^2), no overflow
+            else:
+                z_lo = -n1 * math.log(u_min)
             if z_lo < z_end:
                 z_end, k_end = z_lo, 1
-        if frame == 3:  # the V-cavity G's kinks (:func:`_vcavity_breaks`), smoothed on both sides (code 2)
-            for ab in _vcavity_breaks(mu, s, psi):
+        if frame == 3 or (frame == 4 and mp[0] == VCAVITY_F):  # the V-cavity G's kinks (:func:`_vcavity_breaks`),
+            for ab in _vcavity_breaks(mu, s, psi):  # smoothed on both sides (code 2)
                 if ab > 0.0:
                     ub[m], kb[m] = math.cos(ab), 2
-                    zb[m] = (math.tan(ab) / n) ** 2 if radial == 1 else -n1 * math.log1p(-2.0 * math.sin(0.5 * ab) ** 2)
+                    zb[m] = _zr(radial, math.tan(ab), n) if radial else -n1 * math.log1p(-2.0 * math.sin(0.5 * ab) ** 2)
                     m += 1
-    cv = np.empty(12)
-    cc = np.empty(12, np.int64)
+        if frame == 4 and mp[9] > 0.0:  # Walter's G1 switch N.wo = z_w leaves h's circle: a jump of G, a kink of K
+            th = 0.5 * math.pi - psi
+            aw = math.atan2(math.sqrt((1.0 - mp[9]) * (1.0 + mp[9])), mp[9])
+            for ab in (0.5 * (aw + th), 0.5 * abs(aw - th)):
+                if 0.0 < ab < 0.5 * math.pi:
+                    ub[m], kb[m] = math.cos(ab), 2
+                    zb[m] = _zr(radial, math.tan(ab), n) if radial else -n1 * math.log1p(-2.0 * math.sin(0.5 * ab) ** 2)
+                    m += 1
+        if frame == 4 and mp[11] < 1.0:
+            # K(u) turns on the scale alpha (P's, :func:`_k_numeric`; Schlick's r / (1 - r)) where the lowest N.wo on h's circle,
+            # sin(psi - 2 alpha_h) / (2 u) ~ alpha_f - alpha_h, nears 0 (the horizon break alpha_f = psi / 2, from both
+            # sides) and where the arc's highest N.wo does (alpha_lo = pi / 2 - psi / 2): a first rule on a piece
+            # hundreds of times wider did not see it (GGX alpha = 0.001, mu = 0.59: 1.6e-10 off at rtol 1e-12, the
+            # estimate 6e-13), so these get cuts at alpha_f -+ (alpha / 2) 4^k and alpha_lo - (alpha / 2) 4^k,
+            # without smoothing (code 3), up to the middle of [alpha_f, alpha_lo]
+            a_f, a_lo = 0.5 * psi, 0.5 * math.pi - 0.5 * psi
+            a_mid = 0.5 * (a_f + a_lo)
+            for side in range(3):
+                off = 0.5 * mp[11]
+                for _ in range(16):
+                    ab = a_f - off if side == 0 else (a_f + off if side == 1 else a_lo - off)
+                    if (side == 0 and ab <= 0.0) or (side == 1 and ab >= a_mid) or (side == 2 and ab <= a_mid):
+                        break
+                    ub[m], kb[m] = math.cos(ab), 3
+                    zb[m] = _zr(radial, math.tan(ab), n)
+                    m += 1
+                    off *= 4.0
+    cv = np.empty(MAX_BREAKS + 4)
+    cc = np.empty(MAX_BREAKS + 4, np.int64)
     k = 0
     # tail pieces (increasing u)
     if not skip and u_min < 0.5:
@@ -1120,9 +1394,16 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1):  # pragma: no co
     # with the Beckmann weight, integral_Z^inf e^-t 8 pi (m^2 / 2) u^3 dt, u^3 <= (1 + m^2 Z)^(-3/2) there
     # the V-cavity's K <= 16 pi u mu (c G <= 2 u mu): under the Beckmann weight e^-t (m^2 / 2) u^3 K / u^4 <= 8 pi m^2 mu
     # e^-t; under u^n, integral_0^uz u^(n+1) 16 pi mu du
-    if radial == 1 and frame == 3:
+    if radial == 2:
+        left_out = 0.0  # the range ends at u_lo
+    elif radial == 1 and frame == 4 and mp[0] == SMITH:
+        # K <= 8 pi / P(mu) (4 c F Gamma <= 4 G / mu <= 4 / P(mu)), and (m^2 / 2) u^3 K / u^4 with
+        # 1 / u = sqrt(1 + m^2 t) <= A + B (t - Z), A = sqrt(1 + m^2 Z), B = m^2 / (2 A) (concave)
+        big_a = math.sqrt(1.0 + n * n * Z_MAX)
+        left_out = 4.0 * math.pi * n * n * math.exp(-Z_MAX) * (big_a + 0.5 * n * n / big_a) / mp[8] if k_end == -1 else 0.0
+    elif radial == 1 and frame >= 3:
         left_out = 8.0 * math.pi * n * n * mu * math.exp(-Z_MAX) if k_end == -1 else 0.0
-    elif frame == 3:
+    elif frame >= 3:  # (frame 4 here: the V-cavity with F <= 1)
         left_out = 16.0 * math.pi * mu * math.exp(-Z_MAX * (n + 2.0) / n1) / (n + 2.0) if skip and k_end == -1 else 0.0
     elif radial == 1:
         left_out = 4.0 * math.pi * n * n * math.exp(-Z_MAX) / (1.0 + n * n * Z_MAX) ** 1.5 if k_end == -1 else 0.0
@@ -1173,11 +1454,12 @@ def _bisect(pk, t0, t1, worst, m):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, inodes, iwk, iwg, jac, val, err, conv, evals):  # pragma: no cover
+def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, inodes, iwk, iwg, jac, mp, val, err, conv, evals):  # pragma: no cover
     """Adaptive Gauss-Kronrod (the rule ``nodes``, ``wk``, ``wg``) of integral u^n K(u) du for
     every mu (without the scale); ``frame`` 0 the lobe frame (:func:`_k_closed`, :func:`_k_of_u`), 1-3 the
-    half vector's (:func:`_k_half`, :func:`_k_ward`, :func:`_k_vcavity`), ``radial`` 1 the Beckmann weight
-    in place of u^n (:func:`_pieces`)."""
+    half vector's (:func:`_k_half`, :func:`_k_ward`, :func:`_k_vcavity`; 4 :func:`_k_numeric` with the parameters
+    ``mp``, its P(mu) set here per mu), ``radial`` 1 the Beckmann weight, 2 the GGX weight, in place of u^n
+    (:func:`_pieces`)."""
     cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals, nodes, inodes, rtol)
     kinds = np.empty(MAX_PIECES, np.int64)
     sms = np.empty(MAX_PIECES, np.int64)
@@ -1187,16 +1469,27 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
-        npieces, c2, left_out = _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, cv1)
+        if frame == 4 and mp[0] == SMITH:  # P(mu) = mu / G1(mu)
+            mp[8] = _projected(s, 0.0, mu, int(mp[1]), int(mp[2]), mp[4])
+        npieces, c2, left_out = _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, cv1, mp)
+        # frame 4's inner rule may leave an absolute error iacc / (the node's factor) in K, iacc = itol times a lower
+        # bound of the integral so far over the pieces' total length in tau: its share of the sum is then at most
+        # itol times that bound (the integrand is >= 0; the errors are added to the estimate either way)
+        live = 0
+        for i in range(npieces):
+            live += n_init if w[i] > 0.0 else 0
+        acc = 0.0
         m = 0
         for i in range(npieces):
             if w[i] <= 0.0:
                 continue
             for j in range(n_init):
+                iacc = itol * acc / live
                 pk[m] = i
                 t0[m] = j / n_init
                 t1[m] = (j + 1.0) / n_init
-                kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac)
+                kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
+                acc += max(kv[m] - ke[m], 0.0)
                 m += 1
         start = m
         while True:
@@ -1204,8 +1497,9 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
             if ok or m - start >= max_intervals or m >= cap:
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
-            kv[worst], ke[worst] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac)
-            kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac)
+            iacc = itol * max(tot - e, 0.0) / live
+            kv[worst], ke[worst] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
+            kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
             m += 1
         val[q] = tot
         err[q] = e + r
@@ -1528,6 +1822,9 @@ X_PIECES = 8
 N_INIT_CHAIN = 1
 
 
+#: the radial weights of :class:`Polar` (``_integrate``'s codes)
+_RADIAL = {"power": 0, "beckmann": 1, "ggx": 2}
+
 #: the half-vector frame takes mu >= this (below it mu / (2 u), tan^2(psi / 2) m^2 and their kin underflow; the nested
 #: engine takes such batches, as before the half frame)
 HALF_MU_MIN = 1e-100
@@ -1548,6 +1845,46 @@ def without_1d():
         yield
     finally:
         ONE_D = old
+
+
+def numeric_params(hint: Polar) -> np.ndarray:
+    """Frame 4's parameter array ``mp`` (:data:`MP_SIZE` slots) of a :class:`Polar` hint with ``smith`` or a V-cavity
+    lobe with ``fresnel`` (zeros but the Walter level -1 otherwise); P(mu) is set per mu by :func:`_integrate`."""
+    mp = np.zeros(MP_SIZE)
+    mp[9] = -1.0
+    mp[5:8] = hint.fresnel
+    mp[10] = fresnel_scale(*(float(x) for x in hint.fresnel))
+    mp[11] = math.inf
+    if hint.smith is not None:
+        mp[0], mp[1:5] = SMITH, hint.smith
+        mp[11] = hint.smith[3]
+        if hint.smith[1] == 1:
+            from .models.microfacet import walter_level
+
+            mp[9] = walter_level(float(hint.smith[3]))
+    elif hint.schlick is not None:
+        r = float(hint.schlick)
+        mp[0], mp[4], mp[11] = SCHLICK, r, (r / (1.0 - r) if r < 1.0 else math.inf)
+    else:
+        mp[0] = VCAVITY_F
+    return mp
+
+
+def numeric_integrand(brdf, mu: float, u, rtol: float = 1e-13):
+    """(K(u), error) of frame 4 (:func:`_k_numeric`) for ``brdf``'s hint at N.wi = ``mu`` and the values ``u`` of
+    N.h, at relative tolerance ``rtol`` (the kernel as the engine calls it; for the tests)."""
+    hint = brdf.polar()
+    mp = numeric_params(hint)
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    if mp[0] == SMITH:
+        mp[8] = _projected(s, 0.0, mu, int(mp[1]), int(mp[2]), mp[4])
+    u = np.atleast_1d(np.asarray(u, dtype=float))
+    ibuf, iwork = np.empty(_NODES.shape[0]), np.empty((4, INNER_MAX))
+    val, err = np.empty(u.shape), np.empty(u.shape)
+    for i, v in enumerate(u):
+        val[i], err[i] = _k_numeric(mp, mu, s, math.atan2(mu, s), float(v), math.sqrt((1.0 - v) * (1.0 + v)), rtol, 0.0,
+                                    _NODES, _WK, _WG, mode_code(), ibuf, iwork)
+    return val, err
 
 
 def takes_1d_path(brdf) -> bool:
@@ -1584,9 +1921,20 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         raise ValueError(f"{brdf!r}: a Polar hint with vcavity needs kind 'half', p = 0 and no sqrt_cos")
     if hint.sqrt_cos and (hint.kind != "half" or hint.p != 0.0):
         raise ValueError(f"{brdf!r}: a Polar hint with sqrt_cos needs kind 'half' and p = 0, got {hint.kind!r}, p={hint.p!r}")
-    if hint.radial not in ("power", "beckmann") or (hint.radial == "beckmann" and (hint.kind != "half" or not hint.n > 0)):
-        raise ValueError(f"{brdf!r}: a Polar hint's radial is 'power', or 'beckmann' with kind 'half' and n = m > 0, "
+    if hint.radial not in _RADIAL or (hint.radial != "power" and (hint.kind != "half" or not hint.n > 0)):
+        raise ValueError(f"{brdf!r}: a Polar hint's radial is 'power', or 'beckmann' or 'ggx' with kind 'half' and n = m > 0, "
                          f"got {hint.radial!r} (kind {hint.kind!r}, n {hint.n!r})")
+    numeric = hint.smith is not None or hint.schlick is not None or (hint.vcavity and any(hint.fresnel))
+    if hint.schlick is not None and (hint.kind != "half" or hint.p != 0.0 or hint.vcavity or hint.sqrt_cos
+                                     or hint.smith is not None or hint.radial != "ggx" or not 0.0 < hint.schlick <= 1.0):
+        raise ValueError(f"{brdf!r}: a Polar hint with schlick = r in (0, 1] needs kind 'half', p = 0, the 'ggx' weight "
+                         f"and neither smith, vcavity nor sqrt_cos")
+    if hint.smith is not None and (hint.kind != "half" or hint.p != 0.0 or hint.vcavity or hint.sqrt_cos
+                                   or hint.radial == "power" or len(hint.smith) != 4):
+        raise ValueError(f"{brdf!r}: a Polar hint with smith = (distribution, g1, shadowing, alpha) needs kind 'half', "
+                         f"p = 0, the 'beckmann' or 'ggx' weight and neither vcavity nor sqrt_cos")
+    if any(hint.fresnel) and not (hint.smith is not None or hint.vcavity):
+        raise ValueError(f"{brdf!r}: a Polar hint's fresnel applies to a smith or vcavity lobe only")
     jac = jacobi_rules(1.0 - hint.p) if 0.0 < hint.p < 1.0 else _NO_JACOBI
     val = np.empty(mu.shape)
     err = np.empty(mu.shape)
@@ -1601,8 +1949,13 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         # true error there (m = 0.1, mu = 0.6088: 7.1e-13 against 1.5e-13, at every rtol), the raw |K - G| at most
         # 0.11 of it (7 m x 63 mu x rtol 1e-6 .. 1e-12 against the nested engine at 1e-13): Ward keeps the raw one
         mode = 0 if hint.sqrt_cos else mode_code()
-        _integrate((3 if hint.vcavity else 2 if hint.sqrt_cos else 1) if hint.kind == "half" else 0, 1 if hint.radial == "beckmann" else 0, float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
-                   *(_RULES[RULE]), mode, N_INIT, *_RULES["gk15"], jac, val, err, conv, evals)
+        mp = numeric_params(hint)
+        if numeric:
+            frame = 4
+        else:
+            frame = (3 if hint.vcavity else 2 if hint.sqrt_cos else 1) if hint.kind == "half" else 0
+        _integrate(frame, _RADIAL[hint.radial], float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
+                   *(_RULES[RULE]), mode, N_INIT, *_RULES["gk15"], jac, mp, val, err, conv, evals)
     else:  # a pumped lobe, about N
         cuts = [chain_cuts(hint.levels(float(m)), float(hint.n), float(m)) for m in mu]
         ncut = np.array([len(c) for c in cuts], np.int64)

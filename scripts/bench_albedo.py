@@ -25,6 +25,8 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
     python scripts/bench_albedo.py --p        # only the p-model with p in (0, 1): 1-D path against the nested engine
     python scripts/bench_albedo.py --half     # only the models put on the 1-D path in issue 14's sixth session
                                               # (half vector, closed forms) against the nested engine
+    python scripts/bench_albedo.py --arc      # only the models put on the 1-D path in issue 14's seventh session
+                                              # (a rule on the half vector's arc) against the nested engine
     python scripts/bench_albedo.py --pumped   # only pumped Phong-family chains: 1-D path against the nested engine
     python scripts/bench_albedo.py --breaks   # only the nested families with kinks or levels: the compiled break
                                               # finding against its numpy reference (issue 14 item 3)
@@ -250,6 +252,20 @@ def half_and_closed(rtol=1e-10, repeat=3):
                     {"type": "cook_torrance", "m": 0.05}, {"type": "torrance_sparrow", "d": "D1", "s": 20},
                     {"type": "plastic", "n": 20}, {"type": "oren_nayar"}, {"type": "minnaert", "k": 1.0},
                     {"type": "lacquer"}], "1-D since issue 14's sixth session", rtol, repeat)
+
+
+def on_the_arc(rtol=1e-10, repeat=3):
+    """The models issue 14's seventh session put on the 1-D path: the half vector's azimuth by a rule on its arc
+    (pumpup._polar._k_numeric: GGX and Beckmann with Smith G, with and without a Fresnel factor; Cook-Torrance and
+    Torrance-Sparrow with one; Schlick, 000 eq. 36) and Torrance-Sparrow D3 in closed form under the GGX weight,
+    against the nested engine they had before (:func:`against_nested`)."""
+    against_nested([{"type": "ggx", "alpha": 0.1}, {"type": "ggx", "alpha": 0.5, "shadowing": "correlated"},
+                    {"type": "ggx", "alpha": 0.02, "ior": 1.5}, {"type": "ggx", "alpha": 0.001},
+                    {"type": "beckmann", "alpha": 0.1}, {"type": "beckmann", "alpha": 0.3, "g1": "walter"},
+                    {"type": "beckmann", "alpha": 1.0, "eta": 0.2, "k": 3.0, "shadowing": "correlated", "g1": "walter"},
+                    {"type": "cook_torrance", "m": 0.3, "ior": 1.5}, {"type": "torrance_sparrow", "d": "D4", "s": 0.4, "ior": 1.33},
+                    {"type": "torrance_sparrow", "d": "D3", "s": 0.3}, {"type": "schlick", "r": 0.2},
+                    {"type": "schlick", "r": 0.001}], "1-D since issue 14's seventh session", rtol, repeat)
 
 
 def pumped_chains(rtol=1e-10, repeat=3):
@@ -488,6 +504,9 @@ def main():
         return
     if "--p" in sys.argv:
         p_model()
+        return
+    if "--arc" in sys.argv:
+        on_the_arc()
         return
     if "--pumped" in sys.argv:
         pumped_chains()

@@ -40,13 +40,20 @@ def test_narrowest_microfacet_lobe_is_a_mirror(spec):
     a, e = pumpup.albedo(pumpup.load(spec), [1.0, 0.5], return_error=True)
     assert np.all(np.abs(a - 1.0) <= e + 1e-10), (a, e)
     if spec["alpha"] == MIN_ALPHA and spec["type"] == "ggx":
-        # near grazing the mirror limit with Smith shadowing: E = G(wi, mirror) to O(lobe width / grazing
-        # angle); separable G = G1^2, correlated 1 / (1 + 2 Lambda), Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2
+        # near grazing the mirror limit with Smith shadowing: E = G(wi, mirror) + O((alpha / mu)^3) (the lobe's
+        # width over the grazing angle; measured: the deviation grows as mu^-3 from 6.7e-13 at mu = 1e-4 to 7.6e-7
+        # at 1e-6); separable G = G1^2, correlated 1 / (1 + 2 Lambda), Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2.
+        # (Until issue 14's seventh session the engine's error here was 5e-5, and this test asked 1e-10 of the
+        # limit itself; with an error of 4e-14 the O((alpha / mu)^3) term shows.)
         mu = np.array([1e-4, 1e-6])
         a, e = pumpup.albedo(pumpup.load(spec), mu, return_error=True)
         lam = (np.sqrt(1 + (spec["alpha"] * np.sqrt(1 - mu**2) / mu) ** 2) - 1) / 2
         limit = 1 / (1 + 2 * lam) if spec.get("shadowing") == "correlated" else 1 / (1 + lam) ** 2
-        assert np.all(np.abs(a - limit) <= e + 1e-10), (a, limit, e)
+        assert np.all(np.abs(a - limit) <= e + 2 * (spec["alpha"] / mu) ** 3), (a, limit, e)
+        if spec.get("shadowing", "separable") == "separable":
+            # 30-digit mpmath, the outer integral in tan(alpha_h) / alpha and the inner over h's azimuth of
+            # 4 (wi.h) G1(N.wo) G1(mu) / mu, both by tanh-sinh (scripts/half_mpmath_reference.py ggx 1e-8 1e-6)
+            assert abs(a[1] - 0.99994923964388905852) <= e[1] and e[1] < 1e-12, (a[1], e[1])
 
 
 def test_narrowest_ward_lobe_has_the_mirror_limit():

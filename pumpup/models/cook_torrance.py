@@ -196,15 +196,14 @@ class CookTorrance(BRDF):
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"], kinks=_g_kinks)
 
     def polar(self):
-        if self.p["ior"] is not None:
-            return None  # F(wi.h) varies along the arc of h: the nested engine
         from .._polar import Polar
 
         m = self.p["m"]
-        # 001 eq. 9 with F = 1: exp(-tan^2 / m^2) / (4 pi m^2 cos^4) G / (N.L N.V); the azimuth of h in closed form
-        # (G's minimum of three lines in wi.h), the Beckmann weight in t = tan^2(alpha) / m^2
+        # 001 eq. 9: F exp(-tan^2 / m^2) / (4 pi m^2 cos^4) G / (N.L N.V); the azimuth of h in closed form for F = 1
+        # (G's minimum of three lines in wi.h), by a rule on its arc with F(wi.h); the Beckmann weight in
+        # t = tan^2(alpha) / m^2
         return Polar(n=m, scale=lambda mu: 1.0 / (4.0 * math.pi * m * m * np.asarray(mu, float)), kind="half",
-                     radial="beckmann", vcavity=True)
+                     radial="beckmann", vcavity=True, fresnel=(self.p["ior"] or 0.0, 0.0, 0.0))
 
 
 # ----------------------------------------------------------------------------------------
@@ -356,13 +355,19 @@ class TorranceSparrow(BRDF):
 
     def polar(self):
         d, e, b = self.p["d"], self.p["s"], self.p["b"]
-        if self.p["ior"] is not None or d not in ("D1", "D4"):
-            return None  # F(wi.h) varies along the arc of h; D2, D3 have no weight of the 1-D path: the nested engine
+        if d == "D2":
+            return None  # D2 = b exp(-(c2 alpha)^2) has no weight of the 1-D path: the nested engine
         from .._polar import Polar
 
-        # 002 eq. 10 with F = 1: G D / (pi (N.S)(N.V)); the azimuth of h in closed form (pumpup._polar._k_vcavity)
+        # 002 eq. 10: F G D / (pi (N.S)(N.V)); the azimuth of h in closed form for F = 1 (pumpup._polar._k_vcavity),
+        # by a rule on its arc with F(wi.h)
+        fresnel = (self.p["ior"] or 0.0, 0.0, 0.0)
         if d == "D1":  # D = b cos^e(alpha): the power weight u^e
-            return Polar(n=e, scale=lambda mu: b / (math.pi * np.asarray(mu, float)), kind="half", vcavity=True)
+            return Polar(n=e, scale=lambda mu: b / (math.pi * np.asarray(mu, float)), kind="half", vcavity=True,
+                         fresnel=fresnel)
+        if d == "D3":  # D3 = b (c3^2 / (c3^2 cos^2 + sin^2))^2 = b / (cos^4 (1 + tan^2 / c3^2)^2): the GGX weight
+            return Polar(n=e, scale=lambda mu: b / (math.pi * np.asarray(mu, float)), kind="half", radial="ggx",
+                         vcavity=True, fresnel=fresnel)
         # D4 = exp(-tan^2 / m^2) / (4 m^2 cos^4): Cook-Torrance's
         return Polar(n=e, scale=lambda mu: 1.0 / (4.0 * math.pi * e * e * np.asarray(mu, float)), kind="half",
-                     radial="beckmann", vcavity=True)
+                     radial="beckmann", vcavity=True, fresnel=fresnel)

@@ -318,6 +318,21 @@ class _Microfacet(BRDF):
             0.0 if p["k"] is None else p["k"],
         )
 
+    def polar(self):
+        from .._polar import Polar
+
+        dist, a, shadowing, g1, ior, eta, k = self.kernel_args()
+        if a > 1.0:
+            # rougher than any measured surface: P(N.wo) then has a singularity near N.wo = 1 as well (GGX's branch
+            # point at alpha / sqrt(alpha^2 - 1), Beckmann's exp(-1 / (2 alpha^2 (1 - N.wo)))), which the rule on h's
+            # arc does not grade: the nested engine
+            return None
+        # Walter eq. 20: a(mu) = integral over h of D(h) (1 / 4) [4 (wi.h) F G / N.wi] (d omega_o = 4 (wo.h) d omega_h),
+        # D = w(t) / (pi a^2 cos^4) with w = e^-t (eq. 25) or 1 / (1 + t)^2 (eq. 33), t = tan^2 / a^2; the azimuth of h
+        # by a rule on its arc (pumpup._polar._k_numeric)
+        return Polar(n=a, scale=lambda mu: np.full(np.shape(mu), 0.25 / (math.pi * a * a)), kind="half",
+                     radial=self.distribution, smith=(dist, g1, shadowing, a), fresnel=(ior, eta, k))
+
 
 @register("beckmann")
 class Beckmann(_Microfacet):

@@ -80,3 +80,12 @@ class Schlick(BRDF):
 
     def lobe(self, mu):
         return Lobe(axis="half", radial="ggx", sharpness=self.p["r"])
+
+    def polar(self):
+        from .._polar import Polar
+
+        r, c = self.p["r"], self.p["c"]
+        # 000 eq. 36: r / (1 - (1 - r) cos^2)^2 = 1 / (r cos^4 (1 + tan^2 / r)^2), the GGX weight with alpha = sqrt(r);
+        # 1 / (r + (1 - r) N.V) by the rule on h's arc (pumpup._polar._k_numeric), the rest in the scale
+        return Polar(n=math.sqrt(r), scale=lambda mu: c / (4.0 * math.pi * r * (r + (1.0 - r) * np.asarray(mu, float))),
+                     kind="half", radial="ggx", schlick=r)
