@@ -136,6 +136,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -776,10 +777,11 @@ def _k_numeric(mp, mu, s, psi, u, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, 
     2 e0 sin^2(delta / 2) + b sin(beta0) sin(delta) on a partial arc (N.wo = 0 at delta = 0), low + 2 b
     sin^2(delta / 2) on the full circle (beta0 = pi), no cancellation either way.  The arc is cut where the
     integrand has a kink or a jump: Walter's G1 switch (N.wo = ``mp[9]``), the crossings of the V-cavity's three
-    lines (c = 2 u mu, mu / u, 2 u mu / (4 u^2 - 1), as :func:`_k_vcavity`); for the Smith models, where N.wo =
-    z_c 3^k (below).  The interval with the largest error
-    is bisected until the summed error (QUADPACK's calibration: the integrand is analytic on every piece) is at most
-    max(``itol`` |K|, ``tol_abs``) or INNER_MAX intervals are used; the error is returned either way.  Both signs of beta: 2 x."""
+    lines (c = 2 u mu, mu / u, 2 u mu / (4 u^2 - 1), as :func:`_k_vcavity`); and graded towards the arc's small end
+    where a factor has a singularity near it (N.wo = z_c 3^k, c = c_c 3^k, below).  The interval with the largest
+    error is bisected until the summed error (QUADPACK's calibration: the integrand is analytic on every piece) is at
+    most max(``itol`` |K|, ``tol_abs``) or INNER_MAX intervals are used; the error is returned either way.  Both signs
+    of beta: 2 x."""
     live, b, c0, e0, sb0, beta0, low, _, _ = _half_arc(mu, s, psi, u, sa)
     if not live:
         return 0.0, 0.0
@@ -855,6 +857,44 @@ def _k_numeric(mp, mu, s, psi, u, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, 
         val[m], err[m] = _delta_rule(mp, mu, u, c0, low, sb0, q, mid, hi[m], nodes, wk, wg, mode, ibuf)
         m += 1
 
+
+def numeric_integrand_reference(brdf, mu: float, u) -> np.ndarray:
+    """Plain twin of :func:`_k_numeric`: K(u) from the model's own numpy formula (``BRDF.reference`` at
+    wo = 2 (wi.h) h - wi), integral over h's azimuth of 4 (wi.h) N.wo f_r where N.wo > 0 by scipy's QUADPACK (split at
+    the arc's end, Walter's switch and the V-cavity's crossings), divided by the hint's scale and radial factor
+    (w(t) / u^4 under the Beckmann and GGX weights, u^n under the power weight)."""
+    from scipy.integrate import quad
+
+    hint = brdf.polar()
+    mp = numeric_params(hint)
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    wi = np.array([s, 0.0, mu])
+    scale = float(np.asarray(hint.scale(np.array([mu])), dtype=float).ravel()[0])
+    out = []
+    for v in np.atleast_1d(np.asarray(u, dtype=float)):
+        sa = math.sqrt((1.0 - v) * (1.0 + v))
+
+        def g(beta, v=v, sa=sa):
+            h = np.array([sa * math.cos(beta), sa * math.sin(beta), v])
+            c = float(wi @ h)
+            wo = 2.0 * c * h - wi
+            return 4.0 * c * wo[2] * float(brdf.reference(wi, wo)) if wo[2] > 0.0 else 0.0
+
+        b, a = s * sa, mu * v
+        cuts = [0.5 * mu / v] + ([0.5 * (mu + mp[9]) / v] if mp[9] > 0.0 else [])
+        if mp[0] == VCAVITY_F:
+            cuts += [2.0 * v * mu, mu / v] + ([2.0 * v * mu / (4.0 * v * v - 1.0)] if 4.0 * v * v > 1.0 else [])
+        pts = [math.acos((cv - a) / b) for cv in cuts if b > 0.0 and abs((cv - a) / b) < 1.0] or None
+        if hint.radial == "power":
+            weight = v**hint.n
+        else:
+            t = sa * sa / (v * hint.n) ** 2
+            weight = (math.exp(-t) if hint.radial == "beckmann" else 1.0 / (1.0 + t) ** 2) / v**4
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            k = 2.0 * quad(g, 0.0, math.pi, points=pts, epsabs=0.0, epsrel=1e-13, limit=400)[0]
+        out.append(k / (scale * weight) if weight > 0.0 else math.nan)
+    return np.array(out)
 
 
 def vcavity_integrand_reference(mu: float, u) -> np.ndarray:
@@ -1155,7 +1195,7 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
 Z_MAX = 40.0
 
 
-#: the most breakpoints :func:`_pieces` takes (8, and frame 4's Smith models' graded cuts, 3 x 16)
+#: the most breakpoints :func:`_pieces` takes (8, and frame 4's graded cuts, 3 x 16)
 MAX_BREAKS = 56
 
 #: the most pieces :func:`_pieces` makes (4 tail, the graded cuts above the horizon break, 3 peak; frame 4's cuts)
@@ -1256,7 +1296,7 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
     skip = uz > 0.5
     z_split = Z_MAX if skip else n1 * math.log(2.0)
     # breakpoints in u, and their z = -(n + 1) ln u (or t) to full precision; codes 0: horizon (sqrt
-    # below), 1: level mu (sqrt above), 2: a kink smoothed on both sides
+    # below), 1: level mu (sqrt above), 2: a kink smoothed on both sides, 3: a cut (frame 4's grading), not smoothed
     ub = np.empty(MAX_BREAKS)
     zb = np.empty(MAX_BREAKS)
     kb = np.empty(MAX_BREAKS, np.int64)
