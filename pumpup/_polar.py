@@ -707,8 +707,9 @@ SMITH, VCAVITY_F, SCHLICK = 0, 1, 2
 #: exact, 1 Walter's fit), shadowing (0 separable, 1 height-correlated), alpha, ior, eta, k, P(mu) (set per mu by
 #: :func:`_integrate`), the level N.wo of Walter's G1 switch (-1 for none), the scale c_F of the Fresnel factor's
 #: feature at small wi.h (sqrt(|1 - (eta + i k)^2|), sqrt(ior^2 - 1); inf for none: :func:`fresnel_scale`), the scale
-#: z_s of the integrand's feature at small N.wo (alpha for the Smith models, Schlick's r / (1 - r); inf for none)
-MP_SIZE = 12
+#: z_s of the integrand's feature at small N.wo (alpha for the Smith models, Schlick's r / (1 - r); inf for none), the
+#: relative tolerance (set by :func:`albedo_1d`; :func:`_pieces` leaves out the outer cuts where they cannot matter)
+MP_SIZE = 13
 
 
 def fresnel_scale(ior: float, eta: float, k: float) -> float:
@@ -1169,8 +1170,14 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
                 buf[j] = 0.0
                 continue
             # K's error may be itol |K| or iacc / fac: the second's share of the sum is at most itol times the
-            # integral's lower bound so far (iacc, :func:`_integrate`)
-            k, e = _k_numeric(mp, mu, s, psi, u, sa, itol, iacc / fac, inodes, iwk, iwg, mode, ibuf, iwork)
+            # integral's lower bound so far (iacc, :func:`_integrate`).  Where that exceeds K's bound (0 <= K <= kmax:
+            # 8 pi / P(mu) for the Smith models, 16 pi u mu for the V-cavity, 8 pi for Schlick's; F <= 1), K = 0 with
+            # the error kmax (far in the weight's tail: a narrow GGX lobe's nodes beyond the horizon break)
+            kmax = 8.0 * math.pi / mp[8] if mp[0] == SMITH else (16.0 * math.pi * u * mu if mp[0] == VCAVITY_F else 8.0 * math.pi)
+            if iacc >= kmax * fac:
+                k, e = 0.0, kmax
+            else:
+                k, e = _k_numeric(mp, mu, s, psi, u, sa, itol, iacc / fac, inodes, iwk, iwg, mode, ibuf, iwork)
             buf[j] = k * fac
             ie += wk[j] * e * fac
             noise += (wk[j] + wg[j]) * e * fac  # what the values' errors can hide of |K - G|
@@ -1349,7 +1356,13 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
                     ub[m], kb[m] = math.cos(ab), 2
                     zb[m] = _zr(radial, math.tan(ab), n) if radial else -n1 * math.log1p(-2.0 * math.sin(0.5 * ab) ** 2)
                     m += 1
-        if frame == 4 and mp[11] < 1.0:
+        # (the weight's mass beyond alpha_f / 2, 1 / (1 + t) for GGX's and e^-t for Beckmann's, times K's bound over
+        # P(mu) ~ mu, below 1e-3 rtol: the cuts cannot matter, a narrow lobe far from grazing incidence)
+        tail = 0.0
+        if frame == 4 and mp[11] < 1.0 and radial > 0:
+            t_half = (math.tan(0.25 * psi) / n) ** 2
+            tail = (1.0 / (1.0 + t_half) if radial == 2 else math.exp(-t_half)) / mu
+        if tail > 1e-3 * mp[12]:
             # K(u) turns on the scale alpha (P's, :func:`_k_numeric`; Schlick's r / (1 - r)) where the lowest N.wo on h's circle,
             # sin(psi - 2 alpha_h) / (2 u) ~ alpha_f - alpha_h, nears 0 (the horizon break alpha_f = psi / 2, from both
             # sides) and where the arc's highest N.wo does (alpha_lo = pi / 2 - psi / 2): a first rule on a piece
@@ -1895,6 +1908,7 @@ def numeric_params(hint: Polar) -> np.ndarray:
     mp[5:8] = hint.fresnel
     mp[10] = fresnel_scale(*(float(x) for x in hint.fresnel))
     mp[11] = math.inf
+    mp[12] = 1e-16  # (albedo_1d sets the tolerance)
     if hint.smith is not None:
         mp[0], mp[1:5] = SMITH, hint.smith
         mp[11] = hint.smith[3]
@@ -1990,6 +2004,7 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         # 0.11 of it (7 m x 63 mu x rtol 1e-6 .. 1e-12 against the nested engine at 1e-13): Ward keeps the raw one
         mode = 0 if hint.sqrt_cos else mode_code()
         mp = numeric_params(hint)
+        mp[12] = rtol
         if numeric:
             frame = 4
         else:

@@ -13,6 +13,7 @@ horizon break; the printed error is mpmath's.  A few minutes per value on one co
 
     python scripts/half_mpmath_reference.py ggx 1e-8 1e-6       # alpha, mu: 0.99994923964388905852
     python scripts/half_mpmath_reference.py ggx 0.001 0.59      # 0.9999980591288865563
+    python scripts/half_mpmath_reference.py ggx 1e-4 1e-4       # 0.88161827515105007481
     python scripts/half_mpmath_reference.py schlick 1e-6 1e-5   # r, mu: 45.887293650878604133
     python scripts/half_mpmath_reference.py schlick 1e-6 1e-3   # 1.1685049698945183549
 """
