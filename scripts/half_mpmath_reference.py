@@ -5,7 +5,8 @@ d omega_o = 4 (wo.h) d omega_h, wi.h = c = mu u + s sin(alpha_h) cos(beta), N.wo
 
     a(mu) = integral_0^Y y / (4 pi u (1 + y^2)^2) K(y) dy,  K = 2 integral_0^beta0 4 c Gamma d beta
 
-(the arc beta < beta0 where N.wo > 0), Gamma = G1(N.wo) G1(mu) / mu for GGX (Walter et al. 2007 eq. 20, 33, 34)
+(the arc beta < beta0 where N.wo > 0), Gamma = G1(N.wo) G1(mu) / mu for GGX (Walter et al. 2007 eq. 20, 33, 34),
+N.wo / (N.wo P(mu) + mu P(N.wo) - mu N.wo) for "ggx-correlated" (Heitz 2014; P(w) = w / G1(w))
 and N.wo / ((r + (1 - r) N.wo)(r + (1 - r) mu)) for Schlick (000 eq. 36, with c = 1); Y = 1 / (tan(pi/4 -
 theta_i / 2) alpha), where h's whole circle sends wo below the horizon.  Both integrals by tanh-sinh (mpmath.quad,
 which crowds its nodes at the ends of every piece, where the features are), split at the arc's end and around the
@@ -14,6 +15,7 @@ horizon break; the printed error is mpmath's.  A few minutes per value on one co
     python scripts/half_mpmath_reference.py ggx 1e-8 1e-6       # alpha, mu: 0.99994923964388905852
     python scripts/half_mpmath_reference.py ggx 0.001 0.59      # 0.9999980591288865563
     python scripts/half_mpmath_reference.py ggx 1e-4 1e-4       # 0.88161827515105007481
+    python scripts/half_mpmath_reference.py ggx-correlated 0.5 1e-8
     python scripts/half_mpmath_reference.py schlick 1e-6 1e-5   # r, mu: 45.887293650878604133
     python scripts/half_mpmath_reference.py schlick 1e-6 1e-3   # 1.1685049698945183549
 """
@@ -39,6 +41,8 @@ def albedo(model: str, width: float, mu_: float):
     def gamma(z):
         if model == "schlick":
             return z / ((r + (1 - r) * z) * (r + (1 - r) * mu))  # 000 eq. 36
+        if model == "ggx-correlated":  # 1 / (mu (1 + Lambda(mu) + Lambda(z))), Heitz 2014; P(w) = w / G1(w)
+            return z / (z * mu / g1(mu) + mu * z / g1(z) - mu * z)
         return g1(z) * g1(mu) / mu
 
     def k(y):

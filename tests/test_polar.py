@@ -105,10 +105,15 @@ def test_one_d_agrees_with_the_two_d_engine(spec):
                                   if m(**ex).polar() is not None or m.type in ("lafortune_sum", "lewis_phong", "phong_shader")],
                          ids=lambda s: s["type"])
 def test_one_d_agrees_with_the_two_d_engine_on_every_example(spec):
+    # the models on the rule on h's arc (frame 4) against the nested engine: the 2-D engine misses GGX alpha = 0.5,
+    # correlated, at mu = 1e-8 by 6.7e-11 with an estimate of 5.5e-11 (30-digit mpmath, tests/test_polar_numeric.py)
     f = pumpup.load(spec)
     mu = np.array(MU)
     a, e = pumpup.albedo(f, mu, return_error=True)
-    with _polar.two_d_only():
+    hint = f.polar()
+    on_the_arc = hint is not None and (hint.smith is not None or hint.schlick is not None or any(hint.fresnel))
+    with _polar.without_1d() if on_the_arc else _polar.two_d_only(), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
         b, eb = pumpup.albedo(f, mu, return_error=True)
     assert np.all(np.abs(a - b) <= e + eb), (a, b, e, eb)
 
