@@ -191,7 +191,8 @@ class Polar:
         exp(-tan^2(alpha) / m^2) with m = ``n`` (the modified Ward model, 000 eq. 35), or the GGX weight
         1 / (1 + tan^2(alpha) / m^2)^2 (GGX, Walter et al. 2007 eq. 33; Torrance-Sparrow's D3, 002 sec. 3.2).
     vcavity : bool
-        With kind "half" and p = 0: the lobe is the V-cavity microfacet model's D G / (N.L N.V) with F = 1
+        With kind "half" and p = 0: the lobe is the V-cavity microfacet model's D G / (N.L N.V) with F = 1 (or ``fresnel``'s F, by
+        the rule on h's arc, :func:`_k_numeric`)
         (Cook-Torrance, 001 eq. 9-10; Torrance-Sparrow, 002 eq. 10; :func:`_k_vcavity`), D the radial factor
         (u^n, or with the Beckmann weight D's 1 / cos^4), 1 / N.L in ``scale``.
     ulps : float or callable
