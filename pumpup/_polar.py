@@ -703,14 +703,16 @@ def _k_vcavity(mu, s, psi, u, sa):  # pragma: no cover - compiled; see vcavity_i
 #: frame 4's models (``mp[0]``): the Smith microfacet models (Beckmann, GGX; :class:`Polar` ``smith``), the
 #: V-cavity models with a Fresnel factor (Cook-Torrance, Torrance-Sparrow with ``ior``) and Schlick's model
 #: (``Polar.schlick``)
-SMITH, VCAVITY_F, SCHLICK = 0, 1, 2
+SMITH, VCAVITY_F, SCHLICK, LOBE_F = 0, 1, 2, 3
 #: the slots of frame 4's parameter array ``mp`` (float64): model, Smith's distribution (0 Beckmann, 1 GGX), G1 (0
 #: exact, 1 Walter's fit), shadowing (0 separable, 1 height-correlated), alpha, ior, eta, k, P(mu) (set per mu by
 #: :func:`_integrate`), the level N.wo of Walter's G1 switch (-1 for none), the scale c_F of the Fresnel factor's
 #: feature at small wi.h (sqrt(|1 - (eta + i k)^2|), sqrt(ior^2 - 1); inf for none: :func:`fresnel_scale`), the scale
 #: z_s of the integrand's feature at small N.wo (alpha for the Smith models, Schlick's r / (1 - r); inf for none), the
-#: relative tolerance (set by :func:`albedo_1d`; :func:`_pieces` leaves out the outer cuts where they cannot matter)
-MP_SIZE = 13
+#: relative tolerance (set by :func:`albedo_1d`; :func:`_pieces` leaves out the outer cuts where they cannot matter);
+#: frame 5 (``LOBE_F``: the lobe frame with F(Theta_min), :func:`_k_lobe_fresnel`) also x0 and y0 of F's branch point
+#: (:func:`fresnel_branch`) and the distance rho of its pole near c = 0 (:func:`fresnel_pole`)
+MP_SIZE = 16
 
 
 def fresnel_scale(ior: float, eta: float, k: float) -> float:
@@ -858,6 +860,171 @@ def _k_numeric(mp, mu, s, psi, u, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, 
         val[worst], err[worst] = _delta_rule(mp, mu, u, c0, low, sb0, q, lo[worst], mid, nodes, wk, wg, mode, ibuf)
         val[m], err[m] = _delta_rule(mp, mu, u, c0, low, sb0, q, mid, hi[m], nodes, wk, wg, mode, ibuf)
         m += 1
+
+
+# --- frame 5: the lobe frame with 000 eq. 28's Fresnel factor F(Theta_min) (metal, plastic, the fresnel wrapper) ------
+
+
+#: frame 5 refuses (the nested engine takes the model) where the Fresnel factor's branch point w = sqrt(1 - (eta + i k)^2)
+#: lies closer than this to the real axis but off it (a near-kink: graded cuts would need log(1 / Im w) pieces per arc),
+#: or on it inside (0, 1) (a dielectric's total reflection below eta = 1: F = 1 up to a square-root kink)
+LOBE_F_Y0_MIN = 1e-3
+#: the most graded cuts per side of the branch point on an arc (:func:`_k_lobe_fresnel`) and in alpha (:func:`_pieces`)
+LOBE_F_CUTS = 8
+
+
+def fresnel_branch(eta: float, k: float) -> tuple:
+    """(x0, y0): the branch point w = sqrt(1 - (eta + i k)^2) = x0 - i y0 of the conductor Fresnel factor F(c)
+    (:func:`pumpup.models.metal._fresnel_real`, where the refracted cosine sqrt((eta + i k)^2 - 1 + c^2) vanishes; F is
+    analytic in c elsewhere near [0, 1], its other singularities -w and the conjugates as far), x0 = |Re w|,
+    y0 = |Im w|."""
+    w = complex(1.0 - (eta * eta - k * k), -2.0 * eta * k) ** 0.5
+    return abs(w.real), abs(w.imag)
+
+
+def fresnel_pole(eta: float, k: float) -> float:
+    """rho = 1 / |sqrt((eta + i k)^2 + 1)|: F(c)'s parallel reflectance has poles where A c + sin^2 = 0 (A the refracted
+    cosine times the index), c^2 = 1 / ((eta + i k)^2 + 1), in the left half-plane on the physical sheet; for a
+    strong absorber (|eta + i k| >> 1) near c = 0, at distance ~rho from the arc's small end (eta = 1.1, k = 30:
+    -0.0012 + 0.033 i; a rule blind to it was 1.9e-11 off with an estimate of 4.1e-12 at mu = 1e-3, rtol 1e-10, measured
+    against the nested and 2-D engines): frame 5 grades its arcs towards c = 0 on this scale."""
+    return 1.0 / abs(complex(eta * eta - k * k + 1.0, 2.0 * eta * k) ** 0.5)
+
+
+def lobe_fresnel_ok(eta: float, k: float) -> bool:
+    """Whether frame 5 takes the Fresnel factor of (eta, k) (:data:`LOBE_F_Y0_MIN`)."""
+    x0, y0 = fresnel_branch(eta, k)
+    if y0 == 0.0:
+        return x0 == 0.0 or x0 >= 1.0  # on the real axis: only outside (0, 1) (eta = 1, k = 0: F = 0)
+    return y0 >= LOBE_F_Y0_MIN
+
+
+@njit(cache=True, nogil=True)
+def _lobe_rule(mp, q, a, b, lo, hi, nodes, wk, wg, mode, ibuf):  # pragma: no cover - compiled
+    """(value, error) of the rule on beta in [lo, hi] for F(t) t^q, t = N.wo = a + b cos(beta) (:func:`_k_lobe_fresnel`)."""
+    h = hi - lo
+    for j in range(nodes.shape[0]):
+        t = a + b * math.cos(lo + h * nodes[j])
+        ibuf[j] = _fresnel_real(t, mp[6], mp[7]) * (t if q == 1.0 else 1.0)
+    k, diff, asc, ab = rule_sums(ibuf, wk, wg)
+    return k * h, calibrated(diff * h, asc * h, ab * h, mode)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _beta_at(t, top, b):  # pragma: no cover - compiled
+    """beta where a + b cos(beta) = t, from top - t = 2 b sin^2(beta / 2) (no cancellation near beta = 0)."""
+    return 2.0 * math.asin(min(1.0, math.sqrt(max(0.0, (top - t) / (2.0 * b)))))
+
+
+@njit(cache=True, nogil=True)
+def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, iwork):  # pragma: no cover - compiled; see lobe_fresnel_integrand_reference
+    """(K(u), its error) of frame 5: the integral over the visible arc of N.wo F(max(mu, N.wo)) / max(mu, N.wo)^p,
+    p in {0, 1}, for u = cos(alpha) about R (or wi), um = 1 - u, sa = sin(alpha), c2 = cos(2 theta_i); F the conductor
+    Fresnel factor of (eta, k) = (``mp[6]``, ``mp[7]``), 000 eq. 28.
+
+    Where N.wo < mu the factor is F(mu) / mu^p, a constant: that part is :func:`_k_closed`'s ``below`` times it.  Where
+    N.wo = t = a + b cos(beta) >= mu (|beta| <= beta1 <= pi / 2) the integrand F(t) t^(1 - p) is analytic but near F's
+    branch point w = x0 - i y0 (``mp[13]``, ``mp[14]``, :func:`fresnel_branch`): that arc is cut at t = x0 -+ y0 3^j
+    (each piece then lies about its own length from w) and integrated by the globally adaptive 7/15 rule in beta, the
+    interval with the largest error bisected until the summed error (QUADPACK's calibration) is at most
+    max(``itol`` |K|, ``tol_abs``) or INNER_MAX intervals are used; the error is returned either way.  Both signs of beta:
+    2 x."""
+    _, beta1, below = _k_closed(1.0, mu, c2, u, um, sa)
+    fm = _fresnel_real(mu, mp[6], mp[7])
+    closed = below * fm / (mu if p == 1.0 else 1.0)
+    if beta1 <= 0.0:
+        return 2.0 * closed, 0.0
+    a = mu * u
+    b = math.sqrt((1.0 - mu) * (1.0 + mu)) * sa
+    top = a + b  # t at beta = 0; t = mu at beta1
+    q = 1.0 - p
+    lo, hi, val, err = iwork[0], iwork[1], iwork[2], iwork[3]
+    x0, y0 = mp[13], mp[14]
+    # the cuts at t = x0 + y0 3^j (j falling), x0 - y0 3^j (j rising) and rho 3^j from max(rho, 3 mu) (j falling), merged
+    # in falling t (rising beta); then the arc's end beta1
+    rho = mp[15]
+    r0 = rho if 3.0 * mu <= rho else 3.0 * mu
+    m = 0
+    start = 0.0
+    ia, ib = 0, 0
+    nb = LOBE_F_CUTS
+    while True:
+        ta = -1.0
+        if ia < 2 * LOBE_F_CUTS:
+            ta = x0 + y0 * 3.0 ** (LOBE_F_CUTS - 1 - ia) if ia < LOBE_F_CUTS else x0 - y0 * 3.0 ** (ia - LOBE_F_CUTS)
+        tb = r0 * 3.0 ** (nb - 1 - ib) if ib < nb else -1.0
+        if ta < 0.0 and tb < 0.0:
+            end = beta1
+        else:
+            if ta >= tb:
+                t = ta
+                ia += 1
+            else:
+                t = tb
+                ib += 1
+            if not mu < t < top:
+                continue
+            end = min(_beta_at(t, top, b), beta1)
+        if end > start:
+            lo[m], hi[m] = start, end
+            val[m], err[m] = _lobe_rule(mp, q, a, b, start, end, nodes, wk, wg, mode, ibuf)
+            m += 1
+            start = end
+        if end >= beta1:
+            break
+    while True:
+        tot, e, worst = _tally(val, err, m, 0.0, 0.0)
+        if 2.0 * e <= max(2.0 * itol * abs(tot + closed), tol_abs) or m >= lo.shape[0]:
+            return 2.0 * (tot + closed), 2.0 * e
+        mid = 0.5 * (lo[worst] + hi[worst])
+        lo[m], hi[m] = mid, hi[worst]
+        hi[worst] = mid
+        val[worst], err[worst] = _lobe_rule(mp, q, a, b, lo[worst], mid, nodes, wk, wg, mode, ibuf)
+        val[m], err[m] = _lobe_rule(mp, q, a, b, mid, hi[m], nodes, wk, wg, mode, ibuf)
+        m += 1
+
+
+def lobe_fresnel_integrand_reference(brdf, mu: float, u) -> np.ndarray:
+    """Frame 5's K(u) (:func:`_k_lobe_fresnel`) for ``brdf``'s hint, independently: scipy's ``quad`` over the azimuth
+    beta in [0, pi] of N.wo F(max(mu, N.wo)) / max(mu, N.wo)^p where N.wo = mu u + s sin(alpha) cos(beta) > 0, with F
+    the complex-arithmetic :func:`pumpup.models.metal.fresnel`, the arcs' ends as the rule's points; times 2."""
+    from scipy.integrate import quad
+
+    from .models.metal import fresnel
+
+    hint = brdf.polar()
+    _, eta, k = hint.fresnel
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    out = []
+    for v in np.atleast_1d(np.asarray(u, dtype=float)):
+        a, b = mu * v, s * math.sqrt((1.0 - v) * (1.0 + v))
+
+        def g(beta):
+            t = a + b * math.cos(beta)
+            if t <= 0.0:
+                return 0.0
+            mx = max(mu, t)
+            return t * float(fresnel(mx, eta, k)) / mx**hint.p
+
+        pts = [math.acos(min(1.0, max(-1.0, x))) for x in ((mu - a) / b, -a / b)] if b > 0 else []
+        out.append(2.0 * quad(g, 0.0, math.pi, points=pts or None, epsabs=0.0, epsrel=1e-13, limit=400)[0])
+    return np.array(out)
+
+
+def lobe_fresnel_integrand(brdf, mu: float, u, rtol: float = 1e-13):
+    """(K(u), error) of frame 5 (:func:`_k_lobe_fresnel`) for ``brdf``'s hint at N.wi = ``mu`` and the values ``u`` of
+    cos(alpha) about R, at relative tolerance ``rtol`` (the kernel as the engine calls it; for the tests)."""
+    hint = brdf.polar()
+    mp = numeric_params(hint)
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    c2 = (mu - s) * (mu + s)
+    u = np.atleast_1d(np.asarray(u, dtype=float))
+    ibuf, iwork = np.empty(_NODES.shape[0]), np.empty((4, INNER_MAX))
+    val, err = np.empty(u.shape), np.empty(u.shape)
+    for i, v in enumerate(u):
+        val[i], err[i] = _k_lobe_fresnel(mp, float(hint.p), mu, c2, float(v), 1.0 - float(v), math.sqrt((1.0 - v) * (1.0 + v)),
+                                         rtol, 0.0, _NODES, _WK, _WG, mode_code(), ibuf, iwork)
+    return val, err
 
 
 def numeric_integrand_reference(brdf, mu: float, u) -> np.ndarray:
@@ -1182,6 +1349,19 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
             buf[j] = k * fac
             ie += wk[j] * e * fac
             noise += (wk[j] + wg[j]) * e * fac  # what the values' errors can hide of |K - G|
+    elif frame == 5:  # the lobe frame with F(Theta_min) (:func:`_k_lobe_fresnel`), as frame 4 takes K's errors
+        for j in range(nodes.shape[0]):
+            u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
+            if fac == 0.0:
+                buf[j] = 0.0
+                continue
+            if iacc >= 2.0 * math.pi * fac:  # K <= 2 pi (N.wo F / max(mu, N.wo)^p <= 1)
+                k, e = 0.0, 2.0 * math.pi
+            else:
+                k, e = _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol, iacc / fac, inodes, iwk, iwg, mode, ibuf, iwork)
+            buf[j] = k * fac
+            ie += wk[j] * e * fac
+            noise += (wk[j] + wg[j]) * e * fac
     else:  # the half-vector frame: the Blinn family and modified Ward, p in {0, 1} (frame 1); Ward (frame 2)
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
         psi = math.atan2(mu, s)
@@ -1195,7 +1375,11 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
                 k = _k_vcavity(mu, s, psi, u, sa) / (u * u * u * u if kind >= 2 else 1.0)
             buf[j] = k * fac
     k, diff, asc, ab = rule_sums(buf, wk, wg)
-    return k * h, calibrated((diff + noise) * h, asc * h, ab * h, mode) + ie * h
+    # (frame 5: at most the raw |K - G| raised by the noise, QUADPACK's "min" mode: where the values' errors dominate
+    # |K - G| on a small interval, the calibration's (200 |K - G| / resasc)^1.5 grows as resasc shrinks, and bisecting
+    # raised the total: fresnel over stretched Phong n = 0, eta 0.999, k 0.001 at mu = 1e-3 and rtol 1e-6 went from
+    # 4.1e-8 to 3.0e-7 in 1000 bisections)
+    return k * h, calibrated((diff + noise) * h, asc * h, ab * h, 2 if frame == 5 and mode == 1 else mode) + ie * h
 
 
 #: the peak variable z = -(n + 1) ln u runs at most to Z_MAX: below u = exp(-Z_MAX / (n + 1)) the
@@ -1315,13 +1499,36 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
         skip, z_end, peak = True, Z_MAX, 2
     elif radial == 2:  # ln(1 + t) everywhere, up to u_lo (half frame only)
         skip, z_end, peak = True, math.inf, 3
-    if frame == 0:
+    if frame == 0 or frame == 5:
         if 0.0 < s < 1.0:
             ub[m], zb[m], kb[m] = s, -0.5 * n1 * math.log1p(-mu * mu), 0
             m += 1
-        if p > 0.0 and 0.0 < c2 < 1.0:
+        if (p > 0.0 or frame == 5) and 0.0 < c2 < 1.0:  # (frame 5: F(max(mu, N.wo)) has the level for any p)
             ub[m], zb[m], kb[m] = c2, -n1 * math.log1p(-2.0 * s * s), 1
             m += 1
+        for pt in range(2 if frame == 5 else 0):
+            x0, y0 = (mp[13], mp[14]) if pt == 0 else (0.0, mp[15])  # F's branch point; its pole near 0
+            if not (x0 < 1.0 and x0 + 2.0 * y0 > mu):
+                continue
+            # K(u) turns where the arc's highest or lowest N.wo, cos(theta_i -+ alpha), passes F's branch point's x0
+            # (alpha = |theta_i - theta_0| or theta_i + theta_0), on the scale y0 / sin(theta_0) in alpha: cuts there and
+            # at -+ (that scale / 2) 4^j, not smoothed (code 3), as frame 4's (a first rule on a wide piece may not see it)
+            th_i = math.atan2(s, mu)
+            st0 = math.sqrt((1.0 - x0) * (1.0 + x0))
+            th_0 = math.atan2(st0, x0)
+            for ax in (abs(th_i - th_0), th_i + th_0):
+                if not 0.0 < ax < 0.5 * math.pi:
+                    continue
+                for side in range(3):
+                    off = 0.5 * y0 / st0
+                    for _ in range(LOBE_F_CUTS if side else 1):
+                        ab = ax if side == 0 else (ax - off if side == 1 else ax + off)
+                        if not 0.0 < ab < 0.5 * math.pi or m >= MAX_BREAKS:
+                            break
+                        ub[m], kb[m] = math.cos(ab), 3
+                        zb[m] = -n1 * math.log1p(-2.0 * math.sin(0.5 * ab) ** 2)
+                        m += 1
+                        off *= 4.0
     else:
         psi = math.atan2(mu, s)  # pi / 2 - theta_i, exact near grazing incidence
         hf = 0.25 * psi  # u_f = cos(pi/4 - theta_i/2) = cos(2 hf) = 1 - 2 sin^2(hf)
@@ -1403,7 +1610,7 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
                 left = cc[j] == 1 or cc[j] == 2  # (code 1 only where p > 0, or the half frame's u_lo)
                 right = cc[j + 1] == 0 or cc[j + 1] == 2
                 a = lo
-                if frame != 0 and lo > 0.0:
+                if frame != 0 and frame != 5 and lo > 0.0:
                     # the half frame near grazing incidence: above u_lo ~ mu / 2 and the level u = mu the
                     # arc's end c0 = mu / (2 u) changes on the scale of u itself, so the piece is cut at
                     # lo (1 + 4^i) (as above z_s below): one first interval on [mu / 2, 1/2] hid it
@@ -1422,7 +1629,7 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
         if zb[j] < z_end:
             cv[nc], cc[nc] = zb[j], kb[j]
             nc += 1
-    top = p > 0.0  # u = 1 (z = 0) is a square-root end: the level mu passes through R (through h = N)
+    top = p > 0.0 or frame == 5  # u = 1 (z = 0) is a square-root end: the level mu passes through R (through h = N)
     cv[nc], cc[nc] = z_end, k_end
     nc += 1
     _sorted_cuts(cv, cc, nc)
@@ -1455,6 +1662,8 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
         # 1 / u = sqrt(1 + m^2 t) <= A + B (t - Z), A = sqrt(1 + m^2 Z), B = m^2 / (2 A) (concave)
         big_a = math.sqrt(1.0 + n * n * Z_MAX)
         left_out = 4.0 * math.pi * n * n * math.exp(-Z_MAX) * (big_a + 0.5 * n * n / big_a) / mp[8] if k_end == -1 else 0.0
+    elif frame == 5:  # K <= 2 pi, as in the lobe frame
+        left_out = 2.0 * math.pi * math.exp(-Z_MAX) / n1 if skip and k_end == -1 else 0.0
     elif radial == 1 and frame >= 3:
         left_out = 8.0 * math.pi * n * n * mu * math.exp(-Z_MAX) if k_end == -1 else 0.0
     elif frame >= 3:  # (frame 4 here: the V-cavity with F <= 1)
@@ -1917,6 +2126,10 @@ def numeric_params(hint: Polar) -> np.ndarray:
             from .models.microfacet import walter_level
 
             mp[9] = walter_level(float(hint.smith[3]))
+    elif hint.kind == "lobe" and any(hint.fresnel):  # frame 5: F(max(N.wi, N.wo)) of a conductor (eta, k)
+        mp[0] = LOBE_F
+        mp[13], mp[14] = fresnel_branch(float(hint.fresnel[1]), float(hint.fresnel[2]))
+        mp[15] = fresnel_pole(float(hint.fresnel[1]), float(hint.fresnel[2]))
     elif hint.schlick is not None:
         r = float(hint.schlick)
         mp[0], mp[4], mp[11] = SCHLICK, r, (r / (1.0 - r) if r < 1.0 else math.inf)
@@ -1988,8 +2201,13 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
                                    or hint.radial == "power" or len(hint.smith) != 4):
         raise ValueError(f"{brdf!r}: a Polar hint with smith = (distribution, g1, shadowing, alpha) needs kind 'half', "
                          f"p = 0, the 'beckmann' or 'ggx' weight and neither vcavity nor sqrt_cos")
-    if any(hint.fresnel) and not (hint.smith is not None or hint.vcavity):
-        raise ValueError(f"{brdf!r}: a Polar hint's fresnel applies to a smith or vcavity lobe only")
+    lobe_f = hint.kind == "lobe" and any(hint.fresnel)
+    if lobe_f and (hint.p not in (0.0, 1.0) or hint.chain is not None or hint.fresnel[0] != 0.0 or not hint.fresnel[1] > 0.0
+                   or not lobe_fresnel_ok(float(hint.fresnel[1]), float(hint.fresnel[2]))):
+        raise ValueError(f"{brdf!r}: a lobe's Polar fresnel = (0, eta, k) needs p in {{0, 1}}, no chain, eta > 0 and a "
+                         f"branch point lobe_fresnel_ok accepts, got p={hint.p!r}, fresnel={hint.fresnel!r}")
+    if any(hint.fresnel) and not (hint.smith is not None or hint.vcavity or lobe_f):
+        raise ValueError(f"{brdf!r}: a Polar hint's fresnel applies to a smith, vcavity or lobe hint only")
     jac = jacobi_rules(1.0 - hint.p) if 0.0 < hint.p < 1.0 else _NO_JACOBI
     val = np.empty(mu.shape)
     err = np.empty(mu.shape)
@@ -2008,6 +2226,8 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         mp[12] = rtol
         if numeric:
             frame = 4
+        elif lobe_f:
+            frame = 5
         else:
             frame = (3 if hint.vcavity else 2 if hint.sqrt_cos else 1) if hint.kind == "half" else 0
         _integrate(frame, _RADIAL[hint.radial], float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,

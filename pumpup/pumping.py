@@ -877,12 +877,12 @@ class Pumped(BRDF):
     def polar(self):
         """The 1-D albedo path of a pumped Phong-family lobe (``pumpup._polar``): the base's
         closed-form-azimuth hint, with the divisor g_1 ... g_k (a function of N.wo for a fixed wi)
-        and its kinks; None for any other base."""
+        and its kinks; None for any other base (metal's too: its hint's Fresnel factor is frame 5's alone)."""
         from ._polar import Polar
 
         hint = self.chain()[0].base.polar()
-        if hint is None or hint.kind != "lobe" or hint.chain is not None:
-            return None
+        if hint is None or hint.kind != "lobe" or hint.chain is not None or any(hint.fresnel):
+            return None  # (a base with F(Theta_min), metal's: the chain frame has no Fresnel factor; the nested engine)
         return Polar(n=hint.n, p=hint.p, scale=hint.scale, chain=self._chain_args(),
                      levels=lambda mu: self.lobe(mu).levels)
 

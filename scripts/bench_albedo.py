@@ -27,6 +27,8 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
                                               # (half vector, closed forms) against the nested engine
     python scripts/bench_albedo.py --arc      # only the models put on the 1-D path in issue 14's seventh session
                                               # (a rule on the half vector's arc) against the nested engine
+    python scripts/bench_albedo.py --fresnel  # only the models put on the 1-D path in issue 14's eighth session
+                                              # (the lobe frame with F(Theta_min)) against the nested engine
     python scripts/bench_albedo.py --pumped   # only pumped Phong-family chains: 1-D path against the nested engine
     python scripts/bench_albedo.py --breaks   # only the nested families with kinks or levels: the compiled break
                                               # finding against its numpy reference (issue 14 item 3)
@@ -268,6 +270,18 @@ def on_the_arc(rtol=1e-10, repeat=3):
                     {"type": "schlick", "r": 0.001}], "1-D since issue 14's seventh session", rtol, repeat)
 
 
+def lobe_fresnel(rtol=1e-10, repeat=3):
+    """The models issue 14's eighth session put on the 1-D path: the lobe frame with 000 eq. 28's F(Theta_min) by a rule
+    on the arc where N.V >= N.L (pumpup._polar._k_lobe_fresnel: metal, plastic with an index, the fresnel wrapper of a
+    Phong-family lobe), against the nested engine they had before (:func:`against_nested`)."""
+    against_nested([{"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, {"type": "metal", "n": 1, "eta": 1.5},
+                    {"type": "metal", "n": 500, "eta": 1.1, "k": 6.0}, {"type": "metal", "n": 7.5, "eta": 0.6, "k": 0.3},
+                    {"type": "metal", "n": 20, "eta": 0.5, "k": 0.002}, {"type": "plastic", "n": 20, "eta": 1.5, "ad": 0.3},
+                    {"type": "fresnel", "base": {"type": "phong", "n": 20}, "eta": 0.2, "k": 3.0},
+                    {"type": "fresnel", "base": {"type": "phong", "n": 1}, "eta": 1.1, "k": 30.0}],
+                   "1-D since issue 14's eighth session", rtol, repeat)
+
+
 def pumped_chains(rtol=1e-10, repeat=3):
     """Pumped Phong-family BRDFs (001 eq. 16; the 1-D path since issue 14's fourth session) against
     the nested engine that had them (``Pumped.polar`` switched off: the base's Phong lobe keeps its
@@ -507,6 +521,9 @@ def main():
         return
     if "--arc" in sys.argv:
         on_the_arc()
+        return
+    if "--fresnel" in sys.argv:
+        lobe_fresnel()
         return
     if "--pumped" in sys.argv:
         pumped_chains()

@@ -171,6 +171,19 @@ class Metal(BRDF):
     def lobe(self, mu):
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"], levels=(mu,))
 
+    def polar(self):
+        return _fresnel_polar(self.p["n"], self.p["c"], self.p["eta"], self.p["k"])
+
+
+def _fresnel_polar(n, c, eta, k):
+    """The 1-D path's hint (pumpup._polar, frame 5) of c u^n F(eta + i k, Theta_min) / max(N.L, N.V), 000 eq. 28, or
+    None where its rule on the arc declines the Fresnel factor (a near-kink: the nested engine takes it)."""
+    from .._polar import Polar, lobe_fresnel_ok
+
+    if not lobe_fresnel_ok(float(eta), float(k)):
+        return None
+    return Polar(n=n, p=1.0, scale=lambda mu: np.full(np.shape(mu), c), fresnel=(0.0, float(eta), float(k)))
+
 
 # --- plastic --------------------------------------------------------------------------------
 
@@ -311,11 +324,13 @@ class Plastic(BRDF):
 
     def polar(self):
         q = self.p
-        if q["eta"] is not None or q["ad"] != 0:
-            return None  # F(Theta_min) varies along the arc; the diffuse part is split off by albedo_terms
+        if q["ad"] != 0:
+            return None  # the diffuse part is split off by albedo_terms
         from .._polar import Polar
 
         c = q["a_s"] * (q["n"] + 2.0) / (2.0 * math.pi)  # 000 eq. 30: stretched Phong's lobe (p = 1) times a_s
+        if q["eta"] is not None:
+            return _fresnel_polar(q["n"], c, q["eta"], 0.0)  # 000 eq. 29: F(Theta_min) by frame 5's rule on the arc
         return Polar(n=q["n"], p=1.0, scale=lambda mu: np.full(np.shape(mu), c))
 
 

@@ -1,0 +1,129 @@
+"""The lobe frame with 000 eq. 28's Fresnel factor F(Theta_min) (pumpup._polar frame 5, :func:`pumpup._polar._k_lobe_fresnel`;
+issue 14, eighth session): ``metal``, ``plastic`` with an index, and the ``fresnel`` wrapper over a lobe with p in {0, 1}
+(Phong, stretched Phong, Lafortune, retro, Phong's shader), whose F(max(N.L, N.V)) the rule integrates on the arc
+where N.V >= N.L."""
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import pumpup
+from pumpup import _polar
+
+MU = [1.0, 0.99, 0.9, math.sqrt(3) / 2, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8]
+
+SPECS = [
+    {"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, {"type": "metal", "n": 1, "eta": 1.5},
+    {"type": "metal", "n": 500, "eta": 1.1, "k": 6.0}, {"type": "metal", "n": 7.5, "eta": 0.6, "k": 0.3, "c": 0.5},
+    {"type": "metal", "n": 0, "eta": 0.999, "k": 0.001},  # F's branch point x0 0.049, y0 0.020: graded cuts at both
+    {"type": "metal", "n": 20, "eta": 0.5, "k": 0.002},  # y0 = 1.15e-3, just above LOBE_F_Y0_MIN: 14 cuts per arc
+    {"type": "plastic", "n": 20, "eta": 1.5, "ad": 0.3},
+    {"type": "fresnel", "base": {"type": "phong", "n": 1}, "eta": 1.1, "k": 30.0},  # F's pole at -0.0012 + 0.033 i
+    {"type": "fresnel", "base": {"type": "phong", "n": 20}, "eta": 0.05, "k": 30.0},
+    {"type": "fresnel", "base": {"type": "lafortune", "n": 20, "cx": 1.1, "cy": 1.1, "cz": 1.1, "p": 1.0}, "eta": 1.33},
+    {"type": "fresnel", "base": {"type": "retro", "n": 10}, "eta": 0.2, "k": 3.0},
+    {"type": "fresnel", "base": {"type": "phong_shader", "n": 20}, "eta": 3.0, "k": 0.3},
+]
+IDS = [f"{s['type']}-{s.get('n', s.get('base', {}).get('type'))}-{s['eta']}-{s.get('k', 0)}" for s in SPECS]
+
+
+def _lobe(spec):
+    """The spec whose hint frame 5 takes (plastic's diffuse part is split off by albedo_terms)."""
+    return pumpup.load(dict(spec, ad=0.0) if spec["type"] == "plastic" else spec)
+
+
+@pytest.mark.parametrize("spec", SPECS, ids=IDS)
+def test_kernel_against_scipy_quad(rng, spec):
+    """K(u) against its twin: scipy's quad over the azimuth about R of N.wo F(max(mu, N.wo)) / max(mu, N.wo)^p with the
+    complex-arithmetic Fresnel function (none of the kernel's cuts, arcs or real-arithmetic F), at random u and next to
+    where the arc's ends pass F's branch point and pole, from normal to grazing incidence."""
+    f = _lobe(spec)
+    hint = f.polar()
+    assert hint is not None and hint.kind == "lobe" and hint.fresnel[1] == spec["eta"]
+    x0, y0 = _polar.fresnel_branch(spec["eta"], spec.get("k", 0.0))
+    for mu in (1.0, 0.7, 0.2, 1e-3):
+        th = math.acos(mu)
+        angles = [th - math.acos(min(x0, 1.0)) + d for d in (-2 * y0, 0.0, 2 * y0)] + list(rng.uniform(0, math.pi / 2, 4))
+        us = np.cos([a for a in angles if 0.0 <= a < math.pi / 2] + [0.0])
+        k, e = _polar.lobe_fresnel_integrand(f, mu, us, rtol=1e-13)
+        q = _polar.lobe_fresnel_integrand_reference(f, mu, us)
+        assert np.all(np.abs(k - q) <= 1e-11 * np.abs(q) + 1e-15), (mu, us, k, q)
+        assert np.all(e <= 2e-13 * np.abs(k) + 1e-300)  # the tolerance is met
+
+
+@pytest.mark.parametrize("spec", SPECS, ids=IDS)
+def test_against_the_nested_and_two_d_engines(spec):
+    """The 1-D path against the nested engine at rtol 1e-12 (the engine these models had before) and the 2-D engine,
+    from normal to grazing incidence; at rtol 1e-6, 1e-8 and 1e-10 the estimate bounds the difference and meets the
+    tolerance."""
+    f = pumpup.load(spec)
+    assert _polar.takes_1d_path(_lobe(spec))
+    mu = np.array(MU)
+    with _polar.without_1d(), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
+    for rtol in (1e-6, 1e-8, 1e-10):
+        a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
+        assert np.all(np.abs(a - b) <= e + eb), (rtol, (np.abs(a - b) / (e + eb)).max())
+        assert np.all(e <= rtol * a * 1.0001 + 1e-14)
+    with _polar.two_d_only():
+        c, ec = pumpup.albedo(f, mu[[0, 5, 7]], return_error=True, rtol=1e-10)
+    assert np.all(np.abs(a[[0, 5, 7]] - c) <= e[[0, 5, 7]] + ec)
+
+
+def test_normal_incidence_is_the_fresnel_factor():
+    """At mu = 1 every N.wo <= mu, so F(Theta_min) = F(1) and the albedo of c u^n F / max is F(1) c 2 pi / (n + 2):
+    metal's (c = (n + 2) / (2 pi), 000 eq. 6) is F(1) = ((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2) exactly."""
+    for n, eta, k in ((20, 0.2, 3.0), (1, 1.5, 0.0), (500, 1.1, 6.0), (0, 0.999, 0.001)):
+        a, e = pumpup.albedo(pumpup.load({"type": "metal", "n": n, "eta": eta, "k": k}), [1.0], return_error=True, rtol=1e-12)
+        f1 = ((eta - 1) ** 2 + k * k) / ((eta + 1) ** 2 + k * k)
+        assert abs(a[0] - f1) <= e[0] + 4e-16 * f1, (n, eta, k, a[0] - f1, e[0])
+
+
+def test_which_models_take_it():
+    """Near-kinks of F (its branch point within LOBE_F_Y0_MIN of the real axis, or on it in (0, 1): a dielectric's total
+    reflection below eta = 1), p in (0, 1), a pumped base or a pumped metal and a Lambertian base stay on the nested
+    engine; the hint's refusals."""
+    assert _polar.lobe_fresnel_ok(0.2, 3.0) and _polar.lobe_fresnel_ok(1.5, 0.0) and _polar.lobe_fresnel_ok(1.0, 0.0)
+    assert not _polar.lobe_fresnel_ok(0.6, 0.0) and not _polar.lobe_fresnel_ok(0.5, 1e-4)
+    assert pumpup.load({"type": "metal", "n": 20, "eta": 0.6}).polar() is None
+    assert pumpup.load({"type": "plastic", "n": 20, "eta": 0.6, "ad": 0.0}).polar() is None
+    # a pumped metal: the chain frame has no Fresnel factor (taking the base's lobe without it gave a pumped gold an
+    # albedo of 2.4, caught by tests/test_spectral.py)
+    assert pumpup.pump({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}).polar() is None
+    for base in ({"type": "stretched_phong", "n": 20, "p": 0.5}, {"type": "pumped", "base": {"type": "phong", "n": 20}},
+                 {"type": "lambert"}, {"type": "blinn", "n": 20}):
+        assert pumpup.load({"type": "fresnel", "base": base, "eta": 0.2, "k": 3.0}).polar() is None, base
+    mu = np.array([0.5, 0.1])
+    for hint, match in [({"n": 5.0, "p": 0.5, "fresnel": (0.0, 0.2, 3.0)}, "fresnel"),
+                        ({"n": 5.0, "p": 1.0, "fresnel": (1.5, 0.0, 0.0)}, "fresnel"),
+                        ({"n": 5.0, "p": 1.0, "fresnel": (0.0, 0.6, 0.0)}, "fresnel")]:
+        bad = type("Bad", (), {"polar": lambda self, h=hint: _polar.Polar(scale=lambda m: np.ones(np.shape(m)), **h)})()
+        with pytest.raises(ValueError, match=match):
+            _polar.albedo_1d(bad, mu, 1e-8, 0.0, 100)
+
+
+def test_fresnel_wrapper_of_stretched_phong_is_metal():
+    """``{"type": "fresnel", "base": stretched Phong p = 1, eta, k}`` is ``metal`` (000 eq. 28): the same hint, the
+    same numbers."""
+    a = pumpup.albedo(pumpup.load({"type": "metal", "n": 100, "eta": 1.1, "k": 6.0}), MU, rtol=1e-10)
+    b = pumpup.albedo(pumpup.load({"type": "fresnel", "base": {"type": "stretched_phong", "n": 100, "p": 1.0},
+                                   "eta": 1.1, "k": 6.0}), MU, rtol=1e-10)
+    np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("n,eta,k,mu,ref", [
+    (20, 0.2, 3.0, 0.5, 0.80112984762665040829275345444433606957),
+    (20, 0.2, 3.0, 0.05, 0.53691967160246328697175732129175531695),
+    (7.5, 0.6, 0.3, 0.3, 0.35247684815542318022616560198697820634),
+    (1, 1.1, 30.0, 0.001, 0.74238552420483239024887086292862664743),  # F's pole near c = 0
+    (1, 1.5, 0.0, 0.2, 0.10831605403944787866771866254573111683)])
+def test_metal_against_mpmath(n, eta, k, mu, ref):
+    """metal against 40-digit mpmath values independent of pumpup (scripts/metal_mpmath_reference.py: tanh-sinh in the
+    lobe frame about R and in spherical coordinates about N, agreeing to 1e-41), at rtol 1e-8, 1e-10 and 1e-12."""
+    f = pumpup.load({"type": "metal", "n": n, "eta": eta, "k": k})
+    for rtol in (1e-8, 1e-10, 1e-12):
+        a, e = pumpup.albedo(f, np.array([mu]), return_error=True, rtol=rtol)
+        assert abs(a[0] - ref) <= e[0] <= rtol * ref, (rtol, a[0] - ref, e[0])
