@@ -871,6 +871,9 @@ def _k_numeric(mp, mu, s, psi, u, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, 
 LOBE_F_Y0_MIN = 1e-3
 #: the most graded cuts per side of the branch point on an arc (:func:`_k_lobe_fresnel`) and in alpha (:func:`_pieces`)
 LOBE_F_CUTS = 8
+#: no cuts in alpha (:func:`_pieces`) where the feature's scale there is at least this (rad): the outer rule's first
+#: 21 nodes on a piece of at most pi / 2 see it (metal eta 0.2, k 3: its pole's scale 0.35 had doubled the pieces)
+LOBE_F_WIDE = 0.25
 
 
 def fresnel_branch(eta: float, k: float) -> tuple:
@@ -1508,13 +1511,14 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
             m += 1
         for pt in range(2 if frame == 5 else 0):
             x0, y0 = (mp[13], mp[14]) if pt == 0 else (0.0, mp[15])  # F's branch point; its pole near 0
-            if not (x0 < 1.0 and x0 + 2.0 * y0 > mu):
+            st0 = math.sqrt((1.0 - x0) * (1.0 + x0)) if x0 < 1.0 else 0.0
+            if not (x0 < 1.0 and x0 + 2.0 * y0 > mu and y0 < LOBE_F_WIDE * st0):
                 continue
             # K(u) turns where the arc's highest or lowest N.wo, cos(theta_i -+ alpha), passes F's branch point's x0
             # (alpha = |theta_i - theta_0| or theta_i + theta_0), on the scale y0 / sin(theta_0) in alpha: cuts there and
-            # at -+ (that scale / 2) 4^j, not smoothed (code 3), as frame 4's (a first rule on a wide piece may not see it)
+            # at -+ (that scale / 2) 4^j, not smoothed (code 3), as frame 4's (a first rule on a wide piece may not see it;
+            # one on the scale LOBE_F_WIDE or wider does)
             th_i = math.atan2(s, mu)
-            st0 = math.sqrt((1.0 - x0) * (1.0 + x0))
             th_0 = math.atan2(st0, x0)
             for ax in (abs(th_i - th_0), th_i + th_0):
                 if not 0.0 < ax < 0.5 * math.pi:
@@ -1933,14 +1937,15 @@ def ring_table(n: float) -> tuple:
 
 
 @njit(cache=True, nogil=True)
-def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork):  # pragma: no cover
+def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr):  # pragma: no cover
     """(value, error) of the rule on the elevation x of wo in [lo, hi] for
     t / (max(mu, t)^p g(mu, t)) W(t) cos(x), t = N.wo = sin(x) (001 eq. 16 with 000 eq. 7, 12;
     d omega = dt d phi), g the product of the chain's levels exactly as the BRDF divides by it, and
     W(t) the lobe u^n integrated over the circle N.wo = t: u = A + B cos(phi), A = mu t, B = s cos(x),
     W = (A + B)^n V(kappa), kappa = 2 B / (A + B), A + B = cos(x - x_mu) (x_mu the elevation of the
     lobe's axis; (A + B)^n = exp(n log1p(-2 sin^2((x - x_mu) / 2))), accurate for any n), V from
-    the ring table (:func:`ring_table`, its errors summed with the Kronrod weights)."""
+    the ring table (:func:`ring_table`, its errors summed with the Kronrod weights); with ``fr`` = (1, eta, k) times
+    000 eq. 28's F(max(mu, t)) (a pumped metal, or the fresnel wrapper of a pumped lobe)."""
     h = hi - lo
     ie = 0.0
     xmu = math.atan2(mu, s)
@@ -1962,6 +1967,8 @@ def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, 
             f = t * ct / (max(mu, t) * g)
         else:
             f = t * ct / (max(mu, t) ** p * g)
+        if fr[0] != 0.0:
+            f *= _fresnel_real(max(mu, t), fr[1], fr[2])  # 000 eq. 28, as the kernels compute it
         sx = math.sin(0.5 * (x - xmu))
         d1 = 2.0 * sx * sx
         kappa = min(2.0 * s * ct / (1.0 - d1), 2.0)
@@ -1983,10 +1990,11 @@ def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, 
 
 @njit(cache=True, nogil=True)
 def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, n_init, cuts, ncut, chain,
-                      kb, kc, keps, val, err, conv, evals):  # pragma: no cover
+                      kb, kc, keps, fr, val, err, conv, evals):  # pragma: no cover
     """Adaptive 10/21 quadrature over the elevation of wo of a pumped lobe (:func:`_x_rule`) for every
     mu, from the pieces between ``cuts[q, :ncut[q]]`` (:func:`chain_cuts`), each ``n_init`` intervals to
-    start; ``kb``, ``kc``, ``keps`` the ring table of the lobe's exponent (:func:`ring_table`)."""
+    start; ``kb``, ``kc``, ``keps`` the ring table of the lobe's exponent (:func:`ring_table`); ``fr`` the Fresnel
+    factor's (on, eta, k) (:func:`_x_rule`)."""
     cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals, nodes, nodes, rtol)
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
@@ -2001,7 +2009,7 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
                 pk[m] = i
                 t0[m] = a_ + (b_ - a_) * j / n_init
                 t1[m] = a_ + (b_ - a_) * (j + 1.0) / n_init if j + 1 < n_init else b_
-                kv[m], ke[m] = _x_rule(n, p, mu, s, t0[m], t1[m], chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork)
+                kv[m], ke[m] = _x_rule(n, p, mu, s, t0[m], t1[m], chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr)
                 m += 1
         start = m
         while True:
@@ -2011,8 +2019,8 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
             if ok or m - start >= max_intervals or m >= cap:
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
-            kv[worst], ke[worst] = _x_rule(n, p, mu, s, a_, mid, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork)
-            kv[m], ke[m] = _x_rule(n, p, mu, s, mid, b_, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork)
+            kv[worst], ke[worst] = _x_rule(n, p, mu, s, a_, mid, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr)
+            kv[m], ke[m] = _x_rule(n, p, mu, s, mid, b_, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr)
             m += 1
         val[q] = tot
         err[q] = e + r
@@ -2020,13 +2028,14 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
         evals[q] = nodes.shape[0] * (m + (m - start))
 
 
-def chain_cuts(levels, n: float, mu: float) -> np.ndarray:
+def chain_cuts(levels, n: float, mu: float, fresnel=None) -> np.ndarray:
     """The breakpoints in the elevation x of wo (N.wo = sin x) of a pumped lobe at incidence mu:
     0, pi/2, the levels of g (``levels``), N.wo = mu (max(mu, N.wo)), N.wo = s (u > 0 on the whole
     circle above it), the lobe's peak theta_o = theta_i +- k / sqrt(n), k = 3, 8, 13 (u^n ~
     exp(-n alpha^2 / 2)), N.wo = 2^-(1 + 2k) (:data:`GRADE`), every pi / 16 (:data:`X_PIECES`), and for
-    n < :data:`RING_SMOOTH_N` a grading towards x_s; x = atan2(L, sqrt(1 - L^2)) keeps levels near 1 to full
-    precision."""
+    n < :data:`RING_SMOOTH_N` a grading towards x_s; with ``fresnel`` = (eta, k), N.wo = x0 -+ y0 3^j about F's branch
+    point and rho 3^j towards its pole near 0 (as frame 5's arcs, :func:`_k_lobe_fresnel`; the pole's only where rho <
+    :data:`LOBE_F_WIDE`); x = atan2(L, sqrt(1 - L^2)) keeps levels near 1 to full precision."""
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     L = np.asarray(levels, dtype=np.float64).reshape(-1)
     L = L[(L > 0.0) & (L < 1.0)]
@@ -2053,6 +2062,13 @@ def chain_cuts(levels, n: float, mu: float) -> np.ndarray:
         x.append(math.asin(t))
         t *= GRADE
     x.extend(np.arange(1, X_PIECES) * (0.5 * math.pi / X_PIECES))
+    if fresnel is not None:
+        x0, y0 = fresnel_branch(*fresnel)
+        rho = fresnel_pole(*fresnel)
+        js = 3.0 ** np.arange(LOBE_F_CUTS)
+        t = np.concatenate([x0 + y0 * js, x0 - y0 * js, rho * js if rho < LOBE_F_WIDE else []])
+        t = t[(t > 0.0) & (t < 1.0)]
+        x.extend(np.arctan2(t, np.sqrt((1.0 - t) * (1.0 + t))))
     x = np.unique(np.asarray(x))
     return x[(x >= 0.0) & (x <= 0.5 * math.pi)]
 
@@ -2202,10 +2218,10 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         raise ValueError(f"{brdf!r}: a Polar hint with smith = (distribution, g1, shadowing, alpha) needs kind 'half', "
                          f"p = 0, the 'beckmann' or 'ggx' weight and neither vcavity nor sqrt_cos")
     lobe_f = hint.kind == "lobe" and any(hint.fresnel)
-    if lobe_f and (hint.p not in (0.0, 1.0) or hint.chain is not None or hint.fresnel[0] != 0.0 or not hint.fresnel[1] > 0.0
+    if lobe_f and ((hint.p not in (0.0, 1.0) and hint.chain is None) or hint.fresnel[0] != 0.0 or not hint.fresnel[1] > 0.0
                    or not lobe_fresnel_ok(float(hint.fresnel[1]), float(hint.fresnel[2]))):
-        raise ValueError(f"{brdf!r}: a lobe's Polar fresnel = (0, eta, k) needs p in {{0, 1}}, no chain, eta > 0 and a "
-                         f"branch point lobe_fresnel_ok accepts, got p={hint.p!r}, fresnel={hint.fresnel!r}")
+        raise ValueError(f"{brdf!r}: a lobe's Polar fresnel = (0, eta, k) needs p in {{0, 1}} (any p with a chain), "
+                         f"eta > 0 and a branch point lobe_fresnel_ok accepts, got p={hint.p!r}, fresnel={hint.fresnel!r}")
     if any(hint.fresnel) and not (hint.smith is not None or hint.vcavity or lobe_f):
         raise ValueError(f"{brdf!r}: a Polar hint's fresnel applies to a smith, vcavity or lobe hint only")
     jac = jacobi_rules(1.0 - hint.p) if 0.0 < hint.p < 1.0 else _NO_JACOBI
@@ -2233,11 +2249,13 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         _integrate(frame, _RADIAL[hint.radial], float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
                    *(_RULES[RULE]), mode, N_INIT, *_RULES["gk15"], jac, mp, val, err, conv, evals)
     else:  # a pumped lobe, about N
-        cuts = [chain_cuts(hint.levels(float(m)), float(hint.n), float(m)) for m in mu]
+        fres = (float(hint.fresnel[1]), float(hint.fresnel[2])) if lobe_f else None
+        fr = np.array([1.0 if lobe_f else 0.0, *(fres or (0.0, 0.0))])
+        cuts = [chain_cuts(hint.levels(float(m)), float(hint.n), float(m), fres) for m in mu]
         ncut = np.array([len(c) for c in cuts], np.int64)
         cut = np.zeros((len(mu), int(ncut.max(initial=2))))
         for q, c in enumerate(cuts):
             cut[q, :len(c)] = c
         _integrate_chain(float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
-                         *_RULES[CHAIN_RULE], N_INIT_CHAIN, cut, ncut, hint.chain, *ring_table(float(hint.n)), val, err, conv, evals)
+                         *_RULES[CHAIN_RULE], N_INIT_CHAIN, cut, ncut, hint.chain, *ring_table(float(hint.n)), fr, val, err, conv, evals)
     return scale * val, np.abs(scale) * err, conv, evals

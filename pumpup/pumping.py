@@ -877,14 +877,16 @@ class Pumped(BRDF):
     def polar(self):
         """The 1-D albedo path of a pumped Phong-family lobe (``pumpup._polar``): the base's
         closed-form-azimuth hint, with the divisor g_1 ... g_k (a function of N.wo for a fixed wi)
-        and its kinks; None for any other base (metal's too: its hint's Fresnel factor is frame 5's alone)."""
+        and its kinks, and the base's Fresnel factor F(Theta_min) (metal's); None for any other base."""
         from ._polar import Polar
 
         hint = self.chain()[0].base.polar()
-        if hint is None or hint.kind != "lobe" or hint.chain is not None or any(hint.fresnel):
-            return None  # (a base with F(Theta_min), metal's: the chain frame has no Fresnel factor; the nested engine)
+        if hint is None or hint.kind != "lobe" or hint.chain is not None:
+            return None
+        # (a base with F(Theta_min), metal's, keeps it: the chain frame multiplies by it; dropping it had given a pumped
+        # gold an albedo of 2.4 while it was being built, caught by tests/test_spectral.py)
         return Polar(n=hint.n, p=hint.p, scale=hint.scale, chain=self._chain_args(),
-                     levels=lambda mu: self.lobe(mu).levels)
+                     levels=lambda mu: self.lobe(mu).levels, fresnel=hint.fresnel)
 
     def azimuth_range(self):
         return self.base.azimuth_range()  # g depends on N.wi and N.wo only

@@ -84,17 +84,18 @@ def test_normal_incidence_is_the_fresnel_factor():
 
 def test_which_models_take_it():
     """Near-kinks of F (its branch point within LOBE_F_Y0_MIN of the real axis, or on it in (0, 1): a dielectric's total
-    reflection below eta = 1), p in (0, 1), a pumped base or a pumped metal and a Lambertian base stay on the nested
-    engine; the hint's refusals."""
+    reflection below eta = 1), p in (0, 1), a Lambertian or half-vector base stay on the nested engine; the hint's
+    refusals."""
     assert _polar.lobe_fresnel_ok(0.2, 3.0) and _polar.lobe_fresnel_ok(1.5, 0.0) and _polar.lobe_fresnel_ok(1.0, 0.0)
     assert not _polar.lobe_fresnel_ok(0.6, 0.0) and not _polar.lobe_fresnel_ok(0.5, 1e-4)
     assert pumpup.load({"type": "metal", "n": 20, "eta": 0.6}).polar() is None
     assert pumpup.load({"type": "plastic", "n": 20, "eta": 0.6, "ad": 0.0}).polar() is None
-    # a pumped metal: the chain frame has no Fresnel factor (taking the base's lobe without it gave a pumped gold an
-    # albedo of 2.4, caught by tests/test_spectral.py)
-    assert pumpup.pump({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}).polar() is None
-    for base in ({"type": "stretched_phong", "n": 20, "p": 0.5}, {"type": "pumped", "base": {"type": "phong", "n": 20}},
-                 {"type": "lambert"}, {"type": "blinn", "n": 20}):
+    # a pumped metal keeps its Fresnel factor in the chain frame (a first version dropped it: a pumped gold's albedo was
+    # 2.4, caught by tests/test_spectral.py), as does the fresnel wrapper of a pumped lobe; not with a near-kink
+    assert pumpup.pump({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}).polar().fresnel == (0.0, 0.2, 3.0)
+    assert pumpup.pump({"type": "metal", "n": 20, "eta": 0.6}).polar() is None
+    for base in ({"type": "stretched_phong", "n": 20, "p": 0.5}, {"type": "lambert"}, {"type": "blinn", "n": 20},
+                 {"type": "pumped", "base": {"type": "blinn", "n": 20}}):
         assert pumpup.load({"type": "fresnel", "base": base, "eta": 0.2, "k": 3.0}).polar() is None, base
     mu = np.array([0.5, 0.1])
     for hint, match in [({"n": 5.0, "p": 0.5, "fresnel": (0.0, 0.2, 3.0)}, "fresnel"),
@@ -127,3 +128,32 @@ def test_metal_against_mpmath(n, eta, k, mu, ref):
     for rtol in (1e-8, 1e-10, 1e-12):
         a, e = pumpup.albedo(f, np.array([mu]), return_error=True, rtol=rtol)
         assert abs(a[0] - ref) <= e[0] <= rtol * ref, (rtol, a[0] - ref, e[0])
+
+
+CHAINS = [({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, "g1", 1), ({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, "g2", 2),
+          ({"type": "metal", "n": 5, "eta": 1.1, "k": 30.0}, "g1", 1), ({"type": "metal", "n": 200, "eta": 0.6, "k": 0.3}, "g2", 1),
+          ({"type": "fresnel", "base": {"type": "pumped", "base": {"type": "stretched_phong", "n": 20}}, "eta": 0.2, "k": 3.0},
+           None, 0),
+          ({"type": "fresnel", "base": {"type": "pumped", "base": {"type": "stretched_phong", "n": 20, "p": 0.5}, "g": "g2",
+                                        "levels": 2}, "eta": 0.999, "k": 0.001}, None, 0)]
+
+
+@pytest.mark.parametrize("spec,g,levels", CHAINS, ids=[f"{s['type']}-{g}-{lv}" for s, g, lv in CHAINS])
+def test_pumped_metal_against_the_nested_and_two_d_engines(spec, g, levels):
+    """A pumped metal (001 eq. 16 over 000 eq. 28) and the fresnel wrapper of a pumped lobe (one channel of the
+    colour-keeping pumped metal) take the pumped lobe's frame of N with F(max(mu, N.wo)): against the nested engine at
+    rtol 1e-12 and the 2-D engine; the estimate bounds the difference at rtol 1e-6 and 1e-10 and meets the tolerance."""
+    f = pumpup.pump(spec, g=g, levels=levels) if g else pumpup.load(spec)
+    assert _polar.takes_1d_path(f) and f.polar().chain is not None and any(f.polar().fresnel)
+    mu = np.array(MU)
+    with _polar.without_1d(), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
+    for rtol in (1e-6, 1e-10):
+        a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
+        assert np.all(np.abs(a - b) <= e + eb), (rtol, (np.abs(a - b) / (e + eb)).max())
+        assert np.all(e <= rtol * a * 1.0001 + 1e-14)
+    assert np.all(a - e <= 1.0)  # (a pumped BRDF conserves energy, 001 eq. 18)
+    with _polar.two_d_only():
+        c, ec = pumpup.albedo(f, mu[[0, 5, 7]], return_error=True, rtol=1e-10)
+    assert np.all(np.abs(a[[0, 5, 7]] - c) <= e[[0, 5, 7]] + ec)
