@@ -108,6 +108,6 @@ class FresnelWeighted(BRDF):
 
         hint = self.base.polar()
         if (hint is None or hint.kind != "lobe" or (hint.p not in (0.0, 1.0) and hint.chain is None) or any(hint.fresnel)
-                or not lobe_fresnel_ok(float(self.p["eta"]), float(self.p["k"]))):
+                or not lobe_fresnel_ok(float(self.p["eta"]), float(self.p["k"]), hint.chain is not None)):
             return None
         return dataclasses.replace(hint, fresnel=(0.0, float(self.p["eta"]), float(self.p["k"])))
