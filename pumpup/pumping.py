@@ -852,7 +852,10 @@ class Pumped(BRDF):
                         g = g[(g > 0) & (g <= 1.0)]
                         vals = up(g) - (am if k == 0 else mu)
                 vals = np.where(np.abs(vals) < 1e-13 * max(1.0, am), 0.0, vals)  # rounding of a flat spline: no root
-                found = [brentq(fn, g[i], g[i + 1], xtol=1e-15) for i in np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]]
+                cells = np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]
+                if k == 0:  # (not the root v = mu itself, already a level)
+                    cells = [i for i in cells if not (g[i] <= mu <= g[i + 1] and g[i + 1] - g[i] <= 2.01e-6 * mu)]
+                found = [brentq(fn, g[i], g[i + 1], xtol=1e-15) for i in cells]
             for v in found:
                 if self.controlled:
                     # the crossing value c and the terms that are not crossing there
