@@ -1,5 +1,5 @@
 """One-dimensional albedo where the azimuth integrates in closed form (Phong, Blinn, Ward, Cook-Torrance families) or by
-a rule on known arcs (GGX, Beckmann, Schlick, Fresnel factors).
+a rule on known arcs (GGX, Beckmann, Schlick, Fresnel factors, metal).
 
 Method
 ------
@@ -126,6 +126,18 @@ before its calibration.  GGX alpha = 0.001 showed why the cuts are needed: witho
 nested engine agree).  alpha > 1 (P then has a singularity near N.wo = 1, which is not graded) and Torrance-Sparrow's
 D2 stay on the nested engine.
 
+000 eq. 28's Fresnel factor F(Theta_min) = F(max(N.L, N.V)) (metal, plastic with an index, the ``fresnel`` wrapper of a
+lobe with p in {0, 1}; ``Polar(kind="lobe", fresnel=(0, eta, k))``) takes the lobe frame with a rule on the arc (frame 5,
+:func:`_k_lobe_fresnel`): where N.wo < mu the factor is the constant F(mu) / mu^p, so that part is the closed form's;
+where N.wo = t >= mu the integrand F(t) t^(1 - p) is integrated in beta by the adaptive 7/15 rule, cut at t = x0 -+
+y0 3^j about F's branch point w = sqrt(1 - (eta + i k)^2) = x0 - i y0 (:func:`fresnel_branch`) and at t = rho 3^j towards
+the pole of its parallel reflectance near c = 0 (rho = 1 / |sqrt((eta + i k)^2 + 1)|, :func:`fresnel_pole`: a strong
+absorber's, eta 1.1, k 30, sits at -0.0012 + 0.033 i); the outer variable is cut where the arc's ends pass those points
+(features narrower than :data:`LOBE_F_WIDE`).  A near-kink (Im w < :data:`LOBE_F_Y0_MIN`, or w real in (0, 1): a
+dielectric's total reflection below eta = 1) stays on the nested engine.  A pumped metal, and the fresnel wrapper of a
+pumped lobe, multiply the pumped lobe's frame of N by F(max(mu, N.wo)) (:func:`_x_rule`, cut likewise by
+:func:`chain_cuts`; Im w >= :data:`CHAIN_F_Y0_MIN` there).
+
 A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
 :class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D
 engine stays the reference: :func:`two_d_only` switches the 1-D path off.
@@ -208,7 +220,9 @@ class Polar:
         (:func:`_k_numeric`), D's 1 / (pi alpha^2) and the 1 / 4 in ``scale``.
     fresnel : tuple
         (ior, eta, k): the Fresnel factor at wi.h of a Smith or V-cavity lobe, dielectric (ior > 0) or conductor
-        (eta > 0), or none (all 0); a V-cavity lobe with one takes the rule on h's arc too.
+        (eta > 0), or none (all 0); a V-cavity lobe with one takes the rule on h's arc too.  With kind "lobe" (ior 0, eta
+        > 0): 000 eq. 28's conductor factor F(max(N.L, N.V)) (frame 5, :func:`_k_lobe_fresnel`; with ``chain``, the
+        pumped lobe's frame of N, :func:`_x_rule`).
     schlick : float, optional
         With kind "half", p = 0 and the GGX weight (n = sqrt(r)): Schlick's model (000 eq. 36) with this r, whose
         1 / (r + (1 - r) N.V) the rule on h's arc integrates (:func:`_k_numeric`); 1 / (r + (1 - r) N.L) in ``scale``.

@@ -273,12 +273,16 @@ def on_the_arc(rtol=1e-10, repeat=3):
 def lobe_fresnel(rtol=1e-10, repeat=3):
     """The models issue 14's eighth session put on the 1-D path: the lobe frame with 000 eq. 28's F(Theta_min) by a rule
     on the arc where N.V >= N.L (pumpup._polar._k_lobe_fresnel: metal, plastic with an index, the fresnel wrapper of a
-    Phong-family lobe), against the nested engine they had before (:func:`against_nested`)."""
+    Phong-family lobe) and the pumped lobe's frame of N with it (a pumped metal, the fresnel wrapper of a pumped lobe),
+    against the nested engine they had before (:func:`against_nested`)."""
     against_nested([{"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, {"type": "metal", "n": 1, "eta": 1.5},
                     {"type": "metal", "n": 500, "eta": 1.1, "k": 6.0}, {"type": "metal", "n": 7.5, "eta": 0.6, "k": 0.3},
                     {"type": "metal", "n": 20, "eta": 0.5, "k": 0.002}, {"type": "plastic", "n": 20, "eta": 1.5, "ad": 0.3},
                     {"type": "fresnel", "base": {"type": "phong", "n": 20}, "eta": 0.2, "k": 3.0},
-                    {"type": "fresnel", "base": {"type": "phong", "n": 1}, "eta": 1.1, "k": 30.0}],
+                    {"type": "fresnel", "base": {"type": "phong", "n": 1}, "eta": 1.1, "k": 30.0},
+                    {"type": "pumped", "base": {"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}},
+                    {"type": "fresnel", "base": {"type": "pumped", "base": {"type": "stretched_phong", "n": 20}},
+                     "eta": 0.2, "k": 3.0}],
                    "1-D since issue 14's eighth session", rtol, repeat)
 
 
