@@ -27,7 +27,7 @@ Written for issue 14 (eighth session) without pumpup: tests/test_polar_fresnel.p
 """
 import sys
 import time
-from mpmath import mp, mpf, mpc, sqrt, pi, cos, sin, acos, quad, nstr, fabs
+from mpmath import mp, mpf, mpc, sqrt, pi, cos, sin, acos, quad, nstr
 
 DPS = int(sys.argv[1]) if len(sys.argv) > 1 else 30
 mp.dps = DPS
