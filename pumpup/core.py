@@ -704,7 +704,7 @@ class FunctionBRDF(BRDF):
                 f"function: no function named {name!r} is registered in this session; "
                 "call pumpup.from_function(fn, name=...) first"
             )
-        self.fn, self.reciprocal = _USER_FUNCTIONS[name]
+        self.fn, self.reciprocal, self.isotropic = _USER_FUNCTIONS[name]
 
     def _eval(self, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
         shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
@@ -732,11 +732,17 @@ class FunctionBRDF(BRDF):
     def kernel_args(self) -> tuple:
         return ()
 
-    def azimuth_range(self) -> float:
-        return 2.0 * math.pi  # nothing is known about a user function's symmetry
+    def azimuth_range(self) -> float | None:
+        # nothing is known about a user function's symmetry, unless it was declared (and checked) isotropic
+        return None if self.isotropic else 2.0 * math.pi
 
 
-def from_function(fn: Callable, name: str = "function", reciprocal: bool = True) -> BRDF:
+#: :func:`from_function`'s check of a claim of isotropy: pairs, and the relative change allowed under a rotation about N
+ISOTROPY_PAIRS = 2000
+ISOTROPY_RTOL = 1e-9
+
+
+def from_function(fn: Callable, name: str = "function", reciprocal: bool = True, isotropic: bool = False) -> BRDF:
     """Wrap a callable ``fn(wi, wo) -> f_r`` (numpy, broadcasting) as a BRDF.
 
     Parameters
@@ -749,6 +755,12 @@ def from_function(fn: Callable, name: str = "function", reciprocal: bool = True)
         ``{"type": "function", "name": name}`` loads it again.
     reciprocal : bool
         What the caller claims; :func:`check_reciprocity` measures it.
+    isotropic : bool
+        The caller's claim that f does not change when wi and wo turn together about N (it depends on them through
+        N.wi, N.wo and wi.wo only): the albedo then does not depend on the azimuth of wi, and pumping tabulates it once
+        instead of bounding its supremum over that azimuth (:func:`pumpup.azimuth.sup_albedo`: 16 tables or more).
+        Checked here: f at :data:`ISOTROPY_PAIRS` random pairs against the same pairs turned by random angles, which
+        must agree within :data:`ISOTROPY_RTOL` (relative); a ValueError names the largest change otherwise.
 
     Examples
     --------
@@ -761,8 +773,31 @@ def from_function(fn: Callable, name: str = "function", reciprocal: bool = True)
         raise TypeError(f"from_function needs a callable fn(wi, wo), got {type(fn).__name__}")
     if not isinstance(name, str) or not name:
         raise SpecError("from_function: 'name' must be a non-empty string")
-    _USER_FUNCTIONS[name] = (fn, bool(reciprocal))
-    return FunctionBRDF(name=name)
+    old = _USER_FUNCTIONS.get(name)
+    _USER_FUNCTIONS[name] = (fn, bool(reciprocal), bool(isotropic))
+    f = FunctionBRDF(name=name)
+    if isotropic:
+        rng = np.random.default_rng(20261202)
+        n = ISOTROPY_PAIRS
+        z = rng.uniform(1e-3, 1.0, (2, n))  # (above the horizon, where f is not replaced by 0)
+        ph = rng.uniform(0.0, 2.0 * math.pi, (2, n))
+        turn = rng.uniform(0.0, 2.0 * math.pi, n)
+        r = np.sqrt((1.0 - z) * (1.0 + z))
+        wi, wo, wi2, wo2 = (np.stack([r[k] * np.cos(ph[k] + t), r[k] * np.sin(ph[k] + t), z[k]], axis=-1)
+                            for t in (0.0, turn) for k in (0, 1))
+        try:
+            a, b = f._eval(wi, wo), f._eval(wi2, wo2)
+        except Exception:
+            _USER_FUNCTIONS.pop(name) if old is None else _USER_FUNCTIONS.__setitem__(name, old)
+            raise
+        change = np.abs(a - b) / np.maximum(np.maximum(np.abs(a), np.abs(b)), 1e-300)
+        if change.max() > ISOTROPY_RTOL:
+            i = int(np.argmax(change))
+            _USER_FUNCTIONS.pop(name) if old is None else _USER_FUNCTIONS.__setitem__(name, old)
+            raise ValueError(f"from_function: isotropic=True, but {name!r} changes by {change[i]:.3g} (relative, allowed "
+                             f"{ISOTROPY_RTOL:g}) when wi={wi[i].tolist()}, wo={wo[i].tolist()} turn about N by "
+                             f"{turn[i]:.6g} rad: {float(a[i])!r} against {float(b[i])!r}")
+    return f
 
 
 # ----------------------------------------------------------------------------------------

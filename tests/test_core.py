@@ -103,6 +103,29 @@ def test_from_function_round_trip_and_checks():
         pumpup.from_function(3)
 
 
+def test_from_function_isotropic_claim_is_checked():
+    """isotropic=True: the albedo has no azimuth of wi (azimuth_range None, one table when pumped); the claim is
+    measured on random pairs turned about N, and a function that changes is refused with the pair and the change,
+    leaving no registration behind."""
+    def phong(wi, wo):
+        return 3.0 * np.maximum(2 * wi[..., 2] * wo[..., 2] - np.sum(wi * wo, axis=-1), 0.0) ** 4
+
+    assert pumpup.from_function(phong, name="iso-phong", isotropic=True).azimuth_range() is None
+    assert pumpup.from_function(phong, name="any-phong").azimuth_range() == pytest.approx(2 * np.pi)
+
+    def tilted(wi, wo):  # depends on the azimuth of wi: anisotropic
+        return 0.2 + 0.01 * wi[..., 0] + 0.0 * wo[..., 0]
+
+    with pytest.raises(ValueError, match=r"isotropic=True, but 'tilted' changes by .* when wi=\[.*turn about N"):
+        pumpup.from_function(tilted, name="tilted", isotropic=True)
+    with pytest.raises(pumpup.SpecError, match="no function named 'tilted'"):
+        pumpup.load({"type": "function", "name": "tilted"})
+    # a function that fails on the check's pairs fails there, with its own clear error
+    with pytest.raises(ValueError, match="non-negative"):
+        pumpup.from_function(lambda wi, wo: -np.ones(np.broadcast_shapes(wi.shape, wo.shape)[:-1]), name="neg-iso",
+                             isotropic=True)
+
+
 def test_check_reciprocity_finds_asymmetry_and_reports_worst_pair():
     def lopsided(wi, wo):
         return 0.1 + 0.05 * wi[..., 2] * (1 - wo[..., 2])

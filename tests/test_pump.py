@@ -78,7 +78,7 @@ def test_five_levels(name, g):
 def test_energy_creating_symmetric_function_becomes_plausible():
     # a constant 2/pi reflects twice what it receives; one pumping makes it exactly Lambertian
     f = pumpup.from_function(lambda wi, wo: np.full(np.broadcast_shapes(wi.shape, wo.shape)[:-1], 2 / np.pi),
-                             name="twice-lambert")
+                             name="twice-lambert", isotropic=True)
     assert np.allclose(pumpup.albedo(f, MU), 2.0)
     p = pumpup.pump(f, g="g1", levels=3)
     for level in levels_of(p)[1:]:
@@ -87,12 +87,24 @@ def test_energy_creating_symmetric_function_becomes_plausible():
         np.testing.assert_allclose(a, 1.0, atol=1e-7)
 
 
-def test_user_function_base_two_levels():
-    def phong8(wi, wo):
-        rv = 2 * wi[..., 2] * wo[..., 2] - np.sum(wi * wo, axis=-1)
-        return 10 / (2 * np.pi) * np.maximum(rv, 0) ** 8
+def _phong8(wi, wo):
+    rv = 2 * wi[..., 2] * wo[..., 2] - np.sum(wi * wo, axis=-1)
+    return 10 / (2 * np.pi) * np.maximum(rv, 0) ** 8
 
-    f = pumpup.pump(pumpup.from_function(phong8, name="phong8"), g="g2", levels=2)
+
+def test_user_function_base_two_levels():
+    """A user function declared isotropic (and checked: pumpup.from_function) is tabulated once per level."""
+    f = pumpup.pump(pumpup.from_function(_phong8, name="phong8", isotropic=True), g="g2", levels=2)
+    assert f.base.azimuth_range() is None and "sup" not in f.table().dataset.attrs.get("azimuth", "")
+    check_chain(f, MU[::2])
+
+
+@pytest.mark.slow
+def test_user_function_base_two_levels_sup_over_the_azimuth():
+    """The same function without the claim: nothing is known of its symmetry, so every level's g bounds the supremum
+    over the azimuth of wi (pumpup.azimuth.sup_albedo, 16 tables or more per level; minutes)."""
+    f = pumpup.pump(pumpup.from_function(_phong8, name="phong8-any"), g="g2", levels=2)
+    assert "sup over phi" in f.table().dataset.attrs["azimuth"]
     check_chain(f, MU[::2])
 
 
