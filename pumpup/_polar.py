@@ -1746,7 +1746,8 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
     half vector's (:func:`_k_half`, :func:`_k_ward`, :func:`_k_vcavity`; 4 :func:`_k_numeric` with the parameters
     ``mp``, its P(mu) set here per mu), ``radial`` 1 the Beckmann weight, 2 the GGX weight, in place of u^n
     (:func:`_pieces`)."""
-    cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals, nodes, inodes, rtol)
+    # (room for every piece's first intervals besides max_intervals bisections: up to MAX_PIECES pieces)
+    cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals + MAX_PIECES * n_init, nodes, inodes, rtol)
     kinds = np.empty(MAX_PIECES, np.int64)
     sms = np.empty(MAX_PIECES, np.int64)
     v0 = np.empty(MAX_PIECES)
@@ -2014,7 +2015,9 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
     mu, from the pieces between ``cuts[q, :ncut[q]]`` (:func:`chain_cuts`), each ``n_init`` intervals to
     start; ``kb``, ``kc``, ``keps`` the ring table of the lobe's exponent (:func:`ring_table`); ``fr`` the Fresnel
     factor's (on, eta, k) (:func:`_x_rule`)."""
-    cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals, nodes, nodes, rtol)
+    # (room for every piece's first intervals besides max_intervals bisections: a pumped metal near grazing incidence has
+    # ~100 pieces, more than the 64 spare slots)
+    cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals + cuts.shape[1] * n_init, nodes, nodes, rtol)
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
