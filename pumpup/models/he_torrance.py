@@ -446,7 +446,8 @@ class HeTorrance(BRDF):
         mu = max(float(mu), 1e-3)
         sigma = float(effective_sigma(mu, mu, p["sigma_0"], p["tau"]))
         g = (2.0 * kk * sigma * mu) ** 2
-        m_eff = min(1.0, math.sqrt(max(1.0, g)) / (kk * p["tau"] * mu))
+        den = kk * p["tau"] * mu  # (0 for a denormal tau: the lobe is then as wide as the map allows)
+        m_eff = min(1.0, math.sqrt(max(1.0, g)) / den) if den > 0.0 else 1.0
         # the GGX map tan^2(theta_h) = r x / (1 - x), r = m_eff^2: its tail is heavier than
         # Gaussian, as the series' mixture of Gaussians of widths sqrt(m) is (the Beckmann
         # map's weight 1/x diverges at theta_h -> 90 deg where f does not vanish at grazing)
