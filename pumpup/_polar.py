@@ -921,6 +921,18 @@ def lobe_fresnel_ok(eta: float, k: float, chain: bool = False) -> bool:
     return y0 >= (CHAIN_F_Y0_MIN if chain and x0 < 1.0 else LOBE_F_Y0_MIN)
 
 
+def with_fresnel(hint, eta: float, k: float):
+    """``hint`` (a lobe's, p in {0, 1}, or a pumped lobe's, any p) with 000 eq. 28's F(Theta_min) of (eta, k) added: frame
+    5, or the pumped lobe's frame of N with the factor; None where the path declines it (no such hint, a factor already,
+    a near-kink: :func:`lobe_fresnel_ok`).  For the ``fresnel`` wrapper and the colour-keeping pumped metal's channels."""
+    import dataclasses
+
+    if (hint is None or hint.kind != "lobe" or (hint.p not in (0.0, 1.0) and hint.chain is None) or any(hint.fresnel)
+            or not lobe_fresnel_ok(float(eta), float(k), hint.chain is not None)):
+        return None
+    return dataclasses.replace(hint, fresnel=(0.0, float(eta), float(k)))
+
+
 @njit(cache=True, nogil=True)
 def _lobe_rule(mp, q, a, b, lo, hi, nodes, wk, wg, mode, ibuf):  # pragma: no cover - compiled
     """(value, error) of the rule on beta in [lo, hi] for F(t) t^q, t = N.wo = a + b cos(beta) (:func:`_k_lobe_fresnel`)."""

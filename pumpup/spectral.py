@@ -604,6 +604,12 @@ class _FresnelWeighted(BRDF):
     def sampling_lobe(self, mu):
         return self.lobe_brdf.sampling_lobe(mu)
 
+    def polar(self):
+        """The pumped lobe's 1-D hint with F(Theta_min) (pumpup._polar.with_fresnel), or None."""
+        from ._polar import with_fresnel
+
+        return with_fresnel(self.lobe_brdf.polar(), self.eta, self.k)
+
 
 class SpectralPumpedLobe(Spectral):
     """A colour-keeping pumped metal: the F = 1 lobe pumped once, times F(Theta_min) per wavelength.

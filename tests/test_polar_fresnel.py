@@ -136,3 +136,17 @@ def test_pumped_metal_against_the_nested_and_two_d_engines(spec, g, levels):
     assert f.polar().chain is not None and any(f.polar().fresnel)
     a, e = one_d_against_the_other_engines(f, MU)
     assert np.all(a - e <= 1.0)  # (a pumped BRDF conserves energy, 001 eq. 18)
+
+
+def test_colour_keeping_pumped_metal_channels():
+    """Every wavelength of the colour-keeping pumped metal (pumpup.spectral.SpectralPumpedLobe: the F = 1 lobe pumped
+    once, times F(Theta_min) per wavelength) takes the pumped lobe's frame with its F: against the nested engine."""
+    from pumpup import spectral
+
+    k = spectral.SpectralPumpedLobe(spectral.SpectralMetal("Cu", n=20, wavelengths=[450.0, 650.0]))
+    assert all(m.polar() is not None and m.polar().fresnel[1] == e for m, e in zip(k.models, k.eta))
+    mu = np.array([1.0, 0.7, 0.2, 1e-3])
+    a, e = k.albedo(mu, return_error=True, rtol=1e-10)
+    with _polar.without_1d():
+        b, eb = k.albedo(mu, return_error=True, rtol=1e-12)
+    assert np.all(np.abs(a - b) <= e + eb) and np.all(e <= 1e-10 * a * 1.0001)

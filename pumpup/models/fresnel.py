@@ -102,12 +102,6 @@ class FresnelWeighted(BRDF):
     def polar(self):
         """A lobe base's hint (p in {0, 1}; any p for a pumped lobe's) with F(Theta_min) added: frame 5 of the 1-D path, or
         the pumped lobe's frame of N (pumpup._polar), or None."""
-        import dataclasses
+        from .._polar import with_fresnel
 
-        from .._polar import lobe_fresnel_ok
-
-        hint = self.base.polar()
-        if (hint is None or hint.kind != "lobe" or (hint.p not in (0.0, 1.0) and hint.chain is None) or any(hint.fresnel)
-                or not lobe_fresnel_ok(float(self.p["eta"]), float(self.p["k"]), hint.chain is not None)):
-            return None
-        return dataclasses.replace(hint, fresnel=(0.0, float(self.p["eta"]), float(self.p["k"])))
+        return with_fresnel(self.base.polar(), self.p["eta"], self.p["k"])
