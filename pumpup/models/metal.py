@@ -178,11 +178,9 @@ class Metal(BRDF):
 def _fresnel_polar(n, c, eta, k):
     """The 1-D path's hint (pumpup._polar, frame 5) of c u^n F(eta + i k, Theta_min) / max(N.L, N.V), 000 eq. 28, or
     None where its rule on the arc declines the Fresnel factor (a near-kink: the nested engine takes it)."""
-    from .._polar import Polar, lobe_fresnel_ok
+    from .._polar import Polar, with_fresnel
 
-    if not lobe_fresnel_ok(float(eta), float(k)):
-        return None
-    return Polar(n=n, p=1.0, scale=lambda mu: np.full(np.shape(mu), c), fresnel=(0.0, float(eta), float(k)))
+    return with_fresnel(Polar(n=n, p=1.0, scale=lambda mu: np.full(np.shape(mu), c)), eta, k)
 
 
 # --- plastic --------------------------------------------------------------------------------
