@@ -958,8 +958,9 @@ def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol, tol_abs, nodes, wk, wg, mode
 
     Where N.wo < mu the factor is F(mu) / mu^p, a constant: that part is :func:`_k_closed`'s ``below`` times it.  Where
     N.wo = t = a + b cos(beta) >= mu (|beta| <= beta1 <= pi / 2) the integrand F(t) t^(1 - p) is analytic but near F's
-    branch point w = x0 - i y0 (``mp[13]``, ``mp[14]``, :func:`fresnel_branch`): that arc is cut at t = x0 -+ y0 3^j
-    (each piece then lies about its own length from w) and integrated by the globally adaptive 7/15 rule in beta, the
+    branch point w = x0 - i y0 (``mp[13]``, ``mp[14]``, :func:`fresnel_branch`) and its pole near 0 (at distance rho,
+    ``mp[15]``, :func:`fresnel_pole`): that arc is cut at t = x0 -+ y0 3^j and at t = rho 3^j from max(rho, 3 mu) (each
+    piece then lies about its own length from them) and integrated by the globally adaptive 7/15 rule in beta, the
     interval with the largest error bisected until the summed error (QUADPACK's calibration) is at most
     max(``itol`` |K|, ``tol_abs``) or INNER_MAX intervals are used; the error is returned either way.  Both signs of beta:
     2 x."""
