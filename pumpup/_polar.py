@@ -1046,22 +1046,6 @@ def lobe_fresnel_integrand_reference(brdf, mu: float, u) -> np.ndarray:
     return np.array(out)
 
 
-def lobe_fresnel_integrand(brdf, mu: float, u, rtol: float = 1e-13):
-    """(K(u), error) of frame 5 (:func:`_k_lobe_fresnel`) for ``brdf``'s hint at N.wi = ``mu`` and the values ``u`` of
-    cos(alpha) about R, at relative tolerance ``rtol`` (the kernel as the engine calls it; for the tests)."""
-    hint = brdf.polar()
-    mp = numeric_params(hint)
-    s = math.sqrt((1.0 - mu) * (1.0 + mu))
-    c2 = (mu - s) * (mu + s)
-    u = np.atleast_1d(np.asarray(u, dtype=float))
-    ibuf, iwork = np.empty(_NODES.shape[0]), np.empty((4, INNER_MAX))
-    val, err = np.empty(u.shape), np.empty(u.shape)
-    for i, v in enumerate(u):
-        val[i], err[i] = _k_lobe_fresnel(mp, float(hint.p), mu, c2, float(v), 1.0 - float(v), math.sqrt((1.0 - v) * (1.0 + v)),
-                                         rtol, 0.0, _NODES, _WK, _WG, mode_code(), ibuf, iwork)
-    return val, err
-
-
 def numeric_integrand_reference(brdf, mu: float, u) -> np.ndarray:
     """Plain twin of :func:`_k_numeric`: K(u) from the model's own numpy formula (``BRDF.reference`` at
     wo = 2 (wi.h) h - wi), integral over h's azimuth of 4 (wi.h) N.wo f_r where N.wo > 0 by scipy's QUADPACK (split at
@@ -2190,8 +2174,9 @@ def numeric_params(hint: Polar) -> np.ndarray:
 
 
 def numeric_integrand(brdf, mu: float, u, rtol: float = 1e-13):
-    """(K(u), error) of frame 4 (:func:`_k_numeric`) for ``brdf``'s hint at N.wi = ``mu`` and the values ``u`` of
-    N.h, at relative tolerance ``rtol`` (the kernel as the engine calls it; for the tests)."""
+    """(K(u), error) of frame 4 (:func:`_k_numeric`, ``u`` the values of N.h) or, for a lobe hint with a Fresnel factor,
+    frame 5 (:func:`_k_lobe_fresnel`, ``u`` the values of cos(alpha) about R) for ``brdf``'s hint at N.wi = ``mu``, at
+    relative tolerance ``rtol`` (the kernels as the engine calls them; for the tests)."""
     hint = brdf.polar()
     mp = numeric_params(hint)
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -2201,8 +2186,13 @@ def numeric_integrand(brdf, mu: float, u, rtol: float = 1e-13):
     ibuf, iwork = np.empty(_NODES.shape[0]), np.empty((4, INNER_MAX))
     val, err = np.empty(u.shape), np.empty(u.shape)
     for i, v in enumerate(u):
-        val[i], err[i] = _k_numeric(mp, mu, s, math.atan2(mu, s), float(v), math.sqrt((1.0 - v) * (1.0 + v)), rtol, 0.0,
-                                    _NODES, _WK, _WG, mode_code(), ibuf, iwork)
+        sa = math.sqrt((1.0 - v) * (1.0 + v))
+        if mp[0] == LOBE_F:
+            val[i], err[i] = _k_lobe_fresnel(mp, float(hint.p), mu, (mu - s) * (mu + s), float(v), 1.0 - float(v), sa, rtol,
+                                             0.0, _NODES, _WK, _WG, mode_code(), ibuf, iwork)
+        else:
+            val[i], err[i] = _k_numeric(mp, mu, s, math.atan2(mu, s), float(v), sa, rtol, 0.0, _NODES, _WK, _WG,
+                                        mode_code(), ibuf, iwork)
     return val, err
 
 

@@ -896,17 +896,15 @@ class Pumped(BRDF):
         """The 1-D albedo path of a pumped Phong-family lobe (``pumpup._polar``): the base's
         closed-form-azimuth hint, with the divisor g_1 ... g_k (a function of N.wo for a fixed wi)
         and its kinks, and the base's Fresnel factor F(Theta_min) (metal's); None for any other base."""
-        from ._polar import Polar, lobe_fresnel_ok
+        from ._polar import Polar, with_fresnel
 
         hint = self.chain()[0].base.polar()
         if hint is None or hint.kind != "lobe" or hint.chain is not None:
             return None
-        if any(hint.fresnel) and not lobe_fresnel_ok(hint.fresnel[1], hint.fresnel[2], chain=True):
-            return None  # (a near-kink of F: g has it too)
-        # (a base with F(Theta_min), metal's, keeps it: the chain frame multiplies by it; dropping it had given a pumped
-        # gold an albedo of 2.4 while it was being built, caught by tests/test_spectral.py)
-        return Polar(n=hint.n, p=hint.p, scale=hint.scale, chain=self._chain_args(),
-                     levels=lambda mu: self.lobe(mu).levels, fresnel=hint.fresnel)
+        out = Polar(n=hint.n, p=hint.p, scale=hint.scale, chain=self._chain_args(), levels=lambda mu: self.lobe(mu).levels)
+        # (a base with F(Theta_min), metal's, keeps it: the chain frame multiplies by it, where with_fresnel takes it;
+        # dropping it had given a pumped gold an albedo of 2.4 while it was being built, caught by tests/test_spectral.py)
+        return with_fresnel(out, *hint.fresnel[1:]) if any(hint.fresnel) else out
 
     def azimuth_range(self):
         return self.base.azimuth_range()  # g depends on N.wi and N.wo only
