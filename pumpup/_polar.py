@@ -138,6 +138,19 @@ dielectric's total reflection below eta = 1) stays on the nested engine.  A pump
 pumped lobe, multiply the pumped lobe's frame of N by F(max(mu, N.wo)) (:func:`_x_rule`, cut likewise by
 :func:`chain_cuts`; Im w >= :data:`CHAIN_F_Y0_MIN` there).
 
+GGX with F = 1 and alpha <= 1 (either Smith G) and Schlick's model take the frame of N instead (frame 6,
+:func:`_integrate_n`): for wo at elevation x (N.wo = t = sin x) their G and 1 / (N.L N.V) depend on t only, and the GGX
+weight D = alpha^2 / (pi (1 - (1 - alpha^2) (N.h)^2)^2) integrates over the azimuth of wo in closed form,
+(N.h)^2 = m^2 / |wi + wo|^2 making it rational in cos(phi) (:func:`_ggx_ring`: a sum of three terms >= 0, its two
+square roots products of sums of squares, with no cancellation and no division by N.wi + N.wo).  What is left is one
+integral over x of analytic pieces, graded towards the singularities near the real axis: x_mu +- 2 i atanh(alpha) (the
+peak; the variable is d = x - x_mu, exact where the peak is narrow), P(t)'s branch point at +- i atanh(alpha), Schlick's
+pole at sin x = -r / (1 - r), the height-correlated G's pole at x = -x_mu (:func:`_n_cuts`); 10/21 Gauss-Kronrod with
+QUADPACK's calibration.  No inner rule: 41-170 evaluations per mu for alpha >= 0.1, a 257-point table in 0.7-2.6 ms
+(frame 4 took 30-70 ms), and mu down to the smallest double.  ``scripts/ggx_frame_calibration.py`` measures it against
+frame 4 (:func:`without_n_frame`) at rtol 1e-13 over 26 models, 64 mu and rtol 1e-6 ... 1e-12: no difference beyond
+the reference's own error.
+
 A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
 :class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D
 engine stays the reference: :func:`two_d_only` switches the 1-D path off.
@@ -1351,11 +1364,15 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
         psi = math.atan2(mu, s)
         for j in range(nodes.shape[0]):
             u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * nodes[j])
-            if kind >= 2:
-                fac /= u * u * u * u
             if fac == 0.0:
                 buf[j] = 0.0
                 continue
+            if kind >= 2:
+                # (u^4 underflows below u ~ 1e-81, near grazing incidence, mu < 1e-80: GGX alpha = 1e-8 with an ior at mu =
+                # 1e-100 divided by 0 (the ninth session).  Where u^3 underflows too, below 1e-108, the weight's value there
+                # is below 1e-96 K (GGX's e^-z (m^2 / 2) / u ~ m^4 u / 2, Beckmann's e^-t = 0): left out)
+                u3 = u * u * u
+                fac = fac / (u3 * u) if u3 * u > 0.0 else (fac / u3 / u if u3 > 0.0 else 0.0)
             # K's error may be itol |K| or iacc / fac: the second's share of the sum is at most itol times the
             # integral's lower bound so far (iacc, :func:`_integrate`).  Where that exceeds K's bound (0 <= K <= kmax:
             # 8 pi / P(mu) for the Smith models, 16 pi u mu for the V-cavity, 8 pi for Schlick's; F <= 1), K = 0 with
@@ -1409,8 +1426,13 @@ Z_MAX = 40.0
 #: the most breakpoints :func:`_pieces` takes (8, and frame 4's graded cuts, 3 x 16)
 MAX_BREAKS = 56
 
-#: the most pieces :func:`_pieces` makes (4 tail, the graded cuts above the horizon break, 3 peak; frame 4's cuts)
+#: the most graded pieces :func:`_pieces` makes (:func:`_graded_cuts` stops there; 4 tail, the graded cuts above the
+#: horizon break, 3 peak; frame 4's cuts)
 MAX_PIECES = 128
+#: the size of :func:`_pieces`'s arrays: MAX_PIECES graded ones and the pieces between every two breaks of the tail and the
+#: peak, which come after them (with 128 slots in all, a narrow GGX lobe at grazing incidence, alpha = 1e-8 at mu = 1e-100
+#: and rtol 1e-13 on frame 4, wrote past the end: found in the ninth session by NUMBA_BOUNDSCHECK=1)
+PIECES_CAP = MAX_PIECES + 2 * (MAX_BREAKS + 4)
 
 
 @njit(cache=True, nogil=True)
@@ -1434,7 +1456,7 @@ def _graded_cuts(kind, lo, hi, left, k, margin, kinds, sms, v0, w, v1):  # pragm
     [lo, hi] starts, the next slot, the rest's left smoothing)."""
     a = lo
     step = lo  # the first cut at 2 lo
-    while a + step < hi - step and k < kinds.shape[0] - margin:
+    while a + step < hi - step and k < MAX_PIECES - margin:
         kinds[k] = kind
         sms[k] = (1 if left else 0) if a == lo else 0
         v0[k] = a
@@ -1485,7 +1507,7 @@ def _zr(radial, tb, n):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True)
 def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: no cover - compiled
     """The pieces between the breakpoints, written into ``kinds``, ``sms`` (the smoothing), ``v0``,
-    ``w``, ``v1`` (arrays of :data:`MAX_PIECES`); returns (their number, c2 = cos 2 theta_i, a bound of
+    ``w``, ``v1`` (arrays of :data:`PIECES_CAP`); returns (their number, c2 = cos 2 theta_i, a bound of
     the part left out).
 
     Breakpoints: u = 0, 1/2, 1 and, in the lobe frame (``frame`` 0), u = s (the horizon starts to cut
@@ -1743,13 +1765,13 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
     half vector's (:func:`_k_half`, :func:`_k_ward`, :func:`_k_vcavity`; 4 :func:`_k_numeric` with the parameters
     ``mp``, its P(mu) set here per mu), ``radial`` 1 the Beckmann weight, 2 the GGX weight, in place of u^n
     (:func:`_pieces`)."""
-    # (room for every piece's first intervals besides max_intervals bisections: up to MAX_PIECES pieces)
-    cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals + MAX_PIECES * n_init, nodes, inodes, rtol)
-    kinds = np.empty(MAX_PIECES, np.int64)
-    sms = np.empty(MAX_PIECES, np.int64)
-    v0 = np.empty(MAX_PIECES)
-    w = np.empty(MAX_PIECES)
-    cv1 = np.empty(MAX_PIECES)
+    # (room for every piece's first intervals besides max_intervals bisections: up to PIECES_CAP pieces)
+    cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals + PIECES_CAP * n_init, nodes, inodes, rtol)
+    kinds = np.empty(PIECES_CAP, np.int64)
+    sms = np.empty(PIECES_CAP, np.int64)
+    v0 = np.empty(PIECES_CAP)
+    w = np.empty(PIECES_CAP)
+    cv1 = np.empty(PIECES_CAP)
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -1789,6 +1811,229 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
         err[q] = e + r
         conv[q] = ok
         evals[q] = nodes.shape[0] * (m + (m - start))  # every split evaluates two halves
+
+
+# --- frame 6: the frame of N with the GGX weight's azimuth in closed form (GGX with F = 1, Schlick's model) ---------
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _ggx_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ggx_ring_reference
+    """integral over phi in [0, 2 pi) of the GGX weight D = a2 / (pi (1 - (1 - a2) (N.h)^2)^2) (Walter et al. 2007
+    eq. 33; 000 eq. 36 with a2 = r) on the circle of wo at elevation x = x_mu + d (N.wo = sin x) for wi at elevation x_mu
+    (x_s = pi / 2 - x_mu).
+
+    With X = |wi + wo|^2 = P0 + Q cos(phi) and (N.h)^2 = m^2 / X, m = N.wi + N.wo, D = (a2 / pi) X^2 / (X - k)^2, k = (1 - a2)
+    m^2, and the integral of (1 + k / Y)^2 over phi, Y = X - k = a' + Q cos(phi), is 2 pi (1 + 2 k / R + k^2 a' / R^3),
+    R^2 = (a' - Q)(a' + Q).  Both factors are sums of squares: a' - Q = m^2 (a2 + tan^2(d / 2)), a' + Q = 4 cos^2(d / 2)
+    (a2 S^2 + C^2), S, C = sin, cos((x + x_mu) / 2), m = 2 S cos(d / 2); so, with A = a2 + tan^2(d / 2) and B = a2 S^2 +
+    C^2, the integral is 2 a2 (1 + 2 (1 - a2) S / sqrt(A B) + (1 - a2)^2 S (S^2 A + B) / (2 (A B)^(3/2))): every term
+    >= 0 for a2 <= 1 (no cancellation), no division by m (which vanishes at grazing incidence), and d, the offset from
+    the peak, exact where the peak is narrow (a rule in x itself lost ulp(x) / alpha there: GGX alpha = 1e-5 at mu =
+    0.9986 was 3e-13 off with an estimate of 9e-14), and cosines near pi / 2 as sines of x_s - ... (cos(x) of a rounded x
+    near pi / 2 lost ulp(pi / 2) / alpha: alpha = 1e-8 at mu = 1 did not converge)."""
+    tau = math.tan(0.5 * d)
+    sy, cy = math.sin(xmu + 0.5 * d), math.sin(xs - 0.5 * d)  # (cos(y) as sin(pi / 2 - y): exact near the normal)
+    a = a2 + tau * tau  # (a' - Q) / m^2
+    b = a2 * sy * sy + cy * cy  # (a' + Q) / (4 cos^2(d / 2))
+    r = math.sqrt(a * b)
+    k = 1.0 - a2
+    return 2.0 * a2 * (1.0 + 2.0 * k * sy / r + k * k * sy * (sy * sy * a + b) / (2.0 * r * r * r))
+
+
+def ggx_ring_reference(a2: float, mu: float, x: float) -> float:
+    """:func:`_ggx_ring` at elevation ``x`` by scipy's adaptive quadrature of D over phi (its numpy/scipy twin, for the
+    tests)."""
+    from scipy.integrate import quad
+
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    wi = np.array([s, 0.0, mu])
+
+    def d(phi):
+        wo = np.array([math.cos(x) * math.cos(phi), math.cos(x) * math.sin(phi), math.sin(x)])
+        h = wi + wo
+        c2, s2 = h[2] * h[2] / (h @ h), (h[0] * h[0] + h[1] * h[1]) / (h @ h)  # cos^2, sin^2 of h's angle from N
+        return a2 / (math.pi * (a2 * c2 + s2) ** 2)  # Walter eq. 33: a2 / (pi (a2 cos^2 + sin^2)^2)
+
+    return 2.0 * quad(d, 0.0, math.pi, epsabs=0.0, epsrel=1e-13, limit=1000, points=_peak_points(math.sqrt(a2)))[0]
+
+
+def _peak_points(alpha: float) -> list:
+    """Breakpoints in the azimuth phi in (0, pi) graded towards the mirror direction phi = pi, where a lobe alpha wide
+    peaks (for scipy's quadrature in the references)."""
+    w = alpha * 3.0 ** np.arange(-4, 30)
+    return list(math.pi - w[w < math.pi])
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _n_value(mp, mu, xmu, xs, d):  # pragma: no cover - compiled; see n_integrand_reference
+    """Frame 6's integrand at x = x_mu + d: pi a2 cos(x) sin(x) (:func:`_ggx_ring`) Gamma(sin x), Gamma = 1 / (P(mu) P(t))
+    for GGX with the separable Smith G (Walter et al. 2007 eq. 20, 34), 1 / (t P(mu) + mu P(t) - mu t) with the
+    height-correlated one (Heitz 2014), 1 / (r + (1 - r) t) for Schlick's model (000 eq. 36); P(t) = (t + sqrt(t^2 + a2
+    cos^2 x)) / 2 (microfacet._projected), P(mu) in mp[8]."""
+    a2 = mp[4] if mp[0] == SCHLICK else mp[4] * mp[4]
+    t = math.sin(xmu + d)
+    ct = math.sin(xs - d)  # cos(x)
+    v = math.pi * a2 * ct * t * _ggx_ring(a2, xmu, xs, d)
+    if mp[0] == SCHLICK:
+        return v / (mp[4] + (1.0 - mp[4]) * t)  # 000 eq. 36's 1 / (r + (1 - r) N.V)
+    pt = 0.5 * (t + math.hypot(t, mp[4] * ct))  # P(t) = N.wo / G1(wo), Walter eq. 34
+    return v / (mp[8] * pt if mp[3] == 0.0 else t * mp[8] + mu * pt - mu * t)  # Walter eq. 20; Heitz 2014
+
+
+@njit(cache=True, nogil=True)
+def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode):  # pragma: no cover - compiled
+    """(value, error) of the rule on d = x - x_mu in [lo, hi] of :func:`_n_value`."""
+    h = hi - lo
+    for j in range(nodes.shape[0]):
+        buf[j] = _n_value(mp, mu, xmu, xs, lo + h * nodes[j])
+    k, diff, asc, ab = rule_sums(buf, wk, wg)
+    return k * h, calibrated(diff * h, asc * h, ab * h, mode)
+
+
+def n_integrand(brdf, mu: float, x) -> np.ndarray:
+    """Frame 6's integrand (:func:`_n_value`) for ``brdf``'s hint at N.wi = ``mu`` and elevations ``x`` of wo, as the engine
+    computes it (for the tests)."""
+    mp = numeric_params(brdf.polar())
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    xmu, xs = math.atan2(mu, s), math.atan2(s, mu)
+    if mp[0] == SMITH:
+        mp[8] = 0.5 * (mu + math.hypot(mu, mp[4] * s))
+    return np.array([_n_value(mp, mu, xmu, xs, float(v) - xmu) for v in np.atleast_1d(np.asarray(x, dtype=float))])
+
+
+def n_integrand_reference(brdf, mu: float, x) -> np.ndarray:
+    """Frame 6's integrand (:func:`_n_value`) at elevations ``x`` from the model itself: its BRDF times N.wo integrated over
+    the azimuth of wo by scipy's adaptive quadrature, times cos(x) and divided by the hint's scale (for the tests)."""
+    from scipy.integrate import quad
+
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    wi = np.array([[s, 0.0, mu]])
+    hint = brdf.polar()
+    scale = float(hint.scale(np.array([mu]))[0])
+    alpha = math.sqrt(hint.schlick) if hint.schlick is not None else hint.smith[3]
+    out = []
+    for xv in np.atleast_1d(np.asarray(x, dtype=float)):
+        def f(phi):
+            wo = np.array([[math.cos(xv) * math.cos(phi), math.cos(xv) * math.sin(phi), math.sin(xv)]])
+            return float(brdf.eval(wi, wo)[0]) * math.sin(xv)
+
+        out.append(2.0 * quad(f, 0.0, math.pi, epsabs=0.0, epsrel=1e-13, limit=1000, points=_peak_points(alpha))[0]
+                   * math.cos(xv) / scale)
+    return np.array(out)
+
+
+#: frame 6's breakpoints per mu: 0, pi / 2, x_mu and the graded ones (at most 3 x 20 at alpha = 1e-8)
+N_CUTS = 96
+
+
+@njit(cache=True, nogil=True)
+def _n_cuts(mp, xmu, cut):  # pragma: no cover - compiled; see n_cuts_reference
+    """The breakpoints of frame 6's d = x - x_mu at incidence x_mu, sorted, into ``cut``; returns their number.  The
+    integrand's singularities near x in [0, pi / 2] (:func:`_ggx_ring`, :func:`_n_value`): the weight's at x = x_mu +- 2 i
+    atanh(alpha) (A = 0) and at pi - x_mu +- 2 i atanh(alpha) (B = 0, as far beyond pi / 2 as x_mu is short of it); P(t)'s
+    branch point at x = +- i atanh(alpha) (sin^2 x + alpha^2 cos^2 x = 0); Schlick's pole at sin x = -r / (1 - r); the
+    height-correlated G's pole at x = -x_mu (t P(mu) + mu P(t) - mu t = 0 at t = -mu).  So d is cut at 0 and +- 2
+    atanh(alpha) 3^j, and x at z 3^j from 0 (z = atanh(alpha) or r / (1 - r), and x_mu for the correlated G): every
+    piece then lies at least about its own length from the nearest singularity."""
+    half = 0.5 * math.pi
+    alpha = math.sqrt(mp[4]) if mp[0] == SCHLICK else mp[4]
+    cut[0], cut[1], cut[2] = -xmu, half - xmu, 0.0
+    m = 3
+    d = 2.0 * math.atanh(alpha) if alpha < 1.0 else math.inf
+    while d < half and m < cut.shape[0] - 2:
+        if d < xmu:
+            cut[m] = -d
+            m += 1
+        if d < half - xmu:
+            cut[m] = d
+            m += 1
+        d *= 3.0
+    for which in range(2):
+        if which == 0:
+            if mp[0] == SCHLICK:
+                d = mp[4] / (1.0 - mp[4]) if mp[4] < 1.0 else math.inf
+            else:
+                d = math.atanh(alpha) if alpha < 1.0 else math.inf
+        else:
+            d = 3.0 * xmu if mp[0] == SMITH and mp[3] != 0.0 else math.inf
+        while d < half and m < cut.shape[0]:
+            cut[m] = d - xmu
+            m += 1
+            d *= 3.0
+    cut[:m].sort()
+    return m
+
+
+def n_cuts_reference(brdf, mu: float) -> np.ndarray:
+    """:func:`_n_cuts` for ``brdf``'s hint at N.wi = ``mu``, as elevations x (for the tests)."""
+    mp = numeric_params(brdf.polar())
+    cut = np.empty(N_CUTS)
+    xmu = math.atan2(mu, math.sqrt((1.0 - mu) * (1.0 + mu)))
+    m = _n_cuts(mp, xmu, cut)
+    return cut[:m] + xmu
+
+
+@njit(cache=True, nogil=True)
+def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, val, err, conv, evals):  # pragma: no cover
+    """Frame 6: adaptive 10/21 quadrature over the elevation x = x_mu + d of wo (:func:`_n_rule`) for every mu, from the
+    pieces between :func:`_n_cuts`."""
+    cap, pk, t0, t1, kv, ke, buf, _, _, _ = _buffers(max_intervals + N_CUTS, nodes, nodes, rtol)
+    cut = np.empty(N_CUTS)
+    for q in range(mu_arr.shape[0]):
+        mu = mu_arr[q]
+        s = math.sqrt((1.0 - mu) * (1.0 + mu))
+        xmu, xs = math.atan2(mu, s), math.atan2(s, mu)
+        if mp[0] == SMITH:  # P(mu) = mu / G1(mu), Walter eq. 34
+            mp[8] = 0.5 * (mu + math.hypot(mu, mp[4] * s))
+        nc = _n_cuts(mp, xmu, cut)
+        m = 0
+        for i in range(nc - 1):
+            if cut[i + 1] > cut[i]:
+                pk[m], t0[m], t1[m] = i, cut[i], cut[i + 1]
+                kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, t0[m], t1[m], nodes, wk, wg, buf, mode)
+                m += 1
+        start = m
+        while True:
+            tot, e, r, worst, ok = _status(kv, ke, m, 0.0, rounding, rtol, atol_arr[q])
+            if ok or m - start >= max_intervals or m >= cap:
+                break
+            i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
+            kv[worst], ke[worst] = _n_rule(mp, mu, xmu, xs, a_, mid, nodes, wk, wg, buf, mode)
+            kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, mid, b_, nodes, wk, wg, buf, mode)
+            m += 1
+        val[q] = tot
+        err[q] = e + r
+        conv[q] = ok
+        evals[q] = nodes.shape[0] * (m + (m - start))
+
+
+#: frame 6 is used where it applies (``without_n_frame`` switches it off: those models then take frame 4, the rule on
+#: h's arc, as before it)
+N_FRAME = True
+
+
+@contextlib.contextmanager
+def without_n_frame():
+    """Within the block, ``pumpup.albedo`` takes GGX and Schlick's model by frame 4 (the rule on h's arc,
+    :func:`_k_numeric`) instead of frame 6 (the tests' and the benchmark's second 1-D path for them).  Not meant for
+    concurrent toggling."""
+    global N_FRAME
+    old = N_FRAME
+    N_FRAME = False
+    try:
+        yield
+    finally:
+        N_FRAME = old
+
+
+def takes_n_frame(hint) -> bool:
+    """Whether :func:`albedo_1d` takes ``hint`` about N with the GGX weight's azimuth in closed form (frame 6): GGX with
+    F = 1 and alpha <= 1 (either Smith G), Schlick's model."""
+    if not N_FRAME or hint.kind != "half" or hint.radial != "ggx" or any(hint.fresnel) or hint.vcavity or hint.sqrt_cos:
+        return False
+    if hint.schlick is not None:
+        return hint.p == 0.0 and 0.0 < hint.schlick <= 1.0
+    return hint.smith is not None and hint.smith[0] == 1 and hint.smith[3] <= 1.0 and hint.p == 0.0
 
 
 # --- pumped Phong-family BRDFs: the frame of N -------------------------------------------------
@@ -2222,7 +2467,7 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         return scale.copy(), err, np.ones(mu.shape, bool), np.zeros(mu.shape, np.int64)
     if not 0.0 <= hint.p <= 1.0:
         raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
-    if hint.kind == "half" and mu.size and mu.min() < HALF_MU_MIN:
+    if hint.kind == "half" and mu.size and mu.min() < HALF_MU_MIN and not takes_n_frame(hint):
         return None  # (the half frame's breaks and arcs underflow there: the nested engine, as before)
     if hint.kind == "half" and (hint.p not in (0.0, 1.0) or hint.chain is not None):
         raise ValueError(f"{brdf!r}: a half-vector Polar hint needs p in {{0, 1}} and no chain, got p={hint.p!r}")
@@ -2257,7 +2502,11 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     # atol applies to the scaled albedo: per mu, atol / scale for the unscaled integral
     with np.errstate(divide="ignore"):
         atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
-    if hint.chain is None:
+    if takes_n_frame(hint):  # frame 6: GGX with F = 1, Schlick's model, about N (:func:`_integrate_n`)
+        mp = numeric_params(hint)
+        _integrate_n(mp, mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING, *_RULES["gk21"], mode_code(),
+                     val, err, conv, evals)
+    elif hint.chain is None:
         # Ward's K (elliptic integrals) has a logarithmic term where h's circle starts to be cut (E(k^2) near
         # k^2 = 1), which no substitution here makes analytic: QUADPACK's calibration measured 4.4 x below the
         # true error there (m = 0.1, mu = 0.6088: 7.1e-13 against 1.5e-13, at every rtol), the raw |K - G| at most

@@ -4,6 +4,8 @@ numba does not check indices by default: a write past an array's end corrupts me
 as an abort.  test_properties.py's slow hypothesis test aborted the process that way (in numpy, under the nested
 engine); rerun with bounds checking it named the cause, the 1-D path's first intervals overflowing their buffer (one
 per piece, up to MAX_PIECES = 128, in room for max_regions + 64): Blinn n = 0 at mu = 1.3e-47 with max_regions = 50.
+The ninth session found frame 4's pieces themselves overflowing their 128 slots (GGX alpha = 1e-8 at mu = 1e-100, rtol
+1e-13: a heap corruption that aborted the process), and frame 6 (GGX, Schlick) runs here too, down to mu = 1e-300.
 """
 
 import os
@@ -24,6 +26,14 @@ for spec, mu, regions in cases:
 p = pumpup.pump({"type": "metal", "n": 0.5, "eta": 0.999, "k": 0.01}, g="g2", levels=2)
 a, e = pumpup.albedo(p, [1e-8, 0.5], rtol=1e-10, max_regions=1, return_error=True)
 assert np.all(np.isfinite(a)), a
+from pumpup import _polar
+for spec in ({"type": "ggx", "alpha": 1e-8, "ior": 1.5}, {"type": "ggx", "alpha": 1e-8}):
+    with _polar.without_n_frame():
+        a, e = pumpup.albedo(pumpup.load(spec), [1e-100, 1e-60], rtol=1e-13, return_error=True)
+    assert np.all(np.isfinite(a)), (spec, a)
+for spec in ({"type": "ggx", "alpha": 1e-8, "shadowing": "correlated"}, {"type": "schlick", "r": 1e-12}):
+    a, e = pumpup.albedo(pumpup.load(spec), [1e-300, 1e-8, 0.5, 1.0], rtol=1e-13, max_regions=1, return_error=True)
+    assert np.all(np.isfinite(a)), (spec, a)
 print("ok")
 """
 
