@@ -138,18 +138,23 @@ dielectric's total reflection below eta = 1) stays on the nested engine.  A pump
 pumped lobe, multiply the pumped lobe's frame of N by F(max(mu, N.wo)) (:func:`_x_rule`, cut likewise by
 :func:`chain_cuts`; Im w >= :data:`CHAIN_F_Y0_MIN` there).
 
-GGX with F = 1 and alpha <= 1 (either Smith G) and Schlick's model take the frame of N instead (frame 6,
-:func:`_integrate_n`): for wo at elevation x (N.wo = t = sin x) their G and 1 / (N.L N.V) depend on t only, and the GGX
-weight D = alpha^2 / (pi (1 - (1 - alpha^2) (N.h)^2)^2) integrates over the azimuth of wo in closed form,
-(N.h)^2 = m^2 / |wi + wo|^2 making it rational in cos(phi) (:func:`_ggx_ring`: a sum of three terms >= 0, its two
-square roots products of sums of squares, with no cancellation and no division by N.wi + N.wo).  What is left is one
-integral over x of analytic pieces, graded towards the singularities near the real axis: x_mu +- 2 i atanh(alpha) (the
-peak; the variable is d = x - x_mu, exact where the peak is narrow), P(t)'s branch point at +- i atanh(alpha), Schlick's
-pole at sin x = -r / (1 - r), the height-correlated G's pole at x = -x_mu (:func:`_n_cuts`); 10/21 Gauss-Kronrod with
-QUADPACK's calibration.  No inner rule: 41-170 evaluations per mu for alpha >= 0.1, a 257-point table in 0.7-2.6 ms
-(frame 4 took 30-70 ms), and mu down to the smallest double.  ``scripts/ggx_frame_calibration.py`` measures it against
-frame 4 (:func:`without_n_frame`) at rtol 1e-13 over 26 models, 64 mu and rtol 1e-6 ... 1e-12: no difference beyond
-the reference's own error.
+GGX and Beckmann with F = 1 and alpha <= 1 (either Smith G, exact or Walter's G1) and Schlick's model take the frame of
+N instead (frame 6, :func:`_integrate_n`): for wo at elevation x (N.wo = t = sin x) their G and 1 / (N.L N.V) depend on
+t only, and the weight integrates over the azimuth of wo in closed form, (N.h)^2 = m^2 / |wi + wo|^2 being linear in
+cos(phi) in the denominator.  GGX's D = alpha^2 / (pi (1 - (1 - alpha^2) (N.h)^2)^2) is rational in cos(phi)
+(:func:`_ggx_ring`: three terms >= 0, its two square roots products of sums of squares, with no cancellation and no
+division by N.wi + N.wo); Beckmann's exp(-tan^2 / alpha^2) / (pi alpha^2 cos^4) is exp(-kappa (1 - cos psi)) times a
+quadratic in cos psi, so its integral is three Kummer functions e^-z 1F1(1/2; j + 1; z), z = 2 kappa
+(:func:`_beckmann_ring`; :func:`_kummer_half` sums their series, :func:`_kummer_fast` evaluates Chebyshev pieces of them
+below z = 200).  What is left is one integral over x of analytic pieces, graded towards the singularities near the real
+axis: the peak's (x_mu +- 2 i atanh(alpha) for GGX; Beckmann's Gaussian 2 alpha wide; the variable is d = x - x_mu,
+exact where the peak is narrow), P(t)'s at +- i atanh(alpha) (GGX) or its turn on the scale alpha (Beckmann), Schlick's
+pole at sin x = -r / (1 - r), the pole at x = -x_mu of the height-correlated G and of Beckmann's kappa, Walter's switch
+(:func:`_n_cuts`); 10/21 Gauss-Kronrod with QUADPACK's calibration.  No inner rule: 41-184 evaluations per mu for alpha
+>= 0.1, a 257-point table in 0.7-2.6 ms for GGX and Schlick (frame 4 took 20-70 ms), 4-12 ms for Beckmann (frame 4: 45-200
+ms), and mu down to the smallest double.  ``scripts/n_frame_calibration.py`` measures it against frame 4
+(:func:`without_n_frame`) at rtol 1e-13 over 45 models, 64 mu and rtol 1e-6 ... 1e-12: at most 4e-5 of the estimate beyond
+that reference's own error.  GGX and Beckmann with a Fresnel factor keep frame 4 (F(wi.h) depends on the azimuth).
 
 A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
 :class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D
@@ -230,7 +235,8 @@ class Polar:
         With kind "half", p = 0 and the Beckmann or GGX weight: the lobe is a Smith microfacet model's
         D F G / (4 N.L N.V) (Walter et al. 2007 eq. 20), given as (distribution: 0 Beckmann, 1 GGX; G1: 0 exact, 1
         Walter's fit; shadowing: 0 separable, 1 height-correlated; alpha); its azimuth by a rule on h's arc
-        (:func:`_k_numeric`), D's 1 / (pi alpha^2) and the 1 / 4 in ``scale``.
+        (:func:`_k_numeric`; with F = 1 and alpha <= 1 about N instead, the azimuth of wo in closed form, frame 6,
+        :func:`_integrate_n`), D's 1 / (pi alpha^2) and the 1 / 4 in ``scale``.
     fresnel : tuple
         (ior, eta, k): the Fresnel factor at wi.h of a Smith or V-cavity lobe, dielectric (ior > 0) or conductor
         (eta > 0), or none (all 0); a V-cavity lobe with one takes the rule on h's arc too.  With kind "lobe" (ior 0, eta
@@ -238,7 +244,7 @@ class Polar:
         pumped lobe's frame of N, :func:`_x_rule`).
     schlick : float, optional
         With kind "half", p = 0 and the GGX weight (n = sqrt(r)): Schlick's model (000 eq. 36) with this r, whose
-        1 / (r + (1 - r) N.V) the rule on h's arc integrates (:func:`_k_numeric`); 1 / (r + (1 - r) N.L) in ``scale``.
+        1 / (r + (1 - r) N.V) frame 6 integrates about N (:func:`_integrate_n`); 1 / (r + (1 - r) N.L) in ``scale``.
     """
 
     n: float = 0.0
@@ -1864,19 +1870,157 @@ def _peak_points(alpha: float) -> list:
     return list(math.pi - w[w < math.pi])
 
 
+#: above this z, :func:`_kummer_half` sums the asymptotic series (its smallest term ~ sqrt(2 pi z) e^-z < 1e-20)
+KUMMER_ASYMPTOTIC = 50.0
+
+
+@njit(cache=True, nogil=True)
+def _kummer_half(z):  # pragma: no cover - compiled; tested against mpmath.hyp1f1
+    """(H0, H1, H2), H_j = z^j e^-z 1F1(1/2; j + 1; z) for z >= 0 (inf included): below KUMMER_ASYMPTOTIC the power series
+    (positive terms, DLMF 13.2.2), above it the asymptotic one, z^(j - 1/2) (j! / sqrt(pi)) sum_n (j + 1/2)_n (1/2)_n /
+    (n! z^n) (DLMF 13.7.1; positive terms too, the rest of the function e^-z smaller)."""
+    if z >= KUMMER_ASYMPTOTIC:
+        r = 1.0 / math.sqrt(math.pi * z) if z < math.inf else 0.0
+        h0 = h1 = h2 = 0.0
+        for j in range(3):
+            term, sm = 1.0, 1.0
+            for n in range(200):
+                term *= (j + 0.5 + n) * (0.5 + n) / ((n + 1.0) * z)
+                sm += term
+                if term <= 1e-17 * sm:
+                    break
+            if j == 0:
+                h0 = r * sm
+            elif j == 1:
+                h1 = r * sm
+            else:
+                h2 = 2.0 * r * sm
+        return h0, h1, h2
+    t0 = t1 = t2 = 1.0
+    s0 = s1 = s2 = 1.0
+    n = 0
+    while True:
+        c = (0.5 + n) * z / (n + 1.0)
+        t0 *= c / (1.0 + n)
+        t1 *= c / (2.0 + n)
+        t2 *= c / (3.0 + n)
+        s0 += t0
+        s1 += t1
+        s2 += t2
+        n += 1
+        if n > z and t0 <= 1e-17 * s0:
+            break
+    e = math.exp(-z)
+    return e * s0, z * e * s1, z * z * e * s2
+
+
+#: :func:`_kummer_fast`'s Chebyshev pieces of H_j on [0, 200), interpolating :func:`_kummer_half` at KUMMER_DEGREE + 1
+#: Chebyshev points each (built at import: at most 27 ulps of max H_j on the piece against 30-digit mpmath, the series
+#: itself 10; the series took 120-670 ns a value there, the asymptotic one 130 ns up to 200, the pieces 70)
+KUMMER_EDGES = np.array([0.0, 3.0, 8.0, 16.0, 28.0, 50.0, 80.0, 130.0, 200.0])
+KUMMER_DEGREE = 18
+
+
+def _kummer_table() -> np.ndarray:
+    """The Chebyshev coefficients (piece, j, degree) of :data:`KUMMER_EDGES`' pieces (for :func:`_kummer_fast`)."""
+    n = KUMMER_DEGREE + 1
+    k = np.arange(n)
+    ang = np.pi * (k + 0.5) / n
+    cos = np.cos(np.outer(k, ang))  # [m, k]
+    out = np.empty((len(KUMMER_EDGES) - 1, 3, n))
+    for i, (a, b) in enumerate(zip(KUMMER_EDGES[:-1], KUMMER_EDGES[1:])):
+        h = np.array([_kummer_half(0.5 * (a + b) + 0.5 * (b - a) * math.cos(t)) for t in ang])  # (k, j)
+        c = (2.0 / n) * (cos @ h)
+        c[0] *= 0.5
+        out[i] = c.T
+    return out
+
+
+KUMMER_COEF = _kummer_table()
+
+
+@njit(cache=True, nogil=True)
+def _kummer_fast(z):  # pragma: no cover - compiled; tested against _kummer_half and mpmath
+    """:func:`_kummer_half` by its Chebyshev pieces below 200 (Clenshaw's recurrence), the asymptotic series above."""
+    if z >= KUMMER_EDGES[-1]:
+        return _kummer_half(z)
+    i = 0
+    while z >= KUMMER_EDGES[i + 1]:
+        i += 1
+    a, b = KUMMER_EDGES[i], KUMMER_EDGES[i + 1]
+    x = (2.0 * z - a - b) / (b - a)
+    h0 = h1 = h2 = 0.0
+    for j in range(3):
+        b1 = b2 = 0.0
+        for m in range(KUMMER_DEGREE, 0, -1):
+            b1, b2 = 2.0 * x * b1 - b2 + KUMMER_COEF[i, j, m], b1
+        v = x * b1 - b2 + KUMMER_COEF[i, j, 0]
+        if j == 0:
+            h0 = v
+        elif j == 1:
+            h1 = v
+        else:
+            h2 = v
+    return h0, h1, h2
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _beckmann_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see beckmann_ring_reference
+    """integral over phi in [0, 2 pi) of the Beckmann weight D = exp(-tan^2(h) / a2) / (pi a2 cos^4(h)) (Walter et al.
+    2007 eq. 25) on the circle of wo at elevation x = x_mu + d, for wi at elevation x_mu (x_s = pi / 2 - x_mu).
+
+    With X = |wi + wo|^2 = X_min + Q v, v = 1 - cos(psi) (psi = phi - pi, from the plane of incidence's mirror side),
+    X_min = m^2 (1 + tan^2(d / 2)), Q = 2 sin(theta_i) cos(x), m = N.wi + N.wo: tan^2(h) = X / m^2 - 1 = tau^2 + (Q / m^2) v
+    (tau = tan(d / 2)) and 1 / cos^4 = X^2 / m^4 = (1 + tau^2 + a2 kappa v)^2, kappa = Q / (m^2 a2), so the integral is
+    e^-(tau^2 / a2) / (pi a2) times (1 + tau^2)^2 M0 + 2 (1 + tau^2) a2 kappa M1 + a2^2 kappa^2 M2, M_j = integral of v^j
+    e^-(kappa v) over psi = c_j e^-z 1F1(1/2; j + 1; z), z = 2 kappa, c = (2 pi, 2 pi, 3 pi) (v = 2 sin^2(psi / 2)): in
+    :func:`_kummer_half`'s H_j, (e^-(tau^2 / a2) / a2) (2 (1 + tau^2)^2 H0 + 2 a2 (1 + tau^2) H1 + (3 / 4) a2^2 H2),
+    every term >= 0."""
+    tau = math.tan(0.5 * d)
+    g = math.exp(-tau * tau / a2)
+    if g == 0.0:  # (far in the Gaussian's tail: the rest is finite)
+        return 0.0
+    sy, cd = math.sin(xmu + 0.5 * d), math.cos(0.5 * d)
+    m2 = 4.0 * sy * sy * cd * cd  # (N.wi + N.wo)^2, m = 2 sin((x + x_mu) / 2) cos(d / 2)
+    q = 2.0 * math.sin(xs) * math.sin(xs - d)  # 2 sin(theta_i) cos(x)
+    z = 2.0 * q / (m2 * a2) if m2 * a2 > 0.0 else math.inf
+    h0, h1, h2 = _kummer_fast(z)
+    w = 1.0 + tau * tau
+    return g / a2 * (2.0 * w * w * h0 + 2.0 * a2 * w * h1 + 0.75 * a2 * a2 * h2)
+
+
+def beckmann_ring_reference(a2: float, mu: float, x: float) -> float:
+    """:func:`_beckmann_ring` at elevation ``x`` by scipy's adaptive quadrature of Walter's D over phi (for the tests)."""
+    from scipy.integrate import quad
+
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    wi = np.array([s, 0.0, mu])
+
+    def d(phi):
+        wo = np.array([math.cos(x) * math.cos(phi), math.cos(x) * math.sin(phi), math.sin(x)])
+        h = wi + wo
+        t2 = (h[0] * h[0] + h[1] * h[1]) / (h[2] * h[2])  # tan^2 of h's angle from N
+        return math.exp(-t2 / a2) * (1.0 + t2) ** 2 / (math.pi * a2)  # Walter eq. 25
+
+    return 2.0 * quad(d, 0.0, math.pi, epsabs=0.0, epsrel=1e-13, limit=1000, points=_peak_points(math.sqrt(a2)))[0]
+
+
 @njit(cache=True, nogil=True, inline="always")
 def _n_value(mp, mu, xmu, xs, d):  # pragma: no cover - compiled; see n_integrand_reference
-    """Frame 6's integrand at x = x_mu + d: pi a2 cos(x) sin(x) (:func:`_ggx_ring`) Gamma(sin x), Gamma = 1 / (P(mu) P(t))
-    for GGX with the separable Smith G (Walter et al. 2007 eq. 20, 34), 1 / (t P(mu) + mu P(t) - mu t) with the
-    height-correlated one (Heitz 2014), 1 / (r + (1 - r) t) for Schlick's model (000 eq. 36); P(t) = (t + sqrt(t^2 + a2
-    cos^2 x)) / 2 (microfacet._projected), P(mu) in mp[8]."""
+    """Frame 6's integrand at x = x_mu + d: pi a2 cos(x) sin(x) W(x) Gamma(sin x), W the weight's integral over the
+    azimuth (:func:`_ggx_ring`, :func:`_beckmann_ring`), Gamma = 1 / (P(mu) P(t)) for the separable Smith G (Walter et al.
+    2007 eq. 20), 1 / (t P(mu) + mu P(t) - mu t) for the height-correlated one (Heitz 2014), 1 / (r + (1 - r) t) for
+    Schlick's model (000 eq. 36); P(t) = N.wo / G1(wo) (microfacet._projected, Walter eq. 27, 34), P(mu) in mp[8]."""
     a2 = mp[4] if mp[0] == SCHLICK else mp[4] * mp[4]
+    w = _beckmann_ring(a2, xmu, xs, d) if mp[0] == SMITH and mp[1] == 0.0 else _ggx_ring(a2, xmu, xs, d)
+    if w == 0.0:  # (far in the Beckmann weight's tail)
+        return 0.0
     t = math.sin(xmu + d)
     ct = math.sin(xs - d)  # cos(x)
-    v = math.pi * a2 * ct * t * _ggx_ring(a2, xmu, xs, d)
+    v = math.pi * a2 * ct * t * w
     if mp[0] == SCHLICK:
         return v / (mp[4] + (1.0 - mp[4]) * t)  # 000 eq. 36's 1 / (r + (1 - r) N.V)
-    pt = 0.5 * (t + math.hypot(t, mp[4] * ct))  # P(t) = N.wo / G1(wo), Walter eq. 34
+    pt = _projected(ct, 0.0, t, int(mp[1]), int(mp[2]), mp[4])  # P(t) = N.wo / G1(wo), Walter eq. 27, 34
     return v / (mp[8] * pt if mp[3] == 0.0 else t * mp[8] + mu * pt - mu * t)  # Walter eq. 20; Heitz 2014
 
 
@@ -1897,7 +2041,7 @@ def n_integrand(brdf, mu: float, x) -> np.ndarray:
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     xmu, xs = math.atan2(mu, s), math.atan2(s, mu)
     if mp[0] == SMITH:
-        mp[8] = 0.5 * (mu + math.hypot(mu, mp[4] * s))
+        mp[8] = _projected(s, 0.0, mu, int(mp[1]), int(mp[2]), mp[4])
     return np.array([_n_value(mp, mu, xmu, xs, float(v) - xmu) for v in np.atleast_1d(np.asarray(x, dtype=float))])
 
 
@@ -1932,14 +2076,21 @@ def _n_cuts(mp, xmu, cut):  # pragma: no cover - compiled; see n_cuts_reference
     integrand's singularities near x in [0, pi / 2] (:func:`_ggx_ring`, :func:`_n_value`): the weight's at x = x_mu +- 2 i
     atanh(alpha) (A = 0) and at pi - x_mu +- 2 i atanh(alpha) (B = 0, as far beyond pi / 2 as x_mu is short of it); P(t)'s
     branch point at x = +- i atanh(alpha) (sin^2 x + alpha^2 cos^2 x = 0); Schlick's pole at sin x = -r / (1 - r); the
-    height-correlated G's pole at x = -x_mu (t P(mu) + mu P(t) - mu t = 0 at t = -mu).  So d is cut at 0 and +- 2
-    atanh(alpha) 3^j, and x at z 3^j from 0 (z = atanh(alpha) or r / (1 - r), and x_mu for the correlated G): every
-    piece then lies at least about its own length from the nearest singularity."""
+    height-correlated G's pole at x = -x_mu (t P(mu) + mu P(t) - mu t = 0 at t = -mu).  The Beckmann weight
+    (:func:`_beckmann_ring`) is a Gaussian 2 alpha wide in d, its kappa has a pole where N.wi + N.wo = 0 (x = -x_mu), and
+    its P(t) turns on the scale alpha near x = 0 (erf(tan(x) / alpha)); Walter's rational G1 jumps at N.wo = mp[9].  So d
+    is cut at 0 and +- 2 atanh(alpha) 3^j (Beckmann: +- 2 alpha 3^j), and x at z 3^j from 0 (z = atanh(alpha), alpha or
+    r / (1 - r), and x_mu for the correlated G and for Beckmann) and at Walter's switch: every piece then lies at least
+    about its own length from the nearest singularity."""
     half = 0.5 * math.pi
     alpha = math.sqrt(mp[4]) if mp[0] == SCHLICK else mp[4]
+    beckmann = mp[0] == SMITH and mp[1] == 0.0
     cut[0], cut[1], cut[2] = -xmu, half - xmu, 0.0
     m = 3
-    d = 2.0 * math.atanh(alpha) if alpha < 1.0 else math.inf
+    if 0.0 < mp[9] < 1.0:  # Walter's G1 switch
+        cut[m] = math.asin(mp[9]) - xmu
+        m += 1
+    d = 2.0 * alpha if beckmann else (2.0 * math.atanh(alpha) if alpha < 1.0 else math.inf)
     while d < half and m < cut.shape[0] - 2:
         if d < xmu:
             cut[m] = -d
@@ -1953,9 +2104,9 @@ def _n_cuts(mp, xmu, cut):  # pragma: no cover - compiled; see n_cuts_reference
             if mp[0] == SCHLICK:
                 d = mp[4] / (1.0 - mp[4]) if mp[4] < 1.0 else math.inf
             else:
-                d = math.atanh(alpha) if alpha < 1.0 else math.inf
+                d = alpha if beckmann else (math.atanh(alpha) if alpha < 1.0 else math.inf)
         else:
-            d = 3.0 * xmu if mp[0] == SMITH and mp[3] != 0.0 else math.inf
+            d = 3.0 * xmu if mp[0] == SMITH and (mp[3] != 0.0 or beckmann) else math.inf
         while d < half and m < cut.shape[0]:
             cut[m] = d - xmu
             m += 1
@@ -1983,8 +2134,8 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
         xmu, xs = math.atan2(mu, s), math.atan2(s, mu)
-        if mp[0] == SMITH:  # P(mu) = mu / G1(mu), Walter eq. 34
-            mp[8] = 0.5 * (mu + math.hypot(mu, mp[4] * s))
+        if mp[0] == SMITH:  # P(mu) = mu / G1(mu), Walter eq. 27, 34
+            mp[8] = _projected(s, 0.0, mu, int(mp[1]), int(mp[2]), mp[4])
         nc = _n_cuts(mp, xmu, cut)
         m = 0
         for i in range(nc - 1):
@@ -2014,7 +2165,7 @@ N_FRAME = True
 
 @contextlib.contextmanager
 def without_n_frame():
-    """Within the block, ``pumpup.albedo`` takes GGX and Schlick's model by frame 4 (the rule on h's arc,
+    """Within the block, ``pumpup.albedo`` takes GGX, Beckmann and Schlick's model by frame 4 (the rule on h's arc,
     :func:`_k_numeric`) instead of frame 6 (the tests' and the benchmark's second 1-D path for them).  Not meant for
     concurrent toggling."""
     global N_FRAME
@@ -2027,13 +2178,13 @@ def without_n_frame():
 
 
 def takes_n_frame(hint) -> bool:
-    """Whether :func:`albedo_1d` takes ``hint`` about N with the GGX weight's azimuth in closed form (frame 6): GGX with
-    F = 1 and alpha <= 1 (either Smith G), Schlick's model."""
-    if not N_FRAME or hint.kind != "half" or hint.radial != "ggx" or any(hint.fresnel) or hint.vcavity or hint.sqrt_cos:
+    """Whether :func:`albedo_1d` takes ``hint`` about N with the weight's azimuth in closed form (frame 6): GGX and
+    Beckmann with F = 1 and alpha <= 1 (either Smith G, exact or Walter's G1), Schlick's model."""
+    if not N_FRAME or hint.kind != "half" or any(hint.fresnel) or hint.vcavity or hint.sqrt_cos:
         return False
     if hint.schlick is not None:
         return hint.p == 0.0 and 0.0 < hint.schlick <= 1.0
-    return hint.smith is not None and hint.smith[0] == 1 and hint.smith[3] <= 1.0 and hint.p == 0.0
+    return hint.smith is not None and hint.smith[3] <= 1.0 and hint.p == 0.0
 
 
 # --- pumped Phong-family BRDFs: the frame of N -------------------------------------------------
@@ -2502,7 +2653,7 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     # atol applies to the scaled albedo: per mu, atol / scale for the unscaled integral
     with np.errstate(divide="ignore"):
         atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
-    if takes_n_frame(hint):  # frame 6: GGX with F = 1, Schlick's model, about N (:func:`_integrate_n`)
+    if takes_n_frame(hint):  # frame 6: GGX and Beckmann with F = 1, Schlick's model, about N (:func:`_integrate_n`)
         mp = numeric_params(hint)
         _integrate_n(mp, mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING, *_RULES["gk21"], mode_code(),
                      val, err, conv, evals)

@@ -329,7 +329,7 @@ class _Microfacet(BRDF):
             return None
         # Walter eq. 20: a(mu) = integral over h of D(h) (1 / 4) [4 (wi.h) F G / N.wi] (d omega_o = 4 (wo.h) d omega_h),
         # D = w(t) / (pi a^2 cos^4) with w = e^-t (eq. 25) or 1 / (1 + t)^2 (eq. 33), t = tan^2 / a^2; the azimuth of h
-        # by a rule on its arc (pumpup._polar._k_numeric)
+        # by a rule on its arc (pumpup._polar._k_numeric), or with F = 1 about N in closed form (pumpup._polar._integrate_n)
         return Polar(n=a, scale=lambda mu: np.full(np.shape(mu), 0.25 / (math.pi * a * a)), kind="half",
                      radial=self.distribution, smith=(dist, g1, shadowing, a), fresnel=(ior, eta, k))
 
