@@ -29,6 +29,8 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
                                               # (a rule on the half vector's arc) against the nested engine
     python scripts/bench_albedo.py --fresnel  # only the models put on the 1-D path in issue 14's eighth session
                                               # (the lobe frame with F(Theta_min)) against the nested engine
+    python scripts/bench_albedo.py --nframe   # only GGX, Beckmann (F = 1) and Schlick, about N in closed form since issue
+                                              # 14's ninth session, against the rule on h's arc and the nested engine
     python scripts/bench_albedo.py --pumped   # only pumped Phong-family chains: 1-D path against the nested engine
     python scripts/bench_albedo.py --breaks   # only the nested families with kinks or levels: the compiled break
                                               # finding against its numpy reference (issue 14 item 3)
@@ -233,6 +235,30 @@ def against_nested(specs, label, rtol=1e-10, repeat=3):
         (a, b), (c, d) = out
         print(f"{str(spec):48s} {a * 1e3:10.1f} {c * 1e3:9.1f} {c / a:6.1f} {b * 1e3:9.1f} {d * 1e3:9.1f} {d / b:6.1f}",
               flush=True)
+
+
+def n_frame(rtol=1e-10, repeat=3):
+    """GGX and Beckmann with F = 1 and Schlick's model, about N with the weight's azimuth in closed form (frame 6, issue 14's
+    ninth session) against frame 4, the rule on h's arc they took before (``_polar.without_n_frame``), and the nested
+    engine, same run: a 257-point table (mu uniform in theta) at ``rtol``, one thread, best of ``repeat`` (nested: 1)."""
+    from pumpup import _polar
+
+    mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
+    specs = [{"type": "ggx", "alpha": a} for a in (0.001, 0.1, 0.5)] + [
+        {"type": "ggx", "alpha": 0.3, "shadowing": "correlated"}, {"type": "schlick", "r": 0.2}, {"type": "schlick", "r": 0.001}] + [
+        {"type": "beckmann", "alpha": a} for a in (0.001, 0.1, 0.5)] + [{"type": "beckmann", "alpha": 0.3, "g1": "walter"}]
+    print(f"frame 6 against frame 4 and the nested engine, one thread, ms; 257 mu at rtol {rtol:g}")
+    print(f"{'model':48s} {'frame 6':>8s} {'evals/mu':>8s} {'frame 4':>8s} {'ratio':>6s} {'nested':>8s} {'ratio':>6s}")
+    for spec in specs:
+        f = pumpup.load(spec)
+        times = []
+        for ctx, rep in ((contextlib.nullcontext(), repeat), (_polar.without_n_frame(), repeat), (_polar.without_1d(), 1)):
+            with ctx:
+                pumpup.albedo(f, [0.5, 1e-3], rtol=rtol)
+                times.append(_best(lambda: pumpup.albedo(f, mu, rtol=rtol), rep)[1])
+        ev = np.mean(_polar.albedo_1d(f, mu, rtol, 0.0, 200)[3])
+        t6, t4, tn = times
+        print(f"{str(spec):48s} {t6 * 1e3:8.1f} {ev:8.0f} {t4 * 1e3:8.1f} {t4 / t6:6.1f} {tn * 1e3:8.1f} {tn / t6:6.1f}", flush=True)
 
 
 def p_model(rtol=1e-10, repeat=3):
@@ -528,6 +554,9 @@ def main():
         return
     if "--fresnel" in sys.argv:
         lobe_fresnel()
+        return
+    if "--nframe" in sys.argv:
+        n_frame()
         return
     if "--pumped" in sys.argv:
         pumped_chains()
