@@ -11,13 +11,13 @@ evaluations per mu and the time of a 257-point table at rtol 1e-10 against frame
     PYTHONPATH=. python scripts/n_frame_calibration.py          # about 2 minutes (45 models)
 """
 
-import time
 import warnings
 
 import numpy as np
 
 import pumpup
 from pumpup import _polar
+from pumpup.costs import _best  # (warm-up, then the best of ``repeat``)
 
 SPECS = ([{"type": "ggx", "alpha": a} for a in (1e-8, 1e-5, 0.001, 0.02, 0.1, 0.3, 0.5, 0.8, 1.0)]
          + [{"type": "ggx", "alpha": a, "shadowing": "correlated"} for a in (1e-8, 1e-4, 0.01, 0.1, 0.3, 0.6, 0.9, 1.0)]
@@ -48,21 +48,11 @@ def main():
             loose = max(loose, float((e / (rtol * a)).max()))
         worst_all = max(worst_all, *ratios)
         ev = int(np.mean(_polar.albedo_1d(f, grid, 1e-10, 0.0, 200)[3]))
-        t6 = _best(lambda: pumpup.albedo(f, grid, rtol=1e-10))
+        t6 = _best(lambda: pumpup.albedo(f, grid, rtol=1e-10), 3)
         with _polar.without_n_frame():
-            t4 = _best(lambda: pumpup.albedo(f, grid, rtol=1e-10))
+            t4 = _best(lambda: pumpup.albedo(f, grid, rtol=1e-10), 3)
         print(f"{str(spec):58s} {' '.join(f'{r:10.3g}' for r in ratios):44s} {loose:12.3g} {ev:6d} {t6 * 1e3:6.1f} {t4 * 1e3:10.1f}")
     print(f"worst true error / estimate: {worst_all:.3g}")
-
-
-def _best(fn, repeat=3):
-    fn()
-    best = np.inf
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t)
-    return best
 
 
 if __name__ == "__main__":
