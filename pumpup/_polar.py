@@ -1823,7 +1823,7 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _ggx_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ggx_ring_reference
+def _ggx_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ring_reference
     """integral over phi in [0, 2 pi) of the GGX weight D = a2 / (pi (1 - (1 - a2) (N.h)^2)^2) (Walter et al. 2007
     eq. 33; 000 eq. 36 with a2 = r) on the circle of wo at elevation x = x_mu + d (N.wo = sin x) for wi at elevation x_mu
     (x_s = pi / 2 - x_mu).
@@ -1846,9 +1846,9 @@ def _ggx_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ggx_ring_refe
     return 2.0 * a2 * (1.0 + 2.0 * k * sy / r + k * k * sy * (sy * sy * a + b) / (2.0 * r * r * r))
 
 
-def ggx_ring_reference(a2: float, mu: float, x: float) -> float:
-    """:func:`_ggx_ring` at elevation ``x`` by scipy's adaptive quadrature of D over phi (its numpy/scipy twin, for the
-    tests)."""
+def ring_reference(distribution: int, a2: float, mu: float, x: float) -> float:
+    """:func:`_ggx_ring` (``distribution`` 1) or :func:`_beckmann_ring` (0) at elevation ``x`` by scipy's adaptive
+    quadrature of Walter's D over phi (their numpy/scipy twin, for the tests)."""
     from scipy.integrate import quad
 
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -1858,7 +1858,10 @@ def ggx_ring_reference(a2: float, mu: float, x: float) -> float:
         wo = np.array([math.cos(x) * math.cos(phi), math.cos(x) * math.sin(phi), math.sin(x)])
         h = wi + wo
         c2, s2 = h[2] * h[2] / (h @ h), (h[0] * h[0] + h[1] * h[1]) / (h @ h)  # cos^2, sin^2 of h's angle from N
-        return a2 / (math.pi * (a2 * c2 + s2) ** 2)  # Walter eq. 33: a2 / (pi (a2 cos^2 + sin^2)^2)
+        if distribution == 1:
+            return a2 / (math.pi * (a2 * c2 + s2) ** 2)  # Walter eq. 33: a2 / (pi (a2 cos^2 + sin^2)^2)
+        t2 = s2 / c2
+        return math.exp(-t2 / a2) * (1.0 + t2) ** 2 / (math.pi * a2)  # Walter eq. 25
 
     return 2.0 * quad(d, 0.0, math.pi, epsabs=0.0, epsrel=1e-13, limit=1000, points=_peak_points(math.sqrt(a2)))[0]
 
@@ -1965,7 +1968,7 @@ def _kummer_fast(z):  # pragma: no cover - compiled; tested against _kummer_half
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _beckmann_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see beckmann_ring_reference
+def _beckmann_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ring_reference
     """integral over phi in [0, 2 pi) of the Beckmann weight D = exp(-tan^2(h) / a2) / (pi a2 cos^4(h)) (Walter et al.
     2007 eq. 25) on the circle of wo at elevation x = x_mu + d, for wi at elevation x_mu (x_s = pi / 2 - x_mu).
 
@@ -1989,22 +1992,6 @@ def _beckmann_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see beckmann
     return g / a2 * (2.0 * w * w * h0 + 2.0 * a2 * w * h1 + 0.75 * a2 * a2 * h2)
 
 
-def beckmann_ring_reference(a2: float, mu: float, x: float) -> float:
-    """:func:`_beckmann_ring` at elevation ``x`` by scipy's adaptive quadrature of Walter's D over phi (for the tests)."""
-    from scipy.integrate import quad
-
-    s = math.sqrt((1.0 - mu) * (1.0 + mu))
-    wi = np.array([s, 0.0, mu])
-
-    def d(phi):
-        wo = np.array([math.cos(x) * math.cos(phi), math.cos(x) * math.sin(phi), math.sin(x)])
-        h = wi + wo
-        t2 = (h[0] * h[0] + h[1] * h[1]) / (h[2] * h[2])  # tan^2 of h's angle from N
-        return math.exp(-t2 / a2) * (1.0 + t2) ** 2 / (math.pi * a2)  # Walter eq. 25
-
-    return 2.0 * quad(d, 0.0, math.pi, epsabs=0.0, epsrel=1e-13, limit=1000, points=_peak_points(math.sqrt(a2)))[0]
-
-
 @njit(cache=True, nogil=True, inline="always")
 def _n_value(mp, mu, xmu, xs, d):  # pragma: no cover - compiled; see n_integrand_reference
     """Frame 6's integrand at x = x_mu + d: pi a2 cos(x) sin(x) W(x) Gamma(sin x), W the weight's integral over the
@@ -2025,6 +2012,16 @@ def _n_value(mp, mu, xmu, xs, d):  # pragma: no cover - compiled; see n_integran
 
 
 @njit(cache=True, nogil=True)
+def _n_incidence(mp, mu):  # pragma: no cover - compiled
+    """(x_mu, x_s = pi / 2 - x_mu) of incidence mu, both from atan2 (each exact near its own 0), and P(mu) = mu / G1(mu) into
+    mp[8] for the Smith models (Walter eq. 27, 34)."""
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    if mp[0] == SMITH:
+        mp[8] = _projected(s, 0.0, mu, int(mp[1]), int(mp[2]), mp[4])
+    return math.atan2(mu, s), math.atan2(s, mu)
+
+
+@njit(cache=True, nogil=True)
 def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode):  # pragma: no cover - compiled
     """(value, error) of the rule on d = x - x_mu in [lo, hi] of :func:`_n_value`."""
     h = hi - lo
@@ -2038,10 +2035,7 @@ def n_integrand(brdf, mu: float, x) -> np.ndarray:
     """Frame 6's integrand (:func:`_n_value`) for ``brdf``'s hint at N.wi = ``mu`` and elevations ``x`` of wo, as the engine
     computes it (for the tests)."""
     mp = numeric_params(brdf.polar())
-    s = math.sqrt((1.0 - mu) * (1.0 + mu))
-    xmu, xs = math.atan2(mu, s), math.atan2(s, mu)
-    if mp[0] == SMITH:
-        mp[8] = _projected(s, 0.0, mu, int(mp[1]), int(mp[2]), mp[4])
+    xmu, xs = _n_incidence(mp, mu)
     return np.array([_n_value(mp, mu, xmu, xs, float(v) - xmu) for v in np.atleast_1d(np.asarray(x, dtype=float))])
 
 
@@ -2066,7 +2060,8 @@ def n_integrand_reference(brdf, mu: float, x) -> np.ndarray:
     return np.array(out)
 
 
-#: frame 6's breakpoints per mu: 0, pi / 2, x_mu and the graded ones (at most 3 x 20 at alpha = 1e-8)
+#: frame 6's breakpoints per mu: 0, pi / 2, x_mu, Walter's switch and the graded ones (the peak's two sides, 2 x 17 at
+#: alpha = 1e-8; from 0, up to 26 at Schlick's r = 1e-12; the x_mu grading takes what is left)
 N_CUTS = 96
 
 
@@ -2119,7 +2114,7 @@ def n_cuts_reference(brdf, mu: float) -> np.ndarray:
     """:func:`_n_cuts` for ``brdf``'s hint at N.wi = ``mu``, as elevations x (for the tests)."""
     mp = numeric_params(brdf.polar())
     cut = np.empty(N_CUTS)
-    xmu = math.atan2(mu, math.sqrt((1.0 - mu) * (1.0 + mu)))
+    xmu = _n_incidence(mp, mu)[0]
     m = _n_cuts(mp, xmu, cut)
     return cut[:m] + xmu
 
@@ -2132,10 +2127,7 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
     cut = np.empty(N_CUTS)
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
-        s = math.sqrt((1.0 - mu) * (1.0 + mu))
-        xmu, xs = math.atan2(mu, s), math.atan2(s, mu)
-        if mp[0] == SMITH:  # P(mu) = mu / G1(mu), Walter eq. 27, 34
-            mp[8] = _projected(s, 0.0, mu, int(mp[1]), int(mp[2]), mp[4])
+        xmu, xs = _n_incidence(mp, mu)
         nc = _n_cuts(mp, xmu, cut)
         m = 0
         for i in range(nc - 1):

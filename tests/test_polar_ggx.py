@@ -26,29 +26,33 @@ IDS = [f"{s['type']}-{s.get('alpha', s.get('r'))}-{s.get('shadowing', '')}" for 
 MU = np.array([1.0, 1.0 - 1e-9, 0.99, 0.9, 0.7, 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8])
 
 
-def _ring_mpmath(a2, mu, d):
-    """The integral of Walter's D over the azimuth of wo at elevation asin(mu) + d, at 40 digits (mpmath), graded towards
-    the mirror direction (d, the offset from the peak, is what the closed form takes exactly)."""
+def _ring_mpmath(a2, mu, d, distribution=1):
+    """The integral of Walter's GGX (``distribution`` 1) or Beckmann (0) D over the azimuth of wo at elevation asin(mu) + d,
+    at 40 digits (mpmath), graded towards the mirror direction (d, the offset from the peak, is what the closed forms take
+    exactly)."""
     import mpmath as mp
 
     with mp.workdps(40):
         a2, mu = mp.mpf(a2), mp.mpf(mu)
         s, x = mp.sqrt(1 - mu * mu), mp.asin(mu) + mp.mpf(d)
 
-        def d(phi):
+        def dist(phi):
             hx, hy, hz = s + mp.cos(x) * mp.cos(phi), mp.cos(x) * mp.sin(phi), mu + mp.sin(x)
-            hh = hx * hx + hy * hy + hz * hz
-            return a2 / (mp.pi * (a2 * hz * hz / hh + (hx * hx + hy * hy) / hh) ** 2)  # Walter eq. 33
+            if distribution == 1:
+                hh = hx * hx + hy * hy + hz * hz
+                return a2 / (mp.pi * (a2 * hz * hz / hh + (hx * hx + hy * hy) / hh) ** 2)  # Walter eq. 33
+            t2 = (hx * hx + hy * hy) / (hz * hz)
+            return mp.exp(-t2 / a2) * (1 + t2) ** 2 / (mp.pi * a2)  # Walter eq. 25
 
         w = [mp.sqrt(a2) * mp.mpf(3) ** k for k in range(-6, 14)]
-        return float(2 * mp.quad(d, [mp.mpf(0)] + sorted(mp.pi - v for v in w if v < mp.pi) + [mp.pi]))
+        return float(2 * mp.quad(dist, [mp.mpf(0)] + sorted(mp.pi - v for v in w if v < mp.pi) + [mp.pi]))
 
 
 @pytest.mark.parametrize("a2", [1e-6, 1e-4, 0.01, 0.25, 0.81, 1.0])
 def test_ring_closed_form_against_mpmath(a2):
     """The integral of Walter's D over the azimuth of wo in closed form against a 40-digit mpmath quadrature of D itself,
     at the peak (x = x_mu), beside it, far from it, near the horizon and near the normal.  (scipy's quadrature of D in
-    double precision, ``ggx_ring_reference``, is 7e-11 off at a2 = 1e-6, mu = 1e-3.)"""
+    double precision, ``ring_reference``, is 7e-11 off at a2 = 1e-6, mu = 1e-3.)"""
     pytest.importorskip("mpmath")
     for mu in (1.0, 0.95, 0.6, 1e-3):
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -58,24 +62,7 @@ def test_ring_closed_form_against_mpmath(a2):
                 continue
             assert _polar._ggx_ring(a2, xmu, xs, x - xmu) == pytest.approx(_ring_mpmath(a2, mu, x - xmu), rel=1e-14), (mu, x)
         if a2 >= 0.01:
-            assert _polar._ggx_ring(a2, xmu, xs, 0.3 - xmu) == pytest.approx(_polar.ggx_ring_reference(a2, mu, 0.3), rel=1e-12)
-
-
-def _beckmann_ring_mpmath(a2, mu, d):
-    """The integral of Walter's Beckmann D over the azimuth of wo at elevation asin(mu) + d, at 40 digits (mpmath)."""
-    import mpmath as mp
-
-    with mp.workdps(40):
-        a2, mu = mp.mpf(a2), mp.mpf(mu)
-        s, x = mp.sqrt(1 - mu * mu), mp.asin(mu) + mp.mpf(d)
-
-        def dist(phi):
-            hx, hy, hz = s + mp.cos(x) * mp.cos(phi), mp.cos(x) * mp.sin(phi), mu + mp.sin(x)
-            t2 = (hx * hx + hy * hy) / (hz * hz)
-            return mp.exp(-t2 / a2) * (1 + t2) ** 2 / (mp.pi * a2)  # Walter eq. 25
-
-        w = [mp.sqrt(a2) * mp.mpf(3) ** k for k in range(-6, 14)]
-        return float(2 * mp.quad(dist, [mp.mpf(0)] + sorted(mp.pi - v for v in w if v < mp.pi) + [mp.pi]))
+            assert _polar._ggx_ring(a2, xmu, xs, 0.3 - xmu) == pytest.approx(_polar.ring_reference(1, a2, mu, 0.3), rel=1e-12)
 
 
 @pytest.mark.parametrize("a2", [1e-6, 1e-4, 0.01, 0.25, 1.0])
@@ -91,11 +78,11 @@ def test_beckmann_ring_against_mpmath(a2):
         for x in (xmu, xmu + 0.5 * math.sqrt(a2), xmu - 2.0 * math.sqrt(a2), 0.3, 1e-3, 0.5 * math.pi - 1e-3):
             if not 0.0 <= x <= 0.5 * math.pi:
                 continue
-            ref = _beckmann_ring_mpmath(a2, mu, x - xmu)
+            ref = _ring_mpmath(a2, mu, x - xmu, distribution=0)
             assert abs(_polar._beckmann_ring(a2, xmu, xs, x - xmu) - ref) <= 1e-13 * ref + 1e-14 * peak, (mu, x)
         if a2 >= 0.01:
             got = _polar._beckmann_ring(a2, xmu, xs, 0.3 - xmu)
-            assert got == pytest.approx(_polar.beckmann_ring_reference(a2, mu, 0.3), rel=1e-12)
+            assert got == pytest.approx(_polar.ring_reference(0, a2, mu, 0.3), rel=1e-12)
 
 
 def test_kummer_functions_against_mpmath():
