@@ -2022,21 +2022,48 @@ def _n_incidence(mp, mu):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode):  # pragma: no cover - compiled
-    """(value, error) of the rule on d = x - x_mu in [lo, hi] of :func:`_n_value`."""
+def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain):  # pragma: no cover - compiled
+    """(value, error) of the rule on d = x - x_mu in [lo, hi] of :func:`_n_value`; with a pumped chain (``chain`` not
+    None, :meth:`pumpup.pumping.Pumped._chain_args`) divided by g_1 ... g_k(mu, N.wo) exactly as the chain kernel divides
+    by it (001 eq. 16; written out as in :func:`_x_rule`), its error then the larger of QUADPACK's calibration (for the
+    weight's peak, as without g) and CHAIN_SAFETY |K - G| (for g's splines, which are not analytic: :data:`CHAIN_SAFETY`)."""
     h = hi - lo
     for j in range(nodes.shape[0]):
-        buf[j] = _n_value(mp, mu, xmu, xs, lo + h * nodes[j])
+        d = lo + h * nodes[j]
+        v = _n_value(mp, mu, xmu, xs, d)
+        if chain is not None and v != 0.0:
+            t = math.sin(xmu + d)
+            if min(mu, t) > chain[13]:
+                g = _g_product(max(mu, t), chain[14], chain[15], chain[16], chain[17])
+            else:
+                g = _g_levels(max(mu, t), min(mu, t), chain[0], chain[1], chain[2], chain[3], chain[4], chain[5], chain[6],
+                              chain[7], chain[8], chain[9], chain[10], chain[11], chain[12])
+            v /= g  # 001 eq. 16
+        buf[j] = v
     k, diff, asc, ab = rule_sums(buf, wk, wg)
-    return k * h, calibrated(diff * h, asc * h, ab * h, mode)
+    e = calibrated(diff * h, asc * h, ab * h, mode)
+    return k * h, (max(e, CHAIN_SAFETY * diff * h) if chain is not None else e)
+
+
+@njit(cache=True, nogil=True)
+def _n_values(mp, mu, x, chain):  # pragma: no cover - compiled
+    """:func:`_n_value` (divided by the chain's g where ``chain`` is not None) at the elevations ``x`` (for the tests: the
+    rule's own arithmetic, one node per call)."""
+    xmu, xs = _n_incidence(mp, mu)
+    out = np.empty(x.shape[0])
+    buf = np.empty(1)
+    one = np.ones(1)
+    for i in range(x.shape[0]):
+        d = x[i] - xmu
+        out[i] = _n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, chain)[0]
+    return out
 
 
 def n_integrand(brdf, mu: float, x) -> np.ndarray:
-    """Frame 6's integrand (:func:`_n_value`) for ``brdf``'s hint at N.wi = ``mu`` and elevations ``x`` of wo, as the engine
-    computes it (for the tests)."""
-    mp = numeric_params(brdf.polar())
-    xmu, xs = _n_incidence(mp, mu)
-    return np.array([_n_value(mp, mu, xmu, xs, float(v) - xmu) for v in np.atleast_1d(np.asarray(x, dtype=float))])
+    """Frame 6's integrand (:func:`_n_value`, divided by g for a pumped model) for ``brdf``'s hint at N.wi = ``mu`` and
+    elevations ``x`` of wo, as the engine computes it (for the tests)."""
+    hint = brdf.polar()
+    return _n_values(numeric_params(hint), float(mu), np.atleast_1d(np.asarray(x, dtype=float)), hint.chain)
 
 
 def n_integrand_reference(brdf, mu: float, x) -> np.ndarray:
@@ -2120,29 +2147,37 @@ def n_cuts_reference(brdf, mu: float) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, val, err, conv, evals):  # pragma: no cover
+def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, chain, ecut, necut, val, err, conv,
+                 evals):  # pragma: no cover
     """Frame 6: adaptive 10/21 quadrature over the elevation x = x_mu + d of wo (:func:`_n_rule`) for every mu, from the
-    pieces between :func:`_n_cuts`."""
-    cap, pk, t0, t1, kv, ke, buf, _, _, _ = _buffers(max_intervals + N_CUTS, nodes, nodes, rtol)
-    cut = np.empty(N_CUTS)
+    pieces between :func:`_n_cuts` and, for a pumped model (``chain`` not None), the elevations ``ecut[q, :necut[q]]``
+    (:func:`chain_cuts` of g's kinks)."""
+    cap, pk, t0, t1, kv, ke, buf, _, _, _ = _buffers(max_intervals + N_CUTS + ecut.shape[1], nodes, nodes, rtol)
+    cut = np.empty(N_CUTS + ecut.shape[1])
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         xmu, xs = _n_incidence(mp, mu)
-        nc = _n_cuts(mp, xmu, cut)
+        nc = _n_cuts(mp, xmu, cut[:N_CUTS])
+        for i in range(necut[q]):
+            cut[nc] = ecut[q, i] - xmu
+            nc += 1
+        cut[:nc].sort()
         m = 0
         for i in range(nc - 1):
             if cut[i + 1] > cut[i]:
                 pk[m], t0[m], t1[m] = i, cut[i], cut[i + 1]
-                kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, t0[m], t1[m], nodes, wk, wg, buf, mode)
+                kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, t0[m], t1[m], nodes, wk, wg, buf, mode, chain)
                 m += 1
         start = m
         while True:
             tot, e, r, worst, ok = _status(kv, ke, m, 0.0, rounding, rtol, atol_arr[q])
+            if chain is not None:  # (as :func:`_integrate_chain`: the reported error within the tolerance)
+                ok = ok and (e <= r or e + r <= max(rtol * abs(tot), atol_arr[q]))
             if ok or m - start >= max_intervals or m >= cap:
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
-            kv[worst], ke[worst] = _n_rule(mp, mu, xmu, xs, a_, mid, nodes, wk, wg, buf, mode)
-            kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, mid, b_, nodes, wk, wg, buf, mode)
+            kv[worst], ke[worst] = _n_rule(mp, mu, xmu, xs, a_, mid, nodes, wk, wg, buf, mode, chain)
+            kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, mid, b_, nodes, wk, wg, buf, mode, chain)
             m += 1
         val[q] = tot
         err[q] = e + r
@@ -2584,6 +2619,15 @@ def numeric_integrand(brdf, mu: float, u, rtol: float = 1e-13):
     return val, err
 
 
+def _cut_matrix(cuts: list) -> tuple:
+    """(cut, ncut): the per-mu arrays of cuts as one zero-padded matrix and their lengths."""
+    ncut = np.array([len(c) for c in cuts], np.int64)
+    cut = np.zeros((len(cuts), int(ncut.max(initial=2))))
+    for q, c in enumerate(cuts):
+        cut[q, :len(c)] = c
+    return cut, ncut
+
+
 def takes_1d_path(brdf) -> bool:
     """Whether :func:`albedo_1d` takes ``brdf`` (it has a :class:`Polar` hint and the path is on)."""
     polar = getattr(brdf, "polar", None) if ENABLED and ONE_D else None
@@ -2612,8 +2656,10 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
     if hint.kind == "half" and mu.size and mu.min() < HALF_MU_MIN and not takes_n_frame(hint):
         return None  # (the half frame's breaks and arcs underflow there: the nested engine, as before)
-    if hint.kind == "half" and (hint.p not in (0.0, 1.0) or hint.chain is not None):
-        raise ValueError(f"{brdf!r}: a half-vector Polar hint needs p in {{0, 1}} and no chain, got p={hint.p!r}")
+    if hint.kind == "half" and hint.chain is not None and not takes_n_frame(hint):
+        return None  # (a pumped half-vector model off frame 6, without_n_frame: the nested engine, as before it)
+    if hint.kind == "half" and hint.p not in (0.0, 1.0):
+        raise ValueError(f"{brdf!r}: a half-vector Polar hint needs p in {{0, 1}}, got p={hint.p!r}")
     if hint.vcavity and (hint.kind != "half" or hint.p != 0.0 or hint.sqrt_cos):
         raise ValueError(f"{brdf!r}: a Polar hint with vcavity needs kind 'half', p = 0 and no sqrt_cos")
     if hint.sqrt_cos and (hint.kind != "half" or hint.p != 0.0):
@@ -2647,8 +2693,12 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
     if takes_n_frame(hint):  # frame 6: GGX and Beckmann with F = 1, Schlick's model, about N (:func:`_integrate_n`)
         mp = numeric_params(hint)
+        if hint.chain is None:
+            cut, ncut = np.zeros((len(mu), 0)), np.zeros(len(mu), np.int64)
+        else:  # pumped: g's kinks, its tables' grading and the pi / 16 cuts, as for a pumped lobe
+            cut, ncut = _cut_matrix([chain_cuts(hint.levels(float(m)), 0.0, float(m)) for m in mu])
         _integrate_n(mp, mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING, *_RULES["gk21"], mode_code(),
-                     val, err, conv, evals)
+                     hint.chain, cut, ncut, val, err, conv, evals)
     elif hint.chain is None:
         # Ward's K (elliptic integrals) has a logarithmic term where h's circle starts to be cut (E(k^2) near
         # k^2 = 1), which no substitution here makes analytic: QUADPACK's calibration measured 4.4 x below the
@@ -2668,11 +2718,7 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     else:  # a pumped lobe, about N
         fres = (float(hint.fresnel[1]), float(hint.fresnel[2])) if lobe_f else None
         fr = np.array([1.0 if lobe_f else 0.0, *(fres or (0.0, 0.0))])
-        cuts = [chain_cuts(hint.levels(float(m)), float(hint.n), float(m), fres) for m in mu]
-        ncut = np.array([len(c) for c in cuts], np.int64)
-        cut = np.zeros((len(mu), int(ncut.max(initial=2))))
-        for q, c in enumerate(cuts):
-            cut[q, :len(c)] = c
+        cut, ncut = _cut_matrix([chain_cuts(hint.levels(float(m)), float(hint.n), float(m), fres) for m in mu])
         _integrate_chain(float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
                          *_RULES[CHAIN_RULE], N_INIT_CHAIN, cut, ncut, hint.chain, *ring_table(float(hint.n)), fr, val, err, conv, evals)
     return scale * val, np.abs(scale) * err, conv, evals

@@ -10,6 +10,10 @@ miss of one of the two.
 
     python scripts/pumped_calibration.py              # every third theta of the figures (a few minutes)
     python scripts/pumped_calibration.py --stride 1   # all of them
+    python scripts/pumped_calibration.py --nframe     # pumped GGX, Beckmann and Schlick models instead (frame 6 about
+                                                      # N divided by g, pumpup._polar._integrate_n; issue 14's tenth
+                                                      # session): their estimate is the larger of QUADPACK's calibration
+                                                      # and CHAIN_SAFETY |K - G|
 """
 
 import argparse
@@ -29,20 +33,28 @@ CHAINS = [({"type": "phong", "n": 20}, "g2", 2), ({"type": "phong", "n": 20}, "g
           ({"type": "stretched_phong", "n": 0.5}, "g1", 2), ({"type": "stretched_phong", "n": 20, "p": 0.0}, "g2", 3),
           ({"type": "phong", "n": 20}, "g1", 4), ({"type": "phong", "n": 5}, "g2", 2),
           ({"type": "stretched_phong", "n": 1000}, "g1", 2)]
+#: pumped microfacet models (frame 6 divided by g)
+N_CHAINS = [({"type": "ggx", "alpha": 0.1, "shadowing": "correlated"}, "g2", 2), ({"type": "ggx", "alpha": 0.5}, "g1", 1),
+            ({"type": "ggx", "alpha": 0.02}, "g2", 1), ({"type": "ggx", "alpha": 0.3}, "g1", 3),
+            ({"type": "ggx", "alpha": 1.0}, "g2", 1), ({"type": "beckmann", "alpha": 0.3}, "g2", 2),
+            ({"type": "beckmann", "alpha": 0.05, "g1": "walter"}, "g1", 1), ({"type": "beckmann", "alpha": 0.8}, "g2", 3),
+            ({"type": "schlick", "r": 0.2}, "g1", 2), ({"type": "schlick", "r": 0.01}, "g2", 2)]
 RTOLS = (1e-6, 1e-8, 1e-10, 1e-11, 1e-12)
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--stride", type=int, default=3, help="every k-th of the figures' 300 thetas")
+    ap.add_argument("--nframe", action="store_true", help="the pumped microfacet models (frame 6) instead")
     args = ap.parse_args(argv)
+    chains = N_CHAINS if args.nframe else CHAINS
     figure_mu = np.cos(np.radians(np.linspace(0, 89.9, 300)))[::args.stride]
     mu = np.unique(np.concatenate([np.geomspace(1e-10, 1, 40), [0.1, 0.3, 0.5, 0.7, 0.9, 0.99, 0.9999, 1e-8, 5e-9,
                                                                   0.8494679351215211], figure_mu]))
-    print(f"{len(CHAINS)} chains x {len(mu)} mu; reference: the nested engine at rtol 1e-13")
+    print(f"{len(chains)} chains x {len(mu)} mu; reference: the nested engine at rtol 1e-13")
     worst = 0.0
     t0 = time.perf_counter()
-    for spec, g, levels in CHAINS:
+    for spec, g, levels in chains:
         f = pumpup.pump(spec, g=g, levels=levels)
         for lev in f.chain():
             lev.lookup()
@@ -52,7 +64,7 @@ def main(argv=None):
             ref, ref_err = pumpup.albedo(f, mu, return_error=True, rtol=1e-13)
         finally:
             Pumped.polar = polar
-        line = f"{str(spec):48s} {g} x {levels}:"
+        line = f"{str(spec):60s} {g} x {levels}:"
         for rtol in RTOLS:
             v, e, _, _ = _polar.albedo_1d(f, mu, rtol, 0.0, 10000)
             q = float(np.max(np.abs(v - ref) / (e + ref_err)))
