@@ -212,10 +212,12 @@ class Polar:
     chain : tuple, optional
         A pumped BRDF's divisor (:meth:`pumpup.pumping.Pumped._chain_args`): the integrand is then
         divided by g_1 ... g_k (mu, N.wo) (001 eq. 16), a function of N.wo only for a fixed wi,
-        and the integral is taken about N (:func:`_integrate_chain`).
+        and the integral is taken about N (:func:`_integrate_chain`; for a half-vector hint in frame 6,
+        GGX, Beckmann with F = 1 and Schlick's model, :func:`_integrate_n`).
     levels : callable, optional
         With ``chain``: ``levels(mu)`` -> the values of N.wo where g has a kink
-        (:meth:`pumpup.pumping.Pumped.kink_levels` of every level, and the base's level mu).
+        (:meth:`pumpup.pumping.Pumped.kink_levels` of every level, the kinks its tables inherit with their
+        knots, :meth:`pumpup.pumping.Pumped.table_kinks`, and the base's level mu).
     radial : {"power", "beckmann", "ggx"}
         The lobe's radial factor: u^n ("power"), or, with kind "half", the Beckmann weight
         exp(-tan^2(alpha) / m^2) with m = ``n`` (the modified Ward model, 000 eq. 35), or the GGX weight

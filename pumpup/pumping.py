@@ -887,12 +887,15 @@ class Pumped(BRDF):
         """Values v of N.wo where a level's bound u(v) has a near-kink: a level's table is the albedo of the level below,
         whose g changes form at incidences that do not depend on wo (where a lower level's bound crosses the diagonal,
         u(v) = v for g2, or reaches its cap: :meth:`_kink_fixed`), so every higher level's table inherits those kinks.
-        Its spline follows each with knots bunched towards it (the table's refinement): a near-kink that no rule on a
-        piece across those knots sees (a 2-level g2 pumped GGX, alpha 0.1, height-correlated, at mu = 0.993068: 6.4e-8 off
-        on one piece of the elevation, 9.6 x its |K - G|, at level 1's u(v) = v, v = 0.98814; with a cut there but not
-        at the knots, Beckmann alpha 0.3 at mu = 0.99888 was 2.1e-12 off on the piece beside it, 4.8 x the estimate).  So
-        these are the kinks and, in every table above them, the knots of the bunch around each (those closer than a
-        quarter of the table's median spacing in log(v)): the spline is one polynomial between them."""
+        Its spline follows each with knots bunched towards it (the table's refinement), and rounds the kink off between
+        the nearest ones (1e-6 wide at level 1's u(v) = v, v = 0.98814, of a 2-level g2 pumped GGX, alpha 0.1,
+        height-correlated): a feature that no rule on a piece across those knots sees (at mu = 0.993068 6.4e-8 off on
+        one piece of the elevation, 9.6 x its |K - G|; with a cut at the kink but not at the knots, Beckmann alpha 0.3
+        at mu = 0.99888 was 2.1e-12 off on the piece beside it, 4.8 x the estimate).  So these are the kinks and, in
+        every table above them, a graded mesh of the knots of the bunch around each (those closer than a quarter of
+        the table's median spacing in log(v)): on each side the nearest knot, then every knot at least twice as far
+        from the kink as the last one kept, and the bunch's last (the pieces between grow geometrically away from the
+        feature, as for a singularity; every knot of the bunch cost 2 x 50 cuts and 3000 evaluations per mu)."""
         lk = self.lookup()  # (tied to the bounds they come from, as kink_cache)
         hit = lk.__dict__.get("table_kinks")
         if hit is None:
@@ -908,17 +911,29 @@ class Pumped(BRDF):
                             lo -= 1
                         while hi < len(logx) - 1 and logx[hi + 1] - logx[hi] < small:
                             hi += 1
-                        out |= set(np.exp(logx[lo:hi + 1]).tolist())
+                        lv = math.log(v)
+                        for side in (logx[lo:i][::-1], logx[i:hi + 1]):  # nearest first
+                            last = 0.0
+                            for j, x in enumerate(side):
+                                d = abs(x - lv)
+                                if d > 0 and (last == 0.0 or d >= 2.0 * last or j == len(side) - 1):
+                                    out.add(math.exp(x))
+                                    last = d
                 _, _, diag, caps = lev._kink_fixed()
                 kinks += [float(v) for v in (*diag, *caps) if 0.0 < v < 1.0]
             out |= set(kinks)
             hit = lk.table_kinks = tuple(sorted(v for v in out if 0.0 < v < 1.0))
         return hit
 
+    def _polar_levels(self, mu: float) -> tuple:
+        """The 1-D path's levels of g at incidence mu: the lobe's (:meth:`lobe`) and :meth:`table_kinks` (the nested
+        engine, whose estimate was calibrated without them, keeps the lobe's alone)."""
+        return tuple(sorted(set(self.lobe(mu).levels) | set(self.table_kinks())))
+
     def lobe(self, mu: float) -> Lobe:
         b = self.base.lobe(mu)
         return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
-                    levels=tuple(sorted(set(b.levels) | set(self.kink_levels(mu)) | set(self.table_kinks()))),
+                    levels=tuple(sorted(set(b.levels) | set(self.kink_levels(mu)))),
                     kinks=b.kinks, symmetric=b.symmetric)
 
     def sampling_lobe(self, mu: float) -> Lobe:
@@ -936,10 +951,10 @@ class Pumped(BRDF):
         hint = self.chain()[0].base.polar()
         if hint is not None and hint.chain is None and takes_n_frame(hint):
             # GGX, Beckmann (F = 1) and Schlick's model: frame 6 about N, divided by g (``pumpup._polar._integrate_n``)
-            return dataclasses.replace(hint, chain=self._chain_args(), levels=lambda mu: self.lobe(mu).levels)
+            return dataclasses.replace(hint, chain=self._chain_args(), levels=self._polar_levels)
         if hint is None or hint.kind != "lobe" or hint.chain is not None:
             return None
-        out = Polar(n=hint.n, p=hint.p, scale=hint.scale, chain=self._chain_args(), levels=lambda mu: self.lobe(mu).levels)
+        out = Polar(n=hint.n, p=hint.p, scale=hint.scale, chain=self._chain_args(), levels=self._polar_levels)
         # (a base with F(Theta_min), metal's, keeps it: the chain frame multiplies by it, where with_fresnel takes it;
         # dropping it had given a pumped gold an albedo of 2.4 while it was being built, caught by tests/test_spectral.py)
         return with_fresnel(out, *hint.fresnel[1:]) if any(hint.fresnel) else out
@@ -981,7 +996,7 @@ class _Divided(BRDF):
     def lobe(self, mu):
         b = self.term.lobe(mu)
         return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
-                    levels=tuple(sorted(set(b.levels) | set(self.pumped.kink_levels(mu)) | set(self.pumped.table_kinks()))),
+                    levels=tuple(sorted(set(b.levels) | set(self.pumped.kink_levels(mu)))),
                     kinks=b.kinks, symmetric=b.symmetric)
 
 

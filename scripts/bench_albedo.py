@@ -31,7 +31,8 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
                                               # (the lobe frame with F(Theta_min)) against the nested engine
     python scripts/bench_albedo.py --nframe   # only GGX, Beckmann (F = 1) and Schlick, about N in closed form since issue
                                               # 14's ninth session, against the rule on h's arc and the nested engine
-    python scripts/bench_albedo.py --pumped   # only pumped Phong-family chains: 1-D path against the nested engine
+    python scripts/bench_albedo.py --pumped   # only pumped chains (Phong family; GGX, Beckmann, Schlick in frame 6):
+                                              # 1-D path against the nested engine
     python scripts/bench_albedo.py --breaks   # only the nested families with kinks or levels: the compiled break
                                               # finding against its numpy reference (issue 14 item 3)
 """
@@ -313,11 +314,12 @@ def lobe_fresnel(rtol=1e-10, repeat=3):
 
 
 def pumped_chains(rtol=1e-10, repeat=3):
-    """Pumped Phong-family BRDFs (001 eq. 16; the 1-D path since issue 14's fourth session) against
-    the nested engine that had them (``Pumped.polar`` switched off: the base's Phong lobe keeps its
-    1-D path), same run: a 257-point table at rtol ``rtol`` (mu uniform in theta, the chain's tables
-    built first), one thread, best of ``repeat``; then the three tables of a 3-level g2 pumped Phong
-    n = 20 as ``pumpup.pump`` builds them (``tabulate``'s threads, rtol 1e-9, adaptive grids)."""
+    """Pumped Phong-family BRDFs (001 eq. 16; the 1-D path since issue 14's fourth session) and pumped GGX, Beckmann
+    and Schlick models (frame 6 divided by g since the tenth) against the nested engine that had them (``Pumped.polar``
+    switched off: the base keeps its 1-D path), same run: a 257-point table at rtol ``rtol`` (mu uniform in theta,
+    the chain's tables built first), one thread, best of ``repeat``; then the three tables of a 3-level g2 pumped
+    Phong n = 20 and GGX alpha = 0.3 as ``pumpup.pump`` builds them (``tabulate``'s threads, rtol 1e-9, adaptive
+    grids)."""
     from pumpup.pumping import _TABLES, Pumped
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
@@ -326,7 +328,10 @@ def pumped_chains(rtol=1e-10, repeat=3):
     print(f"{'chain':52s} {'1-D':>8s} {'nested':>9s} {'ratio':>6s}")
     for spec, g, levels in [({"type": "phong", "n": 20}, "g2", 1), ({"type": "phong", "n": 20}, "g2", 2),
                             ({"type": "phong", "n": 20}, "g2", 3), ({"type": "stretched_phong", "n": 20}, "g1", 2),
-                            ({"type": "phong", "n": 200}, "g2", 2)]:
+                            ({"type": "phong", "n": 200}, "g2", 2),
+                            # frame 6 divided by g (issue 14's tenth and eleventh sessions)
+                            ({"type": "ggx", "alpha": 0.3}, "g2", 1), ({"type": "ggx", "alpha": 0.1, "shadowing": "correlated"}, "g2", 2),
+                            ({"type": "beckmann", "alpha": 0.3}, "g1", 2), ({"type": "schlick", "r": 0.2}, "g1", 1)]:
         f = pumpup.pump(spec, g=g, levels=levels)
         for lev in f.chain():
             lev.lookup()
@@ -339,25 +344,28 @@ def pumped_chains(rtol=1e-10, repeat=3):
                 out.append(_best(lambda: pumpup.albedo(f, mu, rtol=rtol), repeat if on else 1)[1])
             finally:
                 Pumped.polar = polar
-        name = f"{spec['type']} n = {spec['n']}, {g} x {levels}"
+        name = ", ".join(f"{k} {v}" for k, v in spec.items() if k != "type")
+        name = f"{spec['type']} {name}, {g} x {levels}"
         print(f"{name:52s} {out[0] * 1e3:8.1f} {out[1] * 1e3:9.1f} {out[1] / out[0]:6.1f}", flush=True)
 
-    def build(n):
+    def build(spec):
         _TABLES.clear()
         t = time.perf_counter()
-        for lev in pumpup.pump({"type": "phong", "n": n}, g="g2", levels=3).chain():
+        for lev in pumpup.pump(spec, g="g2", levels=3).chain():
             lev.lookup()
         return time.perf_counter() - t
 
-    build(21)
-    new = min(build(20) for _ in range(repeat))
-    Pumped.polar = lambda self: None
-    try:
-        old = build(20)
-    finally:
-        Pumped.polar = polar
-    print(f"3-level g2 pumped Phong n = 20, its three tables (tabulate's threads): 1-D {new * 1e3:.0f} ms, "
-          f"nested {old * 1e3:.0f} ms, ratio {old / new:.1f}")
+    for spec, warm in (({"type": "phong", "n": 20}, {"type": "phong", "n": 21}),
+                       ({"type": "ggx", "alpha": 0.3}, {"type": "ggx", "alpha": 0.31})):
+        build(warm)
+        new = min(build(spec) for _ in range(repeat))
+        Pumped.polar = lambda self: None
+        try:
+            old = build(spec)
+        finally:
+            Pumped.polar = polar
+        print(f"3-level g2 pumped {spec}, its three tables (tabulate's threads): 1-D {new * 1e3:.0f} ms, "
+              f"nested {old * 1e3:.0f} ms, ratio {old / new:.1f}", flush=True)
 
 
 #: the nested engine's families (FAMILIES) whose hints have levels or kinks, a pumped one, and three
