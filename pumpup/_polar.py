@@ -247,6 +247,10 @@ class Polar:
     schlick : float, optional
         With kind "half", p = 0 and the GGX weight (n = sqrt(r)): Schlick's model (000 eq. 36) with this r, whose
         1 / (r + (1 - r) N.V) frame 6 integrates about N (:func:`_integrate_n`); 1 / (r + (1 - r) N.L) in ``scale``.
+    factor : tuple, optional
+        A 1/E-scaled model's factor 1 + F0 (1 / U(N.wo) - 1) (Turquin eq. 6, :class:`pumpup.compensate.Scaled`): F0 and
+        the arguments of its look-up U (:attr:`pumpup.compensate._Bound.args`), a function of N.wo alone, so frame 6
+        multiplies each node by it (:func:`_n_rule`); ``levels(mu)`` then gives U's kinks.  Frame 6 only.
     """
 
     n: float = 0.0
@@ -262,6 +266,7 @@ class Polar:
     smith: tuple | None = None
     fresnel: tuple = (0.0, 0.0, 0.0)
     schlick: float | None = None
+    factor: tuple | None = None
 
 
 @contextlib.contextmanager
@@ -1335,6 +1340,7 @@ WG21[11::2] = 0.5 * _WG10[::-1]
 from ._errors import EPS, calibrated, mode_code, rule_sums  # noqa: E402
 from .albedo import NODES as _NODES, WG as _WG, WK as _WK  # noqa: E402  (the engine's 7/15 rule)
 from .pumping import _g_levels, _g_product  # noqa: E402  (g of a pumped chain, as the BRDF divides by it)
+from .compensate import _bound as _scale_bound  # noqa: E402  (U of a 1/E-scaled model, as its kernel looks it up)
 from .models.cook_torrance import _fresnel  # noqa: E402  (frame 4's factors, as the models' kernels compute them)
 from .models.metal import _fresnel_real  # noqa: E402
 from .models.microfacet import _projected  # noqa: E402
@@ -2024,11 +2030,13 @@ def _n_incidence(mp, mu):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain):  # pragma: no cover - compiled
+def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor):  # pragma: no cover - compiled
     """(value, error) of the rule on d = x - x_mu in [lo, hi] of :func:`_n_value`; with a pumped chain (``chain`` not
     None, :meth:`pumpup.pumping.Pumped._chain_args`) divided by g_1 ... g_k(mu, N.wo) exactly as the chain kernel divides
-    by it (001 eq. 16; written out as in :func:`_x_rule`), its error then the larger of QUADPACK's calibration (for the
-    weight's peak, as without g) and CHAIN_SAFETY |K - G| (for g's splines, which are not analytic: :data:`CHAIN_SAFETY`)."""
+    by it (001 eq. 16; written out as in :func:`_x_rule`), or with a 1/E-scaled model's ``factor`` (not None: F0 and
+    :attr:`pumpup.compensate._Bound.args`) times 1 + F0 (1 / U(N.wo) - 1) as its kernel multiplies (Turquin eq. 6,
+    :func:`pumpup.compensate._scale_kernel`); its error then the larger of QUADPACK's calibration (for the weight's peak,
+    as without g) and CHAIN_SAFETY |K - G| (for the splines of g or U, which are not analytic: :data:`CHAIN_SAFETY`)."""
     h = hi - lo
     for j in range(nodes.shape[0]):
         d = lo + h * nodes[j]
@@ -2041,31 +2049,38 @@ def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain):  # pragma
                 g = _g_levels(max(mu, t), min(mu, t), chain[0], chain[1], chain[2], chain[3], chain[4], chain[5], chain[6],
                               chain[7], chain[8], chain[9], chain[10], chain[11], chain[12])
             v /= g  # 001 eq. 16
+        if factor is not None and v != 0.0:
+            u = _scale_bound(math.sin(xmu + d), factor[1], factor[2], factor[3], factor[4], factor[5], factor[6],
+                             factor[7], factor[8], factor[9], factor[10], factor[11], factor[12])
+            if factor[0] == 1.0:
+                v /= u  # Turquin eq. 6 with F0 = 1: f / E(mu_o)
+            else:
+                v *= 1.0 + factor[0] * (1.0 / u - 1.0)  # Turquin eq. 6
         buf[j] = v
     k, diff, asc, ab = rule_sums(buf, wk, wg)
     e = calibrated(diff * h, asc * h, ab * h, mode)
-    return k * h, (max(e, CHAIN_SAFETY * diff * h) if chain is not None else e)
+    return k * h, (max(e, CHAIN_SAFETY * diff * h) if chain is not None or factor is not None else e)
 
 
 @njit(cache=True, nogil=True)
-def _n_values(mp, mu, x, chain):  # pragma: no cover - compiled
-    """:func:`_n_value` (divided by the chain's g where ``chain`` is not None) at the elevations ``x`` (for the tests: the
-    rule's own arithmetic, one node per call)."""
+def _n_values(mp, mu, x, chain, factor):  # pragma: no cover - compiled
+    """:func:`_n_value` (divided by the chain's g, or times the scaled model's factor, where ``chain`` or ``factor`` is
+    not None) at the elevations ``x`` (for the tests: the rule's own arithmetic, one node per call)."""
     xmu, xs = _n_incidence(mp, mu)
     out = np.empty(x.shape[0])
     buf = np.empty(1)
     one = np.ones(1)
     for i in range(x.shape[0]):
         d = x[i] - xmu
-        out[i] = _n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, chain)[0]
+        out[i] = _n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, chain, factor)[0]
     return out
 
 
 def n_integrand(brdf, mu: float, x) -> np.ndarray:
-    """Frame 6's integrand (:func:`_n_value`, divided by g for a pumped model) for ``brdf``'s hint at N.wi = ``mu`` and
-    elevations ``x`` of wo, as the engine computes it (for the tests)."""
+    """Frame 6's integrand (:func:`_n_value`, divided by g for a pumped model, times the factor of a 1/E-scaled one) for
+    ``brdf``'s hint at N.wi = ``mu`` and elevations ``x`` of wo, as the engine computes it (for the tests)."""
     hint = brdf.polar()
-    return _n_values(numeric_params(hint), float(mu), np.atleast_1d(np.asarray(x, dtype=float)), hint.chain)
+    return _n_values(numeric_params(hint), float(mu), np.atleast_1d(np.asarray(x, dtype=float)), hint.chain, hint.factor)
 
 
 def n_integrand_reference(brdf, mu: float, x) -> np.ndarray:
@@ -2149,11 +2164,11 @@ def n_cuts_reference(brdf, mu: float) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, chain, ecut, necut, val, err, conv,
-                 evals):  # pragma: no cover
+def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, chain, factor, ecut, necut, val,
+                 err, conv, evals):  # pragma: no cover
     """Frame 6: adaptive 10/21 quadrature over the elevation x = x_mu + d of wo (:func:`_n_rule`) for every mu, from the
-    pieces between :func:`_n_cuts` and, for a pumped model (``chain`` not None), the elevations ``ecut[q, :necut[q]]``
-    (:func:`chain_cuts` of g's kinks)."""
+    pieces between :func:`_n_cuts` and, for a pumped or a 1/E-scaled model (``chain`` or ``factor`` not None), the
+    elevations ``ecut[q, :necut[q]]`` (:func:`chain_cuts` of the kinks of g or U)."""
     cap, pk, t0, t1, kv, ke, buf, _, _, _ = _buffers(max_intervals + N_CUTS + ecut.shape[1], nodes, nodes, rtol)
     cut = np.empty(N_CUTS + ecut.shape[1])
     for q in range(mu_arr.shape[0]):
@@ -2168,18 +2183,18 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
         for i in range(nc - 1):
             if cut[i + 1] > cut[i]:
                 pk[m], t0[m], t1[m] = i, cut[i], cut[i + 1]
-                kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, t0[m], t1[m], nodes, wk, wg, buf, mode, chain)
+                kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, t0[m], t1[m], nodes, wk, wg, buf, mode, chain, factor)
                 m += 1
         start = m
         while True:
             tot, e, r, worst, ok = _status(kv, ke, m, 0.0, rounding, rtol, atol_arr[q])
-            if chain is not None:  # (as :func:`_integrate_chain`: the reported error within the tolerance)
+            if chain is not None or factor is not None:  # (as :func:`_integrate_chain`: the reported error within the tolerance)
                 ok = ok and (e <= r or e + r <= max(rtol * abs(tot), atol_arr[q]))
             if ok or m - start >= max_intervals or m >= cap:
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
-            kv[worst], ke[worst] = _n_rule(mp, mu, xmu, xs, a_, mid, nodes, wk, wg, buf, mode, chain)
-            kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, mid, b_, nodes, wk, wg, buf, mode, chain)
+            kv[worst], ke[worst] = _n_rule(mp, mu, xmu, xs, a_, mid, nodes, wk, wg, buf, mode, chain, factor)
+            kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, mid, b_, nodes, wk, wg, buf, mode, chain, factor)
             m += 1
         val[q] = tot
         err[q] = e + r
@@ -2658,8 +2673,8 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
     if hint.kind == "half" and mu.size and mu.min() < HALF_MU_MIN and not takes_n_frame(hint):
         return None  # (the half frame's breaks and arcs underflow there: the nested engine, as before)
-    if hint.kind == "half" and hint.chain is not None and not takes_n_frame(hint):
-        return None  # (a pumped half-vector model off frame 6, without_n_frame: the nested engine, as before it)
+    if (hint.kind == "half" and hint.chain is not None or hint.factor is not None) and not takes_n_frame(hint):
+        return None  # (a pumped half-vector or a 1/E-scaled model off frame 6, without_n_frame: the nested engine)
     if hint.kind == "half" and hint.p not in (0.0, 1.0):
         raise ValueError(f"{brdf!r}: a half-vector Polar hint needs p in {{0, 1}}, got p={hint.p!r}")
     if hint.vcavity and (hint.kind != "half" or hint.p != 0.0 or hint.sqrt_cos):
@@ -2695,12 +2710,12 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
     if takes_n_frame(hint):  # frame 6: GGX and Beckmann with F = 1, Schlick's model, about N (:func:`_integrate_n`)
         mp = numeric_params(hint)
-        if hint.chain is None:
+        if hint.chain is None and hint.factor is None:
             cut, ncut = np.zeros((len(mu), 0)), np.zeros(len(mu), np.int64)
-        else:  # pumped: g's kinks, its tables' grading and the pi / 16 cuts, as for a pumped lobe
+        else:  # pumped or scaled: the kinks of g or U, its tables' grading and the pi / 16 cuts, as for a pumped lobe
             cut, ncut = _cut_matrix([chain_cuts(hint.levels(float(m)), 0.0, float(m)) for m in mu])
         _integrate_n(mp, mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING, *_RULES["gk21"], mode_code(),
-                     hint.chain, cut, ncut, val, err, conv, evals)
+                     hint.chain, hint.factor, cut, ncut, val, err, conv, evals)
     elif hint.chain is None:
         # Ward's K (elliptic integrals) has a logarithmic term where h's circle starts to be cut (E(k^2) near
         # k^2 = 1), which no substitution here makes analytic: QUADPACK's calibration measured 4.4 x below the

@@ -595,6 +595,29 @@ class Scaled(_Compensated):
         return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
                     levels=tuple(sorted(set(b.levels) | set(self.bound.kinks))), kinks=b.kinks, symmetric=b.symmetric)
 
+    def polar(self):
+        """The 1-D albedo path of a scaled GGX, Beckmann (F = 1) or Schlick model (``pumpup._polar``, frame 6 about N):
+        the factor depends on N.wo alone, so the base's hint times it (``Polar.factor``), with U's kinks as the levels;
+        None for any other base, or a white whose E table is not such a model's (its table could hold kinks)."""
+        import dataclasses
+
+        from ._polar import takes_n_frame
+
+        hint = self.base.polar()
+        if hint is None or hint.chain is not None or hint.factor is not None or not takes_n_frame(hint):
+            return None
+        if self.white is not self.base:
+            white = self.white.polar()
+            if white is None or white.chain is not None or white.factor is not None or not takes_n_frame(white):
+                return None
+        # U's kinks, and where its look-up turns from the spline to the product table (:func:`_bound`): a level, so
+        # that the cuts are graded in N.wo down to a quarter of it (``chain_cuts``; U(N.wo) is a spline in log N.wo
+        # and not analytic at 0: with the grading only down to a quarter of mu, as g's needs, Schlick r = 0.2 at mu =
+        # 0.985 was 1.0e-11 off on the piece N.wo < 0.172 with an estimate of 2.7e-12)
+        kinks = tuple(self.bound.kinks) + (float(self.bound.args[0]),)
+        return dataclasses.replace(hint, factor=(float(self.p["f0"]), *self.bound.args),
+                                   levels=lambda mu: tuple(sorted({float(mu), *kinks})))
+
     def sampling_lobe(self, mu: float) -> Lobe:
         return self.base.sampling_lobe(mu)
 

@@ -33,6 +33,8 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
                                               # 14's ninth session, against the rule on h's arc and the nested engine
     python scripts/bench_albedo.py --pumped   # only pumped chains (Phong family; GGX, Beckmann, Schlick in frame 6):
                                               # 1-D path against the nested engine
+    python scripts/bench_albedo.py --scaled   # only 1/E-scaled GGX, Beckmann, Schlick (frame 6 times Turquin's factor)
+                                              # against the nested engine
     python scripts/bench_albedo.py --breaks   # only the nested families with kinks or levels: the compiled break
                                               # finding against its numpy reference (issue 14 item 3)
 """
@@ -313,6 +315,15 @@ def lobe_fresnel(rtol=1e-10, repeat=3):
                    "1-D since issue 14's eighth session", rtol, repeat)
 
 
+def scaled(rtol=1e-10, repeat=3):
+    """1/E-scaled GGX, Beckmann and Schlick models (Turquin eq. 6, ``pumpup.compensate(..., method="scale")``; frame 6
+    times the factor since issue 14's eleventh session) against the nested engine they had before (:func:`against_nested`)."""
+    against_nested([{"type": "scaled", "base": b, "f0": f0} for b, f0 in [
+        ({"type": "ggx", "alpha": 0.3}, 1.0), ({"type": "ggx", "alpha": 0.05}, 1.0), ({"type": "ggx", "alpha": 1.0}, 0.5),
+        ({"type": "beckmann", "alpha": 0.1}, 1.0), ({"type": "schlick", "r": 0.2}, 1.0)]],
+        "1/E-scaled, frame 6 since issue 14's eleventh session", rtol, repeat)
+
+
 def pumped_chains(rtol=1e-10, repeat=3):
     """Pumped Phong-family BRDFs (001 eq. 16; the 1-D path since issue 14's fourth session) and pumped GGX, Beckmann
     and Schlick models (frame 6 divided by g since the tenth) against the nested engine that had them (``Pumped.polar``
@@ -568,6 +579,9 @@ def main():
         return
     if "--pumped" in sys.argv:
         pumped_chains()
+        return
+    if "--scaled" in sys.argv:
+        scaled()
         return
     if "--breaks" in sys.argv:
         breaks()
