@@ -603,13 +603,12 @@ class Scaled(_Compensated):
 
         from ._polar import takes_n_frame
 
+        def plain(h):  # GGX, Beckmann with F = 1 or Schlick, neither pumped nor scaled
+            return h is not None and h.chain is None and h.factor is None and takes_n_frame(h)
+
         hint = self.base.polar()
-        if hint is None or hint.chain is not None or hint.factor is not None or not takes_n_frame(hint):
+        if not plain(hint) or (self.white is not self.base and not plain(self.white.polar())):
             return None
-        if self.white is not self.base:
-            white = self.white.polar()
-            if white is None or white.chain is not None or white.factor is not None or not takes_n_frame(white):
-                return None
         # U's kinks, and where its look-up turns from the spline to the product table (:func:`_bound`): a level, so
         # that the cuts are graded in N.wo down to a quarter of it (``chain_cuts``; U(N.wo) is a spline in log N.wo
         # and not analytic at 0: with the grading only down to a quarter of mu, as g's needs, Schlick r = 0.2 at mu =
