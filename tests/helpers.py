@@ -65,10 +65,11 @@ def phong_albedo_1d(n, mu, stretched=False):
     return ref.phong_1d(ref.SPHONG if stretched else ref.PHONG, n, mu)
 
 
-def one_d_against_the_other_engines(f, mu, rtols=(1e-6, 1e-10), two_d_at=(0, 5, 7), whole=False):
-    """The 1-D path (pumpup._polar) against the nested engine at rtol 1e-12 (the 1-D path switched off alone) and, at
-    mu[two_d_at] and the last rtol, the 2-D engine: at every rtol the estimate bounds the difference and meets the
-    tolerance.  Returns (value, error) at the last rtol.  ``whole``: f is a sum whose terms take the path (not asked)."""
+def one_d_against_the_other_engines(f, mu, rtols=(1e-6, 1e-10), two_d_at=(0, 5, 7), whole=False, ref_rtol=1e-12):
+    """The 1-D path (pumpup._polar) against the nested engine at rtol ``ref_rtol`` (the 1-D path switched off alone)
+    and, at mu[two_d_at] and the last rtol, the 2-D engine: at every rtol the estimate bounds the difference and meets
+    the tolerance.  Returns (value, error) at the last rtol.  ``whole``: f is a sum whose terms take the path (not
+    asked)."""
     import warnings
 
     import pumpup
@@ -78,7 +79,7 @@ def one_d_against_the_other_engines(f, mu, rtols=(1e-6, 1e-10), two_d_at=(0, 5, 
     mu = np.asarray(mu, dtype=float)
     with _polar.without_1d(), warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
+        b, eb = pumpup.albedo(f, mu, return_error=True, rtol=ref_rtol)
     for rtol in rtols:
         a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
         assert np.all(np.abs(a - b) <= e + eb), (rtol, (np.abs(a - b) / (e + eb)).max())
