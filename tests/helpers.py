@@ -90,3 +90,22 @@ def one_d_against_the_other_engines(f, mu, rtols=(1e-6, 1e-10), two_d_at=(0, 5, 
             c, ec = pumpup.albedo(f, mu[idx], return_error=True, rtol=rtols[-1])
         assert np.all(np.abs(a[idx] - c) <= e[idx] + ec)
     return a, e
+
+
+def n_frame_integrand_against_eval(f, base):
+    """Frame 6's compiled integrand of ``f`` (pumpup._polar.n_integrand: the rule's own arithmetic) against ``f``'s public
+    ``eval`` times N.wo integrated over the azimuth by scipy (n_integrand_reference), to 1e-10, at mu = 0.9, 0.4, 0.05
+    and elevations on both sides of mu; returns the smallest ratio of f's integrand to ``base``'s (a pumped or scaled
+    model against its base)."""
+    from pumpup import _polar
+
+    low = math.inf
+    for mu in (0.9, 0.4, 0.05):
+        xmu = math.asin(mu)
+        xs = np.array([0.02, 0.3, xmu - 0.05, xmu + 0.04, 1.2, 1.5])
+        xs = xs[(xs > 0.0) & (xs < 0.5 * math.pi)]
+        got = _polar.n_integrand(f, mu, xs)
+        ref = _polar.n_integrand_reference(f, mu, xs)
+        assert np.all(np.abs(got - ref) <= 1e-10 * np.abs(ref)), (mu, xs, got / ref - 1)
+        low = min(low, float(np.min(got / _polar.n_integrand(base, mu, xs))))
+    return low
