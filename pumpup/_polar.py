@@ -32,7 +32,11 @@ cancellation, and b (sin beta0 - sin beta1) as mu^2 (1 - 2u) / (b sin beta0 + b 
 
 This leaves a(mu) = c * integral_0^1 u^n K(u) du.  Its kinks are where the arc starts to be
 cut by the horizon (u = s) and where the level N.wo = mu leaves the circle (u = cos 2 theta_i,
-p > 0 only): these, and u = 1/2, are breakpoints.  On [0, 1/2] the variable is u itself; above
+p > 0 only): these, and u = 1/2 (or the nearest of 0.45, 0.55, 0.4, 0.6 at least 0.02 from every break,
+:data:`SPLITS`), are breakpoints.  A break's square root reaches across the breaks next to it: where two nearly
+coincide (s and cos 2 theta_i near mu = sqrt(3) / 2) the piece beyond the other is graded towards it
+(:func:`_foreign_roots`; found in issue 14's twelfth session: stretched Phong n = 10 at mu = 0.866025 was 3.2e-12 off
+at rtol 1e-12 with an estimate of 6.6e-13).  On [0, 1/2] the variable is u itself; above
 it is z = -(n + 1) ln u, i.e. y = u^(n+1) = e^-z, which absorbs the u^n peak exactly
 (u^n du = e^-z dz / (n + 1); the engine's "power" map, 000 eq. 20, graded logarithmically); z
 stops at Z_MAX = 40, the rest is bounded and added to the error.  Above the horizon break z_s
@@ -136,7 +140,11 @@ absorber's, eta 1.1, k 30, sits at -0.0012 + 0.033 i); the outer variable is cut
 (features narrower than :data:`LOBE_F_WIDE`).  A near-kink (Im w < :data:`LOBE_F_Y0_MIN`, or w real in (0, 1): a
 dielectric's total reflection below eta = 1) stays on the nested engine.  A pumped metal, and the fresnel wrapper of a
 pumped lobe, multiply the pumped lobe's frame of N by F(max(mu, N.wo)) (:func:`_x_rule`, cut likewise by
-:func:`chain_cuts`; Im w >= :data:`CHAIN_F_Y0_MIN` there).
+:func:`chain_cuts`; Im w >= :data:`CHAIN_F_Y0_MIN` there).  Since issue 14's twelfth session a lobe with n >= :data:`LOBE_N_MIN`
+takes that frame too, with g = 1 (:func:`takes_lobe_n_frame`; its cuts :func:`_lobe_n_cuts`, compiled, and QUADPACK's
+calibration instead of CHAIN_SAFETY |K - G|): F is then one factor per node of the elevation instead of a rule on every
+arc, 60-400 evaluations per mu instead of 15 per arc times ~110 arcs (metal n = 20, eta 0.2, k 3: 5.5 ms for 257 mu
+instead of 60 ms); below n = 8 the ring table leaves the pieces next to kappa = 1 to quadrature, and frame 5 is faster.
 
 GGX and Beckmann with F = 1 and alpha <= 1 (either Smith G, exact or Walter's G1) and Schlick's model take the frame of
 N instead (frame 6, :func:`_integrate_n`): for wo at elevation x (N.wo = t = sin x) their G and 1 / (N.L N.V) depend on
@@ -1446,7 +1454,17 @@ MAX_PIECES = 128
 #: the size of :func:`_pieces`'s arrays: MAX_PIECES graded ones and the pieces between every two breaks of the tail and the
 #: peak, which come after them (with 128 slots in all, a narrow GGX lobe at grazing incidence, alpha = 1e-8 at mu = 1e-100
 #: and rtol 1e-13 on frame 4, wrote past the end: found in the ninth session by NUMBA_BOUNDSCHECK=1)
-PIECES_CAP = MAX_PIECES + 2 * (MAX_BREAKS + 4)
+#: the most cuts :func:`_foreign_roots` adds to the tail's or the peak's breaks
+FOREIGN_CUTS = 64
+#: a piece is graded where a break's root lies beyond its end closer than this fraction of its length (:func:`_foreign_roots`:
+#: farther, the 10-point Gauss rule's error is at least 1e-3 of the piece, and the calibrated estimate is then the whole |K - G|)
+FOREIGN_NEAR = 1.0 / 64.0
+#: the split of tail (u) and peak (z) of :func:`_pieces`: the first of these without a break within SPLIT_CLEAR (else the one
+#: farthest from them), so that no range's end lies next to a break it is not (the V-cavity's alpha = pi / 3 is an ulp above
+#: 1/2; the level cos 2 theta_i passes 1/2 at mu = sqrt(3) / 2, where the horizon's s does)
+SPLITS = (0.5, 0.45, 0.55, 0.4, 0.6)
+SPLIT_CLEAR = 0.02
+PIECES_CAP = MAX_PIECES + 2 * (MAX_BREAKS + 4 + FOREIGN_CUTS)
 
 
 @njit(cache=True, nogil=True)
@@ -1461,6 +1479,42 @@ def _sorted_cuts(cv, cc, m):  # pragma: no cover - compiled
             b -= 1
         cv[b + 1] = v
         cc[b + 1] = c
+
+
+@njit(cache=True, nogil=True)
+def _foreign_roots(cv, cc, nc, rv, rc, nr, tail):  # pragma: no cover - compiled
+    """Cuts (code 3) grading a piece between the cuts ``cv[:nc]`` towards its end where the square root of a break
+    (``rv[:nr]``, codes ``rc``: every break, in the range or beyond it) lies beyond that end, closer than an eighth of the
+    piece's length: at that end -+ d 4^i (d the distance) over the piece's half next to it.  A break's root lies on one
+    side of it (in u, ``tail``: code 0 below, 1 above, 2 both; in z = -(n + 1) ln u the other way round) and reaches across
+    any cut next to it: near mu = sqrt(3) / 2 the level's (u = cos 2 theta_i) and the horizon's (u = s) nearly coincide,
+    and the level's root lay 4.5e-6 beyond the end of the peak's piece [0, z_s], where no rule saw it (stretched Phong n =
+    10 at mu = 0.866025, rtol 1e-12: 3.2e-12 off with an estimate of 6.6e-13; 40-digit mpmath, the nested engine and the
+    frame of N agree to 1e-15).  Appends to ``cv``, ``cc`` and sorts them; returns their number."""
+    m = nc
+    for j in range(nr):
+        c = rc[j]
+        low = (c == 0 or c == 2) if tail else (c == 1 or c == 2)  # its root reaches down (to the pieces below it)
+        high = (c == 1 or c == 2) if tail else (c == 0 or c == 2)
+        for i in range(nc - 1):
+            lo, hi = cv[i], cv[i + 1]
+            if low and rv[j] > hi:
+                d = rv[j] - hi
+                x, sign = hi, -1.0
+            elif high and rv[j] < lo:
+                d = lo - rv[j]
+                x, sign = lo, 1.0
+            else:
+                continue
+            if not d < FOREIGN_NEAR * (hi - lo):
+                continue
+            while d < 0.5 * (hi - lo) and m < min(cv.shape[0], nc + FOREIGN_CUTS):
+                cv[m], cc[m] = x + sign * d, 3
+                m += 1
+                d *= 4.0
+    if m > nc:
+        _sorted_cuts(cv, cc, m)
+    return m
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -1645,21 +1699,39 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
                     zb[m] = _zr(radial, math.tan(ab), n)
                     m += 1
                     off *= 4.0
-    cv = np.empty(MAX_BREAKS + 4)
-    cc = np.empty(MAX_BREAKS + 4, np.int64)
+    u_sp = 0.5
+    if not skip:  # the split of tail and peak away from the breaks (SPLITS)
+        far = -1.0
+        for cand in SPLITS:
+            gap = 1.0
+            for j in range(m):
+                if kb[j] != 3:
+                    gap = min(gap, abs(ub[j] - cand))
+            if gap > far:
+                far, u_sp = gap, cand
+            if gap >= SPLIT_CLEAR:
+                break
+        if u_sp != 0.5:
+            if u_min < u_sp:  # the peak ends at the split
+                z_end, k_end = -n1 * math.log(u_sp), -1
+            elif k_end == -1:  # (u_min in [u_sp, 1/2): the range ends at u_min, before the split)
+                z_end, k_end = -n1 * math.log(u_min), 1
+    cv = np.empty(MAX_BREAKS + 4 + FOREIGN_CUTS)
+    cc = np.empty(MAX_BREAKS + 4 + FOREIGN_CUTS, np.int64)
     k = 0
     # tail pieces (increasing u)
-    if not skip and u_min < 0.5:
+    if not skip and u_min < u_sp:
         nc = 0
         cv[nc], cc[nc] = u_min, (1 if u_min > 0.0 else -1)
         nc += 1
         for j in range(m):
-            if u_min < ub[j] < 0.5:
+            if u_min < ub[j] < u_sp:
                 cv[nc], cc[nc] = ub[j], kb[j]
                 nc += 1
-        cv[nc], cc[nc] = 0.5, -1
+        cv[nc], cc[nc] = u_sp, -1
         nc += 1
         _sorted_cuts(cv, cc, nc)
+        nc = _foreign_roots(cv, cc, nc, ub, kb, m, True)
         for j in range(nc - 1):
             lo, hi = cv[j], cv[j + 1]
             if hi > lo:
@@ -1689,6 +1761,7 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
     cv[nc], cc[nc] = z_end, k_end
     nc += 1
     _sorted_cuts(cv, cc, nc)
+    nc = _foreign_roots(cv, cc, nc, zb, kb, m, False)
     for j in range(nc - 1):
         lo, hi = cv[j], cv[j + 1]
         if hi > lo:
@@ -2210,7 +2283,8 @@ N_FRAME = True
 @contextlib.contextmanager
 def without_n_frame():
     """Within the block, ``pumpup.albedo`` takes GGX, Beckmann and Schlick's model by frame 4 (the rule on h's arc,
-    :func:`_k_numeric`) instead of frame 6 (the tests' and the benchmark's second 1-D path for them).  Not meant for
+    :func:`_k_numeric`) instead of frame 6, and a lobe with F(Theta_min) by frame 5 (:func:`_k_lobe_fresnel`) instead of
+    the frame of N (:func:`takes_lobe_n_frame`): the tests' and the benchmark's second 1-D path for them.  Not meant for
     concurrent toggling."""
     global N_FRAME
     old = N_FRAME
@@ -2229,6 +2303,20 @@ def takes_n_frame(hint) -> bool:
     if hint.schlick is not None:
         return hint.p == 0.0 and 0.0 < hint.schlick <= 1.0
     return hint.smith is not None and hint.smith[3] <= 1.0 and hint.p == 0.0
+
+
+#: a lobe with 000 eq. 28's F(Theta_min) (metal, the fresnel wrapper of a lobe) is integrated about N (the pumped lobe's
+#: frame with g = 1, :func:`_integrate_chain`) for n at least this, and in the lobe frame (frame 5) below it, where the ring
+#: table leaves the pieces next to kappa = 1 to quadrature and the elevation is graded towards x_s (measured: n = 1 took 4 x
+#: frame 5's time, n = 7.5 0.8 x, n = 20 0.17 x)
+LOBE_N_MIN = 8.0  # (RING_SMOOTH_N)
+
+
+def takes_lobe_n_frame(hint) -> bool:
+    """Whether :func:`albedo_1d` takes a lobe hint with a Fresnel factor (and no chain) about N (:func:`_integrate_chain`
+    with g = 1) instead of frame 5 (:func:`_k_lobe_fresnel`): n >= :data:`LOBE_N_MIN` and frame 6's switch on
+    (:func:`without_n_frame`)."""
+    return N_FRAME and hint.kind == "lobe" and hint.chain is None and any(hint.fresnel) and hint.n >= LOBE_N_MIN
 
 
 # --- pumped Phong-family BRDFs: the frame of N -------------------------------------------------
@@ -2394,7 +2482,7 @@ def ring_table(n: float) -> tuple:
 
 
 @njit(cache=True, nogil=True)
-def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr):  # pragma: no cover
+def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr, mode):  # pragma: no cover
     """(value, error) of the rule on the elevation x of wo in [lo, hi] for
     t / (max(mu, t)^p g(mu, t)) W(t) cos(x), t = N.wo = sin(x) (001 eq. 16 with 000 eq. 7, 12;
     d omega = dt d phi), g the product of the chain's levels exactly as the BRDF divides by it, and
@@ -2402,7 +2490,9 @@ def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, 
     W = (A + B)^n V(kappa), kappa = 2 B / (A + B), A + B = cos(x - x_mu) (x_mu the elevation of the
     lobe's axis; (A + B)^n = exp(n log1p(-2 sin^2((x - x_mu) / 2))), accurate for any n), V from
     the ring table (:func:`ring_table`, its errors summed with the Kronrod weights); with ``fr`` = (1, eta, k) times
-    000 eq. 28's F(max(mu, t)) (a pumped metal, or the fresnel wrapper of a pumped lobe)."""
+    000 eq. 28's F(max(mu, t)) (a pumped metal, or the fresnel wrapper of a pumped lobe).  Without a chain (None: g = 1,
+    a metal's lobe, :func:`lobe_n_cuts`) the error is QUADPACK's calibration of |K - G| (``mode``) instead of
+    CHAIN_SAFETY |K - G| (which is for g's splines)."""
     h = hi - lo
     ie = 0.0
     xmu = math.atan2(mu, s)
@@ -2413,7 +2503,10 @@ def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, 
         # g_1 ... g_k as the chain kernel divides by it (pumpup.pumping._chain_kernel): the product
         # table where it applies, else level by level (written out: an inlined function that calls
         # the inlined look-ups ran 20 x slower, measured)
-        if min(mu, t) > chain[13]:
+        g = 1.0
+        if chain is None:
+            pass
+        elif min(mu, t) > chain[13]:
             g = _g_product(max(mu, t), chain[14], chain[15], chain[16], chain[17])
         else:
             g = _g_levels(max(mu, t), min(mu, t), chain[0], chain[1], chain[2], chain[3], chain[4], chain[5], chain[6],
@@ -2442,12 +2535,14 @@ def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, 
         buf[j] = f * v
         ie += wk[j] * f * ve
     k, diff, asc, ab = rule_sums(buf, wk, wg)
+    if chain is None:
+        return k * h, calibrated(diff * h, asc * h, ab * h, mode) + ie * h
     return k * h, CHAIN_SAFETY * diff * h + ie * h
 
 
 @njit(cache=True, nogil=True)
 def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, n_init, cuts, ncut, chain,
-                      kb, kc, keps, fr, val, err, conv, evals):  # pragma: no cover
+                      kb, kc, keps, fr, mode, val, err, conv, evals):  # pragma: no cover
     """Adaptive 10/21 quadrature over the elevation of wo of a pumped lobe (:func:`_x_rule`) for every
     mu, from the pieces between ``cuts[q, :ncut[q]]`` (:func:`chain_cuts`), each ``n_init`` intervals to
     start; ``kb``, ``kc``, ``keps`` the ring table of the lobe's exponent (:func:`ring_table`); ``fr`` the Fresnel
@@ -2468,7 +2563,7 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
                 pk[m] = i
                 t0[m] = a_ + (b_ - a_) * j / n_init
                 t1[m] = a_ + (b_ - a_) * (j + 1.0) / n_init if j + 1 < n_init else b_
-                kv[m], ke[m] = _x_rule(n, p, mu, s, t0[m], t1[m], chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr)
+                kv[m], ke[m] = _x_rule(n, p, mu, s, t0[m], t1[m], chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr, mode)
                 m += 1
         start = m
         while True:
@@ -2478,8 +2573,8 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
             if ok or m - start >= max_intervals or m >= cap:
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
-            kv[worst], ke[worst] = _x_rule(n, p, mu, s, a_, mid, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr)
-            kv[m], ke[m] = _x_rule(n, p, mu, s, mid, b_, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr)
+            kv[worst], ke[worst] = _x_rule(n, p, mu, s, a_, mid, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr, mode)
+            kv[m], ke[m] = _x_rule(n, p, mu, s, mid, b_, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr, mode)
             m += 1
         val[q] = tot
         err[q] = e + r
@@ -2487,7 +2582,7 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
         evals[q] = nodes.shape[0] * (m + (m - start))
 
 
-def chain_cuts(levels, n: float, mu: float, fresnel=None) -> np.ndarray:
+def chain_cuts(levels, n: float, mu: float, fresnel=None, chain: bool = True) -> np.ndarray:
     """The breakpoints in the elevation x of wo (N.wo = sin x) of a pumped lobe at incidence mu:
     0, pi/2, the levels of g (``levels``), N.wo = mu (max(mu, N.wo)), N.wo = s (u > 0 on the whole
     circle above it), the lobe's peak theta_o = theta_i +- k / sqrt(n), k = 3, 8, 13 (u^n ~
@@ -2514,13 +2609,14 @@ def chain_cuts(levels, n: float, mu: float, fresnel=None) -> np.ndarray:
         while d > 1e-9:
             x.extend([x_s - d, x_s + d])
             d *= 0.25
-    # g's tables are splines in ln(N.wo): N.wo = 2^-(1 + 2 k) down to a quarter of mu or of the lowest level
-    floor = max(0.25 * min(mu, L.min(initial=1.0)), GRADE_FLOOR)
-    t = 0.5
-    while t > floor:
-        x.append(math.asin(t))
-        t *= GRADE
-    x.extend(np.arange(1, X_PIECES) * (0.5 * math.pi / X_PIECES))
+    if chain:
+        # g's tables are splines in ln(N.wo): N.wo = 2^-(1 + 2 k) down to a quarter of mu or of the lowest level
+        floor = max(0.25 * min(mu, L.min(initial=1.0)), GRADE_FLOOR)
+        t = 0.5
+        while t > floor:
+            x.append(math.asin(t))
+            t *= GRADE
+        x.extend(np.arange(1, X_PIECES) * (0.5 * math.pi / X_PIECES))
     if fresnel is not None:
         x0, y0 = fresnel_branch(*fresnel)
         rho = fresnel_pole(*fresnel)
@@ -2530,6 +2626,51 @@ def chain_cuts(levels, n: float, mu: float, fresnel=None) -> np.ndarray:
         x.extend(np.arctan2(t, np.sqrt((1.0 - t) * (1.0 + t))))
     x = np.unique(np.asarray(x))
     return x[(x >= 0.0) & (x <= 0.5 * math.pi)]
+
+
+#: the most breakpoints of :func:`lobe_n_cuts` per mu (4 + 6 peak cuts, 2 x 15 towards x_s, 3 x LOBE_F_CUTS for F)
+LOBE_N_CUTS = 64
+
+
+@njit(cache=True, nogil=True)
+def _lobe_n_cuts(n, mu_arr, x0, y0, rho):  # pragma: no cover - compiled; see chain_cuts(..., chain=False)
+    """(cut, ncut): :func:`chain_cuts` without a chain (levels (mu,), no grading for g's splines) for every mu, with
+    ``fresnel``'s branch point x0 - i y0 and pole scale rho (:func:`fresnel_branch`, :func:`fresnel_pole`): the cuts of a
+    metal's lobe about N (:func:`_integrate_chain` with g = 1), sorted, duplicates dropped."""
+    half = 0.5 * math.pi
+    cut = np.zeros((mu_arr.shape[0], LOBE_N_CUTS))
+    ncut = np.zeros(mu_arr.shape[0], np.int64)
+    x = np.empty(LOBE_N_CUTS)
+    for q in range(mu_arr.shape[0]):
+        mu = mu_arr[q]
+        s = math.sqrt((1.0 - mu) * (1.0 + mu))
+        x_mu, x_s = math.atan2(mu, s), math.atan2(s, mu)
+        x[0], x[1], x[2], x[3] = 0.0, half, x_mu, x_s
+        m = 4
+        if n > 0.0:
+            for k in (3.0, 8.0, 13.0):
+                x[m], x[m + 1] = x_mu - k / math.sqrt(n), x_mu + k / math.sqrt(n)
+                m += 2
+        if 0.0 < n < RING_SMOOTH_N:
+            d = 0.5
+            while d > 1e-9:
+                x[m], x[m + 1] = x_s - d, x_s + d
+                m += 2
+                d *= 0.25
+        for j in range(LOBE_F_CUTS):
+            sc = 3.0 ** j
+            for t in (x0 + y0 * sc, x0 - y0 * sc, rho * sc if rho < LOBE_F_WIDE else -1.0):
+                if 0.0 < t < 1.0:
+                    x[m] = math.atan2(t, math.sqrt((1.0 - t) * (1.0 + t)))
+                    m += 1
+        x[:m].sort()
+        c = 0
+        for i in range(m):
+            if 0.0 <= x[i] <= half and (c == 0 or x[i] > cut[q, c - 1]):
+                cut[q, c] = x[i]
+                c += 1
+        ncut[q] = c
+    return cut, ncut
 
 
 _RULES = {"gk15": (_NODES, _WK, _WG), "gk21": (NODES21, WK21, WG21)}
@@ -2716,6 +2857,12 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
             cut, ncut = _cut_matrix([chain_cuts(hint.levels(float(m)), 0.0, float(m)) for m in mu])
         _integrate_n(mp, mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING, *_RULES["gk21"], mode_code(),
                      hint.chain, hint.factor, cut, ncut, val, err, conv, evals)
+    elif lobe_f and hint.chain is None and takes_lobe_n_frame(hint):  # a metal's lobe about N (:func:`_integrate_chain`, g = 1)
+        fres = (float(hint.fresnel[1]), float(hint.fresnel[2]))
+        cut, ncut = _lobe_n_cuts(float(hint.n), mu, *fresnel_branch(*fres), fresnel_pole(*fres))
+        _integrate_chain(float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
+                         *_RULES[CHAIN_RULE], N_INIT_CHAIN, cut, ncut, None, *ring_table(float(hint.n)), np.array([1.0, *fres]),
+                         mode_code(), val, err, conv, evals)
     elif hint.chain is None:
         # Ward's K (elliptic integrals) has a logarithmic term where h's circle starts to be cut (E(k^2) near
         # k^2 = 1), which no substitution here makes analytic: QUADPACK's calibration measured 4.4 x below the
@@ -2737,5 +2884,6 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         fr = np.array([1.0 if lobe_f else 0.0, *(fres or (0.0, 0.0))])
         cut, ncut = _cut_matrix([chain_cuts(hint.levels(float(m)), float(hint.n), float(m), fres) for m in mu])
         _integrate_chain(float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
-                         *_RULES[CHAIN_RULE], N_INIT_CHAIN, cut, ncut, hint.chain, *ring_table(float(hint.n)), fr, val, err, conv, evals)
+                         *_RULES[CHAIN_RULE], N_INIT_CHAIN, cut, ncut, hint.chain, *ring_table(float(hint.n)), fr, mode_code(), val, err,
+                         conv, evals)
     return scale * val, np.abs(scale) * err, conv, evals

@@ -31,6 +31,8 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
                                               # (the lobe frame with F(Theta_min)) against the nested engine
     python scripts/bench_albedo.py --nframe   # only GGX, Beckmann (F = 1) and Schlick, about N in closed form since issue
                                               # 14's ninth session, against the rule on h's arc and the nested engine
+    python scripts/bench_albedo.py --lobe-n   # only lobes with F(Theta_min), n >= 8, about N since issue 14's twelfth
+                                              # session, against frame 5 and the nested engine
     python scripts/bench_albedo.py --pumped   # only pumped chains (Phong family; GGX, Beckmann, Schlick in frame 6):
                                               # 1-D path against the nested engine
     python scripts/bench_albedo.py --scaled   # only 1/E-scaled GGX, Beckmann, Schlick (frame 6 times Turquin's factor)
@@ -262,6 +264,35 @@ def n_frame(rtol=1e-10, repeat=3):
         ev = np.mean(_polar.albedo_1d(f, mu, rtol, 0.0, 200)[3])
         t6, t4, tn = times
         print(f"{str(spec):48s} {t6 * 1e3:8.1f} {ev:8.0f} {t4 * 1e3:8.1f} {t4 / t6:6.1f} {tn * 1e3:8.1f} {tn / t6:6.1f}", flush=True)
+
+
+def lobe_n_frame(rtol=1e-10, repeat=3):
+    """Lobes with 000 eq. 28's F(Theta_min) (metal, plastic with an index, the fresnel wrapper; n >= 8) about N with the ring
+    table and g = 1 (issue 14's twelfth session) against frame 5, the lobe frame with a rule on the arc they took before
+    (``_polar.without_n_frame``), and the nested engine, same run: a 257-point table (mu uniform in theta) at ``rtol``, one
+    thread, best of ``repeat`` (nested: 1)."""
+    from pumpup import _polar
+
+    mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
+    specs = [{"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, {"type": "metal", "n": 8, "eta": 1.5},
+             {"type": "metal", "n": 500, "eta": 1.1, "k": 6.0}, {"type": "metal", "n": 10, "eta": 0.6, "k": 0.3},
+             {"type": "metal", "n": 20, "eta": 0.5, "k": 0.002}, {"type": "plastic", "n": 20, "eta": 1.5, "ad": 0.3},
+             {"type": "fresnel", "base": {"type": "phong", "n": 20}, "eta": 0.2, "k": 3.0},
+             {"type": "fresnel", "base": {"type": "retro", "n": 10}, "eta": 1.1, "k": 30.0}]
+    print(f"a lobe with F(Theta_min) about N against frame 5 and the nested engine, one thread, ms; 257 mu at rtol {rtol:g}")
+    print(f"{'model':60s} {'about N':>8s} {'evals/mu':>8s} {'frame 5':>8s} {'ratio':>6s} {'nested':>8s} {'ratio':>6s}")
+    for spec in specs:
+        f = pumpup.load(spec)
+        times = []
+        for ctx, rep in ((contextlib.nullcontext(), repeat), (_polar.without_n_frame(), repeat), (_polar.without_1d(), 1)):
+            with ctx:
+                pumpup.albedo(f, [0.5, 1e-3], rtol=rtol)
+                times.append(_best(lambda: pumpup.albedo(f, mu, rtol=rtol), rep)[1])
+        lobe = pumpup.load(dict(spec, ad=0.0)) if spec["type"] == "plastic" else f  # (plastic's diffuse term split off)
+        ev = np.mean(_polar.albedo_1d(lobe, mu, rtol, 0.0, 200)[3])
+        tn, t5, tnest = times
+        print(f"{str(spec):60s} {tn * 1e3:8.1f} {ev:8.0f} {t5 * 1e3:8.1f} {t5 / tn:6.1f} {tnest * 1e3:8.1f} {tnest / tn:6.1f}",
+              flush=True)
 
 
 def p_model(rtol=1e-10, repeat=3):
@@ -576,6 +607,9 @@ def main():
         return
     if "--nframe" in sys.argv:
         n_frame()
+        return
+    if "--lobe-n" in sys.argv:
+        lobe_n_frame()
         return
     if "--pumped" in sys.argv:
         pumped_chains()

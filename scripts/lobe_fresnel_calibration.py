@@ -26,8 +26,9 @@ from pumpup import _polar
 
 ETAS = (0.05, 0.3, 0.6, 0.9, 0.999, 1.001, 1.1, 1.5, 3.0, 20.0)
 KS = (0.0, 0.001, 0.002, 0.01, 0.3, 3.0, 30.0)
-LOBES = ({"type": "stretched_phong", "n": 0.0}, {"type": "stretched_phong", "n": 7.5}, {"type": "stretched_phong", "n": 500},
-         {"type": "phong", "n": 20}, {"type": "phong", "n": 1})
+LOBES = ({"type": "stretched_phong", "n": 0.0}, {"type": "stretched_phong", "n": 7.5}, {"type": "stretched_phong", "n": 8},
+         {"type": "stretched_phong", "n": 500}, {"type": "phong", "n": 20}, {"type": "phong", "n": 1},
+         {"type": "phong", "n": 2000})
 RTOLS = (1e-6, 1e-8, 1e-10, 1e-12)
 
 

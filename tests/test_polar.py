@@ -59,6 +59,22 @@ def test_against_mpmath_with_honest_error(n, p):
                 assert abs(v - ref) <= 1e-10 * ref
 
 
+@pytest.mark.parametrize("n", [3, 10, 20])
+def test_nearly_coinciding_breaks_against_mpmath(n):
+    """Near mu = sqrt(3) / 2 the level's break (u = cos 2 theta_i) and the horizon's (u = s) nearly coincide, and each one's
+    square root reaches across the other's (stretched Phong n = 10 at mu = 0.866025 was 3.2e-12 off at rtol 1e-12 with an
+    estimate of 6.6e-13 until issue 14's twelfth session: ``_polar._foreign_roots`` grades the piece next to such a root):
+    against the 30-digit mpmath reference, at rtol 1e-8, 1e-10 and 1e-12, the estimate bounds the error."""
+    m0 = math.sqrt(3) / 2
+    mu = m0 * (1.0 + np.array([0.0, -1e-14, 1e-12, -1e-9, 1e-9, -1e-6, 1e-6, -1e-4, 1e-4]))
+    refs = [phong_albedo_1d(n, m, stretched=True) for m in mu]
+    for rtol in (1e-8, 1e-10, 1e-12):
+        a, e, conv, _ = _polar.albedo_1d(_Lobe(n, 1.0), mu, rtol, 0.0, 20000)
+        assert conv.all()
+        for m, v, err, (ref, ref_err) in zip(mu, a, e, refs):
+            assert abs(v - ref) <= err + ref_err, (n, m, rtol, v - ref, err)
+
+
 def test_evaluations_per_mu_are_a_few_hundred():
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     for n, p in [(20, 0), (20, 1), (5000, 1), (1, 0)]:

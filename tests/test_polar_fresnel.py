@@ -62,6 +62,38 @@ def test_against_the_nested_and_two_d_engines(spec):
     one_d_against_the_other_engines(pumpup.load(spec), MU, (1e-6, 1e-8, 1e-10), whole=True)
 
 
+@pytest.mark.parametrize("spec", [s for s in SPECS if s.get("n", s.get("base", {}).get("n", 0)) >= _polar.LOBE_N_MIN],
+                         ids=[i for s, i in zip(SPECS, IDS) if s.get("n", s.get("base", {}).get("n", 0)) >= _polar.LOBE_N_MIN])
+def test_lobe_about_n_against_frame_5(spec):
+    """A lobe with n >= LOBE_N_MIN takes the frame of N (the pumped lobe's, g = 1: the ring table and F(max(mu, N.wo)) per
+    node, issue 14's twelfth session) instead of frame 5 (the lobe frame with a rule on the arc): the two agree within their
+    estimates at rtol 1e-12, and at rtol 1e-6, 1e-8, 1e-10 the frame of N's estimate bounds its distance from frame 5 at
+    1e-12 (less frame 5's own estimate) and meets the tolerance."""
+    f = _lobe(spec)
+    assert _polar.takes_lobe_n_frame(f.polar())
+    mu = np.array(MU)
+    with _polar.without_n_frame():
+        assert not _polar.takes_lobe_n_frame(f.polar())
+        b, eb, *_ = _polar.albedo_1d(f, mu, 1e-12, 0.0, 10000)
+    a, ea, conv, _ = _polar.albedo_1d(f, mu, 1e-12, 0.0, 10000)
+    assert conv.all() and np.all(np.abs(a - b) <= ea + eb), (a - b, ea, eb)
+    for rtol in (1e-6, 1e-8, 1e-10):
+        a, ea, conv, _ = _polar.albedo_1d(f, mu, rtol, 0.0, 10000)
+        assert conv.all() and np.all(np.abs(a - b) - eb <= ea) and np.all(ea <= rtol * a), (rtol, a - b, ea, eb)
+
+
+def test_lobe_n_cuts_against_chain_cuts():
+    """The compiled cuts of a lobe about N (:func:`pumpup._polar._lobe_n_cuts`) are chain_cuts without a chain (no levels but
+    mu, no grading for g's splines), for indices with their branch point and pole near and far, from normal incidence to
+    1e-300."""
+    mu = np.r_[np.cos(np.linspace(0, np.pi / 2, 33)[:-1]), 1e-3, 1e-9, 1e-300]
+    for n in (0.0, 2.0, 20.0, 500.0):
+        for eta, k in ((0.2, 3.0), (1.5, 0.0), (1.1, 30.0), (0.6, 0.3), (0.999, 0.001)):
+            cut, ncut = _polar._lobe_n_cuts(n, mu, *_polar.fresnel_branch(eta, k), _polar.fresnel_pole(eta, k))
+            for q, m in enumerate(mu):
+                np.testing.assert_array_equal(cut[q, :ncut[q]], _polar.chain_cuts([], n, float(m), (eta, k), chain=False))
+
+
 def test_normal_incidence_is_the_fresnel_factor():
     """At mu = 1 every N.wo <= mu, so F(Theta_min) = F(1) and the albedo of c u^n F / max is F(1) c 2 pi / (n + 2):
     metal's (c = (n + 2) / (2 pi), 000 eq. 6) is F(1) = ((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2) exactly."""
@@ -83,6 +115,11 @@ def test_which_models_take_it():
     # 2.4, caught by tests/test_spectral.py), as does the fresnel wrapper of a pumped lobe; not with a near-kink
     assert pumpup.pump({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}).polar().fresnel == (0.0, 0.2, 3.0)
     assert pumpup.pump({"type": "metal", "n": 20, "eta": 0.6}).polar() is None
+    # about N (g = 1) from n = LOBE_N_MIN on, frame 5 below it; a pumped metal's chain takes its own frame of N
+    assert [_polar.takes_lobe_n_frame(pumpup.load({"type": "metal", "n": n, "eta": 0.2, "k": 3.0}).polar())
+            for n in (7.5, 8.0, 500.0)] == [False, True, True]
+    assert not _polar.takes_lobe_n_frame(pumpup.pump({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}).polar())
+    assert not _polar.takes_lobe_n_frame(pumpup.load({"type": "phong", "n": 20}).polar())
     for base in ({"type": "stretched_phong", "n": 20, "p": 0.5}, {"type": "lambert"}, {"type": "blinn", "n": 20},
                  {"type": "pumped", "base": {"type": "blinn", "n": 20}}):
         assert pumpup.load({"type": "fresnel", "base": base, "eta": 0.2, "k": 3.0}).polar() is None, base
