@@ -141,7 +141,7 @@ absorber's, eta 1.1, k 30, sits at -0.0012 + 0.033 i); the outer variable is cut
 dielectric's total reflection below eta = 1) stays on the nested engine.  A pumped metal, and the fresnel wrapper of a
 pumped lobe, multiply the pumped lobe's frame of N by F(max(mu, N.wo)) (:func:`_x_rule`, cut likewise by
 :func:`chain_cuts`; Im w >= :data:`CHAIN_F_Y0_MIN` there).  Since issue 14's twelfth session a lobe with n >= :data:`LOBE_N_MIN`
-takes that frame too, with g = 1 (:func:`takes_lobe_n_frame`; its cuts :func:`_lobe_n_cuts`, compiled, and QUADPACK's
+takes that frame too, with g = 1 (:func:`takes_lobe_n_frame`; its cuts :func:`chain_cut_matrix`, compiled, and QUADPACK's
 calibration instead of CHAIN_SAFETY |K - G|): F is then one factor per node of the elevation instead of a rule on every
 arc, 60-400 evaluations per mu instead of 15 per arc times ~110 arcs (metal n = 20, eta 0.2, k 3: 5.5 ms for 257 mu
 instead of 60 ms); below n = 8 the ring table leaves the pieces next to kappa = 1 to quadrature, and frame 5 is faster.
@@ -2628,25 +2628,35 @@ def chain_cuts(levels, n: float, mu: float, fresnel=None, chain: bool = True) ->
     return x[(x >= 0.0) & (x <= 0.5 * math.pi)]
 
 
-#: the most breakpoints of :func:`lobe_n_cuts` per mu (4 + 6 peak cuts, 2 x 15 towards x_s, 3 x LOBE_F_CUTS for F)
-LOBE_N_CUTS = 64
+#: room in :func:`_chain_cut_matrix` per mu besides the levels: 4 fixed cuts, 6 about the peak, 2 x 15 towards x_s, 20
+#: graded in N.wo (GRADE down to GRADE_FLOOR), X_PIECES - 1, 3 x LOBE_F_CUTS about F's branch point and pole
+CHAIN_CUTS_ROOM = 96
 
 
 @njit(cache=True, nogil=True)
-def _lobe_n_cuts(n, mu_arr, x0, y0, rho):  # pragma: no cover - compiled; see chain_cuts(..., chain=False)
-    """(cut, ncut): :func:`chain_cuts` without a chain (levels (mu,), no grading for g's splines) for every mu, with
-    ``fresnel``'s branch point x0 - i y0 and pole scale rho (:func:`fresnel_branch`, :func:`fresnel_pole`): the cuts of a
-    metal's lobe about N (:func:`_integrate_chain` with g = 1), sorted, duplicates dropped."""
+def _chain_cut_matrix(n, mu_arr, lev, nlev, chain, fres, x0, y0, rho):  # pragma: no cover - compiled; see chain_cuts
+    """(cut, ncut): :func:`chain_cuts` for every mu, compiled (it was a quarter to a half of a pumped or 1/E-scaled table's
+    time in Python): the levels ``lev[q, :nlev[q]]``, ``chain`` (g's grading in N.wo and the pi / 16 cuts), with ``fres``
+    F's branch point x0 - i y0 and pole scale rho (:func:`fresnel_branch`, :func:`fresnel_pole`); sorted, duplicates
+    dropped, as chain_cuts (np.unique) has them."""
     half = 0.5 * math.pi
-    cut = np.zeros((mu_arr.shape[0], LOBE_N_CUTS))
+    cap = CHAIN_CUTS_ROOM + lev.shape[1]
+    cut = np.zeros((mu_arr.shape[0], cap))
     ncut = np.zeros(mu_arr.shape[0], np.int64)
-    x = np.empty(LOBE_N_CUTS)
+    x = np.empty(cap)
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
         x_mu, x_s = math.atan2(mu, s), math.atan2(s, mu)
         x[0], x[1], x[2], x[3] = 0.0, half, x_mu, x_s
         m = 4
+        lmin = 1.0
+        for i in range(nlev[q]):
+            L = lev[q, i]
+            if 0.0 < L < 1.0:
+                x[m] = math.atan2(L, math.sqrt((1.0 - L) * (1.0 + L)))
+                m += 1
+                lmin = min(lmin, L)
         if n > 0.0:
             for k in (3.0, 8.0, 13.0):
                 x[m], x[m + 1] = x_mu - k / math.sqrt(n), x_mu + k / math.sqrt(n)
@@ -2657,12 +2667,26 @@ def _lobe_n_cuts(n, mu_arr, x0, y0, rho):  # pragma: no cover - compiled; see ch
                 x[m], x[m + 1] = x_s - d, x_s + d
                 m += 2
                 d *= 0.25
-        for j in range(LOBE_F_CUTS):
-            sc = 3.0 ** j
-            for t in (x0 + y0 * sc, x0 - y0 * sc, rho * sc if rho < LOBE_F_WIDE else -1.0):
-                if 0.0 < t < 1.0:
-                    x[m] = math.atan2(t, math.sqrt((1.0 - t) * (1.0 + t)))
-                    m += 1
+        if chain:
+            floor = max(0.25 * min(mu, lmin), GRADE_FLOOR)
+            t = 0.5
+            while t > floor:
+                x[m] = math.asin(t)
+                m += 1
+                t *= GRADE
+            for i in range(1, X_PIECES):
+                x[m] = i * (0.5 * math.pi / X_PIECES)
+                m += 1
+        if fres:
+            for side in range(3):
+                if side == 2 and not rho < LOBE_F_WIDE:
+                    break
+                for j in range(LOBE_F_CUTS):
+                    sc = 3.0 ** j
+                    t = x0 + y0 * sc if side == 0 else (x0 - y0 * sc if side == 1 else rho * sc)
+                    if 0.0 < t < 1.0:
+                        x[m] = math.atan2(t, math.sqrt((1.0 - t) * (1.0 + t)))
+                        m += 1
         x[:m].sort()
         c = 0
         for i in range(m):
@@ -2671,6 +2695,18 @@ def _lobe_n_cuts(n, mu_arr, x0, y0, rho):  # pragma: no cover - compiled; see ch
                 c += 1
         ncut[q] = c
     return cut, ncut
+
+
+def chain_cut_matrix(levels, n: float, mu: np.ndarray, fresnel=None, chain: bool = True) -> tuple:
+    """(cut, ncut): :func:`chain_cuts` (``levels(mu)`` or, with None, no levels) at every mu, by the compiled
+    :func:`_chain_cut_matrix`."""
+    mu = np.ascontiguousarray(mu, dtype=np.float64)
+    if levels is None:
+        lev, nlev = np.zeros((mu.size, 0)), np.zeros(mu.size, np.int64)
+    else:
+        lev, nlev = _cut_matrix([np.asarray(levels(float(m)), dtype=np.float64).reshape(-1) for m in mu])
+    x0, y0, rho = (*fresnel_branch(*fresnel), fresnel_pole(*fresnel)) if fresnel is not None else (0.0, 0.0, math.inf)
+    return _chain_cut_matrix(float(n), mu, lev, nlev, bool(chain), fresnel is not None, x0, y0, rho)
 
 
 _RULES = {"gk15": (_NODES, _WK, _WG), "gk21": (NODES21, WK21, WG21)}
@@ -2854,12 +2890,12 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         if hint.chain is None and hint.factor is None:
             cut, ncut = np.zeros((len(mu), 0)), np.zeros(len(mu), np.int64)
         else:  # pumped or scaled: the kinks of g or U, its tables' grading and the pi / 16 cuts, as for a pumped lobe
-            cut, ncut = _cut_matrix([chain_cuts(hint.levels(float(m)), 0.0, float(m)) for m in mu])
+            cut, ncut = chain_cut_matrix(hint.levels, 0.0, mu)
         _integrate_n(mp, mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING, *_RULES["gk21"], mode_code(),
                      hint.chain, hint.factor, cut, ncut, val, err, conv, evals)
     elif lobe_f and hint.chain is None and takes_lobe_n_frame(hint):  # a metal's lobe about N (:func:`_integrate_chain`, g = 1)
         fres = (float(hint.fresnel[1]), float(hint.fresnel[2]))
-        cut, ncut = _lobe_n_cuts(float(hint.n), mu, *fresnel_branch(*fres), fresnel_pole(*fres))
+        cut, ncut = chain_cut_matrix(None, float(hint.n), mu, fres, chain=False)
         _integrate_chain(float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
                          *_RULES[CHAIN_RULE], N_INIT_CHAIN, cut, ncut, None, *ring_table(float(hint.n)), np.array([1.0, *fres]),
                          mode_code(), val, err, conv, evals)
@@ -2882,7 +2918,7 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     else:  # a pumped lobe, about N
         fres = (float(hint.fresnel[1]), float(hint.fresnel[2])) if lobe_f else None
         fr = np.array([1.0 if lobe_f else 0.0, *(fres or (0.0, 0.0))])
-        cut, ncut = _cut_matrix([chain_cuts(hint.levels(float(m)), float(hint.n), float(m), fres) for m in mu])
+        cut, ncut = chain_cut_matrix(hint.levels, float(hint.n), mu, fres)
         _integrate_chain(float(hint.n), float(hint.p), mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING,
                          *_RULES[CHAIN_RULE], N_INIT_CHAIN, cut, ncut, hint.chain, *ring_table(float(hint.n)), fr, mode_code(), val, err,
                          conv, evals)

@@ -82,18 +82,6 @@ def test_lobe_about_n_against_frame_5(spec):
         assert conv.all() and np.all(np.abs(a - b) - eb <= ea) and np.all(ea <= rtol * a), (rtol, a - b, ea, eb)
 
 
-def test_lobe_n_cuts_against_chain_cuts():
-    """The compiled cuts of a lobe about N (:func:`pumpup._polar._lobe_n_cuts`) are chain_cuts without a chain (no levels but
-    mu, no grading for g's splines), for indices with their branch point and pole near and far, from normal incidence to
-    1e-300."""
-    mu = np.r_[np.cos(np.linspace(0, np.pi / 2, 33)[:-1]), 1e-3, 1e-9, 1e-300]
-    for n in (0.0, 2.0, 20.0, 500.0):
-        for eta, k in ((0.2, 3.0), (1.5, 0.0), (1.1, 30.0), (0.6, 0.3), (0.999, 0.001)):
-            cut, ncut = _polar._lobe_n_cuts(n, mu, *_polar.fresnel_branch(eta, k), _polar.fresnel_pole(eta, k))
-            for q, m in enumerate(mu):
-                np.testing.assert_array_equal(cut[q, :ncut[q]], _polar.chain_cuts([], n, float(m), (eta, k), chain=False))
-
-
 def test_normal_incidence_is_the_fresnel_factor():
     """At mu = 1 every N.wo <= mu, so F(Theta_min) = F(1) and the albedo of c u^n F / max is F(1) c 2 pi / (n + 2):
     metal's (c = (n + 2) / (2 pi), 000 eq. 6) is F(1) = ((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2) exactly."""

@@ -188,3 +188,32 @@ def test_chain_cuts():
         assert np.min(np.abs(few - (xs - d))) < 1e-14 and np.min(np.abs(few - (xs + d))) < 1e-14
     assert np.min(np.abs(few - (xs - 0.5))) < 1e-14 and few[-1] == 0.5 * math.pi  # (xs + 0.5 is beyond pi / 2)
     assert np.min(np.abs(x - (xs - 0.125))) > 1e-3  # n = 200: no grading
+
+
+def test_compiled_chain_cuts_are_chain_cuts():
+    """The compiled cuts the engine uses (:func:`pumpup._polar.chain_cut_matrix`) are chain_cuts, value for value: pumped
+    lobes, a pumped metal (F's cuts), a pumped GGX and a 1/E-scaled one (frame 6, n = 0), and a metal's lobe about N (no
+    chain: no levels but mu, no grading for g), from normal incidence to 1e-300; each cut of either within 2 ulps of one of
+    the other (numpy's vectorised arctan2 and the scalar one may differ in the last bit, so a level mu and x_mu can be two
+    cuts in one, one in the other)."""
+
+    def same(a, b):
+        return all(np.min(np.abs(b - v)) <= 4.5e-16 for v in a) and all(np.min(np.abs(a - v)) <= 4.5e-16 for v in b)
+
+    mu = np.r_[np.cos(np.linspace(0, np.pi / 2, 33)[:-1]), 1e-3, 1e-9, 1e-300]
+    cases = [(pumpup.pump({"type": "phong", "n": 20}, g="g2", levels=2), None, True),
+             (pumpup.pump({"type": "stretched_phong", "n": 2.0, "p": 0.5}), None, True),
+             (pumpup.pump({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}), (0.2, 3.0), True),
+             (pumpup.pump({"type": "ggx", "alpha": 0.3}, g="g2"), None, True),
+             (pumpup.compensate({"type": "schlick", "r": 0.2}, method="scale"), None, True)]
+    for f, fres, chain in cases:
+        hint = f.polar()
+        n = 0.0 if hint.kind == "half" else float(hint.n)
+        cut, ncut = _polar.chain_cut_matrix(hint.levels, n, mu, fres, chain)
+        for q, m in enumerate(mu):
+            assert same(cut[q, :ncut[q]], _polar.chain_cuts(hint.levels(float(m)), n, float(m), fres, chain)), (f, m)
+    for n in (0.0, 2.0, 20.0, 500.0):
+        for eta, k in ((0.2, 3.0), (1.5, 0.0), (1.1, 30.0), (0.6, 0.3), (0.999, 0.001)):
+            cut, ncut = _polar.chain_cut_matrix(None, n, mu, (eta, k), chain=False)
+            for q, m in enumerate(mu):
+                assert same(cut[q, :ncut[q]], _polar.chain_cuts([], n, float(m), (eta, k), chain=False)), (n, eta, k, m)
