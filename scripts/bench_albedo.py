@@ -242,18 +242,15 @@ def against_nested(specs, label, rtol=1e-10, repeat=3):
               flush=True)
 
 
-def n_frame(rtol=1e-10, repeat=3):
-    """GGX and Beckmann with F = 1 and Schlick's model, about N with the weight's azimuth in closed form (frame 6, issue 14's
-    ninth session) against frame 4, the rule on h's arc they took before (``_polar.without_n_frame``), and the nested
-    engine, same run: a 257-point table (mu uniform in theta) at ``rtol``, one thread, best of ``repeat`` (nested: 1)."""
+def _against_second_path(specs, title, first, second, width, rtol, repeat, lobe=lambda spec, f: f):
+    """A 257-point table (mu uniform in theta) at ``rtol`` by the 1-D path as it is (``first``), by its second path
+    (``_polar.without_n_frame``: frame 4 or frame 5, ``second``) and by the nested engine, one thread, best of ``repeat``
+    (nested: 1), with the evaluations per mu of the first (of ``lobe(spec, f)``, the term that takes it)."""
     from pumpup import _polar
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
-    specs = [{"type": "ggx", "alpha": a} for a in (0.001, 0.1, 0.5)] + [
-        {"type": "ggx", "alpha": 0.3, "shadowing": "correlated"}, {"type": "schlick", "r": 0.2}, {"type": "schlick", "r": 0.001}] + [
-        {"type": "beckmann", "alpha": a} for a in (0.001, 0.1, 0.5)] + [{"type": "beckmann", "alpha": 0.3, "g1": "walter"}]
-    print(f"frame 6 against frame 4 and the nested engine, one thread, ms; 257 mu at rtol {rtol:g}")
-    print(f"{'model':48s} {'frame 6':>8s} {'evals/mu':>8s} {'frame 4':>8s} {'ratio':>6s} {'nested':>8s} {'ratio':>6s}")
+    print(f"{title}, one thread, ms; 257 mu at rtol {rtol:g}")
+    print(f"{'model':{width}s} {first:>8s} {'evals/mu':>8s} {second:>8s} {'ratio':>6s} {'nested':>8s} {'ratio':>6s}")
     for spec in specs:
         f = pumpup.load(spec)
         times = []
@@ -261,38 +258,34 @@ def n_frame(rtol=1e-10, repeat=3):
             with ctx:
                 pumpup.albedo(f, [0.5, 1e-3], rtol=rtol)
                 times.append(_best(lambda: pumpup.albedo(f, mu, rtol=rtol), rep)[1])
-        ev = np.mean(_polar.albedo_1d(f, mu, rtol, 0.0, 200)[3])
-        t6, t4, tn = times
-        print(f"{str(spec):48s} {t6 * 1e3:8.1f} {ev:8.0f} {t4 * 1e3:8.1f} {t4 / t6:6.1f} {tn * 1e3:8.1f} {tn / t6:6.1f}", flush=True)
+        ev = np.mean(_polar.albedo_1d(lobe(spec, f), mu, rtol, 0.0, 200)[3])
+        t1, t2, tn = times
+        print(f"{str(spec):{width}s} {t1 * 1e3:8.1f} {ev:8.0f} {t2 * 1e3:8.1f} {t2 / t1:6.1f} {tn * 1e3:8.1f} {tn / t1:6.1f}",
+              flush=True)
+
+
+def n_frame(rtol=1e-10, repeat=3):
+    """GGX and Beckmann with F = 1 and Schlick's model, about N with the weight's azimuth in closed form (frame 6, issue 14's
+    ninth session) against frame 4, the rule on h's arc they took before, and the nested engine
+    (:func:`_against_second_path`)."""
+    specs = [{"type": "ggx", "alpha": a} for a in (0.001, 0.1, 0.5)] + [
+        {"type": "ggx", "alpha": 0.3, "shadowing": "correlated"}, {"type": "schlick", "r": 0.2}, {"type": "schlick", "r": 0.001}] + [
+        {"type": "beckmann", "alpha": a} for a in (0.001, 0.1, 0.5)] + [{"type": "beckmann", "alpha": 0.3, "g1": "walter"}]
+    _against_second_path(specs, "frame 6 against frame 4 and the nested engine", "frame 6", "frame 4", 48, rtol, repeat)
 
 
 def lobe_n_frame(rtol=1e-10, repeat=3):
     """Lobes with 000 eq. 28's F(Theta_min) (metal, plastic with an index, the fresnel wrapper; n >= 8) about N with the ring
-    table and g = 1 (issue 14's twelfth session) against frame 5, the lobe frame with a rule on the arc they took before
-    (``_polar.without_n_frame``), and the nested engine, same run: a 257-point table (mu uniform in theta) at ``rtol``, one
-    thread, best of ``repeat`` (nested: 1)."""
-    from pumpup import _polar
-
-    mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
+    table and g = 1 (issue 14's twelfth session) against frame 5, the lobe frame with a rule on the arc they took before,
+    and the nested engine (:func:`_against_second_path`)."""
     specs = [{"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, {"type": "metal", "n": 8, "eta": 1.5},
              {"type": "metal", "n": 500, "eta": 1.1, "k": 6.0}, {"type": "metal", "n": 10, "eta": 0.6, "k": 0.3},
              {"type": "metal", "n": 20, "eta": 0.5, "k": 0.002}, {"type": "plastic", "n": 20, "eta": 1.5, "ad": 0.3},
              {"type": "fresnel", "base": {"type": "phong", "n": 20}, "eta": 0.2, "k": 3.0},
              {"type": "fresnel", "base": {"type": "retro", "n": 10}, "eta": 1.1, "k": 30.0}]
-    print(f"a lobe with F(Theta_min) about N against frame 5 and the nested engine, one thread, ms; 257 mu at rtol {rtol:g}")
-    print(f"{'model':60s} {'about N':>8s} {'evals/mu':>8s} {'frame 5':>8s} {'ratio':>6s} {'nested':>8s} {'ratio':>6s}")
-    for spec in specs:
-        f = pumpup.load(spec)
-        times = []
-        for ctx, rep in ((contextlib.nullcontext(), repeat), (_polar.without_n_frame(), repeat), (_polar.without_1d(), 1)):
-            with ctx:
-                pumpup.albedo(f, [0.5, 1e-3], rtol=rtol)
-                times.append(_best(lambda: pumpup.albedo(f, mu, rtol=rtol), rep)[1])
-        lobe = pumpup.load(dict(spec, ad=0.0)) if spec["type"] == "plastic" else f  # (plastic's diffuse term split off)
-        ev = np.mean(_polar.albedo_1d(lobe, mu, rtol, 0.0, 200)[3])
-        tn, t5, tnest = times
-        print(f"{str(spec):60s} {tn * 1e3:8.1f} {ev:8.0f} {t5 * 1e3:8.1f} {t5 / tn:6.1f} {tnest * 1e3:8.1f} {tnest / tn:6.1f}",
-              flush=True)
+    _against_second_path(specs, "a lobe with F(Theta_min) about N against frame 5 and the nested engine", "about N", "frame 5",
+                         60, rtol, repeat,
+                         lobe=lambda spec, f: pumpup.load(dict(spec, ad=0.0)) if spec["type"] == "plastic" else f)
 
 
 def p_model(rtol=1e-10, repeat=3):
