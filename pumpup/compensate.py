@@ -235,13 +235,17 @@ class _Bound:
 
 
 @njit(cache=True, nogil=True)
-def _deficits(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover
-    """D(m) = max(0, 1 - U(m)) at every m (``m`` > 0), by :func:`_bound`: the kernels' own D, value for value."""
+def _uppers(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover
+    """U(m) at every m (``m`` > 0) by :func:`_bound`: the kernels' own look-up, value for value."""
     out = np.empty(m.shape[0])
     for i in range(m.shape[0]):
-        out[i] = max(0.0, 1.0 - _bound(m[i], pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin,
-                                       cap))
+        out[i] = _bound(m[i], pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap)
     return out
+
+
+def _deficits(m, *args) -> np.ndarray:
+    """D(m) = max(0, 1 - U(m)) at every m (a 1-D array), as the Kulla-Conty kernel forms it from :func:`_uppers`."""
+    return np.maximum(0.0, 1.0 - _uppers(m, *args))
 
 
 def _deficit_moment(bound: _Bound) -> tuple:
@@ -633,6 +637,14 @@ class Scaled(_Compensated):
     def _eval(self, wi, wo):
         return self._run(_scale_kernel, self.p["f0"], wi, wo)
 
+    def kernel_factor(self, mu_o) -> np.ndarray:
+        """1 + F0 (1 / U(mu_o) - 1) with U from the kernels' own look-up (:func:`_uppers`; ``factor`` is its numpy
+        reference), for the furnace toward the viewer's closed form (:meth:`_Transposed.polar`)."""
+        m = np.asarray(mu_o, dtype=np.float64)
+        u = _uppers(np.clip(m, 1e-300, 1.0).reshape(-1), *self.bound.args).reshape(m.shape)
+        f0 = self.p["f0"]
+        return 1.0 / u if f0 == 1.0 else 1.0 + f0 * (1.0 / u - 1.0)
+
     def factor(self, mu_o) -> np.ndarray:
         """1 + F0 (1 / U(mu_o) - 1) in plain numpy (Turquin eq. 6)."""
         u = self.bound.upper(mu_o)
@@ -750,6 +762,27 @@ class _Transposed(BRDF):
         if len(terms) == 1 and terms[0][1] is self.inner:
             return [(1.0, self)]
         return [(w, _Transposed(t)) for w, t in terms]
+
+    def polar(self):
+        """The 1-D path of the furnace toward the viewer of a scaled model, or of one term of a scaled sum: f(wi, wo) =
+        f_r(wi, wo) s(N.wo) with f_r reciprocal, so f(wo, wi) = s(N.wi) f_r(wi, wo) and its albedo at mu is s(mu) times
+        f_r's (000 eq. 2; s = 1 + F0 (1 / U - 1), Turquin eq. 6): f_r's own hint with its scale times s (as the kernel
+        forms it, :meth:`Scaled.kernel_factor`).  None for anything else (the nested engine), or a base forced in
+        without reciprocity.  Until issue 14's twelfth session the nested engine integrated it."""
+        import dataclasses
+
+        if isinstance(self.inner, Scaled):
+            base, scaled = self.inner.base, self.inner
+        elif isinstance(self.inner, _ScaledTerm):
+            base, scaled = self.inner.term, self.inner.scaled
+        else:
+            return None
+        polar = getattr(base, "polar", None)
+        hint = polar() if base.reciprocal and polar is not None else None
+        if hint is None:
+            return None
+        inner_scale = hint.scale
+        return dataclasses.replace(hint, scale=lambda mu: inner_scale(mu) * scaled.kernel_factor(mu))
 
 
 def furnace(f: BRDF, mu, return_error: bool = False, **kw):

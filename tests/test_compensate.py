@@ -186,6 +186,34 @@ def test_scale_with_f0():
     assert np.all((a > E) & (a < 1))
 
 
+@pytest.mark.parametrize("spec,f0", [(GGX, 1.0), ({"type": "beckmann", "alpha": 0.1}, 0.5), ({"type": "phong", "n": 20}, 1.0),
+                                     ({"type": "schlick", "r": 0.2}, 1.0),
+                                     ({"type": "mix", "a": {"type": "lambert"}, "b": GGX, "m": 0.5}, 1.0)],
+                         ids=["ggx", "beckmann-f0.5", "phong", "schlick", "mix"])
+def test_scaled_furnace_toward_the_viewer_in_closed_form(spec, f0):
+    """The furnace toward the viewer of a scaled model (and of each term of a scaled sum) is s(mu) times the base's
+    albedo (000 eq. 2 for the reciprocal base; issue 14's twelfth session, ``_Transposed.polar``): on the 1-D path, and
+    against the nested engine at rtol 1e-12 within the summed estimates, from mu = 1 to 1e-8 and between the nodes."""
+    from pumpup import _polar
+
+    s = pumpup.compensate(spec, method="scale", f0=f0)
+    mu = np.concatenate([MU, RNG_MU])
+    for _, t in comp._Transposed(s).albedo_terms():
+        assert t.polar() is not None and _polar.takes_1d_path(t)
+    a, e = pumpup.furnace(s, mu, return_error=True, rtol=1e-12)
+    with _polar.without_1d():
+        b, eb = pumpup.furnace(s, mu, return_error=True, rtol=1e-12)
+    assert np.all(np.abs(a - b) <= e + eb), (mu, a - b, e, eb)
+    assert np.all(e <= 1e-12 * a)
+
+
+def test_scaled_furnace_of_a_forced_non_reciprocal_base_stays_nested():
+    """Phong's own shader (002, not reciprocal) scaled with ``force``: f(wo, wi) is not s(N.wi) f(wi, wo), so the furnace
+    keeps the nested engine."""
+    s = pumpup.compensate({"type": "phong_shader", "n": 20}, method="scale", force=True)
+    assert not s.base.reciprocal and comp._Transposed(s).polar() is None
+
+
 def test_ward_is_refused_by_kulla_conty_and_pumped_by_g1_g2():
     with pytest.raises(pumpup.SpecError, match=r"kulla_conty: the albedo of the base 'ward' exceeds 1.*negative.*g1"):
         pumpup.compensate({"type": "ward", "m": 0.1}, method="kulla_conty")
