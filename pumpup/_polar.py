@@ -1484,8 +1484,8 @@ def _sorted_cuts(cv, cc, m):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True)
 def _foreign_roots(cv, cc, nc, rv, rc, nr, tail):  # pragma: no cover - compiled
     """Cuts (code 3) grading a piece between the cuts ``cv[:nc]`` towards its end where the square root of a break
-    (``rv[:nr]``, codes ``rc``: every break, in the range or beyond it) lies beyond that end, closer than an eighth of the
-    piece's length: at that end -+ d 4^i (d the distance) over the piece's half next to it.  A break's root lies on one
+    (``rv[:nr]``, codes ``rc``: every break, in the range or beyond it) lies beyond that end, closer than FOREIGN_NEAR of
+    the piece's length: at that end -+ d 4^i (d the distance) over the piece's half next to it.  A break's root lies on one
     side of it (in u, ``tail``: code 0 below, 1 above, 2 both; in z = -(n + 1) ln u the other way round) and reaches across
     any cut next to it: near mu = sqrt(3) / 2 the level's (u = cos 2 theta_i) and the horizon's (u = s) nearly coincide,
     and the level's root lay 4.5e-6 beyond the end of the peak's piece [0, z_s], where no rule saw it (stretched Phong n =
@@ -2491,7 +2491,7 @@ def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, 
     lobe's axis; (A + B)^n = exp(n log1p(-2 sin^2((x - x_mu) / 2))), accurate for any n), V from
     the ring table (:func:`ring_table`, its errors summed with the Kronrod weights); with ``fr`` = (1, eta, k) times
     000 eq. 28's F(max(mu, t)) (a pumped metal, or the fresnel wrapper of a pumped lobe).  Without a chain (None: g = 1,
-    a metal's lobe, :func:`lobe_n_cuts`) the error is QUADPACK's calibration of |K - G| (``mode``) instead of
+    a metal's lobe, :func:`chain_cut_matrix`) the error is QUADPACK's calibration of |K - G| (``mode``) instead of
     CHAIN_SAFETY |K - G| (which is for g's splines)."""
     h = hi - lo
     ie = 0.0
@@ -2503,14 +2503,13 @@ def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, 
         # g_1 ... g_k as the chain kernel divides by it (pumpup.pumping._chain_kernel): the product
         # table where it applies, else level by level (written out: an inlined function that calls
         # the inlined look-ups ran 20 x slower, measured)
-        g = 1.0
-        if chain is None:
-            pass
-        elif min(mu, t) > chain[13]:
-            g = _g_product(max(mu, t), chain[14], chain[15], chain[16], chain[17])
-        else:
-            g = _g_levels(max(mu, t), min(mu, t), chain[0], chain[1], chain[2], chain[3], chain[4], chain[5], chain[6],
-                          chain[7], chain[8], chain[9], chain[10], chain[11], chain[12])
+        g = 1.0  # (no chain: a metal's lobe)
+        if chain is not None:
+            if min(mu, t) > chain[13]:
+                g = _g_product(max(mu, t), chain[14], chain[15], chain[16], chain[17])
+            else:
+                g = _g_levels(max(mu, t), min(mu, t), chain[0], chain[1], chain[2], chain[3], chain[4], chain[5], chain[6],
+                              chain[7], chain[8], chain[9], chain[10], chain[11], chain[12])
         if p == 0.0:
             f = t * ct / g
         elif p == 1.0:
@@ -2589,7 +2588,9 @@ def chain_cuts(levels, n: float, mu: float, fresnel=None, chain: bool = True) ->
     exp(-n alpha^2 / 2)), N.wo = 2^-(1 + 2k) (:data:`GRADE`), every pi / 16 (:data:`X_PIECES`), and for
     n < :data:`RING_SMOOTH_N` a grading towards x_s; with ``fresnel`` = (eta, k), N.wo = x0 -+ y0 3^j about F's branch
     point and rho 3^j towards its pole near 0 (as frame 5's arcs, :func:`_k_lobe_fresnel`; the pole's only where rho <
-    :data:`LOBE_F_WIDE`); x = atan2(L, sqrt(1 - L^2)) keeps levels near 1 to full precision."""
+    :data:`LOBE_F_WIDE`); x = atan2(L, sqrt(1 - L^2)) keeps levels near 1 to full precision.  ``chain`` False (a metal's
+    lobe about N, g = 1): without g's grading in N.wo and the pi / 16 cuts.  The engine computes them compiled, for every
+    mu at once (:func:`chain_cut_matrix`); this is their reference."""
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     L = np.asarray(levels, dtype=np.float64).reshape(-1)
     L = L[(L > 0.0) & (L < 1.0)]

@@ -216,22 +216,55 @@ class _Bound:
                           points=np.exp(self.lookup.logx[1:-1]))
             return v + 10 * err + 1e-15, []
         xg, wg = np.polynomial.legendre.leggauss(8)
-        lo, hi = p.lo[:-1], np.concatenate([p.lo[1:-1], [1.0]])
+        parts, kinks = self._parts()
         total = 0.0
-        kinks = []
-        for s in range(len(lo)):
+        for s, t0, t1 in parts:
+            t = 0.5 * (t0 + t1) + 0.5 * (t1 - t0) * xg
+            m = p.center[s] + t / p.ihalf[s]
+            d = np.maximum(0.0, 1.0 - np.polyval(p.coef[:, s], t))
+            total += 2.0 * float(np.sum(wg * d * m)) * 0.5 * (t1 - t0) / p.ihalf[s]  # 2 D mu dmu
+        return total * (1.0 + 1e-12) + p.mlo ** 2 + 1e-300, sorted(k for k in kinks if 0 < k < 1)
+
+    def _parts(self) -> tuple:
+        """([(piece, t0, t1)], kinks): the smooth parts of the product table's polynomial pieces in t = (m - centre) /
+        half (each piece from t = -1 to its end, the last one to m = 1), cut where U = 1 (D's kinks, also returned in m),
+        for Gauss-Legendre (:meth:`_integral`, :meth:`deficit_moment`)."""
+        p = self.product
+        hi = np.concatenate([p.lo[1:-1], [1.0]])
+        parts, kinks = [], []
+        for s in range(len(p.lo) - 1):
             coef = p.coef[:, s]  # highest power first, in t = (m - centre) / half
             a, b = -1.0, (min(hi[s], 1.0) - p.center[s]) * p.ihalf[s]
             r = np.roots(np.concatenate([coef[:-1], [coef[-1] - 1.0]])) if len(coef) > 1 else np.array([])
             r = np.sort(r[np.abs(r.imag) <= 1e-8 * (1.0 + np.abs(r.real))].real)
             cuts = np.concatenate([[a], r[(r > a) & (r < b)], [b]])
-            for t0, t1 in zip(cuts[:-1], cuts[1:]):
-                t = 0.5 * (t0 + t1) + 0.5 * (t1 - t0) * xg
-                m = p.center[s] + t / p.ihalf[s]
-                d = np.maximum(0.0, 1.0 - np.polyval(coef, t))
-                total += 2.0 * float(np.sum(wg * d * m)) * 0.5 * (t1 - t0) / p.ihalf[s]  # 2 D mu dmu
+            parts += [(s, t0, t1) for t0, t1 in zip(cuts[:-1], cuts[1:])]
             kinks += [float(p.center[s] + x / p.ihalf[s]) for x in cuts[1:-1]]
-        return total * (1.0 + 1e-12) + p.mlo ** 2 + 1e-300, sorted(k for k in kinks if 0 < k < 1)
+        return parts, kinks
+
+    def deficit_moment(self) -> tuple | None:
+        """(I, its error): I = 2 integral_0^1 D(m) m dm of the kernels' own D (:func:`_deficits`), the Kulla-Conty lobe's
+        albedo per unit D(mu_i), over pi (the lobe D(mu_i) D(mu_o) reflects D(mu_i) 2 pi integral D(t) t dt).  Above the
+        product table's mlo D is a polynomial of degree 5 in m on each part (:meth:`_parts`): Gauss-Legendre of 8 nodes is
+        exact there, on D evaluated as the kernels evaluate it, so the error is the rounding of the values (32 eps U per
+        node, summed with the weights); below mlo, 0 <= D <= 1 adds between 0 and mlo^2 (half of it is counted, the other
+        half is error).  (:meth:`_integral`'s I_hi is an upper bound of the same I.)  Cached; None without a product
+        table."""
+        got = getattr(self, "_moment", None)
+        if got is not None or self.product is None:
+            return got
+        p = self.product
+        xg, wg = np.polynomial.legendre.leggauss(8)
+        parts, _ = self._parts()
+        s, t0, t1 = (np.array(c) for c in zip(*parts))
+        t = 0.5 * (t0 + t1)[:, None] + 0.5 * (t1 - t0)[:, None] * xg[None, :]
+        m = (p.center[s][:, None] + t / p.ihalf[s][:, None]).ravel()
+        w = (wg[None, :] * (0.5 * (t1 - t0) / p.ihalf[s])[:, None]).ravel()
+        d = _deficits(m, *self.args)
+        value = float(np.sum(2.0 * w * d * m)) + 0.5 * p.mlo ** 2
+        err = 32.0 * np.finfo(float).eps * float(np.sum(2.0 * w * m * np.maximum(1.0, 1.0 - d))) + 0.5 * p.mlo ** 2
+        self._moment = (value, err)
+        return self._moment
 
 
 @njit(cache=True, nogil=True)
@@ -246,42 +279,6 @@ def _uppers(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_
 def _deficits(m, *args) -> np.ndarray:
     """D(m) = max(0, 1 - U(m)) at every m (a 1-D array), as the Kulla-Conty kernel forms it from :func:`_uppers`."""
     return np.maximum(0.0, 1.0 - _uppers(m, *args))
-
-
-def _deficit_moment(bound: _Bound) -> tuple:
-    """(I, its error): I = 2 integral_0^1 D(m) m dm of the kernels' D (:func:`_deficits`), the Kulla-Conty lobe's albedo
-    per unit D(mu_i), over pi (the lobe D(mu_i) D(mu_o) reflects D(mu_i) 2 pi integral D(t) t dt).  Above the product
-    table's mlo D is a polynomial of degree 5 in m on each piece (the kernels' rows, cut where it crosses 1): Gauss-Legendre
-    of 8 nodes is exact there, on D evaluated as the kernels evaluate it, so the error is the rounding of the values
-    (32 eps U per node, summed with the weights); below mlo, 0 <= D <= 1 adds between 0 and mlo^2 (half of it is counted,
-    the other half is error).  Cached on the bound."""
-    got = getattr(bound, "_moment", None)
-    if got is not None:
-        return got
-    p = bound.product
-    if p is None:  # pragma: no cover - no table has needed it (see _Bound._integral)
-        return None
-    xg, wg = np.polynomial.legendre.leggauss(8)
-    rows = p.rows
-    lo, hi = p.lo[:-1], np.concatenate([p.lo[1:-1], [1.0]])
-    nodes, weights = [], []
-    for s in range(len(lo)):
-        a, b = ((lo[s] - rows[s, 6]) * rows[s, 7], (min(hi[s], 1.0) - rows[s, 6]) * rows[s, 7])  # t = (m - centre) / half
-        r = np.roots(np.concatenate([rows[s, :5], [rows[s, 5] - 1.0]]))  # where U = 1: D's kinks
-        r = np.sort(r[np.abs(r.imag) <= 1e-8 * (1.0 + np.abs(r.real))].real)
-        cuts = np.concatenate([[a], r[(r > a) & (r < b)], [b]])
-        for t0, t1 in zip(cuts[:-1], cuts[1:]):
-            t = 0.5 * (t0 + t1) + 0.5 * (t1 - t0) * xg
-            nodes.append(rows[s, 6] + t / rows[s, 7])
-            weights.append(wg * 0.5 * (t1 - t0) / rows[s, 7])
-    m = np.concatenate(nodes)
-    w = np.concatenate(weights)
-    d = _deficits(m, *bound.args)
-    terms = 2.0 * w * d * m
-    value = float(np.sum(terms)) + 0.5 * p.mlo ** 2
-    err = 32.0 * np.finfo(float).eps * float(np.sum(2.0 * w * m * np.maximum(1.0, 1.0 - d))) + 0.5 * p.mlo ** 2
-    bound._moment = (value, err)
-    return bound._moment
 
 
 def _bounds(white: BRDF) -> _Bound:
@@ -568,12 +565,12 @@ class _MsLobe(BRDF):
 
     def polar(self):
         """The lobe's albedo in closed form (``Polar(kind="constant")``): D(mu) 2 pi integral_0^1 D(t) t dt = D(mu) pi I,
-        D the kernels' own (:func:`_deficits`), I by :func:`_deficit_moment` (exact on the product table's polynomial
-        pieces); the relative error I's, plus 8 ulps for D(mu) pi I itself.  Until issue 14's twelfth session the nested
+        D the kernels' own (:func:`_deficits`), I by :meth:`_Bound.deficit_moment` (exact on the product table's
+        polynomial pieces); the relative error I's, plus 8 ulps for D(mu) pi I itself.  Until issue 14's twelfth session the nested
         engine integrated it (80 ms for 257 mu, GGX alpha = 0.3)."""
         from ._polar import Polar
 
-        got = _deficit_moment(self.kc.bound)
+        got = self.kc.bound.deficit_moment()
         if got is None:  # pragma: no cover
             return None
         i, e = got

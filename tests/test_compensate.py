@@ -40,7 +40,7 @@ def test_kulla_conty_furnace_is_one_within_the_stated_error(spec):
     assert np.all(1.0 - a <= stated(c) + e), (np.max(1 - a), stated(c))
     # and the closed form: a = E + D (I / I_hi), E from the engine
     E, eE = pumpup.albedo(c.base, mu, return_error=True)
-    i, ie = comp._deficit_moment(c.bound)  # (I / I_hi = 1 - 1e-12: the upper bound's slack)
+    i, ie = c.bound.deficit_moment()  # (I / I_hi = 1 - 1e-12: the upper bound's slack)
     np.testing.assert_allclose(a, E + c.bound.deficit(mu) * (i / c.bound.deficit_integral),
                                atol=float(np.max(e + eE)) + ie / c.bound.deficit_integral + 1e-14, rtol=0)
 
@@ -103,7 +103,7 @@ def test_kulla_conty_lobe_in_closed_form(spec):
     c = pumpup.compensate(spec, method="kulla_conty")
     ms = c.albedo_terms()[-1][1]
     assert ms.polar().kind == "constant" and _polar.takes_1d_path(ms)
-    i, e = comp._deficit_moment(c.bound)
+    i, e = c.bound.deficit_moment()
     p = c.bound.product
     edges = np.unique(np.r_[0.0, p.mlo, p.lo[(p.lo > p.mlo) & (p.lo < 1.0)], c.bound.kinks, 1.0])
     v, ve = 0.0, 0.0
@@ -198,6 +198,7 @@ def test_scaled_furnace_toward_the_viewer_in_closed_form(spec, f0):
 
     s = pumpup.compensate(spec, method="scale", f0=f0)
     mu = np.concatenate([MU, RNG_MU])
+    np.testing.assert_allclose(s.kernel_factor(mu), s.factor(mu), rtol=1e-14, atol=0)  # compiled look-up and its reference
     for _, t in comp._Transposed(s).albedo_terms():
         assert t.polar() is not None and _polar.takes_1d_path(t)
     a, e = pumpup.furnace(s, mu, return_error=True, rtol=1e-12)

@@ -212,6 +212,8 @@ def test_compiled_chain_cuts_are_chain_cuts():
         cut, ncut = _polar.chain_cut_matrix(hint.levels, n, mu, fres, chain)
         for q, m in enumerate(mu):
             assert same(cut[q, :ncut[q]], _polar.chain_cuts(hint.levels(float(m)), n, float(m), fres, chain)), (f, m)
+    # (the compiled kernel's room per mu: 4 fixed, 6 about the peak, 2 x 15 towards x_s, 20 graded, the pi / 16 ones, F's)
+    assert _polar.CHAIN_CUTS_ROOM >= 4 + 6 + 30 + 20 + _polar.X_PIECES - 1 + 3 * _polar.LOBE_F_CUTS
     for n in (0.0, 2.0, 20.0, 500.0):
         for eta, k in ((0.2, 3.0), (1.5, 0.0), (1.1, 30.0), (0.6, 0.3), (0.999, 0.001)):
             cut, ncut = _polar.chain_cut_matrix(None, n, mu, (eta, k), chain=False)
