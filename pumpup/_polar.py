@@ -1927,10 +1927,147 @@ def _ggx_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ring_referenc
     return 2.0 * a2 * (1.0 + 2.0 * k * sy / r + k * k * sy * (sy * sy * a + b) / (2.0 * r * r * r))
 
 
-def ring_reference(distribution: int, a2: float, mu: float, x: float) -> float:
+#: frame 6 with a Fresnel factor (GGX, :func:`_ggx_ring_f`): the ring's product rule doubles its F samples from
+#: RING_F_N0 + 1 to at most RING_F_NMAX + 1 on [0, pi]
+RING_F_N0 = 16
+RING_F_NMAX = 128
+#: ... and takes |W_N - W_N/2| times the larger ratio of the last three such steps as W_N's error where both ratios are at most
+#: this (geometric decay of F's coefficients; with the last ratio alone, from N = 16 on, it was 1100 x below the true error
+#: of a strong absorber, eta 1.1, k 6, at itol 1e-6: measured by scripts/ring_fresnel_calibration.py)
+RING_F_RATIO = 0.5
+#: :func:`_ring_f_sums` sums term by term where |1 - z| is below this
+RING_F_DIRECT = 0.25
+#: sin^2(psi / 2) at psi = j pi / RING_F_NMAX (the finest level's samples; a coarser level takes every stride-th)
+_RING_F_SIN2 = np.sin(0.5 * np.pi * np.arange(RING_F_NMAX + 1) / RING_F_NMAX) ** 2
+#: cos(psi), sin(psi) there
+_RING_F_COS = np.cos(np.pi * np.arange(RING_F_NMAX + 1) / RING_F_NMAX)
+_RING_F_SIN = np.sin(np.pi * np.arange(RING_F_NMAX + 1) / RING_F_NMAX)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _ring_f_sums(rho, rn, n, nn, j):  # pragma: no cover - compiled; see ring_f_sums_reference
+    """(C0, C1) = the sums over k = 0 .. nn, the first and last halved, of rho^k cos(k theta) and k rho^k cos(k theta) at
+    theta = n pi / nn = j pi / RING_F_NMAX (``rn`` = rho^nn): geometric sums in z = rho e^(i theta), z^nn = (-1)^n rho^nn
+    real, 1 - z = (1 - rho) + 2 rho sin^2(theta / 2) - i rho sin(theta) without cancellation; at n = 0 and wherever |1 - z|
+    < RING_F_DIRECT, where the closed forms cancel as rho -> 1 (sum k z^k lost 2e-11 at nn = 128, n = 1), term by term."""
+    if n == 0:
+        c0 = c1 = 0.0
+        rk = 1.0
+        for k in range(nn + 1):
+            h = 0.5 if k == 0 or k == nn else 1.0
+            c0 += h * rk
+            c1 += h * k * rk
+            rk *= rho
+        return c0, c1
+    zn = -rn if n % 2 else rn  # z^nn
+    z = complex(rho * _RING_F_COS[j], rho * _RING_F_SIN[j])
+    omz = complex((1.0 - rho) + 2.0 * rho * _RING_F_SIN2[j], -rho * _RING_F_SIN[j])
+    if abs(omz) < RING_F_DIRECT:  # (sum k z^k's closed form loses ~nn^2 eps / |1 - z| there: term by term)
+        c0 = c1 = 0.0
+        zk = complex(1.0, 0.0)
+        for k in range(nn + 1):
+            h = 0.5 if k == 0 or k == nn else 1.0
+            c0 += h * zk.real
+            c1 += h * k * zk.real
+            zk *= z
+        return c0, c1
+    inv = 1.0 / omz
+    g0 = (1.0 - zn * z) * inv  # sum of z^k, k = 0 .. nn
+    g1 = z * (1.0 - (nn + 1.0) * zn + nn * zn * z) * (inv * inv)  # sum of k z^k
+    return g0.real - 0.5 - 0.5 * zn, g1.real - 0.5 * nn * zn
+
+
+def ring_f_sums_reference(rho: float, n: int, nn: int) -> tuple:
+    """:func:`_ring_f_sums` term by term in 40-digit mpmath (for the tests)."""
+    import mpmath
+
+    with mpmath.workdps(40):
+        th = mpmath.pi * n / nn
+        r = mpmath.mpf(rho)
+        terms = [(mpmath.mpf(0.5) if k in (0, nn) else 1) * r ** k * mpmath.cos(k * th) for k in range(nn + 1)]
+        return float(mpmath.fsum(terms)), float(mpmath.fsum(k * t for k, t in enumerate(terms)))
+
+
+@njit(cache=True, nogil=True)
+def _ggx_ring_f(mp, a2, xmu, xs, d, itol, tol_abs, fv):  # pragma: no cover - compiled; see ring_reference
+    """(W, its error): the integral over phi of the GGX weight D times the Fresnel factor F(wi.h) on the circle of wo at
+    x = x_mu + d (:func:`_ggx_ring` with F; ``fv`` a work array of RING_F_NMAX + 1 values).
+
+    On the circle, measured from the mirror side (psi = phi - pi), D = (a2 / pi)(1 + k / Y)^2 with Y = a' - Q cos(psi)
+    (:func:`_ggx_ring`), whose Fourier cosine coefficients are closed forms: with rho = (sqrt(B) - S sqrt(A)) / (sqrt(B) +
+    S sqrt(A)) (= (a' - R) / Q, no cancellation), the integral of D cos(k psi) is M_k = 2 a2 (delta_k0 + rho^k (2 k1 + t2 +
+    k k1^2)), k1 = k / R = (1 - a2) S / sqrt(A B), t2 = k^2 a' / R^3 (M_0 is :func:`_ggx_ring`).  F depends on psi through
+    c = wi.h = sqrt(S^2 + s cos(x) sin^2(psi / 2)) only, smooth and periodic: its cosine interpolant at psi = n pi / N
+    (Chebyshev-Lobatto in cos psi) integrates against D exactly from the M_k, sum'' a_k M_k = (4 a2 / N) sum''_n F_n (1/2 +
+    (2 k1 + t2) C0_n + k1^2 C1_n) (:func:`_ring_f_sums`).  N doubles from RING_F_N0 until W_N's error is at most
+    max(itol W_N, ``tol_abs``) or N = RING_F_NMAX: |W_N - W_N/2|, times the ratio of the last two such steps where that is
+    at most RING_F_RATIO (the coefficients decay geometrically, or faster, so W_N's error is below |W_N - W_N/2| times that
+    ratio).  F's singularities limit the decay: c = 0, at psi = +- 2 i asinh(S / sqrt(s cos x)) (so S must not be
+    small: :data:`N_FRESNEL_S_MIN`), and the index's (:func:`n_fresnel_ok`)."""
+    tau = math.tan(0.5 * d)
+    sy, cy = math.sin(xmu + 0.5 * d), math.sin(xs - 0.5 * d)
+    a = a2 + tau * tau
+    b = a2 * sy * sy + cy * cy
+    r = math.sqrt(a * b)
+    k = 1.0 - a2
+    k1 = k * sy / r
+    al = 2.0 * k1 + k * k * sy * (sy * sy * a + b) / (2.0 * r * r * r)
+    be = k1 * k1
+    sa, sb = sy * math.sqrt(a), math.sqrt(b)
+    rho = (sb - sa) / (sb + sa)
+    q = math.sin(xs) * math.sin(xs - d)  # s cos(x)
+    s2 = sy * sy
+    stride = RING_F_NMAX // RING_F_N0
+    for j in range(0, RING_F_NMAX + 1, stride):
+        c = math.sqrt(s2 + q * _RING_F_SIN2[j])
+        fv[j] = _fresnel_real(c, mp[6], mp[7]) if mp[6] > 0.0 else _fresnel(c, mp[5])
+    prev = _ring_f_level(fv, rho, al, be, RING_F_N0 // 2, 2 * stride)
+    step = step2 = -1.0
+    nn = RING_F_N0
+    while True:
+        w = _ring_f_level(fv, rho, al, be, nn, stride)
+        e = abs(w - prev)
+        # where the last three steps shrink, each by RING_F_RATIO at least (from N = 32 on), |W_N - W_N/2| times the larger
+        # of their two ratios; else |W_N - W_N/2|
+        ratio = max(e / step, step / step2) if step2 > 0.0 else 1.0
+        est = e * ratio if ratio <= RING_F_RATIO else e
+        if est <= max(itol * w, tol_abs / (4.0 * a2)):
+            return 4.0 * a2 * w, 4.0 * a2 * (est + RING_F_ROUNDING * nn * w)
+        if nn >= RING_F_NMAX:
+            return 4.0 * a2 * w, 4.0 * a2 * (est + RING_F_ROUNDING * nn * w)
+        step, step2 = abs(w - prev), step
+        prev = w
+        stride //= 2
+        for j in range(stride, RING_F_NMAX + 1, 2 * stride):  # the next level's new samples
+            c = math.sqrt(s2 + q * _RING_F_SIN2[j])
+            fv[j] = _fresnel_real(c, mp[6], mp[7]) if mp[6] > 0.0 else _fresnel(c, mp[5])
+        nn *= 2
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _ring_f_level(fv, rho, al, be, nn, stride):  # pragma: no cover - compiled
+    """The product rule of :func:`_ggx_ring_f` with nn + 1 samples (every ``stride``-th of ``fv``), over 4 a2."""
+    tot = 0.0
+    rn = rho ** nn
+    for n in range(nn + 1):
+        c0, c1 = _ring_f_sums(rho, rn, n, nn, n * stride)
+        tot += (0.5 if n == 0 or n == nn else 1.0) * fv[n * stride] * (0.5 + al * c0 + be * c1)
+    return tot / nn
+
+
+#: the rounding of :func:`_ggx_ring_f`'s sums per unit of W and per sample (measured in the tests against a summation
+#: term by term in 40-digit mpmath)
+RING_F_ROUNDING = 16.0 * np.finfo(float).eps
+
+
+def ring_reference(distribution: int, a2: float, mu: float, x: float, fresnel=None) -> float:
     """:func:`_ggx_ring` (``distribution`` 1) or :func:`_beckmann_ring` (0) at elevation ``x`` by scipy's adaptive
-    quadrature of Walter's D over phi (their numpy/scipy twin, for the tests)."""
+    quadrature of Walter's D over phi (their numpy/scipy twin, for the tests); with ``fresnel`` = (ior, eta, k), D times
+    the Fresnel factor F(wi.h) (:func:`_ggx_ring_f`; pumpup.models.cook_torrance.fresnel, pumpup.models.metal.fresnel)."""
     from scipy.integrate import quad
+
+    from .models.cook_torrance import fresnel as dielectric
+    from .models.metal import fresnel as conductor
 
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     wi = np.array([s, 0.0, mu])
@@ -1940,9 +2077,14 @@ def ring_reference(distribution: int, a2: float, mu: float, x: float) -> float:
         h = wi + wo
         c2, s2 = h[2] * h[2] / (h @ h), (h[0] * h[0] + h[1] * h[1]) / (h @ h)  # cos^2, sin^2 of h's angle from N
         if distribution == 1:
-            return a2 / (math.pi * (a2 * c2 + s2) ** 2)  # Walter eq. 33: a2 / (pi (a2 cos^2 + sin^2)^2)
-        t2 = s2 / c2
-        return math.exp(-t2 / a2) * (1.0 + t2) ** 2 / (math.pi * a2)  # Walter eq. 25
+            d = a2 / (math.pi * (a2 * c2 + s2) ** 2)  # Walter eq. 33: a2 / (pi (a2 cos^2 + sin^2)^2)
+        else:
+            t2 = s2 / c2
+            d = math.exp(-t2 / a2) * (1.0 + t2) ** 2 / (math.pi * a2)  # Walter eq. 25
+        if fresnel is None:
+            return d
+        c = float(wi @ h) / math.sqrt(h @ h)
+        return d * float(conductor(c, fresnel[1], fresnel[2]) if fresnel[1] > 0.0 else dielectric(c, fresnel[0]))
 
     return 2.0 * quad(d, 0.0, math.pi, epsabs=0.0, epsrel=1e-13, limit=1000, points=_peak_points(math.sqrt(a2)))[0]
 
@@ -2083,9 +2225,15 @@ def _n_value(mp, mu, xmu, xs, d):  # pragma: no cover - compiled; see n_integran
     w = _beckmann_ring(a2, xmu, xs, d) if mp[0] == SMITH and mp[1] == 0.0 else _ggx_ring(a2, xmu, xs, d)
     if w == 0.0:  # (far in the Beckmann weight's tail)
         return 0.0
+    return w * _n_factor(mp, mu, xmu, xs, d, a2)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _n_factor(mp, mu, xmu, xs, d, a2):  # pragma: no cover - compiled; see n_integrand_reference
+    """:func:`_n_value` over W: pi a2 cos(x) sin(x) Gamma(sin x)."""
     t = math.sin(xmu + d)
     ct = math.sin(xs - d)  # cos(x)
-    v = math.pi * a2 * ct * t * w
+    v = math.pi * a2 * ct * t
     if mp[0] == SCHLICK:
         return v / (mp[4] + (1.0 - mp[4]) * t)  # 000 eq. 36's 1 / (r + (1 - r) N.V)
     pt = _projected(ct, 0.0, t, int(mp[1]), int(mp[2]), mp[4])  # P(t) = N.wo / G1(wo), Walter eq. 27, 34
@@ -2103,17 +2251,30 @@ def _n_incidence(mp, mu):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor):  # pragma: no cover - compiled
+def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv):  # pragma: no cover - compiled
     """(value, error) of the rule on d = x - x_mu in [lo, hi] of :func:`_n_value`; with a pumped chain (``chain`` not
     None, :meth:`pumpup.pumping.Pumped._chain_args`) divided by g_1 ... g_k(mu, N.wo) exactly as the chain kernel divides
     by it (001 eq. 16; written out as in :func:`_x_rule`), or with a 1/E-scaled model's ``factor`` (not None: F0 and
     :attr:`pumpup.compensate._Bound.args`) times 1 + F0 (1 / U(N.wo) - 1) as its kernel multiplies (Turquin eq. 6,
     :func:`pumpup.compensate._scale_kernel`); its error then the larger of QUADPACK's calibration (for the weight's peak,
-    as without g) and CHAIN_SAFETY |K - G| (for the splines of g or U, which are not analytic: :data:`CHAIN_SAFETY`)."""
+    as without g) and CHAIN_SAFETY |K - G| (for the splines of g or U, which are not analytic: :data:`CHAIN_SAFETY`).
+    With a Fresnel factor (mp[13] = 1, GGX) the ring is :func:`_ggx_ring_f` at relative tolerance ``itol`` or absolute
+    ``iacc`` / the node's factor (``fv`` its work array), and its errors are taken as frame 4 takes K's (:func:`_gk`):
+    summed with the Kronrod weights, and into |K - G| before its calibration as far as they can hide it."""
     h = hi - lo
+    ie = 0.0
+    noise = 0.0
     for j in range(nodes.shape[0]):
         d = lo + h * nodes[j]
-        v = _n_value(mp, mu, xmu, xs, d)
+        if mp[13] > 0.0:
+            a2 = mp[4] * mp[4]
+            fac = _n_factor(mp, mu, xmu, xs, d, a2)
+            w, we = _ggx_ring_f(mp, a2, xmu, xs, d, itol, iacc / fac if fac > 0.0 else math.inf, fv)
+            v = w * fac
+            ie += wk[j] * we * fac
+            noise += (wk[j] + wg[j]) * we * fac
+        else:
+            v = _n_value(mp, mu, xmu, xs, d)
         if chain is not None and v != 0.0:
             t = math.sin(xmu + d)
             if min(mu, t) > chain[13]:
@@ -2131,8 +2292,8 @@ def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor):  
                 v *= 1.0 + factor[0] * (1.0 / u - 1.0)  # Turquin eq. 6
         buf[j] = v
     k, diff, asc, ab = rule_sums(buf, wk, wg)
-    e = calibrated(diff * h, asc * h, ab * h, mode)
-    return k * h, (max(e, CHAIN_SAFETY * diff * h) if chain is not None or factor is not None else e)
+    e = calibrated((diff + noise) * h, asc * h, ab * h, mode) + ie * h
+    return k * h, (max(e, CHAIN_SAFETY * diff * h + ie * h) if chain is not None or factor is not None else e)
 
 
 @njit(cache=True, nogil=True)
@@ -2145,15 +2306,27 @@ def _n_values(mp, mu, x, chain, factor):  # pragma: no cover - compiled
     one = np.ones(1)
     for i in range(x.shape[0]):
         d = x[i] - xmu
-        out[i] = _n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, chain, factor)[0]
+        out[i] = _n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, chain, factor, INNER_RTOL_MIN, 0.0,
+                         np.empty(RING_F_NMAX + 1))[0]
     return out
+
+
+def n_params(hint) -> np.ndarray:
+    """Frame 6's parameter array: :func:`numeric_params`, and for GGX with a Fresnel factor mp[13] = 1
+    (:func:`_ggx_ring_f`) and mp[14] the scale of F's pole near c = 0 (:func:`fresnel_pole`, a conductor's; 0 for a
+    dielectric) for :func:`_n_cuts`."""
+    mp = numeric_params(hint)
+    if any(hint.fresnel):
+        mp[13] = 1.0
+        mp[14] = fresnel_pole(float(hint.fresnel[1]), float(hint.fresnel[2])) if hint.fresnel[1] > 0.0 else 0.0
+    return mp
 
 
 def n_integrand(brdf, mu: float, x) -> np.ndarray:
     """Frame 6's integrand (:func:`_n_value`, divided by g for a pumped model, times the factor of a 1/E-scaled one) for
     ``brdf``'s hint at N.wi = ``mu`` and elevations ``x`` of wo, as the engine computes it (for the tests)."""
     hint = brdf.polar()
-    return _n_values(numeric_params(hint), float(mu), np.atleast_1d(np.asarray(x, dtype=float)), hint.chain, hint.factor)
+    return _n_values(n_params(hint), float(mu), np.atleast_1d(np.asarray(x, dtype=float)), hint.chain, hint.factor)
 
 
 def n_integrand_reference(brdf, mu: float, x) -> np.ndarray:
@@ -2223,13 +2396,27 @@ def _n_cuts(mp, xmu, cut):  # pragma: no cover - compiled; see n_cuts_reference
             cut[m] = d - xmu
             m += 1
             d *= 3.0
+    if mp[13] > 0.0:  # GGX with F (:func:`_ggx_ring_f`): the rings' smallest wi.h, S = sin((x + x_mu) / 2), at F's scales
+        for which in range(2):  # (the parallel reflectance's pole, the refracted cosine's branch point: mp[14], mp[10])
+            z = mp[14] if which == 0 else mp[10]
+            if not 0.0 < z < 1.0:
+                continue
+            while z > N_FRESNEL_S_MIN:
+                z /= 3.0
+            z *= 3.0
+            while z < 1.0 and m < cut.shape[0]:
+                d = 2.0 * math.asin(z) - 2.0 * xmu
+                if -xmu < d < half - xmu:
+                    cut[m] = d
+                    m += 1
+                z *= 3.0
     cut[:m].sort()
     return m
 
 
 def n_cuts_reference(brdf, mu: float) -> np.ndarray:
     """:func:`_n_cuts` for ``brdf``'s hint at N.wi = ``mu``, as elevations x (for the tests)."""
-    mp = numeric_params(brdf.polar())
+    mp = n_params(brdf.polar())
     cut = np.empty(N_CUTS)
     xmu = _n_incidence(mp, mu)[0]
     m = _n_cuts(mp, xmu, cut)
@@ -2242,8 +2429,9 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
     """Frame 6: adaptive 10/21 quadrature over the elevation x = x_mu + d of wo (:func:`_n_rule`) for every mu, from the
     pieces between :func:`_n_cuts` and, for a pumped or a 1/E-scaled model (``chain`` or ``factor`` not None), the
     elevations ``ecut[q, :necut[q]]`` (:func:`chain_cuts` of the kinks of g or U)."""
-    cap, pk, t0, t1, kv, ke, buf, _, _, _ = _buffers(max_intervals + N_CUTS + ecut.shape[1], nodes, nodes, rtol)
+    cap, pk, t0, t1, kv, ke, buf, _, _, itol = _buffers(max_intervals + N_CUTS + ecut.shape[1], nodes, nodes, rtol)
     cut = np.empty(N_CUTS + ecut.shape[1])
+    fv = np.empty(RING_F_NMAX + 1)
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         xmu, xs = _n_incidence(mp, mu)
@@ -2252,11 +2440,16 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
             cut[nc] = ecut[q, i] - xmu
             nc += 1
         cut[:nc].sort()
+        # a ring's absolute tolerance iacc / (the node's factor), iacc = itol times a lower bound of the integral so far
+        # over the length of x's range, pi / 2: its share of the sum is at most itol times that bound (as :func:`_integrate`)
         m = 0
+        acc = 0.0
         for i in range(nc - 1):
             if cut[i + 1] > cut[i]:
                 pk[m], t0[m], t1[m] = i, cut[i], cut[i + 1]
-                kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, t0[m], t1[m], nodes, wk, wg, buf, mode, chain, factor)
+                kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, t0[m], t1[m], nodes, wk, wg, buf, mode, chain, factor, itol,
+                                       itol * acc / (0.5 * math.pi), fv)
+                acc += max(kv[m] - ke[m], 0.0)
                 m += 1
         start = m
         while True:
@@ -2266,8 +2459,9 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
             if ok or m - start >= max_intervals or m >= cap:
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
-            kv[worst], ke[worst] = _n_rule(mp, mu, xmu, xs, a_, mid, nodes, wk, wg, buf, mode, chain, factor)
-            kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, mid, b_, nodes, wk, wg, buf, mode, chain, factor)
+            iacc = itol * max(tot - e, 0.0) / (0.5 * math.pi)
+            kv[worst], ke[worst] = _n_rule(mp, mu, xmu, xs, a_, mid, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv)
+            kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, mid, b_, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv)
             m += 1
         val[q] = tot
         err[q] = e + r
@@ -2295,11 +2489,38 @@ def without_n_frame():
         N_FRAME = old
 
 
+#: frame 6 takes GGX with a Fresnel factor (:func:`_ggx_ring_f`) at the incidences where every ring's smallest wi.h, S =
+#: sin((x + x_mu) / 2), is at least this (mu >= :data:`N_FRESNEL_MU_MIN`): F(c) has a square-root branch point at c = 0,
+#: which for S below ~0.1 lies too close for the ring's RING_F_NMAX + 1 samples (measured: S = 0.05 was 1e-7 off at N = 64);
+#: frame 4 takes the incidences below it
+N_FRESNEL_S_MIN = 0.125
+N_FRESNEL_MU_MIN = math.sin(2.0 * math.asin(N_FRESNEL_S_MIN))
+#: ... and an index whose F(c) has no other singularity within this of [N_FRESNEL_S_MIN, 1] (:func:`n_fresnel_ok`)
+N_FRESNEL_SING_MIN = 0.1
+
+
+def n_fresnel_ok(ior: float, eta: float, k: float) -> bool:
+    """Whether frame 6 takes the Fresnel factor of a dielectric ``ior`` or a conductor (``eta``, ``k``): F(c)'s singularities
+    but c = 0 (the refracted cosine's branch points +- w, w = sqrt(1 - index^2); the parallel reflectance's poles, on the
+    physical sheet in the left half-plane, :func:`fresnel_pole`) at least :data:`N_FRESNEL_SING_MIN` from the rings' range
+    of c, [:data:`N_FRESNEL_S_MIN`, 1].  A dielectric with ior > 1 has w on the imaginary axis; ior <= 1 (a total
+    reflection's kink at c = w real) and a near-kink conductor (w near the real segment) stay with frame 4."""
+    if eta > 0.0:
+        w = complex(1.0 - (eta * eta - k * k), -2.0 * eta * k) ** 0.5
+        x = min(max(abs(w.real), N_FRESNEL_S_MIN), 1.0)
+        return abs(complex(abs(w.real) - x, w.imag)) >= N_FRESNEL_SING_MIN
+    return ior > 1.0
+
+
 def takes_n_frame(hint) -> bool:
     """Whether :func:`albedo_1d` takes ``hint`` about N with the weight's azimuth in closed form (frame 6): GGX and
-    Beckmann with F = 1 and alpha <= 1 (either Smith G, exact or Walter's G1), Schlick's model."""
-    if not N_FRAME or hint.kind != "half" or any(hint.fresnel) or hint.vcavity or hint.sqrt_cos:
+    Beckmann with F = 1 and alpha <= 1 (either Smith G, exact or Walter's G1), Schlick's model, and GGX with a Fresnel
+    factor :func:`n_fresnel_ok` takes (neither pumped nor scaled; at mu >= :data:`N_FRESNEL_MU_MIN`, frame 4 below)."""
+    if not N_FRAME or hint.kind != "half" or hint.vcavity or hint.sqrt_cos:
         return False
+    if any(hint.fresnel):
+        return (hint.smith is not None and hint.smith[0] == 1 and hint.smith[3] <= 1.0 and hint.p == 0.0
+                and hint.chain is None and hint.factor is None and n_fresnel_ok(*(float(x) for x in hint.fresnel)))
     if hint.schlick is not None:
         return hint.p == 0.0 and 0.0 < hint.schlick <= 1.0
     return hint.smith is not None and hint.smith[3] <= 1.0 and hint.p == 0.0
@@ -2886,8 +3107,18 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     # atol applies to the scaled albedo: per mu, atol / scale for the unscaled integral
     with np.errstate(divide="ignore"):
         atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
-    if takes_n_frame(hint):  # frame 6: GGX and Beckmann with F = 1, Schlick's model, about N (:func:`_integrate_n`)
-        mp = numeric_params(hint)
+    if takes_n_frame(hint) and any(hint.fresnel) and mu.size and mu.min() < N_FRESNEL_MU_MIN:
+        # GGX with F: frame 6 where every ring's wi.h >= N_FRESNEL_S_MIN, frame 4 below (:func:`_ggx_ring_f`)
+        low = mu < N_FRESNEL_MU_MIN
+        with without_n_frame():
+            parts = [albedo_1d(brdf, mu[low], rtol, atol, max_regions)]
+        parts.append(albedo_1d(brdf, mu[~low], rtol, atol, max_regions))
+        out = tuple(np.empty(mu.shape, dtype=x.dtype) for x in parts[0])
+        for o, a_, b_ in zip(out, *parts):
+            o[low], o[~low] = a_, b_
+        return out
+    if takes_n_frame(hint):  # frame 6: GGX and Beckmann with F = 1 or GGX with F, Schlick's model, about N (:func:`_integrate_n`)
+        mp = n_params(hint)
         if hint.chain is None and hint.factor is None:
             cut, ncut = np.zeros((len(mu), 0)), np.zeros(len(mu), np.int64)
         else:  # pumped or scaled: the kinks of g or U, its tables' grading and the pi / 16 cuts, as for a pumped lobe

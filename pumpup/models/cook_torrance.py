@@ -35,9 +35,10 @@ from ..core import MAX_EXPONENT, MAX_INDEX, MAX_WIDTH, MIN_WIDTH, BRDF, Lobe, Pa
 def _fresnel(c, n):  # pragma: no cover - compiled
     if n <= 0.0:
         return 1.0  # no index of refraction given: F = 1
-    g = math.sqrt(n * n + c * c - 1.0)
-    a = (g - c) / (g + c)
-    q = (c * (g + c) - 1.0) / (c * (g - c) + 1.0)
+    n21 = (n - 1.0) * (n + 1.0)
+    g = math.sqrt(n21 + c * c)
+    a = n21 / ((g + c) * (g + c))  # (g - c) / (g + c) without cancellation (an ior near 1: g ~ c)
+    q = (c * (g + c) - 1.0) / (c * n21 / (g + c) + 1.0)
     return 0.5 * a * a * (1.0 + q * q)  # 002 sec. 3.2
 
 
@@ -45,9 +46,10 @@ def _fresnel_reference(c, n):
     """Dielectric Fresnel factor (002 sec. 3.2); 1 when n <= 0 (no index given)."""
     if n <= 0.0:
         return np.ones_like(c)
-    g = np.sqrt(n * n + c * c - 1.0)
-    a = (g - c) / (g + c)
-    q = (c * (g + c) - 1.0) / (c * (g - c) + 1.0)
+    n21 = (n - 1.0) * (n + 1.0)
+    g = np.sqrt(n21 + c * c)
+    a = n21 / ((g + c) * (g + c))  # (g - c) / (g + c), g - c = (n^2 - 1) / (g + c): no cancellation near n = 1
+    q = (c * (g + c) - 1.0) / (c * n21 / (g + c) + 1.0)
     return 0.5 * a * a * (1.0 + q * q)  # 002 sec. 3.2
 
 
