@@ -162,7 +162,25 @@ pole at sin x = -r / (1 - r), the pole at x = -x_mu of the height-correlated G a
 >= 0.1, a 257-point table in 0.7-2.6 ms for GGX and Schlick (frame 4 took 20-70 ms), 4-12 ms for Beckmann (frame 4: 45-200
 ms), and mu down to the smallest double.  ``scripts/n_frame_calibration.py`` measures it against frame 4
 (:func:`without_n_frame`) at rtol 1e-13 over 45 models, 64 mu and rtol 1e-6 ... 1e-12: at most 4e-5 of the estimate beyond
-that reference's own error.  GGX and Beckmann with a Fresnel factor keep frame 4 (F(wi.h) depends on the azimuth).
+that reference's own error.
+
+GGX with a Fresnel factor takes frame 6 too since issue 14's thirteenth session (:func:`_ggx_ring_f`).  On the ring F(wi.h)
+depends on the azimuth, through c = wi.h = sqrt(S^2 + s cos(x) sin^2(psi / 2)) (psi from the mirror side, S = sin((x +
+x_mu) / 2) the ring's smallest c), and has no closed form against D; but D's Fourier cosine coefficients do, M_k = 2 a2
+(delta_k0 + rho^k (2 k1 + t2 + k k1^2)) (the terms of :func:`_ggx_ring`, rho = (a' - R) / Q), so F's cosine interpolant
+at psi = n pi / N integrates against D exactly: a product rule whose weights are geometric sums in rho e^(i psi_n)
+(:func:`_ring_f_sums`), however narrow the peak.  N doubles from 16 to at most 128; the ring's error is |W_N - W_N/2|, or
+that times the larger ratio of the last three such steps where both are below 1/2 (the last ratio alone, from N = 16, was
+1100 x below the true error of a strong absorber at itol 1e-6).  The ring's tolerance is frame 4's: relative, or a share
+of the integral's lower bound so far, and its errors enter the outer estimate as frame 4's K do.  F(c) has a square-root
+branch point at c = 0 (it is not even in c), at psi = +- 2 i asinh(S / sqrt(s cos x)) on the ring, so the product rule
+needs S not small: frame 6 takes mu >= :data:`N_FRESNEL_MU_MIN` = 0.248 (S >= 1/8 on every ring), frame 4 the rest of a
+table, and an index whose other singularities (the refracted cosine's branch points) lie at least 0.1 from [1/8, 1]
+(:func:`n_fresnel_ok`: not a near-kink conductor; a dielectric's lie on the imaginary axis).  The elevation is cut where
+S passes 3^j times the scale of F's pole near c = 0 (:func:`fresnel_pole`) and of its branch point.  17-129 F values per
+ring, 1.3-1.9 us; a 257-point table of GGX alpha 0.3 with eta 0.2, k 3 took 56 ms where frame 4 takes 125 ms at mu >=
+0.248 (``scripts/bench_albedo.py --nframe-f``).  Beckmann with F keeps frame 4: its ring's Fourier coefficients are
+Bessel functions e^-kappa I_k(kappa), not attempted.
 
 A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
 :class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D
@@ -1948,33 +1966,29 @@ _RING_F_SIN = np.sin(np.pi * np.arange(RING_F_NMAX + 1) / RING_F_NMAX)
 def _ring_f_sums(rho, rn, n, nn, j):  # pragma: no cover - compiled; see ring_f_sums_reference
     """(C0, C1) = the sums over k = 0 .. nn, the first and last halved, of rho^k cos(k theta) and k rho^k cos(k theta) at
     theta = n pi / nn = j pi / RING_F_NMAX (``rn`` = rho^nn): geometric sums in z = rho e^(i theta), z^nn = (-1)^n rho^nn
-    real, 1 - z = (1 - rho) + 2 rho sin^2(theta / 2) - i rho sin(theta) without cancellation; at n = 0 and wherever |1 - z|
-    < RING_F_DIRECT, where the closed forms cancel as rho -> 1 (sum k z^k lost 2e-11 at nn = 128, n = 1), term by term."""
-    if n == 0:
-        c0 = c1 = 0.0
-        rk = 1.0
-        for k in range(nn + 1):
-            h = 0.5 if k == 0 or k == nn else 1.0
-            c0 += h * rk
-            c1 += h * k * rk
-            rk *= rho
-        return c0, c1
+    real, 1 - z = (1 - rho) + 2 rho sin^2(theta / 2) - i rho sin(theta) without cancellation; where |1 - z| < RING_F_DIRECT,
+    where the closed forms cancel as rho -> 1 (sum k z^k lost 2e-11 at nn = 128, n = 1), term by term."""
     zn = -rn if n % 2 else rn  # z^nn
-    z = complex(rho * _RING_F_COS[j], rho * _RING_F_SIN[j])
-    omz = complex((1.0 - rho) + 2.0 * rho * _RING_F_SIN2[j], -rho * _RING_F_SIN[j])
-    if abs(omz) < RING_F_DIRECT:  # (sum k z^k's closed form loses ~nn^2 eps / |1 - z| there: term by term)
+    zr, zi = rho * _RING_F_COS[j], rho * _RING_F_SIN[j]
+    p, r = (1.0 - rho) + 2.0 * rho * _RING_F_SIN2[j], zi  # 1 - z = p - i r
+    dd = p * p + r * r
+    if dd < RING_F_DIRECT * RING_F_DIRECT:  # (sum k z^k's closed form loses ~nn^2 eps / |1 - z| there: term by term)
         c0 = c1 = 0.0
         zk = complex(1.0, 0.0)
+        z = complex(zr, zi)
         for k in range(nn + 1):
             h = 0.5 if k == 0 or k == nn else 1.0
             c0 += h * zk.real
             c1 += h * k * zk.real
             zk *= z
         return c0, c1
-    inv = 1.0 / omz
-    g0 = (1.0 - zn * z) * inv  # sum of z^k, k = 0 .. nn
-    g1 = z * (1.0 - (nn + 1.0) * zn + nn * zn * z) * (inv * inv)  # sum of k z^k
-    return g0.real - 0.5 - 0.5 * zn, g1.real - 0.5 * nn * zn
+    # in real arithmetic, 1 / (1 - z) = (p + i r) / dd: sum z^k = (1 - zn z) / (1 - z), sum k z^k = z (1 - (nn + 1) zn +
+    # nn zn z) / (1 - z)^2
+    g0 = ((1.0 - zn * zr) * p + zn * zi * r) / dd
+    a = 1.0 - (nn + 1.0) * zn + nn * zn * zr
+    b = nn * zn * zi
+    g1 = ((zr * a - zi * b) * (p * p - r * r) - (zr * b + zi * a) * (2.0 * p * r)) / (dd * dd)
+    return g0 - 0.5 - 0.5 * zn, g1 - 0.5 * nn * zn
 
 
 def ring_f_sums_reference(rho: float, n: int, nn: int) -> tuple:
@@ -1990,8 +2004,8 @@ def ring_f_sums_reference(rho: float, n: int, nn: int) -> tuple:
 
 @njit(cache=True, nogil=True)
 def _ggx_ring_f(mp, a2, xmu, xs, d, itol, tol_abs, fv):  # pragma: no cover - compiled; see ring_reference
-    """(W, its error): the integral over phi of the GGX weight D times the Fresnel factor F(wi.h) on the circle of wo at
-    x = x_mu + d (:func:`_ggx_ring` with F; ``fv`` a work array of RING_F_NMAX + 1 values).
+    """(W, its error, F's samples): the integral over phi of the GGX weight D times the Fresnel factor F(wi.h) on the circle
+    of wo at x = x_mu + d (:func:`_ggx_ring` with F; ``fv`` a work array of RING_F_NMAX + 1 values).
 
     On the circle, measured from the mirror side (psi = phi - pi), D = (a2 / pi)(1 + k / Y)^2 with Y = a' - Q cos(psi)
     (:func:`_ggx_ring`), whose Fourier cosine coefficients are closed forms: with rho = (sqrt(B) - S sqrt(A)) / (sqrt(B) +
@@ -2022,19 +2036,17 @@ def _ggx_ring_f(mp, a2, xmu, xs, d, itol, tol_abs, fv):  # pragma: no cover - co
         c = math.sqrt(s2 + q * _RING_F_SIN2[j])
         fv[j] = _fresnel_real(c, mp[6], mp[7]) if mp[6] > 0.0 else _fresnel(c, mp[5])
     prev = _ring_f_level(fv, rho, al, be, RING_F_N0 // 2, 2 * stride)
-    step = step2 = -1.0
+    step, step2 = abs(prev - _ring_f_level(fv, rho, al, be, RING_F_N0 // 4, 4 * stride)), -1.0
     nn = RING_F_N0
     while True:
         w = _ring_f_level(fv, rho, al, be, nn, stride)
         e = abs(w - prev)
-        # where the last three steps shrink, each by RING_F_RATIO at least (from N = 32 on), |W_N - W_N/2| times the larger
-        # of their two ratios; else |W_N - W_N/2|
+        # where the last three steps shrink, each by RING_F_RATIO at least (from N = 32 on: W_8 - W_4, W_16 - W_8, W_32 -
+        # W_16), |W_N - W_N/2| times the larger of their two ratios; else |W_N - W_N/2|
         ratio = max(e / step, step / step2) if step2 > 0.0 else 1.0
         est = e * ratio if ratio <= RING_F_RATIO else e
-        if est <= max(itol * w, tol_abs / (4.0 * a2)):
-            return 4.0 * a2 * w, 4.0 * a2 * (est + RING_F_ROUNDING * nn * w)
-        if nn >= RING_F_NMAX:
-            return 4.0 * a2 * w, 4.0 * a2 * (est + RING_F_ROUNDING * nn * w)
+        if est <= max(itol * w, tol_abs / (4.0 * a2)) or nn >= RING_F_NMAX:
+            return 4.0 * a2 * w, 4.0 * a2 * (est + RING_F_ROUNDING * nn * w), nn + 1
         step, step2 = abs(w - prev), step
         prev = w
         stride //= 2
@@ -2269,7 +2281,7 @@ def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, it
         if mp[13] > 0.0:
             a2 = mp[4] * mp[4]
             fac = _n_factor(mp, mu, xmu, xs, d, a2)
-            w, we = _ggx_ring_f(mp, a2, xmu, xs, d, itol, iacc / fac if fac > 0.0 else math.inf, fv)
+            w, we, _ = _ggx_ring_f(mp, a2, xmu, xs, d, itol, iacc / fac if fac > 0.0 else math.inf, fv)
             v = w * fac
             ie += wk[j] * we * fac
             noise += (wk[j] + wg[j]) * we * fac

@@ -31,6 +31,8 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
                                               # (the lobe frame with F(Theta_min)) against the nested engine
     python scripts/bench_albedo.py --nframe   # only GGX, Beckmann (F = 1) and Schlick, about N in closed form since issue
                                               # 14's ninth session, against the rule on h's arc and the nested engine
+    python scripts/bench_albedo.py --nframe-f # only GGX with a Fresnel factor, about N since issue 14's thirteenth session,
+                                              # against the rule on h's arc and the nested engine
     python scripts/bench_albedo.py --lobe-n   # only lobes with F(Theta_min), n >= 8, about N since issue 14's twelfth
                                               # session, against frame 5 and the nested engine
     python scripts/bench_albedo.py --pumped   # only pumped chains (Phong family; GGX, Beckmann, Schlick in frame 6):
@@ -272,6 +274,17 @@ def n_frame(rtol=1e-10, repeat=3):
         {"type": "ggx", "alpha": 0.3, "shadowing": "correlated"}, {"type": "schlick", "r": 0.2}, {"type": "schlick", "r": 0.001}] + [
         {"type": "beckmann", "alpha": a} for a in (0.001, 0.1, 0.5)] + [{"type": "beckmann", "alpha": 0.3, "g1": "walter"}]
     _against_second_path(specs, "frame 6 against frame 4 and the nested engine", "frame 6", "frame 4", 48, rtol, repeat)
+
+
+def n_frame_fresnel(rtol=1e-10, repeat=3):
+    """GGX with a Fresnel factor about N (frame 6 with the ring's product rule, pumpup._polar._ggx_ring_f; issue 14's
+    thirteenth session; frame 4 below mu = N_FRESNEL_MU_MIN) against frame 4, the rule on h's arc they took before, and the
+    nested engine (:func:`_against_second_path`)."""
+    specs = [{"type": "ggx", "alpha": 0.3, "eta": 0.2, "k": 3.0}, {"type": "ggx", "alpha": 0.02, "ior": 1.5},
+             {"type": "ggx", "alpha": 0.5, "shadowing": "correlated", "eta": 1.1, "k": 6.0},
+             {"type": "ggx", "alpha": 0.001, "eta": 1.1, "k": 30.0}, {"type": "ggx", "alpha": 1.0, "ior": 1.33}]
+    _against_second_path(specs, "GGX with F: frame 6 (mu >= 0.248, frame 4 below) against frame 4 and the nested engine",
+                         "frame 6", "frame 4", 72, rtol, repeat)
 
 
 def lobe_n_frame(rtol=1e-10, repeat=3):
@@ -600,6 +613,9 @@ def main():
         return
     if "--nframe" in sys.argv:
         n_frame()
+        return
+    if "--nframe-f" in sys.argv:
+        n_frame_fresnel()
         return
     if "--lobe-n" in sys.argv:
         lobe_n_frame()
