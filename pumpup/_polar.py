@@ -178,9 +178,12 @@ needs S not small: frame 6 takes mu >= :data:`N_FRESNEL_MU_MIN` = 0.248 (S >= 1/
 table, and an index whose other singularities (the refracted cosine's branch points) lie at least 0.1 from [1/8, 1]
 (:func:`n_fresnel_ok`: not a near-kink conductor; a dielectric's lie on the imaginary axis).  The elevation is cut where
 S passes 3^j times the scale of F's pole near c = 0 (:func:`fresnel_pole`) and of its branch point.  17-129 F values per
-ring, 1.3-1.9 us; a 257-point table of GGX alpha 0.3 with eta 0.2, k 3 took 56 ms where frame 4 takes 125 ms at mu >=
-0.248 (``scripts/bench_albedo.py --nframe-f``).  Beckmann with F keeps frame 4: its ring's Fourier coefficients are
-Bessel functions e^-kappa I_k(kappa), not attempted.
+ring (27-35 on average), 1.3-1.9 us; the 216 mu >= 0.248 of a 257-point table at rtol 1e-10 took 39-111 ms where frame 4
+takes 87-196 ms (GGX alpha 0.3 with eta 0.2, k 3; alpha 0.02 with ior 1.5), and the 41 below 0.248 stay at frame 4's
+35-50 ms (``scripts/bench_albedo.py --nframe-f``).  Not taken: a rule per ring for S < 1/8 (adaptive 10/21 in psi graded
+at D's and F's scales, measured at ~400 evaluations per ring: no faster than frame 4 there); pumped or 1/E-scaled GGX with
+F (the nested engine, as before: frame 4 below 0.248 has no chain); Beckmann with F (frame 4: its ring's Fourier
+coefficients are Bessel functions e^-kappa I_k(kappa), not attempted).
 
 A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
 :class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D
@@ -2281,13 +2284,15 @@ def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, it
     h = hi - lo
     ie = 0.0
     noise = 0.0
+    ns = 0
     for j in range(nodes.shape[0]):
         d = lo + h * nodes[j]
         if mp[13] > 0.0:
             a2 = mp[4] * mp[4]
             fac = _n_times(mp, mu, xmu, xs, d, a2, 1.0)
-            w, we, _ = _ggx_ring_f(mp, a2, xmu, xs, d, itol, iacc / fac if fac > 0.0 else math.inf, fv)
-            v = _n_times(mp, mu, xmu, xs, d, a2, w)
+            w, we, nf = _ggx_ring_f(mp, a2, xmu, xs, d, itol, iacc / fac if fac > 0.0 else math.inf, fv)
+            ns += nf
+            v = w * fac
             ie += wk[j] * we * fac
             noise += (wk[j] + wg[j]) * we * fac
         else:
@@ -2310,7 +2315,7 @@ def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, it
         buf[j] = v
     k, diff, asc, ab = rule_sums(buf, wk, wg)
     e = calibrated((diff + noise) * h, asc * h, ab * h, mode) + ie * h
-    return k * h, (max(e, CHAIN_SAFETY * diff * h + ie * h) if chain is not None or factor is not None else e)
+    return k * h, (max(e, CHAIN_SAFETY * diff * h + ie * h) if chain is not None or factor is not None else e), ns
 
 
 @njit(cache=True, nogil=True)
@@ -2461,12 +2466,14 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
         # over the length of x's range, pi / 2: its share of the sum is at most itol times that bound (as :func:`_integrate`)
         m = 0
         acc = 0.0
+        ns = 0
         for i in range(nc - 1):
             if cut[i + 1] > cut[i]:
                 pk[m], t0[m], t1[m] = i, cut[i], cut[i + 1]
-                kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, t0[m], t1[m], nodes, wk, wg, buf, mode, chain, factor, itol,
-                                       itol * acc / (0.5 * math.pi), fv)
+                kv[m], ke[m], nf = _n_rule(mp, mu, xmu, xs, t0[m], t1[m], nodes, wk, wg, buf, mode, chain, factor, itol,
+                                           itol * acc / (0.5 * math.pi), fv)
                 acc += max(kv[m] - ke[m], 0.0)
+                ns += nf
                 m += 1
         start = m
         while True:
@@ -2477,13 +2484,15 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
             iacc = itol * max(tot - e, 0.0) / (0.5 * math.pi)
-            kv[worst], ke[worst] = _n_rule(mp, mu, xmu, xs, a_, mid, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv)
-            kv[m], ke[m] = _n_rule(mp, mu, xmu, xs, mid, b_, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv)
+            kv[worst], ke[worst], nf = _n_rule(mp, mu, xmu, xs, a_, mid, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv)
+            ns += nf
+            kv[m], ke[m], nf = _n_rule(mp, mu, xmu, xs, mid, b_, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv)
+            ns += nf
             m += 1
         val[q] = tot
         err[q] = e + r
         conv[q] = ok
-        evals[q] = nodes.shape[0] * (m + (m - start))
+        evals[q] = nodes.shape[0] * (m + (m - start)) + ns  # (and F's samples on the rings, :func:`_ggx_ring_f`)
 
 
 #: frame 6 is used where it applies (``without_n_frame`` switches it off: those models then take frame 4, the rule on

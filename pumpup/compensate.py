@@ -676,7 +676,7 @@ class Scaled(_Compensated):
         from ._polar import takes_n_frame
 
         def plain(h):  # GGX, Beckmann with F = 1 or Schlick, neither pumped nor scaled
-            return h is not None and h.chain is None and h.factor is None and takes_n_frame(h)
+            return h is not None and h.chain is None and h.factor is None and not any(h.fresnel) and takes_n_frame(h)
 
         hint = self.base.polar()
         if not plain(hint) or (self.white is not self.base and not plain(self.white.polar())):
