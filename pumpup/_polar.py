@@ -2271,7 +2271,7 @@ def _n_incidence(mp, mu):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv):  # pragma: no cover - compiled
+def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv, kind):  # pragma: no cover - compiled
     """(value, error) of the rule on d = x - x_mu in [lo, hi] of :func:`_n_value`; with a pumped chain (``chain`` not
     None, :meth:`pumpup.pumping.Pumped._chain_args`) divided by g_1 ... g_k(mu, N.wo) exactly as the chain kernel divides
     by it (001 eq. 16; written out as in :func:`_x_rule`), or with a 1/E-scaled model's ``factor`` (not None: F0 and
@@ -2280,23 +2280,29 @@ def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, it
     as without g) and CHAIN_SAFETY |K - G| (for the splines of g or U, which are not analytic: :data:`CHAIN_SAFETY`).
     With a Fresnel factor (mp[13] = 1, GGX) the ring is :func:`_ggx_ring_f` at relative tolerance ``itol`` or absolute
     ``iacc`` / the node's factor (``fv`` its work array), and its errors are taken as frame 4 takes K's (:func:`_gk`):
-    summed with the Kronrod weights, and into |K - G| before its calibration as far as they can hide it."""
+    summed with the Kronrod weights, and into |K - G| before its calibration as far as they can hide it.  ``kind`` 0: the
+    variable is d itself; 1 and 2 (a piece off the peak, GGX and Schlick): u = ln |d|, d = e^u or -e^u, the integrand times
+    |d| (:data:`N_LOG_GRADE`)."""
     h = hi - lo
     ie = 0.0
     noise = 0.0
     ns = 0
     for j in range(nodes.shape[0]):
         d = lo + h * nodes[j]
+        jac = 1.0
+        if kind != 0:
+            jac = math.exp(d)
+            d = jac if kind == 1 else -jac
         if mp[13] > 0.0:
             a2 = mp[4] * mp[4]
-            fac = _n_times(mp, mu, xmu, xs, d, a2, 1.0)
+            fac = _n_times(mp, mu, xmu, xs, d, a2, 1.0) * jac
             w, we, nf = _ggx_ring_f(mp, a2, xmu, xs, d, itol, iacc / fac if fac > 0.0 else math.inf, fv)
             ns += nf
             v = w * fac
             ie += wk[j] * we * fac
             noise += (wk[j] + wg[j]) * we * fac
         else:
-            v = _n_value(mp, mu, xmu, xs, d)
+            v = _n_value(mp, mu, xmu, xs, d) * jac
         if chain is not None and v != 0.0:
             t = math.sin(xmu + d)
             if min(mu, t) > chain[13]:
@@ -2329,7 +2335,7 @@ def _n_values(mp, mu, x, chain, factor):  # pragma: no cover - compiled
     for i in range(x.shape[0]):
         d = x[i] - xmu
         out[i] = _n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, chain, factor, INNER_RTOL_MIN, 0.0,
-                         np.empty(RING_F_NMAX + 1))[0]
+                         np.empty(RING_F_NMAX + 1), 0)[0]
     return out
 
 
@@ -2372,6 +2378,42 @@ def n_integrand_reference(brdf, mu: float, x) -> np.ndarray:
     return np.array(out)
 
 
+#: frame 6 grades GGX's and Schlick's peak by this factor per cut, and integrates every piece off the peak in u = ln |d|
+#: (:func:`_n_rule`): there the singularities at d = +- 2 i atanh(alpha) lie pi / 2 from the real axis whatever |d|, so a
+#: piece [a, 27 a] (length ln 27 = 3.3 in u) is as far from them, relative to its length, as [a, 3 a] is in d (0.52 of it
+#: instead of 0.5); GGX alpha = 1e-8 took 34 graded pieces in d, 12 in u
+N_LOG_GRADE = 27.0
+#: ... on the side short of the peak only for |d| <= this times x_mu: towards x = 0, P(t)'s singularity (or Schlick's
+#: pole) lies near d = -x_mu, ln 8 = 2.1 from u = ln(x_mu / 8) (at 1/2 a piece came within 0.23 of its length in u of
+#: it, on the cuts at mu = 1; tests/test_polar_ggx.py checks every piece in the variable it is integrated in)
+N_LOG_SIDE = 0.125
+#: ... and beyond it up to this times the range's end pi / 2 - x_mu (the weight's singularity at x = pi - x_mu + - 2 i
+#: atanh(alpha), where B = 0, lies ln 2 beyond that end in u), then by 3 in u
+N_LOG_END = 0.25
+
+@njit(cache=True, nogil=True, inline="always")
+def _n_kind(logs, a, b, xmu):  # pragma: no cover - compiled
+    """The variable of frame 6's piece [a, b] of d (:func:`_n_rule`): 1 (u = ln d) beyond the peak, 2 (u = ln -d) short of
+    it within N_LOG_SIDE x_mu, where ``logs`` (GGX, Schlick); else 0 (d)."""
+    if logs and a > 0.0:
+        return 1
+    if logs and b < 0.0 and a >= -N_LOG_SIDE * xmu:
+        return 2
+    return 0
+
+
+def n_pieces_reference(brdf, mu: float) -> list:
+    """Frame 6's pieces for ``brdf``'s hint at N.wi = ``mu``: (lo, hi, kind) in d = x - x_mu, kind as :func:`_n_kind`
+    (for the tests)."""
+    hint = brdf.polar()
+    mp = n_params(hint)
+    cut = np.empty(N_CUTS)
+    xmu = _n_incidence(mp, mu)[0]
+    c = cut[:_n_cuts(mp, xmu, cut)]
+    logs = not (mp[0] == SMITH and mp[1] == 0.0)
+    return [(a, b, _n_kind(logs, a, b, xmu)) for a, b in zip(c[:-1], c[1:]) if b > a]
+
+
 #: frame 6's breakpoints per mu: 0, pi / 2, x_mu, Walter's switch and the graded ones (the peak's two sides, 2 x 17 at
 #: alpha = 1e-8; from 0, up to 26 at Schlick's r = 1e-12; the x_mu grading takes what is left)
 N_CUTS = 96
@@ -2397,15 +2439,15 @@ def _n_cuts(mp, xmu, cut):  # pragma: no cover - compiled; see n_cuts_reference
     if 0.0 < mp[9] < 1.0:  # Walter's G1 switch
         cut[m] = math.asin(mp[9]) - xmu
         m += 1
-    d = 2.0 * alpha if beckmann else (2.0 * math.atanh(alpha) if alpha < 1.0 else math.inf)
-    while d < half and m < cut.shape[0] - 2:
-        if d < xmu:
-            cut[m] = -d
+    d0 = 2.0 * alpha if beckmann else (2.0 * math.atanh(alpha) if alpha < 1.0 else math.inf)
+    for side in range(2):  # beyond the peak (d > 0), then short of it; GGX and Schlick in u = ln |d| (:data:`N_LOG_GRADE`)
+        end = half - xmu if side == 0 else xmu
+        top = end * (N_LOG_END if side == 0 else N_LOG_SIDE)  # (where the log grading stops)
+        d = d0
+        while d < end and m < cut.shape[0] - 2:
+            cut[m] = d if side == 0 else -d
             m += 1
-        if d < half - xmu:
-            cut[m] = d
-            m += 1
-        d *= 3.0
+            d = 3.0 * d if beckmann or d >= top else min(N_LOG_GRADE * d, top)
     for which in range(2):
         if which == 0:
             if mp[0] == SCHLICK:
@@ -2454,6 +2496,8 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
     cap, pk, t0, t1, kv, ke, buf, _, _, itol = _buffers(max_intervals + N_CUTS + ecut.shape[1], nodes, nodes, rtol)
     cut = np.empty(N_CUTS + ecut.shape[1])
     fv = np.empty(RING_F_NMAX + 1)
+    kd = np.empty(cap, np.int64)
+    logs = not (mp[0] == SMITH and mp[1] == 0.0)  # (GGX and Schlick; not Beckmann's Gaussian)
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         xmu, xs = _n_incidence(mp, mu)
@@ -2465,16 +2509,23 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
         # a ring's absolute tolerance iacc / (the node's factor), iacc = itol times a lower bound of the integral so far
         # over the length of x's range, pi / 2: its share of the sum is at most itol times that bound (as :func:`_integrate`)
         m = 0
-        acc = 0.0
-        ns = 0
+        length = 0.0  # (of the pieces in their variables)
         for i in range(nc - 1):
             if cut[i + 1] > cut[i]:
-                pk[m], t0[m], t1[m] = i, cut[i], cut[i + 1]
-                kv[m], ke[m], nf = _n_rule(mp, mu, xmu, xs, t0[m], t1[m], nodes, wk, wg, buf, mode, chain, factor, itol,
-                                           itol * acc / (0.5 * math.pi), fv)
-                acc += max(kv[m] - ke[m], 0.0)
-                ns += nf
+                pk[m], t0[m], t1[m], kd[m] = i, cut[i], cut[i + 1], _n_kind(logs, cut[i], cut[i + 1], xmu)
+                if kd[m] == 1:  # off the peak: u = ln |d| (:data:`N_LOG_GRADE`)
+                    t0[m], t1[m] = math.log(cut[i]), math.log(cut[i + 1])
+                elif kd[m] == 2:
+                    t0[m], t1[m] = math.log(-cut[i + 1]), math.log(-cut[i])
+                length += t1[m] - t0[m]
                 m += 1
+        acc = 0.0
+        ns = 0
+        for i in range(m):
+            kv[i], ke[i], nf = _n_rule(mp, mu, xmu, xs, t0[i], t1[i], nodes, wk, wg, buf, mode, chain, factor, itol,
+                                       itol * acc / length, fv, kd[i])
+            acc += max(kv[i] - ke[i], 0.0)
+            ns += nf
         start = m
         while True:
             tot, e, r, worst, ok = _status(kv, ke, m, 0.0, rounding, rtol, atol_arr[q])
@@ -2483,10 +2534,12 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
             if ok or m - start >= max_intervals or m >= cap:
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
-            iacc = itol * max(tot - e, 0.0) / (0.5 * math.pi)
-            kv[worst], ke[worst], nf = _n_rule(mp, mu, xmu, xs, a_, mid, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv)
+            kd[m] = kd[worst]
+            iacc = itol * max(tot - e, 0.0) / length
+            kv[worst], ke[worst], nf = _n_rule(mp, mu, xmu, xs, a_, mid, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv,
+                                               kd[worst])
             ns += nf
-            kv[m], ke[m], nf = _n_rule(mp, mu, xmu, xs, mid, b_, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv)
+            kv[m], ke[m], nf = _n_rule(mp, mu, xmu, xs, mid, b_, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv, kd[m])
             ns += nf
             m += 1
         val[q] = tot

@@ -180,7 +180,12 @@ def test_which_models_take_frame_6():
 @pytest.mark.parametrize("spec", [SPECS[0], SPECS[5], SPECS[8], SPECS[10]], ids=[IDS[0], IDS[5], IDS[8], IDS[10]])
 def test_cuts_keep_every_piece_off_the_singularities(spec):
     """The breakpoints are sorted in [0, pi / 2] with 0, pi / 2 and x_mu among them, and every piece lies at least a third
-    of its length from the peak's singularities x_mu +- 2 i atanh(alpha) and from P(t)'s (or Schlick's pole) near 0."""
+    of its length from the peak's singularities x_mu +- 2 i atanh(alpha), from B = 0's at pi - x_mu +- 2 i atanh(alpha)
+    and from P(t)'s (or Schlick's pole) near 0: in
+    x, or for a piece off the peak (GGX and Schlick, :data:`pumpup._polar.N_LOG_GRADE`) in u = ln |x - x_mu|, the variable
+    the engine integrates it in."""
+    import cmath
+
     f = pumpup.load(spec)
     hint = f.polar()
     alpha = math.sqrt(hint.schlick) if hint.schlick is not None else hint.smith[3]
@@ -190,12 +195,18 @@ def test_cuts_keep_every_piece_off_the_singularities(spec):
         xmu = math.atan2(mu, math.sqrt((1.0 - mu) * (1.0 + mu)))
         assert np.all(np.diff(x) >= 0) and x[0] == 0.0 and x[-1] == 0.5 * math.pi
         assert np.any(np.abs(x - xmu) <= 1e-15)
-        for lo, hi in zip(x[:-1], x[1:]):
-            if hi <= lo:
-                continue
-            dist = [abs(complex(v, 2.0 * math.atanh(alpha)) - complex(min(max(xmu, lo), hi), 0.0)) for v in (xmu,)]
-            dist.append(abs(complex(0.0, near0) - complex(lo, 0.0)) if hint.schlick is None else lo + near0)
-            assert min(dist) >= (hi - lo) / 3.0, (mu, lo, hi, dist)
+        # the singularities in d = x - x_mu: the peak's, P(t)'s (or Schlick's pole), B = 0's
+        sing = [complex(0.0, 2.0 * math.atanh(alpha)), complex(-xmu, near0) if hint.schlick is None else complex(-near0 - xmu, 0.0),
+                complex(math.pi - 2.0 * xmu, 2.0 * math.atanh(alpha))]
+        for lo, hi, kind in _polar.n_pieces_reference(f, mu):
+            if kind:
+                side = 1.0 if kind == 1 else -1.0
+                a, b = sorted((math.log(side * lo), math.log(side * hi)))
+                dist = [abs(cmath.log(side * z) - min(max(cmath.log(side * z).real, a), b)) for z in sing]
+                assert min(dist) >= (b - a) / 3.0, (mu, lo, hi, kind, dist)
+            else:
+                dist = [abs(z - complex(min(max(z.real, lo), hi), 0.0)) for z in sing]
+                assert min(dist) >= (hi - lo) / 3.0, (mu, lo, hi, dist)
 
 
 def test_frame_4_at_a_grazing_narrow_lobe_with_a_fresnel_factor():

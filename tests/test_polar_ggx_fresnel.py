@@ -72,7 +72,8 @@ def test_which_ggx_with_fresnel_take_frame_6():
     for spec in (_spec(0.2, (0, 0.5, 0.002)), {"type": "beckmann", "alpha": 0.2, "ior": 1.5},
                  {"type": "cook_torrance", "m": 0.3, "ior": 1.5},
                  {"type": "pumped", "base": _spec(0.2, (0, 0.2, 3.0))}):
-        assert not _polar.takes_n_frame(pumpup.load(spec).polar()), spec
+        hint = pumpup.load(spec).polar()
+        assert hint is None or not _polar.takes_n_frame(hint), spec
     assert not _polar.n_fresnel_ok(1.0, 0.0, 0.0) and _polar.n_fresnel_ok(1.0001, 0.0, 0.0)
 
 
