@@ -3194,6 +3194,8 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         low = mu < N_FRESNEL_MU_MIN
         with without_n_frame():
             parts = [albedo_1d(brdf, mu[low], rtol, atol, max_regions)]
+        if parts[0] is None:  # (mu < HALF_MU_MIN: frame 4's breaks underflow, the nested engine takes the model, as before)
+            return None
         parts.append(albedo_1d(brdf, mu[~low], rtol, atol, max_regions))
         out = tuple(np.empty(mu.shape, dtype=x.dtype) for x in parts[0])
         for o, a_, b_ in zip(out, *parts):

@@ -119,3 +119,12 @@ def test_integrand_against_the_models_own_eval():
     for mu in (0.41, 0.9):
         x = np.linspace(0.001, 1.5, 7)
         assert np.allclose(_polar.n_integrand(f, mu, x), _polar.n_integrand_reference(f, mu, x), rtol=1e-12, atol=0.0)
+
+
+def test_grazing_incidence_below_frame_4s_range():
+    """mu = 1e-300 with GGX and an index (hypothesis found it: the split handed frame 4's None on): the nested engine takes
+    the model there, as before frame 6 took it, finite and within its estimate of mu = 1e-100's value."""
+    f = pumpup.load({"type": "ggx", "alpha": 0.1, "ior": 1.5})
+    a, e = pumpup.albedo(f, np.array([1e-300, 0.5]), return_error=True, rtol=1e-8)
+    b, eb = pumpup.albedo(f, np.array([1e-100]), return_error=True, rtol=1e-8)
+    assert np.all(np.isfinite(a)) and abs(a[0] - b[0]) <= e[0] + eb[0]
