@@ -2384,7 +2384,7 @@ def n_integrand_reference(brdf, mu: float, x) -> np.ndarray:
 #: frame 6 grades GGX's and Schlick's peak by this factor per cut, and integrates every piece off the peak in u = ln |d|
 #: (:func:`_n_rule`): there the singularities at d = +- 2 i atanh(alpha) lie pi / 2 from the real axis whatever |d|, so a
 #: piece [a, 27 a] (length ln 27 = 3.3 in u) is as far from them, relative to its length, as [a, 3 a] is in d (0.52 of it
-#: instead of 0.5); GGX alpha = 1e-8 took 34 graded pieces in d, 12 in u
+#: instead of 0.5); GGX alpha = 1e-8 at mu = 1/2 took 34 graded pieces in d, now 14
 N_LOG_GRADE = 27.0
 #: ... on the side short of the peak only for |d| <= this times x_mu: towards x = 0, P(t)'s singularity (or Schlick's
 #: pole) lies near d = -x_mu, ln 8 = 2.1 from u = ln(x_mu / 8) (at 1/2 a piece came within 0.23 of its length in u of
@@ -2393,6 +2393,7 @@ N_LOG_SIDE = 0.125
 #: ... and beyond it up to this times the range's end pi / 2 - x_mu (the weight's singularity at x = pi - x_mu + - 2 i
 #: atanh(alpha), where B = 0, lies ln 2 beyond that end in u), then by 3 in u
 N_LOG_END = 0.25
+
 
 @njit(cache=True, nogil=True, inline="always")
 def _n_kind(logs, a, b, xmu):  # pragma: no cover - compiled
@@ -2431,9 +2432,12 @@ def _n_cuts(mp, xmu, cut):  # pragma: no cover - compiled; see n_cuts_reference
     height-correlated G's pole at x = -x_mu (t P(mu) + mu P(t) - mu t = 0 at t = -mu).  The Beckmann weight
     (:func:`_beckmann_ring`) is a Gaussian 2 alpha wide in d, its kappa has a pole where N.wi + N.wo = 0 (x = -x_mu), and
     its P(t) turns on the scale alpha near x = 0 (erf(tan(x) / alpha)); Walter's rational G1 jumps at N.wo = mp[9].  So d
-    is cut at 0 and +- 2 atanh(alpha) 3^j (Beckmann: +- 2 alpha 3^j), and x at z 3^j from 0 (z = atanh(alpha), alpha or
-    r / (1 - r), and x_mu for the correlated G and for Beckmann) and at Walter's switch: every piece then lies at least
-    about its own length from the nearest singularity."""
+    is cut at 0 and +- 2 atanh(alpha) 3^j (Beckmann: +- 2 alpha 3^j; GGX and Schlick 27^j, in u = ln |d|, up to x_mu / 8
+    short of the peak and a quarter of the range's end beyond it, :data:`N_LOG_GRADE`), and x at z 3^j from 0 (z =
+    atanh(alpha), alpha or r / (1 - r), and x_mu for the correlated G and for Beckmann) and at Walter's switch: every piece
+    then lies at least about its own length from the nearest singularity, in the variable it is integrated in.  With a
+    Fresnel factor (mp[13], :func:`_ggx_ring_f`) x is also cut where the rings' smallest wi.h, sin((x + x_mu) / 2), is 3^j
+    times the scales of F's pole (mp[14]) and branch point (mp[10])."""
     half = 0.5 * math.pi
     alpha = math.sqrt(mp[4]) if mp[0] == SCHLICK else mp[4]
     beckmann = mp[0] == SMITH and mp[1] == 0.0
