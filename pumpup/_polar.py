@@ -2020,9 +2020,9 @@ def _ggx_ring_f(mp, a2, xmu, xs, d, itol, tol_abs, fv):  # pragma: no cover - co
     c = wi.h = sqrt(S^2 + s cos(x) sin^2(psi / 2)) only, smooth and periodic: its cosine interpolant at psi = n pi / N
     (Chebyshev-Lobatto in cos psi) integrates against D exactly from the M_k, sum'' a_k M_k = (4 a2 / N) sum''_n F_n (1/2 +
     (2 k1 + t2) C0_n + k1^2 C1_n) (:func:`_ring_f_sums`).  N doubles from RING_F_N0 until W_N's error is at most
-    max(itol W_N, ``tol_abs``) or N = RING_F_NMAX: |W_N - W_N/2|, times the ratio of the last two such steps where that is
-    at most RING_F_RATIO (the coefficients decay geometrically, or faster, so W_N's error is below |W_N - W_N/2| times that
-    ratio).  F's singularities limit the decay: c = 0, at psi = +- 2 i asinh(S / sqrt(s cos x)) (so S must not be
+    max(itol W_N, ``tol_abs``) or N = RING_F_NMAX: |W_N - W_N/2|, times the larger ratio of the last three such steps where
+    both are at most RING_F_RATIO (from N = 32: the coefficients then decay geometrically, or faster, so W_N's error is below
+    |W_N - W_N/2| times that ratio).  F's singularities limit the decay: c = 0, at psi = +- 2 i asinh(S / sqrt(s cos x)) (so S must not be
     small: :data:`N_FRESNEL_S_MIN`), and the index's (:func:`n_fresnel_ok`)."""
     tau = math.tan(0.5 * d)
     sy, cy = math.sin(xmu + 0.5 * d), math.sin(xs - 0.5 * d)
@@ -2049,7 +2049,7 @@ def _ggx_ring_f(mp, a2, xmu, xs, d, itol, tol_abs, fv):  # pragma: no cover - co
         e = abs(w - prev)
         # where the last three steps shrink, each by RING_F_RATIO at least (from N = 32 on: W_8 - W_4, W_16 - W_8, W_32 -
         # W_16), |W_N - W_N/2| times the larger of their two ratios; else |W_N - W_N/2|
-        ratio = max(e / step, step / step2) if step2 > 0.0 else 1.0
+        ratio = max(e / step, step / step2) if step > 0.0 and step2 > 0.0 else 1.0
         est = e * ratio if ratio <= RING_F_RATIO else e
         if est <= max(itol * w, tol_abs / (4.0 * a2)) or nn >= RING_F_NMAX:
             return 4.0 * a2 * w, 4.0 * a2 * (est + RING_F_ROUNDING * nn * w), nn + 1
