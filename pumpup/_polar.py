@@ -797,6 +797,13 @@ def fresnel_scale(ior: float, eta: float, k: float) -> float:
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _fresnel_at(mp, c):  # pragma: no cover - compiled
+    """The Fresnel factor at wi.h = c of frames 4 and 6: the conductor's (eta, k = mp[6], mp[7]; metal.py) or the
+    dielectric's (ior = mp[5], 1 when ior <= 0; cook_torrance.py)."""
+    return _fresnel_real(c, mp[6], mp[7]) if mp[6] > 0.0 else _fresnel(c, mp[5])
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _phi_numeric(mp, mu, u, c0, d):  # pragma: no cover - compiled; see numeric_integrand_reference
     """Frame 4's integrand 4 c F(c) Gamma at d = c - c0 >= 0 (c = wi.h, N.wo = z = 2 u d): Gamma = G / mu for the
     Smith models (G = G1(mu) G1(z) = mu z / (P(mu) P(z)), Walter et al. 2007 eq. 20; or the height-correlated
@@ -805,10 +812,7 @@ def _phi_numeric(mp, mu, u, c0, d):  # pragma: no cover - compiled; see numeric_
     (eta, k) Fresnel factor at c, or 1."""
     c = c0 + d
     z = 2.0 * u * d
-    if mp[6] > 0.0:
-        f = _fresnel_real(c, mp[6], mp[7])  # conductor (metal.py)
-    else:
-        f = _fresnel(c, mp[5])  # dielectric, 1 when ior <= 0 (cook_torrance.py)
+    f = _fresnel_at(mp, c)
     if mp[0] == VCAVITY_F:
         return 4.0 * f * min(c, 2.0 * u * mu, 2.0 * u * z)  # 4 c G, 001 eq. 10
     if mp[0] == SCHLICK:
@@ -2039,8 +2043,7 @@ def _ggx_ring_f(mp, a2, xmu, xs, d, itol, tol_abs, fv):  # pragma: no cover - co
     s2 = sy * sy
     stride = RING_F_NMAX // RING_F_N0
     for j in range(0, RING_F_NMAX + 1, stride):
-        c = math.sqrt(s2 + q * _RING_F_SIN2[j])
-        fv[j] = _fresnel_real(c, mp[6], mp[7]) if mp[6] > 0.0 else _fresnel(c, mp[5])
+        fv[j] = _fresnel_at(mp, math.sqrt(s2 + q * _RING_F_SIN2[j]))
     prev = _ring_f_level(fv, rho, al, be, RING_F_N0 // 2, 2 * stride)
     step, step2 = abs(prev - _ring_f_level(fv, rho, al, be, RING_F_N0 // 4, 4 * stride)), -1.0
     nn = RING_F_N0
@@ -2057,8 +2060,7 @@ def _ggx_ring_f(mp, a2, xmu, xs, d, itol, tol_abs, fv):  # pragma: no cover - co
         prev = w
         stride //= 2
         for j in range(stride, RING_F_NMAX + 1, 2 * stride):  # the next level's new samples
-            c = math.sqrt(s2 + q * _RING_F_SIN2[j])
-            fv[j] = _fresnel_real(c, mp[6], mp[7]) if mp[6] > 0.0 else _fresnel(c, mp[5])
+            fv[j] = _fresnel_at(mp, math.sqrt(s2 + q * _RING_F_SIN2[j]))
         nn *= 2
 
 
@@ -2073,8 +2075,8 @@ def _ring_f_level(fv, rho, al, be, nn, stride):  # pragma: no cover - compiled
     return tot / nn
 
 
-#: the rounding of :func:`_ggx_ring_f`'s sums per unit of W and per sample (measured in the tests against a summation
-#: term by term in 40-digit mpmath)
+#: the rounding of :func:`_ggx_ring_f`'s sums per unit of W and per sample: twice the 8 eps of their scale within which
+#: tests/test_polar_ggx_fresnel.py finds :func:`_ring_f_sums` against a summation term by term in 40-digit mpmath
 RING_F_ROUNDING = 16.0 * np.finfo(float).eps
 
 
@@ -2396,12 +2398,14 @@ N_LOG_END = 0.25
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _n_kind(logs, a, b, xmu):  # pragma: no cover - compiled
-    """The variable of frame 6's piece [a, b] of d (:func:`_n_rule`): 1 (u = ln d) beyond the peak, 2 (u = ln -d) short of
-    it within N_LOG_SIDE x_mu, where ``logs`` (GGX, Schlick); else 0 (d)."""
-    if logs and a > 0.0:
+def _n_kind(mp, a, b, xmu):  # pragma: no cover - compiled
+    """The variable of frame 6's piece [a, b] of d (:func:`_n_rule`): for GGX and Schlick (not Beckmann's Gaussian) 1 (u =
+    ln d) beyond the peak, 2 (u = ln -d) short of it within N_LOG_SIDE x_mu; else 0 (d)."""
+    if mp[0] == SMITH and mp[1] == 0.0:
+        return 0
+    if a > 0.0:
         return 1
-    if logs and b < 0.0 and a >= -N_LOG_SIDE * xmu:
+    if b < 0.0 and a >= -N_LOG_SIDE * xmu:
         return 2
     return 0
 
@@ -2414,8 +2418,7 @@ def n_pieces_reference(brdf, mu: float) -> list:
     cut = np.empty(N_CUTS)
     xmu = _n_incidence(mp, mu)[0]
     c = cut[:_n_cuts(mp, xmu, cut)]
-    logs = not (mp[0] == SMITH and mp[1] == 0.0)
-    return [(a, b, _n_kind(logs, a, b, xmu)) for a, b in zip(c[:-1], c[1:]) if b > a]
+    return [(a, b, _n_kind(mp, a, b, xmu)) for a, b in zip(c[:-1], c[1:]) if b > a]
 
 
 #: frame 6's breakpoints per mu: 0, pi / 2, x_mu, Walter's switch and the graded ones (the peak's two sides, 2 x 17 at
@@ -2504,7 +2507,6 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
     cut = np.empty(N_CUTS + ecut.shape[1])
     fv = np.empty(RING_F_NMAX + 1)
     kd = np.empty(cap, np.int64)
-    logs = not (mp[0] == SMITH and mp[1] == 0.0)  # (GGX and Schlick; not Beckmann's Gaussian)
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         xmu, xs = _n_incidence(mp, mu)
@@ -2514,12 +2516,13 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
             nc += 1
         cut[:nc].sort()
         # a ring's absolute tolerance iacc / (the node's factor), iacc = itol times a lower bound of the integral so far
-        # over the length of x's range, pi / 2: its share of the sum is at most itol times that bound (as :func:`_integrate`)
+        # over the pieces' total length in their variables (d or ln |d|): its share of the sum is then at most itol times
+        # that bound (as :func:`_integrate`)
         m = 0
         length = 0.0  # (of the pieces in their variables)
         for i in range(nc - 1):
             if cut[i + 1] > cut[i]:
-                pk[m], t0[m], t1[m], kd[m] = i, cut[i], cut[i + 1], _n_kind(logs, cut[i], cut[i + 1], xmu)
+                pk[m], t0[m], t1[m], kd[m] = i, cut[i], cut[i + 1], _n_kind(mp, cut[i], cut[i + 1], xmu)
                 if kd[m] == 1:  # off the peak: u = ln |d| (:data:`N_LOG_GRADE`)
                     t0[m], t1[m] = math.log(cut[i]), math.log(cut[i + 1])
                 elif kd[m] == 2:
@@ -2596,6 +2599,13 @@ def n_fresnel_ok(ior: float, eta: float, k: float) -> bool:
         x = min(max(abs(w.real), N_FRESNEL_S_MIN), 1.0)
         return abs(complex(abs(w.real) - x, w.imag)) >= N_FRESNEL_SING_MIN
     return ior > 1.0
+
+
+def takes_n_frame_operand(hint) -> bool:
+    """Whether a pumped chain or a 1/E scale (:meth:`pumpup.pumping.Pumped.polar`, :meth:`pumpup.compensate.Scaled.polar`)
+    may build on ``hint`` in frame 6: GGX, Beckmann (F = 1) or Schlick, neither pumped nor scaled already, and without a
+    Fresnel factor (GGX with F splits its mu with frame 4, which has no chain)."""
+    return hint is not None and hint.chain is None and hint.factor is None and not any(hint.fresnel) and takes_n_frame(hint)
 
 
 def takes_n_frame(hint) -> bool:

@@ -673,10 +673,7 @@ class Scaled(_Compensated):
         None for any other base, or a white whose E table is not such a model's (its table could hold kinks)."""
         import dataclasses
 
-        from ._polar import takes_n_frame
-
-        def plain(h):  # GGX, Beckmann with F = 1 or Schlick, neither pumped nor scaled
-            return h is not None and h.chain is None and h.factor is None and not any(h.fresnel) and takes_n_frame(h)
+        from ._polar import takes_n_frame_operand as plain  # (GGX, Beckmann with F = 1 or Schlick, neither pumped nor scaled)
 
         hint = self.base.polar()
         if not plain(hint) or (self.white is not self.base and not plain(self.white.polar())):

@@ -960,10 +960,10 @@ class Pumped(BRDF):
         any other base."""
         import dataclasses
 
-        from ._polar import Polar, takes_n_frame, with_fresnel
+        from ._polar import Polar, takes_n_frame_operand, with_fresnel
 
         hint = self.chain()[0].base.polar()
-        if hint is not None and hint.chain is None and not any(hint.fresnel) and takes_n_frame(hint):
+        if takes_n_frame_operand(hint):
             # GGX, Beckmann (F = 1) and Schlick's model: frame 6 about N, divided by g (``pumpup._polar._integrate_n``)
             return dataclasses.replace(hint, chain=self._chain_args(), levels=self._polar_levels)
         if hint is None or hint.kind != "lobe" or hint.chain is not None:
