@@ -1557,9 +1557,15 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     value = np.zeros_like(flat)
     error = np.zeros_like(flat)
     ok = np.ones(flat.shape, bool)
-    from . import _nested, _polar
+    from . import _nested, _polar, _slope
 
     for w, term in brdf.albedo_terms():
+        if _slope.takes_slope_path(term, flat):  # anisotropic Ward, at every azimuth of wi (pumpup._slope)
+            v, e, conv, _ = _slope.slope_albedo(term, flat, phflat, rtol, atol, max_regions)
+            value += w * v
+            error += abs(w) * e
+            ok &= conv
+            continue
         turn = None
         if np.any(phflat != 0.0) and term.azimuth_range() is not None:
             turn = phflat

@@ -190,6 +190,10 @@ class WardAniso(BRDF):
         # f is even in the x and y components of L + V: a(phi) = a(-phi) = a(pi - phi)
         return None if self.p["ax"] == self.p["ay"] else math.pi / 2
 
+    def slope(self):
+        """(a_x, a_y, c) for the albedo in slope space (:mod:`pumpup._slope`: one ray integral per direction)."""
+        return self.p["ax"], self.p["ay"], self.p["c"]
+
     def sampling_lobe(self, mu):
         # the wider of the two slopes: a Beckmann density with the narrower one falls off faster
         # than f across the wide axis, and the weights f cos / p would be unbounded
