@@ -196,7 +196,8 @@ def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, nodes, wk, 
     twice = 2.0 if half else 1.0
     itol = 0.25 * rtol
     evals = 0
-    tol_abs = 0.0
+    # the rays' share of the tolerance: over the turn, at most a quarter of atol, or of rtol times the lower bound so far
+    tol_abs = 0.25 * atol / (2.0 * math.pi)
     for i in range(n - 1 - first):
         lo[i] = th0 + offs[first + i]
         hi[i] = th0 + offs[first + i + 1]
@@ -220,8 +221,7 @@ def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, nodes, wk, 
             return tot, e_all, True, evals
         if m >= min(max_intervals, lo.shape[0]):
             return tot, e_all, False, evals
-        # the rays' share of the tolerance: over the turn, at most a quarter of rtol times the lower bound so far
-        tol_abs = max(0.25 * rtol * max(tot - twice * e, 0.0), atol) / (2.0 * math.pi)
+        tol_abs = 0.25 * max(rtol * max(tot - twice * e, 0.0), atol) / (2.0 * math.pi)
         c = 0.5 * (lo[worst] + hi[worst])
         lo[m], hi[m] = c, hi[worst]
         hi[worst] = c
@@ -298,5 +298,5 @@ def ray_reference(b: float, e2: float) -> float:
 
     if big <= 12.0:
         top = math.sqrt(big)
-        return quad(lambda w: 2.0 * w * f(big - w * w), 0.0, top, epsabs=0.0, epsrel=1e-14, limit=500)[0]
-    return quad(f, 0.0, 12.0, epsabs=0.0, epsrel=1e-14, limit=500, points=[1.0, 2.0, 3.0, 5.0])[0]
+        return quad(lambda w: 2.0 * w * f(big - w * w), 0.0, top, epsabs=0.0, epsrel=2e-14, limit=500)[0]
+    return quad(f, 0.0, 12.0, epsabs=0.0, epsrel=2e-14, limit=500, points=[1.0, 2.0, 3.0, 5.0])[0]
