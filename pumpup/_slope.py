@@ -59,6 +59,11 @@ MU_MIN = 1e-100
 
 #: the most intervals of one ray
 RAY_MAX = 64
+#: the ray's cuts on the Gaussian's scale (measured: with the graded cuts below them, one 10/21 rule per piece is within
+#: 1.1e-11 of scipy's ray integral over 7 pairs of slopes x 8 mu x 23 theta; two pieces [0, R/2], [R/2, R] were 2e-4 off)
+RAY_CUTS = np.array([1.6, 3.2])
+#: the most first pieces of a ray
+N_RAY_CUTS = 24
 
 #: the first theta cut towards a ray parallel to the disc's nearest edge, in units of the edge's distance R(th0), and
 #: the grading's factor 4 from there; only where R(th0) < EDGE_MAX (beyond it the Gaussian barely reaches the edge)
@@ -102,26 +107,45 @@ def _roots(b, e2):  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True)
 def _ray(b, e2, itol, tol_abs, nodes, wk, wg, mode, buf, rw):  # pragma: no cover - compiled
-    """(J, error, evaluations) of the ray integral (module docstring), globally adaptive: two pieces, the one next to
-    the horizon in tau where R <= R_MAX, the worst bisected until the error is at most max(itol |J|, tol_abs) or
-    RAY_MAX intervals are used (the error is returned either way)."""
+    """(J, error, evaluations) of the ray integral (module docstring), globally adaptive: the first pieces below, the
+    one next to the horizon in tau where R <= R_MAX, the worst bisected until the error is at most max(itol |J|, tol_abs)
+    or RAY_MAX intervals are used (the error is returned either way)."""
     big, rm = _roots(b, e2)
     lo, hi, val, err, kind = rw[0], rw[1], rw[2], rw[3], rw[4]
     top = min(big, R_MAX)
     tail = 0.0
     if big > R_MAX:  # the Gaussian's tail beyond R_MAX, bounded (module docstring)
         tail = math.exp(-R_MAX * R_MAX) * (0.5 + abs(b) * (0.5 * R_MAX + 0.25 / R_MAX)) * 0.5 * (big - rm)
-    mid = 0.5 * top
-    lo[0], hi[0], kind[0] = 0.0, mid, -1.0
-    val[0], err[0] = _ray_rule(0.0, mid, -1.0, big, b, e2, rm, nodes, wk, wg, mode, buf)
-    if big <= R_MAX:  # tau in [0, 1]: r from R down to mid
-        lo[1], hi[1], kind[1] = 0.0, 1.0, big - mid
-    else:
-        lo[1], hi[1], kind[1] = mid, top, -1.0
-    val[1], err[1] = _ray_rule(lo[1], hi[1], kind[1], big, b, e2, rm, nodes, wk, wg, mode, buf)
-    m = 2
+    # the first pieces: graded by 4 from twice the scale of the singularities next to r = 0 (r_- and the pole of h_z at
+    # r = i / |e|: wide lobes), then the Gaussian's RAY_CUTS, each below 3/4 of the range; the last piece ends at the
+    # horizon (in tau) where R <= R_MAX
     n = nodes.shape[0]
-    evals = 2 * n
+    m = 0
+    a = 0.0
+    c = 2.0 * min(-rm, 1.0 / math.sqrt(e2))
+    j = 0
+    while m < N_RAY_CUTS:
+        if c < RAY_CUTS[0]:
+            nxt = c
+            c *= 4.0
+        elif j < RAY_CUTS.shape[0]:
+            nxt = RAY_CUTS[j]
+            j += 1
+        else:
+            break
+        if nxt >= 0.75 * top:
+            break
+        lo[m], hi[m], kind[m] = a, nxt, -1.0
+        val[m], err[m] = _ray_rule(a, nxt, -1.0, big, b, e2, rm, nodes, wk, wg, mode, buf)
+        a = nxt
+        m += 1
+    if big <= R_MAX:  # tau in [0, 1]: r from R down to a
+        lo[m], hi[m], kind[m] = 0.0, 1.0, big - a
+    else:
+        lo[m], hi[m], kind[m] = a, top, -1.0
+    val[m], err[m] = _ray_rule(lo[m], hi[m], kind[m], big, b, e2, rm, nodes, wk, wg, mode, buf)
+    m += 1
+    evals = m * n
     while True:
         tot = 0.0
         e = tail
