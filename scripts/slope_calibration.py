@@ -1,0 +1,57 @@
+"""Calibration of the slope path (anisotropic Ward, pumpup._slope; issue 14, fourteenth session).
+
+For 9 pairs of slopes (anisotropy 1 ... 1000, widths 1e-3 ... 3, both orders), 14 mu (MU_MIN, 1e-8, 1e-4, 0.003 and 10
+uniform in theta) and 4 azimuths of wi (0, 0.4, pi / 4 + 0.1, pi / 2), at rtol 1e-6, 1e-8, 1e-10 and 1e-12: the true error
+/ the estimate, max(|a - ref| - ref_err, 0) / err, against the nested engine at rtol 1e-13 (``pumpup._polar.without_1d``:
+the half vector's polar angle and azimuth, another parametrisation), its own error counted in the slope path's favour.
+Also the mean evaluations per mu at each rtol.
+
+    PYTHONPATH=. python scripts/slope_calibration.py
+"""
+
+import math
+import time
+import warnings
+
+import numpy as np
+
+import pumpup
+from pumpup import _polar, _slope
+
+PAIRS = [(0.1, 0.3), (0.3, 0.1), (0.05, 0.5), (0.4, 0.02), (1e-3, 1.0), (1.0, 1e-3), (0.01, 0.01), (3.0, 0.5),
+         (0.002, 0.006)]
+PHIS = [0.0, 0.4, math.pi / 4 + 0.1, math.pi / 2]
+RTOLS = [1e-6, 1e-8, 1e-10, 1e-12]
+
+
+def main():
+    t0 = time.perf_counter()
+    mu = np.concatenate([[_slope.MU_MIN, 1e-8, 1e-4, 0.003], np.cos(np.linspace(0.0, 0.5 * math.pi, 11)[:-1])])
+    worst, worst_at = 0.0, None
+    evals = {r: [] for r in RTOLS}
+    n = 0
+    for ax, ay in PAIRS:
+        f = pumpup.load({"type": "ward_aniso", "ax": ax, "ay": ay})
+        for phi in PHIS:
+            with _polar.without_1d(), warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                ref, ref_err = pumpup.albedo(f, mu, phi=phi, rtol=1e-13, return_error=True)
+            for rtol in RTOLS:
+                v, e, conv, ev = _slope.slope_albedo(f, mu, np.full(mu.shape, phi), rtol, 0.0, 10000)
+                evals[rtol].append(ev)
+                ratio = np.maximum(np.abs(v - ref) - ref_err, 0.0) / e
+                n += mu.size
+                if not conv.all():
+                    print(f"  not converged: {(ax, ay)} phi {phi:.3f} rtol {rtol:g} at mu {mu[~conv]}")
+                i = int(np.argmax(ratio))
+                if ratio[i] > worst:
+                    worst, worst_at = float(ratio[i]), ((ax, ay), float(mu[i]), round(phi, 4), rtol,
+                                                        float(v[i]), float(e[i]), float(ref[i]), float(ref_err[i]))
+        print(f"  {(ax, ay)} done, worst so far {worst:.3g} ({time.perf_counter() - t0:.0f} s)", flush=True)
+    print(f"{n} albedos: worst true error / estimate {worst:.3g} at {worst_at}")
+    for r in RTOLS:
+        print(f"  rtol {r:g}: mean evaluations per mu {np.mean(np.concatenate(evals[r])):.0f}")
+
+
+if __name__ == "__main__":
+    main()
