@@ -23,9 +23,11 @@ R > 0 > r_- the roots (1 / (|e|^2 r^2 - 2 b r - 1) = 0, computed without cancell
     J = integral_0^R r e^(-r^2) (1 + r b) sqrt((R - r)(r - r_-)) (1 + r^2 |e|^2)^(-5/2) dr    (:func:`_ray`).
 
 The ray ends at the horizon with a square root: the piece next to R is integrated in tau, r = R - (R - lo) tau^2, which
-makes it analytic.  Beyond r = :data:`R_MAX` (when R is larger) the Gaussian leaves at most
-e^(-R_MAX^2) (1/2 + |b| (R_MAX / 2 + 1 / (4 R_MAX))) (R - r_-) / 2 (bound (1 + r b) by 1 + r |b|, the square root by
-(R - r_-) / 2 and h_z by 1), which is added to the ray's error.  J(theta) is analytic and periodic: the rule over theta is
+makes it analytic.  Beyond r = a = :data:`R_MAX` (when R is larger) the Gaussian leaves at most
+sqrt(R (1 + |r_-| / a)) (I(1.5) + |b| I(2.5)), I(k) = integral_a^inf r^k e^(-r^2) dr <= a^(k - 1) e^(-a^2) / (2 (1 - (k - 1)
+/ (2 a^2))) (bound 1 + r b by 1 + r |b|, (R - r)(r - r_-) by R r (1 + |r_-| / a) and h_z by 1), which is added to the
+ray's error.  (A first bound, (R - r_-) / 2 for the square root, was e^-40 sqrt(R) of J: near grazing incidence, where R
+reaches 1e100, it never let the rays converge.)  J(theta) is analytic and periodic: the rule over theta is
 globally adaptive 10/21 Gauss-Kronrod over one turn, starting with four quarters from the direction of the disc's
 nearest edge (in the stretched plane, away from the disc's centre), where near grazing incidence the rays' lengths
 change fastest.  Each ray is adaptive 10/21 too (two pieces to start, the worst bisected), to a relative tolerance or an
@@ -62,12 +64,20 @@ RAY_MAX = 64
 #: the ray's cuts on the Gaussian's scale (measured: with the graded cuts below them, one 10/21 rule per piece is within
 #: 1.1e-11 of scipy's ray integral over 7 pairs of slopes x 8 mu x 23 theta; two pieces [0, R/2], [R/2, R] were 2e-4 off)
 RAY_CUTS = np.array([1.6, 3.2])
+#: the smallest relative tolerance of a ray: its estimate has the floor 50 eps of every piece (QUADPACK's), and below
+#: about that a ray bisected to RAY_MAX intervals (rtol 3e-14: 7e8 evaluations for one mu)
+RAY_ITOL_MIN = 4e-14
+#: the rule over theta
+THETA_RULE = "gk15"
+#: the rule on a ray
+RAY_RULE = "gk21"
 #: the most first pieces of a ray
 N_RAY_CUTS = 24
 
 #: the first theta cut towards a ray parallel to the disc's nearest edge, in units of the edge's distance R(th0), and
 #: the grading's factor 4 from there; only where R(th0) < EDGE_MAX (beyond it the Gaussian barely reaches the edge)
 EDGE_GRADE = 0.125
+EDGE_FACTOR = 4.0
 EDGE_MAX = 1.0
 #: the most graded cuts per side
 N_GRADE = 40
@@ -115,7 +125,10 @@ def _ray(b, e2, itol, tol_abs, nodes, wk, wg, mode, buf, rw):  # pragma: no cove
     top = min(big, R_MAX)
     tail = 0.0
     if big > R_MAX:  # the Gaussian's tail beyond R_MAX, bounded (module docstring)
-        tail = math.exp(-R_MAX * R_MAX) * (0.5 + abs(b) * (0.5 * R_MAX + 0.25 / R_MAX)) * 0.5 * (big - rm)
+        a2 = R_MAX * R_MAX
+        i15 = 0.5 * math.sqrt(R_MAX) * math.exp(-a2) / (1.0 - 0.25 / a2)  # integral_a^inf r^1.5 e^(-r^2) dr at most
+        i25 = 0.5 * R_MAX * math.sqrt(R_MAX) * math.exp(-a2) / (1.0 - 0.75 / a2)  # ... r^2.5 ...
+        tail = math.sqrt(big * (1.0 - rm / R_MAX)) * (i15 + abs(b) * i25)
     # the first pieces: graded by 4 from twice the scale of the singularities next to r = 0 (r_- and the pole of h_z at
     # r = i / |e|: wide lobes), then the Gaussian's RAY_CUTS, each below 3/4 of the range; the last piece ends at the
     # horizon (in tau) where R <= R_MAX
@@ -167,67 +180,91 @@ def _ray(b, e2, itol, tol_abs, nodes, wk, wg, mode, buf, rw):  # pragma: no cove
 
 
 @njit(cache=True, nogil=True)
-def _theta_rule(lo, hi, ax, ay, cx, cy, itol, tol_abs, nodes, wk, wg, mode, buf, ibuf, rw):  # pragma: no cover
+def _theta_rule(lo, hi, ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes, wk, wg, mode, buf, ibuf, rw):  # pragma: no cover
     """(value, error, sum |K|, evaluations) of the 10/21 rule over theta in [lo, hi] for |e| J(theta), the rays' errors
     added through the Kronrod weights."""
     h = hi - lo
     inner = 0.0
     evals = 0
-    for j in range(nodes.shape[0]):
-        th = lo + h * nodes[j]
+    for j in range(tnodes.shape[0]):
+        th = lo + h * tnodes[j]
         ex = ax * math.cos(th)
         ey = ay * math.sin(th)
         e2 = ex * ex + ey * ey
         el = math.sqrt(e2)
         v, ve, ne = _ray(ex * cx + ey * cy, e2, itol, tol_abs / el, nodes, wk, wg, mode, ibuf, rw)
         buf[j] = el * v
-        inner += wk[j] * el * ve
+        inner += twk[j] * el * ve
         evals += ne
-    k, diff, asc, ab = rule_sums(buf, wk, wg)
+    k, diff, asc, ab = rule_sums(buf, twk, twg)
     return k * h, calibrated(diff * h, asc * h, ab * h, mode) + inner * h, ab * h, evals
 
 
 @njit(cache=True, nogil=True)
-def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, nodes, wk, wg, mode, work, buf, ibuf, rw):  # pragma: no cover
+def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk, twg, nodes, wk, wg, mode, work, buf, ibuf, rw):  # pragma: no cover
     """(integral of |e| J over theta, error, converged, evaluations) at one wi = (s cos phi, s sin phi, mu); ``atol``
     applies to this integral (the caller divides by the scale c mu / pi)."""
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     cx = s * math.cos(phi) / mu
     cy = s * math.sin(phi) / mu
-    th0 = math.atan2(-cy / ay, -cx / ax)  # the disc's nearest edge, in the stretched plane
-    ex = ax * math.cos(th0)
-    ey = ay * math.sin(th0)
-    edge = _roots(ex * cx + ey * cy, ex * ex + ey * ey)[0]  # its distance R(th0)
+    cp = math.cos(phi)
+    sp = math.sin(phi)
+    # the disc's edge nearest to h = N is m* = -(cos phi, sin phi)(1 - s) / mu; in the stretched plane it lies in the
+    # direction th0, its tangent in the directions tpar and tpar + pi (not th0 +- pi / 2 unless a_x = a_y), at the
+    # distance edge from the origin
+    th0 = math.atan2(-sp / ay, -cp / ax)
+    tpar = math.atan2(cp / ay, -sp / ax)
+    edge = mu / (1.0 + s) / (ax * ay * math.sqrt((sp / ax) ** 2 + (cp / ay) ** 2))
     lo, hi, val, err, ab = work[0], work[1], work[2], work[3], work[4]
-    # the first intervals: the quarters from th0 and, where the edge is inside the Gaussian (R(th0) < EDGE_MAX, near
-    # grazing incidence), cuts graded towards the rays parallel to it, th0 -+ pi / 2, on th0's side: there R(theta)
-    # rises from R(th0) to beyond R_MAX within an angle of a few R(th0)
-    offs = np.empty(2 * N_GRADE + 5)
-    n = 0
-    for k in range(5):
-        offs[n] = 0.5 * math.pi * (k - 2)
-        n += 1
-    grade = EDGE_GRADE * edge
-    while edge < EDGE_MAX and grade < 0.25 * math.pi and n < offs.shape[0] - 1:
-        offs[n] = 0.5 * math.pi - grade
-        offs[n + 1] = grade - 0.5 * math.pi
-        n += 2
-        grade *= 4.0
-    offs[:n].sort()
     # wi in the plane of a tangent axis (cx or cy = 0): J is even about th0, half the turn is integrated and doubled
     half = cx == 0.0 or cy == 0.0
-    first = n // 2 if half else 0
     twice = 2.0 if half else 1.0
-    itol = 0.25 * rtol
+    # the first intervals, as offsets from th0: th0 + pi, the edge's parallels and, where the edge is inside the
+    # Gaussian (edge < EDGE_MAX, near grazing incidence), cuts graded from each parallel towards th0, where the rays' R
+    # falls from beyond R_MAX to about the edge's distance within an angle of a few times that distance; gaps wider than
+    # pi / 2 halved
+    offs = np.empty(4 * N_GRADE + 16)
+    n = 0
+    offs[n] = 0.0
+    offs[n + 1] = math.pi
+    n += 2
+    if not half:
+        offs[n] = -math.pi
+        n += 1
+    for j in range(2):
+        o = tpar + math.pi * j - th0
+        o -= 2.0 * math.pi * math.floor(o / (2.0 * math.pi) + 0.5)  # in [-pi, pi)
+        if half and o < 0.0:
+            continue  # (the mirror image of the other parallel)
+        offs[n] = o
+        n += 1
+        grade = EDGE_GRADE * edge
+        while edge < EDGE_MAX and grade < 0.5 * abs(o) and n < offs.shape[0] - 8:  # towards th0
+            offs[n] = o - math.copysign(grade, o)
+            n += 1
+            grade *= EDGE_FACTOR
+        grade = EDGE_GRADE * edge
+        while edge < EDGE_MAX and grade < 0.5 * (math.pi - abs(o)) and n < offs.shape[0] - 8:  # away from it
+            offs[n] = o + math.copysign(grade, o)
+            n += 1
+            grade *= EDGE_FACTOR
+    offs[:n].sort()
+    for i in range(n - 1):
+        if offs[i + 1] - offs[i] > 0.5 * math.pi:
+            offs[n] = 0.5 * (offs[i] + offs[i + 1])
+            n += 1
+    offs[:n].sort()
+    itol = max(0.25 * rtol, RAY_ITOL_MIN)
     evals = 0
     # the rays' share of the tolerance: over the turn, at most a quarter of atol, or of rtol times the lower bound so far
     tol_abs = 0.25 * atol / (2.0 * math.pi)
-    for i in range(n - 1 - first):
-        lo[i] = th0 + offs[first + i]
-        hi[i] = th0 + offs[first + i + 1]
-        val[i], err[i], ab[i], ne = _theta_rule(lo[i], hi[i], ax, ay, cx, cy, itol, tol_abs, nodes, wk, wg, mode, buf, ibuf, rw)
+    for i in range(n - 1):
+        lo[i] = th0 + offs[i]
+        hi[i] = th0 + offs[i + 1]
+        val[i], err[i], ab[i], ne = _theta_rule(lo[i], hi[i], ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes, wk,
+                                                wg, mode, buf, ibuf, rw)
         evals += ne
-    m = n - 1 - first
+    m = n - 1
     while True:
         tot = 0.0
         e = 0.0
@@ -249,24 +286,23 @@ def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, nodes, wk, 
         c = 0.5 * (lo[worst] + hi[worst])
         lo[m], hi[m] = c, hi[worst]
         hi[worst] = c
-        val[worst], err[worst], ab[worst], ne = _theta_rule(lo[worst], c, ax, ay, cx, cy, itol, tol_abs, nodes, wk, wg, mode,
-                                                            buf, ibuf, rw)
+        val[worst], err[worst], ab[worst], ne = _theta_rule(lo[worst], c, ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes,
+                                                            wk, wg, mode, buf, ibuf, rw)
         evals += ne
-        val[m], err[m], ab[m], ne = _theta_rule(c, hi[m], ax, ay, cx, cy, itol, tol_abs, nodes, wk, wg, mode, buf, ibuf, rw)
+        val[m], err[m], ab[m], ne = _theta_rule(c, hi[m], ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes, wk, wg, mode, buf, ibuf, rw)
         evals += ne
         m += 1
 
 
 @njit(cache=True, nogil=True)
-def _slope_all(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, nodes, wk, wg, mode, val, err, conv, evals):  # pragma: no cover
-    n = nodes.shape[0]
-    work = np.empty((5, max(max_intervals, 2 * N_GRADE + 4) + 1))
-    buf = np.empty(n)
-    ibuf = np.empty(n)
+def _slope_all(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk, twg, nodes, wk, wg, mode, val, err, conv, evals):  # pragma: no cover
+    work = np.empty((5, max(max_intervals, 4 * N_GRADE + 16) + 1))
+    buf = np.empty(tnodes.shape[0])
+    ibuf = np.empty(nodes.shape[0])
     rw = np.empty((5, RAY_MAX))
     for i in range(mu.shape[0]):
         val[i], err[i], conv[i], evals[i] = _slope_one(mu[i], phi[i], ax, ay, rtol, atol[i], max_intervals, rounding,
-                                                       nodes, wk, wg, mode, work, buf, ibuf, rw)
+                                                       tnodes, twk, twg, nodes, wk, wg, mode, work, buf, ibuf, rw)
 
 
 def takes_slope_path(brdf, mu: np.ndarray) -> bool:
@@ -281,7 +317,7 @@ def takes_slope_path(brdf, mu: np.ndarray) -> bool:
 def slope_albedo(brdf, mu: np.ndarray, phi: np.ndarray, rtol: float, atol: float, max_regions: int):
     """(value, error, converged, evaluations) of the albedo of anisotropic Ward ``brdf`` at every (mu, phi) (1-D float
     arrays of one length; phi the azimuth of wi from the tangent x axis)."""
-    from ._polar import NODES21, ROUNDING, WG21, WK21
+    from ._polar import _RULES, ROUNDING
 
     ax, ay, c = brdf.slope()
     mu = np.ascontiguousarray(mu, dtype=np.float64)
@@ -296,7 +332,7 @@ def slope_albedo(brdf, mu: np.ndarray, phi: np.ndarray, rtol: float, atol: float
     conv = np.empty(mu.shape, bool)
     evals = np.empty(mu.shape, np.int64)
     _slope_all(mu, phi, float(ax), float(ay), float(rtol), atol_q, int(min(max(max_regions, 4), 10000)), ROUNDING,
-               NODES21, WK21, WG21, mode_code(), val, err, conv, evals)
+               *_RULES[THETA_RULE], *_RULES[RAY_RULE], mode_code(), val, err, conv, evals)
     return scale * val, np.abs(scale) * err, conv, evals
 
 
