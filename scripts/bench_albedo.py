@@ -22,6 +22,8 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
     python scripts/bench_albedo.py --cells    # only the sweep cells and the pumped tables
     python scripts/bench_albedo.py --eval     # only BRDF.eval's overhead (the input checks) and numpy
     python scripts/bench_albedo.py --phong    # only the Phong family's rows (1-D path), no dblquad
+    python scripts/bench_albedo.py --slope    # only anisotropic Ward: the slope path (issue 14's fourteenth session)
+                                              # against the nested engine
     python scripts/bench_albedo.py --p        # only the p-model with p in (0, 1): 1-D path against the nested engine
     python scripts/bench_albedo.py --half     # only the models put on the 1-D path in issue 14's sixth session
                                               # (half vector, closed forms) against the nested engine
@@ -110,7 +112,7 @@ def evaluations(f, mu, rtol):
     """Integrand evaluations of pumpup.albedo(f, mu): the 1-D path's own count, the nested engine's
     (``pumpup._nested.LAST_EVALS`` of every call), the 2-D engine's points counted at its
     accumulation step (once per sign of beta)."""
-    from pumpup import _nested, _polar
+    from pumpup import _nested, _polar, _slope
 
     A = pumpup.albedo_module
     count = [0]
@@ -130,6 +132,9 @@ def evaluations(f, mu, rtol):
     _nested.integrate = counting_nested
     try:
         for _, term in f.albedo_terms():
+            if _slope.takes_slope_path(term, mu):
+                count[0] += int(_slope.slope_albedo(term, mu, np.zeros(mu.shape), rtol, 1e-14, 20000)[3].sum())
+                continue
             fast = _polar.albedo_1d(term, mu, rtol, 1e-14, 20000)
             if fast is not None:
                 count[0] += int(fast[3].sum())
@@ -142,9 +147,12 @@ def evaluations(f, mu, rtol):
 
 
 def path_of(f):
-    """'1-D' (closed-form azimuth), 'nst' (nested quadrature) or '2-D' (cubature) for f at phi = 0."""
-    from pumpup import _nested
+    """'1-D' (closed-form azimuth), 'slp' (anisotropic Ward in slope space), 'nst' (nested quadrature) or '2-D' (cubature)
+    for f at phi = 0."""
+    from pumpup import _nested, _slope
 
+    if all(_slope.takes_slope_path(t, np.array([0.5])) for _, t in f.albedo_terms()):
+        return "slp"
     if all(t.polar() is not None for _, t in f.albedo_terms()):
         return "1-D"
     A = pumpup.albedo_module
@@ -184,13 +192,13 @@ def families(rtol=1e-10, specs=None, dblquad=True):
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     print(f"257-point tables at rtol {rtol:g}, one thread (ms); evaluations per mu; previous = the 2-D engine "
-          f"(paths: 1-D closed-form azimuth, nst nested quadrature, 2-D cubature)")
+          f"(paths: 1-D closed-form azimuth, slp slope space, nst nested quadrature, 2-D cubature)")
     print(f"{'model':58s} {'path':4s} {'albedo':>9s} {'tabulate':>9s} {'evals/mu':>9s} "
           f"{'previous':>9s} {'evals/mu':>9s} {'ratio':>7s} {'dblquad/value':>14s} {'x per value':>11s}")
     for spec in FAMILIES if specs is None else specs:
         f = pumpup.load(spec)
         path = path_of(f)
-        one_d = path == "1-D"
+        one_d = path in ("1-D", "slp")
         repeat = (3 if one_d else 1) if dblquad else 20
         pumpup.albedo(f, [0.5, 1e-3])  # compile / load the kernels
         _, t_new = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), repeat)
@@ -588,6 +596,52 @@ def eval_overhead(n=1_000_000, repeat=15):
               f"eval / _eval = {ratio('previous eval', 'previous _eval')}", flush=True)
 
 
+def slope(rtol=1e-10, repeat=3):
+    """Anisotropic Ward in slope space (pumpup._slope, issue 14's fourteenth session) against the nested engine it took
+    before (``_polar.without_1d`` switches both off), same run: a 257-point table (mu uniform in theta) at phi = 0 and at
+    phi = 0.7, one thread, best of ``repeat`` (nested: 1), with the slope path's evaluations per mu."""
+    from pumpup import _polar, _slope
+
+    mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
+    specs = [{"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, {"type": "ward_aniso", "ax": 0.05, "ay": 0.5},
+             {"type": "ward_aniso", "ax": 0.4, "ay": 0.02}, {"type": "ward_aniso", "ax": 0.01, "ay": 0.01},
+             {"type": "ward_aniso", "ax": 0.001, "ay": 1.0}]
+    print(f"anisotropic Ward: the slope path against the nested engine, one thread, ms; 257 mu at rtol {rtol:g}")
+    print(f"{'model':48s} {'phi':>4s} {'slope':>8s} {'evals/mu':>8s} {'nested':>8s} {'evals/mu':>8s} {'ratio':>6s}")
+    for spec in specs:
+        f = pumpup.load(spec)
+        for phi in (0.0, 0.7):
+            pumpup.albedo(f, [0.5, 1e-3], phi=phi, rtol=rtol)
+            _, t1 = _best(lambda: pumpup.albedo(f, mu, phi=phi, rtol=rtol), repeat)
+            ev1 = np.mean(_slope.slope_albedo(f, mu, np.full(mu.shape, phi), rtol, 0.0, 10000)[3])
+            with _polar.without_1d():
+                pumpup.albedo(f, [0.5, 1e-3], phi=phi, rtol=rtol)
+                _, t2 = _best(lambda: pumpup.albedo(f, mu, phi=phi, rtol=rtol), 1)
+                ev2 = evaluations_nested(f, mu, phi, rtol)
+            print(f"{str(spec):48s} {phi:4.1f} {t1 * 1e3:8.1f} {ev1:8.0f} {t2 * 1e3:8.1f} {ev2:8.0f} {t2 / t1:6.1f}",
+                  flush=True)
+
+
+def evaluations_nested(f, mu, phi, rtol):
+    """The nested engine's integrand evaluations per mu (``pumpup._nested.LAST_EVALS`` of every call) at azimuth phi."""
+    from pumpup import _nested
+
+    count = [0]
+    orig = _nested.integrate
+
+    def counting(*args):
+        out = orig(*args)
+        count[0] += int(_nested.LAST_EVALS.sum())
+        return out
+
+    _nested.integrate = counting
+    try:
+        pumpup.albedo(f, mu, phi=phi, rtol=rtol)
+    finally:
+        _nested.integrate = orig
+    return count[0] / len(mu)
+
+
 def main():
     import os
 
@@ -628,6 +682,9 @@ def main():
         return
     if "--breaks" in sys.argv:
         breaks()
+        return
+    if "--slope" in sys.argv:
+        slope()
         return
     if "--cells" not in sys.argv:
         families()
