@@ -52,9 +52,12 @@ where the hint is not even in beta), and two compiled passes (:func:`pumpup.albe
 form the Kronrod and Gauss sums; each has a plain numpy twin (``*_reference``) that the tests compare
 with it.
 
-Groups with wi turned out of the xz-plane (``phi != 0``) and hint-less BRDFs (a
-:func:`pumpup.from_function`, integrated by the 2-D engine's generic path) are left to the 2-D
-engine.  :func:`pumpup._polar.two_d_only` switches this path off too (the 2-D engine stays the
+Groups with wi turned out of the xz-plane (``phi != 0``) are integrated in the frame of wi at phi = 0 and the points
+turned by phi about N before ``_eval``, as the 2-D engine does (issue 14, fourteenth session; before, they were left to
+the 2-D engine, whose first grid missed the visible tail of a ridge just past a break: ward_aniso ax = 1, ay = 0.001 at
+mu = 0.9877, phi = 0.4 was 1.3e-8 off with an estimate of 5e-14, where the outer substitution towards a break
+(``OUTER_SUB``) puts a node within 2e-6 of the interval of it).  Hint-less BRDFs (a :func:`pumpup.from_function`,
+integrated by the 2-D engine's generic path) are left to the 2-D engine.  :func:`pumpup._polar.two_d_only` switches this path off too (the 2-D engine stays the
 reference); :func:`disabled` switches off only this path.
 """
 
@@ -79,6 +82,7 @@ from .albedo import (
     _power_split,
     _radial,
     _radial_scalar,
+    _rotate,
     _rounding,
     _smooth,
     _smooth_inverse,
@@ -128,7 +132,7 @@ def supports(g) -> bool:
     """Whether this path integrates the group ``g`` (a ``pumpup.albedo._Group``)."""
     from . import _polar
 
-    if not (ENABLED and _polar.ENABLED) or g.phi is not None:
+    if not (ENABLED and _polar.ENABLED):
         return False
     lobe = g.lobe
     generic = lobe.axis == "normal" and lobe.radial == "cosine" and not lobe.symmetric
@@ -444,14 +448,18 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
         v_[:] = 0.0
         _points_kernel(axis, b_node[sl], b_lo[sl], b_w[sl], b_t0[sl], b_t1[sl], sm[sl], mu_n, s_n, ca_n, sa_n, wr_n,
                        inodes, wi_, wo_, w_)
+        if g.phi is not None:  # wi at azimuth phi: the whole configuration turned by phi about N, as the 2-D engine does
+            ph = np.repeat(g.phi[pnode[b_node[sl]]], RI)
+            cp, sp = np.cos(ph), np.sin(ph)
         for sign in signs:
             if sign < 0:
-                wo_[:, 1] *= -1.0  # beta -> -beta flips wo_y in every frame (wi_y = 0)
-            f = np.ascontiguousarray(brdf._eval(wi_, wo_), dtype=np.float64)
-            i = _accumulate(f, wo_[:, 2], w_, v_)
+                wo_[:, 1] *= -1.0  # beta -> -beta flips wo_y in every frame (wi_y = 0), before the turn
+            wi_t, wo_t = (wi_, wo_) if g.phi is None else (_rotate(wi_, cp, sp), _rotate(wo_, cp, sp))
+            f = np.ascontiguousarray(brdf._eval(wi_t, wo_t), dtype=np.float64)
+            i = _accumulate(f, wo_[:, 2], w_, v_)  # (N.wo is unchanged by the turn)
             if i >= 0:
                 raise ValueError(
-                    f"{brdf!r} returned {f[i]!r} at wi={wi_[i].tolist()}, wo={wo_[i].tolist()}: "
+                    f"{brdf!r} returned {f[i]!r} at wi={wi_t[i].tolist()}, wo={wo_t[i].tolist()}: "
                     "a BRDF must be finite and non-negative above the horizon"
                 )
         _rule_kernel(v_, iwk, iwg, Kb[sl], Gb[sl])

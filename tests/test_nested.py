@@ -232,11 +232,11 @@ def test_two_d_only_and_disabled_switch_the_nested_path_off(monkeypatch):
     pumpup.albedo(f, 0.5, phi=0.3)  # isotropic: phi ignored, nested
     assert calls == [1, 1]
     aniso = pumpup.load({"type": "ward_aniso", "ax": 0.1, "ay": 0.3})
-    pumpup.albedo(aniso, 0.5, phi=0.3)  # wi out of the xz-plane: the 2-D engine
-    assert calls == [1, 1]
+    pumpup.albedo(aniso, 0.5, phi=0.3)  # wi out of the xz-plane: nested too, turned (issue 14, fourteenth session)
+    assert calls == [1, 1, 1]
     user = pumpup.from_function(lambda wi, wo: np.full(wi.shape[:-1], 1 / np.pi), name="flat")
     pumpup.albedo(user, 0.5)  # no hint: the 2-D engine's generic path
-    assert calls == [1, 1]
+    assert calls == [1, 1, 1]
 
 
 def test_budget_exhausted_warns_and_the_error_stays_honest():
