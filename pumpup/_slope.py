@@ -63,6 +63,7 @@ import numpy as np
 from numba import njit
 
 from ._errors import calibrated, mode_code, rule_sums
+from ._polar import _tally
 
 __all__ = ["slope_albedo", "takes_slope_path", "ray_reference", "ray_integral"]
 
@@ -174,14 +175,7 @@ def _ray(b, e2, itol, tol_abs, nodes, wk, wg, mode, buf, rw):  # pragma: no cove
     m += 1
     evals = m * n
     while True:
-        tot = 0.0
-        e = tail
-        worst = 0
-        for i in range(m):
-            tot += val[i]
-            e += err[i]
-            if err[i] > err[worst]:
-                worst = i
+        tot, e, worst = _tally(val, err, m, 0.0, tail)
         if e <= max(itol * abs(tot), tol_abs) or m >= lo.shape[0]:
             return tot, e, evals
         c = 0.5 * (lo[worst] + hi[worst])
@@ -195,8 +189,8 @@ def _ray(b, e2, itol, tol_abs, nodes, wk, wg, mode, buf, rw):  # pragma: no cove
 
 @njit(cache=True, nogil=True)
 def _theta_rule(lo, hi, ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes, wk, wg, mode, buf, ibuf, rw):  # pragma: no cover
-    """(value, error, sum |K|, evaluations) of the 10/21 rule over theta in [lo, hi] for |e| J(theta), the rays' errors
-    added through the Kronrod weights."""
+    """(value, error, sum |K|, evaluations) of the rule over theta (:data:`THETA_RULE`) in [lo, hi] for |e| J(theta),
+    the rays' errors added through the Kronrod weights."""
     h = hi - lo
     inner = 0.0
     evals = 0
