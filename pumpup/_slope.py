@@ -89,8 +89,9 @@ RAY_RULE = "gk21"
 #: the most first pieces of a ray
 N_RAY_CUTS = 24
 
-#: the first theta cut towards a ray parallel to the disc's nearest edge, in units of the edge's distance R(th0), and
-#: the grading's factor 4 from there; only where R(th0) < EDGE_MAX (beyond it the Gaussian barely reaches the edge)
+#: the first theta cut on either side of a ray parallel to the disc's nearest edge, in units of the edge's distance from
+#: the origin in the stretched plane, and the grading's factor from there; only where that distance is below EDGE_MAX
+#: (beyond it the Gaussian barely reaches the edge)
 EDGE_GRADE = 0.125
 EDGE_FACTOR = 4.0
 EDGE_MAX = 1.0
@@ -346,10 +347,10 @@ def slope_albedo(brdf, mu: np.ndarray, phi: np.ndarray, rtol: float, atol: float
 
 def ray_integral(b: float, e2: float, rtol: float = 1e-13) -> tuple:
     """(J, error, evaluations) of the compiled ray integral (module docstring) at b = e.c and e2 = |e|^2."""
-    from ._polar import NODES21, WG21, WK21
+    from ._polar import _RULES
 
-    n = len(NODES21)
-    return _ray(float(b), float(e2), float(rtol), 0.0, NODES21, WK21, WG21, mode_code(), np.empty(n), np.empty((5, RAY_MAX)))
+    nodes, wk, wg = _RULES[RAY_RULE]
+    return _ray(float(b), float(e2), float(rtol), 0.0, nodes, wk, wg, mode_code(), np.empty(len(nodes)), np.empty((5, RAY_MAX)))
 
 
 def ray_reference(b: float, e2: float) -> float:
