@@ -6,7 +6,10 @@ uniform in theta) and 4 azimuths of wi (0, 0.4, pi / 4 + 0.1, pi / 2), at rtol 1
 the half vector's polar angle and azimuth, another parametrisation), its own error counted in the slope path's favour.
 Where that ratio exceeds 1/2, the third method decides: the two nested-quad methods of
 ``scripts/independent_ward_aniso.py`` (written without pumpup), their difference and estimates counted in the slope
-path's favour; the worst ratio against the nested engine and against the decider are both printed.  (At a_x / a_y = 1000
+path's favour; the worst ratio against the nested engine and against the decider are both printed.  Where their own
+error exceeds the estimate (mu = 1e-8: the quad methods reach only ~1e-5) the case is listed as undecided, with its
+ratio against the nested engine, and left out of the worst ratio; scripts/independent_ward_aniso_grazing.py decides
+the one such case of this grid (the nested engine is 2e-12 off there, the slope path within 0.002 of its estimate).  (At a_x / a_y = 1000
 the nested engine is off by up to 1.3e-8 with estimates of 5e-14: ``tests/data/independent_ward_aniso.json``.)
 Also the mean evaluations per mu at each rtol.
 
@@ -47,6 +50,7 @@ def main():
     mu = np.concatenate([[_slope.MU_MIN, 1e-8, 1e-4, 0.003], np.cos(np.linspace(0.0, 0.5 * math.pi, 11)[:-1])])
     worst, worst_at = 0.0, None
     evals = {r: [] for r in RTOLS}
+    undecided = []
     n = 0
     for ax, ay in PAIRS:
         f = pumpup.load({"type": "ward_aniso", "ax": ax, "ay": ay})
@@ -67,7 +71,11 @@ def main():
                     print(f"  ratio {ratio[j]:.3g} against the nested engine, {r3:.3g} against the independent methods: "
                           f"{(ax, ay)} mu {mu[j]:.4g} phi {phi:.3f} rtol {rtol:g}: {v[j]!r} +- {e[j]:.2g}, nested "
                           f"{ref[j]!r} +- {ref_err[j]:.2g}, independent {d!r} +- {de:.2g}", flush=True)
-                    ratio[j] = min(ratio[j], r3)
+                    if de > e[j]:  # (the independent methods are not accurate enough there to decide)
+                        undecided.append(((ax, ay), float(mu[j]), round(phi, 4), rtol, float(ratio[j])))
+                        ratio[j] = 0.0
+                    else:
+                        ratio[j] = min(ratio[j], r3)
                 i = int(np.argmax(ratio))
                 if ratio[i] > worst:
                     worst, worst_at = float(ratio[i]), ((ax, ay), float(mu[i]), round(phi, 4), rtol,
@@ -75,6 +83,7 @@ def main():
         print(f"  {(ax, ay)} done, worst so far {worst:.3g} ({time.perf_counter() - t0:.0f} s)", flush=True)
     print(f"{n} albedos: worst true error / estimate {worst:.3g} at {worst_at} (against the nested engine, or the independent "
           f"methods where they decided)")
+    print(f"undecided (the independent methods' error above the estimate; ratio against the nested engine): {undecided}")
     for r in RTOLS:
         print(f"  rtol {r:g}: mean evaluations per mu {np.mean(np.concatenate(evals[r])):.0f}")
 
