@@ -108,9 +108,9 @@ def _best(fn, repeat):
     return out, best
 
 
-def evaluations(f, mu, rtol):
-    """Integrand evaluations of pumpup.albedo(f, mu): the 1-D path's own count, the nested engine's
-    (``pumpup._nested.LAST_EVALS`` of every call), the 2-D engine's points counted at its
+def evaluations(f, mu, rtol, phi=0.0):
+    """Integrand evaluations of pumpup.albedo(f, mu, phi=phi): the 1-D path's or the slope path's own count, the nested
+    engine's (``pumpup._nested.LAST_EVALS`` of every call), the 2-D engine's points counted at its
     accumulation step (once per sign of beta)."""
     from pumpup import _nested, _polar, _slope
 
@@ -133,13 +133,13 @@ def evaluations(f, mu, rtol):
     try:
         for _, term in f.albedo_terms():
             if _slope.takes_slope_path(term, mu):
-                count[0] += int(_slope.slope_albedo(term, mu, np.zeros(mu.shape), rtol, 1e-14, 20000)[3].sum())
+                count[0] += int(_slope.slope_albedo(term, mu, np.full(mu.shape, phi), rtol, 1e-14, 20000)[3].sum())
                 continue
-            fast = _polar.albedo_1d(term, mu, rtol, 1e-14, 20000)
+            fast = _polar.albedo_1d(term, mu, rtol, 1e-14, 20000) if phi == 0.0 else None
             if fast is not None:
                 count[0] += int(fast[3].sum())
             else:
-                pumpup.albedo(term, mu, rtol=rtol)
+                pumpup.albedo(term, mu, phi=phi, rtol=rtol)
     finally:
         A._accumulate = orig
         _nested.integrate = orig_nested
@@ -600,7 +600,7 @@ def slope(rtol=1e-10, repeat=3):
     """Anisotropic Ward in slope space (pumpup._slope, issue 14's fourteenth session) against the nested engine it took
     before (``_polar.without_1d`` switches both off), same run: a 257-point table (mu uniform in theta) at phi = 0 and at
     phi = 0.7, one thread, best of ``repeat`` (nested: 1), with the slope path's evaluations per mu."""
-    from pumpup import _polar, _slope
+    from pumpup import _polar
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     specs = [{"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, {"type": "ward_aniso", "ax": 0.05, "ay": 0.5},
@@ -613,33 +613,13 @@ def slope(rtol=1e-10, repeat=3):
         for phi in (0.0, 0.7):
             pumpup.albedo(f, [0.5, 1e-3], phi=phi, rtol=rtol)
             _, t1 = _best(lambda: pumpup.albedo(f, mu, phi=phi, rtol=rtol), repeat)
-            ev1 = np.mean(_slope.slope_albedo(f, mu, np.full(mu.shape, phi), rtol, 0.0, 10000)[3])
+            ev1 = evaluations(f, mu, rtol, phi)
             with _polar.without_1d():
                 pumpup.albedo(f, [0.5, 1e-3], phi=phi, rtol=rtol)
                 _, t2 = _best(lambda: pumpup.albedo(f, mu, phi=phi, rtol=rtol), 1)
-                ev2 = evaluations_nested(f, mu, phi, rtol)
+                ev2 = evaluations(f, mu, rtol, phi)
             print(f"{str(spec):48s} {phi:4.1f} {t1 * 1e3:8.1f} {ev1:8.0f} {t2 * 1e3:8.1f} {ev2:8.0f} {t2 / t1:6.1f}",
                   flush=True)
-
-
-def evaluations_nested(f, mu, phi, rtol):
-    """The nested engine's integrand evaluations per mu (``pumpup._nested.LAST_EVALS`` of every call) at azimuth phi."""
-    from pumpup import _nested
-
-    count = [0]
-    orig = _nested.integrate
-
-    def counting(*args):
-        out = orig(*args)
-        count[0] += int(_nested.LAST_EVALS.sum())
-        return out
-
-    _nested.integrate = counting
-    try:
-        pumpup.albedo(f, mu, phi=phi, rtol=rtol)
-    finally:
-        _nested.integrate = orig
-    return count[0] / len(mu)
 
 
 def main():

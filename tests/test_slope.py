@@ -1,5 +1,6 @@
-"""Anisotropic Ward in slope space (pumpup._slope, issue 14): the ray integral against scipy, the albedo against the nested
-engine (another parametrisation), Ward's isotropic 1-D path (elliptic integrals) and the model's symmetries."""
+"""Anisotropic Ward in slope space (pumpup._slope, issue 14): the ray integral against scipy, the albedo against the
+independent references (tests/data/independent_ward_aniso.json, the long-double grazing values), the nested engine
+(another parametrisation), Ward's isotropic 1-D path (elliptic integrals) and the model's symmetries."""
 
 import json
 import math
@@ -68,7 +69,7 @@ def test_symmetries_of_the_azimuth():
     mu = np.array([0.02, 0.3, 0.8])
     for phi in (0.7, 0.0):
         a, ea = pumpup.albedo(f, mu, phi=phi, rtol=1e-11, return_error=True)
-        for other in (-phi, math.pi - phi, phi + math.pi, (1e-300 if phi == 0.0 else phi)):
+        for other in (-phi, math.pi - phi, phi + math.pi) + ((1e-300,) if phi == 0.0 else ()):
             b, eb = pumpup.albedo(f, mu, phi=other, rtol=1e-11, return_error=True)
             assert np.all(np.abs(a - b) <= ea + eb), (phi, other, a - b, ea, eb)
 
