@@ -21,9 +21,10 @@ beta only through N.wo, so for every u the integral over the visible arc |beta| 
   2 [beta1 + (a (beta0 - beta1) + b (sin beta0 - sin beta1)) / mu];
 * 0 < p < 1, f = c u^n / max(mu, N.wo)^p (000 eq. 12): the arc where N.wo < mu in closed form as
   for p = 1, divided by mu^p, plus H = integral_0^beta1 (a + b cos beta)^(1 - p) d beta, which is
-  not elementary: an inner quadrature per value of u (:func:`_arc_power`: the 7/15 rule in beta,
-  and near grazing incidence a Gauss-Jacobi rule for the weight (N.wo)^(1 - p) at the arc's end
-  where N.wo -> mu -> 0), its error added to the outer estimate through the outer weights
+  not elementary: an inner quadrature per value of u (:func:`_arc_power`: with N.wo = T - D s^2 an even analytic
+  integrand in s, by the fewest Gauss-Legendre points whose Bernstein-ellipse error bound meets the tolerance, and
+  near grazing incidence a Gauss-Jacobi rule for the weight (N.wo)^(1 - p) at the arc's end where N.wo -> mu -> 0),
+  its error added to the outer estimate through the outer weights
 
 (the same closed form as Lewis's H_s, 002 sec. 4.1, and as ``phong_1d`` of
 ``scripts/independent_reference.py``).  With b^2 - a^2 = sin^2(alpha) - mu^2 and
@@ -317,8 +318,8 @@ def two_d_only():
 # --- the integrand ----------------------------------------------------------------------------
 
 
-#: the inner rule on the arc where N.wo >= mu (p in (0, 1)) is the engine's 7/15 Gauss-Kronrod pair,
-#: globally adaptive on at most INNER_MAX intervals
+#: the inner rule on the arc where N.wo >= mu (p in (0, 1)), should the Gauss-Legendre bound (:func:`_arc_bound`) want
+#: more than GL_MAX points, is the engine's 7/15 Gauss-Kronrod pair, globally adaptive on at most INNER_MAX intervals
 INNER_MAX = 64
 #: the inner rule's relative tolerance is rtol / 8, but not below this (its rounding floor is
 #: QUADPACK's 50 eps of the integral)
@@ -371,10 +372,82 @@ def _tally(val, err, m, tot, e):  # pragma: no cover - compiled
     return tot, e, worst
 
 
+#: the Gauss-Legendre rules of the arc's piece in s (:func:`_arc_bound`), n = 1 .. GL_MAX points: row n holds the
+#: nodes x >= 0 (``GL_X``) and their weights, doubled for x > 0 (``GL_W``): the piece's integrand is even in s
+GL_MAX = 64
+
+
+def _gl_tables():
+    xs, ws = np.zeros((GL_MAX + 1, (GL_MAX + 1) // 2)), np.zeros((GL_MAX + 1, (GL_MAX + 1) // 2))
+    for n in range(1, GL_MAX + 1):
+        x, w = np.polynomial.legendre.leggauss(n)
+        keep = x >= -1e-300  # the nonnegative half (and the middle node of an odd rule, once)
+        xs[n, :keep.sum()] = np.abs(x[keep])[::-1]
+        ws[n, :keep.sum()] = np.where(np.abs(x[keep]) > 1e-300, 2.0 * w[keep], w[keep])[::-1]
+    xs.flags.writeable = False
+    ws.flags.writeable = False
+    return xs, ws
+
+
+GL_X, GL_W = _gl_tables()
+#: the Bernstein ellipses tried for the piece's bound: log(rho) = f log(rho_max), f in ARC_RHO (the last one only where
+#: the nearest singularity is t^q's branch point, where the integrand stays bounded up to rho_max)
+ARC_RHO = (0.9, 0.97, 0.999)
+
+
 @njit(cache=True, nogil=True)
-def _arc_power(q, mu, a, b, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iwork, jac):  # pragma: no cover - compiled
+def _arc_bound(q, big_t, d, b, c, tol):  # pragma: no cover - compiled; see arc_piece_reference
+    """(n, bound): the fewest Gauss-Legendre points (at most GL_MAX; GL_MAX + 1 if none suffices) whose error on
+    P = sqrt(D) c integral_-1^1 F(c x) dx, F(s) = t^q (t - L)^-1/2, t = T - D s^2, is at most ``tol``, and that error
+    bound.  F is analytic but where t = 0 (s^2 = s0^2 = T / D, t^q's branch point) or t = L (s^2 = s1^2 = 2 b / D,
+    a pole of order 1/2): inside the Bernstein ellipse E_rho of x, |x| <= A = (rho + 1 / rho) / 2, so where c A < min(s0,
+    s1) |t| <= T + D c^2 A^2 < 2 T and |t - L| = D |s1^2 - s^2| >= D (s1^2 - c^2 A^2): |F| <= M = (2 T)^q /
+    sqrt(D (s1^2 - c^2 A^2)).  The n-point Gauss rule's error is then at most 64 M / (15 (1 - rho^-2) rho^(2 n))
+    (Trefethen, Approximation Theory and Approximation Practice, Thm 19.3) times sqrt(D) c.  ``ARC_RHO`` are the
+    ellipses tried; the smallest n wins."""
+    s0sq = big_t / d
+    s1sq = 2.0 * b / d
+    best_n = GL_MAX + 1
+    best = 0.0
+    if not tol > 0.0:
+        return best_n, best
+    r = math.sqrt(min(s0sq, s1sq)) / c
+    lrmax = math.log(r + math.sqrt((r - 1.0) * (r + 1.0)))
+    lead = math.log(c * 64.0 / 15.0 * (2.0 * big_t) ** q / tol)  # sqrt(D) c M sqrt(gap) / tol
+    for k in range(len(ARC_RHO)):
+        f = ARC_RHO[k]
+        if f > 0.99 and s1sq <= s0sq:
+            continue
+        lrho = f * lrmax
+        rho = math.exp(lrho)
+        big_a = 0.5 * (rho + 1.0 / rho)
+        gap = s1sq - c * c * big_a * big_a
+        if gap <= 0.0:
+            continue
+        lb = lead - 0.5 * math.log(gap) - math.log(1.0 - 1.0 / (rho * rho))
+        n = max(1, int(math.ceil(lb / (2.0 * lrho))))
+        if n < best_n:
+            best_n = n
+            best = math.exp(lb - 2.0 * n * lrho) * tol
+    return best_n, best
+
+
+@njit(cache=True, nogil=True)
+def _arc_piece(q, big_t, d, b, c, n):  # pragma: no cover - compiled; see arc_piece_reference
+    """P = sqrt(D) c integral_-1^1 F(c x) dx by the n-point Gauss-Legendre rule, F even (:func:`_arc_bound`):
+    integral_(T - D c^2)^T t^q / sqrt((T - t)(t - L)) dt with t = T - D s^2, 2 b = T - L."""
+    tot = 0.0
+    for j in range((n + 1) // 2):
+        s2 = c * c * GL_X[n, j] * GL_X[n, j]
+        t = big_t - d * s2
+        tot += GL_W[n, j] * t**q / math.sqrt(2.0 * b - d * s2)
+    return math.sqrt(d) * c * tot
+
+
+@njit(cache=True, nogil=True)
+def _arc_power(q, mu, a, b, d1, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iwork, jac):  # pragma: no cover - compiled
     """(H, error) of H = integral_0^beta1 (a + b cos beta)^q d beta, q = 1 - p in (0, 1): the arc
-    where N.wo = a + b cos beta >= mu (000 eq. 12's max(N.L, N.V) = N.wo there).
+    where N.wo = a + b cos beta >= mu (000 eq. 12's max(N.L, N.V) = N.wo there); d1 = b^2 - (mu - a)^2.
 
     With t = N.wo, d beta = dt / sqrt((T - t)(t - L)), T = a + b (beta = 0), L = a - b: H is
     integral_mu^T t^q / sqrt((T - t)(t - L)) dt.  Where T > 4 mu (near grazing incidence: (N.wo)^q
@@ -382,21 +455,22 @@ def _arc_power(q, mu, a, b, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iwork,
     integral_0^(T/2) - integral_0^mu by the Gauss-Jacobi rule for the weight t^q (``jac``: nodes and
     weights of two orders, the higher one's value, the difference its error): the rest of the
     integrand has its singularities at T and at L <= mu - (T - 2 mu) < -T / 2, at least T / 2 away,
-    and the rules converge geometrically (measured: 1e-13 at 8 nodes, 1e-16 at 10); the range
-    t in [T / 2, T] is beta in [0, arccos((T / 2 - a) / b)].  Where T <= 4 mu the whole arc is
-    one piece in beta.  The beta piece is globally adaptive: one interval of the 7/15 rule to start,
-    the one with the largest error bisected until the summed error (QUADPACK's calibrated estimate:
-    the piece is analytic) is at most ``rtol`` times a lower bound of K = ``rest`` + H (``rest``
-    >= 0, H at least its estimate less its error, and at least beta1 mu^q) or INNER_MAX intervals
-    are used; the error is returned either way.  ``iwork`` (4 x INNER_MAX) holds the intervals.
-    """
+    and the rules converge geometrically (measured: 1e-13 at 8 nodes, 1e-16 at 10).  The rest,
+    t from T - D c^2 (mu, or T / 2 beyond 4 mu) to T, is t = T - D s^2, s in [0, c] (D = T - mu = d1 / (b + mu - a),
+    without cancellation): an even, analytic integrand in s (:func:`_arc_piece`), by the fewest Gauss-Legendre
+    points whose a-priori error bound (:func:`_arc_bound`) meets ``rtol`` times a lower bound of K = ``rest`` + H
+    (``rest`` >= 0, H >= beta1 mu^q), its rounding added; about 5 values of t^q per call where the 7/15 rule in beta
+    took 15 to 45 (issue 14's fifteenth session).  Should the bound want more than GL_MAX points, the piece is
+    the 7/15 rule in beta, globally adaptive on at most INNER_MAX intervals (``iwork``, 4 x INNER_MAX), until
+    the summed calibrated error meets the same tolerance; the error is returned either way."""
     if beta1 <= 0.0:
         return 0.0, 0.0
-    lo, hi, val, err = iwork[0], iwork[1], iwork[2], iwork[3]
     top = a + b
+    d = d1 / (b + (mu - a))  # T - mu
     fixed = 0.0  # the Gauss-Jacobi part and its error
     fixed_err = 0.0
     end = beta1
+    c = 1.0
     if top > 4.0 * mu:
         low = a - b
         half = 0.5 * top
@@ -406,6 +480,16 @@ def _arc_power(q, mu, a, b, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iwork,
         fixed = q2
         fixed_err = abs(q2 - q1) + 64.0 * EPS * abs(q2)
         end = math.acos((half - a) / b)
+        c = math.sqrt(half / d)  # T - D c^2 = T / 2
+    low_h = beta1 * mu**q  # H's lower bound: t >= mu on the arc, and t >= T / 2 on the piece beyond the Jacobi part
+    if fixed > 0.0:
+        low_h = max(low_h, fixed - fixed_err + end * (0.5 * top) ** q)
+    tol = rtol * (rest + low_h)
+    n, bound = _arc_bound(q, top, d, b, c, max(tol - fixed_err, 0.5 * tol))
+    if n <= GL_MAX:
+        h = _arc_piece(q, top, d, b, c, n)
+        return fixed + h, fixed_err + bound + (n + 16) * EPS * h  # n / 2 terms of a few roundings each, and T, D's
+    lo, hi, val, err = iwork[0], iwork[1], iwork[2], iwork[3]
     lo[0], hi[0] = 0.0, end
     val[0], err[0] = _arc_rule(q, a, b, 0.0, end, nodes, wk, wg, mode, ibuf)
     m = 1
@@ -419,6 +503,16 @@ def _arc_power(q, mu, a, b, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iwork,
         val[worst], err[worst] = _arc_rule(q, a, b, lo[worst], mid, nodes, wk, wg, mode, ibuf)
         val[m], err[m] = _arc_rule(q, a, b, mid, hi[m], nodes, wk, wg, mode, ibuf)
         m += 1
+
+
+def arc_piece_reference(q: float, mu: float, a: float, b: float, d1: float, c: float = 1.0) -> float:
+    """The arc's piece in s (:func:`_arc_piece`) in plain numpy, for N.wo = a + b cos(beta), d1 = b^2 - (mu - a)^2:
+    P by numpy's 200-point Gauss-Legendre rule in s on [0, c] (c = 1: t from mu to T; the compiled kernel's twin)."""
+    d = d1 / (b + (mu - a))  # (mu - a first: b + mu would round b away near mu = 1)
+    x, w = np.polynomial.legendre.leggauss(200)
+    sx = c * x
+    t = a + b - d * sx * sx
+    return float(math.sqrt(d) * c * np.sum(w * t**q / np.sqrt(2.0 * b - d * sx * sx)))
 
 
 #: the unused Gauss-Jacobi argument of the closed forms p in {0, 1} (read-only, as jacobi_rules' arrays:
@@ -487,7 +581,7 @@ def _k_of_u(p, mu, c2, u, um, sa, itol, nodes, wk, wg, mode, ibuf, iwork, jac): 
     # 000 eq. 12: N.wo / max(mu, N.wo)^p, (N.wo)^(1 - p) on the arc N.wo >= mu
     below = below / mu**p
     b = math.sqrt((1.0 - mu) * (1.0 + mu)) * sa  # s sin(alpha)
-    h, e = _arc_power(1.0 - p, mu, mu * u, b, beta1, itol, below, nodes, wk, wg, mode, ibuf, iwork, jac)
+    h, e = _arc_power(1.0 - p, mu, mu * u, b, um * (u - c2), beta1, itol, below, nodes, wk, wg, mode, ibuf, iwork, jac)
     return 2.0 * (h + below), 2.0 * e
 
 

@@ -45,6 +45,81 @@ def test_kernel_integrand_matches_numpy_reference(rng, p):
             assert np.all(err <= 1e-12 * np.abs(got) + 1e-300) and (p not in (0, 1) or np.all(err == 0))
 
 
+def _arc_cases():
+    """(q, mu, u) where the arc's piece is hardest: T near the Gauss-Jacobi split 4 mu, L = a - b near 0 (t^q's
+    branch point and the pole of the substitution at the same distance), D = T - mu tiny, grazing and normal incidence."""
+    cases = []
+    for q in (0.01, 0.25, 0.5, 0.75, 0.99):
+        for mu in (1.0 - 1e-12, 0.9, 0.5, 0.1, 1e-3, 1e-8, 1e-100):
+            s = math.sqrt((1.0 - mu) * (1.0 + mu))
+            c2 = (mu - s) * (mu + s)
+            us = [0.999999, 0.99, 0.9, 0.5, 0.1, max(c2, 0.0) + 1e-9, max(c2, 0.0) + 1e-3]
+            # T = cos(theta_i - alpha) = 4 mu, and L = cos(theta_i + alpha) = 0 (u = s)
+            us += [math.cos(math.acos(mu) - math.acos(min(1.0, 4 * mu))), s]
+            cases += [(q, mu, u) for u in us if c2 < u < 1.0]
+    return cases
+
+
+def test_arc_piece_and_its_bound_against_mpmath():
+    """issue 14's fifteenth session: the arc where N.wo >= mu (p in (0, 1)) by the fewest Gauss-Legendre points in
+    s whose Bernstein-ellipse bound meets the tolerance (``_polar._arc_power``).  Against 24-digit mpmath at rtol 1e-6
+    .. 1e-14, the returned error bounds the true error, and the piece matches its numpy twin (200 points)."""
+    import mpmath
+
+    from pumpup.albedo import NODES, WG, WK
+    from pumpup._errors import mode_code
+
+    mpmath.mp.dps = 24
+    ibuf, iwork = np.empty(15), np.empty((4, _polar.INNER_MAX))
+    worst = 0.0
+    for q, mu, u in _arc_cases():
+        a, b = mu * u, math.sqrt((1.0 - mu) * (1.0 + mu)) * math.sqrt((1.0 - u) * (1.0 + u))
+        # the arc's end and d1 = b^2 - (mu - a)^2 for these a and b, in 24 digits (near mu = 1 the kernels' own
+        # d1 = (1 - u)(u - cos 2 theta_i) carries cos 2 theta_i's rounding, which only the outer rule sees)
+        am, bm, mm = mpmath.mpf(a), mpmath.mpf(b), mpmath.mpf(mu)
+        if bm <= mm - am:
+            continue
+        b1 = mpmath.acos((mm - am) / bm)
+        d1, beta1 = float(bm**2 - (mm - am) ** 2), float(b1)
+        ref = mpmath.quad(lambda t: (am + bm * mpmath.cos(t)) ** q, [0, b1 / 2, b1])
+        jac = _polar.jacobi_rules(q)
+        for rtol in (1e-6, 1e-10, 1e-14):
+            h, e = _polar._arc_power(q, mu, a, b, d1, beta1, rtol, 0.0, NODES, WK, WG, mode_code(), ibuf,
+                                     iwork, jac)
+            err = abs(h - float(ref))
+            assert err <= e + 1e-15 * abs(h), (q, mu, u, rtol, h, float(ref), e)
+            assert e <= (rtol + (_polar.GL_MAX + 16) * 2.3e-16) * abs(h), (q, mu, u, rtol, e / abs(h))
+            worst = max(worst, err / e)
+        if a + b <= 4 * mu:  # the whole arc is the piece in s
+            assert _polar._arc_power(q, mu, a, b, d1, beta1, 1e-14, 0.0, NODES, WK, WG, mode_code(), ibuf,
+                                     iwork, jac)[0] == pytest.approx(_polar.arc_piece_reference(q, mu, a, b, d1), rel=2e-14)
+    assert 0.0 < worst <= 1.0
+
+
+def test_arc_power_beyond_the_rules_falls_back_to_the_adaptive_rule():
+    """A tolerance no Gauss-Legendre rule of at most GL_MAX points meets (its bound) takes the 7/15 rule in beta, and
+    its estimate still bounds the error."""
+    import mpmath
+
+    from pumpup.albedo import NODES, WG, WK
+    from pumpup._errors import mode_code
+
+    q, mu, u = 0.5, 0.3, 0.95
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    c2 = (mu - s) * (mu + s)
+    um, sa = 1.0 - u, math.sqrt((1.0 - u) * (1.0 + u))
+    _, beta1, _ = _polar._k_closed(0.5, mu, c2, u, um, sa)
+    d1 = um * (u - c2)
+    n, _ = _polar._arc_bound(q, mu * u + s * sa, d1 / (s * sa + mu * um), s * sa, 1.0, 1e-300)
+    assert n == _polar.GL_MAX + 1
+    h, e = _polar._arc_power(q, mu, mu * u, s * sa, d1, beta1, 1e-300, 0.0, NODES, WK, WG, mode_code(),
+                             np.empty(15), np.empty((4, _polar.INNER_MAX)), _polar.jacobi_rules(q))
+    mpmath.mp.dps = 30
+    am, bm = mpmath.mpf(mu) * u, mpmath.sqrt(1 - mpmath.mpf(mu) ** 2) * mpmath.sqrt(1 - mpmath.mpf(u) ** 2)
+    ref = mpmath.quad(lambda t: mpmath.sqrt(am + bm * mpmath.cos(t)), [0, mpmath.acos((mu - am) / bm)])
+    assert abs(h - float(ref)) <= e and e < 1e-13
+
+
 @pytest.mark.parametrize("n,p", [(0, 0), (1, 1), (20, 0), (20, 1), (5000, 1), (1e5, 0)])
 def test_against_mpmath_with_honest_error(n, p):
     mu = np.array(MU)
@@ -196,7 +271,7 @@ def test_retro_and_stretched_phong_have_the_same_albedo():
 
 def test_general_p_evaluations():
     """A 257-point table of stretched Phong p = 0.5 at rtol 1e-10 takes as many outer nodes as p = 1
-    (the inner rule's work is per outer node: 15 to a few hundred values of (N.wo)^(1 - p))."""
+    (the inner rule's work is per outer node: about 5 values of (N.wo)^(1 - p) since issue 14's fifteenth session)."""
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     for n in (1.0, 20.0, 1000.0):
         _, _, conv, evals = _polar.albedo_1d(_Lobe(n, 0.5), mu, 1e-10, 1e-14, 20000)
