@@ -103,7 +103,7 @@ c exp(-tan^2(alpha) / m^2) / (4 pi m^2 max(N.L, N.V))) is stretched Blinn's azim
 ``Polar(radial="beckmann")`` integrates it in t = tan^2(alpha) / m^2 (weight e^-t, :func:`_u_at` kind 2) up to
 Z_MAX or the break of u_lo, cut at the same breaks.  Ward's model (000 eq. 34, sqrt(N.L N.V) in the
 denominator; ``Polar(sqrt_cos=True)``) has 4 (wi.h) sqrt(N.wo) on the arc instead: complete elliptic integrals
-(:func:`_k_ward`, Carlson's R_F and R_D), with 1 / sqrt(mu) in the scale; its K has a logarithmic term where
+(:func:`_k_ward`, Carlson's R_F and R_D by the arithmetic-geometric mean), with 1 / sqrt(mu) in the scale; its K has a logarithmic term where
 h's circle starts to be cut, so Ward keeps the raw |K - G| (QUADPACK's calibration measured 4.4 x below the
 true error there).  The V-cavity microfacet models with F = 1 (Cook-Torrance, 001 eq. 9-10; Torrance-Sparrow
 with D1 or D4, 002 eq. 10; ``Polar(vcavity=True)``) integrate 4 c G = 4 min(c, 2 u mu, 2 u N.wo) on the arc: a
@@ -706,49 +706,32 @@ def _k_half(p, mu, s, psi, u, sa):  # pragma: no cover - compiled; see half_inte
 
 
 @njit(cache=True, nogil=True)
-def _carlson_rf(x, y, z):  # pragma: no cover - compiled; tested against scipy.special.elliprf
-    """Carlson's R_F(x, y, z) = 1/2 integral_0^inf dt / sqrt((t + x)(t + y)(t + z)) for x, y, z >= 0, at most
-    one of them 0, by the duplication theorem (Carlson 1995, Numer. Algorithms 10, 13-26, algorithm 1;
-    DLMF 19.36.1), to a relative error ~ eps."""
-    a0 = (x + y + z) / 3.0
-    dx, dy = a0 - x, a0 - y
-    q = max(abs(dx), abs(dy), abs(a0 - z)) * (3.0 * EPS) ** (-1.0 / 6.0)
-    a, p4 = a0, 1.0
-    while p4 * q >= abs(a):
-        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
-        lam = sx * sy + sy * sz + sz * sx
-        x, y, z, a = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam), 0.25 * (a + lam)
-        p4 *= 0.25
-    X, Y = dx * p4 / a, dy * p4 / a
-    Z = -(X + Y)
-    e2 = X * Y - Z * Z
-    e3 = X * Y * Z
-    return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / math.sqrt(a)
-
-
-@njit(cache=True, nogil=True)
-def _carlson_rd(x, y, z):  # pragma: no cover - compiled; tested against scipy.special.elliprd
-    """Carlson's R_D(x, y, z) = 3/2 integral_0^inf dt / ((t + z)^(3/2) sqrt((t + x)(t + y))) for x, y >= 0, at
-    most one of them 0, z > 0 (Carlson 1995, algorithm 4; DLMF 19.36.2), to a relative error ~ eps."""
-    a0 = (x + y + 3.0 * z) / 5.0
-    dx, dy = a0 - x, a0 - y
-    q = max(abs(dx), abs(dy), abs(a0 - z)) * (0.25 * EPS) ** (-1.0 / 6.0)
-    a, p4, tail = a0, 1.0, 0.0
-    while p4 * q >= abs(a):
-        sx, sy, sz = math.sqrt(x), math.sqrt(y), math.sqrt(z)
-        lam = sx * sy + sy * sz + sz * sx
-        tail += p4 / (sz * (z + lam))
-        x, y, z, a = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam), 0.25 * (a + lam)
-        p4 *= 0.25
-    X, Y = dx * p4 / a, dy * p4 / a
-    Z = -(X + Y) / 3.0
-    xy = X * Y
-    e2 = xy - 6.0 * Z * Z
-    e3 = (3.0 * xy - 8.0 * Z * Z) * Z
-    e4 = 3.0 * (xy - Z * Z) * Z * Z
-    e5 = xy * Z * Z * Z
-    poly = 1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0 - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0
-    return p4 * poly / (a * math.sqrt(a)) + 3.0 * tail
+def _complete_kd(y):  # pragma: no cover - compiled; tested against scipy.special.elliprf, elliprd, ellipk, ellipe
+    """(K, D) = (R_F(0, y, 1), R_D(0, y, 1) / 3) for 0 < y <= 1: with m = 1 - y the complete elliptic integrals
+    K(m) = integral_0^(pi/2) d phi / Delta and D(m) = (K - E) / m = integral_0^(pi/2) sin^2 phi d phi / Delta,
+    Delta = sqrt(1 - m sin^2 phi), by the arithmetic-geometric mean (DLMF 19.8.1, 19.8.6): a_0 = 1, g_0 = sqrt(y),
+    c_(n+1) = (a_n - g_n) / 2 = c_n^2 / (4 a_(n+1)) (c_1 = m / (2 (1 + sqrt(y))): no cancellation), K = pi / (2 AGM),
+    K - E = K sum_(n>=0) 2^(n-1) c_n^2 with c_0^2 = m, so D = K (1/2 + sum_(n>=1) 2^(n-1) c_n^2 / m), a sum of
+    positive terms.  Quadratic convergence: at most about 10 steps of one square root each for y down to 1e-300
+    (issue 14's fifteenth session: Carlson's duplication, 170 ns per pair, took most of Ward's K(u))."""
+    m = 1.0 - y
+    kc = math.sqrt(y)
+    a = 0.5 * (1.0 + kc)
+    g = math.sqrt(kc)
+    c = 0.5 * m / (1.0 + kc)
+    tot = c * c
+    w = 1.0
+    for _ in range(64):
+        if c <= EPS * a:
+            break
+        an = 0.5 * (a + g)
+        c = c * c / (4.0 * an)
+        g = math.sqrt(a * g)
+        a = an
+        w *= 2.0
+        tot += w * c * c
+    k = 0.5 * math.pi / a
+    return k, k * (0.5 + (tot / m if m > 0.0 else 0.0))
 
 
 @njit(cache=True, nogil=True)
@@ -759,7 +742,7 @@ def _k_ward(mu, s, psi, u, sa):  # pragma: no cover - compiled; see ward_integra
 
     As in :func:`_k_half`, c = wi.h = c0 + d, N.wo = 2 u d, d = e0 + b cos(beta) >= 0 on the arc |beta| <
     beta0: K = 8 sqrt(2 u) (c0 I_1/2 + I_3/2), I_q = integral_0^beta0 d^q d beta, complete elliptic integrals
-    (Carlson's R_F, R_D): with x = sin(beta / 2), d = T - 2 b x^2, T = d(0), on a partial arc (T < 2 b,
+    (Carlson's R_F, R_D; :func:`_complete_kd`): with x = sin(beta / 2), d = T - 2 b x^2, T = d(0), on a partial arc (T < 2 b,
     M = T / (2 b)) I_1/2 = 2 T / sqrt(2 b) (R_F - R_D / 3), I_-1/2 = 2 R_F / sqrt(2 b), the R at (0, 1 - M, 1);
     on the full circle (k^2 = 2 b / T <= 1) I_1/2 = 2 sqrt(T) E(k^2) = 2 sqrt(T) (R_F - k^2 R_D / 3),
     I_-1/2 = 2 R_F / sqrt(T) at (0, 1 - k^2, 1); and 3 I_3/2 = 4 e0 I_1/2 + (b^2 - e0^2) I_-1/2 (the
@@ -775,17 +758,16 @@ def _k_ward(mu, s, psi, u, sa):  # pragma: no cover - compiled; see ward_integra
             ih, imh = math.pi * math.sqrt(top), math.pi / math.sqrt(top)
         else:
             k2 = 2.0 * b / top
-            rf = _carlson_rf(0.0, low / top, 1.0)
-            ih = 2.0 * math.sqrt(top) * (rf - k2 * _carlson_rd(0.0, low / top, 1.0) / 3.0)
+            rf, rd3 = _complete_kd(low / top)
+            ih = 2.0 * math.sqrt(top) * (rf - k2 * rd3)
             imh = 2.0 * rf / math.sqrt(top)
         bb = -low * top  # b^2 - e0^2 = (b - e0)(b + e0)
     else:
         top = 0.5 * f1 / u  # T = a + b - c0
         gap = 0.5 * f2 / u  # 2 b - T = b - e0
-        rf = _carlson_rf(0.0, gap / (2.0 * b), 1.0)
-        rd = _carlson_rd(0.0, gap / (2.0 * b), 1.0)
+        rf, rd3 = _complete_kd(gap / (2.0 * b))
         sb2 = math.sqrt(2.0 * b)
-        ih = 2.0 * top / sb2 * (rf - rd / 3.0)
+        ih = 2.0 * top / sb2 * (rf - rd3)
         imh = 2.0 * rf / sb2
         bb = gap * top
     i3h = (4.0 * e0 * ih + bb * imh) / 3.0

@@ -378,10 +378,11 @@ def test_half_kernel_against_the_geometry_and_its_numpy_twin(rng, p):
 
 
 def test_ward_kernel_against_the_geometry_and_its_twin(rng):
-    """_k_ward (complete elliptic integrals by Carlson's R_F and R_D) against an independent quadrature of
-    4 (wi.h) sqrt(N.wo) built from wi, h and wo, and its twin (scipy quad of the arc integrals), at random u
-    and on both sides of the arc's breaks; and the compiled R_F, R_D against scipy's."""
-    from scipy.special import elliprd, elliprf
+    """_k_ward (complete elliptic integrals, Carlson's R_F(0, y, 1) and R_D(0, y, 1)) against an independent
+    quadrature of 4 (wi.h) sqrt(N.wo) built from wi, h and wo, and its twin (scipy quad of the arc integrals), at
+    random u and on both sides of the arc's breaks; and the compiled R_F, R_D (the arithmetic-geometric mean, y from
+    the smallest subnormal to 1) against scipy's, and against K(m), E(m) for m = 1 - y."""
+    from scipy.special import ellipe, ellipk, elliprd, elliprf
 
     for mu in (1.0, 0.99, 0.9, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6):
         s = math.sqrt((1 - mu) * (1 + mu))
@@ -393,10 +394,15 @@ def test_ward_kernel_against_the_geometry_and_its_twin(rng):
             q = _k_half_by_quad(0.0, mu, float(u), kind="root")
             assert abs(k - q) <= 1e-13 * max(abs(q), 1.0), (mu, u, k, q)  # (measured: 1.7e-14)
             assert abs(k - _polar.ward_integrand_reference(mu, u)[0]) <= 1e-11 * max(abs(q), 1.0), (mu, u)
-    for args in rng.uniform(0, 3, (300, 3)) * 10.0 ** rng.integers(-12, 4, (300, 3)):
-        for x, y, z in (args, (0.0, args[1], args[2]), (0.0, min(args[1], 1.0), 1.0)):
-            assert abs(_polar._carlson_rf(x, y, z) - elliprf(x, y, z)) <= 2e-15 * elliprf(x, y, z)
-            assert abs(_polar._carlson_rd(x, y, z) - elliprd(x, y, z)) <= 2e-15 * elliprd(x, y, z)
+    ys = np.concatenate([rng.uniform(0, 1, 300), 10.0 ** rng.uniform(-300, 0, 300), 1 - 10.0 ** rng.uniform(-17, 0, 100),
+                         [1.0, 0.5, 1e-300, 5e-324]])
+    for y in ys[ys > 0]:
+        k, d = _polar._complete_kd(float(y))
+        assert abs(k - elliprf(0.0, y, 1.0)) <= 2e-15 * elliprf(0.0, y, 1.0), y
+        assert abs(d - elliprd(0.0, y, 1.0) / 3) <= 2e-15 * elliprd(0.0, y, 1.0) / 3, y
+        if y >= 1e-3:  # (ellipk / ellipe of m = 1 - y: D = (K - E) / m, and K - D = B = (E - (1 - m) K) / m)
+            m = 1.0 - y
+            assert abs(k - ellipk(m)) <= 2e-15 * k and abs(k - m * d - ellipe(m)) <= 4e-15 * ellipe(m), y
 
 
 def test_vcavity_kernel_against_the_geometry_and_its_twin(rng):
