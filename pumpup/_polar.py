@@ -390,9 +390,12 @@ def _gl_tables():
 
 
 GL_X, GL_W = _gl_tables()
-#: the Bernstein ellipses tried for the piece's bound: log(rho) = f log(rho_max), f in ARC_RHO (the last one only where
-#: the nearest singularity is t^q's branch point, where the integrand stays bounded up to rho_max)
-ARC_RHO = (0.9, 0.97, 0.999)
+#: the Bernstein ellipse of the piece's bound (:func:`_arc_bound`): log(rho) at most ARC_RHO_BRANCH times that of the
+#: ellipse through t^q's branch point (the integrand stays bounded up to it) and ARC_RHO_POLE times that through the
+#: pole of (t - L)^-1/2.  Measured over a 257-point table's nodes (q 0.1, 0.5, 0.9; itol 1.25e-7 .. 1.25e-13): 0.03 % more
+#: values than the best of eight ellipses from 0.5 to 0.999 per call
+ARC_RHO_BRANCH = 0.999
+ARC_RHO_POLE = 0.99
 
 
 @njit(cache=True, nogil=True)
@@ -403,31 +406,26 @@ def _arc_bound(q, big_t, d, b, c, tol):  # pragma: no cover - compiled; see arc_
     a pole of order 1/2): inside the Bernstein ellipse E_rho of x, |x| <= A = (rho + 1 / rho) / 2, so where c A < min(s0,
     s1) |t| <= T + D c^2 A^2 < 2 T and |t - L| = D |s1^2 - s^2| >= D (s1^2 - c^2 A^2): |F| <= M = (2 T)^q /
     sqrt(D (s1^2 - c^2 A^2)).  The n-point Gauss rule's error is then at most 64 M / (15 (1 - rho^-2) rho^(2 n))
-    (Trefethen, Approximation Theory and Approximation Practice, Thm 19.3) times sqrt(D) c.  ``ARC_RHO`` are the
-    ellipses tried; the smallest n wins."""
+    (Trefethen, Approximation Theory and Approximation Practice, Thm 19.3) times sqrt(D) c.  log(rho) is the smaller of
+    ARC_RHO_BRANCH log(rho_0) and ARC_RHO_POLE log(rho_1), rho_i the ellipse through s_i / c."""
     s0sq = big_t / d
     s1sq = 2.0 * b / d
     best_n = GL_MAX + 1
     best = 0.0
     if not tol > 0.0:
         return best_n, best
-    r = math.sqrt(min(s0sq, s1sq)) / c
-    lrmax = math.log(r + math.sqrt((r - 1.0) * (r + 1.0)))
-    lead = math.log(c * 64.0 / 15.0 * (2.0 * big_t) ** q / tol)  # sqrt(D) c M sqrt(gap) / tol
-    for k in range(len(ARC_RHO)):
-        f = ARC_RHO[k]
-        if f > 0.99 and s1sq <= s0sq:
-            continue
-        lrho = f * lrmax
-        rho = math.exp(lrho)
-        big_a = 0.5 * (rho + 1.0 / rho)
-        gap = s1sq - c * c * big_a * big_a
-        if gap <= 0.0:
-            continue
-        lb = lead - 0.5 * math.log(gap) - math.log(1.0 - 1.0 / (rho * rho))
-        n = max(1, int(math.ceil(lb / (2.0 * lrho))))
-        if n < best_n:
-            best_n = n
+    r0, r1 = math.sqrt(s0sq) / c, math.sqrt(s1sq) / c  # (both > 1: s0^2 >= 4/3, s1^2 >= 2, c^2 = s0^2 / 2 beyond 4 mu)
+    lrho = min(ARC_RHO_BRANCH * math.log(r0 + math.sqrt((r0 - 1.0) * (r0 + 1.0))),
+               ARC_RHO_POLE * math.log(r1 + math.sqrt((r1 - 1.0) * (r1 + 1.0))))
+    rho = math.exp(lrho)
+    big_a = 0.5 * (rho + 1.0 / rho)
+    gap = s1sq - c * c * big_a * big_a
+    if gap > 0.0:
+        # log of sqrt(D) c 64 M / (15 (1 - rho^-2) tol)
+        lb = math.log(c * 64.0 / 15.0 * (2.0 * big_t) ** q / (math.sqrt(gap) * (1.0 - 1.0 / (rho * rho)) * tol))
+        n = max(1.0, math.ceil(lb / (2.0 * lrho)))
+        if n <= GL_MAX:
+            best_n = int(n)
             best = math.exp(lb - 2.0 * n * lrho) * tol
     return best_n, best
 
