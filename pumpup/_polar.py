@@ -3220,6 +3220,24 @@ def takes_1d_path(brdf) -> bool:
     return polar is not None and polar() is not None
 
 
+def axis_albedo(n: float, nu: np.ndarray, scale: np.ndarray, rtol: float, atol: float, max_regions: int):
+    """(value, error, converged, evaluations) of a power lobe scale (A.wo)_+^n about an axis A at elevation nu = N.A
+    (:meth:`pumpup.core.BRDF.lobe_axis`: Lafortune's lobe, 000 eq. 14, at any azimuth of wi), or None where the 1-D path
+    is off.  Without max(N.L, N.V) the integrand depends on wi only through A, so the albedo is frame 0's p = 0 lobe
+    about R with mu = nu (:func:`_k_closed`), times the scale.  The scale's rounding is added to the error: scale ~
+    |v|^n with |v| from a few roundings, (4 n + 16) eps relative."""
+
+    class _Axis:
+        def polar(self):
+            return Polar(n=float(n), p=0.0, scale=lambda m: scale)
+
+    out = albedo_1d(_Axis(), nu, rtol, atol, max_regions)
+    if out is None:
+        return None
+    val, err, conv, evals = out
+    return val, err + (4.0 * n + 16.0) * EPS * np.abs(val), conv, evals
+
+
 def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     """(value, error, converged, evaluations) of the albedo of ``brdf`` at every mu (a 1-D float
     array), or None when the model has no :class:`Polar` hint (or the 1-D path is off)."""

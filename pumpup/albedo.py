@@ -1566,6 +1566,14 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
             error += abs(w) * e
             ok &= conv
             continue
+        axis = term.lobe_axis(flat, phflat)
+        if axis is not None:  # a power lobe about its own axis (Lafortune's, p = 0), at every azimuth of wi
+            fast = _polar.axis_albedo(*axis, rtol, atol, max_regions)
+            if fast is not None:
+                value += w * fast[0]
+                error += abs(w) * fast[1]
+                ok &= fast[2]
+                continue
         turn = None
         if np.any(phflat != 0.0) and term.azimuth_range() is not None:
             turn = phflat

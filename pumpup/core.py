@@ -478,6 +478,12 @@ class BRDF:
         (the engine then integrates one dimension, ``pumpup._polar``), else None (the default)."""
         return None
 
+    def lobe_axis(self, mu: np.ndarray, phi: np.ndarray):
+        """(n, nu, scale) when, seen from wi at (mu, phi), the model is a power lobe scale (A.wo)_+^n about an axis A at
+        elevation nu = N.A > 0, with no other dependence on wi (the engine then takes the 1-D path about A,
+        :func:`pumpup._polar.axis_albedo`), else None (the default)."""
+        return None
+
     def azimuth_range(self) -> float | None:
         """None if the albedo does not depend on the azimuth phi of wi (an isotropic model, the
         default); otherwise the length P of an interval [0, P] of phi on which a(mu, phi) takes

@@ -153,6 +153,31 @@ class Lafortune(BRDF):
             scale = float(q["c"] * np.float64(C) ** q["n"])
         return Polar(n=q["n"], p=float(q["p"]), scale=lambda mu: np.full(np.shape(mu), scale))
 
+    def lobe_axis(self, mu, phi):
+        """For p = 0 (000 eq. 14): (R.V)_M = v.wo with v = (-cx Lx, -cy Ly, cz Lz), so f = c |v|^n (v^.wo)_+^n, a
+        Phong power lobe about v^ at elevation nu = cz mu / |v|, scaled by c |v|^n (issue 14's fifteenth session: the
+        1-D path about v^ at every azimuth of wi, :func:`pumpup._polar.axis_albedo`).  None for p > 0 (max(N.L, N.V)
+        depends on mu itself), for cz <= 0 (v^ on or below the horizon), where :meth:`polar` applies, and where nu or
+        the scale is not a positive finite number.  With cx = cy, |v| is taken without phi (the albedo is isotropic)."""
+        q = self.p
+        if q["p"] != 0.0 or not q["cz"] > 0.0 or self.polar() is not None:
+            return None
+        mu = np.asarray(mu, dtype=np.float64)
+        s2 = (1.0 - mu) * (1.0 + mu)
+        if q["cx"] == q["cy"]:
+            side = q["cx"] * q["cx"] * s2
+        else:
+            phi = np.asarray(phi, dtype=np.float64)
+            side = s2 * ((q["cx"] * np.cos(phi)) ** 2 + (q["cy"] * np.sin(phi)) ** 2)
+        vz = q["cz"] * mu
+        norm = np.sqrt(side + vz * vz)
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+            nu = np.minimum(vz / norm, 1.0)
+            scale = q["c"] * norm ** q["n"]
+        if not (np.all(nu > 0.0) and np.all(np.isfinite(scale)) and np.all(scale > 0.0)):
+            return None
+        return float(q["n"]), nu, scale
+
     def azimuth_range(self):
         # (R.V)_M is unchanged by x -> -x and by y -> -y of both L and V: a(phi) = a(-phi) = a(pi - phi)
         return None if self.p["cx"] == self.p["cy"] else np.pi / 2
