@@ -41,6 +41,8 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
                                               # 1-D path against the nested engine
     python scripts/bench_albedo.py --scaled   # only 1/E-scaled GGX, Beckmann, Schlick (frame 6 times Turquin's factor)
                                               # against the nested engine
+    python scripts/bench_albedo.py --lafortune  # only Lafortune lobes with p = 0 about their own axis (issue 14's
+                                              # fifteenth session) against the nested engine / the 2-D cubature
     python scripts/bench_albedo.py --breaks   # only the nested families with kinks or levels: the compiled break
                                               # finding against its numpy reference (issue 14 item 3)
 """
@@ -622,6 +624,40 @@ def slope(rtol=1e-10, repeat=3):
                   flush=True)
 
 
+def lafortune_axis(rtol=1e-10, repeat=3):
+    """Lafortune lobes with p = 0 about their own axis v^ (``BRDF.lobe_axis``, ``pumpup._polar.axis_albedo``; issue 14's
+    fifteenth session) against the engine they took before (``lobe_axis`` switched off: the nested engine at phi = 0, the
+    2-D cubature at phi != 0), same run: a 257-point table (mu uniform in theta) at rtol 1e-10 by the axis path, one
+    thread, best of ``repeat``; the engine before on every 16th of those mu (17 values, once; the 2-D cubature takes
+    seconds per value), compared per value of mu."""
+    mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
+    few = mu[::16]
+    specs = [{"type": "lafortune", "n": 10, "cx": 0.8, "cy": 1.2, "cz": 1.1},
+             {"type": "lafortune", "n": 5, "cx": 0.6, "cy": 0.6, "cz": 1.0},
+             {"type": "lafortune", "n": 30, "cx": -0.5, "cy": 0.5, "cz": 0.7, "c": 2.0},
+             {"type": "lafortune_sum", "n": [3.0, 20.0], "cx": [0.7, -1.0], "cy": [1.3, -1.0], "c": [0.5, 1.0]}]
+    print(f"Lafortune p = 0 about its own axis against the engine before, one thread; 257 mu at rtol {rtol:g} (before: "
+          f"17 of them, per value)")
+    print(f"{'model':60s} {'phi':>4s} {'table ms':>9s} {'us/mu':>8s} {'before us/mu':>13s} {'ratio':>7s}")
+    for spec in specs:
+        f = pumpup.load(spec)
+        for phi in (0.0, 0.7):
+            pumpup.albedo(f, [0.5, 1e-3], phi=phi, rtol=rtol)
+            _, t1 = _best(lambda: pumpup.albedo(f, mu, phi=phi, rtol=rtol), repeat)
+            lobes = f.lobes() if hasattr(f, "lobes") else [f]
+            cls = type(lobes[0])
+            saved = cls.lobe_axis
+            cls.lobe_axis = lambda self, m, p: None
+            try:
+                pumpup.albedo(f, [0.5], phi=phi, rtol=rtol)
+                _, t2 = _best(lambda: pumpup.albedo(f, few, phi=phi, rtol=rtol), 1)
+            finally:
+                cls.lobe_axis = saved
+            per1, per2 = t1 / mu.size, t2 / few.size
+            print(f"{str(spec)[:60]:60s} {phi:4.1f} {t1 * 1e3:9.2f} {per1 * 1e6:8.1f} {per2 * 1e6:13.0f} "
+                  f"{per2 / per1:7.0f}", flush=True)
+
+
 def main():
     import os
 
@@ -665,6 +701,9 @@ def main():
         return
     if "--slope" in sys.argv:
         slope()
+        return
+    if "--lafortune" in sys.argv:
+        lafortune_axis()
         return
     if "--cells" not in sys.argv:
         families()
