@@ -149,14 +149,16 @@ def evaluations(f, mu, rtol, phi=0.0):
 
 
 def path_of(f):
-    """'1-D' (closed-form azimuth), 'slp' (anisotropic Ward in slope space), 'nst' (nested quadrature) or '2-D' (cubature)
-    for f at phi = 0."""
+    """'1-D' (closed-form azimuth), 'slp' (anisotropic Ward in slope space), 'axs' (a power lobe about its own axis,
+    Lafortune p = 0), 'nst' (nested quadrature) or '2-D' (cubature) for f at phi = 0."""
     from pumpup import _nested, _slope
 
     if all(_slope.takes_slope_path(t, np.array([0.5])) for _, t in f.albedo_terms()):
         return "slp"
     if all(t.polar() is not None for _, t in f.albedo_terms()):
         return "1-D"
+    if all(t.polar() is not None or t.lobe_axis(np.array([0.5, 1e-3]), np.zeros(2)) is not None for _, t in f.albedo_terms()):
+        return "axs"
     A = pumpup.albedo_module
     ok = all(_nested.supports(g) for _, t in f.albedo_terms() for _, g in A._groups(t, np.array([0.5, 1e-3])))
     return "nst" if ok else "2-D"
