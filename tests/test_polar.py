@@ -69,19 +69,19 @@ def test_arc_piece_and_its_bound_against_mpmath():
     from pumpup.albedo import NODES, WG, WK
     from pumpup._errors import mode_code
 
-    mpmath.mp.dps = 24
     ibuf, iwork = np.empty(15), np.empty((4, _polar.INNER_MAX))
     worst = 0.0
     for q, mu, u in _arc_cases():
         a, b = mu * u, math.sqrt((1.0 - mu) * (1.0 + mu)) * math.sqrt((1.0 - u) * (1.0 + u))
         # the arc's end and d1 = b^2 - (mu - a)^2 for these a and b, in 24 digits (near mu = 1 the kernels' own
         # d1 = (1 - u)(u - cos 2 theta_i) carries cos 2 theta_i's rounding, which only the outer rule sees)
-        am, bm, mm = mpmath.mpf(a), mpmath.mpf(b), mpmath.mpf(mu)
-        if bm <= mm - am:
-            continue
-        b1 = mpmath.acos((mm - am) / bm)
-        d1, beta1 = float(bm**2 - (mm - am) ** 2), float(b1)
-        ref = mpmath.quad(lambda t: (am + bm * mpmath.cos(t)) ** q, [0, b1 / 2, b1])
+        with mpmath.workdps(24):
+            am, bm, mm = mpmath.mpf(a), mpmath.mpf(b), mpmath.mpf(mu)
+            if bm <= mm - am:
+                continue
+            b1 = mpmath.acos((mm - am) / bm)
+            d1, beta1 = float(bm**2 - (mm - am) ** 2), float(b1)
+            ref = mpmath.quad(lambda t: (am + bm * mpmath.cos(t)) ** q, [0, b1 / 2, b1])
         jac = _polar.jacobi_rules(q)
         for rtol in (1e-6, 1e-10, 1e-14):
             h, e = _polar._arc_power(q, mu, a, b, d1, beta1, rtol, 0.0, NODES, WK, WG, mode_code(), ibuf,
@@ -114,9 +114,9 @@ def test_arc_power_beyond_the_rules_falls_back_to_the_adaptive_rule():
     assert n == _polar.GL_MAX + 1
     h, e = _polar._arc_power(q, mu, mu * u, s * sa, d1, beta1, 1e-300, 0.0, NODES, WK, WG, mode_code(),
                              np.empty(15), np.empty((4, _polar.INNER_MAX)), _polar.jacobi_rules(q))
-    mpmath.mp.dps = 30
-    am, bm = mpmath.mpf(mu) * u, mpmath.sqrt(1 - mpmath.mpf(mu) ** 2) * mpmath.sqrt(1 - mpmath.mpf(u) ** 2)
-    ref = mpmath.quad(lambda t: mpmath.sqrt(am + bm * mpmath.cos(t)), [0, mpmath.acos((mu - am) / bm)])
+    with mpmath.workdps(30):
+        am, bm = mpmath.mpf(mu) * u, mpmath.sqrt(1 - mpmath.mpf(mu) ** 2) * mpmath.sqrt(1 - mpmath.mpf(u) ** 2)
+        ref = mpmath.quad(lambda t: mpmath.sqrt(am + bm * mpmath.cos(t)), [0, mpmath.acos((mu - am) / bm)])
     assert abs(h - float(ref)) <= e and e < 1e-13
 
 
