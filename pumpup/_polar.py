@@ -324,7 +324,7 @@ INNER_MAX = 64
 #: the inner rule's relative tolerance is rtol / 8, but not below this (its rounding floor is
 #: QUADPACK's 50 eps of the integral)
 INNER_RTOL_MIN = 1e-14
-#: the orders of the Gauss-Jacobi pair on the arc's end near grazing incidence (:func:`_arc_power`)
+#: the orders of the Gauss-Jacobi rules on the arc's end near grazing incidence (:func:`_arc_power`, :func:`_jacobi_bound`)
 JACOBI_ORDERS = (10, 14)
 
 
@@ -357,6 +357,27 @@ def _jacobi_sum(q, top, low, c, jt, jw):  # pragma: no cover - compiled
         t = c * jt[j]
         s += jw[j] / math.sqrt((top - t) * (t - low))
     return c ** (q + 1.0) * s
+
+
+#: the Bernstein ellipse of :func:`_jacobi_bound`: log(rho) = JACOBI_RHO log(rho_max)
+JACOBI_RHO = 0.95
+
+
+@njit(cache=True, nogil=True)
+def _jacobi_bound(q, top, low, c, n):  # pragma: no cover - compiled; see the tests' mpmath check
+    """A bound of the n-point Gauss-Jacobi rule's error in :func:`_jacobi_sum` (low < 0 < c < top).  With t = c (1 + x) / 2,
+    g(t) = ((top - t)(t - low))^-1/2 is analytic but at x_T = 2 top / c - 1 > 1 and x_L = 2 low / c - 1 < -1 (the square
+    root's cuts lie on the real axis beyond them), so inside the Bernstein ellipse E_rho, |x| <= A = (rho + 1/rho) / 2 <
+    min(x_T, -x_L), |g| <= M = 2 / (c sqrt((x_T - A)(-x_L - A))).  A Gauss rule with a positive weight errs by at most
+    2 W E_(2n-1)(g), W = c^(q+1) / (q + 1) the weight's integral, and E_m(g) <= 2 M rho^-m / (rho - 1) (Trefethen, ATAP
+    Thm 8.2): the bound is 4 W M rho^(1 - 2n) / (rho - 1)."""
+    xt = 2.0 * top / c - 1.0
+    xl = 1.0 - 2.0 * low / c
+    r = min(xt, xl)
+    rho = math.exp(JACOBI_RHO * math.log(r + math.sqrt((r - 1.0) * (r + 1.0))))
+    big_a = 0.5 * (rho + 1.0 / rho)
+    m = 2.0 / (c * math.sqrt((xt - big_a) * (xl - big_a)))
+    return 4.0 * c ** (q + 1.0) / (q + 1.0) * m * rho ** (1.0 - 2.0 * n) / (rho - 1.0)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -451,9 +472,10 @@ def _arc_power(q, mu, a, b, d1, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iw
     integral_mu^T t^q / sqrt((T - t)(t - L)) dt.  Where T > 4 mu (near grazing incidence: (N.wo)^q
     then nears its branch point t = 0 at the arc's end), the range t in [mu, T / 2] is
     integral_0^(T/2) - integral_0^mu by the Gauss-Jacobi rule for the weight t^q (``jac``: nodes and
-    weights of two orders, the higher one's value, the difference its error): the rest of the
-    integrand has its singularities at T and at L <= mu - (T - 2 mu) < -T / 2, at least T / 2 away,
-    and the rules converge geometrically (measured: 1e-13 at 8 nodes, 1e-16 at 10).  The rest,
+    weights of two orders): the rest of the integrand has its singularities at T and at L <= mu - (T - 2 mu) < -T / 2,
+    at least T / 2 away, so the rules converge geometrically, and the shorter one is taken where its a-priori bound
+    (:func:`_jacobi_bound`) meets half the tolerance, the longer one else, the bound its error (until issue 14's
+    fifteenth session: both rules, their difference the error).  The rest,
     t from T - D c^2 (mu, or T / 2 beyond 4 mu) to T, is t = T - D s^2, s in [0, c] (D = T - mu = d1 / (b + mu - a),
     without cancellation): an even, analytic integrand in s (:func:`_arc_piece`), by the fewest Gauss-Legendre
     points whose a-priori error bound (:func:`_arc_bound`) meets ``rtol`` times a lower bound of K = ``rest`` + H
@@ -472,11 +494,17 @@ def _arc_power(q, mu, a, b, d1, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iw
     if top > 4.0 * mu:
         low = a - b
         half = 0.5 * top
-        n1 = JACOBI_ORDERS[0]
-        q1 = _jacobi_sum(q, top, low, half, jac[0, :n1], jac[1, :n1]) - _jacobi_sum(q, top, low, mu, jac[0, :n1], jac[1, :n1])
-        q2 = _jacobi_sum(q, top, low, half, jac[2], jac[3]) - _jacobi_sum(q, top, low, mu, jac[2], jac[3])
-        fixed = q2
-        fixed_err = abs(q2 - q1) + 64.0 * EPS * abs(q2)
+        # the shorter rule where its bound (:func:`_jacobi_bound`) is at most half the tolerance's lower bound, else the
+        # longer one, its bound the error either way (plus the sums' rounding)
+        n1, n2 = JACOBI_ORDERS
+        tol0 = rtol * (rest + beta1 * mu**q)
+        e1 = _jacobi_bound(q, top, low, half, n1) + _jacobi_bound(q, top, low, mu, n1)
+        if e1 <= 0.5 * tol0:
+            fixed = _jacobi_sum(q, top, low, half, jac[0, :n1], jac[1, :n1]) - _jacobi_sum(q, top, low, mu, jac[0, :n1], jac[1, :n1])
+        else:
+            fixed = _jacobi_sum(q, top, low, half, jac[2], jac[3]) - _jacobi_sum(q, top, low, mu, jac[2], jac[3])
+            e1 = _jacobi_bound(q, top, low, half, n2) + _jacobi_bound(q, top, low, mu, n2)
+        fixed_err = e1 + 64.0 * EPS * abs(fixed)
         end = math.acos((half - a) / b)
         c = math.sqrt(half / d)  # T - D c^2 = T / 2
     low_h = beta1 * mu**q  # H's lower bound: t >= mu on the arc, and t >= T / 2 on the piece beyond the Jacobi part
@@ -522,7 +550,7 @@ _NO_JACOBI.flags.writeable = False
 @functools.lru_cache(maxsize=256)
 def jacobi_rules(q: float) -> np.ndarray:
     """Nodes on [0, 1] and weights of the Gauss-Jacobi rules for integral_0^1 t^q g(t) dt, of
-    :data:`JACOBI_ORDERS` (the error estimate, the value): rows t, w of the first, t, w of the second
+    :data:`JACOBI_ORDERS` (the shorter, the longer: :func:`_arc_power`): rows t, w of the first, t, w of the second
     (read-only, cached per q: scipy computes them in about 0.1 ms)."""
     from scipy.special import roots_jacobi
 
