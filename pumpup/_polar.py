@@ -359,8 +359,10 @@ def _jacobi_sum(q, top, low, c, jt, jw):  # pragma: no cover - compiled
     return c ** (q + 1.0) * s
 
 
-#: the Bernstein ellipse of :func:`_jacobi_bound`: log(rho) = JACOBI_RHO log(rho_max)
+#: the Bernstein ellipse of :func:`_jacobi_bound`: log(rho) = JACOBI_RHO log(rho_max), at most JACOBI_LOG_RHO_CAP (rho_max
+#: overflows where c = mu is subnormal: a hypothesis test found mu = 5e-324 giving a NaN error)
 JACOBI_RHO = 0.95
+JACOBI_LOG_RHO_CAP = math.log(1e4)
 
 
 @njit(cache=True, nogil=True)
@@ -368,15 +370,16 @@ def _jacobi_bound(q, top, low, c, n):  # pragma: no cover - compiled; see the te
     """A bound of the n-point Gauss-Jacobi rule's error in :func:`_jacobi_sum` (low < 0 < c < top).  With t = c (1 + x) / 2,
     g(t) = ((top - t)(t - low))^-1/2 is analytic but at x_T = 2 top / c - 1 > 1 and x_L = 2 low / c - 1 < -1 (the square
     root's cuts lie on the real axis beyond them), so inside the Bernstein ellipse E_rho, |x| <= A = (rho + 1/rho) / 2 <
-    min(x_T, -x_L), |g| <= M = 2 / (c sqrt((x_T - A)(-x_L - A))).  A Gauss rule with a positive weight errs by at most
+    min(x_T, -x_L), |g| <= M = 2 / (c sqrt((x_T - A)(-x_L - A))) (computed in t's units, finite as c -> 0).  A Gauss rule with a positive weight errs by at most
     2 W E_(2n-1)(g), W = c^(q+1) / (q + 1) the weight's integral, and E_m(g) <= 2 M rho^-m / (rho - 1) (Trefethen, ATAP
     Thm 8.2): the bound is 4 W M rho^(1 - 2n) / (rho - 1)."""
-    xt = 2.0 * top / c - 1.0
+    xt = 2.0 * top / c - 1.0  # (inf where c is tiny: rho is then capped)
     xl = 1.0 - 2.0 * low / c
     r = min(xt, xl)
-    rho = math.exp(JACOBI_RHO * math.log(r + math.sqrt((r - 1.0) * (r + 1.0))))
+    rho = math.exp(min(JACOBI_RHO * math.log(r + math.sqrt((r - 1.0) * (r + 1.0))), JACOBI_LOG_RHO_CAP))
     big_a = 0.5 * (rho + 1.0 / rho)
-    m = 2.0 / (c * math.sqrt((xt - big_a) * (xl - big_a)))
+    # M in t's units: the ellipse's ends lie at t = c (1 -+ A) / 2, so |T - t| >= T - c (1 + A) / 2 and |t - L| >= -L - c (A - 1) / 2
+    m = 1.0 / math.sqrt((top - 0.5 * c * (1.0 + big_a)) * (-low - 0.5 * c * (big_a - 1.0)))
     return 4.0 * c ** (q + 1.0) / (q + 1.0) * m * rho ** (1.0 - 2.0 * n) / (rho - 1.0)
 
 

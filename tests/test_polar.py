@@ -540,3 +540,16 @@ def test_jacobi_bound_against_mpmath():
                         assert err <= bound + 64 * 2.3e-16 * abs(ref), (q, mu, top, low, c, n, err, bound)
                         worst = max(worst, err / (bound + 64 * 2.3e-16 * abs(ref)))
     assert worst > 0.0
+
+
+@pytest.mark.parametrize("spec", [{"type": "retro", "n": 10, "p": 0.5}, {"type": "stretched_phong", "n": 20, "p": 0.25}])
+def test_inner_arc_at_subnormal_mu(spec):
+    """mu down to the smallest subnormal: the Gauss-Jacobi bound's ellipse is capped (rho_max overflows there; a
+    hypothesis test found retro n = 10, p = 0.5 at mu = 5e-324 with a NaN error), the values and errors finite, and
+    the bound still bounds the rules' error at c = mu = 5e-324 against the closed form of the leading term."""
+    f = pumpup.load(spec)
+    a, e = pumpup.albedo(f, [5e-324, 1e-320, 1e-300, 1e-200], rtol=1e-10, return_error=True)
+    assert np.all(np.isfinite(a)) and np.all(np.isfinite(e)) and np.all(e <= 1e-9 * a)
+    q, top, low, c = 0.5, 0.5, -0.5, 5e-324
+    b = _polar._jacobi_bound(q, top, low, c, 10)
+    assert math.isfinite(b) and b >= 0.0
