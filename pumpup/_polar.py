@@ -404,10 +404,11 @@ GL_MAX = 64
 def _gl_tables():
     xs, ws = np.zeros((GL_MAX + 1, (GL_MAX + 1) // 2)), np.zeros((GL_MAX + 1, (GL_MAX + 1) // 2))
     for n in range(1, GL_MAX + 1):
-        x, w = np.polynomial.legendre.leggauss(n)
-        keep = x >= -1e-300  # the nonnegative half (and the middle node of an odd rule, once)
-        xs[n, :keep.sum()] = np.abs(x[keep])[::-1]
-        ws[n, :keep.sum()] = np.where(np.abs(x[keep]) > 1e-300, 2.0 * w[keep], w[keep])[::-1]
+        x, w = np.polynomial.legendre.leggauss(n)  # (ascending; an odd rule's middle node is 0)
+        k = (n + 1) // 2
+        xs[n, :k], ws[n, :k] = x[::-1][:k], 2.0 * w[::-1][:k]  # the nonnegative half, largest first
+        if n % 2:
+            ws[n, k - 1] = w[n // 2]  # the middle node, once
     xs.flags.writeable = False
     ws.flags.writeable = False
     return xs, ws
@@ -494,13 +495,14 @@ def _arc_power(q, mu, a, b, d1, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iw
     fixed_err = 0.0
     end = beta1
     c = 1.0
+    low_h = beta1 * mu**q  # H's lower bound: t >= mu on the arc (and t >= T / 2 on the piece beyond the Jacobi part)
     if top > 4.0 * mu:
         low = a - b
         half = 0.5 * top
         # the shorter rule where its bound (:func:`_jacobi_bound`) is at most half the tolerance's lower bound, else the
         # longer one, its bound the error either way (plus the sums' rounding)
         n1, n2 = JACOBI_ORDERS
-        tol0 = rtol * (rest + beta1 * mu**q)
+        tol0 = rtol * (rest + low_h)
         e1 = _jacobi_bound(q, top, low, half, n1) + _jacobi_bound(q, top, low, mu, n1)
         if e1 <= 0.5 * tol0:
             fixed = _jacobi_sum(q, top, low, half, jac[0, :n1], jac[1, :n1]) - _jacobi_sum(q, top, low, mu, jac[0, :n1], jac[1, :n1])
@@ -510,7 +512,6 @@ def _arc_power(q, mu, a, b, d1, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iw
         fixed_err = e1 + 64.0 * EPS * abs(fixed)
         end = math.acos((half - a) / b)
         c = math.sqrt(half / d)  # T - D c^2 = T / 2
-    low_h = beta1 * mu**q  # H's lower bound: t >= mu on the arc, and t >= T / 2 on the piece beyond the Jacobi part
     if fixed > 0.0:
         low_h = max(low_h, fixed - fixed_err + end * (0.5 * top) ** q)
     tol = rtol * (rest + low_h)

@@ -545,11 +545,17 @@ def test_jacobi_bound_against_mpmath():
 @pytest.mark.parametrize("spec", [{"type": "retro", "n": 10, "p": 0.5}, {"type": "stretched_phong", "n": 20, "p": 0.25}])
 def test_inner_arc_at_subnormal_mu(spec):
     """mu down to the smallest subnormal: the Gauss-Jacobi bound's ellipse is capped (rho_max overflows there; a
-    hypothesis test found retro n = 10, p = 0.5 at mu = 5e-324 with a NaN error), the values and errors finite, and
-    the bound still bounds the rules' error at c = mu = 5e-324 against the closed form of the leading term."""
+    hypothesis test found retro n = 10, p = 0.5 at mu = 5e-324 with a NaN error): the values and errors are finite and
+    within rtol; the bound is finite at c = 5e-324, and at c = 1e-200 (capped ellipse) it bounds the 10-point rule's
+    error against the integral's expansion 2 c^1.5 / 1.5 (1 + O(c)) for T = 1/2, L = -1/2, q = 1/2."""
     f = pumpup.load(spec)
     a, e = pumpup.albedo(f, [5e-324, 1e-320, 1e-300, 1e-200], rtol=1e-10, return_error=True)
     assert np.all(np.isfinite(a)) and np.all(np.isfinite(e)) and np.all(e <= 1e-9 * a)
-    q, top, low, c = 0.5, 0.5, -0.5, 5e-324
-    b = _polar._jacobi_bound(q, top, low, c, 10)
+    q, top, low = 0.5, 0.5, -0.5
+    jac = _polar.jacobi_rules(q)
+    b = _polar._jacobi_bound(q, top, low, 5e-324, 10)
     assert math.isfinite(b) and b >= 0.0
+    c = 1e-200
+    ref = 2.0 * c**1.5 / 1.5  # g(0) = 1 / sqrt(T (-L)) = 2; the next term is c / T ~ 1e-200 of it
+    v = _polar._jacobi_sum(q, top, low, c, jac[0, :10], jac[1, :10])
+    assert abs(v - ref) <= _polar._jacobi_bound(q, top, low, c, 10) + 64 * 2.3e-16 * ref
