@@ -196,6 +196,7 @@ engine stays the reference: :func:`two_d_only` switches the 1-D path off.
 
 from __future__ import annotations
 
+import cmath
 import contextlib
 import functools
 import math
@@ -889,8 +890,10 @@ SMITH, VCAVITY_F, SCHLICK, LOBE_F = 0, 1, 2, 3
 #: z_s of the integrand's feature at small N.wo (alpha for the Smith models, Schlick's r / (1 - r); inf for none), the
 #: relative tolerance (set by :func:`albedo_1d`; :func:`_pieces` leaves out the outer cuts where they cannot matter);
 #: frame 5 (``LOBE_F``: the lobe frame with F(Theta_min), :func:`_k_lobe_fresnel`) also x0 and y0 of F's branch point
-#: (:func:`fresnel_branch`) and the distance rho of its pole near c = 0 (:func:`fresnel_pole`)
-MP_SIZE = 16
+#: (:func:`fresnel_branch`), the distance rho of its pole near c = 0 (:func:`fresnel_pole`), Brewster's zero c_b (real
+#: and imaginary part, 1 where found: :func:`fresnel_brewster`), |(eta + i k)^2 + 1| (:func:`_lobe_f_bound`) and 1 where
+#: the Gauss-Legendre pieces are on (:data:`LOBE_F_GAUSS`)
+MP_SIZE = 21
 
 
 def fresnel_scale(ior: float, eta: float, k: float) -> float:
@@ -1080,6 +1083,25 @@ def fresnel_pole(eta: float, k: float) -> float:
     return 1.0 / abs(complex(eta * eta - k * k + 1.0, 2.0 * eta * k) ** 0.5)
 
 
+def fresnel_brewster(eta: float, k: float) -> tuple:
+    """(c_b, ok): Brewster's zero c_b of the parallel reflectance's numerator N = A c - (1 - c^2), A = sqrt((eta + i k)^2 - 1
+    + c^2) continued from the real axis, c_b^2 = 1 / ((eta + i k)^2 + 1) (:func:`_lobe_f_bound`), and whether it was
+    found.  On the real axis A is the principal root (Im A^2 = 2 eta k >= 0); from c = Re c_b up to c_b it is the
+    principal root, negated where c^2 - w^2 (w^2 = 1 - (eta + i k)^2) crosses the negative real axis on the way
+    (Im (c^2 - w^2) = 2 Re(c) Im(c) - Im w^2 = 0)."""
+    e2 = complex(eta * eta - k * k, 2.0 * eta * k)
+    cp = 1.0 / cmath.sqrt(e2 + 1.0)
+    w2 = 1.0 - e2
+    for z in (cp, -cp):
+        r, ci = z.real, z.imag
+        y = w2.imag / (2.0 * r) if r != 0.0 else math.inf
+        flip = (0.0 < y < ci or ci < y < 0.0) and r * r - y * y - w2.real < 0.0
+        a = (-1.0 if flip else 1.0) * cmath.sqrt(z * z - w2)
+        if abs(a * z - (1.0 - z * z)) <= 1e-9 * (abs(a * z) + abs(1.0 - z * z)):
+            return z, True
+    return cp, False
+
+
 def lobe_fresnel_ok(eta: float, k: float, chain: bool = False) -> bool:
     """Whether frame 5 (``chain``: the pumped lobe's frame of N) takes the Fresnel factor of (eta, k)
     (:data:`LOBE_F_Y0_MIN`, :data:`CHAIN_F_Y0_MIN`)."""
@@ -1118,6 +1140,255 @@ def _beta_at(t, top, b):  # pragma: no cover - compiled
     return 2.0 * math.asin(min(1.0, math.sqrt(max(0.0, (top - t) / (2.0 * b)))))
 
 
+#: frame 5's Gauss-Legendre pieces (:func:`_lobe_f_bound`): the candidate ellipses, log(R) = f log(R_max) for f in these
+LOBE_F_FRACTIONS = (0.8, 0.5, 0.25)
+#: and log(R) at most this (R_max overflows where a piece is short beside far singular points)
+LOBE_F_LOG_R_CAP = math.log(1e4)
+#: frame 5 drops the arc's first cut where it lies closer to the arc's top T than this times the next piece's length
+#: (that piece, a rule in t, would otherwise see the (T - t)^-1/2 of d beta = dt / sqrt((T - t)(t - L)) next to its end)
+LOBE_F_MERGE = 0.25
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _focal_sum(zr, zi, lo, hi):  # pragma: no cover - compiled
+    """(|z - lo| + |z - hi|) / 2 for z = zr + i zi: the semi-major axis of the Bernstein ellipse of [lo, hi] through z
+    (its parameter R = A + sqrt(A^2 - 1) for A = that over h = (hi - lo) / 2).  For t in the ellipse whose semi-major axis
+    is h A_R, gap(z) = this - h A_R is a lower bound of |t - z| (not positive: z may lie inside): in elliptic
+    coordinates t = m + h cosh(xi + i theta), |dt| >= h sinh(xi) d xi = h d(cosh xi), and a path from t to z crosses the
+    confocal ellipses from t's to z's."""
+    return 0.5 * (math.sqrt((zr - lo) * (zr - lo) + zi * zi) + math.sqrt((zr - hi) * (zr - hi) + zi * zi))
+
+
+@njit(cache=True, nogil=True)
+def _lobe_f_bound(mp, q, lo, d, top, low, first, tol):  # pragma: no cover - compiled; see the tests' mpmath check
+    """(n, bound, values): the Gauss-Legendre rule (n <= GL_MAX points; GL_MAX + 1 if none suffices) of the fewest values
+    whose error on a piece [lo, lo + d] of frame 5's arc (:func:`_lobe_f_gauss`) is at most ``tol``, and its bound.
+
+    The piece is integral G(t) dt, G = F(t) t^q / sqrt((T - t)(t - L)), F the conductor Fresnel factor of
+    e = eta + i k (``mp[6]``, ``mp[7]``; 000 eq. 28), T = ``top``, L = ``low``.  ``first``: lo + d = T, by s with
+    t = T - d s^2, s in [-1, 1]: sqrt(d) integral F t^q / sqrt(t - L) ds, even in s, whose Bernstein ellipse of parameter
+    r maps onto t's of [lo, T] with R = r^2; else in t itself.  The n-point rule errs by at most 64 M / (15 (1 - r^-2)
+    r^(2 n)) times the length factor (Trefethen, ATAP Thm 19.3), M a bound of the integrand on the ellipse, which must
+    avoid F's branch points +-w, +-conj(w) (w^2 = 1 - e^2; x0, y0 = ``mp[13]``, ``mp[14]``: :func:`fresnel_branch`),
+    L and (in t) T.
+
+    M on the t-ellipse E_R of [lo, hi] (semi-axes h A_R, h B_R about m).  Every bound holds for either sign of the
+    refracted cosine A = sqrt(e^2 - 1 + t^2), so for F's continuation, whatever its branch:
+    - |t| <= tau = m + h A_R; |A|^2 = |t - w| |t + w| <= tau^2 + |w|^2 and >= gap(w) gap(-w) (:func:`_gap`);
+    - F = r_s(e) r_s(conj e) (1 + N_e N_conj(e) / (D_e D_conj(e))) / 2 continues |r_s|^2 (1 + |N|^2 / |D|^2) / 2 of
+      the real axis (R_p = R_s |N|^2 / |D|^2, pbrt-v3's FrConductor), r_s = (t - A) / (t + A), N = A t - (1 - t^2),
+      D = A t + 1 - t^2; the bounds for e hold for conj(e) (E_R is symmetric about the real axis);
+    - |r_s| <= (tau + |A|)^2 / |w|^2, as (t - A)(t + A) = w^2; or (tau + |A|) / |t + A|, where on [lo, hi] (A's real
+      part rising, its imaginary part >= 0 falling with t) |t + A| >= max(lo + Re A(lo), Im A(hi)), and E_R lies within
+      h B_R of the segment, where |d(t + A)/dt| <= 1 + tau / min |A|;
+    - |N| <= |A| tau + 1 + tau^2; D N = (e^2 + 1)(t - c_b)(t + c_b), c_b^2 = 1 / (e^2 + 1), so |D| >= |e^2 + 1|
+      gap(c_b) gap(-c_b) / max |N|; and where N(c_b) = 0 (Brewster's zero, ``mp[16:19]``: :func:`fresnel_brewster`,
+      A continued along the real axis to Re c_b, then straight to c_b), |N(t)| <= max |N'| |t - c_b| on the Bernstein
+      ellipse through c_b (or E_R, the larger: convex and symmetric, it holds that path and the straight one from t,
+      and A is analytic on it where it avoids +-w), N' = A + t^2 / A + 2 t, so
+      |D| >= |e^2 + 1| gap(-c_b) / max |N'|: no loss at Brewster's angle;
+    - |t - L|, |T - t| >= gap(L), gap(T).
+    log(R) is the first of LOBE_F_FRACTIONS of log(R_max) that gives a rule; ``values`` is (n + 1) // 2 for ``first``,
+    n else."""
+    eta, k, x0, y0 = mp[6], mp[7], mp[13], mp[14]
+    h = 0.5 * d  # (d = hi - lo; for ``first`` T - lo without cancellation)
+    m = lo + h
+    hi = lo + d
+    best_n = GL_MAX + 1
+    best = 0.0
+    best_v = GL_MAX + 1
+    if not (tol > 0.0 and h > 0.0):
+        return best_n, best, best_v
+    # the semi-major axes of the ellipses through w, -w, L, T, c_b, -c_b: gap(z) = s_z - h A_R (:func:`_gap`)
+    cbr, cbi = mp[16], abs(mp[17])
+    s_w = _focal_sum(x0, y0, lo, hi)
+    s_mw = _focal_sum(-x0, y0, lo, hi)
+    s_l = m - low
+    s_t = top - m
+    s_b = _focal_sum(cbr, cbi, lo, hi)
+    s_mb = _focal_sum(-cbr, cbi, lo, hi)
+    amx = min(s_w, s_mw, s_l) / h
+    if not first:
+        amx = min(amx, s_t / h)
+    lrmax = min(math.log(amx + math.sqrt(max(0.0, (amx - 1.0) * (amx + 1.0)))), LOBE_F_LOG_R_CAP)
+    if not lrmax > 1e-3:
+        return best_n, best, best_v
+    w2 = x0 * x0 + y0 * y0  # |w|^2 = |1 - e^2|
+    e2r, e2i = (eta - k) * (eta + k), 2.0 * eta * k
+    a_lo = cmath.sqrt(complex(e2r - 1.0 + lo * lo, e2i))
+    a_hi = cmath.sqrt(complex(e2r - 1.0 + hi * hi, e2i))
+    s_seg = max(lo + a_lo.real, abs(a_hi.imag))  # |t + A| on [lo, hi]
+    ep1 = mp[19]
+    brewster = mp[18] > 0.0
+    for f in LOBE_F_FRACTIONS:
+        lr = f * lrmax
+        big_r = math.exp(lr)
+        big_a = 0.5 * (big_r + 1.0 / big_r)
+        big_b = 0.5 * (big_r - 1.0 / big_r)
+        ha = h * big_a
+        tau = m + ha
+        dw, dmw, dl = s_w - ha, s_mw - ha, s_l - ha
+        dt = 1.0 if first else s_t - ha
+        if not (dw > 0.0 and dmw > 0.0 and dl > 0.0 and dt > 0.0):
+            continue
+        amin = math.sqrt(dw * dmw)
+        amax = math.sqrt(tau * tau + w2)
+        rs = (tau + amax) * (tau + amax) / w2 if w2 > 0.0 else math.inf
+        s_low = s_seg - (1.0 + tau / amin) * h * big_b
+        if s_low > 0.0:
+            rs = min(rs, (tau + amax) / s_low)
+        nmax = amax * tau + 1.0 + tau * tau
+        d_low = -1.0
+        dm = s_mb - ha  # |t + c_b|
+        if dm > 0.0:
+            if s_b - ha > 0.0:
+                d_low = ep1 * (s_b - ha) * dm / nmax
+            if brewster:
+                ha2 = max(ha, s_b)  # the ellipse through c_b, or E_R
+                tau2 = m + ha2
+                dw2, dmw2 = s_w - ha2, s_mw - ha2
+                if dw2 > 0.0 and dmw2 > 0.0:
+                    d_low = max(d_low, ep1 * dm / (math.sqrt(tau2 * tau2 + w2) + tau2 * tau2 / math.sqrt(dw2 * dmw2) + 2.0 * tau2))
+        if not (d_low > 0.0 and rs < math.inf):
+            continue
+        big_m = 0.5 * rs * rs * (1.0 + (nmax / d_low) ** 2) * (tau if q == 1.0 else 1.0) / math.sqrt(dl * dt)
+        if first:  # sqrt(T - lo) 64 M / (15 (1 - 1 / R) R^n), n points, (n + 1) // 2 values
+            c = math.sqrt(d) * 64.0 * big_m / (15.0 * (1.0 - 1.0 / big_r))
+            n = max(1.0, math.ceil(math.log(c / tol) / lr))
+            v = (n + 1.0) // 2.0
+            bound = c * math.exp(-n * lr)
+        else:  # h 64 M / (15 (1 - R^-2) R^(2 n)), n points and values
+            c = h * 64.0 * big_m / (15.0 * (1.0 - 1.0 / (big_r * big_r)))
+            n = max(1.0, math.ceil(math.log(c / tol) / (2.0 * lr)))
+            v = n
+            bound = c * math.exp(-2.0 * n * lr)
+        if n <= GL_MAX:
+            return int(n), bound, int(v)
+    return best_n, best, best_v
+
+
+@njit(cache=True, nogil=True)
+def _lobe_f_piece(eta, k, q, lo, d, top, low, first, n):  # pragma: no cover - compiled; see lobe_f_piece_reference
+    """integral_lo^(lo + d) F(t) t^q / sqrt((T - t)(t - L)) dt by the n-point Gauss-Legendre rule (:func:`_lobe_f_bound`):
+    ``first`` (lo + d = T) in s, t = T - d s^2, else in t."""
+    tot = 0.0
+    if first:
+        for j in range((n + 1) // 2):
+            s2 = d * GL_X[n, j] * GL_X[n, j]
+            t = top - s2
+            tot += GL_W[n, j] * _fresnel_real(t, eta, k) * t**q / math.sqrt((top - low) - s2)
+        return math.sqrt(d) * tot
+    h = 0.5 * d
+    m = lo + h
+    for j in range((n + 1) // 2):
+        x = h * GL_X[n, j]
+        t = m - x
+        g = _fresnel_real(t, eta, k) * t**q / math.sqrt(((top - m) + x) * ((m - low) - x))
+        if x == 0.0:  # (the middle node of an odd rule, its weight once)
+            tot += GL_W[n, j] * g
+            continue
+        t = m + x
+        g += _fresnel_real(t, eta, k) * t**q / math.sqrt(((top - m) - x) * ((m - low) + x))
+        tot += 0.5 * GL_W[n, j] * g
+    return h * tot
+
+
+@njit(cache=True, nogil=True)
+def _lobe_f_gauss(mp, q, mu, a, b, d, beta1, tol, cut):  # pragma: no cover - compiled
+    """(H, error) of H = integral_0^beta1 F(t) t^q d beta, t = N.wo = a + b cos(beta) >= mu (frame 5's arc,
+    :func:`_k_lobe_fresnel`), d = T - mu, by Gauss-Legendre rules with an a-priori bound (:func:`_lobe_f_bound`) on the
+    pieces between frame 5's cuts (``cut``: falling t in (mu, T)), each at the tolerance ``tol`` times its share of
+    [mu, T]; the error is the bounds plus (n + 64) eps of rounding per piece.  (0, -1) where a piece would want more
+    than GL_MAX points: the caller then takes the adaptive rule."""
+    eta, k = mp[6], mp[7]
+    top = a + b
+    low = a - b
+    nc = cut.shape[0]
+    # the first piece, in s, reaches down to the first cut; drop cuts that lie too close to T (LOBE_F_MERGE)
+    i = 0
+    while i < nc:
+        nxt = cut[i + 1] if i + 1 < nc else mu
+        if top - cut[i] >= LOBE_F_MERGE * (cut[i] - nxt):
+            break
+        i += 1
+    tot = 0.0
+    err = 0.0
+    scale = tol / d
+    lo = cut[i] if i < nc else mu
+    d0 = top - lo if i < nc else d
+    n, bound, _ = _lobe_f_bound(mp, q, lo, d0, top, low, True, scale * d0)
+    if n > GL_MAX:
+        return 0.0, -1.0
+    p = _lobe_f_piece(eta, k, q, lo, d0, top, low, True, n)
+    tot += p
+    err += bound + (n + 64) * EPS * abs(p)
+    while i < nc:
+        hi = cut[i]
+        lo = cut[i + 1] if i + 1 < nc else mu
+        i += 1
+        n, bound, _ = _lobe_f_bound(mp, q, lo, hi - lo, top, low, False, scale * (hi - lo))
+        if n > GL_MAX:
+            return 0.0, -1.0
+        p = _lobe_f_piece(eta, k, q, lo, hi - lo, top, low, False, n)
+        tot += p
+        err += bound + (n + 64) * EPS * abs(p)
+    return tot, err
+
+
+_POW3 = 3.0 ** np.arange(LOBE_F_CUTS)
+
+
+#: frame 5 takes its arcs by the Gauss-Legendre pieces with an a-priori bound (:func:`_lobe_f_gauss`; issue 14's
+#: sixteenth session) where they apply; ``without_lobe_f_gauss`` switches them off (the adaptive 7/15 rule alone, as
+#: before them): the tests' and the benchmark's second rule
+LOBE_F_GAUSS = True
+
+
+@contextlib.contextmanager
+def without_lobe_f_gauss():
+    """Within the block, frame 5 (:func:`_k_lobe_fresnel`) takes every arc by the adaptive 7/15 rule in beta, as before
+    issue 14's sixteenth session (``mp[20]``, set by :func:`numeric_params`).  Not meant for concurrent toggling."""
+    global LOBE_F_GAUSS
+    old = LOBE_F_GAUSS
+    LOBE_F_GAUSS = False
+    try:
+        yield
+    finally:
+        LOBE_F_GAUSS = old
+
+
+
+
+@njit(cache=True, nogil=True)
+def _lobe_f_cuts(mp, mu, top, out):  # pragma: no cover - compiled
+    """Frame 5's cuts of the arc t = N.wo in (mu, T) (:func:`_k_lobe_fresnel`) into ``out``, falling, and their number:
+    t = x0 + y0 3^j (j falling), x0 - y0 3^j (j rising), j < LOBE_F_CUTS, about F's branch point (``mp[13]``,
+    ``mp[14]``), and rho 3^j (j falling) from max(rho, 3 mu), rho the distance of its pole near 0 (``mp[15]``)."""
+    x0, y0 = mp[13], mp[14]
+    rho = mp[15]
+    r0 = rho if 3.0 * mu <= rho else 3.0 * mu
+    m = 0
+    ia, ib = 0, 0
+    while True:
+        ta = -1.0
+        if ia < 2 * LOBE_F_CUTS:
+            ta = x0 + y0 * _POW3[LOBE_F_CUTS - 1 - ia] if ia < LOBE_F_CUTS else x0 - y0 * _POW3[ia - LOBE_F_CUTS]
+        tb = r0 * _POW3[LOBE_F_CUTS - 1 - ib] if ib < LOBE_F_CUTS else -1.0
+        if ta < 0.0 and tb < 0.0:
+            return m
+        if ta >= tb:
+            t = ta
+            ia += 1
+        else:
+            t = tb
+            ib += 1
+        if t <= mu:  # (the rest fall below it too)
+            return m
+        if t < top and (m == 0 or t < out[m - 1]):
+            out[m] = t
+            m += 1
+
+
 @njit(cache=True, nogil=True)
 def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, iwork):  # pragma: no cover - compiled; see lobe_fresnel_integrand_reference
     """(K(u), its error) of frame 5: the integral over the visible arc of N.wo F(max(mu, N.wo)) / max(mu, N.wo)^p,
@@ -1142,32 +1413,22 @@ def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol, tol_abs, nodes, wk, wg, mode
     top = a + b  # t at beta = 0; t = mu at beta1
     q = 1.0 - p
     lo, hi, val, err = iwork[0], iwork[1], iwork[2], iwork[3]
-    x0, y0 = mp[13], mp[14]
-    # the cuts at t = x0 + y0 3^j (j falling), x0 - y0 3^j (j rising) and rho 3^j from max(rho, 3 mu) (j falling), merged
-    # in falling t (rising beta); then the arc's end beta1
-    rho = mp[15]
-    r0 = rho if 3.0 * mu <= rho else 3.0 * mu
+    cut = err[err.shape[0] - 3 * LOBE_F_CUTS:]  # (the initial pieces below write err[m] for m <= nc only)
+    nc = _lobe_f_cuts(mp, mu, top, cut)
+    # the Gauss-Legendre pieces with an a-priori bound (issue 14's sixteenth session), at the tolerance's target for
+    # H >= beta1 min(F) mu^q, min(F) guessed as half the smaller of F(mu), F(T)
+    d = um * (u - c2) / (b + mu * (1.0 - u))  # T - mu = d1 / (b + mu - a), without cancellation
+    h_low = 0.5 * beta1 * min(fm, _fresnel_real(top, mp[6], mp[7])) * (mu if q == 1.0 else 1.0)
+    tol = max(itol * (closed + h_low), 0.5 * tol_abs)
+    if mp[20] > 0.0:
+        h, e = _lobe_f_gauss(mp, q, mu, a, b, d, beta1, tol, cut[:nc])
+        if e >= 0.0:
+            return 2.0 * (closed + h), 2.0 * e
+    # else the globally adaptive 7/15 rule in beta from the same cuts
     m = 0
     start = 0.0
-    ia, ib = 0, 0
-    nb = LOBE_F_CUTS
-    while True:
-        ta = -1.0
-        if ia < 2 * LOBE_F_CUTS:
-            ta = x0 + y0 * 3.0 ** (LOBE_F_CUTS - 1 - ia) if ia < LOBE_F_CUTS else x0 - y0 * 3.0 ** (ia - LOBE_F_CUTS)
-        tb = r0 * 3.0 ** (nb - 1 - ib) if ib < nb else -1.0
-        if ta < 0.0 and tb < 0.0:
-            end = beta1
-        else:
-            if ta >= tb:
-                t = ta
-                ia += 1
-            else:
-                t = tb
-                ib += 1
-            if not mu < t < top:
-                continue
-            end = min(_beta_at(t, top, b), beta1)
+    for i in range(nc + 1):
+        end = min(_beta_at(cut[i], top, b), beta1) if i < nc else beta1
         if end > start:
             lo[m], hi[m] = start, end
             val[m], err[m] = _lobe_rule(mp, q, a, b, start, end, nodes, wk, wg, mode, ibuf)
@@ -3204,8 +3465,13 @@ def numeric_params(hint: Polar) -> np.ndarray:
             mp[9] = walter_level(float(hint.smith[3]))
     elif hint.kind == "lobe" and any(hint.fresnel):  # frame 5: F(max(N.wi, N.wo)) of a conductor (eta, k)
         mp[0] = LOBE_F
-        mp[13], mp[14] = fresnel_branch(float(hint.fresnel[1]), float(hint.fresnel[2]))
-        mp[15] = fresnel_pole(float(hint.fresnel[1]), float(hint.fresnel[2]))
+        eta, k = float(hint.fresnel[1]), float(hint.fresnel[2])
+        mp[13], mp[14] = fresnel_branch(eta, k)
+        mp[15] = fresnel_pole(eta, k)
+        cb, ok = fresnel_brewster(eta, k)
+        mp[16], mp[17], mp[18] = cb.real, cb.imag, 1.0 if ok else 0.0
+        mp[19] = abs(complex(eta * eta - k * k + 1.0, 2.0 * eta * k))  # |e^2 + 1|
+        mp[20] = 1.0 if LOBE_F_GAUSS else 0.0
     elif hint.schlick is not None:
         r = float(hint.schlick)
         mp[0], mp[4], mp[11] = SCHLICK, r, (r / (1.0 - r) if r < 1.0 else math.inf)

@@ -175,3 +175,119 @@ def test_colour_keeping_pumped_metal_channels():
     with _polar.without_1d():
         b, eb = k.albedo(mu, return_error=True, rtol=1e-12)
     assert np.all(np.abs(a - b) <= e + eb) and np.all(e <= 1e-10 * a * 1.0001)
+
+
+# --- frame 5's Gauss-Legendre pieces with an a-priori bound (issue 14, sixteenth session) ----------------------------
+
+#: (eta, k): dielectrics (Brewster's zero on the real axis), conductors, a strong absorber (F's pole near c = 0), F's
+#: branch point near the real axis (x0 0.87, y0 1.2e-3; x0 0.049, y0 0.02), eta near 1
+MATERIALS = [(1.5, 0.0), (1.33, 0.0), (3.0, 0.3), (0.2, 3.0), (0.6, 0.3), (1.1, 30.0), (0.05, 30.0), (0.5, 0.002),
+             (0.999, 0.001), (1.1, 6.0), (2.5, 0.01)]
+
+
+def _fresnel_mp(eta, k, c):
+    """F(c) at real c by the complex-arithmetic formula of pumpup.models.metal.fresnel, in mpmath (r_par with the index
+    squared times c against the refracted cosine times the index, r_perp with c against it)."""
+    import mpmath as mp
+
+    e = mp.mpf(eta) + 1j * mp.mpf(k)
+    a = mp.sqrt(e * e - 1 + c * c)  # the refracted cosine times e, Re >= 0
+    r_par = (e * e * c - a) / (e * e * c + a)
+    r_perp = (c - a) / (c + a)
+    return (abs(r_par) ** 2 + abs(r_perp) ** 2) / 2
+
+
+def test_fresnel_mp_is_the_models_fresnel():
+    """The mpmath F of the tests below is pumpup.models.metal.fresnel (pbrt-v4's FrComplex) at double precision."""
+    import mpmath as mp
+
+    from pumpup.models.metal import fresnel
+
+    with mp.workdps(30):
+        for eta, k in MATERIALS:
+            for c in (1.0, 0.7, 0.3, 0.05, 1e-3):
+                assert float(_fresnel_mp(eta, k, mp.mpf(c))) == pytest.approx(float(fresnel(c, eta, k)), rel=1e-13, abs=1e-300)
+
+
+def test_brewster_zero_of_the_continued_numerator():
+    """fresnel_brewster's c_b is a zero of N = A c - (1 - c^2) for A continued from the real axis: A followed in 4000
+    small steps from Re c_b up to c_b (each step's root the one nearer the last); for a dielectric c_b is
+    cos(theta_B) = 1 / sqrt(1 + eta^2), on the real axis."""
+    for eta, k in MATERIALS:
+        cb, ok = _polar.fresnel_brewster(eta, k)
+        assert ok, (eta, k)
+        e2 = complex(eta * eta - k * k, 2 * eta * k)
+        a = (e2 - 1 + cb.real**2) ** 0.5  # principal on the real axis
+        for t in np.linspace(0.0, 1.0, 4001)[1:]:
+            c = complex(cb.real, t * cb.imag)
+            r = (e2 - 1 + c * c) ** 0.5
+            a = r if abs(r - a) <= abs(r + a) else -r
+        assert abs(a * cb - (1 - cb * cb)) <= 1e-12, (eta, k, cb)
+        if k == 0.0:
+            assert cb.imag == 0.0 and cb.real == pytest.approx(1 / math.sqrt(1 + eta * eta), rel=1e-15)
+
+
+def _pieces(rng, count):
+    """Random pieces of frame 5's arcs: (mu, T, L, lo, d, first), from grazing to normal incidence."""
+    out = []
+    while len(out) < count:
+        mu = float(10 ** rng.uniform(-4, 0)) if rng.uniform() < 0.5 else float(rng.uniform(0.01, 0.99))
+        u = float(rng.uniform(-1, 1))
+        s, sa = math.sqrt(1 - mu * mu), math.sqrt(1 - u * u)
+        top, low = mu * u + s * sa, mu * u - s * sa
+        if not top > mu * (1 + 1e-9):
+            continue
+        first = rng.uniform() < 0.5
+        if first:
+            lo = mu if rng.uniform() < 0.5 else float(rng.uniform(mu, top))
+            out.append((mu, top, low, lo, top - lo, True))
+        else:
+            x = np.sort(rng.uniform(mu, top, 2))
+            hi = float(x[1]) if rng.uniform() < 0.7 else mu + (top - mu) * 0.5
+            lo = float(x[0]) if x[0] < hi else mu
+            out.append((mu, top, low, lo, hi - lo, False))
+    return out
+
+
+@pytest.mark.parametrize("eta,k", MATERIALS)
+def test_gauss_piece_and_its_bound_against_mpmath(rng, eta, k):
+    """_lobe_f_piece's n-point rule errs by at most _lobe_f_bound's bound (plus the returned rounding allowance), against
+    30-digit mpmath tanh-sinh of integral F(t) t^q / sqrt((T - t)(t - L)) dt over the piece, F from the complex formula:
+    random pieces (in s beside T and in t), q in {0, 1}, tolerances 1e-6 .. 1e-14 of the piece; and the bound meets the
+    tolerance asked."""
+    import mpmath as mp
+
+    mpar = _polar.numeric_params(pumpup.load({"type": "metal", "n": 5, "eta": eta, "k": k}).polar())
+    assert mpar[18] == 1.0  # (Brewster's zero found)
+    ran = 0
+    with mp.workdps(30):
+        for (mu, top, low, lo, d, first), q, rt in zip(_pieces(rng, 18), [0.0, 1.0] * 9, [1e-6, 1e-10, 1e-14] * 6):
+            ref_scale = math.sqrt(d) * 3.0  # (the piece is about sqrt(d) in size; the tolerance is relative to that)
+            n, bound, v = _polar._lobe_f_bound(mpar, q, lo, d, top, low, first, rt * ref_scale)
+            if n > _polar.GL_MAX:
+                continue  # (the caller falls back to the adaptive rule)
+            ran += 1
+            assert bound <= rt * ref_scale and v == ((n + 1) // 2 if first else n)
+            p = _polar._lobe_f_piece(eta, k, q, lo, d, top, low, first, n)
+            g = lambda t: _fresnel_mp(eta, k, t) * t**q / mp.sqrt((top - t) * (t - low))  # noqa: E731
+            hi = mp.mpf(top) if first else mp.mpf(lo) + mp.mpf(d)
+            ref = mp.quad(g, [mp.mpf(lo) if not first else mp.mpf(top) - mp.mpf(d), hi])
+            err = abs(float(p - ref))
+            allow = bound + (n + 64) * np.finfo(float).eps * abs(p)
+            assert err <= allow, (mu, top, low, lo, d, first, q, rt, n, err, bound)
+    assert ran >= 6, ran  # (pieces across F's branch point are the adaptive rule's: the engine cuts there)
+
+
+@pytest.mark.parametrize("spec", SPECS, ids=IDS)
+def test_gauss_pieces_against_the_adaptive_rule(spec):
+    """Frame 5 with the Gauss-Legendre pieces against frame 5 with the adaptive 7/15 rule alone (the rule before issue
+    14's sixteenth session, ``without_lobe_f_gauss``) at rtol 1e-12: within their estimates; at rtol 1e-6, 1e-8, 1e-10
+    the estimate bounds the distance (less the other's estimate) and meets the tolerance."""
+    f = _lobe(spec)
+    mu = np.array(MU)
+    with _polar.without_n_frame():  # (n >= LOBE_N_MIN takes the frame of N otherwise)
+        with _polar.without_lobe_f_gauss():
+            b, eb, *_ = _polar.albedo_1d(f, mu, 1e-12, 0.0, 10000)
+        for rtol in (1e-6, 1e-8, 1e-10, 1e-12):
+            a, ea, conv, _ = _polar.albedo_1d(f, mu, rtol, 0.0, 10000)
+            assert conv.all() and np.all(np.abs(a - b) - eb <= ea) and np.all(ea <= rtol * a * 1.0001), (rtol, a - b, ea, eb)
