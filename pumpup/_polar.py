@@ -1150,6 +1150,14 @@ LOBE_F_MERGE = 0.25
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _sqrt_re(x, y):  # pragma: no cover - compiled
+    """Re sqrt(x + i y), the principal root, without cancellation: sqrt((r + x) / 2), or |y| / sqrt(2 (r - x)) for x < 0
+    (r = |x + i y|; 0 for a negative real x)."""
+    r = math.sqrt(x * x + y * y)
+    return math.sqrt(0.5 * (r + x)) if x >= 0.0 else abs(y) / math.sqrt(2.0 * (r - x))
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _focal_sum(zr, zi, lo, hi):  # pragma: no cover - compiled
     """(|z - lo| + |z - hi|) / 2 for z = zr + i zi: the semi-major axis of the Bernstein ellipse of [lo, hi] through z
     (its parameter R = A + sqrt(A^2 - 1) for A = that over h = (hi - lo) / 2).  For t in the ellipse whose semi-major axis
@@ -1215,9 +1223,9 @@ def _lobe_f_bound(mp, q, lo, d, top, low, first, tol):  # pragma: no cover - com
         return best_n, best, best_v
     w2 = x0 * x0 + y0 * y0  # |w|^2 = |1 - e^2|
     e2r, e2i = (eta - k) * (eta + k), 2.0 * eta * k
-    a_lo = cmath.sqrt(complex(e2r - 1.0 + lo * lo, e2i))
-    a_hi = cmath.sqrt(complex(e2r - 1.0 + hi * hi, e2i))
-    s_seg = max(lo + a_lo.real, abs(a_hi.imag))  # |t + A| on [lo, hi]
+    re_lo = _sqrt_re(e2r - 1.0 + lo * lo, e2i)  # Re A(lo)
+    im_hi = e2i / (2.0 * _sqrt_re(e2r - 1.0 + hi * hi, e2i)) if e2i > 0.0 else 0.0  # Im A(hi) >= 0
+    s_seg = max(lo + re_lo, im_hi)  # |t + A| on [lo, hi]
     ep1 = mp[19]
     brewster = mp[18] > 0.0
     for f in LOBE_F_FRACTIONS:

@@ -43,6 +43,9 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
                                               # against the nested engine
     python scripts/bench_albedo.py --lafortune  # only Lafortune lobes with p = 0 about their own axis (issue 14's
                                               # fifteenth session) against the nested engine / the 2-D cubature
+    python scripts/bench_albedo.py --lobe-f   # only frame 5's lobes with n < 8 (metal, plastic, the fresnel wrapper):
+                                              # Gauss-Legendre pieces with an a-priori bound (issue 14's sixteenth
+                                              # session) against the adaptive 7/15 rule they had before
     python scripts/bench_albedo.py --breaks   # only the nested families with kinks or levels: the compiled break
                                               # finding against its numpy reference (issue 14 item 3)
 """
@@ -626,6 +629,47 @@ def slope(rtol=1e-10, repeat=3):
                   flush=True)
 
 
+def lobe_f_gauss(rtol=1e-10, repeat=3):
+    """Frame 5's lobes with F(Theta_min) and n < LOBE_N_MIN (metal, plastic, the fresnel wrapper) with the arcs by
+    Gauss-Legendre pieces and their a-priori bound (``pumpup._polar._lobe_f_gauss``; issue 14's sixteenth session)
+    against the adaptive 7/15 rule they had before (``_polar.without_lobe_f_gauss``), same run: a 257-point table (mu
+    uniform in theta) at ``rtol`` and a sweep cell (257 mu + mean albedo + maximum constant), one thread, best of
+    ``repeat`` each, alternating."""
+    from pumpup import _polar
+    from pumpup.sweeps import default_mu
+
+    mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
+    cell_mu = default_mu(257)
+
+    def cell(spec):
+        f = pumpup.load(spec)
+        pumpup.tabulate(f, mu=cell_mu, threads=1, progress=False)
+        pumpup.mean_albedo(f)
+        pumpup.max_albedo(f)
+
+    specs = [{"type": "metal", "n": 1, "eta": 1.5}, {"type": "metal", "n": 7.5, "eta": 0.6, "k": 0.3},
+             {"type": "metal", "n": 5, "eta": 0.2, "k": 3.0}, {"type": "metal", "n": 2, "eta": 1.1, "k": 6.0},
+             {"type": "metal", "n": 0, "eta": 0.999, "k": 0.001}, {"type": "plastic", "n": 3, "eta": 1.5, "ad": 0.3},
+             {"type": "fresnel", "base": {"type": "phong", "n": 1}, "eta": 1.1, "k": 30.0},
+             {"type": "fresnel", "base": {"type": "retro", "n": 4}, "eta": 0.2, "k": 3.0}]
+    print(f"frame 5, n < {_polar.LOBE_N_MIN:g}: Gauss-Legendre pieces against the adaptive 7/15 rule, one thread, ms (best of "
+          f"{repeat}); table: 257 mu at rtol {rtol:g}; cell: sweep cell")
+    print(f"{'model':62s} {'table':>7s} {'before':>7s} {'ratio':>6s} {'cell':>7s} {'before':>7s} {'ratio':>6s}")
+    for spec in specs:
+        f = pumpup.load(spec)
+        best = {True: [np.inf, np.inf], False: [np.inf, np.inf]}
+        for _ in range(repeat):
+            for gauss in (True, False):
+                with contextlib.nullcontext() if gauss else _polar.without_lobe_f_gauss():
+                    pumpup.albedo(f, [0.5, 1e-3], rtol=rtol)
+                    _, t_table = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), 1)
+                    _, t_cell = _best(lambda: cell(spec), 1)
+                best[gauss] = [min(best[gauss][0], t_table), min(best[gauss][1], t_cell)]
+        (a, b), (c, d) = best[True], best[False]
+        print(f"{str(spec):62s} {a * 1e3:7.1f} {c * 1e3:7.1f} {c / a:6.2f} {b * 1e3:7.1f} {d * 1e3:7.1f} {d / b:6.2f}",
+              flush=True)
+
+
 def lafortune_axis(rtol=1e-10, repeat=3):
     """Lafortune lobes with p = 0 about their own axis v^ (``BRDF.lobe_axis``, ``pumpup._polar.axis_albedo``; issue 14's
     fifteenth session) against the engine they took before (``lobe_axis`` switched off: the nested engine at phi = 0, the
@@ -706,6 +750,9 @@ def main():
         return
     if "--lafortune" in sys.argv:
         lafortune_axis()
+        return
+    if "--lobe-f" in sys.argv:
+        lobe_f_gauss()
         return
     if "--cells" not in sys.argv:
         families()
