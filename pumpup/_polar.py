@@ -892,8 +892,8 @@ SMITH, VCAVITY_F, SCHLICK, LOBE_F = 0, 1, 2, 3
 #: frame 5 (``LOBE_F``: the lobe frame with F(Theta_min), :func:`_k_lobe_fresnel`) also x0 and y0 of F's branch point
 #: (:func:`fresnel_branch`), the distance rho of its pole near c = 0 (:func:`fresnel_pole`), Brewster's zero c_b (real
 #: and imaginary part, 1 where found: :func:`fresnel_brewster`), |(eta + i k)^2 + 1| (:func:`_lobe_f_bound`) and 1 where
-#: the Gauss-Legendre pieces are on (:data:`LOBE_F_GAUSS`)
-MP_SIZE = 21
+#: the Gauss-Legendre pieces are on (:data:`LOBE_F_GAUSS`); per mu (:func:`_lobe_f_prepare`, set by :func:`_integrate`) F(mu),
+#: the number of the arc's cuts in (mu, 1] and the cuts, falling (:data:`MP_SIZE` = 23 + 3 LOBE_F_CUTS, set below)
 
 
 def fresnel_scale(ior: float, eta: float, k: float) -> float:
@@ -1060,6 +1060,8 @@ LOBE_F_Y0_MIN = 1e-3
 CHAIN_F_Y0_MIN = 1e-2
 #: the most graded cuts per side of the branch point on an arc (:func:`_k_lobe_fresnel`) and in alpha (:func:`_pieces`)
 LOBE_F_CUTS = 8
+#: the slots of frame 4's and 5's parameter array ``mp`` (above)
+MP_SIZE = 23 + 3 * LOBE_F_CUTS
 #: no cuts in alpha (:func:`_pieces`) where the feature's scale there is at least this (rad): the outer rule's first
 #: 21 nodes on a piece of at most pi / 2 see it (metal eta 0.2, k 3: its pole's scale 0.35 had doubled the pieces)
 LOBE_F_WIDE = 0.25
@@ -1398,6 +1400,14 @@ def _lobe_f_cuts(mp, mu, top, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
+def _lobe_f_prepare(mp, mu):  # pragma: no cover - compiled
+    """Frame 5's per-mu quantities in ``mp``: F(mu) (``mp[21]``), the arc's cuts in (mu, 1] (:func:`_lobe_f_cuts`, at most
+    3 LOBE_F_CUTS, falling: ``mp[23:]``) and their number (``mp[22]``); every node's arc takes those below its top."""
+    mp[21] = _fresnel_real(mu, mp[6], mp[7])
+    mp[22] = _lobe_f_cuts(mp, mu, 1.0 + 1e-12, mp[23:])
+
+
+@njit(cache=True, nogil=True)
 def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, iwork):  # pragma: no cover - compiled; see lobe_fresnel_integrand_reference
     """(K(u), its error) of frame 5: the integral over the visible arc of N.wo F(max(mu, N.wo)) / max(mu, N.wo)^p,
     p in {0, 1}, for u = cos(alpha) about R (or wi), um = 1 - u, sa = sin(alpha), c2 = cos(2 theta_i); F the conductor
@@ -1412,7 +1422,7 @@ def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol, tol_abs, nodes, wk, wg, mode
     max(``itol`` |K|, ``tol_abs``) or INNER_MAX intervals are used; the error is returned either way.  Both signs of beta:
     2 x."""
     _, beta1, below = _k_closed(1.0, mu, c2, u, um, sa)
-    fm = _fresnel_real(mu, mp[6], mp[7])
+    fm = mp[21]  # F(mu) (:func:`_lobe_f_prepare`)
     closed = below * fm / (mu if p == 1.0 else 1.0)
     if beta1 <= 0.0:
         return 2.0 * closed, 0.0
@@ -1421,8 +1431,12 @@ def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol, tol_abs, nodes, wk, wg, mode
     top = a + b  # t at beta = 0; t = mu at beta1
     q = 1.0 - p
     lo, hi, val, err = iwork[0], iwork[1], iwork[2], iwork[3]
-    cut = err[err.shape[0] - 3 * LOBE_F_CUTS:]  # (the initial pieces below write err[m] for m <= nc only)
-    nc = _lobe_f_cuts(mp, mu, top, cut)
+    nall = int(mp[22])  # the cuts in (mu, 1], falling (:func:`_lobe_f_prepare`): those below T
+    i0 = 0
+    while i0 < nall and mp[23 + i0] >= top:
+        i0 += 1
+    cut = mp[23 + i0:23 + nall]
+    nc = nall - i0
     # the Gauss-Legendre pieces with an a-priori bound (issue 14's sixteenth session), at the tolerance's target for
     # H >= beta1 min(F) mu^q, min(F) guessed as half the smaller of F(mu), F(T)
     d = um * (u - c2) / (b + mu * (1.0 - u))  # T - mu = d1 / (b + mu - a), without cancellation
@@ -2267,6 +2281,8 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
         if frame == 4 and mp[0] == SMITH:  # P(mu) = mu / G1(mu)
             mp[8] = _projected(s, 0.0, mu, int(mp[1]), int(mp[2]), mp[4])
+        elif frame == 5:  # F(mu) and the arcs' cuts
+            _lobe_f_prepare(mp, mu)
         npieces, c2, left_out = _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, cv1, mp)
         # frame 4's inner rule may leave an absolute error iacc / (the node's factor) in K, iacc = itol times a lower
         # bound of the integral so far over the pieces' total length in tau: its share of the sum is then at most
@@ -3500,6 +3516,8 @@ def numeric_integrand(brdf, mu: float, u, rtol: float = 1e-13):
     u = np.atleast_1d(np.asarray(u, dtype=float))
     ibuf, iwork = np.empty(_NODES.shape[0]), np.empty((4, INNER_MAX))
     val, err = np.empty(u.shape), np.empty(u.shape)
+    if mp[0] == LOBE_F:
+        _lobe_f_prepare(mp, mu)
     for i, v in enumerate(u):
         sa = math.sqrt((1.0 - v) * (1.0 + v))
         if mp[0] == LOBE_F:
