@@ -281,8 +281,9 @@ def test_gauss_piece_and_its_bound_against_mpmath(rng, eta, k):
 @pytest.mark.parametrize("spec", SPECS, ids=IDS)
 def test_gauss_pieces_against_the_adaptive_rule(spec):
     """Frame 5 with the Gauss-Legendre pieces against frame 5 with the adaptive 7/15 rule alone (the rule before issue
-    14's sixteenth session, ``without_lobe_f_gauss``) at rtol 1e-12: within their estimates; at rtol 1e-6, 1e-8, 1e-10
-    the estimate bounds the distance (less the other's estimate) and meets the tolerance."""
+    14's sixteenth session, ``without_lobe_f_gauss``) at rtol 1e-12: at rtol 1e-6, 1e-8, 1e-10 and 1e-12 the estimate
+    bounds the distance (less the other's estimate), and up to 1e-10 it meets the tolerance (at 1e-12 the engine's
+    rounding allowance, 64 eps, may take it a little beyond)."""
     f = _lobe(spec)
     mu = np.array(MU)
     with _polar.without_n_frame():  # (n >= LOBE_N_MIN takes the frame of N otherwise)
@@ -290,4 +291,5 @@ def test_gauss_pieces_against_the_adaptive_rule(spec):
             b, eb, *_ = _polar.albedo_1d(f, mu, 1e-12, 0.0, 10000)
         for rtol in (1e-6, 1e-8, 1e-10, 1e-12):
             a, ea, conv, _ = _polar.albedo_1d(f, mu, rtol, 0.0, 10000)
-            assert conv.all() and np.all(np.abs(a - b) - eb <= ea) and np.all(ea <= rtol * a * 1.0001), (rtol, a - b, ea, eb)
+            assert conv.all() and np.all(np.abs(a - b) - eb <= ea), (rtol, a - b, ea, eb)
+            assert rtol < 1e-10 or np.all(ea <= rtol * a), (rtol, ea / a)
