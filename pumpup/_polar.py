@@ -134,7 +134,9 @@ D2 stay on the nested engine.
 000 eq. 28's Fresnel factor F(Theta_min) = F(max(N.L, N.V)) (metal, plastic with an index, the ``fresnel`` wrapper of a
 lobe with p in {0, 1}; ``Polar(kind="lobe", fresnel=(0, eta, k))``) takes the lobe frame with a rule on the arc (frame 5,
 :func:`_k_lobe_fresnel`): where N.wo < mu the factor is the constant F(mu) / mu^p, so that part is the closed form's;
-where N.wo = t >= mu the integrand F(t) t^(1 - p) is integrated in beta by the adaptive 7/15 rule, cut at t = x0 -+
+where N.wo = t >= mu the integrand F(t) t^(1 - p) is integrated by Gauss-Legendre rules with an a-priori bound on
+Bernstein ellipses (:func:`_lobe_f_gauss`, since issue 14's sixteenth session; the adaptive 7/15 rule in beta where they
+would want too many points), cut at t = x0 -+
 y0 3^j about F's branch point w = sqrt(1 - (eta + i k)^2) = x0 - i y0 (:func:`fresnel_branch`) and at t = rho 3^j towards
 the pole of its parallel reflectance near c = 0 (rho = 1 / |sqrt((eta + i k)^2 + 1)|, :func:`fresnel_pole`: a strong
 absorber's, eta 1.1, k 30, sits at -0.0012 + 0.033 i); the outer variable is cut where the arc's ends pass those points
@@ -1303,6 +1305,20 @@ def _lobe_f_piece(eta, k, q, lo, d, top, low, first, n):  # pragma: no cover - c
     return h * tot
 
 
+def lobe_f_piece_reference(eta: float, k: float, q: float, lo: float, d: float, top: float, low: float, first: bool) -> float:
+    """Plain twin of :func:`_lobe_f_piece`: integral_lo^(lo + d) F(t) t^q / sqrt((T - t)(t - L)) dt by numpy's 200-point
+    Gauss-Legendre rule in the same variable (s for ``first``, else t), F the complex-arithmetic
+    :func:`pumpup.models.metal.fresnel`."""
+    from .models.metal import fresnel
+
+    x, w = np.polynomial.legendre.leggauss(200)
+    if first:
+        t = top - d * x * x
+        return float(math.sqrt(d) * np.sum(w * fresnel(t, eta, k) * t**q / np.sqrt((top - low) - d * x * x)))
+    t = lo + 0.5 * d * (1.0 + x)
+    return float(0.5 * d * np.sum(w * fresnel(t, eta, k) * t**q / np.sqrt((top - t) * (t - low))))
+
+
 @njit(cache=True, nogil=True)
 def _lobe_f_gauss(mp, q, mu, a, b, d, beta1, tol, cut):  # pragma: no cover - compiled
     """(H, error) of H = integral_0^beta1 F(t) t^q d beta, t = N.wo = a + b cos(beta) >= mu (frame 5's arc,
@@ -1417,10 +1433,12 @@ def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol, tol_abs, nodes, wk, wg, mode
     N.wo = t = a + b cos(beta) >= mu (|beta| <= beta1 <= pi / 2) the integrand F(t) t^(1 - p) is analytic but near F's
     branch point w = x0 - i y0 (``mp[13]``, ``mp[14]``, :func:`fresnel_branch`) and its pole near 0 (at distance rho,
     ``mp[15]``, :func:`fresnel_pole`): that arc is cut at t = x0 -+ y0 3^j and at t = rho 3^j from max(rho, 3 mu) (each
-    piece then lies about its own length from them) and integrated by the globally adaptive 7/15 rule in beta, the
-    interval with the largest error bisected until the summed error (QUADPACK's calibration) is at most
-    max(``itol`` |K|, ``tol_abs``) or INNER_MAX intervals are used; the error is returned either way.  Both signs of beta:
-    2 x."""
+    piece then lies about its own length from them; computed once per mu, :func:`_lobe_f_prepare`) and its pieces taken
+    by Gauss-Legendre rules with an a-priori bound (:func:`_lobe_f_gauss`; issue 14's sixteenth session) at max(``itol``
+    times a guess of K's lower bound, ``tol_abs`` / 2).  Where a piece would want more than GL_MAX points (or with
+    :func:`without_lobe_f_gauss`) the arc is the globally adaptive 7/15 rule in beta, from the same cuts, the interval
+    with the largest error bisected until the summed error (QUADPACK's calibration) is at most max(``itol`` |K|,
+    ``tol_abs``) or INNER_MAX intervals are used; the error is returned either way.  Both signs of beta: 2 x."""
     _, beta1, below = _k_closed(1.0, mu, c2, u, um, sa)
     fm = mp[21]  # F(mu) (:func:`_lobe_f_prepare`)
     closed = below * fm / (mu if p == 1.0 else 1.0)

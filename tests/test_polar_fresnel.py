@@ -293,3 +293,16 @@ def test_gauss_pieces_against_the_adaptive_rule(spec):
             a, ea, conv, _ = _polar.albedo_1d(f, mu, rtol, 0.0, 10000)
             assert conv.all() and np.all(np.abs(a - b) - eb <= ea), (rtol, a - b, ea, eb)
             assert rtol < 1e-10 or np.all(ea <= rtol * a), (rtol, ea / a)
+
+
+def test_gauss_piece_against_its_numpy_twin(rng):
+    """_lobe_f_piece at its bound's n against lobe_f_piece_reference (numpy, 200 points, the complex Fresnel formula)."""
+    for eta, k in MATERIALS:
+        mpar = _polar.numeric_params(pumpup.load({"type": "metal", "n": 5, "eta": eta, "k": k}).polar())
+        for (mu, top, low, lo, d, first), q in zip(_pieces(rng, 6), [0.0, 1.0] * 3):
+            n, bound, _ = _polar._lobe_f_bound(mpar, q, lo, d, top, low, first, 1e-13 * math.sqrt(d))
+            if n > _polar.GL_MAX:
+                continue
+            p = _polar._lobe_f_piece(eta, k, q, lo, d, top, low, first, n)
+            r = _polar.lobe_f_piece_reference(eta, k, q, lo, d, top, low, first)
+            assert abs(p - r) <= bound + 1e-13 * abs(r), (eta, k, mu, lo, d, first, q, p - r, bound)
