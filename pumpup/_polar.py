@@ -1186,7 +1186,7 @@ def _lobe_f_bound(mp, q, lo, d, top, low, first, tol):  # pragma: no cover - com
 
     M on the t-ellipse E_R of [lo, hi] (semi-axes h A_R, h B_R about m).  Every bound holds for either sign of the
     refracted cosine A = sqrt(e^2 - 1 + t^2), so for F's continuation, whatever its branch:
-    - |t| <= tau = m + h A_R; |A|^2 = |t - w| |t + w| <= tau^2 + |w|^2 and >= gap(w) gap(-w) (:func:`_gap`);
+    - |t| <= tau = m + h A_R; |A|^2 = |t - w| |t + w| <= tau^2 + |w|^2 and >= gap(w) gap(-w) (:func:`_focal_sum`);
     - F = r_s(e) r_s(conj e) (1 + N_e N_conj(e) / (D_e D_conj(e))) / 2 continues |r_s|^2 (1 + |N|^2 / |D|^2) / 2 of
       the real axis (R_p = R_s |N|^2 / |D|^2, pbrt-v3's FrConductor), r_s = (t - A) / (t + A), N = A t - (1 - t^2),
       D = A t + 1 - t^2; the bounds for e hold for conj(e) (E_R is symmetric about the real axis);
@@ -1211,7 +1211,7 @@ def _lobe_f_bound(mp, q, lo, d, top, low, first, tol):  # pragma: no cover - com
     best_v = GL_MAX + 1
     if not (tol > 0.0 and h > 0.0):
         return best_n, best, best_v
-    # the semi-major axes of the ellipses through w, -w, L, T, c_b, -c_b: gap(z) = s_z - h A_R (:func:`_gap`)
+    # the semi-major axes of the ellipses through w, -w, L, T, c_b, -c_b: gap(z) = s_z - h A_R (:func:`_focal_sum`)
     cbr, cbi = mp[16], abs(mp[17])
     s_w = _focal_sum(x0, y0, lo, hi)
     s_mw = _focal_sum(-x0, y0, lo, hi)
@@ -1361,6 +1361,7 @@ def _lobe_f_gauss(mp, q, mu, a, b, d, beta1, tol, cut):  # pragma: no cover - co
     return tot, err
 
 
+#: 3^j, j < LOBE_F_CUTS (:func:`_lobe_f_cuts`)
 _POW3 = 3.0 ** np.arange(LOBE_F_CUTS)
 
 
@@ -1381,8 +1382,6 @@ def without_lobe_f_gauss():
         yield
     finally:
         LOBE_F_GAUSS = old
-
-
 
 
 @njit(cache=True, nogil=True)
@@ -1455,13 +1454,13 @@ def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol, tol_abs, nodes, wk, wg, mode
         i0 += 1
     cut = mp[23 + i0:23 + nall]
     nc = nall - i0
-    # the Gauss-Legendre pieces with an a-priori bound (issue 14's sixteenth session), at the tolerance's target for
-    # H >= beta1 min(F) mu^q, min(F) guessed as half the smaller of F(mu), F(T)
-    d = um * (u - c2) / (b + mu * (1.0 - u))  # T - mu = d1 / (b + mu - a), without cancellation
-    h_low = 0.5 * beta1 * min(fm, _fresnel_real(top, mp[6], mp[7])) * (mu if q == 1.0 else 1.0)
-    tol = max(itol * (closed + h_low), 0.5 * tol_abs)
     if mp[20] > 0.0:
-        h, e = _lobe_f_gauss(mp, q, mu, a, b, d, beta1, tol, cut[:nc])
+        # the Gauss-Legendre pieces with an a-priori bound (issue 14's sixteenth session), at the tolerance's target for
+        # H >= beta1 min(F) mu^q, min(F) guessed as half the smaller of F(mu), F(T)
+        d = um * (u - c2) / (b + mu * um)  # T - mu = d1 / (b + mu - a), without cancellation
+        h_low = 0.5 * beta1 * min(fm, _fresnel_real(top, mp[6], mp[7])) * (mu if q == 1.0 else 1.0)
+        tol = max(itol * (closed + h_low), 0.5 * tol_abs)
+        h, e = _lobe_f_gauss(mp, q, mu, a, b, d, beta1, tol, cut)
         if e >= 0.0:
             return 2.0 * (closed + h), 2.0 * e
     # else the globally adaptive 7/15 rule in beta from the same cuts
