@@ -261,7 +261,7 @@ def _fresnel_dielectric(c, n):
 def _fresnel_conductor(c, eta, k):
     """pumpup.models.metal._fresnel_real: the exact conductor Fresnel factor without cancellation."""
     s2 = (1.0 - c) * (1.0 + c)
-    t0 = eta * eta - k * k - s2
+    t0 = (eta - 1.0) * (eta + 1.0) - k * k + c * c  # eta^2 - k^2 - s^2 without cancellation near eta = 1, c = 0
     big = dr.sqrt(t0 * t0 + (2.0 * eta * k) ** 2)  # a^2 + b^2
     ra = dr.sqrt(dr.maximum(0.5 * (big + t0), 0.0))
     rb = dr.sqrt(dr.maximum(0.5 * (big - t0), 0.0))
@@ -270,7 +270,9 @@ def _fresnel_conductor(c, eta, k):
     b = dr.select(pos, _div(eta * k, dr.maximum(ra, 1e-300)), rb)
     a = dr.select(big == 0.0, 0.0, a)
     b = dr.select(big == 0.0, 0.0, b)
-    rs = _div((a - c) ** 2 + b * b, (a + c) ** 2 + b * b)
+    e21 = (eta - 1.0) * (eta + 1.0) - k * k
+    plus = (a + c) ** 2 + b * b
+    rs = dr.select(plus > 0.0, _div(e21 * e21 + 4.0 * eta * eta * k * k, plus * plus), 0.0)  # |1 - e^2|^2 / |c + A|^4
     rp = rs * _div((a * c - s2) ** 2 + b * b * c * c, (a * c + s2) ** 2 + b * b * c * c)
     return 0.5 * (rs + rp)
 

@@ -32,6 +32,28 @@ def test_fresnel_real_and_complex_agree(eta, k):
     assert fresnel(0.0, eta, k) == pytest.approx(1.0, rel=1e-14)  # grazing
 
 
+@pytest.mark.parametrize("eta,k", [(1.0, 0.0), (1.0 + 1e-7, 0.0), (1.0 - 1e-9, 1e-6), (1.0 + 1e-12, 1e-10), (1.2, 0.0)])
+def test_fresnel_near_index_one_at_grazing_incidence(eta, k):
+    """F near e = 1 at grazing incidence against 40-digit mpmath: e^2 - sin^2 is computed as (e - 1)(e + 1) + c^2 (as
+    e^2 - (1 - c)(1 + c) it lost every digit: eta 1, c = 1e-8 gave F = 0.039 for 0), in both formulas."""
+    import mpmath as mp
+
+    with mp.workdps(40):
+        e = mp.mpf(eta) + 1j * mp.mpf(k)
+        for c in (1e-8, 1e-5, 1e-3, 0.3, 1.0):
+            a = mp.sqrt((e - 1) * (e + 1) + mp.mpf(c) ** 2)  # e cos_t
+            ref = float((abs((e * e * c - a) / (e * e * c + a)) ** 2 + abs((c - a) / (c + a)) ** 2) / 2)
+            for got in (float(fresnel(c, eta, k)), _fresnel_real(c, eta, k)):
+                assert abs(got - ref) <= 1e-13 * ref + 1e-300, (c, got, ref)
+
+
+def test_metal_with_index_one_reflects_nothing():
+    """eta = 1, k = 0: F = 0 at every angle, so the albedo is 0 exactly, grazing incidence included (it was
+    1.9e-10 +- 6e-12 at mu = 1e-8)."""
+    a, e = pumpup.albedo(pumpup.load({"type": "metal", "n": 1, "eta": 1.0}), [1.0, 0.5, 1e-3, 1e-8], return_error=True)
+    assert np.all(a == 0.0) and np.all(e == 0.0), (a, e)
+
+
 def test_fresnel_dielectric_special_angles():
     eta = 1.5
     # Brewster angle: r_par = 0, F = R_perp / 2

@@ -55,10 +55,19 @@ def fresnel(cos_i, eta, k=0.0):
     """
     c = np.clip(np.asarray(cos_i, dtype=np.float64), 0.0, 1.0)
     e = np.asarray(eta, dtype=np.float64) + 1j * np.asarray(k, dtype=np.float64)
-    sin2_i = (1.0 - c) * (1.0 + c)
-    cos_t = np.sqrt(1.0 - sin2_i / (e * e))  # Snell's law, complex angle of refraction
-    r_par = (e * c - cos_t) / (e * c + cos_t)  # Fresnel equations (pbrt-v4 FrComplex)
-    r_perp = (c - e * cos_t) / (c + e * cos_t)
+    # Snell's law, complex angle of refraction: cos_t^2 = 1 - sin^2 / e^2 = ((e - 1)(e + 1) + c^2) / e^2, without the
+    # cancellation of e^2 - sin^2 near e = 1 at grazing incidence (eta 1, c = 1e-8 gave F = 0.039 for 0)
+    e21 = (e - 1.0) * (e + 1.0)  # e^2 - 1
+    cos_t = np.sqrt((e21 + c * c) / (e * e))
+    # the Fresnel equations (pbrt-v4 FrComplex) r_par = (e c - cos_t) / (e c + cos_t), r_perp = (c - e cos_t) / (c + e cos_t);
+    # near e = 1, where both are small, over their denominators squared: (e^2 c)^2 - (e cos_t)^2 = (e^2 - 1)((e^2 + 1) c^2 - 1),
+    # c^2 - (e cos_t)^2 = 1 - e^2 (no cancellation; r_par's form loses digits near a dielectric's total reflection, so
+    # only where |e^2 - 1| < 1/2)
+    near = np.abs(e21) < 0.5
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r_par = np.where(e21 == 0.0, 0.0, np.where(near, e21 * ((e21 + 2.0) * c * c - 1.0) / (e * e * c + e * cos_t) ** 2,
+                                                   (e * c - cos_t) / (e * c + cos_t)))
+        r_perp = np.where(e21 == 0.0, 0.0, -e21 / (c + e * cos_t) ** 2)  # (e = 1: no reflection, c = 0 its limit)
     return 0.5 * (np.abs(r_par) ** 2 + np.abs(r_perp) ** 2)
 
 
@@ -68,11 +77,11 @@ def _fresnel_real(c, eta, k):  # pragma: no cover - compiled
 
     With a + i b = sqrt((eta + i k)^2 - sin^2) (a >= 0), the classic real form
     (e.g. pbrt-v3 FrConductor) becomes a ratio of sums of squares:
-    R_s = ((a - c)^2 + b^2) / ((a + c)^2 + b^2),
+    R_s = ((a - c)^2 + b^2) / ((a + c)^2 + b^2), computed as |1 - (eta + i k)^2|^2 / ((a + c)^2 + b^2)^2,
     R_p = R_s ((a c - s^2)^2 + b^2 c^2) / ((a c + s^2)^2 + b^2 c^2), F = (R_s + R_p) / 2.
     """
     s2 = (1.0 - c) * (1.0 + c)
-    t0 = eta * eta - k * k - s2
+    t0 = (eta - 1.0) * (eta + 1.0) - k * k + c * c  # eta^2 - k^2 - s^2, without cancellation near eta = 1, c = 0
     big = math.hypot(t0, 2.0 * eta * k)  # a^2 + b^2
     if big == 0.0:
         a = 0.0
@@ -83,7 +92,10 @@ def _fresnel_real(c, eta, k):  # pragma: no cover - compiled
     else:
         b = math.sqrt(0.5 * (big - t0))
         a = eta * k / b
-    rs = ((a - c) ** 2 + b * b) / ((a + c) ** 2 + b * b)
+    # R_s = |c - A|^2 / |c + A|^2 = |1 - e^2|^2 / |c + A|^4 (c^2 - A^2 = 1 - e^2): no cancellation where A ~ c (e ~ 1)
+    e21 = (eta - 1.0) * (eta + 1.0) - k * k
+    plus = (a + c) ** 2 + b * b
+    rs = (e21 * e21 + 4.0 * eta * eta * k * k) / (plus * plus) if plus > 0.0 else 0.0  # (0: e = 1 at c = 0, F's limit)
     rp = rs * ((a * c - s2) ** 2 + b * b * c * c) / ((a * c + s2) ** 2 + b * b * c * c)
     return 0.5 * (rs + rp)
 
