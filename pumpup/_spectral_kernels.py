@@ -29,50 +29,53 @@ __all__ = ["flat_pairs", "fresnel_constants", "fresnel_scale_kernel", "fresnel_s
 
 
 def fresnel_constants(eta, k):
-    """The per-wavelength constants of the Fresnel kernels: (eta^2 - k^2, (2 eta k)^2, eta k)."""
+    """The per-wavelength constants of the Fresnel kernels: (eta^2 - k^2 - 1 as (eta - 1)(eta + 1) - k^2, (2 eta k)^2,
+    eta k)."""
     eta = np.ascontiguousarray(eta, dtype=np.float64)
     k = np.ascontiguousarray(k, dtype=np.float64)
-    return eta * eta - k * k, (2.0 * eta * k) ** 2, eta * k
+    return (eta - 1.0) * (eta + 1.0) - k * k, (2.0 * eta * k) ** 2, eta * k
 
 
 @njit(cache=True, inline="always")
-def _fresnel_select(cc, s2, e2k2, ek2, ek):  # pragma: no cover - compiled
+def _fresnel_select(cc, s2, e21, ek2, ek):  # pragma: no cover - compiled
     """F(eta + i k, theta) with cos(theta) = cc, sin^2 = s2, from the hoisted constants.
 
     The same formula as ``_fresnel_real`` (a + i b = sqrt((eta + i k)^2 - sin^2), a >= 0):
-    R_s = ((a - c)^2 + b^2) / ((a + c)^2 + b^2),
+    R_s = ((a - c)^2 + b^2) / ((a + c)^2 + b^2) = |1 - (eta + i k)^2|^2 / ((a + c)^2 + b^2)^2,
     R_p = R_s ((a c - s^2)^2 + b^2 c^2) / ((a c + s^2)^2 + b^2 c^2), F = (R_s + R_p) / 2
     (000 eq. 27; pbrt-v3 FrConductor), with the larger of a, b from the cancellation-free root
-    sqrt((|z| + |t0|) / 2) and the smaller as eta k / that root, and one division.
+    sqrt((|z| + |t0|) / 2) and the smaller as eta k / that root, and one division.  ``e21`` is
+    eta^2 - k^2 - 1 (:func:`fresnel_constants`), so t0 = e21 + c^2 and R_s lose nothing near eta + i k = 1.
     """
-    t0 = e2k2 - s2
+    t0 = e21 + cc * cc
     big = math.sqrt(t0 * t0 + ek2)  # |(eta + i k)^2 - sin^2| = a^2 + b^2 (eta, k <= 1e3: no overflow)
     q = math.sqrt(0.5 * (big + abs(t0)))  # the larger of a, b
     r = ek / max(q, 1e-300)  # the smaller (q = 0 only where eta k = 0: then r = 0)
     a = q if t0 >= 0.0 else r
     b = r if t0 >= 0.0 else q
     b2 = b * b
-    am = a - cc
     ap = a + cc
-    ns = am * am + b2  # R_s = ns / ds
     ds = ap * ap + b2
+    ns = (e21 * e21 + ek2) / ds  # R_s = ns / ds (|c - A|^2 = |1 - e^2|^2 / |c + A|^2)
     x = a * cc - s2
     y = a * cc + s2
     bc2 = b2 * cc * cc
     npar = x * x + bc2  # R_p / R_s = npar / dp
     dp = y * y + bc2
+    if ds == 0.0:  # (eta + i k = 1 at c = 0: F's limit 0)
+        return 0.0
     return 0.5 * ns * (dp + npar) / (ds * dp)  # (R_s + R_p) / 2
 
 
 @njit(cache=True, nogil=True)
-def metal_eval_kernel(wi, wo, n, c, e2k2, ek2, ek, out):  # pragma: no cover - compiled
+def metal_eval_kernel(wi, wo, n, c, e21, ek2, ek, out):  # pragma: no cover - compiled
     """000 eq. 28 at every wavelength: ``out[p, j]`` = f_r(wi[p], wo[p], lambda_j) [1/sr].
 
-    ``wi``, ``wo``: (P, 3) unit vectors; ``e2k2``, ``ek2``, ``ek``: :func:`fresnel_constants`
+    ``wi``, ``wo``: (P, 3) unit vectors; ``e21``, ``ek2``, ``ek``: :func:`fresnel_constants`
     of the W wavelengths; ``out``: (P, W), written everywhere (0 below the horizon and outside
     the lobe).
     """
-    nw = e2k2.shape[0]
+    nw = e21.shape[0]
     for p in range(wi.shape[0]):
         lz = wi[p, 2]
         vz = wo[p, 2]
@@ -85,7 +88,7 @@ def metal_eval_kernel(wi, wo, n, c, e2k2, ek2, ek, out):  # pragma: no cover - c
         lobe = c * rv**n / cc  # c cos^n(alpha) / cos(Theta_min), shared by all wavelengths
         s2 = (1.0 - cc) * (1.0 + cc)
         for j in range(nw):
-            out[p, j] = lobe * _fresnel_select(cc, s2, e2k2[j], ek2[j], ek[j])  # 000 eq. 28
+            out[p, j] = lobe * _fresnel_select(cc, s2, e21[j], ek2[j], ek[j])  # 000 eq. 28
 
 
 def metal_eval_reference(wi, wo, n, c, eta, k):
@@ -103,11 +106,11 @@ def metal_eval_reference(wi, wo, n, c, eta, k):
 
 
 @njit(cache=True, nogil=True)
-def fresnel_scale_kernel(f, wi, wo, e2k2, ek2, ek, out):  # pragma: no cover - compiled
+def fresnel_scale_kernel(f, wi, wo, e21, ek2, ek, out):  # pragma: no cover - compiled
     """``out[p, j]`` = f[p] F(eta_j + i k_j, Theta_min) with cos(Theta_min) = max(N.wi, N.wo).
 
     ``f``: (P,) values that are 0 below the horizon (kept 0 there)."""
-    nw = e2k2.shape[0]
+    nw = e21.shape[0]
     for p in range(f.shape[0]):
         cc = min(max(wi[p, 2], wo[p, 2]), 1.0)  # cos(Theta_min), clipped as pumpup.models.metal.fresnel
         if f[p] == 0.0 or cc <= 0.0:
@@ -117,7 +120,7 @@ def fresnel_scale_kernel(f, wi, wo, e2k2, ek2, ek, out):  # pragma: no cover - c
         s2 = (1.0 - cc) * (1.0 + cc)
         fp = f[p]
         for j in range(nw):
-            out[p, j] = fp * _fresnel_select(cc, s2, e2k2[j], ek2[j], ek[j])
+            out[p, j] = fp * _fresnel_select(cc, s2, e21[j], ek2[j], ek[j])
 
 
 def fresnel_scale_reference(f, wi, wo, eta, k):
