@@ -239,3 +239,21 @@ def test_tiny_wavelength_is_refused_in_one_line():
     for wl in (3.3692610298414625e-181, 1e-300):
         with pytest.raises(pumpup.SpecError, match=r"'sigma_0' / 'wavelength' = .* outside its allowed range"):
             pumpup.load({"type": "he_torrance", "sigma_0": 0.1, "tau": 1.7, "wavelength": wl})
+
+
+def test_fresnel_near_index_one_is_metals():
+    """He-Torrance's Fresnel factor is metal's (no cancellation near n + i k = 1: n = 1 at c = 1e-8 gave 0.039 for 0),
+    compiled and numpy, against 40-digit mpmath."""
+    import mpmath as mp
+
+    from pumpup.models.he_torrance import _fresnel_c
+
+    assert fresnel_unpolarised(np.array([1e-8, 0.5]), 1.0)[0] == 0.0 and _fresnel_c(1e-8, 1.0, 0.0) == 0.0
+    with mp.workdps(40):
+        for n, k in ((1.0 + 1e-7, 0.0), (1.5, 0.0), (0.2, 3.0)):
+            e = mp.mpf(n) + 1j * mp.mpf(k)
+            for c in (1e-8, 1e-3, 0.5, 1.0):
+                a = mp.sqrt((e - 1) * (e + 1) + mp.mpf(c) ** 2)
+                ref = float((abs((e * e * c - a) / (e * e * c + a)) ** 2 + abs((c - a) / (c + a)) ** 2) / 2)
+                for got in (float(fresnel_unpolarised(c, n, k)), _fresnel_c(c, n, k)):
+                    assert abs(got - ref) <= 1e-13 * ref + 1e-300, (n, k, c, got, ref)

@@ -95,6 +95,7 @@ import numpy as np
 from numba import njit, vectorize
 
 from ..core import MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, SpecError, register
+from .metal import _fresnel_real, fresnel
 
 #: relative bound on the truncation remainder of the directional-diffuse series
 SERIES_RTOL = 1e-13
@@ -115,12 +116,7 @@ def _fresnel_c(c, n, k):  # pragma: no cover - compiled
     """Unpolarised Fresnel reflectance |F|^2 at cos = c of the index n + i k (n <= 0: 1)."""
     if n <= 0.0:
         return 1.0
-    eta = complex(n, k)
-    sin2 = max(0.0, 1.0 - c * c)
-    cos_t = np.sqrt(1.0 - sin2 / (eta * eta))  # Snell's law, complex (pbrt-v4 FrComplex)
-    r_par = (eta * c - cos_t) / (eta * c + cos_t)
-    r_perp = (c - eta * cos_t) / (c + eta * cos_t)
-    return 0.5 * (abs(r_par) ** 2 + abs(r_perp) ** 2)
+    return _fresnel_real(min(max(c, 0.0), 1.0), n, k)  # (metal's, without cancellation near n + i k = 1)
 
 
 @njit(cache=True)
@@ -246,12 +242,7 @@ def fresnel_unpolarised(c, n=None, k=0.0):
     c = np.asarray(c, dtype=np.float64)
     if n is None or n <= 0:
         return np.ones_like(c)
-    eta = complex(n, k)
-    sin2 = np.maximum(0.0, 1.0 - c * c)
-    cos_t = np.sqrt(1.0 - sin2 / (eta * eta) + 0j)
-    r_par = (eta * c - cos_t) / (eta * c + cos_t)
-    r_perp = (c - eta * cos_t) / (c + eta * cos_t)
-    return 0.5 * (np.abs(r_par) ** 2 + np.abs(r_perp) ** 2)
+    return fresnel(c, n, k)  # (metal's complex formula, without cancellation near n + i k = 1)
 
 
 def shadowing(mu, m0):
