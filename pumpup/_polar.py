@@ -1206,11 +1206,8 @@ def _lobe_f_bound(mp, q, lo, d, top, low, first, tol):  # pragma: no cover - com
     h = 0.5 * d  # (d = hi - lo; for ``first`` T - lo without cancellation)
     m = lo + h
     hi = lo + d
-    best_n = GL_MAX + 1
-    best = 0.0
-    best_v = GL_MAX + 1
     if not (tol > 0.0 and h > 0.0):
-        return best_n, best, best_v
+        return GL_MAX + 1, 0.0, GL_MAX + 1
     # the semi-major axes of the ellipses through w, -w, L, T, c_b, -c_b: gap(z) = s_z - h A_R (:func:`_focal_sum`)
     cbr, cbi = mp[16], abs(mp[17])
     s_w = _focal_sum(x0, y0, lo, hi)
@@ -1224,7 +1221,7 @@ def _lobe_f_bound(mp, q, lo, d, top, low, first, tol):  # pragma: no cover - com
         amx = min(amx, s_t / h)
     lrmax = min(math.log(amx + math.sqrt(max(0.0, (amx - 1.0) * (amx + 1.0)))), LOBE_F_LOG_R_CAP)
     if not lrmax > 1e-3:
-        return best_n, best, best_v
+        return GL_MAX + 1, 0.0, GL_MAX + 1
     w2 = x0 * x0 + y0 * y0  # |w|^2 = |1 - e^2|
     e2r, e2i = (eta - k) * (eta + k), 2.0 * eta * k
     re_lo = _sqrt_re(e2r - 1.0 + lo * lo, e2i)  # Re A(lo)
@@ -1276,7 +1273,7 @@ def _lobe_f_bound(mp, q, lo, d, top, low, first, tol):  # pragma: no cover - com
             bound = c * math.exp(-2.0 * n * lr)
         if n <= GL_MAX:
             return int(n), bound, int(v)
-    return best_n, best, best_v
+    return GL_MAX + 1, 0.0, GL_MAX + 1
 
 
 @njit(cache=True, nogil=True)
@@ -1385,8 +1382,8 @@ def without_lobe_f_gauss():
 
 
 @njit(cache=True, nogil=True)
-def _lobe_f_cuts(mp, mu, top, out):  # pragma: no cover - compiled
-    """Frame 5's cuts of the arc t = N.wo in (mu, T) (:func:`_k_lobe_fresnel`) into ``out``, falling, and their number:
+def _lobe_f_cuts(mp, mu, out):  # pragma: no cover - compiled
+    """Frame 5's cuts of the arcs t = N.wo in (mu, 1] (:func:`_k_lobe_fresnel`) into ``out``, falling, and their number:
     t = x0 + y0 3^j (j falling), x0 - y0 3^j (j rising), j < LOBE_F_CUTS, about F's branch point (``mp[13]``,
     ``mp[14]``), and rho 3^j (j falling) from max(rho, 3 mu), rho the distance of its pole near 0 (``mp[15]``)."""
     x0, y0 = mp[13], mp[14]
@@ -1409,7 +1406,7 @@ def _lobe_f_cuts(mp, mu, top, out):  # pragma: no cover - compiled
             ib += 1
         if t <= mu:  # (the rest fall below it too)
             return m
-        if t < top and (m == 0 or t < out[m - 1]):
+        if t <= 1.0 and (m == 0 or t < out[m - 1]):
             out[m] = t
             m += 1
 
@@ -1419,7 +1416,7 @@ def _lobe_f_prepare(mp, mu):  # pragma: no cover - compiled
     """Frame 5's per-mu quantities in ``mp``: F(mu) (``mp[21]``), the arc's cuts in (mu, 1] (:func:`_lobe_f_cuts`, at most
     3 LOBE_F_CUTS, falling: ``mp[23:]``) and their number (``mp[22]``); every node's arc takes those below its top."""
     mp[21] = _fresnel_real(mu, mp[6], mp[7])
-    mp[22] = _lobe_f_cuts(mp, mu, 1.0 + 1e-12, mp[23:])
+    mp[22] = _lobe_f_cuts(mp, mu, mp[23:])
 
 
 @njit(cache=True, nogil=True)

@@ -56,14 +56,14 @@ def _fresnel_select(cc, s2, e21, ek2, ek):  # pragma: no cover - compiled
     b2 = b * b
     ap = a + cc
     ds = ap * ap + b2
+    if ds == 0.0:  # (eta + i k = 1 at c = 0: F's limit 0; before the division, which would raise)
+        return 0.0
     ns = (e21 * e21 + ek2) / ds  # R_s = ns / ds (|c - A|^2 = |1 - e^2|^2 / |c + A|^2)
     x = a * cc - s2
     y = a * cc + s2
     bc2 = b2 * cc * cc
     npar = x * x + bc2  # R_p / R_s = npar / dp
     dp = y * y + bc2
-    if ds == 0.0:  # (eta + i k = 1 at c = 0: F's limit 0)
-        return 0.0
     return 0.5 * ns * (dp + npar) / (ds * dp)  # (R_s + R_p) / 2
 
 
