@@ -2692,7 +2692,8 @@ def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, it
     ``iacc`` / the node's factor (``fv`` its work array), and its errors are taken as frame 4 takes K's (:func:`_gk`):
     summed with the Kronrod weights, and into |K - G| before its calibration as far as they can hide it.  ``kind`` 0: the
     variable is d itself; 1 and 2 (a piece off the peak, GGX and Schlick): u = ln |d|, d = e^u or -e^u, the integrand times
-    |d| (:data:`N_LOG_GRADE`)."""
+    |d| (:data:`N_LOG_GRADE`); 3 (a piece near x = 0, GGX and Schlick): u = ln x, d = e^u - x_mu, the integrand times x
+    (:data:`N_LOG_GRADE`)."""
     h = hi - lo
     ie = 0.0
     noise = 0.0
@@ -2702,7 +2703,7 @@ def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, it
         jac = 1.0
         if kind != 0:
             jac = math.exp(d)
-            d = jac if kind == 1 else -jac
+            d = jac if kind == 1 else (-jac if kind == 2 else jac - xmu)
         if mp[13] > 0.0:
             a2 = mp[4] * mp[4]
             fac = _n_times(mp, mu, xmu, xs, d, a2, 1.0) * jac
@@ -2796,6 +2797,9 @@ N_LOG_GRADE = 27.0
 #: ... on the side short of the peak only for |d| <= this times x_mu: towards x = 0, P(t)'s singularity (or Schlick's
 #: pole) lies near d = -x_mu, ln 8 = 2.1 from u = ln(x_mu / 8) (at 1/2 a piece came within 0.23 of its length in u of
 #: it, on the cuts at mu = 1; tests/test_polar_ggx.py checks every piece in the variable it is integrated in)
+#: ... and from x = 0 up to this times x_mu, by N_LOG_GRADE in u = ln x (:func:`_n_kind` 3; issue 14's eighteenth session):
+#: P(t)'s singularities at x = +- i atanh(alpha) lie pi / 2 from the real u axis whatever x (Schlick's pole at x ~ -r / (1 -
+#: r), pi), the peak's ln 8 beyond the last piece (GGX alpha = 1e-8 had 17 pieces graded by 3 in x there, now 6)
 N_LOG_SIDE = 0.125
 #: ... and beyond it up to this times the range's end pi / 2 - x_mu (the weight's singularity at x = pi - x_mu + - 2 i
 #: atanh(alpha), where B = 0, lies ln 2 beyond that end in u), then by 3 in u
@@ -2805,13 +2809,16 @@ N_LOG_END = 0.25
 @njit(cache=True, nogil=True, inline="always")
 def _n_kind(mp, a, b, xmu):  # pragma: no cover - compiled
     """The variable of frame 6's piece [a, b] of d (:func:`_n_rule`): for GGX and Schlick (not Beckmann's Gaussian) 1 (u =
-    ln d) beyond the peak, 2 (u = ln -d) short of it within N_LOG_SIDE x_mu; else 0 (d)."""
+    ln d) beyond the peak, 2 (u = ln -d) short of it within N_LOG_SIDE x_mu, 3 (u = ln x, x = x_mu + d) near x = 0 within
+    N_LOG_SIDE x_mu but off x = 0 itself (:data:`N_LOG_GRADE`); else 0 (d)."""
     if mp[0] == SMITH and mp[1] == 0.0:
         return 0
     if a > 0.0:
         return 1
     if b < 0.0 and a >= -N_LOG_SIDE * xmu:
         return 2
+    if a > -xmu and b + xmu <= N_LOG_SIDE * xmu * (1.0 + 1e-12):
+        return 3
     return 0
 
 
@@ -2863,6 +2870,7 @@ def _n_cuts(mp, xmu, cut):  # pragma: no cover - compiled; see n_cuts_reference
             cut[m] = d if side == 0 else -d
             m += 1
             d = 3.0 * d if beckmann or d >= top else min(N_LOG_GRADE * d, top)
+    top = 0.0 if beckmann else N_LOG_SIDE * xmu  # (GGX, Schlick: by N_LOG_GRADE in u = ln x up to there, :func:`_n_kind`)
     for which in range(2):
         if which == 0:
             if mp[0] == SCHLICK:
@@ -2874,7 +2882,7 @@ def _n_cuts(mp, xmu, cut):  # pragma: no cover - compiled; see n_cuts_reference
         while d < half and m < cut.shape[0]:
             cut[m] = d - xmu
             m += 1
-            d *= 3.0
+            d = min(N_LOG_GRADE * d, top) if which == 0 and d < top else 3.0 * d
     if mp[13] > 0.0:  # GGX with F (:func:`_ggx_ring_f`): the rings' smallest wi.h, S = sin((x + x_mu) / 2), at F's scales
         for which in range(2):  # (the parallel reflectance's pole, the refracted cosine's branch point: mp[14], mp[10])
             z = mp[14] if which == 0 else mp[10]
@@ -2932,6 +2940,8 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
                     t0[m], t1[m] = math.log(cut[i]), math.log(cut[i + 1])
                 elif kd[m] == 2:
                     t0[m], t1[m] = math.log(-cut[i + 1]), math.log(-cut[i])
+                elif kd[m] == 3:  # near x = 0: u = ln x (:data:`N_LOG_GRADE`)
+                    t0[m], t1[m] = math.log(cut[i] + xmu), math.log(cut[i + 1] + xmu)
                 length += t1[m] - t0[m]
                 m += 1
         acc = 0.0

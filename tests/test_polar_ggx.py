@@ -182,8 +182,8 @@ def test_cuts_keep_every_piece_off_the_singularities(spec):
     """The breakpoints are sorted in [0, pi / 2] with 0, pi / 2 and x_mu among them, and every piece lies at least a third
     of its length from the peak's singularities x_mu +- 2 i atanh(alpha), from B = 0's at pi - x_mu +- 2 i atanh(alpha)
     and from P(t)'s (or Schlick's pole) near 0: in
-    x, or for a piece off the peak (GGX and Schlick, :data:`pumpup._polar.N_LOG_GRADE`) in u = ln |x - x_mu|, the variable
-    the engine integrates it in."""
+    x, or for a piece off the peak (GGX and Schlick, :data:`pumpup._polar.N_LOG_GRADE`) in u = ln |x - x_mu|, or near x = 0
+    in u = ln x, the variable the engine integrates it in."""
     import cmath
 
     f = pumpup.load(spec)
@@ -199,10 +199,11 @@ def test_cuts_keep_every_piece_off_the_singularities(spec):
         sing = [complex(0.0, 2.0 * math.atanh(alpha)), complex(-xmu, near0) if hint.schlick is None else complex(-near0 - xmu, 0.0),
                 complex(math.pi - 2.0 * xmu, 2.0 * math.atanh(alpha))]
         for lo, hi, kind in _polar.n_pieces_reference(f, mu):
-            if kind:
-                side = 1.0 if kind == 1 else -1.0
-                a, b = sorted((math.log(side * lo), math.log(side * hi)))
-                dist = [abs(cmath.log(side * z) - min(max(cmath.log(side * z).real, a), b)) for z in sing]
+            if kind:  # u = ln |d| beyond the peak (1) or short of it (2); u = ln x = ln(x_mu + d) near x = 0 (3)
+                side, shift = (1.0, 0.0) if kind == 1 else ((-1.0, 0.0) if kind == 2 else (1.0, xmu))
+                a, b = sorted((math.log(side * (lo + shift)), math.log(side * (hi + shift))))
+                dist = [abs(cmath.log(side * (z + shift)) - min(max(cmath.log(side * (z + shift)).real, a), b))
+                        for z in sing]
                 assert min(dist) >= (b - a) / 3.0, (mu, lo, hi, kind, dist)
             else:
                 dist = [abs(z - complex(min(max(z.real, lo), hi), 0.0)) for z in sing]
