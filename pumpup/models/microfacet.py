@@ -70,8 +70,9 @@ _G1 = {"exact": 0, "walter": 1}
 def _projected(x, y, z, dist, g1, alpha):  # pragma: no cover - compiled
     """P = z (1 + Lambda) = z / G1 for a direction (x, y, z) with z > 0 (see the module docstring)."""
     s = math.sqrt(x * x + y * y)  # sin theta (times |w|)
-    if dist == 1:
-        return 0.5 * (z + math.hypot(z, alpha * s))  # z / G1, G1 = 2 / (1 + sqrt(1 + alpha^2 tan^2)), Walter eq. 34
+    if dist == 1:  # z / G1, G1 = 2 / (1 + sqrt(1 + alpha^2 tan^2)), Walter eq. 34
+        w = alpha * s  # (a unit vector, MIN_ALPHA <= alpha <= MAX_WIDTH: z^2 + w^2 neither overflows nor underflows, so a
+        return 0.5 * (z + math.sqrt(z * z + w * w))  # plain root instead of math.hypot, which took ~20 ns a call)
     if s == 0.0:
         return z  # normal incidence: Lambda = 0
     a = z / (alpha * s)  # a = 1 / (alpha tan theta), Walter eq. 27
