@@ -160,6 +160,68 @@ def _upper_array(mu, logx, coef, v0, slope0, margin_lo, margin, cap, out):  # pr
         out[k] = _upper_scalar(mu[k], logx, coef, v0, slope0, margin_lo, margin, cap)
 
 
+@njit(cache=True, nogil=True)
+def _upper_root(lo, hi, kind, target, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
+    """u in [lo, hi] where the bound U(u) (:func:`_upper_scalar`) meets ``target`` (``kind`` 0 or 2) or u itself (1), given
+    a change of sign of the difference at the ends: bisection until the bracket is at most 1e-15 + 4 eps u wide (where
+    scipy's brentq at xtol 1e-15, which :meth:`Pumped._kink_levels` called from Python, stops too); its midpoint.
+    Compiled, a root costs ~2 us instead of ~60 us of Python calls (issue 14's eighteenth session: the per-mu kink search
+    took two thirds of a 2-level pumped GGX table)."""
+    flo = _upper_scalar(lo, logx, coef, v0, slope0, margin_lo, margin, cap) - (lo if kind == 1 else target)
+    while hi - lo > 1e-15 + 8.9e-16 * hi:
+        mid = 0.5 * (lo + hi)
+        fm = _upper_scalar(mid, logx, coef, v0, slope0, margin_lo, margin, cap) - (mid if kind == 1 else target)
+        if fm == 0.0:
+            return mid
+        if (fm < 0.0) == (flo < 0.0):
+            lo, flo = mid, fm
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+@njit(cache=True, nogil=True)
+def _kink_roots(g, ug, kind, target, mu, scale, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
+    """The roots v of U(v) = ``target`` (``kind`` 0 or 2) or U(v) = v (1) that the grid ``g`` (U's values ``ug``) brackets
+    (:meth:`Pumped._kink_levels`, its search for one k in one compiled pass): differences below 1e-13 ``scale`` count as
+    0 (the rounding of a flat spline: no root), every cell where they change sign gives its root (:func:`_upper_root`);
+    for kind 0 the points mu (1 -+ 1e-6) join the grid and the cell between them, which holds the root v = mu itself, is
+    skipped."""
+    n = g.shape[0]
+    extra = np.empty(2)
+    ne = 0
+    if kind == 0:
+        for e in (mu * (1.0 - 1e-6), mu * (1.0 + 1e-6)):
+            if e <= 1.0:
+                extra[ne] = e
+                ne += 1
+    m = n + ne
+    x = np.empty(m)
+    vals = np.empty(m)
+    i = j = 0
+    for q in range(m):  # the grid and the extra points, merged (an extra point before a grid node it equals)
+        if j < ne and (i >= n or extra[j] <= g[i]):
+            x[q] = extra[j]
+            u = _upper_scalar(extra[j], logx, coef, v0, slope0, margin_lo, margin, cap)
+            j += 1
+        else:
+            x[q] = g[i]
+            u = ug[i]
+            i += 1
+        d = u - (x[q] if kind == 1 else target)
+        vals[q] = 0.0 if abs(d) < 1e-13 * scale else d
+    out = np.empty(m)
+    k = 0
+    for q in range(m - 1):
+        if not ((vals[q] < 0.0 and vals[q + 1] > 0.0) or (vals[q] > 0.0 and vals[q + 1] < 0.0)):
+            continue
+        if kind == 0 and x[q] <= mu <= x[q + 1] and x[q + 1] - x[q] <= 2.01e-6 * mu:
+            continue  # (the root v = mu itself, already a level)
+        out[k] = _upper_root(x[q], x[q + 1], kind, target, logx, coef, v0, slope0, margin_lo, margin, cap)
+        k += 1
+    return out[:k]
+
+
 #: cells of the uniform index over log(mu) that the chain kernel uses to find a table interval
 _INDEX_CELLS = 4096
 
@@ -837,8 +899,6 @@ class Pumped(BRDF):
 
     def _kink_levels(self, mu: float) -> tuple:
         """:meth:`kink_levels`, computed (the parts that do not depend on mu once, :meth:`_kink_fixed`)."""
-        from scipy.optimize import brentq
-
         lk = self.lookup()
         up = lk.upper
         grid, au, diag, caps = self._kink_fixed()
@@ -850,26 +910,13 @@ class Pumped(BRDF):
             if k == 1 and am <= 1.0:
                 found = diag  # u(v) = v, found once (with the threshold below at am <= 1)
             else:
-                fn = [lambda u: float(up(u)) - am, lambda u: float(up(u)) - u, lambda u: float(up(u)) - mu][k]
-                g, vals = grid, au - (am if k == 0 else (grid if k == 1 else mu))
-                if k != 1:
-                    # two roots in one cell show no sign change there: where u turns (a non-monotone base, metal's
-                    # albedo with a minimum), the cells next to the turn are searched on 16 points each
-                    # (:meth:`_kink_turns`), and for k = 0 the cell of mu (a root itself) is split at mu -+ 1e-6 of it: a
-                    # pumped metal (eta 0.9, k 0.3, n 20) lost the kink at v = 0.9699 next to mu = 0.9659 and the 1-D path
-                    # was 5.0e-9 off with an estimate of 1.0e-9
-                    g, ug = self._kink_turns()
-                    if k == 0:
-                        two = np.array([mu * (1 - 1e-6), mu * (1 + 1e-6)])
-                        two = two[two <= 1.0]
-                        at = np.searchsorted(g, two)
-                        g, ug = np.insert(g, at, two), np.insert(ug, at, up(two))
-                    vals = ug - (am if k == 0 else mu)
-                vals = np.where(np.abs(vals) < 1e-13 * max(1.0, am), 0.0, vals)  # rounding of a flat spline: no root
-                cells = np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]
-                if k == 0:  # (not the root v = mu itself, already a level)
-                    cells = [i for i in cells if not (g[i] <= mu <= g[i + 1] and g[i + 1] - g[i] <= 2.01e-6 * mu)]
-                found = [brentq(fn, g[i], g[i + 1], xtol=1e-15) for i in cells]
+                # two roots in one cell show no sign change there: where u turns (a non-monotone base, metal's albedo
+                # with a minimum), the cells next to the turn are searched on 16 points each (:meth:`_kink_turns`), and for
+                # k = 0 the cell of mu (a root itself) is split at mu -+ 1e-6 of it: a pumped metal (eta 0.9, k 0.3, n 20)
+                # lost the kink at v = 0.9699 next to mu = 0.9659 and the 1-D path was 5.0e-9 off with an estimate of
+                # 1.0e-9.  The search is compiled (:func:`_kink_roots`)
+                g, ug = (grid, au) if k == 1 else self._kink_turns()
+                found = [float(v) for v in _kink_roots(g, ug, k, am if k == 0 else mu, mu, max(1.0, am), *lk.args())]
             for v in found:
                 if self.controlled:
                     # the crossing value c and the terms that are not crossing there
