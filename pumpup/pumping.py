@@ -165,8 +165,8 @@ def _upper_root(lo, hi, kind, target, logx, coef, v0, slope0, margin_lo, margin,
     """u in [lo, hi] where the bound U(u) (:func:`_upper_scalar`) meets ``target`` (``kind`` 0 or 2) or u itself (1), given
     a change of sign of the difference at the ends: bisection until the bracket is at most 1e-15 + 4 eps u wide (where
     scipy's brentq at xtol 1e-15, which :meth:`Pumped._kink_levels` called from Python, stops too); its midpoint.
-    Compiled, a root costs ~2 us instead of ~60 us of Python calls (issue 14's eighteenth session: the per-mu kink search
-    took two thirds of a 2-level pumped GGX table)."""
+    Compiled (issue 14's eighteenth session): the brentq calls took ~60 us each in cProfile, and the per-mu kink search two
+    thirds of a first 2-level pumped GGX table."""
     flo = _upper_scalar(lo, logx, coef, v0, slope0, margin_lo, margin, cap) - (lo if kind == 1 else target)
     while hi - lo > 1e-15 + 8.9e-16 * hi:
         mid = 0.5 * (lo + hi)
