@@ -55,6 +55,38 @@ def test_an_unresolved_table_falls_back():
     assert (m, e) == tuple(pumpup.mean_albedo(g, return_error=True))
 
 
+@pytest.mark.parametrize("spec", [{"type": "phong", "n": 20000}, {"type": "ward", "m": 0.1},
+                                  {"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, {"type": "stretched_phong", "n": 20, "p": 0.5}])
+def test_the_estimate_bounds_the_error_of_a_barely_resolved_table(spec):
+    """The quintic spline's error is the larger difference to the cubic's and to the quintic's through every other node:
+    with the cubic's alone, Phong n = 20000 (its grazing feature a node or two wide on the sweep's grid) was 1.1e-9 off
+    with an estimate of 3.5e-10.  Ward's and anisotropic Ward's steep rise at grazing incidence makes the whole table
+    miss the tolerance: the table is cut short and the rest is computed afresh (scripts/reuse_calibration.py)."""
+    f = pumpup.load(spec)
+    pumpup.tabulate(f, mu=MU, progress=False)
+    m, e = pumpup.mean_albedo(f, return_error=True)
+    ref, ref_e = pumpup.mean_albedo(pumpup.load(spec), rtol=1e-12, return_error=True)  # no table: afresh
+    assert abs(m - ref) <= e + ref_e and e <= 1e-9 * m
+
+
+def test_a_table_whose_grazing_end_is_unresolved_is_cut_short():
+    f = pumpup.load({"type": "ward", "m": 0.1})  # the albedo diverges at grazing incidence (001 sec. 2.1)
+    pumpup.tabulate(f, mu=MU, progress=False)
+    mu, a, e, _ = _reuse.recall(f)
+    fresh = _fresh_low(f, 1e-9)
+    assert _reuse._mean_of(mu, a, e, 1e-9, fresh)[0] is None  # the whole table misses the tolerance
+    calls = []
+    reused = _reuse.mean_from_table(f, 1e-9, lambda mu_min, scale: calls.append(mu_min) or fresh(mu_min, scale))
+    assert reused is not None
+    assert calls[0] == mu[0] and mu[0] < calls[1] <= _reuse.TRUNCATE_MU_MAX  # the second table starts higher
+
+
+def test_a_table_cut_short_too_far_from_grazing_falls_back():
+    f = pumpup.load({"type": "metal", "n": 0, "eta": 0.999, "k": 0.001})  # the albedo rises from mu ~ 0.35
+    pumpup.tabulate(f, mu=MU, progress=False)
+    assert _reuse.mean_from_table(f, 1e-9, _fresh_low(f, 1e-9)) is None
+
+
 def test_only_the_tabulated_object_and_a_proportional_unit_model():
     f = pumpup.load({"type": "phong", "n": 20})
     pumpup.tabulate(f, mu=MU, progress=False)
