@@ -86,7 +86,8 @@ def base_table(base: BRDF, progress: bool | None = None):
     if _uses_file_tables(base):  # computed from a file's tables: serves this object only
         with _lock_for(f"derived#{id(base)}"):
             if getattr(base, "_derived_table", None) is None:
-                ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress)
+                ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress,
+                              breaks=albedo_kinks(base))
                 base._derived_table = AlbedoTable.from_dataset(ds)
                 base._derived_table.dataset = ds
         return base._derived_table
@@ -97,12 +98,38 @@ def base_table(base: BRDF, progress: bool | None = None):
                 # an anisotropic base: the table bounds the supremum over the azimuth of wi (001 eq. 17
                 # needs g >= a(L) for every L, not only for L in the xz-plane; pumpup.azimuth)
                 phi = None if base.azimuth_range() is None else "sup"
-                ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress, phi=phi)
+                ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress, phi=phi,
+                              breaks=albedo_kinks(base))
                 t = AlbedoTable.from_dataset(ds)
                 t.dataset = ds
                 _TABLES[key] = t
     return _TABLES[key]
 
+
+def albedo_kinks(brdf: BRDF):
+    """The kinks of the albedo of ``brdf`` where it is a pumped level (None for any other model), for its table's
+    spline to be split there (:class:`pumpup.tables.AlbedoTable`'s breaks): the albedo at incidence v of a pumped level
+    has a kink where the g of that level or of one below changes its form at incidences that do not depend on wo --
+    its bound crosses the diagonal, u(v) = v (g2), or reaches its cap (:meth:`Pumped._kink_fixed`).  Before issue 14's
+    nineteenth session one spline went across them, rounded them off between knots the adaptive grid bunched
+    towards them, and the 1-D path cut the elevation at those knots (:meth:`Pumped.table_kinks`): ~25 more pieces
+    per mu in a 2-level g2 pumped GGX alpha 0.1.
+
+    Only kinks between the second and the next-to-last node of the grid the table starts from
+    (:func:`pumpup.tables.default_grid`) split it: Phong's, Beckmann's and stretched Phong's levels cross the diagonal
+    within 3e-4 of mu = 1, inside the grid's last interval, where a piece of two or three nodes made a 3-level g2 pumped
+    Phong's third bound dip (its running maximum then added a flat and its kink) and its three tables took 15 % longer;
+    those keep the one spline, and :meth:`Pumped.table_kinks`' cuts at the knots bunched around them, as before."""
+    if not isinstance(brdf, Pumped):
+        return None
+    from .tables import default_grid
+
+    grid = default_grid()
+    out = set()
+    for lev in brdf.chain():
+        _, _, diag, caps = lev._kink_fixed()
+        out.update(float(v) for v in (*diag, *caps) if grid[1] < v < grid[-2])
+    return sorted(out)
 
 _LOCKS: dict[str, threading.Lock] = {}
 _LOCKS_LOCK = threading.Lock()

@@ -79,6 +79,11 @@ class AlbedoTable:
     the table extrapolates the power law through its last two nodes (linear in log a versus
     log mu).
 
+    ``breaks`` are values of mu where the albedo has a kink, nodes of the table: the spline is split there
+    into independent splines on either side (a pumped level's albedo has a kink where the level below changes
+    its g's form, :meth:`pumpup.pumping.Pumped.table_breaks`; one spline across it rounds the kink off and the
+    adaptive grid bunches its nodes towards it).
+
     ``interp_error`` is the largest difference between the interpolant and the computed
     albedo at the midpoints of the intervals, measured when the grid was built (or 0 if
     the grid was given and not checked).  :meth:`upper` is an upper bound of the true
@@ -90,8 +95,8 @@ class AlbedoTable:
     DEGREE = 5
 
     def __init__(self, mu, value, error, interp_error: float = 0.0, spec: dict | None = None,
-                 degree: int | None = None):
-        from scipy.interpolate import CubicSpline, PPoly, make_interp_spline
+                 degree: int | None = None, breaks=()):
+        from scipy.interpolate import PPoly
 
         mu = np.asarray(mu, dtype=np.float64)
         order = np.argsort(mu)
@@ -102,12 +107,27 @@ class AlbedoTable:
         self.spec = spec
         if len(self.mu) < 2:
             raise ValueError("an albedo table needs at least two values of mu")
-        self.degree = self.degree_for(len(self.mu), degree)
+        inner = np.unique(np.asarray(breaks, dtype=np.float64).reshape(-1))
+        inner = inner[(inner > self.mu[0]) & (inner < self.mu[-1])]
+        at = np.searchsorted(self.mu, inner)
+        if inner.size and not np.array_equal(self.mu[at], inner):
+            raise ValueError(f"an albedo table's breaks must be nodes of its mu, got {inner[self.mu[at] != inner][:3]}")
+        #: the values of mu where the spline is split (inner nodes)
+        self.breaks = tuple(float(b) for b in inner)
+        ends = [0, *at.tolist(), len(self.mu) - 1]
         lx = np.log(self.mu)
-        if self.degree == 5:  # a piecewise polynomial in log(mu), breakpoints at the inner knots
-            self._spline = PPoly.from_spline(make_interp_spline(lx, self.value, k=5), extrapolate=True)
-        else:
-            self._spline = CubicSpline(lx, self.value, bc_type="not-a-knot", extrapolate=True)
+        pieces = [self._piece(lx[i:j + 1], self.value[i:j + 1], degree) for i, j in zip(ends[:-1], ends[1:])]
+        self.degree = max(d for d, _ in pieces)
+        if len(pieces) == 1:
+            self._spline = pieces[0][1]
+        else:  # one piecewise polynomial in log(mu): the pieces' intervals of positive length (a B-spline's PPoly
+            # repeats its end knots) and their coefficients, lower degrees padded
+            cs, xs = [], [pieces[0][1].x[:1]]
+            for _, p in pieces:
+                keep = np.diff(p.x) > 0
+                cs.append(np.pad(p.c[:, keep], ((self.degree + 1 - p.c.shape[0], 0), (0, 0))))
+                xs.append(p.x[1:][keep])
+            self._spline = PPoly(np.concatenate(cs, axis=1), np.concatenate(xs), extrapolate=True)
         a0, a1 = self.value[0], self.value[1]
         #: slope of the power law below the first node (0: constant extrapolation)
         self.slope_below = ((math.log(a1) - math.log(a0)) / (math.log(self.mu[1]) - math.log(self.mu[0]))
@@ -117,6 +137,16 @@ class AlbedoTable:
         #: added below the first node, where the extrapolation is a guess: also the spread of the
         #: first interval and the first node's quadrature error
         self.margin_below = self.margin + float(self.error[0]) + abs(float(a1) - float(a0))
+
+    @classmethod
+    def _piece(cls, lx, value, degree):
+        """(degree, PPoly): the interpolating spline of :meth:`degree_for` (not-a-knot ends) through (lx, value)."""
+        from scipy.interpolate import CubicSpline, PPoly, make_interp_spline
+
+        d = cls.degree_for(len(lx), degree)
+        if d == 5:  # a piecewise polynomial in log(mu), breakpoints at the inner knots
+            return d, PPoly.from_spline(make_interp_spline(lx, value, k=5), extrapolate=True)
+        return d, CubicSpline(lx, value, bc_type="not-a-knot", extrapolate=True)
 
     @classmethod
     def degree_for(cls, n: int, degree: int | None = None) -> int:
@@ -130,7 +160,8 @@ class AlbedoTable:
     def from_dataset(cls, ds) -> "AlbedoTable":
         return cls(ds["mu"].values, ds["albedo"].values, ds["albedo_error"].values,
                    float(ds.attrs.get("interpolation_error", 0.0)), json.loads(ds.attrs["spec"]),
-                   degree=int(ds.attrs.get("interpolation_degree", 3)))  # files from before the quintic: cubic
+                   degree=int(ds.attrs.get("interpolation_degree", 3)),  # files from before the quintic: cubic
+                   breaks=np.atleast_1d(ds.attrs.get("interpolation_breaks", [])))
 
     def __call__(self, mu) -> np.ndarray:
         m = check_mu(mu)
@@ -166,7 +197,13 @@ def nondecreasing(spline) -> bool:
     d1 = spline.derivative()
     crit = d1.derivative().roots(extrapolate=False)
     pts = np.concatenate([spline.x, crit[np.isfinite(crit)]])
-    return bool(np.all(d1(pts) >= 0))
+    # (and every piece's derivative at its right end: a spline split at a kink, AlbedoTable's breaks, is only C0 there;
+    # within the rounding of its terms, as a piece that ends where the derivative has a root, at a flat's start in
+    # pumping._monotone_envelope, ends at +-1e-17 or so)
+    h = np.diff(spline.x)
+    terms = [d1.c[j] * h ** (d1.c.shape[0] - 1 - j) for j in range(d1.c.shape[0])]
+    right, size = sum(terms), sum(np.abs(t) for t in terms)
+    return bool(np.all(d1(pts) >= 0) and np.all(right >= -64.0 * np.finfo(float).eps * size))
 
 
 def _near_new_nodes(order: np.ndarray, n_new: int) -> np.ndarray:
@@ -187,7 +224,7 @@ def _midpoints(mu: np.ndarray) -> np.ndarray:
 
 def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
              interp_tol: float = 1e-7, mu_min: float = 1e-8, max_points: int = 2049, progress: bool | None = None,
-             threads: int | None = None, phi=None):
+             threads: int | None = None, phi=None, breaks=None):
     """Tabulate the directional albedo of ``brdf``.
 
     Parameters
@@ -220,6 +257,10 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
         over ``mu`` of an upper bound of the supremum over phi of a(mu, phi), what the pumping
         operator needs of an anisotropic base (:func:`pumpup.azimuth.sup_albedo`; the plain
         table for an isotropic model).
+    breaks : array_like, optional
+        Values of mu in (``mu_min``, 1) where the albedo has a kink, for an adaptive grid over ``mu`` alone: they
+        join the grid, and the interpolating spline is split there (:class:`AlbedoTable`; the attribute
+        ``interpolation_breaks``).  The pumping operator gives those of a pumped level's albedo.
 
     Returns
     -------
@@ -248,6 +289,12 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     max_points = check_count("tabulate", "max_points", max_points, 2, MAX_POINTS_LIMIT)
     from .azimuth import table_values
 
+    if breaks is not None:
+        breaks = np.unique(np.asarray(breaks, dtype=np.float64).reshape(-1))
+        if mu is not None or phi is not None and not (isinstance(phi, str) and phi == "sup"):
+            raise ValueError("tabulate: breaks need an adaptive grid (mu=None) over mu alone (phi None or 'sup')")
+        if not np.all((breaks > mu_min) & (breaks < 1.0)):
+            raise ValueError(f"tabulate: breaks must lie in (mu_min, 1) = ({mu_min:g}, 1), got {breaks.tolist()}")
     values, phis, phi_kind = table_values(brdf, phi, rtol, atol, threads, interp_tol)
     # mean_albedo and max_albedo of this object may reuse a table at phi = 0 (not a supremum, not a grid)
     reusable = phis is None and phi_kind != "sup"
@@ -260,6 +307,8 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
         return _dataset(brdf, grid, val, err, rtol, atol, 0.0, "given", phis, phi_kind)
     check_mu(mu_min)
     grid = default_grid(mu_min=mu_min)
+    if breaks is not None:
+        grid = np.unique(np.concatenate([grid, breaks]))
     with _progress(len(grid), f"albedo {brdf.type}", progress) as bar:
         val, err = values(grid, bar)
         interp_error = 0.0
@@ -269,7 +318,7 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
             bar.total += len(mids)
             mval, merr = values(mids, bar)
             if val.ndim == 1:
-                miss = np.abs(AlbedoTable(grid, val, err)(mids) - mval)
+                miss = np.abs(AlbedoTable(grid, val, err, breaks=() if breaks is None else breaks)(mids) - mval)
             else:  # a table over (mu, phi): the worst column
                 miss = np.max([np.abs(AlbedoTable(grid, val[:, j], err[:, j])(mids) - mval[:, j])
                                for j in range(val.shape[1])], axis=0)
@@ -288,7 +337,7 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
             interp_error = max(interp_error, float(miss.max()))
     if reusable:
         _reuse.remember(brdf, grid, val, err, rtol)
-    return _dataset(brdf, grid, val, err, rtol, atol, interp_error, "adaptive", phis, phi_kind)
+    return _dataset(brdf, grid, val, err, rtol, atol, interp_error, "adaptive", phis, phi_kind, breaks)
 
 
 #: threads that compute the albedos of a table (None: one per core, or one for a BRDF on the 1-D path,
@@ -359,7 +408,7 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
     return val, err
 
 
-def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind, phis=None, phi_kind=None):
+def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind, phis=None, phi_kind=None, breaks=None):
     import xarray as xr
 
     if phis is not None:
@@ -397,6 +446,11 @@ def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind, phis=None,
             "pumpup_version": __version__,
         },
     )
+    if breaks is not None and len(breaks):
+        # (one break as a number: netCDF reads a one-element array attribute back as a number, and the file's digest
+        # must see what is read back)
+        ds.attrs["interpolation_breaks"] = float(breaks[0]) if len(breaks) == 1 else np.asarray(breaks, dtype=np.float64)
+        ds.attrs["interpolation"] += "; split at interpolation_breaks, the kinks of the albedo"
     if phi_kind is not None:  # an anisotropic model: say which azimuth of wi the values hold
         from .azimuth import describe_phi
 

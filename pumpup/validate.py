@@ -12,7 +12,8 @@ and never silently different numbers.  What is checked, for an albedo table:
 * ``albedo`` and ``albedo_error`` finite and >= 0;
 * the ``spec`` attribute JSON of a loadable model (a user function's spec needs its function
   registered in the session and is only checked for its form); ``interpolation_error`` finite
-  and >= 0, ``interpolation_degree`` 3 or 5, ``rtol`` and ``atol`` finite and > 0 where present.
+  and >= 0, ``interpolation_degree`` 3 or 5, ``rtol`` and ``atol`` finite and > 0 where present,
+  ``interpolation_breaks`` (where present) inner nodes of ``mu``.
 
 Byte flips in the data are caught by HDF5's Fletcher-32 checksums, which :func:`checksum_encoding`
 turns on for every numeric variable (netCDF4's ``fletcher32``); netCDF then refuses to read a
@@ -202,6 +203,12 @@ def validate_dataset(ds, path: str) -> None:
             d = ds.attrs["interpolation_degree"]
             if isinstance(d, bool) or not isinstance(d, (int, np.integer)) or int(d) not in (3, 5):
                 raise TableError(f"{path!r}: attribute 'interpolation_degree' must be 3 or 5, got {d!r}")
+        if "interpolation_breaks" in ds.attrs:  # (AlbedoTable's kinks: inner nodes of mu)
+            b = np.atleast_1d(ds.attrs["interpolation_breaks"])
+            mu = ds["mu"].values
+            if (b.dtype.kind != "f" or b.ndim != 1 or not np.all(np.isfinite(b)) or not np.all(np.isin(b, mu))
+                    or b.size and not (b.min() > mu.min() and b.max() < mu.max())):
+                raise TableError(f"{path!r}: attribute 'interpolation_breaks' must list inner nodes of mu, got {b!r}")
         if ds.sizes["mu"] < 2:
             raise TableError(f"{path!r}: an albedo table needs at least two values of mu")
         return

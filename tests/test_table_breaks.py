@@ -1,0 +1,95 @@
+"""An albedo table split at the kinks of the albedo (AlbedoTable's breaks, tabulate(breaks=...)): a pumped level's table
+has them where a level below changes its g's form (pumping.albedo_kinks; issue 14's nineteenth session)."""
+
+import numpy as np
+import pytest
+
+import pumpup
+from pumpup import pumping
+from pumpup.tables import AlbedoTable, nondecreasing
+from pumpup.validate import TableError
+
+
+def _kinked(mu):
+    lx = np.log(mu)
+    return 0.3 + 0.2 * np.abs(lx - np.log(0.6)) + 0.01 * lx**2  # a kink at mu = 0.6, quadratic in log(mu) on either side
+
+
+def test_a_split_spline_follows_a_kink_the_whole_one_rounds_off():
+    mu = np.unique(np.concatenate([np.geomspace(1e-3, 1.0, 40), [0.6]]))
+    v = _kinked(mu)
+    x = np.geomspace(1e-3, 1.0, 2001)
+    split = AlbedoTable(mu, v, np.zeros_like(v), breaks=[0.6])
+    whole = AlbedoTable(mu, v, np.zeros_like(v))
+    assert split.breaks == (0.6,) and split.degree == 5
+    assert np.max(np.abs(split(x) - _kinked(x))) < 1e-13 and np.max(np.abs(whole(x) - _kinked(x))) > 1e-4
+    assert split(np.array([0.6]))[0] == pytest.approx(_kinked(0.6), abs=1e-15)  # continuous at the break
+
+
+def test_breaks_must_be_nodes():
+    mu = np.geomspace(1e-3, 1.0, 12)
+    with pytest.raises(ValueError, match="breaks must be nodes"):
+        AlbedoTable(mu, mu, 0 * mu, breaks=[0.5])
+
+
+def test_short_pieces_take_lower_degrees():
+    mu = np.array([0.01, 0.1, 0.2, 0.3, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0])
+    t = AlbedoTable(mu, np.sqrt(mu), 0 * mu, breaks=[0.2])  # 3 nodes below the break: a cubic there
+    assert t.degree == 5 and t._spline.c.shape[0] == 6
+    np.testing.assert_allclose(t(mu), np.sqrt(mu), rtol=0, atol=1e-15)
+
+
+def test_monotone_check_sees_a_fall_before_a_break():
+    """A split spline is only C0 at a break: a piece that falls into it, with no turn of its slope inside, shows it at
+    its right end only (the check once looked at the breakpoints, where the piece to the right is evaluated)."""
+    mu = np.geomspace(0.1, 1.0, 15)
+    lx, b = np.log(mu), mu[7]
+    rise = np.where(lx <= lx[7], lx, lx[7] + 3.0 * (lx - lx[7]))  # increasing, a kink at b
+    assert AlbedoTable(mu, rise, 0 * mu, breaks=[b]).is_increasing()
+    peak = 0.5 * (lx[6] + lx[7])  # below b a parabola (reproduced exactly) that turns down between the last nodes
+    fall = np.where(lx <= lx[7], -((lx - peak) ** 2), -((lx[7] - peak) ** 2) + 3.0 * (lx - lx[7]))
+    t = AlbedoTable(mu, fall, 0 * mu, breaks=[b])
+    d1 = t._spline.derivative()
+    assert np.all(d1(t._spline.x) >= 0)  # every breakpoint, as the check once saw them
+    assert not nondecreasing(t._spline)
+
+
+def test_tabulate_refuses_bad_breaks():
+    f = pumpup.load({"type": "lambert"})
+    with pytest.raises(ValueError, match=r"breaks must lie in \(mu_min, 1\)"):
+        pumpup.tabulate(f, breaks=[1.5], progress=False)
+    with pytest.raises(ValueError, match="breaks need an adaptive grid"):
+        pumpup.tabulate(f, mu=[0.5, 1.0], breaks=[0.5], progress=False)
+
+
+def test_a_pumped_level_is_tabulated_split_at_the_level_below_kinks(tmp_path):
+    """2-level g2 pumped GGX alpha 0.1: level 1's bound crosses the diagonal at v = 0.98814, a kink of the level-2
+    table's albedo.  Split there the table needs about half the nodes (the whole spline's grid bunched towards it:
+    241 nodes before), and the 1-D path about two thirds of the evaluations (1448 per mu before)."""
+    p = pumpup.pump({"type": "ggx", "alpha": 0.1, "shadowing": "correlated"}, g="g2", levels=2)
+    kinks = pumping.albedo_kinks(p.base)
+    assert any(abs(k - 0.98814) < 1e-5 for k in kinks)
+    t = p.table()
+    assert set(kinks) <= set(t.breaks) | {k for k in kinks if k <= t.mu[0]}
+    whole = pumpup.tabulate(p.base, rtol=pumping.TABLE_RTOL, interp_tol=pumping.TABLE_INTERP_TOL, progress=False)
+    assert len(t.mu) < 0.6 * whole.sizes["mu"]
+    assert t.interp_error <= pumping.TABLE_INTERP_TOL
+    path = tmp_path / "ggx_g2.nc"
+    pumpup.save_pumped(p, path)
+    q = pumpup.load_pumped(path)
+    assert q.table().breaks == t.breaks
+    mu = np.array([1.0, 0.99, 0.98814, 0.9, 0.5, 0.1])
+    np.testing.assert_array_equal(pumpup.albedo(q, mu), pumpup.albedo(p, mu))
+
+
+def test_a_file_whose_breaks_are_not_nodes_is_refused(tmp_path):
+    ds = pumpup.tabulate(pumpup.load({"type": "phong", "n": 5}), mu=np.geomspace(0.01, 1.0, 9), progress=False)
+    path = tmp_path / "t.nc"
+    for breaks in (0.5, np.array([ds["mu"].values[3], 0.5])):  # one (written as a number) and two
+        ds.attrs["interpolation_breaks"] = breaks
+        pumpup.write_table(ds, path)
+        with pytest.raises(TableError, match="interpolation_breaks"):
+            pumpup.open_table(path)
+    ds.attrs["interpolation_breaks"] = float(ds["mu"].values[3])  # a node: read back, the digest matches
+    pumpup.write_table(ds, path)
+    assert pumpup.AlbedoTable.from_dataset(pumpup.open_table(path)).breaks == (float(ds["mu"].values[3]),)
