@@ -74,6 +74,9 @@ def test_a_pumped_level_is_tabulated_split_at_the_level_below_kinks(tmp_path):
     whole = pumpup.tabulate(p.base, rtol=pumping.TABLE_RTOL, interp_tol=pumping.TABLE_INTERP_TOL, progress=False)
     assert len(t.mu) < 0.6 * whole.sizes["mu"]
     assert t.interp_error <= pumping.TABLE_INTERP_TOL
+    near = 0.98814369 * (1.0 + np.linspace(-1e-3, 1e-3, 41))  # about the break: the bound holds (001 eq. 17's g >= a)
+    a = pumpup.albedo(p.base, near, rtol=1e-12)
+    assert np.all(p.lookup().upper(near) >= a) and np.max(np.abs(t(near) - a)) <= t.margin
     path = tmp_path / "ggx_g2.nc"
     pumpup.save_pumped(p, path)
     q = pumpup.load_pumped(path)
