@@ -3599,7 +3599,7 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         return None
     mu = np.ascontiguousarray(mu, dtype=np.float64)
     scale = np.broadcast_to(np.asarray(hint.scale(mu), dtype=np.float64), mu.shape)
-    if not np.all(np.isfinite(scale)):
+    if not np.isfinite(scale).all():
         return None  # (an overflowing constant) the 2-D engine reports what the model returns
     if hint.kind == "constant":
         ulps = hint.ulps(mu) if callable(hint.ulps) else hint.ulps
@@ -3642,9 +3642,9 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     err = np.empty(mu.shape)
     conv = np.empty(mu.shape, bool)
     evals = np.empty(mu.shape, np.int64)
-    # atol applies to the scaled albedo: per mu, atol / scale for the unscaled integral
-    with np.errstate(divide="ignore"):
-        atol_q = np.where(scale != 0, float(atol) / np.abs(scale), np.inf)
+    # atol applies to the scaled albedo: per mu, atol / scale for the unscaled integral (inf where the scale is 0)
+    atol_q = np.full(mu.shape, np.inf)
+    np.divide(float(atol), np.abs(scale), out=atol_q, where=scale != 0)
     if takes_n_frame(hint) and any(hint.fresnel) and mu.size and mu.min() < N_FRESNEL_MU_MIN:
         # GGX with F: frame 6 where every ring's wi.h >= N_FRESNEL_S_MIN, frame 4 below (:func:`_ggx_ring_f`)
         low = mu < N_FRESNEL_MU_MIN

@@ -107,6 +107,8 @@ def check_mu(mu) -> np.ndarray:
         m = np.asarray(mu, dtype=np.float64)
     except (TypeError, ValueError):
         raise ValueError(f"mu must be a number or an array of numbers in (0, 1], got {mu!r}") from None
+    if ((m > 0) & (m <= 1)).all():  # (NaN fails both comparisons, inf the second: one pass where all is well)
+        return m
     bad = ~np.isfinite(m) | (m <= 0) | (m > 1)
     if np.any(bad):
         i = tuple(int(k) for k in np.argwhere(bad)[0]) if m.ndim else ()
@@ -117,6 +119,8 @@ def check_mu(mu) -> np.ndarray:
 
 def check_phi(phi) -> np.ndarray:
     """``phi`` (the azimuth of wi, radians) as a float64 array, or a ValueError naming it."""
+    if type(phi) is float and math.isfinite(phi):  # (the default, 0.0: no numpy check needed)
+        return np.asarray(phi)
     if isinstance(phi, (str, bytes)) or phi is None:
         raise ValueError(f"phi (the azimuth of wi, in radians) must be a finite number, got {phi!r}")
     try:
@@ -1548,12 +1552,13 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     max_regions = check_count("albedo", "max_regions", max_regions, 0, MAX_REGIONS_LIMIT)  # 0: the first grid
     m = check_mu(mu)
     ph = check_phi(phi)
-    try:
-        m, ph = np.broadcast_arrays(m, ph)
-    except ValueError:
-        raise ValueError(f"phi (shape {ph.shape}) does not broadcast against mu (shape {m.shape})") from None
+    if ph.ndim:
+        try:
+            m, ph = np.broadcast_arrays(m, ph)
+        except ValueError:
+            raise ValueError(f"phi (shape {ph.shape}) does not broadcast against mu (shape {m.shape})") from None
     flat = np.array(m, dtype=np.float64).ravel()
-    phflat = np.array(ph, dtype=np.float64).ravel()
+    phflat = np.array(ph, dtype=np.float64).ravel() if ph.ndim else np.full(flat.shape, float(ph))
     value = np.zeros_like(flat)
     error = np.zeros_like(flat)
     ok = np.ones(flat.shape, bool)
@@ -1575,7 +1580,7 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
                 ok &= fast[2]
                 continue
         turn = None
-        if np.any(phflat != 0.0) and term.azimuth_range() is not None:
+        if (float(ph) != 0.0 if not ph.ndim else bool((phflat != 0.0).any())) and term.azimuth_range() is not None:
             turn = phflat
         # closed-form azimuth (isotropic models only, where phi does not matter), or None
         fast = _polar.albedo_1d(term, flat, rtol, atol, max_regions) if turn is None else None
