@@ -118,8 +118,9 @@ def albedo_kinks(brdf: BRDF):
     Only kinks between the second and the next-to-last node of the grid the table starts from
     (:func:`pumpup.tables.default_grid`) split it: Phong's, Beckmann's and stretched Phong's levels cross the diagonal
     within 3e-4 of mu = 1, inside the grid's last interval, where a piece of two or three nodes made a 3-level g2 pumped
-    Phong's third bound dip (its running maximum then added a flat and its kink) and its three tables took 15 % longer;
-    those keep the one spline, and :meth:`Pumped.table_kinks`' cuts at the knots bunched around them, as before."""
+    Phong's third bound dip (its running maximum then added a flat and its kink; its three tables took 87-97 ms against
+    76-79, one sitting); those keep the one spline, and :meth:`Pumped.table_kinks`' cuts at the knots bunched around
+    them, as before."""
     if not isinstance(brdf, Pumped):
         return None
     from .tables import default_grid
@@ -130,6 +131,7 @@ def albedo_kinks(brdf: BRDF):
         _, _, diag, caps = lev._kink_fixed()
         out.update(float(v) for v in (*diag, *caps) if grid[1] < v < grid[-2])
     return sorted(out)
+
 
 _LOCKS: dict[str, threading.Lock] = {}
 _LOCKS_LOCK = threading.Lock()
@@ -1017,7 +1019,7 @@ class Pumped(BRDF):
         """The 1-D path's levels of g at incidence mu: the lobe's (:meth:`lobe`) and :meth:`table_kinks` (the nested
         engine, whose estimate was calibrated without them, keeps the lobe's alone).  The lobe's levels are every level's
         :meth:`kink_levels` and the innermost base's lobe levels, gathered here without the Lobe of every level (this
-        runs for every mu of a table, in Python: the Lobes and their sorts took ~20 % of a cached 2-level table)."""
+        runs for every mu of a table, in Python: the Lobes and their sorts took ~15 % of a cached 2-level table)."""
         out = set(self.table_kinks())
         cur = self
         while isinstance(cur, Pumped):

@@ -81,7 +81,7 @@ class AlbedoTable:
 
     ``breaks`` are values of mu where the albedo has a kink, nodes of the table: the spline is split there
     into independent splines on either side (a pumped level's albedo has a kink where the level below changes
-    its g's form, :meth:`pumpup.pumping.Pumped.table_breaks`; one spline across it rounds the kink off and the
+    its g's form, :func:`pumpup.pumping.albedo_kinks`; one spline across it rounds the kink off and the
     adaptive grid bunches its nodes towards it).
 
     ``interp_error`` is the largest difference between the interpolant and the computed
@@ -290,7 +290,10 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     from .azimuth import table_values
 
     if breaks is not None:
-        breaks = np.unique(np.asarray(breaks, dtype=np.float64).reshape(-1))
+        try:
+            breaks = np.unique(np.asarray(breaks, dtype=np.float64).reshape(-1))
+        except (TypeError, ValueError):
+            raise ValueError(f"tabulate: breaks must be numbers in (mu_min, 1), got {breaks!r}") from None
         if mu is not None or phi is not None and not (isinstance(phi, str) and phi == "sup"):
             raise ValueError("tabulate: breaks need an adaptive grid (mu=None) over mu alone (phi None or 'sup')")
         if not np.all((breaks > mu_min) & (breaks < 1.0)):

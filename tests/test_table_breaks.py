@@ -56,8 +56,11 @@ def test_monotone_check_sees_a_fall_before_a_break():
 
 def test_tabulate_refuses_bad_breaks():
     f = pumpup.load({"type": "lambert"})
-    with pytest.raises(ValueError, match=r"breaks must lie in \(mu_min, 1\)"):
-        pumpup.tabulate(f, breaks=[1.5], progress=False)
+    for bad in ([1.5], [float("nan")], [1e-9]):
+        with pytest.raises(ValueError, match=r"breaks must lie in \(mu_min, 1\)"):
+            pumpup.tabulate(f, breaks=bad, progress=False)
+    with pytest.raises(ValueError, match=r"breaks must be numbers in \(mu_min, 1\)"):
+        pumpup.tabulate(f, breaks=["a"], progress=False)
     with pytest.raises(ValueError, match="breaks need an adaptive grid"):
         pumpup.tabulate(f, mu=[0.5, 1.0], breaks=[0.5], progress=False)
 
