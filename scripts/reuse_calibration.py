@@ -7,7 +7,7 @@ Gauss-Kronrod in mu over fresh values), its own error counted in the reused valu
 the mean was taken, the true error / the estimate, and the time of the mean; then the worst ratio.
 
 Until this session the spline's estimate was |quintic - cubic| alone: Phong n = 20000 was 1.1e-9 off with an estimate of
-3.5e-10 (ratio 3.2), where the grid barely resolves its grazing feature and both splines are off alike.
+3.5e-10 (ratio 3.2): the grid barely resolves a feature there, and both splines are off alike.
 
     PYTHONPATH=. python scripts/reuse_calibration.py
 """

@@ -59,7 +59,7 @@ def test_an_unresolved_table_falls_back():
                                   {"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, {"type": "stretched_phong", "n": 20, "p": 0.5}])
 def test_the_estimate_bounds_the_error_of_a_barely_resolved_table(spec):
     """The quintic spline's error is the larger difference to the cubic's and to the quintic's through every other node:
-    with the cubic's alone, Phong n = 20000 (its grazing feature a node or two wide on the sweep's grid) was 1.1e-9 off
+    with the cubic's alone, Phong n = 20000 (a feature that the sweep's grid barely resolves) was 1.1e-9 off
     with an estimate of 3.5e-10.  Ward's and anisotropic Ward's steep rise at grazing incidence makes the whole table
     miss the tolerance: the table is cut short and the rest is computed afresh (scripts/reuse_calibration.py)."""
     f = pumpup.load(spec)
