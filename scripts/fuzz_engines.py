@@ -11,8 +11,9 @@ culprit: decide it with a third method (``scripts/independent_microfacet.py`` fo
 Found this way: GGX alpha 1.3e-4 at mu = 6.05e-5.  The 1-D path (0.8967913960373392, estimate 2.3e-14) agrees with
 the independent script (0.8967913960367667 +- 1.9e-8) and with the 2-D engine; the nested engine is 9e-9 off with
 estimates of 2e-10 to 3e-9 at every rtol (36-42 x at alpha 1e-4, mu 6e-5 and 1e-4; 1.3 x at alpha 1e-3, mu 1e-5).
-The nested engine is not GGX's path (frame 6 is); it is the tests' second engine and the path of models without a
-1-D path.
+Beckmann alpha 1e-4 agrees there (8.7e-13), the height-correlated GGX is off alike (6.4-6.6e-9, about 0.7 alpha^2):
+GGX's heavy tail is the suspect, not Smith's G at the horizon.  The nested engine is not GGX's path (frame 6 is); it is
+the tests' second engine and the path of models without a 1-D path.
 
     PYTHONPATH=. python scripts/fuzz_engines.py [seed] [seconds]
 """
