@@ -543,14 +543,25 @@ def _radial_inverse(kind: str, k: float, alpha: float) -> tuple[float, float]:
 def _smooth_inverse(x: float, xc: float) -> float:
     """tau with tau^2 (3 - 2 tau) = x, precise at both ends (the map is symmetric about 1/2)."""
     small = min(x, xc)
-    tau = 0.5 - math.sin(math.asin(1.0 - 2.0 * small) / 3.0)
+    if small < 1e-4:
+        # the series tau = t0 (1 + t0 / 3 + ...), t0 = sqrt(small / 3): the closed form below rounds 1 - 2 small, and
+        # for small below about 1e-16 it started Newton at tau = 0 or 5.6e-17, whence three steps did not come back
+        # (xc = 9.2e-18 gave 1 - tau = 6.8e-3 for 1.7e-9: GGX alpha = 1e-4's horizon break at mu = 6.05e-5, 6.8e-9
+        # off with an estimate of 2.8e-10, issue 14's twentieth session)
+        t0 = math.sqrt(small / 3.0)
+        tau = t0 * (1.0 + t0 / 3.0)
+    else:
+        tau = 0.5 - math.sin(math.asin(1.0 - 2.0 * small) / 3.0)
     for _ in range(3):  # Newton on the small side, where the residual keeps its digits
         d = 6.0 * tau * (1.0 - tau)
         if d <= 0:
-            tau = math.sqrt(small / 3.0)
-            continue
+            break  # small = 0: tau = 0
         tau -= (tau * tau * (3.0 - 2.0 * tau) - small) / d
     return tau if x <= xc else 1.0 - tau
+
+
+#: horizon breaks whose map variable x or 1 - x is below this are the end itself (_horizon_breaks)
+_BREAK_MIN = 1e-200
 
 
 def _horizon_breaks(lobe: Lobe, mu: float) -> np.ndarray:
@@ -572,7 +583,10 @@ def _horizon_breaks(lobe: Lobe, mu: float) -> np.ndarray:
     for a in alphas:
         if 0 < a < math.pi / 2:
             x, xc = _radial_inverse(lobe.radial, lobe.sharpness, a)
-            if x > 0 and xc > 0:
+            # x is the radial weight's measure: a break with x or 1 - x below _BREAK_MIN closes a region that weighs
+            # nothing (Cook-Torrance m = 0.2 at mu = 0.359: x = 1.7e-315, tau_x = 2.4e-158, and the map's Jacobian
+            # k^2 cos^3 / (2 x) overflowed at the nodes below it)
+            if min(x, xc) > _BREAK_MIN:
                 out.append(_smooth_inverse(x, xc))
     return np.array(out)
 

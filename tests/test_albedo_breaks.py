@@ -6,14 +6,16 @@ own kinks), never against the engine itself."""
 
 import math
 import sys
+import warnings
 
 import numpy as np
 import pytest
-from scipy.integrate import quad
+from scipy.integrate import IntegrationWarning, quad
 from scipy.optimize import brentq
 
 import pumpup
 from pumpup import _polar
+from pumpup.albedo import AlbedoWarning
 
 A = sys.modules["pumpup.albedo"]
 GL = np.polynomial.legendre.leggauss(200)
@@ -144,6 +146,91 @@ def test_cook_torrance_2d_engine_bounds_its_error(rtol):
     assert abs(float(a) - ref) <= float(e) + REF_ERR, (float(a), ref, float(e))
     b, eb = pumpup.albedo(pumpup.load(CT), MU_CT, return_error=True, rtol=1e-13)
     assert abs(float(b) - ref) <= float(eb) + REF_ERR, (float(b), ref, float(eb))
+
+
+def test_smooth_inverse_to_full_precision_near_both_ends():
+    """tau with tau^2 (3 - 2 tau) = s, against Newton in 50 digits, for s from 1e-300 to 1/2 and on both ends: the closed
+    form rounds 1 - 2 s, and for s below about 1e-16 three Newton steps from its start did not come back (s = 9.2e-18
+    gave 6.8e-3 for 1.7e-9)."""
+    import mpmath as mp
+
+    with mp.workdps(50):
+        for s in np.logspace(-300, math.log10(0.5), 400):
+            u = mp.sqrt(mp.mpf(s) / 3)
+            for _ in range(30):
+                u -= (u * u * (3 - 2 * u) - s) / (6 * u * (1 - u))
+            assert abs(A._smooth_inverse(s, 1.0 - s) - float(u)) <= 4e-16 * float(u), s
+            assert abs((1.0 - A._smooth_inverse(1.0 - s, s)) - float(u)) <= 2.3e-16, s
+    assert A._smooth_inverse(0.0, 1.0) == 0.0 and A._smooth_inverse(1.0, 0.0) == 1.0
+
+
+def _ggx_half_vector_reference(alpha, mu):
+    """GGX (separable Smith, F = 1) albedo in the half vector's coordinates t = tan(theta_h), beta, scipy's quad nested:
+    D cos(theta_h) d omega_h = dx d beta / (2 pi) with x = t^2 / (alpha^2 + t^2), and f cos(theta_o) d omega_o =
+    D (wi.h) G1(wi) G1(wo) / mu d omega_h; wo is above the horizon for cos(beta) > mu (1 - 2 c^2) / (2 c s_i s_h)."""
+    si = math.sqrt((1.0 - mu) * (1.0 + mu))
+
+    def g1(c):
+        return 2.0 / (1.0 + math.sqrt(1.0 + alpha * alpha * (1.0 - c * c) / (c * c)))
+
+    g1i = g1(mu)
+
+    def arc(t):
+        c = 1.0 / math.sqrt(1.0 + t * t)
+        s = t * c
+        c0 = mu * (1.0 - 2.0 * c * c) / (2.0 * c * si * s)
+        if c0 >= 1.0:
+            return 0.0
+
+        def g(b):
+            ih = si * s * math.cos(b) + mu * c
+            oz = 2.0 * ih * c - mu
+            return ih * g1i * g1(oz) / (mu * c) if oz > 0 else 0.0
+
+        v = quad(g, 0.0, math.acos(max(c0, -1.0)), epsabs=0, epsrel=1e-13, limit=200)[0]
+        return 2.0 * v / (2.0 * math.pi) * 2.0 * alpha * alpha * t / (alpha * alpha + t * t) ** 2
+
+    top = 4.0 / mu  # the arc is empty beyond t = 2 / mu or so
+    pts = [0.0] + [alpha * 10 ** (k / 4) for k in range(-8, 200) if alpha * 10 ** (k / 4) < top] + [top]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", IntegrationWarning)  # quad's roundoff notice at 1e-13; it agrees with frame 6 to 1e-16
+        return sum(quad(arc, a, b, epsabs=0, epsrel=1e-13, limit=200)[0] for a, b in zip(pts[:-1], pts[1:]))
+
+
+@pytest.mark.parametrize("engine", ["nested", "2d"])
+def test_ggx_tiny_alpha_at_grazing_finds_its_far_horizon_break(engine):
+    """GGX alpha = 1e-4 at mu = 6.05e-5: the arc vanishes at tan(theta_h) = 3.3e4, 1 - tau_x = 1.7e-9, where the half
+    vectors beyond tan(theta_h) = 1.45 still carry 4.9e-5 of the albedo.  ``_smooth_inverse`` put that break at 1 - tau
+    = 6.8e-3, and both engines were 4.7-6.8e-9 off with estimates of 2.5e-9 and 2.8e-10 (found by
+    ``scripts/fuzz_engines.py``).  The 1-D path (frame 6), GGX's default, agreed with this reference to 1e-16."""
+    alpha, mu = 1e-4, 6.05e-5
+    ref = _ggx_half_vector_reference(alpha, mu)
+    f = pumpup.load({"type": "ggx", "alpha": alpha})
+    lobe = f.lobe(mu)
+    assert 1.0 - A._horizon_breaks(lobe, mu).max() < 2e-9
+    switch = _polar.without_1d() if engine == "nested" else _polar.two_d_only()
+    with switch, warnings.catch_warnings():
+        warnings.simplefilter("ignore", AlbedoWarning)  # the budget may run out at rtol 1e-12; the estimate stays honest
+        for rtol in (1e-10, 1e-12):
+            a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
+            assert abs(float(a) - ref) <= float(e) + REF_ERR, (rtol, float(a), ref, float(e))
+    a1, e1 = pumpup.albedo(f, mu, return_error=True, rtol=1e-13)
+    assert abs(float(a1) - ref) <= float(e1) + REF_ERR
+
+
+def test_a_horizon_break_where_the_weight_underflows_is_dropped():
+    """Cook-Torrance m = 0.2 at mu = 0.35905733: the arc vanishes at x = exp(-tan^2 / m^2) = 1.7e-315, and a break at
+    tau_x = 2.4e-158 put nodes where the map's Jacobian k^2 cos^3 / (2 x) overflows (the nested engine returned inf, the
+    pumped Cook-Torrance's table failed).  Such a break is the end itself (the region weighs nothing); both engines
+    agree with the 1-D path."""
+    f = pumpup.load({"type": "cook_torrance", "m": 0.2})
+    mu = 0.35905733
+    assert A._horizon_breaks(f.lobe(mu), mu).min() > 1e-100
+    ref, eref = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
+    for switch in (_polar.without_1d, _polar.two_d_only):
+        with switch():
+            a, e = pumpup.albedo(f, mu, return_error=True, rtol=1e-10)
+        assert np.isfinite(a) and abs(float(a) - float(ref)) <= float(e + eref), (switch.__name__, float(a), float(ref))
 
 
 # --- wi out of the xz-plane: the model's axes cross the horizon --------------------------------
