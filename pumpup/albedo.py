@@ -561,7 +561,7 @@ def _smooth_inverse(x: float, xc: float) -> float:
 
 
 #: horizon breaks whose map variable x or 1 - x is below this are the end itself (_horizon_breaks)
-_BREAK_MIN = 1e-200
+_BREAK_MIN = 1e-30
 
 
 def _horizon_breaks(lobe: Lobe, mu: float) -> np.ndarray:
@@ -584,9 +584,11 @@ def _horizon_breaks(lobe: Lobe, mu: float) -> np.ndarray:
         if 0 < a < math.pi / 2:
             x, xc = _radial_inverse(lobe.radial, lobe.sharpness, a)
             # x is the radial weight's measure: a break with x or 1 - x below _BREAK_MIN closes a region that weighs
-            # nothing (Cook-Torrance m = 0.2 at mu = 0.359: x = 1.7e-315, tau_x = 2.4e-158, and the map's Jacobian
-            # k^2 cos^3 / (2 x) overflowed at the nodes below it)
-            if min(x, xc) > _BREAK_MIN:
+            # nothing (below x the integrand per unit x is at most about 1 / mu; beyond 1 - x, GGX's tail, about
+            # alpha / (mu sqrt(1 - x)); Cook-Torrance m = 0.2 at mu = 0.359: x = 1.7e-315 put a break at tau_x =
+            # 2.4e-158, where the map's Jacobian k^2 cos^3 / (2 x) overflowed; a break at 3e-56 would cost the
+            # nested engine 46 graded intervals)
+            if x > _BREAK_MIN and xc > _BREAK_MIN**2:
                 out.append(_smooth_inverse(x, xc))
     return np.array(out)
 
