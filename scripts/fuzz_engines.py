@@ -18,6 +18,7 @@ GGX's path (frame 6 is); it is the tests' second engine and the path of models w
 
     PYTHONPATH=. python scripts/fuzz_engines.py [seed] [seconds]
     PYTHONPATH=. python scripts/fuzz_engines.py --two-d [seed] [seconds]   # models without a 1-D path: against the 2-D engine
+    PYTHONPATH=. python scripts/fuzz_engines.py --tables [seed] [seconds]  # a table's interpolant against fresh values
 """
 
 import sys
@@ -111,12 +112,55 @@ def main_2d(rng, budget):
         r[~np.isfinite(r)] = np.inf  # an inf or a NaN from either engine is a disagreement too
         if np.any(r > 1):
             bad += 1
+            # a third opinion, the nested engine at rtol 1e-12 (the default path's own engine for most of these, but
+            # its 1-D path for a mix's GGX): which of the two is the odd one
+            with _polar.without_1d():
+                c, ec = pumpup.albedo(f, mu[r > 1], rtol=1e-12, return_error=True, max_regions=200000, phi=phi)
+            odd = np.where(np.abs(b[r > 1] - c) > eb[r > 1] + ec, "2-D", "default")
             print("DISAGREE", spec, "phi", phi, "rtol", rtol, "mu", mu[r > 1], "a", a[r > 1], "2-D", b[r > 1],
-                  "est", e[r > 1], "2-D est", eb[r > 1], "ratio", r[r > 1], flush=True)
+                  "est", e[r > 1], "2-D est", eb[r > 1], "ratio", r[r > 1], "nested", c, "+-", ec, "odd one", odd,
+                  flush=True)
     print(f"cases {n}, disagreements {bad}")
 
 
+def main_tables(rng, budget):
+    """A table's interpolant against fresh values (``--tables``): ``pumpup.tabulate`` at its defaults, then the albedo at
+    40 random mu (log-uniform from the table's first node to 1, and uniform) at rtol 1e-12; a miss larger than the
+    table's margin (``AlbedoTable.margin``: 2 x the interpolation error measured at midpoints + the largest quadrature
+    error; ``margin_below`` below the first node) plus the fresh value's estimate is printed."""
+    from pumpup.tables import AlbedoTable
+
+    bad = n = 0
+    t0 = time.time()
+    while time.time() - t0 < budget:
+        spec = rand_spec(rng) if rng.random() < 0.7 else rand_spec_2d(rng)
+        try:
+            f = pumpup.load(spec)
+        except ValueError:
+            continue
+        phi = None if f.azimuth_range() is None else 0.0
+        t = AlbedoTable.from_dataset(pumpup.tabulate(f, phi=phi) if phi is not None else pumpup.tabulate(f))
+        mu = np.sort(np.concatenate([10 ** rng.uniform(np.log10(t.mu[0]), 0, 30), rng.uniform(t.mu[0], 1, 10)]))
+        a, e = pumpup.albedo(f, mu, rtol=1e-12, return_error=True, max_regions=200000, phi=phi or 0.0)
+        miss = np.abs(t(mu) - a) - e
+        r = miss / t.margin
+        r[~np.isfinite(r)] = np.inf
+        n += 1
+        if np.any(r > 1):
+            bad += 1
+            i = int(np.argmax(r))
+            print("MISS", spec, "mu", mu[i], "table", t(mu[i : i + 1])[0], "fresh", a[i], "+-", e[i], "margin", t.margin,
+                  "ratio", r[i], "nodes", len(t.mu), flush=True)
+    print(f"tables {n}, misses {bad}")
+
+
 def main():
+    if "--tables" in sys.argv:
+        sys.argv.remove("--tables")
+        warnings.simplefilter("ignore")
+        main_tables(np.random.default_rng(int(sys.argv[1]) if len(sys.argv) > 1 else 0),
+                    float(sys.argv[2]) if len(sys.argv) > 2 else 300.0)
+        return
     if "--two-d" in sys.argv:
         sys.argv.remove("--two-d")
         warnings.simplefilter("ignore")

@@ -99,3 +99,43 @@ def test_a_file_whose_breaks_are_not_nodes_is_refused(tmp_path):
     ds.attrs["interpolation_breaks"] = float(ds["mu"].values[3])  # a node: read back, the digest matches
     pumpup.write_table(ds, path)
     assert pumpup.AlbedoTable.from_dataset(pumpup.open_table(path)).breaks == (float(ds["mu"].values[3]),)
+
+
+def test_a_g1_level_albedo_has_a_kink_where_its_bound_equals_the_bound_at_the_normal():
+    """GGX alpha 0.5's albedo falls from mu = 1 and rises again at grazing, so the bound u(v) of its g1 pumping equals
+    u(1) at v = 0.4788: there the set of wo with u(N.wo) > u(v) is born at the normal, and the level's albedo has a
+    jump of its second derivative (measured here: second differences +0.099 on one side, -0.258 on the other) that no
+    cut of g marks.  ``Pumped._kink_normal`` finds it and ``albedo_kinks`` splits the table above it there.  With g2 and
+    u(1) <= 1, g at wo = N is max(u(v), 1): no such kink."""
+    f = pumpup.pump({"type": "ggx", "alpha": 0.5}, g="g1", levels=1)
+    (v0,) = f._kink_normal()
+    assert abs(float(f.lookup().upper(v0)) - float(f.lookup().upper(1.0))) < 1e-12
+    h = 2e-3
+    a = pumpup.albedo(f, v0 + h * np.arange(-6, 7), rtol=1e-13)
+    d2 = np.diff(a, 2) / h**2
+    left, right = d2[:4], d2[-4:]  # the second differences that do not straddle v0
+    assert np.ptp(left) < 0.01 and np.ptp(right) < 0.05 and left.min() - right.max() > 0.3, d2
+    assert v0 in pumping.albedo_kinks(pumpup.pump({"type": "ggx", "alpha": 0.5}, g="g1", levels=2).base)
+    assert pumpup.pump({"type": "ggx", "alpha": 0.5}, g="g2", levels=1)._kink_normal() == []
+
+
+def test_two_level_g1_pumped_ward_at_normal_incidence_bounds_its_error():
+    """Rough Ward (m = 0.885, found by ``scripts/fuzz_engines.py --two-d``): before its level-2 table was split at the
+    level-1 kink v = 0.0605 (u(v) = u(1), above), the table bunched 726 nodes around it and rounded it off over 1e-4 in
+    theta_o, and the nested engine was 1.6e-12 off at mu = 1 with an estimate of 8.1e-13 (rtol 1e-10).  Reference: at
+    normal incidence the albedo is a 1-D integral over theta_o (scipy's quad, split at every level's cut)."""
+    from scipy.integrate import quad
+
+    f = pumpup.load({"type": "pumped", "base": {"type": "ward", "m": 0.885}, "g": "g1", "levels": 2})
+    assert len(f.table().breaks) == 1
+    wi = np.array([0.0, 0.0, 1.0])
+
+    def ring(th):
+        return float(f.eval(wi, np.array([np.sin(th), 0.0, np.cos(th)]))) * np.cos(th) * np.sin(th) * 2 * np.pi
+
+    cuts = sorted(np.arccos(u) for u in (*f.lobe(1.0).levels, *f.table_kinks()) if 0 < u < 1)
+    ends = [0.0, *cuts, np.pi / 2]
+    ref = sum(quad(ring, lo, hi, epsabs=1e-17, epsrel=1e-13, limit=400)[0] for lo, hi in zip(ends[:-1], ends[1:]))
+    for rtol in (1e-8, 1e-10, 1e-11):
+        a, e = pumpup.albedo(f, 1.0, rtol=rtol, return_error=True)
+        assert abs(float(a) - ref) <= float(e) + 1e-13, (rtol, float(a) - ref, float(e))
