@@ -465,7 +465,7 @@ class _Level:
         for r in range(1, self.deg):  # Horner: the spline piece in d = log(mu) - logx[lo]
             val = val * d + self.coef[lo + r * m1]
         below = self.v0 * dr.exp(self.slope0 * (lm - self.logx0)) + self.margin_lo  # power law below the table
-        u = dr.select(lm <= self.logx0, below, val + self.margin)
+        u = dr.select(lm < self.logx0, below, val + self.margin)  # (as pumping._upper_log)
         return dr.minimum(u, self.cap) if math.isfinite(self.cap) else u
 
     def g(self, mi_, mo):

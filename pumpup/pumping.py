@@ -167,7 +167,10 @@ def _upper_scalar(mu, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma
 def _upper_log(lm, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
     """:func:`_upper_scalar` of mu = exp(lm) (binary search for the piece)."""
     n = logx.shape[0]
-    if lm <= logx[0]:
+    # below the first node only, as AlbedoTable.upper: at mu = mu0 itself the power law's margin (|a1 - a0| + ..., 24 for
+    # Ward m = 0.885's 651 at mu0 = 1e-8) made the bound jump up there, a pumped level's albedo at exactly mu0 3.6 %
+    # below its limit from above, and the level above's table bisected towards its first node (571 nodes, 2e-23 apart)
+    if lm < logx[0]:
         return min(cap, v0 * math.exp(slope0 * (lm - logx[0])) + margin_lo)
     lo, hi = 0, n - 1
     while hi - lo > 1:  # binary search for the interval
@@ -325,7 +328,7 @@ def _g_levels(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, contr
                 if lmin > 0.0:
                     lmin = math.log(mmin)
                 lm = lmin
-            if lm <= logx[a]:
+            if lm < logx[a]:  # (as _upper_log)
                 u = v0[j] * math.exp(slope0[j] * (lm - logx[a])) + margin_lo[j]
             else:
                 c = int((lm - index_lo[j]) * index_h_inv[j])

@@ -158,6 +158,11 @@ class AlbedoTable:
 
     @classmethod
     def from_dataset(cls, ds) -> "AlbedoTable":
+        """The table of a dataset over mu alone; one over (mu, phi) (an anisotropic model's, ``tabulate(f, phi=...)``)
+        must be cut to one azimuth first (``ds.isel(phi=0)``): before, scipy's spline raised an unreadable error."""
+        if ds["albedo"].dims != ("mu",):
+            raise ValueError(f"an albedo table is a function of mu alone, got a dataset over {ds['albedo'].dims}; "
+                             "take one azimuth first, e.g. ds.isel(phi=0)")
         return cls(ds["mu"].values, ds["albedo"].values, ds["albedo_error"].values,
                    float(ds.attrs.get("interpolation_error", 0.0)), json.loads(ds.attrs["spec"]),
                    degree=int(ds.attrs.get("interpolation_degree", 3)),  # files from before the quintic: cubic

@@ -175,3 +175,14 @@ def test_table_is_the_same_on_any_number_of_threads(monkeypatch, threads):
 def test_tabulate_bad_threads(threads):
     with pytest.raises(ValueError, match="threads must be an integer >= 1"):
         pumpup.tabulate(pumpup.load({"type": "lambert"}), mu=[0.5], threads=threads)
+
+
+def test_a_table_over_mu_and_phi_is_refused_with_one_clear_line():
+    """An anisotropic model's table over (mu, phi) made AlbedoTable.from_dataset fail inside scipy's spline ("len(c)>=n-k-1
+    failed"; found by scripts/fuzz_engines.py --tables); it now names the dimensions, and one azimuth of it is a table."""
+    f = pumpup.load({"type": "ward_aniso", "ax": 0.2, "ay": 0.3})
+    ds = pumpup.tabulate(f, phi=[0.0, 0.5], progress=False, rtol=1e-6)
+    with pytest.raises(ValueError, match=r"function of mu alone.*\('mu', 'phi'\).*isel\(phi=0\)"):
+        pumpup.AlbedoTable.from_dataset(ds)
+    t = pumpup.AlbedoTable.from_dataset(ds.isel(phi=1))
+    np.testing.assert_allclose(t(np.array([0.5])), pumpup.albedo(f, 0.5, phi=0.5), rtol=0, atol=10 * t.margin)
