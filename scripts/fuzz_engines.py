@@ -19,8 +19,10 @@ GGX's path (frame 6 is); it is the tests' second engine and the path of models w
     PYTHONPATH=. python scripts/fuzz_engines.py [seed] [seconds]
     PYTHONPATH=. python scripts/fuzz_engines.py --two-d [seed] [seconds]   # models without a 1-D path: against the 2-D engine
     PYTHONPATH=. python scripts/fuzz_engines.py --tables [seed] [seconds]  # a table's interpolant against fresh values
+    PYTHONPATH=. python scripts/fuzz_engines.py --mean [seed] [seconds]    # mean_albedo against a quad of fresh values
 """
 
+import math
 import sys
 import time
 import warnings
@@ -160,7 +162,53 @@ def main_tables(rng, budget):
     print(f"tables {n}, misses {bad}")
 
 
+def main_mean(rng, budget):
+    """``pumpup.mean_albedo(f, return_error=True)`` (a table's spline where one was just made, else afresh) against
+    scipy's quad of 2 mu a(mu) over [0, 1] with the albedo at rtol 1e-13 (``--mean``); half the cases tabulate first."""
+    from scipy.integrate import quad
+
+    bad = n = 0
+    t0 = time.time()
+    while time.time() - t0 < budget:
+        spec = rand_spec(rng) if rng.random() < 0.7 else rand_spec_2d(rng)
+        try:
+            f = pumpup.load(spec)
+        except ValueError:
+            continue
+        if f.azimuth_range() is not None:
+            continue  # (an anisotropic model's mean needs an azimuth)
+        try:
+            if rng.random() < 0.5:
+                pumpup.tabulate(f)
+            m, em = pumpup.mean_albedo(f, return_error=True)
+        except Exception as err:
+            bad += 1
+            print("ERROR", spec, type(err).__name__, str(err).splitlines()[0], flush=True)
+            continue
+        errs = []
+
+        def g(x):
+            a, e = pumpup.albedo(f, x, rtol=1e-13, return_error=True)
+            errs.append(float(e) * 2 * x)
+            return 2.0 * x * float(a)
+
+        ref, eref = quad(g, 0.0, 1.0, epsabs=1e-15, epsrel=1e-12, limit=400, points=[1e-6, 1e-4, 1e-2, 0.1, 0.5])
+        eref += max(errs)  # each value's own error, integrated over [0, 1] at most
+        n += 1
+        r = (abs(m - ref) - eref) / em if em > 0 else (math.inf if abs(m - ref) > eref else 0.0)
+        if not np.isfinite(m) or r > 1:
+            bad += 1
+            print("MEAN", spec, "mean", m, "+-", em, "quad", ref, "+-", eref, "ratio", r, flush=True)
+    print(f"means {n}, misses {bad}")
+
+
 def main():
+    if "--mean" in sys.argv:
+        sys.argv.remove("--mean")
+        warnings.simplefilter("ignore")
+        main_mean(np.random.default_rng(int(sys.argv[1]) if len(sys.argv) > 1 else 0),
+                  float(sys.argv[2]) if len(sys.argv) > 2 else 300.0)
+        return
     if "--tables" in sys.argv:
         sys.argv.remove("--tables")
         warnings.simplefilter("ignore")
