@@ -167,9 +167,10 @@ def _upper_scalar(mu, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma
 def _upper_log(lm, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
     """:func:`_upper_scalar` of mu = exp(lm) (binary search for the piece)."""
     n = logx.shape[0]
-    # below the first node only, as AlbedoTable.upper: at mu = mu0 itself the power law's margin (|a1 - a0| + ..., 24 for
-    # Ward m = 0.885's 651 at mu0 = 1e-8) made the bound jump up there, a pumped level's albedo at exactly mu0 3.6 %
-    # below its limit from above, and the level above's table bisected towards its first node (571 nodes, 2e-23 apart)
+    # below the first node only, as AlbedoTable.upper: at mu = mu0 itself the power law's margin (|a1 - a0| + ...,
+    # 24 for Ward m = 0.885's 651 at mu0 = 1e-8) made the bound jump up there, a pumped level's albedo at exactly mu0
+    # 3.6 % below its limit from above, and the level above's table bisected towards its first node (504 nodes within
+    # 1e-9 of it, 2e-23 apart)
     if lm < logx[0]:
         return min(cap, v0 * math.exp(slope0 * (lm - logx[0])) + margin_lo)
     lo, hi = 0, n - 1
@@ -917,10 +918,10 @@ class Pumped(BRDF):
         """The incidences v < 1 where the bound u(v) equals u(1), its value at wo = N: there the set of wo whose bound
         exceeds u(v) (g1: where g = u(N.wo)) is born at the normal or vanishes, so this level's albedo has a near-kink
         at v (a jump of its second derivative) although no cut of g sits there for a wo (g2: only where u(1) > 1,
-        below).  Only a bound that is not monotone has one (rough Ward's albedo falls from mu = 1 and rises again at grazing; a metal's has a minimum).
-        Issue 14's twentieth session: a 2-level g1 pumped Ward m = 0.885 had its level-2 table bunch 726 nodes
-        around v = 0.0606 and round the kink off there, and the nested engine was 1.6e-12 off at mu = 1 with an
-        estimate of 8.1e-13."""
+        below).  Only a bound that is not monotone has one (rough Ward's albedo falls from mu = 1 and rises again at
+        grazing; a metal's has a minimum).  Issue 14's twentieth session: a 2-level g1 pumped Ward m = 0.885 had its
+        level-2 table bunch 37 nodes between v = 0.05 and 0.07 (4 with the break) and round the kink at 0.0605 off,
+        and the nested engine was 1.6e-12 off at mu = 1 with an estimate of 8.1e-13."""
         from scipy.optimize import brentq
 
         lk = self.lookup()
