@@ -1878,8 +1878,9 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
 Z_MAX = 40.0
 
 
-#: the most breakpoints :func:`_pieces` takes (8, and frame 4's graded cuts, 3 x 16)
-MAX_BREAKS = 56
+#: the most breakpoints :func:`_pieces` takes (8, frame 4's graded cuts, 3 x 16, and its cuts about F's branch point,
+#: 2 x (1 + 2 LOBE_F_CUTS))
+MAX_BREAKS = 96
 
 #: the most graded pieces :func:`_pieces` makes (:func:`_graded_cuts` stops there; 4 tail, the graded cuts above the
 #: horizon break, 3 peak; frame 4's cuts)
@@ -2107,6 +2108,32 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
                     ub[m], kb[m] = math.cos(ab), 2
                     zb[m] = _zr(radial, math.tan(ab), n) if radial else -n1 * math.log1p(-2.0 * math.sin(0.5 * ab) ** 2)
                     m += 1
+        if frame == 4 and mp[0] == SMITH:
+            # a conductor's F(c) whose branch point w = x0 - i y0 lies near the real axis inside (0, 1) (eta < 1, small k:
+            # a near-kink at c = x0): h's circle at alpha has c = wi.h in [cos(alpha + theta_i), cos(alpha - theta_i)], so
+            # K(u) turns where an end of that range passes x0, at alpha = |theta_i -+ theta_0|, on the scale y0 / sin(theta_0)
+            # in alpha; near normal incidence c hardly varies on the circle and the whole near-kink is K's.  Cuts there
+            # and at -+ (that scale / 2) 4^j, not smoothed (code 3), as frame 5's in the lobe frame.  Without them GGX
+            # alpha = 0.003 with eta 0.271, k 0.0605 at mu = 1 was 2.4e-11 off with an estimate of 3.5e-12 (rtol 1e-10;
+            # issue 14's twentieth session, scripts/fuzz_engines.py)
+            x0, y0 = mp[13], mp[14]
+            st0 = math.sqrt((1.0 - x0) * (1.0 + x0)) if 0.0 < x0 < 1.0 else 0.0
+            if st0 > 0.0 and y0 < x0 and y0 < LOBE_F_WIDE * st0:
+                th_i = 0.5 * math.pi - psi
+                th_0 = math.atan2(st0, x0)
+                for ax in (abs(th_i - th_0), th_i + th_0):
+                    if not 0.0 < ax < 0.5 * math.pi:
+                        continue
+                    for side in range(3):
+                        off = 0.5 * y0 / st0
+                        for _ in range(LOBE_F_CUTS if side else 1):
+                            ab = ax if side == 0 else (ax - off if side == 1 else ax + off)
+                            if not 0.0 < ab < 0.5 * math.pi or m >= MAX_BREAKS:
+                                break
+                            ub[m], kb[m] = math.cos(ab), 3
+                            zb[m] = _zr(radial, math.tan(ab), n) if radial else -n1 * math.log1p(-2.0 * math.sin(0.5 * ab) ** 2)
+                            m += 1
+                            off *= 4.0
         # (the weight's mass beyond alpha_f / 2, 1 / (1 + t) for GGX's and e^-t for Beckmann's, times K's bound over
         # P(mu) ~ mu, below 1e-3 rtol: the cuts cannot matter, a narrow lobe far from grazing incidence)
         tail = 0.0
@@ -2126,7 +2153,7 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
                 off = 0.5 * mp[11]
                 for _ in range(16):
                     ab = a_f - off if side == 0 else (a_f + off if side == 1 else a_lo - off)
-                    if (side == 0 and ab <= 0.0) or (side == 1 and ab >= a_mid) or (side == 2 and ab <= a_mid):
+                    if (side == 0 and ab <= 0.0) or (side == 1 and ab >= a_mid) or (side == 2 and ab <= a_mid) or m >= MAX_BREAKS:
                         break
                     ub[m], kb[m] = math.cos(ab), 3
                     zb[m] = _zr(radial, math.tan(ab), n)
@@ -3509,6 +3536,8 @@ def numeric_params(hint: Polar) -> np.ndarray:
     if hint.smith is not None:
         mp[0], mp[1:5] = SMITH, hint.smith
         mp[11] = hint.smith[3]
+        if hint.fresnel[1] > 0.0:  # a conductor's branch point, for :func:`_pieces`' cuts (frame 6 reuses 13, 14: n_params)
+            mp[13], mp[14] = fresnel_branch(float(hint.fresnel[1]), float(hint.fresnel[2]))
         if hint.smith[1] == 1:
             from .models.microfacet import walter_level
 
