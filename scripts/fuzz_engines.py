@@ -16,6 +16,12 @@ the far horizon break (1 - tau_x = 1.7e-9) at 6.8e-3 (Newton from a start that r
 engines agree with a half-vector quadrature to 5e-13 (``tests/test_albedo_breaks.py``).  The nested engine is not
 GGX's path (frame 6 is); it is the tests' second engine and the path of models without a 1-D path.
 
+Found in the twentieth session (each mended, with a test): a pumped level's albedo kinked where its bound equals its value
+at the normal (--two-d; ``Pumped._kink_normal``); a (mu, phi) dataset crashing ``AlbedoTable.from_dataset`` (--tables);
+frame 4 blind to a near-real branch point of F at normal incidence (GGX alpha .003, eta .271, k .0605 at mu = 1: 6.9 x);
+the nested engine blind to G1's fall at the horizon near normal incidence for alpha < 1.5e-3 (up to 26 x;
+``_nested._alpha_grading``).  Left: the 2-D engine's flaw of the same kind (GGX alpha 2.7e-4 at mu = 1: 60 x).
+
     PYTHONPATH=. python scripts/fuzz_engines.py [seed] [seconds]
     PYTHONPATH=. python scripts/fuzz_engines.py --two-d [seed] [seconds]   # models without a 1-D path: against the 2-D engine
     PYTHONPATH=. python scripts/fuzz_engines.py --tables [seed] [seconds]  # a table's interpolant against fresh values
