@@ -2006,6 +2006,29 @@ def _zr(radial, tb, n):  # pragma: no cover - compiled
     return t if radial == 1 else math.log1p(t)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _branch_cuts(ub, zb, kb, m, th_i, x0, y0, st0, radial, n, n1):  # pragma: no cover - compiled
+    """:func:`_pieces`' cuts about F's branch point x0 - i y0 (st0 = sqrt(1 - x0^2)): where the arc's (frame 5) or h's
+    circle's (frame 4) highest or lowest cosine, cos(theta_i -+ alpha), passes x0 (alpha = |theta_i - theta_0| or theta_i +
+    theta_0), and at -+ (y0 / sin(theta_0) / 2) 4^j from there, j < LOBE_F_CUTS, not smoothed (code 3); u = cos(alpha),
+    z by the radial weight (``radial`` 0: -(n + 1) ln u).  Returns the new number of breaks (at most MAX_BREAKS)."""
+    th_0 = math.atan2(st0, x0)
+    for ax in (abs(th_i - th_0), th_i + th_0):
+        if not 0.0 < ax < 0.5 * math.pi:
+            continue
+        for side in range(3):
+            off = 0.5 * y0 / st0
+            for _ in range(LOBE_F_CUTS if side else 1):
+                ab = ax if side == 0 else (ax - off if side == 1 else ax + off)
+                if not 0.0 < ab < 0.5 * math.pi or m >= MAX_BREAKS:
+                    break
+                ub[m], kb[m] = math.cos(ab), 3
+                zb[m] = _zr(radial, math.tan(ab), n) if radial else -n1 * math.log1p(-2.0 * math.sin(0.5 * ab) ** 2)
+                m += 1
+                off *= 4.0
+    return m
+
+
 @njit(cache=True, nogil=True)
 def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: no cover - compiled
     """The pieces between the breakpoints, written into ``kinds``, ``sms`` (the smoothing), ``v0``,
@@ -2058,21 +2081,7 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
             # (alpha = |theta_i - theta_0| or theta_i + theta_0), on the scale y0 / sin(theta_0) in alpha: cuts there and
             # at -+ (that scale / 2) 4^j, not smoothed (code 3), as frame 4's (a first rule on a wide piece may not see it;
             # one on the scale LOBE_F_WIDE or wider does)
-            th_i = math.atan2(s, mu)
-            th_0 = math.atan2(st0, x0)
-            for ax in (abs(th_i - th_0), th_i + th_0):
-                if not 0.0 < ax < 0.5 * math.pi:
-                    continue
-                for side in range(3):
-                    off = 0.5 * y0 / st0
-                    for _ in range(LOBE_F_CUTS if side else 1):
-                        ab = ax if side == 0 else (ax - off if side == 1 else ax + off)
-                        if not 0.0 < ab < 0.5 * math.pi or m >= MAX_BREAKS:
-                            break
-                        ub[m], kb[m] = math.cos(ab), 3
-                        zb[m] = -n1 * math.log1p(-2.0 * math.sin(0.5 * ab) ** 2)
-                        m += 1
-                        off *= 4.0
+            m = _branch_cuts(ub, zb, kb, m, math.atan2(s, mu), x0, y0, st0, 0, n, n1)
     else:
         psi = math.atan2(mu, s)  # pi / 2 - theta_i, exact near grazing incidence
         hf = 0.25 * psi  # u_f = cos(pi/4 - theta_i/2) = cos(2 hf) = 1 - 2 sin^2(hf)
@@ -2119,21 +2128,7 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
             x0, y0 = mp[13], mp[14]
             st0 = math.sqrt((1.0 - x0) * (1.0 + x0)) if 0.0 < x0 < 1.0 else 0.0
             if st0 > 0.0 and y0 < x0 and y0 < LOBE_F_WIDE * st0:
-                th_i = 0.5 * math.pi - psi
-                th_0 = math.atan2(st0, x0)
-                for ax in (abs(th_i - th_0), th_i + th_0):
-                    if not 0.0 < ax < 0.5 * math.pi:
-                        continue
-                    for side in range(3):
-                        off = 0.5 * y0 / st0
-                        for _ in range(LOBE_F_CUTS if side else 1):
-                            ab = ax if side == 0 else (ax - off if side == 1 else ax + off)
-                            if not 0.0 < ab < 0.5 * math.pi or m >= MAX_BREAKS:
-                                break
-                            ub[m], kb[m] = math.cos(ab), 3
-                            zb[m] = _zr(radial, math.tan(ab), n) if radial else -n1 * math.log1p(-2.0 * math.sin(0.5 * ab) ** 2)
-                            m += 1
-                            off *= 4.0
+                m = _branch_cuts(ub, zb, kb, m, 0.5 * math.pi - psi, x0, y0, st0, radial, n, n1)
         # (the weight's mass beyond alpha_f / 2, 1 / (1 + t) for GGX's and e^-t for Beckmann's, times K's bound over
         # P(mu) ~ mu, below 1e-3 rtol: the cuts cannot matter, a narrow lobe far from grazing incidence)
         tail = 0.0

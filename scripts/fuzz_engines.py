@@ -209,24 +209,13 @@ def main_mean(rng, budget):
 
 
 def main():
-    if "--mean" in sys.argv:
-        sys.argv.remove("--mean")
-        warnings.simplefilter("ignore")
-        main_mean(np.random.default_rng(int(sys.argv[1]) if len(sys.argv) > 1 else 0),
-                  float(sys.argv[2]) if len(sys.argv) > 2 else 300.0)
-        return
-    if "--tables" in sys.argv:
-        sys.argv.remove("--tables")
-        warnings.simplefilter("ignore")
-        main_tables(np.random.default_rng(int(sys.argv[1]) if len(sys.argv) > 1 else 0),
-                    float(sys.argv[2]) if len(sys.argv) > 2 else 300.0)
-        return
-    if "--two-d" in sys.argv:
-        sys.argv.remove("--two-d")
-        warnings.simplefilter("ignore")
-        main_2d(np.random.default_rng(int(sys.argv[1]) if len(sys.argv) > 1 else 0),
-                float(sys.argv[2]) if len(sys.argv) > 2 else 300.0)
-        return
+    for flag, mode in (("--mean", main_mean), ("--tables", main_tables), ("--two-d", main_2d)):
+        if flag in sys.argv:
+            sys.argv.remove(flag)
+            warnings.simplefilter("ignore")
+            mode(np.random.default_rng(int(sys.argv[1]) if len(sys.argv) > 1 else 0),
+                 float(sys.argv[2]) if len(sys.argv) > 2 else 300.0)
+            return
     warnings.simplefilter("ignore")
     rng = np.random.default_rng(int(sys.argv[1]) if len(sys.argv) > 1 else 0)
     budget = float(sys.argv[2]) if len(sys.argv) > 2 else 300.0
