@@ -98,17 +98,22 @@ def rand_spec_2d(rng):
     return {"type": "mix", "a": {"type": "lambert"}, "b": rand_spec(rng), "m": float(rng.uniform(0, 1))}
 
 
+def _draws(rng, budget, draw):
+    """(spec, BRDF) pairs from ``draw(rng)`` for ``budget`` seconds (specs the models refuse are skipped)."""
+    t0 = time.time()
+    while time.time() - t0 < budget:
+        spec = draw(rng)
+        try:
+            yield spec, pumpup.load(spec)
+        except ValueError:
+            continue
+
+
 def main_2d(rng, budget):
     """The default path against the 2-D engine (``pumpup._polar.two_d_only``) at rtol 1e-12, with wi turned out of the
     xz-plane (phi) for the anisotropic models."""
     bad = n = 0
-    t0 = time.time()
-    while time.time() - t0 < budget:
-        spec = rand_spec_2d(rng)
-        try:
-            f = pumpup.load(spec)
-        except ValueError:
-            continue
+    for spec, f in _draws(rng, budget, rand_spec_2d):
         mu = np.array([10 ** rng.uniform(-6, 0), rng.uniform(0, 1), 1.0])
         phi = float(rng.uniform(0, 2 * np.pi)) if spec["type"] == "ward_aniso" else 0.0
         rtol = float(rng.choice([1e-6, 1e-8, 1e-10]))
@@ -131,6 +136,10 @@ def main_2d(rng, budget):
     print(f"cases {n}, disagreements {bad}")
 
 
+def _any_spec(rng):
+    return rand_spec(rng) if rng.random() < 0.7 else rand_spec_2d(rng)
+
+
 def main_tables(rng, budget):
     """A table's interpolant against fresh values (``--tables``): ``pumpup.tabulate`` at its defaults, then the albedo at
     40 random mu (log-uniform from the table's first node to 1, and uniform) at rtol 1e-12; a miss larger than the
@@ -139,13 +148,7 @@ def main_tables(rng, budget):
     from pumpup.tables import AlbedoTable
 
     bad = n = 0
-    t0 = time.time()
-    while time.time() - t0 < budget:
-        spec = rand_spec(rng) if rng.random() < 0.7 else rand_spec_2d(rng)
-        try:
-            f = pumpup.load(spec)
-        except ValueError:
-            continue
+    for spec, f in _draws(rng, budget, _any_spec):
         phi = None if f.azimuth_range() is None else 0.0
         try:
             t = AlbedoTable.from_dataset(pumpup.tabulate(f, phi=phi).isel(phi=0) if phi is not None else pumpup.tabulate(f))
@@ -174,13 +177,7 @@ def main_mean(rng, budget):
     from scipy.integrate import quad
 
     bad = n = 0
-    t0 = time.time()
-    while time.time() - t0 < budget:
-        spec = rand_spec(rng) if rng.random() < 0.7 else rand_spec_2d(rng)
-        try:
-            f = pumpup.load(spec)
-        except ValueError:
-            continue
+    for spec, f in _draws(rng, budget, _any_spec):
         if f.azimuth_range() is not None:
             continue  # (an anisotropic model's mean needs an azimuth)
         try:
@@ -220,13 +217,7 @@ def main():
     rng = np.random.default_rng(int(sys.argv[1]) if len(sys.argv) > 1 else 0)
     budget = float(sys.argv[2]) if len(sys.argv) > 2 else 300.0
     bad = n = 0
-    t0 = time.time()
-    while time.time() - t0 < budget:
-        spec = rand_spec(rng)
-        try:
-            f = pumpup.load(spec)
-        except ValueError:
-            continue
+    for spec, f in _draws(rng, budget, rand_spec):
         mu = np.array([10 ** rng.uniform(-6, 0), rng.uniform(0, 1), 1.0])
         rtol = float(rng.choice([1e-6, 1e-8, 1e-10]))
         a, e = pumpup.albedo(f, mu, rtol=rtol, return_error=True)
