@@ -106,7 +106,7 @@ def base_table(base: BRDF, progress: bool | None = None):
     return _TABLES[key]
 
 
-def albedo_kinks(brdf: BRDF):
+def albedo_kinks(brdf: BRDF, inside_grid: bool = True):
     """The kinks of the albedo of ``brdf`` where it is a pumped level (None for any other model), for its table's
     spline to be split there (:class:`pumpup.tables.AlbedoTable`'s breaks): the albedo at incidence v of a pumped level
     has a kink where the g of that level or of one below changes its form at incidences that do not depend on wo --
@@ -120,16 +120,17 @@ def albedo_kinks(brdf: BRDF):
     within 3e-4 of mu = 1, inside the grid's last interval, where a piece of two or three nodes made a 3-level g2 pumped
     Phong's third bound dip (its running maximum then added a flat and its kink; its three tables took 87-97 ms against
     76-79, one sitting); those keep the one spline, and :meth:`Pumped.table_kinks`' cuts at the knots bunched around
-    them, as before."""
+    them, as before.  ``inside_grid=False``: every kink in (0, 1) (:func:`pumpup.mean_albedo`'s first intervals)."""
     if not isinstance(brdf, Pumped):
         return None
     from .tables import default_grid
 
     grid = default_grid()
+    lo, hi = (grid[1], grid[-2]) if inside_grid else (0.0, 1.0)
     out = set()
     for lev in brdf.chain():
         _, _, diag, caps = lev._kink_fixed()
-        out.update(float(v) for v in (*diag, *caps, *lev._kink_normal()) if grid[1] < v < grid[-2])
+        out.update(float(v) for v in (*diag, *caps, *lev._kink_normal()) if lo < v < hi)
     return sorted(out)
 
 

@@ -20,7 +20,9 @@ Found in the twentieth session (each mended, with a test): a pumped level's albe
 at the normal (--two-d; ``Pumped._kink_normal``); a (mu, phi) dataset crashing ``AlbedoTable.from_dataset`` (--tables);
 frame 4 blind to a near-real branch point of F at normal incidence (GGX alpha .003, eta .271, k .0605 at mu = 1: 6.9 x);
 the nested engine blind to G1's fall at the horizon near normal incidence for alpha < 1.5e-3 (up to 26 x;
-``_nested._alpha_grading``).  Left: the 2-D engine's flaw of the same kind (GGX alpha 2.7e-4 at mu = 1: 60 x).
+``_nested._alpha_grading``); a pumped level's mean albedo integrated across its kinks (--mean: 10 x;
+``mean_albedo``'s first intervals end at them now).  Left: the 2-D engine's flaw of the same kind as the nested
+engine's (GGX alpha 2.7e-4 at mu = 1: 60 x).
 
     PYTHONPATH=. python scripts/fuzz_engines.py [seed] [seconds]
     PYTHONPATH=. python scripts/fuzz_engines.py --two-d [seed] [seconds]   # models without a 1-D path: against the 2-D engine
