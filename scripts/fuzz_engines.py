@@ -21,7 +21,8 @@ at the normal (--two-d; ``Pumped._kink_normal``); a (mu, phi) dataset crashing `
 frame 4 blind to a near-real branch point of F at normal incidence (GGX alpha .003, eta .271, k .0605 at mu = 1: 6.9 x);
 the nested engine blind to G1's fall at the horizon near normal incidence for alpha < 1.5e-3 (up to 26 x;
 ``_nested._alpha_grading``); a pumped level's mean albedo integrated across its kinks (--mean: 10 x;
-``mean_albedo``'s first intervals end at them now).  Left: the 2-D engine's flaw of the same kind as the nested
+``mean_albedo``'s first intervals end at them now), and across mu ~ alpha near grazing (2.6 x; two more first
+intervals there).  Left: the 2-D engine's flaw of the same kind as the nested
 engine's (GGX alpha 2.7e-4 at mu = 1: 60 x).
 
     PYTHONPATH=. python scripts/fuzz_engines.py [seed] [seconds]
