@@ -42,7 +42,7 @@ class Row:
 
     @property
     def agrees(self) -> bool | None:
-        return None if self.published is None else agrees(self.computed, self.published)
+        return None if self.published is None else agrees(self.computed, self.published, self.error)
 
 
 class _Cache:
