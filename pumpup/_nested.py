@@ -75,19 +75,18 @@ from .albedo import (
     NODES,
     WG,
     WK,
-    _BREAK_MIN,
     _accumulate,
     _horizon_breaks,
     _kink_breaks,
     _kink_coefficients,
     _power_split,
     _radial,
-    _radial_inverse,
     _radial_scalar,
     _rotate,
     _rounding,
     _smooth,
     _smooth_inverse,
+    _tau_of_angle,
 )
 
 __all__ = ["ENABLED", "disabled", "inner_error", "integrate", "interval_error", "supports"]
@@ -531,10 +530,9 @@ def _alpha_grading(lobe, mu: float) -> np.ndarray:
         off = 0.5 * a
         while off < 0.25:
             for ab in (af - off, af + off):
-                if 0.0 < ab < 0.5 * math.pi:
-                    x, xc = _radial_inverse(lobe.radial, float(lobe.sharpness), ab)
-                    if x > _BREAK_MIN and xc > _BREAK_MIN**2:
-                        out.append(_smooth_inverse(x, xc))
+                tau = _tau_of_angle(lobe, ab) if 0.0 < ab < 0.5 * math.pi else None
+                if tau is not None:
+                    out.append(tau)
             off *= 4.0
     return np.array(out)
 

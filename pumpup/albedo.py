@@ -582,15 +582,20 @@ def _horizon_breaks(lobe: Lobe, mu: float) -> np.ndarray:
     out = []
     for a in alphas:
         if 0 < a < math.pi / 2:
-            x, xc = _radial_inverse(lobe.radial, lobe.sharpness, a)
-            # x is the radial weight's measure: a break with x or 1 - x below _BREAK_MIN closes a region that weighs
-            # nothing (below x the integrand per unit x is at most about 1 / mu; beyond 1 - x, GGX's tail, about
-            # alpha / (mu sqrt(1 - x)); Cook-Torrance m = 0.2 at mu = 0.359: x = 1.7e-315 put a break at tau_x =
-            # 2.4e-158, where the map's Jacobian k^2 cos^3 / (2 x) overflowed; a break at 3e-56 would cost the
-            # nested engine 46 graded intervals)
-            if x > _BREAK_MIN and xc > _BREAK_MIN**2:
-                out.append(_smooth_inverse(x, xc))
+            tau = _tau_of_angle(lobe, a)
+            if tau is not None:
+                out.append(tau)
     return np.array(out)
+
+
+def _tau_of_angle(lobe: Lobe, alpha: float) -> float | None:
+    """tau_x of the polar angle ``alpha`` in the lobe's radial map, or None where the map variable x or 1 - x is below
+    :data:`_BREAK_MIN`: x is the radial weight's measure, and a break there closes a region that weighs nothing (below x
+    the integrand per unit x is at most about 1 / mu; beyond 1 - x, GGX's tail, about alpha / (mu sqrt(1 - x));
+    Cook-Torrance m = 0.2 at mu = 0.359: x = 1.7e-315 put a break at tau_x = 2.4e-158, where the map's Jacobian
+    k^2 cos^3 / (2 x) overflowed; a break at 3e-56 would cost the nested engine 46 graded intervals)."""
+    x, xc = _radial_inverse(lobe.radial, lobe.sharpness, alpha)
+    return _smooth_inverse(x, xc) if x > _BREAK_MIN and xc > _BREAK_MIN**2 else None
 
 
 _TAU_SCAN = np.unique(np.concatenate([

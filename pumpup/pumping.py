@@ -129,9 +129,17 @@ def albedo_kinks(brdf: BRDF, inside_grid: bool = True):
     lo, hi = (grid[1], grid[-2]) if inside_grid else (0.0, 1.0)
     out = set()
     for lev in brdf.chain():
-        _, _, diag, caps = lev._kink_fixed()
-        out.update(float(v) for v in (*diag, *caps, *lev._kink_normal()) if lo < v < hi)
+        out.update(v for v in lev._albedo_kinks() if lo < v < hi)
     return sorted(out)
+
+
+def _sign_roots(grid, vals, fn) -> list:
+    """The roots of ``fn`` in every cell of ``grid`` where ``vals`` (fn on the grid) changes sign (scipy's brentq, xtol
+    1e-15)."""
+    from scipy.optimize import brentq
+
+    idx = np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]
+    return [brentq(fn, grid[i], grid[i + 1], xtol=1e-15) for i in idx]
 
 
 _LOCKS: dict[str, threading.Lock] = {}
@@ -890,8 +898,6 @@ class Pumped(BRDF):
         """What :meth:`_kink_levels` needs at every mu, computed once per bound: the grid of the
         root search (the table's nodes and their midpoints), the bound on it, and the kinks that do not
         depend on mu: v where u(v) = v (g2) and where u(v) reaches its cap."""
-        from scipy.optimize import brentq
-
         lk = self.lookup()
         hit = lk.__dict__.get("kink_fixed")
         if hit is not None:
@@ -901,17 +907,13 @@ class Pumped(BRDF):
         grid = np.unique(np.concatenate([t.mu, np.sqrt(t.mu[:-1] * t.mu[1:]), [1.0]]))
         au = up(grid)
 
-        def roots(vals, fn):
-            idx = np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]
-            return [brentq(fn, grid[i], grid[i + 1], xtol=1e-15) for i in idx]
-
         diag = []
         if self.controlled:  # (:meth:`_kink_levels` uses these where U(mu) <= 1, as the threshold assumes)
             vals = au - grid
-            diag = roots(np.where(np.abs(vals) < 1e-13, 0.0, vals), lambda u: float(up(u)) - u)
+            diag = _sign_roots(grid, np.where(np.abs(vals) < 1e-13, 0.0, vals), lambda u: float(up(u)) - u)
         caps = []
         if math.isfinite(lk.cap):
-            caps = roots(up(grid, capped=False) - lk.cap, lambda u: float(up(u, capped=False)) - lk.cap)
+            caps = _sign_roots(grid, up(grid, capped=False) - lk.cap, lambda u: float(up(u, capped=False)) - lk.cap)
         lk.kink_fixed = out = (grid, au, diag, caps)
         return out
 
@@ -923,8 +925,6 @@ class Pumped(BRDF):
         grazing; a metal's has a minimum).  Issue 14's twentieth session: a 2-level g1 pumped Ward m = 0.885 had its
         level-2 table bunch 37 nodes between v = 0.05 and 0.07 (4 with the break) and round the kink at 0.0605 off,
         and the nested engine was 1.6e-12 off at mu = 1 with an estimate of 8.1e-13."""
-        from scipy.optimize import brentq
-
         lk = self.lookup()
         hit = lk.__dict__.get("kink_normal")
         if hit is None:
@@ -935,12 +935,15 @@ class Pumped(BRDF):
                 # the cap's kink (:meth:`_kink_fixed`), not where u(v) = u(1)
                 lk.kink_normal = []
                 return []
-            vals = au - a1
             inner = grid < 1.0
-            g, v = grid[inner], vals[inner]
-            idx = np.nonzero(np.sign(v[:-1]) * np.sign(v[1:]) < 0)[0]
-            hit = lk.kink_normal = [brentq(lambda u: float(lk.upper(u)) - a1, g[i], g[i + 1], xtol=1e-15) for i in idx]
+            hit = lk.kink_normal = _sign_roots(grid[inner], au[inner] - a1, lambda u: float(lk.upper(u)) - a1)
         return hit
+
+    def _albedo_kinks(self) -> list:
+        """The incidences where this level's albedo has a kink that does not depend on wo: its bound crosses the
+        diagonal or reaches its cap (:meth:`_kink_fixed`), or equals its value at the normal (:meth:`_kink_normal`)."""
+        _, _, diag, caps = self._kink_fixed()
+        return [float(v) for v in (*diag, *caps, *self._kink_normal())]
 
     def _kink_turns(self):
         """The root search's grid with the cells next to every turn of the bound on it split into 16 (those of a
@@ -1041,8 +1044,7 @@ class Pumped(BRDF):
                                 if d > 0 and (last == 0.0 or d >= 2.0 * last or j == len(side) - 1):
                                     out.add(math.exp(x))
                                     last = d
-                _, _, diag, caps = lev._kink_fixed()
-                kinks += [float(v) for v in (*diag, *caps, *lev._kink_normal()) if 0.0 < v < 1.0]
+                kinks += [v for v in lev._albedo_kinks() if 0.0 < v < 1.0]
             out |= set(kinks)
             hit = lk.table_kinks = tuple(sorted(v for v in out if 0.0 < v < 1.0))
         return hit
