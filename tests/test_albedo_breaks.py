@@ -430,3 +430,53 @@ def test_engines_near_normal_incidence_see_the_shadowing_at_the_horizon(alpha, m
     with (_polar.without_1d() if engine == "nested" else _polar.two_d_only()):
         a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
     assert abs(float(a) - float(ref)) <= float(e) + float(eref), (float(a) - float(ref), float(e))
+
+
+@pytest.mark.parametrize("n", [5.0, 96.6, 1073.0, 1e4])
+def test_power_map_is_continuous_at_its_split(n):
+    """The two-piece power map meets at x = 1/2 with cos(alpha) = u_s = 1/2.  Its peak piece computed y = ys + (1 - ys)
+    (2 x - 1) as 1 - 2 (1 - ys)(1 - x), which rounds ys = 2^-(n+1) off beyond n = 52: at x = 1/2 itself it gave
+    alpha = 90 deg, and the kink scan, which samples tau = 1/2, saw the wrong sign there (next test)."""
+    x = np.array([0.5, 0.5 - 2**-40])
+    ca, sa, jac = A._radial("power", n, x, 1.0 - x)
+    assert ca[0] == 0.5 and abs(ca[1] - 0.5) < 1e-11 and sa[0] == math.sqrt(0.75)
+    assert np.all(np.isfinite(jac))  # (0 where it would overflow: a point one double wide, n > 1020)
+    assert A._radial_scalar(1, n, 0.5, 0.5)[:2] == (ca[0], sa[0])
+
+
+def test_2d_engine_sees_a_kink_that_enters_and_leaves_above_the_split():
+    """Torrance-Sparrow D1 (s = 96.6, ior 2.617) at mu = 0.965: the geometry factor's cut 2 cos(alpha) N.wo = wi.h enters
+    the arc at alpha = 0.435 and leaves it at 0.612, both within the kink scan's cell [1/2, 0.5025] of tau (alpha from
+    60 deg to 0.33 rad).  With the map wrong at tau = 1/2 (previous test) the scan missed the first, and the last piece,
+    open only between the two, had no node: the 2-D engine was 1.77e-7 off with an estimate of 1.4e-14 at every rtol
+    and first grid (found by ``scripts/fuzz_engines.py --two-d``).  Reference: a tensor Gauss-Legendre rule in the half
+    vector's spherical coordinates (within 4e-14 of the 1-D path and the nested engine)."""
+    f = pumpup.load({"type": "torrance_sparrow", "d": "D1", "s": 96.59526104151392, "ior": 2.6169635397891735})
+    mu = 0.965
+    s = math.sqrt(1.0 - mu * mu)
+    wi = np.array([s, 0.0, mu])
+    xg, wg = np.polynomial.legendre.leggauss(10)
+
+    def nodes(a, b, P):
+        e = np.linspace(a, b, P + 1)
+        return ((e[1:] + e[:-1])[:, None] / 2 + np.diff(e)[:, None] / 2 * xg).ravel(), (np.diff(e)[:, None] / 2 * wg).ravel()
+
+    th, wt = nodes(0.0, 0.95, 160)  # (D1 = cos^96.6 of the half angle: 1e-10 of its peak at 0.95 rad)
+    ph, wp = nodes(0.0, math.pi, 160)
+    T = th[:, None]
+    h = np.stack([np.sin(T) * np.cos(ph), np.sin(T) * np.sin(ph), np.cos(T) * np.ones_like(ph)], -1)
+    c = h @ wi
+    wo = 2.0 * c[..., None] * h - wi
+    up = (wo[..., 2] > 0) & (c > 0)
+    wo[~up] = [0.0, 0.0, 1.0]
+    val = np.where(up, f.eval(np.broadcast_to(wi, wo.shape), wo) * wo[..., 2] * 4.0 * c * np.sin(T), 0.0)
+    ref = 2.0 * float(np.sum(val * wt[:, None] * wp))
+    lobe = f.lobe(mu)
+    breaks = A._kink_breaks(lobe, np.array([mu]), np.zeros((1, 0)))[0]
+    x, xc, _ = A._smooth(breaks)
+    ca, sa, _ = A._radial(lobe.radial, lobe.sharpness, x, xc)
+    assert np.any(np.abs(np.arctan2(sa, ca) - 0.43515) < 1e-4)  # the cut's entry is a break
+    for rtol in (1e-8, 1e-12):
+        with _polar.two_d_only():
+            a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
+        assert abs(float(a) - ref) <= float(e) + 1e-13, (float(a) - ref, float(e))
