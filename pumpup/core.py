@@ -473,6 +473,13 @@ class BRDF:
         """Linear decomposition f = sum w_k f_k used by the engine (default: itself)."""
         return [(1.0, self)]
 
+    def albedo_breaks(self) -> tuple:
+        """Incidences mu in (0, 1) where the albedo a(mu) has a kink that does not depend on wo (default: none), for a
+        table's spline to be split there (``pumpup.tabulate``'s ``breaks``, the pumping operator's base tables) and
+        for :func:`pumpup.mean_albedo`'s first intervals to end there: a Fresnel factor's total reflection
+        (:func:`pumpup.models.metal.fresnel_levels`).  A pumped level's own kinks come from the pumping operator."""
+        return ()
+
     def polar(self):
         """A :class:`pumpup._polar.Polar` hint when the azimuth of the albedo integral is closed-form
         (the engine then integrates one dimension, ``pumpup._polar``), else None (the default)."""

@@ -107,7 +107,8 @@ def base_table(base: BRDF, progress: bool | None = None):
 
 
 def albedo_kinks(brdf: BRDF, inside_grid: bool = True):
-    """The kinks of the albedo of ``brdf`` where it is a pumped level (None for any other model), for its table's
+    """The kinks of the albedo of ``brdf`` where it is a pumped level, and its innermost base's own
+    (:meth:`pumpup.core.BRDF.albedo_breaks`; None for a model that is not pumped and has none), for its table's
     spline to be split there (:class:`pumpup.tables.AlbedoTable`'s breaks): the albedo at incidence v of a pumped level
     has a kink where the g of that level or of one below changes its form at incidences that do not depend on wo --
     its bound crosses the diagonal, u(v) = v (g2), or reaches its cap (:meth:`Pumped._kink_fixed`).  Before issue 14's
@@ -121,16 +122,15 @@ def albedo_kinks(brdf: BRDF, inside_grid: bool = True):
     Phong's third bound dip (its running maximum then added a flat and its kink; its three tables took 87-97 ms against
     76-79, one sitting); those keep the one spline, and :meth:`Pumped.table_kinks`' cuts at the knots bunched around
     them, as before.  ``inside_grid=False``: every kink in (0, 1) (:func:`pumpup.mean_albedo`'s first intervals)."""
-    if not isinstance(brdf, Pumped):
-        return None
     from .tables import default_grid
 
     grid = default_grid()
     lo, hi = (grid[1], grid[-2]) if inside_grid else (0.0, 1.0)
-    out = set()
-    for lev in brdf.chain():
+    chain = brdf.chain() if isinstance(brdf, Pumped) else []
+    out = {v for v in (chain[0].base if chain else brdf).albedo_breaks() if lo < v < hi}  # the innermost base's
+    for lev in chain:
         out.update(v for v in lev._albedo_kinks() if lo < v < hi)
-    return sorted(out)
+    return sorted(out) if out or chain else None
 
 
 def _sign_roots(grid, vals, fn) -> list:

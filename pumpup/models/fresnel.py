@@ -16,7 +16,7 @@ import numpy as np
 from numba import vectorize
 
 from ..core import MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, register
-from .metal import _fresnel_real, fresnel
+from .metal import _fresnel_real, fresnel, fresnel_levels
 
 __all__ = ["FresnelWeighted"]
 
@@ -89,9 +89,13 @@ class FresnelWeighted(BRDF):
         return np.where(f != 0.0, f * fresnel(mx, self.p["eta"], self.p["k"]), 0.0)  # 000 eq. 28, complex form
 
     def lobe(self, mu):
-        b = self.base.lobe(mu)  # F(max(N.wi, N.wo)) adds a kink at N.wo = mu
+        b = self.base.lobe(mu)  # F(max(N.wi, N.wo)) adds a kink at N.wo = mu, and one where F has its own
         return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
-                    levels=tuple(sorted(set(b.levels) | {float(mu)})), kinks=b.kinks, symmetric=b.symmetric)
+                    levels=tuple(sorted(set(b.levels) | {float(mu), *fresnel_levels(self.p["eta"], self.p["k"])})),
+                    kinks=b.kinks, symmetric=b.symmetric)
+
+    def albedo_breaks(self):
+        return tuple(sorted({*fresnel_levels(self.p["eta"], self.p["k"]), *self.base.albedo_breaks()}))
 
     def sampling_lobe(self, mu):
         return self.base.sampling_lobe(mu)  # F only rescales the base

@@ -105,6 +105,25 @@ def _up(wi, wo):
 # --- metal ----------------------------------------------------------------------------------
 
 
+#: a Fresnel factor whose branch point lies closer than this to the real axis inside (0, 1) adds its real part as a
+#: level of the quadrature hint (:func:`fresnel_levels`)
+FRESNEL_LEVEL_Y0 = 0.05
+
+
+def fresnel_levels(eta: float, k: float) -> tuple:
+    """The level N.wo = x0 where F(eta + i k, max(N.wi, N.wo)) has a kink or a near-kink, for a model's ``Lobe`` hint: ()
+    or (x0,).  Below eta = 1 with k = 0 (a dielectric seen from the denser side) F = 1 up to cos = x0 = sqrt(1 - eta^2),
+    total reflection, with a square-root kink there; a small k makes it a near-kink, the branch point
+    sqrt(1 - (eta + i k)^2) = x0 - i y0 (:func:`pumpup._polar.fresnel_branch`) y0 off the axis.  The 1-D path declines
+    such a factor (``pumpup._polar.lobe_fresnel_ok``) and the nested engine, blind to the kink, bisected towards it:
+    fresnel over Blinn n = 5, eta = 0.551, k = 0 took 0.25-0.41 s per value at rtol 1e-10 (issue 14's twenty-first
+    session, ``scripts/fuzz_engines.py --registry``)."""
+    from .._polar import fresnel_branch
+
+    x0, y0 = fresnel_branch(float(eta), float(k))
+    return (x0,) if 0.0 < x0 < 1.0 and y0 < FRESNEL_LEVEL_Y0 else ()
+
+
 @vectorize(cache=True)
 def _metal_kernel(lx, ly, lz, vx, vy, vz, n, eta, k, c):  # pragma: no cover - compiled
     if lz <= 0.0 or vz <= 0.0:
@@ -169,7 +188,11 @@ class Metal(BRDF):
     reference_fn = staticmethod(_metal_reference)
 
     def lobe(self, mu):
-        return Lobe(axis="mirror", radial="power", sharpness=self.p["n"], levels=(mu,))
+        return Lobe(axis="mirror", radial="power", sharpness=self.p["n"],
+                    levels=tuple(sorted({float(mu), *fresnel_levels(self.p["eta"], self.p["k"])})))
+
+    def albedo_breaks(self):
+        return fresnel_levels(self.p["eta"], self.p["k"])  # F(max(mu, N.wo)) turns at mu = x0 too
 
     def polar(self):
         return _fresnel_polar(self.p["n"], self.p["c"], self.p["eta"], self.p["k"])
@@ -318,7 +341,11 @@ class Plastic(BRDF):
         return [(1.0, self.with_params(ad=0.0)), (self.p["ad"], load({"type": "lambert", "albedo": 1.0}))]
 
     def lobe(self, mu):
-        return Lobe(axis="mirror", radial="power", sharpness=self.p["n"], levels=(mu,))
+        return Lobe(axis="mirror", radial="power", sharpness=self.p["n"],
+                    levels=tuple(sorted({float(mu), *self.albedo_breaks()})))
+
+    def albedo_breaks(self):
+        return () if self.p["eta"] is None else fresnel_levels(self.p["eta"], 0.0)
 
     def polar(self):
         q = self.p

@@ -62,6 +62,9 @@ class Mix(BRDF):
         m = self.p["m"]
         return (1.0 - m) * np.asarray(self.p["a"].reference(wi, wo)) + m * np.asarray(self.p["b"].reference(wi, wo))
 
+    def albedo_breaks(self):
+        return tuple(sorted({*self.p["a"].albedo_breaks(), *self.p["b"].albedo_breaks()}))
+
     def albedo_terms(self):
         m = self.p["m"]
         out = []
