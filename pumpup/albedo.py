@@ -154,20 +154,20 @@ def _radial(kind: str, k: float, x: np.ndarray, xc: np.ndarray):
         # cos^n peak (000 eq. 20).  A single power map would be singular at alpha = 90 deg.
         us, ys = _power_split(k)
         tail = x < 0.5
-        low = xc > 0.25  # y below 1/2: ys + (1 - ys)(2 x - 1) keeps ys (1 - (1 - ys) rounds it off beyond n = 52)
         with np.errstate(divide="ignore", invalid="ignore"):
-            y = np.where(low, ys + (1.0 - ys) * (2.0 * x - 1.0), 1.0 - 2.0 * (1.0 - ys) * xc)  # exact near y = 1 too
-            ly = np.where(low, np.log(y), np.log1p(-2.0 * (1.0 - ys) * xc)) / (k + 1.0)
+            y = 1.0 - 2.0 * (1.0 - ys) * xc  # = ys + (1 - ys)(2 x - 1), kept exact near y = 1
+            ly = np.log1p(-2.0 * (1.0 - ys) * xc) / (k + 1.0)
             ca_peak = np.exp(ly)
             sa_peak = np.sqrt(-np.expm1(ly) * (1.0 + ca_peak))
             jac_peak = 2.0 * (1.0 - ys) * ca_peak / ((k + 1.0) * y)
-            # a point at x = 1/2 itself where y = ys is subnormal (n > 1020) or 0: the Jacobian overflows; such a point
-            # only ends an interval one double wide, where the nested engine's grid above the split starts
-            jac_peak = np.where(np.isfinite(jac_peak), jac_peak, 0.0)
-        ca_tail = np.where(tail | (y > 0), 2.0 * us * x, us)  # (ys underflows beyond n = 1074: the limit from below)
-        ca = np.where(tail | (y <= 0), ca_tail, ca_peak)
-        sa = np.where(tail | (y <= 0), np.sqrt((1.0 - ca_tail) * (1.0 + ca_tail)), sa_peak)
-        jac = np.where(tail, 2.0 * us, jac_peak)
+        # at x = 1/2 itself 1 - (1 - ys) rounds ys off beyond n = 52 (y = 0): alpha is the split's, cos(alpha) = u_s, not
+        # 90 deg (the kink scan samples tau = 1/2 and saw the wrong side there), with the weight 0 the point had before
+        # (it only ends intervals one double wide)
+        at_split = ~tail & (y <= 0.0)
+        ca_tail = np.where(at_split, us, 2.0 * us * x)
+        ca = np.where(tail | at_split, ca_tail, ca_peak)
+        sa = np.where(tail | at_split, np.sqrt((1.0 - ca_tail) * (1.0 + ca_tail)), sa_peak)
+        jac = np.where(tail, 2.0 * us, np.where(at_split, 0.0, jac_peak))
         return ca, sa, jac
     if kind == "beckmann":  # tan^2 alpha = -m^2 ln x
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -295,18 +295,14 @@ def _radial_scalar(kind, k, x, xc):  # pragma: no cover - compiled; see _radial
         if x < 0.5:
             c = 2.0 * us * x
             return c, math.sqrt((1.0 - c) * (1.0 + c)), 2.0 * us
-        if xc > 0.25:  # as in _radial: y = ys at x = 1/2, cos(alpha) = us
-            y = ys + (1.0 - ys) * (2.0 * x - 1.0)
-            if y <= 0.0:  # ys underflows beyond n = 1074: the limit from below (jac as in _radial)
-                return us, math.sqrt((1.0 - us) * (1.0 + us)), 0.0
-            ly = math.log(y) / (k + 1.0)
-        else:
-            y = 1.0 - 2.0 * (1.0 - ys) * xc
-            ly = math.log1p(-2.0 * (1.0 - ys) * xc) / (k + 1.0)
+        y = 1.0 - 2.0 * (1.0 - ys) * xc
+        if y <= 0.0:  # x = 1/2 with ys rounded off: the split's alpha, weight 0 (as in _radial)
+            return us, math.sqrt((1.0 - us) * (1.0 + us)), 0.0
+        ly = math.log1p(-2.0 * (1.0 - ys) * xc) / (k + 1.0)
         c = math.exp(ly)
         sa = math.sqrt(-math.expm1(ly) * (1.0 + c))
-        jac = 2.0 * (1.0 - ys) * c / ((k + 1.0) * y) if y > 0 else 0.0
-        return c, sa, (jac if jac < math.inf else 0.0)  # as in _radial
+        jac = 2.0 * (1.0 - ys) * c / ((k + 1.0) * y)
+        return c, sa, jac
     if kind == 2:
         lg = math.log(x) if x < 0.5 else math.log1p(-xc)
         if x <= 0.0:

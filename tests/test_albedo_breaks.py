@@ -440,7 +440,7 @@ def test_power_map_is_continuous_at_its_split(n):
     x = np.array([0.5, 0.5 - 2**-40])
     ca, sa, jac = A._radial("power", n, x, 1.0 - x)
     assert ca[0] == 0.5 and abs(ca[1] - 0.5) < 1e-11 and sa[0] == math.sqrt(0.75)
-    assert np.all(np.isfinite(jac))  # (0 where it would overflow: a point one double wide, n > 1020)
+    assert np.all(np.isfinite(jac))  # (0 at the split itself where ys is rounded off: the weight that point had)
     assert A._radial_scalar(1, n, 0.5, 0.5)[:2] == (ca[0], sa[0])
 
 
