@@ -265,7 +265,8 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     breaks : array_like, optional
         Values of mu in (``mu_min``, 1) where the albedo has a kink, for an adaptive grid over ``mu`` alone: they
         join the grid, and the interpolating spline is split there (:class:`AlbedoTable`; the attribute
-        ``interpolation_breaks``).  The pumping operator gives those of a pumped level's albedo.
+        ``interpolation_breaks``).  The pumping operator gives those of a pumped level's albedo.  Default: the
+        model's own, :meth:`pumpup.core.BRDF.albedo_breaks` (none for most models).
 
     Returns
     -------
@@ -294,6 +295,11 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     max_points = check_count("tabulate", "max_points", max_points, 2, MAX_POINTS_LIMIT)
     from .azimuth import table_values
 
+    if breaks is None and mu is None and (phi is None or isinstance(phi, str) and phi == "sup"):
+        # the model's own kinks (BRDF.albedo_breaks: a Fresnel factor's total reflection): metal n = 5, eta = 0.551 took
+        # 748 nodes and 15 s without them, 322 and 7.3 s with them (issue 14's twenty-first session)
+        own = [b for b in brdf.albedo_breaks() if mu_min < b < 1.0]
+        breaks = own or None
     if breaks is not None:
         try:
             breaks = np.unique(np.asarray(breaks, dtype=np.float64).reshape(-1))

@@ -169,3 +169,19 @@ def test_he_torrance_below_index_one():
     f.__dict__["_f_kinks"] = None  # the hint as before
     b, eb = pumpup.albedo(f, mu, rtol=1e-10, return_error=True)
     assert np.all(np.abs(a - b) <= e + eb), (a - b, e, eb)
+
+
+def test_tabulate_splits_at_the_models_own_kink():
+    """``pumpup.tabulate`` takes the model's albedo_breaks by default: the spline is split at mu = x0, where the albedo
+    has a square-root kink, and the interpolant stays within its margin on both sides of it."""
+    from pumpup.tables import AlbedoTable
+
+    f = pumpup.load({"type": "metal", "n": 5.0, "eta": ETA})
+    ds = pumpup.tabulate(f, interp_tol=1e-5)
+    assert float(ds.attrs["interpolation_breaks"]) == pytest.approx(X0, rel=1e-15)
+    t = AlbedoTable.from_dataset(ds)
+    mu = np.concatenate([X0 + np.logspace(-8, -1, 8), X0 - np.logspace(-8, -1, 8)])
+    a, e = pumpup.albedo(f, mu, rtol=1e-12, return_error=True)
+    assert np.all(np.abs(t(mu) - a) <= t.margin + e)
+    assert "interpolation_breaks" not in pumpup.tabulate(pumpup.load({"type": "metal", "n": 5.0, "eta": 1.5}),
+                                                          interp_tol=1e-5).attrs
