@@ -146,7 +146,8 @@ def main_2d(rng, budget):
 
 
 def _any_spec(rng):
-    return rand_spec(rng) if rng.random() < 0.7 else rand_spec_2d(rng)
+    r = rng.random()
+    return rand_spec(rng) if r < 0.5 else (rand_spec_2d(rng) if r < 0.7 else rand_spec_registry(rng))
 
 
 def main_tables(rng, budget):
