@@ -38,6 +38,7 @@ per value and minutes per table on the nested engine).
 """
 
 import math
+import signal
 import sys
 import time
 import warnings
@@ -157,17 +158,25 @@ def main_tables(rng, budget):
     error; ``margin_below`` below the first node) plus the fresh value's estimate is printed."""
     from pumpup.tables import AlbedoTable
 
-    bad = n = 0
+    _arm_alarm()
+    bad = n = slow = 0
     for spec, f in _draws(rng, budget, _any_spec):
         phi = None if f.azimuth_range() is None else 0.0
+        signal.alarm(CASE_SECONDS)
         try:
             t = AlbedoTable.from_dataset(pumpup.tabulate(f, phi=phi).isel(phi=0) if phi is not None else pumpup.tabulate(f))
+            mu = np.sort(np.concatenate([10 ** rng.uniform(np.log10(t.mu[0]), 0, 30), rng.uniform(t.mu[0], 1, 10)]))
+            a, e = pumpup.albedo(f, mu, rtol=1e-12, return_error=True, max_regions=200000, phi=phi or 0.0)
+        except TimeoutError:
+            slow += 1
+            print("SLOW", spec, flush=True)
+            continue
         except Exception as err:  # a crash is a finding too
             bad += 1
             print("ERROR", spec, type(err).__name__, str(err).splitlines()[0], flush=True)
             continue
-        mu = np.sort(np.concatenate([10 ** rng.uniform(np.log10(t.mu[0]), 0, 30), rng.uniform(t.mu[0], 1, 10)]))
-        a, e = pumpup.albedo(f, mu, rtol=1e-12, return_error=True, max_regions=200000, phi=phi or 0.0)
+        finally:
+            signal.alarm(0)
         miss = np.abs(t(mu) - a) - e
         with np.errstate(divide="ignore", invalid="ignore"):
             r = np.where(miss > 0, miss / t.margin, 0.0)  # (a zero albedo, table and margin: no miss)
@@ -178,7 +187,7 @@ def main_tables(rng, budget):
             i = int(np.argmax(r))
             print("MISS", spec, "mu", mu[i], "table", t(mu[i : i + 1])[0], "fresh", a[i], "+-", e[i], "margin", t.margin,
                   "ratio", r[i], "nodes", len(t.mu), flush=True)
-    print(f"tables {n}, misses {bad}")
+    print(f"tables {n}, misses {bad}, slow {slow}")
 
 
 #: --mean prints a case that takes longer than this (seconds)
@@ -278,20 +287,23 @@ def rand_spec_registry(rng, depth=0):
     return spec
 
 
-#: --registry skips a case that takes longer than this (seconds) and prints it
+#: --registry and --tables stop a case that takes longer than this (seconds) and print it
 CASE_SECONDS = 120
+
+
+def _arm_alarm():
+    """SIGALRM raises TimeoutError (``signal.alarm(CASE_SECONDS)`` before a case, ``signal.alarm(0)`` after it)."""
+    def alarm(*_):
+        raise TimeoutError
+
+    signal.signal(signal.SIGALRM, alarm)
 
 
 def main_registry(rng, budget):
     """Every registered model (``--registry``): the default path at rtol 1e-6 ... 1e-10 against the 2-D engine at rtol
     1e-12 (with wi at a random azimuth for an anisotropic model), the nested engine as a third opinion where the two
     disagree.  A case slower than ``CASE_SECONDS`` is stopped and printed (SLOW)."""
-    import signal
-
-    def alarm(*_):
-        raise TimeoutError
-
-    signal.signal(signal.SIGALRM, alarm)
+    _arm_alarm()
     bad = n = slow = 0
     for spec, f in _draws(rng, budget, rand_spec_registry):
         mu = np.array([10 ** rng.uniform(-6, 0), rng.uniform(0, 1), 1.0])
