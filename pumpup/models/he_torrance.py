@@ -448,13 +448,9 @@ class HeTorrance(BRDF):
         """The hint's kink wi.h = x0 where |F|^2 at the bisector angle has total reflection (n < 1, k = 0) or a near-kink
         (:func:`pumpup.models.metal.fresnel_levels`; one object per BRDF, as the microfacet models'), else None.  n = 0.6:
         the nested engine took 0.9 s for three values at rtol 1e-8 without it (n = 1.5: 0.1 s), the 2-D engine 95 s."""
-        hit = self.__dict__.get("_f_kinks", False)
-        if hit is False:
-            from .microfacet import _WiHKink
+        from .microfacet import wih_kinks
 
-            lev = self.albedo_breaks()
-            hit = self.__dict__["_f_kinks"] = _WiHKink(lev[0]) if lev else None
-        return hit
+        return wih_kinks(self, self.p["n"], self.p["k"])
 
     def albedo_breaks(self):
         from .metal import fresnel_levels

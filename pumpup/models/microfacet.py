@@ -309,6 +309,19 @@ class _WiHKink:
         return [(np.asarray(mu, dtype=np.float64) * cos_a - self.x0, np.asarray(s, dtype=np.float64) * sin_a)]
 
 
+def wih_kinks(brdf, eta, k):
+    """The ``kinks`` of ``brdf``'s Lobe hint where a Fresnel factor of eta + i k at wi.h (GGX, Beckmann; He-Torrance's
+    bisector angle) has a kink or a near-kink, wi.h = x0 (:func:`pumpup.models.metal.fresnel_levels`), or None; one
+    object per BRDF (the engine groups values of mu by it), kept in its ``__dict__``."""
+    hit = brdf.__dict__.get("_f_kinks", False)
+    if hit is False:
+        from .metal import fresnel_levels
+
+        lev = fresnel_levels(eta, k or 0.0) if eta is not None else ()
+        hit = brdf.__dict__["_f_kinks"] = _WiHKink(lev[0]) if lev else None
+    return hit
+
+
 class _Microfacet(BRDF):
     """Shared machinery of :class:`Beckmann` and :class:`GGX`."""
 
@@ -332,13 +345,7 @@ class _Microfacet(BRDF):
         F(wi.h) has a kink or a near-kink, at wi.h = x0 (total reflection below eta = 1 with k = 0, or a small k;
         :func:`pumpup.models.metal.fresnel_levels`): wi.h - x0 = (mu cos(alpha) - x0) + s sin(alpha) cos(beta) for h
         at (alpha, beta) about N.  Else None."""
-        hit = self.__dict__.get("_f_kinks", False)
-        if hit is False:
-            from .metal import fresnel_levels
-
-            lev = fresnel_levels(self.p["eta"], self.p["k"] or 0.0) if self.p["eta"] is not None else ()
-            hit = self.__dict__["_f_kinks"] = _WiHKink(lev[0]) if lev else None
-        return hit
+        return wih_kinks(self, self.p["eta"], self.p["k"])
 
     def kernel_args(self) -> tuple:
         p = self.p
