@@ -154,8 +154,8 @@ def mean_from_table(brdf, rtol: float, fresh_part):
     # nodes a few doubles apart in mu can share theta = arccos(mu) (an adaptive grid that bisected towards a jump of the
     # albedo down to the last bit: Beckmann alpha 0.0052 with Walter's G1, whose switch level is a jump, put 70 nodes at
     # mu = 0.00829462; the splines refused duplicate nodes, found by scripts/fuzz_engines.py --mean): the last of each
-    s = np.sqrt((1.0 - mu) * (1.0 + mu))
-    keep = np.r_[np.arctan2(s, mu)[:-1] != np.arctan2(s, mu)[1:], True]
+    theta = np.arctan2(np.sqrt((1.0 - mu) * (1.0 + mu)), mu)
+    keep = np.r_[theta[:-1] != theta[1:], True]
     mu, a, e = mu[keep], a[keep], e[keep]
     if len(mu) < 12 or mu[-1] != 1.0 or not (np.all(np.isfinite(a)) and np.all(np.isfinite(e))):
         return None

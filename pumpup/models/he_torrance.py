@@ -442,15 +442,11 @@ class HeTorrance(BRDF):
         # the GGX map tan^2(theta_h) = r x / (1 - x), r = m_eff^2: its tail is heavier than
         # Gaussian, as the series' mixture of Gaussians of widths sqrt(m) is (the Beckmann
         # map's weight 1/x diverges at theta_h -> 90 deg where f does not vanish at grazing)
-        return Lobe(axis="half", radial="ggx", sharpness=m_eff * m_eff, kinks=self._fresnel_kinks())
-
-    def _fresnel_kinks(self):
-        """The hint's kink wi.h = x0 where |F|^2 at the bisector angle has total reflection (n < 1, k = 0) or a near-kink
-        (:func:`pumpup.models.metal.fresnel_levels`; one object per BRDF, as the microfacet models'), else None.  n = 0.6:
-        the nested engine took 0.9 s for three values at rtol 1e-8 without it (n = 1.5: 0.1 s), the 2-D engine 95 s."""
+        # and the kink wi.h = x0 where |F|^2 at the bisector angle has total reflection (n < 1) or a near-kink: n = 0.6
+        # took the nested engine 0.9 s for three values at rtol 1e-8 without it (n = 1.5: 0.1 s), the 2-D engine 95 s
         from .microfacet import wih_kinks
 
-        return wih_kinks(self, self.p["n"], self.p["k"])
+        return Lobe(axis="half", radial="ggx", sharpness=m_eff * m_eff, kinks=wih_kinks(self, p["n"], p["k"]))
 
     def albedo_breaks(self):
         from .metal import fresnel_levels

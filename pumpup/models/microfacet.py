@@ -299,7 +299,7 @@ POLAR_F_Y0_MIN = 1e-6
 
 
 class _WiHKink:
-    """The Lobe hint's kink wi.h = x0 of a half-vector lobe (:meth:`_Microfacet._fresnel_kinks`), a + b cos(beta) = 0
+    """The Lobe hint's kink wi.h = x0 of a half-vector lobe (:func:`wih_kinks`), a + b cos(beta) = 0
     with a = mu cos(alpha) - x0, b = s sin(alpha) (a class, not a closure: a BRDF pickles for dask)."""
 
     def __init__(self, x0: float):
@@ -339,13 +339,6 @@ class _Microfacet(BRDF):
             )
         if p["k"] is not None and p["eta"] is None:
             raise SpecError(f"{self.type}: parameter 'k' (extinction) needs 'eta', the real part of the complex index")
-
-    def _fresnel_kinks(self):
-        """The Lobe hint's ``kinks`` (one function per object: the engine groups values of mu by it) where a conductor's
-        F(wi.h) has a kink or a near-kink, at wi.h = x0 (total reflection below eta = 1 with k = 0, or a small k;
-        :func:`pumpup.models.metal.fresnel_levels`): wi.h - x0 = (mu cos(alpha) - x0) + s sin(alpha) cos(beta) for h
-        at (alpha, beta) about N.  Else None."""
-        return wih_kinks(self, self.p["eta"], self.p["k"])
 
     def kernel_args(self) -> tuple:
         p = self.p
@@ -442,7 +435,8 @@ class Beckmann(_Microfacet):
 
     def lobe(self, mu: float) -> Lobe:
         levels = (walter_level(self.p["alpha"]),) if self.p["g1"] == "walter" else ()
-        return Lobe(axis="half", radial="beckmann", sharpness=self.p["alpha"], levels=levels, kinks=self._fresnel_kinks())
+        return Lobe(axis="half", radial="beckmann", sharpness=self.p["alpha"], levels=levels,
+                    kinks=wih_kinks(self, self.p["eta"], self.p["k"]))
 
 
 @register("ggx")
@@ -498,4 +492,5 @@ class GGX(_Microfacet):
     def lobe(self, mu: float) -> Lobe:
         # D = (1 / (pi r)) r^2 / (1 - (1 - r) cos^2)^2 with r = alpha^2: the "ggx" radial map;
         # alpha > 1 peaks at grazing half vectors, where r = 1 (uniform in sin^2) is the neutral map
-        return Lobe(axis="half", radial="ggx", sharpness=min(self.p["alpha"] ** 2, 1.0), kinks=self._fresnel_kinks())
+        return Lobe(axis="half", radial="ggx", sharpness=min(self.p["alpha"] ** 2, 1.0),
+                    kinks=wih_kinks(self, self.p["eta"], self.p["k"]))
