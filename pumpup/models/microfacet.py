@@ -368,10 +368,9 @@ class _Microfacet(BRDF):
             # own (issue 14's twenty-first session, scripts/fuzz_engines.py --registry); separable G, or F = 1, is fine
             return None
         if eta > 0.0:
-            from .._polar import fresnel_branch
+            from .metal import fresnel_levels
 
-            x0, y0 = fresnel_branch(eta, k)
-            if 0.0 < x0 < 1.0 and y0 < POLAR_F_Y0_MIN:
+            if fresnel_levels(eta, k, POLAR_F_Y0_MIN):
                 return None  # a kink of F(wi.h) at x0, or a near-kink sharper than frame 4's cuts see: the nested engine
         # Walter eq. 20: a(mu) = integral over h of D(h) (1 / 4) [4 (wi.h) F G / N.wi] (d omega_o = 4 (wo.h) d omega_h),
         # D = w(t) / (pi a^2 cos^4) with w = e^-t (eq. 25) or 1 / (1 + t)^2 (eq. 33), t = tan^2 / a^2; the azimuth of h
