@@ -289,6 +289,11 @@ class Polar:
         A 1/E-scaled model's factor 1 + F0 (1 / U(N.wo) - 1) (Turquin eq. 6, :class:`pumpup.compensate.Scaled`): F0 and
         the arguments of its look-up U (:attr:`pumpup.compensate._Bound.args`), a function of N.wo alone, so frame 6
         multiplies each node by it (:func:`_n_rule`); ``levels(mu)`` then gives U's kinks.  Frame 6 only.
+    fmax : tuple, optional
+        (eta, k): 000 eq. 28's conductor factor F(max(N.L, N.V)) on a frame 6 model (the ``fresnel`` wrapper of GGX,
+        Beckmann with F = 1 or Schlick's model, pumped or not; :func:`with_fresnel_max`): a function of N.wo alone for a
+        fixed wi, so frame 6 multiplies each node by it (:func:`_n_rule`), its kink N.wo = mu a cut already and the
+        elevation cut about its branch point and pole as a pumped metal's (:func:`chain_cuts`).  Frame 6 only.
     """
 
     n: float = 0.0
@@ -305,6 +310,7 @@ class Polar:
     fresnel: tuple = (0.0, 0.0, 0.0)
     schlick: float | None = None
     factor: tuple | None = None
+    fmax: tuple | None = None
 
 
 @contextlib.contextmanager
@@ -1127,6 +1133,22 @@ def with_fresnel(hint, eta: float, k: float):
             or not lobe_fresnel_ok(float(eta), float(k), hint.chain is not None)):
         return None
     return dataclasses.replace(hint, fresnel=(0.0, float(eta), float(k)))
+
+
+def with_fresnel_max(hint, eta: float, k: float):
+    """``hint`` (frame 6's: GGX, Beckmann with F = 1 or Schlick's model, pumped or not, not 1/E-scaled) with 000 eq. 28's
+    F(max(N.L, N.V)) of (eta, k) as a factor of each node (``Polar.fmax``); None where the path declines it: no such hint,
+    a Fresnel factor already, or a near-kink (:func:`lobe_fresnel_ok`, as for a lobe: F's branch point at least
+    :data:`LOBE_F_Y0_MIN` from the real axis, :data:`CHAIN_F_Y0_MIN` with a pumped chain, whose g has the near-kink
+    too).  For the ``fresnel`` wrapper (issue 14's twenty-second session: the nested engine took GGX alpha 1.6e-4 with eta
+    0.497, k 3.15 at mu = 7.3e-6 14.6 s at rtol 1e-10)."""
+    import dataclasses
+
+    if (hint is None or hint.kind != "half" or hint.factor is not None or any(hint.fresnel) or hint.fmax is not None
+            or not takes_n_frame(dataclasses.replace(hint, chain=None, levels=None))
+            or not lobe_fresnel_ok(float(eta), float(k), hint.chain is not None)):
+        return None
+    return dataclasses.replace(hint, fmax=(float(eta), float(k)))
 
 
 @njit(cache=True, nogil=True)
@@ -2708,7 +2730,8 @@ def _n_incidence(mp, mu):  # pragma: no cover - compiled
 def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv, kind):  # pragma: no cover - compiled
     """(value, error) of the rule on d = x - x_mu in [lo, hi] of :func:`_n_value`; with a pumped chain (``chain`` not
     None, :meth:`pumpup.pumping.Pumped._chain_args`) divided by g_1 ... g_k(mu, N.wo) exactly as the chain kernel divides
-    by it (001 eq. 16; written out as in :func:`_x_rule`), or with a 1/E-scaled model's ``factor`` (not None: F0 and
+    by it (001 eq. 16; written out as in :func:`_x_rule`; first times F(max(mu, N.wo)) where mp[15] = 1, ``Polar.fmax``,
+    analytic between the cuts), or with a 1/E-scaled model's ``factor`` (not None: F0 and
     :attr:`pumpup.compensate._Bound.args`) times 1 + F0 (1 / U(N.wo) - 1) as its kernel multiplies (Turquin eq. 6,
     :func:`pumpup.compensate._scale_kernel`); its error then the larger of QUADPACK's calibration (for the weight's peak,
     as without g) and CHAIN_SAFETY |K - G| (for the splines of g or U, which are not analytic: :data:`CHAIN_SAFETY`).
@@ -2738,6 +2761,8 @@ def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, it
             noise += (wk[j] + wg[j]) * we * fac
         else:
             v = _n_value(mp, mu, xmu, xs, d) * jac
+        if mp[15] > 0.0 and v != 0.0:  # the fresnel wrapper's F(max(N.wi, N.wo)), 000 eq. 28 (:attr:`Polar.fmax`)
+            v *= _fresnel_real(max(mu, math.sin(xmu + d)), mp[16], mp[17])
         if chain is not None and v != 0.0:
             t = math.sin(xmu + d)
             if min(mu, t) > chain[13]:
@@ -2777,11 +2802,13 @@ def _n_values(mp, mu, x, chain, factor):  # pragma: no cover - compiled
 def n_params(hint) -> np.ndarray:
     """Frame 6's parameter array: :func:`numeric_params`, and for GGX with a Fresnel factor mp[13] = 1
     (:func:`_ggx_ring_f`) and mp[14] the scale of F's pole near c = 0 (:func:`fresnel_pole`, a conductor's; 0 for a
-    dielectric) for :func:`_n_cuts`."""
+    dielectric) for :func:`_n_cuts`; with ``Polar.fmax`` = (eta, k) mp[15:18] = 1, eta, k (:func:`_n_rule`)."""
     mp = numeric_params(hint)
     if any(hint.fresnel):
         mp[13] = 1.0
         mp[14] = fresnel_pole(float(hint.fresnel[1]), float(hint.fresnel[2])) if hint.fresnel[1] > 0.0 else 0.0
+    if hint.fmax is not None:  # 000 eq. 28's F(max(N.wi, N.wo)) of a conductor (eta, k): a factor per node (:func:`_n_rule`)
+        mp[15], mp[16], mp[17] = 1.0, *hint.fmax
     return mp
 
 
@@ -3044,7 +3071,8 @@ def takes_n_frame_operand(hint) -> bool:
     """Whether a pumped chain or a 1/E scale (:meth:`pumpup.pumping.Pumped.polar`, :meth:`pumpup.compensate.Scaled.polar`)
     may build on ``hint`` in frame 6: GGX, Beckmann (F = 1) or Schlick, neither pumped nor scaled already, and without a
     Fresnel factor (GGX with F splits its mu with frame 4, which has no chain)."""
-    return hint is not None and hint.chain is None and hint.factor is None and not any(hint.fresnel) and takes_n_frame(hint)
+    return (hint is not None and hint.chain is None and hint.factor is None and not any(hint.fresnel) and hint.fmax is None
+            and takes_n_frame(hint))
 
 
 def takes_n_frame(hint) -> bool:
@@ -3634,8 +3662,8 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
     if hint.kind == "half" and mu.size and mu.min() < HALF_MU_MIN and not takes_n_frame(hint):
         return None  # (the half frame's breaks and arcs underflow there: the nested engine, as before)
-    if (hint.kind == "half" and hint.chain is not None or hint.factor is not None) and not takes_n_frame(hint):
-        return None  # (a pumped half-vector or a 1/E-scaled model off frame 6, without_n_frame: the nested engine)
+    if (hint.kind == "half" and hint.chain is not None or hint.factor is not None or hint.fmax is not None) and not takes_n_frame(hint):
+        return None  # (a pumped half-vector, a 1/E-scaled model or F(Theta_min) off frame 6, without_n_frame: the nested engine)
     if hint.kind == "half" and hint.p not in (0.0, 1.0):
         raise ValueError(f"{brdf!r}: a half-vector Polar hint needs p in {{0, 1}}, got p={hint.p!r}")
     if hint.vcavity and (hint.kind != "half" or hint.p != 0.0 or hint.sqrt_cos):
@@ -3683,10 +3711,12 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         return out
     if takes_n_frame(hint):  # frame 6: GGX and Beckmann with F = 1 or GGX with F, Schlick's model, about N (:func:`_integrate_n`)
         mp = n_params(hint)
-        if hint.chain is None and hint.factor is None:
+        if hint.chain is None and hint.factor is None and hint.fmax is None:
             cut, ncut = np.zeros((len(mu), 0)), np.zeros(len(mu), np.int64)
-        else:  # pumped or scaled: the kinks of g or U, its tables' grading and the pi / 16 cuts, as for a pumped lobe
-            cut, ncut = chain_cut_matrix(hint.levels, 0.0, mu)
+        else:  # pumped or scaled: the kinks of g or U, its tables' grading and the pi / 16 cuts, as for a pumped lobe;
+            # with F(Theta_min) (fmax) the cuts about its branch point and pole (its kink N.wo = mu is d = 0, a cut already)
+            cut, ncut = chain_cut_matrix(hint.levels, 0.0, mu, hint.fmax,
+                                         chain=hint.chain is not None or hint.factor is not None)
         _integrate_n(mp, mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING, *_RULES["gk21"], mode_code(),
                      hint.chain, hint.factor, cut, ncut, val, err, conv, evals)
     elif lobe_f and hint.chain is None and takes_lobe_n_frame(hint):  # a metal's lobe about N (:func:`_integrate_chain`, g = 1)

@@ -1074,16 +1074,21 @@ class Pumped(BRDF):
     def polar(self):
         """The 1-D albedo path of a pumped Phong-family lobe or of a pumped GGX, Beckmann (F = 1) or Schlick model
         (``pumpup._polar``, the frame of N): the base's closed-form-azimuth hint, with the divisor g_1 ... g_k (a
-        function of N.wo for a fixed wi) and its kinks, and the base's Fresnel factor F(Theta_min) (metal's); None for
-        any other base."""
+        function of N.wo for a fixed wi) and its kinks, and the base's Fresnel factor F(Theta_min) (metal's, or the
+        ``fresnel`` wrapper's over GGX, Beckmann or Schlick, ``Polar.fmax``); None for any other base."""
         import dataclasses
 
-        from ._polar import Polar, takes_n_frame_operand, with_fresnel
+        from ._polar import Polar, takes_n_frame_operand, with_fresnel, with_fresnel_max
 
         hint = self.chain()[0].base.polar()
         if takes_n_frame_operand(hint):
             # GGX, Beckmann (F = 1) and Schlick's model: frame 6 about N, divided by g (``pumpup._polar._integrate_n``)
             return dataclasses.replace(hint, chain=self._chain_args(), levels=self._polar_levels)
+        if hint is not None and hint.fmax is not None and hint.chain is None:
+            # ... with the fresnel wrapper's F(Theta_min) (``Polar.fmax``): again, where the near-kink of F is far enough
+            # for a chain (g has it too: ``pumpup._polar.CHAIN_F_Y0_MIN``)
+            out = dataclasses.replace(hint, fmax=None, chain=self._chain_args(), levels=self._polar_levels)
+            return with_fresnel_max(out, *hint.fmax)
         if hint is None or hint.kind != "lobe" or hint.chain is not None:
             return None
         out = Polar(n=hint.n, p=hint.p, scale=hint.scale, chain=self._chain_args(), levels=self._polar_levels)

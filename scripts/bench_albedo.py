@@ -37,6 +37,9 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
                                               # against the rule on h's arc and the nested engine
     python scripts/bench_albedo.py --lobe-n   # only lobes with F(Theta_min), n >= 8, about N since issue 14's twelfth
                                               # session, against frame 5 and the nested engine
+    python scripts/bench_albedo.py --fmax     # only the fresnel wrapper over GGX, Beckmann, Schlick (pumped or not), frame
+                                              # 6 with F(Theta_min) per node since issue 14's twenty-second session,
+                                              # against the nested engine
     python scripts/bench_albedo.py --pumped   # only pumped chains (Phong family; GGX, Beckmann, Schlick in frame 6):
                                               # 1-D path against the nested engine
     python scripts/bench_albedo.py --scaled   # only 1/E-scaled GGX, Beckmann, Schlick (frame 6 times Turquin's factor)
@@ -375,6 +378,21 @@ def scaled(rtol=1e-10, repeat=3):
         ({"type": "ggx", "alpha": 0.3}, 1.0), ({"type": "ggx", "alpha": 0.05}, 1.0), ({"type": "ggx", "alpha": 1.0}, 0.5),
         ({"type": "beckmann", "alpha": 0.1}, 1.0), ({"type": "schlick", "r": 0.2}, 1.0)]],
         "1/E-scaled, frame 6 since issue 14's eleventh session", rtol, repeat)
+
+
+def fresnel_max(rtol=1e-10, repeat=3):
+    """The fresnel wrapper (000 eq. 28's F(max(N.L, N.V))) over GGX, Beckmann and Schlick's model, pumped or not: frame 6
+    with F a factor of each node since issue 14's twenty-second session (``Polar.fmax``), against the nested engine they
+    had before (:func:`against_nested`)."""
+    ggx = {"type": "fresnel", "base": {"type": "ggx", "alpha": 0.1}, "eta": 0.2, "k": 3.0}
+    against_nested([{"type": "fresnel", "base": {"type": "ggx", "alpha": 0.3}, "eta": 0.2, "k": 3.0}, ggx,
+                    {"type": "fresnel", "base": {"type": "ggx", "alpha": 0.02, "shadowing": "correlated"}, "eta": 1.5},
+                    {"type": "fresnel", "base": {"type": "beckmann", "alpha": 0.1}, "eta": 1.1, "k": 6.0},
+                    {"type": "fresnel", "base": {"type": "schlick", "r": 0.2}, "eta": 0.2, "k": 3.0},
+                    {"type": "pumped", "base": ggx, "g": "g2", "levels": 2},
+                    {"type": "fresnel", "base": {"type": "pumped", "base": {"type": "ggx", "alpha": 0.1}}, "eta": 0.2,
+                     "k": 3.0}],
+                   "F(Theta_min) over frame 6's models, 1-D since issue 14's twenty-second session", rtol, repeat)
 
 
 def pumped_chains(rtol=1e-10, repeat=3):
@@ -742,6 +760,9 @@ def main():
         return
     if "--lobe-n" in sys.argv:
         lobe_n_frame()
+        return
+    if "--fmax" in sys.argv:
+        fresnel_max()
         return
     if "--pumped" in sys.argv:
         pumped_chains()

@@ -35,6 +35,7 @@ per value and minutes per table on the nested engine).
     PYTHONPATH=. python scripts/fuzz_engines.py --tables [seed] [seconds]  # a table's interpolant against fresh values
     PYTHONPATH=. python scripts/fuzz_engines.py --mean [seed] [seconds]    # mean_albedo against a quad of fresh values
     PYTHONPATH=. python scripts/fuzz_engines.py --registry [seed] [seconds]  # every registered model against the 2-D engine
+    PYTHONPATH=. python scripts/fuzz_engines.py --fmax [seed] [seconds]   # the fresnel wrapper over GGX, Beckmann, Schlick
 """
 
 import math
@@ -79,6 +80,23 @@ def rand_spec(rng):
         return {"type": t, "n": float(10 ** rng.uniform(0, 3)), "cx": -1.0, "cy": -1.0, "cz": 1.0}
     return {"type": "plastic", "n": float(10 ** rng.uniform(0, 2.5)), "eta": float(rng.uniform(1.2, 2)),
             "ad": float(rng.uniform(0, 0.5))}
+
+
+def rand_spec_fmax(rng):
+    """The fresnel wrapper (F(max(N.L, N.V))) over GGX, Beckmann (F = 1) or Schlick's model, a third of them pumped (either
+    order): frame 6 with F per node since issue 14's twenty-second session (``--fmax``: the default mode's comparison with
+    the nested engine, on these only)."""
+    base = {"type": "schlick", "r": float(10 ** rng.uniform(-4, 0))} if rng.random() < 0.2 else {
+        "type": str(rng.choice(["ggx", "beckmann"])), "alpha": float(10 ** rng.uniform(-3, 0)),
+        "shadowing": str(rng.choice(["separable", "correlated"]))}
+    eta, k = float(10 ** rng.uniform(-1, 0.5)), float(rng.choice([0.0, 10 ** rng.uniform(-3, 1.2)]))
+    kind = rng.random()
+    if kind < 0.67:
+        return {"type": "fresnel", "base": base, "eta": eta, "k": k}
+    pumped = {"g": str(rng.choice(["g1", "g2"])), "levels": int(rng.integers(1, 3))}
+    if kind < 0.83:
+        return {"type": "pumped", "base": {"type": "fresnel", "base": base, "eta": eta, "k": k}, **pumped}
+    return {"type": "fresnel", "base": {"type": "pumped", "base": base, **pumped}, "eta": eta, "k": k}
 
 
 def rand_spec_2d(rng):
@@ -344,10 +362,14 @@ def main():
                  float(sys.argv[2]) if len(sys.argv) > 2 else 300.0)
             return
     warnings.simplefilter("ignore")
+    draw = rand_spec
+    if "--fmax" in sys.argv:
+        sys.argv.remove("--fmax")
+        draw = rand_spec_fmax
     rng = np.random.default_rng(int(sys.argv[1]) if len(sys.argv) > 1 else 0)
     budget = float(sys.argv[2]) if len(sys.argv) > 2 else 300.0
     bad = n = 0
-    for spec, f in _draws(rng, budget, rand_spec):
+    for spec, f in _draws(rng, budget, draw):
         mu = np.array([10 ** rng.uniform(-6, 0), rng.uniform(0, 1), 1.0])
         rtol = float(rng.choice([1e-6, 1e-8, 1e-10]))
         a, e = pumpup.albedo(f, mu, rtol=rtol, return_error=True)

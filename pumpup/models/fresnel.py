@@ -105,7 +105,11 @@ class FresnelWeighted(BRDF):
 
     def polar(self):
         """A lobe base's hint (p in {0, 1}; any p for a pumped lobe's) with F(Theta_min) added: frame 5 of the 1-D path, or
-        the pumped lobe's frame of N (pumpup._polar), or None."""
-        from .._polar import with_fresnel
+        the pumped lobe's frame of N; or a GGX, Beckmann (F = 1) or Schlick base's, pumped or not, with F(Theta_min) as
+        a factor of frame 6's nodes (``Polar.fmax``); or None (pumpup._polar)."""
+        from .._polar import with_fresnel, with_fresnel_max
 
-        return with_fresnel(self.base.polar(), self.p["eta"], self.p["k"])
+        hint = self.base.polar()
+        if hint is not None and hint.kind == "half":
+            return with_fresnel_max(hint, self.p["eta"], self.p["k"])
+        return with_fresnel(hint, self.p["eta"], self.p["k"])
