@@ -193,6 +193,13 @@ at D's and F's scales, measured at ~400 evaluations per ring: no faster than fra
 F (the nested engine, as before: frame 4 below 0.248 has no chain); Beckmann with F (frame 4: its ring's Fourier
 coefficients are Bessel functions e^-kappa I_k(kappa), not attempted).
 
+The ``fresnel`` wrapper's F(max(N.L, N.V)) (000 eq. 28) over GGX, Beckmann (F = 1) or Schlick's model, pumped or not,
+takes frame 6 since issue 14's twenty-second session (``Polar.fmax``, :func:`with_fresnel_max`): for a fixed wi it depends
+on N.wo alone, so it is one factor per ring, as a pumped chain's g is; its kink N.wo = mu is the cut d = 0, and the
+elevation is cut about F's branch point and pole as a pumped metal's (:func:`chain_cuts`).  A near-kink (branch point
+within :data:`LOBE_F_Y0_MIN` of the real axis, :data:`CHAIN_F_Y0_MIN` with a chain) stays on the nested engine.  A
+257-point table takes 3-12 ms where the nested engine took 0.2-0.4 s (``scripts/bench_albedo.py --fmax``).
+
 A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
 :class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D
 engine stays the reference: :func:`two_d_only` switches the 1-D path off.
