@@ -2733,6 +2733,16 @@ def _n_incidence(mp, mu):  # pragma: no cover - compiled
     return math.atan2(mu, s), math.atan2(s, mu)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _n_chain_g(chain, mu, t):  # pragma: no cover - compiled
+    """g_1 ... g_k(mu, t) of a pumped chain at N.wo = t, as the chain kernel computes it (``pumpup.pumping._g_product``,
+    ``_g_levels``; 001 eq. 16)."""
+    if min(mu, t) > chain[13]:
+        return _g_product(max(mu, t), chain[14], chain[15], chain[16], chain[17])
+    return _g_levels(max(mu, t), min(mu, t), chain[0], chain[1], chain[2], chain[3], chain[4], chain[5], chain[6],
+                     chain[7], chain[8], chain[9], chain[10], chain[11], chain[12])
+
+
 @njit(cache=True, nogil=True)
 def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv, kind):  # pragma: no cover - compiled
     """(value, error) of the rule on d = x - x_mu in [lo, hi] of :func:`_n_value`; with a pumped chain (``chain`` not
@@ -2758,26 +2768,28 @@ def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, it
         if kind != 0:
             jac = math.exp(d)
             d = jac if kind == 1 else (-jac if kind == 2 else jac - xmu)
+        we, rf = 0.0, 0.0  # the ring's error and its factor to the node's units (:func:`_ggx_ring_f`)
+        g = 1.0
         if mp[13] > 0.0:
+            if chain is not None:  # (g first: the ring's absolute tolerance is in the units of the node divided by it)
+                g = _n_chain_g(chain, mu, math.sin(xmu + d))
             a2 = mp[4] * mp[4]
             fac = _n_times(mp, mu, xmu, xs, d, a2, 1.0) * jac
-            w, we, nf = _ggx_ring_f(mp, a2, xmu, xs, d, itol, iacc / fac if fac > 0.0 else math.inf, fv)
+            w, we, nf = _ggx_ring_f(mp, a2, xmu, xs, d, itol, iacc * g / fac if fac > 0.0 else math.inf, fv)
             ns += nf
             v = w * fac
-            ie += wk[j] * we * fac
-            noise += (wk[j] + wg[j]) * we * fac
+            rf = fac
         else:
             v = _n_value(mp, mu, xmu, xs, d) * jac
         if mp[15] > 0.0 and v != 0.0:  # the fresnel wrapper's F(max(N.wi, N.wo)), 000 eq. 28 (:attr:`Polar.fmax`)
             v *= _fresnel_real(max(mu, math.sin(xmu + d)), mp[16], mp[17])
         if chain is not None and v != 0.0:
-            t = math.sin(xmu + d)
-            if min(mu, t) > chain[13]:
-                g = _g_product(max(mu, t), chain[14], chain[15], chain[16], chain[17])
-            else:
-                g = _g_levels(max(mu, t), min(mu, t), chain[0], chain[1], chain[2], chain[3], chain[4], chain[5], chain[6],
-                              chain[7], chain[8], chain[9], chain[10], chain[11], chain[12])
+            if mp[13] <= 0.0:
+                g = _n_chain_g(chain, mu, math.sin(xmu + d))
             v /= g  # 001 eq. 16
+            rf /= g
+        ie += wk[j] * we * rf
+        noise += (wk[j] + wg[j]) * we * rf
         if factor is not None and v != 0.0:
             u = _scale_bound(math.sin(xmu + d), factor[1], factor[2], factor[3], factor[4], factor[5], factor[6],
                              factor[7], factor[8], factor[9], factor[10], factor[11], factor[12])
@@ -3085,12 +3097,13 @@ def takes_n_frame_operand(hint) -> bool:
 def takes_n_frame(hint) -> bool:
     """Whether :func:`albedo_1d` takes ``hint`` about N with the weight's azimuth in closed form (frame 6): GGX and
     Beckmann with F = 1 and alpha <= 1 (either Smith G, exact or Walter's G1), Schlick's model, and GGX with a Fresnel
-    factor :func:`n_fresnel_ok` takes (neither pumped nor scaled; at mu >= :data:`N_FRESNEL_MU_MIN`, frame 4 below)."""
+    factor :func:`n_fresnel_ok` takes (pumped or not, not scaled; at mu >= :data:`N_FRESNEL_MU_MIN`, frame 4 below, or
+    with a pumped chain the nested engine, :func:`one_d_part`)."""
     if not N_FRAME or hint.kind != "half" or hint.vcavity or hint.sqrt_cos:
         return False
-    if any(hint.fresnel):
+    if any(hint.fresnel):  # (pumped too: a chain's g per node; mu below N_FRESNEL_MU_MIN then the nested engine's, one_d_part)
         return (hint.smith is not None and hint.smith[0] == 1 and hint.smith[3] <= 1.0 and hint.p == 0.0
-                and hint.chain is None and hint.factor is None and n_fresnel_ok(*(float(x) for x in hint.fresnel)))
+                and hint.factor is None and n_fresnel_ok(*(float(x) for x in hint.fresnel)))
     if hint.schlick is not None:
         return hint.p == 0.0 and 0.0 < hint.schlick <= 1.0
     return hint.smith is not None and hint.smith[3] <= 1.0 and hint.p == 0.0
@@ -3624,9 +3637,28 @@ def _cut_matrix(cuts: list) -> tuple:
 
 
 def takes_1d_path(brdf) -> bool:
-    """Whether :func:`albedo_1d` takes ``brdf`` (it has a :class:`Polar` hint and the path is on)."""
+    """Whether :func:`albedo_1d` takes ``brdf`` (it has a :class:`Polar` hint and the path is on) at every mu."""
     polar = getattr(brdf, "polar", None) if ENABLED and ONE_D else None
-    return polar is not None and polar() is not None
+    hint = polar() if polar is not None else None
+    return hint is not None and not _partial(hint)
+
+
+def _partial(hint) -> bool:
+    """Whether frame 6 takes ``hint`` at mu >= :data:`N_FRESNEL_MU_MIN` only, and the nested engine the rest: a pumped GGX
+    with a Fresnel factor (frame 4, which takes GGX with F below it, has no chain)."""
+    return any(hint.fresnel) and hint.chain is not None and takes_n_frame(hint)
+
+
+def one_d_part(brdf, mu: np.ndarray):
+    """The mu (a mask) at which :func:`albedo_1d` takes ``brdf`` where it declines the batch as a whole, or None: a pumped
+    GGX with a Fresnel factor at mu >= :data:`N_FRESNEL_MU_MIN` (:func:`_partial`; issue 14's twenty-second session: a
+    257-point table of 1-level g2 pumped GGX 0.1 with eta 0.2, k 3 took the nested engine 28 s).  ``pumpup.albedo`` gives
+    the rest to the nested engine."""
+    polar = getattr(brdf, "polar", None) if ENABLED and ONE_D else None
+    hint = polar() if polar is not None else None
+    if hint is None or not _partial(hint):
+        return None
+    return np.asarray(mu) >= N_FRESNEL_MU_MIN
 
 
 def axis_albedo(n: float, nu: np.ndarray, scale: np.ndarray, rtol: float, atol: float, max_regions: int):
@@ -3706,6 +3738,8 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     np.divide(float(atol), np.abs(scale), out=atol_q, where=scale != 0)
     if takes_n_frame(hint) and any(hint.fresnel) and mu.size and mu.min() < N_FRESNEL_MU_MIN:
         # GGX with F: frame 6 where every ring's wi.h >= N_FRESNEL_S_MIN, frame 4 below (:func:`_ggx_ring_f`)
+        if hint.chain is not None:
+            return None  # (pumped: frame 4 has no chain; ``pumpup.albedo`` asks one_d_part for the mu frame 6 takes)
         low = mu < N_FRESNEL_MU_MIN
         with without_n_frame():
             parts = [albedo_1d(brdf, mu[low], rtol, atol, max_regions)]

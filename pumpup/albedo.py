@@ -1621,10 +1621,20 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
             error += abs(w) * fast[1]
             ok &= fast[2]
             continue
-        for idx, g in _groups(term, flat, turn):
+        rest = None  # (the mu left to the engines below, where the 1-D path takes some: _polar.one_d_part)
+        part = _polar.one_d_part(term, flat) if turn is None else None
+        if part is not None and part.any():
+            fast = _polar.albedo_1d(term, flat[part], rtol, atol, max_regions)
+            value[part] += w * fast[0]
+            error[part] += abs(w) * fast[1]
+            ok[part] &= fast[2]
+            rest = np.flatnonzero(~part)
+        for idx, g in _groups(term, flat if rest is None else flat[rest], turn):
             # the nested quadrature (pumpup._nested) where it applies, else the 2-D cubature
             nested = _nested.supports(g)
             v, e, conv = (_nested.integrate if nested else _integrate_group)(term, g, rtol, atol, max_regions)
+            if rest is not None:
+                idx = rest[idx]
             value[idx] += w * v
             error[idx] += abs(w) * e
             ok[idx] &= conv

@@ -40,6 +40,8 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
     python scripts/bench_albedo.py --fmax     # only the fresnel wrapper over GGX, Beckmann, Schlick (pumped or not), frame
                                               # 6 with F(Theta_min) per node since issue 14's twenty-second session,
                                               # against the nested engine
+    python scripts/bench_albedo.py --pumped-f # only pumped GGX with F(wi.h): frame 6 at mu >= 0.248 since issue 14's
+                                              # twenty-second session, against the nested engine
     python scripts/bench_albedo.py --pumped   # only pumped chains (Phong family; GGX, Beckmann, Schlick in frame 6):
                                               # 1-D path against the nested engine
     python scripts/bench_albedo.py --scaled   # only 1/E-scaled GGX, Beckmann, Schlick (frame 6 times Turquin's factor)
@@ -393,6 +395,16 @@ def fresnel_max(rtol=1e-10, repeat=3):
                     {"type": "fresnel", "base": {"type": "pumped", "base": {"type": "ggx", "alpha": 0.1}}, "eta": 0.2,
                      "k": 3.0}],
                    "F(Theta_min) over frame 6's models, 1-D since issue 14's twenty-second session", rtol, repeat)
+
+
+def pumped_fresnel(rtol=1e-10, repeat=3):
+    """Pumped GGX with a Fresnel factor F(wi.h): frame 6 divided by g at mu >= N_FRESNEL_MU_MIN since issue 14's
+    twenty-second session, the nested engine below (``_polar.one_d_part``), against the nested engine at every mu as before
+    (:func:`against_nested`)."""
+    against_nested([{"type": "pumped", "base": {"type": "ggx", "alpha": 0.1, "eta": 0.2, "k": 3.0}, "g": "g2"},
+                    {"type": "pumped", "base": {"type": "ggx", "alpha": 0.3, "ior": 1.5}, "g": "g1", "levels": 2},
+                    {"type": "pumped", "base": {"type": "ggx", "alpha": 0.02, "eta": 1.1, "k": 6.0}, "g": "g2"}],
+                   "pumped GGX with F(wi.h), frame 6 at mu >= 0.248 since issue 14's twenty-second session", rtol, repeat)
 
 
 def pumped_chains(rtol=1e-10, repeat=3):
@@ -760,6 +772,9 @@ def main():
         return
     if "--lobe-n" in sys.argv:
         lobe_n_frame()
+        return
+    if "--pumped-f" in sys.argv:
+        pumped_fresnel()
         return
     if "--fmax" in sys.argv:
         fresnel_max()

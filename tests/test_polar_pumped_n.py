@@ -34,9 +34,11 @@ def test_pumped_microfacet_models_take_frame_6():
         assert hint is not None and hint.chain is not None and _polar.takes_n_frame(hint), spec
         with _polar.without_n_frame():  # off frame 6 a pumped half-vector model goes to the nested engine
             assert _polar.albedo_1d(f, np.array([0.5]), 1e-8, 0.0, 1000) is None
-    # with Fresnel (frame 4) or alpha > 1: the nested engine, as before
-    assert pumpup.pump({"type": "ggx", "alpha": 0.3, "ior": 1.5}, g="g1").polar() is None
+    # alpha > 1: the nested engine, as before; with Fresnel at mu >= N_FRESNEL_MU_MIN only since issue 14's twenty-second
+    # session (tests/test_polar_pumped_fresnel.py)
     assert pumpup.pump({"type": "ggx", "alpha": 1.5}, g="g1").polar() is None
+    f = pumpup.pump({"type": "ggx", "alpha": 0.3, "ior": 1.5}, g="g1")
+    assert f.polar().chain is not None and not _polar.takes_1d_path(f) and _polar.one_d_part(f, np.array([0.1, 0.5])).tolist() == [False, True]
 
 
 @pytest.mark.parametrize("case", CASES[:3], ids=_id)
