@@ -2826,7 +2826,7 @@ def n_params(hint) -> np.ndarray:
     if any(hint.fresnel):
         mp[13] = 1.0
         mp[14] = fresnel_pole(float(hint.fresnel[1]), float(hint.fresnel[2])) if hint.fresnel[1] > 0.0 else 0.0
-    if hint.fmax is not None:  # 000 eq. 28's F(max(N.wi, N.wo)) of a conductor (eta, k): a factor per node (:func:`_n_rule`)
+    if hint.fmax is not None:  # 000 eq. 28's F(max(N.wi, N.wo)) of a conductor (eta, k): a factor per node (_n_rule)
         mp[15], mp[16], mp[17] = 1.0, *hint.fmax
     return mp
 
@@ -3101,7 +3101,7 @@ def takes_n_frame(hint) -> bool:
     with a pumped chain the nested engine, :func:`one_d_part`)."""
     if not N_FRAME or hint.kind != "half" or hint.vcavity or hint.sqrt_cos:
         return False
-    if any(hint.fresnel):  # (pumped too: a chain's g per node; mu below N_FRESNEL_MU_MIN then the nested engine's, one_d_part)
+    if any(hint.fresnel):  # (pumped too: g per node; below N_FRESNEL_MU_MIN the nested engine, one_d_part)
         return (hint.smith is not None and hint.smith[0] == 1 and hint.smith[3] <= 1.0 and hint.p == 0.0
                 and hint.factor is None and n_fresnel_ok(*(float(x) for x in hint.fresnel)))
     if hint.schlick is not None:
@@ -3701,8 +3701,9 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         raise ValueError(f"{brdf!r}: a Polar hint needs p in [0, 1], got {hint.p!r}")
     if hint.kind == "half" and mu.size and mu.min() < HALF_MU_MIN and not takes_n_frame(hint):
         return None  # (the half frame's breaks and arcs underflow there: the nested engine, as before)
-    if (hint.kind == "half" and hint.chain is not None or hint.factor is not None or hint.fmax is not None) and not takes_n_frame(hint):
-        return None  # (a pumped half-vector, a 1/E-scaled model or F(Theta_min) off frame 6, without_n_frame: the nested engine)
+    off_n = hint.kind == "half" and hint.chain is not None or hint.factor is not None or hint.fmax is not None
+    if off_n and not takes_n_frame(hint):
+        return None  # (a pumped half-vector, a 1/E-scaled model or F(Theta_min) off frame 6: the nested engine)
     if hint.kind == "half" and hint.p not in (0.0, 1.0):
         raise ValueError(f"{brdf!r}: a half-vector Polar hint needs p in {{0, 1}}, got p={hint.p!r}")
     if hint.vcavity and (hint.kind != "half" or hint.p != 0.0 or hint.sqrt_cos):
@@ -3755,7 +3756,7 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         if hint.chain is None and hint.factor is None and hint.fmax is None:
             cut, ncut = np.zeros((len(mu), 0)), np.zeros(len(mu), np.int64)
         else:  # pumped or scaled: the kinks of g or U, its tables' grading and the pi / 16 cuts, as for a pumped lobe;
-            # with F(Theta_min) (fmax) the cuts about its branch point and pole (its kink N.wo = mu is d = 0, a cut already)
+            # with F(Theta_min) (fmax) the cuts about its branch point and pole (its kink N.wo = mu: d = 0, a cut)
             cut, ncut = chain_cut_matrix(hint.levels, 0.0, mu, hint.fmax,
                                          chain=hint.chain is not None or hint.factor is not None)
         _integrate_n(mp, mu, float(rtol), atol_q, int(min(max_regions, 10000)), ROUNDING, *_RULES["gk21"], mode_code(),

@@ -21,7 +21,8 @@ from pumpup import _polar
 MU = np.array([1.0, 0.999, 0.9, 0.7, 0.5, 0.3, 0.1, 0.01, 1e-4, 1e-8])
 
 BASES = [{"type": "ggx", "alpha": 0.3}, {"type": "ggx", "alpha": 0.02, "shadowing": "correlated"},
-         {"type": "beckmann", "alpha": 0.1}, {"type": "schlick", "r": 0.2}, {"type": "beckmann", "alpha": 0.5, "g1": "walter"}]
+         {"type": "beckmann", "alpha": 0.1}, {"type": "schlick", "r": 0.2},
+         {"type": "beckmann", "alpha": 0.5, "g1": "walter"}]
 #: (eta, k): a metal, a strong absorber (its pole near c = 0 graded), a dielectric's real index, and one whose branch point
 #: lies 0.02 off the real axis at x0 = 0.44 (graded about it)
 INDICES = [(0.2, 3.0), (1.1, 30.0), (1.5, 0.0), (0.9, 0.01)]
@@ -72,7 +73,8 @@ def test_integrand_against_the_models_own_eval(base, eta, k):
 def test_estimate_bounds_the_truth_and_engines_agree(base, eta, k):
     """Frame 6 times F at rtol 1e-6 ... 1e-12 against the nested engine at 1e-13 (and the 2-D engine at three mu): the
     difference within the summed estimates, the estimate within the tolerance asked."""
-    one_d_against_the_other_engines(_wrap(base, eta, k), MU, rtols=(1e-6, 1e-9, 1e-12), two_d_at=(0, 4, 7), ref_rtol=1e-13)
+    one_d_against_the_other_engines(_wrap(base, eta, k), MU, rtols=(1e-6, 1e-9, 1e-12), two_d_at=(0, 4, 7),
+                                    ref_rtol=1e-13)
 
 
 @pytest.mark.parametrize("spec", [

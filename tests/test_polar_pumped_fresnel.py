@@ -1,11 +1,12 @@
-"""Pumped GGX with a Fresnel factor F(wi.h) (issue 14's twenty-second session): frame 6 (the product rule of D and F on each
-ring, pumpup._polar._ggx_ring_f) divided by the chain's g at each node, at mu >= N_FRESNEL_MU_MIN; the nested engine below
-(frame 4, which takes GGX with F there, has no chain; ``pumpup._polar.one_d_part``).  Before, the nested engine took every
-mu: a 257-point table of 1-level g2 pumped GGX 0.1 with eta 0.2, k 3 took 28 s, now about 1 s with its base table.
+"""Pumped GGX with a Fresnel factor F(wi.h) (issue 14's twenty-second session): frame 6 (the product rule of D and F on
+each ring, pumpup._polar._ggx_ring_f) divided by the chain's g at each node, at mu >= N_FRESNEL_MU_MIN; the nested engine
+below (frame 4, which takes GGX with F there, has no chain; ``pumpup._polar.one_d_part``).  Before, the nested engine
+took every mu: a 257-point table of 1-level g2 pumped GGX 0.1 with eta 0.2, k 3 took 28 s, now about 1 s with its base
+table.
 
 Checked against the model's own ``eval`` integrated over the azimuth by scipy (the integrand, g included) and the nested
-engine at rtol 1e-12 and 1e-13, the estimate bounding the difference at every rtol; the ring's error is divided by g as the
-node is (a pumped g is below 1)."""
+engine at rtol 1e-13, the estimate bounding the difference at every rtol; the ring's error is divided by g as the node is
+(a pumped g is below 1)."""
 
 import warnings
 
@@ -20,8 +21,8 @@ from pumpup import _polar
 SPECS = [
     {"type": "pumped", "base": {"type": "ggx", "alpha": 0.1, "eta": 0.2, "k": 3.0}, "g": "g2", "levels": 1},
     {"type": "pumped", "base": {"type": "ggx", "alpha": 0.3, "ior": 1.5}, "g": "g1", "levels": 2},
-    {"type": "pumped", "base": {"type": "ggx", "alpha": 0.02, "eta": 1.1, "k": 6.0, "shadowing": "correlated"}, "g": "g2",
-     "levels": 2},
+    {"type": "pumped", "base": {"type": "ggx", "alpha": 0.02, "eta": 1.1, "k": 6.0, "shadowing": "correlated"},
+     "g": "g2", "levels": 2},
     {"type": "pumped", "base": {"type": "ggx", "alpha": 0.6, "eta": 1.0, "k": 0.1}, "g": "g1", "levels": 1},
 ]
 IDS = ["ggx-0.1-metal-g2", "ggx-0.3-glass-g1x2", "ggx-0.02-absorber-g2x2", "ggx-0.6-weak-g1"]
@@ -76,8 +77,8 @@ def test_estimate_bounds_the_truth(spec):
 
 
 def test_a_table_through_both_paths():
-    """``pumpup.tabulate`` of a pumped GGX with F: its interpolant against fresh values (rtol 1e-12) within its margin, on
-    both sides of N_FRESNEL_MU_MIN."""
+    """``pumpup.tabulate`` of a pumped GGX with F: its interpolant against fresh values (rtol 1e-12) within its margin,
+    on both sides of N_FRESNEL_MU_MIN."""
     from pumpup.tables import AlbedoTable
 
     f = pumpup.load(SPECS[0])
