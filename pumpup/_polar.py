@@ -258,7 +258,8 @@ class Polar:
         A pumped BRDF's divisor (:meth:`pumpup.pumping.Pumped._chain_args`): the integrand is then
         divided by g_1 ... g_k (mu, N.wo) (001 eq. 16), a function of N.wo only for a fixed wi,
         and the integral is taken about N (:func:`_integrate_chain`; for a half-vector hint in frame 6,
-        GGX, Beckmann with F = 1 and Schlick's model, :func:`_integrate_n`).
+        GGX, Beckmann with F = 1 and Schlick's model, :func:`_integrate_n`; GGX with F at mu >= N_FRESNEL_MU_MIN only,
+        :func:`one_d_part`).
     levels : callable, optional
         With ``chain``: ``levels(mu)`` -> the values of N.wo where g has a kink
         (:meth:`pumpup.pumping.Pumped.kink_levels` of every level, the kinks its tables inherit with their
