@@ -211,6 +211,7 @@ import cmath
 import contextlib
 import functools
 import math
+import threading
 import warnings
 from dataclasses import dataclass
 
@@ -3049,6 +3050,17 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
 N_FRAME = True
 
 
+#: per thread: :func:`albedo_1d` switches frame 6 off for its own call on GGX with F below N_FRESNEL_MU_MIN (frame 4
+#: there); a global switch, as ``without_n_frame`` is, raced under threads (another thread's mu took frame 4 meanwhile,
+#: right but other bits; two threads restoring each other's old value could leave it off for good)
+_LOCAL = threading.local()
+
+
+def _n_frame_on() -> bool:
+    """Frame 6 on: :data:`N_FRAME`, and not switched off in this thread (:data:`_LOCAL`)."""
+    return N_FRAME and not getattr(_LOCAL, "n_frame_off", False)
+
+
 @contextlib.contextmanager
 def without_n_frame():
     """Within the block, ``pumpup.albedo`` takes GGX, Beckmann and Schlick's model by frame 4 (the rule on h's arc,
@@ -3100,7 +3112,7 @@ def takes_n_frame(hint) -> bool:
     Beckmann with F = 1 and alpha <= 1 (either Smith G, exact or Walter's G1), Schlick's model, and GGX with a Fresnel
     factor :func:`n_fresnel_ok` takes (pumped or not, not scaled; at mu >= :data:`N_FRESNEL_MU_MIN`, frame 4 below, or
     with a pumped chain the nested engine, :func:`one_d_part`)."""
-    if not N_FRAME or hint.kind != "half" or hint.vcavity or hint.sqrt_cos:
+    if not _n_frame_on() or hint.kind != "half" or hint.vcavity or hint.sqrt_cos:
         return False
     if any(hint.fresnel):  # (pumped too: g per node; below N_FRESNEL_MU_MIN the nested engine, one_d_part)
         return (hint.smith is not None and hint.smith[0] == 1 and hint.smith[3] <= 1.0 and hint.p == 0.0
@@ -3121,7 +3133,7 @@ def takes_lobe_n_frame(hint) -> bool:
     """Whether :func:`albedo_1d` takes a lobe hint with a Fresnel factor (and no chain) about N (:func:`_integrate_chain`
     with g = 1) instead of frame 5 (:func:`_k_lobe_fresnel`): n >= :data:`LOBE_N_MIN` and frame 6's switch on
     (:func:`without_n_frame`)."""
-    return N_FRAME and hint.kind == "lobe" and hint.chain is None and any(hint.fresnel) and hint.n >= LOBE_N_MIN
+    return _n_frame_on() and hint.kind == "lobe" and hint.chain is None and any(hint.fresnel) and hint.n >= LOBE_N_MIN
 
 
 # --- pumped Phong-family BRDFs: the frame of N -------------------------------------------------
@@ -3743,8 +3755,11 @@ def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
         if hint.chain is not None:
             return None  # (pumped: frame 4 has no chain; ``pumpup.albedo`` asks one_d_part for the mu frame 6 takes)
         low = mu < N_FRESNEL_MU_MIN
-        with without_n_frame():
+        _LOCAL.n_frame_off = True  # (this thread only: frame 4 for these)
+        try:
             parts = [albedo_1d(brdf, mu[low], rtol, atol, max_regions)]
+        finally:
+            _LOCAL.n_frame_off = False
         if parts[0] is None:  # (mu < HALF_MU_MIN: frame 4's breaks underflow, the nested engine takes the model, as before)
             return None
         parts.append(albedo_1d(brdf, mu[~low], rtol, atol, max_regions))

@@ -174,3 +174,32 @@ def test_near_kink_conductor_at_normal_incidence(shadowing):
     a, e = pumpup.albedo(f, mu, rtol=1e-10, return_error=True)
     b, eb = nested_reference(f, mu)
     assert np.all(np.abs(a - b) <= e + eb), (a - b, e, eb)
+
+
+def test_the_frame_4_split_is_per_thread():
+    """GGX with F below N_FRESNEL_MU_MIN takes frame 4 by switching frame 6 off for that call: per thread since issue 14's
+    twenty-second session.  A global switch raced under threads: another thread's mu above it took frame 4 while one had
+    it off (right values, other bits: this test failed 4 times in 4 on 316b97c), and two calls restoring each other's old
+    value could leave it off for good.  Values from three threads at once equal one thread's, bit for bit."""
+    import threading
+
+    f = pumpup.load(_spec(0.3, (0, 0.2, 3.0)))
+    mu = np.array([0.05, 0.1, 0.2, 0.3, 0.6, 0.9])
+    ref = pumpup.albedo(f, mu, rtol=1e-8)
+    out, errors = [], []
+
+    def work():
+        try:
+            for _ in range(40):
+                out.append(pumpup.albedo(f, mu, rtol=1e-8))
+        except Exception as err:  # pragma: no cover - reported below
+            errors.append(err)
+
+    threads = [threading.Thread(target=work) for _ in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors and len(out) == 120
+    assert all(np.array_equal(a, ref) for a in out)
+    assert _polar.N_FRAME and _polar.takes_n_frame(f.polar())
