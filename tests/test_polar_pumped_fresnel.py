@@ -86,3 +86,28 @@ def test_a_table_through_both_paths():
     mu = np.array([0.9, 0.6, 0.33, 0.2490, 0.2470, 0.1, 0.01])
     a, e = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
     assert np.all(np.abs(t(mu) - a) <= t.margin + e)
+
+
+def test_the_rings_error_is_divided_by_g():
+    """A node's ring error (:func:`pumpup._polar._ggx_ring_f`) enters the rule's error divided by g, as the node's value
+    is: one node at a time (as ``_n_values`` calls the rule), the pumped node's value and error are the plain node's
+    divided by g.  g is below 1: without the division a pumped node's ring error was under-reported by the factor g
+    (issue 14's twenty-second session; the values' tests above do not see a factor of 0.5-1 at their tolerances)."""
+    import math
+
+    f = pumpup.load(SPECS[0])
+    hint = f.polar()
+    mp = _polar.n_params(hint)
+    one, buf, fv = np.ones(1), np.empty(1), np.empty(_polar.RING_F_NMAX + 1)
+    for mu in (0.3, 0.7, 0.95):
+        xmu, xs = _polar._n_incidence(mp, mu)
+        for x in (0.1, 0.6, 1.2):
+            d = x - xmu
+            g = _polar._n_chain_g(hint.chain, mu, math.sin(x))
+            assert 0.0 < g < 1.0
+            plain = _polar._n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, None, None, 1e-6, 0.0, fv,
+                                   0)
+            pumped = _polar._n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, hint.chain, None, 1e-6,
+                                    0.0, fv, 0)
+            assert pumped[0] == pytest.approx(plain[0] / g, rel=1e-14)
+            assert pumped[1] == pytest.approx(plain[1] / g, rel=1e-12), (mu, x, pumped[1] * g / plain[1])
