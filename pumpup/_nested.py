@@ -476,6 +476,23 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
     return sv, inner, absk, evals
 
 
+#: segments per call of :func:`_evaluate`: its block arrays (a dozen of 8 bytes per segment and outer node, more where
+#: the ends are graded) grow with the segments a refinement round adds.  Found by ``scripts/fuzz_engines.py --fmax 22``
+#: (issue 14's twenty-second session): a nested reference at max_regions 200000 grew past 23 GB and the kernel killed
+#: it.  Each segment's values do not depend on the others in its call, so the chunks change no bit
+SEG_CHUNK = 100_000
+
+
+def _evaluate_chunked(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i_sub=None):
+    """:func:`_evaluate` in calls of at most :data:`SEG_CHUNK` segments (memory bounded), concatenated."""
+    if len(seg_int) <= SEG_CHUNK:
+        return _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i_sub)
+    parts = [_evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int[a:a + SEG_CHUNK], seg_piece[a:a + SEG_CHUNK],
+                       seg_t0[a:a + SEG_CHUNK], seg_t1[a:a + SEG_CHUNK], i_sub) for a in range(0, len(seg_int), SEG_CHUNK)]
+    return (np.concatenate([q[0] for q in parts]), np.concatenate([q[1] for q in parts]),
+            np.concatenate([q[2] for q in parts]), sum(q[3] for q in parts))
+
+
 #: outer intervals that end at a break integrate in v with x = x0 + h v^2 towards it (module docstring)
 OUTER_SUB = True
 #: the crossings of two cuts are breaks of the outer variable too (module docstring)
@@ -669,7 +686,7 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
     s_piece = np.tile(np.repeat(np.arange(n_pieces), M_INIT), nI)
     s_t0 = np.tile(grid[:-1], nI * n_pieces)
     s_t1 = np.tile(grid[1:], nI * n_pieces)
-    s_v, s_e, s_a, evals = _evaluate(brdf, g, i_prob, i_x0, i_x1, s_int, s_piece, s_t0, s_t1, i_sub)
+    s_v, s_e, s_a, evals = _evaluate_chunked(brdf, g, i_prob, i_x0, i_x1, s_int, s_piece, s_t0, s_t1, i_sub)
     # the budget counts outer intervals, an interval with m sub-intervals per piece m times
     seg_count = lambda: np.bincount(i_prob[s_int], minlength=P) / n_pieces
     budget = max_regions + seg_count()
@@ -734,7 +751,7 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
         new_piece = np.concatenate([s_piece[sel], s_piece[sel], s_piece[moved], s_piece[moved]])
         new_t0 = np.concatenate([s_t0[sel], tm, s_t0[moved], s_t0[moved]])
         new_t1 = np.concatenate([tm, s_t1[sel], s_t1[moved], s_t1[moved]])
-        cv, ce, ca, cev = _evaluate(brdf, g, i_prob, i_x0, i_x1, new_int, new_piece, new_t0, new_t1, i_sub)
+        cv, ce, ca, cev = _evaluate_chunked(brdf, g, i_prob, i_x0, i_x1, new_int, new_piece, new_t0, new_t1, i_sub)
         evals = evals + cev
         keep = ~(sel | moved)
         s_int = np.concatenate([s_int[keep], new_int])
