@@ -3100,9 +3100,10 @@ def n_fresnel_ok(ior: float, eta: float, k: float) -> bool:
 
 
 def takes_n_frame_operand(hint) -> bool:
-    """Whether a pumped chain or a 1/E scale (:meth:`pumpup.pumping.Pumped.polar`, :meth:`pumpup.compensate.Scaled.polar`)
-    may build on ``hint`` in frame 6: GGX, Beckmann (F = 1) or Schlick, neither pumped nor scaled already, and without a
-    Fresnel factor (GGX with F splits its mu with frame 4, which has no chain)."""
+    """Whether a 1/E scale (:meth:`pumpup.compensate.Scaled.polar`) may build on ``hint`` in frame 6: GGX, Beckmann
+    (F = 1) or Schlick, neither pumped nor scaled already, and without a Fresnel factor (GGX with F splits its mu with
+    frame 4, which has no factor; F(Theta_min) with U not tested).  A pumped chain builds on more
+    (:meth:`pumpup.pumping.Pumped.polar`: GGX with F, and F(Theta_min) through :func:`with_fresnel_max`)."""
     return (hint is not None and hint.chain is None and hint.factor is None and not any(hint.fresnel) and hint.fmax is None
             and takes_n_frame(hint))
 
@@ -3649,10 +3650,15 @@ def _cut_matrix(cuts: list) -> tuple:
     return cut, ncut
 
 
+def _hint(brdf):
+    """``brdf``'s :class:`Polar` hint, or None (none, or the 1-D path off)."""
+    polar = getattr(brdf, "polar", None) if ENABLED and ONE_D else None
+    return polar() if polar is not None else None
+
+
 def takes_1d_path(brdf) -> bool:
     """Whether :func:`albedo_1d` takes ``brdf`` (it has a :class:`Polar` hint and the path is on) at every mu."""
-    polar = getattr(brdf, "polar", None) if ENABLED and ONE_D else None
-    hint = polar() if polar is not None else None
+    hint = _hint(brdf)
     return hint is not None and not _partial(hint)
 
 
@@ -3667,8 +3673,7 @@ def one_d_part(brdf, mu: np.ndarray):
     GGX with a Fresnel factor at mu >= :data:`N_FRESNEL_MU_MIN` (:func:`_partial`; issue 14's twenty-second session: a
     257-point table of 1-level g2 pumped GGX 0.1 with eta 0.2, k 3 took the nested engine 0.70 s, now 0.28 s).
     ``pumpup.albedo`` gives the rest to the nested engine."""
-    polar = getattr(brdf, "polar", None) if ENABLED and ONE_D else None
-    hint = polar() if polar is not None else None
+    hint = _hint(brdf)
     if hint is None or not _partial(hint):
         return None
     return np.asarray(mu) >= N_FRESNEL_MU_MIN
@@ -3695,10 +3700,7 @@ def axis_albedo(n: float, nu: np.ndarray, scale: np.ndarray, rtol: float, atol: 
 def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int):
     """(value, error, converged, evaluations) of the albedo of ``brdf`` at every mu (a 1-D float
     array), or None when the model has no :class:`Polar` hint (or the 1-D path is off)."""
-    if not (ENABLED and ONE_D):
-        return None
-    polar = getattr(brdf, "polar", None)
-    hint = polar() if polar is not None else None
+    hint = _hint(brdf)
     if hint is None:
         return None
     mu = np.ascontiguousarray(mu, dtype=np.float64)

@@ -1078,16 +1078,13 @@ class Pumped(BRDF):
         ``fresnel`` wrapper's over GGX, Beckmann or Schlick, ``Polar.fmax``); None for any other base."""
         import dataclasses
 
-        from ._polar import Polar, takes_n_frame, takes_n_frame_operand, with_fresnel, with_fresnel_max
+        from ._polar import Polar, takes_n_frame, with_fresnel, with_fresnel_max
 
         hint = self.chain()[0].base.polar()
-        if takes_n_frame_operand(hint):
-            # GGX, Beckmann (F = 1) and Schlick's model: frame 6 about N, divided by g (``pumpup._polar._integrate_n``)
-            return dataclasses.replace(hint, chain=self._chain_args(), levels=self._polar_levels)
-        if (hint is not None and any(hint.fresnel) and hint.kind == "half" and hint.chain is None and hint.factor is None
+        if (hint is not None and hint.chain is None and hint.factor is None and hint.fmax is None
                 and takes_n_frame(hint)):
-            # GGX with a Fresnel factor: frame 6 at mu >= N_FRESNEL_MU_MIN, divided by g; the nested engine below
-            # (``pumpup._polar.one_d_part``)
+            # GGX, Beckmann (F = 1) and Schlick's model: frame 6 about N, divided by g (``pumpup._polar._integrate_n``);
+            # GGX with a Fresnel factor at mu >= N_FRESNEL_MU_MIN, the nested engine below (``pumpup._polar.one_d_part``)
             return dataclasses.replace(hint, chain=self._chain_args(), levels=self._polar_levels)
         if hint is not None and hint.fmax is not None and hint.chain is None:
             # ... with the fresnel wrapper's F(Theta_min) (``Polar.fmax``): again, where the near-kink of F is far enough

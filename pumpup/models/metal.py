@@ -110,7 +110,7 @@ def _up(wi, wo):
 FRESNEL_LEVEL_Y0 = 0.05
 
 
-def fresnel_levels(eta: float, k: float, y0_max: float = None) -> tuple:
+def fresnel_levels(eta: float, k: float, y0_max: float | None = None) -> tuple:
     """The level N.wo = x0 where F(eta + i k, max(N.wi, N.wo)) has a kink or a near-kink, for a model's ``Lobe`` hint: ()
     or (x0,): the branch point's real part inside (0, 1), its imaginary part below ``y0_max`` (default
     :data:`FRESNEL_LEVEL_Y0`; ``pumpup.models.microfacet`` asks with its own threshold whether frame 4 declines).  Below
