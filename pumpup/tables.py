@@ -227,6 +227,14 @@ def _midpoints(mu: np.ndarray) -> np.ndarray:
     return np.sqrt(mu[:-1] * mu[1:])
 
 
+def _splittable(mu: np.ndarray) -> np.ndarray:
+    """Whether each interval of consecutive nodes has its midpoint (:func:`_midpoints`) strictly inside in log(mu), the
+    spline's variable (whose doubles are coarser than mu's: 3.6e-15 at log(mu) = -18.4, mu's relative step 1.1e-16)."""
+    lx = np.log(mu)
+    lm = np.log(_midpoints(mu))
+    return (lm > lx[:-1]) & (lm < lx[1:])
+
+
 def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
              interp_tol: float = 1e-7, mu_min: float = 1e-8, max_points: int = 2049, progress: bool | None = None,
              threads: int | None = None, phi=None, breaks=None):
@@ -327,7 +335,9 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
         val, err = values(grid, bar)
         interp_error = 0.0
         todo = np.ones(len(grid) - 1, bool)  # intervals not yet checked
-        while todo.any() and len(grid) < max_points:
+        miss = None
+
+        def misses(grid, val, err, todo):
             mids = _midpoints(grid)[todo]
             bar.total += len(mids)
             mval, merr = values(mids, bar)
@@ -336,7 +346,19 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
             else:  # a table over (mu, phi): the worst column
                 miss = np.max([np.abs(AlbedoTable(grid, val[:, j], err[:, j])(mids) - mval[:, j])
                                for j in range(val.shape[1])], axis=0)
-            bad = miss > interp_tol
+            return mids, mval, merr, miss
+
+        while todo.any() and len(grid) < max_points:
+            mids, mval, merr, miss = misses(grid, val, err, todo)
+            # an interval whose midpoint is not a new value of log(mu) is not split: its miss counts as an accepted one.
+            # The bisection reaches one where the values' own noise exceeds interp_tol (a divergent albedo, 3.5e6 at mu =
+            # 1.08e-8 with errors of 1e-5: interp_tol 1e-7 is 3e-14 of it), or at a jump of the albedo.  It split such an
+            # interval into two nodes of one log(mu) before (ValueError from scipy; issue 14's twenty-third session)
+            split = _splittable(grid)[todo]
+            bad = (miss > interp_tol) & split
+            # (within such an interval the spline takes one end's value at every mu: its ends' spread counts too)
+            spread = np.abs(val[1:] - val[:-1])[todo]
+            miss = np.where(split, miss, np.maximum(miss, spread if spread.ndim == 1 else spread.max(axis=1)))
             interp_error = max(interp_error, float(miss[~bad].max(initial=0.0)))
             # accept the good intervals; add the bad midpoints as nodes
             new_mu = np.concatenate([grid, mids[bad]])
@@ -348,6 +370,8 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
             # again every interval within three nodes of a new one
             todo = _near_new_nodes(order, int(bad.sum()))
         if todo.any():
+            if miss is None:  # (max_points below the first grid's size: its misses, measured once)
+                miss = misses(grid, val, err, todo)[3]
             interp_error = max(interp_error, float(miss.max()))
     if reusable:
         _reuse.remember(brdf, grid, val, err, rtol)

@@ -50,6 +50,65 @@ def test_interpolation_error_is_honest_between_nodes_for_a_diverging_albedo():
     assert np.all(table.upper(mu) >= a)
 
 
+def _fake_values(monkeypatch, fn):
+    """tabulate's values from ``fn(mu)`` (no quadrature; error 1e-16): its adaptive grid alone under test."""
+    from pumpup import azimuth
+
+    def table_values(brdf, phi, rtol, atol, threads, interp_tol):
+        return (lambda mu, bar: (fn(mu), np.full(mu.shape, 1e-16))), None, None
+
+    monkeypatch.setattr(azimuth, "table_values", table_values)
+
+
+def test_adaptive_grid_splits_no_interval_below_the_doubles_of_log_mu(monkeypatch):
+    """A jump the grid does not know of, at mu = 1.1e-8 (where log(mu)'s doubles are 25 times coarser than mu's): the
+    bisection closes in on it, splits no interval whose midpoint is not a new value of log(mu), and counts the last
+    one's spread, the jump, as interpolation error: the spline takes one end's value at every mu within it.  Before
+    issue 14's twenty-third session it split down to two nodes of one log(mu) (scipy's ValueError; a divergent albedo
+    did it under its own noise)."""
+    from pumpup import tables
+
+    _fake_values(monkeypatch, lambda mu: np.where(mu > 1.1e-8, 2.0, 1.0) + mu)
+    ds = pumpup.tabulate(pumpup.load({"type": "lambert"}), progress=False)
+    mu = ds["mu"].values
+    lx = np.log(mu)
+    assert np.all(np.diff(lx) > 0)
+    last = np.flatnonzero(~tables._splittable(mu))
+    assert len(last) and np.all(np.abs(mu[last] / 1.1e-8 - 1.0) < 1e-10)  # (it did close in, and only there)
+    assert ds.attrs["interpolation_error"] >= 1.0  # (the jump; not the 1e-7 of the smooth parts)
+
+
+def test_a_jump_of_the_albedo_counts_in_the_margin():
+    """Beckmann alpha 0.0052 with Walter's G1, whose switch level mu = 0.0083 is a jump of 5.3e-5 in the albedo: the
+    grid closes in on it to an interval 5 doubles wide whose midpoint is no new log(mu), and at the 4 doubles inside it
+    the table is off by the jump.  Its margin covers them (it was 2e-7 before issue 14's twenty-third session)."""
+    from pumpup.models.microfacet import walter_level
+
+    alpha = 0.005184313347496449
+    f = pumpup.load({"type": "beckmann", "alpha": alpha, "g1": "walter"})
+    table = pumpup.AlbedoTable.from_dataset(pumpup.tabulate(f, progress=False))
+    i = np.searchsorted(table.mu, walter_level(alpha))
+    inside = [np.nextafter(table.mu[i - 1], 1.0)]
+    while inside[-1] < table.mu[i]:
+        inside.append(np.nextafter(inside[-1], 1.0))
+    inside = np.array(inside[:-1])
+    fresh, err = pumpup.albedo(f, inside, rtol=1e-12, return_error=True)
+    assert len(inside) and np.abs(table(inside) - fresh).max() > 1e-5  # (the case)
+    assert np.all(np.abs(table(inside) - fresh) <= table.margin + err)
+
+
+def test_max_points_below_the_first_grid_measures_its_misses(monkeypatch):
+    """max_points below the first grid's 45 nodes: that grid, with its misses at the midpoints measured once as the
+    interpolation error (an UnboundLocalError before issue 14's twenty-third session)."""
+    f = pumpup.load({"type": "phong", "n": 20})
+    ds = pumpup.tabulate(f, max_points=10, progress=False)
+    assert ds.sizes["mu"] == len(pumpup.tables.default_grid())
+    table = pumpup.AlbedoTable.from_dataset(ds)
+    mids = np.sqrt(ds["mu"].values[:-1] * ds["mu"].values[1:])
+    assert table.interp_error == pytest.approx(np.abs(table(mids) - pumpup.albedo(f, mids)).max(), rel=1e-6)
+    assert table.interp_error > 1e-7  # (the full table's tolerance: unmet here, and said)
+
+
 def test_netcdf_round_trip_is_exact(phong_table, tmp_path):
     path = pumpup.write_table(phong_table, tmp_path / "t.nc")
     back = pumpup.open_table(path)
