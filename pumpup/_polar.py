@@ -2423,8 +2423,10 @@ RING_F_NMAX = 128
 #: this (geometric decay of F's coefficients; with the last ratio alone, from N = 16 on, it was 1100 x below the true error
 #: of a strong absorber, eta 1.1, k 6, at itol 1e-6: measured by scripts/ring_fresnel_calibration.py)
 RING_F_RATIO = 0.5
-#: :func:`_ring_f_sums` sums term by term where |1 - z| is below this
-RING_F_DIRECT = 0.25
+#: :func:`_ring_f_sums` sums term by term where nn |1 - z| is below this (at most the sample n = 0, where 1 - rho < 2 / nn:
+#: n >= 1 has |1 - z| >= rho sin(pi / nn)); until issue 14's twenty-third session, where |1 - z| < 0.25, up to ~nn / 12
+#: samples of nn + 1 terms each, a quarter of GGX alpha 0.02 with ior 1.5's table time
+RING_F_DIRECT = 2.0
 #: sin^2(psi / 2) at psi = j pi / RING_F_NMAX (the finest level's samples; a coarser level takes every stride-th)
 _RING_F_SIN2 = np.sin(0.5 * np.pi * np.arange(RING_F_NMAX + 1) / RING_F_NMAX) ** 2
 #: cos(psi), sin(psi) there
@@ -2436,13 +2438,16 @@ _RING_F_SIN = np.sin(np.pi * np.arange(RING_F_NMAX + 1) / RING_F_NMAX)
 def _ring_f_sums(rho, rn, n, nn, j):  # pragma: no cover - compiled; see ring_f_sums_reference
     """(C0, C1) = the sums over k = 0 .. nn, the first and last halved, of rho^k cos(k theta) and k rho^k cos(k theta) at
     theta = n pi / nn = j pi / RING_F_NMAX (``rn`` = rho^nn): geometric sums in z = rho e^(i theta), z^nn = (-1)^n rho^nn
-    real, 1 - z = (1 - rho) + 2 rho sin^2(theta / 2) - i rho sin(theta) without cancellation; where |1 - z| < RING_F_DIRECT,
-    where the closed forms cancel as rho -> 1 (sum k z^k lost 2e-11 at nn = 128, n = 1), term by term."""
+    real, 1 - z = w = (1 - rho) + 2 rho sin^2(theta / 2) - i rho sin(theta) without cancellation.  sum k z^k = z N / w^2
+    with N = 1 - (nn + 1) z^nn + nn z^(nn + 1) = (1 - z^nn) - nn z^nn w: of size nn^2 |w|^2 where nn |w| is small, from
+    terms of size nn |w| (the first form's terms are of size nn: it lost 2e-11 at nn = 128, n = 1).  Its error is then
+    about eps (1 + nn |w|) / |w|^2, within a few eps of the sum's scale nn^2 where nn |w| >= 1; below RING_F_DIRECT, term
+    by term."""
     zn = -rn if n % 2 else rn  # z^nn
     zr, zi = rho * _RING_F_COS[j], rho * _RING_F_SIN[j]
     p, r = (1.0 - rho) + 2.0 * rho * _RING_F_SIN2[j], zi  # 1 - z = p - i r
     dd = p * p + r * r
-    if dd < RING_F_DIRECT * RING_F_DIRECT:  # (sum k z^k's closed form loses ~nn^2 eps / |1 - z| there: term by term)
+    if nn * nn * dd < RING_F_DIRECT * RING_F_DIRECT:  # (term by term)
         c0 = c1 = 0.0
         zk = complex(1.0, 0.0)
         z = complex(zr, zi)
@@ -2454,9 +2459,9 @@ def _ring_f_sums(rho, rn, n, nn, j):  # pragma: no cover - compiled; see ring_f_
         return c0, c1
     # in real arithmetic, 1 / (1 - z) = (p + i r) / dd: sum z^k = (1 - zn z) / (1 - z), sum k z^k = z (1 - (nn + 1) zn +
     # nn zn z) / (1 - z)^2
-    g0 = ((1.0 - zn * zr) * p + zn * zi * r) / dd
-    a = 1.0 - (nn + 1.0) * zn + nn * zn * zr
-    b = nn * zn * zi
+    g0 = (((1.0 - zn) + zn * p) * p + zn * zi * r) / dd  # (1 - zn z = (1 - zn) + zn w)
+    a = (1.0 - zn) - nn * zn * p  # N = a + i b
+    b = nn * zn * r
     g1 = ((zr * a - zi * b) * (p * p - r * r) - (zr * b + zi * a) * (2.0 * p * r)) / (dd * dd)
     return g0 - 0.5 - 0.5 * zn, g1 - 0.5 * nn * zn
 
