@@ -200,6 +200,8 @@ def table_values(brdf: BRDF, phi, rtol, atol, threads, interp_tol):
             return v, e
         return sup, None, "sup"
     phis = np.atleast_1d(check_phi(phi)).astype(np.float64).ravel()
+    if not len(phis):
+        raise ValueError("tabulate: phi must hold at least one azimuth (radians), got an empty array")
     if len(np.unique(phis)) != len(phis):
         raise ValueError("tabulate: the values of phi must be distinct")
 

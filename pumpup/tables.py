@@ -54,8 +54,12 @@ def default_grid(n_theta: int = 33, mu_min: float = 1e-8) -> np.ndarray:
     """
     theta = np.linspace(0.0, np.pi / 2, n_theta)[:-1]
     mu = np.cos(theta)
-    mu = mu[mu > 0.02]
-    decades = np.logspace(math.log10(0.02), math.log10(mu_min), max(2, int(round(math.log10(0.02 / mu_min))) * 2 + 1))
+    mu = mu[mu > max(0.02, mu_min)]
+    if mu_min >= 0.02:  # (no decades: the grid starts at mu_min itself)
+        return np.unique(np.concatenate([mu, [mu_min, 1.0]]))
+    # (log10(0.02) - log10(mu_min), not log10(0.02 / mu_min): that overflows for a subnormal mu_min)
+    lo = math.log10(mu_min)
+    decades = np.logspace(math.log10(0.02), lo, max(2, int(round(math.log10(0.02) - lo)) * 2 + 1))
     return np.unique(np.concatenate([mu, decades, [1.0]]))
 
 
@@ -98,15 +102,26 @@ class AlbedoTable:
                  degree: int | None = None, breaks=()):
         from scipy.interpolate import PPoly
 
-        mu = np.asarray(mu, dtype=np.float64)
+        mu = np.asarray(mu, dtype=np.float64).reshape(-1)
+        value = np.asarray(value, dtype=np.float64).reshape(-1)
+        error = np.asarray(error, dtype=np.float64).reshape(-1)
+        if len(mu) < 2:
+            raise ValueError("an albedo table needs at least two values of mu")
+        if not (len(value) == len(mu) == len(error)):
+            raise ValueError(f"an albedo table needs one value and one error per mu: {len(mu)} mu, {len(value)} values, "
+                             f"{len(error)} errors")
+        if not np.all((mu > 0) & (mu <= 1)):
+            raise ValueError(f"an albedo table's mu must lie in (0, 1], got {mu[~((mu > 0) & (mu <= 1))][:3].tolist()}")
+        if not (np.all(np.isfinite(value)) and np.all(np.isfinite(error)) and np.all(error >= 0)):
+            raise ValueError("an albedo table's values must be finite and its errors finite and >= 0")
         order = np.argsort(mu)
         self.mu = mu[order]
-        self.value = np.asarray(value, dtype=np.float64)[order]
-        self.error = np.asarray(error, dtype=np.float64)[order]
+        if np.any(np.diff(np.log(self.mu)) <= 0):  # (the spline's variable: distinct in log(mu))
+            raise ValueError("an albedo table's mu must be distinct (in log(mu), the interpolant's variable)")
+        self.value = value[order]
+        self.error = error[order]
         self.interp_error = float(interp_error)
         self.spec = spec
-        if len(self.mu) < 2:
-            raise ValueError("an albedo table needs at least two values of mu")
         inner = np.unique(np.asarray(breaks, dtype=np.float64).reshape(-1))
         inner = inner[(inner > self.mu[0]) & (inner < self.mu[-1])]
         at = np.searchsorted(self.mu, inner)
@@ -223,8 +238,9 @@ def _near_new_nodes(order: np.ndarray, n_new: int) -> np.ndarray:
 
 
 def _midpoints(mu: np.ndarray) -> np.ndarray:
-    """Midpoints of consecutive nodes in log(mu)."""
-    return np.sqrt(mu[:-1] * mu[1:])
+    """Midpoints of consecutive nodes in log(mu) (sqrt(a b), or sqrt(a) sqrt(b) where a b underflows)."""
+    ab = mu[:-1] * mu[1:]
+    return np.where(ab > 1e-290, np.sqrt(ab), np.sqrt(mu[:-1]) * np.sqrt(mu[1:]))
 
 
 def _splittable(mu: np.ndarray) -> np.ndarray:

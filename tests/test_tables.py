@@ -109,6 +109,40 @@ def test_max_points_below_the_first_grid_measures_its_misses(monkeypatch):
     assert table.interp_error > 1e-7  # (the full table's tolerance: unmet here, and said)
 
 
+@pytest.mark.parametrize("mu_min", [1e-300, 5e-324])
+def test_tiny_mu_min(mu_min):
+    """mu_min down to the smallest double: the grid reaches it (its midpoints underflowed to 0 at 1e-300, and
+    log10(0.02 / mu_min) overflowed for a subnormal one), and the values there are the closed form's limit."""
+    f = pumpup.load({"type": "lambert", "albedo": 0.5})
+    ds = pumpup.tabulate(f, mu_min=mu_min, progress=False)
+    assert ds["mu"].values[0] == mu_min and np.all(ds["mu"].values > 0)
+    np.testing.assert_allclose(ds["albedo"].values, 0.5, rtol=1e-12)
+
+
+def test_mu_min_above_the_decades():
+    """mu_min >= 0.02: the grid starts at mu_min (it reached down to 0.02 before)."""
+    ds = pumpup.tabulate(pumpup.load({"type": "phong", "n": 20}), mu_min=0.5, progress=False)
+    assert ds["mu"].values[0] == 0.5
+
+
+@pytest.mark.parametrize("args,message", [
+    (([0.5, 0.5, 1.0], [1, 1, 1], [0, 0, 0]), "distinct"),
+    (([0.5, 0.7, 1.0], [1, np.nan, 1], [0, 0, 0]), "finite"),
+    (([0.5, 0.7, 1.0], [1, 1, 1], [0, -1e-9, 0]), "finite and >= 0"),
+    (([-0.5, 0.7, 1.0], [1, 1, 1], [0, 0, 0]), "(0, 1]"),
+    (([0.5, 0.7, 1.0], [1, 1], [0, 0, 0]), "one value and one error per mu"),
+    (([0.5], [1], [0]), "at least two"),
+])
+def test_albedo_table_bad_input(args, message):
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace("]", r"\]")):
+        pumpup.AlbedoTable(*args)
+
+
+def test_tabulate_with_no_azimuth():
+    with pytest.raises(ValueError, match="phi must hold at least one azimuth"):
+        pumpup.tabulate(pumpup.load({"type": "ward_aniso", "ax": 0.1, "ay": 0.3}), phi=[])
+
+
 def test_netcdf_round_trip_is_exact(phong_table, tmp_path):
     path = pumpup.write_table(phong_table, tmp_path / "t.nc")
     back = pumpup.open_table(path)
