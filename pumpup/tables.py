@@ -616,8 +616,12 @@ def write_table(ds, path) -> str:
     Fletcher-32 checksum on every numeric variable (:func:`pumpup.validate.checksum_encoding`) and
     a digest of the whole content in the attribute ``pumpup_digest``, which :func:`open_table`
     checks (:func:`pumpup.validate.content_digest`)."""
+    import xarray as xr
+
     from .validate import checksum_encoding
 
+    if not isinstance(ds, xr.Dataset):
+        raise TypeError(f"write_table needs an xarray.Dataset (pumpup.tabulate's), got {type(ds).__name__}")
     ds = _digested(ds)
     with atomic_path(path) as tmp:
         ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=checksum_encoding(ds))
@@ -873,5 +877,6 @@ def max_constant(brdf: BRDF, **kw) -> tuple[float, float]:
     >>> round(c, 12)
     1.0
     """
+    _check_brdf("max_constant", brdf)
     m = max_albedo(brdf, **kw)
     return m.constant, m.theta_deg

@@ -143,6 +143,14 @@ def test_tabulate_with_no_azimuth():
         pumpup.tabulate(pumpup.load({"type": "ward_aniso", "ax": 0.1, "ay": 0.3}), phi=[])
 
 
+def test_write_table_and_max_constant_name_themselves(tmp_path):
+    with pytest.raises(TypeError, match="write_table needs an xarray.Dataset"):
+        pumpup.write_table({"albedo": [1.0]}, tmp_path / "t.nc")
+    assert not list(tmp_path.iterdir())
+    with pytest.raises(TypeError, match="max_constant needs a pumpup BRDF"):
+        pumpup.max_constant("phong")
+
+
 def test_netcdf_round_trip_is_exact(phong_table, tmp_path):
     path = pumpup.write_table(phong_table, tmp_path / "t.nc")
     back = pumpup.open_table(path)
