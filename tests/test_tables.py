@@ -97,6 +97,21 @@ def test_a_jump_of_the_albedo_counts_in_the_margin():
     assert np.all(np.abs(table(inside) - fresh) <= table.margin + err)
 
 
+def test_the_interval_at_the_normal_is_checked_below_its_midpoint():
+    """A g1 pumped plastic with n = 5284: its lobe reaches the normal below theta ~ 1 degree, inside the grid's last
+    interval [0.9988, 1], whose midpoint in log(mu) lies at theta = 2 degrees.  The table was 3.1e-7 off at mu =
+    0.99995 with a margin of 2.0e-7 (scripts/fuzz_engines.py --tables 43); the checks at 1 - mu = (1 - a) 2^-k count
+    in its interpolation error now."""
+    spec = {"type": "pumped", "base": {"type": "plastic", "n": 5284.234871880557, "ad": 0.2771143076394261,
+                                       "a_s": 0.047413995704811085}, "g": "g1", "levels": 1}
+    f = pumpup.load(spec)
+    table = pumpup.AlbedoTable.from_dataset(pumpup.tabulate(f, progress=False))
+    mu = np.linspace(0.999, 1.0, 41)
+    fresh, err = pumpup.albedo(f, mu, rtol=1e-12, return_error=True)
+    assert np.abs(table(mu) - fresh).max() > 2.5e-7  # (the case: beyond the old margin)
+    assert np.all(np.abs(table(mu) - fresh) <= table.margin + err)
+
+
 def test_max_points_below_the_first_grid_measures_its_misses(monkeypatch):
     """max_points below the first grid's 45 nodes: that grid, with its misses at the midpoints measured once as the
     interpolation error (an UnboundLocalError before issue 14's twenty-third session)."""
