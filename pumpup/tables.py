@@ -275,7 +275,9 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
         The grid of cos(theta_i) in (0, 1].  If omitted, the grid adapts: it starts from
         :func:`default_grid` (down to ``mu_min``) and bisects (in log mu) every interval
         where the interpolant misses the computed albedo at the midpoint by more than
-        ``interp_tol``; the largest miss found is stored as ``interpolation_error``.
+        ``interp_tol``; the largest miss found is stored as ``interpolation_error``, with
+        the misses at 1 - mu = (1 - a) 2^-k in the last interval [a, 1] (whose midpoint in
+        log(mu) lies at theta_a / sqrt(2)) and the spread of any interval too narrow to split.
     rtol, atol : float
         Quadrature tolerance of every value (see :func:`pumpup.albedo`).
     interp_tol : float
@@ -369,43 +371,38 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
             return np.max([np.abs(AlbedoTable(grid, val[:, j], err[:, j])(pts) - pval[:, j])
                            for j in range(val.shape[1])], axis=0)
 
-        def add(grid, val, err, pts, pval, perr):
-            """The nodes with pts added, sorted, and the intervals within three nodes of a new one (to check again: a
-            new node changes the spline everywhere, mostly within a few intervals)."""
-            new_mu = np.concatenate([grid, pts])
+        todo = np.ones(len(grid) - 1, bool)  # intervals not yet checked
+        miss = None
+        while todo.any() and len(grid) < max_points:
+            mids = _midpoints(grid)[todo]
+            bar.total += len(mids)
+            mval, merr = values(mids, bar)
+            miss = spline_miss(grid, val, err, mids, mval)
+            # an interval whose midpoint is not a new value of log(mu) is not split: its miss counts as an accepted one.
+            # The bisection reaches one where the values' own noise exceeds interp_tol (a divergent albedo, 3.5e6 at mu =
+            # 1.08e-8 with errors of 1e-5: interp_tol 1e-7 is 3e-14 of it), or at a jump of the albedo.  It split such an
+            # interval into two nodes of one log(mu) before (ValueError from scipy; issue 14's twenty-third session)
+            split = _splittable(grid)[todo]
+            bad = (miss > interp_tol) & split
+            # (within such an interval the spline takes one end's value at every mu: its ends' spread counts too)
+            spread = np.abs(val[1:] - val[:-1])[todo]
+            miss = np.where(split, miss, np.maximum(miss, spread if spread.ndim == 1 else spread.max(axis=1)))
+            interp_error = max(interp_error, float(miss[~bad].max(initial=0.0)))
+            # accept the good intervals; add the bad midpoints as nodes
+            new_mu = np.concatenate([grid, mids[bad]])
             order = np.argsort(new_mu)
-            return (new_mu[order], np.concatenate([val, pval])[order], np.concatenate([err, perr])[order],
-                    _near_new_nodes(order, len(pts)))
-
-        def refine(grid, val, err, todo, interp_error):
-            miss = None
-            while todo.any() and len(grid) < max_points:
+            grid = new_mu[order]
+            val = np.concatenate([val, mval[bad]])[order]
+            err = np.concatenate([err, merr[bad]])[order]
+            # a new node changes the spline everywhere, mostly within a few intervals: check
+            # again every interval within three nodes of a new one
+            todo = _near_new_nodes(order, int(bad.sum()))
+        if todo.any():
+            if miss is None:  # (max_points below the first grid's size: its misses, measured once)
                 mids = _midpoints(grid)[todo]
                 bar.total += len(mids)
-                mval, merr = values(mids, bar)
-                miss = spline_miss(grid, val, err, mids, mval)
-                # an interval whose midpoint is not a new value of log(mu) is not split: its miss counts as an accepted
-                # one.  The bisection reaches one where the values' own noise exceeds interp_tol (a divergent albedo,
-                # 3.5e6 at mu = 1.08e-8 with errors of 1e-5: interp_tol 1e-7 is 3e-14 of it), or at a jump of the albedo.
-                # It split such an interval into two nodes of one log(mu) before (ValueError from scipy; issue 14's
-                # twenty-third session)
-                split = _splittable(grid)[todo]
-                bad = (miss > interp_tol) & split
-                # (within such an interval the spline takes one end's value at every mu: its ends' spread counts too)
-                spread = np.abs(val[1:] - val[:-1])[todo]
-                miss = np.where(split, miss, np.maximum(miss, spread if spread.ndim == 1 else spread.max(axis=1)))
-                interp_error = max(interp_error, float(miss[~bad].max(initial=0.0)))
-                # accept the good intervals; add the bad midpoints as nodes
-                grid, val, err, todo = add(grid, val, err, mids[bad], mval[bad], merr[bad])
-            if todo.any():
-                if miss is None:  # (max_points below the grid's size: its misses, measured once)
-                    mids = _midpoints(grid)[todo]
-                    bar.total += len(mids)
-                    miss = spline_miss(grid, val, err, mids, values(mids, bar)[0])
-                interp_error = max(interp_error, float(miss.max()))
-            return grid, val, err, interp_error
-
-        grid, val, err, interp_error = refine(grid, val, err, np.ones(len(grid) - 1, bool), interp_error)
+                miss = spline_miss(grid, val, err, mids, values(mids, bar)[0])
+            interp_error = max(interp_error, float(miss.max()))
         # the interval that ends at mu = 1: its midpoint in log(mu) lies at theta / sqrt(2) of its lower end's theta, so
         # 70 % of it in theta had no check.  A sharp lobe's pumped level turns there (the lobe reaches the normal below
         # theta ~ its width: pumped plastic n = 5284 was 3.1e-7 off at mu = 0.99995 with a margin of 2.0e-7, found by
