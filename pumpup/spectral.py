@@ -203,7 +203,7 @@ class Spectral:
         from . import _reuse
         from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
         from .core import check_count, check_open_unit, check_tolerance
-        from .tables import MAX_POINTS_LIMIT, AlbedoTable, _dataset, _midpoints, _near_new_nodes, default_grid
+        from .tables import MAX_POINTS_LIMIT, _dataset, adaptive_grid, default_grid
 
         if phi is not None:
             raise SpecError("Spectral.tabulate: parameter 'phi' must be None (the spectral models are isotropic)")
@@ -230,27 +230,8 @@ class Spectral:
             check_mu(mu_min)
             grid = default_grid(mu_min=mu_min)
             vals, errs = values(grid)
-            interp = np.zeros(nw)
-            todo = np.ones(len(grid) - 1, bool)  # intervals not yet checked
-            miss = np.zeros((0, nw))
-            while todo.any() and len(grid) < max_points:
-                mids = _midpoints(grid)[todo]
-                mval, merr = values(mids)
-                miss = np.column_stack([np.abs(AlbedoTable(grid, vals[:, j], errs[:, j])(mids) - mval[:, j])
-                                        for j in range(nw)])
-                bad = (miss > interp_tol).any(axis=1)  # an interval fails if any wavelength misses
-                if (~bad).any():
-                    interp = np.maximum(interp, miss[~bad].max(axis=0))
-                new_mu = np.concatenate([grid, mids[bad]])
-                order = np.argsort(new_mu)
-                grid = new_mu[order]
-                vals = np.concatenate([vals, mval[bad]])[order]
-                errs = np.concatenate([errs, merr[bad]])[order]
-                # a new node changes the spline mostly within a few intervals: check again every
-                # interval within three nodes of a new one (as pumpup.tabulate)
-                todo = _near_new_nodes(order, int(bad.sum()))
-            if todo.any() and miss.size:  # stopped by max_points: the misses not resolved count
-                interp = np.maximum(interp, miss.max(axis=0))
+            # one grid for every wavelength: an interval fails if any wavelength misses (pumpup.tables.adaptive_grid)
+            grid, vals, errs, interp = adaptive_grid(grid, vals, errs, values, interp_tol, max_points)
             kind = "adaptive"
         for j, m in enumerate(self.models):  # mean_albedo / max_albedo of a model may reuse its column
             _reuse.remember(m, grid, vals[:, j], errs[:, j], rtol)
@@ -260,7 +241,7 @@ class Spectral:
                 "albedo": (("mu", "wavelength"), vals, template["albedo"].attrs),
                 "albedo_error": (("mu", "wavelength"), errs, template["albedo_error"].attrs),
                 "interpolation_error": ("wavelength", interp, {
-                    "long_name": "largest interpolation miss found at the checked midpoints", "units": "1"}),
+                    "long_name": "largest interpolation miss found at the checked points", "units": "1"}),
                 **{name: ("wavelength", v, {"long_name": _VARIABLE_NAMES[name], "units": "1"})
                    for name, v in self.wavelength_variables().items()},
             },

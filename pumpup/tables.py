@@ -262,6 +262,71 @@ def _splittable(mu: np.ndarray) -> np.ndarray:
     return (lm > lx[:-1]) & (lm < lx[1:])
 
 
+def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar=None):
+    """The adaptive grid of :func:`tabulate` (and of :meth:`pumpup.spectral.Spectral.tabulate`), from the values
+    ``val``, ``err`` at the nodes ``grid``: (grid, val, err, interp), ``interp`` the interpolation error per column.
+
+    ``val``, ``err`` are (n,) or (n, columns) (a table over (mu, phi), or (mu, wavelength)); ``values(mu)`` gives them
+    at new mu.  Every interval where the interpolant (:class:`AlbedoTable`, split at ``breaks``) of any column misses the
+    value at the midpoint in log(mu) by more than ``interp_tol`` is bisected, until none does or the grid has
+    ``max_points`` nodes; ``interp`` is each column's largest miss over the accepted intervals (all the last misses when
+    ``max_points`` stopped it), and over the checks of the last interval at 1 - mu = (1 - a) 2^-k (:func:`_near_one`)."""
+    one = val.ndim == 1
+    V, E = (val[:, None], err[:, None]) if one else (val, err)
+
+    def column_values(pts):
+        if bar is not None:
+            bar.total += len(pts)
+        v, e = values(pts)
+        return (v[:, None], e[:, None]) if one else (v, e)
+
+    def misses(grid, V, E, pts, pv):
+        return np.column_stack([np.abs(AlbedoTable(grid, V[:, j], E[:, j], breaks=breaks)(pts) - pv[:, j])
+                                for j in range(V.shape[1])])
+
+    interp = np.zeros(V.shape[1])
+    todo = np.ones(len(grid) - 1, bool)  # intervals not yet checked
+    miss = None
+    while todo.any() and len(grid) < max_points:
+        mids = _midpoints(grid)[todo]
+        mv, me = column_values(mids)
+        miss = misses(grid, V, E, mids, mv)
+        # an interval whose midpoint is not a new value of log(mu) is not split: its miss counts as an accepted one.
+        # The bisection reaches one where the values' own noise exceeds interp_tol (a divergent albedo, 3.5e6 at mu =
+        # 1.08e-8 with errors of 1e-5: interp_tol 1e-7 is 3e-14 of it), or at a jump of the albedo.  It split such an
+        # interval into two nodes of one log(mu) before (ValueError from scipy; issue 14's twenty-third session)
+        split = _splittable(grid)[todo]
+        bad = (miss > interp_tol).any(axis=1) & split
+        # (within such an interval the spline takes one end's value at every mu: its ends' spread counts too)
+        miss = np.where(split[:, None], miss, np.maximum(miss, np.abs(V[1:] - V[:-1])[todo]))
+        if (~bad).any():
+            interp = np.maximum(interp, miss[~bad].max(axis=0))
+        # accept the good intervals; add the bad midpoints as nodes
+        new_mu = np.concatenate([grid, mids[bad]])
+        order = np.argsort(new_mu)
+        grid = new_mu[order]
+        V = np.concatenate([V, mv[bad]])[order]
+        E = np.concatenate([E, me[bad]])[order]
+        # a new node changes the spline everywhere, mostly within a few intervals: check
+        # again every interval within three nodes of a new one
+        todo = _near_new_nodes(order, int(bad.sum()))
+    if todo.any():
+        if miss is None:  # (max_points below the first grid's size: its misses, measured once)
+            mids = _midpoints(grid)[todo]
+            miss = misses(grid, V, E, mids, column_values(mids)[0])
+        interp = np.maximum(interp, miss.max(axis=0))
+    # the interval that ends at mu = 1: its midpoint in log(mu) lies at theta / sqrt(2) of its lower end's theta, so 70 %
+    # of it in theta had no check.  A sharp lobe's pumped level turns there (the lobe reaches the normal below theta ~
+    # its width: pumped plastic n = 5284 was 3.1e-7 off at mu = 0.99995 with a margin of 2.0e-7, found by
+    # scripts/fuzz_engines.py --tables 43), and so does a g2 level whose bound crosses the diagonal within it (a kink
+    # the table's one spline goes across: pumping.albedo_kinks).  It is checked at 1 - mu = (1 - a) 2^-k too, down to
+    # NEAR_ONE_MIN, and the largest miss there counts (issue 14's twenty-third session)
+    pts = _near_one(grid[-2])
+    if len(pts):
+        interp = np.maximum(interp, misses(grid, V, E, pts, column_values(pts)[0]).max(axis=0))
+    return grid, (V[:, 0] if one else V), (E[:, 0] if one else E), interp
+
+
 def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
              interp_tol: float = 1e-7, mu_min: float = 1e-8, max_points: int = 2049, progress: bool | None = None,
              threads: int | None = None, phi=None, breaks=None):
@@ -362,57 +427,9 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
         grid = np.unique(np.concatenate([grid, breaks]))
     with _progress(len(grid), f"albedo {brdf.type}", progress) as bar:
         val, err = values(grid, bar)
-        interp_error = 0.0
-
-        def spline_miss(grid, val, err, pts, pval):
-            if val.ndim == 1:
-                return np.abs(AlbedoTable(grid, val, err, breaks=() if breaks is None else breaks)(pts) - pval)
-            # a table over (mu, phi): the worst column
-            return np.max([np.abs(AlbedoTable(grid, val[:, j], err[:, j])(pts) - pval[:, j])
-                           for j in range(val.shape[1])], axis=0)
-
-        todo = np.ones(len(grid) - 1, bool)  # intervals not yet checked
-        miss = None
-        while todo.any() and len(grid) < max_points:
-            mids = _midpoints(grid)[todo]
-            bar.total += len(mids)
-            mval, merr = values(mids, bar)
-            miss = spline_miss(grid, val, err, mids, mval)
-            # an interval whose midpoint is not a new value of log(mu) is not split: its miss counts as an accepted one.
-            # The bisection reaches one where the values' own noise exceeds interp_tol (a divergent albedo, 3.5e6 at mu =
-            # 1.08e-8 with errors of 1e-5: interp_tol 1e-7 is 3e-14 of it), or at a jump of the albedo.  It split such an
-            # interval into two nodes of one log(mu) before (ValueError from scipy; issue 14's twenty-third session)
-            split = _splittable(grid)[todo]
-            bad = (miss > interp_tol) & split
-            # (within such an interval the spline takes one end's value at every mu: its ends' spread counts too)
-            spread = np.abs(val[1:] - val[:-1])[todo]
-            miss = np.where(split, miss, np.maximum(miss, spread if spread.ndim == 1 else spread.max(axis=1)))
-            interp_error = max(interp_error, float(miss[~bad].max(initial=0.0)))
-            # accept the good intervals; add the bad midpoints as nodes
-            new_mu = np.concatenate([grid, mids[bad]])
-            order = np.argsort(new_mu)
-            grid = new_mu[order]
-            val = np.concatenate([val, mval[bad]])[order]
-            err = np.concatenate([err, merr[bad]])[order]
-            # a new node changes the spline everywhere, mostly within a few intervals: check
-            # again every interval within three nodes of a new one
-            todo = _near_new_nodes(order, int(bad.sum()))
-        if todo.any():
-            if miss is None:  # (max_points below the first grid's size: its misses, measured once)
-                mids = _midpoints(grid)[todo]
-                bar.total += len(mids)
-                miss = spline_miss(grid, val, err, mids, values(mids, bar)[0])
-            interp_error = max(interp_error, float(miss.max()))
-        # the interval that ends at mu = 1: its midpoint in log(mu) lies at theta / sqrt(2) of its lower end's theta, so
-        # 70 % of it in theta had no check.  A sharp lobe's pumped level turns there (the lobe reaches the normal below
-        # theta ~ its width: pumped plastic n = 5284 was 3.1e-7 off at mu = 0.99995 with a margin of 2.0e-7, found by
-        # scripts/fuzz_engines.py --tables 43), and so does a g2 level whose bound crosses the diagonal within it (a
-        # kink the table's one spline goes across: albedo_kinks).  It is checked at 1 - mu = (1 - a) 2^-k too, down to
-        # NEAR_ONE_MIN, and the largest miss there counts in interpolation_error (issue 14's twenty-third session)
-        pts = _near_one(grid[-2])
-        if len(pts):
-            bar.total += len(pts)
-            interp_error = max(interp_error, float(spline_miss(grid, val, err, pts, values(pts, bar)[0]).max()))
+        grid, val, err, interp = adaptive_grid(grid, val, err, lambda m: values(m, bar), interp_tol, max_points,
+                                               () if breaks is None else breaks, bar)
+        interp_error = float(interp.max())
     if reusable:
         _reuse.remember(brdf, grid, val, err, rtol)
     return _dataset(brdf, grid, val, err, rtol, atol, interp_error, "adaptive", phis, phi_kind, breaks)
