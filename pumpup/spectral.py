@@ -203,7 +203,7 @@ class Spectral:
         from . import _reuse
         from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
         from .core import check_count, check_open_unit, check_tolerance
-        from .tables import MAX_POINTS_LIMIT, _dataset, adaptive_grid, default_grid
+        from .tables import MAX_POINTS_LIMIT, _dataset, adaptive_grid, built_on_tables, default_grid
 
         if phi is not None:
             raise SpecError("Spectral.tabulate: parameter 'phi' must be None (the spectral models are isotropic)")
@@ -231,7 +231,8 @@ class Spectral:
             grid = default_grid(mu_min=mu_min)
             vals, errs = values(grid)
             # one grid for every wavelength: an interval fails if any wavelength misses (pumpup.tables.adaptive_grid)
-            grid, vals, errs, interp = adaptive_grid(grid, vals, errs, values, interp_tol, max_points)
+            grid, vals, errs, interp = adaptive_grid(grid, vals, errs, values, interp_tol, max_points,
+                                                     off_grid=built_on_tables(self.spec))
             kind = "adaptive"
         for j, m in enumerate(self.models):  # mean_albedo / max_albedo of a model may reuse its column
             _reuse.remember(m, grid, vals[:, j], errs[:, j], rtol)

@@ -262,7 +262,21 @@ def _splittable(mu: np.ndarray) -> np.ndarray:
     return (lm > lx[:-1]) & (lm < lx[1:])
 
 
-def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar=None):
+#: the models whose BRDF reads pumpup's own albedo tables (pumping's g, compensation's E): :func:`adaptive_grid` also checks
+#: their tables off the dyadic points (:func:`built_on_tables`)
+TABLE_MODELS = ("pumped", "kulla_conty", "scaled")
+
+
+def built_on_tables(spec) -> bool:
+    """Whether a spec, at any depth, holds a model of :data:`TABLE_MODELS`."""
+    if isinstance(spec, dict):
+        return spec.get("type") in TABLE_MODELS or any(built_on_tables(v) for v in spec.values())
+    if isinstance(spec, (list, tuple)):
+        return any(built_on_tables(v) for v in spec)
+    return False
+
+
+def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar=None, off_grid=False):
     """The adaptive grid of :func:`tabulate` (and of :meth:`pumpup.spectral.Spectral.tabulate`), from the values
     ``val``, ``err`` at the nodes ``grid``: (grid, val, err, interp), ``interp`` the interpolation error per column.
 
@@ -270,7 +284,8 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
     at new mu.  Every interval where the interpolant (:class:`AlbedoTable`, split at ``breaks``) of any column misses the
     value at the midpoint in log(mu) by more than ``interp_tol`` is bisected, until none does or the grid has
     ``max_points`` nodes; ``interp`` is each column's largest miss over the accepted intervals (all the last misses when
-    ``max_points`` stopped it), and over the checks of the last interval at 1 - mu = (1 - a) 2^-k (:func:`_near_one`)."""
+    ``max_points`` stopped it), and over the checks of the last interval at 1 - mu = (1 - a) 2^-k (:func:`_near_one`).
+    ``off_grid``: also over checks of every interval at its thirds in log(mu) (:func:`built_on_tables`)."""
     one = val.ndim == 1
     V, E = (val[:, None], err[:, None]) if one else (val, err)
 
@@ -322,6 +337,17 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
     # the table's one spline goes across: pumping.albedo_kinks).  It is checked at 1 - mu = (1 - a) 2^-k too, down to
     # NEAR_ONE_MIN, and the largest miss there counts (issue 14's twenty-third session)
     pts = _near_one(grid[-2])
+    if off_grid:
+        # a model that reads pumpup's own tables (a pumped level's g, a compensation's E) inherits their interpolation
+        # error between their nodes, and those nodes are this grid's and its midpoints: a check there is blind to it.
+        # Kulla-Conty over Torrance-Sparrow D1 (s 844, ior 1.53) was exact at its nodes and midpoints and 6.0e-8 off at
+        # mu = 0.039 with a margin of 5.9e-9 (scripts/fuzz_engines.py --tables 44; issue 14's twenty-third session).  The
+        # thirds of each interval in log(mu) are no nodes of a dyadic refinement; one third alone left it 1.24 x its
+        # margin (the interval held two of E's pieces), both 0.58 x
+        lx = np.log(grid)
+        thirds = np.concatenate([np.exp((2.0 * lx[:-1] + lx[1:]) / 3.0), np.exp((lx[:-1] + 2.0 * lx[1:]) / 3.0)])
+        inside = (np.log(thirds) > np.tile(lx[:-1], 2)) & (np.log(thirds) < np.tile(lx[1:], 2))
+        pts = np.concatenate([thirds[inside], pts])
     if len(pts):
         interp = np.maximum(interp, misses(grid, V, E, pts, column_values(pts)[0]).max(axis=0))
     return grid, (V[:, 0] if one else V), (E[:, 0] if one else E), interp
@@ -428,7 +454,7 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
     with _progress(len(grid), f"albedo {brdf.type}", progress) as bar:
         val, err = values(grid, bar)
         grid, val, err, interp = adaptive_grid(grid, val, err, lambda m: values(m, bar), interp_tol, max_points,
-                                               () if breaks is None else breaks, bar)
+                                               () if breaks is None else breaks, bar, built_on_tables(brdf.spec))
         interp_error = float(interp.max())
     if reusable:
         _reuse.remember(brdf, grid, val, err, rtol)

@@ -112,6 +112,21 @@ def test_the_interval_at_the_normal_is_checked_below_its_midpoint():
     assert np.all(np.abs(table(mu) - fresh) <= table.margin + err)
 
 
+def test_a_model_that_reads_tables_is_checked_off_the_dyadic_points():
+    """Kulla-Conty over Torrance-Sparrow D1 (s 844, ior 1.53) reads its base's E table, whose interpolant is exact at
+    the same nodes and midpoints this grid checks: its table claimed a margin of 5.9e-9 and was 6.0e-8 off at mu = 0.039
+    (scripts/fuzz_engines.py --tables 44).  The thirds of every interval count now (tables.built_on_tables)."""
+    spec = {"type": "kulla_conty", "base": {"type": "torrance_sparrow", "d": "D1", "s": 843.9511741619182,
+                                            "ior": 1.5263287885853667}}
+    assert pumpup.tables.built_on_tables(spec) and not pumpup.tables.built_on_tables(spec["base"])
+    f = pumpup.load(spec)
+    table = pumpup.AlbedoTable.from_dataset(pumpup.tabulate(f, progress=False))
+    mu = np.geomspace(0.02, 0.05, 31)
+    fresh, err = pumpup.albedo(f, mu, rtol=1e-12, return_error=True)
+    assert np.abs(table(mu) - fresh).max() > 5e-8  # (the case: 8 x the old margin)
+    assert np.all(np.abs(table(mu) - fresh) <= table.margin + err)
+
+
 def test_max_points_below_the_first_grid_measures_its_misses(monkeypatch):
     """max_points below the first grid's 45 nodes: that grid, with its misses at the midpoints measured once as the
     interpolation error (an UnboundLocalError before issue 14's twenty-third session)."""
