@@ -30,6 +30,11 @@ x = 1/2 for n > 52, so the kink scan missed a cut of Torrance-Sparrow's G enteri
 off, 1270 x); a Fresnel factor's total reflection (eta < 1, k = 0) unknown to the hints (--registry: correct, but 0.3 s
 per value and minutes per table on the nested engine).
 
+Found in the twenty-third session by --tables (each mended, with a test in tests/test_tables.py): a divergent albedo bisected
+down to two nodes of one log(mu) (scipy's ValueError); a table across a jump (Beckmann with Walter's G1) whose margin hid it;
+pumped plastic n = 5284 turning inside the interval at the normal, which only its midpoint checked (1.55 x its margin); and
+Kulla-Conty over Torrance-Sparrow, exact at the very points the grid checks because it reads a table built on them (8.6 x).
+
     PYTHONPATH=. python scripts/fuzz_engines.py [seed] [seconds]
     PYTHONPATH=. python scripts/fuzz_engines.py --two-d [seed] [seconds]   # models without a 1-D path: against the 2-D engine
     PYTHONPATH=. python scripts/fuzz_engines.py --tables [seed] [seconds]  # a table's interpolant against fresh values
