@@ -286,7 +286,7 @@ def test_cli_spectral_errors_one_line_status_2(argv, match, capsys, tmp_path, mo
     assert __import__("re").search(match, err), err
 
 
-def test_spectral_adaptive_grid_is_tabulates():
+def test_spectral_tables_share_tabulates_adaptive_grid():
     """The spectral table's adaptive grid is pumpup.tabulate's (pumpup.tables.adaptive_grid): with max_points below the
     first grid's size it measures that grid's misses per wavelength, where its own copy of the loop reported 0 (issue
     14's twenty-third session); and each wavelength's column agrees with tabulate of that wavelength's model on the
