@@ -116,7 +116,8 @@ class AlbedoTable:
             raise ValueError("an albedo table's values must be finite and its errors finite and >= 0")
         order = np.argsort(mu)
         self.mu = mu[order]
-        if np.any(np.diff(np.log(self.mu)) <= 0):  # (the spline's variable: distinct in log(mu))
+        lx = np.log(self.mu)  # (the spline's variable: its nodes must be distinct in it)
+        if np.any(np.diff(lx) <= 0):
             raise ValueError("an albedo table's mu must be distinct (in log(mu), the interpolant's variable)")
         self.value = value[order]
         self.error = error[order]
@@ -130,7 +131,6 @@ class AlbedoTable:
         #: the values of mu where the spline is split (inner nodes)
         self.breaks = tuple(float(b) for b in inner)
         ends = [0, *at.tolist(), len(self.mu) - 1]
-        lx = np.log(self.mu)
         pieces = [self._piece(lx[i:j + 1], self.value[i:j + 1], degree) for i, j in zip(ends[:-1], ends[1:])]
         self.degree = max(d for d, _ in pieces)
         if len(pieces) == 1:
