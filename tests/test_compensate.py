@@ -120,6 +120,25 @@ def test_kulla_conty_lobe_in_closed_form(spec):
     assert np.all(ea <= 1e-12 * a + 1e-300)  # (I's rounding bound, 32 eps, against I = 0.0088 for alpha = 0.05)
 
 
+@pytest.mark.parametrize("engine", ["nested", "2-D"])
+def test_kulla_conty_lobe_on_the_engines_near_grazing(engine):
+    """The Kulla-Conty lobe of Phong n = 987 (f_avg 0.69) near mu = 5.1e-4 on the nested and 2-D engines (the fuzz's
+    reference, scripts/fuzz_engines.py --registry 47): D(N.wo), a spline in log(N.wo), about the normal, was 3.4 x (2-D)
+    and 3.0 x (nested) their estimates at rtol 1e-12 against the closed form D(mu) pi I (checked against scipy's quad
+    above).  The hint's levels N.wo = 10^-k (compensate.TABLE_DECADES) grade the radial variable there."""
+    from pumpup import _polar
+
+    f = pumpup.load({"type": "kulla_conty", "base": {"type": "phong", "n": 986.5971775489417}, "f_avg": 0.6893058353882096})
+    ms = f.albedo_terms()[-1][1]
+    assert set(comp.TABLE_DECADES) <= set(ms.lobe(0.5).levels)
+    mu = np.linspace(0.000510255, 0.000510265, 9)
+    exact, ee = pumpup.albedo(ms, mu, return_error=True, rtol=1e-12)
+    with _polar.two_d_only() if engine == "2-D" else _polar.without_1d():
+        for rtol in (1e-10, 1e-12):
+            a, ea = pumpup.albedo(ms, mu, return_error=True, rtol=rtol, max_regions=200000)
+            assert np.all(np.abs(a - exact) <= ea + ee), (rtol, a - exact, ea, ee)
+
+
 def test_kulla_conty_against_brute_force_quadrature():
     """An independent reference: a 600 x 400 Gauss-Legendre grid in (theta_o, phi_o), numpy only,
     of the base plus the lobe evaluated from its definition (base Beckmann alpha = 0.6, smooth)."""
@@ -213,6 +232,30 @@ def test_scaled_furnace_of_a_forced_non_reciprocal_base_stays_nested():
     keeps the nested engine."""
     s = pumpup.compensate({"type": "phong_shader", "n": 20}, method="scale", force=True)
     assert not s.base.reciprocal and comp._Transposed(s).polar() is None
+
+
+def test_scaled_lobe_about_the_normal_against_rings():
+    """Scaled Lafortune n = 148 (cx = cy = -1, a lobe about the normal's hint) near grazing incidence: 1 / U(N.wo), a
+    spline in log(N.wo), has features on every scale of N.wo, all in the nested engine's last first interval of the
+    radial variable.  At rtol 1e-6 it was 1.56 x its estimate at mu = 2.6e-6 and 1.14 x at 0.01 (scripts/fuzz_engines.py
+    --registry 47); the hint's levels at N.wo = 10^-k (compensate.TABLE_DECADES) grade it.  The reference: quad in
+    N.wo between the table's nodes, Gauss-Legendre in the azimuth where the lobe is positive."""
+    from test_albedo_breaks import _rings
+
+    f = pumpup.load({"type": "scaled", "base": {"type": "lafortune", "n": 148.1120358399101, "cx": -1.0, "cy": -1.0,
+                                                "cz": 1.0}})
+    assert f.lobe(0.5).axis == "normal" and set(comp.TABLE_DECADES) <= set(f.lobe(0.5).levels)
+    for mu in (2.55020188e-06, 0.01):
+        s = math.sqrt((1.0 - mu) * (1.0 + mu))
+
+        def cuts(mo, so):  # the lobe's argument s so cos(phi) + mu mo is positive for cos(phi) > -mu mo / (s so)
+            a, b = mu * mo, s * so
+            return [0.0, math.pi if a >= b else math.acos(-a / b)]
+
+        ref = _rings(f, mu, cuts, np.concatenate([np.exp(f.bound.lookup.logx), [s]]))
+        for rtol in (1e-6, 1e-8, 1e-10):
+            a, e = pumpup.albedo(f, mu, rtol=rtol, return_error=True)
+            assert abs(float(a) - ref) <= float(e) + 1e-13, (mu, rtol, float(a), ref, float(e))
 
 
 def test_ward_is_refused_by_kulla_conty_and_pumped_by_g1_g2():
