@@ -58,7 +58,7 @@ import numpy as np
 from numba import njit
 
 from .core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register
-from .pumping import _CELL_SHIFT, Pumped, _float_bits, _key, _Lookup, _Product, _ProductError, _upper_scalar, file_tables, from_file
+from .pumping import TABLE_DECADES, _CELL_SHIFT, table_decades, Pumped, _float_bits, _key, _Lookup, _Product, _ProductError, _upper_scalar, file_tables, from_file
 
 __all__ = ["compensate", "KullaConty", "Scaled", "save_compensated", "load_compensated", "furnace",
            "compensation_table", "METHODS", "fresnel_average"]
@@ -582,21 +582,10 @@ class _MsLobe(BRDF):
                      ulps=8.0 + rel / np.finfo(float).eps)
 
 
-#: levels N.wo = 10^-k that a lobe about the normal adds where it carries a factor tabulated in log(N.wo) (the nested and
-#: 2-D engines): 1 / U(N.wo) of a scaled model, D(N.wo) of the Kulla-Conty lobe.  Such a spline has features on every
-#: scale of N.wo down to its table's smallest node; about the normal a level is one value of the radial variable, and
-#: those scales all lie in the first grid's last interval, [7/8, 1] (N.wo < 0.21), whose 7- and 15-point rules agreed
-#: while both missed.  Scaled Lafortune n = 148 (cx = cy = -1, cz = 1) at rtol 1e-6 was 1.14-1.56 x its estimate at every
-#: mu from 0.01 down to 2.6e-6, and the Kulla-Conty lobe of Phong n = 987 (f_avg 0.69) at rtol 1e-12 3.4 x on the 2-D
-#: engine, the fuzz's reference (scripts/fuzz_engines.py --registry 47; issue 14's twenty-fourth session).  A lobe about
-#: another axis has N.wo vary along its arcs, where the estimate held (levels there cut every arc: 1.2-2.5 x the time)
-TABLE_DECADES = tuple(10.0 ** -k for k in range(1, 9))
-
-
 def _scaled_lobe(b: Lobe, bound) -> Lobe:
-    """The hint of a scaled lobe: the base's (``b``), with U's kinks and, about the normal, :data:`TABLE_DECADES` as
-    levels."""
-    levels = set(b.levels) | set(bound.kinks) | (set(TABLE_DECADES) if b.axis == "normal" else set())
+    """The hint of a scaled lobe: the base's (``b``), with U's kinks and, about the normal, the levels of
+    :func:`pumpup.pumping.table_decades`."""
+    levels = set(b.levels) | set(bound.kinks) | table_decades(b)
     return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness, levels=tuple(sorted(levels)), kinks=b.kinks,
                 symmetric=b.symmetric)
 

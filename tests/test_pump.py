@@ -312,3 +312,26 @@ def test_product_table_that_cannot_reach_its_tolerance_falls_back(monkeypatch, r
     assert f.lookup().increasing and f.product() is None
     wi, wo = random_directions(rng, 2000), random_directions(rng, 2000)[::-1]
     np.testing.assert_allclose(f.eval(wi, wo), f.reference(wi, wo), rtol=1e-13, atol=1e-300)
+
+
+def test_pumped_lobe_about_the_normal_against_rings():
+    """g2 pumped Minnaert k = 0.31 at mu = 0.88: g(N.wo) is the base's albedo table below N.wo = mu, a spline in log(N.wo)
+    with features on every scale, which about the normal all lay in the nested (and 2-D) engine's last first interval:
+    4.1 x its estimate at every rtol from 1e-6 to 1e-12.  The hint's levels N.wo = 10^-k (pumping.TABLE_DECADES) grade
+    it.  The reference: f / g is constant on a ring of N.wo, so quad in N.wo between the table's nodes (the rings of
+    tests/test_albedo_breaks.py)."""
+    import math
+
+    from pumpup import _polar
+    from pumpup.pumping import TABLE_DECADES
+    from test_albedo_breaks import _rings
+
+    f = pumpup.load({"type": "pumped", "base": {"type": "minnaert", "k": 0.3089221621228797}, "g": "g2"})
+    mu = 0.880332154
+    assert set(TABLE_DECADES) <= set(f.lobe(mu).levels)
+    ref = _rings(f, mu, lambda mo, so: [0.0, math.pi], np.concatenate([[mu], np.exp(f.lookup().logx)]))
+    for engine in (None, _polar.two_d_only):
+        with engine() if engine else _polar.without_1d():
+            for rtol in (1e-6, 1e-10, 1e-12):
+                a, e = pumpup.albedo(f, mu, rtol=rtol, return_error=True)
+                assert abs(float(a) - ref) <= float(e) + 1e-15, (rtol, float(a), ref, float(e))
