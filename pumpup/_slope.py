@@ -97,6 +97,8 @@ EDGE_FACTOR = 4.0
 EDGE_MAX = 1.0
 #: the most graded cuts per side
 N_GRADE = 40
+#: room for the first cuts over theta (the edge's and the axes' gradings, :func:`_slope_one`)
+OFFS_CAP = 8 * N_GRADE + 32
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -232,7 +234,7 @@ def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk
     # Gaussian (edge < EDGE_MAX, near grazing incidence), cuts graded from each parallel towards th0, where the rays' R
     # falls from beyond R_MAX to about the edge's distance within an angle of a few times that distance; gaps wider than
     # pi / 2 halved
-    offs = np.empty(4 * N_GRADE + 16)
+    offs = np.empty(OFFS_CAP)
     n = 0
     offs[n] = 0.0
     offs[n + 1] = math.pi
@@ -257,6 +259,30 @@ def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk
             offs[n] = o + math.copysign(grade, o)
             n += 1
             grade *= EDGE_FACTOR
+    # |e|^2 = a_x^2 cos^2(theta) + a_y^2 sin^2(theta) vanishes at theta = theta_a +- i atanh(a_min / a_max), theta_a the
+    # direction of the smaller slope's axis (pi / 2 and 3 pi / 2 where a_y < a_x): |e| J(theta) has a branch point that
+    # close to the real axis.  The rule's 7 and 15 points on an interval ending near theta_a agreed while both missed:
+    # a_x = 0.743, a_y = 0.0149 at mu = 1 (phi = 5.898) was 8.0e-10 off with an estimate of 4.7e-11 at rtol 1e-8, 72 x at
+    # mu = 1 - 1e-9 and rtol 1e-10 (scripts/fuzz_engines.py --registry 47; issue 14's twenty-fourth session).  Cuts at
+    # theta_a and graded by EDGE_FACTOR from the branch point's distance on both sides
+    if ax != ay:
+        dist = math.atanh(min(ax, ay) / max(ax, ay))
+        for j in range(2):
+            o = (0.5 * math.pi if ay < ax else 0.0) + math.pi * j - th0
+            o -= 2.0 * math.pi * math.floor(o / (2.0 * math.pi) + 0.5)  # in [-pi, pi)
+            if half:
+                o = abs(o)  # (J is even about th0: its mirror image)
+            for side in (-1.0, 1.0):
+                grade = dist
+                while grade < 0.25 * math.pi and n < offs.shape[0] - 8:
+                    q = o + side * grade
+                    if -math.pi < q < math.pi and not (half and q <= 0.0):
+                        offs[n] = q
+                        n += 1
+                    grade *= EDGE_FACTOR
+            if -math.pi < o < math.pi and not (half and o <= 0.0) and n < offs.shape[0] - 8:
+                offs[n] = o
+                n += 1
     offs[:n].sort()
     for i in range(n - 1):
         if offs[i + 1] - offs[i] > 0.5 * math.pi:
@@ -305,7 +331,7 @@ def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk
 
 @njit(cache=True, nogil=True)
 def _slope_all(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk, twg, nodes, wk, wg, mode, val, err, conv, evals):  # pragma: no cover
-    work = np.empty((5, max(max_intervals, 4 * N_GRADE + 16) + 1))
+    work = np.empty((5, max(max_intervals, OFFS_CAP) + 1))
     buf = np.empty(tnodes.shape[0])
     ibuf = np.empty(nodes.shape[0])
     rw = np.empty((5, RAY_MAX))
