@@ -35,6 +35,14 @@ down to two nodes of one log(mu) (scipy's ValueError); a table across a jump (Be
 pumped plastic n = 5284 turning inside the interval at the normal, which only its midpoint checked (1.55 x its margin); and
 Kulla-Conty over Torrance-Sparrow, exact at the very points the grid checks because it reads a table built on them (8.6 x).
 
+Found in the twenty-fourth session by --registry 47 (each mended, with a test): lobes about the normal that carry a table in
+log(N.wo) (a scaled model's 1 / U, the Kulla-Conty lobe's D, a pumped level's g) on the nested and 2-D engines, whose
+features on every scale of N.wo lay in one first interval (scaled Lafortune 1.56 x, scaled lacquer 2.5 x, the Kulla-Conty
+lobe of Phong n = 987 3.4 x on the 2-D engine, g2 pumped Minnaert 4.1 x: ``pumping.TABLE_DECADES``); the slope path near
+normal incidence for a_x / a_y = 50, whose |e| has a branch point 0.02 off the real axis of theta (72 x).  Left: the 2-D
+engine unconverged on fresnel (eta 0.232) over plastic (n 34.4, eta 1.88, ad 0.33) at mu = 0.306, 1.75-4 x its estimate at
+max_regions 2e3-2e5 (the default path and the nested engine agree to 1e-9 there).
+
     PYTHONPATH=. python scripts/fuzz_engines.py [seed] [seconds]
     PYTHONPATH=. python scripts/fuzz_engines.py --two-d [seed] [seconds]   # models without a 1-D path: against the 2-D engine
     PYTHONPATH=. python scripts/fuzz_engines.py --tables [seed] [seconds]  # a table's interpolant against fresh values
