@@ -338,54 +338,6 @@ BREAK_MODELS = [
     {"type": "pumped", "base": {"type": "cook_torrance", "m": 0.3}, "g": "g2"},
     SCALED, {"type": "kulla_conty", "base": {"type": "cook_torrance", "m": 0.3}},
 ]
-# --- pumped Cook-Torrance: a level of g that is one of the geometry factor's cuts ---------------------------------------
-
-PUMPED_CT = {"type": "pumped", "base": {"type": "cook_torrance", "m": 0.3, "ior": 1.5}, "g": "g2"}
-
-
-def test_a_level_on_a_cut_of_the_model_adds_no_crossings():
-    """g's kink N.wo = mu is also Cook-Torrance's kink wo_z - mu: the crossing function of the two is rounding noise,
-    whose sign changes gave 292 breaks at mu = 0.5 (60 x the base model's evaluations on the nested engine).  One curve
-    computed twice has no crossing (albedo.COINCIDENT); a level 1e-7 away still crosses the other cuts."""
-    lobe = pumpup.load(CT).lobe(0.5)
-    mu = np.array([0.5])
-    plain = A._kink_breaks(lobe, mu, np.zeros((1, 0)))[0]
-    breaks = {}
-    for level in (0.5, 0.5 + 1e-7):
-        breaks[level] = A._kink_breaks(lobe, mu, np.array([[level]]))
-        _assert_same_bits(breaks[level], A._kink_breaks_reference(lobe, mu, np.array([[level]])))
-    assert len(plain) <= len(breaks[0.5][0]) <= len(plain) + 4, (len(plain), len(breaks[0.5][0]))
-    assert len(breaks[0.5 + 1e-7][0]) > len(breaks[0.5][0])
-
-
-@pytest.mark.parametrize("engine", ["nested", "2-D"])
-def test_pumped_cook_torrance_against_rings(engine):
-    """Pumped Cook-Torrance (g2) at mu = 0.5 against the rings of :func:`_ct_reference` (g is one number on a ring of
-    constant mu_o; its kink mu_o = mu a point of the quadrature in mu_o), with the breaks above."""
-    f = pumpup.load(PUMPED_CT)
-    s = math.sqrt(0.75)
-
-    def ck(mo):
-        so = math.sqrt((1.0 - mo) * (1.0 + mo))
-        return (2.0 * min(0.5, mo) * (0.5 + mo) - 1.0 - 0.5 * mo) / (s * so)
-
-    def cuts(mo, so):
-        c = ck(mo)
-        return [0.0] + ([math.acos(c)] if -1 < c < 1 else []) + [math.pi]
-
-    grid = np.linspace(1e-9, 1 - 1e-12, 4001)
-    pts = [0.5, *[v for v in f.kink_levels(0.5) if 0.0 < v < 1.0]]
-    for sign in (1.0, -1.0):
-        h = np.array([ck(m) - sign for m in grid])
-        pts += [brentq(lambda m: ck(m) - sign, grid[i], grid[i + 1], xtol=1e-16)
-                for i in np.nonzero(np.sign(h[:-1]) * np.sign(h[1:]) < 0)[0]]
-    ref = _rings(f, 0.5, cuts, pts)
-    with _polar.two_d_only() if engine == "2-D" else contextlib.nullcontext():
-        for rtol in (1e-10, 1e-12):
-            a, e = pumpup.albedo(f, 0.5, return_error=True, rtol=rtol)
-            assert abs(float(a) - ref) <= float(e) + REF_ERR, (rtol, float(a), ref, float(e))
-
-
 #: mu uniform in theta (as the tables), grazing, normal, and the cases above
 BREAK_MU = np.unique(np.concatenate([np.cos(np.linspace(0, np.pi / 2, 258)[:-1]),
                                      [1e-8, 1e-6, 1e-3, MU_CT, 0.5, MU_SCALED, 1 - 1e-9, 1.0]]))
@@ -529,3 +481,51 @@ def test_2d_engine_sees_a_kink_that_enters_and_leaves_above_the_split():
         with _polar.two_d_only():
             a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
         assert abs(float(a) - ref) <= float(e) + 1e-13, (float(a) - ref, float(e))
+
+
+# --- pumped Cook-Torrance: a level of g that is one of the geometry factor's cuts ---------------------------------------
+
+PUMPED_CT = {"type": "pumped", "base": {"type": "cook_torrance", "m": 0.3, "ior": 1.5}, "g": "g2"}
+
+
+def test_a_level_on_a_cut_of_the_model_adds_no_crossings():
+    """g's kink N.wo = mu is also Cook-Torrance's kink wo_z - mu: the crossing function of the two is rounding noise,
+    whose sign changes gave 292 breaks at mu = 0.5 (40-60 x the base model's evaluations on the nested engine).  One curve
+    computed twice has no crossing (albedo.COINCIDENT); a level 1e-7 away still crosses the other cuts."""
+    lobe = pumpup.load(CT).lobe(0.5)
+    mu = np.array([0.5])
+    plain = A._kink_breaks(lobe, mu, np.zeros((1, 0)))[0]
+    breaks = {}
+    for level in (0.5, 0.5 + 1e-7):
+        breaks[level] = A._kink_breaks(lobe, mu, np.array([[level]]))
+        _assert_same_bits(breaks[level], A._kink_breaks_reference(lobe, mu, np.array([[level]])))
+    assert len(plain) <= len(breaks[0.5][0]) <= len(plain) + 4, (len(plain), len(breaks[0.5][0]))
+    assert len(breaks[0.5 + 1e-7][0]) > len(breaks[0.5][0])
+
+
+@pytest.mark.parametrize("engine", ["nested", "2-D"])
+def test_pumped_cook_torrance_against_rings(engine):
+    """Pumped Cook-Torrance (g2) at mu = 0.5 against the rings of :func:`_ct_reference` (g is one number on a ring of
+    constant mu_o; its kink mu_o = mu a point of the quadrature in mu_o), with the breaks above."""
+    f = pumpup.load(PUMPED_CT)
+    s = math.sqrt(0.75)
+
+    def ck(mo):
+        so = math.sqrt((1.0 - mo) * (1.0 + mo))
+        return (2.0 * min(0.5, mo) * (0.5 + mo) - 1.0 - 0.5 * mo) / (s * so)
+
+    def cuts(mo, so):
+        c = ck(mo)
+        return [0.0] + ([math.acos(c)] if -1 < c < 1 else []) + [math.pi]
+
+    grid = np.linspace(1e-9, 1 - 1e-12, 4001)
+    pts = [0.5, *[v for v in f.kink_levels(0.5) if 0.0 < v < 1.0]]
+    for sign in (1.0, -1.0):
+        h = np.array([ck(m) - sign for m in grid])
+        pts += [brentq(lambda m: ck(m) - sign, grid[i], grid[i + 1], xtol=1e-16)
+                for i in np.nonzero(np.sign(h[:-1]) * np.sign(h[1:]) < 0)[0]]
+    ref = _rings(f, 0.5, cuts, pts)
+    with _polar.two_d_only() if engine == "2-D" else contextlib.nullcontext():
+        for rtol in (1e-10, 1e-12):
+            a, e = pumpup.albedo(f, 0.5, return_error=True, rtol=rtol)
+            assert abs(float(a) - ref) <= float(e) + REF_ERR, (rtol, float(a), ref, float(e))
