@@ -39,16 +39,10 @@ Found in the twenty-fourth session by --registry 47 (each mended, with a test): 
 log(N.wo) (a scaled model's 1 / U, the Kulla-Conty lobe's D, a pumped level's g) on the nested and 2-D engines, whose
 features on every scale of N.wo lay in one first interval (scaled Lafortune 1.56 x, scaled lacquer 2.5 x, the Kulla-Conty
 lobe of Phong n = 987 3.4 x on the 2-D engine, g2 pumped Minnaert 4.1 x: ``pumping.TABLE_DECADES``); the slope path near
-normal incidence for a_x / a_y = 50, whose |e| has a branch point 0.02 off the real axis of theta (72 x).  Left: the 2-D
-engine unconverged on fresnel (eta 0.232) over plastic (n 34.4, eta 1.88, ad 0.33) at mu = 0.306, 1.75-4 x its estimate at
-max_regions 2e3-2e5 (the default path and the nested engine agree to 1e-9 there).
-
-    PYTHONPATH=. python scripts/fuzz_engines.py [seed] [seconds]
-    PYTHONPATH=. python scripts/fuzz_engines.py --two-d [seed] [seconds]   # models without a 1-D path: against the 2-D engine
-    PYTHONPATH=. python scripts/fuzz_engines.py --tables [seed] [seconds]  # a table's interpolant against fresh values
-    PYTHONPATH=. python scripts/fuzz_engines.py --mean [seed] [seconds]    # mean_albedo against a quad of fresh values
-    PYTHONPATH=. python scripts/fuzz_engines.py --registry [seed] [seconds]  # every registered model against the 2-D engine
-    PYTHONPATH=. python scripts/fuzz_engines.py --fmax [seed] [seconds]   # the fresnel wrapper over GGX, Beckmann, Schlick
+normal incidence for a_x / a_y = 50, whose |e| has a branch point 0.02 off the real axis of theta (72 x); and the 2-D
+engine unconverged on fresnel (eta 0.232) over plastic (n 34.4, eta 1.88, ad 0.33) at mu = 0.306, which showed that every
+engine was wrong there (0.2908 for 0.4060, with estimates of 1e-9): the fresnel wrapper was one albedo term with plastic's
+specular hint for its Lambert part too (``FresnelWeighted.albedo_terms`` now splits it over the base's terms).
 """
 
 import math

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import vectorize
 
-from ..core import MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, register
+from ..core import MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, SpecError, load, register
 from .metal import _fresnel_real, fresnel, fresnel_levels
 
 __all__ = ["FresnelWeighted"]
@@ -93,6 +93,20 @@ class FresnelWeighted(BRDF):
         return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
                     levels=tuple(sorted(set(b.levels) | {float(mu), *fresnel_levels(self.p["eta"], self.p["k"])})),
                     kinks=b.kinks, symmetric=b.symmetric)
+
+    def albedo_terms(self):
+        """F(Theta_min) times each of the base's linear terms (F sum w_k f_k = sum w_k F f_k), each term with its own
+        hint; itself where the base is one term, or where a term has no spec of its own.  As one term, fresnel over plastic
+        (n 34.4, eta 1.88, ad 0.33) had the specular lobe's hint (the power map about the mirror, n = 34) for its Lambert
+        part too, which then lay in the map's compressed tail: the 2-D engine at mu = 0.306 did not converge and was 1.75-4
+        x its estimate at max_regions 2e3-2e5 (scripts/fuzz_engines.py --registry 47; issue 14's twenty-fourth session)."""
+        terms = self.base.albedo_terms()
+        if len(terms) == 1 and terms[0][1] is self.base:
+            return [(1.0, self)]
+        try:
+            return [(w, load({"type": "fresnel", "base": t.spec, "eta": self.p["eta"], "k": self.p["k"]})) for w, t in terms]
+        except SpecError:  # (a term that is no model of the registry: a compensated model's parts)
+            return [(1.0, self)]
 
     def albedo_breaks(self):
         return tuple(sorted({*fresnel_levels(self.p["eta"], self.p["k"]), *self.base.albedo_breaks()}))
