@@ -1157,7 +1157,7 @@ class _Divided(BRDF):
     def lobe(self, mu):
         b = self.term.lobe(mu)
         return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
-                    levels=tuple(sorted(set(b.levels) | set(self.pumped.kink_levels(mu)))),
+                    levels=tuple(sorted(set(b.levels) | set(self.pumped.kink_levels(mu)) | table_decades(b))),
                     kinks=b.kinks, symmetric=b.symmetric)
 
 

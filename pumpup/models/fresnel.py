@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import vectorize
 
-from ..core import MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, SpecError, load, register
+from ..core import MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, register
 from .metal import _fresnel_real, fresnel, fresnel_levels
 
 __all__ = ["FresnelWeighted"]
@@ -96,17 +96,15 @@ class FresnelWeighted(BRDF):
 
     def albedo_terms(self):
         """F(Theta_min) times each of the base's linear terms (F sum w_k f_k = sum w_k F f_k), each term with its own
-        hint; itself where the base is one term, or where a term has no spec of its own.  As one term, fresnel over plastic
-        (n 34.4, eta 1.88, ad 0.33) had the specular lobe's hint (the power map about the mirror, n = 34) for its Lambert
-        part too, which then lay in the map's compressed tail: the 2-D engine at mu = 0.306 did not converge and was 1.75-4
-        x its estimate at max_regions 2e3-2e5 (scripts/fuzz_engines.py --registry 47; issue 14's twenty-fourth session)."""
+        hint (:class:`_FresnelTerm`); itself where the base is one term.  As one term, fresnel over plastic (n 34.4, eta
+        1.88, ad 0.33) had the specular lobe's hint (the power map about the mirror, n = 34) for its Lambert part too,
+        and the engines lost part of it with estimates of 1e-9 (0.2908 for 0.4060 at mu = 0.306, eta 0.232), and over a
+        2-level pumped plastic half of it (0.468 for 0.959 at mu = 1; scripts/fuzz_engines.py --registry 47 and 48;
+        issue 14's twenty-fourth session)."""
         terms = self.base.albedo_terms()
         if len(terms) == 1 and terms[0][1] is self.base:
             return [(1.0, self)]
-        try:
-            return [(w, load({"type": "fresnel", "base": t.spec, "eta": self.p["eta"], "k": self.p["k"]})) for w, t in terms]
-        except SpecError:  # (a term that is no model of the registry: a compensated model's parts)
-            return [(1.0, self)]
+        return [(w, _FresnelTerm(t, self.p["eta"], self.p["k"])) for w, t in terms]
 
     def albedo_breaks(self):
         return tuple(sorted({*fresnel_levels(self.p["eta"], self.p["k"]), *self.base.albedo_breaks()}))
@@ -127,3 +125,21 @@ class FresnelWeighted(BRDF):
         if hint is not None and hint.kind == "half":
             return with_fresnel_max(hint, self.p["eta"], self.p["k"])
         return with_fresnel(hint, self.p["eta"], self.p["k"])
+
+
+class _FresnelTerm(FresnelWeighted):
+    """One linear term of the ``fresnel`` wrapper over a sum: F(Theta_min) f_k, f_k any term of the base (a model, or a
+    part of a pumped or compensated model, which has no spec of the registry), with f_k's own hint."""
+
+    type = "fresnel-term"
+
+    def __init__(self, term: BRDF, eta: float, k: float):  # noqa: D107 - bypasses the registry's parameter parsing
+        self.p = {"base": term, "eta": float(eta), "k": float(k)}
+        self.reciprocal = bool(term.reciprocal)
+
+    @property
+    def spec(self) -> dict:
+        return {"type": self.type, "base": self.base.spec, "eta": self.p["eta"], "k": self.p["k"]}
+
+    def albedo_terms(self):
+        return [(1.0, self)]
