@@ -136,8 +136,7 @@ def supports(g) -> bool:
     if not (ENABLED and _polar.ENABLED):
         return False
     lobe = g.lobe
-    generic = lobe.axis == "normal" and lobe.radial == "cosine" and not lobe.symmetric
-    return not generic and lobe.axis in _AXIS_CODE and lobe.radial in _RADIAL_CODE
+    return not lobe.generic and lobe.axis in _AXIS_CODE and lobe.radial in _RADIAL_CODE
 
 
 def inner_error(kronrod, gauss):

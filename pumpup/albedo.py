@@ -1420,8 +1420,7 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
     Phong n = 1 at mu = 0.01 gave 1.9e-7 and 7e-12 off on the two grids), and it is converged only if both
     are and their difference meets the tolerance.  This costs the generic path about twice the evaluations.
     """
-    generic = g.lobe.axis == "normal" and g.lobe.radial == "cosine" and not g.lobe.symmetric
-    if generic and GENERIC_CHECK and grid is None:
+    if g.lobe.generic and GENERIC_CHECK and grid is None:
         lev = np.concatenate([g.levels, g.mu[:, None]], axis=1)
         g2 = _Group(lobe=g.lobe, mu=g.mu, levels=lev, phi=g.phi)
         v1, e1, c1 = _integrate_group(brdf, g2, rtol, atol, max_regions, grid=(8, 8))
@@ -1430,8 +1429,8 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
         return v2, np.maximum(e1, e2) + diff, c1 & c2 & (diff <= np.maximum(rtol * np.abs(v2), atol))
     P = len(g.mu)
     n_pieces = 1 + g.levels.shape[1] + (len(g.lobe.kinks(np.array([0.5]), np.array([0.5]), np.array([0.5]), np.array([0.5]))) if g.lobe.kinks else 0)
-    nx = NX_INIT if not generic else (8 if grid is None else grid[0])
-    nt = NT_INIT if not generic else (8 if grid is None else grid[1])
+    nx = NX_INIT if not g.lobe.generic else (8 if grid is None else grid[0])
+    nt = NT_INIT if not g.lobe.generic else (8 if grid is None else grid[1])
     # initial rectangles: nx x nt per piece per problem, with the x grid also split where
     # the horizon starts to cut the lobe and where it hides it completely
     gt = np.linspace(0, 1, nt + 1)

@@ -204,6 +204,12 @@ class Lobe:
     symmetric: bool = True
     # terms of the same lobe family added linearly are handled by BRDF.albedo_terms
 
+    @property
+    def generic(self) -> bool:
+        """Whether this is the hint of a model without one (:meth:`BRDF.lobe`'s default: about the normal, the cosine
+        map, not symmetric), which the 2-D engine's generic path integrates without trusting it."""
+        return self.axis == "normal" and self.radial == "cosine" and not self.symmetric
+
 
 # ----------------------------------------------------------------------------------------
 # The BRDF base class and the registry

@@ -644,8 +644,7 @@ def table_decades(b: Lobe) -> set:
     of a model without one (about the normal, the cosine map, not symmetric: :func:`pumpup.from_function`'s), which the
     2-D engine's generic path integrates without trusting it (there the levels cost a pumped user function 12 x the
     time, and its estimate held without them against a ring quadrature)."""
-    generic = b.radial == "cosine" and not b.symmetric
-    return set(TABLE_DECADES) if b.axis == "normal" and not generic else set()
+    return set(TABLE_DECADES) if b.axis == "normal" and not b.generic else set()
 
 
 @register("pumped")

@@ -88,7 +88,7 @@ def _nested_applies(f) -> bool:
     vector's models: the nested engine integrated those before, and is their second engine in the tests)."""
     for _, t in f.albedo_terms():
         lobe = t.lobe(0.5)
-        if lobe.axis == "normal" and lobe.radial == "cosine" and not lobe.symmetric:
+        if lobe.generic:
             return False
     return True
 
