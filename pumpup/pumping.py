@@ -647,6 +647,14 @@ def table_decades(b: Lobe) -> set:
     return set(TABLE_DECADES) if b.axis == "normal" and not b.generic else set()
 
 
+def _divided_lobe(b: Lobe, pumped: "Pumped", mu: float) -> Lobe:
+    """The hint of f / g for the hint ``b`` of f (a pumped model's base, or one term of its sum): b with g's kink levels
+    at incidence ``mu`` and, about the normal, :func:`table_decades` (g is a table in log(N.wo))."""
+    return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
+                levels=tuple(sorted(set(b.levels) | set(pumped.kink_levels(mu)) | table_decades(b))),
+                kinks=b.kinks, symmetric=b.symmetric)
+
+
 @register("pumped")
 class Pumped(BRDF):
     """One level of albedo pumping-up, f*(wi, wo) = f(wi, wo) / g(wi, wo) (001 eq. 16).
@@ -1084,10 +1092,7 @@ class Pumped(BRDF):
         return tuple(sorted(out))
 
     def lobe(self, mu: float) -> Lobe:
-        b = self.base.lobe(mu)
-        return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
-                    levels=tuple(sorted(set(b.levels) | set(self.kink_levels(mu)) | table_decades(b))),
-                    kinks=b.kinks, symmetric=b.symmetric)
+        return _divided_lobe(self.base.lobe(mu), self, mu)
 
     def sampling_lobe(self, mu: float) -> Lobe:
         return self.base.sampling_lobe(mu)  # f / g has the lobe of f; g only rescales it
@@ -1154,10 +1159,7 @@ class _Divided(BRDF):
         return self.term.azimuth_range()
 
     def lobe(self, mu):
-        b = self.term.lobe(mu)
-        return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
-                    levels=tuple(sorted(set(b.levels) | set(self.pumped.kink_levels(mu)) | table_decades(b))),
-                    kinks=b.kinks, symmetric=b.symmetric)
+        return _divided_lobe(self.term.lobe(mu), self.pumped, mu)
 
 
 def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False) -> Pumped:
