@@ -186,7 +186,11 @@ class _Bound:
             p = self.product
             pargs = (p.mlo, p.cbase, p.cstart, p.lo, p.rows)
         self.args = pargs + lk.args()
-        self.deficit_integral, self.kinks = self._integral()
+        self.deficit_integral, kinks = self._integral()
+        #: the kinks of D in (0, 1): where U reaches 1, and the table's breaks (:attr:`pumpup.tables.AlbedoTable.breaks`,
+        #: the spline's split points: the albedo's own, Cook-Torrance's pumpup.models.cook_torrance.RETRO_BREAK, a Fresnel
+        #: factor's total reflection), the levels of every lobe that carries U(N.wo)
+        self.kinks = sorted(set(kinks) | {b for b in table.breaks if 0.0 < b < 1.0})
 
     def upper(self, mu) -> np.ndarray:
         """U(mu) in plain numpy (the reference of :func:`_bound`)."""

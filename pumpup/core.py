@@ -480,10 +480,13 @@ class BRDF:
         return [(1.0, self)]
 
     def albedo_breaks(self) -> tuple:
-        """Incidences mu in (0, 1) where the albedo a(mu) has a kink that does not depend on wo (default: none), for a
-        table's spline to be split there (``pumpup.tabulate``'s ``breaks``, the pumping operator's base tables) and
-        for :func:`pumpup.mean_albedo`'s first intervals to end there: a Fresnel factor's total reflection
-        (:func:`pumpup.models.metal.fresnel_levels`).  A pumped level's own kinks come from the pumping operator."""
+        """Incidences mu in (0, 1) where the albedo a(mu) has a kink, or a jump in a low derivative, that does not
+        depend on wo (default: none), for a table's spline to be split there (``pumpup.tabulate``'s ``breaks``, the
+        pumping operator's base tables, the compensation tables) and for :func:`pumpup.mean_albedo`'s first intervals
+        to end there: a Fresnel factor's total reflection (:func:`pumpup.models.metal.fresnel_levels`), the jump of a''
+        at mu = 1 / sqrt(2) of 001 eq. 10's geometry factor (:data:`pumpup.models.cook_torrance.RETRO_BREAK`).  A lobe
+        that carries such a table in N.wo has a level at each (a pumped level's g, a 1/E scaling's U).  A pumped level's
+        own kinks come from the pumping operator."""
         return ()
 
     def polar(self):

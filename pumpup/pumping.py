@@ -1031,6 +1031,13 @@ class Pumped(BRDF):
         for p, q, value in lk.flats:  # mu on a flat piece of the bound: u(v) = U up to its end q
             if p <= mu <= q and value < lk.cap:
                 out.append(q)
+        # the table's breaks (its spline's split points: the base's albedo_breaks, Cook-Torrance's
+        # pumpup.models.cook_torrance.RETRO_BREAK, and a lower level's kinks) are kinks of u(v), so of g where u(v) is its
+        # largest term (issue 14's twenty-fifth session)
+        for v in lk.table.breaks:
+            uv = float(up(v))
+            if uv >= am * (1 - 1e-12) and (not self.controlled or uv >= max(mu, v) * (1 - 1e-12)):
+                out.append(v)
         levels = []
         for u in sorted(out):  # one level per kink: roots that agree to 1e-12 are the same kink
             if 0 < u < 1 and (not levels or u - levels[-1] > 1e-12 * u):

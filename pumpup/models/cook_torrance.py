@@ -77,6 +77,17 @@ def fresnel(cos_theta, ior):
     return _fresnel_reference(np.asarray(cos_theta, dtype=np.float64), 0.0 if ior is None else float(ior))
 
 
+#: the incidence mu = 1 / sqrt(2) where the albedo of every model with the geometry factor G of 001 eq. 10 (Cook-Torrance,
+#: Torrance-Sparrow with any D) has a jump in its second derivative: at the retro direction wo = wi both of G's terms are
+#: 2 mu^2 and meet the level N.wo = mu where G switches between them, so the region G < 1 reaches across that level for mu
+#: below it and not above.  Measured by one-sided fits of a(mu) at rtol 1e-13 (tests/test_retro_break.py): a'' = 0.864
+#: below and 0.952 above for Cook-Torrance m = 0.538, 2.28 and 2.68 for Torrance-Sparrow D1 e = 2.  A table's spline
+#: went across it, its knots bunched there, and an engine integrating 1 / U(N.wo) of a 1/E scaling across those knots
+#: under-reported: scaled Cook-Torrance m = 0.538 at mu = 0.9999 was 4.4e-10 off with an estimate of 8.2e-11 at rtol 1e-8
+#: and 1e-10 (scripts/fuzz_engines.py --registry 49 found m = 0.428 at mu = 1, 1.04 x; issue 14's twenty-fifth session)
+RETRO_BREAK = math.sqrt(0.5)
+
+
 def _g_kinks(mu, s, cos_a, sin_a):
     """Where the geometry factor G (001 eq. 10) switches branch, for the albedo engine.
 
@@ -193,6 +204,9 @@ class CookTorrance(BRDF):
 
     def kernel_args(self):
         return (self.p["m"], _ior_arg(self.p["ior"]))
+
+    def albedo_breaks(self):
+        return (RETRO_BREAK,)  # G's two terms meet the level N.wo = mu at wo = wi there
 
     def lobe(self, mu):
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"], kinks=_g_kinks)
@@ -342,6 +356,9 @@ class TorranceSparrow(BRDF):
 
     def kernel_args(self):
         return (_D_CODES[self.p["d"]], self.p["s"], self.p["b"], _ior_arg(self.p["ior"]))
+
+    def albedo_breaks(self):
+        return (RETRO_BREAK,)  # G's two terms meet the level N.wo = mu at wo = wi there
 
     def lobe(self, mu):
         d, s = self.p["d"], self.p["s"]
