@@ -689,6 +689,13 @@ class Scaled(_Compensated):
         hint = self.base.polar()
         if not plain(hint) or (self.white is not self.base and not plain(self.white.polar())):
             return None
+        white = self.white.polar()
+        if white.smith is not None and white.smith[1] == 1:
+            # Beckmann with Walter's G1, whose albedo jumps at the switch level (pumpup.models.microfacet.walter_level):
+            # the table's spline rings across the jump among hundreds of knots (614 nodes, margin 1.1e-4, for alpha
+            # 0.19), which frame 6's pieces did not see: F0 0.11 at mu = 0.9999 was 2.9e-12 off with an estimate of
+            # 3.1e-14 (94 x), alpha 0.035 at mu = 0.074 28 x.  The nested engine takes it (issue 14's twenty-fifth session)
+            return None
         # U's kinks, and where its look-up turns from the spline to the product table (:func:`_bound`): a level, so
         # that the cuts are graded in N.wo down to a quarter of it (``chain_cuts``; U(N.wo) is a spline in log N.wo
         # and not analytic at 0: with the grading only down to a quarter of mu, as g's needs, Schlick r = 0.2 at mu =

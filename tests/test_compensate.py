@@ -452,3 +452,35 @@ def test_anisotropic_base_refused():
     for method in ("kulla_conty", "scale"):
         with pytest.raises(pumpup.SpecError, match="anisotropic"):
             pumpup.compensate({"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, method=method)
+
+
+def test_scaled_beckmann_declines_frame_6_only_with_walters_g1():
+    """(The fast half of the next test.)"""
+    spec = {"type": "scaled", "base": {"type": "beckmann", "alpha": 0.19}}
+    assert pumpup.load(spec).polar() is not None
+    assert pumpup.load({**spec, "base": {**spec["base"], "g1": "walter"}}).polar() is None
+
+
+@pytest.mark.slow
+def test_scaled_beckmann_with_walters_g1_takes_the_nested_engine():
+    """Beckmann with Walter's G1: its albedo jumps at the switch level (5.7e-5 relative), and its E table's spline rings
+    across the jump among hundreds of knots (614 nodes, margin 1.1e-4 for alpha 0.19).  Frame 6 times 1 / U(N.wo) did
+    not see it: alpha 0.19 (F0 0.11) at mu = 0.9999 was 2.9e-12 off with an estimate of 3.1e-14 (94 x), alpha 0.091
+    (F0 0.96) at mu = 0.324 37 x at rtol 1e-10 (issue 14's twenty-fifth session).  The nested engine takes it; the
+    reference: rings (quad in N.wo between the table's knots and the switch level, Gauss-Legendre in the azimuth graded
+    towards the mirror side, where D peaks; 2 minutes, most of it the rings)."""
+    from test_albedo_breaks import _rings
+
+    from pumpup.models.microfacet import walter_level
+
+    for alpha, f0, mu in ((0.1913728316510363, 0.10708949613728647, 0.9999),
+                          (0.09098619502161732, 0.9585229997993715, 0.32410506187394855)):
+        f = pumpup.load({"type": "scaled", "base": {"type": "beckmann", "alpha": alpha, "g1": "walter"}, "f0": f0})
+        assert f.polar() is None
+        lo = f.bound.product.lo
+        pts = np.concatenate([lo[(lo > 0) & (lo < 1)], f.bound.kinks, [walter_level(alpha), mu],
+                              np.exp(f.bound.lookup.logx)])
+        ref = _rings(f, mu, lambda mo, so: [0.0, math.pi - 0.5, math.pi - 0.1, math.pi - 0.02, math.pi], pts)
+        for rtol in (1e-8, 1e-10):
+            a, e = pumpup.albedo(f, mu, rtol=rtol, return_error=True)
+            assert abs(float(a) - ref) <= float(e) + 1e-14, (alpha, mu, rtol, float(a), ref, float(e))
