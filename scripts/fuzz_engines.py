@@ -43,6 +43,13 @@ normal incidence for a_x / a_y = 50, whose |e| has a branch point 0.02 off the r
 engine unconverged on fresnel (eta 0.232) over plastic (n 34.4, eta 1.88, ad 0.33) at mu = 0.306, which showed that every
 engine was wrong there (0.2908 for 0.4060, with estimates of 1e-9): the fresnel wrapper was one albedo term with plastic's
 specular hint for its Lambert part too (``FresnelWeighted.albedo_terms`` now splits it over the base's terms).
+
+Found in the twenty-fifth session by --registry 49 (mended, with tests): scaled Cook-Torrance near the normal, 1.04 x
+(up to 5.3 x in a scan around it), whose E table's spline went across the jump of a'' at mu = 1 / sqrt(2) of 001 eq.
+10's geometry factor (``pumpup.models.cook_torrance.RETRO_BREAK``, now an albedo break); following it, a 1/E scaling
+of Beckmann with Walter's G1 in frame 6 (94 x; the nested engine takes it now).  Its other disagreement is the 2-D
+engine's: anisotropic Ward a_x 0.0101, a_y 0.450 at mu = 0.957, phi 1.535, 36 x at rtol 1e-12 (the slope path, the
+nested engine and scripts/independent_ward_aniso.py's two methods agree).
 """
 
 import math
