@@ -687,9 +687,9 @@ class Scaled(_Compensated):
         from ._polar import takes_n_frame_operand as plain  # (GGX, Beckmann with F = 1 or Schlick, neither pumped nor scaled)
 
         hint = self.base.polar()
-        if not plain(hint) or (self.white is not self.base and not plain(self.white.polar())):
+        white = hint if self.white is self.base else self.white.polar()
+        if not plain(hint) or not plain(white):
             return None
-        white = self.white.polar()
         if white.smith is not None and white.smith[1] == 1:
             # Beckmann with Walter's G1, whose albedo jumps at the switch level (pumpup.models.microfacet.walter_level):
             # the table's spline rings across the jump among hundreds of knots (614 nodes, margin 1.1e-4, for alpha
