@@ -526,9 +526,7 @@ class KullaConty(_Compensated):
         return out
 
     def lobe(self, mu: float) -> Lobe:
-        b = self.base.lobe(mu)
-        return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
-                    levels=tuple(sorted(set(b.levels) | set(self.bound.kinks))), kinks=b.kinks, symmetric=b.symmetric)
+        return self.base.lobe(mu).with_levels(self.bound.kinks)
 
     def sampling_lobe(self, mu: float) -> Lobe:
         return self.base.sampling_lobe(mu)
@@ -589,9 +587,7 @@ class _MsLobe(BRDF):
 def _scaled_lobe(b: Lobe, bound) -> Lobe:
     """The hint of a scaled lobe: the base's (``b``), with U's kinks and, about the normal, the levels of
     :func:`pumpup.pumping.table_decades`."""
-    levels = set(b.levels) | set(bound.kinks) | table_decades(b)
-    return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness, levels=tuple(sorted(levels)), kinks=b.kinks,
-                symmetric=b.symmetric)
+    return b.with_levels(bound.kinks, table_decades(b))
 
 
 @register("scaled")

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Callable, ClassVar
 
 import numpy as np
@@ -209,6 +209,11 @@ class Lobe:
         """Whether this is the hint of a model without one (:meth:`BRDF.lobe`'s default: about the normal, the cosine
         map, not symmetric), which the 2-D engine's generic path integrates without trusting it."""
         return self.axis == "normal" and self.radial == "cosine" and not self.symmetric
+
+    def with_levels(self, *more) -> "Lobe":
+        """This hint with the levels of each iterable in ``more`` added (a factor of N.wo that the model multiplies
+        its base by: a pumped level's g, a scaled model's 1 / U, a Fresnel factor's F(Theta_min))."""
+        return replace(self, levels=tuple(sorted(set(self.levels).union(*more))))
 
 
 # ----------------------------------------------------------------------------------------

@@ -650,9 +650,7 @@ def table_decades(b: Lobe) -> set:
 def _divided_lobe(b: Lobe, pumped: "Pumped", mu: float) -> Lobe:
     """The hint of f / g for the hint ``b`` of f (a pumped model's base, or one term of its sum): b with g's kink levels
     at incidence ``mu`` and, about the normal, :func:`table_decades` (g is a table in log(N.wo))."""
-    return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
-                levels=tuple(sorted(set(b.levels) | set(pumped.kink_levels(mu)) | table_decades(b))),
-                kinks=b.kinks, symmetric=b.symmetric)
+    return b.with_levels(pumped.kink_levels(mu), table_decades(b))
 
 
 @register("pumped")

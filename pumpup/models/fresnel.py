@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import vectorize
 
-from ..core import MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, register
+from ..core import MAX_INDEX, MIN_INDEX, BRDF, Param, register
 from .metal import _fresnel_real, fresnel, fresnel_levels
 
 __all__ = ["FresnelWeighted"]
@@ -89,10 +89,8 @@ class FresnelWeighted(BRDF):
         return np.where(f != 0.0, f * fresnel(mx, self.p["eta"], self.p["k"]), 0.0)  # 000 eq. 28, complex form
 
     def lobe(self, mu):
-        b = self.base.lobe(mu)  # F(max(N.wi, N.wo)) adds a kink at N.wo = mu, and one where F has its own
-        return Lobe(axis=b.axis, radial=b.radial, sharpness=b.sharpness,
-                    levels=tuple(sorted(set(b.levels) | {float(mu), *fresnel_levels(self.p["eta"], self.p["k"])})),
-                    kinks=b.kinks, symmetric=b.symmetric)
+        # F(max(N.wi, N.wo)) adds a kink at N.wo = mu, and one where F has its own
+        return self.base.lobe(mu).with_levels((float(mu),), fresnel_levels(self.p["eta"], self.p["k"]))
 
     def albedo_terms(self):
         """F(Theta_min) times each of the base's linear terms (F sum w_k f_k = sum w_k F f_k), each term with its own
