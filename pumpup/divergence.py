@@ -13,6 +13,7 @@ visible arc of the azimuth in closed form).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -111,6 +112,15 @@ def divergence(brdf: BRDF | dict, mu_min: float = 1e-8, window: tuple[float, flo
 # --------------------------------------------------------------------------------------------
 
 
+@functools.lru_cache(maxsize=8)
+def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """numpy's n-point Gauss-Legendre rule on [-1, 1], built once per n (read-only arrays)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    x.flags.writeable = False
+    w.flags.writeable = False
+    return x, w
+
+
 def _cap_integral(mu: float, delta0: float, weight, phi_limits, n: int = 96) -> float:
     """Integral over half-vectors H in the cap delta <= delta0 of weight(delta, cos phi) * 4 (L.H) d omega_H,
     over the arc of phi given by ``phi_limits(delta) -> (lo, hi)`` (in [0, pi], doubled by symmetry).
@@ -118,11 +128,11 @@ def _cap_integral(mu: float, delta0: float, weight, phi_limits, n: int = 96) -> 
     Gauss-Legendre in delta and in phi (the integrand is smooth inside the limits).
     """
     s = math.sqrt((1 - mu) * (1 + mu))
-    xd, wd = np.polynomial.legendre.leggauss(n)
+    xd, wd = _gauss_legendre(n)
     d = 0.5 * delta0 * (xd + 1)
     wdd = 0.5 * delta0 * wd
     total = 0.0
-    xp, wp = np.polynomial.legendre.leggauss(n)
+    xp, wp = xd, wd
     for dk, wk in zip(d, wdd):
         lo, hi = phi_limits(dk)
         if hi <= lo:
