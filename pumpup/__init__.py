@@ -1,81 +1,105 @@
 """pumpup: physically plausible reflectance models, their albedo, and the albedo pumping-up operator.
 
-See DESIGN.md for the conventions (N = (0, 0, 1), wi towards the light, wo towards the
-viewer, f_r without the cosine factor, mu = cos(theta_i)).
+Conventions: the surface normal is N = (0, 0, 1); ``wi`` points towards the light, ``wo`` towards
+the viewer; ``BRDF.eval`` returns f_r in 1/sr without the cosine factor; ``mu`` = cos(theta_i)
+(see :class:`pumpup.BRDF`).
+
+``import pumpup`` is instant: each public name below is imported from its module the first time
+it is used (PEP 562), so numba, scipy and xarray load only when a computation needs them.
 """
 
-from ._version import __version__
-from . import albedo as albedo_module
-from .albedo import albedo
-from . import _polar  # noqa: F401  (the 1-D albedo path; pumpup._polar.two_d_only() for the 2-D reference)
-from . import reproduce
-from . import testing
-from . import render
-from .divergence import divergence
-from .pumping import Pumped, load_pumped, pump, save_pumped
-from .compensate import KullaConty, Scaled, compensate, furnace, load_compensated, save_compensated
-from . import sampling
-from .sampling import mc_albedo, mc_radiance, sample
-from .tables import AlbedoTable, max_albedo, max_constant, mean_albedo, open_table, tabulate, write_table
-from .sweeps import sweep
-from . import luts as lut_module
-from .luts import audit, lut
-from .fitting import FitResult, fit
-from .core import (
-    BRDF,
-    Lobe,
-    Param,
-    ReciprocityResult,
-    SpecError,
-    check_reciprocity,
-    from_function,
-    load,
-    register,
-    registry,
-)
+from __future__ import annotations
 
-__all__ = [
-    "__version__",
-    "albedo_module",
-    "reproduce",
-    "render",
-    "albedo",
-    "divergence",
-    "sampling",
-    "sample",
-    "mc_albedo",
-    "mc_radiance",
-    "Pumped",
-    "pump",
-    "save_pumped",
-    "load_pumped",
-    "compensate",
-    "furnace",
-    "KullaConty",
-    "Scaled",
-    "save_compensated",
-    "load_compensated",
-    "AlbedoTable",
-    "max_albedo",
-    "max_constant",
-    "mean_albedo",
-    "open_table",
-    "tabulate",
-    "sweep",
-    "lut",
-    "audit",
-    "lut_module",
-    "fit",
-    "FitResult",
-    "write_table",
-    "BRDF",
-    "Lobe",
-    "Param",
-    "ReciprocityResult",
-    "SpecError",
-    "check_reciprocity",
-    "from_function",
-    "load",
-    "register",
-    "registry",
-]
+import importlib
+import sys
+import types
+
+from ._version import __version__
+
+#: public name -> (module, attribute); attribute None means the module itself
+_PUBLIC = {
+    "albedo_module": ("albedo", None),
+    "albedo": ("albedo", "albedo"),
+    "reproduce": ("reproduce", None),
+    "testing": ("testing", None),
+    "render": ("render", None),
+    "divergence": ("divergence", "divergence"),
+    "Pumped": ("pumping", "Pumped"),
+    "load_pumped": ("pumping", "load_pumped"),
+    "pump": ("pumping", "pump"),
+    "save_pumped": ("pumping", "save_pumped"),
+    "KullaConty": ("compensate", "KullaConty"),
+    "Scaled": ("compensate", "Scaled"),
+    "compensate": ("compensate", "compensate"),
+    "furnace": ("compensate", "furnace"),
+    "load_compensated": ("compensate", "load_compensated"),
+    "save_compensated": ("compensate", "save_compensated"),
+    "sampling": ("sampling", None),
+    "mc_albedo": ("sampling", "mc_albedo"),
+    "mc_radiance": ("sampling", "mc_radiance"),
+    "sample": ("sampling", "sample"),
+    "AlbedoTable": ("tables", "AlbedoTable"),
+    "max_albedo": ("tables", "max_albedo"),
+    "max_constant": ("tables", "max_constant"),
+    "mean_albedo": ("tables", "mean_albedo"),
+    "open_table": ("tables", "open_table"),
+    "tabulate": ("tables", "tabulate"),
+    "write_table": ("tables", "write_table"),
+    "sweep": ("sweeps", "sweep"),
+    "lut_module": ("luts", None),
+    "audit": ("luts", "audit"),
+    "lut": ("luts", "lut"),
+    "FitResult": ("fitting", "FitResult"),
+    "fit": ("fitting", "fit"),
+    "BRDF": ("core", "BRDF"),
+    "Lobe": ("core", "Lobe"),
+    "Param": ("core", "Param"),
+    "ReciprocityResult": ("core", "ReciprocityResult"),
+    "SpecError": ("core", "SpecError"),
+    "check_reciprocity": ("core", "check_reciprocity"),
+    "from_function": ("core", "from_function"),
+    "load": ("core", "load"),
+    "register": ("core", "register"),
+    "registry": ("core", "registry"),
+}
+
+#: public functions named like the module that holds them: importing the module must not replace them
+_FUNCTIONS_NAMED_LIKE_MODULES = frozenset(name for name, (module, attr) in _PUBLIC.items() if name == module and attr)
+
+__all__ = ["__version__", *_PUBLIC]
+
+
+def __getattr__(name: str):
+    """Import a public name (or a submodule, ``pumpup.tables``) on first use."""
+    if name in _PUBLIC:
+        module_name, attr = _PUBLIC[name]
+        module = importlib.import_module(f"{__name__}.{module_name}")
+        value = module if attr is None else getattr(module, attr)
+    elif not name.startswith("__"):
+        try:
+            value = importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__name__}.{name}":
+                raise
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
+
+class _Package(types.ModuleType):
+    """The package's module type: the import system's binding of a submodule (``pumpup.albedo``, the
+    module) never replaces the public function of the same name (``pumpup.albedo``, the function)."""
+
+    def __setattr__(self, name: str, value) -> None:
+        if name in _FUNCTIONS_NAMED_LIKE_MODULES and isinstance(value, types.ModuleType):
+            return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package

@@ -211,6 +211,7 @@ import cmath
 import contextlib
 import functools
 import math
+import os
 import threading
 import warnings
 from dataclasses import dataclass
@@ -2652,7 +2653,9 @@ def _kummer_table() -> np.ndarray:
     return out
 
 
-KUMMER_COEF = _kummer_table()
+#: :func:`_kummer_table`, read from the package's data (computing it means running the compiled series at import);
+#: ``tests/test_startup.py`` checks the file against :func:`_kummer_table`
+KUMMER_COEF = np.load(os.path.join(os.path.dirname(__file__), "data", "kummer_chebyshev.npy"))
 
 
 @njit(cache=True, nogil=True)

