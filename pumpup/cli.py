@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import signal
 import sys
 
 
@@ -1007,8 +1008,6 @@ def cmd_warmup(args) -> int:
 
 def _interrupted() -> UsageError:
     """The one line of Ctrl-C; later Ctrl-Cs are ignored while the process exits."""
-    import signal
-
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     print("pumpup: interrupted", file=sys.stderr, flush=True)
     return UsageError("pumpup: interrupted", 130)
@@ -1068,8 +1067,6 @@ def main(argv: list[str] | None = None, notify: bool = False) -> int:
 def console_main() -> None:
     """The ``pumpup`` console script: :func:`main`, then an exit in which a late Ctrl-C or a closed pipe
     prints nothing more (Ctrl-C is ignored once the command has finished and flushed its output)."""
-    import signal
-
     try:
         code = main(notify=True)
         sys.stdout.flush()
