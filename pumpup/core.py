@@ -1,6 +1,6 @@
 """The BRDF interface, the model registry, specs, user functions and the reciprocity check.
 
-Conventions (DESIGN.md; every model in pumpup follows them)
+Conventions (every model in pumpup follows them)
 ------------------------------------------------------------
 * Local shading frame: the surface normal is N = (0, 0, 1).  Directions are unit
   3-vectors on the last axis of an array; every function broadcasts over the
@@ -243,6 +243,8 @@ def registry() -> dict[str, type["BRDF"]]:
 
 
 def _ensure_models() -> None:
+    """Import the modules that register the built-in types: the operators, then the models."""
+    from . import compensate, pumping  # noqa: F401  (register pumped, kulla_conty, scaled)
     from . import models  # noqa: F401  (registers the built-in models)
 
 

@@ -8,7 +8,7 @@ quantisation error of the storage format, and the error of the renderer's own lo
 bilinear interpolation at its coordinates, clamping included) against the true E between the
 nodes.  :func:`audit` reads a shipped table and grades it against pumpup's truth.
 
-Definitions (DESIGN.md): E(mu) = integral of f_r cos(theta_o) d omega_o (000 eq. 2) with F = 1;
+Definitions: E(mu) = integral of f_r cos(theta_o) d omega_o (000 eq. 2) with F = 1;
 E_avg = 2 integral_0^1 E(mu) mu dmu (000 eq. 33); the split-sum pair (Karis 2013, Filament's
 DFG) A = integral (1 - Fc) f_r cos d omega_o and B = integral Fc f_r cos d omega_o with
 Fc = (1 - wi.h)^5 (Schlick), so that E = A + B for F0 = 1 and a Schlick-Fresnel albedo is

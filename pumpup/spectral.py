@@ -354,7 +354,7 @@ class SpectralMetal(Spectral):
 
     @property
     def spec(self) -> dict:
-        """A JSON-able description (the DESIGN.md form ``{"type": "metal", "material": ..., "n": ...}``)."""
+        """A JSON-able description (the spec form ``{"type": "metal", "material": ..., "n": ...}``)."""
         out: dict[str, Any] = {"type": "metal", "n": self.n, "c": self.c, "wavelengths": self.wavelengths.tolist()}
         if self.material is not None:
             out["material"] = self.material
@@ -426,7 +426,7 @@ class SpectralMetal(Spectral):
         return ((self.eta - 1) ** 2 + self.k**2) / ((self.eta + 1) ** 2 + self.k**2)
 
 def load(spec: Any) -> Spectral:
-    """A spectral model from the DESIGN.md spec ``{"type": "metal", "material": "Au", "n": 20}``.
+    """A spectral model from the spec ``{"type": "metal", "material": "Au", "n": 20}``.
 
     Accepts ``material`` (or per-wavelength ``eta``/``k`` lists) with ``n``, optional ``c`` and
     ``wavelengths`` (a list of nm or ``"rgb"``), ``{"type": "plastic", ...}``

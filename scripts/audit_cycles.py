@@ -31,8 +31,7 @@ import pumpup  # noqa: E402
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     root = os.path.dirname(HERE)
-    default = next((p for p in (os.path.join(root, "..", "shared", "peer-tables", "cycles_shader.tables"),
-                                "/work/shared/peer-tables/cycles_shader.tables") if os.path.isfile(p)), None)
+    default = os.path.join(root, "tests", "data", "cycles_shader.tables")  # Cycles' shipped tables
     ap.add_argument("path", nargs="?", default=default)
     ap.add_argument("--worst", type=int, default=6)
     ap.add_argument("--rtol", type=float, default=1e-9)

@@ -39,8 +39,7 @@ def best(fn, repeat):
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    default = next((p for p in (os.path.join(here, "..", "shared", "peer-tables", "cycles_shader.tables"),
-                                "/work/shared/peer-tables/cycles_shader.tables") if os.path.isfile(p)), None)
+    default = os.path.join(here, "tests", "data", "cycles_shader.tables")  # Cycles' shipped tables
     ap.add_argument("--cycles", default=default, help="the shipped Cycles shader.tables")
     ap.add_argument("--repeat", type=int, default=2)
     args = ap.parse_args()

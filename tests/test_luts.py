@@ -1,7 +1,7 @@
 """Renderer look-up tables (pumpup.luts): readers, writers, the renderer's look-up, audits.
 
-Small tables in each preset's format keep the default suite fast; the real Cycles file is
-read when a copy of shared/ lies beside the repository (../shared) or at /work/shared.
+Small tables in each preset's format keep the default suite fast; the real Cycles file ships in
+tests/data (Blender's shader.tables, Apache-2.0, its header kept).
 """
 
 import dataclasses
@@ -20,12 +20,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 EXT = {"c": ".h", "filament": ".inc", "npy": ".npy", "netcdf": ".nc", "exr": ".exr"}
 
 
-def _shared_cycles():
-    for base in (os.path.join(ROOT, "..", "shared"), "/work/shared"):
-        path = os.path.join(base, "peer-tables", "cycles_shader.tables")
-        if os.path.isfile(path):
-            return path
-    return None
+#: Cycles' shipped albedo tables (src/scene/shader.tables), an unchanged copy
+CYCLES_TABLES = os.path.join(ROOT, "tests", "data", "cycles_shader.tables")
 
 
 def small(name, n_mu=6, n_rough=5, **kw):
@@ -90,9 +86,8 @@ def test_audit_finds_the_row_and_column_that_are_wrong(tmp_path):
     assert r.max_abs > 1e-2
 
 
-@pytest.mark.skipif(_shared_cycles() is None, reason="needs shared/peer-tables beside the repository")
 def test_real_cycles_file():
-    path = _shared_cycles()
+    path = CYCLES_TABLES
     tab = luts.read_table(path, "cycles")
     assert tab["E"].shape == (32, 32) and tab["E_avg"].shape == (32,)
     # the second printed row is y = 1 (mu = 1/31): 1.000000f, 0.999451f, 0.990086f, ...
@@ -109,9 +104,7 @@ def test_real_cycles_file():
 
 @pytest.mark.slow
 def test_real_cycles_audit_full():
-    path = _shared_cycles()
-    if path is None:
-        pytest.skip("needs shared/peer-tables")
+    path = CYCLES_TABLES
     r = pumpup.audit(path, preset="cycles", lookup_check=False)
     assert r.n_nodes == 1024 and r.max_abs < 2e-6 and r.above_one == 0
     assert r.eavg["vs_truth"] < 2e-6

@@ -27,7 +27,9 @@ README = os.path.join(ROOT, "README.md")
 #: commands of the README's bash blocks that the default suite does not run, with the reason
 EXPENSIVE = {
     "python -m pytest -q": "the test suite itself: CI runs it (.ci/run), a test cannot run it inside itself",
-    "pumpup reproduce": "about a minute on 2 free cores: run by test_expensive_bash_commands (-m slow)",
+    "pumpup reproduce": "about 10 s, and it rewrites every table: run by test_expensive_bash_commands (-m slow)",
+    "pumpup render scene 000-fig8 --spp 64 --size 256 --variant auto --out scenes":
+        "a path-traced scene, minutes: run by test_expensive_bash_commands (-m slow)",
 }
 #: commands that are never run by a test, even with -m slow
 NEVER = {"python -m pytest -q"}
