@@ -1064,9 +1064,29 @@ def main(argv: list[str] | None = None, notify: bool = False) -> int:
     raise UsageError(message) from None
 
 
+def _redeliver_interrupts(hook):
+    """An unraisable-exception hook that sends a KeyboardInterrupt on again instead of printing it: Ctrl-C that lands
+    in a callback from C (llvmlite's, while numba compiles) cannot propagate there, and Python would print it as
+    "Exception ignored" and go on.  The interrupt is sent again 10 ms later, from a timer thread, so that it arrives
+    in ordinary Python code (and again, should it land in a callback once more)."""
+    import _thread
+    import threading
+
+    def unraisable(args) -> None:
+        if args.exc_type is not None and issubclass(args.exc_type, KeyboardInterrupt):
+            timer = threading.Timer(0.01, _thread.interrupt_main)
+            timer.daemon = True
+            timer.start()
+            return
+        hook(args)
+
+    return unraisable
+
+
 def console_main() -> None:
     """The ``pumpup`` console script: :func:`main`, then an exit in which a late Ctrl-C or a closed pipe
     prints nothing more (Ctrl-C is ignored once the command has finished and flushed its output)."""
+    sys.unraisablehook = _redeliver_interrupts(sys.unraisablehook)
     try:
         code = main(notify=True)
         sys.stdout.flush()

@@ -83,15 +83,25 @@ def test_the_parsers_see_every_block():
     assert len(blocks()) >= 5 and any(lang == "bash" for lang, _, _ in blocks())
 
 
+def clone_entries() -> list[str]:
+    """The top-level entries a fresh clone has: those git tracks (every entry but .git outside a git checkout)."""
+    try:
+        r = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    except OSError:
+        r = None
+    if r is None or r.returncode != 0 or not r.stdout.strip():
+        return [name for name in os.listdir(ROOT) if name != ".git"]
+    return sorted({line.split("/", 1)[0] for line in r.stdout.splitlines()})
+
+
 @pytest.fixture
 def workspace(tmp_path):
     """A scratch directory that mirrors the repository root, and a PATH on which ``pumpup`` is
     this checkout's command line."""
     work = tmp_path / "root"
     work.mkdir()
-    for name in os.listdir(ROOT):
-        if name not in (".git",):
-            os.symlink(os.path.join(ROOT, name), work / name)
+    for name in clone_entries():
+        os.symlink(os.path.join(ROOT, name), work / name)
     bindir = tmp_path / "bin"
     bindir.mkdir()
     shim = bindir / "pumpup"
