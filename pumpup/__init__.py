@@ -18,22 +18,22 @@ from ._version import __version__
 
 #: public name -> (module, attribute); attribute None means the module itself
 _PUBLIC = {
-    "albedo_module": ("albedo", None),
-    "albedo": ("albedo", "albedo"),
+    "albedo_module": ("engine.cubature", None),
+    "albedo": ("engine", "albedo"),
     "reproduce": ("reproduce", None),
     "testing": ("testing", None),
     "render": ("render", None),
     "divergence": ("divergence", "divergence"),
-    "Pumped": ("pumping", "Pumped"),
-    "load_pumped": ("pumping", "load_pumped"),
-    "pump": ("pumping", "pump"),
-    "save_pumped": ("pumping", "save_pumped"),
-    "KullaConty": ("compensate", "KullaConty"),
-    "Scaled": ("compensate", "Scaled"),
-    "compensate": ("compensate", "compensate"),
-    "furnace": ("compensate", "furnace"),
-    "load_compensated": ("compensate", "load_compensated"),
-    "save_compensated": ("compensate", "save_compensated"),
+    "Pumped": ("operators.pumping", "Pumped"),
+    "load_pumped": ("operators.pumping", "load_pumped"),
+    "pump": ("operators.pumping", "pump"),
+    "save_pumped": ("operators.pumping", "save_pumped"),
+    "KullaConty": ("operators.compensate", "KullaConty"),
+    "Scaled": ("operators.compensate", "Scaled"),
+    "compensate": ("operators.compensate", "compensate"),
+    "furnace": ("operators.compensate", "furnace"),
+    "load_compensated": ("operators.compensate", "load_compensated"),
+    "save_compensated": ("operators.compensate", "save_compensated"),
     "sampling": ("sampling", None),
     "mc_albedo": ("sampling", "mc_albedo"),
     "mc_radiance": ("sampling", "mc_radiance"),
@@ -63,10 +63,13 @@ _PUBLIC = {
     "registry": ("core", "registry"),
 }
 
-#: public functions named like the module that holds them: importing the module must not replace them
-_FUNCTIONS_NAMED_LIKE_MODULES = frozenset(name for name, (module, attr) in _PUBLIC.items() if name == module and attr)
+#: public functions named like a submodule of the package: importing the submodule must not replace them
+_FUNCTIONS_NAMED_LIKE_MODULES = frozenset({"divergence"})
 
 __all__ = ["__version__", *_PUBLIC]
+
+#: the modules whose types and loaders the registry imports on first use, in this order (:mod:`pumpup.core`)
+PROVIDERS = ("pumpup.operators.pumping", "pumpup.operators.compensate", "pumpup.models", "pumpup.spectral")
 
 
 def __getattr__(name: str):

@@ -294,7 +294,7 @@ def cmd_pump(args) -> int:
 
     import pumpup
 
-    from pumpup.pumping import MAX_LEVELS
+    from pumpup.operators.pumping import MAX_LEVELS
 
     if not 1 <= args.levels <= MAX_LEVELS:
         raise SystemExit(f"pumpup: --levels: levels must be an integer in [1, {MAX_LEVELS}], got {args.levels}")
@@ -361,7 +361,7 @@ def cmd_reproduce(args) -> int:
 
 def cmd_divergence(args) -> int:
     from .divergence import analysis_dataset, divergence, plot
-    from .provenance import write_generated
+    from .tables.provenance import write_generated
 
     from pumpup.core import check_open_unit
 
@@ -1054,6 +1054,8 @@ def main(argv: list[str] | None = None, notify: bool = False) -> int:
             raise
         message = _one_line(exc.code)
     except (ValueError, TypeError, OSError, ImportError) as exc:  # SpecError is a ValueError; ImportError: an extra
+        if _PENDING_INTERRUPT:
+            raise _interrupted() from None
         if debug:
             raise
         message = _one_line(f"pumpup: {exc}")
@@ -1062,6 +1064,11 @@ def main(argv: list[str] | None = None, notify: bool = False) -> int:
     except KeyboardInterrupt:
         raise _interrupted() from None
     raise UsageError(message) from None
+
+
+#: set when a Ctrl-C was swallowed in a callback from C: whatever the command does next (numba, its compile broken
+#: off, may raise an error of its own before the interrupt arrives again), it ends as an interruption
+_PENDING_INTERRUPT: list = []
 
 
 def _redeliver_interrupts(hook):
@@ -1074,6 +1081,7 @@ def _redeliver_interrupts(hook):
 
     def unraisable(args) -> None:
         if args.exc_type is not None and issubclass(args.exc_type, KeyboardInterrupt):
+            _PENDING_INTERRUPT.append(True)
             timer = threading.Timer(0.01, _thread.interrupt_main)
             timer.daemon = True
             timer.start()
@@ -1090,12 +1098,18 @@ def console_main() -> None:
     try:
         code = main(notify=True)
         sys.stdout.flush()
+        if _PENDING_INTERRUPT:
+            raise KeyboardInterrupt
     except KeyboardInterrupt:
         code = _interrupted().code
     except BrokenPipeError:
         code = _closed_stdout()
     except SystemExit as exc:
         code = exc.code
+    except Exception:
+        if not _PENDING_INTERRUPT:
+            raise
+        code = _interrupted().code
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     except ValueError:  # not the main thread

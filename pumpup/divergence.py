@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .albedo import albedo
+from .engine.cubature import albedo
 from .core import BRDF, load
 
 __all__ = ["divergence", "DivergenceResult", "ward_bound", "cook_torrance_bound", "analysis_dataset", "MODELS"]

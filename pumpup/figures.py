@@ -13,9 +13,9 @@ import os
 
 import numpy as np
 
-from .albedo import albedo
+from .engine.cubature import albedo
 from .core import load
-from .pumping import Pumped, pump
+from .operators.pumping import Pumped, pump
 from .tables import atomic_path, max_constant
 
 THETA = np.linspace(0.0, 89.9, 300)  # incidence angles of the albedo and mirror-radiance curves [deg]
@@ -179,7 +179,7 @@ def make_figures(table_dir="tables", figure_dir="figures"):
     os.makedirs(table_dir, exist_ok=True)
     os.makedirs(figure_dir, exist_ok=True)
     ds = pumping_dataset()
-    from .provenance import write_generated
+    from .tables.provenance import write_generated
 
     write_generated(ds, os.path.join(table_dir, "pumping_figures.nc"))
     st = stretched_dataset()

@@ -165,7 +165,7 @@ class FitData:
 
     @classmethod
     def build(cls, target: BRDF, pairs, mu, lobe_fraction, rtol):
-        from .albedo import albedo
+        from .engine.cubature import albedo
 
         wi, wo, view, weight = pairs
         cos_l = wi[:, 2]
@@ -205,7 +205,7 @@ def relative_errors(brdf: BRDF, data: FitData, rtol: float, scale: float = 1.0, 
     """(e_f, e_a, bound of e_a from the albedo error estimates) of ``scale * brdf`` on ``data``.
 
     With ``return_albedo``, also the albedo of ``scale * brdf`` at ``data.mu``."""
-    from .albedo import albedo
+    from .engine.cubature import albedo
 
     m = np.asarray(brdf._eval(data.wi[data.region], data.wo[data.region]), dtype=np.float64) * data.cos_l[data.region]
     e_f = float(np.max(np.abs(scale * m / data.t[data.region] - 1.0)))  # 001 eq. 3, relative
@@ -333,7 +333,7 @@ def sup_albedo_error(target: BRDF, brdf: BRDF, mu: np.ndarray, a_t: np.ndarray, 
     taken as the maximum).  Returns (e_a, mu*)."""
     from scipy.optimize import minimize_scalar
 
-    from .albedo import albedo
+    from .engine.cubature import albedo
 
     q = np.abs(a / a_t - 1.0)
     i = int(np.argmax(q))
@@ -483,12 +483,12 @@ def _load_target(target: Any) -> BRDF:
     if isinstance(target, BRDF):
         return target
     if isinstance(target, str):
-        from .cli import parse_spec
+        from .core import parse_spec
 
         try:
             target = parse_spec(target)
-        except SystemExit as exc:
-            raise FitError(f"fit: target {target!r} does not load: {str(exc).removeprefix('pumpup: ')}") from None
+        except SpecError as exc:
+            raise FitError(f"fit: target {target!r} does not load: {exc}") from None
     if not isinstance(target, dict):
         raise TypeError(f"fit: target must be a pumpup BRDF, a spec dict or a spec string, got {type(target).__name__}")
     try:
@@ -635,7 +635,7 @@ class _Problem:
         return s
 
     def build(self, values, scale=None) -> BRDF:
-        from .pumping import pump
+        from .operators.pumping import pump
 
         s = self.spec(values, scale)
         if self.pump is not None:
@@ -692,7 +692,7 @@ class _Problem:
         """The albedo of f on the search mu (at the search tolerance), or None if not finite."""
         import warnings
 
-        from .albedo import AlbedoWarning, albedo
+        from .engine.cubature import AlbedoWarning, albedo
 
         self.albedo_evaluations += 1
         with warnings.catch_warnings():
@@ -920,7 +920,7 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
         mu_search = np.cos(np.linspace(0.0, math.acos(mu_min), n_mu_search))
         mu_final = np.cos(np.linspace(0.0, math.acos(mu_min), n_mu))
     else:
-        from .albedo import check_mu
+        from .engine.cubature import check_mu
 
         try:
             mu_search = mu_final = np.unique(check_mu(mu).ravel())[::-1]
@@ -1039,7 +1039,7 @@ def plot_fits(results, path, views_deg=(0.0, 45.0, 75.0), labels=None, title=Non
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .albedo import albedo
+    from .engine.cubature import albedo
     from .tables import atomic_path
 
     results = list(results)

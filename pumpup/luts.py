@@ -282,12 +282,9 @@ def model_spec(model, preset=None) -> tuple[dict, str]:
     elif isinstance(model, dict):
         spec = dict(model)
     elif isinstance(model, str):
-        from .cli import parse_spec
+        from .core import parse_spec
 
-        try:
-            spec = parse_spec(model)
-        except SystemExit as exc:
-            raise SpecError(str(exc).removeprefix("pumpup: ")) from None
+        spec = parse_spec(model)
     else:
         raise TypeError(f"model must be a name, a spec dict or a BRDF, got {type(model).__name__}")
     kind = spec.get("type")
@@ -307,7 +304,7 @@ def _brdf(spec: dict, param: str, rough: float) -> BRDF:
 
 
 def _albedo(f: BRDF, mu, rtol: float, max_regions: int, atol: float = 1e-14):
-    from .albedo import AlbedoWarning, albedo
+    from .engine.cubature import AlbedoWarning, albedo
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", AlbedoWarning)  # the error estimate says it; counted by the caller
@@ -373,7 +370,7 @@ def mean_albedo_grid(spec: dict, param: str, rough, *, rtol: float = 1e-8, max_r
     :func:`pumpup.mean_albedo`), starting from 6 panels graded towards grazing; the error adds
     |K - G| and the propagated albedo errors.
     """
-    from .albedo import NODES, WG, WK
+    from .engine.cubature import NODES, WG, WK
 
     rough = np.asarray(rough, dtype=np.float64)
 

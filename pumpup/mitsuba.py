@@ -48,8 +48,8 @@ The BSDF
     the result rounded once to Mitsuba's float32), so in ``llvm_*`` variants it is traced into
     Mitsuba's kernels; in ``scalar_*`` variants the same code runs on Python floats.  A pumped
     model divides by the same upper bounds of the albedo tables as pumpup's compiled kernel
-    (spline + margin, capped at 1; :class:`pumpup.pumping._Lookup`): through pumpup's product table G(m)
-    of all levels where it has one (:class:`pumpup.pumping._Product`, piece found from the float64 bits
+    (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`): through pumpup's product table G(m)
+    of all levels where it has one (:class:`pumpup.operators.pumping._Product`, piece found from the float64 bits
     of m = max(N.wi, N.wo)), else level by level, with ``dr.gather`` on the tables; its value is rounded down before the cast to float32
     (x (1 - 2^-23)), so the exported BSDF is pointwise at most the double-precision one and
     keeps its proof of energy conservation (001 eq. 18).
@@ -360,7 +360,7 @@ def _dr_cook_torrance(l, v, m, ior):
 
 
 def _projected(w, dist, g1, alpha):
-    """pumpup.models.microfacet._projected: P = z (1 + Lambda) = z / G1 (Walter et al. 2007)."""
+    """pumpup.physics.microfacet.projected: P = z (1 + Lambda) = z / G1 (Walter et al. 2007)."""
     x, y, z = w
     s = dr.sqrt(x * x + y * y)
     if dist == 1:
@@ -425,8 +425,8 @@ SUPPORTED = tuple(sorted(set(_KERNELS) | {"pumped", "fresnel"}))
 
 
 class _Level:
-    """One pumping level in Dr.Jit: the upper bound u(mu) of :func:`pumpup.pumping._upper_scalar` on
-    the same arrays (:class:`pumpup.pumping._Lookup`), found by a binary search of fixed length."""
+    """One pumping level in Dr.Jit: the upper bound u(mu) of :func:`pumpup.physics.lookups.upper_scalar` on
+    the same arrays (:class:`pumpup.operators.pumping._Lookup`), found by a binary search of fixed length."""
 
     def __init__(self, lookup, controlled: bool):
         lk = lookup
@@ -461,7 +461,7 @@ class _Level:
         for r in range(1, self.deg):  # Horner: the spline piece in d = log(mu) - logx[lo]
             val = val * d + self.coef[lo + r * m1]
         below = self.v0 * dr.exp(self.slope0 * (lm - self.logx0)) + self.margin_lo  # power law below the table
-        u = dr.select(lm < self.logx0, below, val + self.margin)  # (as pumping._upper_log)
+        u = dr.select(lm < self.logx0, below, val + self.margin)  # (as pumpup.physics.lookups.upper_log)
         return dr.minimum(u, self.cap) if math.isfinite(self.cap) else u
 
     def g(self, mi_, mo):
@@ -473,13 +473,13 @@ class _Level:
 
 class _ProductG:
     """The chain kernel's fast path in Dr.Jit: G(m) = g_1 ... g_k as one piecewise quintic in
-    m = max(N.wi, N.wo) (:class:`pumpup.pumping._Product`, the same pieces and coefficients, already scaled
+    m = max(N.wi, N.wo) (:class:`pumpup.operators.pumping._Product`, the same pieces and coefficients, already scaled
     up by 1 + epsilon), the piece found from the float64 bits of m, for min(N.wi, N.wo) > ``mlo``."""
 
     def __init__(self, prod):
-        from .pumping import _CELL_SHIFT, _bits
+        from .physics.lookups import CELL_SHIFT, float_bits_reference
 
-        self.mlo, self.cbase, self.shift = float(prod.mlo), int(prod.cbase), _CELL_SHIFT
+        self.mlo, self.cbase, self.shift = float(prod.mlo), int(prod.cbase), CELL_SHIFT
         self.ncell = len(prod.cstart)
         self.deg = prod.rows.shape[1] - 3
         self.width = prod.rows.shape[1]
@@ -491,14 +491,14 @@ class _ProductG:
         bounds = (np.arange(self.cbase, self.cbase + self.ncell + 1, dtype=np.int64) << self.shift).view(np.float64)
         ends = np.searchsorted(prod.lo[:-1], bounds[1:], side="left") - 1
         self.steps = int(max(0, np.max(ends - self.cstart_np))) + 1
-        self._bits = _bits
+        self._bits = float_bits_reference
 
     def __call__(self, m):
         if _jit():
             bits = dr.reinterpret_array(mi.UInt64, m) >> self.shift
             c = mi.UInt32(dr.minimum(dr.maximum(bits, self.cbase) - self.cbase, self.ncell - 1))
             s = dr.gather(mi.UInt32, self.cstart, c)
-            for _ in range(self.steps):  # forward to the piece that holds m (pumpup.pumping._Product.piece)
+            for _ in range(self.steps):  # forward to the piece that holds m (pumpup.operators.pumping._Product.piece)
                 s = dr.select(m >= self.lo[s + 1], s + 1, s)
         else:
             c = min(max((int(self._bits(m)) >> self.shift) - self.cbase, 0), self.ncell - 1)
@@ -508,7 +508,7 @@ class _ProductG:
         w, d = self.width, self.deg
         t = (m - self.rows[s * w + d + 1]) * self.rows[s * w + d + 2]
         g = self.rows[s * w] * t
-        for r in range(1, d):  # Horner, in the order of pumpup.pumping._horner
+        for r in range(1, d):  # Horner, in the order of pumpup.physics.lookups.horner
             g = (g + self.rows[s * w + r]) * t
         return g + self.rows[s * w + d]
 
@@ -525,7 +525,7 @@ class _DrModel:
         #: (eta, k) of an outer ``fresnel`` model (base x F(Theta_min), pumpup.models.fresnel), else None
         self.fresnel = (brdf.p["eta"], brdf.p["k"]) if brdf.type == "fresnel" else None
         base = brdf.p["base"] if self.fresnel is not None else brdf
-        from .pumping import Pumped
+        from .operators.pumping import Pumped
 
         prod = base.product() if isinstance(base, Pumped) else None
         self.product = _ProductG(prod) if prod is not None else None
@@ -676,7 +676,7 @@ def _spec_from_props(props) -> Any:
                 return json.loads(s)
             except json.JSONDecodeError as exc:
                 raise SpecError(f"pumpup plugin: 'spec' is not valid JSON: {exc}") from None
-        from .cli import parse_spec
+        from .core import parse_spec
 
         return parse_spec(s)  # the short form, phong:n=20
     if "model" in keys:

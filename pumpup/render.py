@@ -47,7 +47,7 @@ radiance towards V is integral f_r(L, V) (N.L) d omega_L over the hemisphere: fo
 reciprocal BRDF exactly the directional albedo a(mu_V) at mu_V = N.V (000 eq. 2), which
 pumpup's engine computes.  :func:`furnace` tabulates a(mu) once per session
 (``pumpup.tabulate``, adaptive grid down to mu = 1e-8; for a reciprocal model at the default
-tolerances it is the pumping operator's own table, ``pumpup.pumping.base_table``) and looks
+tolerances it is the pumping operator's own table, ``pumpup.operators.pumping.base_table``) and looks
 every pixel up in the table; ``Image.error`` is the table's stated bound (twice the measured interpolation
 error plus the largest quadrature error, as in ``AlbedoTable.upper``).  A non-reciprocal
 model is integrated over the incidence direction instead (its albedo with the roles of
@@ -362,8 +362,8 @@ _TRANSPOSED: dict = {}
 
 
 def _pump_module():
-    """The module pumpup.pumping (where the pumping tables are cached)."""
-    from . import pumping
+    """The module pumpup.operators.pumping (where the pumping tables are cached)."""
+    from .operators import pumping
 
     return pumping
 
@@ -371,8 +371,8 @@ def _pump_module():
 def furnace_table(f, mu_min: float = 1e-8, *, rtol: float | None = None, interp_tol: float | None = None):
     """The albedo table a furnace image looks up: (AlbedoTable, bound, transposed).
 
-    With the default tolerances (None: ``pumpup.pumping.TABLE_RTOL`` and ``TABLE_INTERP_TOL``, 1e-9
-    and 1e-7) the table of a reciprocal model is the pumping operator's (``pumpup.pumping.base_table``,
+    With the default tolerances (None: ``pumpup.operators.pumping.TABLE_RTOL`` and ``TABLE_INTERP_TOL``, 1e-9
+    and 1e-7) the table of a reciprocal model is the pumping operator's (``pumpup.operators.pumping.base_table``,
     down to mu = 1e-8, computed once per session and shared: the furnace of a pumped level is the
     table the next level divides by); other tables are cached here per spec and tolerances.
     ``mu_min`` is the smallest mu the table must reach without extrapolation.  ``bound`` is the

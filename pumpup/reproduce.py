@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .albedo import albedo
+from .engine.cubature import albedo
 from .core import load
 from .published import TABLE2, TABLE3, TABLE4, TEXT, Published, agrees
 from .tables import atomic_path, max_albedo, mean_albedo
@@ -270,7 +270,7 @@ def reproduce(out: str = "tables", only: list[str] | None = None, progress: bool
         raise OSError(f"cannot create the output directory {out!r}: {exc}") from None
     if not os.access(out, os.W_OK):
         raise OSError(f"the output directory {out!r} is not writable")
-    from .provenance import write_generated
+    from .tables.provenance import write_generated
 
     cache = _Cache()
     t0 = time.perf_counter()

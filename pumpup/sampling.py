@@ -46,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, vectorize
 
-from .albedo import check_mu
+from .engine.cubature import check_mu
 from .core import BRDF, Lobe, as_directions
 
 __all__ = ["Strategy", "acceptance", "efficiency_dataset", "mc_albedo", "mc_radiance", "pdf", "plot_efficiency", "sample",
@@ -619,7 +619,7 @@ def second_moment(brdf: BRDF, mu, *, kind: str = "lobe", rtol: float = 1e-9, ret
     >>> bool(0 < m2 - pumpup.albedo(f, 1.0)**2 < 0.1)
     True
     """
-    from .albedo import albedo
+    from .engine.cubature import albedo
 
     f = _check_brdf(brdf)
     return albedo(_MomentIntegrand(f, kind, "second"), mu, return_error=return_error, rtol=rtol)
@@ -637,7 +637,7 @@ def acceptance(brdf: BRDF, mu, *, kind: str = "lobe", rtol: float = 1e-9, return
     >>> round(float(pumpup.sampling.acceptance(f, 1e-9)), 6)   # half the lobe is below the horizon
     0.5
     """
-    from .albedo import albedo
+    from .engine.cubature import albedo
 
     f = _check_brdf(brdf)
     return albedo(_MomentIntegrand(f, kind, "density"), mu, return_error=return_error, rtol=rtol)
@@ -666,7 +666,7 @@ def efficiency_dataset(ns=EFFICIENCY_N, theta_deg=EFFICIENCY_THETA, mu_grazing: 
     import xarray as xr
 
     from ._version import __version__
-    from .albedo import albedo
+    from .engine.cubature import albedo
     from .core import load
 
     mu = np.concatenate([np.cos(np.radians(np.asarray(theta_deg, dtype=np.float64))), [mu_grazing]])

@@ -19,7 +19,7 @@ model and with its stretched or pumped version, side by side:
     measured metal's F(Theta_min) per RGB channel (the pumped one keeps the colour).  Here
     a gold cube with four small cubes (turned 45 degrees) on a grey Lambert plate.
 
-Metals: measured gold, silver, copper and aluminium (:mod:`pumpup.optical`: Johnson & Christy 1972
+Metals: measured gold, silver, copper and aluminium (:mod:`pumpup.spectral.optical`: Johnson & Christy 1972
 for Au, Ag, Cu; Rakic 1995 for Al), one complex index n + i k per RGB channel, the measured one at
 :data:`pumpup.spectral.RGB_WAVELENGTHS` (630, 532, 465 nm), so each channel is a real conductor's
 Fresnel factor F(Theta_min) (000 eq. 28: 0 <= F <= 1, F -> 1 at grazing).  Each panel kind is a
@@ -108,13 +108,13 @@ def _phong(n, c=None):
     return s
 
 
-#: the scenes' metals: colour name -> :mod:`pumpup.optical` material
+#: the scenes' metals: colour name -> :mod:`pumpup.spectral.optical` material
 METALS = {"gold": "Au", "silver": "Ag", "copper": "Cu", "aluminium": "Al"}
 
 
 def metal_index(colour) -> tuple[list, list]:
     """(eta, k) per RGB channel of a scene metal: its measured index at ``spectral.RGB_WAVELENGTHS``."""
-    from . import optical
+    from .spectral import optical
     from .spectral import RGB_WAVELENGTHS
 
     eta, k = optical.constants(METALS[colour], list(RGB_WAVELENGTHS))

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from ._version import __version__
-from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
+from .engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
 from .core import BRDF, SpecError, load
 
 __all__ = ["SWEEP_KIND", "default_mu", "dimension_name", "sweep"]
@@ -156,7 +156,7 @@ def cell_model(spec: dict, pump: dict | None) -> BRDF:
     """The model of one cell: ``load(spec)``, pumped with ``pump`` if given."""
     f = load(spec)
     if pump:
-        from .pumping import pump as pump_fn
+        from .operators.pumping import pump as pump_fn
 
         f = pump_fn(f, **pump)
     return f
@@ -164,7 +164,7 @@ def cell_model(spec: dict, pump: dict | None) -> BRDF:
 
 def _cell(spec: dict, pump: dict | None, mu: np.ndarray, opts: dict) -> dict[str, Any]:
     """Everything the sweep stores for one cell: a pure function of its arguments."""
-    from .pumping import _TABLES, Pumped, _key
+    from .operators.pumping import _TABLES, Pumped, _key
     from .tables import max_albedo, mean_albedo, tabulate
 
     f = cell_model(spec, pump)
@@ -363,8 +363,8 @@ def warm_kernels(f: BRDF) -> None:
     previously compiled argument types"), once per sweep.  One value of the innermost base's
     albedo runs every kernel of the engine and the model (a pumped chain's own kernel compiles
     under numba's lock)."""
-    from .albedo import albedo
-    from .pumping import Pumped
+    from .engine.cubature import albedo
+    from .operators.pumping import Pumped
 
     base = f
     while isinstance(base, Pumped):

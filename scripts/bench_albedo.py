@@ -10,9 +10,9 @@ Measures, on this machine:
 First, for every built-in model family (issue 14): the time of a 257-point table (mu uniform in
 theta) at rtol 1e-10 on one thread (``pumpup.albedo`` on the 257 values, and ``pumpup.tabulate``
 with ``threads=1``), the integrand evaluations per value of mu, the path the engine takes (1-D:
-the closed-form azimuth of ``pumpup._polar``; nst: the nested quadrature of ``pumpup._nested``;
+the closed-form azimuth of ``pumpup.engine.polar``; nst: the nested quadrature of ``pumpup.engine.nested``;
 2-D: the cubature), and for the 1-D and nested families the previous engine (the 2-D cubature,
-``pumpup._polar.two_d_only()``, which switches off both) measured in the same run, with
+``pumpup.engine.polar.two_d_only()``, which switches off both) measured in the same run, with
 the ratio; then scipy ``dblquad`` at mu = 0.5 and epsrel 1e-10 per value (stopped after 60 s), and
 the sweep cell (257 mu + mean albedo + maximum constant) and the three tables of a 3-level g2
 pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs after a warm-up.
@@ -121,9 +121,11 @@ def _best(fn, repeat):
 
 def evaluations(f, mu, rtol, phi=0.0):
     """Integrand evaluations of pumpup.albedo(f, mu, phi=phi): the 1-D path's or the slope path's own count, the nested
-    engine's (``pumpup._nested.LAST_EVALS`` of every call), the 2-D engine's points counted at its
+    engine's (``pumpup.engine.nested.LAST_EVALS`` of every call), the 2-D engine's points counted at its
     accumulation step (once per sign of beta)."""
-    from pumpup import _nested, _polar, _slope
+    from pumpup.engine import nested as _nested
+    from pumpup.engine import polar as _polar
+    from pumpup.engine import slope as _slope
 
     A = pumpup.albedo_module
     count = [0]
@@ -160,7 +162,8 @@ def evaluations(f, mu, rtol, phi=0.0):
 def path_of(f):
     """'1-D' (closed-form azimuth), 'slp' (anisotropic Ward in slope space), 'axs' (a power lobe about its own axis,
     Lafortune p = 0), 'nst' (nested quadrature) or '2-D' (cubature) for f at phi = 0."""
-    from pumpup import _nested, _slope
+    from pumpup.engine import nested as _nested
+    from pumpup.engine import slope as _slope
 
     if all(_slope.takes_slope_path(t, np.array([0.5])) for _, t in f.albedo_terms()):
         return "slp"
@@ -201,7 +204,7 @@ PHONG_FAMILY = [{"type": "phong", "n": 20}, {"type": "stretched_phong", "n": 20}
 
 
 def families(rtol=1e-10, specs=None, dblquad=True):
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     print(f"257-point tables at rtol {rtol:g}, one thread (ms); evaluations per mu; previous = the 2-D engine "
@@ -238,7 +241,7 @@ def against_nested(specs, label, rtol=1e-10, repeat=3):
     ``_polar.without_1d``; ``two_d_only`` would switch off the nested engine too), same run, same rtol: a
     257-point table (mu uniform in theta) and a sweep cell (257 mu of ``default_mu`` + mean albedo + maximum
     constant), one thread, best of ``repeat``."""
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
     from pumpup.sweeps import default_mu
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
@@ -269,7 +272,7 @@ def _against_second_path(specs, title, first, second, width, rtol, repeat, lobe=
     """A 257-point table (mu uniform in theta) at ``rtol`` by the 1-D path as it is (``first``), by its second path
     (``_polar.without_n_frame``: frame 4 or frame 5, ``second``) and by the nested engine, one thread, best of ``repeat``
     (nested: 1), with the evaluations per mu of the first (of ``lobe(spec, f)``, the term that takes it)."""
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     print(f"{title}, one thread, ms; 257 mu at rtol {rtol:g}")
@@ -298,7 +301,7 @@ def n_frame(rtol=1e-10, repeat=3):
 
 
 def n_frame_fresnel(rtol=1e-10, repeat=3):
-    """GGX with a Fresnel factor about N (frame 6 with the ring's product rule, pumpup._polar._ggx_ring_f; issue 14's
+    """GGX with a Fresnel factor about N (frame 6 with the ring's product rule, pumpup.engine.polar._ggx_ring_f; issue 14's
     thirteenth session; frame 4 below mu = N_FRESNEL_MU_MIN) against frame 4, the rule on h's arc they took before, and the
     nested engine (:func:`_against_second_path`)."""
     specs = [{"type": "ggx", "alpha": 0.3, "eta": 0.2, "k": 3.0}, {"type": "ggx", "alpha": 0.02, "ior": 1.5},
@@ -345,7 +348,7 @@ def half_and_closed(rtol=1e-10, repeat=3):
 
 def on_the_arc(rtol=1e-10, repeat=3):
     """The models issue 14's seventh session put on the 1-D path: the half vector's azimuth by a rule on its arc
-    (pumpup._polar._k_numeric: GGX and Beckmann with Smith G, with and without a Fresnel factor; Cook-Torrance and
+    (pumpup.engine.polar._k_numeric: GGX and Beckmann with Smith G, with and without a Fresnel factor; Cook-Torrance and
     Torrance-Sparrow with one; Schlick, 000 eq. 36) and Torrance-Sparrow D3 in closed form under the GGX weight,
     against the nested engine they had before (:func:`against_nested`)."""
     against_nested([{"type": "ggx", "alpha": 0.1}, {"type": "ggx", "alpha": 0.5, "shadowing": "correlated"},
@@ -359,7 +362,7 @@ def on_the_arc(rtol=1e-10, repeat=3):
 
 def lobe_fresnel(rtol=1e-10, repeat=3):
     """The models issue 14's eighth session put on the 1-D path: the lobe frame with 000 eq. 28's F(Theta_min) by a rule
-    on the arc where N.V >= N.L (pumpup._polar._k_lobe_fresnel: metal, plastic with an index, the fresnel wrapper of a
+    on the arc where N.V >= N.L (pumpup.engine.polar._k_lobe_fresnel: metal, plastic with an index, the fresnel wrapper of a
     Phong-family lobe) and the pumped lobe's frame of N with it (a pumped metal, the fresnel wrapper of a pumped lobe),
     against the nested engine they had before (:func:`against_nested`)."""
     against_nested([{"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, {"type": "metal", "n": 1, "eta": 1.5},
@@ -414,7 +417,7 @@ def pumped_chains(rtol=1e-10, repeat=3):
     the chain's tables built first), one thread, best of ``repeat``; then the three tables of a 3-level g2 pumped
     Phong n = 20 and GGX alpha = 0.3 as ``pumpup.pump`` builds them (``tabulate``'s threads, rtol 1e-9, adaptive
     grids)."""
-    from pumpup.pumping import _TABLES, Pumped
+    from pumpup.operators.pumping import _TABLES, Pumped
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     polar = Pumped.polar
@@ -484,7 +487,7 @@ def breaks(rtol=1e-10, repeat=7):
     previous code) in the same run, round robin, best of ``repeat``; beside each, the time of the break
     finding alone (its calls during the table).  The two give the same breaks bit for bit, so the same
     tables: the script checks the values and errors are identical."""
-    from pumpup import _nested
+    from pumpup.engine import nested as _nested
 
     A = pumpup.albedo_module
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
@@ -533,8 +536,9 @@ def breaks(rtol=1e-10, repeat=7):
 
 
 def cells():
-    from pumpup import _polar, _reuse
-    from pumpup.pumping import _TABLES
+    from pumpup.engine import polar as _polar
+    from pumpup.tables import reuse as _reuse
+    from pumpup.operators.pumping import _TABLES
     from pumpup.sweeps import default_mu
 
     mu = default_mu(257)
@@ -641,10 +645,10 @@ def eval_overhead(n=1_000_000, repeat=15):
 
 
 def slope(rtol=1e-10, repeat=3):
-    """Anisotropic Ward in slope space (pumpup._slope, issue 14's fourteenth session) against the nested engine it took
+    """Anisotropic Ward in slope space (pumpup.engine.slope, issue 14's fourteenth session) against the nested engine it took
     before (``_polar.without_1d`` switches both off), same run: a 257-point table (mu uniform in theta) at phi = 0 and at
     phi = 0.7, one thread, best of ``repeat`` (nested: 1), with the slope path's evaluations per mu."""
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     specs = [{"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, {"type": "ward_aniso", "ax": 0.05, "ay": 0.5},
@@ -668,11 +672,11 @@ def slope(rtol=1e-10, repeat=3):
 
 def lobe_f_gauss(rtol=1e-10, repeat=3):
     """Frame 5's lobes with F(Theta_min) and n < LOBE_N_MIN (metal, plastic, the fresnel wrapper) with the arcs by
-    Gauss-Legendre pieces and their a-priori bound (``pumpup._polar._lobe_f_gauss``; issue 14's sixteenth session)
+    Gauss-Legendre pieces and their a-priori bound (``pumpup.engine.polar._lobe_f_gauss``; issue 14's sixteenth session)
     against the adaptive 7/15 rule they had before (``_polar.without_lobe_f_gauss``), same run: a 257-point table (mu
     uniform in theta) at ``rtol`` and a sweep cell (257 mu + mean albedo + maximum constant), one thread, best of
     ``repeat`` each, alternating."""
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
     from pumpup.sweeps import default_mu
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
@@ -708,7 +712,7 @@ def lobe_f_gauss(rtol=1e-10, repeat=3):
 
 
 def lafortune_axis(rtol=1e-10, repeat=3):
-    """Lafortune lobes with p = 0 about their own axis v^ (``BRDF.lobe_axis``, ``pumpup._polar.axis_albedo``; issue 14's
+    """Lafortune lobes with p = 0 about their own axis v^ (``BRDF.lobe_axis``, ``pumpup.engine.polar.axis_albedo``; issue 14's
     fifteenth session) against the engine they took before (``lobe_axis`` switched off: the nested engine at phi = 0, the
     2-D cubature at phi != 0), same run: a 257-point table (mu uniform in theta) at rtol 1e-10 by the axis path, one
     thread, best of ``repeat``; the engine before on every 16th of those mu (17 values, once; the 2-D cubature takes

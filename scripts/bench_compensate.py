@@ -25,7 +25,7 @@ f = pumpup.load({"type": "ggx", "alpha": 0.3})
 f._eval(np.array([0, 0, 1.0]), np.array([0, 0, 1.0]))
 pumpup.albedo(f, 0.5)  # the engine's kernels loaded from numba's cache, outside the timing
 import sys
-comp = sys.modules["pumpup.compensate"]
+comp = sys.modules["pumpup.operators.compensate"]
 comp.compensation_table(pumpup.load({"type": "lambert", "albedo": 0.5}))  # and the compensation code paths
 pumpup.compensate({"type": "lambert", "albedo": 0.5})
 w, c = time.perf_counter(), time.process_time()

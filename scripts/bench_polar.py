@@ -20,7 +20,7 @@ import time
 import numpy as np
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 
 SPECS = [{"type": "phong", "n": 20}, {"type": "stretched_phong", "n": 20},
          {"type": "stretched_phong", "n": 20, "p": 0.0}, {"type": "retro", "n": 10}]

@@ -60,7 +60,7 @@ def main(argv=None) -> int:
 
     print(f"\n{'furnace':34s} {'first [s]':>9s} {'again [s]':>9s} {'look-up [s]':>11s} {'nodes':>5s} "
           f"{'one albedo [s]':>14s} {'first / one':>11s}")
-    pm = sys.modules["pumpup.pumping"]
+    pm = sys.modules["pumpup.operators.pumping"]
     for spec in ({"type": "lambert", "albedo": 0.8}, {"type": "phong", "n": 20}, {"type": "stretched_phong", "n": 20},
                  {"type": "ggx", "alpha": 0.3}):
         f = pumpup.load(spec)

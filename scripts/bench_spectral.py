@@ -84,7 +84,7 @@ class count_values:
     """Count the albedo values (model, mu) computed inside the block: the load-independent cost."""
 
     def __enter__(self):
-        mod, tab = sys.modules["pumpup.albedo"], sys.modules["pumpup.tables"]
+        mod, tab = sys.modules["pumpup.engine.cubature"], sys.modules["pumpup.tables"]
         self.orig, self.n = mod.albedo, 0
 
         def counting(brdf, mu, *a, **k):
@@ -95,7 +95,7 @@ class count_values:
         return self
 
     def __exit__(self, *exc):
-        sys.modules["pumpup.albedo"].albedo = sys.modules["pumpup.tables"].albedo = self.orig
+        sys.modules["pumpup.engine.cubature"].albedo = sys.modules["pumpup.tables"].albedo = self.orig
 
 
 def bench_counts(n):

@@ -76,7 +76,7 @@ def main() -> None:
             cache = os.path.join(tmp, "numba-cache")
             env = dict(os.environ, NUMBA_CACHE_DIR=cache, MPLBACKEND="Agg")
             run(pumpup + ["warmup", "--quiet"], tmp, env)  # reproduce's own time, not its compile
-            cpu, wall, rc = run(pumpup + ["reproduce", "--out", os.path.join(tmp, "tables")], tmp, env)
+            cpu, wall, rc = run(pumpup + ["reproduce", "--out", os.path.join(tmp, "reproduced")], tmp, env)
             rows.append(("pumpup reproduce (kernels cached)", cpu, wall, "< 10 s", rc))
             shutil.rmtree(cache)
             cpu, wall, rc = run(pumpup + ["warmup", "--quiet"], tmp, env)

@@ -340,7 +340,7 @@ def main(argv=None):
     t0 = time.perf_counter()
     ds = study(quick=a.quick)
     ds.attrs["seconds"] = time.perf_counter() - t0
-    from pumpup.provenance import write_generated  # stamps the commit that made it (issue 13 item 15)
+    from pumpup.tables.provenance import write_generated  # stamps the commit that made it (issue 13 item 15)
 
     path = os.path.join(a.out, "compensation.nc")
     write_generated(ds, path)

@@ -23,12 +23,12 @@ The references (all computed without pumpup):
   (1, 000 eq. 6), Lewis's Phong (k_rho at every mu, 002 eq. 22).
 
 Engines are a small registry, :data:`ENGINES`: name -> (context manager, applies(brdf)).  The
-"1-D" engine is the closed-form-azimuth path of ``pumpup._polar`` (it applies to the models with
+"1-D" engine is the closed-form-azimuth path of ``pumpup.engine.polar`` (it applies to the models with
 a Polar hint), "2-D" the adaptive cubature of ``pumpup.albedo`` (``_polar.two_d_only``); a new
 engine (the nested 1-D x 1-D engine of issue 14 item 2) is one more entry.  Estimates
 (:data:`ESTIMATES`): "raw" is |K - G| everywhere (the engines before issue 14), "quadpack"
 QUADPACK's calibration everywhere, "min" the smaller of the two, "default" what the engines use
-now (the 1-D path calibrated, the 2-D engine raw: ``pumpup._errors`` says why).
+now (the 1-D path calibrated, the 2-D engine raw: ``pumpup.physics.quadrature`` says why).
 ``tests/test_error_calibration.py`` uses the same functions, with "default".
 
 Beside the independent references, "self" cases judge the 2-D engine against itself at rtol
@@ -70,19 +70,19 @@ def _has_polar(f) -> bool:
 
 
 def _two_d():
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
 
     return _polar.two_d_only()
 
 
 def _without_1d():
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
 
     return _polar.without_1d()
 
 
 def _nested_applies(f) -> bool:
-    """The nested quadrature (pumpup._nested) integrates f: every term with a lobe hint (a
+    """The nested quadrature (pumpup.engine.nested) integrates f: every term with a lobe hint (a
     from_function BRDF stays on the 2-D engine).  It is judged with the 1-D path off (``_without_1d``),
     so also on the models that path takes (the Phong family, and since issue 14's sixth session the half
     vector's models: the nested engine integrated those before, and is their second engine in the tests)."""
@@ -102,18 +102,18 @@ ENGINES = {
 }
 
 def _estimates(mode):
-    from pumpup import _errors
+    from pumpup.physics import quadrature as _errors
 
     return _errors.estimates(mode)
 
 
 def _raw():
-    from pumpup import _errors
+    from pumpup.physics import quadrature as _errors
 
     return _errors.raw_estimate()
 
 
-#: "default": what the engines use (the 1-D path calibrated, the 2-D engine raw, pumpup._errors);
+#: "default": what the engines use (the 1-D path calibrated, the 2-D engine raw, pumpup.physics.quadrature);
 #: "raw": |K - G| everywhere (before issue 14); "quadpack" / "min": that estimate everywhere
 ESTIMATES = {
     "default": contextlib.nullcontext,

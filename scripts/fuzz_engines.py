@@ -3,10 +3,10 @@
 Draws built-in models with extreme parameters (lobe exponents 0.1-1e4, roughness 1e-4-1, Fresnel factors with eta
 0.1-3 and k 0.01-16, Schlick r down to 1e-6, p-models), three incidences (mu log-uniform down to 1e-6, uniform, 1) and
 an rtol (1e-6, 1e-8, 1e-10); computes the albedo on its default path and again with the 1-D path off
-(``pumpup._polar.without_1d``: the nested engine) at rtol 1e-12, and prints every case where the two differ by more
+(``pumpup.engine.polar.without_1d``: the nested engine) at rtol 1e-12, and prints every case where the two differ by more
 than the default path's estimate plus the reference's, with the ratio.  A case printed is a disagreement, not yet a
 culprit: decide it with a third method (``scripts/independent_microfacet.py`` for GGX and Beckmann, the 2-D engine,
-``pumpup._polar.two_d_only``).
+``pumpup.engine.polar.two_d_only``).
 
 Found this way: GGX alpha 1.3e-4 at mu = 6.05e-5.  The 1-D path (0.8967913960373392, estimate 2.3e-14) agrees with
 the independent script (0.8967913960367667 +- 1.9e-8); the nested engine was 9e-9 off with estimates of 2e-10 to 3e-9
@@ -61,7 +61,7 @@ import warnings
 import numpy as np
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 
 
 def rand_spec(rng):
@@ -156,7 +156,7 @@ def _draws(rng, budget, draw):
 
 
 def main_2d(rng, budget):
-    """The default path against the 2-D engine (``pumpup._polar.two_d_only``) at rtol 1e-12, with wi turned out of the
+    """The default path against the 2-D engine (``pumpup.engine.polar.two_d_only``) at rtol 1e-12, with wi turned out of the
     xz-plane (phi) for the anisotropic models."""
     bad = n = 0
     for spec, f in _draws(rng, budget, rand_spec_2d):

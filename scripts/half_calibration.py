@@ -1,11 +1,11 @@
 """How honest is the half-vector 1-D path's error estimate?  (issue 14, sixth session)
 
-For the models whose albedo the 1-D path integrates about N for the half vector (pumpup._polar,
+For the models whose albedo the 1-D path integrates about N for the half vector (pumpup.engine.polar,
 Polar kind "half": the Blinn family, Ward, modified Ward, Cook-Torrance and Torrance-Sparrow D1, D3, D4 with
 F = 1 in closed form; the Smith microfacet models GGX and Beckmann, the V-cavity models with a Fresnel factor and
-Schlick's model by a rule on h's arc, pumpup._polar._k_numeric), at 60 mu uniform in theta plus 1e-3, 1e-5 and 1e-8, and rtol 1e-6, 1e-8, 1e-10, 1e-12, the
+Schlick's model by a rule on h's arc, pumpup.engine.polar._k_numeric), at 60 mu uniform in theta plus 1e-3, 1e-5 and 1e-8, and rtol 1e-6, 1e-8, 1e-10, 1e-12, the
 ratio of the true error to the estimate, the truth being the nested engine at rtol 1e-13 (the engine
-these models had before, reached with the 1-D path switched off, pumpup._polar.without_1d), its own
+these models had before, reached with the 1-D path switched off, pumpup.engine.polar.without_1d), its own
 error counted in the 1-D path's favour: max(|a - ref| - ref_err, 0) / estimate.  A ratio above 1 is a
 dishonest estimate.  Prints the worst ratio per family and rtol, and the evaluations per mu.
 
@@ -18,7 +18,7 @@ import warnings
 import numpy as np
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 
 FAMILIES = {
     "blinn": [{"type": "blinn", "n": n} for n in (0, 0.5, 1, 3, 16, 100, 1000, 1e5)],

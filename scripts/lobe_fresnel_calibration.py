@@ -1,13 +1,13 @@
 """How honest is the error estimate of the 1-D path with 000 eq. 28's Fresnel factor?  (issue 14, eighth session)
 
-The lobe frame with F(Theta_min) (pumpup._polar frame 5, _k_lobe_fresnel: metal, plastic with an index, the fresnel
+The lobe frame with F(Theta_min) (pumpup.engine.polar frame 5, _k_lobe_fresnel: metal, plastic with an index, the fresnel
 wrapper of a Phong-family lobe) and the pumped lobe's frame of N with it (a pumped metal, the fresnel wrapper of a
 pumped lobe), over every index the rule takes of eta in {0.05, 0.3, 0.6, 0.9, 0.999, 1.001, 1.1, 1.5, 3, 20} x
 k in {0, 0.001, 0.002, 0.01, 0.3, 3, 30} (the near-kinks, Im sqrt(1 - (eta + i k)^2) < 1e-3, go to the nested
 engine, and with a pumped lobe those below 1e-2), five lobes (stretched Phong n = 0, 7.5, 500 and Phong n = 20, 1 under the fresnel wrapper) and, with
 ``--pumped``, a g1-pumped metal n = 20 per index; at 60 mu uniform in theta plus 1e-3, 1e-5, 1e-8 and rtol 1e-6,
 1e-8, 1e-10, 1e-12: the ratio of the true error to the estimate, the truth being the nested engine at rtol 1e-13
-(pumpup._polar.without_1d), its own error counted in the 1-D path's favour: max(|a - ref| - ref_err, 0) / estimate.
+(pumpup.engine.polar.without_1d), its own error counted in the 1-D path's favour: max(|a - ref| - ref_err, 0) / estimate.
 A ratio above 1 is a dishonest estimate.  Prints one row per index and lobe (worst ratio@mu/evaluations per mu for
 each rtol) and the worst overall.
 
@@ -22,7 +22,7 @@ import warnings
 import numpy as np
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 
 ETAS = (0.05, 0.3, 0.6, 0.9, 0.999, 1.001, 1.1, 1.5, 3.0, 20.0)
 KS = (0.0, 0.001, 0.002, 0.01, 0.3, 3.0, 30.0)

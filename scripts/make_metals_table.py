@@ -25,7 +25,8 @@ def build(path="tables/metals.nc"):
     import xarray as xr
 
     import pumpup
-    from pumpup import optical, spectral
+    from pumpup.spectral import optical
+    from pumpup import spectral
     from pumpup.tables import default_grid
 
     mu = default_grid(n_theta=17, mu_min=1e-4)
@@ -62,7 +63,7 @@ def build(path="tables/metals.nc"):
         },
     )
     ds["wavelength"].attrs["units"] = "nm"
-    from pumpup.provenance import write_generated
+    from pumpup.tables.provenance import write_generated
 
     write_generated(ds, path)  # with the commit of the code that made it (tests/test_generated_data.py)
     return ds

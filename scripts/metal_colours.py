@@ -1,4 +1,4 @@
-"""The sRGB colours of the metals of pumpup.optical: normal-incidence F0 and mean albedo (README table).
+"""The sRGB colours of the metals of pumpup.spectral.optical: normal-incidence F0 and mean albedo (README table).
 
 Prints a Markdown table: linear sRGB (CIE 1931 2-degree observer, D65) of
 * F0 at the 8 default wavelengths (400-680 nm by 40 nm, the SpectralMetal default),
@@ -12,7 +12,8 @@ beside the published linear sRGB F0 ("BaseColor") values of the Unreal Engine 4 
 
 import numpy as np
 
-from pumpup import optical, spectral
+from pumpup.spectral import optical
+from pumpup import spectral
 
 PUBLISHED = {  # Unreal Engine 4 documentation, "Physically Based Materials", linear sRGB
     "Au": (1.000, 0.766, 0.336), "Ag": (0.972, 0.960, 0.915), "Cu": (0.955, 0.637, 0.538),

@@ -1,9 +1,9 @@
 """How honest is frame 6's error estimate?  (issue 14, ninth session)
 
-Frame 6 (pumpup._polar._integrate_n) integrates GGX and Beckmann with F = 1 (both Smith G, exact or Walter's G1) and
+Frame 6 (pumpup.engine.polar._integrate_n) integrates GGX and Beckmann with F = 1 (both Smith G, exact or Walter's G1) and
 Schlick's model about N, with the weight's azimuth in closed form.  Its reference here is frame 4, the rule on h's arc these models took before
-(pumpup._polar.without_n_frame), at rtol 1e-13, an independent path (other variables, other cuts, an inner rule), and
-where it is honest the nested engine at 1e-13 (pumpup._polar.without_1d).  For every model, 60 mu uniform in theta
+(pumpup.engine.polar.without_n_frame), at rtol 1e-13, an independent path (other variables, other cuts, an inner rule), and
+where it is honest the nested engine at 1e-13 (pumpup.engine.polar.without_1d).  For every model, 60 mu uniform in theta
 plus 1e-3, 1e-5, 1e-8 and 1e-300 (frame 4 at 1e-100 there: the albedo is flat to ~mu), and rtol 1e-6 ... 1e-12: the
 worst max(|a - ref| - ref_err, 0) / estimate (above 1: a dishonest estimate), the worst estimate / (rtol a), the
 evaluations per mu and the time of a 257-point table at rtol 1e-10 against frame 4's.
@@ -16,7 +16,7 @@ import warnings
 import numpy as np
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 from pumpup.costs import _best  # (warm-up, then the best of ``repeat``)
 
 SPECS = ([{"type": "ggx", "alpha": a} for a in (1e-8, 1e-5, 0.001, 0.02, 0.1, 0.3, 0.5, 0.8, 1.0)]

@@ -3,7 +3,7 @@
 For 15 pumped chains (g1 and g2, 1-4 levels, n from 0.5 to 5000, p in {0, 0.5, 1}, retro) and mu from
 1e-10 to 1 (a geometric grid, a few round values, and every ``--stride``-th of the 300 thetas of
 tables/pumping_figures.nc), the 1-D path about N at rtol 1e-6 ... 1e-12 against the nested engine at
-rtol 1e-13 on the same BRDFs (``pumpup._polar.albedo_1d`` switched off; the chains' tables are built once, by the
+rtol 1e-13 on the same BRDFs (``pumpup.engine.polar.albedo_1d`` switched off; the chains' tables are built once, by the
 1-D path, so both engines integrate the same BRDF).  Prints, per chain and rtol, the largest
 |value - reference| / (estimate + reference's estimate), and the worst over all; a value above 1 is a
 miss of one of the two.
@@ -11,7 +11,7 @@ miss of one of the two.
     python scripts/pumped_calibration.py              # every third theta of the figures (a few minutes)
     python scripts/pumped_calibration.py --stride 1   # all of them
     python scripts/pumped_calibration.py --nframe     # pumped GGX, Beckmann and Schlick models instead (frame 6 about
-                                                      # N divided by g, pumpup._polar._integrate_n; issue 14's tenth
+                                                      # N divided by g, pumpup.engine.polar._integrate_n; issue 14's tenth
                                                       # session): their estimate is the larger of QUADPACK's calibration
                                                       # and CHAIN_SAFETY |K - G|
     python scripts/pumped_calibration.py --scaled     # 1/E-scaled GGX, Beckmann and Schlick models (frame 6 times
@@ -25,7 +25,7 @@ import time
 import numpy as np
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 
 CHAINS = [({"type": "phong", "n": 20}, "g2", 2), ({"type": "phong", "n": 20}, "g2", 3),
           ({"type": "stretched_phong", "n": 20}, "g1", 2), ({"type": "phong", "n": 200}, "g2", 2),

@@ -16,7 +16,7 @@ import time
 import warnings
 
 import pumpup
-from pumpup import _reuse
+from pumpup.tables import reuse as _reuse
 from pumpup.sweeps import default_mu
 
 SPECS = ([{"type": "phong", "n": n} for n in (20, 300, 1000, 3000, 5000, 10000, 20000, 50000)]

@@ -1,4 +1,4 @@
-"""Calibration of frame 6 with a Fresnel factor (pumpup._polar._ggx_ring_f; issue 14, thirteenth session).
+"""Calibration of frame 6 with a Fresnel factor (pumpup.engine.polar._ggx_ring_f; issue 14, thirteenth session).
 
 1. The ring: GGX's D times F(wi.h) over the azimuth of wo, for 7 indices (a dielectric near 1 and at 1.5 and 3; a metal, a
    strong absorber whose pole lies near c = 0, a weak absorber, a conductor with eta < 1), 6 alpha from 1e-4 to 1, 9 mu from
@@ -19,7 +19,7 @@ import warnings
 import numpy as np
 
 import pumpup
-from pumpup import _polar as P
+from pumpup.engine import polar as P
 
 MATERIALS = [(1.0001, 0.0, 0.0), (1.5, 0.0, 0.0), (3.0, 0.0, 0.0), (0.0, 0.2, 3.0), (0.0, 1.1, 30.0), (0.0, 1.0, 0.1),
              (0.0, 0.6, 1.5)]

@@ -13,7 +13,7 @@ import argparse
 import os
 
 from pumpup.sampling import efficiency_dataset, plot_efficiency
-from pumpup.provenance import write_generated
+from pumpup.tables.provenance import write_generated
 
 
 def main(argv=None):

@@ -1,8 +1,8 @@
-"""Calibration of the slope path (anisotropic Ward, pumpup._slope; issue 14, fourteenth session).
+"""Calibration of the slope path (anisotropic Ward, pumpup.engine.slope; issue 14, fourteenth session).
 
 For 9 pairs of slopes (anisotropy 1 ... 1000, widths 1e-3 ... 3, both orders), 14 mu (MU_MIN, 1e-8, 1e-4, 0.003 and 10
 uniform in theta) and 4 azimuths of wi (0, 0.4, pi / 4 + 0.1, pi / 2), at rtol 1e-6, 1e-8, 1e-10 and 1e-12: the true error
-/ the estimate, max(|a - ref| - ref_err, 0) / err, against the nested engine at rtol 1e-13 (``pumpup._polar.without_1d``:
+/ the estimate, max(|a - ref| - ref_err, 0) / err, against the nested engine at rtol 1e-13 (``pumpup.engine.polar.without_1d``:
 the half vector's polar angle and azimuth, another parametrisation), its own error counted in the slope path's favour.
 Where that ratio exceeds 1/2, the third method decides: the two nested-quad methods of
 ``scripts/independent_ward_aniso.py`` (written without pumpup), their difference and estimates counted in the slope
@@ -26,7 +26,8 @@ import warnings
 import numpy as np
 
 import pumpup
-from pumpup import _polar, _slope
+from pumpup.engine import polar as _polar
+from pumpup.engine import slope as _slope
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from independent_ward_aniso import albedo_A, albedo_B  # noqa: E402

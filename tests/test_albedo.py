@@ -137,9 +137,9 @@ def test_brdf_returning_nan_or_negative_is_refused():
 
 def test_unmet_tolerance_warns_and_reports_the_larger_error():
     f = pumpup.load({"type": "stretched_phong", "n": 20})
-    # the 2-D engine's budget (the 1-D path of pumpup._polar reaches the rounding floor at once:
+    # the 2-D engine's budget (the 1-D path of pumpup.engine.polar reaches the rounding floor at once:
     # tests/test_polar.py checks its own budget)
-    with warnings.catch_warnings(record=True) as w, pumpup._polar.two_d_only():
+    with warnings.catch_warnings(record=True) as w, pumpup.engine.polar.two_d_only():
         warnings.simplefilter("always")
         a, e = pumpup.albedo(f, 0.3, return_error=True, rtol=1e-15, atol=0, max_regions=10)
     assert any(issubclass(x.category, pumpup.albedo_module.AlbedoWarning) for x in w)
@@ -160,7 +160,7 @@ def test_unmet_tolerance_warns_and_reports_the_larger_error():
 def test_compiled_geometry_matches_numpy_reference(spec, rng):
     import sys
 
-    A = sys.modules["pumpup.albedo"]
+    A = sys.modules["pumpup.engine.cubature"]
     f = pumpup.load(spec)
     n = 20000
     mu = np.concatenate([10 ** rng.uniform(-8, 0, n - 2), [1.0, 1e-8]])
@@ -213,7 +213,7 @@ def test_max_regions_counts_the_refinement_beyond_the_first_grid():
     exact, exact_err = phong_albedo_1d(20, 0.5)
     out = {}
     for mr in (0, 10):
-        with pytest.warns(pumpup.albedo_module.AlbedoWarning), pumpup._polar.two_d_only():  # the 2-D engine
+        with pytest.warns(pumpup.albedo_module.AlbedoWarning), pumpup.engine.polar.two_d_only():  # the 2-D engine
             out[mr] = pumpup.albedo(f, 0.5, return_error=True, rtol=1e-12, max_regions=mr)
     assert out[10][1] < out[0][1]
     for a, e in out.values():

@@ -15,10 +15,10 @@ from scipy.integrate import IntegrationWarning, quad
 from scipy.optimize import brentq
 
 import pumpup
-from pumpup import _polar
-from pumpup.albedo import AlbedoWarning
+from pumpup.engine import polar as _polar
+from pumpup.engine.cubature import AlbedoWarning
 
-A = sys.modules["pumpup.albedo"]
+A = sys.modules["pumpup.engine.cubature"]
 GL = np.polynomial.legendre.leggauss(200)
 
 #: the independent references below agree with each other (200 and 300 phi nodes) and with the

@@ -138,7 +138,7 @@ def test_cli_phi_in_degrees(capsys):
 
 @pytest.mark.parametrize("mu,n_phi", [([0.3, 0.8], 12), pytest.param([0.02, 0.1], 48, marks=pytest.mark.slow)])
 def test_sup_albedo_bounds_every_azimuth(rng, mu, n_phi):
-    from pumpup.azimuth import sup_albedo
+    from pumpup.tables.azimuth import sup_albedo
 
     f = pumpup.load({"type": "ward_aniso", "ax": 0.4, "ay": 0.02, "c": 0.8})
     mu = np.array(mu)
@@ -151,7 +151,7 @@ def test_sup_albedo_bounds_every_azimuth(rng, mu, n_phi):
 
 
 def test_sup_albedo_of_an_isotropic_model_is_its_albedo():
-    from pumpup.azimuth import sup_albedo
+    from pumpup.tables.azimuth import sup_albedo
 
     f = pumpup.load({"type": "phong", "n": 20})
     v, e = sup_albedo(f, [0.3, 1.0])
@@ -163,7 +163,7 @@ def test_sup_albedo_of_an_isotropic_model_is_its_albedo():
 def loose_tables(monkeypatch):
     import sys
 
-    mod = sys.modules["pumpup.pumping"]  
+    mod = sys.modules["pumpup.operators.pumping"]  
     monkeypatch.setattr(mod, "TABLE_RTOL", 1e-7)
     monkeypatch.setattr(mod, "TABLE_INTERP_TOL", 1e-5)
     before = set(mod._TABLES)
@@ -189,7 +189,7 @@ def test_pumped_anisotropic_albedo_at_most_one_at_every_azimuth(loose_tables, g,
 
 
 def test_trigonometric_interpolant_is_exact_below_nyquist():
-    from pumpup.azimuth import _period, _trig_up
+    from pumpup.tables.azimuth import _period, _trig_up
 
     # a cos(2 phi) + b cos(4 phi) sampled on [0, pi/2] (J = 4, even extension to a period of pi) is
     # reproduced exactly at the midpoints and on the dense grid

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup import _checks
+from pumpup.core import checks as _checks
 from pumpup.core import UNIT_TOL
 
 

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup.compensate import KullaConty, Scaled, compensation_table
+from pumpup.operators.compensate import KullaConty, Scaled, compensation_table
 from helpers import at_mu, direction_pairs
 
-comp = sys.modules["pumpup.compensate"]
+comp = sys.modules["pumpup.operators.compensate"]
 
 MU = np.array([1.0, 0.9, 0.7, 0.5, 0.3, 0.1, 0.03, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8])
 # between the nodes of the tables
@@ -98,7 +98,7 @@ def test_kulla_conty_lobe_in_closed_form(spec):
     within the summed estimates, from mu = 1 to 1e-8 and between the table's nodes."""
     from scipy.integrate import quad
 
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
 
     c = pumpup.compensate(spec, method="kulla_conty")
     ms = c.albedo_terms()[-1][1]
@@ -126,7 +126,7 @@ def test_kulla_conty_lobe_on_the_engines_near_grazing(engine):
     reference, scripts/fuzz_engines.py --registry 47): D(N.wo), a spline in log(N.wo), about the normal, was 3.4 x (2-D)
     and 3.0 x (nested) their estimates at rtol 1e-12 against the closed form D(mu) pi I (checked against scipy's quad
     above).  The hint's levels N.wo = 10^-k (compensate.TABLE_DECADES) grade the radial variable there."""
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
 
     f = pumpup.load({"type": "kulla_conty", "base": {"type": "phong", "n": 986.5971775489417}, "f_avg": 0.6893058353882096})
     ms = f.albedo_terms()[-1][1]
@@ -213,7 +213,7 @@ def test_scaled_furnace_toward_the_viewer_in_closed_form(spec, f0):
     """The furnace toward the viewer of a scaled model (and of each term of a scaled sum) is s(mu) times the base's
     albedo (000 eq. 2 for the reciprocal base; issue 14's twelfth session, ``_Transposed.polar``): on the 1-D path, and
     against the nested engine at rtol 1e-12 within the summed estimates, from mu = 1 to 1e-8 and between the nodes."""
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
 
     s = pumpup.compensate(spec, method="scale", f0=f0)
     mu = np.concatenate([MU, RNG_MU])
@@ -308,7 +308,7 @@ def test_save_and_load_without_recomputing(tmp_path, monkeypatch):
     before = [f.eval(wi, wo) for f in (c, s, nested)]
     paths = [pumpup.save_compensated(f, tmp_path / f"f{i}.nc") for i, f in enumerate((c, s, nested))]
     comp._TABLES.clear()
-    sys.modules["pumpup.pumping"]._TABLES.clear()
+    sys.modules["pumpup.operators.pumping"]._TABLES.clear()
     def no_tables(*a, **k):
         raise AssertionError("a table was recomputed")
 
@@ -318,7 +318,7 @@ def test_save_and_load_without_recomputing(tmp_path, monkeypatch):
         assert g == f
         np.testing.assert_array_equal(g.eval(wi, wo), v)
     # the file's tables served only the loaded objects: the session's caches are still empty (issue 13 item 5)
-    assert not comp._TABLES and not sys.modules["pumpup.pumping"]._TABLES
+    assert not comp._TABLES and not sys.modules["pumpup.operators.pumping"]._TABLES
     with pytest.raises(ValueError, match="not a saved compensated BRDF"):
         pumpup.write_table(c.table().dataset, tmp_path / "t.nc")
         pumpup.load_compensated(tmp_path / "t.nc")

@@ -137,7 +137,7 @@ def test_oren_nayar_albedo_in_closed_form():
     import warnings
 
     mp = pytest.importorskip("mpmath")
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
     from pumpup.models.diffuse import oren_nayar_albedo
 
     mp.mp.dps = 40
@@ -167,7 +167,7 @@ def test_minnaert_and_lacquer_albedos_in_closed_form():
     import warnings
 
     mp = pytest.importorskip("mpmath")
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
 
     mp.mp.dps = 30
     mu = np.array([1.0, 0.9, 0.5, 0.2, 0.05, 1e-2, 1e-3])

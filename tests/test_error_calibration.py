@@ -15,7 +15,7 @@ import error_calibration as cal
 import numpy as np
 import pytest
 
-from pumpup import _errors
+from pumpup.physics import quadrature as _errors
 
 
 def test_compiled_estimate_matches_its_reference(rng):
@@ -114,7 +114,7 @@ def test_raw_estimate_is_the_previous_engine():
 def test_two_d_engine_keeps_the_raw_estimate_where_kinks_are_unmarked():
     # a pumped Blinn divides by an interpolated albedo table: kinks at its knots that no hint marks.
     # QUADPACK's scaling assumes smoothness and was measured 1.12 x (rtol 1e-10) and 1.64 x (1e-11)
-    # below the true error at mu = 1e-3 (pumpup._errors); the default (raw) estimate bounds it
+    # below the true error at mu = 1e-3 (pumpup.physics.quadrature); the default (raw) estimate bounds it
     case = next(c for c in cal.cases(quick=True) if c["id"].startswith("self-") and "blinn" in c["id"]
                 and c["mu"] == 1e-3)
     for rtol in (1e-10, 1e-11):

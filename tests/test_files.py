@@ -14,7 +14,7 @@ import pytest
 import xarray as xr
 
 import pumpup
-from pumpup.validate import TableError
+from pumpup.tables.validate import TableError
 
 LAMBERT_HALF = {"type": "lambert", "albedo": 0.5}
 
@@ -153,7 +153,7 @@ def _edit_group(src, dst, group, fn):
             for k, v in d.attrs.items():
                 nc.setncattr(k, v)
     else:  # consistent with its digest: the deeper checks must catch it
-        from pumpup.validate import content_digest
+        from pumpup.tables.validate import content_digest
 
         d.attrs["pumpup_digest"] = content_digest(d)
         d.to_netcdf(dst, mode="a", group=group, engine="netcdf4")
@@ -209,7 +209,7 @@ def test_a_loaded_file_does_not_poison_the_cache(tmp_path):
     pumpup.write_table(xr.Dataset(attrs={"pumpup_kind": "pumpup pumped BRDF", "spec": json.dumps(p.spec),
                                          "levels": 1, "pumpup_version": "x"}), edited)
     d.attrs.pop("pumpup_digest", None)
-    from pumpup.validate import content_digest
+    from pumpup.tables.validate import content_digest
 
     d.attrs["pumpup_digest"] = content_digest(d)
     d.to_netcdf(edited, mode="a", group="level1", engine="netcdf4")

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup import pumping
+from pumpup.operators import pumping
 from pumpup.models.metal import fresnel_levels
 
 sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
@@ -42,8 +42,8 @@ def test_hints_carry_the_kink(spec):
     assert f.albedo_breaks() == pytest.approx((X0,), rel=1e-15)
     if spec["type"] != "mix":
         assert any(abs(u - X0) < 1e-15 for u in f.lobe(0.3).levels)
-    assert pumping.albedo_kinks(f) == pytest.approx([X0], rel=1e-15)  # its tables are split there
-    assert pumping.albedo_kinks(pumpup.load({"type": "lambert"})) is None
+    assert f.albedo_kinks(*pumping.grid_interior()) == pytest.approx([X0], rel=1e-15)  # its tables are split there
+    assert pumpup.load({"type": "lambert"}).albedo_kinks(*pumping.grid_interior()) is None
 
 
 @pytest.mark.parametrize("n", [0.358, 5.0])
@@ -129,7 +129,7 @@ def test_microfacet_with_total_reflection(spec, mu):
     """F(wi.h) with eta = 0.551, k = 0 has a square-root kink at wi.h = x0.  Frame 4 of the 1-D path, which took it, was
     1.0e-7 off with an estimate of 7.9e-13 for GGX 0.3 at mu = 0.05, 1.9e-12 with 2.1e-14 at 0.95, and Beckmann 0.1 at 0.95
     3.8e-11 with 9.2e-14 (and 19 s); the nested engine, now with the kink in its hint, is its path."""
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
 
     f = pumpup.load(spec)
     assert not _polar.takes_1d_path(f) and f.lobe(mu).kinks is not None
@@ -142,7 +142,7 @@ def test_microfacet_with_total_reflection(spec, mu):
 def test_microfacet_paths_by_the_branch_point():
     """The 1-D path declines F(wi.h) whose branch point lies closer than POLAR_F_Y0_MIN to (0, 1); the hint's kink
     follows fresnel_levels."""
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
 
     for k, one_d, kink in ((0.0, False, True), (1e-9, False, True), (1e-3, True, True), (0.1, True, False)):
         f = pumpup.load({"type": "ggx", "alpha": 0.3, "eta": ETA, "k": k})
@@ -193,7 +193,7 @@ def test_beckmann_walter_correlated_with_fresnel(spec, mu):
     """Walter's G1 (a jump at its switch level) in the height-correlated G with a Fresnel factor: frame 4 was 7 x its
     estimate at rtol 1e-10 (the first case: 1.27e-11 off, estimate 1.8e-12) and 3.8 x at 1e-12 (the second), against the
     2-D engine at rtol 1e-13 (found by ``scripts/fuzz_engines.py --registry``).  The nested engine takes it now."""
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
 
     f = pumpup.load(spec)
     assert not _polar.takes_1d_path(f)

@@ -14,7 +14,7 @@ import subprocess
 import pytest
 
 import pumpup
-from pumpup.provenance import PROVENANCE_ATTRS, same_data, source_commit
+from pumpup.tables.provenance import PROVENANCE_ATTRS, same_data, source_commit
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TABLES = os.path.join(ROOT, "tables")

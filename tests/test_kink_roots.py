@@ -1,4 +1,4 @@
-"""The compiled kink search of a pumped BRDF (pumpup.pumping._kink_roots, _upper_root; issue 14, eighteenth session)
+"""The compiled kink search of a pumped BRDF (pumpup.physics.lookups.kink_roots, _upper_root; issue 14, eighteenth session)
 against the numpy and scipy search it replaced (np.insert, np.sign and brentq on the bound)."""
 
 import numpy as np
@@ -6,11 +6,10 @@ import pytest
 from scipy.optimize import brentq
 
 import pumpup
-from pumpup import pumping
 
 
 def _reference_roots(lk, g, ug, kind, target, mu, scale):
-    """The search as :meth:`pumpup.pumping.Pumped._kink_levels` did it before it was compiled."""
+    """The search as :meth:`pumpup.operators.pumping.Pumped._kink_levels` did it before it was compiled."""
     up = lk.upper
     if kind == 0:
         two = np.array([mu * (1 - 1e-6), mu * (1 + 1e-6)])
@@ -44,7 +43,7 @@ def test_kink_roots_against_brentq(spec):
         for kind in (0, 1, 2):
             g, ug = (grid, au) if kind == 1 else (tg, tu)
             target = am if kind == 0 else mu
-            got = pumping._kink_roots(g, ug, kind, target, mu, max(1.0, am), *lk.args())
+            got = pumpup.physics.lookups.kink_roots(g, ug, kind, target, mu, max(1.0, am), *lk.args())
             ref = _reference_roots(lk, g, ug, kind, target, mu, max(1.0, am))
             assert len(got) == len(ref), (mu, kind, got, ref)
             assert np.all(np.abs(np.asarray(got) - np.asarray(ref)) <= 1e-14), (mu, kind, got, ref)
@@ -64,7 +63,7 @@ def test_upper_root_brackets_the_root():
     for target in u.min() + (u.max() - u.min()) * np.array([0.1, 0.5, 0.9]):
         vals = u - target
         for i in np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]:
-            r = pumping._upper_root(grid[i], grid[i + 1], 0, target, *args)
+            r = pumpup.physics.lookups.upper_root(grid[i], grid[i + 1], 0, target, *args)
             lo, hi = lk.upper(r - 2e-15) - target, lk.upper(r + 2e-15) - target
             assert lo * hi <= 0.0, (target, r, lo, hi)
             checked += 1

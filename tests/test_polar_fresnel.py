@@ -1,4 +1,4 @@
-"""The lobe frame with 000 eq. 28's Fresnel factor F(Theta_min) (pumpup._polar frame 5, :func:`pumpup._polar._k_lobe_fresnel`;
+"""The lobe frame with 000 eq. 28's Fresnel factor F(Theta_min) (pumpup.engine.polar frame 5, :func:`pumpup.engine.polar._k_lobe_fresnel`;
 issue 14, eighth session): ``metal``, ``plastic`` with an index, and the ``fresnel`` wrapper over a lobe with p in {0, 1}
 (Phong, stretched Phong, Lafortune, retro, Phong's shader), whose F(max(N.L, N.V)) the rule integrates on the arc
 where N.V >= N.L."""
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 from helpers import one_d_against_the_other_engines
 
 MU = [1.0, 0.99, 0.9, math.sqrt(3) / 2, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8]

@@ -16,7 +16,7 @@ import pytest
 from helpers import n_frame_integrand_against_eval, one_d_against_the_other_engines
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 
 MU = np.array([1.0, 0.999, 0.9, 0.7, 0.5, 0.3, 0.1, 0.01, 1e-4, 1e-8])
 

@@ -1,5 +1,5 @@
 """Frame 6 (issue 14, ninth session): GGX and Beckmann with F = 1 (either Smith G, exact or Walter's G1) and Schlick's
-model about N, the weight's azimuth in closed form (:func:`pumpup._polar._ggx_ring`, :func:`_beckmann_ring` with
+model about N, the weight's azimuth in closed form (:func:`pumpup.engine.polar._ggx_ring`, :func:`_beckmann_ring` with
 :func:`_kummer_fast`), one rule over the elevation of wo (:func:`_integrate_n`).
 
 Its independent references: scipy's quadrature of Walter's D over the azimuth (the closed form), the model's own
@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 
 SPECS = [{"type": "ggx", "alpha": a} for a in (1e-8, 1e-4, 0.02, 0.3, 1.0)] + \
         [{"type": "ggx", "alpha": a, "shadowing": "correlated"} for a in (1e-6, 0.01, 0.5)] + \
@@ -182,7 +182,7 @@ def test_cuts_keep_every_piece_off_the_singularities(spec):
     """The breakpoints are sorted in [0, pi / 2] with 0, pi / 2 and x_mu among them, and every piece lies at least a third
     of its length from the peak's singularities x_mu +- 2 i atanh(alpha), from B = 0's at pi - x_mu +- 2 i atanh(alpha)
     and from P(t)'s (or Schlick's pole) near 0: in
-    x, or for a piece off the peak (GGX and Schlick, :data:`pumpup._polar.N_LOG_GRADE`) in u = ln |x - x_mu|, or near x = 0
+    x, or for a piece off the peak (GGX and Schlick, :data:`pumpup.engine.polar.N_LOG_GRADE`) in u = ln |x - x_mu|, or near x = 0
     in u = ln x, the variable the engine integrates it in."""
     import cmath
 

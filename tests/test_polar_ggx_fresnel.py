@@ -1,5 +1,5 @@
 """Frame 6 with a Fresnel factor (issue 14, thirteenth session): GGX's D times F(wi.h) integrated over the azimuth of wo by
-a product rule whose weights are D's Fourier coefficients in closed form (pumpup._polar._ggx_ring_f), against scipy's
+a product rule whose weights are D's Fourier coefficients in closed form (pumpup.engine.polar._ggx_ring_f), against scipy's
 quadrature of D F on the ring, 40-digit mpmath sums, frame 4 (the rule on h's arc) and the nested engine."""
 
 import math
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 
 sys.path.insert(0, str(Path(__file__).parent))
 from helpers import nested_reference  # noqa: E402
@@ -163,7 +163,7 @@ def test_near_kink_conductor_at_normal_incidence(shadowing):
     (which takes such an index) cut on h's arc only.  At normal incidence wi.h hardly varies on h's circle, so the whole
     near-kink is the outer integrand's, and there was no cut: at mu = 1 GGX alpha 0.003 was 2.4e-11 off with an estimate
     of 3.5e-12 (rtol 1e-10; found by scripts/fuzz_engines.py).  Now the elevation is cut where an end of the circle's
-    range of wi.h passes x0 (pumpup._polar._pieces)."""
+    range of wi.h passes x0 (pumpup.engine.polar._pieces)."""
     eta, k, alpha = 0.27134575896438146, 0.0605363844525441, 0.003000403524851649
     f = pumpup.load({"type": "ggx", "alpha": alpha, "eta": eta, "k": k, "shadowing": shadowing})
     ref = _normal_incidence_reference(alpha, eta, k)  # (at mu = 1 the two shadowings agree: Lambda(N) = 0)

@@ -1,4 +1,4 @@
-"""The half vector's azimuth by a rule on its arc (pumpup._polar frame 4, :func:`pumpup._polar._k_numeric`; issue 14,
+"""The half vector's azimuth by a rule on its arc (pumpup.engine.polar frame 4, :func:`pumpup.engine.polar._k_numeric`; issue 14,
 seventh session): the Smith microfacet models (GGX, Beckmann; separable or height-correlated G, exact or Walter's G1,
 with or without a Fresnel factor), the V-cavity models with a Fresnel factor (Cook-Torrance, Torrance-Sparrow with
 ``ior``) and Schlick's model; and Torrance-Sparrow's D3, whose azimuth is closed-form, under the GGX weight."""
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 from helpers import one_d_against_the_other_engines
 
 MU = [1.0, 0.99, 0.9, math.sqrt(3) / 2, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8]

@@ -15,7 +15,8 @@ from scipy.integrate import quad
 from scipy.special import roots_legendre
 
 import pumpup
-from pumpup import _nested, _polar
+from pumpup.engine import nested as _nested
+from pumpup.engine import polar as _polar
 
 # (0.8495: a wide piece that one first interval got wrong; 1e-8 and below: the tables' first node, and
 # sin(theta_i) rounding to 1)
@@ -81,7 +82,7 @@ def test_against_an_independent_quadrature_about_the_normal(case):
     for m, v, err in zip(mu, a, e):
         ref, ref_err = albedo_about_normal(f, float(m))
         # the BRDF divides by the product table, the reference by the levels one by one: they differ by
-        # at most 2 epsilon ~ 4e-14 of the value (pumpup.pumping._Product)
+        # at most 2 epsilon ~ 4e-14 of the value (pumpup.operators.pumping._Product)
         assert abs(v - ref) <= err + ref_err + 1e-13 * ref, (case, m, v, ref, err, ref_err)
         assert abs(v - ref) <= 5e-12 * ref
 
@@ -191,7 +192,7 @@ def test_chain_cuts():
 
 
 def test_compiled_chain_cuts_are_chain_cuts():
-    """The compiled cuts the engine uses (:func:`pumpup._polar.chain_cut_matrix`) are chain_cuts, value for value: pumped
+    """The compiled cuts the engine uses (:func:`pumpup.engine.polar.chain_cut_matrix`) are chain_cuts, value for value: pumped
     lobes, a pumped metal (F's cuts), a pumped GGX and a 1/E-scaled one (frame 6, n = 0), and a metal's lobe about N (no
     chain: no levels but mu, no grading for g), from normal incidence to 1e-300; each cut of either within 2 ulps of one of
     the other (numpy's vectorised arctan2 and the scalar one may differ in the last bit, so a level mu and x_mu can be two

@@ -1,6 +1,6 @@
 """Pumped GGX with a Fresnel factor F(wi.h) (issue 14's twenty-second session): frame 6 (the product rule of D and F on
-each ring, pumpup._polar._ggx_ring_f) divided by the chain's g at each node, at mu >= N_FRESNEL_MU_MIN; the nested engine
-below (frame 4, which takes GGX with F there, has no chain; ``pumpup._polar.one_d_part``).  Before, the nested engine
+each ring, pumpup.engine.polar._ggx_ring_f) divided by the chain's g at each node, at mu >= N_FRESNEL_MU_MIN; the nested engine
+below (frame 4, which takes GGX with F there, has no chain; ``pumpup.engine.polar.one_d_part``).  Before, the nested engine
 took every mu: a 257-point table of 1-level g2 pumped GGX 0.1 with eta 0.2, k 3 took 0.70 s, now 0.28 s
 (``scripts/bench_albedo.py --pumped-f``).
 
@@ -16,7 +16,7 @@ import pytest
 from helpers import nested_reference
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 
 SPECS = [
     {"type": "pumped", "base": {"type": "ggx", "alpha": 0.1, "eta": 0.2, "k": 3.0}, "g": "g2", "levels": 1},
@@ -89,7 +89,7 @@ def test_a_table_through_both_paths():
 
 
 def test_the_rings_error_is_divided_by_g():
-    """A node's ring error (:func:`pumpup._polar._ggx_ring_f`) enters the rule's error divided by g, as the node's value
+    """A node's ring error (:func:`pumpup.engine.polar._ggx_ring_f`) enters the rule's error divided by g, as the node's value
     is: one node at a time (as ``_n_values`` calls the rule), the pumped node's value and error are the plain node's
     divided by g.  g is below 1: without the division a pumped node's ring error was under-reported by the factor g
     (issue 14's twenty-second session; the values' tests above do not see a factor of 0.5-1 at their tolerances)."""

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup.pumping import Pumped, _TABLES
+from pumpup.operators.pumping import Pumped, _TABLES
 from helpers import random_directions
 
 MU = np.array([1.0, 0.95, 0.8, 0.6, 0.4, 0.2, 0.1, 0.03, 1e-2, 1e-3, 1e-5, 1e-8])
@@ -102,7 +102,7 @@ def test_user_function_base_two_levels():
 @pytest.mark.slow
 def test_user_function_base_two_levels_sup_over_the_azimuth():
     """The same function without the claim: nothing is known of its symmetry, so every level's g bounds the supremum
-    over the azimuth of wi (pumpup.azimuth.sup_albedo, 16 tables or more per level; minutes)."""
+    over the azimuth of wi (pumpup.tables.azimuth.sup_albedo, 16 tables or more per level; minutes)."""
     f = pumpup.pump(pumpup.from_function(_phong8, name="phong8-any"), g="g2", levels=2)
     assert "sup over phi" in f.table().dataset.attrs["azimuth"]
     check_chain(f, MU[::2])
@@ -222,7 +222,7 @@ def test_product_table_of_a_monotone_chain(rng, spec, g):
     """The kernel's fast path divides by G(m), one function of m = max(N.wi, N.wo) for all
     levels: never below the product of the levels' g, above it by at most twice its epsilon (checked
     at 2e5 random m and at every piece's ends), and the kernel evaluates exactly that G."""
-    from pumpup.pumping import _CELL_SHIFT, _bits
+    from pumpup.physics.lookups import CELL_SHIFT as _CELL_SHIFT, float_bits_reference as _bits
 
     f = pumpup.pump(pumpup.load(spec), g=g, levels=3)
     p = f.product()
@@ -264,11 +264,11 @@ def test_running_maximum_of_a_table_that_dips_within_its_margin(monkeypatch):
     """A table that falls by less than its margin is replaced by its running maximum: an upper
     bound that is non-decreasing and exceeds the spline by at most the margin; a larger dip is
     refused.  The third level of pumped Phong (n = 20, g2) dips by 1.9e-7 near mu = 1 when its base
-    table comes from the 2-D engine (from the 1-D path of pumpup._polar, whose values differ within
+    table comes from the 2-D engine (from the 1-D path of pumpup.engine.polar, whose values differ within
     their errors, all three levels increase: the real-model part runs on the 2-D engine's tables)."""
     from scipy.interpolate import PPoly, make_interp_spline
 
-    from pumpup.pumping import _monotone_envelope
+    from pumpup.operators.pumping import _monotone_envelope
     from pumpup.tables import nondecreasing
 
     x = np.linspace(-3, 0, 12)
@@ -290,8 +290,8 @@ def test_running_maximum_of_a_table_that_dips_within_its_margin(monkeypatch):
 
     import sys
 
-    monkeypatch.setattr(sys.modules["pumpup.pumping"], "_TABLES", {})  # tables of this test only
-    with pumpup._polar.two_d_only():
+    monkeypatch.setattr(sys.modules["pumpup.operators.pumping"], "_TABLES", {})  # tables of this test only
+    with pumpup.engine.polar.two_d_only():
         f = pumpup.pump(pumpup.load(BASES["phong"]), g="g2", levels=3)
         lk = f.lookup()
     assert lk.envelope and lk.increasing and not lk.table.is_increasing()
@@ -305,7 +305,7 @@ def test_running_maximum_of_a_table_that_dips_within_its_margin(monkeypatch):
 
 
 def test_product_table_that_cannot_reach_its_tolerance_falls_back(monkeypatch, rng):
-    from pumpup.pumping import _Product
+    from pumpup.operators.pumping import _Product
 
     monkeypatch.setattr(_Product, "TOL", 0.0)  # unreachable: bisects until 1e5 pieces, then gives up
     f = pumpup.pump(pumpup.load(BASES["phong"]), g="g2", levels=1)
@@ -322,8 +322,8 @@ def test_pumped_lobe_about_the_normal_against_rings():
     tests/test_albedo_breaks.py)."""
     import math
 
-    from pumpup import _polar
-    from pumpup.pumping import TABLE_DECADES
+    from pumpup.engine import polar as _polar
+    from pumpup.operators.pumping import TABLE_DECADES
     from test_albedo_breaks import _rings
 
     f = pumpup.load({"type": "pumped", "base": {"type": "minnaert", "k": 0.3089221621228797}, "g": "g2"})

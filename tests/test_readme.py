@@ -156,7 +156,7 @@ def test_expensive_list_names_real_commands():
 
 def test_readme_claims_match_the_code():
     """Item 16: the README's word on the GIL and on where 'divergence all' writes."""
-    from pumpup.albedo import _accumulate, _geometry_kernel
+    from pumpup.engine.cubature import _accumulate, _geometry_kernel
     from pumpup.cli import build_parser
 
     text = open(README).read()

@@ -49,7 +49,7 @@ def test_stored_tables_are_what_the_command_produces(name):
         np.testing.assert_allclose(fresh["theta_deg"], stored["theta_deg"], rtol=0, atol=1e-4)
         fresh, stored = fresh.drop_vars("theta_deg"), stored.drop_vars("theta_deg")
     xr.testing.assert_allclose(fresh, stored, rtol=1e-8, atol=1e-13)
-    from pumpup.provenance import PROVENANCE_ATTRS  # version, commit, digest: where it was made
+    from pumpup.tables.provenance import PROVENANCE_ATTRS  # version, commit, digest: where it was made
 
     assert {k: v for k, v in fresh.attrs.items() if k not in PROVENANCE_ATTRS} == \
            {k: v for k, v in stored.attrs.items() if k not in PROVENANCE_ATTRS}

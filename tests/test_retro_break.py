@@ -12,7 +12,7 @@ import pytest
 from scipy.optimize import brentq
 
 import pumpup
-from pumpup import _polar
+from pumpup.engine import polar as _polar
 from pumpup.models.cook_torrance import RETRO_BREAK
 
 sys.path.insert(0, str(Path(__file__).parent))

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup import _reuse
+from pumpup.tables import reuse as _reuse
 from pumpup.sweeps import default_mu
 
 DATA = json.loads((pathlib.Path(__file__).parent / "data" / "independent_reference.json").read_text())

@@ -293,7 +293,7 @@ def test_efficiency_table_regression(efficiency):
     for v in ("albedo", "second_moment", "acceptance"):
         diff = np.abs(stored[v] - efficiency[v])
         assert float((diff - stored[v + "_error"] - efficiency[v + "_error"]).max()) <= 1e-15, v
-    from pumpup.provenance import same_data
+    from pumpup.tables.provenance import same_data
 
     assert same_data(stored, efficiency)  # and bit for bit what the code produces (issue 13, item 15)
 

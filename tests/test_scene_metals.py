@@ -9,7 +9,8 @@ import pytest
 
 import pumpup
 import pumpup.scenes as S
-from pumpup import optical, spectral
+from pumpup.spectral import optical
+from pumpup import spectral
 from pumpup.models.metal import fresnel
 
 from helpers import direction_pairs

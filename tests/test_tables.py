@@ -52,7 +52,7 @@ def test_interpolation_error_is_honest_between_nodes_for_a_diverging_albedo():
 
 def _fake_values(monkeypatch, fn):
     """tabulate's values from ``fn(mu)`` (no quadrature; error 1e-16): its adaptive grid alone under test."""
-    from pumpup import azimuth
+    from pumpup.tables import azimuth
 
     def table_values(brdf, phi, rtol, atol, threads, interp_tol):
         return (lambda mu, bar: (fn(mu), np.full(mu.shape, 1e-16))), None, None
@@ -260,7 +260,7 @@ def test_blinn_max_constant_matches_table_2_of_000():
 
 def test_compiled_upper_bound_is_the_tables_upper_bound(phong_table):
     # the pumping operator's look-up and AlbedoTable.upper are one definition (capped at 1)
-    from pumpup.pumping import _Lookup
+    from pumpup.operators.pumping import _Lookup
 
     table = pumpup.AlbedoTable.from_dataset(phong_table)
     lookup = _Lookup(table)

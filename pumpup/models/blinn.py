@@ -86,9 +86,9 @@ class Blinn(BRDF):
 
 
 def _half_hint(n, p, c):
-    """The closed-form-azimuth hint (pumpup._polar, kind "half") of a lobe c (N.H)^n / max(N.L, N.V)^p,
+    """The closed-form-azimuth hint (pumpup.engine.polar, kind "half") of a lobe c (N.H)^n / max(N.L, N.V)^p,
     p in {0, 1}: the half vector's azimuth about N integrates in closed form."""
-    from .._polar import Polar
+    from ..core.hints import Polar
 
     return Polar(n=n, p=float(p), scale=lambda mu: np.full(np.shape(mu), c), kind="half")
 

@@ -21,60 +21,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, vectorize
+from numba import vectorize
 
 from ._half import tan2_half
 from ..core import MAX_EXPONENT, MAX_INDEX, MAX_WIDTH, MIN_WIDTH, BRDF, Lobe, Param, SpecError, register
+from ..physics.fresnel import dielectric_reference as _fresnel_reference
+from ..physics.fresnel import dielectric_scalar as _fresnel
+from ..physics.fresnel import fresnel_dielectric as fresnel  # noqa: F401  (pumpup.models.cook_torrance.fresnel)
 
 # ----------------------------------------------------------------------------------------
 # Shared pieces: Fresnel, geometry factor, and the kinks of G for the albedo engine
 # ----------------------------------------------------------------------------------------
-
-
-@njit(cache=True)
-def _fresnel(c, n):  # pragma: no cover - compiled
-    if n <= 0.0:
-        return 1.0  # no index of refraction given: F = 1
-    n21 = (n - 1.0) * (n + 1.0)
-    g = math.sqrt(n21 + c * c)
-    a = n21 / ((g + c) * (g + c))  # (g - c) / (g + c) without cancellation (an ior near 1: g ~ c)
-    q = (c * (g + c) - 1.0) / (c * n21 / (g + c) + 1.0)
-    return 0.5 * a * a * (1.0 + q * q)  # 002 sec. 3.2
-
-
-def _fresnel_reference(c, n):
-    """Dielectric Fresnel factor (002 sec. 3.2); 1 when n <= 0 (no index given)."""
-    if n <= 0.0:
-        return np.ones_like(c)
-    n21 = (n - 1.0) * (n + 1.0)
-    g = np.sqrt(n21 + c * c)
-    a = n21 / ((g + c) * (g + c))  # (g - c) / (g + c), g - c = (n^2 - 1) / (g + c): no cancellation near n = 1
-    q = (c * (g + c) - 1.0) / (c * n21 / (g + c) + 1.0)
-    return 0.5 * a * a * (1.0 + q * q)  # 002 sec. 3.2
-
-
-def fresnel(cos_theta, ior):
-    """Fresnel reflectance of a dielectric for unpolarised light (002 sec. 3.2).
-
-    Parameters
-    ----------
-    cos_theta : array_like
-        Cosine of the angle of incidence on the facet, c = V.H, in [0, 1].
-    ior : float or None
-        Real index of refraction n > 1; None gives F = 1.
-
-    Returns
-    -------
-    ndarray
-        F = (g - c)^2 / (2 (g + c)^2) [1 + (c (g + c) - 1)^2 / (c (g - c) + 1)^2],
-        g = sqrt(n^2 + c^2 - 1); ((n - 1) / (n + 1))^2 at normal incidence.
-
-    Examples
-    --------
-    >>> round(float(fresnel(1.0, 1.5)), 12)
-    0.04
-    """
-    return _fresnel_reference(np.asarray(cos_theta, dtype=np.float64), 0.0 if ior is None else float(ior))
 
 
 #: the incidence mu = 1 / sqrt(2) where the albedo of every model with the geometry factor G of 001 eq. 10 (Cook-Torrance,
@@ -212,7 +169,7 @@ class CookTorrance(BRDF):
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"], kinks=_g_kinks)
 
     def polar(self):
-        from .._polar import Polar
+        from ..core.hints import Polar
 
         m = self.p["m"]
         # 001 eq. 9: F exp(-tan^2 / m^2) / (4 pi m^2 cos^4) G / (N.L N.V); the azimuth of h in closed form for F = 1
@@ -376,17 +333,17 @@ class TorranceSparrow(BRDF):
         d, e, b = self.p["d"], self.p["s"], self.p["b"]
         if d == "D2":
             return None  # D2 = b exp(-(c2 alpha)^2) has no weight of the 1-D path: the nested engine
-        from .._polar import Polar
+        from ..core.hints import Polar
 
-        # 002 eq. 10: F G D / (pi (N.S)(N.V)); the azimuth of h in closed form for F = 1 (pumpup._polar._k_vcavity),
+        # 002 eq. 10: F G D / (pi (N.S)(N.V)); the azimuth of h in closed form for F = 1 (pumpup.engine.polar._k_vcavity),
         # by a rule on its arc with F(wi.h)
-        fresnel = (self.p["ior"] or 0.0, 0.0, 0.0)
+        fresnel_factor = (self.p["ior"] or 0.0, 0.0, 0.0)
         if d == "D1":  # D = b cos^e(alpha): the power weight u^e
             return Polar(n=e, scale=lambda mu: b / (math.pi * np.asarray(mu, float)), kind="half", vcavity=True,
-                         fresnel=fresnel)
+                         fresnel=fresnel_factor)
         if d == "D3":  # D3 = b (c3^2 / (c3^2 cos^2 + sin^2))^2 = b / (cos^4 (1 + tan^2 / c3^2)^2): the GGX weight
             return Polar(n=e, scale=lambda mu: b / (math.pi * np.asarray(mu, float)), kind="half", radial="ggx",
-                         vcavity=True, fresnel=fresnel)
+                         vcavity=True, fresnel=fresnel_factor)
         # D4 = exp(-tan^2 / m^2) / (4 m^2 cos^4): Cook-Torrance's
         return Polar(n=e, scale=lambda mu: 1.0 / (4.0 * math.pi * e * e * np.asarray(mu, float)), kind="half",
-                     radial="beckmann", vcavity=True, fresnel=fresnel)
+                     radial="beckmann", vcavity=True, fresnel=fresnel_factor)

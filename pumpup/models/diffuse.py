@@ -76,7 +76,7 @@ class Minnaert(BRDF):
         return Lobe(axis="normal", radial="cosine", symmetric=True)
 
     def polar(self):
-        from .._polar import Polar
+        from ..core.hints import Polar
 
         k, b = self.p["k"], self.p["b"]
         return Polar(kind="constant", scale=lambda mu: b * 2.0 * math.pi / (k + 1.0) * np.asarray(mu, float) ** (k - 1.0))
@@ -141,7 +141,7 @@ class Lacquer(BRDF):
     def polar(self):
         from scipy.special import expn
 
-        from .._polar import Polar
+        from ..core.hints import Polar
 
         c, s = self.p["c"], self.p["s"]
         e3 = float(expn(3, s))  # integral_0^1 t e^(-s/t) dt = E_3(s) (t = 1/x); E_3(0) = 1/2: Lambert's pi c
@@ -237,7 +237,7 @@ class OrenNayar(BRDF):
         return Lobe(axis="normal", radial="cosine", levels=(mu,), symmetric=True)
 
     def polar(self):
-        from .._polar import Polar
+        from ..core.hints import Polar
 
         rho, sigma = self.p["albedo"], self.p["sigma"]
         return Polar(kind="constant", scale=lambda mu: oren_nayar_albedo(mu, rho, sigma))

@@ -116,8 +116,8 @@ class FresnelWeighted(BRDF):
     def polar(self):
         """A lobe base's hint (p in {0, 1}; any p for a pumped lobe's) with F(Theta_min) added: frame 5 of the 1-D path, or
         the pumped lobe's frame of N; or a GGX, Beckmann (F = 1) or Schlick base's, pumped or not, with F(Theta_min) as
-        a factor of frame 6's nodes (``Polar.fmax``); or None (pumpup._polar)."""
-        from .._polar import with_fresnel, with_fresnel_max
+        a factor of frame 6's nodes (``Polar.fmax``); or None (pumpup.engine.polar)."""
+        from ..engine.polar import with_fresnel, with_fresnel_max
 
         hint = self.base.polar()
         if hint is not None and hint.kind == "half":

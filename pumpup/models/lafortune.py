@@ -159,10 +159,10 @@ class Lafortune(BRDF):
         return _isotropic_lobe(q["n"], q["cx"], q["cy"], q["cz"], q["p"], mu)
 
     def polar(self):
-        """The closed-form-azimuth hint (pumpup._polar) where the lobe is isotropic:
+        """The closed-form-azimuth hint (pumpup.engine.polar) where the lobe is isotropic:
         cx = cy = cz = C > 0 gives (R.V)_M = C (R.V) (stretched Phong), cx = cy = -cz, cz = C > 0
         gives C (L.V) (the retro-reflective lobe); the scale is c C^n (000 eq. 14, 15)."""
-        from .._polar import Polar
+        from ..core.hints import Polar
 
         q = self.p
         C = q["cz"]
@@ -175,7 +175,7 @@ class Lafortune(BRDF):
     def lobe_axis(self, mu, phi):
         """For p = 0 (000 eq. 14): (R.V)_M = v.wo with v = (-cx Lx, -cy Ly, cz Lz), so f = c |v|^n (v^.wo)_+^n, a
         Phong power lobe about v^ at elevation nu = cz mu / |v|, scaled by c |v|^n (issue 14's fifteenth session: the
-        1-D path about v^ at every azimuth of wi, :func:`pumpup._polar.axis_albedo`).  None for p > 0 (max(N.L, N.V)
+        1-D path about v^ at every azimuth of wi, :func:`pumpup.engine.polar.axis_albedo`).  None for p > 0 (max(N.L, N.V)
         depends on mu itself), for cz <= 0 (v^ on or below the horizon), where :meth:`polar` applies, and where nu or
         the scale is not a positive finite number.  With cx = cy, |v| is taken without phi (the albedo is isotropic)."""
         q = self.p

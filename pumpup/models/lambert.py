@@ -48,7 +48,7 @@ class Lambert(BRDF):
         return Lobe(axis="normal", radial="cosine")
 
     def polar(self):
-        from .._polar import Polar
+        from ..core.hints import Polar
 
         a = self.p["albedo"]
         return Polar(kind="constant", scale=lambda mu: np.full(np.shape(mu), a))  # albedo / pi * pi

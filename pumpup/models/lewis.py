@@ -192,7 +192,7 @@ class LewisPhong(BRDF):
     def polar(self):
         """k_rho / H_s(mu) times reciprocal Phong with c = 1 (002 eq. 22), when k_sigma = 1; the
         H_s is the one :meth:`_eval` divides by (:func:`_hs_at`)."""
-        from .._polar import Polar
+        from ..core.hints import Polar
 
         q = self.p
         if q["k_sigma"] != 1:

@@ -15,77 +15,17 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import njit, vectorize
+from numba import vectorize
 
-from .._spectral_kernels import _fresnel_select
 from ..core import MAX_EXPONENT, MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, SpecError, load, register
+from ..physics.fresnel import FRESNEL_LEVEL_Y0, fresnel_levels  # noqa: F401  (re-exported for the models)
+from ..physics.fresnel import conductor_scalar as _fresnel_real
+from ..physics.fresnel import fresnel_conductor as fresnel
 
 __all__ = ["Metal", "Plastic", "fresnel", "per_channel"]
 
 
 # --- Fresnel reflectance -----------------------------------------------------------------
-
-
-def fresnel(cos_i, eta, k=0.0):
-    """Unpolarised Fresnel reflectance of a smooth interface with complex index eta + i k.
-
-    The exact formula with complex arithmetic, as pbrt-v4's ``FrComplex``:
-    cos_t = sqrt(1 - sin^2(theta_i) / eta^2),
-    r_par = (eta cos_i - cos_t) / (eta cos_i + cos_t),
-    r_perp = (cos_i - eta cos_t) / (cos_i + eta cos_t),
-    F = (|r_par|^2 + |r_perp|^2) / 2.
-
-    Parameters
-    ----------
-    cos_i : array_like
-        Cosine of the incidence angle, clipped to [0, 1].
-    eta : float or array_like, > 0
-        Real part of the relative refractive index (dimensionless).
-    k : float or array_like, >= 0
-        Extinction coefficient (imaginary part of the index); 0 for a dielectric.
-
-    Returns
-    -------
-    ndarray
-        F in [0, 1].
-
-    Examples
-    --------
-    >>> round(float(fresnel(1.0, 1.5)), 12)  # ((eta - 1) / (eta + 1))^2
-    0.04
-    """
-    c = np.clip(np.asarray(cos_i, dtype=np.float64), 0.0, 1.0)
-    e = np.asarray(eta, dtype=np.float64) + 1j * np.asarray(k, dtype=np.float64)
-    # Snell's law, complex angle of refraction: cos_t^2 = 1 - sin^2 / e^2 = ((e - 1)(e + 1) + c^2) / e^2, without the
-    # cancellation of e^2 - sin^2 near e = 1 at grazing incidence (eta 1, c = 1e-8 gave F = 0.039 for 0)
-    e21 = (e - 1.0) * (e + 1.0)  # e^2 - 1
-    cos_t = np.sqrt((e21 + c * c) / (e * e))
-    # the Fresnel equations (pbrt-v4 FrComplex) r_par = (e c - cos_t) / (e c + cos_t), r_perp = (c - e cos_t) / (c + e cos_t);
-    # near e = 1, where both are small, over their denominators squared: (e^2 c)^2 - (e cos_t)^2 = (e^2 - 1)((e^2 + 1) c^2 - 1),
-    # c^2 - (e cos_t)^2 = 1 - e^2 (no cancellation; r_par's form loses digits near a dielectric's total reflection, so
-    # only where |e^2 - 1| < 1/2)
-    near = np.abs(e21) < 0.5
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r_par = np.where(e21 == 0.0, 0.0, np.where(near, e21 * ((e21 + 2.0) * c * c - 1.0) / (e * e * c + e * cos_t) ** 2,
-                                                   (e * c - cos_t) / (e * c + cos_t)))
-        r_perp = np.where(e21 == 0.0, 0.0, -e21 / (c + e * cos_t) ** 2)  # (e = 1: no reflection, c = 0 its limit)
-    return 0.5 * (np.abs(r_par) ** 2 + np.abs(r_perp) ** 2)
-
-
-@njit(cache=True)
-def _fresnel_real(c, eta, k):  # pragma: no cover - compiled
-    """``fresnel`` in real arithmetic, free of cancellation (for the numba kernels).
-
-    With a + i b = sqrt((eta + i k)^2 - sin^2) (a >= 0), the classic real form
-    (e.g. pbrt-v3 FrConductor) becomes a ratio of sums of squares:
-    R_s = ((a - c)^2 + b^2) / ((a + c)^2 + b^2), computed as |1 - (eta + i k)^2|^2 / ((a + c)^2 + b^2)^2,
-    R_p = R_s ((a c - s^2)^2 + b^2 c^2) / ((a c + s^2)^2 + b^2 c^2), F = (R_s + R_p) / 2: the spectral kernels'
-    :func:`pumpup._spectral_kernels._fresnel_select` with its constants from (eta, k) (one square root for a^2 + b^2
-    instead of math.hypot, which took more than half of the time: 40-46 ns a value before, 12.6-12.8 after, measured
-    in a compiled loop; eta, k <= MAX_INDEX, so the squares do not overflow).
-    """
-    ek = eta * k
-    return _fresnel_select(c, (1.0 - c) * (1.0 + c), (eta - 1.0) * (eta + 1.0) - k * k, 4.0 * ek * ek, ek)
 
 
 def _phong_c(q):
@@ -103,27 +43,6 @@ def _up(wi, wo):
 
 
 # --- metal ----------------------------------------------------------------------------------
-
-
-#: a Fresnel factor whose branch point lies closer than this to the real axis inside (0, 1) adds its real part as a
-#: level of the quadrature hint (:func:`fresnel_levels`)
-FRESNEL_LEVEL_Y0 = 0.05
-
-
-def fresnel_levels(eta: float, k: float, y0_max: float | None = None) -> tuple:
-    """The level N.wo = x0 where F(eta + i k, max(N.wi, N.wo)) has a kink or a near-kink, for a model's ``Lobe`` hint: ()
-    or (x0,): the branch point's real part inside (0, 1), its imaginary part below ``y0_max`` (default
-    :data:`FRESNEL_LEVEL_Y0`; ``pumpup.models.microfacet`` asks with its own threshold whether frame 4 declines).  Below
-    eta = 1 with k = 0 (a dielectric seen from the denser side) F = 1 up to cos = x0 = sqrt(1 - eta^2), total reflection,
-    with a square-root kink there; a small k makes it a near-kink, the branch point sqrt(1 - (eta + i k)^2) = x0 - i y0
-    (:func:`pumpup._polar.fresnel_branch`) y0 off the axis.  The 1-D path declines such a factor
-    (``pumpup._polar.lobe_fresnel_ok``) and the nested engine, blind to the kink, bisected towards it: fresnel over Blinn
-    n = 5, eta = 0.551, k = 0 took 0.25-0.41 s per value at rtol 1e-10 (issue 14's twenty-first session,
-    ``scripts/fuzz_engines.py --registry``)."""
-    from .._polar import fresnel_branch
-
-    x0, y0 = fresnel_branch(float(eta), float(k))
-    return (x0,) if 0.0 < x0 < 1.0 and y0 < (FRESNEL_LEVEL_Y0 if y0_max is None else y0_max) else ()
 
 
 @vectorize(cache=True)
@@ -201,9 +120,10 @@ class Metal(BRDF):
 
 
 def _fresnel_polar(n, c, eta, k):
-    """The 1-D path's hint (pumpup._polar, frame 5) of c u^n F(eta + i k, Theta_min) / max(N.L, N.V), 000 eq. 28, or
+    """The 1-D path's hint (pumpup.engine.polar, frame 5) of c u^n F(eta + i k, Theta_min) / max(N.L, N.V), 000 eq. 28, or
     None where its rule on the arc declines the Fresnel factor (a near-kink: the nested engine takes it)."""
-    from .._polar import Polar, with_fresnel
+    from ..core.hints import Polar
+    from ..engine.polar import with_fresnel
 
     return with_fresnel(Polar(n=n, p=1.0, scale=lambda mu: np.full(np.shape(mu), c)), eta, k)
 
@@ -353,7 +273,7 @@ class Plastic(BRDF):
         q = self.p
         if q["ad"] != 0:
             return None  # the diffuse part is split off by albedo_terms
-        from .._polar import Polar
+        from ..core.hints import Polar
 
         c = q["a_s"] * (q["n"] + 2.0) / (2.0 * math.pi)  # 000 eq. 30: stretched Phong's lobe (p = 1) times a_s
         if q["eta"] is not None:

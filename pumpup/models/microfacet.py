@@ -42,19 +42,17 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import njit, vectorize
+from numba import vectorize
 
 from ..core import MAX_INDEX, MAX_WIDTH, MIN_ALPHA, MIN_INDEX, BRDF, Lobe, Param, SpecError, register
 from ._half import tan2_half
 from .cook_torrance import _IOR, _fresnel, _fresnel_reference
+from ..physics.microfacet import projected, projected_reference, walter_level
 from .metal import _fresnel_real
 from .metal import fresnel as _fresnel_complex
 
 __all__ = ["GGX", "Beckmann", "ndf", "smith_g1", "smith_lambda", "walter_level"]
 
-_SQRT_PI = math.sqrt(math.pi)
-#: Walter et al. 2007 eq. 27: G1 ~ (3.535 a + 2.181 a^2) / (1 + 2.276 a + 2.577 a^2) for a < 1.6, else 1
-_W_A1, _W_A2, _W_B1, _W_B2, _W_CUT = 3.535, 2.181, 2.276, 2.577, 1.6
 
 _DIST = {"beckmann": 0, "ggx": 1}
 _SHADOWING = {"separable": 0, "correlated": 1}
@@ -64,23 +62,6 @@ _G1 = {"exact": 0, "walter": 1}
 # ----------------------------------------------------------------------------------------
 # Compiled pieces
 # ----------------------------------------------------------------------------------------
-
-
-@njit(cache=True, inline="always")
-def _projected(x, y, z, dist, g1, alpha):  # pragma: no cover - compiled
-    """P = z (1 + Lambda) = z / G1 for a direction (x, y, z) with z > 0 (see the module docstring)."""
-    s = math.sqrt(x * x + y * y)  # sin theta (times |w|)
-    if dist == 1:  # z / G1, G1 = 2 / (1 + sqrt(1 + alpha^2 tan^2)), Walter eq. 34
-        w = alpha * s  # (a unit vector, MIN_ALPHA <= alpha <= MAX_WIDTH: z^2 + w^2 neither overflows nor underflows, so a
-        return 0.5 * (z + math.sqrt(z * z + w * w))  # plain root instead of math.hypot, which took ~20 ns a call)
-    if s == 0.0:
-        return z  # normal incidence: Lambda = 0
-    a = z / (alpha * s)  # a = 1 / (alpha tan theta), Walter eq. 27
-    if g1 == 0:
-        return 0.5 * (z * (1.0 + math.erf(a)) + alpha * s * math.exp(-a * a) / _SQRT_PI)  # Walter eq. 27 (exact)
-    if a >= _W_CUT:
-        return z  # rational fit: G1 = 1 for a >= 1.6, Walter eq. 27
-    return alpha * s * (1.0 + _W_B1 * a + _W_B2 * a * a) / (_W_A1 + _W_A2 * a)  # z / G1, Walter eq. 27 (rational)
 
 
 @vectorize(cache=True)
@@ -107,8 +88,8 @@ def _mf_kernel(lx, ly, lz, vx, vy, vz, dist, alpha, shadowing, g1, ior, eta, k):
         f = _fresnel_real(c, eta, k)  # conductor (metal.py)
     else:
         f = _fresnel(c, ior)  # dielectric, 1 when ior <= 0 (cook_torrance.py)
-    pl = _projected(lx, ly, lz, dist, g1, alpha)
-    pv = _projected(vx, vy, vz, dist, g1, alpha)
+    pl = projected(lx, ly, lz, dist, g1, alpha)
+    pv = projected(vx, vy, vz, dist, g1, alpha)
     if shadowing == 0:
         return d * f / (4.0 * pl * pv)  # D F G1(wi) G1(wo) / (4 N.wi N.wo), Walter eq. 20
     return d * f / (4.0 * (vz * pl + lz * pv - lz * vz))  # G = 1 / (1 + Lambda_i + Lambda_o), Heitz 2014
@@ -117,22 +98,6 @@ def _mf_kernel(lx, ly, lz, vx, vy, vz, dist, alpha, shadowing, g1, ior, eta, k):
 # ----------------------------------------------------------------------------------------
 # The numpy reference and the public helper functions
 # ----------------------------------------------------------------------------------------
-
-
-def _projected_reference(w, dist, g1, alpha):
-    from scipy.special import erf
-
-    x, y, z = w[..., 0], w[..., 1], w[..., 2]
-    s = np.sqrt(x * x + y * y)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        if dist == 1:
-            return 0.5 * (z + np.hypot(z, alpha * s))  # Walter eq. 34
-        a = z / (alpha * s)  # inf at normal incidence
-        if g1 == 0:
-            p = 0.5 * (z * (1.0 + erf(a)) + alpha * s * np.exp(-a * a) / _SQRT_PI)  # Walter eq. 27
-        else:
-            p = np.where(a >= _W_CUT, z, alpha * s * (1.0 + _W_B1 * a + _W_B2 * a * a) / (_W_A1 + _W_A2 * a))
-    return np.where(s == 0.0, z, p)
 
 
 def _mf_reference(wi, wo, dist, alpha, shadowing, g1, ior, eta, k):
@@ -155,8 +120,8 @@ def _mf_reference(wi, wo, dist, alpha, shadowing, g1, ior, eta, k):
             d = a2 / (np.pi * q * q)  # Walter eq. 33
         c = 0.5 * np.sqrt(s[..., 0] ** 2 + s[..., 1] ** 2 + s[..., 2] ** 2)  # wi.h
         f = _fresnel_complex(c, eta, k) if eta > 0 else _fresnel_reference(c, ior)
-        pl = _projected_reference(wi, dist, g1, alpha)
-        pv = _projected_reference(wo, dist, g1, alpha)
+        pl = projected_reference(wi, dist, g1, alpha)
+        pv = projected_reference(wo, dist, g1, alpha)
         if shadowing == 0:
             val = d * f / (4.0 * pl * pv)  # Walter eq. 20, separable Smith
         else:
@@ -239,7 +204,7 @@ def smith_lambda(cos_theta: Any, alpha: float, distribution: str = "beckmann", g
     dist, code = _check_kind(distribution, g1)
     c = _as_cos(cos_theta)
     w = np.stack([np.sqrt((1.0 - c) * (1.0 + c)), np.zeros_like(c), c], axis=-1)
-    return _projected_reference(w, dist, code, float(alpha)) / c - 1.0
+    return projected_reference(w, dist, code, float(alpha)) / c - 1.0
 
 
 def smith_g1(cos_theta: Any, alpha: float, distribution: str = "beckmann", g1: str = "exact") -> np.ndarray:
@@ -268,15 +233,7 @@ def smith_g1(cos_theta: Any, alpha: float, distribution: str = "beckmann", g1: s
     dist, code = _check_kind(distribution, g1)
     c = _as_cos(cos_theta)
     w = np.stack([np.sqrt((1.0 - c) * (1.0 + c)), np.zeros_like(c), c], axis=-1)
-    return c / _projected_reference(w, dist, code, float(alpha))
-
-
-def walter_level(alpha: float) -> float:
-    """N.w where Walter's rational G1 switches to 1 (a = 1.6): 1.6 alpha / sqrt(1 + 2.56 alpha^2).
-
-    The fit jumps there by 5.7e-5 (relative), so the albedo engine gets it as a breakpoint.
-    """
-    return _W_CUT * alpha / math.sqrt(1.0 + (_W_CUT * alpha) ** 2)
+    return c / projected_reference(w, dist, code, float(alpha))
 
 
 # ----------------------------------------------------------------------------------------
@@ -289,7 +246,7 @@ _ETA = Param(None, lo=MIN_INDEX, hi=MAX_INDEX, doc="conductor: real part of the 
 _K = Param(None, lo=0.0, hi=MAX_INDEX, doc="conductor: extinction coefficient (with eta; default 0)")
 
 
-#: the 1-D path (frame 4) declines a conductor's F(wi.h) whose branch point x0 - i y0 (:func:`pumpup._polar.fresnel_branch`)
+#: the 1-D path (frame 4) declines a conductor's F(wi.h) whose branch point x0 - i y0 (:func:`pumpup.engine.polar.fresnel_branch`)
 #: lies inside (0, 1) closer than this to the real axis; the nested engine takes it, with the kink wi.h = x0 in its hint
 #: (:class:`_WiHKink`).  Measured against the nested and 2-D engines at rtol 1e-13 (eta 0.551; GGX 0.3, 0.02, Beckmann
 #: 0.1; mu 0.05 ... 0.95): frame 4 was up to 1.3e5 x its estimate for y0 = 0 (k = 0: total reflection below eta = 1; GGX
@@ -353,7 +310,7 @@ class _Microfacet(BRDF):
         )
 
     def polar(self):
-        from .._polar import Polar
+        from ..core.hints import Polar
 
         dist, a, shadowing, g1, ior, eta, k = self.kernel_args()
         if a > 1.0:
@@ -374,7 +331,7 @@ class _Microfacet(BRDF):
                 return None  # a kink of F(wi.h) at x0, or a near-kink sharper than frame 4's cuts see: the nested engine
         # Walter eq. 20: a(mu) = integral over h of D(h) (1 / 4) [4 (wi.h) F G / N.wi] (d omega_o = 4 (wo.h) d omega_h),
         # D = w(t) / (pi a^2 cos^4) with w = e^-t (eq. 25) or 1 / (1 + t)^2 (eq. 33), t = tan^2 / a^2; the azimuth of h
-        # by a rule on its arc (pumpup._polar._k_numeric), or with F = 1 about N in closed form (pumpup._polar._integrate_n)
+        # by a rule on its arc (pumpup.engine.polar._k_numeric), or with F = 1 about N in closed form (pumpup.engine.polar._integrate_n)
         return Polar(n=a, scale=lambda mu: np.full(np.shape(mu), 0.25 / (math.pi * a * a)), kind="half",
                      radial=self.distribution, smith=(dist, g1, shadowing, a), fresnel=(ior, eta, k))
 

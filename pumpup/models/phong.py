@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import njit, vectorize
 
-from .._checks import off_unit
+from ..core.checks import off_unit
 from ..core import MAX_EXPONENT, BRDF, Lobe, Param, dot, register
 
 
@@ -147,10 +147,10 @@ class Phong(BRDF):
 
 
 def _polar_hint(n, p, c, per_mu=None):
-    """The closed-form-azimuth hint (pumpup._polar) of a lobe c u^n / max(N.L, N.V)^p, p in [0, 1]
+    """The closed-form-azimuth hint (pumpup.engine.polar) of a lobe c u^n / max(N.L, N.V)^p, p in [0, 1]
     (closed form for p in {0, 1}, an inner rule on one arc between them); ``per_mu(mu)`` multiplies
     c (Phong's shader: 1 / mu)."""
-    from .._polar import Polar
+    from ..core.hints import Polar
 
     if per_mu is None:
         return Polar(n=n, p=float(p), scale=lambda mu: np.full(np.shape(mu), c))

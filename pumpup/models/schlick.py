@@ -82,10 +82,10 @@ class Schlick(BRDF):
         return Lobe(axis="half", radial="ggx", sharpness=self.p["r"])
 
     def polar(self):
-        from .._polar import Polar
+        from ..core.hints import Polar
 
         r, c = self.p["r"], self.p["c"]
         # 000 eq. 36: r / (1 - (1 - r) cos^2)^2 = 1 / (r cos^4 (1 + tan^2 / r)^2), the GGX weight with alpha = sqrt(r);
-        # 1 / (r + (1 - r) N.V) about N, the weight's azimuth in closed form (pumpup._polar._integrate_n), the rest in the scale
+        # 1 / (r + (1 - r) N.V) about N, the weight's azimuth in closed form (pumpup.engine.polar._integrate_n), the rest in the scale
         return Polar(n=math.sqrt(r), scale=lambda mu: c / (4.0 * math.pi * r * (r + (1.0 - r) * np.asarray(mu, float))),
                      kind="half", radial="ggx", schlick=r)

@@ -85,11 +85,11 @@ class Ward(BRDF):
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"])
 
     def polar(self):
-        from .._polar import Polar
+        from ..core.hints import Polar
 
         m, c = self.p["m"], self.p["c"]
         # 000 eq. 34: c / (4 pi m^2 sqrt(mu)) times exp(-tan^2(alpha) / m^2) / sqrt(N.wo); the half vector's azimuth
-        # by complete elliptic integrals (pumpup._polar._k_ward), the Beckmann weight in t = tan^2(alpha) / m^2
+        # by complete elliptic integrals (pumpup.engine.polar._k_ward), the Beckmann weight in t = tan^2(alpha) / m^2
         return Polar(n=m, p=0.0, scale=lambda mu: c / (4.0 * math.pi * m * m * np.sqrt(mu)), kind="half",
                      radial="beckmann", sqrt_cos=True)
 
@@ -191,7 +191,7 @@ class WardAniso(BRDF):
         return None if self.p["ax"] == self.p["ay"] else math.pi / 2
 
     def slope(self):
-        """(a_x, a_y, c) for the albedo in slope space (:mod:`pumpup._slope`: one ray integral per direction)."""
+        """(a_x, a_y, c) for the albedo in slope space (:mod:`pumpup.engine.slope`: one ray integral per direction)."""
         return self.p["ax"], self.p["ay"], self.p["c"]
 
     def sampling_lobe(self, mu):
@@ -256,7 +256,7 @@ class ModifiedWard(BRDF):
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"], levels=(mu,))
 
     def polar(self):
-        from .._polar import Polar
+        from ..core.hints import Polar
 
         m, c = self.p["m"], self.p["c"]
         # 000 eq. 35: c / (4 pi m^2) times exp(-tan^2(alpha) / m^2) / max(N.L, N.V), the half vector's azimuth

@@ -19,10 +19,11 @@ implementation; the tests compare kernel, twin and the one-wavelength models.
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 from numba import njit
+
+from ..physics.fresnel import conductor_select as _fresnel_select
 
 __all__ = ["flat_pairs", "fresnel_constants", "fresnel_scale_kernel", "fresnel_scale_reference", "metal_eval_kernel",
            "metal_eval_reference"]
@@ -34,37 +35,6 @@ def fresnel_constants(eta, k):
     eta = np.ascontiguousarray(eta, dtype=np.float64)
     k = np.ascontiguousarray(k, dtype=np.float64)
     return (eta - 1.0) * (eta + 1.0) - k * k, (2.0 * eta * k) ** 2, eta * k
-
-
-@njit(cache=True, inline="always")
-def _fresnel_select(cc, s2, e21, ek2, ek):  # pragma: no cover - compiled
-    """F(eta + i k, theta) with cos(theta) = cc, sin^2 = s2, from the hoisted constants.
-
-    The same formula as ``_fresnel_real`` (a + i b = sqrt((eta + i k)^2 - sin^2), a >= 0):
-    R_s = ((a - c)^2 + b^2) / ((a + c)^2 + b^2) = |1 - (eta + i k)^2|^2 / ((a + c)^2 + b^2)^2,
-    R_p = R_s ((a c - s^2)^2 + b^2 c^2) / ((a c + s^2)^2 + b^2 c^2), F = (R_s + R_p) / 2
-    (000 eq. 27; pbrt-v3 FrConductor), with the larger of a, b from the cancellation-free root
-    sqrt((|z| + |t0|) / 2) and the smaller as eta k / that root, and one division.  ``e21`` is
-    eta^2 - k^2 - 1 (:func:`fresnel_constants`), so t0 = e21 + c^2 and R_s lose nothing near eta + i k = 1.
-    """
-    t0 = e21 + cc * cc
-    big = math.sqrt(t0 * t0 + ek2)  # |(eta + i k)^2 - sin^2| = a^2 + b^2 (eta, k <= 1e3: no overflow)
-    q = math.sqrt(0.5 * (big + abs(t0)))  # the larger of a, b
-    r = ek / max(q, 1e-300)  # the smaller (q = 0 only where eta k = 0: then r = 0)
-    a = q if t0 >= 0.0 else r
-    b = r if t0 >= 0.0 else q
-    b2 = b * b
-    ap = a + cc
-    ds = ap * ap + b2
-    if ds == 0.0:  # (eta + i k = 1 at c = 0: F's limit 0; before the division, which would raise)
-        return 0.0
-    ns = (e21 * e21 + ek2) / ds  # R_s = ns / ds (|c - A|^2 = |1 - e^2|^2 / |c + A|^2)
-    x = a * cc - s2
-    y = a * cc + s2
-    bc2 = b2 * cc * cc
-    npar = x * x + bc2  # R_p / R_s = npar / dp
-    dp = y * y + bc2
-    return 0.5 * ns * (dp + npar) / (ds * dp)  # (R_s + R_p) / 2
 
 
 @njit(cache=True, nogil=True)
@@ -93,7 +63,7 @@ def metal_eval_kernel(wi, wo, n, c, e21, ek2, ek, out):  # pragma: no cover - co
 
 def metal_eval_reference(wi, wo, n, c, eta, k):
     """Plain numpy twin of :func:`metal_eval_kernel` (complex Fresnel, broadcasting)."""
-    from .models.metal import fresnel
+    from ..physics.fresnel import fresnel_conductor as fresnel
 
     wi = np.asarray(wi, dtype=np.float64)
     wo = np.asarray(wo, dtype=np.float64)
@@ -125,7 +95,7 @@ def fresnel_scale_kernel(f, wi, wo, e21, ek2, ek, out):  # pragma: no cover - co
 
 def fresnel_scale_reference(f, wi, wo, eta, k):
     """Plain numpy twin of :func:`fresnel_scale_kernel` (complex Fresnel, broadcasting)."""
-    from .models.metal import fresnel
+    from ..physics.fresnel import fresnel_conductor as fresnel
 
     f = np.asarray(f, dtype=np.float64)
     mx = np.maximum(np.asarray(wi)[..., 2], np.asarray(wo)[..., 2])
@@ -139,7 +109,7 @@ def flat_pairs(wi, wo):
     The checks are :func:`pumpup.core.as_directions` (unit 3-vectors, finite) and
     :func:`pumpup.core.check_pair` (broadcastable), with their messages; arrays of equal shape
     are not copied."""
-    from .core import as_directions, check_pair
+    from ..core import as_directions, check_pair
 
     wi = as_directions(wi, "wi")
     wo = as_directions(wo, "wo")

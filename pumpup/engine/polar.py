@@ -50,7 +50,7 @@ interval (``N_INIT``).
 
 Error estimate (issue 14 item 4): per interval QUADPACK's calibration of |K - G|,
 resasc min(1, (200 |K - G| / resasc)^1.5) with its floor 50 eps resabs
-(:func:`pumpup._errors.calibrated`), summed, plus the rounding term ``ROUNDING`` sum |K| and
+(:func:`pumpup.physics.quadrature.calibrated`), summed, plus the rounding term ``ROUNDING`` sum |K| and
 the bound of the part beyond Z_MAX.  Measured by ``scripts/error_calibration.py`` over every
 independent reference of ``tests/`` (30-digit mpmath Phong values n = 0 .. 1e5 from normal to
 grazing incidence, tests/data/independent_reference.json, the closed forms) at rtol 1e-6 ..
@@ -61,14 +61,14 @@ meet rtol 1e-10 almost everywhere: 98 evaluations per mu for Phong n = 20 on a 2
 n = 20, 99 for retro n = 10.
 
 Pumped lobes (001 eq. 16): a pumped Phong-family BRDF f / (g_1 ... g_k) divides the lobe by g(mu,
-N.wo), which for a fixed wi depends on wo through N.wo = t only (:meth:`pumpup.pumping.Pumped.polar`,
+N.wo), which for a fixed wi depends on wo through N.wo = t only (:meth:`pumpup.operators.pumping.Pumped.polar`,
 ``Polar.chain``).  So the frame turns to N: with wo at elevation x (t = sin x) and azimuth phi,
 
     a(mu) / scale = integral_0^(pi/2) t cos(x) / (max(mu, t)^p g(mu, t)) W(t) dx,
     W(t) = integral over phi of u_+^n,  u = A + B cos(phi),  A = mu t,  B = s cos(x),
 
-g is looked up once per node of x (exactly as the chain kernel divides by it, ``pumpup.pumping._g_product``,
-``_g_levels``), and W, the lobe on the circle N.wo = t, is (A + B)^n V(kappa) with kappa = 2B / (A + B) in
+g is looked up once per node of x (exactly as the chain kernel divides by it, ``pumpup.physics.lookups.g_product``,
+``g_levels``), and W, the lobe on the circle N.wo = t, is (A + B)^n V(kappa) with kappa = 2B / (A + B) in
 [0, 2], u = (A + B)(1 - kappa sin^2(phi / 2)): V depends on n and kappa only, so it is tabulated once per n
 (:func:`ring_table`: Chebyshev pieces to 1e-14, their errors carried; pieces next to kappa = 1, where V has a
 term |kappa - 1|^(n + 1/2), computed by quadrature when they cannot be fitted), and A + B = cos(x - x_mu)
@@ -207,17 +207,18 @@ engine stays the reference: :func:`two_d_only` switches the 1-D path off.
 
 from __future__ import annotations
 
-import cmath
 import contextlib
 import functools
 import math
 import os
 import threading
 import warnings
-from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
+
+from ..core.hints import Polar
+from ..physics.fresnel import fresnel_branch, fresnel_brewster, fresnel_pole
 
 __all__ = ["Polar", "albedo_1d", "two_d_only", "integrand", "integrand_reference"]
 
@@ -231,96 +232,6 @@ ROUNDING = 64.0 * np.finfo(float).eps
 #: initial subintervals of every piece (1 since the calibrated estimate: every piece is smooth
 #: after its substitution, and 2 only doubled the evaluations; measured in scripts/error_calibration.py)
 N_INIT = 1
-
-
-@dataclass(frozen=True)
-class Polar:
-    """A model's closed-form-azimuth hint for :func:`albedo_1d`.
-
-    a(mu) = scale(mu) * integral over the hemisphere of u^n / max(mu, N.wo)^p cos(theta_o)
-    d omega_o, u = (A.wo)_+ with A the mirror direction of wi or wi itself (the integral is the
-    same for both), or, for ``kind="constant"``, a(mu) = scale(mu) exactly.
-
-    Parameters
-    ----------
-    n : float, >= 0
-        Exponent of the lobe.
-    p : float in [0, 1]
-        Power of max(N.L, N.V) in the denominator (0 and 1 in closed form, between them an inner
-        rule on the arc where N.wo >= mu, :func:`_arc_power`).
-    scale : callable
-        ``scale(mu) -> ndarray`` of the same shape: the constant of the model (c, c C^n for a
-        Lafortune lobe, k_s / mu for Phong's shader, k_rho / H_s(mu) for Lewis's Phong).
-    kind : {"lobe", "constant", "half"}
-        "half": u is N.h, h the half vector of wi and wo (the Blinn family, 000 eq. 31, 32; 002
-        eq. 24; with ``radial``, ``sqrt_cos``, ``vcavity`` below also modified Ward, Ward, Cook-Torrance and
-        Torrance-Sparrow), p in {0, 1}: a(mu) = scale(mu) * integral_0^1 u^n K(u) du with the azimuth of h
-        about N in closed form (:func:`_k_half`, :func:`_k_ward`, :func:`_k_vcavity`).
-    chain : tuple, optional
-        A pumped BRDF's divisor (:meth:`pumpup.pumping.Pumped._chain_args`): the integrand is then
-        divided by g_1 ... g_k (mu, N.wo) (001 eq. 16), a function of N.wo only for a fixed wi,
-        and the integral is taken about N (:func:`_integrate_chain`; for a half-vector hint in frame 6,
-        GGX, Beckmann with F = 1 and Schlick's model, :func:`_integrate_n`; GGX with F at mu >= N_FRESNEL_MU_MIN only,
-        :func:`one_d_part`).
-    levels : callable, optional
-        With ``chain``: ``levels(mu)`` -> the values of N.wo where g has a kink
-        (:meth:`pumpup.pumping.Pumped.kink_levels` of every level, the kinks its tables inherit with their
-        knots, :meth:`pumpup.pumping.Pumped.table_kinks`, and the base's level mu).
-    radial : {"power", "beckmann", "ggx"}
-        The lobe's radial factor: u^n ("power"), or, with kind "half", the Beckmann weight
-        exp(-tan^2(alpha) / m^2) with m = ``n`` (the modified Ward model, 000 eq. 35), or the GGX weight
-        1 / (1 + tan^2(alpha) / m^2)^2 (GGX, Walter et al. 2007 eq. 33; Torrance-Sparrow's D3, 002 sec. 3.2).
-    vcavity : bool
-        With kind "half" and p = 0: the lobe is the V-cavity microfacet model's D G / (N.L N.V) with F = 1 (or ``fresnel``'s F, by
-        the rule on h's arc, :func:`_k_numeric`)
-        (Cook-Torrance, 001 eq. 9-10; Torrance-Sparrow, 002 eq. 10; :func:`_k_vcavity`), D the radial factor
-        (u^n, or with the Beckmann weight D's 1 / cos^4), 1 / N.L in ``scale``.
-    ulps : float or callable
-        With kind "constant": the relative error of ``scale`` in units of eps (or ``ulps(mu)``), as bounded
-        and measured for each closed form.
-    sqrt_cos : bool
-        With kind "half" and p = 0: the lobe is divided by sqrt(N.wo) (Ward, 000 eq. 34: sqrt(N.L N.V), its
-        1 / sqrt(N.L) in ``scale``; :func:`_k_ward`).
-    smith : tuple, optional
-        With kind "half", p = 0 and the Beckmann or GGX weight: the lobe is a Smith microfacet model's
-        D F G / (4 N.L N.V) (Walter et al. 2007 eq. 20), given as (distribution: 0 Beckmann, 1 GGX; G1: 0 exact, 1
-        Walter's fit; shadowing: 0 separable, 1 height-correlated; alpha); its azimuth by a rule on h's arc
-        (:func:`_k_numeric`; with F = 1 and alpha <= 1 about N instead, the azimuth of wo in closed form, frame 6,
-        :func:`_integrate_n`), D's 1 / (pi alpha^2) and the 1 / 4 in ``scale``.
-    fresnel : tuple
-        (ior, eta, k): the Fresnel factor at wi.h of a Smith or V-cavity lobe, dielectric (ior > 0) or conductor
-        (eta > 0), or none (all 0); a V-cavity lobe with one takes the rule on h's arc too.  With kind "lobe" (ior 0, eta
-        > 0): 000 eq. 28's conductor factor F(max(N.L, N.V)) (frame 5, :func:`_k_lobe_fresnel`; with ``chain``, the
-        pumped lobe's frame of N, :func:`_x_rule`).
-    schlick : float, optional
-        With kind "half", p = 0 and the GGX weight (n = sqrt(r)): Schlick's model (000 eq. 36) with this r, whose
-        1 / (r + (1 - r) N.V) frame 6 integrates about N (:func:`_integrate_n`); 1 / (r + (1 - r) N.L) in ``scale``.
-    factor : tuple, optional
-        A 1/E-scaled model's factor 1 + F0 (1 / U(N.wo) - 1) (Turquin eq. 6, :class:`pumpup.compensate.Scaled`): F0 and
-        the arguments of its look-up U (:attr:`pumpup.compensate._Bound.args`), a function of N.wo alone, so frame 6
-        multiplies each node by it (:func:`_n_rule`); ``levels(mu)`` then gives U's kinks.  Frame 6 only.
-    fmax : tuple, optional
-        (eta, k): 000 eq. 28's conductor factor F(max(N.L, N.V)) on a frame 6 model (the ``fresnel`` wrapper of GGX,
-        Beckmann with F = 1 or Schlick's model, pumped or not; :func:`with_fresnel_max`): a function of N.wo alone for a
-        fixed wi, so frame 6 multiplies each node by it (:func:`_n_rule`), its kink N.wo = mu a cut already and the
-        elevation cut about its branch point and pole as a pumped metal's (:func:`chain_cuts`).  Frame 6 only.
-    """
-
-    n: float = 0.0
-    p: float = 0.0
-    scale: object = None
-    kind: str = "lobe"
-    chain: tuple | None = None
-    levels: object = None
-    radial: str = "power"
-    sqrt_cos: bool = False
-    ulps: object = 4.0
-    vcavity: bool = False
-    smith: tuple | None = None
-    fresnel: tuple = (0.0, 0.0, 0.0)
-    schlick: float | None = None
-    factor: tuple | None = None
-    fmax: tuple | None = None
 
 
 @contextlib.contextmanager
@@ -722,7 +633,7 @@ def _k_half(p, mu, s, psi, u, sa):  # pragma: no cover - compiled; see half_inte
     arc's ends depend on 2 alpha - psi).
 
     d omega_o = 4 (wo.h) d omega_h and wo.h = wi.h = c = a + b cos(beta), a = mu u, b = s sa (the
-    form of N.wo about R, pumpup._polar's lobe frame); N.wo = 2 c u - mu, so N.wo > 0 where
+    form of N.wo about R, pumpup.engine.polar's lobe frame); N.wo = 2 c u - mu, so N.wo > 0 where
     c > c0 = mu / (2 u), and N.wo >= mu where c >= c1 = 2 c0.  On the arc |beta| < beta0 (c > c0),
     with d = c - c0 >= 0: p = 0 integrates 4 c 2 u d = 8 u (c0 d + d^2); p = 1 that on the part
     |beta| > beta1 (c < c1), divided by mu = 2 u c0, and 4 c on |beta| < beta1.  The arc's end beta0 comes
@@ -946,7 +857,7 @@ def _phi_numeric(mp, mu, u, c0, d):  # pragma: no cover - compiled; see numeric_
         return 4.0 * f * min(c, 2.0 * u * mu, 2.0 * u * z)  # 4 c G, 001 eq. 10
     if mp[0] == SCHLICK:
         return 4.0 * c * z / (mp[4] + (1.0 - mp[4]) * z)  # 000 eq. 36's 1 / (r + (1 - r) N.V), times N.V
-    if mp[1] == 1.0:  # GGX: P = (z + sqrt(z^2 + alpha^2 sin^2)) / 2, Walter eq. 34 (microfacet._projected, one sqrt)
+    if mp[1] == 1.0:  # GGX: P = (z + sqrt(z^2 + alpha^2 sin^2)) / 2, Walter eq. 34 (physics.microfacet.projected, one sqrt)
         pz = 0.5 * (z + math.sqrt(z * z + mp[4] * mp[4] * ((1.0 - z) * (1.0 + z))))
     else:
         pz = _projected(math.sqrt((1.0 - z) * (1.0 + z)), 0.0, z, 0, int(mp[2]), mp[4])
@@ -1085,43 +996,6 @@ MP_SIZE = 23 + 3 * LOBE_F_CUTS
 #: no cuts in alpha (:func:`_pieces`) where the feature's scale there is at least this (rad): the outer rule's first
 #: 21 nodes on a piece of at most pi / 2 see it (metal eta 0.2, k 3: its pole's scale 0.35 had doubled the pieces)
 LOBE_F_WIDE = 0.25
-
-
-def fresnel_branch(eta: float, k: float) -> tuple:
-    """(x0, y0): the branch point w = sqrt(1 - (eta + i k)^2) = x0 - i y0 of the conductor Fresnel factor F(c)
-    (:func:`pumpup.models.metal._fresnel_real`, where the refracted cosine sqrt((eta + i k)^2 - 1 + c^2) vanishes; F is
-    analytic in c elsewhere near [0, 1], its other singularities -w and the conjugates as far), x0 = |Re w|,
-    y0 = |Im w|."""
-    w = complex(1.0 - (eta * eta - k * k), -2.0 * eta * k) ** 0.5
-    return abs(w.real), abs(w.imag)
-
-
-def fresnel_pole(eta: float, k: float) -> float:
-    """rho = 1 / |sqrt((eta + i k)^2 + 1)|: F(c)'s parallel reflectance has poles where A c + sin^2 = 0 (A the refracted
-    cosine times the index), c^2 = 1 / ((eta + i k)^2 + 1), in the left half-plane on the physical sheet; for a
-    strong absorber (|eta + i k| >> 1) near c = 0, at distance ~rho from the arc's small end (eta = 1.1, k = 30:
-    -0.0012 + 0.033 i; a rule blind to it was 1.9e-11 off with an estimate of 4.1e-12 at mu = 1e-3, rtol 1e-10, measured
-    against the nested and 2-D engines): frame 5 grades its arcs towards c = 0 on this scale."""
-    return 1.0 / abs(complex(eta * eta - k * k + 1.0, 2.0 * eta * k) ** 0.5)
-
-
-def fresnel_brewster(eta: float, k: float) -> tuple:
-    """(c_b, ok): Brewster's zero c_b of the parallel reflectance's numerator N = A c - (1 - c^2), A = sqrt((eta + i k)^2 - 1
-    + c^2) continued from the real axis, c_b^2 = 1 / ((eta + i k)^2 + 1) (:func:`_lobe_f_bound`), and whether it was
-    found.  On the real axis A is the principal root (Im A^2 = 2 eta k >= 0); from c = Re c_b up to c_b it is the
-    principal root, negated where c^2 - w^2 (w^2 = 1 - (eta + i k)^2) crosses the negative real axis on the way
-    (Im (c^2 - w^2) = 2 Re(c) Im(c) - Im w^2 = 0)."""
-    e2 = complex(eta * eta - k * k, 2.0 * eta * k)
-    cp = 1.0 / cmath.sqrt(e2 + 1.0)
-    w2 = 1.0 - e2
-    for z in (cp, -cp):
-        r, ci = z.real, z.imag
-        y = w2.imag / (2.0 * r) if r != 0.0 else math.inf
-        flip = (0.0 < y < ci or ci < y < 0.0) and r * r - y * y - w2.real < 0.0
-        a = (-1.0 if flip else 1.0) * cmath.sqrt(z * z - w2)
-        if abs(a * z - (1.0 - z * z)) <= 1e-9 * (abs(a * z) + abs(1.0 - z * z)):
-            return z, True
-    return cp, False
 
 
 def lobe_fresnel_ok(eta: float, k: float, chain: bool = False) -> bool:
@@ -1340,7 +1214,7 @@ def lobe_f_piece_reference(eta: float, k: float, q: float, lo: float, d: float, 
     """Plain twin of :func:`_lobe_f_piece`: integral_lo^(lo + d) F(t) t^q / sqrt((T - t)(t - L)) dt by numpy's 200-point
     Gauss-Legendre rule in the same variable (s for ``first``, else t), F the complex-arithmetic
     :func:`pumpup.models.metal.fresnel`."""
-    from .models.metal import fresnel
+    from ..physics.fresnel import fresnel_conductor as fresnel
 
     x, w = np.polynomial.legendre.leggauss(200)
     if first:
@@ -1524,7 +1398,7 @@ def lobe_fresnel_integrand_reference(brdf, mu: float, u) -> np.ndarray:
     the complex-arithmetic :func:`pumpup.models.metal.fresnel`, the arcs' ends as the rule's points; times 2."""
     from scipy.integrate import quad
 
-    from .models.metal import fresnel
+    from ..physics.fresnel import fresnel_conductor as fresnel
 
     hint = brdf.polar()
     _, eta, k = hint.fresnel
@@ -1716,7 +1590,7 @@ def integrand_reference(n: float, p: float, mu: float, u: np.ndarray) -> np.ndar
 def integrand(n: float, p: float, mu: float, u, rtol: float = 1e-13):
     """(u^n K(u), its error) by the compiled kernel at every u in [0, 1] (for tests and checks;
     ``rtol`` is the inner rule's relative tolerance for p in (0, 1))."""
-    from .albedo import NODES, WG, WK
+    from .cubature import NODES, WG, WK
 
     u = np.atleast_1d(np.asarray(u, dtype=np.float64))
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -1810,13 +1684,13 @@ WK21 = 0.5 * np.concatenate([_WGK21[:-1], _WGK21[::-1]])
 WG21 = np.zeros(21)
 WG21[1:10:2] = 0.5 * _WG10
 WG21[11::2] = 0.5 * _WG10[::-1]
-from ._errors import EPS, calibrated, mode_code, rule_sums  # noqa: E402
-from .albedo import NODES as _NODES, WG as _WG, WK as _WK  # noqa: E402  (the engine's 7/15 rule)
-from .pumping import _g_levels, _g_product  # noqa: E402  (g of a pumped chain, as the BRDF divides by it)
-from .compensate import _bound as _scale_bound  # noqa: E402  (U of a 1/E-scaled model, as its kernel looks it up)
-from .models.cook_torrance import _fresnel  # noqa: E402  (frame 4's factors, as the models' kernels compute them)
-from .models.metal import _fresnel_real  # noqa: E402
-from .models.microfacet import _projected  # noqa: E402
+from ..physics.quadrature import EPS, calibrated, mode_code, rule_sums  # noqa: E402
+from .cubature import NODES as _NODES, WG as _WG, WK as _WK  # noqa: E402  (the engine's 7/15 rule)
+from ..physics.lookups import g_levels, g_product  # noqa: E402  (g of a pumped chain, as the BRDF divides by it)
+from ..physics.lookups import scale_bound as _scale_bound  # noqa: E402  (U of a 1/E-scaled model, as its kernel looks it up)
+from ..physics.fresnel import dielectric_scalar as _fresnel  # noqa: E402  (frame 4's factors, as the models' kernels)
+from ..physics.fresnel import conductor_scalar as _fresnel_real  # noqa: E402
+from ..physics.microfacet import projected as _projected  # noqa: E402
 #: the rule of the 1-D path (measured and tested with "gk21": 90-190 evaluations per mu for the
 #: Phong family at rtol 1e-10)
 RULE = "gk21"
@@ -1824,7 +1698,7 @@ RULE = "gk21"
 
 @njit(cache=True, nogil=True)
 def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc):  # pragma: no cover
-    """(K, error) of the rule on [t0, t1]; the error is :func:`pumpup._errors.calibrated` of
+    """(K, error) of the rule on [t0, t1]; the error is :func:`pumpup.physics.quadrature.calibrated` of
     |K - G| (``mode`` 1) or |K - G| itself (0), plus for p in (0, 1) and frame 4 the inner errors of the
     integrand's values (the inner rule ``inodes``, ``iwk``, ``iwg`` at relative tolerance
     ``itol``; frame 4 also at absolute tolerance ``iacc`` / the node's factor, :func:`_integrate`) summed with
@@ -2554,8 +2428,8 @@ def ring_reference(distribution: int, a2: float, mu: float, x: float, fresnel=No
     S ~ 0.05, scipy missed the feature by 3e-7, measured against mpmath)."""
     from scipy.integrate import quad
 
-    from .models.cook_torrance import fresnel as dielectric
-    from .models.metal import fresnel as conductor
+    from ..physics.fresnel import fresnel_conductor as conductor
+    from ..physics.fresnel import fresnel_dielectric as dielectric
 
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     wi = np.array([s, 0.0, mu])
@@ -2713,7 +2587,7 @@ def _n_value(mp, mu, xmu, xs, d):  # pragma: no cover - compiled; see n_integran
     """Frame 6's integrand at x = x_mu + d: pi a2 cos(x) sin(x) W(x) Gamma(sin x), W the weight's integral over the
     azimuth (:func:`_ggx_ring`, :func:`_beckmann_ring`), Gamma = 1 / (P(mu) P(t)) for the separable Smith G (Walter et al.
     2007 eq. 20), 1 / (t P(mu) + mu P(t) - mu t) for the height-correlated one (Heitz 2014), 1 / (r + (1 - r) t) for
-    Schlick's model (000 eq. 36); P(t) = N.wo / G1(wo) (microfacet._projected, Walter eq. 27, 34), P(mu) in mp[8]."""
+    Schlick's model (000 eq. 36); P(t) = N.wo / G1(wo) (physics.microfacet.projected, Walter eq. 27, 34), P(mu) in mp[8]."""
     a2 = mp[4] if mp[0] == SCHLICK else mp[4] * mp[4]
     w = _beckmann_ring(a2, xmu, xs, d) if mp[0] == SMITH and mp[1] == 0.0 else _ggx_ring(a2, xmu, xs, d)
     if w == 0.0:  # (far in the Beckmann weight's tail)
@@ -2745,22 +2619,22 @@ def _n_incidence(mp, mu):  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True, inline="always")
 def _n_chain_g(chain, mu, t):  # pragma: no cover - compiled
-    """g_1 ... g_k(mu, t) of a pumped chain at N.wo = t, as the chain kernel computes it (``pumpup.pumping._g_product``,
-    ``_g_levels``; 001 eq. 16)."""
+    """g_1 ... g_k(mu, t) of a pumped chain at N.wo = t, as the chain kernel computes it (``pumpup.physics.lookups.g_product``,
+    ``g_levels``; 001 eq. 16)."""
     if min(mu, t) > chain[13]:
-        return _g_product(max(mu, t), chain[14], chain[15], chain[16], chain[17])
-    return _g_levels(max(mu, t), min(mu, t), chain[0], chain[1], chain[2], chain[3], chain[4], chain[5], chain[6],
+        return g_product(max(mu, t), chain[14], chain[15], chain[16], chain[17])
+    return g_levels(max(mu, t), min(mu, t), chain[0], chain[1], chain[2], chain[3], chain[4], chain[5], chain[6],
                      chain[7], chain[8], chain[9], chain[10], chain[11], chain[12])
 
 
 @njit(cache=True, nogil=True)
 def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv, kind):  # pragma: no cover - compiled
     """(value, error) of the rule on d = x - x_mu in [lo, hi] of :func:`_n_value`; with a pumped chain (``chain`` not
-    None, :meth:`pumpup.pumping.Pumped._chain_args`) divided by g_1 ... g_k(mu, N.wo) exactly as the chain kernel divides
+    None, :meth:`pumpup.operators.pumping.Pumped._chain_args`) divided by g_1 ... g_k(mu, N.wo) exactly as the chain kernel divides
     by it (001 eq. 16; written out as in :func:`_x_rule`; first times F(max(mu, N.wo)) where mp[15] = 1, ``Polar.fmax``,
     analytic between the cuts), or with a 1/E-scaled model's ``factor`` (not None: F0 and
-    :attr:`pumpup.compensate._Bound.args`) times 1 + F0 (1 / U(N.wo) - 1) as its kernel multiplies (Turquin eq. 6,
-    :func:`pumpup.compensate._scale_kernel`); its error then the larger of QUADPACK's calibration (for the weight's peak,
+    :attr:`pumpup.operators.compensate._Bound.args`) times 1 + F0 (1 / U(N.wo) - 1) as its kernel multiplies (Turquin eq. 6,
+    :func:`pumpup.operators.compensate._scale_kernel`); its error then the larger of QUADPACK's calibration (for the weight's peak,
     as without g) and CHAIN_SAFETY |K - G| (for the splines of g or U, which are not analytic: :data:`CHAIN_SAFETY`).
     With a Fresnel factor (mp[13] = 1, GGX) the ring is :func:`_ggx_ring_f` at relative tolerance ``itol`` or absolute
     ``iacc`` / the node's factor (``fv`` its work array), and its errors are taken as frame 4 takes K's (:func:`_gk`):
@@ -3108,10 +2982,10 @@ def n_fresnel_ok(ior: float, eta: float, k: float) -> bool:
 
 
 def takes_n_frame_operand(hint) -> bool:
-    """Whether a 1/E scale (:meth:`pumpup.compensate.Scaled.polar`) may build on ``hint`` in frame 6: GGX, Beckmann
+    """Whether a 1/E scale (:meth:`pumpup.operators.compensate.Scaled.polar`) may build on ``hint`` in frame 6: GGX, Beckmann
     (F = 1) or Schlick, neither pumped nor scaled already, and without a Fresnel factor (GGX with F splits its mu with
     frame 4, which has no factor; F(Theta_min) with U not tested).  A pumped chain builds on more
-    (:meth:`pumpup.pumping.Pumped.polar`: GGX with F, and F(Theta_min) through :func:`with_fresnel_max`)."""
+    (:meth:`pumpup.operators.pumping.Pumped.polar`: GGX with F, and F(Theta_min) through :func:`with_fresnel_max`)."""
     return (hint is not None and hint.chain is None and hint.factor is None and not any(hint.fresnel) and hint.fmax is None
             and takes_n_frame(hint))
 
@@ -3326,15 +3200,15 @@ def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, 
         x = lo + h * nodes[j]
         t = math.sin(x)
         ct = math.cos(x)
-        # g_1 ... g_k as the chain kernel divides by it (pumpup.pumping._chain_kernel): the product
+        # g_1 ... g_k as the chain kernel divides by it (pumpup.operators.pumping._chain_kernel): the product
         # table where it applies, else level by level (written out: an inlined function that calls
         # the inlined look-ups ran 20 x slower, measured)
         g = 1.0  # (no chain: a metal's lobe)
         if chain is not None:
             if min(mu, t) > chain[13]:
-                g = _g_product(max(mu, t), chain[14], chain[15], chain[16], chain[17])
+                g = g_product(max(mu, t), chain[14], chain[15], chain[16], chain[17])
             else:
-                g = _g_levels(max(mu, t), min(mu, t), chain[0], chain[1], chain[2], chain[3], chain[4], chain[5], chain[6],
+                g = g_levels(max(mu, t), min(mu, t), chain[0], chain[1], chain[2], chain[3], chain[4], chain[5], chain[6],
                               chain[7], chain[8], chain[9], chain[10], chain[11], chain[12])
         if p == 0.0:
             f = t * ct / g
@@ -3578,7 +3452,7 @@ ONE_D = True
 @contextlib.contextmanager
 def without_1d():
     """Within the block, ``pumpup.albedo`` ignores the 1-D path only: the models that have it go to the
-    nested engine (``pumpup._nested``), as before they had it (the tests' and the calibration's
+    nested engine (``pumpup.engine.nested``), as before they had it (the tests' and the calibration's
     second engine for them).  Not meant for concurrent toggling."""
     global ONE_D
     old = ONE_D
@@ -3604,7 +3478,7 @@ def numeric_params(hint: Polar) -> np.ndarray:
         if hint.fresnel[1] > 0.0:  # a conductor's branch point, for :func:`_pieces`' cuts (frame 6 reuses 13, 14: n_params)
             mp[13], mp[14] = fresnel_branch(float(hint.fresnel[1]), float(hint.fresnel[2]))
         if hint.smith[1] == 1:
-            from .models.microfacet import walter_level
+            from ..physics.microfacet import walter_level
 
             mp[9] = walter_level(float(hint.smith[3]))
     elif hint.kind == "lobe" and any(hint.fresnel):  # frame 5: F(max(N.wi, N.wo)) of a conductor (eta, k)

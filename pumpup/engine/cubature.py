@@ -36,10 +36,10 @@ The reported error is the sum of |K - G| over all rectangles plus a rounding ter
 pessimistic on smooth integrands by design (true error / estimate at most 0.18, median 1.3e-3
 over every independent reference of ``tests/`` at rtol 1e-6 .. 1e-12,
 ``scripts/error_calibration.py``), and the tests check it against closed forms and against
-independent quadratures.  QUADPACK's calibrated estimate (:mod:`pumpup._errors`, used by the
+independent quadratures.  QUADPACK's calibrated estimate (:mod:`pumpup.physics.quadrature`, used by the
 1-D path) is not used here by default: the integrand of a pumped or compensated BRDF has kinks
 at the knots of its albedo table that no hint marks, and there the calibrated estimate was
-measured below the true error (``pumpup._errors.MODE_2D`` switches it on for measurements).
+measured below the true error (``pumpup.physics.quadrature.MODE_2D`` switches it on for measurements).
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numba import njit
 
-from .core import BRDF, Lobe
+from ..core import BRDF, Lobe
 
 __all__ = ["albedo", "check_mu", "check_phi", "AlbedoWarning"]
 
@@ -475,12 +475,12 @@ def _accumulate(f, cos_o, weight, total):  # pragma: no cover - compiled
 def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
     """Apply the 15 x 15 Gauss-Kronrod tensor rule to rectangles; return (K, err, ex, et).
 
-    err is the error estimate of the rectangle, |K - G| (or, when ``pumpup._errors.MODE_2D``
+    err is the error estimate of the rectangle, |K - G| (or, when ``pumpup.physics.quadrature.MODE_2D``
     asks for it, QUADPACK's calibration of it: not the default, see the module docstring);
     ex and et, the same for the Gauss rule in x only and in t only, choose the split direction."""
-    from ._errors import calibrated_array, mode_code
+    from ..physics.quadrature import calibrated_array, mode_code
 
-    mode = mode_code(smooth=False)  # raw |K - G| unless pumpup._errors.MODE_2D says otherwise
+    mode = mode_code(smooth=False)  # raw |K - G| unless pumpup.physics.quadrature.MODE_2D says otherwise
     R = len(prob)
     out = np.empty((R, 4))
     per = max(1, chunk // 225)
@@ -502,12 +502,12 @@ def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
         gk = np.einsum("rij,i,j->r", v, WG, WK) * area  # Gauss in x: measures the x error
         kg = np.einsum("rij,i,j->r", v, WK, WG) * area
         out[sl, 0] = kk
-        if mode == 0:  # the raw |K - G| (pumpup._errors.raw_estimate)
+        if mode == 0:  # the raw |K - G| (pumpup.physics.quadrature.raw_estimate)
             out[sl, 1] = np.abs(kk - gg)
             out[sl, 2] = np.abs(kk - gk)
             out[sl, 3] = np.abs(kk - kg)
             continue
-        # QUADPACK's calibration (pumpup._errors) with the tensor Kronrod rule's resasc (the
+        # QUADPACK's calibration (pumpup.physics.quadrature) with the tensor Kronrod rule's resasc (the
         # integral of |f - mean f|) and resabs; per axis the same resasc, so ex >= et (the split
         # direction) is the comparison of the raw per-axis differences, as before
         mean = (kk / area)[:, None, None]
@@ -616,7 +616,7 @@ _END_GAP = 1e-10
 #: two cuts whose crossing function a_j b_k - a_k b_j stays within COINCIDENT eps S_j S_k at every node of the scan
 #: (S a bound of the magnitudes a cut's coefficients are computed from: |a| + |b| of a model's kink, |a0 - u| + |b0| +
 #: |u| of a level N.wo = u, |a0| + |b0| of the horizon) are one curve, computed twice: its "roots" are rounding noise.
-#: A pumped Cook-Torrance has the level N.wo = mu of g2 and g1 (:meth:`pumpup.pumping.Pumped.kink_levels`) and the
+#: A pumped Cook-Torrance has the level N.wo = mu of g2 and g1 (:meth:`pumpup.operators.pumping.Pumped.kink_levels`) and the
 #: geometry factor's kink N.wo = mu (:func:`pumpup.models.cook_torrance._g_kinks`): 292 such breaks at mu = 0.5 gave
 #: the nested engine 448 first intervals where the base model has 25, 40-60 x its evaluations (issue 14's
 #: twenty-fourth session)
@@ -1323,7 +1323,7 @@ def _graded(points: np.ndarray) -> np.ndarray:
 
 
 #: a piece end at the cut of a small level is graded where the integrand's scale there, in tau_t, is
-#: below this (as ``pumpup._nested.D_GRADE``)
+#: below this (as ``pumpup.engine.nested.D_GRADE``)
 D_GRADE = 0.05
 #: at most this many graded breaks towards one end (steps d 4^k, k < K_GRADE)
 K_GRADE = 16
@@ -1352,7 +1352,7 @@ def _level_end_scales(lobe: Lobe, mu: float, levels: np.ndarray, gx: np.ndarray,
     lev = np.asarray(levels, dtype=np.float64)
     if not len(lev) or not np.any(lev > 0) or lobe.axis == "normal":  # around N, no level cuts the arc
         return np.full((C, n_pieces), np.inf)
-    from ._nested import _nodes_reference
+    from .nested import _nodes_reference
 
     tx = (gx[:-1, None] + np.diff(gx)[:, None] * _SCALE_NODES[None, :]).ravel()
     N = len(tx)
@@ -1434,7 +1434,7 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
     # initial rectangles: nx x nt per piece per problem, with the x grid also split where
     # the horizon starts to cut the lobe and where it hides it completely
     gt = np.linspace(0, 1, nt + 1)
-    from ._nested import _alpha_grading  # _nested imports this module
+    from .nested import _alpha_grading  # _nested imports this module
 
     cols = []
     kink_breaks = _kink_breaks(g.lobe, g.mu, g.levels)
@@ -1445,7 +1445,7 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
         breaks = np.concatenate([_horizon_breaks(g.lobe, float(g.mu[p_])),
                                  kink_breaks[p_]])
         # and, near normal incidence on a microfacet lobe, towards both horizon breaks on the roughness's scale
-        # (``pumpup._nested._alpha_grading``: G1(wo) falls to 0 within alpha of the horizon; GGX alpha = 2.7e-4 at
+        # (``pumpup.engine.nested._alpha_grading``: G1(wo) falls to 0 within alpha of the horizon; GGX alpha = 2.7e-4 at
         # mu = 1 was 2.6e-11 off with an estimate of 4.1e-13, 62 x, before)
         gx = np.unique(np.concatenate([np.linspace(0, 1, nx + 1), _graded(breaks), _alpha_grading(g.lobe, float(g.mu[p_]))]))
         # and the pieces that end at the cut of a small level graded towards it in tau_t
@@ -1616,7 +1616,7 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
         if getattr(brdf, "is_spectral", False):  # pumpup.spectral: one albedo per wavelength, on a trailing axis
             return brdf.albedo(mu, return_error=return_error, rtol=rtol, atol=atol, max_regions=max_regions, phi=phi)
         raise TypeError(f"albedo needs a pumpup BRDF, got {type(brdf).__name__}; wrap functions with pumpup.from_function")
-    from .core import check_count, check_tolerance
+    from ..core import check_count, check_tolerance
 
     rtol = check_tolerance("albedo", "rtol", rtol)
     atol = check_tolerance("albedo", "atol", atol, hi=math.inf, zero=True)  # 0: relative only
@@ -1633,10 +1633,12 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     value = np.zeros_like(flat)
     error = np.zeros_like(flat)
     ok = np.ones(flat.shape, bool)
-    from . import _nested, _polar, _slope
+    from . import nested as _nested
+    from . import polar as _polar
+    from . import slope as _slope
 
     for w, term in brdf.albedo_terms():
-        if _slope.takes_slope_path(term, flat):  # anisotropic Ward, at every azimuth of wi (pumpup._slope)
+        if _slope.takes_slope_path(term, flat):  # anisotropic Ward, at every azimuth of wi (pumpup.engine.slope)
             v, e, conv, _ = _slope.slope_albedo(term, flat, phflat, rtol, atol, max_regions)
             value += w * v
             error += abs(w) * e
@@ -1669,7 +1671,7 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
             ok[part] &= fast[2]
             rest = np.flatnonzero(~part)
         for idx, g in _groups(term, flat if rest is None else flat[rest], turn):
-            # the nested quadrature (pumpup._nested) where it applies, else the 2-D cubature
+            # the nested quadrature (pumpup.engine.nested) where it applies, else the 2-D cubature
             nested = _nested.supports(g)
             v, e, conv = (_nested.integrate if nested else _integrate_group)(term, g, rtol, atol, max_regions)
             if rest is not None:

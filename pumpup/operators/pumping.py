@@ -14,18 +14,23 @@ evaluates, tabulates, pumps again and round-trips through its spec.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
 import threading
 
 import numpy as np
-from numba import njit, types
-from numba.extending import intrinsic
+from numba import njit
 
-from .core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register
+from ..core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register, registry
+from ..physics.lookups import CELL_SHIFT, float_bits_reference, g_levels, g_product, horner, INDEX_CELLS, kink_roots, PRODUCT_DEGREE, upper_array
 
-__all__ = ["pump", "Pumped", "save_pumped", "load_pumped", "base_table"]
+__all__ = ["pump", "Pumped", "save_pumped", "load_pumped", "base_table", "pump_model", "FILE_KINDS"]
+
+#: the ``pumpup_kind`` of a saved pumped model that another module reads -> its reader ``(path, root) -> model``
+#: (:func:`load_pumped`; :mod:`pumpup.spectral` adds its own)
+FILE_KINDS: dict = {}
 
 #: accuracy of the albedo tables that pumped BRDFs divide by: g is an upper bound that exceeds
 #: the albedo by about 2 x TABLE_INTERP_TOL, so the pumped albedo is lower than the ideal by
@@ -78,7 +83,7 @@ def from_file(kind: str, key: str):
 
 def base_table(base: BRDF, progress: bool | None = None):
     """The albedo table of ``base`` used by the pumping operator (cached per session)."""
-    from .tables import AlbedoTable, tabulate
+    from ..tables import AlbedoTable, tabulate
 
     own = from_file("pump", _key(base))
     if own is not None:
@@ -87,7 +92,7 @@ def base_table(base: BRDF, progress: bool | None = None):
         with _lock_for(f"derived#{id(base)}"):
             if getattr(base, "_derived_table", None) is None:
                 ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress,
-                              breaks=albedo_kinks(base))
+                              breaks=base.albedo_kinks(*grid_interior()))
                 base._derived_table = AlbedoTable.from_dataset(ds)
                 base._derived_table.dataset = ds
         return base._derived_table
@@ -96,41 +101,23 @@ def base_table(base: BRDF, progress: bool | None = None):
         with _lock_for(key):  # one thread computes a base's table; the others wait for it
             if key not in _TABLES:
                 # an anisotropic base: the table bounds the supremum over the azimuth of wi (001 eq. 17
-                # needs g >= a(L) for every L, not only for L in the xz-plane; pumpup.azimuth)
+                # needs g >= a(L) for every L, not only for L in the xz-plane; pumpup.tables.azimuth)
                 phi = None if base.azimuth_range() is None else "sup"
                 ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress, phi=phi,
-                              breaks=albedo_kinks(base))
+                              breaks=base.albedo_kinks(*grid_interior()))
                 t = AlbedoTable.from_dataset(ds)
                 t.dataset = ds
                 _TABLES[key] = t
     return _TABLES[key]
 
 
-def albedo_kinks(brdf: BRDF, inside_grid: bool = True):
-    """The kinks of the albedo of ``brdf`` where it is a pumped level, and its innermost base's own
-    (:meth:`pumpup.core.BRDF.albedo_breaks`; None for a model that is not pumped and has none), for its table's
-    spline to be split there (:class:`pumpup.tables.AlbedoTable`'s breaks): the albedo at incidence v of a pumped level
-    has a kink where the g of that level or of one below changes its form at incidences that do not depend on wo --
-    its bound crosses the diagonal, u(v) = v (g2), or reaches its cap (:meth:`Pumped._kink_fixed`).  Before issue 14's
-    nineteenth session one spline went across them, rounded them off between knots the adaptive grid bunched
-    towards them, and the 1-D path cut the elevation at those knots (:meth:`Pumped.table_kinks`): ~25 more pieces
-    per mu in a 2-level g2 pumped GGX alpha 0.1.
-
-    Only kinks between the second and the next-to-last node of the grid the table starts from
-    (:func:`pumpup.tables.default_grid`) split it: Phong's, Beckmann's and stretched Phong's levels cross the diagonal
-    within 3e-4 of mu = 1, inside the grid's last interval, where a piece of two or three nodes made a 3-level g2 pumped
-    Phong's third bound dip (its running maximum then added a flat and its kink; its three tables took 87-97 ms against
-    76-79, one sitting); those keep the one spline, and :meth:`Pumped.table_kinks`' cuts at the knots bunched around
-    them, as before.  ``inside_grid=False``: every kink in (0, 1) (:func:`pumpup.mean_albedo`'s first intervals)."""
-    from .tables import default_grid
+def grid_interior() -> tuple[float, float]:
+    """The second and the next-to-last node of the grid a table starts from (:func:`pumpup.tables.default_grid`): only
+    kinks between them split a base table (:meth:`Pumped.albedo_kinks`)."""
+    from ..tables import default_grid
 
     grid = default_grid()
-    lo, hi = (grid[1], grid[-2]) if inside_grid else (0.0, 1.0)
-    chain = brdf.chain() if isinstance(brdf, Pumped) else []
-    out = {v for v in (chain[0].base if chain else brdf).albedo_breaks() if lo < v < hi}  # the innermost base's
-    for lev in chain:
-        out.update(v for v in lev._albedo_kinks() if lo < v < hi)
-    return sorted(out) if out or chain else None
+    return grid[1], grid[-2]
 
 
 def _sign_roots(grid, vals, fn) -> list:
@@ -166,215 +153,20 @@ def _uses_file_tables(brdf: BRDF) -> bool:
 
 
 @njit(cache=True, nogil=True)
-def _upper_scalar(mu, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
-    """Upper bound of a(mu): the table's spline piece in log(mu) (power law below the first node) + margin,
-    at most ``cap``."""
-    return _upper_log(math.log(mu), logx, coef, v0, slope0, margin_lo, margin, cap)
-
-
-@njit(cache=True, nogil=True)
-def _upper_log(lm, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
-    """:func:`_upper_scalar` of mu = exp(lm) (binary search for the piece)."""
-    n = logx.shape[0]
-    # below the first node only, as AlbedoTable.upper: at mu = mu0 itself the power law's margin (|a1 - a0| + ...,
-    # 24 for Ward m = 0.885's 651 at mu0 = 1e-8) made the bound jump up there, a pumped level's albedo at exactly mu0
-    # 3.6 % below its limit from above, and the level above's table bisected towards its first node (504 nodes within
-    # 1e-9 of it, 2e-23 apart)
-    if lm < logx[0]:
-        return min(cap, v0 * math.exp(slope0 * (lm - logx[0])) + margin_lo)
-    lo, hi = 0, n - 1
-    while hi - lo > 1:  # binary search for the interval
-        mid = (lo + hi) // 2
-        if logx[mid] <= lm:
-            lo = mid
-        else:
-            hi = mid
-    d = lm - logx[lo]
-    val = coef[0, lo]
-    for r in range(1, coef.shape[0]):  # Horner: the spline piece in d = log(mu) - logx[lo]
-        val = val * d + coef[r, lo]
-    return min(cap, val + margin)
-
-
-@njit(cache=True, nogil=True)
-def _upper_array(mu, logx, coef, v0, slope0, margin_lo, margin, cap, out):  # pragma: no cover - compiled
-    for k in range(mu.shape[0]):
-        out[k] = _upper_scalar(mu[k], logx, coef, v0, slope0, margin_lo, margin, cap)
-
-
-@njit(cache=True, nogil=True)
-def _upper_root(lo, hi, kind, target, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
-    """u in [lo, hi] where the bound U(u) (:func:`_upper_scalar`) meets ``target`` (``kind`` 0 or 2) or u itself (1), given
-    a change of sign of the difference at the ends: bisection until the bracket is at most 1e-15 + 4 eps u wide (where
-    scipy's brentq at xtol 1e-15, which :meth:`Pumped._kink_levels` called from Python, stops too); its midpoint.
-    Compiled (issue 14's eighteenth session): the brentq calls took ~60 us each in cProfile, and the per-mu kink search two
-    thirds of a first 2-level pumped GGX table."""
-    flo = _upper_scalar(lo, logx, coef, v0, slope0, margin_lo, margin, cap) - (lo if kind == 1 else target)
-    while hi - lo > 1e-15 + 8.9e-16 * hi:
-        mid = 0.5 * (lo + hi)
-        fm = _upper_scalar(mid, logx, coef, v0, slope0, margin_lo, margin, cap) - (mid if kind == 1 else target)
-        if fm == 0.0:
-            return mid
-        if (fm < 0.0) == (flo < 0.0):
-            lo, flo = mid, fm
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
-
-
-@njit(cache=True, nogil=True)
-def _kink_roots(g, ug, kind, target, mu, scale, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
-    """The roots v of U(v) = ``target`` (``kind`` 0 or 2) or U(v) = v (1) that the grid ``g`` (U's values ``ug``) brackets
-    (:meth:`Pumped._kink_levels`, its search for one k in one compiled pass): differences below 1e-13 ``scale`` count as
-    0 (the rounding of a flat spline: no root), every cell where they change sign gives its root (:func:`_upper_root`);
-    for kind 0 the points mu (1 -+ 1e-6) join the grid and the cell between them, which holds the root v = mu itself, is
-    skipped."""
-    n = g.shape[0]
-    extra = np.empty(2)
-    ne = 0
-    if kind == 0:
-        for e in (mu * (1.0 - 1e-6), mu * (1.0 + 1e-6)):
-            if e <= 1.0:
-                extra[ne] = e
-                ne += 1
-    m = n + ne
-    x = np.empty(m)
-    vals = np.empty(m)
-    i = j = 0
-    for q in range(m):  # the grid and the extra points, merged (an extra point before a grid node it equals)
-        if j < ne and (i >= n or extra[j] <= g[i]):
-            x[q] = extra[j]
-            u = _upper_scalar(extra[j], logx, coef, v0, slope0, margin_lo, margin, cap)
-            j += 1
-        else:
-            x[q] = g[i]
-            u = ug[i]
-            i += 1
-        d = u - (x[q] if kind == 1 else target)
-        vals[q] = 0.0 if abs(d) < 1e-13 * scale else d
-    out = np.empty(m)
-    k = 0
-    for q in range(m - 1):
-        if not ((vals[q] < 0.0 and vals[q + 1] > 0.0) or (vals[q] > 0.0 and vals[q + 1] < 0.0)):
-            continue
-        if kind == 0 and x[q] <= mu <= x[q + 1] and x[q + 1] - x[q] <= 2.01e-6 * mu:
-            continue  # (the root v = mu itself, already a level)
-        out[k] = _upper_root(x[q], x[q + 1], kind, target, logx, coef, v0, slope0, margin_lo, margin, cap)
-        k += 1
-    return out[:k]
-
-
-#: cells of the uniform index over log(mu) that the chain kernel uses to find a table interval
-_INDEX_CELLS = 4096
-
-#: the product table of a monotone chain (:class:`_Product`): polynomials of degree
-#: _PRODUCT_DEGREE in m, their pieces found through 2^_CELL_BITS cells per octave numbered by the
-#: float's bits (measured on 3-level Phong: 4 bits 28 ns per pair, 6 bits 25, 8 bits 21; degree 4
-#: needs twice the pieces of degree 5 and was slower)
-_CELL_BITS = 8
-_CELL_SHIFT = 52 - _CELL_BITS
-_PRODUCT_DEGREE = 5
-
-
-@intrinsic
-def _float_bits(typingctx, x):  # pragma: no cover - compiled
-    """The IEEE-754 bits of a float64 as an int64 (a free bit cast; for x > 0 the bits increase
-    with x, and ``bits >> _CELL_SHIFT`` numbers the cells of :class:`_Product`)."""
-    if not isinstance(x, types.Float):
-        return None
-
-    def codegen(context, builder, signature, args):
-        return builder.bitcast(args[0], context.get_value_type(types.int64))
-
-    return types.int64(types.float64), codegen
-
-
-def _bits(x) -> np.ndarray:
-    """numpy reference of :func:`_float_bits`."""
-    return np.asarray(x, dtype=np.float64).view(np.int64)
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _g_product(mmax, pcbase, pcstart, plo, prow):  # pragma: no cover - compiled
-    """The chain kernel's fast path: g_1 g_2 ... g_k as one function of mmax = max(N.wi, N.wo)
-    (:class:`_Product`; mmax above its ``mlo``): the piece found from the bits of mmax (no logarithm),
-    evaluated by Horner's rule; ``prow[s]`` holds the piece's coefficients, centre and inverse
-    half-width (one cache line).  Inlined where it is called."""
-    last_cell = pcstart.shape[0] - 1
-    deg = prow.shape[1] - 3
-    s = pcstart[min((_float_bits(mmax) >> _CELL_SHIFT) - pcbase, last_cell)]
-    s += mmax >= plo[s + 1]  # most cells hold one or two pieces: a branch-free step,
-    while mmax >= plo[s + 1]:  # then a loop that is rarely entered
-        s += 1
-    t = (mmax - prow[s, deg + 1]) * prow[s, deg + 2]
-    if deg == 5:  # written out (Horner, the order of _horner)
-        return (((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t
-                 + prow[s, 4]) * t + prow[s, 5])
-    g_all = prow[s, 0] * t
-    for r in range(1, deg):
-        g_all = (g_all + prow[s, r]) * t
-    return g_all + prow[s, deg]
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _g_levels(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
-              index, index_lo, index_h_inv):  # pragma: no cover - compiled
-    """The product of all levels' g (001 eq. 20, 21) at N.wi, N.wo with max ``mmax`` and min ``mmin``
-    (both > 0), level by level: each level's upper bound looked up (spline piece in log(mu), power
-    law below its first node, at most its cap).  Inlined where it is called (a call per look-up
-    cost 20 x the look-up, measured)."""
-    ncell = index.shape[1]
-    lmax = math.log(mmax)
-    lmin = 1.0  # log(mmin), taken only when needed (it is <= 0)
-    g_all = 1.0
-    for j in range(offsets.shape[0] - 1):
-        a, b = offsets[j], offsets[j + 1]
-        nlook = 1 if (increasing[j] and mmin > mu0[j]) else 2
-        g = 0.0
-        for t in range(nlook):
-            if t == 0:
-                lm = lmax
-            else:
-                if lmin > 0.0:
-                    lmin = math.log(mmin)
-                lm = lmin
-            if lm < logx[a]:  # (as _upper_log)
-                u = v0[j] * math.exp(slope0[j] * (lm - logx[a])) + margin_lo[j]
-            else:
-                c = int((lm - index_lo[j]) * index_h_inv[j])
-                i = index[j, min(max(c, 0), ncell - 1)]
-                while i < b - 2 and logx[i + 1] <= lm:
-                    i += 1
-                d = lm - logx[i]
-                if coef.shape[0] == 6:  # the quintic, written out (Horner)
-                    u = ((((coef[0, i] * d + coef[1, i]) * d + coef[2, i]) * d + coef[3, i]) * d
-                         + coef[4, i]) * d + coef[5, i]
-                else:
-                    u = coef[0, i]
-                    for r in range(1, coef.shape[0]):  # Horner
-                        u = u * d + coef[r, i]
-            g = max(g, min(cap[j], u))  # 001 eq. 20
-        if controlled[j]:
-            g = max(g, mmax)  # 001 eq. 21
-        g_all *= g
-    return g_all
-
-
-@njit(cache=True, nogil=True)
 def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
                   index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow):  # pragma: no cover - compiled
     """All levels of a pumped chain in one pass: f / (g_1 g_2 ... g_k) (001 eq. 16), in place.
 
     The tables of the levels are concatenated (level j owns nodes offsets[j]:offsets[j+1]);
-    ``coef`` holds the upper bound (spline + margin, as :func:`_upper_scalar`) and a uniform
+    ``coef`` holds the upper bound (spline + margin, as :func:`upper_scalar`) and a uniform
     index over log(mu) finds the piece in O(1).  Where a level's bound is non-decreasing
     (``increasing``, :meth:`AlbedoTable.is_increasing`) and both cosines lie on its spline
     (above ``mu0``), max(u(mu_i), u(mu_o)) = u(max(mu_i, mu_o)): one look-up serves the level
-    (:func:`_g_levels`).  ``wi`` and ``wo`` are (n, 3) arrays of any strides (no copies).  Tested
+    (:func:`g_levels`).  ``wi`` and ``wo`` are (n, 3) arrays of any strides (no copies).  Tested
     against the plain numpy reference, :meth:`Pumped.reference`, which pumps level by level.
 
     Fast path: where every level's bound increases, the product of all levels' g is one function
-    of mmax (:class:`_Product`, :func:`_g_product`; ``pmlo`` = inf turns it off).  Tested against
+    of mmax (:class:`_Product`, :func:`g_product`; ``pmlo`` = inf turns it off).  Tested against
     :meth:`_Product.__call__` and the reference.
     """
     for k in range(f.shape[0]):
@@ -384,11 +176,11 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
             continue
         mmax, mmin = max(mi, mo), min(mi, mo)
         if mmin > pmlo:  # the fast path: one look-up for all levels (no branch on f = 0: 0 / g = 0)
-            f[k] = f[k] / _g_product(mmax, pcbase, pcstart, plo, prow)  # 001 eq. 16, all levels
+            f[k] = f[k] / g_product(mmax, pcbase, pcstart, plo, prow)  # 001 eq. 16, all levels
             continue
         if f[k] == 0.0:
             continue
-        f[k] = f[k] / _g_levels(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
+        f[k] = f[k] / g_levels(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
                                 increasing, mu0, index, index_lo, index_h_inv)  # 001 eq. 16, all levels
 
 
@@ -446,14 +238,6 @@ def _monotone_envelope(spline, margin: float):
     return nx, nc, flats
 
 
-def _horner(coef, t):
-    """sum_r coef[r] t^(d - r) by Horner's rule, in the order the compiled kernel uses."""
-    v = coef[0] * t
-    for r in range(1, coef.shape[0] - 1):
-        v = (v + coef[r]) * t
-    return v + coef[-1]
-
-
 class _ProductError(RuntimeError):
     """The product table cannot reach its tolerance (the kernel then looks up level by level)."""
 
@@ -467,14 +251,14 @@ class _Product:
     class tabulates it as a piecewise polynomial in m itself, so the kernel takes no logarithm.
     Pieces: at most an eighth of an octave, split at every breakpoint of the levels' splines and
     at every kink (u_j = cap, u_j = m), so that G is analytic on each; on each a Chebyshev
-    interpolant of degree _PRODUCT_DEGREE, bisected until it matches G to ``TOL`` (relative) at
+    interpolant of degree PRODUCT_DEGREE, bisected until it matches G to ``TOL`` (relative) at
     4 (degree + 1) + 1 test points (G itself is computed to about 1e-14: the levels' splines are
     polynomials in log m).  The coefficients are then scaled by 1 + ``epsilon`` (twice the
     largest miss, plus 4 ulp; about 2e-14), so the kernel divides by at least G and at most
     G (1 + 2 ``epsilon``): the pumped BRDF comes out lower than the level-by-level reference by
     at most 2 ``epsilon`` (relative).
-    The kernel finds the piece from the bits of m: cell c = (bits(m) >> _CELL_SHIFT) - cbase,
-    2^_CELL_BITS cells per octave, ``cstart[c]`` the piece where the cell starts (most cells
+    The kernel finds the piece from the bits of m: cell c = (bits(m) >> CELL_SHIFT) - cbase,
+    2^CELL_BITS cells per octave, ``cstart[c]`` the piece where the cell starts (most cells
     hold one piece).  :meth:`__call__` is the plain numpy version of that look-up.
     """
 
@@ -485,17 +269,17 @@ class _Product:
         # above mlo every level is on its spline (not the power law below its first node; the
         # 1e-12 keeps log(m) clear of the first breakpoint's rounding)
         self.mlo = max(max(lk.mu0, math.exp(lk.logx[0])) for lk in looks) * (1.0 + 1e-12)
-        b0 = int(_bits(self.mlo)) >> _CELL_SHIFT
-        b1 = int(_bits(1.0)) >> _CELL_SHIFT
+        b0 = int(float_bits_reference(self.mlo)) >> CELL_SHIFT
+        b1 = int(float_bits_reference(1.0)) >> CELL_SHIFT
         self.cbase = b0
-        bounds = (np.arange(b0, b1 + 1, dtype=np.int64) << _CELL_SHIFT).view(np.float64)
+        bounds = (np.arange(b0, b1 + 1, dtype=np.int64) << CELL_SHIFT).view(np.float64)
         knots = np.exp(np.concatenate([lk.logx for lk in looks]))
         eighths = 2.0 ** np.arange(math.floor(math.log2(self.mlo)), 0, 0.125)  # pieces span at most 1/8 octave
         br = np.unique(np.concatenate([[self.mlo, 1.0], eighths, knots]))
         br = br[(br >= self.mlo) & (br <= 1.0)]
         br = np.unique(np.concatenate([br, self._kinks(br)]))
         lo, hi = br[:-1], br[1:]
-        deg = _PRODUCT_DEGREE
+        deg = PRODUCT_DEGREE
         xk = np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))  # Chebyshev points
         vand = np.polynomial.chebyshev.chebvander(xk, deg)
         to_mono = np.array([np.pad(np.polynomial.chebyshev.cheb2poly(np.eye(deg + 1)[k]), (0, deg - k))
@@ -506,7 +290,7 @@ class _Product:
             center, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
             vals = self.exact(center[:, None] + half[:, None] * xk[None, :])
             coef = (vals @ fit)[:, ::-1].T  # (deg + 1, pieces), highest power first
-            miss = np.abs(_horner(coef[..., None], tt) / self.exact(center[:, None] + half[:, None] * tt) - 1.0)
+            miss = np.abs(horner(coef[..., None], tt) / self.exact(center[:, None] + half[:, None] * tt) - 1.0)
             worst = miss.max(axis=1)
             # bisect the pieces that miss, unless already narrower than 1e-9 m (then the miss is
             # the rounding of G itself, and it goes into epsilon)
@@ -526,7 +310,7 @@ class _Product:
         #: what the kernel reads for piece s: coefficients, centre, inverse half-width
         self.rows = np.ascontiguousarray(np.concatenate([self.coef, center[None], self.ihalf[None]]).T)
         self.lo = np.concatenate([lo, [math.inf]])  # a sentinel ends the search
-        # cell c = (bits(m) >> _CELL_SHIFT) - cbase starts at bounds[c]; the last starts at m = 1
+        # cell c = (bits(m) >> CELL_SHIFT) - cbase starts at bounds[c]; the last starts at m = 1
         self.cstart = np.clip(np.searchsorted(lo, bounds, side="right") - 1, 0, len(lo) - 1).astype(np.int32)
 
     def _g(self, j, m):
@@ -561,7 +345,7 @@ class _Product:
         """The piece that holds m (> mlo), found as the kernel finds it: the cell from the bits of
         m, then forward."""
         m = np.asarray(m, dtype=np.float64)
-        c = np.minimum((_bits(m) >> _CELL_SHIFT) - self.cbase, len(self.cstart) - 1)
+        c = np.minimum((float_bits_reference(m) >> CELL_SHIFT) - self.cbase, len(self.cstart) - 1)
         s = self.cstart[c]
         while True:
             step = m >= self.lo[s + 1]
@@ -573,7 +357,7 @@ class _Product:
         """The kernel's G(m) in plain numpy (m > mlo): the reference of the fast path."""
         m = np.asarray(m, dtype=np.float64)
         s = self.piece(m)
-        return _horner(self.coef[:, s], (m - self.center[s]) * self.ihalf[s])
+        return horner(self.coef[:, s], (m - self.center[s]) * self.ihalf[s])
 
 
 class _Lookup:
@@ -582,7 +366,7 @@ class _Lookup:
     def __init__(self, table):
         from scipy.interpolate import PPoly
 
-        from .tables import nondecreasing
+        from ..tables import nondecreasing
 
         t = table
         self.margin, self.margin_lo = t.margin, t.margin_below  # as in AlbedoTable.upper
@@ -622,7 +406,7 @@ class _Lookup:
         mu = np.asarray(mu, dtype=np.float64)
         out = np.empty(mu.size)
         args = self.args() if capped else self.args()[:-1] + (math.inf,)
-        _upper_array(np.ascontiguousarray(mu.ravel()), *args, out)
+        upper_array(np.ascontiguousarray(mu.ravel()), *args, out)
         return out.reshape(mu.shape)
 
 
@@ -815,14 +599,14 @@ class Pumped(BRDF):
         sizes = [len(lk.logx) for lk in looks]
         offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
         coef = np.zeros((looks[0].coef.shape[0], offsets[-1]))
-        index = np.zeros((len(looks), _INDEX_CELLS), dtype=np.int64)
+        index = np.zeros((len(looks), INDEX_CELLS), dtype=np.int64)
         lo = np.array([lk.logx[0] for lk in looks])
-        h = np.array([(lk.logx[-1] - lk.logx[0]) / _INDEX_CELLS for lk in looks])
+        h = np.array([(lk.logx[-1] - lk.logx[0]) / INDEX_CELLS for lk in looks])
         for j, (lk, a) in enumerate(zip(looks, offsets[:-1])):
             n = lk.coef.shape[1]
             coef[:, a:a + n] = lk.coef
-            coef[-1, a:a + n] += lk.margin  # the same upper bound as _upper_scalar
-            starts = lo[j] + h[j] * np.arange(_INDEX_CELLS)
+            coef[-1, a:a + n] += lk.margin  # the same upper bound as upper_scalar
+            starts = lo[j] + h[j] * np.arange(INDEX_CELLS)
             index[j] = a + np.clip(np.searchsorted(lk.logx, starts, side="right") - 1, 0, n - 1)
         return (
             offsets, np.concatenate([lk.logx for lk in looks]), coef,
@@ -852,7 +636,7 @@ class Pumped(BRDF):
     def _product_args(self):
         p = self.product()
         if p is None:  # off: pmlo = inf
-            return math.inf, 0, np.zeros(1, np.int32), np.full(2, math.inf), np.zeros((1, _PRODUCT_DEGREE + 3))
+            return math.inf, 0, np.zeros(1, np.int32), np.full(2, math.inf), np.zeros((1, PRODUCT_DEGREE + 3))
         return p.mlo, p.cbase, p.cstart, p.lo, p.rows
 
     #: pairs per pass when many are evaluated at once: the base's values and the directions are
@@ -861,7 +645,7 @@ class Pumped(BRDF):
     BLOCK = 8192
 
     def _eval(self, wi, wo):
-        from .core import slabs
+        from ..core import slabs
 
         shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
         n = math.prod(shape)
@@ -966,6 +750,26 @@ class Pumped(BRDF):
             hit = lk.kink_normal = _sign_roots(grid[inner], au[inner] - a1, lambda u: float(lk.upper(u)) - a1)
         return hit
 
+    def albedo_kinks(self, lo: float = 0.0, hi: float = 1.0) -> list:
+        """The kinks in (lo, hi) of the albedo of this pumped level and of every level below it, and its innermost
+        base's own (:meth:`pumpup.core.BRDF.albedo_breaks`), for its table's spline to be split there
+        (:class:`pumpup.tables.AlbedoTable`'s breaks): the albedo at incidence v of a pumped level has a kink where the
+        g of that level or of one below changes its form at incidences that do not depend on wo -- its bound crosses
+        the diagonal, u(v) = v (g2), or reaches its cap (:meth:`_kink_fixed`).  One spline across them rounded them
+        off between knots the adaptive grid bunched towards them, and the 1-D path cut the elevation at those knots
+        (:meth:`table_kinks`): ~25 more pieces per mu in a 2-level g2 pumped GGX alpha 0.1.
+
+        A base table (:func:`base_table`) asks for the kinks between the second and the next-to-last node of the grid
+        it starts from (:func:`grid_interior`): Phong's, Beckmann's and stretched Phong's levels cross the diagonal
+        within 3e-4 of mu = 1, inside the grid's last interval, where a piece of two or three nodes made a 3-level g2
+        pumped Phong's third bound dip; those keep the one spline, and :meth:`table_kinks`' cuts at the knots bunched
+        around them.  :func:`pumpup.mean_albedo`'s first intervals end at every kink in (0, 1)."""
+        chain = self.chain()
+        out = {v for v in chain[0].base.albedo_breaks() if lo < v < hi}  # the innermost base's
+        for lev in chain:
+            out.update(v for v in lev._albedo_kinks() if lo < v < hi)
+        return sorted(out)
+
     def _albedo_kinks(self) -> list:
         """The incidences where this level's albedo has a kink that does not depend on wo: its bound crosses the
         diagonal or reaches its cap (:meth:`_kink_fixed`), or equals its value at the normal (:meth:`_kink_normal`)."""
@@ -1005,9 +809,9 @@ class Pumped(BRDF):
                 # with a minimum), the cells next to the turn are searched on 16 points each (:meth:`_kink_turns`), and for
                 # k = 0 the cell of mu (a root itself) is split at mu -+ 1e-6 of it: a pumped metal (eta 0.9, k 0.3, n 20)
                 # lost the kink at v = 0.9699 next to mu = 0.9659 and the 1-D path was 5.0e-9 off with an estimate of
-                # 1.0e-9.  The search is compiled (:func:`_kink_roots`)
+                # 1.0e-9.  The search is compiled (:func:`kink_roots`)
                 g, ug = (grid, au) if k == 1 else self._kink_turns()
-                found = [float(v) for v in _kink_roots(g, ug, k, am if k == 0 else mu, mu, max(1.0, am), *lk.args())]
+                found = [float(v) for v in kink_roots(g, ug, k, am if k == 0 else mu, mu, max(1.0, am), *lk.args())]
             for v in found:
                 if self.controlled:
                     # the crossing value c and the terms that are not crossing there
@@ -1104,22 +908,24 @@ class Pumped(BRDF):
 
     def polar(self):
         """The 1-D albedo path of a pumped Phong-family lobe or of a pumped GGX, Beckmann (F = 1) or Schlick model
-        (``pumpup._polar``, the frame of N): the base's closed-form-azimuth hint, with the divisor g_1 ... g_k (a
+        (``pumpup.engine.polar``, the frame of N): the base's closed-form-azimuth hint, with the divisor g_1 ... g_k (a
         function of N.wo for a fixed wi) and its kinks, and the base's Fresnel factor F(Theta_min) (metal's, or the
         ``fresnel`` wrapper's over GGX, Beckmann or Schlick, ``Polar.fmax``); None for any other base."""
         import dataclasses
 
-        from ._polar import Polar, takes_n_frame, with_fresnel, with_fresnel_max
+        from ..core.hints import Polar
+
+        from ..engine.polar import takes_n_frame, with_fresnel, with_fresnel_max
 
         hint = self.chain()[0].base.polar()
         if (hint is not None and hint.chain is None and hint.factor is None and hint.fmax is None
                 and takes_n_frame(hint)):
-            # GGX, Beckmann (F = 1) and Schlick's model: frame 6 about N, divided by g (``pumpup._polar._integrate_n``);
-            # GGX with a Fresnel factor at mu >= N_FRESNEL_MU_MIN, the nested engine below (``pumpup._polar.one_d_part``)
+            # GGX, Beckmann (F = 1) and Schlick's model: frame 6 about N, divided by g (``pumpup.engine.polar._integrate_n``);
+            # GGX with a Fresnel factor at mu >= N_FRESNEL_MU_MIN, the nested engine below (``pumpup.engine.polar.one_d_part``)
             return dataclasses.replace(hint, chain=self._chain_args(), levels=self._polar_levels)
         if hint is not None and hint.fmax is not None and hint.chain is None:
             # ... with the fresnel wrapper's F(Theta_min) (``Polar.fmax``): again, where the near-kink of F is far enough
-            # for a chain (g has it too: ``pumpup._polar.CHAIN_F_Y0_MIN``)
+            # for a chain (g has it too: ``pumpup.engine.polar.CHAIN_F_Y0_MIN``)
             out = dataclasses.replace(hint, fmax=None, chain=self._chain_args(), levels=self._polar_levels)
             return with_fresnel_max(out, *hint.fmax)
         if hint is None or hint.kind != "lobe" or hint.chain is not None:
@@ -1202,17 +1008,20 @@ def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False)
         raise SpecError(f"pump: levels must be an integer in [1, {MAX_LEVELS}], got {levels!r}")
     if not isinstance(force, (bool, np.bool_)):
         raise SpecError(f"pump: force must be true or false, got {force!r}")
-    base = load(brdf)
-    if getattr(base, "is_spectral", False):  # pumpup.spectral: each wavelength divided by its own g
-        from .spectral import SpectralPumped
+    return pump_model(load(brdf), g, int(levels), force)
 
-        return SpectralPumped(base, g=g, levels=int(levels), force=bool(force))
-    return Pumped(base=base, g=g, levels=int(levels), force=force)
+
+@functools.singledispatch
+def pump_model(base, g: str, levels: int, force) -> Pumped:
+    """:func:`pump` of a loaded model, its arguments checked: a :class:`Pumped`.  Other kinds of model register their
+    own (:mod:`pumpup.spectral`: each wavelength divided by its own g)."""
+    return Pumped(base=base, g=g, levels=levels, force=force)
 
 
 # --- saving and loading: one netCDF file, a group per level -----------------------------------
 
 
+@functools.singledispatch
 def save_pumped(f: Pumped, path) -> str:
     """Write a pumped BRDF and the albedo tables of all its levels to one netCDF file.
 
@@ -1221,12 +1030,8 @@ def save_pumped(f: Pumped, path) -> str:
     """
     import xarray as xr
 
-    from ._version import __version__
+    from .._version import __version__
 
-    if getattr(f, "is_spectral", False):  # one file with a wavelength dimension (pumpup.spectral_ops)
-        from .spectral_ops import save_spectral_pumped
-
-        return save_spectral_pumped(f, path)
     if not isinstance(f, Pumped):
         raise TypeError("save_pumped needs a pumped BRDF (pumpup.pump)")
     chain = []
@@ -1235,7 +1040,7 @@ def save_pumped(f: Pumped, path) -> str:
         chain.append(cur)
         cur = cur.base
     chain.reverse()  # innermost first
-    from .tables import write_groups
+    from ..tables import write_groups
 
     root = xr.Dataset(attrs={"pumpup_kind": "pumpup pumped BRDF", "spec": json.dumps(f.spec, sort_keys=True),
                              "levels": len(chain), "pumpup_version": __version__})
@@ -1252,18 +1057,18 @@ def load_pumped(path) -> Pumped:
 
     Raises
     ------
-    pumpup.validate.TableError (a ValueError)
+    pumpup.tables.validate.TableError (a ValueError)
         If the file is damaged, edited, or not a saved pumped BRDF (the message says what).
     """
-    from .tables import open_table
-    from .validate import TableError, spec_attribute
+    from ..tables import open_table
+    from ..tables.validate import TableError, spec_attribute
 
     where = os.fspath(path)
     root = open_table(path)
-    if root.attrs.get("pumpup_kind") == "pumpup spectral pumped BRDF":  # save_pumped of a spectral BRDF
-        from .spectral_ops import load_spectral_pumped
-
-        return load_spectral_pumped(path, root)
+    registry()  # (the providers: a kind of file below may be theirs)
+    other = FILE_KINDS.get(root.attrs.get("pumpup_kind"))
+    if other is not None:  # another kind of pumped model's file (pumpup.spectral's, with a wavelength dimension)
+        return other(path, root)
     if root.attrs.get("pumpup_kind") != "pumpup pumped BRDF":
         raise TableError(f"{where!r} is a pumpup table, not a saved pumped BRDF")
     spec = spec_attribute(where, root)
@@ -1286,8 +1091,8 @@ def attach_level_table(path, where: str, group: str, level: "Pumped", what: str)
     """Read the albedo table in ``group`` of a saved pumped file, check that it is the table of
     ``level``'s base (``what`` names the level in the message) and make it that object's own table;
     every problem is one :class:`TableError` naming the file and the group."""
-    from .tables import AlbedoTable, open_table
-    from .validate import TableError
+    from ..tables import AlbedoTable, open_table
+    from ..tables.validate import TableError
 
     try:
         ds = open_table(path, group=group)

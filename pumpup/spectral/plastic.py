@@ -2,7 +2,7 @@
 
 f_r(L, V, lambda) = a_d(lambda) / pi + a_s (n + 2) / (2 pi) cos^n(alpha) / cos(Theta_min)
 F(kappa(lambda), Theta_min)  (000 eq. 29), with the real index kappa(lambda) of a named
-dielectric from :mod:`pumpup.optical` (PMMA, polycarbonate, polystyrene, BK7, fused silica,
+dielectric from :mod:`pumpup.spectral.optical` (PMMA, polycarbonate, polystyrene, BK7, fused silica,
 from the refractiveindex.info database) or given per wavelength, and a diffuse albedo a_d
 (the colour) per wavelength.  Without an index F = 1, 000 eq. 30 (the paper's RGB plastic:
 ``"wavelengths": "rgb"`` and ``"ad": [r, g, b]``).
@@ -26,9 +26,9 @@ from typing import Any
 import numpy as np
 
 from . import optical
-from .core import SpecError
-from .core import load as _load_scalar
-from .spectral import RGB_WAVELENGTHS, Spectral
+from ..core import SpecError
+from ..core import load as _load_scalar
+from . import RGB_WAVELENGTHS, Spectral
 
 __all__ = ["SpectralPlastic"]
 
@@ -53,7 +53,7 @@ class SpectralPlastic(Spectral):
     Parameters
     ----------
     material : str, optional
-        A dielectric of :data:`pumpup.optical.DIELECTRICS` (``"PMMA"``, ``"polycarbonate"``,
+        A dielectric of :data:`pumpup.spectral.optical.DIELECTRICS` (``"PMMA"``, ``"polycarbonate"``,
         ``"polystyrene"``, ``"BK7"``, ``"fused_silica"``): its measured real index n(lambda) gives F.
         Omit it to give ``eta``, or neither for F = 1 (000 eq. 30).
     n : float, >= 0
@@ -66,7 +66,7 @@ class SpectralPlastic(Spectral):
     eta : float or list of float, optional
         Real refractive index per wavelength (instead of ``material``).
     wavelengths : list of float or "rgb", optional
-        Vacuum wavelengths [nm]; default :data:`pumpup.optical.DEFAULT_WAVELENGTHS` with
+        Vacuum wavelengths [nm]; default :data:`pumpup.spectral.optical.DEFAULT_WAVELENGTHS` with
         ``material``, required without it; ``"rgb"`` stands for :data:`pumpup.spectral.RGB_WAVELENGTHS`.
     """
 

@@ -234,7 +234,7 @@ def fresh_low(brdf, mu_min: float, abs_tol: float, rtol: float, max_intervals: i
     absolute tolerance keeps it below abs_tol / 2 however small a(mu) is relative to the mean: near
     grazing incidence, where the values cost most, a cell's mean asks them for about 1e-6 instead of
     rtol / 10 (the p-model's cell: issue 14)."""
-    from .albedo import NODES, WG, WK, albedo
+    from ..engine.cubature import NODES, WG, WK, albedo
 
     atol = max(1e-15, abs_tol / (4.0 * mu_min * mu_min))
 

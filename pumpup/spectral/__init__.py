@@ -3,7 +3,7 @@
 000 sec. 5 evaluates the metallic BRDF "at 8 discrete wavelengths" with measured complex
 indices and converts the result to XYZ and RGB.  :class:`SpectralMetal` holds one
 :class:`pumpup.models.metal.Metal` per wavelength (a shared exponent n and scale c, the index
-n + i k of that wavelength from :mod:`pumpup.optical` or given per channel) and evaluates them
+n + i k of that wavelength from :mod:`pumpup.spectral.optical` or given per channel) and evaluates them
 all at once on a trailing wavelength axis.
 
 The albedo engine (:func:`pumpup.albedo`, :func:`pumpup.tabulate`) integrates one scalar
@@ -12,8 +12,8 @@ BRDF, so a spectral metal is not a registered model type: :meth:`SpectralMetal.a
 trailing ``wavelength`` axis / dimension, each value with its own error estimate.
 :func:`pumpup.load` builds these objects from spectral specs, and :func:`pumpup.albedo`,
 ``tabulate``, ``mean_albedo``, ``pump``, ``compensate`` and ``save_pumped`` hand them to their
-methods (the ``is_spectral`` marker); plastics are in :mod:`pumpup.spectral_plastic`, energy
-compensation and saved files in :mod:`pumpup.spectral_ops`.
+methods (the ``is_spectral`` marker); plastics are in :mod:`pumpup.spectral.plastic`, energy
+compensation and saved files in :mod:`pumpup.spectral.ops`.
 
 Colour (:func:`to_xyz`, :func:`to_srgb`) uses colour-science with the CIE 1931 2-degree
 observer and illuminant D65: a spectrum of reflectances or albedos is read as the reflectance
@@ -35,9 +35,9 @@ import numpy as np
 from numba import njit, vectorize
 
 from . import optical
-from .core import BRDF, SpecError
-from .core import load as _load_scalar
-from .models.metal import _fresnel_real
+from ..core import BRDF, SpecError
+from ..core import load as _load_scalar
+from ..physics.fresnel import conductor_scalar as _fresnel_real
 
 __all__ = ["load", "Spectral", "SpectralMetal", "SpectralPumped", "to_xyz", "to_srgb", "RGB_WAVELENGTHS"]
 
@@ -158,7 +158,7 @@ class Spectral:
         one per core); a value does not depend on the others computed with it, so the result
         does not depend on ``threads``.
         """
-        from .albedo import check_mu
+        from ..engine.cubature import check_mu
 
         m = np.asarray(mu, dtype=np.float64)
         flat = np.ascontiguousarray(m.reshape(-1))
@@ -170,7 +170,7 @@ class Spectral:
 
     def mean_albedo(self, return_error: bool = False, **kw):
         """Mean (cosine-weighted hemispherical) albedo per wavelength, :func:`pumpup.mean_albedo` (000 eq. 33)."""
-        from .tables import mean_albedo
+        from ..tables import mean_albedo
 
         out = [mean_albedo(m, return_error=True, **kw) for m in self.models]
         v = np.array([o[0] for o in out])
@@ -200,10 +200,10 @@ class Spectral:
 
         import xarray as xr
 
-        from . import _reuse
-        from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
-        from .core import check_count, check_open_unit, check_tolerance
-        from .tables import MAX_POINTS_LIMIT, _dataset, adaptive_grid, built_on_tables, default_grid
+        from ..tables import reuse as _reuse
+        from ..engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
+        from ..core import check_count, check_open_unit, check_tolerance
+        from ..tables import MAX_POINTS_LIMIT, _dataset, adaptive_grid, built_on_tables, default_grid
 
         if phi is not None:
             raise SpecError("Spectral.tabulate: parameter 'phi' must be None (the spectral models are isotropic)")
@@ -266,7 +266,7 @@ class SpectralPumped(Spectral):
     divided by its own correction g (:func:`pumpup.pump` of that wavelength's model)."""
 
     def __init__(self, base: Spectral, g: str = "g1", levels: int = 1, force: bool = False):
-        from .pumping import pump
+        from ..operators.pumping import pump
 
         self.base = base
         self.material = base.material
@@ -297,12 +297,12 @@ class SpectralMetal(Spectral):
     Parameters
     ----------
     material : str, optional
-        A metal of :mod:`pumpup.optical` (``"Au"``, ``"Ag"``, ``"Cu"``, ``"Al"``, ...); its
+        A metal of :mod:`pumpup.spectral.optical` (``"Au"``, ``"Ag"``, ``"Cu"``, ``"Al"``, ...); its
         measured index is used at every wavelength.  Omit it to give ``eta`` (and ``k``).
     n : float, >= 0
         Phong exponent (000 eq. 28).
     wavelengths : list of float, optional
-        Vacuum wavelengths [nm]; default :data:`pumpup.optical.DEFAULT_WAVELENGTHS` (eight
+        Vacuum wavelengths [nm]; default :data:`pumpup.spectral.optical.DEFAULT_WAVELENGTHS` (eight
         from 400 to 680 nm) with ``material``, required length = len(eta) without it.
         ``"rgb"`` stands for :data:`RGB_WAVELENGTHS`.
     eta, k : list of float, optional
@@ -370,11 +370,11 @@ class SpectralMetal(Spectral):
 
         The geometry (cos(alpha), cos(Theta_min), the lobe) is computed once per pair in one
         compiled pass and only the Fresnel factor F(eta + i k, Theta_min) per wavelength
-        (000 eq. 27, 28; :func:`pumpup._spectral_kernels.metal_eval_kernel`, whose numpy twin is
+        (000 eq. 27, 28; :func:`pumpup.spectral.kernels.metal_eval_kernel`, whose numpy twin is
         ``metal_eval_reference``).  Equal to the one-wavelength models (``self.models``) to a few
         ulp; 8 wavelengths cost about 2x one ``Metal.eval`` (``scripts/bench_spectral.py``).
         """
-        from ._spectral_kernels import flat_pairs, fresnel_constants, metal_eval_kernel
+        from .kernels import flat_pairs, fresnel_constants, metal_eval_kernel
 
         a, b, shape = flat_pairs(wi, wo)
         if getattr(self, "_fconst", None) is None:
@@ -409,7 +409,7 @@ class SpectralMetal(Spectral):
 
         Differs from :meth:`eval` by at most f_r(F = 1) times ``fresnel_table()[1]`` (measured when the table is built; from 9e-9 for Au to 4e-8, the largest over the nine metals at the default wavelengths).
         """
-        from ._spectral_kernels import flat_pairs
+        from .kernels import flat_pairs
 
         a2, b2, shape = flat_pairs(wi, wo)  # every direction checked (unit, finite), as eval
         table, _ = self.fresnel_table()
@@ -430,9 +430,9 @@ def load(spec: Any) -> Spectral:
 
     Accepts ``material`` (or per-wavelength ``eta``/``k`` lists) with ``n``, optional ``c`` and
     ``wavelengths`` (a list of nm or ``"rgb"``), ``{"type": "plastic", ...}``
-    (:class:`pumpup.spectral_plastic.SpectralPlastic`), ``{"type": "pumped", "base": <spectral
+    (:class:`pumpup.spectral.plastic.SpectralPlastic`), ``{"type": "pumped", "base": <spectral
     spec>, "g": ..., "levels": ...}`` and ``{"type": "kulla_conty" | "scaled", "base": <spectral
-    spec>, ...}`` (:class:`pumpup.spectral_ops.SpectralCompensated`); ``spec`` round-trips.
+    spec>, ...}`` (:class:`pumpup.spectral.ops.SpectralCompensated`); ``spec`` round-trips.
     :func:`pumpup.load` calls this for every spectral spec (:func:`pumpup.core.is_spectral_spec`).
 
     Examples
@@ -445,7 +445,7 @@ def load(spec: Any) -> Spectral:
     if isinstance(spec, Spectral):
         return spec
     if isinstance(spec, str):
-        from .core import parse_spec
+        from ..core import parse_spec
 
         spec = parse_spec(spec)
     if not isinstance(spec, dict) or "type" not in spec:
@@ -457,7 +457,7 @@ def load(spec: Any) -> Spectral:
         if bad or "base" not in kw:
             raise SpecError(f"spectral.load: a pumped spec needs 'base' and allows {', '.join(sorted(allowed))}; "
                             f"got {sorted(kw)}")
-        from .pumping import pump
+        from ..operators.pumping import pump
 
         return pump(load(kw["base"]), g=kw.get("g", "g1"), levels=kw.get("levels", 1), force=kw.get("force", False))
     if spec["type"] == "pumped_lobe":  # the colour-keeping pumped metal (SpectralPumpedLobe)
@@ -471,11 +471,11 @@ def load(spec: Any) -> Spectral:
             raise SpecError(f"spectral.load: parameter 'base' of pumped_lobe must be a spectral metal, got {base!r}")
         return SpectralPumpedLobe(base, g=kw.get("g", "g1"), levels=kw.get("levels", 1))
     if spec["type"] in ("kulla_conty", "scaled"):
-        from .spectral_ops import SpectralCompensated
+        from .ops import SpectralCompensated
 
         return SpectralCompensated.from_spec(spec, load)
     if spec["type"] == "plastic":
-        from .spectral_plastic import SpectralPlastic
+        from .plastic import SpectralPlastic
 
         return SpectralPlastic.from_spec(spec)
     if spec["type"] != "metal":
@@ -494,7 +494,7 @@ def load(spec: Any) -> Spectral:
 
 
 def _xyz_one(values: np.ndarray, wavelengths: np.ndarray) -> np.ndarray:
-    from ._extras import require
+    from .._extras import require
 
     colour = require("colour", "CIE XYZ and sRGB colour of spectra")
     sd = colour.SpectralDistribution(dict(zip(wavelengths.tolist(), values.tolist())))
@@ -536,7 +536,7 @@ def to_srgb(values, wavelengths, encoded: bool = False) -> np.ndarray:
 
     Out-of-gamut values are returned as computed (not clipped).
     """
-    from ._extras import require
+    from .._extras import require
 
     colour = require("colour", "CIE XYZ and sRGB colour of spectra")
     xyz = to_xyz(values, wavelengths)
@@ -549,7 +549,7 @@ def to_srgb(values, wavelengths, encoded: bool = False) -> np.ndarray:
 class _FresnelWeighted(BRDF):
     """One wavelength of :class:`SpectralPumpedLobe`: f_r = f*(wi, wo) F(eta + i k, Theta_min) [1/sr].
 
-    ``lobe`` is the pumped F = 1 lobe (a :class:`pumpup.pumping.Pumped`), shared by all
+    ``lobe`` is the pumped F = 1 lobe (a :class:`pumpup.operators.pumping.Pumped`), shared by all
     wavelengths; the albedo engine integrates this product with the lobe's quadrature hint
     (its lobe and the kinks of g; F(max(N.wi, N.wo)) adds the kink N.wo = mu, already a level
     of the pumped lobe's hint).  Not a registered type: its spec describes it, it does not load.
@@ -575,7 +575,7 @@ class _FresnelWeighted(BRDF):
         return np.where(f != 0.0, f * _fresnel_vec(np.maximum(mx, 0.0), self.eta, self.k), 0.0)  # 000 eq. 28
 
     def reference(self, wi, wo):
-        from .models.metal import fresnel
+        from ..physics.fresnel import fresnel_conductor as fresnel
 
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
@@ -589,8 +589,8 @@ class _FresnelWeighted(BRDF):
         return self.lobe_brdf.sampling_lobe(mu)
 
     def polar(self):
-        """The pumped lobe's 1-D hint with F(Theta_min) (pumpup._polar.with_fresnel), or None."""
-        from ._polar import with_fresnel
+        """The pumped lobe's 1-D hint with F(Theta_min) (pumpup.engine.polar.with_fresnel), or None."""
+        from ..engine.polar import with_fresnel
 
         return with_fresnel(self.lobe_brdf.polar(), self.eta, self.k)
 
@@ -616,7 +616,7 @@ class SpectralPumpedLobe(Spectral):
       the last because g >= a_L(wi) (001, after eq. 17); so the spectral albedo is bounded by the
       pumped lobe's, which is the pumping bound of a single BRDF;
     * one pumping table instead of one per wavelength: g needs the albedo of L only, which does
-      not depend on the wavelength (``pumpup.pumping.base_table`` of L, computed once and shared
+      not depend on the wavelength (``pumpup.operators.pumping.base_table`` of L, computed once and shared
       with every other pumping of the same lobe).
 
     Parameters
@@ -638,7 +638,7 @@ class SpectralPumpedLobe(Spectral):
     """
 
     def __init__(self, base: SpectralMetal, g: str = "g1", levels: int = 1):
-        from .pumping import pump
+        from ..operators.pumping import pump
 
         if not isinstance(base, SpectralMetal):
             raise TypeError(f"SpectralPumpedLobe: 'base' must be a SpectralMetal, got {type(base).__name__}")
@@ -665,9 +665,9 @@ class SpectralPumpedLobe(Spectral):
         """f_r [1/sr] at every wavelength, shape broadcast(wi, wo)[:-1] + (len(wavelengths),).
 
         f* once per pair (the pumped lobe's compiled chain), then F(Theta_min) per wavelength in
-        one compiled pass (:func:`pumpup._spectral_kernels.fresnel_scale_kernel`).
+        one compiled pass (:func:`pumpup.spectral.kernels.fresnel_scale_kernel`).
         """
-        from ._spectral_kernels import flat_pairs, fresnel_constants, fresnel_scale_kernel
+        from .kernels import flat_pairs, fresnel_constants, fresnel_scale_kernel
 
         a, b, shape = flat_pairs(wi, wo)
         if self._fconst is None:
@@ -679,7 +679,7 @@ class SpectralPumpedLobe(Spectral):
 
     def lobe_albedo(self, mu, return_error: bool = False, **kw):
         """The albedo a*(mu) of the pumped lobe f* (the bound of every wavelength's albedo)."""
-        from .albedo import albedo
+        from ..engine.cubature import albedo
 
         return albedo(self.pumped_lobe, mu, return_error=return_error, **kw)
 
@@ -691,8 +691,8 @@ def _spread(spectral: Spectral, mus: np.ndarray, threads: int | None = None, **k
     every n-th mu, so the dear grazing values are spread over the tasks."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from .albedo import albedo
-    from .tables import THREADS, _cores
+    from ..engine.cubature import albedo
+    from ..tables import THREADS, _cores
 
     if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1):
         raise ValueError(f"threads must be an integer >= 1, got {threads!r}")
@@ -727,3 +727,52 @@ def _spread(spectral: Spectral, mus: np.ndarray, threads: int | None = None, **k
 
 
 __all__ += ["SpectralPumpedLobe"]
+
+
+# --- how the core and the operators take spectral models --------------------------------------
+
+from ..core import is_spectral_spec, register_loader  # noqa: E402
+from ..operators import compensate as _compensate  # noqa: E402
+from ..operators import pumping as _pumping  # noqa: E402
+
+register_loader(is_spectral_spec, load)
+
+
+@_pumping.pump_model.register(Spectral)
+def _pump_spectral(base: Spectral, g: str, levels: int, force) -> SpectralPumped:
+    return SpectralPumped(base, g=g, levels=levels, force=bool(force))  # each wavelength divided by its own g
+
+
+@_pumping.save_pumped.register(Spectral)
+def _save_spectral(f: Spectral, path) -> str:
+    from .ops import save_spectral_pumped
+
+    return save_spectral_pumped(f, path)  # one file with a wavelength dimension
+
+
+def _load_spectral(path, root):
+    from .ops import load_spectral_pumped
+
+    return load_spectral_pumped(path, root)
+
+
+_pumping.FILE_KINDS["pumpup spectral pumped BRDF"] = _load_spectral
+
+
+@_compensate.furnace.register(Spectral)
+def _furnace_spectral(f: Spectral, mu, return_error: bool = False, **kw):
+    out = [_compensate.furnace(m, mu, return_error=True, **kw) for m in f.models]  # each wavelength's furnace
+    v, e = np.stack([np.asarray(o[0]) for o in out], axis=-1), np.stack([np.asarray(o[1]) for o in out], axis=-1)
+    return (v, e) if return_error else v
+
+
+@_compensate.compensate_model.register(Spectral)
+def _compensate_spectral(base: Spectral, method: str, *, f0, f_avg, white, force):
+    from .ops import compensate_spectral
+
+    return compensate_spectral(base, method, f0=f0, f_avg=f_avg, white=white, force=bool(force))
+
+
+from .._lazy import submodules  # noqa: E402
+
+__getattr__ = submodules(__name__)  # the package's modules on first use (pumpup.spectral.<module>)

@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from .core import SpecError
-from .spectral import Spectral, SpectralPumped
+from ..core import SpecError
+from . import Spectral, SpectralPumped
 
 __all__ = ["SpectralCompensated", "compensate_spectral", "save_spectral_pumped", "load_spectral_pumped",
            "SPECTRAL_PUMPED_KIND"]
@@ -54,7 +54,7 @@ class SpectralCompensated(Spectral):
         As :func:`pumpup.compensate`, applied to each wavelength's model.
     f0, f_avg : float, in [0, 1], optional
         Shared by all wavelengths when given; by default "kulla_conty" takes each wavelength's
-        own F_avg from its Fresnel factor (:func:`pumpup.compensate.fresnel_average`) and
+        own F_avg from its Fresnel factor (:func:`pumpup.operators.compensate.fresnel_average`) and
         "scale" takes F0 = 1.
     white : BRDF or spec, optional
         The Fresnel-1 BRDF whose albedo is E (default: each model without its Fresnel factor).
@@ -64,7 +64,7 @@ class SpectralCompensated(Spectral):
 
     def __init__(self, base: Spectral, method: str = "kulla_conty", *, f0=None, f_avg=None, white=None,
                  force: bool = False):
-        from .compensate import compensate
+        from ..operators.compensate import compensate
 
         if method not in ("kulla_conty", "scale"):
             raise SpecError(f"compensate: method must be 'kulla_conty' or 'scale' here (pumping: 'g1', 'g2' through "
@@ -137,8 +137,8 @@ def save_spectral_pumped(f: Spectral, path) -> str:
     """
     import xarray as xr
 
-    from ._version import __version__
-    from .tables import write_groups
+    from .._version import __version__
+    from ..tables import write_groups
 
     if not isinstance(f, SpectralPumped):
         raise TypeError(f"save_pumped needs a pumped BRDF (pumpup.pump); got {f!r}, a spectral model that is not pumped")
@@ -171,13 +171,13 @@ def load_spectral_pumped(path, root=None) -> SpectralPumped:
 
     Raises
     ------
-    pumpup.validate.TableError (a ValueError)
+    pumpup.tables.validate.TableError (a ValueError)
         If the file is damaged, edited, or not a saved spectral pumped BRDF.
     """
-    from .core import load
-    from .pumping import attach_level_table
-    from .tables import open_table
-    from .validate import TableError, spec_attribute
+    from ..core import load
+    from ..operators.pumping import attach_level_table
+    from ..tables import open_table
+    from ..tables.validate import TableError, spec_attribute
 
     where = os.fspath(path)
     if root is None:

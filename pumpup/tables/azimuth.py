@@ -40,8 +40,8 @@ import math
 
 import numpy as np
 
-from .albedo import check_phi
-from .core import BRDF
+from ..engine.cubature import check_phi
+from ..core import BRDF
 
 __all__ = ["sup_albedo", "J_START", "J_MAX", "SAFETY"]
 
@@ -108,8 +108,8 @@ def sup_albedo(brdf: BRDF, mu, *, rtol: float = 1e-10, atol: float = 1e-14, tol:
         least the largest sample) and ``error`` = SAFETY x the measured interpolation error
         + the largest quadrature error of the samples (see the module docstring).
     """
-    from .albedo import check_mu
-    from .tables import _chunked
+    from ..engine.cubature import check_mu
+    from . import _chunked
 
     m = check_mu(mu)
     flat = m.ravel()
@@ -183,7 +183,7 @@ def table_values(brdf: BRDF, phi, rtol, atol, threads, interp_tol):
 
     ``val`` is (n,) for a table over mu, (n, k) for one over (mu, phi); ``phi_kind`` is what
     the attributes of a table over mu of an anisotropic model say: 0.0 or "sup"."""
-    from .tables import _chunked
+    from . import _chunked
 
     aniso = brdf.azimuth_range() is not None
     if phi is None:
@@ -233,7 +233,7 @@ def describe_phi(ds, brdf, kind):
     """Say in the attributes of a table over mu which azimuth of wi it holds."""
     if kind == "sup":
         ds.attrs["azimuth"] = ("sup over phi: albedo + albedo_error bounds the supremum over the azimuth of wi "
-                               "of a(mu, phi) (pumpup.azimuth.sup_albedo)")
+                               "of a(mu, phi) (pumpup.tables.azimuth.sup_albedo)")
         ds["albedo"].attrs["long_name"] = "supremum over phi of the directional albedo (centre of the bound)"
     else:
         ds.attrs["azimuth"] = f"phi = {float(kind):g} rad: wi in the xz-plane (the albedo of this model depends on phi)"

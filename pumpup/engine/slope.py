@@ -33,7 +33,7 @@ scale; each piece is adaptive 10/21 Gauss-Kronrod (the worst bisected) to a rela
 albedo's lower bound so far.
 
 J(theta) is analytic and periodic; the rule over theta is globally adaptive 7/15 Gauss-Kronrod over the turn, the rays'
-errors added through the Kronrod weights as frame 4 does (:func:`pumpup._polar._k_numeric`).  Near grazing incidence the
+errors added through the Kronrod weights as frame 4 does (:func:`pumpup.engine.polar._k_numeric`).  Near grazing incidence the
 disc's edge nearest to h = N, m* = -(cos phi, sin phi)(1 - s) / mu, comes within the Gaussian: in the stretched plane it
 is a line at the distance ``edge`` = mu / ((1 + s) a_x a_y |T|), T = (-sin phi / a_x, cos phi / a_y) its direction.  A ray
 at an angle delta from it meets it at R ~ edge / sin(delta), so J changes from its value near the edge to the full
@@ -44,8 +44,8 @@ sides (:data:`EDGE_GRADE`), where ``edge`` < :data:`EDGE_MAX`.  Found by the cal
 a_x / a_y = 1000 at mu = 1e-4 4e-7 off, and cuts on the near side only (0.05, 0.5) at mu = 0.003 8.4e-13 off with an
 estimate of 5e-13.  Where wi lies in the plane of a tangent axis (phi = 0 or pi / 2, and isotropic models, which take
 phi = 0) J is even about th0 and half the turn is integrated.  The estimate per interval, of the rays and of theta, is
-QUADPACK's calibration of |K - G| (:func:`pumpup._errors.calibrated`), plus the rounding term
-:data:`pumpup._polar.ROUNDING` times the sum of |K|.
+QUADPACK's calibration of |K - G| (:func:`pumpup.physics.quadrature.calibrated`), plus the rounding term
+:data:`pumpup.engine.polar.ROUNDING` times the sum of |K|.
 
 Checked in ``tests/test_slope.py`` against ``tests/data/independent_ward_aniso.json`` (two nested-quad methods written
 without pumpup, ``scripts/independent_ward_aniso.py``), against the nested engine at rtol 1e-13 (the half vector's polar
@@ -62,8 +62,8 @@ import math
 import numpy as np
 from numba import njit
 
-from ._errors import calibrated, mode_code, rule_sums
-from ._polar import _tally
+from ..physics.quadrature import calibrated, mode_code, rule_sums
+from .polar import _tally
 
 __all__ = ["slope_albedo", "takes_slope_path", "ray_reference", "ray_integral"]
 
@@ -343,7 +343,7 @@ def _slope_all(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk
 def takes_slope_path(brdf, mu: np.ndarray) -> bool:
     """Whether :func:`slope_albedo` takes ``brdf`` at every mu (the model offers ``slope()``, the 1-D path is on, and
     mu >= :data:`MU_MIN`)."""
-    from . import _polar
+    from . import polar as _polar
 
     hint = getattr(brdf, "slope", None)
     return bool(_polar.ENABLED and _polar.ONE_D and hint is not None and (mu.size == 0 or mu.min() >= MU_MIN))
@@ -352,7 +352,7 @@ def takes_slope_path(brdf, mu: np.ndarray) -> bool:
 def slope_albedo(brdf, mu: np.ndarray, phi: np.ndarray, rtol: float, atol: float, max_regions: int):
     """(value, error, converged, evaluations) of the albedo of anisotropic Ward ``brdf`` at every (mu, phi) (1-D float
     arrays of one length; phi the azimuth of wi from the tangent x axis)."""
-    from ._polar import _RULES, ROUNDING
+    from .polar import _RULES, ROUNDING
 
     ax, ay, c = brdf.slope()
     mu = np.ascontiguousarray(mu, dtype=np.float64)
@@ -373,7 +373,7 @@ def slope_albedo(brdf, mu: np.ndarray, phi: np.ndarray, rtol: float, atol: float
 
 def ray_integral(b: float, e2: float, rtol: float = 1e-13) -> tuple:
     """(J, error, evaluations) of the compiled ray integral (module docstring) at b = e.c and e2 = |e|^2."""
-    from ._polar import _RULES
+    from .polar import _RULES
 
     nodes, wk, wg = _RULES[RAY_RULE]
     return _ray(float(b), float(e2), float(rtol), 0.0, nodes, wk, wg, mode_code(), np.empty(len(nodes)), np.empty((5, RAY_MAX)))

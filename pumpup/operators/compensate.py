@@ -50,6 +50,7 @@ E / U <= 1, and 1 - E / U <= (U - E) / E.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -57,8 +58,9 @@ import os
 import numpy as np
 from numba import njit
 
-from .core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register
-from .pumping import TABLE_DECADES, _CELL_SHIFT, table_decades, Pumped, _float_bits, _key, _Lookup, _Product, _ProductError, _upper_scalar, file_tables, from_file
+from ..core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register
+from ..physics.lookups import CELL_SHIFT, float_bits, scale_bound, upper_scalar
+from .pumping import TABLE_DECADES, table_decades, Pumped, _key, _Lookup, _Product, _ProductError, file_tables, from_file
 
 __all__ = ["compensate", "KullaConty", "Scaled", "save_compensated", "load_compensated", "furnace",
            "compensation_table", "METHODS", "fresnel_average"]
@@ -77,7 +79,7 @@ _TABLES: dict[str, object] = {}  # cache key of the white base -> AlbedoTable (w
 
 def compensation_table(white: BRDF, progress: bool | None = None):
     """The albedo table E of ``white`` used by the compensation operators (cached per session)."""
-    from .tables import AlbedoTable, tabulate
+    from ..tables import AlbedoTable, tabulate
 
     key = _key(white)
     own = from_file("compensate", key)  # a file being loaded: its table serves only its objects
@@ -95,26 +97,10 @@ def compensation_table(white: BRDF, progress: bool | None = None):
 
 
 @njit(cache=True, nogil=True)
-def _bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover
-    """U(m) >= E(m): above ``pmlo`` the polynomial piece of the product table found from the bits
-    of m (pump._Product, scaled up by its 1 + epsilon); below it the table's spline look-up.  The
-    kernels below write it out (a call per look-up cost 20 x the look-up; with numba's
-    ``inline="always"`` Kulla-Conty evaluated at 3.5 x its base against 1.35 x written out, measured
-    with scripts/bench_compensate.py in one sitting)."""
-    if m > pmlo:
-        s = pcstart[min((_float_bits(m) >> _CELL_SHIFT) - pcbase, pcstart.shape[0] - 1)]
-        while m >= plo[s + 1]:
-            s += 1
-        t = (m - prow[s, 6]) * prow[s, 7]
-        return ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
-    return _upper_scalar(m, logx, coef, v0, slope0, margin_lo, margin, cap)
-
-
-@njit(cache=True, nogil=True)
 def _kc_kernel(f, wi, wo, scale, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin,
                cap):  # pragma: no cover - compiled
     """f += scale D(mu_i) D(mu_o) in place, D = max(0, 1 - U) (KC eq. 1; see the module docstring).
-    The look-up of :func:`_bound`, written out.  Tested against :meth:`KullaConty.reference`."""
+    The look-up of :func:`scale_bound`, written out.  Tested against :meth:`KullaConty.reference`."""
     last = pcstart.shape[0] - 1
     for k in range(f.shape[0]):
         mi, mo = wi[k, 2], wo[k, 2]
@@ -122,21 +108,21 @@ def _kc_kernel(f, wi, wo, scale, pmlo, pcbase, pcstart, plo, prow, logx, coef, v
             f[k] = 0.0
             continue
         if mi > pmlo:
-            s = pcstart[min((_float_bits(mi) >> _CELL_SHIFT) - pcbase, last)]
+            s = pcstart[min((float_bits(mi) >> CELL_SHIFT) - pcbase, last)]
             while mi >= plo[s + 1]:
                 s += 1
             t = (mi - prow[s, 6]) * prow[s, 7]
             ui = ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
         else:
-            ui = _upper_scalar(mi, logx, coef, v0, slope0, margin_lo, margin, cap)
+            ui = upper_scalar(mi, logx, coef, v0, slope0, margin_lo, margin, cap)
         if mo > pmlo:
-            s = pcstart[min((_float_bits(mo) >> _CELL_SHIFT) - pcbase, last)]
+            s = pcstart[min((float_bits(mo) >> CELL_SHIFT) - pcbase, last)]
             while mo >= plo[s + 1]:
                 s += 1
             t = (mo - prow[s, 6]) * prow[s, 7]
             uo = ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
         else:
-            uo = _upper_scalar(mo, logx, coef, v0, slope0, margin_lo, margin, cap)
+            uo = upper_scalar(mo, logx, coef, v0, slope0, margin_lo, margin, cap)
         di, do = 1.0 - ui, 1.0 - uo
         if di > 0.0 and do > 0.0:
             f[k] += scale * (di * do)  # KC eq. 1 (di * do: the same bits for (wi, wo) and (wo, wi))
@@ -145,7 +131,7 @@ def _kc_kernel(f, wi, wo, scale, pmlo, pcbase, pcstart, plo, prow, logx, coef, v
 @njit(cache=True, nogil=True)
 def _scale_kernel(f, wi, wo, f0, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin,
                   cap):  # pragma: no cover - compiled
-    """f *= 1 + F0 (1 / U(mu_o) - 1) in place (Turquin eq. 6), the look-up of :func:`_bound` written
+    """f *= 1 + F0 (1 / U(mu_o) - 1) in place (Turquin eq. 6), the look-up of :func:`scale_bound` written
     out.  Tested against :meth:`Scaled.reference`."""
     last = pcstart.shape[0] - 1
     for k in range(f.shape[0]):
@@ -154,13 +140,13 @@ def _scale_kernel(f, wi, wo, f0, pmlo, pcbase, pcstart, plo, prow, logx, coef, v
             f[k] = 0.0
             continue
         if mo > pmlo:
-            s = pcstart[min((_float_bits(mo) >> _CELL_SHIFT) - pcbase, last)]
+            s = pcstart[min((float_bits(mo) >> CELL_SHIFT) - pcbase, last)]
             while mo >= plo[s + 1]:
                 s += 1
             t = (mo - prow[s, 6]) * prow[s, 7]
             u = ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
         else:
-            u = _upper_scalar(mo, logx, coef, v0, slope0, margin_lo, margin, cap)
+            u = upper_scalar(mo, logx, coef, v0, slope0, margin_lo, margin, cap)
         if f0 == 1.0:
             f[k] = f[k] / u  # Turquin eq. 6 with F0 = 1: f / E(mu_o)
         else:
@@ -179,7 +165,7 @@ class _Bound:
         except _ProductError:  # pragma: no cover - no table has needed it
             self.product = None
         if self.product is not None and self.product.rows.shape[1] != 8:  # pragma: no cover
-            raise AssertionError("the kernels are written for a product table of degree 5 (pump._PRODUCT_DEGREE)")
+            raise AssertionError("the kernels are written for a product table of degree 5 (pumpup.physics.lookups.PRODUCT_DEGREE)")
         if self.product is None:
             pargs = (math.inf, 0, np.zeros(1, np.int32), np.full(2, math.inf), np.zeros((1, 8)))
         else:
@@ -193,7 +179,7 @@ class _Bound:
         self.kinks = sorted(set(kinks) | {b for b in table.breaks if 0.0 < b < 1.0})
 
     def upper(self, mu) -> np.ndarray:
-        """U(mu) in plain numpy (the reference of :func:`_bound`)."""
+        """U(mu) in plain numpy (the reference of :func:`scale_bound`)."""
         mu = np.asarray(mu, dtype=np.float64)
         out = self.lookup.upper(np.clip(mu, 1e-300, 1.0))
         if self.product is not None:
@@ -273,10 +259,10 @@ class _Bound:
 
 @njit(cache=True, nogil=True)
 def _uppers(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover
-    """U(m) at every m (``m`` > 0) by :func:`_bound`: the kernels' own look-up, value for value."""
+    """U(m) at every m (``m`` > 0) by :func:`scale_bound`: the kernels' own look-up, value for value."""
     out = np.empty(m.shape[0])
     for i in range(m.shape[0]):
-        out[i] = _bound(m[i], pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap)
+        out[i] = scale_bound(m[i], pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap)
     return out
 
 
@@ -305,11 +291,11 @@ def fresnel_average(base: BRDF, nodes: int = 64) -> float:
     x, w = np.polynomial.legendre.leggauss(nodes)
     mu = 0.5 * (x + 1.0)
     if p.get("eta") is not None:
-        from .models.metal import fresnel
+        from ..physics.fresnel import fresnel_conductor as fresnel
 
         fr = fresnel(mu, p["eta"], p.get("k") or 0.0)
     else:
-        from .models.cook_torrance import fresnel
+        from ..physics.fresnel import fresnel_dielectric as fresnel
 
         fr = fresnel(mu, p["ior"])
     return float(np.clip(np.sum(w * 0.5 * 2.0 * fr * mu), 0.0, 1.0))
@@ -451,7 +437,7 @@ class KullaConty(_Compensated):
     PROBE_MU = (1.0, 0.5, 0.1, 1e-2, 1e-4, 1e-6, 1e-8)
 
     def _precheck(self) -> None:
-        from .albedo import albedo
+        from ..engine.cubature import albedo
 
         a, e = albedo(self.white, np.array(self.PROBE_MU), return_error=True, rtol=1e-6, atol=1e-12)
         self._refuse_above_one(np.array(self.PROBE_MU), a, e)
@@ -571,7 +557,7 @@ class _MsLobe(BRDF):
         D the kernels' own (:func:`_deficits`), I by :meth:`_Bound.deficit_moment` (exact on the product table's
         polynomial pieces); the relative error I's, plus 8 ulps for D(mu) pi I itself.  Until issue 14's twelfth session the nested
         engine integrated it (80 ms for 257 mu, GGX alpha = 0.3)."""
-        from ._polar import Polar
+        from ..core.hints import Polar
 
         got = self.kc.bound.deficit_moment()
         if got is None:  # pragma: no cover
@@ -586,7 +572,7 @@ class _MsLobe(BRDF):
 
 def _scaled_lobe(b: Lobe, bound) -> Lobe:
     """The hint of a scaled lobe: the base's (``b``), with U's kinks and, about the normal, the levels of
-    :func:`pumpup.pumping.table_decades`."""
+    :func:`pumpup.operators.pumping.table_decades`."""
     return b.with_levels(bound.kinks, table_decades(b))
 
 
@@ -675,12 +661,12 @@ class Scaled(_Compensated):
         return _scaled_lobe(self.base.lobe(mu), self.bound)
 
     def polar(self):
-        """The 1-D albedo path of a scaled GGX, Beckmann (F = 1) or Schlick model (``pumpup._polar``, frame 6 about N):
+        """The 1-D albedo path of a scaled GGX, Beckmann (F = 1) or Schlick model (``pumpup.engine.polar``, frame 6 about N):
         the factor depends on N.wo alone, so the base's hint times it (``Polar.factor``), with U's kinks as the levels;
         None for any other base, or a white whose E table is not such a model's (its table could hold kinks)."""
         import dataclasses
 
-        from ._polar import takes_n_frame_operand as plain  # (GGX, Beckmann with F = 1 or Schlick, neither pumped nor scaled)
+        from ..engine.polar import takes_n_frame_operand as plain  # (GGX, Beckmann with F = 1 or Schlick, neither pumped nor scaled)
 
         hint = self.base.polar()
         white = hint if self.white is self.base else self.white.polar()
@@ -692,7 +678,7 @@ class Scaled(_Compensated):
             # 0.19), which frame 6's pieces did not see: F0 0.11 at mu = 0.9999 was 2.9e-12 off with an estimate of
             # 3.1e-14 (94 x), alpha 0.035 at mu = 0.074 28 x.  The nested engine takes it (issue 14's twenty-fifth session)
             return None
-        # U's kinks, and where its look-up turns from the spline to the product table (:func:`_bound`): a level, so
+        # U's kinks, and where its look-up turns from the spline to the product table (:func:`scale_bound`): a level, so
         # that the cuts are graded in N.wo down to a quarter of it (``chain_cuts``; U(N.wo) is a spline in log N.wo
         # and not analytic at 0: with the grading only down to a quarter of mu, as g's needs, Schlick r = 0.2 at mu =
         # 0.985 was 1.0e-11 off on the piece N.wo < 0.172 with an estimate of 2.7e-12)
@@ -790,18 +776,15 @@ class _Transposed(BRDF):
         return dataclasses.replace(hint, scale=lambda mu: inner_scale(mu) * scaled.kernel_factor(mu))
 
 
+@functools.singledispatch
 def furnace(f: BRDF, mu, return_error: bool = False, **kw):
     """The white furnace toward a viewer at cos(theta_o) = mu: integral f(wi, wo) cos(theta_i) d omega_i.
 
     For a reciprocal BRDF this is its albedo a(mu) (000 eq. 2); for ``scaled`` it is the
     quantity the scaling makes 1.  Keywords go to :func:`pumpup.albedo`.
     """
-    from .albedo import albedo
+    from ..engine.cubature import albedo
 
-    if getattr(f, "is_spectral", False):  # pumpup.spectral: each wavelength's furnace, on a trailing axis
-        out = [furnace(m, mu, return_error=True, **kw) for m in f.models]
-        v, e = np.stack([np.asarray(o[0]) for o in out], axis=-1), np.stack([np.asarray(o[1]) for o in out], axis=-1)
-        return (v, e) if return_error else v
     g = f if f.reciprocal else _Transposed(f)
     return albedo(g, mu, return_error=return_error, **kw)
 
@@ -817,7 +800,7 @@ def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None 
     ----------
     f : BRDF or spec
         Any BRDF the engine can tabulate (one channel), or a spectral model or spec: each
-        wavelength compensated on its own (:class:`pumpup.spectral_ops.SpectralCompensated`).
+        wavelength compensated on its own (:class:`pumpup.spectral.ops.SpectralCompensated`).
     method : {"kulla_conty", "scale", "g1", "g2"}
         "kulla_conty": f + F_ms f_ms (:class:`KullaConty`); "scale": f (1 + F0 (1/E(mu_o) - 1))
         (:class:`Scaled`, not reciprocal); "g1", "g2": one level of pumping (001 eq. 20, 21;
@@ -855,11 +838,13 @@ def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None 
             raise SpecError(f"compensate: {name} must be a number in [0, 1], got {v!r}")
     if not isinstance(force, (bool, np.bool_)):
         raise SpecError(f"compensate: force must be true or false, got {force!r}")
-    base = load(f)
-    if getattr(base, "is_spectral", False):  # pumpup.spectral: every wavelength compensated on its own
-        from .spectral_ops import compensate_spectral
+    return compensate_model(load(f), method, f0=f0, f_avg=f_avg, white=white, force=force)
 
-        return compensate_spectral(base, method, f0=f0, f_avg=f_avg, white=white, force=bool(force))
+
+@functools.singledispatch
+def compensate_model(base: BRDF, method: str, *, f0, f_avg, white, force) -> BRDF:
+    """:func:`compensate` of a loaded model, its arguments checked.  Other kinds of model register their own
+    (:mod:`pumpup.spectral`: every wavelength compensated on its own)."""
     if method in ("g1", "g2"):
         if f0 is not None or f_avg is not None or white is not None:
             raise SpecError(f"compensate: method {method!r} (pumping) takes no f0, f_avg or white")
@@ -903,10 +888,10 @@ def save_compensated(f: BRDF, path) -> str:
     """
     import xarray as xr
 
-    from ._version import __version__
+    from .._version import __version__
     from .pumping import _TABLES as PUMP_TABLES
     from .pumping import base_table
-    from .tables import write_groups
+    from ..tables import write_groups
 
     if not isinstance(f, BRDF):
         raise TypeError(f"save_compensated needs a pumpup BRDF, got {type(f).__name__}")
@@ -933,7 +918,7 @@ def save_compensated(f: BRDF, path) -> str:
 
 def load_compensated(path) -> BRDF:
     """Load a BRDF saved by :func:`save_compensated`, without recomputing its tables."""
-    from .tables import AlbedoTable, open_table
+    from ..tables import AlbedoTable, open_table
 
     root = open_table(path)
     if root.attrs.get("pumpup_kind") != "pumpup compensated BRDF":

@@ -67,7 +67,7 @@ def write_generated(ds, path) -> bool:
 
     Returns True if the file was written.
     """
-    from .tables import open_table, write_table
+    from . import open_table, write_table
 
     ds = ds.copy()
     ds.attrs["pumpup_commit"] = source_commit()

@@ -20,10 +20,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._version import __version__
-from . import _reuse
-from .albedo import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
-from .core import BRDF, check_count, check_open_unit, check_tolerance
+from .._version import __version__
+from . import reuse as _reuse
+from ..engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
+from ..core import BRDF, check_count, check_open_unit, check_tolerance
 
 __all__ = [
     "tabulate",
@@ -85,7 +85,7 @@ class AlbedoTable:
 
     ``breaks`` are values of mu where the albedo has a kink, nodes of the table: the spline is split there
     into independent splines on either side (a pumped level's albedo has a kink where the level below changes
-    its g's form, :func:`pumpup.pumping.albedo_kinks`; one spline across it rounds the kink off and the
+    its g's form, :meth:`pumpup.operators.pumping.Pumped.albedo_kinks`; one spline across it rounds the kink off and the
     adaptive grid bunches its nodes towards it).
 
     ``interp_error`` is the largest difference between the interpolant and the computed
@@ -334,7 +334,7 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
     # of it in theta had no check.  A sharp lobe's pumped level turns there (the lobe reaches the normal below theta ~
     # its width: pumped plastic n = 5284 was 3.1e-7 off at mu = 0.99995 with a margin of 2.0e-7, found by
     # scripts/fuzz_engines.py --tables 43), and so does a g2 level whose bound crosses the diagonal within it (a kink
-    # the table's one spline goes across: pumping.albedo_kinks).  It is checked at 1 - mu = (1 - a) 2^-k too, down to
+    # the table's one spline goes across: Pumped.albedo_kinks).  It is checked at 1 - mu = (1 - a) 2^-k too, down to
     # NEAR_ONE_MIN, and the largest miss there counts (issue 14's twenty-third session)
     pts = _near_one(grid[-2])
     if off_grid:
@@ -388,7 +388,7 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
         (an isotropic model's values are the same in every column, computed once); the
         adaptive grid in mu then meets ``interp_tol`` in every column.  ``"sup"``: a table
         over ``mu`` of an upper bound of the supremum over phi of a(mu, phi), what the pumping
-        operator needs of an anisotropic base (:func:`pumpup.azimuth.sup_albedo`; the plain
+        operator needs of an anisotropic base (:func:`pumpup.tables.azimuth.sup_albedo`; the plain
         table for an isotropic model).
     breaks : array_like, optional
         Values of mu in (``mu_min``, 1) where the albedo has a kink, for an adaptive grid over ``mu`` alone: they
@@ -462,7 +462,7 @@ def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = D
 
 
 #: threads that compute the albedos of a table (None: one per core, or one for a BRDF on the 1-D path,
-#: ``pumpup._polar``).  The compiled kernels release the GIL; a value of mu does not depend on the
+#: ``pumpup.engine.polar``).  The compiled kernels release the GIL; a value of mu does not depend on the
 #: others computed with it, so the table is the same for any number of threads (tested).  The nested
 #: engine gains (Blinn n = 16: 74 -> 64 ms on 2 cores); the 1-D path's values cost microseconds, and
 #: the Python around them (a pumped lobe's levels and cuts per mu) holds the GIL, so there a second
@@ -487,7 +487,7 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
     (default :data:`THREADS`; every k-th mu to thread k: grazing values, the dear ones, are spread over all)."""
     val = np.empty_like(mu)
     err = np.empty_like(mu)
-    from . import _polar
+    from ..engine import polar as _polar
 
     if _polar.takes_1d_path(brdf):
         # its values cost microseconds: one call for them all (chunks of 32 cost Phong n = 20's 257-point table
@@ -680,9 +680,9 @@ def atomic_path(path):
 
 def write_table(ds, path) -> str:
     """Write a Dataset to netCDF atomically (a temporary file renamed into place), with a
-    Fletcher-32 checksum on every numeric variable (:func:`pumpup.validate.checksum_encoding`) and
+    Fletcher-32 checksum on every numeric variable (:func:`pumpup.tables.validate.checksum_encoding`) and
     a digest of the whole content in the attribute ``pumpup_digest``, which :func:`open_table`
-    checks (:func:`pumpup.validate.content_digest`)."""
+    checks (:func:`pumpup.tables.validate.content_digest`)."""
     import xarray as xr
 
     from .validate import checksum_encoding
@@ -720,14 +720,14 @@ def write_groups(path, root, groups) -> str:
 
 def open_table(path, group: str | None = None):
     """Open a netCDF table written by pumpup, fully loaded into memory, and validate it
-    (:func:`pumpup.validate.validate_dataset`: variables, coordinates, shapes, finite values,
+    (:func:`pumpup.tables.validate.validate_dataset`: variables, coordinates, shapes, finite values,
     mu in (0, 1] strictly increasing, albedo >= 0, a loadable spec; checksums).
 
     Raises
     ------
     FileNotFoundError
         If there is no such file.
-    pumpup.validate.TableError (a ValueError)
+    pumpup.tables.validate.TableError (a ValueError)
         If the file is damaged, not netCDF, not a pumpup table, or fails a check; the message
         names the file and what is wrong.
     """
@@ -773,7 +773,7 @@ def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False, m
     >>> round(pumpup.mean_albedo(pumpup.load({"type": "lambert", "albedo": 0.25})), 12)
     0.25
     """
-    from .albedo import NODES, WG, WK
+    from ..engine.cubature import NODES, WG, WK
 
     if getattr(brdf, "is_spectral", False):  # pumpup.spectral: one mean albedo per wavelength
         return brdf.mean_albedo(rtol=rtol, return_error=return_error, max_intervals=max_intervals)
@@ -796,16 +796,15 @@ def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False, m
         k = fv @ WK
         return k, np.abs(k - fv @ WG), fe @ WK
 
-    # a pumped level's albedo has kinks (pumping.albedo_kinks): first intervals end there.  Without them a 2-level g1
+    # a pumped level's albedo has kinks (BRDF.albedo_kinks): first intervals end there.  Without them a 2-level g1
     # pumped stretched Phong (n = 0.127, p = 1: kinks at mu = 0.309, 0.345, 0.741, 0.745) had a mean 1.05e-9 off with an
     # estimate of 1.0e-10 (issue 14's twentieth session, scripts/fuzz_engines.py --mean)
-    from .albedo import _smooth_inverse
-    from .pumping import albedo_kinks
+    from ..engine.cubature import _smooth_inverse
 
     # and two more towards grazing incidence, tau = 1/16 and 1/32 (mu = 0.011, 0.0029): the albedo there turns on the
     # roughness's scale, and the first interval [0, 1/8] (mu up to 0.043) was 4.2 x its |K - G| off for a 1-level g2
     # pumped GGX alpha 0.0194 (the mean 1.05e-9 off, 2.6 x its estimate; fuzz_engines --mean)
-    kinks = albedo_kinks(brdf, inside_grid=False) or []
+    kinks = brdf.albedo_kinks() or []
     edges = np.unique(np.concatenate([np.linspace(0, 1, 9), [1.0 / 16, 1.0 / 32],
                                       [_smooth_inverse(v, 1.0 - v) for v in kinks]]))
     a, b = edges[:-1], edges[1:]
@@ -947,3 +946,8 @@ def max_constant(brdf: BRDF, **kw) -> tuple[float, float]:
     _check_brdf("max_constant", brdf)
     m = max_albedo(brdf, **kw)
     return m.constant, m.theta_deg
+
+
+from .._lazy import submodules  # noqa: E402
+
+__getattr__ = submodules(__name__)  # the package's modules on first use (pumpup.tables.<module>)

@@ -242,10 +242,37 @@ def registry() -> dict[str, type["BRDF"]]:
     return dict(_REGISTRY)
 
 
+#: modules that register types (``@register``) or loaders (:func:`register_loader`) when imported, in the order they
+#: are imported on the registry's first use.  The package root names pumpup's own (``pumpup.PROVIDERS``: the
+#: operators, the models, the spectral models); another package adds its own with :func:`add_provider`.
+_PROVIDERS: list[str] = []
+_PROVIDED: set[str] = set()
+#: (applies, load): a spec that ``applies(spec)`` accepts is built by ``load(spec)`` (the spectral models)
+_LOADERS: list[tuple[Callable[[Any], bool], Callable[[Any], Any]]] = []
+
+
+def add_provider(module: str) -> None:
+    """Have the registry import ``module`` (a dotted name) on its next use, so that its types register themselves."""
+    if module not in _PROVIDERS:
+        _PROVIDERS.append(module)
+
+
+def register_loader(applies: Callable[[Any], bool], loader: Callable[[Any], Any]) -> None:
+    """Let :func:`load` hand every spec for which ``applies(spec)`` is true to ``loader(spec)`` (before the registry)."""
+    _LOADERS.append((applies, loader))
+
+
 def _ensure_models() -> None:
-    """Import the modules that register the built-in types: the operators, then the models."""
-    from . import compensate, pumping  # noqa: F401  (register pumped, kulla_conty, scaled)
-    from . import models  # noqa: F401  (registers the built-in models)
+    """Import the provider modules not imported yet (the package root's ``PROVIDERS`` first): their types register."""
+    import importlib
+
+    if not _PROVIDERS:
+        for module in importlib.import_module(__name__.rpartition(".")[0]).PROVIDERS:
+            add_provider(module)
+    for module in _PROVIDERS:
+        if module not in _PROVIDED:
+            _PROVIDED.add(module)  # (first: a provider may load specs while it is imported)
+            importlib.import_module(module)
 
 
 def slabs(shape: tuple, block: int):
@@ -269,7 +296,7 @@ def slabs(shape: tuple, block: int):
 def as_directions(w: Any, name: str) -> np.ndarray:
     """Check that ``w`` holds unit 3-vectors on its last axis; return it as float64.
 
-    The check is one compiled pass (``pumpup._checks.first_bad``) with no temporaries, so its memory
+    The check is one compiled pass (``pumpup.core.checks.first_bad``) with no temporaries, so its memory
     does not grow with the array (the numpy check once allocated 1.5 GB for 1e8 directions)."""
     a = _as_vectors(w, name)
     check_directions(a, name)
@@ -291,7 +318,7 @@ def _as_vectors(w: Any, name: str) -> np.ndarray:
 def check_directions(a: np.ndarray, name: str) -> None:
     """Raise the ValueError of :func:`as_directions` (naming ``name``) if a row of the float64
     array ``a`` (..., 3) is not finite or not of unit length within ``UNIT_TOL``."""
-    from ._checks import first_bad  # finiteness and unit length in one compiled pass
+    from .checks import first_bad  # finiteness and unit length in one compiled pass
 
     lead = a.shape[:-1]
     bad_value, bad_norm = first_bad(a, UNIT_TOL)
@@ -419,7 +446,7 @@ class BRDF:
             check_directions(b, "wo")
             return self._eval(a, b)
         # checked while evaluated, in one compiled pass over both arguments (issue 14 item 6)
-        from ._checks import unit_bounds
+        from .checks import unit_bounds
 
         out = np.empty(a.shape[:-1])
         bad_i, bad_o = self.rows_kernel(*rows, out.reshape(-1), True, *unit_bounds(UNIT_TOL), *self.kernel_args())
@@ -431,7 +458,7 @@ class BRDF:
 
     #: optional: a compiled loop ``(wi, wo, out, check, lo2, hi2, *kernel_args) -> (bad_i, bad_o)``
     #: over the rows of C-contiguous (N, 3) arrays that writes ``kernel``'s values into ``out`` (N,)
-    #: and, when ``check``, returns the first row of wi and of wo where ``pumpup._checks.off_unit``
+    #: and, when ``check``, returns the first row of wi and of wo where ``pumpup.core.checks.off_unit``
     #: holds (-1 where none).  ``eval`` then checks its input in the same pass as it evaluates, and
     #: ``_eval`` uses it without the check, for arguments of one shape (``_rows``).  Used only while
     #: ``_eval`` is BRDF's own: a subclass that overrides ``_eval`` takes the check-then-``_eval`` path.
@@ -493,18 +520,25 @@ class BRDF:
         to end there: a Fresnel factor's total reflection (:func:`pumpup.models.metal.fresnel_levels`), the jump of a''
         at mu = 1 / sqrt(2) of 001 eq. 10's geometry factor (:data:`pumpup.models.cook_torrance.RETRO_BREAK`).  A lobe
         that carries such a table in N.wo has a level at each (a pumped level's g, a 1/E scaling's U).  A pumped level's
-        own kinks come from the pumping operator."""
+        own kinks come from the pumping operator (:meth:`albedo_kinks`)."""
         return ()
 
+    def albedo_kinks(self, lo: float = 0.0, hi: float = 1.0) -> list | None:
+        """Every incidence in (lo, hi) where a table of this model's albedo must split its spline: its
+        :meth:`albedo_breaks`, sorted, or None where it has none (an operator adds the kinks it makes: a pumped
+        level's g changes its form at incidences that do not depend on wo)."""
+        out = sorted(v for v in self.albedo_breaks() if lo < v < hi)
+        return out or None
+
     def polar(self):
-        """A :class:`pumpup._polar.Polar` hint when the azimuth of the albedo integral is closed-form
-        (the engine then integrates one dimension, ``pumpup._polar``), else None (the default)."""
+        """A :class:`pumpup.engine.polar.Polar` hint when the azimuth of the albedo integral is closed-form
+        (the engine then integrates one dimension, ``pumpup.engine.polar``), else None (the default)."""
         return None
 
     def lobe_axis(self, mu: np.ndarray, phi: np.ndarray):
         """(n, nu, scale) when, seen from wi at (mu, phi), the model is a power lobe scale (A.wo)_+^n about an axis A at
         elevation nu = N.A > 0, with no other dependence on wi (the engine then takes the 1-D path about A,
-        :func:`pumpup._polar.axis_albedo`), else None (the default)."""
+        :func:`pumpup.engine.polar.axis_albedo`), else None (the default)."""
         return None
 
     def azimuth_range(self) -> float | None:
@@ -555,12 +589,11 @@ def load(spec: Any) -> BRDF:
     if not isinstance(name, str):
         raise SpecError(f"a spec's 'type' must be a model name (a string), got {name!r}; "
                         f"known types: {', '.join(_REGISTRY)}")
-    if name not in _REGISTRY and name != "pumped_lobe":  # pumped_lobe: spectral only (below)
+    for applies, loader in _LOADERS:  # a material or per-wavelength lists: the spectral models' loader
+        if applies(spec):
+            return loader(spec)
+    if name not in _REGISTRY:
         raise SpecError(f"unknown model type {name!r}; known types: {', '.join(_REGISTRY)}")
-    if is_spectral_spec(spec):  # a material or per-wavelength lists: pumpup.spectral (imported only then)
-        from . import spectral
-
-        return spectral.load(spec)
     kwargs = {k: v for k, v in spec.items() if k != "type"}
     return _REGISTRY[name](**kwargs)
 
@@ -787,7 +820,7 @@ def from_function(fn: Callable, name: str = "function", reciprocal: bool = True,
     isotropic : bool
         The caller's claim that f does not change when wi and wo turn together about N (it depends on them through
         N.wi, N.wo and wi.wo only): the albedo then does not depend on the azimuth of wi, and pumping tabulates it once
-        instead of bounding its supremum over that azimuth (:func:`pumpup.azimuth.sup_albedo`: 16 tables or more).
+        instead of bounding its supremum over that azimuth (:func:`pumpup.tables.azimuth.sup_albedo`: 16 tables or more).
         Checked here: f at :data:`ISOTROPY_PAIRS` random pairs against the same pairs turned by random angles, which
         must agree within :data:`ISOTROPY_RTOL` (relative); a ValueError names the largest change otherwise.
 
@@ -925,3 +958,8 @@ def check_reciprocity(brdf: BRDF, tol: float = 1e-12, n_mu: int = 24, n_phi: int
         pairs=int(rel.size),
         tol=tol,
     )
+
+
+from .._lazy import submodules  # noqa: E402
+
+__getattr__ = submodules(__name__)  # the package's modules on first use (pumpup.core.<module>)

@@ -16,14 +16,14 @@ which is *smaller* than |K - G| when the interval is well resolved (|K - G| < re
 called converged on the strength of a lucky Gauss value.  Below it lies a rounding floor,
 ``50 eps resabs`` (QUADPACK's own), and the engines add their integrand's rounding term on top.
 
-:func:`calibrated` is the compiled version (callable from any numba kernel: ``pumpup._polar``,
+:func:`calibrated` is the compiled version (callable from any numba kernel: ``pumpup.engine.polar``,
 a nested engine; ``pumpup.albedo``'s tensor rule uses :func:`calibrated_array` when
 :data:`MODE_2D` asks for it);
 :func:`calibrated_reference` is its plain-Python twin and the tests compare the two.
 
 What was measured
 -----------------
-``scripts/error_calibration.py`` prints, for the 1-D path (``pumpup._polar``) and the 2-D
+``scripts/error_calibration.py`` prints, for the 1-D path (``pumpup.engine.polar``) and the 2-D
 engine, the distribution of true error / estimate over every independent reference in
 ``tests/`` (``tests/data/independent_reference.json``, ``independent_anisotropic.json``, the
 30-digit mpmath Phong values, the closed forms) at rtol 1e-6 .. 1e-12, with the raw and the
@@ -56,7 +56,7 @@ every kink marked) references: at most 0.12 calibrated, 0.18 raw, 0.23 with "min
 evaluations change by only -13 % .. +14 % (``--cost``; Cook-Torrance m = 0.3: +14 %), since the
 refinement is spent where rectangles are poorly resolved, and there QUADPACK's estimate is the
 larger one.  The 1-D path's evaluations are set by its first intervals: the gain there is
-``pumpup._polar.N_INIT`` = 1 (one first interval per piece, was 2), which the calibrated
+``pumpup.engine.polar.N_INIT`` = 1 (one first interval per piece, was 2), which the calibrated
 estimate meets at rtol 1e-10 almost everywhere.
 """
 
@@ -71,7 +71,7 @@ __all__ = ["MODE", "MODE_2D", "calibrated", "calibrated_array", "calibrated_refe
            "raw_estimate"]
 
 #: the estimate of the engines whose pieces are smooth by construction (the 1-D path of
-#: ``pumpup._polar``): "quadpack" (calibrated), "min" or "raw" (|K - G|, as before issue 14)
+#: ``pumpup.engine.polar``): "quadpack" (calibrated), "min" or "raw" (|K - G|, as before issue 14)
 MODE = "quadpack"
 #: the estimate of the 2-D engine, whose integrand may have kinks no hint marks (the knots of a
 #: pumped BRDF's albedo table, a Kulla-Conty lobe's E(mu), a ``from_function``): "raw" (see
@@ -88,7 +88,7 @@ def mode_code(smooth: bool = True) -> int:
     smaller of the two; ``smooth`` selects :data:`MODE` (True) or :data:`MODE_2D` (False)."""
     mode = MODE if smooth else MODE_2D
     if mode not in ("quadpack", "raw", "min"):
-        raise ValueError(f"pumpup._errors.MODE{'' if smooth else '_2D'} must be 'quadpack', 'min' or 'raw', "
+        raise ValueError(f"pumpup.physics.quadrature.MODE{'' if smooth else '_2D'} must be 'quadpack', 'min' or 'raw', "
                          f"got {mode!r}")
     return {"raw": 0, "quadpack": 1, "min": 2}[mode]
 

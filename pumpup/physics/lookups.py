@@ -1,0 +1,240 @@
+"""The bounded look-ups that pumped and compensated BRDFs read, compiled, each beside its plain numpy twin.
+
+An albedo table (``pumpup.tables.AlbedoTable``) is flattened into arrays: its spline pieces in log(mu) with the margin
+that makes them an upper bound of the albedo (:func:`upper_scalar`, :func:`upper_array`; below the first node a power
+law), and, for a chain of pumped levels or a 1/E scaling, one product table of polynomial pieces in m = max(N.wi, N.wo)
+found from the bits of m (:func:`g_product`, :func:`scale_bound`).  The pumped BRDF divides by g (001 eq. 16, 20,
+21), the engine integrates it node by node, and the Mitsuba plugin evaluates it: all three read these functions.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, types
+from numba.extending import intrinsic
+
+
+@njit(cache=True, nogil=True)
+def upper_scalar(mu, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
+    """Upper bound of a(mu): the table's spline piece in log(mu) (power law below the first node) + margin,
+    at most ``cap``."""
+    return upper_log(math.log(mu), logx, coef, v0, slope0, margin_lo, margin, cap)
+
+
+@njit(cache=True, nogil=True)
+def upper_log(lm, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
+    """:func:`upper_scalar` of mu = exp(lm) (binary search for the piece)."""
+    n = logx.shape[0]
+    # below the first node only, as AlbedoTable.upper: at mu = mu0 itself the power law's margin (|a1 - a0| + ...,
+    # 24 for Ward m = 0.885's 651 at mu0 = 1e-8) made the bound jump up there, a pumped level's albedo at exactly mu0
+    # 3.6 % below its limit from above, and the level above's table bisected towards its first node (504 nodes within
+    # 1e-9 of it, 2e-23 apart)
+    if lm < logx[0]:
+        return min(cap, v0 * math.exp(slope0 * (lm - logx[0])) + margin_lo)
+    lo, hi = 0, n - 1
+    while hi - lo > 1:  # binary search for the interval
+        mid = (lo + hi) // 2
+        if logx[mid] <= lm:
+            lo = mid
+        else:
+            hi = mid
+    d = lm - logx[lo]
+    val = coef[0, lo]
+    for r in range(1, coef.shape[0]):  # Horner: the spline piece in d = log(mu) - logx[lo]
+        val = val * d + coef[r, lo]
+    return min(cap, val + margin)
+
+
+@njit(cache=True, nogil=True)
+def upper_array(mu, logx, coef, v0, slope0, margin_lo, margin, cap, out):  # pragma: no cover - compiled
+    for k in range(mu.shape[0]):
+        out[k] = upper_scalar(mu[k], logx, coef, v0, slope0, margin_lo, margin, cap)
+
+
+@njit(cache=True, nogil=True)
+def upper_root(lo, hi, kind, target, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
+    """u in [lo, hi] where the bound U(u) (:func:`upper_scalar`) meets ``target`` (``kind`` 0 or 2) or u itself (1), given
+    a change of sign of the difference at the ends: bisection until the bracket is at most 1e-15 + 4 eps u wide (where
+    scipy's brentq at xtol 1e-15, which :meth:`Pumped._kink_levels` called from Python, stops too); its midpoint.
+    Compiled (issue 14's eighteenth session): the brentq calls took ~60 us each in cProfile, and the per-mu kink search two
+    thirds of a first 2-level pumped GGX table."""
+    flo = upper_scalar(lo, logx, coef, v0, slope0, margin_lo, margin, cap) - (lo if kind == 1 else target)
+    while hi - lo > 1e-15 + 8.9e-16 * hi:
+        mid = 0.5 * (lo + hi)
+        fm = upper_scalar(mid, logx, coef, v0, slope0, margin_lo, margin, cap) - (mid if kind == 1 else target)
+        if fm == 0.0:
+            return mid
+        if (fm < 0.0) == (flo < 0.0):
+            lo, flo = mid, fm
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+@njit(cache=True, nogil=True)
+def kink_roots(g, ug, kind, target, mu, scale, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
+    """The roots v of U(v) = ``target`` (``kind`` 0 or 2) or U(v) = v (1) that the grid ``g`` (U's values ``ug``) brackets
+    (:meth:`Pumped._kink_levels`, its search for one k in one compiled pass): differences below 1e-13 ``scale`` count as
+    0 (the rounding of a flat spline: no root), every cell where they change sign gives its root (:func:`upper_root`);
+    for kind 0 the points mu (1 -+ 1e-6) join the grid and the cell between them, which holds the root v = mu itself, is
+    skipped."""
+    n = g.shape[0]
+    extra = np.empty(2)
+    ne = 0
+    if kind == 0:
+        for e in (mu * (1.0 - 1e-6), mu * (1.0 + 1e-6)):
+            if e <= 1.0:
+                extra[ne] = e
+                ne += 1
+    m = n + ne
+    x = np.empty(m)
+    vals = np.empty(m)
+    i = j = 0
+    for q in range(m):  # the grid and the extra points, merged (an extra point before a grid node it equals)
+        if j < ne and (i >= n or extra[j] <= g[i]):
+            x[q] = extra[j]
+            u = upper_scalar(extra[j], logx, coef, v0, slope0, margin_lo, margin, cap)
+            j += 1
+        else:
+            x[q] = g[i]
+            u = ug[i]
+            i += 1
+        d = u - (x[q] if kind == 1 else target)
+        vals[q] = 0.0 if abs(d) < 1e-13 * scale else d
+    out = np.empty(m)
+    k = 0
+    for q in range(m - 1):
+        if not ((vals[q] < 0.0 and vals[q + 1] > 0.0) or (vals[q] > 0.0 and vals[q + 1] < 0.0)):
+            continue
+        if kind == 0 and x[q] <= mu <= x[q + 1] and x[q + 1] - x[q] <= 2.01e-6 * mu:
+            continue  # (the root v = mu itself, already a level)
+        out[k] = upper_root(x[q], x[q + 1], kind, target, logx, coef, v0, slope0, margin_lo, margin, cap)
+        k += 1
+    return out[:k]
+
+
+#: cells of the uniform index over log(mu) that the chain kernel uses to find a table interval
+INDEX_CELLS = 4096
+
+
+#: the product table of a monotone chain (:class:`_Product`): polynomials of degree
+#: PRODUCT_DEGREE in m, their pieces found through 2^CELL_BITS cells per octave numbered by the
+#: float's bits (measured on 3-level Phong: 4 bits 28 ns per pair, 6 bits 25, 8 bits 21; degree 4
+#: needs twice the pieces of degree 5 and was slower)
+CELL_BITS = 8
+
+
+CELL_SHIFT = 52 - CELL_BITS
+
+
+PRODUCT_DEGREE = 5
+
+
+@intrinsic
+def float_bits(typingctx, x):  # pragma: no cover - compiled
+    """The IEEE-754 bits of a float64 as an int64 (a free bit cast; for x > 0 the bits increase
+    with x, and ``bits >> CELL_SHIFT`` numbers the cells of :class:`_Product`)."""
+    if not isinstance(x, types.Float):
+        return None
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], context.get_value_type(types.int64))
+
+    return types.int64(types.float64), codegen
+
+
+def float_bits_reference(x) -> np.ndarray:
+    """numpy reference of :func:`float_bits`."""
+    return np.asarray(x, dtype=np.float64).view(np.int64)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def g_product(mmax, pcbase, pcstart, plo, prow):  # pragma: no cover - compiled
+    """The chain kernel's fast path: g_1 g_2 ... g_k as one function of mmax = max(N.wi, N.wo)
+    (:class:`_Product`; mmax above its ``mlo``): the piece found from the bits of mmax (no logarithm),
+    evaluated by Horner's rule; ``prow[s]`` holds the piece's coefficients, centre and inverse
+    half-width (one cache line).  Inlined where it is called."""
+    last_cell = pcstart.shape[0] - 1
+    deg = prow.shape[1] - 3
+    s = pcstart[min((float_bits(mmax) >> CELL_SHIFT) - pcbase, last_cell)]
+    s += mmax >= plo[s + 1]  # most cells hold one or two pieces: a branch-free step,
+    while mmax >= plo[s + 1]:  # then a loop that is rarely entered
+        s += 1
+    t = (mmax - prow[s, deg + 1]) * prow[s, deg + 2]
+    if deg == 5:  # written out (Horner, the order of horner)
+        return (((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t
+                 + prow[s, 4]) * t + prow[s, 5])
+    g_all = prow[s, 0] * t
+    for r in range(1, deg):
+        g_all = (g_all + prow[s, r]) * t
+    return g_all + prow[s, deg]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def g_levels(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
+              index, index_lo, index_h_inv):  # pragma: no cover - compiled
+    """The product of all levels' g (001 eq. 20, 21) at N.wi, N.wo with max ``mmax`` and min ``mmin``
+    (both > 0), level by level: each level's upper bound looked up (spline piece in log(mu), power
+    law below its first node, at most its cap).  Inlined where it is called (a call per look-up
+    cost 20 x the look-up, measured)."""
+    ncell = index.shape[1]
+    lmax = math.log(mmax)
+    lmin = 1.0  # log(mmin), taken only when needed (it is <= 0)
+    g_all = 1.0
+    for j in range(offsets.shape[0] - 1):
+        a, b = offsets[j], offsets[j + 1]
+        nlook = 1 if (increasing[j] and mmin > mu0[j]) else 2
+        g = 0.0
+        for t in range(nlook):
+            if t == 0:
+                lm = lmax
+            else:
+                if lmin > 0.0:
+                    lmin = math.log(mmin)
+                lm = lmin
+            if lm < logx[a]:  # (as upper_log)
+                u = v0[j] * math.exp(slope0[j] * (lm - logx[a])) + margin_lo[j]
+            else:
+                c = int((lm - index_lo[j]) * index_h_inv[j])
+                i = index[j, min(max(c, 0), ncell - 1)]
+                while i < b - 2 and logx[i + 1] <= lm:
+                    i += 1
+                d = lm - logx[i]
+                if coef.shape[0] == 6:  # the quintic, written out (Horner)
+                    u = ((((coef[0, i] * d + coef[1, i]) * d + coef[2, i]) * d + coef[3, i]) * d
+                         + coef[4, i]) * d + coef[5, i]
+                else:
+                    u = coef[0, i]
+                    for r in range(1, coef.shape[0]):  # Horner
+                        u = u * d + coef[r, i]
+            g = max(g, min(cap[j], u))  # 001 eq. 20
+        if controlled[j]:
+            g = max(g, mmax)  # 001 eq. 21
+        g_all *= g
+    return g_all
+
+
+def horner(coef, t):
+    """sum_r coef[r] t^(d - r) by Horner's rule, in the order the compiled kernel uses."""
+    v = coef[0] * t
+    for r in range(1, coef.shape[0] - 1):
+        v = (v + coef[r]) * t
+    return v + coef[-1]
+
+
+@njit(cache=True, nogil=True)
+def scale_bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover
+    """U(m) >= E(m): above ``pmlo`` the polynomial piece of the product table found from the bits
+    of m (pump._Product, scaled up by its 1 + epsilon); below it the table's spline look-up.  The
+    kernels below write it out (a call per look-up cost 20 x the look-up; with numba's
+    ``inline="always"`` Kulla-Conty evaluated at 3.5 x its base against 1.35 x written out, measured
+    with scripts/bench_compensate.py in one sitting)."""
+    if m > pmlo:
+        s = pcstart[min((float_bits(m) >> CELL_SHIFT) - pcbase, pcstart.shape[0] - 1)]
+        while m >= plo[s + 1]:
+            s += 1
+        t = (m - prow[s, 6]) * prow[s, 7]
+        return ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
+    return upper_scalar(m, logx, coef, v0, slope0, margin_lo, margin, cap)
