@@ -327,7 +327,33 @@ class Strategy:
         return np.asarray(out, dtype=np.float64)
 
 
-def strategy(brdf: BRDF, mu: float = 1.0, kind: str = "lobe") -> Strategy:
+@dataclass(frozen=True)
+class OwnSampling:
+    """The sampling density of a model that draws its own directions (:attr:`pumpup.core.BRDF.own_sampler`), with
+    :class:`Strategy`'s interface."""
+
+    brdf: BRDF
+
+    @property
+    def names(self) -> list[str]:
+        return [f"{self.brdf.type}'s own"]
+
+    def __str__(self) -> str:
+        return f"1 x {self.names[0]}"
+
+    def sample(self, wo: np.ndarray, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        """n draws of wi given one wo (shape (3,)): (wi (n, 3), pdf (n,)); rejected draws are 0, 0."""
+        u = rng.random((2, n))
+        wi, p = self.brdf.sample_wi(wo, u[0], u[1])
+        return np.asarray(wi, dtype=np.float64), np.asarray(p, dtype=np.float64)
+
+    def pdf(self, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
+        """Density [1/sr] of wi given wo, broadcast over the leading axes."""
+        return np.asarray(self.brdf.pdf_wi(np.asarray(wi, dtype=np.float64), np.asarray(wo, dtype=np.float64)),
+                          dtype=np.float64)
+
+
+def strategy(brdf: BRDF, mu: float = 1.0, kind: str = "lobe") -> Strategy | OwnSampling:
     """The sampling strategy of ``brdf`` for a conditioning direction with cos(theta) = mu.
 
     Parameters
@@ -351,6 +377,8 @@ def strategy(brdf: BRDF, mu: float = 1.0, kind: str = "lobe") -> Strategy:
         return Strategy(((1.0, COSINE, 0.0),))
     if kind != "lobe":
         raise ValueError(f"sampling strategy must be 'lobe' or 'cosine', got {kind!r}")
+    if brdf.own_sampler:  # the model's own importance sampling (BRDF.sample_wi)
+        return OwnSampling(brdf)
     by_mu = getattr(brdf, "sampling_terms", None)  # terms weighted for this mu (the Kulla-Conty mixture)
     terms = by_mu(float(mu)) if by_mu is not None else brdf.albedo_terms()
     weights = np.array([abs(w) for w, _ in terms], dtype=np.float64)

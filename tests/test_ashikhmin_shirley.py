@@ -6,7 +6,6 @@ import math
 import numpy as np
 import pytest
 
-import pumpup.models.ashikhmin_shirley  # registers "ashikhmin_shirley" (pumpup.models does not import it yet)
 import pumpup
 from pumpup.testing import chi2_test
 
@@ -387,3 +386,31 @@ def test_albedo_hard_cases(spec, mu, phi):
     r, r_err = ref.albedo_cylinder(mu, phi=phi, **spec)
     assert r_err < 1e-10
     assert abs(float(a) - r) <= float(err) + r_err, (float(a), float(err), r, r_err)
+
+
+def test_pumpup_sample_uses_the_papers_sampling():
+    """pumpup.sample, pumpup.sampling.pdf and pumpup.mc_albedo draw with the model's own sampler (BRDF.own_sampler)."""
+    f = pumpup.load({"type": "ashikhmin_shirley", "nu": 10, "nv": 1000, "rs": 0.5, "rd": 0.3})
+    wo = np.array([0.6, 0.0, 0.8])
+    wi, p = pumpup.sample(f, wo, 2000, np.random.default_rng(3))
+    u = np.random.default_rng(3).random((2, 2000))
+    wi2, p2 = f.sample_wi(wo, u[0], u[1])
+    np.testing.assert_array_equal(wi, wi2)
+    np.testing.assert_array_equal(p, p2)
+    np.testing.assert_allclose(pumpup.sampling.pdf(f, wi[p > 0], wo), p[p > 0], rtol=1e-12)
+    assert str(pumpup.sampling.strategy(f)) == "1 x ashikhmin_shirley's own"
+    a, e = pumpup.mc_albedo(f, 0.8, 200_000, np.random.default_rng(5))
+    exact = float(pumpup.albedo(f, [0.8])[0])
+    assert abs(a - exact) < 5 * e, (a, e, exact)
+
+
+def test_the_diffuse_term_is_a_closed_form_term():
+    """The albedo splits into the specular lobe (a half-vector hint, Lobe) and the diffuse term, whose hint is the closed
+    form of an existing family (Polar kind "constant"): its albedo is rd (1 - rs) (1 - (1 - mu / 2)^5) exactly."""
+    f = pumpup.load({"type": "ashikhmin_shirley", "nu": 100, "nv": 100, "rs": 0.05, "rd": 0.8})
+    terms = f.albedo_terms()
+    assert len(terms) == 2
+    mu = np.array([1.0, 0.5, 0.05])
+    (wd, diffuse), = [(w, t) for w, t in terms if t.type == "ashikhmin_shirley-diffuse"]
+    assert diffuse.polar() is not None and diffuse.polar().kind == "constant"
+    np.testing.assert_allclose(wd * pumpup.albedo(diffuse, mu), 0.8 * 0.95 * (1 - (1 - mu / 2) ** 5), rtol=1e-14)

@@ -509,6 +509,19 @@ class BRDF:
         faster than f."""
         return self.lobe(mu)
 
+    #: True where the model draws its own incidence directions (:meth:`sample_wi`, :meth:`pdf_wi`, e.g. a paper's
+    #: importance sampling); otherwise ``pumpup.sample`` builds a mixture from the :meth:`sampling_lobe` hints
+    own_sampler: ClassVar[bool] = False
+
+    def sample_wi(self, wo: np.ndarray, u1: np.ndarray, u2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The model's own sampling (where :attr:`own_sampler`): wi of shape (n, 3) drawn for one ``wo`` (3,) from the
+        uniform numbers ``u1``, ``u2`` (n,), and their density [1/sr]; a rejected draw is wi = 0 with density 0."""
+        raise NotImplementedError(f"{type(self).__name__} has no sampler of its own (own_sampler is False)")
+
+    def pdf_wi(self, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
+        """The density [1/sr] with which :meth:`sample_wi` draws ``wi`` (any leading shape) given ``wo`` (3,)."""
+        raise NotImplementedError(f"{type(self).__name__} has no sampler of its own (own_sampler is False)")
+
     def albedo_terms(self) -> list[tuple[float, "BRDF"]]:
         """Linear decomposition f = sum w_k f_k used by the engine (default: itself)."""
         return [(1.0, self)]

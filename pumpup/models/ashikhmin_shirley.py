@@ -179,7 +179,7 @@ class _Diffuse(BRDF):
         return Lobe(axis="normal", radial="cosine")
 
     def polar(self):
-        from .._polar import Polar
+        from ..core.hints import Polar
 
         # 1 - (1 - mu/2)^5 by log1p and expm1: a few ulps
         return Polar(kind="constant", scale=diffuse_albedo, ulps=8.0)
@@ -251,6 +251,7 @@ class AshikhminShirley(BRDF):
     ]
     kernel = staticmethod(_kernel)
     reference_fn = staticmethod(_reference)
+    own_sampler = True  # AS 2000 eq. 6-9 (sample_wi, pdf_wi): pumpup.sample and pumpup.mc_albedo draw with them
 
     def diffuse_probability(self) -> float:
         """P_d = rd (1 - rs) / (1 + rd (1 - rs)): the diffuse term's albedo bound rd (1 - rs) against 1,
