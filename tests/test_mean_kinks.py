@@ -15,7 +15,6 @@ import pytest
 from scipy.integrate import quad
 
 import pumpup
-from pumpup.operators import pumping
 
 SPECS = {
     "stretched_phong": {"type": "pumped", "base": {"type": "stretched_phong", "n": 0.12655111259560692, "p": 1.0},
