@@ -1,6 +1,10 @@
 import numpy as np
 import pytest
 
+#: the independent references are programs and modules the tests import, not tests: their doctests are not collected
+#: (some of them compute their tables when run as scripts)
+collect_ignore_glob = ["reference/*.py"]
+
 
 @pytest.fixture
 def rng():

@@ -57,10 +57,10 @@ def phong_albedo_1d(n, mu, stretched=False):
     """Independent albedo of reciprocal (c = (n+2)/(2 pi)) or stretched Phong.
 
     The azimuth about R in closed form, then a 1-D mpmath quadrature at 30 digits
-    (scripts/independent_reference.py, which never imports pumpup).  Returns
+    (tests/reference/independent_reference.py, which never imports pumpup).  Returns
     (value, error estimate).
     """
-    import independent_reference as ref
+    from reference import independent_reference as ref
 
     return ref.phong_1d(ref.SPHONG if stretched else ref.PHONG, n, mu)
 
@@ -122,3 +122,21 @@ def n_frame_integrand_against_eval(f, base):
         assert np.all(np.abs(got - ref) <= 1e-10 * np.abs(ref)), (mu, xs, got / ref - 1)
         low = min(low, float(np.min(got / _polar.n_integrand(base, mu, xs))))
     return low
+
+
+def load_script(path: str):
+    """The module of a script of the repository's ``scripts/`` folder (``"make/compensation_study.py"``), imported
+    from its file, for a test that runs one of its functions (scripts are programs, not a package)."""
+    import importlib.util
+    import os
+    import sys
+
+    full = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scripts", path)
+    name = "script_" + os.path.splitext(os.path.basename(path))[0]
+    if name in sys.modules:
+        return sys.modules[name]
+    spec = importlib.util.spec_from_file_location(name, full)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module

@@ -203,7 +203,7 @@ def test_ggx_tiny_alpha_at_grazing_finds_its_far_horizon_break(engine):
     """GGX alpha = 1e-4 at mu = 6.05e-5: the arc vanishes at tan(theta_h) = 3.3e4, 1 - tau_x = 1.7e-9, where the half
     vectors beyond tan(theta_h) = 1.45 still carry 4.9e-5 of the albedo.  ``_smooth_inverse`` put that break at 1 - tau
     = 6.8e-3, and both engines were 4.7-6.8e-9 off with estimates of 2.5e-9 and 2.8e-10 (found by
-    ``scripts/fuzz_engines.py``).  The 1-D path (frame 6), GGX's default, agreed with this reference to 1e-16."""
+    ``scripts/studies/fuzz_engines.py``).  The 1-D path (frame 6), GGX's default, agreed with this reference to 1e-16."""
     alpha, mu = 1e-4, 6.05e-5
     ref = _ggx_half_vector_reference(alpha, mu)
     f = pumpup.load({"type": "ggx", "alpha": alpha})
@@ -267,7 +267,7 @@ def test_anisotropic_axis_cuts_crossing_the_horizon():
 # --- the p-model near grazing incidence: the branch point beyond the cut of the level N.wo = mu -----
 
 def _p_reference(model, n, p, mu):
-    """(value, error) of tests/data/independent_p.json (30-digit mpmath, scripts/independent_p.py)."""
+    """(value, error) of tests/data/independent_p.json (30-digit mpmath, tests/reference/independent_p.py)."""
     import json
     import pathlib
 
@@ -321,7 +321,7 @@ def test_level_end_scales():
 
 # --- the compiled break finding against its plain numpy reference, bit for bit -------------------
 
-#: every built-in family of scripts/bench_albedo.py's FAMILIES whose hint has levels or kinks, the
+#: every built-in family of scripts/bench/bench_albedo.py's FAMILIES whose hint has levels or kinks, the
 #: other distributions and radial maps of the microfacet models, and compositions (pumped: levels of
 #: g; scaled and Kulla-Conty: the kinks of their tables)
 BREAK_MODELS = [
@@ -408,7 +408,7 @@ def test_engines_near_normal_incidence_see_the_shadowing_at_the_horizon(alpha, m
     theta_i, and the engines' grids, graded towards the horizon break on the scale of its distance to the end of
     the range, did not see it: the nested engine was 1.3-26 x its estimate on the first four cases (issue 14's twentieth
     session), the 2-D engine 3.3-62 x on five of the six (twenty-first; 2.7e-4 at mu = 1: 2.6e-11 off, estimate 4.1e-13), both
-    found by ``scripts/fuzz_engines.py``.  Both grids are now also graded on alpha's scale (``_nested._alpha_grading``).
+    found by ``scripts/studies/fuzz_engines.py``.  Both grids are now also graded on alpha's scale (``_nested._alpha_grading``).
     Reference: the 1-D path (frame 6), which agrees with 30-digit mpmath at mu = 1 (checked here)."""
     f = pumpup.load({"type": "ggx", "alpha": alpha})
     ref, eref = pumpup.albedo(f, mu, return_error=True, rtol=1e-13)
@@ -450,7 +450,7 @@ def test_2d_engine_sees_a_kink_that_enters_and_leaves_above_the_split():
     the arc at alpha = 0.435 and leaves it at 0.612, both within the kink scan's cell [1/2, 0.5025] of tau (alpha from
     60 deg to 0.33 rad).  With the map wrong at tau = 1/2 (previous test) the scan missed the first, and the last piece,
     open only between the two, had no node: the 2-D engine was 1.77e-7 off with an estimate of 1.4e-14 at every rtol
-    and first grid (found by ``scripts/fuzz_engines.py --two-d``).  Reference: a tensor Gauss-Legendre rule in the half
+    and first grid (found by ``scripts/studies/fuzz_engines.py --two-d``).  Reference: a tensor Gauss-Legendre rule in the half
     vector's spherical coordinates (within 4e-14 of the 1-D path and the nested engine)."""
     f = pumpup.load({"type": "torrance_sparrow", "d": "D1", "s": 96.59526104151392, "ior": 2.6169635397891735})
     mu = 0.965

@@ -21,7 +21,7 @@ def _generic(f, name):
 @pytest.mark.parametrize("row", [r for r in ROWS if r["phi"] == 0.0],
                          ids=lambda r: f"{r['model']}-{json.dumps(r['params'])}-mu{r['mu']}")
 def test_independent_reference_in_the_xz_plane(row):
-    # scripts/independent_anisotropic.py: two nested-quad methods that never import pumpup
+    # tests/reference/independent_anisotropic.py: two nested-quad methods that never import pumpup
     f = pumpup.load({"type": row["model"], **row["params"]})
     a, e = pumpup.albedo(f, row["mu"], return_error=True)
     assert np.isfinite(a) and np.isfinite(e)

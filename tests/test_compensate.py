@@ -123,7 +123,7 @@ def test_kulla_conty_lobe_in_closed_form(spec):
 @pytest.mark.parametrize("engine", ["nested", "2-D"])
 def test_kulla_conty_lobe_on_the_engines_near_grazing(engine):
     """The Kulla-Conty lobe of Phong n = 987 (f_avg 0.69) near mu = 5.1e-4 on the nested and 2-D engines (the fuzz's
-    reference, scripts/fuzz_engines.py --registry 47): D(N.wo), a spline in log(N.wo), about the normal, was 3.4 x (2-D)
+    reference, scripts/studies/fuzz_engines.py --registry 47): D(N.wo), a spline in log(N.wo), about the normal, was 3.4 x (2-D)
     and 3.0 x (nested) their estimates at rtol 1e-12 against the closed form D(mu) pi I (checked against scipy's quad
     above).  The hint's levels N.wo = 10^-k (compensate.TABLE_DECADES) grade the radial variable there."""
     from pumpup.engine import polar as _polar
@@ -237,7 +237,7 @@ def test_scaled_furnace_of_a_forced_non_reciprocal_base_stays_nested():
 def test_scaled_lobe_about_the_normal_against_rings():
     """Scaled Lafortune n = 148 (cx = cy = -1, a lobe about the normal's hint) near grazing incidence: 1 / U(N.wo), a
     spline in log(N.wo), has features on every scale of N.wo, all in the nested engine's last first interval of the
-    radial variable.  At rtol 1e-6 it was 1.56 x its estimate at mu = 2.6e-6 and 1.14 x at 0.01 (scripts/fuzz_engines.py
+    radial variable.  At rtol 1e-6 it was 1.56 x its estimate at mu = 2.6e-6 and 1.14 x at 0.01 (scripts/studies/fuzz_engines.py
     --registry 47); the hint's levels at N.wo = 10^-k (compensate.TABLE_DECADES) grade it.  The reference: quad in
     N.wo between the table's nodes, Gauss-Legendre in the azimuth where the lobe is positive."""
     from test_albedo_breaks import _rings
@@ -416,11 +416,13 @@ def test_cli_compensate_and_check(tmp_path, capsys):
 
 
 def test_study_rows_match_the_stored_table():
-    """scripts/compensation_study.py's own function on two rows of tables/compensation.nc (no timing);
+    """scripts/make/compensation_study.py's own function on two rows of tables/compensation.nc (no timing);
     and the stored refusal of Ward by Kulla-Conty."""
     from pathlib import Path
 
-    import compensation_study as cs
+    from helpers import load_script
+
+    cs = load_script("make/compensation_study.py")
 
     ds = pumpup.open_table(Path(__file__).resolve().parents[1] / "tables" / "compensation.nc")
     specs = json.loads(ds.attrs["specs"])

@@ -35,7 +35,7 @@ def test_bounded_models(spec):
 
 
 def test_engine_at_the_smallest_mu_against_the_independent_method():
-    import independent_reference as ref  # scripts/, never imports pumpup
+    from reference import independent_reference as ref  # never imports pumpup
 
     for name, code in [("ward", ref.WARD), ("cook_torrance", ref.CT)]:
         value, err = ref.albedo_A(code, 0.1, 1e-8)

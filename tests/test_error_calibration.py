@@ -1,5 +1,5 @@
 """The engines' error estimates bound the true error on every independent reference, at every
-tolerance (issue 14 item 4): the calibration harness of scripts/error_calibration.py.
+tolerance (issue 14 item 4): the calibration harness of scripts/calibration/error_calibration.py.
 
 A case whose reference error exceeds the tolerance (rtol * a) cannot judge that tolerance and is
 skipped (the ward_aniso rows of tests/data/independent_anisotropic.json below ~1e-7, the JSON
@@ -11,11 +11,13 @@ entry there.  The default suite runs the quick subset; the full set is marked sl
 
 import math
 
-import error_calibration as cal
 import numpy as np
 import pytest
+from helpers import load_script
 
 from pumpup.physics import quadrature as _errors
+
+cal = load_script("calibration/error_calibration.py")
 
 
 def test_compiled_estimate_matches_its_reference(rng):

@@ -52,7 +52,7 @@ def test_narrowest_microfacet_lobe_is_a_mirror(spec):
         assert np.all(np.abs(a - limit) <= e + 2 * (spec["alpha"] / mu) ** 3), (a, limit, e)
         if spec.get("shadowing", "separable") == "separable":
             # 30-digit mpmath, the outer integral in tan(alpha_h) / alpha and the inner over h's azimuth of
-            # 4 (wi.h) G1(N.wo) G1(mu) / mu, both by tanh-sinh (scripts/half_mpmath_reference.py ggx 1e-8 1e-6)
+            # 4 (wi.h) G1(N.wo) G1(mu) / mu, both by tanh-sinh (tests/reference/half_mpmath_reference.py ggx 1e-8 1e-6)
             assert abs(a[1] - 0.99994923964388905852) <= e[1] and e[1] < 1e-12, (a[1], e[1])
 
 

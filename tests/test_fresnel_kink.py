@@ -2,7 +2,7 @@
 up to cos = x0 = sqrt(1 - eta^2), total reflection, and has a square-root kink there; a small k makes it a near-kink.
 The 1-D path declines such a factor and the nested engine, blind to the kink, bisected towards it: fresnel over Blinn
 n = 5, eta = 0.551 took 0.25-0.41 s per value at rtol 1e-10, a pumped one's base table minutes (issue 14's twenty-first
-session, ``scripts/fuzz_engines.py --registry``).  The hints now carry the level N.wo = x0
+session, ``scripts/studies/fuzz_engines.py --registry``).  The hints now carry the level N.wo = x0
 (:func:`pumpup.models.metal.fresnel_levels`) and the albedo's kink at mu = x0 (``BRDF.albedo_breaks``).  The values are
 checked against an independent quadrature in spherical coordinates about N split at the kink."""
 
@@ -192,7 +192,7 @@ def test_tabulate_splits_at_the_models_own_kink():
 def test_beckmann_walter_correlated_with_fresnel(spec, mu):
     """Walter's G1 (a jump at its switch level) in the height-correlated G with a Fresnel factor: frame 4 was 7 x its
     estimate at rtol 1e-10 (the first case: 1.27e-11 off, estimate 1.8e-12) and 3.8 x at 1e-12 (the second), against the
-    2-D engine at rtol 1e-13 (found by ``scripts/fuzz_engines.py --registry``).  The nested engine takes it now."""
+    2-D engine at rtol 1e-13 (found by ``scripts/studies/fuzz_engines.py --registry``).  The nested engine takes it now."""
     from pumpup.engine import polar as _polar
 
     f = pumpup.load(spec)

@@ -31,7 +31,7 @@ def test_fresnel_over_a_sum_takes_its_terms():
 
 def test_fresnel_over_a_pumped_plastic_at_the_normal():
     """2-level g1 pumped plastic (n 290, ad 0.40) under F (eta 0.454, k 7.29) at mu = 1: as one term the nested engine
-    gave 0.468 +- 4e-4 and the 2-D engine 0.441 +- 0.011 for 0.959 (scripts/fuzz_engines.py --registry 48).  At wi = N
+    gave 0.468 +- 4e-4 and the 2-D engine 0.441 +- 0.011 for 0.959 (scripts/studies/fuzz_engines.py --registry 48).  At wi = N
     the integrand depends on N.wo alone: the reference is Gauss-Legendre in N.wo, graded towards the lobe at 1."""
     f = pumpup.load({"type": "fresnel", "base": {"type": "pumped", "base": {"type": "plastic", "n": 289.95982714742524,
                      "eta": 1.5957343463248426, "ad": 0.3995720056517486}, "g": "g1", "levels": 2},

@@ -79,8 +79,7 @@ def test_reproduce_changes_no_byte_of_the_checkout(tmp_path):
 
 @pytest.mark.slow
 def test_figure_data_and_plots_are_what_the_code_produces(tmp_path):
-    """scripts/pumping_figures.py and scripts/sampling_efficiency.py (minutes)."""
-    import sys
+    """scripts/make/pumping_figures.py and scripts/make/sampling_efficiency.py (minutes)."""
 
     from pumpup.figures import make_figures
 
@@ -90,8 +89,9 @@ def test_figure_data_and_plots_are_what_the_code_produces(tmp_path):
     for n in ("pumping_figures.nc", "stretched_phong_albedo.nc", "sampling_efficiency.nc"):
         shutil.copy(os.path.join(TABLES, n), tables / n)
     make_figures(str(tables), str(figures))
-    sys.path.insert(0, os.path.join(ROOT, "scripts"))
-    import sampling_efficiency
+    from helpers import load_script
+
+    sampling_efficiency = load_script("make/sampling_efficiency.py")
 
     sampling_efficiency.main(["--out", str(tables), "--figures", str(figures)])
     for n in ("pumping_figures.nc", "stretched_phong_albedo.nc", "sampling_efficiency.nc"):

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-import independent_microfacet as ind
+from reference import independent_microfacet as ind
 import pumpup
 from pumpup.models.cook_torrance import fresnel as fresnel_dielectric
 from pumpup.models.metal import fresnel as fresnel_complex
@@ -328,7 +328,7 @@ CROSS = [
 
 @pytest.mark.parametrize("dist,shadowing,g1", CROSS)
 def test_albedo_against_independent_quadrature(dist, shadowing, g1):
-    # scripts/independent_microfacet.py: textbook formulas, spherical coordinates about N, nested
+    # tests/reference/independent_microfacet.py: textbook formulas, spherical coordinates about N, nested
     # QUADPACK; it never imports pumpup
     for alpha, mu in itertools.product([0.05, 0.6], [1.0, 0.3, 1e-4]):
         spec = {"type": dist, "alpha": alpha, "shadowing": shadowing, **({"g1": g1} if dist == "beckmann" else {})}

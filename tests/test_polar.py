@@ -237,7 +237,7 @@ P_DATA = json.loads((pathlib.Path(__file__).parent / "data" / "independent_p.jso
 
 @pytest.mark.parametrize("model", ["stretched_phong", "retro"])
 def test_general_p_against_the_independent_references(model):
-    """scripts/independent_p.py (never imports pumpup): 30-digit mpmath about the lobe axis with the
+    """tests/reference/independent_p.py (never imports pumpup): 30-digit mpmath about the lobe axis with the
     azimuth integrated numerically, checked by two scipy orders about N.  At every rtol the estimate
     bounds the true error, and at rtol 1e-10 the value is within 1e-10."""
     rows = [e for e in P_DATA if e["model"] == model]

@@ -136,7 +136,7 @@ def test_fresnel_wrapper_of_stretched_phong_is_metal():
     (1, 1.1, 30.0, 0.001, 0.74238552420483239024887086292862664743),  # F's pole near c = 0
     (1, 1.5, 0.0, 0.2, 0.10831605403944787866771866254573111683)])
 def test_metal_against_mpmath(n, eta, k, mu, ref):
-    """metal against 40-digit mpmath values independent of pumpup (scripts/metal_mpmath_reference.py: tanh-sinh in the
+    """metal against 40-digit mpmath values independent of pumpup (tests/reference/metal_mpmath_reference.py: tanh-sinh in the
     lobe frame about R and in spherical coordinates about N, agreeing to 1e-41), at rtol 1e-8, 1e-10 and 1e-12."""
     f = pumpup.load({"type": "metal", "n": n, "eta": eta, "k": k})
     for rtol in (1e-8, 1e-10, 1e-12):

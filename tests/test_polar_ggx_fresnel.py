@@ -162,7 +162,7 @@ def test_near_kink_conductor_at_normal_incidence(shadowing):
     """eta = 0.271, k = 0.0605: F's branch point lies 0.017 off the real axis at c = 0.9646, a near-kink that frame 4
     (which takes such an index) cut on h's arc only.  At normal incidence wi.h hardly varies on h's circle, so the whole
     near-kink is the outer integrand's, and there was no cut: at mu = 1 GGX alpha 0.003 was 2.4e-11 off with an estimate
-    of 3.5e-12 (rtol 1e-10; found by scripts/fuzz_engines.py).  Now the elevation is cut where an end of the circle's
+    of 3.5e-12 (rtol 1e-10; found by scripts/studies/fuzz_engines.py).  Now the elevation is cut where an end of the circle's
     range of wi.h passes x0 (pumpup.engine.polar._pieces)."""
     eta, k, alpha = 0.27134575896438146, 0.0605363844525441, 0.003000403524851649
     f = pumpup.load({"type": "ggx", "alpha": alpha, "eta": eta, "k": k, "shadowing": shadowing})

@@ -182,7 +182,7 @@ def test_which_models_take_it():
     ({"type": "schlick", "r": 1e-6}, 1e-5, 45.887293650878604133),
     ({"type": "schlick", "r": 1e-6}, 1e-3, 1.1685049698945183549)])
 def test_against_30_digit_mpmath(spec, mu, ref):
-    """Narrow lobes against 30-digit mpmath values, independent of pumpup (scripts/half_mpmath_reference.py, a few
+    """Narrow lobes against 30-digit mpmath values, independent of pumpup (tests/reference/half_mpmath_reference.py, a few
     minutes each: tanh-sinh over tan(alpha_h) and over h's azimuth), at rtol 1e-10 and 1e-12."""
     f = pumpup.load(spec)
     for rtol in (1e-10, 1e-12):

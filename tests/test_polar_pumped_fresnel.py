@@ -2,7 +2,7 @@
 each ring, pumpup.engine.polar._ggx_ring_f) divided by the chain's g at each node, at mu >= N_FRESNEL_MU_MIN; the nested engine
 below (frame 4, which takes GGX with F there, has no chain; ``pumpup.engine.polar.one_d_part``).  Before, the nested engine
 took every mu: a 257-point table of 1-level g2 pumped GGX 0.1 with eta 0.2, k 3 took 0.70 s, now 0.28 s
-(``scripts/bench_albedo.py --pumped-f``).
+(``scripts/bench/bench_albedo.py --pumped-f``).
 
 Checked against the model's own ``eval`` integrated over the azimuth by scipy (the integrand, g included) and the nested
 engine at rtol 1e-13, the estimate bounding the difference at every rtol; the ring's error is divided by g as the node is

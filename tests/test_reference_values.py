@@ -1,4 +1,4 @@
-"""The engine against the independent reference (scripts/independent_reference.py, which
+"""The engine against the independent reference (tests/reference/independent_reference.py, which
 computes every number by nested quadrature in spherical coordinates and never imports
 pumpup; tests/data/independent_reference.json holds its output)."""
 

@@ -80,7 +80,7 @@ def _ct_rings(f, mu, extra):
 
 
 #: (m, mu): scaled Cook-Torrance (F0 0.32) 5.3 x its estimate at (0.538, 0.9999), 1.57 x at (0.597, 1), 1.04 x at
-#: (0.428, 1) (scripts/fuzz_engines.py --registry 49), with the table's spline across the break
+#: (0.428, 1) (scripts/studies/fuzz_engines.py --registry 49), with the table's spline across the break
 SCALED_CASES = [(0.5380484445259031, 0.9999), (0.5966016958353019, 1.0), (0.42826548851833385, 1.0)]
 
 

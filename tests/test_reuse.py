@@ -61,7 +61,7 @@ def test_the_estimate_bounds_the_error_of_a_barely_resolved_table(spec):
     """The quintic spline's error is the larger difference to the cubic's and to the quintic's through every other node:
     with the cubic's alone, Phong n = 20000 (a feature that the sweep's grid barely resolves) was 1.1e-9 off
     with an estimate of 3.5e-10.  Ward's and anisotropic Ward's steep rise at grazing incidence makes the whole table
-    miss the tolerance: the table is cut short and the rest is computed afresh (scripts/reuse_calibration.py)."""
+    miss the tolerance: the table is cut short and the rest is computed afresh (scripts/calibration/reuse_calibration.py)."""
     f = pumpup.load(spec)
     pumpup.tabulate(f, mu=MU, progress=False)
     m, e = pumpup.mean_albedo(f, return_error=True)
@@ -114,7 +114,7 @@ def test_reuse_agrees_with_fresh_two_d_models(spec):
 def test_a_table_with_nodes_that_share_theta():
     """Beckmann alpha 0.0052 with Walter's G1: its switch level mu = 0.0083 is a jump of the albedo, and the adaptive grid
     bisected towards it down to the last bit, 70 nodes that share theta = arccos(mu).  The mean from that table raised
-    scipy's "Expect x to not have duplicates" (found by scripts/fuzz_engines.py --mean); it keeps the last of each now,
+    scipy's "Expect x to not have duplicates" (found by scripts/studies/fuzz_engines.py --mean); it keeps the last of each now,
     and agrees with the mean afresh within the two estimates."""
     f = pumpup.load({"type": "beckmann", "alpha": 0.005184313347496449, "g1": "walter"})
     fresh, e_fresh = pumpup.mean_albedo(f, return_error=True)

@@ -282,7 +282,7 @@ def efficiency():
 
 
 def test_efficiency_table_regression(efficiency):
-    """The stored study (scripts/sampling_efficiency.py) equals a fresh computation within the
+    """The stored study (scripts/make/sampling_efficiency.py) equals a fresh computation within the
     quadrature error estimates."""
     import os
 

@@ -124,7 +124,7 @@ INDEPENDENT = json.load(open(os.path.join(os.path.dirname(__file__), "data", "in
 
 @pytest.mark.parametrize("row", INDEPENDENT, ids=lambda r: f"{r['params']['ax']}-{r['params']['ay']}-mu{r['mu']}-phi{r['phi']:.3f}")
 def test_albedo_against_the_independent_reference(row):
-    # scripts/independent_ward_aniso.py: two nested-quad methods written without pumpup, agreeing to 1.2e-13 or better
+    # tests/reference/independent_ward_aniso.py: two nested-quad methods written without pumpup, agreeing to 1.2e-13 or better
     f = pumpup.load({"type": "ward_aniso", **row["params"]})
     for rtol in (1e-8, 1e-10, 1e-12):
         a, e = pumpup.albedo(f, row["mu"], phi=row["phi"], rtol=rtol, return_error=True)
@@ -144,7 +144,7 @@ def test_nested_engine_at_other_azimuths_against_the_independent_reference(row):
 
 @pytest.mark.parametrize("mu,value", [(1e-8, 1.2078149107898225), (1e-4, 0.012506657640590035)])
 def test_grazing_narrow_lobe_against_a_long_double_reference(mu, value):
-    # scripts/independent_ward_aniso_grazing.py: two cancellation-free methods in long double, written without pumpup,
+    # tests/reference/independent_ward_aniso_grazing.py: two cancellation-free methods in long double, written without pumpup,
     # agreeing to 1e-19 (phi the double below: 5e-17 relative under the values at pi/4 + 0.1, allowed as 1e-16).  At
     # mu = 1e-8 the nested and 2-D engines (wi turned by phi) give 1.2078149107921772 +- 1.3e-12 and
     # 1.20781491079219 +- 7.5e-13: 2e-12 off, left open (the closing note of issue 14's fourteenth session)

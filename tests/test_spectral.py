@@ -127,7 +127,7 @@ def test_pump_per_wavelength():
 
 
 def test_metals_table_file():
-    """tables/metals.nc (scripts/make_metals_table.py): valid, <= 1 within error, recomputable."""
+    """tables/metals.nc (scripts/make/make_metals_table.py): valid, <= 1 within error, recomputable."""
     from pathlib import Path
 
     path = Path(__file__).resolve().parent.parent / "tables" / "metals.nc"

@@ -120,7 +120,7 @@ def test_a_g1_level_albedo_has_a_kink_where_its_bound_equals_the_bound_at_the_no
 
 
 def test_two_level_g1_pumped_ward_at_normal_incidence_bounds_its_error():
-    """Rough Ward (m = 0.885, found by ``scripts/fuzz_engines.py --two-d``): before its level-2 table was split at the
+    """Rough Ward (m = 0.885, found by ``scripts/studies/fuzz_engines.py --two-d``): before its level-2 table was split at the
     level-1 kink v = 0.0605 (u(v) = u(1), above), the table bunched 37 nodes between 0.05 and 0.07 and rounded the
     kink off over 1e-4 in theta_o, and the nested engine was 1.6e-12 off at mu = 1 with an estimate of 8.1e-13 (rtol
     1e-10).  Reference: at normal incidence the albedo is a 1-D integral over theta_o (scipy's quad, split at every

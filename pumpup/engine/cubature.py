@@ -35,7 +35,7 @@ adaptive cubature then finds its lobes and kinks by itself, more slowly.
 The reported error is the sum of |K - G| over all rectangles plus a rounding term: it is
 pessimistic on smooth integrands by design (true error / estimate at most 0.18, median 1.3e-3
 over every independent reference of ``tests/`` at rtol 1e-6 .. 1e-12,
-``scripts/error_calibration.py``), and the tests check it against closed forms and against
+``scripts/calibration/error_calibration.py``), and the tests check it against closed forms and against
 independent quadratures.  QUADPACK's calibrated estimate (:mod:`pumpup.physics.quadrature`, used by the
 1-D path) is not used here by default: the integrand of a pumped or compensated BRDF has kinks
 at the knots of its albedo table that no hint marks, and there the calibrated estimate was

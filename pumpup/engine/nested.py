@@ -95,7 +95,7 @@ __all__ = ["ENABLED", "disabled", "inner_error", "integrate", "interval_error", 
 ENABLED = True
 
 #: initial intervals of tau_x before the breaks are added (as the 2-D engine's NX_INIT).  4 saved 5-40 %
-#: of the evaluations per mu and stayed honest on scripts/error_calibration.py (max ratio 0.126), but the
+#: of the evaluations per mu and stayed honest on scripts/calibration/error_calibration.py (max ratio 0.126), but the
 #: doctest of pumpup.luts.audit then failed: GGX alpha = 1e-8 at mu = 1e-6, which converges at no
 #: budget, gave values 9e-6 apart (within their estimates, 3.5e-4) at rtol 1e-7 and 1e-8 with 200
 #: regions; 2 under-reported (Kulla-Conty lobe of Phong n = 20, mu = 0.3: 2.7 x the estimate)
@@ -476,7 +476,7 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
 
 
 #: segments per call of :func:`_evaluate`: its block arrays (a dozen of 8 bytes per segment and outer node, more where
-#: the ends are graded) grow with the segments a refinement round adds.  Found by ``scripts/fuzz_engines.py --fmax 22``
+#: the ends are graded) grow with the segments a refinement round adds.  Found by ``scripts/studies/fuzz_engines.py --fmax 22``
 #: (issue 14's twenty-second session): a nested reference at max_regions 200000 grew past 23 GB and the kernel killed
 #: it.  Each segment's values do not depend on the others in its call, so the chunks change no bit
 SEG_CHUNK = 100_000
@@ -533,7 +533,7 @@ def _alpha_grading(lobe, mu: float) -> np.ndarray:
     theta_i, but near it the outer integrand has the whole feature next to the break, where the grading towards the break
     (on the scale of its distance to the end of the range) did not see it: GGX alpha = 1.4e-3 at mu = 1 was 6.4 x its
     estimate at rtol 1e-10, alpha = 3e-4 at mu = 1 - 1e-9 26 x at 1e-12 (issue 14's twentieth session,
-    ``scripts/fuzz_engines.py``)."""
+    ``scripts/studies/fuzz_engines.py``)."""
     if lobe.axis != "half" or lobe.radial not in ("ggx", "beckmann"):
         return np.array([])
     a = math.sqrt(lobe.sharpness) if lobe.radial == "ggx" else float(lobe.sharpness)

@@ -27,7 +27,7 @@ beta only through N.wo, so for every u the integral over the visible arc |beta| 
   its error added to the outer estimate through the outer weights
 
 (the same closed form as Lewis's H_s, 002 sec. 4.1, and as ``phong_1d`` of
-``scripts/independent_reference.py``).  With b^2 - a^2 = sin^2(alpha) - mu^2 and
+``tests/reference/independent_reference.py``).  With b^2 - a^2 = sin^2(alpha) - mu^2 and
 b^2 - (mu - a)^2 = (1 - u)(u - cos 2 theta_i) the sines and angles are computed without
 cancellation, and b (sin beta0 - sin beta1) as mu^2 (1 - 2u) / (b sin beta0 + b sin beta1).
 
@@ -51,7 +51,7 @@ interval (``N_INIT``).
 Error estimate (issue 14 item 4): per interval QUADPACK's calibration of |K - G|,
 resasc min(1, (200 |K - G| / resasc)^1.5) with its floor 50 eps resabs
 (:func:`pumpup.physics.quadrature.calibrated`), summed, plus the rounding term ``ROUNDING`` sum |K| and
-the bound of the part beyond Z_MAX.  Measured by ``scripts/error_calibration.py`` over every
+the bound of the part beyond Z_MAX.  Measured by ``scripts/calibration/error_calibration.py`` over every
 independent reference of ``tests/`` (30-digit mpmath Phong values n = 0 .. 1e5 from normal to
 grazing incidence, tests/data/independent_reference.json, the closed forms) at rtol 1e-6 ..
 1e-12: true error / estimate at most 0.015 (median 2.5e-4; the raw |K - G| gave at most 0.03),
@@ -127,7 +127,7 @@ so that each piece lies its own length from it.  The outer variable is cut at th
 the horizon break and the range's end, :func:`_pieces`).  Each K carries its error (relative ``itol``, or an absolute
 share of the integral's lower bound so far), added to the outer estimate through the Kronrod weights and into |K - G|
 before its calibration.  GGX alpha = 0.001 showed why the cuts are needed: without the outer ones the first version was
-1.6e-10 off at rtol 1e-12 with an estimate of 6e-13 (30-digit mpmath, ``scripts/half_mpmath_reference.py``, and the
+1.6e-10 off at rtol 1e-12 with an estimate of 6e-13 (30-digit mpmath, ``tests/reference/half_mpmath_reference.py``, and the
 nested engine agree).  alpha > 1 (P then has a singularity near N.wo = 1, which is not graded) and Torrance-Sparrow's
 D2 stay on the nested engine.
 
@@ -168,7 +168,7 @@ and since its eighteenth the pieces from x = 0 up to x_mu / 8 in u = ln x, grade
 pi / 2 from that axis; alpha = 1e-8: 608 evaluations per mu, a 257-point table in 15 ms instead of 19-23).
 No inner rule: 41-184 evaluations per mu for alpha
 >= 0.1, a 257-point table in 0.7-2.6 ms for GGX and Schlick (frame 4 took 20-70 ms), 4-12 ms for Beckmann (frame 4: 45-200
-ms), and mu down to the smallest double.  ``scripts/n_frame_calibration.py`` measures it against frame 4
+ms), and mu down to the smallest double.  ``scripts/calibration/n_frame_calibration.py`` measures it against frame 4
 (:func:`without_n_frame`) at rtol 1e-13 over 45 models, 64 mu and rtol 1e-6 ... 1e-12: at most 4e-5 of the estimate beyond
 that reference's own error.
 
@@ -188,7 +188,7 @@ table, and an index whose other singularities (the refracted cosine's branch poi
 S passes 3^j times the scale of F's pole near c = 0 (:func:`fresnel_pole`) and of its branch point.  17-129 F values per
 ring (27-35 on average), 1.3-1.9 us; the 216 mu >= 0.248 of a 257-point table at rtol 1e-10 took 39-111 ms where frame 4
 takes 87-196 ms (GGX alpha 0.3 with eta 0.2, k 3; alpha 0.02 with ior 1.5), and the 41 below 0.248 stay at frame 4's
-35-50 ms (``scripts/bench_albedo.py --nframe-f``).  Not taken: a rule per ring for S < 1/8 (adaptive 10/21 in psi graded
+35-50 ms (``scripts/bench/bench_albedo.py --nframe-f``).  Not taken: a rule per ring for S < 1/8 (adaptive 10/21 in psi graded
 at D's and F's scales, measured at ~400 evaluations per ring: no faster than frame 4 there); pumped or 1/E-scaled GGX with
 F (the nested engine, as before: frame 4 below 0.248 has no chain); Beckmann with F (frame 4: its ring's Fourier
 coefficients are Bessel functions e^-kappa I_k(kappa), not attempted).
@@ -198,7 +198,7 @@ takes frame 6 since issue 14's twenty-second session (``Polar.fmax``, :func:`wit
 on N.wo alone, so it is one factor per ring, as a pumped chain's g is; its kink N.wo = mu is the cut d = 0, and the
 elevation is cut about F's branch point and pole as a pumped metal's (:func:`chain_cuts`).  A near-kink (branch point
 within :data:`LOBE_F_Y0_MIN` of the real axis, :data:`CHAIN_F_Y0_MIN` with a chain) stays on the nested engine.  A
-257-point table takes 3-12 ms where the nested engine took 0.2-0.4 s (``scripts/bench_albedo.py --fmax``).
+257-point table takes 3-12 ms where the nested engine took 0.2-0.4 s (``scripts/bench/bench_albedo.py --fmax``).
 
 A model offers this path through :meth:`pumpup.core.BRDF.polar`, which returns a
 :class:`Polar` hint (or None); ``pumpup.albedo`` uses it before the 2-D engine.  The 2-D
@@ -230,7 +230,7 @@ ENABLED = True
 ROUNDING = 64.0 * np.finfo(float).eps
 
 #: initial subintervals of every piece (1 since the calibrated estimate: every piece is smooth
-#: after its substitution, and 2 only doubled the evaluations; measured in scripts/error_calibration.py)
+#: after its substitution, and 2 only doubled the evaluations; measured in scripts/calibration/error_calibration.py)
 N_INIT = 1
 
 
@@ -2030,7 +2030,7 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
             # in alpha; near normal incidence c hardly varies on the circle and the whole near-kink is K's.  Cuts there
             # and at -+ (that scale / 2) 4^j, not smoothed (code 3), as frame 5's in the lobe frame.  Without them GGX
             # alpha = 0.003 with eta 0.271, k 0.0605 at mu = 1 was 2.4e-11 off with an estimate of 3.5e-12 (rtol 1e-10;
-            # issue 14's twentieth session, scripts/fuzz_engines.py)
+            # issue 14's twentieth session, scripts/studies/fuzz_engines.py)
             x0, y0 = mp[13], mp[14]
             st0 = math.sqrt((1.0 - x0) * (1.0 + x0)) if 0.0 < x0 < 1.0 else 0.0
             if st0 > 0.0 and y0 < x0 and y0 < LOBE_F_WIDE * st0:
@@ -2296,7 +2296,7 @@ RING_F_N0 = 16
 RING_F_NMAX = 128
 #: ... and takes |W_N - W_N/2| times the larger ratio of the last three such steps as W_N's error where both ratios are at most
 #: this (geometric decay of F's coefficients; with the last ratio alone, from N = 16 on, it was 1100 x below the true error
-#: of a strong absorber, eta 1.1, k 6, at itol 1e-6: measured by scripts/ring_fresnel_calibration.py)
+#: of a strong absorber, eta 1.1, k 6, at itol 1e-6: measured by scripts/calibration/ring_fresnel_calibration.py)
 RING_F_RATIO = 0.5
 #: :func:`_ring_f_sums` sums term by term where nn |1 - z| is below this (at most the sample n = 0, where 1 - rho < 2 / nn:
 #: n >= 1 has |1 - z| >= rho sin(pi / nn)); until issue 14's twenty-third session, where |1 - z| < 0.25, up to ~nn / 12
@@ -3421,7 +3421,7 @@ _RULES = {"gk15": (_NODES, _WK, _WG), "gk21": (NODES21, WK21, WG21)}
 #: 1e-12, against the lobe frame's engine at 1e-13 on the same BRDFs: the worst true error was 0.49 of
 #: the estimate (one case excepted, where the lobe frame was the one off: retro n = 10 at mu = 0.3705,
 #: 9e-13, by the nested engine and this one at 1e-13); with the raw |K - G| it was 1.41, without the
-#: pi / 16 cuts 4.19.  `python scripts/pumped_calibration.py` repeats it against the nested engine at
+#: pi / 16 cuts 4.19.  `python scripts/calibration/pumped_calibration.py` repeats it against the nested engine at
 #: 1e-13 (in the tree): worst 0.50 over 149 mu.
 CHAIN_SAFETY = 3.0
 #: the rule of a pumped lobe's quadrature over the elevation (and of the ring table's)

@@ -48,9 +48,9 @@ QUADPACK's calibration of |K - G| (:func:`pumpup.physics.quadrature.calibrated`)
 :data:`pumpup.engine.polar.ROUNDING` times the sum of |K|.
 
 Checked in ``tests/test_slope.py`` against ``tests/data/independent_ward_aniso.json`` (two nested-quad methods written
-without pumpup, ``scripts/independent_ward_aniso.py``), against the nested engine at rtol 1e-13 (the half vector's polar
+without pumpup, ``tests/reference/independent_ward_aniso.py``), against the nested engine at rtol 1e-13 (the half vector's polar
 angle and azimuth), against Ward's isotropic 1-D path (complete elliptic integrals) at a_x = a_y, and the ray integral
-against scipy's quadrature (:func:`ray_reference`); ``scripts/slope_calibration.py`` over 9 pairs of slopes x 14 mu x 4
+against scipy's quadrature (:func:`ray_reference`); ``scripts/calibration/slope_calibration.py`` over 9 pairs of slopes x 14 mu x 4
 azimuths x 4 rtol.  At a_x / a_y = 1000 the nested engine is off by up to 1.3e-8 with estimates of 5e-14, where the slope
 path agrees with both independent methods.
 """
@@ -263,7 +263,7 @@ def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk
     # direction of the smaller slope's axis (pi / 2 and 3 pi / 2 where a_y < a_x): |e| J(theta) has a branch point that
     # close to the real axis.  The rule's 7 and 15 points on an interval ending near theta_a agreed while both missed:
     # a_x = 0.743, a_y = 0.0149 at mu = 1 (phi = 5.898) was 8.0e-10 off with an estimate of 4.7e-11 at rtol 1e-8, 72 x at
-    # mu = 1 - 1e-9 and rtol 1e-10 (scripts/fuzz_engines.py --registry 47; issue 14's twenty-fourth session).  Cuts at
+    # mu = 1 - 1e-9 and rtol 1e-10 (scripts/studies/fuzz_engines.py --registry 47; issue 14's twenty-fourth session).  Cuts at
     # theta_a and graded by EDGE_FACTOR from the branch point's distance on both sides
     if ax != ay:
         dist = math.atanh(min(ax, ay) / max(ax, ay))

@@ -41,7 +41,7 @@ from ..physics.fresnel import fresnel_dielectric as fresnel  # noqa: F401  (pump
 #: below and 0.952 above for Cook-Torrance m = 0.538, 2.28 and 2.68 for Torrance-Sparrow D1 e = 2.  A table's spline
 #: went across it, its knots bunched there, and an engine integrating 1 / U(N.wo) of a 1/E scaling across those knots
 #: under-reported: scaled Cook-Torrance m = 0.538 at mu = 0.9999 was 4.4e-10 off with an estimate of 8.2e-11 at rtol 1e-8
-#: and 1e-10 (scripts/fuzz_engines.py --registry 49 found m = 0.428 at mu = 1, 1.04 x; issue 14's twenty-fifth session)
+#: and 1e-10 (scripts/studies/fuzz_engines.py --registry 49 found m = 0.428 at mu = 1, 1.04 x; issue 14's twenty-fifth session)
 RETRO_BREAK = math.sqrt(0.5)
 
 

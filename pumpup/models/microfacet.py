@@ -251,7 +251,7 @@ _K = Param(None, lo=0.0, hi=MAX_INDEX, doc="conductor: extinction coefficient (w
 #: (:class:`_WiHKink`).  Measured against the nested and 2-D engines at rtol 1e-13 (eta 0.551; GGX 0.3, 0.02, Beckmann
 #: 0.1; mu 0.05 ... 0.95): frame 4 was up to 1.3e5 x its estimate for y0 = 0 (k = 0: total reflection below eta = 1; GGX
 #: 0.3 at mu = 0.05 1.0e-7 off, estimate 7.9e-13) and y0 = 6.6e-13, 18 x for 6.6e-10, within its estimate from 6.6e-8 up
-#: (issue 14's twenty-first session, ``scripts/fuzz_engines.py --registry``)
+#: (issue 14's twenty-first session, ``scripts/studies/fuzz_engines.py --registry``)
 POLAR_F_Y0_MIN = 1e-6
 
 
@@ -322,7 +322,7 @@ class _Microfacet(BRDF):
             # Walter's G1 (its jump at the switch level) in the height-correlated G with a Fresnel factor: frame 4 was up
             # to 7 x its estimate against the 2-D engine at rtol 1e-13 (alpha 0.0032, ior 1.917, mu 1.75e-6: 1.27e-11 off,
             # estimate 1.8e-12 at rtol 1e-10; alpha 0.3, ior 1.5: 3.8 x at 1e-12), the nested engine within 0.02 x of its
-            # own (issue 14's twenty-first session, scripts/fuzz_engines.py --registry); separable G, or F = 1, is fine
+            # own (issue 14's twenty-first session, scripts/studies/fuzz_engines.py --registry); separable G, or F = 1, is fine
             return None
         if eta > 0.0:
             from .metal import fresnel_levels

@@ -417,7 +417,7 @@ class _Lookup:
 #: grid's last interval, [7/8, 1] (N.wo < 0.21), whose 7- and 15-point rules agreed while both missed.  Scaled Lafortune
 #: n = 148 (cx = cy = -1, cz = 1) at rtol 1e-6 was 1.14-1.56 x its estimate at every mu from 0.01 down to 2.6e-6, the
 #: Kulla-Conty lobe of Phong n = 987 (f_avg 0.69) at rtol 1e-12 3.4 x on the 2-D engine, the fuzz's reference
-#: (scripts/fuzz_engines.py --registry 47), and g2 pumped Minnaert k = 0.31 at mu = 0.88 4.1 x at every rtol from 1e-6 to
+#: (scripts/studies/fuzz_engines.py --registry 47), and g2 pumped Minnaert k = 0.31 at mu = 0.88 4.1 x at every rtol from 1e-6 to
 #: 1e-12 (issue 14's twenty-fourth session).  A lobe about another axis has N.wo vary along its arcs, where the estimate
 #: held (levels there cut every arc: 1.2-2.5 x the time)
 TABLE_DECADES = tuple(10.0 ** -k for k in range(1, 9))
@@ -641,7 +641,7 @@ class Pumped(BRDF):
 
     #: pairs per pass when many are evaluated at once: the base's values and the directions are
     #: still in the cache when the chain kernel reads them (2e6 pairs, 3-level Phong: 26 -> 21 ns
-    #: per pair, measured with scripts/bench_eval.py)
+    #: per pair, measured with scripts/bench/bench_eval.py)
     BLOCK = 8192
 
     def _eval(self, wi, wo):

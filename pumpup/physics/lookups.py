@@ -230,7 +230,7 @@ def scale_bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, mar
     of m (pump._Product, scaled up by its 1 + epsilon); below it the table's spline look-up.  The
     kernels below write it out (a call per look-up cost 20 x the look-up; with numba's
     ``inline="always"`` Kulla-Conty evaluated at 3.5 x its base against 1.35 x written out, measured
-    with scripts/bench_compensate.py in one sitting)."""
+    with scripts/bench/bench_compensate.py in one sitting)."""
     if m > pmlo:
         s = pcstart[min((float_bits(m) >> CELL_SHIFT) - pcbase, pcstart.shape[0] - 1)]
         while m >= plo[s + 1]:

@@ -23,7 +23,7 @@ a nested engine; ``pumpup.albedo``'s tensor rule uses :func:`calibrated_array` w
 
 What was measured
 -----------------
-``scripts/error_calibration.py`` prints, for the 1-D path (``pumpup.engine.polar``) and the 2-D
+``scripts/calibration/error_calibration.py`` prints, for the 1-D path (``pumpup.engine.polar``) and the 2-D
 engine, the distribution of true error / estimate over every independent reference in
 ``tests/`` (``tests/data/independent_reference.json``, ``independent_anisotropic.json``, the
 30-digit mpmath Phong values, the closed forms) at rtol 1e-6 .. 1e-12, with the raw and the
@@ -49,7 +49,7 @@ the engine's favour); the Kulla-Conty lobe of Phong n = 20 at rtol 1e-10, 0.89 x
 the raw estimate).  So the 2-D engine keeps the raw
 |K - G| (MODE_2D = "raw"): honesty wins.
 
-Measured (``PYTHONPATH=.:scripts:tests python scripts/error_calibration.py --worst``, 168
+Measured (``PYTHONPATH=.:scripts:tests python scripts/calibration/error_calibration.py --worst``, 168
 independent references x rtol 1e-6, 1e-8, 1e-10, 1e-12): 1-D path, true error / estimate at
 most 0.015 calibrated (0.03 raw), never above 1.  The 2-D engine on the same (smooth, or with
 every kink marked) references: at most 0.12 calibrated, 0.18 raw, 0.23 with "min"; but its

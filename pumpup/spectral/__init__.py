@@ -372,7 +372,7 @@ class SpectralMetal(Spectral):
         compiled pass and only the Fresnel factor F(eta + i k, Theta_min) per wavelength
         (000 eq. 27, 28; :func:`pumpup.spectral.kernels.metal_eval_kernel`, whose numpy twin is
         ``metal_eval_reference``).  Equal to the one-wavelength models (``self.models``) to a few
-        ulp; 8 wavelengths cost about 2x one ``Metal.eval`` (``scripts/bench_spectral.py``).
+        ulp; 8 wavelengths cost about 2x one ``Metal.eval`` (``scripts/bench/bench_spectral.py``).
         """
         from .kernels import flat_pairs, fresnel_constants, metal_eval_kernel
 

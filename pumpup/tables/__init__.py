@@ -333,7 +333,7 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
     # the interval that ends at mu = 1: its midpoint in log(mu) lies at theta / sqrt(2) of its lower end's theta, so 70 %
     # of it in theta had no check.  A sharp lobe's pumped level turns there (the lobe reaches the normal below theta ~
     # its width: pumped plastic n = 5284 was 3.1e-7 off at mu = 0.99995 with a margin of 2.0e-7, found by
-    # scripts/fuzz_engines.py --tables 43), and so does a g2 level whose bound crosses the diagonal within it (a kink
+    # scripts/studies/fuzz_engines.py --tables 43), and so does a g2 level whose bound crosses the diagonal within it (a kink
     # the table's one spline goes across: Pumped.albedo_kinks).  It is checked at 1 - mu = (1 - a) 2^-k too, down to
     # NEAR_ONE_MIN, and the largest miss there counts (issue 14's twenty-third session)
     pts = _near_one(grid[-2])
@@ -341,7 +341,7 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
         # a model that reads pumpup's own tables (a pumped level's g, a compensation's E) inherits their interpolation
         # error between their nodes, and those nodes are this grid's and its midpoints: a check there is blind to it.
         # Kulla-Conty over Torrance-Sparrow D1 (s 844, ior 1.53) was exact at its nodes and midpoints and 6.0e-8 off at
-        # mu = 0.039 with a margin of 5.9e-9 (scripts/fuzz_engines.py --tables 44; issue 14's twenty-third session).  The
+        # mu = 0.039 with a margin of 5.9e-9 (scripts/studies/fuzz_engines.py --tables 44; issue 14's twenty-third session).  The
         # thirds of each interval in log(mu) are no nodes of a dyadic refinement; one third alone left it 1.24 x its
         # margin (the interval held two of E's pieces), both 0.58 x
         lx = np.log(grid)
@@ -798,7 +798,7 @@ def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False, m
 
     # a pumped level's albedo has kinks (BRDF.albedo_kinks): first intervals end there.  Without them a 2-level g1
     # pumped stretched Phong (n = 0.127, p = 1: kinks at mu = 0.309, 0.345, 0.741, 0.745) had a mean 1.05e-9 off with an
-    # estimate of 1.0e-10 (issue 14's twentieth session, scripts/fuzz_engines.py --mean)
+    # estimate of 1.0e-10 (issue 14's twentieth session, scripts/studies/fuzz_engines.py --mean)
     from ..engine.cubature import _smooth_inverse
 
     # and two more towards grazing incidence, tau = 1/16 and 1/32 (mu = 0.011, 0.0029): the albedo there turns on the

@@ -11,7 +11,7 @@ about 220 and 97 fresh values:
   node (the interpolation error of the quintic is far below that of the cubic where both resolve the
   albedo; where the grid barely resolves a feature both can be off alike, and the coarser grid then
   misses it by far more: Phong n = 20000 on the sweep's grid was 1.1e-9 off with a difference to the
-  cubic's of 3.5e-10, to the coarser quintic's of 2.9e-9; ``scripts/reuse_calibration.py``), plus the
+  cubic's of 3.5e-10, to the coarser quintic's of 2.9e-9; ``scripts/calibration/reuse_calibration.py``), plus the
   table's quadrature errors through the absolute weights of the rule.  The part below the
   table's smallest mu is integrated afresh (adaptive Gauss-Kronrod in mu).  Where that estimate misses
   the requested tolerance because of a steep rise at grazing incidence that the grid does not resolve
@@ -153,7 +153,7 @@ def mean_from_table(brdf, rtol: float, fresh_part):
     mu, a, e, _ = t
     # nodes a few doubles apart in mu can share theta = arccos(mu) (an adaptive grid that bisected towards a jump of the
     # albedo down to the last bit: Beckmann alpha 0.0052 with Walter's G1, whose switch level is a jump, put 70 nodes at
-    # mu = 0.00829462; the splines refused duplicate nodes, found by scripts/fuzz_engines.py --mean): the last of each
+    # mu = 0.00829462; the splines refused duplicate nodes, found by scripts/studies/fuzz_engines.py --mean): the last of each
     theta = np.arctan2(np.sqrt((1.0 - mu) * (1.0 + mu)), mu)
     keep = np.r_[theta[:-1] != theta[1:], True]
     mu, a, e = mu[keep], a[keep], e[keep]

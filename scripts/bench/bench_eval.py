@@ -1,0 +1,114 @@
+"""Evaluations per second of every built-in model, and the cost relative to reciprocal Phong.
+
+In the spirit of 000 Table 1 / Table 5 (the paper found stretched Phong only 8 % dearer than
+Phong).  One core, 2e6 random direction pairs in the upper hemisphere, best of 5 runs after
+a warm-up call (so numba compilation is not timed).  The baseline (reciprocal Phong) is
+measured in the same run.
+
+    python scripts/bench/bench_eval.py [--pumped] [--spectral]
+
+(These are the kernels, ``_eval``.  The cost of ``BRDF.eval``'s input checks, and eval against a
+fused numpy expression, is ``python scripts/bench/bench_albedo.py --eval``.)
+
+``--spectral`` also times the spectral gold of 000 sec. 5 (8 wavelengths, n = 20) against one
+wavelength (the scalar ``metal``), with input checks on both: 000 eq. 27/28 with the Fresnel factor
+evaluated directly per wavelength, and eq. 28 with F(Theta_min) tabulated per wavelength.
+
+``--pumped`` also builds a 3-level pumped Phong (g2, n = 20) and reports its evaluation cost
+relative to the base and the time to build its three albedo tables (issue 4's targets: at most
+2 x the base, under a second).  The build is timed twice: first in the process (n = 21, which
+also loads the compiled kernels) and then warm (n = 20); tables are computed on
+``pumpup.tables.THREADS`` threads (default one per core).
+"""
+
+import sys
+import time
+
+import numpy as np
+
+import pumpup
+
+N = 2_000_000
+
+
+def directions(rng, n):
+    v = rng.normal(size=(n, 3))
+    v /= np.linalg.norm(v, axis=-1, keepdims=True)
+    v[:, 2] = np.abs(v[:, 2])
+    return v
+
+
+def rate(f, wi, wo, repeat=5):
+    f._eval(wi[:10], wo[:10])  # compile / load the cached kernel
+    best = np.inf
+    for _ in range(repeat):
+        t = time.perf_counter()
+        f._eval(wi, wo)
+        best = min(best, time.perf_counter() - t)
+    return len(wi) / best
+
+
+def main():
+    rng = np.random.default_rng(1)
+    wi, wo = directions(rng, N), directions(rng, N)
+    cases = [(name, {"type": name, **cls.examples[0]}) for name, cls in pumpup.registry().items() if cls.examples]
+    base = rate(pumpup.load({"type": "phong", "n": 20}), wi, wo)
+    print(f"{'model':18s} {'spec':58s} {'evals/s':>10s} {'cost vs phong':>14s}")
+    print(f"{'phong (baseline)':18s} {str({'n': 20}):58s} {base:10.3g} {1.0:14.2f}")
+    for name, spec in cases:
+        r = rate(pumpup.load(spec), wi, wo)
+        shown = {k: v for k, v in spec.items() if k != "type"}
+        print(f"{name:18s} {str(shown)[:58]:58s} {r:10.3g} {base / r:14.2f}")
+    ht = rate(pumpup.load({"type": "he_torrance", "sigma_0": 0.1, "tau": 1.7}), wi, wo)
+    print(f"\nhe_torrance (000 Fig. 5 parameters) costs {base / ht:.1f} x Phong ({ht:.3g} evals/s); 000 Table 1: 320")
+    print("\nThe pairs of 000 Table 5, at the same parameters:")
+    for a, b in [({"type": "phong", "n": 20}, {"type": "stretched_phong", "n": 20}),
+                 ({"type": "blinn", "n": 20}, {"type": "stretched_blinn", "n": 20}),
+                 ({"type": "ward", "m": 0.1}, {"type": "modified_ward", "m": 0.1})]:
+        ra, rb = rate(pumpup.load(a), wi, wo), rate(pumpup.load(b), wi, wo)
+        print(f"  {b['type']:16s} costs {ra / rb:5.2f} x {a['type']} ({rb:.3g} vs {ra:.3g} evals/s)")
+    if "--pumped" in sys.argv:
+        def build(n):
+            t = time.perf_counter()
+            f = pumpup.pump({"type": "phong", "n": n}, g="g2", levels=3)
+            for lev in f.chain():
+                lev.lookup()
+            return f, time.perf_counter() - t
+
+        _, cold = build(21)  # the first in this process also loads the engine's compiled kernels
+        f, warm = build(20)
+        r = rate(f, wi, wo)
+        print(f"\n3-level pumped Phong n = 20 (g2): {r:.3g} evals/s, {base / r:.2f} x the base Phong; "
+              f"its 3 albedo tables took {warm:.2f} s to build ({cold:.2f} s for n = 21, the first in the process)")
+    if "--spectral" in sys.argv:
+        spectral_rows(wi, wo)
+
+
+def spectral_rows(wi, wo, repeat=5):
+    """000 eq. 28 tabulated vs eq. 27/28 direct vs one wavelength, in this run (``--spectral``)."""
+    from pumpup import spectral
+
+    gold = spectral.SpectralMetal("Au", n=20)
+    one = gold.models[3]  # 520 nm
+
+    def secs(fn):
+        fn(wi[:10], wo[:10])
+        best = np.inf
+        for _ in range(repeat):
+            t = time.perf_counter()
+            fn(wi, wo)
+            best = min(best, time.perf_counter() - t)
+        return best
+
+    t1 = secs(one.eval)
+    td = secs(gold.eval)
+    tt = secs(gold.eval_tabulated)
+    print(f"\nspectral gold, n = 20, {len(wi):.0e} pairs (input checks included):")
+    print(f"  one wavelength (metal, 520 nm)               {len(wi) / t1:10.3g} pairs/s  1.00")
+    print(f"  8 wavelengths, eq. 27/28 Fresnel direct      {len(wi) / td:10.3g} pairs/s  {td / t1:.2f} x one")
+    print(f"  8 wavelengths, eq. 28 F(Theta_min) tabulated {len(wi) / tt:10.3g} pairs/s  {tt / t1:.2f} x one"
+          f"  (|F error| <= {gold.fresnel_table()[1]:.1e})")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,77 @@
+#!/usr/bin/env python
+"""Timings of issue 16: renderer look-up tables (pumpup.luts).
+
+    python scripts/bench/bench_lut.py [--cycles PATH] [--repeat N]
+
+Prints, with the load average (the machine is shared: read the ratios, not the seconds):
+
+* the 32 x 32 GGX E table of the Cycles preset at rtol 1e-8 (nodes only; target < 1 s on 2 cores);
+* the 128 x 128 Filament DFG (E and the Fc-weighted B at every texel; target < 10 s);
+* an audit of the shipped Cycles table (nodes at rtol 1e-7; target < 2 s), and the same with the
+  E_avg and look-up checks, which cost more;
+* a baseline measured in the same run: one 32-value GGX albedo column at rtol 1e-8 on one
+  thread, so the other numbers can be read as multiples of it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+
+
+import pumpup  # noqa: E402
+from pumpup import luts  # noqa: E402
+
+
+def best(fn, repeat):
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return min(times)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    here = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    default = os.path.join(here, "tests", "data", "cycles_shader.tables")  # Cycles' shipped tables
+    ap.add_argument("--cycles", default=default, help="the shipped Cycles shader.tables")
+    ap.add_argument("--repeat", type=int, default=2)
+    args = ap.parse_args()
+
+    print(f"load average before: {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f}; cores this process may use: "
+          f"{len(os.sched_getaffinity(0))}")
+    spec, param = luts.model_spec("ggx", "cycles")
+    mu, rough = luts.nodes("cycles")
+    f = luts._brdf(spec, param, rough[10])
+    luts._albedo(f, mu, 1e-8, 400)  # compile / warm
+    pumpup.lut("ggx", preset=luts.PRESETS["bsdl"], lookup_check=False)  # warm the split and the threads
+
+    base = best(lambda: luts._albedo(f, mu, 1e-8, 400), args.repeat)
+    print(f"baseline: one 32-value GGX column (rough = 10/31), one thread: {base:.3f} s")
+
+    t = best(lambda: pumpup.lut("ggx", preset="cycles", rtol=1e-8, eavg=False, lookup_check=False), args.repeat)
+    print(f"cycles 32 x 32 E at rtol 1e-8: {t:.2f} s  ({t / base:.1f} x baseline; target 1 s)")
+
+    t = best(lambda: pumpup.lut("ggx", preset="filament", rtol=1e-8, lookup_check=False), 1)
+    print(f"filament 128 x 128 DFG (E and B): {t:.2f} s  ({t / base:.1f} x baseline; target 10 s)")
+
+    if args.cycles:
+        t = best(lambda: pumpup.audit(args.cycles, preset="cycles", lookup_check=False, eavg=False), args.repeat)
+        print(f"audit of {os.path.basename(args.cycles)}, the 1024 nodes at rtol 1e-7: {t:.2f} s  "
+              f"({t / base:.1f} x baseline; target 2 s)")
+        t = best(lambda: pumpup.audit(args.cycles, preset="cycles"), 1)
+        print(f"  with E_avg and the look-up error: {t:.2f} s")
+    else:
+        print("no Cycles table found (give --cycles PATH)")
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
