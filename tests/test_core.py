@@ -146,3 +146,28 @@ def test_direction_set_includes_grazing():
     d = direction_set()
     assert d[:, 2].min() <= 1e-8 and d[:, 2].max() == 1.0
     np.testing.assert_allclose(np.linalg.norm(d, axis=-1), 1.0, rtol=1e-15)
+
+
+def test_first_loads_from_many_threads_see_the_whole_registry():
+    """The registry imports its providers on first use; a thread that loads while another is still importing them waits
+    for them (a Mitsuba scene instantiates pumpup's plugins from its own threads: 'unknown model type' before)."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("import threading, pumpup\n"
+            "errors = []\n"
+            "def load():\n"
+            "    try:\n"
+            "        pumpup.load({'type': 'fresnel', 'base': {'type': 'phong', 'n': 20}, 'eta': 0.5, 'k': 2.0})\n"
+            "    except Exception as exc:\n"
+            "        errors.append(repr(exc))\n"
+            "threads = [threading.Thread(target=load) for _ in range(8)]\n"
+            "[t.start() for t in threads]\n"
+            "[t.join() for t in threads]\n"
+            "print(errors)\n")
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ, PYTHONPATH=root)
+    for _ in range(3):
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
+        assert r.returncode == 0 and r.stdout.strip() == "[]", (r.stdout, r.stderr[-2000:])

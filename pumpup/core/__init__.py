@@ -246,7 +246,6 @@ def registry() -> dict[str, type["BRDF"]]:
 #: are imported on the registry's first use.  The package root names pumpup's own (``pumpup.PROVIDERS``: the
 #: operators, the models, the spectral models); another package adds its own with :func:`add_provider`.
 _PROVIDERS: list[str] = []
-_PROVIDED: set[str] = set()
 #: (applies, load): a spec that ``applies(spec)`` accepts is built by ``load(spec)`` (the spectral models)
 _LOADERS: list[tuple[Callable[[Any], bool], Callable[[Any], Any]]] = []
 
@@ -263,16 +262,16 @@ def register_loader(applies: Callable[[Any], bool], loader: Callable[[Any], Any]
 
 
 def _ensure_models() -> None:
-    """Import the provider modules not imported yet (the package root's ``PROVIDERS`` first): their types register."""
+    """Import the provider modules (the package root's ``PROVIDERS`` first): their types register.  An imported one
+    costs a look-up in ``sys.modules``; one that another thread is importing is waited for (the import lock), so no
+    thread sees a registry half filled."""
     import importlib
 
     if not _PROVIDERS:
         for module in importlib.import_module(__name__.rpartition(".")[0]).PROVIDERS:
             add_provider(module)
-    for module in _PROVIDERS:
-        if module not in _PROVIDED:
-            _PROVIDED.add(module)  # (first: a provider may load specs while it is imported)
-            importlib.import_module(module)
+    for module in tuple(_PROVIDERS):
+        importlib.import_module(module)
 
 
 def slabs(shape: tuple, block: int):
