@@ -1,4 +1,4 @@
-"""The compiled direction checks of as_directions (pumpup/_checks.py) against their numpy twin,
+"""The compiled direction checks of as_directions (pumpup/core/checks.py) against their numpy twin,
 and the messages of BRDF.eval for bad directions."""
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""The 1-D albedo path (closed-form azimuth, pumpup/_polar.py) against its numpy reference, the
+"""The 1-D albedo path (closed-form azimuth, pumpup/engine/polar.py) against its numpy reference, the
 independent 1-D mpmath quadrature, the 2-D engine, and closed forms; its error estimate bounds the
 true error at every tolerance tested."""
 

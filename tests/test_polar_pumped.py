@@ -1,4 +1,4 @@
-"""The 1-D albedo path of pumped Phong-family BRDFs (pumpup/_polar.py, ``Polar.chain``): the
+"""The 1-D albedo path of pumped Phong-family BRDFs (pumpup/engine/polar.py, ``Polar.chain``): the
 closed-form azimuth of the base lobe outside, an inner rule on the arc for g(mu, N.wo) inside.
 
 Checked against an independent quadrature about the normal (numpy's level-by-level reference of

@@ -1,4 +1,4 @@
-"""Pumped GGX, Beckmann (F = 1) and Schlick models on the 1-D path (pumpup/_polar.py, frame 6 about N divided by g,
+"""Pumped GGX, Beckmann (F = 1) and Schlick models on the 1-D path (pumpup/engine/polar.py, frame 6 about N divided by g,
 ``_integrate_n`` with ``Polar.chain``): g_1 ... g_k depends on N.wi and N.wo only, so on each ring N.wo = t it is a
 constant and the closed-form azimuth of frame 6 still holds; the elevation's rule divides by it.
 

@@ -1,4 +1,4 @@
-"""1/E-scaled GGX, Beckmann (F = 1) and Schlick models on the 1-D path (pumpup/_polar.py, frame 6 about N times
+"""1/E-scaled GGX, Beckmann (F = 1) and Schlick models on the 1-D path (pumpup/engine/polar.py, frame 6 about N times
 Turquin's factor 1 + F0 (1 / U(N.wo) - 1), ``Polar.factor``): the factor depends on N.wo alone, so on each ring it is a
 constant and frame 6's closed-form azimuth still holds; the elevation's rule multiplies by it.
 

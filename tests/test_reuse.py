@@ -1,4 +1,4 @@
-"""mean_albedo and max_albedo reuse the table just computed for the same BRDF object (pumpup/_reuse.py):
+"""mean_albedo and max_albedo reuse the table just computed for the same BRDF object (pumpup/tables/reuse.py):
 the same numbers within the stated errors, the independent references, and a fall-back where the
 table cannot meet the tolerance."""
 

@@ -1,6 +1,6 @@
-"""The 1-D path (pumpup/_polar.py) against a previous version of it, in the same run (issue 14).
+"""The 1-D path (pumpup/engine/polar.py) against a previous version of it, in the same run (issue 14).
 
-Loads ``pumpup/_polar.py`` as it was at a git revision (default 2a636a4: before issue 14's
+Loads ``pumpup/engine/polar.py`` as it was at a git revision (default 2a636a4: before issue 14's
 calibrated estimate, one first interval per piece and the allocation-free pieces) beside the
 current one, and times ``albedo_1d`` on the Phong family's 257-point tables (mu uniform in theta)
 at rtol 1e-10, interleaved, best of 40 each; prints both, the ratio, the evaluations per mu, and
@@ -28,8 +28,12 @@ SPECS = [{"type": "phong", "n": 20}, {"type": "stretched_phong", "n": 20},
 
 def previous(rev):
     root = pathlib.Path(__file__).resolve().parents[2]
-    src = subprocess.run(["git", "-C", str(root), "show", f"{rev}:pumpup/_polar.py"], check=True,
-                         capture_output=True, text=True).stdout
+    for where in ("pumpup/engine/polar.py", "pumpup/_polar.py"):  # (its path before the layered packages)
+        r = subprocess.run(["git", "-C", str(root), "show", f"{rev}:{where}"], capture_output=True, text=True)
+        if r.returncode == 0:
+            break
+    r.check_returncode()
+    src = r.stdout
     path = pathlib.Path(tempfile.mkdtemp()) / "_polar_previous.py"
     path.write_text(src)
     spec = importlib.util.spec_from_file_location("pumpup._polar_previous", path)
@@ -44,7 +48,7 @@ def main():
     old = previous(rev)
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores; 257-point tables at rtol 1e-10, "
-          f"albedo_1d, best of 40 (interleaved); previous = pumpup/_polar.py at {rev}")
+          f"albedo_1d, best of 40 (interleaved); previous = pumpup/engine/polar.py at {rev}")
     for s in SPECS:
         term = pumpup.load(s).albedo_terms()[0][1]
         mods = {"previous": old, "now": _polar}

@@ -1,4 +1,4 @@
-"""Calibration of the pumped Phong-family path's error estimate (pumpup/_polar.py, ``CHAIN_SAFETY``).
+"""Calibration of the pumped Phong-family path's error estimate (pumpup/engine/polar.py, ``CHAIN_SAFETY``).
 
 For 15 pumped chains (g1 and g2, 1-4 levels, n from 0.5 to 5000, p in {0, 0.5, 1}, retro) and mu from
 1e-10 to 1 (a geometric grid, a few round values, and every ``--stride``-th of the 300 thetas of

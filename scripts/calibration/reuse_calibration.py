@@ -1,4 +1,4 @@
-"""Calibration of the mean albedo taken from a table (pumpup/_reuse.py, issue 14's item 5; nineteenth session).
+"""Calibration of the mean albedo taken from a table (pumpup/tables/reuse.py, issue 14's item 5; nineteenth session).
 
 For built-in models from wide to very narrow lobes, Ward's divergent grazing albedo and sharp Fresnel features, on the
 sweep's grid (``pumpup.sweeps.default_mu(257)``): the table, then ``pumpup.mean_albedo`` at rtol 1e-9 (from the table,
