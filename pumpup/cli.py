@@ -496,7 +496,6 @@ def cmd_mc(args) -> int:
 
 
 def cmd_compensate(args) -> int:
-
     import numpy as np
 
     import pumpup
