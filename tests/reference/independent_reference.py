@@ -270,7 +270,6 @@ def albedo_A(model, p, mu):
 def albedo_B(model, p, mu):
     """outer over theta_V with different split points"""
     sti = sin_theta_i(mu)
-    errs = [0.0]
     tp = t_points(model, p, mu, SC_B)
     thp = [math.acos(x) for x in tp]
 
