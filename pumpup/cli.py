@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import _thread
 import argparse
 import json
 import math
+import os
 import signal
 import sys
+import threading
 
 
 def parse_spec(text: str) -> dict:
@@ -1032,8 +1035,6 @@ def main(argv: list[str] | None = None, notify: bool = False) -> int:
     with 130.  The arguments are parsed before the library is imported.  Set PUMPUP_TRACEBACK=1 to
     see the traceback of an error instead.  ``notify``: before numba compiles a kernel that is not in its
     cache, say so in one line on stderr (when stderr is a terminal; the console script sets it)."""
-    import os
-
     debug = bool(os.environ.get("PUMPUP_TRACEBACK"))
     try:
         args = build_parser().parse_args(argv)
@@ -1053,7 +1054,7 @@ def main(argv: list[str] | None = None, notify: bool = False) -> int:
             raise
         message = _one_line(exc.code)
     except (ValueError, TypeError, OSError, ImportError) as exc:  # SpecError is a ValueError; ImportError: an extra
-        if _PENDING_INTERRUPT:
+        if _PENDING_INTERRUPT or _caused_by_interrupt(exc):
             raise _interrupted() from None
         if debug:
             raise
@@ -1063,6 +1064,18 @@ def main(argv: list[str] | None = None, notify: bool = False) -> int:
     except KeyboardInterrupt:
         raise _interrupted() from None
     raise UsageError(message) from None
+
+
+def _caused_by_interrupt(exc: BaseException) -> bool:
+    """Whether a KeyboardInterrupt is in ``exc``'s chain: Ctrl-C while a C extension imports (numpy's import of
+    datetime) surfaces as that module's ImportError."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 #: set when a Ctrl-C was swallowed in a callback from C: whatever the command does next (numba, its compile broken
@@ -1075,8 +1088,6 @@ def _redeliver_interrupts(hook):
     in a callback from C (llvmlite's, while numba compiles) cannot propagate there, and Python would print it as
     "Exception ignored" and go on.  The interrupt is sent again 10 ms later, from a timer thread, so that it arrives
     in ordinary Python code (and again, should it land in a callback once more)."""
-    import _thread
-    import threading
 
     def unraisable(args) -> None:
         if args.exc_type is not None and issubclass(args.exc_type, KeyboardInterrupt):
@@ -1093,8 +1104,8 @@ def _redeliver_interrupts(hook):
 def console_main() -> None:
     """The ``pumpup`` console script: :func:`main`, then an exit in which a late Ctrl-C or a closed pipe
     prints nothing more (Ctrl-C is ignored once the command has finished and flushed its output)."""
-    sys.unraisablehook = _redeliver_interrupts(sys.unraisablehook)
     try:
+        sys.unraisablehook = _redeliver_interrupts(sys.unraisablehook)
         code = main(notify=True)
         sys.stdout.flush()
         if _PENDING_INTERRUPT:
@@ -1105,8 +1116,8 @@ def console_main() -> None:
         code = _closed_stdout()
     except SystemExit as exc:
         code = exc.code
-    except Exception:
-        if not _PENDING_INTERRUPT:
+    except Exception as exc:
+        if not (_PENDING_INTERRUPT or _caused_by_interrupt(exc)):
             raise
         code = _interrupted().code
     try:
