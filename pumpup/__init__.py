@@ -69,7 +69,8 @@ _FUNCTIONS_NAMED_LIKE_MODULES = frozenset({"divergence"})
 __all__ = ["__version__", *_PUBLIC]
 
 #: the modules whose types and loaders the registry imports on first use, in this order (:mod:`pumpup.core`)
-PROVIDERS = ("pumpup.operators.pumping", "pumpup.operators.compensate", "pumpup.models", "pumpup.spectral")
+PROVIDERS = ("pumpup.operators.pumping", "pumpup.operators.compensate", "pumpup.models", "pumpup.spectral",
+             "pumpup.tables")
 
 
 def __getattr__(name: str):

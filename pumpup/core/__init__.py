@@ -242,12 +242,31 @@ def registry() -> dict[str, type["BRDF"]]:
     return dict(_REGISTRY)
 
 
-#: modules that register types (``@register``) or loaders (:func:`register_loader`) when imported, in the order they
-#: are imported on the registry's first use.  The package root names pumpup's own (``pumpup.PROVIDERS``: the
-#: operators, the models, the spectral models); another package adds its own with :func:`add_provider`.
+#: modules that register types (``@register``), loaders (:func:`register_loader`) or services (:func:`provide`) when
+#: imported, in the order they are imported on the registry's first use.  The package root names pumpup's own
+#: (``pumpup.PROVIDERS``: the operators, the models, the spectral models, the tables); another package adds its own
+#: with :func:`add_provider`.
 _PROVIDERS: list[str] = []
 #: (applies, load): a spec that ``applies(spec)`` accepts is built by ``load(spec)`` (the spectral models)
 _LOADERS: list[tuple[Callable[[Any], bool], Callable[[Any], Any]]] = []
+
+
+#: what an upper layer offers the models by name: "max_albedo" (``pumpup.tables.max_albedo``, which plastic's energy
+#: check calls while it is built); the provider modules register them
+_SERVICES: dict[str, Callable[..., Any]] = {}
+
+
+def provide(name: str, fn: Callable[..., Any]) -> None:
+    """Offer ``fn`` to the lower layers as the service ``name`` (see :func:`service`)."""
+    _SERVICES[name] = fn
+
+
+def service(name: str) -> Callable[..., Any]:
+    """The function an upper layer registered as ``name`` (:func:`provide`), its providers imported first."""
+    _ensure_models()
+    if name not in _SERVICES:
+        raise LookupError(f"no provider offers the service {name!r}; known: {', '.join(sorted(_SERVICES)) or 'none'}")
+    return _SERVICES[name]
 
 
 def add_provider(module: str) -> None:

@@ -166,7 +166,9 @@ def _plastic_max_s(n: float, eta) -> float:
     ``metal`` with k = 0 (the same kernel, 000 eq. 28-29) or stretched Phong without Fresnel."""
     key = (float(n), eta)
     if key not in _MAX_S_CACHE:
-        from ..tables import max_albedo
+        from ..core import service
+
+        max_albedo = service("max_albedo")  # pumpup.tables.max_albedo
 
         lobe = load({"type": "stretched_phong", "n": n, "p": 1.0}) if eta is None else \
             load({"type": "metal", "n": n, "eta": eta, "k": 0.0})

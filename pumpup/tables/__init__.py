@@ -23,7 +23,7 @@ import numpy as np
 from .._version import __version__
 from . import reuse as _reuse
 from ..engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
-from ..core import BRDF, check_count, check_open_unit, check_tolerance
+from ..core import BRDF, check_count, check_open_unit, check_tolerance, provide
 
 __all__ = [
     "tabulate",
@@ -947,6 +947,8 @@ def max_constant(brdf: BRDF, **kw) -> tuple[float, float]:
     m = max_albedo(brdf, **kw)
     return m.constant, m.theta_deg
 
+
+provide("max_albedo", max_albedo)  # for plastic's energy check (models may not import this layer)
 
 from .._lazy import submodules  # noqa: E402
 
