@@ -246,7 +246,7 @@ def _divergence_report(ds) -> str:
     for i, name in enumerate(ds.model.values):
         lines.append(f"| {name} | {ds.verdict.values[i]} | {float(ds.k[i]):.5f} ± {float(ds.k_error[i]):.1g} | "
                      f"{float(ds.albedo[i, -1]):.6g} |")
-    lines += ["", "001 claims that Ward and Cook-Torrance diverge; see the README for why Cook-Torrance does not.", ""]
+    lines += ["", "001 claims that Ward and Cook-Torrance diverge; see docs/user-guide.md for why Cook-Torrance does not.", ""]
     return "\n".join(lines)
 
 

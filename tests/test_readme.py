@@ -1,4 +1,4 @@
-"""Every ```python and ```bash block of README.md runs (issue 13, item 12).
+"""Every ```python and ```bash block of README.md and docs/user-guide.md runs.
 
 The python blocks run in order as ONE script (a file, as a user would save them; the processes
 scheduler of the sweep example then needs its main guard) in a fresh process.  The bash blocks
@@ -23,6 +23,8 @@ import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 README = os.path.join(ROOT, "README.md")
+#: the documents whose examples run, in this order (the user guide's python blocks continue the README's script)
+DOCUMENTS = [README, os.path.join(ROOT, "docs", "user-guide.md")]
 
 #: commands of the README's bash blocks that the default suite does not run, with the reason
 EXPENSIVE = {
@@ -36,8 +38,11 @@ NEVER = {"python -m pytest -q"}
 
 
 def blocks(text=None):
-    """(language, code, line number) of every fenced python or bash block."""
-    text = open(README).read() if text is None else text
+    """(language, code, line number) of every fenced python or bash block of ``text``, or (language, code,
+    "FILE line N") of every document's."""
+    if text is None:
+        return [(lang, code, f"{os.path.relpath(path, ROOT)} line {line}") for path in DOCUMENTS
+                for lang, code, line in blocks(open(path).read())]
     out = []
     for m in re.finditer(r"^```(python|bash)[ \t]*\n(.*?)^```", text, re.S | re.M):
         out.append((m.group(1), m.group(2), text[:m.start()].count("\n") + 1))
@@ -117,7 +122,7 @@ def test_python_blocks_run_as_one_script(workspace):
     code = []
     for lang, block, line in blocks():
         if lang == "python":
-            code.append(f"# --- README.md line {line}\n{block}")
+            code.append(f"# --- {line}\n{block}")
     script = work / "readme_examples.py"
     script.write_text("\n".join(code))
     r = subprocess.run([sys.executable, str(script)], cwd=work, env=env, capture_output=True, text=True,
@@ -133,7 +138,7 @@ def test_bash_blocks_run(workspace):
         if cmd in EXPENSIVE:
             continue
         r = subprocess.run(["bash", "-c", cmd], cwd=work, env=env, capture_output=True, text=True, timeout=900)
-        assert r.returncode == 0, f"README.md line {line}: {cmd}\n{r.stderr[-2000:]}"
+        assert r.returncode == 0, f"{line}: {cmd}\n{r.stderr[-2000:]}"
         ran += 1
     assert ran >= 1
 
@@ -145,7 +150,7 @@ def test_expensive_bash_commands(workspace):
     for cmd, line in bash_commands():
         if cmd in EXPENSIVE and cmd not in NEVER:
             r = subprocess.run(["bash", "-c", cmd], cwd=work, env=env, capture_output=True, text=True, timeout=3600)
-            assert r.returncode == 0, f"README.md line {line}: {cmd}\n{r.stderr[-2000:]}"
+            assert r.returncode == 0, f"{line}: {cmd}\n{r.stderr[-2000:]}"
 
 
 def test_expensive_list_names_real_commands():
@@ -159,7 +164,7 @@ def test_readme_claims_match_the_code():
     from pumpup.engine.cubature import _accumulate, _geometry_kernel
     from pumpup.cli import build_parser
 
-    text = open(README).read()
+    text = "".join(open(path).read() for path in DOCUMENTS)
     assert "hold the GIL" not in text and "kernels release the GIL" in text
     for kernel in (_geometry_kernel, _accumulate):
         assert kernel.targetoptions.get("nogil") is True
