@@ -14,6 +14,7 @@ import importlib
 import sys
 import types
 
+from ._lazy import submodules
 from ._version import __version__
 
 #: public name -> (module, attribute); attribute None means the module itself
@@ -63,8 +64,8 @@ _PUBLIC = {
     "registry": ("core", "registry"),
 }
 
-#: public functions named like a submodule of the package: importing the submodule must not replace them
-_FUNCTIONS_NAMED_LIKE_MODULES = frozenset({"divergence"})
+#: public functions named like the submodule that holds them (``divergence``): importing it must not replace them
+_FUNCTIONS_NAMED_LIKE_MODULES = frozenset(name for name, (module, attr) in _PUBLIC.items() if name == module and attr)
 
 __all__ = ["__version__", *_PUBLIC]
 
@@ -73,21 +74,17 @@ PROVIDERS = ("pumpup.operators.pumping", "pumpup.operators.compensate", "pumpup.
              "pumpup.tables")
 
 
+_submodule = submodules(__name__)
+
+
 def __getattr__(name: str):
     """Import a public name (or a submodule, ``pumpup.tables``) on first use."""
     if name in _PUBLIC:
         module_name, attr = _PUBLIC[name]
         module = importlib.import_module(f"{__name__}.{module_name}")
         value = module if attr is None else getattr(module, attr)
-    elif not name.startswith("__"):
-        try:
-            value = importlib.import_module(f"{__name__}.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name != f"{__name__}.{name}":
-                raise
-            raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
     else:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+        value = _submodule(name)
     globals()[name] = value
     return value
 

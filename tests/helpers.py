@@ -140,3 +140,12 @@ def load_script(path: str):
     sys.modules[name] = module
     spec.loader.exec_module(module)
     return module
+
+
+def default_sigint():
+    """For ``subprocess.Popen(preexec_fn=...)``: SIGINT's default action in the child before exec, which Python turns
+    into KeyboardInterrupt.  A test run started in the background of a shell inherits SIGINT ignored, and Python then
+    keeps ignoring it."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)

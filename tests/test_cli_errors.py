@@ -13,6 +13,8 @@ import pytest
 import pumpup
 from pumpup import cli
 
+from helpers import default_sigint
+
 
 @pytest.fixture
 def no_work(monkeypatch):
@@ -72,12 +74,6 @@ def test_divergence_all_outside_the_repository_fails_first(capsys, no_work, tmp_
     assert code == 2 and "--tables tables: directory does not exist" in err
 
 
-def _default_sigint():
-    """In the child before exec: SIGINT's default action, which Python turns into KeyboardInterrupt.  A test run
-    started in the background of a shell inherits SIGINT ignored, and Python then keeps ignoring it."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-
-
 def test_errors_of_a_real_process_and_ctrl_c(tmp_path):
     env = dict(os.environ, PYTHONPATH=os.path.dirname(os.path.dirname(os.path.abspath(pumpup.__file__))))
     r = subprocess.run([sys.executable, "-m", "pumpup.cli", "table", "phong:n=20", "--out", "nodir/x.nc"],
@@ -86,7 +82,7 @@ def test_errors_of_a_real_process_and_ctrl_c(tmp_path):
     # Ctrl-C in the middle of a long computation: one line, status 130
     p = subprocess.Popen([sys.executable, "-m", "pumpup.cli", "divergence", "all", "--tables", ".", "--figures", "."],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path, env=env,
-                         preexec_fn=_default_sigint)
+                         preexec_fn=default_sigint)
     deadline = time.time() + 120
     while time.time() < deadline and p.poll() is None and _cpu_seconds(p.pid) < 4.0:
         time.sleep(0.2)  # until it is computing (imports take about 1 s of CPU)

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 import pumpup
+from helpers import default_sigint
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 #: modules that a bare ``import pumpup`` (and ``pumpup --help``) must not load
@@ -29,12 +30,6 @@ CLI_STARTED = ("import os, pumpup.cli as cli\n_main = cli.main\n"
                f"    os.write(2, {MARK!r}.encode())\n"
                "    return _main(*a, **k)\n"
                "cli.main = main\ncli.console_main()\n")
-
-
-def _default_sigint():
-    """In the child before exec: SIGINT's default action, which Python turns into KeyboardInterrupt.  A test run
-    started in the background of a shell inherits SIGINT ignored, and Python then keeps ignoring it."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def _env(**extra):
@@ -88,14 +83,15 @@ def test_importing_the_engine_compiles_and_calls_no_kernel():
     assert dispatchers > 100 and overloads == 0
 
 
-def test_public_names_resolve_and_albedo_stays_the_function():
+def test_public_names_resolve_and_functions_stay_functions():
     import importlib
 
     for name in pumpup.__all__:
         assert getattr(pumpup, name) is not None, name
-    engine = importlib.import_module("pumpup.engine.cubature")  # the module binds no attribute over the function
+    engine = importlib.import_module("pumpup.engine.cubature")
     assert callable(pumpup.albedo) and pumpup.albedo is engine.albedo
-    assert callable(pumpup.compensate) and callable(pumpup.divergence)
+    divergence = importlib.import_module("pumpup.divergence")  # the submodule binds no attribute over the function
+    assert pumpup.divergence is divergence.divergence and callable(pumpup.compensate)
     assert pumpup.albedo_module is engine
     assert set(pumpup.__all__) <= set(dir(pumpup))
     with pytest.raises(AttributeError, match="no attribute 'no_such_name'"):
@@ -119,7 +115,7 @@ def test_ctrl_c_is_one_line_and_130(delay, cold, tmp_path):
     (where a SIGINT can land in llvmlite's callbacks from C): one line, status 130."""
     env = _env(NUMBA_CACHE_DIR=str(tmp_path)) if cold else _env()
     p = subprocess.Popen([sys.executable, "-c", CLI_STARTED, "pump", "phong:n=20", "--levels", "3"], cwd=ROOT, env=env,
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=_default_sigint)
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=default_sigint)
     seen = b""
     while MARK.encode() not in seen:
         byte = p.stderr.read(1)
@@ -136,7 +132,7 @@ def test_ctrl_c_is_one_line_and_130(delay, cold, tmp_path):
 def test_ctrl_c_after_the_command_finished_adds_nothing():
     """A SIGINT that arrives while Python exits after a finished command: the command's status and output stand."""
     p = subprocess.Popen([sys.executable, "-c", CLI + "; import time; time.sleep(5)", "models"], cwd=ROOT,
-                         env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=_default_sigint)
+                         env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=default_sigint)
     out = p.stdout.readline()
     time.sleep(1.0)
     p.send_signal(signal.SIGINT)

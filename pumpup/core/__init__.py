@@ -247,6 +247,7 @@ def registry() -> dict[str, type["BRDF"]]:
 #: (``pumpup.PROVIDERS``: the operators, the models, the spectral models, the tables); another package adds its own
 #: with :func:`add_provider`.
 _PROVIDERS: list[str] = []
+_PROVIDED = False  # every provider imported (to the end)
 #: (applies, load): a spec that ``applies(spec)`` accepts is built by ``load(spec)`` (the spectral models)
 _LOADERS: list[tuple[Callable[[Any], bool], Callable[[Any], Any]]] = []
 
@@ -271,8 +272,10 @@ def service(name: str) -> Callable[..., Any]:
 
 def add_provider(module: str) -> None:
     """Have the registry import ``module`` (a dotted name) on its next use, so that its types register themselves."""
+    global _PROVIDED
     if module not in _PROVIDERS:
         _PROVIDERS.append(module)
+        _PROVIDED = False
 
 
 def register_loader(applies: Callable[[Any], bool], loader: Callable[[Any], Any]) -> None:
@@ -284,13 +287,19 @@ def _ensure_models() -> None:
     """Import the provider modules (the package root's ``PROVIDERS`` first): their types register.  An imported one
     costs a look-up in ``sys.modules``; one that another thread is importing is waited for (the import lock), so no
     thread sees a registry half filled."""
+    global _PROVIDED
+    if _PROVIDED:
+        return
     import importlib
+    import sys
 
     if not _PROVIDERS:
         for module in importlib.import_module(__name__.rpartition(".")[0]).PROVIDERS:
             add_provider(module)
     for module in tuple(_PROVIDERS):
         importlib.import_module(module)
+    # done once every provider has finished importing (not one this thread is still inside of): later loads skip this
+    _PROVIDED = not any(getattr(sys.modules[m].__spec__, "_initializing", False) for m in _PROVIDERS)
 
 
 def slabs(shape: tuple, block: int):

@@ -33,12 +33,10 @@ import os
 import sys
 import time
 import warnings
-from pathlib import Path
 
 import numpy as np
 from scipy.integrate import IntegrationWarning, dblquad
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "tests"))  # tests/reference: the independent references
 from reference import independent_microfacet as ind  # noqa: E402
 

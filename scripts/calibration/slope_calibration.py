@@ -29,7 +29,6 @@ import pumpup
 from pumpup.engine import polar as _polar
 from pumpup.engine import slope as _slope
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "tests"))  # tests/reference: the independent references
 from reference.independent_ward_aniso import albedo_A, albedo_B  # noqa: E402
 

@@ -19,8 +19,8 @@ import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
-sys.path.insert(0, HERE)
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, ROOT)  # this checkout's pumpup
 
 import numpy as np  # noqa: E402
 
@@ -31,7 +31,7 @@ import pumpup  # noqa: E402
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    root = os.path.dirname(HERE)
+    root = ROOT
     default = os.path.join(root, "tests", "data", "cycles_shader.tables")  # Cycles' shipped tables
     ap.add_argument("path", nargs="?", default=default)
     ap.add_argument("--worst", type=int, default=6)

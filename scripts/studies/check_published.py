@@ -34,7 +34,6 @@ from scipy.optimize import minimize_scalar
 import mpmath
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "tests"))  # tests/reference: the independent references
 from reference import independent_reference as IR  # noqa: E402  (independent of pumpup)
 
