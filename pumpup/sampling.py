@@ -379,8 +379,7 @@ def strategy(brdf: BRDF, mu: float = 1.0, kind: str = "lobe") -> Strategy | OwnS
         raise ValueError(f"sampling strategy must be 'lobe' or 'cosine', got {kind!r}")
     if brdf.own_sampler:  # the model's own importance sampling (BRDF.sample_wi)
         return OwnSampling(brdf)
-    by_mu = getattr(brdf, "sampling_terms", None)  # terms weighted for this mu (the Kulla-Conty mixture)
-    terms = by_mu(float(mu)) if by_mu is not None else brdf.albedo_terms()
+    terms = brdf.sampling_terms(float(mu))  # the terms weighted for this mu (the Kulla-Conty mixture's)
     weights = np.array([abs(w) for w, _ in terms], dtype=np.float64)
     if not np.all(np.isfinite(weights)) or weights.sum() <= 0:
         weights = np.ones(len(terms))
@@ -568,7 +567,7 @@ def mc_albedo(brdf: BRDF, mu, n: int, rng=None, *, kind: str = "lobe"):
     for i, x in enumerate(flat):
         w = np.array([math.sqrt((1.0 - x) * (1.0 + x)), 0.0, x])
         est[i], se[i] = _weights(t, strategy(f, x, kind), w, n, g)
-    delta = getattr(f, "delta_albedo", None)
+    delta = f.delta_albedo
     if delta is not None:
         est += delta(flat)  # a delta lobe (he_torrance's specular part): exact, no variance
     if m.ndim == 0:

@@ -72,10 +72,10 @@ def nested_reference(f, mu, rtol=1e-12):
 
     import pumpup
     from pumpup.engine import nested as _nested
-    from pumpup.engine import polar as _polar
+    from pumpup.engine import normal_frame as _normal_frame
 
     _nested.LAST_EVALS = None
-    with _polar.without_1d(), warnings.catch_warnings():
+    with without_1d(), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         out = pumpup.albedo(f, np.asarray(mu, dtype=float), return_error=True, rtol=rtol)
     assert len(f.albedo_terms()) > 1 or _nested.LAST_EVALS is not None
@@ -88,9 +88,9 @@ def one_d_against_the_other_engines(f, mu, rtols=(1e-6, 1e-10), two_d_at=(0, 5, 
     the tolerance.  Returns (value, error) at the last rtol.  ``whole``: f is a sum whose terms take the path (not
     asked)."""
     import pumpup
-    from pumpup.engine import polar as _polar
+    from pumpup.engine import normal_frame as _normal_frame
 
-    assert whole or _polar.takes_1d_path(f)
+    assert whole or takes_1d(f)
     mu = np.asarray(mu, dtype=float)
     b, eb = nested_reference(f, mu, ref_rtol)
     for rtol in rtols:
@@ -99,28 +99,28 @@ def one_d_against_the_other_engines(f, mu, rtols=(1e-6, 1e-10), two_d_at=(0, 5, 
         assert np.all(e <= rtol * a * 1.0001 + 1e-14)
     if len(two_d_at):
         idx = list(two_d_at)
-        with _polar.two_d_only():
+        with two_d_only():
             c, ec = pumpup.albedo(f, mu[idx], return_error=True, rtol=rtols[-1])
         assert np.all(np.abs(a[idx] - c) <= e[idx] + ec)
     return a, e
 
 
 def n_frame_integrand_against_eval(f, base):
-    """Frame 6's compiled integrand of ``f`` (pumpup.engine.polar.n_integrand: the rule's own arithmetic) against ``f``'s public
+    """Frame 6's compiled integrand of ``f`` (pumpup.engine.normal_frame.n_integrand: the rule's own arithmetic) against ``f``'s public
     ``eval`` times N.wo integrated over the azimuth by scipy (n_integrand_reference), to 1e-10, at mu = 0.9, 0.4, 0.05
     and elevations on both sides of mu; returns the smallest ratio of f's integrand to ``base``'s (a pumped or scaled
     model against its base)."""
-    from pumpup.engine import polar as _polar
+    from pumpup.engine import normal_frame as _normal_frame
 
     low = math.inf
     for mu in (0.9, 0.4, 0.05):
         xmu = math.asin(mu)
         xs = np.array([0.02, 0.3, xmu - 0.05, xmu + 0.04, 1.2, 1.5])
         xs = xs[(xs > 0.0) & (xs < 0.5 * math.pi)]
-        got = _polar.n_integrand(f, mu, xs)
-        ref = _polar.n_integrand_reference(f, mu, xs)
+        got = _normal_frame.n_integrand(f, mu, xs)
+        ref = _normal_frame.n_integrand_reference(f, mu, xs)
         assert np.all(np.abs(got - ref) <= 1e-10 * np.abs(ref)), (mu, xs, got / ref - 1)
-        low = min(low, float(np.min(got / _polar.n_integrand(base, mu, xs))))
+        low = min(low, float(np.min(got / _normal_frame.n_integrand(base, mu, xs))))
     return low
 
 
@@ -149,3 +149,85 @@ def default_sigint():
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+# --- the engine's routes, for the tests ------------------------------------------------------------------------------
+
+#: the values of mu at which a hint's routes are asked when a test does not say (as the routing table's mu ranges see
+#: them: above and below N_FRESNEL_MU_MIN, grazing, normal)
+ROUTE_MU = np.concatenate([np.geomspace(1e-6, 1.0, 61), [0.2, 0.3, 0.5, 0.9]])
+
+
+def view(f):
+    """``f``'s azimuth hint as the kernels read it (:func:`pumpup.engine.hint_view.kernel_view`), or None."""
+    from pumpup.engine.hint_view import kernel_view
+
+    hint = f.azimuth_hint()
+    return None if hint is None else kernel_view(hint)
+
+
+def hint_routes(f, mu=None) -> set:
+    """The 1-D routes the routing table gives ``f``'s own hint (``f`` a BRDF or an AzimuthHint) at ``mu``."""
+    from pumpup.core.hints import AzimuthHint
+    from pumpup.engine.routes import hint_routes as routes
+
+    hint = f if isinstance(f, AzimuthHint) else f.azimuth_hint()
+    mu = ROUTE_MU if mu is None else np.asarray(mu, dtype=float).reshape(-1)
+    return {route for route, _ in routes(hint, mu)} if hint is not None else set()
+
+
+def one_d_mask(f, mu) -> np.ndarray:
+    """The values of ``mu`` the 1-D routes of ``f``'s own hint take."""
+    from pumpup.engine.routes import hint_routes as routes
+
+    mu = np.asarray(mu, dtype=float).reshape(-1)
+    out = np.zeros(mu.shape, bool)
+    hint = f.azimuth_hint()
+    for _, m in routes(hint, mu) if hint is not None else ():
+        out |= m
+    return out
+
+
+def takes_1d(f, mu=None) -> bool:
+    """Whether the 1-D routes of ``f``'s own hint take it at every mu (default :data:`ROUTE_MU`)."""
+    return bool(one_d_mask(f, ROUTE_MU if mu is None else mu).all())
+
+
+def two_d_only():
+    """The 2-D cubature alone (the reference)."""
+    from pumpup.engine.routes import using
+
+    return using(engine="2d")
+
+
+def without_1d():
+    """No 1-D route: the nested quadrature where it applies, else the 2-D cubature."""
+    from pumpup.engine.routes import using
+
+    return using(engine="nested")
+
+
+def without_normal_frames():
+    """Every route but the frames of N (``normal``, ``lobe_normal``): GGX, Beckmann and Schlick then take the rule on
+    h's arc (``half_arc``), a lobe with F(max) the lobe frame (``lobe_fresnel``), a pumped or scaled one of them the
+    nested quadrature: the tests' second 1-D route for them."""
+    from pumpup.engine.routes import using
+
+    return using(without={"normal", "lobe_normal"})
+
+
+def without_nested():
+    """Every route but the nested quadrature (the 2-D cubature takes its values)."""
+    from pumpup.engine.routes import using
+
+    return using(without={"nested"})
+
+
+def takes_normal(f) -> bool:
+    """Whether the routing table gives ``f`` (a BRDF or a hint) the frame of N, ``normal``, at some mu."""
+    return "normal" in hint_routes(f)
+
+
+def takes_lobe_normal(f) -> bool:
+    """Whether the routing table gives ``f`` (a BRDF or a hint) the lobe's frame of N, ``lobe_normal``, at some mu."""
+    return "lobe_normal" in hint_routes(f)

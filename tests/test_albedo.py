@@ -8,6 +8,7 @@ from scipy.special import expn
 
 import pumpup
 from helpers import phong_albedo_1d
+import helpers
 
 MU = np.array([1.0, 0.999, 0.9, 0.7, 0.5, 0.3, 0.1, 0.03, 1e-2, 1e-3, 1e-5, 1e-8])
 
@@ -139,7 +140,7 @@ def test_unmet_tolerance_warns_and_reports_the_larger_error():
     f = pumpup.load({"type": "stretched_phong", "n": 20})
     # the 2-D engine's budget (the 1-D path of pumpup.engine.polar reaches the rounding floor at once:
     # tests/test_polar.py checks its own budget)
-    with warnings.catch_warnings(record=True) as w, pumpup.engine.polar.two_d_only():
+    with warnings.catch_warnings(record=True) as w, helpers.two_d_only():
         warnings.simplefilter("always")
         a, e = pumpup.albedo(f, 0.3, return_error=True, rtol=1e-15, atol=0, max_regions=10)
     assert any(issubclass(x.category, pumpup.albedo_module.AlbedoWarning) for x in w)
@@ -213,7 +214,7 @@ def test_max_regions_counts_the_refinement_beyond_the_first_grid():
     exact, exact_err = phong_albedo_1d(20, 0.5)
     out = {}
     for mr in (0, 10):
-        with pytest.warns(pumpup.albedo_module.AlbedoWarning), pumpup.engine.polar.two_d_only():  # the 2-D engine
+        with pytest.warns(pumpup.albedo_module.AlbedoWarning), helpers.two_d_only():  # the 2-D engine
             out[mr] = pumpup.albedo(f, 0.5, return_error=True, rtol=1e-12, max_regions=mr)
     assert out[10][1] < out[0][1]
     for a, e in out.values():

@@ -15,8 +15,8 @@ from scipy.integrate import IntegrationWarning, quad
 from scipy.optimize import brentq
 
 import pumpup
-from pumpup.engine import polar as _polar
 from pumpup.engine.cubature import AlbedoWarning
+import helpers
 
 A = sys.modules["pumpup.engine.cubature"]
 GL = np.polynomial.legendre.leggauss(200)
@@ -87,7 +87,7 @@ def test_a_level_near_one_is_found_where_it_touches_the_arc():
 @pytest.mark.parametrize("rtol", [1e-10, 1e-13])
 def test_scaled_phong_2d_engine_bounds_its_error(rtol):
     ref = _scaled_reference()
-    with _polar.two_d_only():
+    with helpers.two_d_only():
         a, e = pumpup.albedo(pumpup.load(SCALED), MU_SCALED, return_error=True, rtol=rtol)
     assert abs(float(a) - ref) <= float(e) + REF_ERR, (float(a), ref, float(e))
     # and the nested engine (which starts from the same breaks)
@@ -142,7 +142,7 @@ def test_crossing_cuts_are_breaks():
 @pytest.mark.parametrize("rtol", [1e-10, 3e-11])
 def test_cook_torrance_2d_engine_bounds_its_error(rtol):
     ref = _ct_reference(CT, MU_CT)
-    with _polar.two_d_only():
+    with helpers.two_d_only():
         a, e = pumpup.albedo(pumpup.load(CT), MU_CT, return_error=True, rtol=rtol)
     assert abs(float(a) - ref) <= float(e) + REF_ERR, (float(a), ref, float(e))
     b, eb = pumpup.albedo(pumpup.load(CT), MU_CT, return_error=True, rtol=1e-13)
@@ -209,7 +209,7 @@ def test_ggx_tiny_alpha_at_grazing_finds_its_far_horizon_break(engine):
     f = pumpup.load({"type": "ggx", "alpha": alpha})
     lobe = f.lobe(mu)
     assert 1.0 - A._horizon_breaks(lobe, mu).max() < 2e-9
-    switch = _polar.without_1d() if engine == "nested" else _polar.two_d_only()
+    switch = helpers.without_1d() if engine == "nested" else helpers.two_d_only()
     with switch, warnings.catch_warnings():
         warnings.simplefilter("ignore", AlbedoWarning)  # the budget may run out at rtol 1e-12; the estimate stays honest
         for rtol in (1e-10, 1e-12):
@@ -228,7 +228,7 @@ def test_a_horizon_break_where_the_weight_underflows_is_dropped():
     mu = 0.35905733
     assert A._horizon_breaks(f.lobe(mu), mu).min() > 1e-100
     ref, eref = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
-    for switch in (_polar.without_1d, _polar.two_d_only):
+    for switch in (helpers.without_1d, helpers.two_d_only):
         with switch():
             a, e = pumpup.albedo(f, mu, return_error=True, rtol=1e-10)
         assert np.isfinite(a) and abs(float(a) - float(ref)) <= float(e + eref), (switch.__name__, float(a), float(ref))
@@ -289,7 +289,7 @@ def test_p_model_near_grazing_2d_engine_bounds_its_error(case, rtol):
     model, n, p, mu = case
     ref, ref_err = _p_reference(model, n, p, mu)
     f = pumpup.load({"type": model, "n": float(n), "p": p})
-    with _polar.two_d_only():
+    with helpers.two_d_only():
         a, e = pumpup.albedo(f, mu, rtol=rtol, atol=0.0, return_error=True)
     assert abs(float(a) - ref) <= float(e) + ref_err, (float(a), float(e), abs(float(a) - ref))
     assert float(e) <= max(rtol * ref, 64 * np.finfo(float).eps * ref)
@@ -428,7 +428,7 @@ def test_engines_near_normal_incidence_see_the_shadowing_at_the_horizon(alpha, m
                           *(1 - mp.mpf(10) ** -j for j in (12, 9, 6, 4, 3))})
             exact = float(mp.fsum(mp.quad(h, [a, b]) for a, b in zip(pts[:-1], pts[1:])))
         assert abs(float(ref) - exact) <= float(eref) + 1e-16
-    with (_polar.without_1d() if engine == "nested" else _polar.two_d_only()):
+    with (helpers.without_1d() if engine == "nested" else helpers.two_d_only()):
         a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
     assert abs(float(a) - float(ref)) <= float(e) + float(eref), (float(a) - float(ref), float(e))
 
@@ -478,7 +478,7 @@ def test_2d_engine_sees_a_kink_that_enters_and_leaves_above_the_split():
     ca, sa, _ = A._radial(lobe.radial, lobe.sharpness, x, xc)
     assert np.any(np.abs(np.arctan2(sa, ca) - 0.43515) < 1e-4)  # the cut's entry is a break
     for rtol in (1e-8, 1e-12):
-        with _polar.two_d_only():
+        with helpers.two_d_only():
             a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
         assert abs(float(a) - ref) <= float(e) + 1e-13, (float(a) - ref, float(e))
 
@@ -525,7 +525,7 @@ def test_pumped_cook_torrance_against_rings(engine):
         pts += [brentq(lambda m: ck(m) - sign, grid[i], grid[i + 1], xtol=1e-16)
                 for i in np.nonzero(np.sign(h[:-1]) * np.sign(h[1:]) < 0)[0]]
     ref = _rings(f, 0.5, cuts, pts)
-    with _polar.two_d_only() if engine == "2-D" else contextlib.nullcontext():
+    with helpers.two_d_only() if engine == "2-D" else contextlib.nullcontext():
         for rtol in (1e-10, 1e-12):
             a, e = pumpup.albedo(f, 0.5, return_error=True, rtol=rtol)
             assert abs(float(a) - ref) <= float(e) + REF_ERR, (rtol, float(a), ref, float(e))

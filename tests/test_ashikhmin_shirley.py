@@ -9,6 +9,7 @@ import pytest
 import pumpup
 from pumpup.testing import chi2_test
 
+import helpers
 from helpers import at_mu, direction_pairs
 from reference import ashikhmin_shirley as ref
 
@@ -408,11 +409,32 @@ def test_pumpup_sample_uses_the_papers_sampling():
 
 def test_the_diffuse_term_is_a_closed_form_term():
     """The albedo splits into the specular lobe (a half-vector hint, Lobe) and the diffuse term, whose hint is the closed
-    form of an existing family (Polar kind "constant"): its albedo is rd (1 - rs) (1 - (1 - mu / 2)^5) exactly."""
+    form of an existing family (``ClosedForm``): its albedo is rd (1 - rs) (1 - (1 - mu / 2)^5) exactly."""
     f = pumpup.load({"type": "ashikhmin_shirley", "nu": 100, "nv": 100, "rs": 0.05, "rd": 0.8})
     terms = f.albedo_terms()
     assert len(terms) == 2
     mu = np.array([1.0, 0.5, 0.05])
     (wd, diffuse), = [(w, t) for w, t in terms if t.type == "ashikhmin_shirley-diffuse"]
-    assert diffuse.polar() is not None and diffuse.polar().kind == "constant"
+    assert helpers.hint_routes(diffuse) and helpers.view(diffuse).kind == "constant"
     np.testing.assert_allclose(wd * pumpup.albedo(diffuse, mu), 0.8 * 0.95 * (1 - (1 - mu / 2) ** 5), rtol=1e-14)
+
+
+@pytest.mark.parametrize("spec", [{"nu": 10, "nv": 10, "rs": 1.0}, {"nu": 100, "nv": 100, "rs": 0.05, "rd": 0.8},
+                                  {"nu": 0, "nv": 0, "rs": 0.2, "rd": 0.5}, {"nu": 5000, "nv": 5000, "rs": 0.9}],
+                         ids=str)
+def test_isotropic_lobe_takes_a_1d_route(spec):
+    """Isotropic, the specular lobe takes the rule on the half vector's arc (``half_arc``; the 1 / (h.k) cancels the
+    Jacobian): its route is a 1-D one at every mu, and its albedo agrees with the nested engine at rtol 1e-12 within
+    the summed estimates, from normal to grazing incidence; anisotropic, the nested engine."""
+    from pumpup.engine.routes import plan
+
+    f = load(**spec)
+    mu = np.array([1.0, 0.9, 0.5, 0.2, 0.05, 1e-3, 1e-6])
+    routes = {r for _, t in f.albedo_terms() for r, _, _ in plan(t, mu)}
+    assert routes <= {"half_arc", "closed"} and "half_arc" in routes, routes
+    a, e = pumpup.albedo(f, mu, return_error=True, rtol=1e-10, engine="1d")
+    with helpers.without_1d():
+        b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
+    assert np.all(np.abs(a - b) <= e + eb), (np.abs(a - b) / (e + eb)).max()
+    assert np.all(e <= 1e-10 * a)
+    assert {r for _, t in load(nu=10, nv=1000, rs=0.5).albedo_terms() for r, _, _ in plan(t, mu)} == {"nested"}

@@ -13,6 +13,7 @@ import pytest
 import pumpup
 from pumpup.operators.compensate import KullaConty, Scaled, compensation_table
 from helpers import at_mu, direction_pairs
+import helpers
 
 comp = sys.modules["pumpup.operators.compensate"]
 
@@ -98,11 +99,10 @@ def test_kulla_conty_lobe_in_closed_form(spec):
     within the summed estimates, from mu = 1 to 1e-8 and between the table's nodes."""
     from scipy.integrate import quad
 
-    from pumpup.engine import polar as _polar
 
     c = pumpup.compensate(spec, method="kulla_conty")
     ms = c.albedo_terms()[-1][1]
-    assert ms.polar().kind == "constant" and _polar.takes_1d_path(ms)
+    assert helpers.view(ms).kind == "constant" and helpers.takes_1d(ms)
     i, e = c.bound.deficit_moment()
     p = c.bound.product
     edges = np.unique(np.r_[0.0, p.mlo, p.lo[(p.lo > p.mlo) & (p.lo < 1.0)], c.bound.kinks, 1.0])
@@ -114,7 +114,7 @@ def test_kulla_conty_lobe_in_closed_form(spec):
     assert abs(i - v) <= e + ve and i <= c.bound.deficit_integral, (i, v, e, ve)
     mu = np.concatenate([MU, RNG_MU])
     a, ea = pumpup.albedo(ms, mu, return_error=True, rtol=1e-12)
-    with _polar.without_1d():
+    with helpers.without_1d():
         b, eb = pumpup.albedo(ms, mu, return_error=True, rtol=1e-12)
     assert np.all(np.abs(a - b) <= ea + eb), (mu, a - b, ea, eb)
     assert np.all(ea <= 1e-12 * a + 1e-300)  # (I's rounding bound, 32 eps, against I = 0.0088 for alpha = 0.05)
@@ -126,14 +126,13 @@ def test_kulla_conty_lobe_on_the_engines_near_grazing(engine):
     reference, scripts/studies/fuzz_engines.py --registry 47): D(N.wo), a spline in log(N.wo), about the normal, was 3.4 x (2-D)
     and 3.0 x (nested) their estimates at rtol 1e-12 against the closed form D(mu) pi I (checked against scipy's quad
     above).  The hint's levels N.wo = 10^-k (compensate.TABLE_DECADES) grade the radial variable there."""
-    from pumpup.engine import polar as _polar
 
     f = pumpup.load({"type": "kulla_conty", "base": {"type": "phong", "n": 986.5971775489417}, "f_avg": 0.6893058353882096})
     ms = f.albedo_terms()[-1][1]
     assert set(comp.TABLE_DECADES) <= set(ms.lobe(0.5).levels)
     mu = np.linspace(0.000510255, 0.000510265, 9)
     exact, ee = pumpup.albedo(ms, mu, return_error=True, rtol=1e-12)
-    with _polar.two_d_only() if engine == "2-D" else _polar.without_1d():
+    with helpers.two_d_only() if engine == "2-D" else helpers.without_1d():
         for rtol in (1e-10, 1e-12):
             a, ea = pumpup.albedo(ms, mu, return_error=True, rtol=rtol, max_regions=200000)
             assert np.all(np.abs(a - exact) <= ea + ee), (rtol, a - exact, ea, ee)
@@ -213,15 +212,14 @@ def test_scaled_furnace_toward_the_viewer_in_closed_form(spec, f0):
     """The furnace toward the viewer of a scaled model (and of each term of a scaled sum) is s(mu) times the base's
     albedo (000 eq. 2 for the reciprocal base; issue 14's twelfth session, ``_Transposed.polar``): on the 1-D path, and
     against the nested engine at rtol 1e-12 within the summed estimates, from mu = 1 to 1e-8 and between the nodes."""
-    from pumpup.engine import polar as _polar
 
     s = pumpup.compensate(spec, method="scale", f0=f0)
     mu = np.concatenate([MU, RNG_MU])
     np.testing.assert_allclose(s.kernel_factor(mu), s.factor(mu), rtol=1e-14, atol=0)  # compiled look-up and its reference
     for _, t in comp._Transposed(s).albedo_terms():
-        assert t.polar() is not None and _polar.takes_1d_path(t)
+        assert helpers.hint_routes(t) and helpers.takes_1d(t)
     a, e = pumpup.furnace(s, mu, return_error=True, rtol=1e-12)
-    with _polar.without_1d():
+    with helpers.without_1d():
         b, eb = pumpup.furnace(s, mu, return_error=True, rtol=1e-12)
     assert np.all(np.abs(a - b) <= e + eb), (mu, a - b, e, eb)
     assert np.all(e <= 1e-12 * a)
@@ -231,7 +229,7 @@ def test_scaled_furnace_of_a_forced_non_reciprocal_base_stays_nested():
     """Phong's own shader (002, not reciprocal) scaled with ``force``: f(wo, wi) is not s(N.wi) f(wi, wo), so the furnace
     keeps the nested engine."""
     s = pumpup.compensate({"type": "phong_shader", "n": 20}, method="scale", force=True)
-    assert not s.base.reciprocal and comp._Transposed(s).polar() is None
+    assert not s.base.reciprocal and not helpers.hint_routes(comp._Transposed(s))
 
 
 def test_scaled_lobe_about_the_normal_against_rings():
@@ -459,8 +457,8 @@ def test_anisotropic_base_refused():
 def test_scaled_beckmann_declines_frame_6_only_with_walters_g1():
     """(The fast half of the next test.)"""
     spec = {"type": "scaled", "base": {"type": "beckmann", "alpha": 0.19}}
-    assert pumpup.load(spec).polar() is not None
-    assert pumpup.load({**spec, "base": {**spec["base"], "g1": "walter"}}).polar() is None
+    assert helpers.hint_routes(pumpup.load(spec))
+    assert not helpers.hint_routes(pumpup.load({**spec, "base": {**spec["base"], "g1": "walter"}}))
 
 
 @pytest.mark.slow
@@ -478,7 +476,7 @@ def test_scaled_beckmann_with_walters_g1_takes_the_nested_engine():
     for alpha, f0, mu in ((0.1913728316510363, 0.10708949613728647, 0.9999),
                           (0.09098619502161732, 0.9585229997993715, 0.32410506187394855)):
         f = pumpup.load({"type": "scaled", "base": {"type": "beckmann", "alpha": alpha, "g1": "walter"}, "f0": f0})
-        assert f.polar() is None
+        assert not helpers.hint_routes(f)
         lo = f.bound.product.lo
         pts = np.concatenate([lo[(lo > 0) & (lo < 1)], f.bound.kinks, [walter_level(alpha), mu],
                               np.exp(f.bound.lookup.logx)])

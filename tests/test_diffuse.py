@@ -9,6 +9,7 @@ from scipy.integrate import quad
 import pumpup
 
 from helpers import direction_pairs, polar
+import helpers
 
 N = np.array([0.0, 0.0, 1.0])
 
@@ -137,7 +138,6 @@ def test_oren_nayar_albedo_in_closed_form():
     import warnings
 
     mp = pytest.importorskip("mpmath")
-    from pumpup.engine import polar as _polar
     from pumpup.models.diffuse import oren_nayar_albedo
 
     mp.mp.dps = 40
@@ -154,7 +154,7 @@ def test_oren_nayar_albedo_in_closed_form():
                  {"type": "oren_nayar", "sigma": 1.2}):
         f = pumpup.load(spec)
         a, e = pumpup.albedo(f, mu, return_error=True)
-        with _polar.without_1d(), warnings.catch_warnings():
+        with helpers.without_1d(), warnings.catch_warnings():
             warnings.simplefilter("ignore")
             b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
         assert np.all(np.abs(a - b) <= e + eb) and np.all(e <= 1e-15 * a)
@@ -167,7 +167,6 @@ def test_minnaert_and_lacquer_albedos_in_closed_form():
     import warnings
 
     mp = pytest.importorskip("mpmath")
-    from pumpup.engine import polar as _polar
 
     mp.mp.dps = 30
     mu = np.array([1.0, 0.9, 0.5, 0.2, 0.05, 1e-2, 1e-3])
@@ -185,7 +184,7 @@ def test_minnaert_and_lacquer_albedos_in_closed_form():
     for spec in ({"type": "lacquer"}, {"type": "lacquer", "s": 1.5}, {"type": "minnaert", "k": 0.8}, {"type": "minnaert", "k": 2.0}):
         f = pumpup.load(spec)
         a, e = pumpup.albedo(f, mu, return_error=True)
-        with _polar.without_1d(), warnings.catch_warnings():
+        with helpers.without_1d(), warnings.catch_warnings():
             warnings.simplefilter("ignore")
             b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
         assert np.all(np.abs(a - b) <= e + eb), spec

@@ -18,6 +18,7 @@ from pumpup.models.metal import fresnel_levels
 
 sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
 from test_albedo_breaks import _rings  # noqa: E402
+import helpers
 
 ETA = 0.551
 X0 = math.sqrt(1.0 - ETA * ETA)
@@ -129,10 +130,9 @@ def test_microfacet_with_total_reflection(spec, mu):
     """F(wi.h) with eta = 0.551, k = 0 has a square-root kink at wi.h = x0.  Frame 4 of the 1-D path, which took it, was
     1.0e-7 off with an estimate of 7.9e-13 for GGX 0.3 at mu = 0.05, 1.9e-12 with 2.1e-14 at 0.95, and Beckmann 0.1 at 0.95
     3.8e-11 with 9.2e-14 (and 19 s); the nested engine, now with the kink in its hint, is its path."""
-    from pumpup.engine import polar as _polar
 
     f = pumpup.load(spec)
-    assert not _polar.takes_1d_path(f) and f.lobe(mu).kinks is not None
+    assert not helpers.takes_1d(f) and f.lobe(mu).kinks is not None
     ref = _wih_reference(f, mu, X0)
     for rtol in (1e-8, 1e-10, 1e-12):
         a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
@@ -142,11 +142,10 @@ def test_microfacet_with_total_reflection(spec, mu):
 def test_microfacet_paths_by_the_branch_point():
     """The 1-D path declines F(wi.h) whose branch point lies closer than POLAR_F_Y0_MIN to (0, 1); the hint's kink
     follows fresnel_levels."""
-    from pumpup.engine import polar as _polar
 
     for k, one_d, kink in ((0.0, False, True), (1e-9, False, True), (1e-3, True, True), (0.1, True, False)):
         f = pumpup.load({"type": "ggx", "alpha": 0.3, "eta": ETA, "k": k})
-        assert _polar.takes_1d_path(f) == one_d and (f.lobe(0.5).kinks is not None) == kink, k
+        assert helpers.takes_1d(f) == one_d and (f.lobe(0.5).kinks is not None) == kink, k
     assert pumpup.load({"type": "ggx", "alpha": 0.3, "eta": 0.2, "k": 3.0}).lobe(0.5).kinks is None
     import pickle
 
@@ -193,11 +192,10 @@ def test_beckmann_walter_correlated_with_fresnel(spec, mu):
     """Walter's G1 (a jump at its switch level) in the height-correlated G with a Fresnel factor: frame 4 was 7 x its
     estimate at rtol 1e-10 (the first case: 1.27e-11 off, estimate 1.8e-12) and 3.8 x at 1e-12 (the second), against the
     2-D engine at rtol 1e-13 (found by ``scripts/studies/fuzz_engines.py --registry``).  The nested engine takes it now."""
-    from pumpup.engine import polar as _polar
 
     f = pumpup.load(spec)
-    assert not _polar.takes_1d_path(f)
-    with _polar.two_d_only():
+    assert not helpers.takes_1d(f)
+    with helpers.two_d_only():
         ref, eref = pumpup.albedo(f, mu, return_error=True, rtol=1e-13, max_regions=400000)
     for rtol in (1e-8, 1e-10, 1e-12):
         a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)

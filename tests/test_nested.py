@@ -14,6 +14,8 @@ import pumpup
 from pumpup.engine import nested as _nested
 from pumpup.engine import polar as _polar
 from pumpup.engine.cubature import NODES, WG, WK, AlbedoWarning, _groups, _integrate_group, _kink_coefficients, _smooth
+import helpers
+from pumpup.engine.routes import using
 
 
 @pytest.fixture(autouse=True)
@@ -21,7 +23,7 @@ def _nested_for_the_blinn_family_too():
     """These tests use the Blinn family as the nested engine's examples; since issue 14's sixth session
     its azimuth about N is closed-form (pumpup.engine.polar, kind "half"), so the 1-D path is switched off here
     and the nested engine integrates it, as before."""
-    with _polar.without_1d():
+    with helpers.without_1d():
         yield
 
 A = sys.modules["pumpup.engine.cubature"]
@@ -32,9 +34,10 @@ DIRECTIONAL = [e for e in DATA["entries"] if e["quantity"] == "directional_albed
 
 
 @pytest.fixture
-def no_1d(monkeypatch):
-    """Switch off the closed-form-azimuth path only, so the nested engine takes the Phong family too."""
-    monkeypatch.setattr(_polar, "albedo_1d", lambda *a, **k: None)
+def no_1d():
+    """No 1-D route, so the nested engine takes the Phong family too."""
+    with helpers.without_1d():
+        yield
 
 
 def _by_engine(f, mu, nested, rtol=1e-10):
@@ -80,7 +83,7 @@ def test_error_bounds_the_truth_at_every_rtol(spec, rtol):
     f = pumpup.load(spec)
     mu = np.array([1.0, 0.9, 0.5, 0.3414, 0.1, 1e-2, 1e-4, 1e-7])
     a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
-    with _nested.disabled():
+    with helpers.without_nested():
         t, et = pumpup.albedo(f, mu, return_error=True, rtol=1e-13)
     assert np.all(np.abs(a - t) <= e + et), (mu, a - t, e)
     assert np.all(e <= rtol * a + 1e-14 + 64 * np.finfo(float).eps * a)
@@ -96,8 +99,8 @@ def test_p_model_near_grazing_bounds_its_error(mu, rtol, monkeypatch):
     Gauss-Jacobi rule at the arc's end, a different method; within 1e-15 of tests/data/independent_p.json),
     its own error added."""
     f = pumpup.load({"type": "stretched_phong", "n": 1, "p": 0.5})
-    monkeypatch.setattr(_polar, "ONE_D", True)  # (the module's fixture switched the 1-D path off)
-    t, et, *_ = _polar.albedo_1d(f, np.array([mu]), 1e-13, 0.0, 10000)
+    with using(engine="auto"):  # (the module's fixture left the 1-D routes out)
+        t, et, *_ = _polar.albedo_1d(f, np.array([mu]), 1e-13, 0.0, 10000)
     a, e, used = _by_engine(f, mu, nested=True, rtol=rtol)
     assert all(used)
     assert abs(a[0] - t[0]) <= e[0] + et[0], (a[0], e[0], a[0] - t[0])
@@ -225,9 +228,9 @@ def test_two_d_only_and_disabled_switch_the_nested_path_off(monkeypatch):
     monkeypatch.setattr(_nested, "integrate", lambda *a: calls.append(1) or real(*a))
     pumpup.albedo(f, 0.5)
     assert calls == [1]
-    with _polar.two_d_only():
+    with helpers.two_d_only():
         pumpup.albedo(f, 0.5)
-    with _nested.disabled():
+    with helpers.without_nested():
         pumpup.albedo(f, 0.5)
     assert calls == [1]
     pumpup.albedo(f, 0.5, phi=0.3)  # isotropic: phi ignored, nested
@@ -282,7 +285,7 @@ def test_evaluation_counts_per_mu(spec, capsys, no_1d):
 
     A._accumulate = counting
     try:
-        with _nested.disabled():
+        with helpers.without_nested():
             pumpup.albedo(f, mu)
     finally:
         A._accumulate = orig
@@ -320,7 +323,7 @@ def test_sharp_power_lobes_where_the_split_underflows(n):
     f = pumpup.load({"type": "blinn", "n": n})
     mu = np.array([1.0, 0.5, 1e-3])
     a, e = pumpup.albedo(f, mu, return_error=True)
-    with _nested.disabled():
+    with helpers.without_nested():
         b, eb = pumpup.albedo(f, mu, return_error=True)
     assert np.all(np.abs(a - b) <= e + eb), (a - b, e, eb)
 
@@ -332,7 +335,7 @@ def test_anisotropic_ridge_at_phi_zero(ax, ay):
     square-root substitution at those ends)."""
     f = pumpup.load({"type": "ward_aniso", "ax": ax, "ay": ay})
     a, e = pumpup.albedo(f, np.array([1.0, 0.5]), return_error=True)
-    with _nested.disabled():
+    with helpers.without_nested():
         b, eb = pumpup.albedo(f, np.array([1.0, 0.5]), return_error=True)
     assert np.all(np.abs(a - b) <= e + eb), (a, b, e, eb)
     assert abs(a[0] - 1.0) < 2e-6
@@ -355,8 +358,8 @@ def test_segments_in_chunks_change_no_bit(monkeypatch):
     for spec in ({"type": "ward_aniso", "ax": 0.05, "ay": 0.3},
                  {"type": "pumped", "base": {"type": "blinn", "n": 30}, "g": "g2", "levels": 2}):
         f = pumpup.load(spec)
-        f.polar()  # (the pumped tables first, with the default chunks)
-        with _polar.without_1d(), warnings.catch_warnings():
+        f.azimuth_hint()  # (the pumped tables first, with the default chunks)
+        with helpers.without_1d(), warnings.catch_warnings():
             warnings.simplefilter("ignore")
             a, e = pumpup.albedo(f, mu, rtol=1e-10, return_error=True)
             monkeypatch.setattr(_nested, "SEG_CHUNK", 7)

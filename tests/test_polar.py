@@ -14,6 +14,10 @@ from helpers import phong_albedo_1d
 
 import pumpup
 from pumpup.engine import polar as _polar
+from pumpup.engine import half_frames as _half_frames, lobe_frame as _lobe_frame, outer_rule as _outer_rule
+import helpers
+from pumpup.core.hints import AzimuthHint, HalfVectorLobe, PowerLobe, VCavityLobe, WardLobe
+from pumpup.engine.routes import current, using
 
 # grazing, the breakpoints' special cases (mu = 1/2: s = cos 30 deg; 1/sqrt(2): cos 2 theta = 0;
 # sqrt(3)/2: s = 1/2, the split of the tail), and ordinary angles
@@ -26,9 +30,9 @@ class _Lobe:
     def __init__(self, n, p):
         self.n, self.p = n, p
 
-    def polar(self):
+    def azimuth_hint(self):
         c = (self.n + 2) / (2 * math.pi)
-        return _polar.Polar(n=self.n, p=self.p, scale=lambda mu: np.full(np.shape(mu), c))
+        return AzimuthHint(PowerLobe(n=self.n, p=self.p), scale=lambda mu: np.full(np.shape(mu), c))
 
 
 @pytest.mark.parametrize("p", [0.0, 0.3, 0.5, 0.9, 1.0])
@@ -38,8 +42,8 @@ def test_kernel_integrand_matches_numpy_reference(rng, p):
             s = math.sqrt((1 - mu) * (1 + mu))
             c2 = (mu - s) * (mu + s)
             u = np.concatenate([rng.uniform(0, 1, 60 if 0 < p < 1 else 200), [0.0, 0.5, 1.0, s, max(c2, 0.0)]])
-            ref = _polar.integrand_reference(n, p, mu, u)
-            got, err = _polar.integrand(n, p, mu, u)
+            ref = _lobe_frame.integrand_reference(n, p, mu, u)
+            got, err = _lobe_frame.integrand(n, p, mu, u)
             # the reference's arccos form loses digits near the arc's ends (and p > 0 divides by mu^p)
             np.testing.assert_allclose(got, ref, rtol=1e-9, atol=1e-9 * max(1.0, mu**-p) * np.max(np.abs(ref)))
             assert np.all(err <= 1e-12 * np.abs(got) + 1e-300) and (p not in (0, 1) or np.all(err == 0))
@@ -62,14 +66,14 @@ def _arc_cases():
 
 def test_arc_piece_and_its_bound_against_mpmath():
     """issue 14's fifteenth session: the arc where N.wo >= mu (p in (0, 1)) by the fewest Gauss-Legendre points in
-    s whose Bernstein-ellipse bound meets the tolerance (``_polar._arc_power``).  Against 24-digit mpmath at rtol 1e-6
+    s whose Bernstein-ellipse bound meets the tolerance (``_lobe_frame._arc_power``).  Against 24-digit mpmath at rtol 1e-6
     .. 1e-14, the returned error bounds the true error, and the piece matches its numpy twin (200 points)."""
     import mpmath
 
     from pumpup.engine.cubature import NODES, WG, WK
     from pumpup.physics.quadrature import mode_code
 
-    ibuf, iwork = np.empty(15), np.empty((4, _polar.INNER_MAX))
+    ibuf, iwork = np.empty(15), np.empty((4, _lobe_frame.INNER_MAX))
     worst = 0.0
     for q, mu, u in _arc_cases():
         a, b = mu * u, math.sqrt((1.0 - mu) * (1.0 + mu)) * math.sqrt((1.0 - u) * (1.0 + u))
@@ -82,17 +86,17 @@ def test_arc_piece_and_its_bound_against_mpmath():
             b1 = mpmath.acos((mm - am) / bm)
             d1, beta1 = float(bm**2 - (mm - am) ** 2), float(b1)
             ref = mpmath.quad(lambda t: (am + bm * mpmath.cos(t)) ** q, [0, b1 / 2, b1])
-        jac = _polar.jacobi_rules(q)
+        jac = _lobe_frame.jacobi_rules(q)
         for rtol in (1e-6, 1e-10, 1e-14):
-            h, e = _polar._arc_power(q, mu, a, b, d1, beta1, rtol, 0.0, NODES, WK, WG, mode_code(), ibuf,
+            h, e = _lobe_frame._arc_power(q, mu, a, b, d1, beta1, rtol, 0.0, NODES, WK, WG, mode_code(), ibuf,
                                      iwork, jac)
             err = abs(h - float(ref))
             assert err <= e + 1e-15 * abs(h), (q, mu, u, rtol, h, float(ref), e)
-            assert e <= (rtol + (_polar.GL_MAX + 16) * 2.3e-16) * abs(h), (q, mu, u, rtol, e / abs(h))
+            assert e <= (rtol + (_lobe_frame.GL_MAX + 16) * 2.3e-16) * abs(h), (q, mu, u, rtol, e / abs(h))
             worst = max(worst, err / e)
         if a + b <= 4 * mu:  # the whole arc is the piece in s
-            assert _polar._arc_power(q, mu, a, b, d1, beta1, 1e-14, 0.0, NODES, WK, WG, mode_code(), ibuf,
-                                     iwork, jac)[0] == pytest.approx(_polar.arc_piece_reference(q, mu, a, b, d1), rel=2e-14)
+            assert _lobe_frame._arc_power(q, mu, a, b, d1, beta1, 1e-14, 0.0, NODES, WK, WG, mode_code(), ibuf,
+                                     iwork, jac)[0] == pytest.approx(_lobe_frame.arc_piece_reference(q, mu, a, b, d1), rel=2e-14)
     assert 0.0 < worst <= 1.0
 
 
@@ -108,12 +112,12 @@ def test_arc_power_beyond_the_rules_falls_back_to_the_adaptive_rule():
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     c2 = (mu - s) * (mu + s)
     um, sa = 1.0 - u, math.sqrt((1.0 - u) * (1.0 + u))
-    _, beta1, _ = _polar._k_closed(0.5, mu, c2, u, um, sa)
+    _, beta1, _ = _lobe_frame._k_closed(0.5, mu, c2, u, um, sa)
     d1 = um * (u - c2)
-    n, _ = _polar._arc_bound(q, mu * u + s * sa, d1 / (s * sa + mu * um), s * sa, 1.0, 1e-300)
-    assert n == _polar.GL_MAX + 1
-    h, e = _polar._arc_power(q, mu, mu * u, s * sa, d1, beta1, 1e-300, 0.0, NODES, WK, WG, mode_code(),
-                             np.empty(15), np.empty((4, _polar.INNER_MAX)), _polar.jacobi_rules(q))
+    n, _ = _lobe_frame._arc_bound(q, mu * u + s * sa, d1 / (s * sa + mu * um), s * sa, 1.0, 1e-300)
+    assert n == _lobe_frame.GL_MAX + 1
+    h, e = _lobe_frame._arc_power(q, mu, mu * u, s * sa, d1, beta1, 1e-300, 0.0, NODES, WK, WG, mode_code(),
+                             np.empty(15), np.empty((4, _lobe_frame.INNER_MAX)), _lobe_frame.jacobi_rules(q))
     with mpmath.workdps(30):
         am, bm = mpmath.mpf(mu) * u, mpmath.sqrt(1 - mpmath.mpf(mu) ** 2) * mpmath.sqrt(1 - mpmath.mpf(u) ** 2)
         ref = mpmath.quad(lambda t: mpmath.sqrt(am + bm * mpmath.cos(t)), [0, mpmath.acos((mu - am) / bm)])
@@ -138,7 +142,7 @@ def test_against_mpmath_with_honest_error(n, p):
 def test_nearly_coinciding_breaks_against_mpmath(n):
     """Near mu = sqrt(3) / 2 the level's break (u = cos 2 theta_i) and the horizon's (u = s) nearly coincide, and each one's
     square root reaches across the other's (stretched Phong n = 10 at mu = 0.866025 was 3.2e-12 off at rtol 1e-12 with an
-    estimate of 6.6e-13 until issue 14's twelfth session: ``_polar._foreign_roots`` grades the piece next to such a root):
+    estimate of 6.6e-13 until issue 14's twelfth session: ``_outer_rule._foreign_roots`` grades the piece next to such a root):
     against the 30-digit mpmath reference, at rtol 1e-8, 1e-10 and 1e-12, the estimate bounds the error."""
     m0 = math.sqrt(3) / 2
     mu = m0 * (1.0 + np.array([0.0, -1e-14, 1e-12, -1e-9, 1e-9, -1e-6, 1e-6, -1e-4, 1e-4]))
@@ -182,10 +186,10 @@ SPECS = [
 @pytest.mark.parametrize("spec", SPECS, ids=[s["type"] for s in SPECS])
 def test_one_d_agrees_with_the_two_d_engine(spec):
     f = pumpup.load(spec)
-    assert all(t.polar() is not None for _, t in f.albedo_terms())  # the 1-D path is taken
+    assert all(helpers.hint_routes(t) for _, t in f.albedo_terms())  # the 1-D path is taken
     mu = np.array([1.0, 0.7, 0.3, 1e-3, 1e-7])
     a, e = pumpup.albedo(f, mu, return_error=True)
-    with _polar.two_d_only():
+    with helpers.two_d_only():
         b, eb = pumpup.albedo(f, mu, return_error=True)
     assert np.all(np.abs(a - b) <= e + eb), (a, b, e, eb)
     assert np.all(e <= 1e-10 * a + 1e-14)
@@ -193,7 +197,7 @@ def test_one_d_agrees_with_the_two_d_engine(spec):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("spec", [dict(type=m.type, **ex) for m in pumpup.registry().values() for ex in m.examples
-                                  if m(**ex).polar() is not None or m.type in ("lafortune_sum", "lewis_phong", "phong_shader")],
+                                  if helpers.hint_routes(m(**ex)) or m.type in ("lafortune_sum", "lewis_phong", "phong_shader")],
                          ids=lambda s: s["type"])
 def test_one_d_agrees_with_the_two_d_engine_on_every_example(spec):
     # the models on the rule on h's arc (frame 4) against the nested engine: the 2-D engine misses GGX alpha = 0.5,
@@ -201,9 +205,9 @@ def test_one_d_agrees_with_the_two_d_engine_on_every_example(spec):
     f = pumpup.load(spec)
     mu = np.array(MU)
     a, e = pumpup.albedo(f, mu, return_error=True)
-    hint = f.polar()
+    hint = helpers.view(f)
     on_the_arc = hint is not None and (hint.smith is not None or hint.schlick is not None or any(hint.fresnel))
-    with _polar.without_1d() if on_the_arc else _polar.two_d_only(), warnings.catch_warnings():
+    with helpers.without_1d() if on_the_arc else helpers.two_d_only(), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         b, eb = pumpup.albedo(f, mu, return_error=True)
     assert np.all(np.abs(a - b) <= e + eb), (a, b, e, eb)
@@ -221,13 +225,12 @@ def test_general_p_against_the_other_engines(n, p, monkeypatch):
     mu = np.array(MU)
     a, e, conv, _ = _polar.albedo_1d(f, mu, 1e-10, 0.0, 10000)
     assert conv.all() and np.all(e <= 1e-10 * a)
-    with monkeypatch.context() as mp:
-        mp.setattr(_polar, "albedo_1d", lambda *args, **kw: None)
+    with monkeypatch.context() as mp, helpers.without_1d():
         mp.setattr(_nested, "LAST_EVALS", None)
         b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
         assert _nested.LAST_EVALS is not None  # the nested engine did it
     assert np.all(np.abs(a - b) <= e + eb), (np.abs(a - b) / (e + eb)).max()
-    with _polar.two_d_only():
+    with helpers.two_d_only():
         c, ec = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
     assert np.all(np.abs(a - c) <= e + ec), (np.abs(a - c) / (e + ec)).max()
 
@@ -263,7 +266,7 @@ def test_retro_and_stretched_phong_have_the_same_albedo():
     the same energy: their albedos (the 2-D engine's, from the BRDFs themselves) agree."""
     mu = np.array([0.9, 0.4, 0.05, 1e-4])
     for p in (0.0, 0.5, 1.0):
-        with _polar.two_d_only():
+        with helpers.two_d_only():
             a, e = pumpup.albedo(pumpup.load({"type": "retro", "n": 10, "p": p}), mu, return_error=True)
             b, eb = pumpup.albedo(pumpup.load({"type": "stretched_phong", "n": 10, "p": p}), mu, return_error=True)
         assert np.all(np.abs(a - b) <= e + eb)
@@ -284,10 +287,10 @@ def test_models_without_a_closed_azimuth_decline():
                  {"type": "ggx", "alpha": 2.0}, {"type": "beckmann", "alpha": 1.5},
                  {"type": "torrance_sparrow", "d": "D2", "s": 5}, {"type": "phong_shader", "n": 5, "kd": 0.1},
                  {"type": "phong_blinn", "n": 5, "kd": 0.1}]:
-        assert pumpup.load(spec).polar() is None, spec
+        assert not helpers.hint_routes(pumpup.load(spec)), spec
     user = pumpup.from_function(lambda wi, wo: np.full(np.broadcast_shapes(wi.shape, wo.shape)[:-1], 0.5 / np.pi),
                                 name="half-grey-polar")
-    assert user.polar() is None
+    assert not helpers.hint_routes(user)
     assert abs(float(pumpup.albedo(user, 0.4)) - 0.5) < 1e-9  # the generic 2-D cubature, as before
 
 
@@ -319,12 +322,20 @@ def test_budget_warns_and_keeps_an_honest_error():
         assert abs(a - ref) <= e + ref_err and e > 1e-13 * a
 
 
-def test_two_d_only_restores_the_switch():
-    assert _polar.ENABLED
-    with pytest.raises(RuntimeError), _polar.two_d_only():
-        assert not _polar.ENABLED
+def test_using_restores_the_choice():
+    assert current().engine == "auto" and not current().without
+    with pytest.raises(RuntimeError), helpers.two_d_only():
+        assert current().engine == "2d"
+        with helpers.without_nested():
+            assert current().engine == "2d" and current().without == {"nested"}
+        assert not current().without
         raise RuntimeError
-    assert _polar.ENABLED
+    assert current().engine == "auto" and not current().without
+    with pytest.raises(ValueError, match="engine must be one of"):
+        pumpup.albedo(pumpup.load({"type": "phong", "n": 2}), 0.5, engine="3d")
+    with pytest.raises(ValueError, match="unknown routes"):
+        with using(without={"frame6"}):
+            pass
 
 
 # --- the Blinn family: the half vector's azimuth about N in closed form (kind "half") -----------------
@@ -369,9 +380,9 @@ def test_half_kernel_against_the_geometry_and_its_numpy_twin(rng, p):
         edges = [math.cos(math.pi / 4 + th / 2), math.cos(math.pi / 4 - th / 2), mu]
         us = np.concatenate([rng.uniform(0, 1, 12), [1.0, 1 - 1e-12], [e * (1 + d) for e in edges for d in (-1e-6, 1e-6)]])
         for u in us[(us > 0) & (us <= 1)]:
-            k = _polar._k_half(p, mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
+            k = _half_frames._k_half(p, mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
             q = _k_half_by_quad(p, mu, float(u))
-            twin = _polar.half_integrand_reference(p, mu, np.array([u]))[0]
+            twin = _half_frames.half_integrand_reference(p, mu, np.array([u]))[0]
             assert abs(k - q) <= 1e-13 * max(abs(q), 1.0), (p, mu, u, k, q)  # K is at most 8 pi (measured: 1.3e-15)
             # (the twin's differences of antiderivatives cancel, by ~1 / mu for p = 1: the kernel avoids them)
             assert abs(k - twin) <= 1e-11 * max(abs(twin), 1.0) + 1e-15 * mu**-p, (p, mu, u, k, twin)
@@ -390,14 +401,14 @@ def test_ward_kernel_against_the_geometry_and_its_twin(rng):
         edges = [math.cos(math.pi / 4 + th / 2), math.cos(math.pi / 4 - th / 2)]
         us = np.concatenate([rng.uniform(0, 1, 10), [1.0, 1 - 1e-12], [e * (1 + d) for e in edges for d in (-1e-6, 1e-6)]])
         for u in us[(us > 0) & (us <= 1)]:
-            k = _polar._k_ward(mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
+            k = _half_frames._k_ward(mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
             q = _k_half_by_quad(0.0, mu, float(u), kind="root")
             assert abs(k - q) <= 1e-13 * max(abs(q), 1.0), (mu, u, k, q)  # (measured: 1.7e-14)
-            assert abs(k - _polar.ward_integrand_reference(mu, u)[0]) <= 1e-11 * max(abs(q), 1.0), (mu, u)
+            assert abs(k - _half_frames.ward_integrand_reference(mu, u)[0]) <= 1e-11 * max(abs(q), 1.0), (mu, u)
     ys = np.concatenate([rng.uniform(0, 1, 300), 10.0 ** rng.uniform(-300, 0, 300), 1 - 10.0 ** rng.uniform(-17, 0, 100),
                          [1.0, 0.5, 1e-300, 5e-324]])
     for y in ys[ys > 0]:
-        k, d = _polar._complete_kd(float(y))
+        k, d = _half_frames._complete_kd(float(y))
         assert abs(k - elliprf(0.0, y, 1.0)) <= 2e-15 * elliprf(0.0, y, 1.0), y
         assert abs(d - elliprd(0.0, y, 1.0) / 3) <= 2e-15 * elliprd(0.0, y, 1.0) / 3, y
         if y >= 1e-3:  # (ellipk / ellipe of m = 1 - y: D = (K - E) / m, and K - D = B = (E - (1 - m) K) / m)
@@ -413,15 +424,15 @@ def test_vcavity_kernel_against_the_geometry_and_its_twin(rng):
     for mu in (1.0, 0.99, 0.9, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8):
         s = math.sqrt((1 - mu) * (1 + mu))
         psi = math.atan2(mu, s)
-        brk = [math.cos(x) for x in _polar._vcavity_breaks(mu, s, psi) if x > 0]
+        brk = [math.cos(x) for x in _outer_rule._vcavity_breaks(mu, s, psi) if x > 0]
         us = np.concatenate([rng.uniform(0, 1, 8), np.geomspace(mu, 1, 6), [0.5, 1 / math.sqrt(2), mu, 1.0],
                              [b * (1 + d) for b in brk for d in (-1e-7, 1e-7)]])
         for u in us[(us > 0) & (us <= 1)]:
-            k = _polar._k_vcavity(mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
+            k = _half_frames._k_vcavity(mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
             q = _k_half_by_quad(0.0, mu, float(u), kind="vcavity")
             # relative, with a floor of 1e-14 mu (K <= 16 pi u mu, and the albedo is K / mu)
             assert abs(k - q) <= 1e-12 * abs(q) + 1e-14 * mu, (mu, u, k, q)
-            assert abs(k - _polar.vcavity_integrand_reference(mu, u)[0]) <= 1e-11 * abs(q) + 1e-14 * mu, (mu, u)
+            assert abs(k - _half_frames.vcavity_integrand_reference(mu, u)[0]) <= 1e-11 * abs(q) + 1e-14 * mu, (mu, u)
 
 
 def test_trig_tails_against_mpmath():
@@ -432,10 +443,10 @@ def test_trig_tails_against_mpmath():
     defs = [lambda x: mp.quad(lambda t: 1 - mp.cos(t), [0, x]), lambda x: mp.quad(lambda t: mp.cos(t) - mp.cos(x), [0, x]),
             lambda x: mp.quad(lambda t: (mp.cos(t) - mp.cos(x)) ** 2, [0, x]), lambda x: mp.quad(lambda t: (1 - mp.cos(t)) ** 2, [0, x])]
     for x in (1e-9, 1e-4, 0.01, 0.3, 0.7, 0.999, 1.0, 1.5, 2.5, math.pi):
-        twin = _polar.half_moments_reference(x)
+        twin = _half_frames.half_moments_reference(x)
         for which, f in enumerate(defs):
             ref = float(f(mp.mpf(x)))
-            assert abs(_polar._trig_tail(x, which) - ref) <= 2e-15 * ref, (x, which)
+            assert abs(_half_frames._trig_tail(x, which) - ref) <= 2e-15 * ref, (x, which)
             if x >= 1.0:
                 assert abs(twin[which] - ref) <= 1e-14 * ref, (x, which)
 
@@ -463,16 +474,16 @@ def test_blinn_family_against_the_nested_and_two_d_engines(spec):
     reached by switching off the 1-D path alone) and the 2-D engine, from normal to grazing incidence; at
     rtol 1e-6 and 1e-10 the estimate bounds the difference, and at 1e-10 it meets the tolerance."""
     f = pumpup.load(spec)
-    assert all(t.polar() is not None and t.polar().kind == "half" for _, t in f.albedo_terms() if t.type != "lambert")
+    assert all(helpers.hint_routes(t) and helpers.view(t).kind == "half" for _, t in f.albedo_terms() if t.type != "lambert")
     mu = np.array(MU)
-    with _polar.without_1d(), warnings.catch_warnings():
+    with helpers.without_1d(), warnings.catch_warnings():
         warnings.simplefilter("ignore")  # (modified Ward m = 1e-4 misses 1e-12 near grazing: its error is still honest)
         b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
     for rtol in (1e-6, 1e-10):
         a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
         assert np.all(np.abs(a - b) <= e + eb), (rtol, (np.abs(a - b) / (e + eb)).max())
         assert np.all(e <= rtol * a * 1.0001 + 1e-14)  # (atol 1e-14: modified Ward m = 100's albedo is ~1e-4)
-    with _polar.two_d_only():
+    with helpers.two_d_only():
         c, ec = pumpup.albedo(f, mu[[0, 5, 7, 9]], return_error=True, rtol=1e-10)
     assert np.all(np.abs(a[[0, 5, 7, 9]] - c) <= e[[0, 5, 7, 9]] + ec)
 
@@ -494,48 +505,48 @@ def test_blinn_family_evaluations_and_refusals():
                  {"type": "ward", "m": 0.1}, {"type": "cook_torrance", "m": 0.3}, {"type": "torrance_sparrow", "d": "D1", "s": 20}):
         _, _, conv, evals = _polar.albedo_1d(pumpup.load(spec), mu, 1e-10, 1e-14, 20000)
         assert conv.all() and evals.mean() < 300 and evals.max() < 1000, (spec, evals.mean(), evals.max())
-    for hint, match in [({"n": 5.0, "p": 0.5, "kind": "half"}, "p in"), ({"n": 0.1, "p": 1.0, "radial": "beckmann"}, "radial"),
-                        ({"n": 0.1, "p": 1.0, "kind": "half", "radial": "gauss"}, "radial"),
-                        ({"n": 0.1, "p": 1.0, "kind": "half", "radial": "beckmann", "sqrt_cos": True}, "sqrt_cos"),
-                        ({"n": 0.1, "p": 1.0, "kind": "half", "vcavity": True}, "vcavity")]:
-        bad = type("Bad", (), {"polar": lambda self, h=hint: _polar.Polar(scale=lambda m: np.ones(np.shape(m)), **h)})()
+    for family, args, match in [(HalfVectorLobe, {"n": 5.0, "p": 0.5}, "p must be 0 or 1"),
+                                (HalfVectorLobe, {"n": 0.1, "p": 1.0, "radial": "gauss"}, "radial"),
+                                (HalfVectorLobe, {"n": 0.0, "p": 1.0, "radial": "beckmann"}, "radial"),
+                                (WardLobe, {"m": 0.0}, "m must be"), (VCavityLobe, {"n": 0.1, "radial": "gauss"}, "radial"),
+                                (PowerLobe, {"n": 5.0, "p": 1.5}, "p must be"), (PowerLobe, {"n": -1.0}, "n must be")]:
         with pytest.raises(ValueError, match=match):
-            _polar.albedo_1d(bad, mu[:3], 1e-8, 0.0, 100)
-    assert pumpup.pump({"type": "stretched_blinn", "n": 8}, g="g1").polar() is None  # pumped: the nested engine
+            family(**args)
+    assert not helpers.hint_routes(pumpup.pump({"type": "stretched_blinn", "n": 8}, g="g1"))  # pumped: the nested engine
 
 
 def test_pumped_plastic_takes_the_chain_path():
     """Plastic without Fresnel (000 eq. 30) has stretched Phong's lobe, so its pumped levels take the 1-D
-    path about N (pumpup.engine.polar._integrate_chain); against the nested engine on the same BRDFs (their tables
+    path about N (pumpup.engine.chain_frame._integrate_chain); against the nested engine on the same BRDFs (their tables
     built first) at rtol 1e-12."""
     mu = np.array([1.0, 0.7, 0.3, 0.05, 1e-3])
     for g in ("g1", "g2"):
         f = pumpup.pump({"type": "plastic", "n": 20, "ad": 0.0, "a_s": 0.9}, g=g, levels=2)
-        assert f.polar() is not None and f.polar().chain is not None
+        assert helpers.hint_routes(f) and helpers.view(f).chain is not None
         a, e = pumpup.albedo(f, mu, return_error=True)
-        with _polar.without_1d(), warnings.catch_warnings():
+        with helpers.without_1d(), warnings.catch_warnings():
             warnings.simplefilter("ignore")
             b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
         assert np.all(np.abs(a - b) <= e + eb), (g, (np.abs(a - b) / (e + eb)).max())
 
 
 def test_jacobi_bound_against_mpmath():
-    """The a-priori bound of the Gauss-Jacobi rules at the arc's end near grazing incidence (``_polar._jacobi_bound``,
+    """The a-priori bound of the Gauss-Jacobi rules at the arc's end near grazing incidence (``_lobe_frame._jacobi_bound``,
     issue 14's fifteenth session: it replaced the difference of the two rules as the error) bounds the true error of
     each rule, against 30-digit mpmath, over q 0.01 .. 0.99, T / mu from 4 to 1e8 and L from -T / 2 down to -1."""
     import mpmath
 
     worst = 0.0
     for q in (0.01, 0.5, 0.99):
-        jac = _polar.jacobi_rules(q)
+        jac = _lobe_frame.jacobi_rules(q)
         for mu, top in [(0.1, 0.41), (1e-3, 0.9), (1e-8, 0.5), (0.02, 1.0)]:
             for low in (-0.5 * top - 1e-12, -top, -1.0):
                 for c in (0.5 * top, mu):
                     with mpmath.workdps(30):
                         ref = float(mpmath.quad(lambda t: t**q / mpmath.sqrt((top - t) * (t - low)), [0, c]))
-                    for row, n in ((0, _polar.JACOBI_ORDERS[0]), (2, _polar.JACOBI_ORDERS[1])):
-                        v = _polar._jacobi_sum(q, top, low, c, jac[row, :n], jac[row + 1, :n])
-                        bound = _polar._jacobi_bound(q, top, low, c, n)
+                    for row, n in ((0, _lobe_frame.JACOBI_ORDERS[0]), (2, _lobe_frame.JACOBI_ORDERS[1])):
+                        v = _lobe_frame._jacobi_sum(q, top, low, c, jac[row, :n], jac[row + 1, :n])
+                        bound = _lobe_frame._jacobi_bound(q, top, low, c, n)
                         err = abs(v - ref)
                         assert err <= bound + 64 * 2.3e-16 * abs(ref), (q, mu, top, low, c, n, err, bound)
                         worst = max(worst, err / (bound + 64 * 2.3e-16 * abs(ref)))
@@ -552,10 +563,10 @@ def test_inner_arc_at_subnormal_mu(spec):
     a, e = pumpup.albedo(f, [5e-324, 1e-320, 1e-300, 1e-200], rtol=1e-10, return_error=True)
     assert np.all(np.isfinite(a)) and np.all(np.isfinite(e)) and np.all(e <= 1e-10 * a)
     q, top, low = 0.5, 0.5, -0.5
-    jac = _polar.jacobi_rules(q)
-    b = _polar._jacobi_bound(q, top, low, 5e-324, 10)
+    jac = _lobe_frame.jacobi_rules(q)
+    b = _lobe_frame._jacobi_bound(q, top, low, 5e-324, 10)
     assert math.isfinite(b) and b >= 0.0
     c = 1e-200
     ref = 2.0 * c**1.5 / 1.5  # g(0) = 1 / sqrt(T (-L)) = 2; the next term is c / T ~ 1e-200 of it
-    v = _polar._jacobi_sum(q, top, low, c, jac[0, :10], jac[1, :10])
-    assert abs(v - ref) <= _polar._jacobi_bound(q, top, low, c, 10) + 64 * 2.3e-16 * ref
+    v = _lobe_frame._jacobi_sum(q, top, low, c, jac[0, :10], jac[1, :10])
+    assert abs(v - ref) <= _lobe_frame._jacobi_bound(q, top, low, c, 10) + 64 * 2.3e-16 * ref

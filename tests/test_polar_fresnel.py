@@ -1,4 +1,4 @@
-"""The lobe frame with 000 eq. 28's Fresnel factor F(Theta_min) (pumpup.engine.polar frame 5, :func:`pumpup.engine.polar._k_lobe_fresnel`;
+"""The lobe frame with 000 eq. 28's Fresnel factor F(Theta_min) (pumpup.engine.polar frame 5, :func:`pumpup.engine.lobe_fresnel._k_lobe_fresnel`;
 issue 14, eighth session): ``metal``, ``plastic`` with an index, and the ``fresnel`` wrapper over a lobe with p in {0, 1}
 (Phong, stretched Phong, Lafortune, retro, Phong's shader), whose F(max(N.L, N.V)) the rule integrates on the arc
 where N.V >= N.L."""
@@ -10,7 +10,13 @@ import pytest
 
 import pumpup
 from pumpup.engine import polar as _polar
+from pumpup.engine import chain_frame as _chain_frame, half_arc as _half_arc, lobe_frame as _lobe_frame, lobe_fresnel as _lobe_fresnel
+from pumpup.physics import fresnel as _fresnel_mod
 from helpers import one_d_against_the_other_engines
+import helpers
+from pumpup.core.hints import AzimuthHint, FresnelAtMax, PowerLobe
+from pumpup.engine.lobe_fresnel import lobe_fresnel_ok
+from pumpup.engine.routes import using
 
 MU = [1.0, 0.99, 0.9, math.sqrt(3) / 2, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8]
 
@@ -40,15 +46,15 @@ def test_kernel_against_scipy_quad(rng, spec):
     complex-arithmetic Fresnel function (none of the kernel's cuts, arcs or real-arithmetic F), at random u and next to
     where the arc's ends pass F's branch point and pole, from normal to grazing incidence."""
     f = _lobe(spec)
-    hint = f.polar()
-    assert hint is not None and hint.kind == "lobe" and hint.fresnel[1] == spec["eta"]
-    x0, y0 = _polar.fresnel_branch(spec["eta"], spec.get("k", 0.0))
+    hint = helpers.view(f)
+    assert helpers.takes_1d(f) and hint.kind == "lobe" and hint.fresnel[1] == spec["eta"]
+    x0, y0 = _fresnel_mod.fresnel_branch(spec["eta"], spec.get("k", 0.0))
     for mu in (1.0, 0.7, 0.2, 1e-3):
         th = math.acos(mu)
         angles = [th - math.acos(min(x0, 1.0)) + d for d in (-2 * y0, 0.0, 2 * y0)] + list(rng.uniform(0, math.pi / 2, 4))
         us = np.cos([a for a in angles if 0.0 <= a < math.pi / 2] + [0.0])
-        k, e = _polar.numeric_integrand(f, mu, us, rtol=1e-13)
-        q = _polar.lobe_fresnel_integrand_reference(f, mu, us)
+        k, e = _lobe_fresnel.numeric_integrand(f, mu, us, rtol=1e-13)
+        q = _lobe_fresnel.lobe_fresnel_integrand_reference(f, mu, us)
         assert np.all(np.abs(k - q) <= 1e-11 * np.abs(q) + 1e-15), (mu, us, k, q)
         assert np.all(e <= 2e-13 * np.abs(k) + 1e-300)  # the tolerance is met
 
@@ -58,22 +64,22 @@ def test_against_the_nested_and_two_d_engines(spec):
     """The 1-D path against the nested engine at rtol 1e-12 (the engine these models had before) and the 2-D engine,
     from normal to grazing incidence; at rtol 1e-6, 1e-8 and 1e-10 the estimate bounds the difference and meets the
     tolerance."""
-    assert _polar.takes_1d_path(_lobe(spec))
+    assert helpers.takes_1d(_lobe(spec))
     one_d_against_the_other_engines(pumpup.load(spec), MU, (1e-6, 1e-8, 1e-10), whole=True)
 
 
-@pytest.mark.parametrize("spec", [s for s in SPECS if s.get("n", s.get("base", {}).get("n", 0)) >= _polar.LOBE_N_MIN],
-                         ids=[i for s, i in zip(SPECS, IDS) if s.get("n", s.get("base", {}).get("n", 0)) >= _polar.LOBE_N_MIN])
+@pytest.mark.parametrize("spec", [s for s in SPECS if s.get("n", s.get("base", {}).get("n", 0)) >= _chain_frame.LOBE_N_MIN],
+                         ids=[i for s, i in zip(SPECS, IDS) if s.get("n", s.get("base", {}).get("n", 0)) >= _chain_frame.LOBE_N_MIN])
 def test_lobe_about_n_against_frame_5(spec):
     """A lobe with n >= LOBE_N_MIN takes the frame of N (the pumped lobe's, g = 1: the ring table and F(max(mu, N.wo)) per
     node, issue 14's twelfth session) instead of frame 5 (the lobe frame with a rule on the arc): the two agree within their
     estimates at rtol 1e-12, and at rtol 1e-6, 1e-8, 1e-10 the frame of N's estimate bounds its distance from frame 5 at
     1e-12 (less frame 5's own estimate) and meets the tolerance."""
     f = _lobe(spec)
-    assert _polar.takes_lobe_n_frame(f.polar())
+    assert helpers.takes_lobe_normal(f.azimuth_hint())
     mu = np.array(MU)
-    with _polar.without_n_frame():
-        assert not _polar.takes_lobe_n_frame(f.polar())
+    with helpers.without_normal_frames():
+        assert not helpers.takes_lobe_normal(f.azimuth_hint())
         b, eb, *_ = _polar.albedo_1d(f, mu, 1e-12, 0.0, 10000)
     a, ea, conv, _ = _polar.albedo_1d(f, mu, 1e-12, 0.0, 10000)
     assert conv.all() and np.all(np.abs(a - b) <= ea + eb), (a - b, ea, eb)
@@ -95,29 +101,29 @@ def test_which_models_take_it():
     """Near-kinks of F (its branch point within LOBE_F_Y0_MIN of the real axis, or on it in (0, 1): a dielectric's total
     reflection below eta = 1), p in (0, 1), a Lambertian or half-vector base stay on the nested engine; the hint's
     refusals."""
-    assert _polar.lobe_fresnel_ok(0.2, 3.0) and _polar.lobe_fresnel_ok(1.5, 0.0) and _polar.lobe_fresnel_ok(1.0, 0.0)
-    assert not _polar.lobe_fresnel_ok(0.6, 0.0) and not _polar.lobe_fresnel_ok(0.5, 1e-4)
-    assert pumpup.load({"type": "metal", "n": 20, "eta": 0.6}).polar() is None
-    assert pumpup.load({"type": "plastic", "n": 20, "eta": 0.6, "ad": 0.0}).polar() is None
+    assert lobe_fresnel_ok(0.2, 3.0) and lobe_fresnel_ok(1.5, 0.0) and lobe_fresnel_ok(1.0, 0.0)
+    assert not lobe_fresnel_ok(0.6, 0.0) and not lobe_fresnel_ok(0.5, 1e-4)
+    assert not helpers.hint_routes(pumpup.load({"type": "metal", "n": 20, "eta": 0.6}))
+    assert not helpers.hint_routes(pumpup.load({"type": "plastic", "n": 20, "eta": 0.6, "ad": 0.0}))
     # a pumped metal keeps its Fresnel factor in the chain frame (a first version dropped it: a pumped gold's albedo was
     # 2.4, caught by tests/test_spectral.py), as does the fresnel wrapper of a pumped lobe; not with a near-kink
-    assert pumpup.pump({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}).polar().fresnel == (0.0, 0.2, 3.0)
-    assert pumpup.pump({"type": "metal", "n": 20, "eta": 0.6}).polar() is None
+    assert helpers.view(pumpup.pump({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0})).fresnel == (0.0, 0.2, 3.0)
+    assert not helpers.hint_routes(pumpup.pump({"type": "metal", "n": 20, "eta": 0.6}))
     # about N (g = 1) from n = LOBE_N_MIN on, frame 5 below it; a pumped metal's chain takes its own frame of N
-    assert [_polar.takes_lobe_n_frame(pumpup.load({"type": "metal", "n": n, "eta": 0.2, "k": 3.0}).polar())
+    assert [helpers.takes_lobe_normal(pumpup.load({"type": "metal", "n": n, "eta": 0.2, "k": 3.0}).azimuth_hint())
             for n in (7.5, 8.0, 500.0)] == [False, True, True]
-    assert not _polar.takes_lobe_n_frame(pumpup.pump({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}).polar())
-    assert not _polar.takes_lobe_n_frame(pumpup.load({"type": "phong", "n": 20}).polar())
+    assert not helpers.takes_lobe_normal(pumpup.pump({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}).azimuth_hint())
+    assert not helpers.takes_lobe_normal(pumpup.load({"type": "phong", "n": 20}).azimuth_hint())
     for base in ({"type": "stretched_phong", "n": 20, "p": 0.5}, {"type": "lambert"}, {"type": "blinn", "n": 20},
                  {"type": "pumped", "base": {"type": "blinn", "n": 20}}):
-        assert pumpup.load({"type": "fresnel", "base": base, "eta": 0.2, "k": 3.0}).polar() is None, base
+        assert not helpers.hint_routes(pumpup.load({"type": "fresnel", "base": base, "eta": 0.2, "k": 3.0})), base
     mu = np.array([0.5, 0.1])
-    for hint, match in [({"n": 5.0, "p": 0.5, "fresnel": (0.0, 0.2, 3.0)}, "fresnel"),
-                        ({"n": 5.0, "p": 1.0, "fresnel": (1.5, 0.0, 0.0)}, "fresnel"),
-                        ({"n": 5.0, "p": 1.0, "fresnel": (0.0, 0.6, 0.0)}, "fresnel")]:
-        bad = type("Bad", (), {"polar": lambda self, h=hint: _polar.Polar(scale=lambda m: np.ones(np.shape(m)), **h)})()
-        with pytest.raises(ValueError, match=match):
-            _polar.albedo_1d(bad, mu, 1e-8, 0.0, 100)
+    # F(max) on a lobe with p outside {0, 1} without a chain, or with a near-kink: no 1-D route
+    for p, eta, k in [(0.5, 0.2, 3.0), (1.0, 0.6, 0.0), (1.0, 0.5, 1e-4)]:
+        hint = AzimuthHint(PowerLobe(n=5.0, p=p), scale=lambda m: np.ones(np.shape(m)), factors=(FresnelAtMax(eta, k),))
+        assert not helpers.hint_routes(hint), (p, eta, k)
+    assert helpers.hint_routes(AzimuthHint(PowerLobe(n=5.0, p=1.0), scale=lambda m: np.ones(np.shape(m)),
+                                           factors=(FresnelAtMax(0.2, 3.0),))) == {"lobe_fresnel"}
 
 
 def test_fresnel_wrapper_of_stretched_phong_is_metal():
@@ -158,7 +164,7 @@ def test_pumped_metal_against_the_nested_and_two_d_engines(spec, g, levels):
     colour-keeping pumped metal) take the pumped lobe's frame of N with F(max(mu, N.wo)): against the nested engine at
     rtol 1e-12 and the 2-D engine; the estimate bounds the difference at rtol 1e-6 and 1e-10 and meets the tolerance."""
     f = pumpup.pump(spec, g=g, levels=levels) if g else pumpup.load(spec)
-    assert f.polar().chain is not None and any(f.polar().fresnel)
+    assert helpers.view(f).chain is not None and any(helpers.view(f).fresnel)
     a, e = one_d_against_the_other_engines(f, MU)
     assert np.all(a - e <= 1.0)  # (a pumped BRDF conserves energy, 001 eq. 18)
 
@@ -169,10 +175,10 @@ def test_colour_keeping_pumped_metal_channels():
     from pumpup import spectral
 
     k = spectral.SpectralPumpedLobe(spectral.SpectralMetal("Cu", n=20, wavelengths=[450.0, 650.0]))
-    assert all(m.polar() is not None and m.polar().fresnel[1] == e for m, e in zip(k.models, k.eta))
+    assert all(helpers.hint_routes(m) and helpers.view(m).fresnel[1] == e for m, e in zip(k.models, k.eta))
     mu = np.array([1.0, 0.7, 0.2, 1e-3])
     a, e = k.albedo(mu, return_error=True, rtol=1e-10)
-    with _polar.without_1d():
+    with helpers.without_1d():
         b, eb = k.albedo(mu, return_error=True, rtol=1e-12)
     assert np.all(np.abs(a - b) <= e + eb) and np.all(e <= 1e-10 * a * 1.0001)
 
@@ -214,7 +220,7 @@ def test_brewster_zero_of_the_continued_numerator():
     small steps from Re c_b up to c_b (each step's root the one nearer the last); for a dielectric c_b is
     cos(theta_B) = 1 / sqrt(1 + eta^2), on the real axis."""
     for eta, k in MATERIALS:
-        cb, ok = _polar.fresnel_brewster(eta, k)
+        cb, ok = _fresnel_mod.fresnel_brewster(eta, k)
         assert ok, (eta, k)
         e2 = complex(eta * eta - k * k, 2 * eta * k)
         a = (e2 - 1 + cb.real**2) ** 0.5  # principal on the real axis
@@ -257,18 +263,18 @@ def test_gauss_piece_and_its_bound_against_mpmath(rng, eta, k):
     tolerance asked."""
     import mpmath as mp
 
-    mpar = _polar.numeric_params(pumpup.load({"type": "metal", "n": 5, "eta": eta, "k": k}).polar())
+    mpar = _half_arc.numeric_params(pumpup.load({"type": "metal", "n": 5, "eta": eta, "k": k}).azimuth_hint())
     assert mpar[18] == 1.0  # (Brewster's zero found)
     ran = 0
     with mp.workdps(30):
         for (mu, top, low, lo, d, first), q, rt in zip(_pieces(rng, 18), [0.0, 1.0] * 9, [1e-6, 1e-10, 1e-14] * 6):
             ref_scale = math.sqrt(d) * 3.0  # (the piece is about sqrt(d) in size; the tolerance is relative to that)
-            n, bound, v = _polar._lobe_f_bound(mpar, q, lo, d, top, low, first, rt * ref_scale)
-            if n > _polar.GL_MAX:
+            n, bound, v = _lobe_fresnel._lobe_f_bound(mpar, q, lo, d, top, low, first, rt * ref_scale)
+            if n > _lobe_frame.GL_MAX:
                 continue  # (the caller falls back to the adaptive rule)
             ran += 1
             assert bound <= rt * ref_scale and v == ((n + 1) // 2 if first else n)
-            p = _polar._lobe_f_piece(eta, k, q, lo, d, top, low, first, n)
+            p = _lobe_fresnel._lobe_f_piece(eta, k, q, lo, d, top, low, first, n)
             g = lambda t: _fresnel_mp(eta, k, t) * t**q / mp.sqrt((top - t) * (t - low))  # noqa: E731
             hi = mp.mpf(top) if first else mp.mpf(lo) + mp.mpf(d)
             ref = mp.quad(g, [mp.mpf(lo) if not first else mp.mpf(top) - mp.mpf(d), hi])
@@ -286,8 +292,8 @@ def test_gauss_pieces_against_the_adaptive_rule(spec):
     rounding allowance, 64 eps, may take it a little beyond)."""
     f = _lobe(spec)
     mu = np.array(MU)
-    with _polar.without_n_frame():  # (n >= LOBE_N_MIN takes the frame of N otherwise)
-        with _polar.without_lobe_f_gauss():
+    with helpers.without_normal_frames():  # (n >= LOBE_N_MIN takes the frame of N otherwise)
+        with using(lobe_fresnel_gauss=False):
             b, eb, *_ = _polar.albedo_1d(f, mu, 1e-12, 0.0, 10000)
         for rtol in (1e-6, 1e-8, 1e-10, 1e-12):
             a, ea, conv, _ = _polar.albedo_1d(f, mu, rtol, 0.0, 10000)
@@ -298,11 +304,11 @@ def test_gauss_pieces_against_the_adaptive_rule(spec):
 def test_gauss_piece_against_its_numpy_twin(rng):
     """_lobe_f_piece at its bound's n against lobe_f_piece_reference (numpy, 200 points, the complex Fresnel formula)."""
     for eta, k in MATERIALS:
-        mpar = _polar.numeric_params(pumpup.load({"type": "metal", "n": 5, "eta": eta, "k": k}).polar())
+        mpar = _half_arc.numeric_params(pumpup.load({"type": "metal", "n": 5, "eta": eta, "k": k}).azimuth_hint())
         for (mu, top, low, lo, d, first), q in zip(_pieces(rng, 6), [0.0, 1.0] * 3):
-            n, bound, _ = _polar._lobe_f_bound(mpar, q, lo, d, top, low, first, 1e-13 * math.sqrt(d))
-            if n > _polar.GL_MAX:
+            n, bound, _ = _lobe_fresnel._lobe_f_bound(mpar, q, lo, d, top, low, first, 1e-13 * math.sqrt(d))
+            if n > _lobe_frame.GL_MAX:
                 continue
-            p = _polar._lobe_f_piece(eta, k, q, lo, d, top, low, first, n)
-            r = _polar.lobe_f_piece_reference(eta, k, q, lo, d, top, low, first)
+            p = _lobe_fresnel._lobe_f_piece(eta, k, q, lo, d, top, low, first, n)
+            r = _lobe_fresnel.lobe_f_piece_reference(eta, k, q, lo, d, top, low, first)
             assert abs(p - r) <= bound + 1e-13 * abs(r), (eta, k, mu, lo, d, first, q, p - r, bound)

@@ -1,5 +1,5 @@
 """Frame 6 with a Fresnel factor (issue 14, thirteenth session): GGX's D times F(wi.h) integrated over the azimuth of wo by
-a product rule whose weights are D's Fourier coefficients in closed form (pumpup.engine.polar._ggx_ring_f), against scipy's
+a product rule whose weights are D's Fourier coefficients in closed form (pumpup.engine.normal_frame._ggx_ring_f), against scipy's
 quadrature of D F on the ring, 40-digit mpmath sums, frame 4 (the rule on h's arc) and the nested engine."""
 
 import math
@@ -11,10 +11,12 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup.engine import polar as _polar
+from pumpup.engine import half_arc as _half_arc, normal_frame as _normal_frame
 
 sys.path.insert(0, str(Path(__file__).parent))
 from helpers import nested_reference  # noqa: E402
+import helpers
+from pumpup.engine.normal_frame import N_FRESNEL_MU_MIN, n_fresnel_ok
 
 #: (ior, eta, k): a dielectric, a glass near 1, a metal, a strong absorber (its pole near c = 0), a weak one
 MATERIALS = [(1.5, 0.0, 0.0), (1.0001, 0.0, 0.0), (0.0, 0.2, 3.0), (0.0, 1.1, 30.0), (0.0, 1.0, 0.1)]
@@ -34,21 +36,21 @@ def test_ring_against_scipy(alpha, fresnel):
     1e-12, plus 1e-12 of the value for scipy's own error (it integrates at epsrel 1e-13); and with F = 1 (no index) frame
     6's closed form :func:`_ggx_ring`, within 1e-14."""
     a2 = alpha * alpha
-    fv = np.empty(_polar.RING_F_NMAX + 1)
-    mp = np.zeros(_polar.MP_SIZE)
+    fv = np.empty(_normal_frame.RING_F_NMAX + 1)
+    mp = np.zeros(_half_arc.MP_SIZE)
     mp[5:8] = fresnel
-    for mu in (_polar.N_FRESNEL_MU_MIN, 0.5, 0.9, 1.0):
+    for mu in (N_FRESNEL_MU_MIN, 0.5, 0.9, 1.0):
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
         xmu, xs = math.atan2(mu, s), math.atan2(s, mu)
         for x in (0.0, 0.2, xmu - 0.01, xmu, 1.2, 0.5 * math.pi):
-            ref = _polar.ring_reference(1, a2, mu, x, fresnel)
+            ref = _normal_frame.ring_reference(1, a2, mu, x, fresnel)
             for itol in (1e-6, 1e-12):
-                w, e, _ = _polar._ggx_ring_f(mp, a2, xmu, xs, x - xmu, itol, 0.0, fv)
+                w, e, _ = _normal_frame._ggx_ring_f(mp, a2, xmu, xs, x - xmu, itol, 0.0, fv)
                 assert abs(w - ref) <= e + 1e-12 * ref, (mu, x, itol, w, ref, e)
-    one = np.zeros(_polar.MP_SIZE)
+    one = np.zeros(_half_arc.MP_SIZE)
     for d in (-0.3, 0.0, 0.4):
-        w, e, _ = _polar._ggx_ring_f(one, a2, 0.5, 0.5 * math.pi - 0.5, d, 1e-13, 0.0, fv)
-        assert abs(w - _polar._ggx_ring(a2, 0.5, 0.5 * math.pi - 0.5, d)) <= 1e-14 * w and e <= 1e-13 * w
+        w, e, _ = _normal_frame._ggx_ring_f(one, a2, 0.5, 0.5 * math.pi - 0.5, d, 1e-13, 0.0, fv)
+        assert abs(w - _normal_frame._ggx_ring(a2, 0.5, 0.5 * math.pi - 0.5, d)) <= 1e-14 * w and e <= 1e-13 * w
 
 
 @pytest.mark.parametrize("rho", [0.0, 0.3, 0.9, 0.999, 1.0 - 1e-6, 1.0 - 1e-10])
@@ -56,11 +58,11 @@ def test_geometric_sums_against_mpmath(rho):
     """The product rule's sums (closed forms in z = rho e^(i theta); term by term at theta = 0) against 40-digit mpmath,
     within a few ulp of the terms' scale."""
     for nn in (8, 16, 64, 128):
-        stride = _polar.RING_F_NMAX // nn
+        stride = _normal_frame.RING_F_NMAX // nn
         scale1 = sum(k * rho ** k for k in range(nn + 1)) + 1.0
         for n in range(nn + 1):
-            c0, c1 = _polar._ring_f_sums(rho, rho ** nn, n, nn, n * stride)
-            r0, r1 = _polar.ring_f_sums_reference(rho, n, nn)
+            c0, c1 = _normal_frame._ring_f_sums(rho, rho ** nn, n, nn, n * stride)
+            r0, r1 = _normal_frame.ring_f_sums_reference(rho, n, nn)
             assert abs(c0 - r0) <= 8 * np.finfo(float).eps * (nn + 1), (nn, n)
             assert abs(c1 - r1) <= 8 * np.finfo(float).eps * scale1, (nn, n)
 
@@ -70,15 +72,14 @@ def test_which_ggx_with_fresnel_take_frame_6():
     near-kink conductor (eta 0.5, k 0.002: w ~ 0.87), Beckmann or V-cavity models with F.  A pumped GGX with F takes it
     at mu >= N_FRESNEL_MU_MIN only (tests/test_polar_pumped_fresnel.py)."""
     for spec in (_spec(0.2, (1.5, 0, 0)), _spec(0.2, (0, 0.2, 3.0)), _spec(1.0, (0, 1.0, 0.1), shadowing="correlated")):
-        assert _polar.takes_n_frame(pumpup.load(spec).polar()), spec
+        assert helpers.takes_normal(pumpup.load(spec).azimuth_hint()), spec
     for spec in (_spec(0.2, (0, 0.5, 0.002)), {"type": "beckmann", "alpha": 0.2, "ior": 1.5},
                  {"type": "cook_torrance", "m": 0.3, "ior": 1.5}):
-        hint = pumpup.load(spec).polar()
-        assert hint is None or not _polar.takes_n_frame(hint), spec
-    assert not _polar.n_fresnel_ok(1.0, 0.0, 0.0) and _polar.n_fresnel_ok(1.0001, 0.0, 0.0)
+        assert not helpers.takes_normal(pumpup.load(spec)), spec
+    assert not n_fresnel_ok(1.0, 0.0, 0.0) and n_fresnel_ok(1.0001, 0.0, 0.0)
 
 
-MU = np.array([1.0, 0.99, 0.8, 0.5, 0.3, _polar.N_FRESNEL_MU_MIN, 0.2, 0.01])
+MU = np.array([1.0, 0.99, 0.8, 0.5, 0.3, N_FRESNEL_MU_MIN, 0.2, 0.01])
 
 
 @pytest.mark.parametrize("fresnel", MATERIALS)
@@ -89,8 +90,8 @@ def test_albedo_against_frame_4(alpha, extra, fresnel):
     summed estimates, at rtol 1e-8 and 1e-12; each estimate within its rtol (or the default atol: the glass near 1 reflects
     ~1e-9)."""
     f = pumpup.load(_spec(alpha, fresnel, **extra))
-    assert _polar.takes_n_frame(f.polar())
-    with _polar.without_n_frame(), warnings.catch_warnings():
+    assert helpers.takes_normal(f.azimuth_hint())
+    with helpers.without_normal_frames(), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         b, eb = pumpup.albedo(f, MU, return_error=True, rtol=1e-13)
     for rtol in (1e-8, 1e-12):
@@ -119,7 +120,7 @@ def test_integrand_against_the_models_own_eval():
     f = pumpup.load(_spec(0.5, (0, 1.1, 6.0), shadowing="correlated"))
     for mu in (0.41, 0.9):
         x = np.linspace(0.001, 1.5, 7)
-        assert np.allclose(_polar.n_integrand(f, mu, x), _polar.n_integrand_reference(f, mu, x), rtol=1e-12, atol=0.0)
+        assert np.allclose(_normal_frame.n_integrand(f, mu, x), _normal_frame.n_integrand_reference(f, mu, x), rtol=1e-12, atol=0.0)
 
 
 def test_grazing_incidence_below_frame_4s_range():
@@ -163,7 +164,7 @@ def test_near_kink_conductor_at_normal_incidence(shadowing):
     (which takes such an index) cut on h's arc only.  At normal incidence wi.h hardly varies on h's circle, so the whole
     near-kink is the outer integrand's, and there was no cut: at mu = 1 GGX alpha 0.003 was 2.4e-11 off with an estimate
     of 3.5e-12 (rtol 1e-10; found by scripts/studies/fuzz_engines.py).  Now the elevation is cut where an end of the circle's
-    range of wi.h passes x0 (pumpup.engine.polar._pieces)."""
+    range of wi.h passes x0 (pumpup.engine.outer_rule._pieces)."""
     eta, k, alpha = 0.27134575896438146, 0.0605363844525441, 0.003000403524851649
     f = pumpup.load({"type": "ggx", "alpha": alpha, "eta": eta, "k": k, "shadowing": shadowing})
     ref = _normal_incidence_reference(alpha, eta, k)  # (at mu = 1 the two shadowings agree: Lambda(N) = 0)
@@ -202,4 +203,4 @@ def test_the_frame_4_split_is_per_thread():
         t.join()
     assert not errors and len(out) == 120
     assert all(np.array_equal(a, ref) for a in out)
-    assert _polar.N_FRAME and _polar.takes_n_frame(f.polar())
+    assert helpers.takes_normal(f)

@@ -1,4 +1,4 @@
-"""The half vector's azimuth by a rule on its arc (pumpup.engine.polar frame 4, :func:`pumpup.engine.polar._k_numeric`; issue 14,
+"""The half vector's azimuth by a rule on its arc (pumpup.engine.polar frame 4, :func:`pumpup.engine.half_arc._k_numeric`; issue 14,
 seventh session): the Smith microfacet models (GGX, Beckmann; separable or height-correlated G, exact or Walter's G1,
 with or without a Fresnel factor), the V-cavity models with a Fresnel factor (Cook-Torrance, Torrance-Sparrow with
 ``ior``) and Schlick's model; and Torrance-Sparrow's D3, whose azimuth is closed-form, under the GGX weight."""
@@ -10,8 +10,10 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup.engine import polar as _polar
+from pumpup.engine import half_arc as _half_arc, half_frames as _half_frames, hint_view as _hint_view, lobe_fresnel as _lobe_fresnel, outer_rule as _outer_rule
 from helpers import one_d_against_the_other_engines
+import helpers
+from pumpup.core.hints import AzimuthHint, Fresnel, SchlickLobe, SmithLobe, VCavityLobe
 
 MU = [1.0, 0.99, 0.9, math.sqrt(3) / 2, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8]
 
@@ -29,50 +31,50 @@ KERNEL_SPECS = [{"type": "ggx", "alpha": 0.1}, {"type": "ggx", "alpha": 0.003},
 @pytest.mark.parametrize("spec", KERNEL_SPECS, ids=[f"{s['type']}-{s.get('alpha', s.get('m', s.get('s', s.get('r'))))}" for s in KERNEL_SPECS])
 def test_numeric_kernel_against_the_geometry(rng, spec):
     """K(u) against its numpy twin, the integral over h's azimuth of the model's own numpy formula (none of the
-    kernel's algebra: _polar.numeric_integrand_reference), at random u and where K turns: next to the horizon break
+    kernel's algebra: _half_arc.numeric_integrand_reference), at random u and where K turns: next to the horizon break
     alpha_f = pi/4 - theta_i/2 at the scale of alpha, near the end of the range alpha_lo = pi/4 + theta_i/2, at
     theta_i / 2 (h halfway between wi and N) and at h = N."""
     f = pumpup.load(spec)
-    hint = f.polar()
-    assert hint is not None and (hint.smith is not None or hint.schlick is not None or any(hint.fresnel))
+    hint = helpers.view(f)
+    assert helpers.takes_1d(f) and (hint.smith is not None or hint.schlick is not None or any(hint.fresnel))
     sc = spec.get("alpha", spec.get("m", spec.get("r", 0.1)))
     for mu in (1.0, 0.7, 0.2, 1e-3):
         th = math.acos(mu)
         a_f, a_lo = math.pi / 4 - th / 2, math.pi / 4 + th / 2
         angles = np.concatenate([rng.uniform(0, a_lo, 3), [a_f - sc / 2, a_f + 2 * sc, a_lo - sc, th / 2, 0.0]])
         us = np.cos(angles[(angles >= 0) & (angles < a_lo)])
-        k, e = _polar.numeric_integrand(f, mu, us, rtol=1e-13)
-        q = _polar.numeric_integrand_reference(f, mu, us)
+        k, e = _lobe_fresnel.numeric_integrand(f, mu, us, rtol=1e-13)
+        q = _half_arc.numeric_integrand_reference(f, mu, us)
         ok = np.isfinite(q)  # (the weight underflows far out in Beckmann's tail)
         assert np.all(np.abs(k - q)[ok] <= 1e-11 * np.abs(q)[ok] + 1e-300), (mu, us, k, q)
         assert np.all(e <= 2e-13 * np.abs(k) + 1e-300)  # the tolerance is met
 
 
 class _Hinted:
-    """Just a Polar hint."""
+    """Just an azimuth hint."""
 
     def __init__(self, hint):
         self.hint = hint
 
-    def polar(self):
+    def azimuth_hint(self):
         return self.hint
 
 
 def test_vcavity_rule_with_fresnel_one_is_the_closed_form(rng):
     """The V-cavity integrand by the rule on h's arc with F = 1 against _k_vcavity's closed form (the minimum of three
     lines in wi.h), from normal to grazing incidence: the arc's geometry and the cuts at the crossings."""
-    plain = _Hinted(_polar.Polar(n=0.3, kind="half", radial="beckmann", vcavity=True))  # fresnel (0, 0, 0): F = 1
-    mp = _polar.numeric_params(plain.polar())
-    assert mp[0] == _polar.VCAVITY_F and mp[5] == 0.0 and math.isinf(mp[10])
+    plain = _Hinted(AzimuthHint(VCavityLobe(n=0.3, radial="beckmann"), scale=lambda m: np.ones(np.shape(m))))  # F = 1
+    mp = _half_arc.numeric_params(_hint_view.kernel_view(plain.azimuth_hint()))
+    assert mp[0] == _half_arc.VCAVITY_F and mp[5] == 0.0 and math.isinf(mp[10])
     for mu in (1.0, 0.9, 0.5, 0.2, 1e-3, 1e-6, 1e-8):
         s = math.sqrt((1 - mu) * (1 + mu))
         psi = math.atan2(mu, s)
-        brk = [math.cos(x) for x in _polar._vcavity_breaks(mu, s, psi) if x > 0]
+        brk = [math.cos(x) for x in _outer_rule._vcavity_breaks(mu, s, psi) if x > 0]
         us = np.concatenate([rng.uniform(0, 1, 8), [0.5, 1 / math.sqrt(2), mu, 1.0], [b * (1 + d) for b in brk for d in (-1e-7, 1e-7)]])
         us = us[(us > 0) & (us <= 1)]
-        k, _ = _polar.numeric_integrand(plain, mu, us, rtol=1e-14)
+        k, _ = _lobe_fresnel.numeric_integrand(plain, mu, us, rtol=1e-14)
         for u, kv in zip(us, k):
-            ref = _polar._k_vcavity(mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
+            ref = _half_frames._k_vcavity(mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
             assert abs(kv - ref) <= 1e-12 * abs(ref) + 1e-14 * mu, (mu, u, kv, ref)  # (as _k_vcavity against quad; K <= 16 pi u mu)
 
 
@@ -131,7 +133,7 @@ def test_normal_incidence_against_mpmath():
             f = pumpup.load({"type": dist, "alpha": alpha})
             a, e = pumpup.albedo(f, np.array([1.0]), return_error=True, rtol=1e-12)
             assert abs(a[0] - ref) <= e[0] and e[0] <= 1e-12 * ref, (dist, alpha, a[0] - ref, e[0])
-            with _polar.without_1d():
+            with helpers.without_1d():
                 b, eb = pumpup.albedo(f, np.array([1.0]), return_error=True, rtol=1e-12)
             assert abs(b[0] - ref) <= eb[0], (dist, alpha, b[0] - ref, eb[0])
 
@@ -154,21 +156,19 @@ def test_smooth_mirror_limit():
 def test_which_models_take_it():
     """alpha > 1 (P then has a singularity near N.wo = 1 too, which the rule does not grade) and D2 stay on the
     nested engine; the hint's refusals."""
-    assert pumpup.load({"type": "ggx", "alpha": 2.0}).polar() is None
-    assert pumpup.load({"type": "beckmann", "alpha": 1.5}).polar() is None
-    assert pumpup.load({"type": "torrance_sparrow", "d": "D2", "s": 5.0, "ior": 1.5}).polar() is None
-    assert pumpup.load({"type": "ggx", "alpha": 1.0}).polar().smith == (1, 0, 0, 1.0)
+    assert not helpers.hint_routes(pumpup.load({"type": "ggx", "alpha": 2.0}))
+    assert not helpers.hint_routes(pumpup.load({"type": "beckmann", "alpha": 1.5}))
+    assert not helpers.hint_routes(pumpup.load({"type": "torrance_sparrow", "d": "D2", "s": 5.0, "ior": 1.5}))
+    assert helpers.view(pumpup.load({"type": "ggx", "alpha": 1.0})).smith == (1, 0, 0, 1.0)
     mu = np.array([0.5, 0.1])
-    for hint, match in [({"n": 0.1, "kind": "half", "radial": "ggx", "smith": (1, 0, 0, 0.1), "p": 1.0}, "smith"),
-                        ({"n": 0.1, "kind": "half", "radial": "power", "smith": (1, 0, 0, 0.1)}, "smith"),
-                        ({"n": 0.1, "kind": "half", "radial": "ggx", "smith": (1, 0, 0)}, "smith"),
-                        ({"n": 5.0, "kind": "half", "fresnel": (1.5, 0.0, 0.0)}, "fresnel"),
-                        ({"n": 0.1, "kind": "half", "radial": "gauss"}, "radial"),
-                        ({"n": 0.1, "kind": "half", "radial": "beckmann", "schlick": 0.01}, "schlick"),
-                        ({"n": 0.1, "kind": "half", "radial": "ggx", "schlick": 0.0}, "schlick")]:
-        bad = type("Bad", (), {"polar": lambda self, h=hint: _polar.Polar(scale=lambda m: np.ones(np.shape(m)), **h)})()
+    for family, args, match in [(SmithLobe, {"distribution": "gauss", "alpha": 0.1}, "SmithLobe"),
+                                (SmithLobe, {"distribution": "ggx", "alpha": 0.0}, "SmithLobe"),
+                                (SmithLobe, {"distribution": "ggx", "alpha": 0.1, "g1": "fit"}, "SmithLobe"),
+                                (SmithLobe, {"distribution": "ggx", "alpha": 0.1, "shadowing": "none"}, "SmithLobe"),
+                                (Fresnel, {"ior": 1.5, "eta": 0.2}, "Fresnel"), (Fresnel, {}, "Fresnel"),
+                                (SchlickLobe, {"r": 0.0}, "r must be"), (SchlickLobe, {"r": 1.5}, "r must be")]:
         with pytest.raises(ValueError, match=match):
-            _polar.albedo_1d(bad, mu, 1e-8, 0.0, 100)
+            family(**args)
 
 
 @pytest.mark.parametrize("spec,mu,ref", [
@@ -206,7 +206,7 @@ def test_a_renderers_table_at_its_tolerance(shadowing):
         assert np.all(np.abs(a - b) <= e + eb), (alpha, (np.abs(a - b) / (e + eb)).max())
         assert np.all(e <= 1e-8 * a) and np.all(eb <= 1e-12 * b), (alpha, e / a, eb / b)
         if alpha >= 0.01:
-            with _polar.without_1d(), warnings.catch_warnings():
+            with helpers.without_1d(), warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 c, ec = pumpup.albedo(f, mu[2:], return_error=True, rtol=1e-12)
             assert np.all(np.abs(b[2:] - c) <= eb[2:] + ec), (alpha, (np.abs(b[2:] - c) / (eb[2:] + ec)).max())

@@ -16,7 +16,8 @@ from scipy.special import roots_legendre
 
 import pumpup
 from pumpup.engine import nested as _nested
-from pumpup.engine import polar as _polar
+from pumpup.engine import chain_frame as _chain_frame, half_arc as _half_arc, lobe_frame as _lobe_frame, outer_rule as _outer_rule
+import helpers
 
 # (0.8495: a wide piece that one first interval got wrong; 1e-8 and below: the tables' first node, and
 # sin(theta_i) rounding to 1)
@@ -67,11 +68,11 @@ def albedo_about_normal(f, mu, epsrel=1e-12):
 
 def test_pumped_phong_family_takes_the_1d_path():
     for spec, g, levels in CASES:
-        hint = _pumped(spec, g, levels).polar()
-        assert hint is not None and hint.chain is not None, spec
+        f = _pumped(spec, g, levels)
+        assert helpers.takes_1d(f) and helpers.view(f).chain is not None, spec
     # no closed-form azimuth under the divisor: the nested engine, as before
-    assert pumpup.pump({"type": "blinn", "n": 16}, g="g2").polar() is None
-    assert pumpup.pump({"type": "lambert"}, g="g1").polar() is None
+    assert not helpers.hint_routes(pumpup.pump({"type": "blinn", "n": 16}, g="g2"))
+    assert not helpers.hint_routes(pumpup.pump({"type": "lambert"}, g="g1"))
 
 
 @pytest.mark.parametrize("case", CASES[:3], ids=lambda c: f"{c[0]['type']}-{c[0]['n']}-{c[1]}-{c[2]}")
@@ -92,8 +93,7 @@ def test_estimate_bounds_the_truth_and_engines_agree(case, monkeypatch):
     """The 1-D path at rtol 1e-8 ... 1e-12 against the nested engine at 1e-13 (the 1-D path switched
     off alone; asserted to run): the difference within the summed estimates."""
     f = _pumped(*case)
-    with monkeypatch.context() as m:
-        m.setattr(_polar, "albedo_1d", lambda *a, **k: None)
+    with monkeypatch.context() as m, helpers.without_1d():
         _nested.LAST_EVALS = None
         ref, ref_err = pumpup.albedo(f, MU, return_error=True, rtol=1e-13)
         assert _nested.LAST_EVALS is not None  # the nested engine ran
@@ -107,7 +107,7 @@ def test_against_the_2d_engine():
     f = _pumped({"type": "phong", "n": 20}, "g2", 3)
     mu = np.array([0.95, 0.6, 0.2, 1e-3])
     a, e = pumpup.albedo(f, mu, return_error=True, rtol=1e-11)
-    with _polar.two_d_only():
+    with helpers.two_d_only():
         b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-11)
     assert np.all(np.abs(a - b) <= e + eb), (a - b, e, eb)
 
@@ -151,17 +151,17 @@ def test_ring_table_against_mpmath(n):
     quadrature where a piece next to kappa = 1 could not be fitted) against 40-digit references, within
     its own error and 1e-13; the table covers [0, 2] without gaps.  (n = 1e6, kappa = 0.95: the quadrature
     once cut the half-arc only at 4 widths, and the rule beyond saw zeros at its nodes: 6.3e-5 off.)"""
-    kb, kc, keps = _polar.ring_table(n)
+    kb, kc, keps = _chain_frame.ring_table(n)
     assert kb[0] == 0.0 and kb[-1] == 2.0 and np.all(np.diff(kb) > 0)
-    nodes, wk, wg = _polar._RULES["gk21"]
-    ibuf, iwork = np.empty(21), np.empty((5, _polar.INNER_MAX))
+    nodes, wk, wg = _outer_rule._RULES["gk21"]
+    ibuf, iwork = np.empty(21), np.empty((5, _lobe_frame.INNER_MAX))
     rng = np.random.default_rng(int(n * 10))
     kappas = np.concatenate([[0.0, 1e-9, 0.3, 0.95, 1.0 - 1e-7, 1.0, 1.0 + 1e-7, 1.5, 2.0], rng.uniform(0, 2, 12),
                              1.0 + rng.uniform(-1e-5, 1e-5, 4)])
     for kappa in kappas:
-        v, e = _polar._ring_at(kappa, kb, kc, keps)
+        v, e = _chain_frame._ring_at(kappa, kb, kc, keps)
         if e < 0:  # a piece left to quadrature
-            v, e = _polar._ring_quad(n, kappa, 1e-15, nodes, wk, wg, ibuf, iwork)
+            v, e = _chain_frame._ring_quad(n, kappa, 1e-15, nodes, wk, wg, ibuf, iwork)
         ref = _v_reference(n, kappa)
         assert abs(v - ref) <= e + 1e-15 * ref, (n, kappa, v, ref, e)
         assert e <= 1e-13 * ref, (n, kappa, e)
@@ -174,7 +174,7 @@ def test_chain_cuts():
     mu, n = 0.3, 200.0
     s = math.sqrt(1 - mu * mu)
     levels = (mu, 0.95, 0.999)
-    x = _polar.chain_cuts(levels, n, mu)
+    x = _chain_frame.chain_cuts(levels, n, mu)
     assert x[0] == 0.0 and x[-1] == 0.5 * math.pi and np.all(np.diff(x) > 0)
     xmu = math.atan2(mu, s)
     want = [math.asin(v) for v in levels] + [xmu, math.atan2(s, mu), math.asin(0.5), math.asin(0.125)]
@@ -183,7 +183,7 @@ def test_chain_cuts():
     for w in want:
         assert np.min(np.abs(x - w)) < 1e-14, w
     assert np.min(np.abs(x - math.asin(0.25 * 0.125))) > 1e-3  # no grading below a quarter of mu
-    few = _polar.chain_cuts(levels, 2.0, mu)  # small n: graded towards x_s on both sides
+    few = _chain_frame.chain_cuts(levels, 2.0, mu)  # small n: graded towards x_s on both sides
     xs = math.atan2(s, mu)
     for d in (0.125, 0.5 * 0.25 ** 5):
         assert np.min(np.abs(few - (xs - d))) < 1e-14 and np.min(np.abs(few - (xs + d))) < 1e-14
@@ -192,7 +192,7 @@ def test_chain_cuts():
 
 
 def test_compiled_chain_cuts_are_chain_cuts():
-    """The compiled cuts the engine uses (:func:`pumpup.engine.polar.chain_cut_matrix`) are chain_cuts, value for value: pumped
+    """The compiled cuts the engine uses (:func:`pumpup.engine.chain_frame.chain_cut_matrix`) are chain_cuts, value for value: pumped
     lobes, a pumped metal (F's cuts), a pumped GGX and a 1/E-scaled one (frame 6, n = 0), and a metal's lobe about N (no
     chain: no levels but mu, no grading for g), from normal incidence to 1e-300; each cut of either within 2 ulps of one of
     the other (numpy's vectorised arctan2 and the scalar one may differ in the last bit, so a level mu and x_mu can be two
@@ -208,15 +208,15 @@ def test_compiled_chain_cuts_are_chain_cuts():
              (pumpup.pump({"type": "ggx", "alpha": 0.3}, g="g2"), None, True),
              (pumpup.compensate({"type": "schlick", "r": 0.2}, method="scale"), None, True)]
     for f, fres, chain in cases:
-        hint = f.polar()
+        hint = helpers.view(f)
         n = 0.0 if hint.kind == "half" else float(hint.n)
-        cut, ncut = _polar.chain_cut_matrix(hint.levels, n, mu, fres, chain)
+        cut, ncut = _chain_frame.chain_cut_matrix(hint.levels, n, mu, fres, chain)
         for q, m in enumerate(mu):
-            assert same(cut[q, :ncut[q]], _polar.chain_cuts(hint.levels(float(m)), n, float(m), fres, chain)), (f, m)
+            assert same(cut[q, :ncut[q]], _chain_frame.chain_cuts(hint.levels(float(m)), n, float(m), fres, chain)), (f, m)
     # (the compiled kernel's room per mu: 4 fixed, 6 about the peak, 2 x 15 towards x_s, 20 graded, the pi / 16 ones, F's)
-    assert _polar.CHAIN_CUTS_ROOM >= 4 + 6 + 30 + 20 + _polar.X_PIECES - 1 + 3 * _polar.LOBE_F_CUTS
+    assert _chain_frame.CHAIN_CUTS_ROOM >= 4 + 6 + 30 + 20 + _chain_frame.X_PIECES - 1 + 3 * _half_arc.LOBE_F_CUTS
     for n in (0.0, 2.0, 20.0, 500.0):
         for eta, k in ((0.2, 3.0), (1.5, 0.0), (1.1, 30.0), (0.6, 0.3), (0.999, 0.001)):
-            cut, ncut = _polar.chain_cut_matrix(None, n, mu, (eta, k), chain=False)
+            cut, ncut = _chain_frame.chain_cut_matrix(None, n, mu, (eta, k), chain=False)
             for q, m in enumerate(mu):
-                assert same(cut[q, :ncut[q]], _polar.chain_cuts([], n, float(m), (eta, k), chain=False)), (n, eta, k, m)
+                assert same(cut[q, :ncut[q]], _chain_frame.chain_cuts([], n, float(m), (eta, k), chain=False)), (n, eta, k, m)

@@ -1,5 +1,5 @@
 """Pumped GGX with a Fresnel factor F(wi.h) (issue 14's twenty-second session): frame 6 (the product rule of D and F on
-each ring, pumpup.engine.polar._ggx_ring_f) divided by the chain's g at each node, at mu >= N_FRESNEL_MU_MIN; the nested engine
+each ring, pumpup.engine.normal_frame._ggx_ring_f) divided by the chain's g at each node, at mu >= N_FRESNEL_MU_MIN; the nested engine
 below (frame 4, which takes GGX with F there, has no chain; ``pumpup.engine.polar.one_d_part``).  Before, the nested engine
 took every mu: a 257-point table of 1-level g2 pumped GGX 0.1 with eta 0.2, k 3 took 0.70 s, now 0.28 s
 (``scripts/bench/bench_albedo.py --pumped-f``).
@@ -17,6 +17,9 @@ from helpers import nested_reference
 
 import pumpup
 from pumpup.engine import polar as _polar
+from pumpup.engine import normal_frame as _normal_frame
+import helpers
+from pumpup.engine.normal_frame import N_FRESNEL_MU_MIN
 
 SPECS = [
     {"type": "pumped", "base": {"type": "ggx", "alpha": 0.1, "eta": 0.2, "k": 3.0}, "g": "g2", "levels": 1},
@@ -33,18 +36,18 @@ MU = np.array([1.0, 0.99, 0.9, 0.7, 0.5, 0.3, 0.25, 0.2480, 0.2, 0.05, 1e-3, 1e-
 def test_which_take_frame_6_and_where():
     for spec in SPECS:
         f = pumpup.load(spec)
-        hint = f.polar()
-        assert hint.chain is not None and any(hint.fresnel) and _polar.takes_n_frame(hint), spec
-        assert not _polar.takes_1d_path(f)  # (not at every mu: tabulate keeps its threads for the nested part)
-        assert np.array_equal(_polar.one_d_part(f, MU), MU >= _polar.N_FRESNEL_MU_MIN)
+        hint = helpers.view(f)
+        assert hint.chain is not None and any(hint.fresnel) and helpers.takes_normal(f), spec
+        assert not helpers.takes_1d(f)  # (not at every mu: tabulate keeps its threads for the nested part)
+        assert np.array_equal(helpers.one_d_mask(f, MU), MU >= N_FRESNEL_MU_MIN)
         assert _polar.albedo_1d(f, MU, 1e-8, 0.0, 1000) is None  # (the batch as a whole: pumpup.albedo splits it)
-        assert _polar.albedo_1d(f, MU[MU >= _polar.N_FRESNEL_MU_MIN], 1e-8, 0.0, 1000) is not None
-        with _polar.without_n_frame():
-            assert pumpup.load(spec).polar() is None
+        assert _polar.albedo_1d(f, MU[MU >= N_FRESNEL_MU_MIN], 1e-8, 0.0, 1000) is not None
+        with helpers.without_normal_frames():
+            assert not helpers.hint_routes(pumpup.load(spec))
     # not: a near-kink conductor (frame 6's n_fresnel_ok), Beckmann with F, a 1/E-scaled GGX with F
-    assert pumpup.load({"type": "pumped", "base": {"type": "ggx", "alpha": 0.2, "eta": 0.5, "k": 0.002}}).polar() is None
-    assert pumpup.load({"type": "pumped", "base": {"type": "beckmann", "alpha": 0.2, "ior": 1.5}}).polar() is None
-    assert _polar.one_d_part(pumpup.load({"type": "ggx", "alpha": 0.2, "ior": 1.5}), MU) is None
+    assert not helpers.hint_routes(pumpup.load({"type": "pumped", "base": {"type": "ggx", "alpha": 0.2, "eta": 0.5, "k": 0.002}}))
+    assert not helpers.hint_routes(pumpup.load({"type": "pumped", "base": {"type": "beckmann", "alpha": 0.2, "ior": 1.5}}))
+    assert helpers.one_d_mask(pumpup.load({"type": "ggx", "alpha": 0.2, "ior": 1.5}), MU).all()  # (F(wi.h) unpumped: 1-D at every mu)
 
 
 @pytest.mark.parametrize("spec", SPECS, ids=IDS)
@@ -56,10 +59,10 @@ def test_integrand_against_the_models_own_eval(spec):
     for mu in (0.3, 0.6, 0.95):
         x = np.array([0.02, 0.3, np.arcsin(mu) - 0.05, np.arcsin(mu) + 0.04, 1.2, 1.5])
         x = x[(x > 0.0) & (x < 0.5 * np.pi)]
-        got = _polar.n_integrand(f, mu, x)
-        ref = _polar.n_integrand_reference(f, mu, x)
+        got = _normal_frame.n_integrand(f, mu, x)
+        ref = _normal_frame.n_integrand_reference(f, mu, x)
         assert np.all(np.abs(got - ref) <= 1e-10 * np.abs(ref)), (mu, got / ref - 1)
-        assert np.all(got >= _polar.n_integrand(base, mu, x) * (1 - 1e-12))
+        assert np.all(got >= _normal_frame.n_integrand(base, mu, x) * (1 - 1e-12))
 
 
 @pytest.mark.parametrize("spec", SPECS, ids=IDS)
@@ -89,25 +92,25 @@ def test_a_table_through_both_paths():
 
 
 def test_the_rings_error_is_divided_by_g():
-    """A node's ring error (:func:`pumpup.engine.polar._ggx_ring_f`) enters the rule's error divided by g, as the node's value
+    """A node's ring error (:func:`pumpup.engine.normal_frame._ggx_ring_f`) enters the rule's error divided by g, as the node's value
     is: one node at a time (as ``_n_values`` calls the rule), the pumped node's value and error are the plain node's
     divided by g.  g is below 1: without the division a pumped node's ring error was under-reported by the factor g
     (issue 14's twenty-second session; the values' tests above do not see a factor of 0.5-1 at their tolerances)."""
     import math
 
     f = pumpup.load(SPECS[0])
-    hint = f.polar()
-    mp = _polar.n_params(hint)
-    one, buf, fv = np.ones(1), np.empty(1), np.empty(_polar.RING_F_NMAX + 1)
+    hint = helpers.view(f)
+    mp = _normal_frame.n_params(hint)
+    one, buf, fv = np.ones(1), np.empty(1), np.empty(_normal_frame.RING_F_NMAX + 1)
     for mu in (0.3, 0.7, 0.95):
-        xmu, xs = _polar._n_incidence(mp, mu)
+        xmu, xs = _normal_frame._n_incidence(mp, mu)
         for x in (0.1, 0.6, 1.2):
             d = x - xmu
-            g = _polar._n_chain_g(hint.chain, mu, math.sin(x))
+            g = _normal_frame._n_chain_g(hint.chain, mu, math.sin(x))
             assert 0.0 < g < 1.0
-            plain = _polar._n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, None, None, 1e-6, 0.0, fv,
+            plain = _normal_frame._n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, None, None, 1e-6, 0.0, fv,
                                    0)
-            pumped = _polar._n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, hint.chain, None, 1e-6,
+            pumped = _normal_frame._n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, hint.chain, None, 1e-6,
                                     0.0, fv, 0)
             assert pumped[0] == pytest.approx(plain[0] / g, rel=1e-14)
             assert pumped[1] == pytest.approx(plain[1] / g, rel=1e-12), (mu, x, pumped[1] * g / plain[1])

@@ -14,6 +14,8 @@ from helpers import n_frame_integrand_against_eval, nested_reference, one_d_agai
 
 import pumpup
 from pumpup.engine import polar as _polar
+import helpers
+from pumpup.engine.normal_frame import N_FRESNEL_MU_MIN
 
 MU = np.array([1.0, 0.999, 0.99, 0.9, 0.7, 0.5, 0.3, 0.1, 0.01, 1e-4, 1e-8])
 
@@ -30,16 +32,16 @@ def _id(case):
 def test_pumped_microfacet_models_take_frame_6():
     for spec, g, levels in CASES:
         f = pumpup.pump(spec, g=g, levels=levels)
-        hint = f.polar()
-        assert hint is not None and hint.chain is not None and _polar.takes_n_frame(hint), spec
-        with _polar.without_n_frame():  # off frame 6 a pumped half-vector model goes to the nested engine
+        hint = helpers.view(f)
+        assert hint.chain is not None and helpers.takes_normal(f), spec
+        with helpers.without_normal_frames():  # off frame 6 a pumped half-vector model goes to the nested engine
             assert _polar.albedo_1d(f, np.array([0.5]), 1e-8, 0.0, 1000) is None
     # alpha > 1: the nested engine, as before; with Fresnel at mu >= N_FRESNEL_MU_MIN only since issue 14's twenty-second
     # session (tests/test_polar_pumped_fresnel.py)
-    assert pumpup.pump({"type": "ggx", "alpha": 1.5}, g="g1").polar() is None
+    assert not helpers.hint_routes(pumpup.pump({"type": "ggx", "alpha": 1.5}, g="g1"))
     f = pumpup.pump({"type": "ggx", "alpha": 0.3, "ior": 1.5}, g="g1")
-    assert f.polar().chain is not None and not _polar.takes_1d_path(f)
-    assert _polar.one_d_part(f, np.array([0.1, 0.5])).tolist() == [False, True]
+    assert helpers.view(f).chain is not None and not helpers.takes_1d(f)
+    assert helpers.one_d_mask(f, np.array([0.1, 0.5])).tolist() == [False, True]
 
 
 @pytest.mark.parametrize("case", CASES[:3], ids=_id)
@@ -74,7 +76,7 @@ def test_near_kinks_of_the_levels_tables():
     knots = np.exp(f.chain()[1].lookup().logx)
     near = knots[np.abs(np.log(knots / diag[0])) < 0.01]
     assert 1 <= len(near) <= 6, near  # its grid does not bunch there (at least 10 knots on each side before the split)
-    assert set(kinks.tolist()) <= set(f.polar().levels(0.5))  # the 1-D path's cuts (the nested engine: the lobe's alone)
+    assert set(kinks.tolist()) <= set(helpers.view(f).levels(0.5))  # the 1-D path's cuts (the nested engine: the lobe's alone)
     mu = np.array([0.993068])
     ref, ref_err = nested_reference(f, mu, 1e-13)
     for rtol in (1e-6, 1e-8, 1e-10):
@@ -92,7 +94,7 @@ def test_against_the_2d_engine():
     f = pumpup.pump({"type": "ggx", "alpha": 0.3}, g="g2", levels=2)
     mu = np.array([0.6])  # (the 2-D engine: 6 s per mu here)
     a, e = pumpup.albedo(f, mu, return_error=True, rtol=1e-8)
-    with _polar.two_d_only():
+    with helpers.two_d_only():
         b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-8)
     assert np.all(np.abs(a - b) <= e + eb), (a - b, e, eb)
 

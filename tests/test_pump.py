@@ -10,6 +10,7 @@ import pytest
 import pumpup
 from pumpup.operators.pumping import Pumped, _TABLES
 from helpers import random_directions
+import helpers
 
 MU = np.array([1.0, 0.95, 0.8, 0.6, 0.4, 0.2, 0.1, 0.03, 1e-2, 1e-3, 1e-5, 1e-8])
 # between the nodes of every table: the interpolant must not let the pumped albedo exceed 1 there
@@ -291,7 +292,7 @@ def test_running_maximum_of_a_table_that_dips_within_its_margin(monkeypatch):
     import sys
 
     monkeypatch.setattr(sys.modules["pumpup.operators.pumping"], "_TABLES", {})  # tables of this test only
-    with pumpup.engine.polar.two_d_only():
+    with helpers.two_d_only():
         f = pumpup.pump(pumpup.load(BASES["phong"]), g="g2", levels=3)
         lk = f.lookup()
     assert lk.envelope and lk.increasing and not lk.table.is_increasing()
@@ -322,7 +323,6 @@ def test_pumped_lobe_about_the_normal_against_rings():
     tests/test_albedo_breaks.py)."""
     import math
 
-    from pumpup.engine import polar as _polar
     from pumpup.operators.pumping import TABLE_DECADES
     from test_albedo_breaks import _rings
 
@@ -330,7 +330,7 @@ def test_pumped_lobe_about_the_normal_against_rings():
     mu = 0.880332154
     assert set(TABLE_DECADES) <= set(f.lobe(mu).levels)
     ref = _rings(f, mu, lambda mo, so: [0.0, math.pi], np.concatenate([[mu], np.exp(f.lookup().logx)]))
-    for engine in (_polar.without_1d, _polar.two_d_only):  # (the nested engine, the 2-D one)
+    for engine in (helpers.without_1d, helpers.two_d_only):  # (the nested engine, the 2-D one)
         with engine():
             for rtol in (1e-6, 1e-10, 1e-12):
                 a, e = pumpup.albedo(f, mu, rtol=rtol, return_error=True)

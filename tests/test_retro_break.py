@@ -12,11 +12,11 @@ import pytest
 from scipy.optimize import brentq
 
 import pumpup
-from pumpup.engine import polar as _polar
 from pumpup.models.cook_torrance import RETRO_BREAK
 
 sys.path.insert(0, str(Path(__file__).parent))
 from test_albedo_breaks import _rings  # noqa: E402
+import helpers
 
 VCAVITY = [{"type": "cook_torrance", "m": 0.538}, {"type": "torrance_sparrow", "d": "D1", "s": 2.0}]
 
@@ -91,7 +91,7 @@ def test_scaled_cook_torrance_near_the_normal_against_rings(m, mu, engine):
     assert RETRO_BREAK in f.bound.table.breaks and RETRO_BREAK in f.lobe(mu).levels
     lo = f.bound.product.lo
     ref = _ct_rings(f, mu, [*lo[(lo > 0) & (lo < 1)], *f.bound.kinks])
-    with _polar.two_d_only() if engine == "2-D" else contextlib.nullcontext():
+    with helpers.two_d_only() if engine == "2-D" else contextlib.nullcontext():
         for rtol in (1e-8, 1e-10):
             a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
             assert abs(float(a) - ref) <= float(e) + 1e-14, (rtol, float(a), ref, float(e))

@@ -11,13 +11,14 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup.engine import polar as _polar
 from pumpup.engine import slope as _slope
 from pumpup.engine.cubature import AlbedoWarning
+import helpers
+from pumpup.engine.routes import route_names
 
 
 def _nested(f, mu, phi, rtol=1e-13):
-    with _polar.without_1d(), warnings.catch_warnings():
+    with helpers.without_1d(), warnings.catch_warnings():
         warnings.simplefilter("ignore", AlbedoWarning)
         return pumpup.albedo(f, mu, phi=phi, rtol=rtol, return_error=True)
 
@@ -84,11 +85,11 @@ def test_half_turn_needs_fewer_evaluations():
 
 def test_paths_taken():
     f = pumpup.load({"type": "ward_aniso", "ax": 0.1, "ay": 0.3})
-    assert _slope.takes_slope_path(f, np.array([0.5, _slope.MU_MIN]))
-    assert not _slope.takes_slope_path(f, np.array([0.5, _slope.MU_MIN / 2]))  # the nested engine, as before
-    with _polar.without_1d():
-        assert not _slope.takes_slope_path(f, np.array([0.5]))
-    assert not _slope.takes_slope_path(pumpup.load({"type": "ward", "m": 0.1}), np.array([0.5]))
+    assert route_names(f, [0.5, _slope.MU_MIN]).tolist() == [["slope", "slope"]]
+    assert route_names(f, [0.5, _slope.MU_MIN / 2]).tolist() == [["slope", "nested"]]  # the nested engine below
+    with helpers.without_1d():
+        assert route_names(f, [0.5]).tolist() == [["nested"]]
+    assert route_names(pumpup.load({"type": "ward", "m": 0.1}), [0.5]).tolist() == [["ward"]]
 
 
 def test_below_the_smallest_mu_the_nested_engine_answers():

@@ -570,9 +570,28 @@ class BRDF:
         out = sorted(v for v in self.albedo_breaks() if lo < v < hi)
         return out or None
 
-    def polar(self):
-        """A :class:`pumpup.engine.polar.Polar` hint when the azimuth of the albedo integral is closed-form
-        (the engine then integrates one dimension, ``pumpup.engine.polar``), else None (the default)."""
+    def azimuth_hint(self):
+        """An :class:`~pumpup.core.hints.AzimuthHint` (the model's family, its scale and factors) when the azimuth of
+        the albedo integral is closed-form or a rule on known arcs: the routing table (:mod:`pumpup.engine.routes`) then
+        picks a 1-D route for it.  None (the default): the nested quadrature or the 2-D cubature."""
+        return None
+
+    #: the relative error of :meth:`eval` where it is a truncated series (He-Torrance's), added to the albedo's error
+    #: estimate; 0 for an exact formula
+    eval_rtol: float = 0.0
+
+    #: ``delta_albedo(mu)``: the albedo of a delta lobe in the mirror direction (He-Torrance's specular part), added
+    #: to the integral exactly; None (the default) for a model without one
+    delta_albedo = None
+
+    def sampling_terms(self, mu: float) -> list:
+        """[(weight, term)] to sample from at incidence mu: the albedo terms (the default), or terms weighted for
+        this mu (Kulla-Conty's mixture)."""
+        return self.albedo_terms()
+
+    def slope_hint(self):
+        """(a_x, a_y, c) when the albedo is one ray integral per direction in slope space (anisotropic Ward, 000 eq.
+        33: the ``slope`` route, :mod:`pumpup.engine.slope`), else None (the default)."""
         return None
 
     def lobe_axis(self, mu: np.ndarray, phi: np.ndarray):

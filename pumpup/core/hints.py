@@ -1,102 +1,226 @@
-"""The hints a model gives the albedo engine about the azimuth of its albedo integral.
+"""What a model tells the albedo engine about the azimuth of its albedo integral.
 
-:class:`Polar` says that the integral over the azimuth is closed-form (or a rule on an arc) for the model's family, so
-the engine integrates one dimension (:mod:`pumpup.engine.polar`).  A model returns one from ``BRDF.polar()``; an
-operator (pumping, a 1/E scaling, a Fresnel factor) adds its factor of N.wo to its base's.
+A model whose albedo integral has a closed-form azimuth (or one the engine takes by a rule on known arcs) returns an
+:class:`AzimuthHint` from :meth:`pumpup.core.BRDF.azimuth_hint`: the model's *family* (one of the records below, with
+typed parameters), the constant ``scale(mu)`` in front of it, and the *factors* of N.wo that operators multiply it by.
+The engine's routing table (:mod:`pumpup.engine.routes`) reads the hint and picks the route; a model or an operator never
+names a route.
+
+Families (each a frozen record):
+
+- :class:`ClosedForm`: a(mu) = scale(mu) exactly (Lambert, Minnaert, Oren-Nayar, Kulla-Conty's lobe).
+- :class:`PowerLobe`: u^n / max(N.wi, N.wo)^p with u = (R.wo)_+ (Phong, Lafortune, Lewis, metal; 000 eq. 14, 28).
+- :class:`HalfVectorLobe`: w(N.h) / max(N.wi, N.wo)^p, w a power, Beckmann or GGX weight (Blinn, modified Ward; 000
+  eq. 31, 35).
+- :class:`WardLobe`: the Beckmann weight / sqrt(N.wi N.wo) (Ward, 000 eq. 34).
+- :class:`VCavityLobe`: D G F / (N.wi N.wo) with the V-cavity G (Cook-Torrance, Torrance-Sparrow; 001 eq. 9-10).
+- :class:`SmithLobe`: D F G / (4 N.wi N.wo) with Smith's G (Walter et al. 2007 eq. 20).
+- :class:`SchlickLobe`: Schlick's model (000 eq. 36).
+- :class:`AshikhminShirleyLobe`: Ashikhmin and Shirley's isotropic lobe with Schlick's F(wi.h) (AS 2000 eq. 4).
+
+Factors (functions of N.wo for a fixed wi, which an operator adds to its base's hint):
+
+- :class:`DivideByG`: pumping's divisor g_1 ... g_k (001 eq. 16).
+- :class:`InverseAlbedoFactor`: 1/E compensation's 1 + F0 (1 / U(N.wo) - 1) (Turquin eq. 6).
+- :class:`FresnelAtMax`: 000 eq. 28's conductor factor F(max(N.wi, N.wo)).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from typing import Union
 
-__all__ = ["Polar"]
+__all__ = [
+    "AshikhminShirleyLobe", "AzimuthHint", "ClosedForm", "DivideByG", "Fresnel", "FresnelAtMax", "HalfVectorLobe", "InverseAlbedoFactor",
+    "PowerLobe", "SchlickLobe", "SmithLobe", "VCavityLobe", "WardLobe",
+]
+
+RADIAL_WEIGHTS = ("power", "beckmann", "ggx")
+
+
+def _bad(record: str, what: str) -> None:
+    raise ValueError(f"{record}: {what}")
 
 
 @dataclass(frozen=True)
-class Polar:
-    """A model's closed-form-azimuth hint for :func:`albedo_1d`.
+class Fresnel:
+    """A Fresnel factor at wi.h: a dielectric of real index ``ior`` > 0, or a conductor ``eta`` + i ``k`` (eta > 0)."""
 
-    a(mu) = scale(mu) * integral over the hemisphere of u^n / max(mu, N.wo)^p cos(theta_o)
-    d omega_o, u = (A.wo)_+ with A the mirror direction of wi or wi itself (the integral is the
-    same for both), or, for ``kind="constant"``, a(mu) = scale(mu) exactly.
+    ior: float = 0.0
+    eta: float = 0.0
+    k: float = 0.0
 
-    Parameters
-    ----------
-    n : float, >= 0
-        Exponent of the lobe.
-    p : float in [0, 1]
-        Power of max(N.L, N.V) in the denominator (0 and 1 in closed form, between them an inner
-        rule on the arc where N.wo >= mu, :func:`_arc_power`).
-    scale : callable
-        ``scale(mu) -> ndarray`` of the same shape: the constant of the model (c, c C^n for a
-        Lafortune lobe, k_s / mu for Phong's shader, k_rho / H_s(mu) for Lewis's Phong).
-    kind : {"lobe", "constant", "half"}
-        "half": u is N.h, h the half vector of wi and wo (the Blinn family, 000 eq. 31, 32; 002
-        eq. 24; with ``radial``, ``sqrt_cos``, ``vcavity`` below also modified Ward, Ward, Cook-Torrance and
-        Torrance-Sparrow), p in {0, 1}: a(mu) = scale(mu) * integral_0^1 u^n K(u) du with the azimuth of h
-        about N in closed form (:func:`_k_half`, :func:`_k_ward`, :func:`_k_vcavity`).
-    chain : tuple, optional
-        A pumped BRDF's divisor (:meth:`pumpup.operators.pumping.Pumped._chain_args`): the integrand is then
-        divided by g_1 ... g_k (mu, N.wo) (001 eq. 16), a function of N.wo only for a fixed wi,
-        and the integral is taken about N (:func:`_integrate_chain`; for a half-vector hint in frame 6,
-        GGX, Beckmann with F = 1 and Schlick's model, :func:`_integrate_n`; GGX with F at mu >= N_FRESNEL_MU_MIN only,
-        :func:`one_d_part`).
-    levels : callable, optional
-        With ``chain``: ``levels(mu)`` -> the values of N.wo where g has a kink
-        (:meth:`pumpup.operators.pumping.Pumped.kink_levels` of every level, the kinks its tables inherit with their
-        knots, :meth:`pumpup.operators.pumping.Pumped.table_kinks`, and the base's level mu).
-    radial : {"power", "beckmann", "ggx"}
-        The lobe's radial factor: u^n ("power"), or, with kind "half", the Beckmann weight
-        exp(-tan^2(alpha) / m^2) with m = ``n`` (the modified Ward model, 000 eq. 35), or the GGX weight
-        1 / (1 + tan^2(alpha) / m^2)^2 (GGX, Walter et al. 2007 eq. 33; Torrance-Sparrow's D3, 002 sec. 3.2).
-    vcavity : bool
-        With kind "half" and p = 0: the lobe is the V-cavity microfacet model's D G / (N.L N.V) with F = 1 (or ``fresnel``'s F, by
-        the rule on h's arc, :func:`_k_numeric`)
-        (Cook-Torrance, 001 eq. 9-10; Torrance-Sparrow, 002 eq. 10; :func:`_k_vcavity`), D the radial factor
-        (u^n, or with the Beckmann weight D's 1 / cos^4), 1 / N.L in ``scale``.
-    ulps : float or callable
-        With kind "constant": the relative error of ``scale`` in units of eps (or ``ulps(mu)``), as bounded
-        and measured for each closed form.
-    sqrt_cos : bool
-        With kind "half" and p = 0: the lobe is divided by sqrt(N.wo) (Ward, 000 eq. 34: sqrt(N.L N.V), its
-        1 / sqrt(N.L) in ``scale``; :func:`_k_ward`).
-    smith : tuple, optional
-        With kind "half", p = 0 and the Beckmann or GGX weight: the lobe is a Smith microfacet model's
-        D F G / (4 N.L N.V) (Walter et al. 2007 eq. 20), given as (distribution: 0 Beckmann, 1 GGX; G1: 0 exact, 1
-        Walter's fit; shadowing: 0 separable, 1 height-correlated; alpha); its azimuth by a rule on h's arc
-        (:func:`_k_numeric`; with F = 1 and alpha <= 1 about N instead, the azimuth of wo in closed form, frame 6,
-        :func:`_integrate_n`), D's 1 / (pi alpha^2) and the 1 / 4 in ``scale``.
-    fresnel : tuple
-        (ior, eta, k): the Fresnel factor at wi.h of a Smith or V-cavity lobe, dielectric (ior > 0) or conductor
-        (eta > 0), or none (all 0); a V-cavity lobe with one takes the rule on h's arc too.  With kind "lobe" (ior 0, eta
-        > 0): 000 eq. 28's conductor factor F(max(N.L, N.V)) (frame 5, :func:`_k_lobe_fresnel`; with ``chain``, the
-        pumped lobe's frame of N, :func:`_x_rule`).
-    schlick : float, optional
-        With kind "half", p = 0 and the GGX weight (n = sqrt(r)): Schlick's model (000 eq. 36) with this r, whose
-        1 / (r + (1 - r) N.V) frame 6 integrates about N (:func:`_integrate_n`); 1 / (r + (1 - r) N.L) in ``scale``.
-    factor : tuple, optional
-        A 1/E-scaled model's factor 1 + F0 (1 / U(N.wo) - 1) (Turquin eq. 6, :class:`pumpup.operators.compensate.Scaled`): F0 and
-        the arguments of its look-up U (:attr:`pumpup.operators.compensate._Bound.args`), a function of N.wo alone, so frame 6
-        multiplies each node by it (:func:`_n_rule`); ``levels(mu)`` then gives U's kinks.  Frame 6 only.
-    fmax : tuple, optional
-        (eta, k): 000 eq. 28's conductor factor F(max(N.L, N.V)) on a frame 6 model (the ``fresnel`` wrapper of GGX,
-        Beckmann with F = 1 or Schlick's model, pumped or not; :func:`with_fresnel_max`): a function of N.wo alone for a
-        fixed wi, so frame 6 multiplies each node by it (:func:`_n_rule`), its kink N.wo = mu a cut already and the
-        elevation cut about its branch point and pole as a pumped metal's (:func:`chain_cuts`).  Frame 6 only.
-    """
+    def __post_init__(self):
+        if (self.ior > 0.0) == (self.eta > 0.0):
+            _bad("Fresnel", f"give ior > 0 (dielectric) or eta > 0 (conductor), got ior={self.ior!r}, eta={self.eta!r}")
 
-    n: float = 0.0
+
+@dataclass(frozen=True)
+class ClosedForm:
+    """a(mu) = scale(mu) exactly; ``ulps`` the relative error of the scale in units of eps (or ``ulps(mu)``), as
+    bounded and measured for each closed form."""
+
+    ulps: float | Callable = 4.0
+
+
+@dataclass(frozen=True)
+class PowerLobe:
+    """u^n / max(N.wi, N.wo)^p with u = (R.wo)_+, R the mirror direction of wi (or wi itself: the integral is the
+    same), n >= 0, p in [0, 1]."""
+
+    n: float
     p: float = 0.0
-    scale: object = None
-    kind: str = "lobe"
-    chain: tuple | None = None
-    levels: object = None
+
+    def __post_init__(self):
+        if not 0.0 <= self.p <= 1.0:
+            _bad("PowerLobe", f"p must be in [0, 1], got {self.p!r}")
+        if not self.n >= 0.0:
+            _bad("PowerLobe", f"n must be >= 0, got {self.n!r}")
+
+
+@dataclass(frozen=True)
+class HalfVectorLobe:
+    """w(N.h) / max(N.wi, N.wo)^p, p in {0, 1}: w = (N.h)^n ("power", the Blinn family, 000 eq. 31, 32), or the
+    Beckmann weight exp(-tan^2(alpha) / n^2) (modified Ward, 000 eq. 35), or the GGX weight
+    1 / (1 + tan^2(alpha) / n^2)^2 (Walter et al. 2007 eq. 33)."""
+
+    n: float
+    p: float = 0.0
     radial: str = "power"
-    sqrt_cos: bool = False
-    ulps: object = 4.0
-    vcavity: bool = False
-    smith: tuple | None = None
-    fresnel: tuple = (0.0, 0.0, 0.0)
-    schlick: float | None = None
-    factor: tuple | None = None
-    fmax: tuple | None = None
+
+    def __post_init__(self):
+        if self.p not in (0.0, 1.0):
+            _bad("HalfVectorLobe", f"p must be 0 or 1, got {self.p!r}")
+        if self.radial not in RADIAL_WEIGHTS or (self.radial != "power" and not self.n > 0.0):
+            _bad("HalfVectorLobe", f"radial must be one of {RADIAL_WEIGHTS} (n > 0 for a weight), got {self.radial!r}")
+
+
+@dataclass(frozen=True)
+class WardLobe:
+    """Ward's lobe (000 eq. 34): the Beckmann weight exp(-tan^2(alpha) / m^2) divided by sqrt(N.wo) (its 1 / sqrt(N.wi)
+    in the scale)."""
+
+    m: float
+
+    def __post_init__(self):
+        if not self.m > 0.0:
+            _bad("WardLobe", f"m must be > 0, got {self.m!r}")
+
+
+@dataclass(frozen=True)
+class VCavityLobe:
+    """The V-cavity microfacet model's D G F / (N.wi N.wo) (Cook-Torrance, 001 eq. 9-10; Torrance-Sparrow, 002 eq.
+    10): D the radial weight of exponent or width ``n`` (with the Beckmann weight D's 1 / cos^4), F = 1 or ``fresnel``
+    at wi.h, 1 / N.wi in the scale."""
+
+    n: float
+    radial: str = "power"
+    fresnel: Fresnel | None = None
+
+    def __post_init__(self):
+        if self.radial not in RADIAL_WEIGHTS or (self.radial != "power" and not self.n > 0.0):
+            _bad("VCavityLobe", f"radial must be one of {RADIAL_WEIGHTS} (n > 0 for a weight), got {self.radial!r}")
+
+
+@dataclass(frozen=True)
+class SmithLobe:
+    """A Smith microfacet model's D F G / (4 N.wi N.wo) (Walter et al. 2007 eq. 20): ``distribution`` "beckmann" or
+    "ggx" of roughness ``alpha``, G1 "exact" or Walter's fit ("walter"), shadowing "separable" or "correlated", F = 1
+    or ``fresnel`` at wi.h; D's 1 / (pi alpha^2) and the 1 / 4 in the scale."""
+
+    distribution: str
+    alpha: float
+    g1: str = "exact"
+    shadowing: str = "separable"
+    fresnel: Fresnel | None = None
+
+    def __post_init__(self):
+        if self.distribution not in ("beckmann", "ggx") or self.g1 not in ("exact", "walter") \
+                or self.shadowing not in ("separable", "correlated") or not self.alpha > 0.0:
+            _bad("SmithLobe", f"needs distribution 'beckmann' or 'ggx', g1 'exact' or 'walter', shadowing 'separable' or "
+                              f"'correlated' and alpha > 0, got {self.distribution!r}, {self.g1!r}, {self.shadowing!r}, "
+                              f"{self.alpha!r}")
+
+
+@dataclass(frozen=True)
+class SchlickLobe:
+    """Schlick's model (000 eq. 36) with r in (0, 1]: the GGX weight with alpha = sqrt(r) and
+    1 / (r + (1 - r) N.wo) (its 1 / (r + (1 - r) N.wi) in the scale)."""
+
+    r: float
+
+    def __post_init__(self):
+        if not 0.0 < self.r <= 1.0:
+            _bad("SchlickLobe", f"r must be in (0, 1], got {self.r!r}")
+
+
+@dataclass(frozen=True)
+class AshikhminShirleyLobe:
+    """Ashikhmin and Shirley's isotropic lobe (N.h)^n F(wi.h) / ((wi.h) max(N.wi, N.wo)) with Schlick's
+    F(c) = rs + (1 - rs) (1 - c)^5 (AS 2000 eq. 4, 5); sqrt((nu + 1)(nv + 1)) / (8 pi) in the scale."""
+
+    n: float
+    rs: float
+
+    def __post_init__(self):
+        if not self.n >= 0.0 or not 0.0 <= self.rs <= 1.0:
+            _bad("AshikhminShirleyLobe", f"needs n >= 0 and rs in [0, 1], got n={self.n!r}, rs={self.rs!r}")
+
+
+Family = Union[ClosedForm, PowerLobe, HalfVectorLobe, WardLobe, VCavityLobe, SmithLobe, SchlickLobe,
+               AshikhminShirleyLobe]
+
+
+@dataclass(frozen=True)
+class DivideByG:
+    """Pumping's divisor g_1 ... g_k (mu, N.wo) (001 eq. 16): ``lookups``, the compiled look-ups of every level's
+    bound (:class:`pumpup.physics.lookups.GChain`), and ``levels(mu)``, the values of N.wo where g has a kink."""
+
+    lookups: tuple
+    levels: Callable = field(compare=False)
+
+
+@dataclass(frozen=True)
+class InverseAlbedoFactor:
+    """1/E compensation's factor 1 + f0 (1 / U(N.wo) - 1) (Turquin eq. 6): ``bound``, the arguments of the compiled
+    look-up U (a bounded spline of the white model's albedo), and ``levels(mu)``, U's kinks."""
+
+    f0: float
+    bound: tuple
+    levels: Callable = field(compare=False)
+
+
+@dataclass(frozen=True)
+class FresnelAtMax:
+    """000 eq. 28's conductor factor F(eta + i k, max(N.wi, N.wo))."""
+
+    eta: float
+    k: float
+
+
+Factor = Union[DivideByG, InverseAlbedoFactor, FresnelAtMax]
+
+
+@dataclass(frozen=True)
+class AzimuthHint:
+    """A model's family, its constant ``scale(mu)`` (an array of the shape of mu) and the factors of N.wo operators
+    multiply it by.  The albedo is scale(mu) times the family's integral with the factors (for :class:`ClosedForm`,
+    scale(mu) itself)."""
+
+    family: Family
+    scale: Callable
+    factors: tuple = ()
+
+    @property
+    def family_name(self) -> str:
+        """The family record's class name."""
+        return type(self.family).__name__
+
+    def factor(self, kind: type):
+        """The factor of type ``kind``, or None."""
+        return next((f for f in self.factors if isinstance(f, kind)), None)
+
+    def times(self, factor) -> AzimuthHint:
+        """This hint with one more factor."""
+        return replace(self, factors=(*self.factors, factor))

@@ -1400,27 +1400,26 @@ def _rounding(lobe: Lobe) -> float:
     return 16.0 * eps * (4.0 + n)
 
 
-#: the generic path (a BRDF without a hint: ``from_function``) cuts at N.wo = mu and runs on two first grids
-GENERIC_CHECK = True
 #: the second first grid of the generic path (nx, nt), besides (8, 8)
 GENERIC_GRID2 = (7, 11)
 
 
-def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_regions: int, grid=None):
+def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_regions: int, grid=None,
+                     generic_check: bool = True):
     """(value, error, converged) per problem of the group by the adaptive cubature.
 
     A BRDF without a hint (the generic path: axis "normal", radial "cosine", not symmetric) may have kinks no
     hint marks, and a first rectangle that straddles one is refined only if its |K - G| shows it, which a kink
     does not (the slow test test_every_example_engine_and_generic_path_agree failed on 26 of the 107 registry
     examples at mu = 0.01 since it was written, by up to 5000 x the estimate: e.g. stretched Phong n = 1,
-    1.9e-7 off with an estimate of 3.8e-11 at every rtol).  So the generic path (``GENERIC_CHECK``) cuts at
+    1.9e-7 off with an estimate of 3.8e-11 at every rtol).  So the generic path (``generic_check``) cuts at
     N.wo = mu, the kink of every max(N.L, N.V) (that alone mended 22 of the 28 examples), and integrates on
     two first grids, (8, 8) and ``GENERIC_GRID2``: the value is the second's, the error the larger estimate
     plus the difference of the two (a kink missed by one grid and not by the other shows there: stretched
     Phong n = 1 at mu = 0.01 gave 1.9e-7 and 7e-12 off on the two grids), and it is converged only if both
     are and their difference meets the tolerance.  This costs the generic path about twice the evaluations.
     """
-    if g.lobe.generic and GENERIC_CHECK and grid is None:
+    if g.lobe.generic and generic_check and grid is None:
         lev = np.concatenate([g.levels, g.mu[:, None]], axis=1)
         g2 = _Group(lobe=g.lobe, mu=g.mu, levels=lev, phi=g.phi)
         v1, e1, c1 = _integrate_group(brdf, g2, rtol, atol, max_regions, grid=(8, 8))
@@ -1563,7 +1562,7 @@ def _groups(brdf: BRDF, mu: np.ndarray, phi: np.ndarray | None = None):
 
 
 def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
-           max_regions: int = 20000, phi=0.0):
+           max_regions: int = 20000, phi=0.0, engine: str | None = None):
     """Directional albedo a(mu) of ``brdf`` (000 eq. 2; Lewis's k_rho, 002 eq. 15).
 
     a(mu, phi) = integral over the hemisphere of f_r(wi, wo) cos(theta_o) d omega_o, with
@@ -1591,6 +1590,11 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
         against ``mu``.  An anisotropic BRDF's albedo depends on it (``ward_aniso``,
         ``lafortune`` with cx != cy, a user function); for a model whose
         :meth:`~pumpup.core.BRDF.azimuth_range` is None (isotropic) it is ignored.
+    engine : {"auto", "1d", "nested", "2d"}, optional
+        Which routes may integrate (:mod:`pumpup.engine.routes`): every route ("auto", the default); the 1-D routes
+        only ("1d": an error for a model or a value of mu none of them takes); the nested quadrature where it applies,
+        else the 2-D cubature ("nested"); the 2-D cubature alone ("2d", the reference the others are tested against).
+        None: the choice in force (:func:`pumpup.engine.routes.using`, by default "auto").
 
     Returns
     -------
@@ -1633,56 +1637,35 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     value = np.zeros_like(flat)
     error = np.zeros_like(flat)
     ok = np.ones(flat.shape, bool)
-    from . import nested as _nested
-    from . import polar as _polar
-    from . import slope as _slope
+    from . import nested, polar, slope
+    from .routes import check_engine, current, plan, using
 
+    choice = current()
+    if engine is not None and check_engine("albedo", engine) != choice.engine:
+        with using(engine=engine):
+            return albedo(brdf, mu, return_error=return_error, rtol=rtol, atol=atol, max_regions=max_regions, phi=phi)
+    turn = phflat if (float(ph) != 0.0 if not ph.ndim else bool((phflat != 0.0).any())) else None
     for w, term in brdf.albedo_terms():
-        if _slope.takes_slope_path(term, flat):  # anisotropic Ward, at every azimuth of wi (pumpup.engine.slope)
-            v, e, conv, _ = _slope.slope_albedo(term, flat, phflat, rtol, atol, max_regions)
-            value += w * v
-            error += abs(w) * e
-            ok &= conv
-            continue
-        axis = term.lobe_axis(flat, phflat)
-        if axis is not None:  # a power lobe about its own axis (Lafortune's, p = 0), at every azimuth of wi
-            fast = _polar.axis_albedo(*axis, rtol, atol, max_regions)
-            if fast is not None:
-                value += w * fast[0]
-                error += abs(w) * fast[1]
-                ok &= fast[2]
-                continue
-        turn = None
-        if (float(ph) != 0.0 if not ph.ndim else bool((phflat != 0.0).any())) and term.azimuth_range() is not None:
-            turn = phflat
-        # closed-form azimuth (isotropic models only, where phi does not matter), or None
-        fast = _polar.albedo_1d(term, flat, rtol, atol, max_regions) if turn is None else None
-        if fast is not None:
-            value += w * fast[0]
-            error += abs(w) * fast[1]
-            ok &= fast[2]
-            continue
-        rest = None  # (the mu left to the engines below, where the 1-D path takes some: _polar.one_d_part)
-        part = _polar.one_d_part(term, flat) if turn is None else None
-        if part is not None and part.any():
-            fast = _polar.albedo_1d(term, flat[part], rtol, atol, max_regions)
-            value[part] += w * fast[0]
-            error[part] += abs(w) * fast[1]
-            ok[part] &= fast[2]
-            rest = np.flatnonzero(~part)
-        for idx, g in _groups(term, flat if rest is None else flat[rest], turn):
-            # the nested quadrature (pumpup.engine.nested) where it applies, else the 2-D cubature
-            nested = _nested.supports(g)
-            v, e, conv = (_nested.integrate if nested else _integrate_group)(term, g, rtol, atol, max_regions)
-            if rest is not None:
-                idx = rest[idx]
+        for route, idx, payload in plan(term, flat, turn, choice):
+            if route == "slope":  # anisotropic Ward, at every azimuth of wi (pumpup.engine.slope)
+                v, e, conv, _ = slope.slope_albedo(term, flat[idx], phflat[idx], rtol, atol, max_regions)
+            elif route == "lobe_axis":  # a power lobe about its own axis (Lafortune's, p = 0), at every azimuth of wi
+                n, nu, scale = payload
+                v, e, conv, _ = polar.axis_albedo(n, np.broadcast_to(nu, flat.shape)[idx],
+                                                  np.broadcast_to(scale, flat.shape)[idx], rtol, atol, max_regions)
+            elif route == "nested":
+                v, e, conv = nested.integrate(term, payload, rtol, atol, max_regions)
+            elif route == "cubature":
+                v, e, conv = _integrate_group(term, payload, rtol, atol, max_regions, generic_check=choice.generic_check)
+            else:  # the 1-D routes of the model's azimuth hint (pumpup.engine.polar)
+                v, e, conv, _ = polar.run(route, payload, flat[idx], rtol, atol, max_regions, choice.lobe_fresnel_gauss)
             value[idx] += w * v
             error[idx] += abs(w) * e
             ok[idx] &= conv
     # a model's delta lobe (he_torrance's specular part) is added analytically; a model whose eval
     # is exact to a relative eval_rtol (a truncated series) has that share added to the error
-    error += getattr(brdf, "eval_rtol", 0.0) * value
-    delta = getattr(brdf, "delta_albedo", None)
+    error += brdf.eval_rtol * value
+    delta = brdf.delta_albedo
     if delta is not None:
         w = np.asarray(delta(flat), dtype=np.float64)
         value, error = value + w, error + 1e-15 * w

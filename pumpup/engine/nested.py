@@ -57,13 +57,12 @@ turned by phi about N before ``_eval``, as the 2-D engine does (issue 14, fourte
 the 2-D engine, whose first grid missed the visible tail of a ridge just past a break: ward_aniso ax = 1, ay = 0.001 at
 mu = 0.9877, phi = 0.4 was 1.3e-8 off with an estimate of 5e-14, where the outer substitution towards a break
 (``OUTER_SUB``) puts a node within 2e-6 of the interval of it).  Hint-less BRDFs (a :func:`pumpup.from_function`,
-integrated by the 2-D engine's generic path) are left to the 2-D engine.  :func:`pumpup.engine.polar.two_d_only` switches this path off too (the 2-D engine stays the
-reference); :func:`disabled` switches off only this path.
+integrated by the 2-D engine's generic path) are left to the 2-D engine.  ``engine="2d"`` leaves this path out (the 2-D
+engine stays the reference), as does ``pumpup.engine.routes.using(without={"nested"})``.
 """
 
 from __future__ import annotations
 
-import contextlib
 import math
 
 import numpy as np
@@ -89,10 +88,7 @@ from .cubature import (
     _tau_of_angle,
 )
 
-__all__ = ["ENABLED", "disabled", "inner_error", "integrate", "interval_error", "supports"]
-
-#: the nested path is used where it applies (``disabled()`` switches it off)
-ENABLED = True
+__all__ = ["inner_error", "integrate", "interval_error", "supports"]
 
 #: initial intervals of tau_x before the breaks are added (as the 2-D engine's NX_INIT).  4 saved 5-40 %
 #: of the evaluations per mu and stayed honest on scripts/calibration/error_calibration.py (max ratio 0.126), but the
@@ -116,25 +112,8 @@ _INNER = (NODES, WK, WG)
 LAST_EVALS: np.ndarray | None = None
 
 
-@contextlib.contextmanager
-def disabled():
-    """Within the block, ``pumpup.albedo`` uses the 2-D engine where it would use the nested one
-    (the benchmark's previous engine).  Not meant for concurrent toggling."""
-    global ENABLED
-    old = ENABLED
-    ENABLED = False
-    try:
-        yield
-    finally:
-        ENABLED = old
-
-
 def supports(g) -> bool:
     """Whether this path integrates the group ``g`` (a ``pumpup.engine.cubature._Group``)."""
-    from . import polar as _polar
-
-    if not (ENABLED and _polar.ENABLED):
-        return False
     lobe = g.lobe
     return not lobe.generic and lobe.axis in _AXIS_CODE and lobe.radial in _RADIAL_CODE
 

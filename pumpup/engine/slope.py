@@ -63,9 +63,9 @@ import numpy as np
 from numba import njit
 
 from ..physics.quadrature import calibrated, mode_code, rule_sums
-from .polar import _tally
+from .lobe_frame import _tally
 
-__all__ = ["slope_albedo", "takes_slope_path", "ray_reference", "ray_integral"]
+__all__ = ["slope_albedo", "ray_reference", "ray_integral"]
 
 #: the ray's cut: e^(-R_MAX^2) = e^-40, as the 1-D path's Z_MAX (beyond it a bound joins the error)
 R_MAX = math.sqrt(40.0)
@@ -340,21 +340,13 @@ def _slope_all(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk
                                                        tnodes, twk, twg, nodes, wk, wg, mode, work, buf, ibuf, rw)
 
 
-def takes_slope_path(brdf, mu: np.ndarray) -> bool:
-    """Whether :func:`slope_albedo` takes ``brdf`` at every mu (the model offers ``slope()``, the 1-D path is on, and
-    mu >= :data:`MU_MIN`)."""
-    from . import polar as _polar
-
-    hint = getattr(brdf, "slope", None)
-    return bool(_polar.ENABLED and _polar.ONE_D and hint is not None and (mu.size == 0 or mu.min() >= MU_MIN))
-
-
 def slope_albedo(brdf, mu: np.ndarray, phi: np.ndarray, rtol: float, atol: float, max_regions: int):
     """(value, error, converged, evaluations) of the albedo of anisotropic Ward ``brdf`` at every (mu, phi) (1-D float
     arrays of one length; phi the azimuth of wi from the tangent x axis)."""
-    from .polar import _RULES, ROUNDING
+    from .outer_rule import _RULES
+    from .lobe_frame import ROUNDING
 
-    ax, ay, c = brdf.slope()
+    ax, ay, c = brdf.slope_hint()
     mu = np.ascontiguousarray(mu, dtype=np.float64)
     phi = np.ascontiguousarray(np.broadcast_to(phi, mu.shape), dtype=np.float64)
     if ax == ay:  # isotropic: the albedo does not depend on phi, and phi = 0 takes half the turn
@@ -373,7 +365,7 @@ def slope_albedo(brdf, mu: np.ndarray, phi: np.ndarray, rtol: float, atol: float
 
 def ray_integral(b: float, e2: float, rtol: float = 1e-13) -> tuple:
     """(J, error, evaluations) of the compiled ray integral (module docstring) at b = e.c and e2 = |e|^2."""
-    from .polar import _RULES
+    from .outer_rule import _RULES
 
     nodes, wk, wg = _RULES[RAY_RULE]
     return _ray(float(b), float(e2), float(rtol), 0.0, nodes, wk, wg, mode_code(), np.empty(len(nodes)), np.empty((5, RAY_MAX)))

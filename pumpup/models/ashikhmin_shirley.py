@@ -178,11 +178,11 @@ class _Diffuse(BRDF):
     def lobe(self, mu):
         return Lobe(axis="normal", radial="cosine")
 
-    def polar(self):
-        from ..core.hints import Polar
+    def azimuth_hint(self):
+        from ..core.hints import AzimuthHint, ClosedForm
 
         # 1 - (1 - mu/2)^5 by log1p and expm1: a few ulps
-        return Polar(kind="constant", scale=diffuse_albedo, ulps=8.0)
+        return AzimuthHint(ClosedForm(ulps=8.0), scale=diffuse_albedo)
 
 
 def _y_axis(mu, s, cos_a, sin_a):
@@ -270,6 +270,19 @@ class AshikhminShirley(BRDF):
         # (unsplit, nu = nv = 100, rs = 0.05, rd = 0.8 at mu = 0.3 came out 0.4259 +- 4.5e-4, with a warning,
         # against 0.565209)
         return [(1.0, self.with_params(rd=0.0)), (w, _Diffuse())]
+
+    def azimuth_hint(self):
+        """Isotropic with no diffuse term: Ashikhmin and Shirley's family (AS 2000 eq. 4), whose albedo in half-vector
+        coordinates is (n + 1) / (8 pi) times the integral of (N.h)^n 4 F(wi.h) N.wo / max(N.wi, N.wo) over h (the
+        1 / (h.k) cancels the Jacobian 4 (wo.h)); None otherwise (anisotropic: the nested engine; a diffuse term: the
+        terms have their own)."""
+        from ..core.hints import AshikhminShirleyLobe, AzimuthHint
+
+        nu, nv, rs, rd = self.p["nu"], self.p["nv"], self.p["rs"], self.p["rd"]
+        if nu != nv or rd * (1.0 - rs) != 0.0:
+            return None
+        norm = math.sqrt((nu + 1.0) * (nv + 1.0)) / (8.0 * math.pi)  # AS 2000 eq. 4
+        return AzimuthHint(AshikhminShirleyLobe(n=float(nu), rs=float(rs)), scale=lambda mu: np.full(np.shape(mu), norm))
 
     def lobe(self, mu):
         # (N.h)^e(phi_h), e = nu cos^2 phi_h + nv sin^2 phi_h, in x = (N.h)^(n+1) ("power" about h) behaves as

@@ -81,16 +81,16 @@ class Blinn(BRDF):
     def lobe(self, mu):
         return Lobe(axis="half", radial="power", sharpness=self.p["n"])
 
-    def polar(self):
+    def azimuth_hint(self):
         return _half_hint(self.p["n"], 0.0, self.p["c"])  # 000 eq. 31
 
 
 def _half_hint(n, p, c):
-    """The closed-form-azimuth hint (pumpup.engine.polar, kind "half") of a lobe c (N.H)^n / max(N.L, N.V)^p,
-    p in {0, 1}: the half vector's azimuth about N integrates in closed form."""
-    from ..core.hints import Polar
+    """The azimuth hint of a lobe c (N.H)^n / max(N.L, N.V)^p, p in {0, 1} (000 eq. 31, 32): the half vector's
+    azimuth about N integrates in closed form."""
+    from ..core.hints import AzimuthHint, HalfVectorLobe
 
-    return Polar(n=n, p=float(p), scale=lambda mu: np.full(np.shape(mu), c), kind="half")
+    return AzimuthHint(HalfVectorLobe(n=n, p=float(p)), scale=lambda mu: np.full(np.shape(mu), c))
 
 
 # --- stretched Blinn ------------------------------------------------------------------------
@@ -147,7 +147,7 @@ class StretchedBlinn(BRDF):
     def lobe(self, mu):
         return Lobe(axis="half", radial="power", sharpness=self.p["n"], levels=(mu,))
 
-    def polar(self):
+    def azimuth_hint(self):
         return _half_hint(self.p["n"], 1.0, self.p["c"])  # 000 eq. 32
 
 
@@ -211,7 +211,7 @@ class PhongBlinn(BRDF):
     def lobe(self, mu):
         return Lobe(axis="half", radial="power", sharpness=self.p["n"])
 
-    def polar(self):
+    def azimuth_hint(self):
         if self.p["kd"] != 0:
             return None  # albedo_terms splits off the diffuse part
         return _half_hint(self.p["n"], 0.0, self.p["ks"])  # 002 eq. 24

@@ -168,15 +168,16 @@ class CookTorrance(BRDF):
     def lobe(self, mu):
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"], kinks=_g_kinks)
 
-    def polar(self):
-        from ..core.hints import Polar
+    def azimuth_hint(self):
+        from ..core.hints import AzimuthHint, Fresnel, VCavityLobe
 
         m = self.p["m"]
         # 001 eq. 9: F exp(-tan^2 / m^2) / (4 pi m^2 cos^4) G / (N.L N.V); the azimuth of h in closed form for F = 1
         # (G's minimum of three lines in wi.h), by a rule on its arc with F(wi.h); the Beckmann weight in
         # t = tan^2(alpha) / m^2
-        return Polar(n=m, scale=lambda mu: 1.0 / (4.0 * math.pi * m * m * np.asarray(mu, float)), kind="half",
-                     radial="beckmann", vcavity=True, fresnel=(self.p["ior"] or 0.0, 0.0, 0.0))
+        fresnel = Fresnel(ior=self.p["ior"]) if self.p["ior"] else None
+        return AzimuthHint(VCavityLobe(n=m, radial="beckmann", fresnel=fresnel),
+                           scale=lambda mu: 1.0 / (4.0 * math.pi * m * m * np.asarray(mu, float)))
 
 
 # ----------------------------------------------------------------------------------------
@@ -329,21 +330,20 @@ class TorranceSparrow(BRDF):
             return Lobe(axis="half", radial="ggx", sharpness=min(s * s, 1.0), kinks=_g_kinks)
         return Lobe(axis="half", radial="beckmann", sharpness=s, kinks=_g_kinks)
 
-    def polar(self):
+    def azimuth_hint(self):
         d, e, b = self.p["d"], self.p["s"], self.p["b"]
         if d == "D2":
             return None  # D2 = b exp(-(c2 alpha)^2) has no weight of the 1-D path: the nested engine
-        from ..core.hints import Polar
+        from ..core.hints import AzimuthHint, Fresnel, VCavityLobe
 
         # 002 eq. 10: F G D / (pi (N.S)(N.V)); the azimuth of h in closed form for F = 1 (pumpup.engine.polar._k_vcavity),
         # by a rule on its arc with F(wi.h)
-        fresnel_factor = (self.p["ior"] or 0.0, 0.0, 0.0)
+        fresnel = Fresnel(ior=self.p["ior"]) if self.p["ior"] else None
         if d == "D1":  # D = b cos^e(alpha): the power weight u^e
-            return Polar(n=e, scale=lambda mu: b / (math.pi * np.asarray(mu, float)), kind="half", vcavity=True,
-                         fresnel=fresnel_factor)
+            return AzimuthHint(VCavityLobe(n=e, fresnel=fresnel), scale=lambda mu: b / (math.pi * np.asarray(mu, float)))
         if d == "D3":  # D3 = b (c3^2 / (c3^2 cos^2 + sin^2))^2 = b / (cos^4 (1 + tan^2 / c3^2)^2): the GGX weight
-            return Polar(n=e, scale=lambda mu: b / (math.pi * np.asarray(mu, float)), kind="half", radial="ggx",
-                         vcavity=True, fresnel=fresnel_factor)
+            return AzimuthHint(VCavityLobe(n=e, radial="ggx", fresnel=fresnel),
+                               scale=lambda mu: b / (math.pi * np.asarray(mu, float)))
         # D4 = exp(-tan^2 / m^2) / (4 m^2 cos^4): Cook-Torrance's
-        return Polar(n=e, scale=lambda mu: 1.0 / (4.0 * math.pi * e * e * np.asarray(mu, float)), kind="half",
-                     radial="beckmann", vcavity=True, fresnel=fresnel_factor)
+        return AzimuthHint(VCavityLobe(n=e, radial="beckmann", fresnel=fresnel),
+                           scale=lambda mu: 1.0 / (4.0 * math.pi * e * e * np.asarray(mu, float)))

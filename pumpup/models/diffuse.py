@@ -75,11 +75,11 @@ class Minnaert(BRDF):
     def lobe(self, mu):
         return Lobe(axis="normal", radial="cosine", symmetric=True)
 
-    def polar(self):
-        from ..core.hints import Polar
+    def azimuth_hint(self):
+        from ..core.hints import AzimuthHint, ClosedForm
 
         k, b = self.p["k"], self.p["b"]
-        return Polar(kind="constant", scale=lambda mu: b * 2.0 * math.pi / (k + 1.0) * np.asarray(mu, float) ** (k - 1.0))
+        return AzimuthHint(ClosedForm(), scale=lambda mu: b * 2.0 * math.pi / (k + 1.0) * np.asarray(mu, float) ** (k - 1.0))
 
 
 # --- Neumann-Neumann lacquer -----------------------------------------------------------------
@@ -138,18 +138,18 @@ class Lacquer(BRDF):
     def lobe(self, mu):
         return Lobe(axis="normal", radial="cosine", symmetric=True)
 
-    def polar(self):
+    def azimuth_hint(self):
         from scipy.special import expn
 
-        from ..core.hints import Polar
+        from ..core.hints import AzimuthHint, ClosedForm
 
         c, s = self.p["c"], self.p["s"]
         e3 = float(expn(3, s))  # integral_0^1 t e^(-s/t) dt = E_3(s) (t = 1/x); E_3(0) = 1/2: Lambert's pi c
         # a(mu) = 2 pi c e^(-s/mu) E_3(s).  Error: scipy's E_3 within 3.9 eps of mpmath (s in [0, 700]), a few ulps of
         # products, and e^(-s/mu) inherits the rounding of s / mu, eps s / mu (as the kernel does): 8 + 2 s / mu eps
-        return Polar(kind="constant", ulps=lambda mu: 8.0 + 2.0 * s / mu,
-                     scale=lambda mu: 2.0 * math.pi * c * np.exp(-s / np.asarray(mu, float)) * e3 if s > 0
-                     else np.full(np.shape(mu), math.pi * c))
+        return AzimuthHint(ClosedForm(ulps=lambda mu: 8.0 + 2.0 * s / mu),
+                           scale=lambda mu: 2.0 * math.pi * c * np.exp(-s / np.asarray(mu, float)) * e3 if s > 0
+                           else np.full(np.shape(mu), math.pi * c))
 
 
 # --- Oren-Nayar ------------------------------------------------------------------------------
@@ -236,11 +236,11 @@ class OrenNayar(BRDF):
         # alpha and beta swap where N.wo = mu: a kink at wo_z = mu
         return Lobe(axis="normal", radial="cosine", levels=(mu,), symmetric=True)
 
-    def polar(self):
-        from ..core.hints import Polar
+    def azimuth_hint(self):
+        from ..core.hints import AzimuthHint, ClosedForm
 
         rho, sigma = self.p["albedo"], self.p["sigma"]
-        return Polar(kind="constant", scale=lambda mu: oren_nayar_albedo(mu, rho, sigma))
+        return AzimuthHint(ClosedForm(), scale=lambda mu: oren_nayar_albedo(mu, rho, sigma))
 
 
 def oren_nayar_albedo(mu, albedo=1.0, sigma=0.3):

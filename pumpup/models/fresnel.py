@@ -113,16 +113,12 @@ class FresnelWeighted(BRDF):
     def azimuth_range(self):
         return self.base.azimuth_range()  # F depends on N.wi and N.wo only
 
-    def polar(self):
-        """A lobe base's hint (p in {0, 1}; any p for a pumped lobe's) with F(Theta_min) added: frame 5 of the 1-D path, or
-        the pumped lobe's frame of N; or a GGX, Beckmann (F = 1) or Schlick base's, pumped or not, with F(Theta_min) as
-        a factor of frame 6's nodes (``Polar.fmax``); or None (pumpup.engine.polar)."""
-        from ..engine.polar import with_fresnel, with_fresnel_max
+    def azimuth_hint(self):
+        """The base's hint times F(max(N.wi, N.wo)) (000 eq. 28), or None without one."""
+        from ..core.hints import FresnelAtMax
 
-        hint = self.base.polar()
-        if hint is not None and hint.kind == "half":
-            return with_fresnel_max(hint, self.p["eta"], self.p["k"])
-        return with_fresnel(hint, self.p["eta"], self.p["k"])
+        hint = self.base.azimuth_hint()
+        return None if hint is None else hint.times(FresnelAtMax(self.p["eta"], self.p["k"]))
 
 
 class _FresnelTerm(FresnelWeighted):

@@ -158,11 +158,11 @@ class Lafortune(BRDF):
         q = self.p
         return _isotropic_lobe(q["n"], q["cx"], q["cy"], q["cz"], q["p"], mu)
 
-    def polar(self):
+    def azimuth_hint(self):
         """The closed-form-azimuth hint (pumpup.engine.polar) where the lobe is isotropic:
         cx = cy = cz = C > 0 gives (R.V)_M = C (R.V) (stretched Phong), cx = cy = -cz, cz = C > 0
         gives C (L.V) (the retro-reflective lobe); the scale is c C^n (000 eq. 14, 15)."""
-        from ..core.hints import Polar
+        from ..core.hints import AzimuthHint, PowerLobe
 
         q = self.p
         C = q["cz"]
@@ -170,7 +170,7 @@ class Lafortune(BRDF):
             return None
         with np.errstate(over="ignore"):
             scale = float(q["c"] * np.float64(C) ** q["n"])
-        return Polar(n=q["n"], p=float(q["p"]), scale=lambda mu: np.full(np.shape(mu), scale))
+        return AzimuthHint(PowerLobe(n=q["n"], p=float(q["p"])), scale=lambda mu: np.full(np.shape(mu), scale))
 
     def lobe_axis(self, mu, phi):
         """For p = 0 (000 eq. 14): (R.V)_M = v.wo with v = (-cx Lx, -cy Ly, cz Lz), so f = c |v|^n (v^.wo)_+^n, a
@@ -179,7 +179,7 @@ class Lafortune(BRDF):
         depends on mu itself), for cz <= 0 (v^ on or below the horizon), where :meth:`polar` applies, and where nu or
         the scale is not a positive finite number.  With cx = cy, |v| is taken without phi (the albedo is isotropic)."""
         q = self.p
-        if q["p"] != 0.0 or not q["cz"] > 0.0 or self.polar() is not None:
+        if q["p"] != 0.0 or not q["cz"] > 0.0 or self.azimuth_hint() is not None:
             return None
         mu = np.asarray(mu, dtype=np.float64)
         s2 = (1.0 - mu) * (1.0 + mu)

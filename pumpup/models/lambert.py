@@ -47,8 +47,8 @@ class Lambert(BRDF):
     def lobe(self, mu):
         return Lobe(axis="normal", radial="cosine")
 
-    def polar(self):
-        from ..core.hints import Polar
+    def azimuth_hint(self):
+        from ..core.hints import AzimuthHint, ClosedForm
 
         a = self.p["albedo"]
-        return Polar(kind="constant", scale=lambda mu: np.full(np.shape(mu), a))  # albedo / pi * pi
+        return AzimuthHint(ClosedForm(), scale=lambda mu: np.full(np.shape(mu), a))  # albedo / pi * pi

@@ -189,15 +189,15 @@ class LewisPhong(BRDF):
         return [(q["k_rho"] * q["k_sigma"], self.with_params(k_rho=1.0, k_sigma=1.0)),
                 (q["k_rho"] * (1.0 - q["k_sigma"]), lambert)]
 
-    def polar(self):
+    def azimuth_hint(self):
         """k_rho / H_s(mu) times reciprocal Phong with c = 1 (002 eq. 22), when k_sigma = 1; the
         H_s is the one :meth:`_eval` divides by (:func:`_hs_at`)."""
-        from ..core.hints import Polar
+        from ..core.hints import AzimuthHint, PowerLobe
 
         q = self.p
         if q["k_sigma"] != 1:
             return None  # albedo_terms splits off the diffuse part
-        return Polar(n=q["n"], p=0, scale=lambda mu: q["k_rho"] / _hs_at(np.asarray(mu), q["n"]))
+        return AzimuthHint(PowerLobe(n=q["n"], p=0.0), scale=lambda mu: q["k_rho"] / _hs_at(np.asarray(mu), q["n"]))
 
     def lobe(self, mu):
         if self.p["k_sigma"] == 1:

@@ -115,17 +115,16 @@ class Metal(BRDF):
     def albedo_breaks(self):
         return fresnel_levels(self.p["eta"], self.p["k"])  # F(max(mu, N.wo)) turns at mu = x0 too
 
-    def polar(self):
-        return _fresnel_polar(self.p["n"], self.p["c"], self.p["eta"], self.p["k"])
+    def azimuth_hint(self):
+        return _fresnel_hint(self.p["n"], self.p["c"], self.p["eta"], self.p["k"])
 
 
-def _fresnel_polar(n, c, eta, k):
-    """The 1-D path's hint (pumpup.engine.polar, frame 5) of c u^n F(eta + i k, Theta_min) / max(N.L, N.V), 000 eq. 28, or
-    None where its rule on the arc declines the Fresnel factor (a near-kink: the nested engine takes it)."""
-    from ..core.hints import Polar
-    from ..engine.polar import with_fresnel
+def _fresnel_hint(n, c, eta, k):
+    """The azimuth hint of c u^n F(eta + i k, Theta_min) / max(N.L, N.V) (000 eq. 28): a power lobe with p = 1 times
+    the factor F(max(N.wi, N.wo))."""
+    from ..core.hints import AzimuthHint, FresnelAtMax, PowerLobe
 
-    return with_fresnel(Polar(n=n, p=1.0, scale=lambda mu: np.full(np.shape(mu), c)), eta, k)
+    return AzimuthHint(PowerLobe(n=n, p=1.0), scale=lambda mu: np.full(np.shape(mu), c), factors=(FresnelAtMax(eta, k),))
 
 
 # --- plastic --------------------------------------------------------------------------------
@@ -271,16 +270,16 @@ class Plastic(BRDF):
     def albedo_breaks(self):
         return () if self.p["eta"] is None else fresnel_levels(self.p["eta"], 0.0)
 
-    def polar(self):
+    def azimuth_hint(self):
         q = self.p
         if q["ad"] != 0:
             return None  # the diffuse part is split off by albedo_terms
-        from ..core.hints import Polar
+        from ..core.hints import AzimuthHint, PowerLobe
 
         c = q["a_s"] * (q["n"] + 2.0) / (2.0 * math.pi)  # 000 eq. 30: stretched Phong's lobe (p = 1) times a_s
         if q["eta"] is not None:
-            return _fresnel_polar(q["n"], c, q["eta"], 0.0)  # 000 eq. 29: F(Theta_min) by frame 5's rule on the arc
-        return Polar(n=q["n"], p=1.0, scale=lambda mu: np.full(np.shape(mu), c))
+            return _fresnel_hint(q["n"], c, q["eta"], 0.0)  # 000 eq. 29: F(Theta_min) by frame 5's rule on the arc
+        return AzimuthHint(PowerLobe(n=q["n"], p=1.0), scale=lambda mu: np.full(np.shape(mu), c))
 
 
 # --- one model per channel -------------------------------------------------------------------

@@ -246,15 +246,6 @@ _ETA = Param(None, lo=MIN_INDEX, hi=MAX_INDEX, doc="conductor: real part of the 
 _K = Param(None, lo=0.0, hi=MAX_INDEX, doc="conductor: extinction coefficient (with eta; default 0)")
 
 
-#: the 1-D path (frame 4) declines a conductor's F(wi.h) whose branch point x0 - i y0 (:func:`pumpup.engine.polar.fresnel_branch`)
-#: lies inside (0, 1) closer than this to the real axis; the nested engine takes it, with the kink wi.h = x0 in its hint
-#: (:class:`_WiHKink`).  Measured against the nested and 2-D engines at rtol 1e-13 (eta 0.551; GGX 0.3, 0.02, Beckmann
-#: 0.1; mu 0.05 ... 0.95): frame 4 was up to 1.3e5 x its estimate for y0 = 0 (k = 0: total reflection below eta = 1; GGX
-#: 0.3 at mu = 0.05 1.0e-7 off, estimate 7.9e-13) and y0 = 6.6e-13, 18 x for 6.6e-10, within its estimate from 6.6e-8 up
-#: (issue 14's twenty-first session, ``scripts/studies/fuzz_engines.py --registry``)
-POLAR_F_Y0_MIN = 1e-6
-
-
 class _WiHKink:
     """The Lobe hint's kink wi.h = x0 of a half-vector lobe (:func:`wih_kinks`), a + b cos(beta) = 0
     with a = mu cos(alpha) - x0, b = s sin(alpha) (a class, not a closure: a BRDF pickles for dask)."""
@@ -309,31 +300,17 @@ class _Microfacet(BRDF):
             0.0 if p["k"] is None else p["k"],
         )
 
-    def polar(self):
-        from ..core.hints import Polar
+    def azimuth_hint(self):
+        from ..core.hints import AzimuthHint, Fresnel, SmithLobe
 
-        dist, a, shadowing, g1, ior, eta, k = self.kernel_args()
-        if a > 1.0:
-            # rougher than any measured surface: P(N.wo) then has a singularity near N.wo = 1 as well (GGX's branch
-            # point at alpha / sqrt(alpha^2 - 1), Beckmann's exp(-1 / (2 alpha^2 (1 - N.wo)))), which the rule on h's
-            # arc does not grade: the nested engine
-            return None
-        if g1 == _G1["walter"] and shadowing == _SHADOWING["correlated"] and (ior > 0.0 or eta > 0.0):
-            # Walter's G1 (its jump at the switch level) in the height-correlated G with a Fresnel factor: frame 4 was up
-            # to 7 x its estimate against the 2-D engine at rtol 1e-13 (alpha 0.0032, ior 1.917, mu 1.75e-6: 1.27e-11 off,
-            # estimate 1.8e-12 at rtol 1e-10; alpha 0.3, ior 1.5: 3.8 x at 1e-12), the nested engine within 0.02 x of its
-            # own (issue 14's twenty-first session, scripts/studies/fuzz_engines.py --registry); separable G, or F = 1, is fine
-            return None
-        if eta > 0.0:
-            from .metal import fresnel_levels
-
-            if fresnel_levels(eta, k, POLAR_F_Y0_MIN):
-                return None  # a kink of F(wi.h) at x0, or a near-kink sharper than frame 4's cuts see: the nested engine
+        p, a = self.p, self.p["alpha"]
+        fresnel = (Fresnel(ior=p["ior"]) if p["ior"] is not None
+                   else Fresnel(eta=p["eta"], k=p["k"] or 0.0) if p["eta"] is not None else None)
         # Walter eq. 20: a(mu) = integral over h of D(h) (1 / 4) [4 (wi.h) F G / N.wi] (d omega_o = 4 (wo.h) d omega_h),
-        # D = w(t) / (pi a^2 cos^4) with w = e^-t (eq. 25) or 1 / (1 + t)^2 (eq. 33), t = tan^2 / a^2; the azimuth of h
-        # by a rule on its arc (pumpup.engine.polar._k_numeric), or with F = 1 about N in closed form (pumpup.engine.polar._integrate_n)
-        return Polar(n=a, scale=lambda mu: np.full(np.shape(mu), 0.25 / (math.pi * a * a)), kind="half",
-                     radial=self.distribution, smith=(dist, g1, shadowing, a), fresnel=(ior, eta, k))
+        # D = w(t) / (pi a^2 cos^4) with w = e^-t (eq. 25) or 1 / (1 + t)^2 (eq. 33), t = tan^2 / a^2
+        return AzimuthHint(SmithLobe(distribution=self.distribution, alpha=a, g1=p.get("g1", "exact"),
+                                     shadowing=p["shadowing"], fresnel=fresnel),
+                           scale=lambda mu: np.full(np.shape(mu), 0.25 / (math.pi * a * a)))
 
 
 @register("beckmann")

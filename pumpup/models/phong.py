@@ -142,7 +142,7 @@ class Phong(BRDF):
     def lobe(self, mu):
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"])
 
-    def polar(self):
+    def azimuth_hint(self):
         return _polar_hint(self.p["n"], 0.0, self.p["c"])
 
 
@@ -150,11 +150,11 @@ def _polar_hint(n, p, c, per_mu=None):
     """The closed-form-azimuth hint (pumpup.engine.polar) of a lobe c u^n / max(N.L, N.V)^p, p in [0, 1]
     (closed form for p in {0, 1}, an inner rule on one arc between them); ``per_mu(mu)`` multiplies
     c (Phong's shader: 1 / mu)."""
-    from ..core.hints import Polar
+    from ..core.hints import AzimuthHint, PowerLobe
 
     if per_mu is None:
-        return Polar(n=n, p=float(p), scale=lambda mu: np.full(np.shape(mu), c))
-    return Polar(n=n, p=float(p), scale=lambda mu: c * per_mu(mu))
+        return AzimuthHint(PowerLobe(n=n, p=float(p)), scale=lambda mu: np.full(np.shape(mu), c))
+    return AzimuthHint(PowerLobe(n=n, p=float(p)), scale=lambda mu: c * per_mu(mu))
 
 
 # --- stretched Phong / p-model ------------------------------------------------------------
@@ -219,7 +219,7 @@ class StretchedPhong(BRDF):
         levels = (mu,) if self.p["p"] > 0 else ()
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"], levels=levels)
 
-    def polar(self):
+    def azimuth_hint(self):
         return _polar_hint(self.p["n"], self.p["p"], self.p["c"])  # 000 eq. 7, 12
 
 
@@ -271,7 +271,7 @@ class Retro(BRDF):
         levels = (mu,) if self.p["p"] > 0 else ()
         return Lobe(axis="retro", radial="power", sharpness=self.p["n"], levels=levels)
 
-    def polar(self):
+    def azimuth_hint(self):
         # around wi, N.wo = mu u + s sqrt(1 - u^2) cos(beta) as around R: the same 1-D integral
         return _polar_hint(self.p["n"], self.p["p"], self.p["c"])  # 000 eq. 13
 
@@ -330,7 +330,7 @@ class PhongShader(BRDF):
     def lobe(self, mu):
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"])
 
-    def polar(self):
+    def azimuth_hint(self):
         if self.p["kd"] != 0:
             return None  # albedo_terms splits off the diffuse part
         return _polar_hint(self.p["n"], 0.0, self.p["ks"], per_mu=lambda mu: 1.0 / mu)  # 002 eq. 5, 8

@@ -84,14 +84,13 @@ class Ward(BRDF):
     def lobe(self, mu):
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"])
 
-    def polar(self):
-        from ..core.hints import Polar
+    def azimuth_hint(self):
+        from ..core.hints import AzimuthHint, HalfVectorLobe, WardLobe
 
         m, c = self.p["m"], self.p["c"]
         # 000 eq. 34: c / (4 pi m^2 sqrt(mu)) times exp(-tan^2(alpha) / m^2) / sqrt(N.wo); the half vector's azimuth
         # by complete elliptic integrals (pumpup.engine.polar._k_ward), the Beckmann weight in t = tan^2(alpha) / m^2
-        return Polar(n=m, p=0.0, scale=lambda mu: c / (4.0 * math.pi * m * m * np.sqrt(mu)), kind="half",
-                     radial="beckmann", sqrt_cos=True)
+        return AzimuthHint(WardLobe(m=m), scale=lambda mu: c / (4.0 * math.pi * m * m * np.sqrt(mu)))
 
 
 # --- anisotropic Ward -----------------------------------------------------------------------
@@ -190,7 +189,7 @@ class WardAniso(BRDF):
         # f is even in the x and y components of L + V: a(phi) = a(-phi) = a(pi - phi)
         return None if self.p["ax"] == self.p["ay"] else math.pi / 2
 
-    def slope(self):
+    def slope_hint(self):
         """(a_x, a_y, c) for the albedo in slope space (:mod:`pumpup.engine.slope`: one ray integral per direction)."""
         return self.p["ax"], self.p["ay"], self.p["c"]
 
@@ -255,11 +254,11 @@ class ModifiedWard(BRDF):
     def lobe(self, mu):
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"], levels=(mu,))
 
-    def polar(self):
-        from ..core.hints import Polar
+    def azimuth_hint(self):
+        from ..core.hints import AzimuthHint, HalfVectorLobe, WardLobe
 
         m, c = self.p["m"], self.p["c"]
         # 000 eq. 35: c / (4 pi m^2) times exp(-tan^2(alpha) / m^2) / max(N.L, N.V), the half vector's azimuth
         # in closed form (stretched Blinn's, p = 1) and the Beckmann weight in t = tan^2(alpha) / m^2
-        return Polar(n=m, p=1.0, scale=lambda mu: np.full(np.shape(mu), c / (4.0 * math.pi * m * m)), kind="half",
-                     radial="beckmann")
+        return AzimuthHint(HalfVectorLobe(n=m, p=1.0, radial="beckmann"),
+                           scale=lambda mu: np.full(np.shape(mu), c / (4.0 * math.pi * m * m)))

@@ -552,12 +552,12 @@ class _MsLobe(BRDF):
         return Lobe(axis="normal", radial="cosine", levels=tuple(sorted(set(self.kc.bound.kinks) | set(TABLE_DECADES))),
                     symmetric=True)
 
-    def polar(self):
-        """The lobe's albedo in closed form (``Polar(kind="constant")``): D(mu) 2 pi integral_0^1 D(t) t dt = D(mu) pi I,
+    def azimuth_hint(self):
+        """The lobe's albedo in closed form (:class:`~pumpup.core.hints.ClosedForm`): D(mu) 2 pi integral_0^1 D(t) t dt = D(mu) pi I,
         D the kernels' own (:func:`_deficits`), I by :meth:`_Bound.deficit_moment` (exact on the product table's
         polynomial pieces); the relative error I's, plus 8 ulps for D(mu) pi I itself.  Until issue 14's twelfth session the nested
         engine integrated it (80 ms for 257 mu, GGX alpha = 0.3)."""
-        from ..core.hints import Polar
+        from ..core.hints import AzimuthHint, ClosedForm
 
         got = self.kc.bound.deficit_moment()
         if got is None:  # pragma: no cover
@@ -565,9 +565,9 @@ class _MsLobe(BRDF):
         i, e = got
         args = self.kc.bound.args
         rel = e / i if i > 0.0 else 0.0
-        return Polar(kind="constant", scale=lambda mu: math.pi * i * _deficits(np.asarray(mu, dtype=np.float64).reshape(-1),
-                                                                                *args).reshape(np.shape(mu)),
-                     ulps=8.0 + rel / np.finfo(float).eps)
+        return AzimuthHint(ClosedForm(ulps=8.0 + rel / np.finfo(float).eps),
+                           scale=lambda mu: math.pi * i * _deficits(np.asarray(mu, dtype=np.float64).reshape(-1),
+                                                                    *args).reshape(np.shape(mu)))
 
 
 def _scaled_lobe(b: Lobe, bound) -> Lobe:
@@ -660,31 +660,32 @@ class Scaled(_Compensated):
     def lobe(self, mu: float) -> Lobe:
         return _scaled_lobe(self.base.lobe(mu), self.bound)
 
-    def polar(self):
-        """The 1-D albedo path of a scaled GGX, Beckmann (F = 1) or Schlick model (``pumpup.engine.polar``, frame 6 about N):
-        the factor depends on N.wo alone, so the base's hint times it (``Polar.factor``), with U's kinks as the levels;
-        None for any other base, or a white whose E table is not such a model's (its table could hold kinks)."""
-        import dataclasses
+    def azimuth_hint(self):
+        """The base's hint times 1 + F0 (1 / U(N.wo) - 1) (Turquin eq. 6; :class:`~pumpup.core.hints.InverseAlbedoFactor`),
+        a function of N.wo alone, with U's kinks as its levels; None where the base has no hint, or where U is not
+        smooth between its kinks: the white model must be a Smith lobe with F = 1, the exact G1 and alpha <= 1, or
+        Schlick's, with no factors of its own."""
+        from ..core.hints import InverseAlbedoFactor, SchlickLobe, SmithLobe
 
-        from ..engine.polar import takes_n_frame_operand as plain  # (GGX, Beckmann with F = 1 or Schlick, neither pumped nor scaled)
-
-        hint = self.base.polar()
-        white = hint if self.white is self.base else self.white.polar()
-        if not plain(hint) or not plain(white):
+        hint = self.base.azimuth_hint()
+        white = hint if self.white is self.base else self.white.azimuth_hint()
+        if hint is None or white is None or white.factors:
             return None
-        if white.smith is not None and white.smith[1] == 1:
-            # Beckmann with Walter's G1, whose albedo jumps at the switch level (pumpup.models.microfacet.walter_level):
-            # the table's spline rings across the jump among hundreds of knots (614 nodes, margin 1.1e-4, for alpha
-            # 0.19), which frame 6's pieces did not see: F0 0.11 at mu = 0.9999 was 2.9e-12 off with an estimate of
-            # 3.1e-14 (94 x), alpha 0.035 at mu = 0.074 28 x.  The nested engine takes it (issue 14's twenty-fifth session)
+        f = white.family
+        if not (isinstance(f, SchlickLobe) or isinstance(f, SmithLobe) and f.fresnel is None and f.alpha <= 1.0
+                and f.g1 == "exact"):
+            # Walter's G1, whose albedo jumps at the switch level (pumpup.models.microfacet.walter_level): the table's
+            # spline rings across the jump among hundreds of knots (614 nodes, margin 1.1e-4, for Beckmann alpha 0.19),
+            # which the 1-D route's pieces did not see: F0 0.11 at mu = 0.9999 was 2.9e-12 off with an estimate of
+            # 3.1e-14 (94 x), alpha 0.035 at mu = 0.074 28 x
             return None
         # U's kinks, and where its look-up turns from the spline to the product table (:func:`scale_bound`): a level, so
         # that the cuts are graded in N.wo down to a quarter of it (``chain_cuts``; U(N.wo) is a spline in log N.wo
         # and not analytic at 0: with the grading only down to a quarter of mu, as g's needs, Schlick r = 0.2 at mu =
         # 0.985 was 1.0e-11 off on the piece N.wo < 0.172 with an estimate of 2.7e-12)
         kinks = tuple(self.bound.kinks) + (float(self.bound.args[0]),)
-        return dataclasses.replace(hint, factor=(float(self.p["f0"]), *self.bound.args),
-                                   levels=lambda mu: tuple(sorted({float(mu), *kinks})))
+        return hint.times(InverseAlbedoFactor(f0=float(self.p["f0"]), bound=tuple(self.bound.args),
+                                              levels=lambda mu: tuple(sorted({float(mu), *kinks}))))
 
     def sampling_lobe(self, mu: float) -> Lobe:
         return self.base.sampling_lobe(mu)
@@ -754,7 +755,7 @@ class _Transposed(BRDF):
             return [(1.0, self)]
         return [(w, _Transposed(t)) for w, t in terms]
 
-    def polar(self):
+    def azimuth_hint(self):
         """The 1-D path of the furnace toward the viewer of a scaled model, or of one term of a scaled sum: f(wi, wo) =
         f_r(wi, wo) s(N.wo) with f_r reciprocal, so f(wo, wi) = s(N.wi) f_r(wi, wo) and its albedo at mu is s(mu) times
         f_r's (000 eq. 2; s = 1 + F0 (1 / U - 1), Turquin eq. 6): f_r's own hint with its scale times s (as the kernel
@@ -768,8 +769,7 @@ class _Transposed(BRDF):
             base, scaled = self.inner.term, self.inner.scaled
         else:
             return None
-        polar = getattr(base, "polar", None)
-        hint = polar() if base.reciprocal and polar is not None else None
+        hint = base.azimuth_hint() if base.reciprocal else None
         if hint is None:
             return None
         inner_scale = hint.scale

@@ -24,7 +24,7 @@ import numpy as np
 from numba import njit
 
 from ..core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register, registry
-from ..physics.lookups import CELL_SHIFT, float_bits_reference, g_levels, g_product, horner, INDEX_CELLS, kink_roots, PRODUCT_DEGREE, upper_array
+from ..physics.lookups import CELL_SHIFT, GChain, float_bits_reference, g_levels, g_product, horner, INDEX_CELLS, kink_roots, PRODUCT_DEGREE, upper_array
 
 __all__ = ["pump", "Pumped", "save_pumped", "load_pumped", "base_table", "pump_model", "FILE_KINDS"]
 
@@ -561,7 +561,7 @@ class Pumped(BRDF):
         albedo is w(mu) / g(mu, mu) (001 eq. 16, 20, 21).  The bound still holds: the base's table,
         and so g >= a(mu), includes the delta, so (integral of f + w) / g <= a(mu) / a(mu) = 1.
         """
-        base = getattr(self.base, "delta_albedo", None)
+        base = self.base.delta_albedo
         if base is None:
             return None
 
@@ -574,7 +574,7 @@ class Pumped(BRDF):
     @property
     def eval_rtol(self) -> float:
         """The base's relative error of eval (a truncated series), unchanged by the division by g."""
-        return getattr(self.base, "eval_rtol", 0.0)
+        return self.base.eval_rtol
 
     def chain(self) -> list["Pumped"]:
         """The pumped levels from the innermost (level 1) to this one."""
@@ -608,7 +608,7 @@ class Pumped(BRDF):
             coef[-1, a:a + n] += lk.margin  # the same upper bound as upper_scalar
             starts = lo[j] + h[j] * np.arange(INDEX_CELLS)
             index[j] = a + np.clip(np.searchsorted(lk.logx, starts, side="right") - 1, 0, n - 1)
-        return (
+        return GChain(
             offsets, np.concatenate([lk.logx for lk in looks]), coef,
             *(np.array([getattr(lk, name) for lk in looks], dtype=float)
               for name in ("v0", "slope0", "margin_lo", "cap")),
@@ -906,34 +906,13 @@ class Pumped(BRDF):
     def sampling_lobe(self, mu: float) -> Lobe:
         return self.base.sampling_lobe(mu)  # f / g has the lobe of f; g only rescales it
 
-    def polar(self):
-        """The 1-D albedo path of a pumped Phong-family lobe or of a pumped GGX, Beckmann (F = 1) or Schlick model
-        (``pumpup.engine.polar``, the frame of N): the base's closed-form-azimuth hint, with the divisor g_1 ... g_k (a
-        function of N.wo for a fixed wi) and its kinks, and the base's Fresnel factor F(Theta_min) (metal's, or the
-        ``fresnel`` wrapper's over GGX, Beckmann or Schlick, ``Polar.fmax``); None for any other base."""
-        import dataclasses
+    def azimuth_hint(self):
+        """The innermost base's hint divided by g_1 ... g_k (mu, N.wo) (001 eq. 16), a function of N.wo for a fixed wi,
+        with g's kinks (:class:`~pumpup.core.hints.DivideByG`); None where the base has no hint."""
+        from ..core.hints import DivideByG
 
-        from ..core.hints import Polar
-
-        from ..engine.polar import takes_n_frame, with_fresnel, with_fresnel_max
-
-        hint = self.chain()[0].base.polar()
-        if (hint is not None and hint.chain is None and hint.factor is None and hint.fmax is None
-                and takes_n_frame(hint)):
-            # GGX, Beckmann (F = 1) and Schlick's model: frame 6 about N, divided by g (``pumpup.engine.polar._integrate_n``);
-            # GGX with a Fresnel factor at mu >= N_FRESNEL_MU_MIN, the nested engine below (``pumpup.engine.polar.one_d_part``)
-            return dataclasses.replace(hint, chain=self._chain_args(), levels=self._polar_levels)
-        if hint is not None and hint.fmax is not None and hint.chain is None:
-            # ... with the fresnel wrapper's F(Theta_min) (``Polar.fmax``): again, where the near-kink of F is far enough
-            # for a chain (g has it too: ``pumpup.engine.polar.CHAIN_F_Y0_MIN``)
-            out = dataclasses.replace(hint, fmax=None, chain=self._chain_args(), levels=self._polar_levels)
-            return with_fresnel_max(out, *hint.fmax)
-        if hint is None or hint.kind != "lobe" or hint.chain is not None:
-            return None
-        out = Polar(n=hint.n, p=hint.p, scale=hint.scale, chain=self._chain_args(), levels=self._polar_levels)
-        # (a base with F(Theta_min), metal's, keeps it: the chain frame multiplies by it, where with_fresnel takes it;
-        # dropping it had given a pumped gold an albedo of 2.4 while it was being built, caught by tests/test_spectral.py)
-        return with_fresnel(out, *hint.fresnel[1:]) if any(hint.fresnel) else out
+        hint = self.chain()[0].base.azimuth_hint()
+        return None if hint is None else hint.times(DivideByG(self._chain_args(), self._polar_levels))
 
     def azimuth_range(self):
         return self.base.azimuth_range()  # g depends on N.wi and N.wo only

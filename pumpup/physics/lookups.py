@@ -10,6 +10,7 @@ found from the bits of m (:func:`g_product`, :func:`scale_bound`).  The pumped B
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numpy as np
 from numba import njit, types
@@ -238,3 +239,13 @@ def scale_bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, mar
         t = (m - prow[s, 6]) * prow[s, 7]
         return ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
     return upper_scalar(m, logx, coef, v0, slope0, margin_lo, margin, cap)
+
+
+#: a pumped chain's look-ups, as the compiled kernels read them (:meth:`pumpup.operators.pumping.Pumped._chain_args`):
+#: every level's upper bound (:func:`g_levels`' arguments) and the product table of all levels (:func:`g_product`'s,
+#: with the N.wo above which it applies, ``product_mlo``; inf when there is none)
+GChain = namedtuple("GChain", [
+    "offsets", "logx", "coef", "v0", "slope0", "margin_lo", "cap", "controlled", "increasing", "mu0", "index", "index_lo",
+    "index_h_inv", "product_mlo", "product_cbase", "product_cstart", "product_lo", "product_rows",
+])
+

@@ -588,11 +588,12 @@ class _FresnelWeighted(BRDF):
     def sampling_lobe(self, mu):
         return self.lobe_brdf.sampling_lobe(mu)
 
-    def polar(self):
-        """The pumped lobe's 1-D hint with F(Theta_min) (pumpup.engine.polar.with_fresnel), or None."""
-        from ..engine.polar import with_fresnel
+    def azimuth_hint(self):
+        """The pumped lobe's hint times F(max(N.wi, N.wo)) (000 eq. 28), or None without one."""
+        from ..core.hints import FresnelAtMax
 
-        return with_fresnel(self.lobe_brdf.polar(), self.eta, self.k)
+        hint = self.lobe_brdf.azimuth_hint()
+        return None if hint is None else hint.times(FresnelAtMax(self.eta, self.k))
 
 
 class SpectralPumpedLobe(Spectral):

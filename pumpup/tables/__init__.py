@@ -487,9 +487,9 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
     (default :data:`THREADS`; every k-th mu to thread k: grazing values, the dear ones, are spread over all)."""
     val = np.empty_like(mu)
     err = np.empty_like(mu)
-    from ..engine import polar as _polar
+    from ..engine.routes import one_d_everywhere
 
-    if _polar.takes_1d_path(brdf):
+    if one_d_everywhere(brdf, mu):
         # its values cost microseconds: one call for them all (chunks of 32 cost Phong n = 20's 257-point table
         # 1.8 ms against 1.4 ms, issue 14's twenty-third session); the values do not depend on the batch
         chunk = max(chunk, len(mu))

@@ -12,7 +12,7 @@ theta) at rtol 1e-10 on one thread (``pumpup.albedo`` on the 257 values, and ``p
 with ``threads=1``), the integrand evaluations per value of mu, the path the engine takes (1-D:
 the closed-form azimuth of ``pumpup.engine.polar``; nst: the nested quadrature of ``pumpup.engine.nested``;
 2-D: the cubature), and for the 1-D and nested families the previous engine (the 2-D cubature,
-``pumpup.engine.polar.two_d_only()``, which switches off both) measured in the same run, with
+``using(engine="2d")``, which switches off both) measured in the same run, with
 the ratio; then scipy ``dblquad`` at mu = 0.5 and epsrel 1e-10 per value (stopped after 60 s), and
 the sweep cell (257 mu + mean albedo + maximum constant) and the three tables of a 3-level g2
 pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs after a warm-up.
@@ -65,6 +65,7 @@ import numpy as np
 from scipy.integrate import dblquad
 
 import pumpup
+from pumpup.engine.routes import one_d_everywhere, route_names, using
 
 
 def dblquad_albedo(f, mu, epsrel):
@@ -125,6 +126,7 @@ def evaluations(f, mu, rtol, phi=0.0):
     accumulation step (once per sign of beta)."""
     from pumpup.engine import nested as _nested
     from pumpup.engine import polar as _polar
+    from pumpup.engine import chain_frame as _chain_frame
     from pumpup.engine import slope as _slope
 
     A = pumpup.albedo_module
@@ -145,7 +147,7 @@ def evaluations(f, mu, rtol, phi=0.0):
     _nested.integrate = counting_nested
     try:
         for _, term in f.albedo_terms():
-            if _slope.takes_slope_path(term, mu):
+            if set(route_names(term, mu).ravel()) == {"slope"}:
                 count[0] += int(_slope.slope_albedo(term, mu, np.full(mu.shape, phi), rtol, 1e-14, 20000)[3].sum())
                 continue
             fast = _polar.albedo_1d(term, mu, rtol, 1e-14, 20000) if phi == 0.0 else None
@@ -165,11 +167,11 @@ def path_of(f):
     from pumpup.engine import nested as _nested
     from pumpup.engine import slope as _slope
 
-    if all(_slope.takes_slope_path(t, np.array([0.5])) for _, t in f.albedo_terms()):
+    if all(route_names(t, [0.5])[0, 0] == "slope" for _, t in f.albedo_terms()):
         return "slp"
-    if all(t.polar() is not None for _, t in f.albedo_terms()):
+    if all(one_d_everywhere(t, np.array([0.5, 1e-3])) for _, t in f.albedo_terms()):
         return "1-D"
-    if all(t.polar() is not None or t.lobe_axis(np.array([0.5, 1e-3]), np.zeros(2)) is not None for _, t in f.albedo_terms()):
+    if all(t.azimuth_hint() is not None or t.lobe_axis(np.array([0.5, 1e-3]), np.zeros(2)) is not None for _, t in f.albedo_terms()):
         return "axs"
     A = pumpup.albedo_module
     ok = all(_nested.supports(g) for _, t in f.albedo_terms() for _, g in A._groups(t, np.array([0.5, 1e-3])))
@@ -205,6 +207,7 @@ PHONG_FAMILY = [{"type": "phong", "n": 20}, {"type": "stretched_phong", "n": 20}
 
 def families(rtol=1e-10, specs=None, dblquad=True):
     from pumpup.engine import polar as _polar
+    from pumpup.engine import chain_frame as _chain_frame
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     print(f"257-point tables at rtol {rtol:g}, one thread (ms); evaluations per mu; previous = the 2-D engine "
@@ -221,7 +224,7 @@ def families(rtol=1e-10, specs=None, dblquad=True):
         _, t_tab = _best(lambda: pumpup.tabulate(f, mu=mu, rtol=rtol, threads=1, progress=False), repeat)
         ev = evaluations(f, mu, rtol)
         if path != "2-D":
-            with _polar.two_d_only():
+            with using(engine="2d"):
                 pumpup.albedo(f, [0.5, 1e-3])
                 _, t_old = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), 1)
                 ev_old = evaluations(f, mu, rtol)
@@ -238,10 +241,11 @@ def families(rtol=1e-10, specs=None, dblquad=True):
 
 def against_nested(specs, label, rtol=1e-10, repeat=3):
     """Models on the 1-D path against the nested engine they had before (the 1-D path switched off alone,
-    ``_polar.without_1d``; ``two_d_only`` would switch off the nested engine too), same run, same rtol: a
+    ``using(engine="nested")``; ``engine="2d"`` would switch off the nested engine too), same run, same rtol: a
     257-point table (mu uniform in theta) and a sweep cell (257 mu of ``default_mu`` + mean albedo + maximum
     constant), one thread, best of ``repeat``."""
     from pumpup.engine import polar as _polar
+    from pumpup.engine import chain_frame as _chain_frame
     from pumpup.sweeps import default_mu
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
@@ -257,7 +261,7 @@ def against_nested(specs, label, rtol=1e-10, repeat=3):
     for spec in specs:
         out = []
         for one_d in (True, False):
-            with contextlib.nullcontext() if one_d else _polar.without_1d():
+            with contextlib.nullcontext() if one_d else using(engine="nested"):
                 f = pumpup.load(spec)
                 pumpup.albedo(f, [0.5, 1e-3], rtol=rtol)
                 _, t_table = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), repeat if one_d else 1)
@@ -270,9 +274,10 @@ def against_nested(specs, label, rtol=1e-10, repeat=3):
 
 def _against_second_path(specs, title, first, second, width, rtol, repeat, lobe=lambda spec, f: f):
     """A 257-point table (mu uniform in theta) at ``rtol`` by the 1-D path as it is (``first``), by its second path
-    (``_polar.without_n_frame``: frame 4 or frame 5, ``second``) and by the nested engine, one thread, best of ``repeat``
+    (``using(without={"normal", "lobe_normal"})``: frame 4 or frame 5, ``second``) and by the nested engine, one thread, best of ``repeat``
     (nested: 1), with the evaluations per mu of the first (of ``lobe(spec, f)``, the term that takes it)."""
     from pumpup.engine import polar as _polar
+    from pumpup.engine import chain_frame as _chain_frame
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     print(f"{title}, one thread, ms; 257 mu at rtol {rtol:g}")
@@ -280,7 +285,7 @@ def _against_second_path(specs, title, first, second, width, rtol, repeat, lobe=
     for spec in specs:
         f = pumpup.load(spec)
         times = []
-        for ctx, rep in ((contextlib.nullcontext(), repeat), (_polar.without_n_frame(), repeat), (_polar.without_1d(), 1)):
+        for ctx, rep in ((contextlib.nullcontext(), repeat), (using(without={"normal", "lobe_normal"}), repeat), (using(engine="nested"), 1)):
             with ctx:
                 pumpup.albedo(f, [0.5, 1e-3], rtol=rtol)
                 times.append(_best(lambda: pumpup.albedo(f, mu, rtol=rtol), rep)[1])
@@ -301,7 +306,7 @@ def n_frame(rtol=1e-10, repeat=3):
 
 
 def n_frame_fresnel(rtol=1e-10, repeat=3):
-    """GGX with a Fresnel factor about N (frame 6 with the ring's product rule, pumpup.engine.polar._ggx_ring_f; issue 14's
+    """GGX with a Fresnel factor about N (frame 6 with the ring's product rule, pumpup.engine.normal_frame._ggx_ring_f; issue 14's
     thirteenth session; frame 4 below mu = N_FRESNEL_MU_MIN) against frame 4, the rule on h's arc they took before, and the
     nested engine (:func:`_against_second_path`)."""
     specs = [{"type": "ggx", "alpha": 0.3, "eta": 0.2, "k": 3.0}, {"type": "ggx", "alpha": 0.02, "ior": 1.5},
@@ -348,7 +353,7 @@ def half_and_closed(rtol=1e-10, repeat=3):
 
 def on_the_arc(rtol=1e-10, repeat=3):
     """The models issue 14's seventh session put on the 1-D path: the half vector's azimuth by a rule on its arc
-    (pumpup.engine.polar._k_numeric: GGX and Beckmann with Smith G, with and without a Fresnel factor; Cook-Torrance and
+    (pumpup.engine.half_arc._k_numeric: GGX and Beckmann with Smith G, with and without a Fresnel factor; Cook-Torrance and
     Torrance-Sparrow with one; Schlick, 000 eq. 36) and Torrance-Sparrow D3 in closed form under the GGX weight,
     against the nested engine they had before (:func:`against_nested`)."""
     against_nested([{"type": "ggx", "alpha": 0.1}, {"type": "ggx", "alpha": 0.5, "shadowing": "correlated"},
@@ -362,7 +367,7 @@ def on_the_arc(rtol=1e-10, repeat=3):
 
 def lobe_fresnel(rtol=1e-10, repeat=3):
     """The models issue 14's eighth session put on the 1-D path: the lobe frame with 000 eq. 28's F(Theta_min) by a rule
-    on the arc where N.V >= N.L (pumpup.engine.polar._k_lobe_fresnel: metal, plastic with an index, the fresnel wrapper of a
+    on the arc where N.V >= N.L (pumpup.engine.lobe_fresnel._k_lobe_fresnel: metal, plastic with an index, the fresnel wrapper of a
     Phong-family lobe) and the pumped lobe's frame of N with it (a pumped metal, the fresnel wrapper of a pumped lobe),
     against the nested engine they had before (:func:`against_nested`)."""
     against_nested([{"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, {"type": "metal", "n": 1, "eta": 1.5},
@@ -402,7 +407,7 @@ def fresnel_max(rtol=1e-10, repeat=3):
 
 def pumped_fresnel(rtol=1e-10, repeat=3):
     """Pumped GGX with a Fresnel factor F(wi.h): frame 6 divided by g at mu >= N_FRESNEL_MU_MIN since issue 14's
-    twenty-second session, the nested engine below (``_polar.one_d_part``), against the nested engine at every mu as before
+    twenty-second session, the nested engine below (``pumpup.engine.routes``), against the nested engine at every mu as before
     (:func:`against_nested`)."""
     against_nested([{"type": "pumped", "base": {"type": "ggx", "alpha": 0.1, "eta": 0.2, "k": 3.0}, "g": "g2"},
                     {"type": "pumped", "base": {"type": "ggx", "alpha": 0.3, "ior": 1.5}, "g": "g1", "levels": 2},
@@ -537,6 +542,7 @@ def breaks(rtol=1e-10, repeat=7):
 
 def cells():
     from pumpup.engine import polar as _polar
+    from pumpup.engine import chain_frame as _chain_frame
     from pumpup.tables import reuse as _reuse
     from pumpup.operators.pumping import _TABLES
     from pumpup.sweeps import default_mu
@@ -566,7 +572,7 @@ def cells():
         recall = _reuse.recall
         _reuse.recall = lambda brdf: None  # the previous engine: no reuse of the table either
         try:
-            with _polar.two_d_only():
+            with using(engine="2d"):
                 old = cell(spec)
         finally:
             _reuse.recall = recall
@@ -574,7 +580,7 @@ def cells():
               f"previous engine {old * 1e3:.1f} ms, ratio {old / new:.1f}", flush=True)
     pumped(21)  # the first build in the process loads the compiled kernels
     new = min(pumped(20) for _ in range(2))
-    with _polar.two_d_only():
+    with using(engine="2d"):
         old = pumped(20)
     print(f"3-level g2 pumped Phong n = 20, its three tables (tabulate's threads): {new * 1e3:.0f} ms, "
           f"previous engine {old * 1e3:.0f} ms, ratio {old / new:.2f}")
@@ -646,9 +652,10 @@ def eval_overhead(n=1_000_000, repeat=15):
 
 def slope(rtol=1e-10, repeat=3):
     """Anisotropic Ward in slope space (pumpup.engine.slope, issue 14's fourteenth session) against the nested engine it took
-    before (``_polar.without_1d`` switches both off), same run: a 257-point table (mu uniform in theta) at phi = 0 and at
+    before (``using(engine="nested")`` leaves both out), same run: a 257-point table (mu uniform in theta) at phi = 0 and at
     phi = 0.7, one thread, best of ``repeat`` (nested: 1), with the slope path's evaluations per mu."""
     from pumpup.engine import polar as _polar
+    from pumpup.engine import chain_frame as _chain_frame
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     specs = [{"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, {"type": "ward_aniso", "ax": 0.05, "ay": 0.5},
@@ -662,7 +669,7 @@ def slope(rtol=1e-10, repeat=3):
             pumpup.albedo(f, [0.5, 1e-3], phi=phi, rtol=rtol)
             _, t1 = _best(lambda: pumpup.albedo(f, mu, phi=phi, rtol=rtol), repeat)
             ev1 = evaluations(f, mu, rtol, phi)
-            with _polar.without_1d():
+            with using(engine="nested"):
                 pumpup.albedo(f, [0.5, 1e-3], phi=phi, rtol=rtol)
                 _, t2 = _best(lambda: pumpup.albedo(f, mu, phi=phi, rtol=rtol), 1)
                 ev2 = evaluations(f, mu, rtol, phi)
@@ -672,11 +679,12 @@ def slope(rtol=1e-10, repeat=3):
 
 def lobe_f_gauss(rtol=1e-10, repeat=3):
     """Frame 5's lobes with F(Theta_min) and n < LOBE_N_MIN (metal, plastic, the fresnel wrapper) with the arcs by
-    Gauss-Legendre pieces and their a-priori bound (``pumpup.engine.polar._lobe_f_gauss``; issue 14's sixteenth session)
-    against the adaptive 7/15 rule they had before (``_polar.without_lobe_f_gauss``), same run: a 257-point table (mu
+    Gauss-Legendre pieces and their a-priori bound (``pumpup.engine.lobe_fresnel._lobe_f_gauss``; issue 14's sixteenth session)
+    against the adaptive 7/15 rule they had before (``using(lobe_fresnel_gauss=False)``), same run: a 257-point table (mu
     uniform in theta) at ``rtol`` and a sweep cell (257 mu + mean albedo + maximum constant), one thread, best of
     ``repeat`` each, alternating."""
     from pumpup.engine import polar as _polar
+    from pumpup.engine import chain_frame as _chain_frame
     from pumpup.sweeps import default_mu
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
@@ -693,7 +701,7 @@ def lobe_f_gauss(rtol=1e-10, repeat=3):
              {"type": "metal", "n": 0, "eta": 0.999, "k": 0.001}, {"type": "plastic", "n": 3, "eta": 1.5, "ad": 0.3},
              {"type": "fresnel", "base": {"type": "phong", "n": 1}, "eta": 1.1, "k": 30.0},
              {"type": "fresnel", "base": {"type": "retro", "n": 4}, "eta": 0.2, "k": 3.0}]
-    print(f"frame 5, n < {_polar.LOBE_N_MIN:g}: Gauss-Legendre pieces against the adaptive 7/15 rule, one thread, ms (best of "
+    print(f"frame 5, n < {_chain_frame.LOBE_N_MIN:g}: Gauss-Legendre pieces against the adaptive 7/15 rule, one thread, ms (best of "
           f"{repeat}); table: 257 mu at rtol {rtol:g}; cell: sweep cell")
     print(f"{'model':62s} {'table':>7s} {'before':>7s} {'ratio':>6s} {'cell':>7s} {'before':>7s} {'ratio':>6s}")
     for spec in specs:
@@ -701,7 +709,7 @@ def lobe_f_gauss(rtol=1e-10, repeat=3):
         best = {True: [np.inf, np.inf], False: [np.inf, np.inf]}
         for _ in range(repeat):
             for gauss in (True, False):
-                with contextlib.nullcontext() if gauss else _polar.without_lobe_f_gauss():
+                with contextlib.nullcontext() if gauss else using(lobe_fresnel_gauss=False):
                     pumpup.albedo(f, [0.5, 1e-3], rtol=rtol)
                     _, t_table = _best(lambda: pumpup.albedo(f, mu, rtol=rtol), 1)
                     _, t_cell = _best(lambda: cell(spec), 1)

@@ -24,7 +24,7 @@ The references (all computed without pumpup):
 
 Engines are a small registry, :data:`ENGINES`: name -> (context manager, applies(brdf)).  The
 "1-D" engine is the closed-form-azimuth path of ``pumpup.engine.polar`` (it applies to the models with
-a Polar hint), "2-D" the adaptive cubature of ``pumpup.albedo`` (``_polar.two_d_only``); a new
+a Polar hint), "2-D" the adaptive cubature of ``pumpup.albedo`` (``using(engine="2d")``); a new
 engine (the nested 1-D x 1-D engine of issue 14 item 2) is one more entry.  Estimates
 (:data:`ESTIMATES`): "raw" is |K - G| everywhere (the engines before issue 14), "quadpack"
 QUADPACK's calibration everywhere, "min" the smaller of the two, "default" what the engines use
@@ -55,6 +55,7 @@ import time
 import warnings
 
 import numpy as np
+from pumpup.engine.routes import using
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data"
@@ -67,19 +68,16 @@ MP_MU = [1.0, 0.9, math.sqrt(3) / 2, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-
 
 
 def _has_polar(f) -> bool:
-    return all(t.polar() is not None for _, t in f.albedo_terms())
+    return all(t.azimuth_hint() is not None for _, t in f.albedo_terms())
 
 
 def _two_d():
-    from pumpup.engine import polar as _polar
 
-    return _polar.two_d_only()
+    return using(engine="2d")
 
 
 def _without_1d():
-    from pumpup.engine import polar as _polar
-
-    return _polar.without_1d()
+    return using(engine="nested")
 
 
 def _nested_applies(f) -> bool:

@@ -3,9 +3,9 @@
 For the models whose albedo the 1-D path integrates about N for the half vector (pumpup.engine.polar,
 Polar kind "half": the Blinn family, Ward, modified Ward, Cook-Torrance and Torrance-Sparrow D1, D3, D4 with
 F = 1 in closed form; the Smith microfacet models GGX and Beckmann, the V-cavity models with a Fresnel factor and
-Schlick's model by a rule on h's arc, pumpup.engine.polar._k_numeric), at 60 mu uniform in theta plus 1e-3, 1e-5 and 1e-8, and rtol 1e-6, 1e-8, 1e-10, 1e-12, the
+Schlick's model by a rule on h's arc, pumpup.engine.half_arc._k_numeric), at 60 mu uniform in theta plus 1e-3, 1e-5 and 1e-8, and rtol 1e-6, 1e-8, 1e-10, 1e-12, the
 ratio of the true error to the estimate, the truth being the nested engine at rtol 1e-13 (the engine
-these models had before, reached with the 1-D path switched off, pumpup.engine.polar.without_1d), its own
+these models had before, reached with the 1-D path switched off, using(engine="nested")), its own
 error counted in the 1-D path's favour: max(|a - ref| - ref_err, 0) / estimate.  A ratio above 1 is a
 dishonest estimate.  Prints the worst ratio per family and rtol, and the evaluations per mu.
 
@@ -19,6 +19,7 @@ import numpy as np
 
 import pumpup
 from pumpup.engine import polar as _polar
+from pumpup.engine.routes import using
 
 FAMILIES = {
     "blinn": [{"type": "blinn", "n": n} for n in (0, 0.5, 1, 3, 16, 100, 1000, 1e5)],
@@ -67,7 +68,7 @@ def main():
         evals = []
         for spec in specs:
             f = pumpup.load(spec)
-            with _polar.without_1d(), warnings.catch_warnings():
+            with using(engine="nested"), warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 ref, ref_err = pumpup.albedo(f, mu, rtol=1e-13, return_error=True)
             for r in RTOLS:

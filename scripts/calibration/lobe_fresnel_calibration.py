@@ -7,7 +7,7 @@ k in {0, 0.001, 0.002, 0.01, 0.3, 3, 30} (the near-kinks, Im sqrt(1 - (eta + i k
 engine, and with a pumped lobe those below 1e-2), five lobes (stretched Phong n = 0, 7.5, 500 and Phong n = 20, 1 under the fresnel wrapper) and, with
 ``--pumped``, a g1-pumped metal n = 20 per index; at 60 mu uniform in theta plus 1e-3, 1e-5, 1e-8 and rtol 1e-6,
 1e-8, 1e-10, 1e-12: the ratio of the true error to the estimate, the truth being the nested engine at rtol 1e-13
-(pumpup.engine.polar.without_1d), its own error counted in the 1-D path's favour: max(|a - ref| - ref_err, 0) / estimate.
+(using(engine="nested")), its own error counted in the 1-D path's favour: max(|a - ref| - ref_err, 0) / estimate.
 A ratio above 1 is a dishonest estimate.  Prints one row per index and lobe (worst ratio@mu/evaluations per mu for
 each rtol) and the worst overall.
 
@@ -23,6 +23,9 @@ import numpy as np
 
 import pumpup
 from pumpup.engine import polar as _polar
+from pumpup.engine import lobe_fresnel as _lobe_fresnel
+from pumpup.physics import fresnel as _fresnel_mod
+from pumpup.engine.routes import one_d_everywhere, using
 
 ETAS = (0.05, 0.3, 0.6, 0.9, 0.999, 1.001, 1.1, 1.5, 3.0, 20.0)
 KS = (0.0, 0.001, 0.002, 0.01, 0.3, 3.0, 30.0)
@@ -34,9 +37,9 @@ RTOLS = (1e-6, 1e-8, 1e-10, 1e-12)
 
 def worst_per_rtol(f, mu, rtols, atol=1e-14):
     """For each rtol, (the worst (|a - ref| - ref_err) / estimate of the 1-D path over ``mu``, the mu where it lies, the
-    mean evaluations per mu), against the nested engine at rtol 1e-13 (``_polar.without_1d``), its own error counted in
+    mean evaluations per mu), against the nested engine at rtol 1e-13 (``using(engine="nested")``), its own error counted in
     the path's favour (negative where the difference is within it).  Also for scripts/studies/breaks_scan.py."""
-    with _polar.without_1d(), warnings.catch_warnings():
+    with using(engine="nested"), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ref, ref_err = pumpup.albedo(f, mu, rtol=1e-13, return_error=True)
     out = []
@@ -55,16 +58,16 @@ def main():
     worst = 0.0
     for eta in ETAS:
         for k in KS:
-            if not _polar.lobe_fresnel_ok(eta, k):
+            if not _lobe_fresnel.lobe_fresnel_ok(eta, k):
                 continue
-            x0, y0 = _polar.fresnel_branch(eta, k)
+            x0, y0 = _fresnel_mod.fresnel_branch(eta, k)
             if pumped:
                 models = [("pumped metal n 20", pumpup.pump({"type": "metal", "n": 20, "eta": eta, "k": k}))]
             else:
                 models = [(f"{b['type'][:9]} n {b['n']:g}", pumpup.load({"type": "fresnel", "base": b, "eta": eta, "k": k}))
                           for b in LOBES]
             for name, f in models:
-                if not _polar.takes_1d_path(f):
+                if not one_d_everywhere(f, mu):
                     print(f"eta {eta:6g} k {k:6g} (x0 {x0:7.3g} y0 {y0:7.3g}) {name:20s} the nested engine's (a near-kink)")
                     continue
                 cells = []

@@ -1,4 +1,4 @@
-"""Calibration of frame 6 with a Fresnel factor (pumpup.engine.polar._ggx_ring_f; issue 14, thirteenth session).
+"""Calibration of frame 6 with a Fresnel factor (pumpup.engine.normal_frame._ggx_ring_f; issue 14, thirteenth session).
 
 1. The ring: GGX's D times F(wi.h) over the azimuth of wo, for 7 indices (a dielectric near 1 and at 1.5 and 3; a metal, a
    strong absorber whose pole lies near c = 0, a weak absorber, a conductor with eta < 1), 6 alpha from 1e-4 to 1, 9 mu from
@@ -19,31 +19,32 @@ import warnings
 import numpy as np
 
 import pumpup
-from pumpup.engine import polar as P
+from pumpup.engine import half_arc as _half_arc, normal_frame as _normal_frame
+from pumpup.engine.routes import hint_routes, using
 
 MATERIALS = [(1.0001, 0.0, 0.0), (1.5, 0.0, 0.0), (3.0, 0.0, 0.0), (0.0, 0.2, 3.0), (0.0, 1.1, 30.0), (0.0, 1.0, 0.1),
              (0.0, 0.6, 1.5)]
 
 
 def rings():
-    fv = np.empty(P.RING_F_NMAX + 1)
+    fv = np.empty(_normal_frame.RING_F_NMAX + 1)
     worst, worst_at, against_quad, n = 0.0, None, 0.0, 0
     for fr in MATERIALS:
-        mp = np.zeros(P.MP_SIZE)
+        mp = np.zeros(_half_arc.MP_SIZE)
         mp[5:8] = fr
         for alpha in (1e-4, 0.01, 0.1, 0.3, 0.6, 1.0):
             a2 = alpha * alpha
-            for mu in np.linspace(P.N_FRESNEL_MU_MIN, 1.0, 9):
+            for mu in np.linspace(_normal_frame.N_FRESNEL_MU_MIN, 1.0, 9):
                 s = math.sqrt((1.0 - mu) * (1.0 + mu))
                 xmu, xs = math.atan2(mu, s), math.atan2(s, mu)
                 for x in np.linspace(0.0, 0.5 * math.pi, 31):
-                    ref = P._ggx_ring_f(mp, a2, xmu, xs, x - xmu, 0.0, 0.0, fv)[0]
+                    ref = _normal_frame._ggx_ring_f(mp, a2, xmu, xs, x - xmu, 0.0, 0.0, fv)[0]
                     n += 1
                     if n % 10 == 0:
-                        q = P.ring_reference(1, a2, mu, x, fr)
+                        q = _normal_frame.ring_reference(1, a2, mu, x, fr)
                         against_quad = max(against_quad, abs(q - ref) / ref if ref > 0 else 0.0)
                     for itol in (1e-6, 1e-8, 1e-10, 1e-12, 1e-13):
-                        w, e, _ = P._ggx_ring_f(mp, a2, xmu, xs, x - xmu, itol, 0.0, fv)
+                        w, e, _ = _normal_frame._ggx_ring_f(mp, a2, xmu, xs, x - xmu, itol, 0.0, fv)
                         r = abs(w - ref) / e if e > 0 else (0.0 if w == ref else math.inf)
                         if r > worst:
                             worst, worst_at = r, (fr, alpha, round(float(mu), 4), round(float(x), 4), itol)
@@ -56,12 +57,12 @@ def albedos():
              {"type": "ggx", "alpha": 1e-3, "eta": 1.1, "k": 30.0}, {"type": "ggx", "alpha": 1.0, "ior": 1.0001},
              {"type": "ggx", "alpha": 0.1, "eta": 1.0, "k": 0.1}, {"type": "ggx", "alpha": 0.05, "ior": 3.0},
              {"type": "ggx", "alpha": 0.7, "eta": 0.6, "k": 1.5, "shadowing": "correlated"}]
-    mu = np.linspace(P.N_FRESNEL_MU_MIN, 1.0, 24)
+    mu = np.linspace(_normal_frame.N_FRESNEL_MU_MIN, 1.0, 24)
     rows = []
     for spec in specs:
         f = pumpup.load(spec)
-        assert P.takes_n_frame(f.polar()), spec
-        with P.without_n_frame(), warnings.catch_warnings():
+        assert any(r == "normal" for r, _ in hint_routes(f.azimuth_hint(), mu)), spec
+        with using(without={"normal", "lobe_normal"}), warnings.catch_warnings():
             warnings.simplefilter("ignore")
             b, eb = pumpup.albedo(f, mu, return_error=True, rtol=1e-13, atol=0.0)
         worst = 0.0

@@ -2,7 +2,7 @@
 
 For 9 pairs of slopes (anisotropy 1 ... 1000, widths 1e-3 ... 3, both orders), 14 mu (MU_MIN, 1e-8, 1e-4, 0.003 and 10
 uniform in theta) and 4 azimuths of wi (0, 0.4, pi / 4 + 0.1, pi / 2), at rtol 1e-6, 1e-8, 1e-10 and 1e-12: the true error
-/ the estimate, max(|a - ref| - ref_err, 0) / err, against the nested engine at rtol 1e-13 (``pumpup.engine.polar.without_1d``:
+/ the estimate, max(|a - ref| - ref_err, 0) / err, against the nested engine at rtol 1e-13 (``using(engine="nested")``:
 the half vector's polar angle and azimuth, another parametrisation), its own error counted in the slope path's favour.
 Where that ratio exceeds 1/2, the third method decides: the two nested-quad methods of
 ``tests/reference/independent_ward_aniso.py`` (written without pumpup), their difference and estimates counted in the slope
@@ -26,11 +26,11 @@ import warnings
 import numpy as np
 
 import pumpup
-from pumpup.engine import polar as _polar
 from pumpup.engine import slope as _slope
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "tests"))  # tests/reference: the independent references
 from reference.independent_ward_aniso import albedo_A, albedo_B  # noqa: E402
+from pumpup.engine.routes import using
 
 PAIRS = [(0.1, 0.3), (0.3, 0.1), (0.05, 0.5), (0.4, 0.02), (1e-3, 1.0), (1.0, 1e-3), (0.01, 0.01), (3.0, 0.5),
          (0.002, 0.006)]
@@ -56,7 +56,7 @@ def main():
     for ax, ay in PAIRS:
         f = pumpup.load({"type": "ward_aniso", "ax": ax, "ay": ay})
         for phi in PHIS:
-            with _polar.without_1d(), warnings.catch_warnings():
+            with using(engine="nested"), warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 ref, ref_err = pumpup.albedo(f, mu, phi=phi, rtol=1e-13, return_error=True)
             for rtol in RTOLS:

@@ -5,7 +5,7 @@ frame the level (u = mu) meets the split of tail and peak at mu = 1/2 and the ho
 models of frames 0-5 (Phong family with p in {0.5, 1}, Blinn family, Cook-Torrance, Torrance-Sparrow, Ward, modified
 Ward, metal n < 8, GGX and Cook-Torrance with a Fresnel factor), at 180 mu (150 random in theta, 15 on each side of
 sqrt(3)/2 and of 1/2 at relative distances 1e-14 ... 1e-3) and rtol 1e-10 and 1e-12, prints the worst ratio
-max(|a - ref| - ref_err, 0) / estimate against the nested engine at rtol 1e-13 (``pumpup.engine.polar.without_1d``), where
+max(|a - ref| - ref_err, 0) / estimate against the nested engine at rtol 1e-13 (``using(engine="nested")``), where
 it lies, and the evaluations per mu.  A ratio above 1 is a dishonest estimate (the previous session's code: 4.69 for
 stretched Phong and retro n = 10 at mu = sqrt(3)/2 (1 - 1e-6)).
 

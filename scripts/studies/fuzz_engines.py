@@ -3,10 +3,10 @@
 Draws built-in models with extreme parameters (lobe exponents 0.1-1e4, roughness 1e-4-1, Fresnel factors with eta
 0.1-3 and k 0.01-16, Schlick r down to 1e-6, p-models), three incidences (mu log-uniform down to 1e-6, uniform, 1) and
 an rtol (1e-6, 1e-8, 1e-10); computes the albedo on its default path and again with the 1-D path off
-(``pumpup.engine.polar.without_1d``: the nested engine) at rtol 1e-12, and prints every case where the two differ by more
+(``using(engine="nested")``: the nested engine) at rtol 1e-12, and prints every case where the two differ by more
 than the default path's estimate plus the reference's, with the ratio.  A case printed is a disagreement, not yet a
 culprit: decide it with a third method (``tests/reference/independent_microfacet.py`` for GGX and Beckmann, the 2-D engine,
-``pumpup.engine.polar.two_d_only``).
+``using(engine="2d")``).
 
 Found this way: GGX alpha 1.3e-4 at mu = 6.05e-5.  The 1-D path (0.8967913960373392, estimate 2.3e-14) agrees with
 the independent script (0.8967913960367667 +- 1.9e-8); the nested engine was 9e-9 off with estimates of 2e-10 to 3e-9
@@ -61,7 +61,7 @@ import warnings
 import numpy as np
 
 import pumpup
-from pumpup.engine import polar as _polar
+from pumpup.engine.routes import using
 
 
 def rand_spec(rng):
@@ -156,7 +156,7 @@ def _draws(rng, budget, draw):
 
 
 def main_2d(rng, budget):
-    """The default path against the 2-D engine (``pumpup.engine.polar.two_d_only``) at rtol 1e-12, with wi turned out of the
+    """The default path against the 2-D engine (``using(engine="2d")``) at rtol 1e-12, with wi turned out of the
     xz-plane (phi) for the anisotropic models."""
     bad = n = 0
     for spec, f in _draws(rng, budget, rand_spec_2d):
@@ -164,7 +164,7 @@ def main_2d(rng, budget):
         phi = float(rng.uniform(0, 2 * np.pi)) if spec["type"] == "ward_aniso" else 0.0
         rtol = float(rng.choice([1e-6, 1e-8, 1e-10]))
         a, e = pumpup.albedo(f, mu, rtol=rtol, return_error=True, phi=phi)
-        with _polar.two_d_only():
+        with using(engine="2d"):
             b, eb = pumpup.albedo(f, mu, rtol=1e-12, return_error=True, max_regions=200000, phi=phi)
         n += 1
         r = (np.abs(a - b) - eb) / np.maximum(e, 1e-300)
@@ -173,7 +173,7 @@ def main_2d(rng, budget):
             bad += 1
             # a third opinion, the nested engine at rtol 1e-12 (the default path's own engine for most of these, but
             # its 1-D path for a mix's GGX): which of the two is the odd one
-            with _polar.without_1d():
+            with using(engine="nested"):
                 c, ec = pumpup.albedo(f, mu[r > 1], rtol=1e-12, return_error=True, max_regions=200000, phi=phi)
             odd = np.where(np.abs(b[r > 1] - c) > eb[r > 1] + ec, "2-D", "default")
             print("DISAGREE", spec, "phi", phi, "rtol", rtol, "mu", mu[r > 1], "a", a[r > 1], "2-D", b[r > 1],
@@ -348,14 +348,14 @@ def main_registry(rng, budget):
         signal.alarm(CASE_SECONDS)
         try:
             a, e = pumpup.albedo(f, mu, rtol=rtol, return_error=True, phi=phi)
-            with _polar.two_d_only():
+            with using(engine="2d"):
                 b, eb = pumpup.albedo(f, mu, rtol=1e-12, return_error=True, max_regions=200000, phi=phi)
             n += 1
             r = (np.abs(a - b) - eb) / np.maximum(e, 1e-300)
             r[~np.isfinite(r)] = np.inf
             if np.any(r > 1):
                 bad += 1
-                with _polar.without_1d():
+                with using(engine="nested"):
                     c, ec = pumpup.albedo(f, mu[r > 1], rtol=1e-12, return_error=True, max_regions=200000, phi=phi)
                 print("DISAGREE", spec, "phi", phi, "rtol", rtol, "mu", mu[r > 1], "a", a[r > 1], "2-D", b[r > 1],
                       "est", e[r > 1], "2-D est", eb[r > 1], "ratio", r[r > 1], "nested", c, "+-", ec, flush=True)
@@ -391,7 +391,7 @@ def main():
         mu = np.array([10 ** rng.uniform(-6, 0), rng.uniform(0, 1), 1.0])
         rtol = float(rng.choice([1e-6, 1e-8, 1e-10]))
         a, e = pumpup.albedo(f, mu, rtol=rtol, return_error=True)
-        with _polar.without_1d():
+        with using(engine="nested"):
             b, eb = pumpup.albedo(f, mu, rtol=1e-12, return_error=True, max_regions=200000)
         n += 1
         r = (np.abs(a - b) - eb) / np.maximum(e, 1e-300)
