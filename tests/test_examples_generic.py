@@ -26,7 +26,7 @@ def _agree(name, params, mu):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the generic path may stop at its work limit: its error says so
         b, eb = pumpup.albedo(g, mu, return_error=True, rtol=1e-10)
-    if hasattr(f, "delta_albedo"):  # a delta in the mirror direction (he_torrance): eval holds no part of it
+    if f.delta_albedo is not None:  # a delta in the mirror direction (he_torrance): eval holds no part of it
         b = b + np.asarray(f.delta_albedo(np.asarray(mu)), dtype=float)
     assert np.all(np.isfinite(a)) and np.all(np.isfinite(b))
     bad = np.abs(a - b) > e + eb
