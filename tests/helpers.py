@@ -72,7 +72,6 @@ def nested_reference(f, mu, rtol=1e-12):
 
     import pumpup
     from pumpup.engine import nested as _nested
-    from pumpup.engine import normal_frame as _normal_frame
 
     _nested.LAST_EVALS = None
     with without_1d(), warnings.catch_warnings():
@@ -88,7 +87,6 @@ def one_d_against_the_other_engines(f, mu, rtols=(1e-6, 1e-10), two_d_at=(0, 5, 
     the tolerance.  Returns (value, error) at the last rtol.  ``whole``: f is a sum whose terms take the path (not
     asked)."""
     import pumpup
-    from pumpup.engine import normal_frame as _normal_frame
 
     assert whole or takes_1d(f)
     mu = np.asarray(mu, dtype=float)

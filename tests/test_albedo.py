@@ -9,6 +9,7 @@ from scipy.special import expn
 import pumpup
 from helpers import phong_albedo_1d
 import helpers
+from pumpup.engine import lobe_geometry
 
 MU = np.array([1.0, 0.999, 0.9, 0.7, 0.5, 0.3, 0.1, 0.03, 1e-2, 1e-3, 1e-5, 1e-8])
 
@@ -168,15 +169,15 @@ def test_compiled_geometry_matches_numpy_reference(spec, rng):
     lobe = f.lobe(0.5)
     levels = mu[:, None].copy() if lobe.levels else np.zeros((n, 0))  # the kink N.wo = mu of max(N.L, N.V)
     tx, tt = rng.uniform(0, 1, n), rng.uniform(0, 1, n)
-    x, xc, _ = A._smooth(tx)
-    ka, kb = A._kink_coefficients(lobe, mu, x, xc) if lobe.kinks else (np.zeros((n, 0)), np.zeros((n, 0)))
+    x, xc, _ = lobe_geometry.smooth(tx)
+    ka, kb = lobe_geometry.kink_coefficients(lobe, mu, x, xc) if lobe.kinks else (np.zeros((n, 0)), np.zeros((n, 0)))
     pieces = 1 + levels.shape[1] + ka.shape[1]
     piece = rng.integers(0, pieces, n)
     wi, wo_ref, w_ref = A._geometry_reference(lobe, mu, levels, ka, kb, piece, tx, tt)
     wi_k = np.empty((n, 3))
     wo = np.empty((n, 3))
     w = np.empty(n)
-    A._geometry_kernel(A._AXIS_CODE[lobe.axis], A._RADIAL_CODE[lobe.radial], float(lobe.sharpness), mu,
+    A._geometry_kernel(lobe_geometry.AXIS_CODE[lobe.axis], lobe_geometry.RADIAL_CODE[lobe.radial], float(lobe.sharpness), mu,
                        np.ascontiguousarray(levels), np.arange(n), ka, kb, piece, tx, tt, wi_k, wo, w)
     np.testing.assert_allclose(wi_k, wi, rtol=1e-15)
     # where a piece has zero width the kernel returns weight 0 (the reference may give 0 * inf)
@@ -194,12 +195,12 @@ def test_radial_maps_are_finite_at_the_ends():
     xc = np.array([1.0, 1.0, 1.0, 1 - 1e-10, 0.5, 1e-10, 0.0])
     for kind, k in [("cosine", 0.0), ("power", 20.0), ("power", 1e4), ("beckmann", 0.1), ("ggx", 1e-3),
                     ("gaussian", 0.5), ("gaussian", 5.0), ("gaussian", 40.0)]:
-        ca, sa, _ = A._radial(kind, k, x, xc)
+        ca, sa, _ = lobe_geometry.radial_map(kind, k, x, xc)
         assert np.all(np.isfinite(ca)) and np.all(np.isfinite(sa)), (kind, k, ca, sa)
         np.testing.assert_allclose(ca * ca + sa * sa, 1.0, atol=1e-15)
-        code = A._RADIAL_CODE[kind]
+        code = lobe_geometry.RADIAL_CODE[kind]
         for xi, xci, c, s in zip(x, xc, ca, sa):
-            cs, ss, _ = A._radial_scalar(code, k, xi, xci)
+            cs, ss, _ = lobe_geometry.radial_map_scalar(code, k, xi, xci)
             assert abs(cs - c) <= 1e-15 and abs(ss - s) <= 1e-15, (kind, k, xi)
     f = pumpup.load({"type": "torrance_sparrow", "d": "D2", "s": 5.0, "ior": 1.5})
     a, err = pumpup.albedo(f, np.array([0.5, 0.1]), return_error=True)

@@ -17,6 +17,7 @@ from scipy.optimize import brentq
 import pumpup
 from pumpup.engine.cubature import AlbedoWarning
 import helpers
+from pumpup.engine import arc_breaks, lobe_geometry
 
 A = sys.modules["pumpup.engine.cubature"]
 GL = np.polynomial.legendre.leggauss(200)
@@ -77,9 +78,9 @@ def test_a_level_near_one_is_found_where_it_touches_the_arc():
     lobe = f.lobe(MU_SCALED)
     (u,) = lobe.levels
     assert 1 - 1e-6 < u < 1
-    breaks = A._kink_breaks(lobe, np.array([MU_SCALED]), np.array([lobe.levels]))[0]
+    breaks = arc_breaks.kink_breaks(lobe, np.array([MU_SCALED]), np.array([lobe.levels]))[0]
     th, w = math.acos(MU_SCALED), math.acos(u)
-    want = [A._smooth_inverse(*A._radial_inverse(lobe.radial, lobe.sharpness, a)) for a in (th + w, th - w)]
+    want = [lobe_geometry.smooth_inverse(*lobe_geometry.radial_map_inverse(lobe.radial, lobe.sharpness, a)) for a in (th + w, th - w)]
     assert len(breaks) == 2
     np.testing.assert_allclose(np.sort(breaks), want, rtol=0, atol=1e-9)
 
@@ -129,11 +130,11 @@ def test_crossing_cuts_are_breaks():
     tau_x near 0.0022; the pieces are the cuts in sorted order, so every piece end has a kink there."""
     f = pumpup.load(CT)
     lobe = f.lobe(MU_CT)
-    breaks = A._kink_breaks(lobe, np.array([MU_CT]), np.zeros((1, 0)))[0]
+    breaks = arc_breaks.kink_breaks(lobe, np.array([MU_CT]), np.zeros((1, 0)))[0]
     near = breaks[(breaks > 0.001953) & (breaks < 0.003094)]  # the rectangle that was 1.3e-11 off
     assert len(near) >= 1
-    x, xc, _ = A._smooth(near[:1])
-    ca, sa, _ = A._radial(lobe.radial, lobe.sharpness, x, xc)
+    x, xc, _ = lobe_geometry.smooth(near[:1])
+    ca, sa, _ = lobe_geometry.radial_map(lobe.radial, lobe.sharpness, x, xc)
     s = math.sqrt(1 - MU_CT**2)
     cut = [float(np.arccos(np.clip(-a / b, -1, 1))[0]) for a, b in lobe.kinks(np.array([MU_CT]), np.array([s]), ca, sa)]
     assert max(cut) - min(cut) < 1e-7, cut
@@ -160,9 +161,9 @@ def test_smooth_inverse_to_full_precision_near_both_ends():
             u = mp.sqrt(mp.mpf(s) / 3)
             for _ in range(30):
                 u -= (u * u * (3 - 2 * u) - s) / (6 * u * (1 - u))
-            assert abs(A._smooth_inverse(s, 1.0 - s) - float(u)) <= 4e-16 * float(u), s
-            assert abs((1.0 - A._smooth_inverse(1.0 - s, s)) - float(u)) <= 2.3e-16, s
-    assert A._smooth_inverse(0.0, 1.0) == 0.0 and A._smooth_inverse(1.0, 0.0) == 1.0
+            assert abs(lobe_geometry.smooth_inverse(s, 1.0 - s) - float(u)) <= 4e-16 * float(u), s
+            assert abs((1.0 - lobe_geometry.smooth_inverse(1.0 - s, s)) - float(u)) <= 2.3e-16, s
+    assert lobe_geometry.smooth_inverse(0.0, 1.0) == 0.0 and lobe_geometry.smooth_inverse(1.0, 0.0) == 1.0
 
 
 def _ggx_half_vector_reference(alpha, mu):
@@ -201,14 +202,14 @@ def _ggx_half_vector_reference(alpha, mu):
 @pytest.mark.parametrize("engine", ["nested", "2d"])
 def test_ggx_tiny_alpha_at_grazing_finds_its_far_horizon_break(engine):
     """GGX alpha = 1e-4 at mu = 6.05e-5: the arc vanishes at tan(theta_h) = 3.3e4, 1 - tau_x = 1.7e-9, where the half
-    vectors beyond tan(theta_h) = 1.45 still carry 4.9e-5 of the albedo.  ``_smooth_inverse`` put that break at 1 - tau
+    vectors beyond tan(theta_h) = 1.45 still carry 4.9e-5 of the albedo.  ``smooth_inverse`` put that break at 1 - tau
     = 6.8e-3, and both engines were 4.7-6.8e-9 off with estimates of 2.5e-9 and 2.8e-10 (found by
     ``scripts/studies/fuzz_engines.py``).  The 1-D path (frame 6), GGX's default, agreed with this reference to 1e-16."""
     alpha, mu = 1e-4, 6.05e-5
     ref = _ggx_half_vector_reference(alpha, mu)
     f = pumpup.load({"type": "ggx", "alpha": alpha})
     lobe = f.lobe(mu)
-    assert 1.0 - A._horizon_breaks(lobe, mu).max() < 2e-9
+    assert 1.0 - arc_breaks.horizon_breaks(lobe, mu).max() < 2e-9
     switch = helpers.without_1d() if engine == "nested" else helpers.two_d_only()
     with switch, warnings.catch_warnings():
         warnings.simplefilter("ignore", AlbedoWarning)  # the budget may run out at rtol 1e-12; the estimate stays honest
@@ -226,7 +227,7 @@ def test_a_horizon_break_where_the_weight_underflows_is_dropped():
     agree with the 1-D path."""
     f = pumpup.load({"type": "cook_torrance", "m": 0.2})
     mu = 0.35905733
-    assert A._horizon_breaks(f.lobe(mu), mu).min() > 1e-100
+    assert arc_breaks.horizon_breaks(f.lobe(mu), mu).min() > 1e-100
     ref, eref = pumpup.albedo(f, mu, return_error=True, rtol=1e-12)
     for switch in (helpers.without_1d, helpers.two_d_only):
         with switch():
@@ -304,8 +305,8 @@ def test_level_end_scales():
     d = A._level_end_scales(lobe, mu, np.array([mu]), gx, 2)
     assert d.shape == (1, 2) and d[0, 1] == np.inf
     tx = gx[0] + (gx[1] - gx[0]) * A._SCALE_NODES
-    x, xc, _ = A._smooth(tx)
-    ca, sa, _ = A._radial("power", 1.0, x, xc)
+    x, xc, _ = lobe_geometry.smooth(tx)
+    ca, sa, _ = lobe_geometry.radial_map("power", 1.0, x, xc)
     s = math.sqrt(1 - mu * mu)
     cut = np.arccos((mu - mu * ca) / (s * sa))  # N.wo = mu ca + s sa cos(beta) = mu
     expect = np.sqrt(mu / (3 * s * sa * np.sin(cut) * cut))
@@ -368,23 +369,23 @@ def _assert_same_bits(new, ref):
 
 @pytest.mark.parametrize("spec", BREAK_MODELS, ids=str)
 def test_kink_breaks_match_the_reference_bit_for_bit(spec, monkeypatch):
-    """_kink_breaks (numba scan, all searches advancing together with several steps per round) gives
-    the breaks of _kink_breaks_reference (the plain numpy twin: one step per call) to the last bit and
+    """kink_breaks (numba scan, all searches advancing together with several steps per round) gives
+    the breaks of kink_breaks_reference (the plain numpy twin: one step per call) to the last bit and
     in the same order, with and without the crossings, for every depth of the rounds' trees of steps
     (one step per round as the reference, and as deep as allowed), with the scan's first pass too
     short (the second pass) and with one problem per chunk of the scan."""
     found = 0
     for lobe, mu, levels in _break_groups(spec):
         for crossings in (True, False):
-            ref = A._kink_breaks_reference(lobe, mu, levels, crossings=crossings)
+            ref = arc_breaks.kink_breaks_reference(lobe, mu, levels, crossings=crossings)
             found += sum(len(r) for r in ref)
-            _assert_same_bits(A._kink_breaks(lobe, mu, levels, crossings=crossings), ref)
+            _assert_same_bits(arc_breaks.kink_breaks(lobe, mu, levels, crossings=crossings), ref)
             if crossings:
                 for points, room, chunk in ((1, 16, 8192), (10**6, 0, 700)):
                     monkeypatch.setattr(A, "_ROUND_POINTS", points)
                     monkeypatch.setattr(A, "_SCAN_ROOM", room)
                     monkeypatch.setattr(A, "_CHUNK", chunk)
-                    _assert_same_bits(A._kink_breaks(lobe, mu, levels, crossings=crossings), ref)
+                    _assert_same_bits(arc_breaks.kink_breaks(lobe, mu, levels, crossings=crossings), ref)
                 monkeypatch.undo()
     assert found > 0
 
@@ -395,9 +396,9 @@ def test_kink_breaks_touching_pairs_match_the_reference():
     f = pumpup.load(SCALED)
     mu = np.array([0.3, MU_SCALED, 0.9, MU_SCALED])
     (_, g), = [(i, g) for i, g in A._groups(f, mu) if len(g.mu) == len(mu)]
-    ref = A._kink_breaks_reference(g.lobe, g.mu, g.levels)
+    ref = arc_breaks.kink_breaks_reference(g.lobe, g.mu, g.levels)
     assert len(ref[1]) >= 2
-    _assert_same_bits(A._kink_breaks(g.lobe, g.mu, g.levels), ref)
+    _assert_same_bits(arc_breaks.kink_breaks(g.lobe, g.mu, g.levels), ref)
 
 
 @pytest.mark.parametrize("engine", ["nested", "2-D"])
@@ -439,10 +440,10 @@ def test_power_map_is_continuous_at_its_split(n):
     (2 x - 1) as 1 - 2 (1 - ys)(1 - x), which rounds ys = 2^-(n+1) off beyond n = 52: at x = 1/2 itself it gave
     alpha = 90 deg, and the kink scan, which samples tau = 1/2, saw the wrong sign there (next test)."""
     x = np.array([0.5, 0.5 - 2**-40])
-    ca, sa, jac = A._radial("power", n, x, 1.0 - x)
+    ca, sa, jac = lobe_geometry.radial_map("power", n, x, 1.0 - x)
     assert ca[0] == 0.5 and abs(ca[1] - 0.5) < 1e-11 and sa[0] == math.sqrt(0.75)
     assert np.all(np.isfinite(jac))  # (0 at the split itself where ys is rounded off: the weight that point had)
-    assert A._radial_scalar(1, n, 0.5, 0.5)[:2] == (ca[0], sa[0])
+    assert lobe_geometry.radial_map_scalar(1, n, 0.5, 0.5)[:2] == (ca[0], sa[0])
 
 
 def test_2d_engine_sees_a_kink_that_enters_and_leaves_above_the_split():
@@ -473,9 +474,9 @@ def test_2d_engine_sees_a_kink_that_enters_and_leaves_above_the_split():
     val = np.where(up, f.eval(np.broadcast_to(wi, wo.shape), wo) * wo[..., 2] * 4.0 * c * np.sin(T), 0.0)
     ref = 2.0 * float(np.sum(val * wt[:, None] * wp))
     lobe = f.lobe(mu)
-    breaks = A._kink_breaks(lobe, np.array([mu]), np.zeros((1, 0)))[0]
-    x, xc, _ = A._smooth(breaks)
-    ca, sa, _ = A._radial(lobe.radial, lobe.sharpness, x, xc)
+    breaks = arc_breaks.kink_breaks(lobe, np.array([mu]), np.zeros((1, 0)))[0]
+    x, xc, _ = lobe_geometry.smooth(breaks)
+    ca, sa, _ = lobe_geometry.radial_map(lobe.radial, lobe.sharpness, x, xc)
     assert np.any(np.abs(np.arctan2(sa, ca) - 0.43515) < 1e-4)  # the cut's entry is a break
     for rtol in (1e-8, 1e-12):
         with helpers.two_d_only():
@@ -494,11 +495,11 @@ def test_a_level_on_a_cut_of_the_model_adds_no_crossings():
     computed twice has no crossing (albedo.COINCIDENT); a level 1e-7 away still crosses the other cuts."""
     lobe = pumpup.load(CT).lobe(0.5)
     mu = np.array([0.5])
-    plain = A._kink_breaks(lobe, mu, np.zeros((1, 0)))[0]
+    plain = arc_breaks.kink_breaks(lobe, mu, np.zeros((1, 0)))[0]
     breaks = {}
     for level in (0.5, 0.5 + 1e-7):
-        breaks[level] = A._kink_breaks(lobe, mu, np.array([[level]]))
-        _assert_same_bits(breaks[level], A._kink_breaks_reference(lobe, mu, np.array([[level]])))
+        breaks[level] = arc_breaks.kink_breaks(lobe, mu, np.array([[level]]))
+        _assert_same_bits(breaks[level], arc_breaks.kink_breaks_reference(lobe, mu, np.array([[level]])))
     assert len(plain) <= len(breaks[0.5][0]) <= len(plain) + 4, (len(plain), len(breaks[0.5][0]))
     assert len(breaks[0.5 + 1e-7][0]) > len(breaks[0.5][0])
 

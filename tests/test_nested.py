@@ -13,9 +13,11 @@ import pytest
 import pumpup
 from pumpup.engine import nested as _nested
 from pumpup.engine import polar as _polar
-from pumpup.engine.cubature import NODES, WG, WK, AlbedoWarning, _groups, _integrate_group, _kink_coefficients, _smooth
+from pumpup.engine.cubature import NODES, WG, WK, AlbedoWarning, _groups, _integrate_group
+from pumpup.engine.lobe_geometry import kink_coefficients, smooth
 import helpers
 from pumpup.engine.routes import using
+from pumpup.engine import lobe_geometry
 
 
 @pytest.fixture(autouse=True)
@@ -144,7 +146,7 @@ def _group(spec, mu):
 
 @pytest.mark.parametrize("spec,mu", KERNEL_CASES, ids=[c[0]["type"] for c in KERNEL_CASES])
 def test_kernels_match_their_numpy_twins(spec, mu):
-    from pumpup.engine.cubature import _AXIS_CODE, _RADIAL_CODE
+    from pumpup.engine.lobe_geometry import AXIS_CODE, RADIAL_CODE
 
     _, g = _group(spec, mu)
     lobe = g.lobe
@@ -154,14 +156,14 @@ def test_kernels_match_their_numpy_twins(spec, mu):
     mu_n = np.full(N, mu)
     lev = np.repeat(g.levels, N, axis=0)
     if lobe.kinks is not None:
-        x, xc, _ = _smooth(tx)
-        ka, kb = _kink_coefficients(lobe, mu_n, x, xc)
+        x, xc, _ = smooth(tx)
+        ka, kb = kink_coefficients(lobe, mu_n, x, xc)
     else:
         ka = kb = np.zeros((N, 0))
     ref = _nested._nodes_reference(lobe.axis, lobe.radial, float(lobe.sharpness), mu_n, lev, ka, kb, tx)
     E = lev.shape[1] + ka.shape[1] + 2
     got = [np.empty(N) for _ in range(4)] + [np.empty((N, E)), np.empty((N, E), np.int64), np.empty((N, E))]
-    _nested._nodes_kernel(_AXIS_CODE[lobe.axis], _RADIAL_CODE[lobe.radial], float(lobe.sharpness), mu_n, lev,
+    _nested._nodes_kernel(AXIS_CODE[lobe.axis], RADIAL_CODE[lobe.radial], float(lobe.sharpness), mu_n, lev,
                           np.ascontiguousarray(ka), np.ascontiguousarray(kb), tx, *got)
     for r_, k_ in zip(ref, got):
         np.testing.assert_allclose(k_, r_, rtol=1e-12, atol=1e-14)
@@ -180,7 +182,7 @@ def test_kernels_match_their_numpy_twins(spec, mu):
     wi_r, wo_r, w_r = _nested._points_reference(lobe.axis, node, lo, width, t0, t1, mu_n, s_n, ca_n, sa_n, wr_n, sm)
     S = len(node) * 15
     wi, wo, w = np.empty((S, 3)), np.empty((S, 3)), np.empty(S)
-    _nested._points_kernel(_AXIS_CODE[lobe.axis], node, lo, width, t0, t1, sm, mu_n, s_n, ca_n, sa_n, wr_n, NODES,
+    _nested._points_kernel(AXIS_CODE[lobe.axis], node, lo, width, t0, t1, sm, mu_n, s_n, ca_n, sa_n, wr_n, NODES,
                            wi, wo, w)
     np.testing.assert_allclose(wi, wi_r, rtol=1e-13, atol=1e-15)
     np.testing.assert_allclose(wo, wo_r, rtol=1e-12, atol=1e-14)
@@ -189,14 +191,14 @@ def test_kernels_match_their_numpy_twins(spec, mu):
     f = np.abs(rng.normal(size=S))
     f[::5] = 0.0
     vals = np.zeros(S)
-    assert _nested._accumulate(f, wo[:, 2], w, vals) == -1
+    assert _nested.accumulate(f, wo[:, 2], w, vals) == -1
     np.testing.assert_allclose(vals, _nested._values_reference(f, wo[:, 2], w), rtol=1e-15, atol=1e-300)
     K, G = np.zeros(S // 15), np.zeros(S // 15)
     _nested._rule_kernel(vals, WK, WG, K, G)
     for got_, ref_ in zip((K, G), _nested._rule_reference(vals, WK, WG)):
         np.testing.assert_allclose(got_, ref_, rtol=1e-13, atol=1e-300)
     f[17] = np.nan
-    assert _nested._accumulate(f, wo[:, 2], w, vals) == 17
+    assert _nested.accumulate(f, wo[:, 2], w, vals) == 17
 
 
 def test_nested_integrand_equals_the_2d_geometry():
@@ -277,18 +279,18 @@ def test_evaluation_counts_per_mu(spec, capsys, no_1d):
     pumpup.albedo(f, mu)
     nested = _nested.LAST_EVALS.astype(float)
     count = [0]
-    orig = A._accumulate
+    orig = lobe_geometry.accumulate
 
     def counting(fv, cos_o, weight, total):
         count[0] += fv.shape[0]
         return orig(fv, cos_o, weight, total)
 
-    A._accumulate = counting
+    lobe_geometry.accumulate = counting
     try:
         with helpers.without_nested():
             pumpup.albedo(f, mu)
     finally:
-        A._accumulate = orig
+        lobe_geometry.accumulate = orig
     two_d = count[0] / len(mu)
     with capsys.disabled():
         print(f"\n{spec}: evaluations per mu, nested {nested.mean():.0f} (max {nested.max():.0f}), 2-D {two_d:.0f}")

@@ -15,7 +15,6 @@ from helpers import n_frame_integrand_against_eval, nested_reference, one_d_agai
 import pumpup
 from pumpup.engine import polar as _polar
 import helpers
-from pumpup.engine.normal_frame import N_FRESNEL_MU_MIN
 
 MU = np.array([1.0, 0.999, 0.99, 0.9, 0.7, 0.5, 0.3, 0.1, 0.01, 1e-4, 1e-8])
 

@@ -161,12 +161,13 @@ def test_expensive_list_names_real_commands():
 
 def test_readme_claims_match_the_code():
     """Item 16: the README's word on the GIL and on where 'divergence all' writes."""
-    from pumpup.engine.cubature import _accumulate, _geometry_kernel
+    from pumpup.engine.cubature import _geometry_kernel
+    from pumpup.engine.lobe_geometry import accumulate
     from pumpup.cli import build_parser
 
     text = "".join(open(path).read() for path in DOCUMENTS)
     assert "hold the GIL" not in text and "kernels release the GIL" in text
-    for kernel in (_geometry_kernel, _accumulate):
+    for kernel in (_geometry_kernel, accumulate):
         assert kernel.targetoptions.get("nogil") is True
     args = build_parser().parse_args(["divergence", "all"])
     assert f"`{args.tables}/divergence.nc` and `{args.figures}/divergence.png`" in text

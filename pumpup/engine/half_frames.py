@@ -273,7 +273,6 @@ def _k_vcavity(mu, s, psi, u, sa):  # pragma: no cover - compiled; see vcavity_i
 def vcavity_integrand_reference(mu: float, u) -> np.ndarray:
     """Plain twin of :func:`_k_vcavity` by scipy's QUADPACK over beta of 4 min(c, 2 u mu, 4 u^2 c - 2 u mu)
     where c > mu / (2 u) (split at the lines' crossings)."""
-    import warnings
 
     from scipy.integrate import quad
 
@@ -300,7 +299,6 @@ def vcavity_integrand_reference(mu: float, u) -> np.ndarray:
 def ward_integrand_reference(mu: float, u: np.ndarray) -> np.ndarray:
     """Plain numpy K(u) of :func:`_k_ward`: the arc integrals I_q = integral_0^beta0 (e0 + b cos(beta))^q
     d beta by scipy's QUADPACK (beta0 from arccos), K = 8 sqrt(2 u) (c0 I_1/2 + I_3/2)."""
-    import warnings
 
     from scipy.integrate import quad
 

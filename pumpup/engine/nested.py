@@ -11,8 +11,8 @@ the hint already says.  This module integrates the same integrand as a nested qu
 (issue 14, item 2):
 
 * outer: globally adaptive 7/15 Gauss-Kronrod in tau_x on [0, 1] (QUADPACK's qk15), started on
-  the 2-D engine's breaks (eight intervals, :data:`NX_INIT`, the horizon breaks ``_horizon_breaks``, the kink breaks
-  ``_kink_breaks`` including the crossings of two cuts), a grid graded geometrically towards each
+  the 2-D engine's breaks (eight intervals, :data:`NX_INIT`, the horizon breaks ``horizon_breaks``, the kink breaks
+  ``kink_breaks`` including the crossings of two cuts), a grid graded geometrically towards each
   break (ratio 16: :func:`_graded_coarse`) and one above the "power" map's split
   (:func:`_split_breaks`); the intervals whose error exceeds their share of the tolerance are
   refined.  An interval that ends at a break is integrated in v with x = x0 + h v^2 (x1 - h (1 - v)^2,
@@ -37,7 +37,7 @@ the hint already says.  This module integrates the same integrand as a nested qu
 * the error of an interval is the outer |K - G| plus the inner errors carried through the
   (positive) outer Kronrod weights (:func:`interval_error`; the integral of |I_h - I| over the
   interval is bounded by the latter), plus, for the whole value, the 2-D engine's rounding term
-  (``_rounding``);
+  (``lobe_rounding``);
 * refinement: an interval whose inner error is the larger part of its error has its segments
   above their share (and its worst one) bisected in v (never silently accepted); one whose
   outer error dominates is bisected in tau_x (in v where it has the substitution: at x0 + h / 4,
@@ -48,7 +48,7 @@ the hint already says.  This module integrates the same integrand as a nested qu
 
 The geometry runs in two compiled passes per batch (:func:`_nodes_kernel`: per outer node;
 :func:`_points_kernel`: per point), the model's ``_eval`` once per batch on all points (twice
-where the hint is not even in beta), and two compiled passes (:func:`pumpup.engine.cubature._accumulate`, :func:`_rule_kernel`)
+where the hint is not even in beta), and two compiled passes (:func:`pumpup.engine.cubature.accumulate`, :func:`_rule_kernel`)
 form the Kronrod and Gauss sums; each has a plain numpy twin (``*_reference``) that the tests compare
 with it.
 
@@ -68,24 +68,22 @@ import math
 import numpy as np
 from numba import njit
 
-from .cubature import (
-    _AXIS_CODE,
-    _RADIAL_CODE,
+from .arc_breaks import horizon_breaks, kink_breaks, tau_of_angle
+from .lobe_geometry import (
+    AXIS_CODE,
     NODES,
+    RADIAL_CODE,
     WG,
     WK,
-    _accumulate,
-    _horizon_breaks,
-    _kink_breaks,
-    _kink_coefficients,
-    _power_split,
-    _radial,
-    _radial_scalar,
-    _rotate,
-    _rounding,
-    _smooth,
-    _smooth_inverse,
-    _tau_of_angle,
+    accumulate,
+    kink_coefficients,
+    lobe_rounding,
+    power_split,
+    radial_map,
+    radial_map_scalar,
+    rotate_wi,
+    smooth,
+    smooth_inverse,
 )
 
 __all__ = ["inner_error", "integrate", "interval_error", "supports"]
@@ -115,7 +113,7 @@ LAST_EVALS: np.ndarray | None = None
 def supports(g) -> bool:
     """Whether this path integrates the group ``g`` (a ``pumpup.engine.cubature._Group``)."""
     lobe = g.lobe
-    return not lobe.generic and lobe.axis in _AXIS_CODE and lobe.radial in _RADIAL_CODE
+    return not lobe.generic and lobe.axis in AXIS_CODE and lobe.radial in RADIAL_CODE
 
 
 def inner_error(kronrod, gauss):
@@ -143,8 +141,8 @@ def _nodes_reference(axis: str, radial: str, k: float, mu, levels, ka, kb, tx):
     and cuts beyond the arc) and ``dn`` = b0 sin(edge) = |d N.wo / d beta| there (0 elsewhere).
     """
     s = np.sqrt((1.0 - mu) * (1.0 + mu))
-    x, xc, dx = _smooth(tx)
-    ca, sa, jac = _radial(radial, k, x, xc)
+    x, xc, dx = smooth(tx)
+    ca, sa, jac = radial_map(radial, k, x, xc)
     if axis == "normal":
         a0, b0 = ca, np.zeros_like(ca)
     elif axis in ("mirror", "retro"):
@@ -188,7 +186,7 @@ def _nodes_kernel(axis, radial, k, mu, levels, ka, kb, tx, s_o, ca_o, sa_o, wr_o
         x = u * u * (3.0 - 2.0 * u)  # smoothing substitution x = tau^2 (3 - 2 tau)
         xc = (1.0 - u) ** 2 * (1.0 + 2.0 * u)
         dx = 6.0 * u * (1.0 - u)
-        ca, sa, jac = _radial_scalar(radial, k, x, xc)
+        ca, sa, jac = radial_map_scalar(radial, k, x, xc)
         if axis == 0:
             a0, b0 = ca, 0.0
         elif axis == 3:
@@ -322,7 +320,7 @@ def _points_kernel(axis, node, lo, width, t0, t1, sm, mu, s_n, ca_n, sa_n, wr_n,
 # --- Kronrod and Gauss sums per segment --------------------------------------------------------------
 
 def _values_reference(f, cos_o, weight):
-    """Plain numpy twin of :func:`pumpup.engine.cubature._accumulate` as this module uses it (on zeros): f cos(theta_o)
+    """Plain numpy twin of :func:`pumpup.engine.cubature.accumulate` as this module uses it (on zeros): f cos(theta_o)
     weight where all three are positive."""
     return np.where((f > 0) & (cos_o > 0) & (weight > 0), f * cos_o * weight, 0.0)
 
@@ -372,8 +370,8 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
     mu_n = np.ascontiguousarray(g.mu[pnode])
     lev_n = np.ascontiguousarray(g.levels[pnode])
     if lobe.kinks is not None:  # the model's kink coefficients: once per outer node (issue 14 item 3)
-        x, xc, _ = _smooth(tx)
-        ka, kb = _kink_coefficients(lobe, mu_n, x, xc)
+        x, xc, _ = smooth(tx)
+        ka, kb = kink_coefficients(lobe, mu_n, x, xc)
     else:
         ka = kb = np.zeros((len(tx), 0))
     N = len(tx)
@@ -382,7 +380,7 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
     edges = np.empty((N, E))
     lab = np.empty((N, E), np.int64)
     dn = np.empty((N, E))
-    _nodes_kernel(_AXIS_CODE[lobe.axis], _RADIAL_CODE[lobe.radial], float(lobe.sharpness), mu_n, lev_n,
+    _nodes_kernel(AXIS_CODE[lobe.axis], RADIAL_CODE[lobe.radial], float(lobe.sharpness), mu_n, lev_n,
                   np.ascontiguousarray(ka), np.ascontiguousarray(kb), tx, s_n, ca_n, sa_n, wr_n, edges, lab, dn)
     # blocks: (segment, outer node) pairs where the segment's piece is not empty at that node
     S = len(seg_int)
@@ -419,7 +417,7 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
     Gb = np.zeros(B)
     vals = np.empty(C * RI)
     signs = (1.0,) if lobe.symmetric else (1.0, -1.0)
-    axis = _AXIS_CODE[lobe.axis]
+    axis = AXIS_CODE[lobe.axis]
     for c0 in range(0, B, CHUNK):
         sl = slice(c0, min(B, c0 + CHUNK))
         n = (sl.stop - sl.start) * RI
@@ -433,9 +431,9 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
         for sign in signs:
             if sign < 0:
                 wo_[:, 1] *= -1.0  # beta -> -beta flips wo_y in every frame (wi_y = 0), before the turn
-            wi_t, wo_t = (wi_, wo_) if g.phi is None else (_rotate(wi_, cp, sp), _rotate(wo_, cp, sp))
+            wi_t, wo_t = (wi_, wo_) if g.phi is None else (rotate_wi(wi_, cp, sp), rotate_wi(wo_, cp, sp))
             f = np.ascontiguousarray(brdf._eval(wi_t, wo_t), dtype=np.float64)
-            i = _accumulate(f, wo_[:, 2], w_, v_)  # (N.wo is unchanged by the turn)
+            i = accumulate(f, wo_[:, 2], w_, v_)  # (N.wo is unchanged by the turn)
             if i >= 0:
                 raise ValueError(
                     f"{brdf!r} returned {f[i]!r} at wi={wi_t[i].tolist()}, wo={wo_t[i].tolist()}: "
@@ -478,12 +476,12 @@ CROSSINGS = True
 
 #: ratio of the geometric grid above the power map's split (_split_breaks)
 SPLIT_RATIO = 4.0
-#: ratio of the geometric grid towards a break (the 2-D engine's _graded uses 4)
+#: ratio of the geometric grid towards a break (the 2-D engine's graded uses 4)
 GRADE_RATIO = 16.0
 
 
 def _graded_coarse(points: np.ndarray) -> np.ndarray:
-    """Breakpoints with a grid graded geometrically towards each, as ``pumpup.engine.cubature._graded`` but
+    """Breakpoints with a grid graded geometrically towards each, as ``pumpup.engine.cubature.graded`` but
     with steps d 16^k: the outer rule's |K - G| sees the variation on one step (measured on the
     tests' references), and a break 7e-18 from an end (Cook-Torrance's second horizon at mu = 0.5)
     costs 14 intervals instead of 27."""
@@ -525,7 +523,7 @@ def _alpha_grading(lobe, mu: float) -> np.ndarray:
         off = 0.5 * a
         while off < 0.25:
             for ab in (af - off, af + off):
-                tau = _tau_of_angle(lobe, ab) if 0.0 < ab < 0.5 * math.pi else None
+                tau = tau_of_angle(lobe, ab) if 0.0 < ab < 0.5 * math.pi else None
                 if tau is not None:
                     out.append(tau)
             off *= 4.0
@@ -553,14 +551,14 @@ def _split_breaks(lobe) -> np.ndarray:
     """
     if lobe.radial != "power":
         return np.array([])
-    _, ys = _power_split(float(lobe.sharpness))
+    _, ys = power_split(float(lobe.sharpness))
     out = []
     # below y = 1e-16 the rest of the peak piece weighs at most 1e-16 of it (u^n du = dy / (n + 1)); for
     # n > 1073 y_s underflows to 0, so the grid starts there
     y = max(SPLIT_RATIO * ys, 1e-16)
     while y < 0.25:
         xc = 0.5 * (1.0 - y) / (1.0 - ys)  # 1 - x, x = 1/2 + (y - y_s) / (2 (1 - y_s))
-        out.append(_smooth_inverse(1.0 - xc, xc))
+        out.append(smooth_inverse(1.0 - xc, xc))
         y *= SPLIT_RATIO
     return np.array(out)
 
@@ -646,11 +644,11 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
                                                          np.array([0.5]))) if g.lobe.kinks else 0)
     # the crossings of two cuts change the order of the pieces; the arc's integral is not analytic there
     # (module docstring): breaks here too, as in the 2-D engine
-    kink_breaks = _kink_breaks(g.lobe, g.mu, g.levels, crossings=CROSSINGS)
+    arc_kinks = kink_breaks(g.lobe, g.mu, g.levels, crossings=CROSSINGS)
     split = _split_breaks(g.lobe)
     cols = []
     for p_ in range(P):
-        breaks = _merged(np.concatenate([_horizon_breaks(g.lobe, float(g.mu[p_])), kink_breaks[p_]]))
+        breaks = _merged(np.concatenate([horizon_breaks(g.lobe, float(g.mu[p_])), arc_kinks[p_]]))
         gx = np.unique(np.concatenate([np.linspace(0, 1, NX_INIT + 1), _graded_coarse(breaks), split,
                                        _alpha_grading(g.lobe, float(g.mu[p_]))]))
         at_break = np.isin(gx, breaks) if OUTER_SUB else np.zeros(len(gx), bool)
@@ -668,7 +666,7 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
     # the budget counts outer intervals, an interval with m sub-intervals per piece m times
     seg_count = lambda: np.bincount(i_prob[s_int], minlength=P) / n_pieces
     budget = max_regions + seg_count()
-    rounding = _rounding(g.lobe)
+    rounding = lobe_rounding(g.lobe)
     while True:
         nI = len(i_prob)
         RO = s_v.shape[1]

@@ -175,8 +175,8 @@ class CookTorrance(BRDF):
         # 001 eq. 9: F exp(-tan^2 / m^2) / (4 pi m^2 cos^4) G / (N.L N.V); the azimuth of h in closed form for F = 1
         # (G's minimum of three lines in wi.h), by a rule on its arc with F(wi.h); the Beckmann weight in
         # t = tan^2(alpha) / m^2
-        fresnel = Fresnel(ior=self.p["ior"]) if self.p["ior"] else None
-        return AzimuthHint(VCavityLobe(n=m, radial="beckmann", fresnel=fresnel),
+        f_at_h = Fresnel(ior=self.p["ior"]) if self.p["ior"] else None
+        return AzimuthHint(VCavityLobe(n=m, radial="beckmann", fresnel=f_at_h),
                            scale=lambda mu: 1.0 / (4.0 * math.pi * m * m * np.asarray(mu, float)))
 
 
@@ -338,12 +338,12 @@ class TorranceSparrow(BRDF):
 
         # 002 eq. 10: F G D / (pi (N.S)(N.V)); the azimuth of h in closed form for F = 1 (pumpup.engine.polar._k_vcavity),
         # by a rule on its arc with F(wi.h)
-        fresnel = Fresnel(ior=self.p["ior"]) if self.p["ior"] else None
+        f_at_h = Fresnel(ior=self.p["ior"]) if self.p["ior"] else None
         if d == "D1":  # D = b cos^e(alpha): the power weight u^e
-            return AzimuthHint(VCavityLobe(n=e, fresnel=fresnel), scale=lambda mu: b / (math.pi * np.asarray(mu, float)))
+            return AzimuthHint(VCavityLobe(n=e, fresnel=f_at_h), scale=lambda mu: b / (math.pi * np.asarray(mu, float)))
         if d == "D3":  # D3 = b (c3^2 / (c3^2 cos^2 + sin^2))^2 = b / (cos^4 (1 + tan^2 / c3^2)^2): the GGX weight
-            return AzimuthHint(VCavityLobe(n=e, radial="ggx", fresnel=fresnel),
+            return AzimuthHint(VCavityLobe(n=e, radial="ggx", fresnel=f_at_h),
                                scale=lambda mu: b / (math.pi * np.asarray(mu, float)))
         # D4 = exp(-tan^2 / m^2) / (4 m^2 cos^4): Cook-Torrance's
-        return AzimuthHint(VCavityLobe(n=e, radial="beckmann", fresnel=fresnel),
+        return AzimuthHint(VCavityLobe(n=e, radial="beckmann", fresnel=f_at_h),
                            scale=lambda mu: 1.0 / (4.0 * math.pi * e * e * np.asarray(mu, float)))

@@ -85,7 +85,7 @@ class Ward(BRDF):
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"])
 
     def azimuth_hint(self):
-        from ..core.hints import AzimuthHint, HalfVectorLobe, WardLobe
+        from ..core.hints import AzimuthHint, WardLobe
 
         m, c = self.p["m"], self.p["c"]
         # 000 eq. 34: c / (4 pi m^2 sqrt(mu)) times exp(-tan^2(alpha) / m^2) / sqrt(N.wo); the half vector's azimuth
@@ -255,7 +255,7 @@ class ModifiedWard(BRDF):
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"], levels=(mu,))
 
     def azimuth_hint(self):
-        from ..core.hints import AzimuthHint, HalfVectorLobe, WardLobe
+        from ..core.hints import AzimuthHint, HalfVectorLobe
 
         m, c = self.p["m"], self.p["c"]
         # 000 eq. 35: c / (4 pi m^2) times exp(-tan^2(alpha) / m^2) / max(N.L, N.V), the half vector's azimuth

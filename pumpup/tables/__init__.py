@@ -773,7 +773,7 @@ def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False, m
     >>> round(pumpup.mean_albedo(pumpup.load({"type": "lambert", "albedo": 0.25})), 12)
     0.25
     """
-    from ..engine.cubature import NODES, WG, WK
+    from ..engine.lobe_geometry import NODES, WG, WK
 
     if getattr(brdf, "is_spectral", False):  # pumpup.spectral: one mean albedo per wavelength
         return brdf.mean_albedo(rtol=rtol, return_error=return_error, max_intervals=max_intervals)
@@ -799,14 +799,14 @@ def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False, m
     # a pumped level's albedo has kinks (BRDF.albedo_kinks): first intervals end there.  Without them a 2-level g1
     # pumped stretched Phong (n = 0.127, p = 1: kinks at mu = 0.309, 0.345, 0.741, 0.745) had a mean 1.05e-9 off with an
     # estimate of 1.0e-10 (issue 14's twentieth session, scripts/studies/fuzz_engines.py --mean)
-    from ..engine.cubature import _smooth_inverse
+    from ..engine.lobe_geometry import smooth_inverse
 
     # and two more towards grazing incidence, tau = 1/16 and 1/32 (mu = 0.011, 0.0029): the albedo there turns on the
     # roughness's scale, and the first interval [0, 1/8] (mu up to 0.043) was 4.2 x its |K - G| off for a 1-level g2
     # pumped GGX alpha 0.0194 (the mean 1.05e-9 off, 2.6 x its estimate; fuzz_engines --mean)
     kinks = brdf.albedo_kinks() or []
     edges = np.unique(np.concatenate([np.linspace(0, 1, 9), [1.0 / 16, 1.0 / 32],
-                                      [_smooth_inverse(v, 1.0 - v) for v in kinks]]))
+                                      [smooth_inverse(v, 1.0 - v) for v in kinks]]))
     a, b = edges[:-1], edges[1:]
     k, qe, pe = rule(a, b)
     while True:

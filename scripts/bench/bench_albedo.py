@@ -126,12 +126,11 @@ def evaluations(f, mu, rtol, phi=0.0):
     accumulation step (once per sign of beta)."""
     from pumpup.engine import nested as _nested
     from pumpup.engine import polar as _polar
-    from pumpup.engine import chain_frame as _chain_frame
     from pumpup.engine import slope as _slope
 
     A = pumpup.albedo_module
     count = [0]
-    orig = A._accumulate
+    orig = A.accumulate
     orig_nested = _nested.integrate
 
     def counting(fv, cos_o, weight, total):
@@ -143,7 +142,7 @@ def evaluations(f, mu, rtol, phi=0.0):
         count[0] += int(_nested.LAST_EVALS.sum())
         return out
 
-    A._accumulate = counting
+    A.accumulate = counting
     _nested.integrate = counting_nested
     try:
         for _, term in f.albedo_terms():
@@ -156,7 +155,7 @@ def evaluations(f, mu, rtol, phi=0.0):
             else:
                 pumpup.albedo(term, mu, phi=phi, rtol=rtol)
     finally:
-        A._accumulate = orig
+        A.accumulate = orig
         _nested.integrate = orig_nested
     return count[0] / len(mu)
 
@@ -165,7 +164,6 @@ def path_of(f):
     """'1-D' (closed-form azimuth), 'slp' (anisotropic Ward in slope space), 'axs' (a power lobe about its own axis,
     Lafortune p = 0), 'nst' (nested quadrature) or '2-D' (cubature) for f at phi = 0."""
     from pumpup.engine import nested as _nested
-    from pumpup.engine import slope as _slope
 
     if all(route_names(t, [0.5])[0, 0] == "slope" for _, t in f.albedo_terms()):
         return "slp"
@@ -206,8 +204,6 @@ PHONG_FAMILY = [{"type": "phong", "n": 20}, {"type": "stretched_phong", "n": 20}
 
 
 def families(rtol=1e-10, specs=None, dblquad=True):
-    from pumpup.engine import polar as _polar
-    from pumpup.engine import chain_frame as _chain_frame
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     print(f"257-point tables at rtol {rtol:g}, one thread (ms); evaluations per mu; previous = the 2-D engine "
@@ -244,8 +240,6 @@ def against_nested(specs, label, rtol=1e-10, repeat=3):
     ``using(engine="nested")``; ``engine="2d"`` would switch off the nested engine too), same run, same rtol: a
     257-point table (mu uniform in theta) and a sweep cell (257 mu of ``default_mu`` + mean albedo + maximum
     constant), one thread, best of ``repeat``."""
-    from pumpup.engine import polar as _polar
-    from pumpup.engine import chain_frame as _chain_frame
     from pumpup.sweeps import default_mu
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
@@ -277,7 +271,6 @@ def _against_second_path(specs, title, first, second, width, rtol, repeat, lobe=
     (``using(without={"normal", "lobe_normal"})``: frame 4 or frame 5, ``second``) and by the nested engine, one thread, best of ``repeat``
     (nested: 1), with the evaluations per mu of the first (of ``lobe(spec, f)``, the term that takes it)."""
     from pumpup.engine import polar as _polar
-    from pumpup.engine import chain_frame as _chain_frame
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     print(f"{title}, one thread, ms; 257 mu at rtol {rtol:g}")
@@ -488,7 +481,7 @@ BREAK_FAMILIES = [
 
 def breaks(rtol=1e-10, repeat=7):
     """A 257-point table (mu uniform in theta) at rtol ``rtol``, one thread, with the compiled break finding
-    (``albedo._kink_breaks``) and with its plain numpy reference (``albedo._kink_breaks_reference``, the
+    (``albedo.kink_breaks``) and with its plain numpy reference (``albedo.kink_breaks_reference``, the
     previous code) in the same run, round robin, best of ``repeat``; beside each, the time of the break
     finding alone (its calls during the table).  The two give the same breaks bit for bit, so the same
     tables: the script checks the values and errors are identical."""
@@ -496,11 +489,11 @@ def breaks(rtol=1e-10, repeat=7):
 
     A = pumpup.albedo_module
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
-    impl = {"compiled": A._kink_breaks, "reference": A._kink_breaks_reference}
+    impl = {"compiled": A.kink_breaks, "reference": A.kink_breaks_reference}
 
     def use(fn):
-        A._kink_breaks = fn
-        _nested._kink_breaks = fn
+        A.kink_breaks = fn
+        _nested.kink_breaks = fn
 
     print(f"257-point tables at rtol {rtol:g}, one thread, ms (best of {repeat}, round robin); breaks: the "
           f"break finding's share")
@@ -541,8 +534,6 @@ def breaks(rtol=1e-10, repeat=7):
 
 
 def cells():
-    from pumpup.engine import polar as _polar
-    from pumpup.engine import chain_frame as _chain_frame
     from pumpup.tables import reuse as _reuse
     from pumpup.operators.pumping import _TABLES
     from pumpup.sweeps import default_mu
@@ -654,8 +645,6 @@ def slope(rtol=1e-10, repeat=3):
     """Anisotropic Ward in slope space (pumpup.engine.slope, issue 14's fourteenth session) against the nested engine it took
     before (``using(engine="nested")`` leaves both out), same run: a 257-point table (mu uniform in theta) at phi = 0 and at
     phi = 0.7, one thread, best of ``repeat`` (nested: 1), with the slope path's evaluations per mu."""
-    from pumpup.engine import polar as _polar
-    from pumpup.engine import chain_frame as _chain_frame
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     specs = [{"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, {"type": "ward_aniso", "ax": 0.05, "ay": 0.5},
@@ -683,7 +672,6 @@ def lobe_f_gauss(rtol=1e-10, repeat=3):
     against the adaptive 7/15 rule they had before (``using(lobe_fresnel_gauss=False)``), same run: a 257-point table (mu
     uniform in theta) at ``rtol`` and a sweep cell (257 mu + mean albedo + maximum constant), one thread, best of
     ``repeat`` each, alternating."""
-    from pumpup.engine import polar as _polar
     from pumpup.engine import chain_frame as _chain_frame
     from pumpup.sweeps import default_mu
 

@@ -11,7 +11,7 @@ culprit: decide it with a third method (``tests/reference/independent_microfacet
 Found this way: GGX alpha 1.3e-4 at mu = 6.05e-5.  The 1-D path (0.8967913960373392, estimate 2.3e-14) agrees with
 the independent script (0.8967913960367667 +- 1.9e-8); the nested engine was 9e-9 off with estimates of 2e-10 to 3e-9
 at every rtol (36-42 x at alpha 1e-4, mu 6e-5 and 1e-4; 1.3 x at alpha 1e-3, mu 1e-5), and at alpha 1e-4 the 2-D
-engine too (4.7e-9 off, estimate 2.5e-9).  The cause, found in the twentieth session: ``albedo._smooth_inverse`` put
+engine too (4.7e-9 off, estimate 2.5e-9).  The cause, found in the twentieth session: ``albedo.smooth_inverse`` put
 the far horizon break (1 - tau_x = 1.7e-9) at 6.8e-3 (Newton from a start that rounds 1 - 2 (1 - x)); mended, both
 engines agree with a half-vector quadrature to 5e-13 (``tests/test_albedo_breaks.py``).  The nested engine is not
 GGX's path (frame 6 is); it is the tests' second engine and the path of models without a 1-D path.

@@ -55,7 +55,7 @@ def direction(mu, phi):
     return np.array([s * math.cos(phi), s * math.sin(phi), mu])
 
 
-def _graded(centres, lo, hi, w, ratio=2.0):
+def graded(centres, lo, hi, w, ratio=2.0):
     """Breaks in [lo, hi]: the ends, each centre and centre +- w ratio^k."""
     pts = {lo, hi}
     for c in centres:
@@ -84,12 +84,12 @@ def hemisphere_integral(g, theta_c, phi_c, width, axes_width, n=20, chunk=200_00
 
     theta_c, phi_c: the peak; width: the smallest panel about it [rad]; axes_width: the smallest panel in phi about
     the tangent axes (phi = k pi / 2).  Returns the value on n nodes per panel."""
-    tb = _graded([theta_c], 0.0, 0.5 * math.pi, width)
+    tb = graded([theta_c], 0.0, 0.5 * math.pi, width)
     wphi = width / max(math.sin(theta_c), width)
     lo, hi = phi_c - math.pi, phi_c + math.pi
     axes = [k * 0.5 * math.pi for k in range(-4, 9)]
-    pb = np.union1d(_graded([phi_c], lo, hi, min(wphi, 1.0)),
-                    _graded([a for a in axes if lo < a < hi], lo, hi, axes_width))
+    pb = np.union1d(graded([phi_c], lo, hi, min(wphi, 1.0)),
+                    graded([a for a in axes if lo < a < hi], lo, hi, axes_width))
     pb = pb[np.r_[True, np.diff(pb) > 1e-14]]
     t, wt = _rule(tb, n)
     p, wp = _rule(pb, n)
@@ -154,7 +154,7 @@ def cylinder_integral(g, axis, t_c, psi_c, kink_mu, width, n=20):
     centres (graded by 2)."""
     other = 1 - axis
     rt = math.sqrt((1.0 - kink_mu) * (1.0 + kink_mu))  # |t| where the slice leaves the region w_z > kink_mu
-    tb = _graded([t_c, -rt, rt], -1.0, 1.0, width)
+    tb = graded([t_c, -rt, rt], -1.0, 1.0, width)
     t, wt = _rule(tb, n)
     total = 0.0
     for tk, wk in zip(t, wt):
@@ -163,7 +163,7 @@ def cylinder_integral(g, axis, t_c, psi_c, kink_mu, width, n=20):
         pc = psi_c(tk)
         if pc is not None:
             centres.append(pc)
-        pb = _graded(centres, 0.0, math.pi, width / max(r, width))
+        pb = graded(centres, 0.0, math.pi, width / max(r, width))
         if kink_mu < r:
             p1 = math.asin(kink_mu / r)
             pb = np.union1d(pb, [p1, math.pi - p1])
