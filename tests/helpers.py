@@ -1,8 +1,14 @@
 """Shared helpers for the tests (importable: tests/ is on pytest's pythonpath)."""
 
 import math
+import pathlib
 
 import numpy as np
+
+#: the repository root
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+#: the tests' data files (tests/data)
+DATA = ROOT / "tests" / "data"
 
 
 def random_directions(rng, n, below=0.1, grazing=0.05):
@@ -122,6 +128,37 @@ def n_frame_integrand_against_eval(f, base):
     return low
 
 
+#: the Gauss-Legendre rule of :func:`rings` in the azimuth
+_RINGS_GL = np.polynomial.legendre.leggauss(200)
+
+
+def rings(f, mu, ring_cuts, mu_points):
+    """integral of f(wi, wo) cos(theta_o) d omega_o, wi = (sqrt(1 - mu^2), 0, mu): quad over mu_o on
+    the intervals between ``mu_points``, Gauss-Legendre (200 nodes) in phi_o on [0, pi] (the integrand is
+    even in phi_o) between the cuts ``ring_cuts(mu_o)``.  An independent reference (it evaluates the BRDF's numpy
+    ``reference`` only, never the engine) for the tests of the engines' breaks (tests/engine/test_cubature.py) and of
+    the models and operators whose lobes carry tables in N.wo."""
+    from scipy.integrate import quad
+
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    wi = np.array([s, 0.0, mu])
+    xg, wg = _RINGS_GL
+
+    def ring(mo):
+        so = math.sqrt((1.0 - mo) * (1.0 + mo))
+        cuts = ring_cuts(mo, so)
+        total = 0.0
+        for a, b in zip(cuts[:-1], cuts[1:]):
+            ph = a + 0.5 * (b - a) * (xg + 1.0)
+            wo = np.stack([so * np.cos(ph), so * np.sin(ph), np.full_like(ph, mo)], axis=-1)
+            total += 0.5 * (b - a) * float(np.sum(wg * f.reference(wi, wo)))
+        return 2.0 * total * mo
+
+    pts = np.unique(np.concatenate([[0.0, 1.0], np.asarray(mu_points, float)]))
+    pts = pts[(pts >= 0) & (pts <= 1)]
+    return sum(quad(ring, a, b, epsabs=1e-16, epsrel=1e-13, limit=200)[0] for a, b in zip(pts[:-1], pts[1:]))
+
+
 def load_script(path: str):
     """The module of a script of the repository's ``scripts/`` folder (``"make/compensation_study.py"``), imported
     from its file, for a test that runs one of its functions (scripts are programs, not a package)."""
@@ -129,7 +166,7 @@ def load_script(path: str):
     import os
     import sys
 
-    full = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scripts", path)
+    full = str(ROOT / "scripts" / path)
     name = "script_" + os.path.splitext(os.path.basename(path))[0]
     if name in sys.modules:
         return sys.modules[name]

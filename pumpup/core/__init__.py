@@ -48,14 +48,14 @@ UNIT_TOL = 1e-6
 #: exponent n where the albedo engine is accurate (issue 13 item 4).  The lobe's angular width is
 #: about m, alpha or 1 / sqrt(n) rad; directions carry rounding errors of ~1e-16, so a lobe 1e-6 wide
 #: is resolved to ~1e-10 relative (ggx alpha = 1e-20 gave 5551 +- 5e-7 at mu = 0.5, beckmann 1e-18
-#: 30.8, phong n = 1e50 8.0 +- 2.8e36; at these ends the values are right: tests/test_extremes.py).
+#: 30.8, phong n = 1e50 8.0 +- 2.8e36; at these ends the values are right: tests/core/test_param_ranges.py).
 #: Beyond MAX_WIDTH a microfacet lobe is not a surface any more (and the engine slows: minutes for
 #: pumped ward_aniso with ax = 1e6).  Models refuse values outside with a SpecError.
 MIN_WIDTH = 1e-6
 #: the microfacet roughness alpha of ggx and beckmann goes lower, to 1e-8: renderers clamp roughness at 1e-4
 #: and square it (Blender Cycles' albedo tables, pumpup.luts), and there the engine agrees with the mirror
 #: limit with Smith shadowing, E = G(wi, mirror) (1 - E = O(alpha^2 tan^2)), within its error for mu >= 1e-6
-#: (tests/test_extremes.py)
+#: (tests/core/test_param_ranges.py)
 MIN_ALPHA = 1e-8
 MAX_WIDTH = 1e3
 MAX_EXPONENT = 1e6

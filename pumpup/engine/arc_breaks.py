@@ -73,7 +73,7 @@ _EPS = float(np.finfo(float).eps)
 
 def kink_breaks_reference(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool = True) -> list[np.ndarray]:
     """Plain numpy reference of :func:`kink_breaks`: the same breaks, bit for bit and in the same
-    order (``tests/test_albedo_breaks.py`` checks the two against each other).
+    order (``tests/engine/test_cubature.py`` checks the two against each other).
 
     The functions whose roots are breaks are sampled on ``_TAU_SCAN`` for all problems at once (an
     (F P, G) array), and every sign change and every touching pair (:func:`_touching_pairs_reference`)
@@ -651,7 +651,7 @@ def kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool 
     points a search asks for stay numpy where they are not exact arithmetic (the model's
     ``Lobe.kinks``, and ``radial_map`` where it takes logs or exponentials: :func:`_prepare_points`), so
     the breaks are those of :func:`kink_breaks_reference`, the plain numpy twin, bit for bit and in
-    the same order (``tests/test_albedo_breaks.py``).
+    the same order (``tests/engine/test_cubature.py``).
     """
     P = len(mu)
     if not levels.shape[1] and lobe.kinks is None:

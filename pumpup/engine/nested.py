@@ -673,7 +673,7 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
         F = np.bincount((s_int[:, None] * RO + np.arange(RO)).ravel(), s_v.ravel(), minlength=nI * RO).reshape(nI, RO)
         # the outer sums column by column, not by a matrix product: BLAS's order of the terms depends on
         # the matrix's size and alignment, and so did the last bits of the error, with the batch a value
-        # of mu was computed in (a table then depended on the number of threads; tests/test_tables.py)
+        # of mu was computed in (a table then depended on the number of threads; tests/tables/test_tables.py)
         kron, gauss = _weighted_columns(F, _OUTER[1]), _weighted_columns(F, _OUTER[2])
         inner = np.bincount(s_int, s_e, minlength=nI)
         outer = np.abs(kron - gauss)

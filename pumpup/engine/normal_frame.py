@@ -176,7 +176,8 @@ def _ring_f_level(fv, rho, al, be, nn, stride):  # pragma: no cover - compiled
 
 
 #: the rounding of :func:`_ggx_ring_f`'s sums per unit of W and per sample: twice the 8 eps of their scale within which
-#: tests/test_polar_ggx_fresnel.py finds :func:`_ring_f_sums` against a summation term by term in 40-digit mpmath
+#: tests/engine/test_route_normal_fresnel.py finds :func:`_ring_f_sums` against a summation term by term in 40-digit
+#: mpmath
 RING_F_ROUNDING = 16.0 * np.finfo(float).eps
 
 
@@ -288,7 +289,7 @@ def _kummer_table() -> np.ndarray:
 
 
 #: :func:`_kummer_table`, read from the package's data (computing it means running the compiled series at import);
-#: ``tests/test_startup.py`` checks the file against :func:`_kummer_table`
+#: ``tests/project/test_startup.py`` checks the file against :func:`_kummer_table`
 KUMMER_COEF = np.load(os.path.join(os.path.dirname(__file__), "data", "kummer_chebyshev.npy"))
 
 
@@ -513,7 +514,7 @@ def n_integrand_reference(brdf, mu: float, x) -> np.ndarray:
 N_LOG_GRADE = 27.0
 #: ... on the side short of the peak only for |d| <= this times x_mu: towards x = 0, P(t)'s singularity (or Schlick's
 #: pole) lies near d = -x_mu, ln 8 = 2.1 from u = ln(x_mu / 8) (at 1/2 a piece came within 0.23 of its length in u of
-#: it, on the cuts at mu = 1; tests/test_polar_ggx.py checks every piece in the variable it is integrated in)
+#: it, on the cuts at mu = 1; tests/engine/test_route_normal.py checks every piece in the variable it is integrated in)
 #: ... and from x = 0 up to this times x_mu, by N_LOG_GRADE in u = ln x (:func:`_n_kind` 3; issue 14's eighteenth session):
 #: P(t)'s singularities at x = +- i atanh(alpha) lie pi / 2 from the real u axis whatever x (Schlick's pole at x ~ -r / (1 -
 #: r), pi), the peak's ln 8 beyond the last piece (GGX alpha = 1e-8 had 17 pieces graded by 3 in x there, now 6)

@@ -81,7 +81,7 @@ per interval is ``CHAIN_SAFETY`` (3) times the raw |K - G| (measured: true error
 chains, 351 mu from 1e-10 to 1, rtol 1e-6 ... 1e-12).  Until issue 14's fifth session the lobe frame served
 pumped lobes too, with an adaptive rule on the arc for every outer node: g was looked up ~50 000 times per mu
 instead of ~400, and the three tables of 3-level g2 pumped Phong n = 20 took 180-230 ms instead of 58-83.
-Checked in ``tests/test_polar_pumped.py`` against an independent quadrature about N (numpy's
+Checked in ``tests/engine/test_route_pumped_lobe.py`` against an independent quadrature about N (numpy's
 level-by-level reference), the nested engine at rtol 1e-13 and the 2-D engine, and the ring table against
 40-digit mpmath.
 

@@ -47,7 +47,7 @@ phi = 0) J is even about th0 and half the turn is integrated.  The estimate per 
 QUADPACK's calibration of |K - G| (:func:`pumpup.physics.quadrature.calibrated`), plus the rounding term
 :data:`pumpup.engine.polar.ROUNDING` times the sum of |K|.
 
-Checked in ``tests/test_slope.py`` against ``tests/data/independent_ward_aniso.json`` (two nested-quad methods written
+Checked in ``tests/engine/test_slope.py`` against ``tests/data/independent_ward_aniso.json`` (two nested-quad methods written
 without pumpup, ``tests/reference/independent_ward_aniso.py``), against the nested engine at rtol 1e-13 (the half vector's polar
 angle and azimuth), against Ward's isotropic 1-D path (complete elliptic integrals) at a_x = a_y, and the ray integral
 against scipy's quadrature (:func:`ray_reference`); ``scripts/calibration/slope_calibration.py`` over 9 pairs of slopes x 14 mu x 4

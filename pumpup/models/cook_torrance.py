@@ -34,14 +34,15 @@ from ..physics.fresnel import fresnel_dielectric as fresnel  # noqa: F401  (pump
 # ----------------------------------------------------------------------------------------
 
 
-#: the incidence mu = 1 / sqrt(2) where the albedo of every model with the geometry factor G of 001 eq. 10 (Cook-Torrance,
-#: Torrance-Sparrow with any D) has a jump in its second derivative: at the retro direction wo = wi both of G's terms are
-#: 2 mu^2 and meet the level N.wo = mu where G switches between them, so the region G < 1 reaches across that level for mu
-#: below it and not above.  Measured by one-sided fits of a(mu) at rtol 1e-13 (tests/test_retro_break.py): a'' = 0.864
-#: below and 0.952 above for Cook-Torrance m = 0.538, 2.28 and 2.68 for Torrance-Sparrow D1 e = 2.  A table's spline
-#: went across it, its knots bunched there, and an engine integrating 1 / U(N.wo) of a 1/E scaling across those knots
-#: under-reported: scaled Cook-Torrance m = 0.538 at mu = 0.9999 was 4.4e-10 off with an estimate of 8.2e-11 at rtol 1e-8
-#: and 1e-10 (scripts/studies/fuzz_engines.py --registry 49 found m = 0.428 at mu = 1, 1.04 x; issue 14's twenty-fifth session)
+#: the incidence mu = 1 / sqrt(2) where the albedo of every model with the geometry factor G of 001 eq. 10
+#: (Cook-Torrance, Torrance-Sparrow with any D) has a jump in its second derivative: at the retro direction wo = wi both
+#: of G's terms are 2 mu^2 and meet the level N.wo = mu where G switches between them, so the region G < 1 reaches
+#: across that level for mu below it and not above.  Measured by one-sided fits of a(mu) at rtol 1e-13
+#: (tests/models/test_cook_torrance_retro_break.py): a'' = 0.864 below and 0.952 above for Cook-Torrance m = 0.538, 2.28
+#: and 2.68 for Torrance-Sparrow D1 e = 2.  A table's spline went across it, its knots bunched there, and an engine
+#: integrating 1 / U(N.wo) of a 1/E scaling across those knots under-reported: scaled Cook-Torrance m = 0.538 at mu =
+#: 0.9999 was 4.4e-10 off with an estimate of 8.2e-11 at rtol 1e-8 and 1e-10 (scripts/studies/fuzz_engines.py --registry
+#: 49 found m = 0.428 at mu = 1, 1.04 x; issue 14's twenty-fifth session)
 RETRO_BREAK = math.sqrt(0.5)
 
 

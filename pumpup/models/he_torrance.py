@@ -53,7 +53,7 @@ Notation, in pumpup's frame (wi towards the light, wo towards the viewer, N = z)
   other factor), and G = (|s|^2 / s_z)^2.  This is a derivation, not a quotation: the
   polarisation-resolved form of HTSG is not implemented.
 
-Check of the constants (a test, ``tests/test_he_torrance.py``): for g >> 1 the series is
+Check of the constants (a test, ``tests/models/test_he_torrance.py``): for g >> 1 the series is
 dominated by m ~ g, sum ~ exp(-v_xy^2 tau^2 / (4 g)) / g, and rho_dd becomes
 F S exp(-tan^2 theta_h / m^2) / (4 pi m^2 cos^4 theta_h cos theta_i cos theta_r) with
 m = 2 sigma / tau: Torrance-Sparrow with the Beckmann distribution and Smith shadowing,

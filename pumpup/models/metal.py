@@ -229,7 +229,7 @@ class Plastic(BRDF):
         # is it only where max S = 1: the stretched lobe (n + 2)/(2 pi) cos^n / cos(Theta_min)
         # reflects more than 1 for small n (max S = 1.0858 at n = 0, 45 degrees; 1.0104 at
         # n = 0.5, 1.00028 at n = 1) and exactly 1 at normal incidence for n >= 2 (measured with
-        # pumpup.max_albedo, and max S falls with n; tests/test_energy_claims.py); F <= 1 only lowers S.
+        # pumpup.max_albedo, and max S falls with n; tests/models/test_energy_claims.py); F <= 1 only lowers S.
         ad, a_s, n = self.p["ad"], self.p["a_s"], self.p["n"]
         if a_s + ad > 1.0 + 1e-12:  # the model's own constraint (000 sec. 5.2), necessary where F = 1
             raise SpecError(

@@ -40,7 +40,7 @@ its first piece).  Then, for any direction (the lobe is symmetric, so either int
 since F_ms <= 1 and I <= I_hi, and from below a_kc >= 1 - (U - E) - (I_hi - I) / I_hi
 (F_ms = 1): the compensated albedo is 1 to within about two table margins (2e-7 with
 the default tables).  Taking a lower bound of E instead would put D above the true deficit
-and the albedo above 1 by the table's margin (tests/test_compensate.py shows both).  A base
+and the albedo above 1 by the table's margin (tests/operators/test_compensate.py shows both).  A base
 whose albedo exceeds 1 beyond its error (Ward near grazing) would need D < 0 (f_ms < 0):
 ``kulla_conty`` refuses it; pumping (g1, g2) handles it.
 

@@ -27,7 +27,7 @@ What was measured
 engine, the distribution of true error / estimate over every independent reference in
 ``tests/`` (``tests/data/independent_reference.json``, ``independent_anisotropic.json``, the
 30-digit mpmath Phong values, the closed forms) at rtol 1e-6 .. 1e-12, with the raw and the
-calibrated estimate; ``tests/test_error_calibration.py`` asserts that the engines' estimates
+calibrated estimate; ``tests/physics/test_error_calibration.py`` asserts that the engines' estimates
 still bound the true error on all of them.
 
 :data:`MODE` selects the estimate of the 1-D path, :data:`MODE_2D` that of the 2-D engine:

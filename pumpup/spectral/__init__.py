@@ -608,7 +608,7 @@ class SpectralPumpedLobe(Spectral):
     is white.  Here only the lobe's geometric loss (the energy cut off by the horizon) is
     restored; F keeps the colour.
 
-    Plausibility (tested in tests/test_spectral_speed.py):
+    Plausibility (tested in tests/spectral/test_spectral_speed.py):
 
     * reciprocal: f* is reciprocal (g is symmetric in wi, wo, 001 eq. 20, 21, and L is
       reciprocal) and F(Theta_min) depends on max(N.L, N.V), symmetric in L and V;

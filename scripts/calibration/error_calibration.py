@@ -29,7 +29,7 @@ engine (the nested 1-D x 1-D engine of issue 14 item 2) is one more entry.  Esti
 (:data:`ESTIMATES`): "raw" is |K - G| everywhere (the engines before issue 14), "quadpack"
 QUADPACK's calibration everywhere, "min" the smaller of the two, "default" what the engines use
 now (the 1-D path calibrated, the 2-D engine raw: ``pumpup.physics.quadrature`` says why).
-``tests/test_error_calibration.py`` uses the same functions, with "default".
+``tests/physics/test_error_calibration.py`` uses the same functions, with "default".
 
 Beside the independent references, "self" cases judge the 2-D engine against itself at rtol
 1e-13 with the raw estimate (its own error subtracted) on integrands with kinks that no hint

@@ -41,7 +41,7 @@ FAMILIES = {
     "cook_torrance, F": [{"type": "cook_torrance", "m": m, "ior": i} for m, i in ((0.02, 1.5), (0.3, 1.5), (0.6, 20.0),
                                                                                    (1.0, 1.001), (3.0, 3.0))],
     # (r = 1e-6 near grazing incidence: the nested reference is 4.8e-7 off there with an estimate of 1.5e-7, against
-    # 30-digit mpmath; tests/test_polar_numeric.py checks the 1-D path against mpmath there instead)
+    # 30-digit mpmath; tests/engine/test_route_half_arc.py checks the 1-D path against mpmath there instead)
     "schlick": [{"type": "schlick", "r": r} for r in (1e-4, 0.001, 0.01, 0.1, 0.5, 1.0)],
     "torrance_sparrow F": [{"type": "torrance_sparrow", "d": d, "s": e, "ior": i}
                            for d, e, i in (("D1", 5, 1.33), ("D1", 200, 1.33), ("D3", 0.3, 1.33), ("D4", 0.4, 1.001),

@@ -65,7 +65,7 @@ def build(path="tables/metals.nc"):
     ds["wavelength"].attrs["units"] = "nm"
     from pumpup.tables.provenance import write_generated
 
-    write_generated(ds, path)  # with the commit of the code that made it (tests/test_generated_data.py)
+    write_generated(ds, path)  # with the commit of the code that made it (tests/project/test_generated_data.py)
     return ds
 
 

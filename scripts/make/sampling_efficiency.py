@@ -3,7 +3,7 @@
 Writes tables/sampling_efficiency.nc (variance per sample of the Phong-lobe estimator for
 reciprocal Phong and stretched Phong, against the viewing angle, for several n; computed by
 the albedo engine, no Monte Carlo) and figures/sampling_efficiency.png, and prints the
-grazing-angle check of 000 eq. 26.  The regression test (tests/test_sampling.py) calls the
+grazing-angle check of 000 eq. 26.  The regression test (tests/apps/test_sampling.py) calls the
 same function, :func:`pumpup.sampling.efficiency_dataset`.
 
     python scripts/make/sampling_efficiency.py [--out tables] [--figures figures]

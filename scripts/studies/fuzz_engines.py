@@ -13,7 +13,7 @@ the independent script (0.8967913960367667 +- 1.9e-8); the nested engine was 9e-
 at every rtol (36-42 x at alpha 1e-4, mu 6e-5 and 1e-4; 1.3 x at alpha 1e-3, mu 1e-5), and at alpha 1e-4 the 2-D
 engine too (4.7e-9 off, estimate 2.5e-9).  The cause, found in the twentieth session: ``albedo.smooth_inverse`` put
 the far horizon break (1 - tau_x = 1.7e-9) at 6.8e-3 (Newton from a start that rounds 1 - 2 (1 - x)); mended, both
-engines agree with a half-vector quadrature to 5e-13 (``tests/test_albedo_breaks.py``).  The nested engine is not
+engines agree with a half-vector quadrature to 5e-13 (``tests/engine/test_cubature.py``).  The nested engine is not
 GGX's path (frame 6 is); it is the tests' second engine and the path of models without a 1-D path.
 
 Found in the twentieth session (each mended, with a test): a pumped level's albedo kinked where its bound equals its value
@@ -30,7 +30,7 @@ x = 1/2 for n > 52, so the kink scan missed a cut of Torrance-Sparrow's G enteri
 off, 1270 x); a Fresnel factor's total reflection (eta < 1, k = 0) unknown to the hints (--registry: correct, but 0.3 s
 per value and minutes per table on the nested engine).
 
-Found in the twenty-third session by --tables (each mended, with a test in tests/test_tables.py): a divergent albedo bisected
+Found in the twenty-third session by --tables (each mended, with a test in tests/tables/test_tables.py): a divergent albedo bisected
 down to two nodes of one log(mu) (scipy's ValueError); a table across a jump (Beckmann with Walter's G1) whose margin hid it;
 pumped plastic n = 5284 turning inside the interval at the normal, which only its midpoint checked (1.55 x its margin); and
 Kulla-Conty over Torrance-Sparrow, exact at the very points the grid checks because it reads a table built on them (8.6 x).

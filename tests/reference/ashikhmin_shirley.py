@@ -1,4 +1,4 @@
-"""An independent Ashikhmin-Shirley BRDF and albedo quadrature, for tests/test_ashikhmin_shirley.py.
+"""An independent Ashikhmin-Shirley BRDF and albedo quadrature, for tests/models/test_ashikhmin_shirley.py.
 
 Written from the paper's formulas (M. Ashikhmin and P. Shirley, "An Anisotropic Phong BRDF Model", Journal of
 Graphics Tools 5(2), 2000, eq. 4 and 5) in the most literal way: h is normalised, its azimuth phi_h taken with

@@ -12,7 +12,7 @@ phi = pi/4 + 0.1.  Two methods in 80-bit long double, composite Gauss-Legendre w
 
 They agree to < 1e-19 relative; grids 24x24 ... 48x48 panels and larger domains moved them by <= 1e-18.  Results (phi
 exactly pi/4 + 0.1; with phi the double 0.8853981633974483 the values are 5e-17 relative lower):
-mu = 1e-8: 1.20781491078982252; mu = 1e-4: 0.012506657640590035 (tests/test_slope.py).
+mu = 1e-8: 1.20781491078982252; mu = 1e-4: 0.012506657640590035 (tests/engine/test_slope.py).
 
 Run: ``python tests/reference/independent_ward_aniso_grazing.py`` (a few minutes).
 """

@@ -1,0 +1,411 @@
+"""The Mitsuba 3 bridge (pumpup.mitsuba): probe and fallback, the plugin against pumpup, Mitsuba's
+chi-square test, and Mitsuba's BSDFs measured by pumpup.
+
+Skipped when mitsuba is not installed; the llvm tests are skipped when the llvm variant does not
+pass the subprocess probe (e.g. libLLVM < 17), the scalar ones run wherever mitsuba imports.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import pumpup
+import helpers
+
+ROOT = str(helpers.ROOT)
+
+
+def _run(code, env=None, timeout=300):
+    e = dict(os.environ)
+    e["PYTHONPATH"] = ROOT + os.pathsep + e.get("PYTHONPATH", "")
+    e.update(env or {})
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=e,
+                          timeout=timeout)
+
+
+mi = pytest.importorskip("mitsuba")
+dr = pytest.importorskip("drjit")
+pm = pytest.importorskip("pumpup.mitsuba")
+
+LLVM = "llvm_ad_rgb"
+LLVM_OK, LLVM_WHY = pm.probe(LLVM)
+needs_llvm = pytest.mark.skipif(not LLVM_OK, reason=f"{LLVM} unusable here: {LLVM_WHY}")
+
+LLVM15 = "/usr/lib/x86_64-linux-gnu/libLLVM-15.so.1"
+
+#: one spec per supported type (and Fresnel / shadowing options); pumped ones at the end
+SPECS = [
+    {"type": "lambert", "albedo": 0.3},
+    {"type": "phong", "n": 20},
+    {"type": "phong", "n": 5000},
+    {"type": "stretched_phong", "n": 50, "p": 0.5},
+    {"type": "stretched_phong", "n": 20},
+    {"type": "retro", "n": 10},
+    {"type": "blinn", "n": 30},
+    {"type": "stretched_blinn", "n": 20},
+    {"type": "ward", "m": 0.2},
+    {"type": "modified_ward", "m": 0.2},
+    {"type": "ward_aniso", "ax": 0.1, "ay": 0.3},
+    {"type": "schlick", "r": 0.1},
+    {"type": "cook_torrance", "m": 0.3, "ior": 1.5},
+    {"type": "ggx", "alpha": 0.3},
+    {"type": "ggx", "alpha": 0.4, "ior": 1.5, "shadowing": "correlated"},
+    {"type": "beckmann", "alpha": 0.2, "g1": "walter", "eta": 0.2, "k": 3.0},
+    {"type": "beckmann", "alpha": 0.5, "shadowing": "correlated"},
+    {"type": "metal", "n": 20, "eta": 0.2, "k": 3.0},
+    {"type": "plastic", "n": 100, "ad": 0.3, "a_s": 0.6, "eta": 1.5},
+    {"type": "pumped", "base": {"type": "phong", "n": 20}, "g": "g2", "levels": 2},
+    {"type": "pumped", "base": {"type": "ward", "m": 0.2}, "g": "g1"},
+]
+PUMPED = [s for s in SPECS if s["type"] == "pumped"]
+#: the models the default suite runs the Monte Carlo and chi-square checks on (all of SPECS under -m slow):
+#: the Phong lobe, its stretched p-model, both microfacet half-vector lobes with Fresnel, a mixture,
+#: the anisotropic tangent frame, and both pumped chains
+FAST = [SPECS[i] for i in (1, 3, 10, 13, 15, 18)] + PUMPED
+
+
+def _split(specs):
+    """pytest params: FAST specs in the default suite, the others marked slow."""
+    return [pytest.param(s, id=json.dumps(s, separators=(",", ":"))[:60],
+                         marks=() if s in FAST else pytest.mark.slow) for s in specs]
+
+
+def _ids(specs):
+    return [json.dumps(s, separators=(",", ":"))[:60] for s in specs]
+
+
+def _pairs(n, rng):
+    """Random pairs above the horizon plus grazing ones (cosines down to 1e-9, below the 1e-8 where pumped
+    chains leave their product table), float32-exact."""
+    def dirs(m, zmin=None):
+        x = rng.normal(size=(m, 3))
+        x[:, 2] = np.abs(x[:, 2])
+        x /= np.linalg.norm(x, axis=1)[:, None]
+        if zmin is not None:  # grazing: z in [zmin, 1e-2], log-uniform
+            z = np.exp(rng.uniform(np.log(zmin), np.log(1e-2), m))
+            s = np.sqrt(1 - z * z)
+            ph = rng.uniform(0, 2 * np.pi, m)
+            x = np.stack([s * np.cos(ph), s * np.sin(ph), z], -1)
+        return x.astype(np.float32).astype(np.float64)
+    v = dirs(n)  # near the mirror direction (sharp lobes): wi = mirror(wo) + 0.02 x noise
+    m = v * np.array([-1.0, -1.0, 1.0]) + 0.02 * rng.normal(size=v.shape)
+    m[:, 2] = np.abs(m[:, 2])
+    m = (m / np.linalg.norm(m, axis=1)[:, None]).astype(np.float32).astype(np.float64)
+    wi = np.concatenate([dirs(n), m, dirs(n // 4, 1e-9), dirs(n // 4)])
+    wo = np.concatenate([dirs(n), v, dirs(n // 4), dirs(n // 4, 1e-9)])
+    return wi, wo
+
+
+def _plugin_eval(b, wi, wo, channel=0):
+    """Mitsuba eval with si.wi = pumpup's wo and Mitsuba's wo = pumpup's wi."""
+    ctx = mi.BSDFContext()
+    if dr.is_jit_v(mi.Float):
+        si = dr.zeros(mi.SurfaceInteraction3f, len(wi))
+        si.wi = mi.Vector3f(*(mi.Float(wo[:, i].astype(np.float32)) for i in range(3)))
+        w = mi.Vector3f(*(mi.Float(wi[:, i].astype(np.float32)) for i in range(3)))
+        val, pdf = b.eval_pdf(ctx, si, w)
+        ev = b.eval(ctx, si, w)
+        assert np.array_equal(np.array(ev), np.array(val))  # eval_pdf = (eval, pdf)
+        assert np.array_equal(np.array(b.pdf(ctx, si, w)), np.array(pdf))
+        return np.array(val[channel], dtype=np.float64), np.array(pdf, dtype=np.float64)
+    vals, pdfs = [], []
+    si = mi.SurfaceInteraction3f()
+    for a, c in zip(wi, wo):
+        si.wi = mi.Vector3f(*map(float, c))
+        w = mi.Vector3f(*map(float, a))
+        v, p = b.eval_pdf(ctx, si, w)
+        assert v[channel] == b.eval(ctx, si, w)[channel] and p == b.pdf(ctx, si, w)
+        vals.append(v[channel])
+        pdfs.append(p)
+    return np.array(vals), np.array(pdfs)
+
+
+#: relative bound of one rounding to float32, plus the double evaluation's own error
+F32 = 2.0**-24 + 1e-12
+
+
+def _check_agreement(spec, variant, n, rng):
+    pm.register(variant)
+    f = pumpup.load(spec)
+    b = pm.load_dict({"type": "pumpup", "spec": spec})
+    wi, wo = _pairs(n, rng)
+    got, pdf = _plugin_eval(b, wi, wo)
+    ref = f.eval(wi, wo) * wi[:, 2]  # Mitsuba's eval includes cos(theta) of its wo (pumpup's wi)
+    tiny = np.finfo(np.float32).tiny  # below it float32 rounds absolutely (denormals)
+    pumped = spec["type"] == "pumped"
+    tol = 2.0**-23 + F32 if pumped else F32  # pumped values are rounded down by 2^-23 before the cast
+    err = np.abs(got - ref)
+    assert np.all(err <= np.maximum(tol * ref, tiny)), f"worst relative difference {np.max(err / ref):.3g}"
+    if pumped:  # never above pumpup's value
+        assert np.all(got <= ref * (1 + 1e-12) + tiny)
+    assert np.sum(ref > 1e-30) > n // 3  # many pairs tested with a non-zero value
+    return pdf
+
+
+@needs_llvm
+@pytest.mark.parametrize("spec", SPECS, ids=_ids(SPECS))
+def test_eval_agrees_with_pumpup_llvm(spec, rng):
+    _check_agreement(spec, LLVM, 2000, rng)
+
+
+@pytest.mark.parametrize("spec", SPECS[:: 3] + PUMPED[:1], ids=_ids(SPECS[:: 3] + PUMPED[:1]))
+def test_eval_agrees_with_pumpup_scalar(spec, rng):
+    _check_agreement(spec, "scalar_rgb", 24, rng)
+
+
+@needs_llvm
+@pytest.mark.parametrize("spec", SPECS[::2], ids=_ids(SPECS[::2]))
+def test_pdf_is_pumpups_sampling_density(spec, rng):
+    pm.register(LLVM)
+    f = pumpup.load(spec)
+    b = pm.load_dict({"type": "pumpup", "spec": spec})
+    for theta in (0.0, 50.0, 89.0):
+        wo = np.array([math.sin(math.radians(theta)), 0.0, math.cos(math.radians(theta))])
+        wo = wo.astype(np.float32).astype(np.float64)
+        wi, _ = _pairs(400, rng)
+        _, pdf = _plugin_eval(b, wi, np.broadcast_to(wo, wi.shape))
+        ref = pumpup.sampling.pdf(f, wi, wo)  # at the same float32 directions
+        ok = ref > 1e-30
+        assert np.allclose(pdf[ok], ref[ok], rtol=F32, atol=0)  # one float32 rounding
+        assert np.all(pdf[~ok] <= 1e-30)
+
+
+def _sample(b, wo, n, seed):
+    """n plugin samples at the view direction wo (Mitsuba's si.wi): (bs.wo, bs.pdf, weight[0])."""
+    rng = np.random.default_rng(seed)
+    u = rng.random((3, n)).astype(np.float32)
+    si = dr.zeros(mi.SurfaceInteraction3f, n)
+    si.wi = mi.Vector3f(*map(float, wo))
+    bs, w = b.sample(mi.BSDFContext(), si, mi.Float(u[0]), mi.Point2f(mi.Float(u[1]), mi.Float(u[2])))
+    d = np.stack([np.array(bs.wo.x), np.array(bs.wo.y), np.array(bs.wo.z)], -1).astype(np.float64)
+    return d, np.array(bs.pdf, dtype=np.float64), np.array(w, dtype=np.float64), si, bs
+
+
+@needs_llvm
+@pytest.mark.parametrize("spec", _split(SPECS))
+def test_mc_albedo_within_4_standard_errors(spec):
+    """Mitsuba Monte Carlo with the plugin's own sample() against pumpup.albedo (reciprocal models:
+    the albedo at wo is the albedo at wi)."""
+    pm.register(LLVM)
+    f = pumpup.load(spec)
+    b = pm.load_dict({"type": "pumpup", "spec": spec})
+    for k, mu in enumerate((1.0, 0.6, 0.1)):
+        wo = np.array([math.sqrt(1 - mu * mu), 0.0, mu], dtype=np.float32)
+        d, pdf, w, si, bs = _sample(b, wo, 100_000, seed=17 + k)
+        x = w[0]
+        est, se = x.mean(), x.std(ddof=1) / math.sqrt(len(x))
+        truth = float(pumpup.albedo(f, float(wo[2])))
+        assert abs(est - truth) <= 4 * se + 1e-6 * truth, f"mu={mu}: MC {est:.6f} +- {se:.2g}, pumpup {truth:.6f}"
+        # the sample's pdf is pdf(bs.wo) and its weight is eval / pdf, at the returned direction
+        ok = pdf > 0
+        ev, p2 = b.eval_pdf(mi.BSDFContext(), si, bs.wo)
+        ev, p2 = np.array(ev, dtype=np.float64), np.array(p2, dtype=np.float64)
+        assert np.array_equal(p2[ok], pdf[ok])
+        q = ev[:, ok] / pdf[ok]  # three float32 roundings apart; eval may underflow to 0 where the weight does not
+        assert np.all(np.abs(w[:, ok] - q) <= 3e-7 * q + np.finfo(np.float32).tiny / pdf[ok])
+        assert np.all(w[:, ~ok] == 0)
+
+
+@pytest.mark.parametrize("spec", [SPECS[1], SPECS[13]], ids=_ids([SPECS[1], SPECS[13]]))
+def test_mc_albedo_scalar(spec):
+    pm.register("scalar_rgb")
+    f = pumpup.load(spec)
+    b = pm.load_dict({"type": "pumpup", "spec": spec})
+    rng = np.random.default_rng(5)
+    mu = 0.6
+    si = mi.SurfaceInteraction3f()
+    si.wi = mi.Vector3f(math.sqrt(1 - mu * mu), 0.0, mu)
+    ctx = mi.BSDFContext()
+    xs = []
+    for u in rng.random((2000, 3)):
+        bs, w = b.sample(ctx, si, float(u[0]), mi.Point2f(float(u[1]), float(u[2])))
+        xs.append(w[0])
+        if w[0] > 0:
+            assert bs.pdf == np.float32(b.pdf(ctx, si, bs.wo))  # Mitsuba stores it in float32
+    xs = np.array(xs)
+    est, se = xs.mean(), xs.std(ddof=1) / math.sqrt(len(xs))
+    assert abs(est - float(pumpup.albedo(f, float(np.float32(mu))))) <= 4 * se
+
+
+# --- Mitsuba's own chi-square test -------------------------------------------------------------
+
+CHI2_SPECS = [s for s in SPECS if not (s["type"] == "phong" and s["n"] > 1000)]
+CHI2_ANGLES = (0.0, 45.0, 80.0)
+#: Mitsuba's ChiSquareTest integrates the pdf over each cell by the trapezoid rule on ires^2
+#: points; its default ires = 4 misjudges lobes squeezed against the horizon at 80 degrees
+#: (Mitsuba's own roughconductor, Beckmann alpha = 0.2 without visible-normal sampling, fails it
+#: there too: a cell's expected count 131 where a 400^2-point integral of the pdf gives 84).  The
+#: significance (0.01) and the Sidak correction are Mitsuba's defaults.
+CHI2_IRES = 16
+
+
+def _chi2(sample_spec, wi, test_count, pdf_spec=None, ires=CHI2_IRES):
+    from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
+
+    sf, pf = BSDFAdapter("pumpup", pm.bsdf_dict(sample_spec), wi=wi)
+    if pdf_spec is not None:
+        _, pf = BSDFAdapter("pumpup", pm.bsdf_dict(pdf_spec), wi=wi)
+    ch = ChiSquareTest(domain=SphericalDomain(), sample_func=sf, pdf_func=pf, sample_dim=3, ires=ires, seed=3)
+    return ch.run(test_count=test_count, quiet=True), ch
+
+
+@needs_llvm
+@pytest.mark.parametrize("spec", _split(CHI2_SPECS))
+def test_mitsuba_chi2(spec):
+    pm.register(LLVM)
+    for theta in CHI2_ANGLES:
+        wi = [math.sin(math.radians(theta)), 0.0, math.cos(math.radians(theta))]
+        ok, ch = _chi2(spec, wi, test_count=len(CHI2_SPECS) * len(CHI2_ANGLES))
+        assert ok, f"theta = {theta}: {ch.messages}"
+    _cleanup()
+
+
+@needs_llvm
+@pytest.mark.parametrize("wrong", [
+    ({"type": "phong", "n": 20}, {"type": "phong", "n": 23}),  # exponent off
+    ({"type": "ggx", "alpha": 0.3}, {"type": "ggx", "alpha": 0.33}),  # roughness off by 10 %
+    ({"type": "pumped", "base": {"type": "blinn", "n": 30}, "g": "g1"}, {"type": "lambert"}),  # cosine pdf for a lobe
+], ids=["phong-n", "ggx-alpha", "pumped-blinn-cosine"])
+def test_mitsuba_chi2_rejects_a_wrong_pdf(wrong):
+    pm.register(LLVM)
+    ok, ch = _chi2(wrong[0], [math.sin(0.5), 0.0, math.cos(0.5)], test_count=len(CHI2_SPECS) * len(CHI2_ANGLES),
+                   pdf_spec=wrong[1])
+    assert not ok
+    _cleanup()
+
+
+def _cleanup():
+    p = os.path.join(os.getcwd(), "chi2_data.py")  # Mitsuba's ChiSquareTest dumps failing tables here
+    if os.path.exists(p):
+        os.remove(p)
+
+
+# --- the probe and the fallback -----------------------------------------------------------------
+
+
+@pytest.mark.skipif(not os.path.exists(LLVM15), reason=f"needs {LLVM15} (Dr.Jit 1.5 aborts on it)")
+def test_probe_detects_libllvm15_and_falls_back_to_scalar():
+    """Dr.Jit 1.5 on libLLVM 15 aborts the process at the first kernel; register() must survive."""
+    code = ("import pumpup.mitsuba as pm, mitsuba as mi\n"
+            "v = pm.register()\n"
+            "b = pm.load_dict({'type': 'pumpup', 'spec': {'type': 'phong', 'n': 20}})\n"
+            "si = mi.SurfaceInteraction3f(); si.wi = mi.Vector3f(0, 0, 1)\n"
+            "print('VARIANT', v, b.eval(mi.BSDFContext(), si, mi.Vector3f(0, 0, 1))[0])\n")
+    r = _run(code, env={"DRJIT_LIBLLVM_PATH": LLVM15})
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.split()[:2] == ["VARIANT", "scalar_rgb"]
+    assert abs(float(r.stdout.split()[2]) - 22 / (2 * math.pi)) < 1e-5
+    lines = [ln for ln in r.stderr.splitlines() if ln.startswith("pumpup.mitsuba:")]
+    assert len(lines) == 1 and "SIGABRT" in lines[0] and "libllvm19" in lines[0]
+
+
+def test_probe_of_a_missing_library_fails_cleanly():
+    r = _run("import pumpup.mitsuba as pm; ok, why = pm.probe('llvm_ad_rgb'); print(ok); print(why)",
+             env={"DRJIT_LIBLLVM_PATH": "/nonexistent/libLLVM.so"})
+    assert r.returncode == 0, r.stderr
+    out = r.stdout.splitlines()
+    assert out[0] == "False" and "exited with status" in out[1]
+
+
+def test_probe_of_scalar_and_unknown_variants():
+    assert pm.probe("scalar_rgb") == (True, "")
+    ok, why = pm.probe("no_such_variant")
+    assert not ok and "no variant" in why
+
+
+# --- specs and errors ---------------------------------------------------------------------------
+
+
+def test_spec_forms_and_errors():
+    pm.register("scalar_rgb")
+    si = mi.SurfaceInteraction3f()
+    si.wi = mi.Vector3f(0, 0, 1)
+    ctx = mi.BSDFContext()
+    w = mi.Vector3f(0, 0.6, 0.8)
+    ref = pumpup.load({"type": "phong", "n": 20}).eval([0, 0.6, 0.8], [0, 0, 1]) * 0.8
+    for d in ({"type": "pumpup", "spec": json.dumps({"type": "phong", "n": 20})},
+              {"type": "pumpup", "spec": "phong:n=20"},
+              {"type": "pumpup", "model": "phong", "n": 20},
+              pm.bsdf_dict(pumpup.load({"type": "phong", "n": 20}))):
+        assert abs(mi.load_dict(d).eval(ctx, si, w)[0] / ref - 1) < 1e-6
+    with pytest.raises(RuntimeError, match="minnaert"):  # Mitsuba wraps the SpecError
+        pm.load_dict({"type": "pumpup", "spec": {"type": "minnaert", "k": 1.0}})
+    with pytest.raises(RuntimeError, match="'n'"):
+        pm.load_dict({"type": "pumpup", "spec": {"type": "phong", "n": -1}})
+    with pytest.raises(RuntimeError, match="needs a 'spec'"):
+        mi.load_dict({"type": "pumpup"})
+    with pytest.raises(TypeError, match="spec must be"):
+        pm.bsdf_dict(3)
+
+
+def test_rgb_list_spec_gives_one_model_per_channel():
+    pm.register("scalar_rgb")
+    from pumpup.models.metal import per_channel
+
+    gold = per_channel("metal", n=200, eta=[0.18, 0.42, 1.37], k=[3.42, 2.35, 1.77])
+    b = pm.load_dict({"type": "pumpup", "spec": [g.spec for g in gold]})
+    si = mi.SurfaceInteraction3f()
+    si.wi = mi.Vector3f(0.6, 0, 0.8)
+    v = b.eval(mi.BSDFContext(), si, mi.Vector3f(-0.6, 0, 0.8))
+    x, z = float(np.float32(0.6)), float(np.float32(0.8))  # the float32 directions Mitsuba holds
+    for c in range(3):
+        ref = gold[c].eval([-x, 0, z], [x, 0, z]) * z
+        assert abs(v[c] / ref - 1) <= F32
+
+
+def test_ward_aniso_uses_the_shading_frame_tangent():
+    """ax is along Mitsuba's local x (the frame's tangent s): a half vector tilted along x falls off
+    with ax, along y with ay."""
+    pm.register("scalar_rgb")
+    spec = {"type": "ward_aniso", "ax": 0.1, "ay": 0.3}
+    b = pm.load_dict({"type": "pumpup", "spec": spec})
+    f = pumpup.load(spec)
+    si = mi.SurfaceInteraction3f()
+    ctx = mi.BSDFContext()
+    for axis in (0, 1):
+        v = np.array([0.0, 0.0, 1.0])
+        l = np.array([0.0, 0.0, 1.0])
+        l[axis] = 0.3
+        l /= np.linalg.norm(l)
+        si.wi = mi.Vector3f(*v)
+        got = b.eval(ctx, si, mi.Vector3f(*map(float, l)))[0]
+        assert abs(got / (f.eval(l.astype(np.float32).astype(float), v) * np.float32(l[2])) - 1) < 1e-6
+    assert f.eval([0.3, 0, 1] / np.linalg.norm([0.3, 0, 1]), [0, 0, 1]) < f.eval(
+        [0, 0.3, 1] / np.linalg.norm([0.3, 0, 1]), [0, 0, 1])
+
+
+# --- Mitsuba's BSDFs in pumpup --------------------------------------------------------------------
+
+
+@needs_llvm
+def test_from_mitsuba_roughconductor_is_pumpups_ggx_and_beckmann(rng):
+    for dist, spec in (("ggx", {"type": "ggx", "alpha": 0.3}),
+                       ("beckmann", {"type": "beckmann", "alpha": 0.3, "g1": "walter"})):
+        m = pm.from_mitsuba({"type": "roughconductor", "distribution": dist, "alpha": 0.3}, variant=LLVM)
+        f = pumpup.load(spec)
+        wi, wo = _pairs(400, rng)
+        a, b = m.eval(wi, wo), f.eval(wi, wo)
+        ok = b > 1e-20
+        assert np.allclose(a[ok], b[ok], rtol=2e-5)  # Mitsuba's float32 evaluation
+        assert np.all(a[~ok] <= 1e-20)
+
+
+@needs_llvm
+def test_from_mitsuba_diffuse_albedo_and_reciprocity():
+    m = pm.from_mitsuba({"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.2, 0.5, 0.8]}}, channel=1,
+                        variant=LLVM)
+    a, err = pumpup.albedo(m, [1.0, 0.3, 1e-3], return_error=True, rtol=1e-6)
+    assert np.all(np.abs(a - 0.5) <= err + 1e-7)  # float32 reflectance: 0.5 exactly; 1 / pi in float32
+    # Mitsuba evaluates f cos in float32, and from_mitsuba divides the cosine out: reciprocal to
+    # float32 rounding only (two roundings each way), not to pumpup's 1e-12
+    r = pumpup.check_reciprocity(m)
+    assert 0 < r.max_rel_error <= 4 * 2.0**-24
+    with pytest.raises(ValueError, match="channel"):
+        pm.from_mitsuba({"type": "diffuse"}, channel=3, variant=LLVM)

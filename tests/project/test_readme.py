@@ -1,0 +1,174 @@
+"""Every ```python and ```bash block of README.md and docs/user-guide.md runs.
+
+The python blocks run in order as ONE script (a file, as a user would save them; the processes
+scheduler of the sweep example then needs its main guard) in a fresh process.  The bash blocks
+run line by line with ``pumpup`` meaning this checkout's command line.  Both run in a scratch
+directory that mirrors the repository root (a symlink to every top-level entry but .git), so
+the examples read what they would read from the root while the files they write (tables,
+sweeps) do not land in the checkout.
+
+The README's first block holds the install commands.  Of each line, the ``pip install ...``
+part is skipped (it would reinstall the package); the rest runs, except what is listed in
+EXPENSIVE with the reason.  A block added to the README later is run by these tests unchanged.
+"""
+
+import os
+import re
+import shlex
+import subprocess
+import sys
+import textwrap
+
+import pytest
+import helpers
+
+ROOT = str(helpers.ROOT)
+README = os.path.join(ROOT, "README.md")
+#: the documents whose examples run, in this order (the user guide's python blocks continue the README's script)
+DOCUMENTS = [README, os.path.join(ROOT, "docs", "user-guide.md")]
+
+#: commands of the README's bash blocks that the default suite does not run, with the reason
+EXPENSIVE = {
+    "python -m pytest -q": "the test suite itself: CI runs it (.ci/run), a test cannot run it inside itself",
+    "pumpup reproduce": "about 10 s, and it rewrites every table: run by test_expensive_bash_commands (-m slow)",
+    "pumpup render scene 000-fig8 --spp 64 --size 256 --variant auto --out scenes":
+        "a path-traced scene, minutes: run by test_expensive_bash_commands (-m slow)",
+}
+#: commands that are never run by a test, even with -m slow
+NEVER = {"python -m pytest -q"}
+
+
+def blocks(text=None):
+    """(language, code, line number) of every fenced python or bash block of ``text``, or (language, code,
+    "FILE line N") of every document's."""
+    if text is None:
+        return [(lang, code, f"{os.path.relpath(path, ROOT)} line {line}") for path in DOCUMENTS
+                for lang, code, line in blocks(open(path).read())]
+    out = []
+    for m in re.finditer(r"^```(python|bash)[ \t]*\n(.*?)^```", text, re.S | re.M):
+        out.append((m.group(1), m.group(2), text[:m.start()].count("\n") + 1))
+    return out
+
+
+def bash_commands(text=None):
+    """The commands of the bash blocks: lines (joined at a trailing backslash), comments dropped,
+    split at '&&', without the 'pip install' parts."""
+    out = []
+    for lang, code, line in blocks(text):
+        if lang != "bash":
+            continue
+        for ln in re.sub(r"\s*\\\n\s*", " ", code).splitlines():
+            ln = ln.split(" #")[0].strip()
+            if not ln or ln.startswith("#"):
+                continue
+            for part in ln.split("&&"):
+                part = part.strip()
+                if part and not part.startswith("pip install"):
+                    out.append((part, line))
+    return out
+
+
+def test_the_parsers_see_every_block():
+    text = textwrap.dedent('''\
+        # x
+        ```bash
+        pip install -e . && pumpup reproduce
+        pip install -e ".[test]" && python -m pytest -q   # CI
+        pumpup models \\
+            --help
+        ```
+        ```python
+        x = 1
+        ```
+        ```text
+        not code
+        ```
+    ''')
+    assert [b[0] for b in blocks(text)] == ["bash", "python"]
+    assert [c for c, _ in bash_commands(text)] == ["pumpup reproduce", "python -m pytest -q", "pumpup models --help"]
+    assert len(blocks()) >= 5 and any(lang == "bash" for lang, _, _ in blocks())
+
+
+def clone_entries() -> list[str]:
+    """The top-level entries a fresh clone has: those git tracks (every entry but .git outside a git checkout)."""
+    try:
+        r = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    except OSError:
+        r = None
+    if r is None or r.returncode != 0 or not r.stdout.strip():
+        return [name for name in os.listdir(ROOT) if name != ".git"]
+    return sorted({line.split("/", 1)[0] for line in r.stdout.splitlines()})
+
+
+@pytest.fixture
+def workspace(tmp_path):
+    """A scratch directory that mirrors the repository root, and a PATH on which ``pumpup`` is
+    this checkout's command line."""
+    work = tmp_path / "root"
+    work.mkdir()
+    for name in clone_entries():
+        os.symlink(os.path.join(ROOT, name), work / name)
+    bindir = tmp_path / "bin"
+    bindir.mkdir()
+    shim = bindir / "pumpup"
+    shim.write_text(f"#!/bin/sh\nexec {shlex.quote(sys.executable)} -m pumpup.cli \"$@\"\n")
+    shim.chmod(0o755)
+    env = dict(os.environ, PYTHONPATH=ROOT, PATH=f"{bindir}{os.pathsep}{os.environ['PATH']}", MPLBACKEND="Agg")
+    env.pop("PYTHONSTARTUP", None)
+    return work, env
+
+
+def test_python_blocks_run_as_one_script(workspace):
+    work, env = workspace
+    code = []
+    for lang, block, line in blocks():
+        if lang == "python":
+            code.append(f"# --- {line}\n{block}")
+    script = work / "readme_examples.py"
+    script.write_text("\n".join(code))
+    r = subprocess.run([sys.executable, str(script)], cwd=work, env=env, capture_output=True, text=True,
+                       timeout=900)
+    assert r.returncode == 0, r.stderr[-3000:]
+    assert "Traceback" not in r.stderr
+
+
+def test_bash_blocks_run(workspace):
+    work, env = workspace
+    ran = 0
+    for cmd, line in bash_commands():
+        if cmd in EXPENSIVE:
+            continue
+        r = subprocess.run(["bash", "-c", cmd], cwd=work, env=env, capture_output=True, text=True, timeout=900)
+        assert r.returncode == 0, f"{line}: {cmd}\n{r.stderr[-2000:]}"
+        ran += 1
+    assert ran >= 1
+
+
+@pytest.mark.slow
+def test_expensive_bash_commands(workspace):
+    work, env = workspace
+    os.unlink(work / "tables")  # reproduce writes tables/: here, not into the checkout
+    for cmd, line in bash_commands():
+        if cmd in EXPENSIVE and cmd not in NEVER:
+            r = subprocess.run(["bash", "-c", cmd], cwd=work, env=env, capture_output=True, text=True, timeout=3600)
+            assert r.returncode == 0, f"{line}: {cmd}\n{r.stderr[-2000:]}"
+
+
+def test_expensive_list_names_real_commands():
+    """EXPENSIVE may only excuse commands that are in the README (no stale excuses)."""
+    cmds = {c for c, _ in bash_commands()}
+    assert set(EXPENSIVE) <= cmds, set(EXPENSIVE) - cmds
+
+
+def test_readme_claims_match_the_code():
+    """Item 16: the README's word on the GIL and on where 'divergence all' writes."""
+    from pumpup.engine.cubature import _geometry_kernel
+    from pumpup.engine.lobe_geometry import accumulate
+    from pumpup.cli import build_parser
+
+    text = "".join(open(path).read() for path in DOCUMENTS)
+    assert "hold the GIL" not in text and "kernels release the GIL" in text
+    for kernel in (_geometry_kernel, accumulate):
+        assert kernel.targetoptions.get("nogil") is True
+    args = build_parser().parse_args(["divergence", "all"])
+    assert f"`{args.tables}/divergence.nc` and `{args.figures}/divergence.png`" in text
