@@ -35,6 +35,8 @@ SPECS = {
     "pumped phong g2 x2": {"type": "pumped", "base": {"type": "phong", "n": 20}, "g": "g2", "levels": 2},
     "scaled ggx": {"type": "scaled", "base": {"type": "ggx", "alpha": 0.3}},
     "kulla_conty ggx": {"type": "kulla_conty", "base": {"type": "ggx", "alpha": 0.3}},
+    "ashikhmin_shirley n=10 rs=0.5": {"type": "ashikhmin_shirley", "nu": 10, "nv": 10, "rs": 0.5},
+    "fresnel(ggx) Au-like": {"type": "fresnel", "base": {"type": "ggx", "alpha": 0.3}, "eta": 0.2, "k": 3.0},
 }
 
 WORKLOAD = r'''
