@@ -358,9 +358,9 @@ def test_kink_breaks_match_the_reference_bit_for_bit(spec, monkeypatch):
             _assert_same_bits(arc_breaks.kink_breaks(lobe, mu, levels, crossings=crossings), ref)
             if crossings:
                 for points, room, chunk in ((1, 16, 8192), (10**6, 0, 700)):
-                    monkeypatch.setattr(A, "_ROUND_POINTS", points)
-                    monkeypatch.setattr(A, "_SCAN_ROOM", room)
-                    monkeypatch.setattr(A, "_CHUNK", chunk)
+                    monkeypatch.setattr(arc_breaks, "_ROUND_POINTS", points)
+                    monkeypatch.setattr(arc_breaks, "_SCAN_ROOM", room)
+                    monkeypatch.setattr(arc_breaks, "_CHUNK", chunk)
                     _assert_same_bits(arc_breaks.kink_breaks(lobe, mu, levels, crossings=crossings), ref)
                 monkeypatch.undo()
     assert found > 0

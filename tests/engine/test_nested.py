@@ -278,18 +278,18 @@ def test_evaluation_counts_per_mu(spec, capsys, no_1d):
     pumpup.albedo(f, mu)
     nested = _nested.LAST_EVALS.astype(float)
     count = [0]
-    orig = lobe_geometry.accumulate
+    orig = A.accumulate  # (the 2-D cubature's own name for it: nested has its own)
 
     def counting(fv, cos_o, weight, total):
         count[0] += fv.shape[0]
         return orig(fv, cos_o, weight, total)
 
-    lobe_geometry.accumulate = counting
+    A.accumulate = counting
     try:
         with helpers.without_nested():
             pumpup.albedo(f, mu)
     finally:
-        lobe_geometry.accumulate = orig
+        A.accumulate = orig
     two_d = count[0] / len(mu)
     with capsys.disabled():
         print(f"\n{spec}: evaluations per mu, nested {nested.mean():.0f} (max {nested.max():.0f}), 2-D {two_d:.0f}")
