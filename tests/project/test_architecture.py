@@ -7,10 +7,10 @@ import os
 import shutil
 import subprocess
 import sys
-import tomllib
 
-import pytest
 import helpers
+import pytest
+import tomllib
 
 ROOT = str(helpers.ROOT)
 
