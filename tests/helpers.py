@@ -88,9 +88,9 @@ def nested_reference(f, mu, rtol=1e-12):
 
 
 def one_d_against_the_other_engines(f, mu, rtols=(1e-6, 1e-10), two_d_at=(0, 5, 7), whole=False, ref_rtol=1e-12):
-    """The 1-D path (pumpup.engine.polar) against the nested engine at rtol ``ref_rtol`` (the 1-D path switched off alone)
-    and, at mu[two_d_at] and the last rtol, the 2-D engine: at every rtol the estimate bounds the difference and meets
-    the tolerance.  Returns (value, error) at the last rtol.  ``whole``: f is a sum whose terms take the path (not
+    """The 1-D path (pumpup.engine.polar) against the nested engine at rtol ``ref_rtol`` (the 1-D path switched off
+    alone) and, at mu[two_d_at] and the last rtol, the 2-D engine: at every rtol the estimate bounds the difference and
+    meets the tolerance.  Returns (value, error) at the last rtol.  ``whole``: f is a sum whose terms take the path (not
     asked)."""
     import pumpup
 
@@ -110,10 +110,10 @@ def one_d_against_the_other_engines(f, mu, rtols=(1e-6, 1e-10), two_d_at=(0, 5, 
 
 
 def n_frame_integrand_against_eval(f, base):
-    """Frame 6's compiled integrand of ``f`` (pumpup.engine.normal_frame.n_integrand: the rule's own arithmetic) against ``f``'s public
-    ``eval`` times N.wo integrated over the azimuth by scipy (n_integrand_reference), to 1e-10, at mu = 0.9, 0.4, 0.05
-    and elevations on both sides of mu; returns the smallest ratio of f's integrand to ``base``'s (a pumped or scaled
-    model against its base)."""
+    """Frame 6's compiled integrand of ``f`` (pumpup.engine.normal_frame.n_integrand: the rule's own arithmetic) against
+    ``f``'s public ``eval`` times N.wo integrated over the azimuth by scipy (n_integrand_reference), to 1e-10, at mu =
+    0.9, 0.4, 0.05 and elevations on both sides of mu; returns the smallest ratio of f's integrand to ``base``'s (a
+    pumped or scaled model against its base)."""
     from pumpup.engine import normal_frame as _normal_frame
 
     low = math.inf

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import pumpup
-pf = importlib.import_module("pumpup.fitting")
 from pumpup.cli import main
 
+pf = importlib.import_module("pumpup.fitting")
 
 # --- independent recomputation of the reported errors --------------------------------------
 
@@ -199,7 +199,8 @@ def test_bad_target_type_and_family(monkeypatch):
     with pytest.raises(pumpup.SpecError, match="family must be a registered model type"):
         pumpup.fit({"type": "ggx", "alpha": 0.1}, "stretched_fong", params={"n": (1, 10)})
     with pytest.raises(pumpup.SpecError, match="zero on every direction"):
-        zero = pumpup.from_function(lambda wi, wo: np.zeros(np.broadcast_shapes(wi.shape, wo.shape)[:-1]), name="zero_fit")
+        zero = pumpup.from_function(lambda wi, wo: np.zeros(np.broadcast_shapes(wi.shape, wo.shape)[:-1]),
+                                    name="zero_fit")
         pumpup.fit(zero, "stretched_phong", params={"n": (1, 10)})
 
 

@@ -10,12 +10,12 @@ import os
 import subprocess
 import sys
 
+import helpers
 import numpy as np
 import pytest
 
 import pumpup
 from pumpup import luts
-import helpers
 
 ROOT = str(helpers.ROOT)
 EXT = {"c": ".h", "filament": ".inc", "npy": ".npy", "netcdf": ".nc", "exr": ".exr"}
@@ -31,7 +31,7 @@ def small(name, n_mu=6, n_rough=5, **kw):
 
 
 def _write_c(path, name, values):
-    items = ", ".join("%ff" % float(np.float32(v)) for v in np.ravel(values))
+    items = ", ".join(f"{float(np.float32(v)):f}f" for v in np.ravel(values))
     with open(path, "w") as fh:
         fh.write(f"/* test */\nstatic const float {name}[{np.size(values)}] = {{\n  {items}\n}};\n")
 
@@ -339,7 +339,7 @@ def test_appleseed_layout_rows_are_roughness(tmp_path):
     vals = np.array([[10 * y + x for x in range(4)] for y in range(3)]) / 100.0  # y: rough, x: mu
     avg = np.array([0.9, 0.8, 0.7])
     path = tmp_path / "a.cpp"
-    items = ", ".join("%ff" % v for v in np.concatenate([vals.ravel(), avg]))
+    items = ", ".join(f"{v:f}f" for v in np.concatenate([vals.ravel(), avg]))
     path.write_text(f"extern const float g_glossy_ggx_albedo_table[15] =\n{{\n    {items}\n}};\n")
     tab = luts.read_table(path, p)
     assert tab["E"].shape == (4, 3) and tab["E"][3, 1] == pytest.approx(0.13)  # mu index 3, rough index 1

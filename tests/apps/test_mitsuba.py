@@ -13,11 +13,11 @@ import os
 import subprocess
 import sys
 
+import helpers
 import numpy as np
 import pytest
 
 import pumpup
-import helpers
 
 ROOT = str(helpers.ROOT)
 
@@ -371,12 +371,12 @@ def test_ward_aniso_uses_the_shading_frame_tangent():
     ctx = mi.BSDFContext()
     for axis in (0, 1):
         v = np.array([0.0, 0.0, 1.0])
-        l = np.array([0.0, 0.0, 1.0])
-        l[axis] = 0.3
-        l /= np.linalg.norm(l)
+        light = np.array([0.0, 0.0, 1.0])
+        light[axis] = 0.3
+        light /= np.linalg.norm(light)
         si.wi = mi.Vector3f(*v)
-        got = b.eval(ctx, si, mi.Vector3f(*map(float, l)))[0]
-        assert abs(got / (f.eval(l.astype(np.float32).astype(float), v) * np.float32(l[2])) - 1) < 1e-6
+        got = b.eval(ctx, si, mi.Vector3f(*map(float, light)))[0]
+        assert abs(got / (f.eval(light.astype(np.float32).astype(float), v) * np.float32(light[2])) - 1) < 1e-6
     assert f.eval([0.3, 0, 1] / np.linalg.norm([0.3, 0, 1]), [0, 0, 1]) < f.eval(
         [0, 0.3, 1] / np.linalg.norm([0.3, 0, 1]), [0, 0, 1])
 

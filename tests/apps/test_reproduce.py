@@ -3,6 +3,7 @@ regression baseline, and clear errors."""
 
 import os
 
+import helpers
 import numpy as np
 import pytest
 import xarray as xr
@@ -11,7 +12,6 @@ import pumpup
 from pumpup.cli import main
 from pumpup.published import TABLE2, TABLE3, TABLE4, TEXT, Published, agrees
 from pumpup.reproduce import LIMITS, TABLES, compute
-import helpers
 
 TABLE_DIR = str(helpers.ROOT / "tables")
 
@@ -27,11 +27,14 @@ def test_agreement_rule_uses_the_printed_digits():
     p = Published("x", "1", "c", "0.350")
     assert agrees(0.3496, p) and agrees(0.35049, p) and not agrees(0.3506, p)
     assert agrees(20.64, Published("x", "1", "c", "20.6")) and not agrees(20.66, Published("x", "1", "c", "20.6"))
-    assert agrees(7.82e-3, Published("x", "1", "c", "7.8e-3")) and not agrees(7.86e-3, Published("x", "1", "c", "7.8e-3"))
+    assert (agrees(7.82e-3, Published("x", "1", "c", "7.8e-3"))
+            and not agrees(7.86e-3, Published("x", "1", "c", "7.8e-3")))
     assert agrees(0.6667, Published("x", "1", "c", "1"))  # a rounded "1"...
     # a value on a rounding boundary, printed rounded half up: agrees on either side within its error
-    assert agrees(0.6875, Published("x", "4", "c", "0.688")) and agrees(0.6875 - 1e-16, Published("x", "4", "c", "0.688"))
-    assert agrees(0.68749, Published("x", "4", "c", "0.688"), error=2e-5) and not agrees(0.68749, Published("x", "4", "c", "0.688"))
+    assert (agrees(0.6875, Published("x", "4", "c", "0.688"))
+            and agrees(0.6875 - 1e-16, Published("x", "4", "c", "0.688")))
+    assert (agrees(0.68749, Published("x", "4", "c", "0.688"), error=2e-5)
+            and not agrees(0.68749, Published("x", "4", "c", "0.688")))
     assert not agrees(0.6667, Published("x", "inf", "c", "1", exact=True))  # ...is not the exact limit 1
     assert agrees(2 / 3 + 1e-9, Published("x", "n = 2", "c", "2/3", exact=True))
 

@@ -2,12 +2,12 @@
 
 import math
 
+import helpers
 import numpy as np
 import pytest
 
 import pumpup
 from pumpup import sampling as S
-import helpers
 
 KINDS = [(S.COSINE, 0.0), (S.MIRROR, 0.0), (S.MIRROR, 7.0), (S.MIRROR, 1e4), (S.RETRO, 30.0),
          (S.HALF_POWER, 0.0), (S.HALF_POWER, 50.0), (S.HALF_BECKMANN, 0.05), (S.HALF_BECKMANN, 0.6),
@@ -77,7 +77,8 @@ class _Density(pumpup.BRDF):
     def lobe(self, mu):
         axis, radial, s = {S.COSINE: ("normal", "cosine", 0.0), S.MIRROR: ("mirror", "power", self.k),
                            S.RETRO: ("retro", "power", self.k), S.HALF_POWER: ("half", "power", self.k),
-                           S.HALF_BECKMANN: ("half", "beckmann", self.k), S.HALF_GGX: ("half", "ggx", self.k)}[self.kind]
+                           S.HALF_BECKMANN: ("half", "beckmann", self.k),
+                           S.HALF_GGX: ("half", "ggx", self.k)}[self.kind]
         return pumpup.Lobe(axis=axis, radial=radial, sharpness=s)
 
 
@@ -341,7 +342,8 @@ def test_efficiency_claims_of_000_sec_4_2(efficiency):
 # chi-square goodness of fit of every sampler (pumpup.testing, in the manner of pbrt-v4 and Mitsuba 3)
 # ----------------------------------------------------------------------------------------
 
-CHI2_VIEWS = np.array([[0.0, 0.0, 1.0], [0.6, 0.0, 0.8], [0.8 * math.sqrt(1 - 0.1**2), 0.6 * math.sqrt(1 - 0.1**2), 0.1]])
+CHI2_VIEWS = np.array([[0.0, 0.0, 1.0], [0.6, 0.0, 0.8],
+                       [0.8 * math.sqrt(1 - 0.1**2), 0.6 * math.sqrt(1 - 0.1**2), 0.1]])
 
 CHI2_MODELS = [
     {"type": "phong", "n": 20},

@@ -6,14 +6,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers import direction_pairs
 
 import pumpup
 import pumpup.scenes as S
-from pumpup.spectral import optical
 from pumpup import spectral
 from pumpup.models.metal import fresnel
-
-from helpers import direction_pairs
+from pumpup.spectral import optical
 
 
 def _up_pairs(rng, m=400):

@@ -8,12 +8,12 @@ import os
 import subprocess
 import sys
 
+import helpers
 import numpy as np
 import pytest
 
 import pumpup
 import pumpup.scenes as S
-import helpers
 
 ROOT = str(helpers.ROOT)
 

@@ -8,13 +8,13 @@ import os
 import subprocess
 import sys
 
+import helpers
 import numpy as np
 import pytest
 import xarray as xr
 
 import pumpup
 from pumpup.cli import main
-import helpers
 
 sweep_module = importlib.import_module("pumpup.sweeps")
 REAL_CELL = sweep_module._cell

@@ -8,10 +8,10 @@ import sys
 import textwrap
 import time
 
+import helpers
 import pytest
 
 import pumpup
-import helpers
 
 sw = sys.modules["pumpup.sweeps"]
 A = dict(spec={"type": "lambert"}, params={"albedo": [0.25, 0.5]}, mu=[0.5, 1.0], scheduler="synchronous",
@@ -114,7 +114,8 @@ def test_killing_a_process_sweep_ends_its_workers(tmp_path):
     alive = workers
     while alive and time.time() < deadline:
         time.sleep(0.2)
-        alive = [w for w in alive if os.path.exists(f"/proc/{w}") and open(f"/proc/{w}/stat").read().rsplit(")", 1)[1].split()[0] != "Z"]
+        alive = [w for w in alive if os.path.exists(f"/proc/{w}")
+                 and open(f"/proc/{w}/stat").read().rsplit(")", 1)[1].split()[0] != "Z"]
     for w in alive:
         os.kill(w, signal.SIGKILL)
     assert not alive, f"workers {alive} outlived the killed sweep"

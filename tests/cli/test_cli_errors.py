@@ -9,11 +9,10 @@ import sys
 import time
 
 import pytest
+from helpers import default_sigint
 
 import pumpup
 from pumpup import cli
-
-from helpers import default_sigint
 
 
 @pytest.fixture

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup.core import checks as _checks
 from pumpup.core import UNIT_TOL
+from pumpup.core import checks as _checks
 
 
 def _unit(rng, n):
@@ -19,10 +19,12 @@ def test_kernel_matches_numpy_reference(rng):
         v = _unit(rng, 50)
         for _ in range(rng.integers(0, 3)):
             i, k = rng.integers(0, 50), rng.integers(0, 3)
-            v[i, k] = rng.choice([np.nan, np.inf, -np.inf, 1e200, v[i, k] * (1 + rng.choice([-1, 1]) * 10 ** rng.uniform(-8, -3))])
+            v[i, k] = rng.choice([np.nan, np.inf, -np.inf, 1e200,
+                                  v[i, k] * (1 + rng.choice([-1, 1]) * 10 ** rng.uniform(-8, -3))])
         assert _checks.first_bad(v, UNIT_TOL) == _checks.first_bad_reference(v, UNIT_TOL), v
     # the edge of the tolerance, both sides
-    v = np.array([[0.0, 0.0, 1.0 + 0.999 * UNIT_TOL], [0.0, 0.0, 1.0 - 0.999 * UNIT_TOL], [0.0, 0.0, 1.0 + 1.001 * UNIT_TOL]])
+    v = np.array([[0.0, 0.0, 1.0 + 0.999 * UNIT_TOL], [0.0, 0.0, 1.0 - 0.999 * UNIT_TOL],
+                  [0.0, 0.0, 1.0 + 1.001 * UNIT_TOL]])
     assert _checks.first_bad(v, UNIT_TOL) == (-1, 2) == _checks.first_bad_reference(v, UNIT_TOL)
 
 
@@ -36,7 +38,8 @@ def test_eval_messages(rng):
     with pytest.raises(ValueError, match=r"^wi contains non-finite values \(first at index \(1, 2\)\)$"):
         f.eval(bad, good)
     bad[1, 2, 0] = 0.5
-    with pytest.raises(ValueError, match=r"^wo must be unit vectors \(\|w\| = 1 within 1e-06\); \|wo\[0, 1\]\| = 1\.1$"):
+    with pytest.raises(ValueError,
+                       match=r"^wo must be unit vectors \(\|w\| = 1 within 1e-06\); \|wo\[0, 1\]\| = 1\.1$"):
         f.eval(good, bad)
     with pytest.raises(ValueError, match=r"\|wi\[\]\| = 2$"):
         f.eval([0.0, 0.0, 2.0], [0.0, 0.0, 1.0])
@@ -52,7 +55,8 @@ def test_off_unit_matches_numpy_reference(rng):
     v = _unit(rng, 400)
     v[::7] *= 1 + rng.choice([-1, 1], size=(len(v[::7]), 1)) * 10 ** rng.uniform(-8, -4, size=(len(v[::7]), 1))
     v[3, 1], v[11, 0], v[19, 2], v[23, 0] = np.nan, np.inf, -np.inf, 1e200
-    v = np.vstack([v, [[0.0, 0.0, 1.0 + 0.999 * UNIT_TOL], [0.0, 0.0, 1.0 - 0.999 * UNIT_TOL], [0.0, 0.0, 1.0 + 1.001 * UNIT_TOL]]])
+    v = np.vstack([v, [[0.0, 0.0, 1.0 + 0.999 * UNIT_TOL], [0.0, 0.0, 1.0 - 0.999 * UNIT_TOL],
+                       [0.0, 0.0, 1.0 + 1.001 * UNIT_TOL]]])
     got = np.array([_checks.off_unit(x, y, z, lo2, hi2) for x, y, z in v])
     ref = _checks.off_unit_reference(v, UNIT_TOL)
     np.testing.assert_array_equal(got, ref)

@@ -1,11 +1,11 @@
 """The BRDF interface: specs, registry, input checks, user functions, reciprocity check."""
 
+import helpers
 import numpy as np
 import pytest
 
 import pumpup
 from pumpup.core import SpecError
-import helpers
 
 
 def test_unknown_type_lists_known_types():

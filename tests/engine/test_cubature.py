@@ -9,16 +9,16 @@ import math
 import sys
 import warnings
 
+import helpers
 import numpy as np
 import pytest
+from helpers import rings
 from scipy.integrate import IntegrationWarning, quad
 from scipy.optimize import brentq
 
 import pumpup
-from pumpup.engine.cubature import AlbedoWarning
-import helpers
-from helpers import rings
 from pumpup.engine import arc_breaks, lobe_geometry
+from pumpup.engine.cubature import AlbedoWarning
 
 A = sys.modules["pumpup.engine.cubature"]
 
@@ -57,7 +57,8 @@ def test_a_level_near_one_is_found_where_it_touches_the_arc():
     assert 1 - 1e-6 < u < 1
     breaks = arc_breaks.kink_breaks(lobe, np.array([MU_SCALED]), np.array([lobe.levels]))[0]
     th, w = math.acos(MU_SCALED), math.acos(u)
-    want = [lobe_geometry.smooth_inverse(*lobe_geometry.radial_map_inverse(lobe.radial, lobe.sharpness, a)) for a in (th + w, th - w)]
+    want = [lobe_geometry.smooth_inverse(*lobe_geometry.radial_map_inverse(lobe.radial, lobe.sharpness, a))
+            for a in (th + w, th - w)]
     assert len(breaks) == 2
     np.testing.assert_allclose(np.sort(breaks), want, rtol=0, atol=1e-9)
 
@@ -128,9 +129,9 @@ def test_cook_torrance_2d_engine_bounds_its_error(rtol):
 
 
 def test_smooth_inverse_to_full_precision_near_both_ends():
-    """tau with tau^2 (3 - 2 tau) = s, against Newton in 50 digits, for s from 1e-300 to 1/2 and on both ends: the closed
-    form rounds 1 - 2 s, and for s below about 1e-16 three Newton steps from its start did not come back (s = 9.2e-18
-    gave 6.8e-3 for 1.7e-9)."""
+    """tau with tau^2 (3 - 2 tau) = s, against Newton in 50 digits, for s from 1e-300 to 1/2 and on both ends: the
+    closed form rounds 1 - 2 s, and for s below about 1e-16 three Newton steps from its start did not come back (s =
+    9.2e-18 gave 6.8e-3 for 1.7e-9)."""
     import mpmath as mp
 
     with mp.workdps(50):
@@ -172,7 +173,8 @@ def _ggx_half_vector_reference(alpha, mu):
     top = 4.0 / mu  # the arc is empty beyond t = 2 / mu or so
     pts = [0.0] + [alpha * 10 ** (k / 4) for k in range(-8, 200) if alpha * 10 ** (k / 4) < top] + [top]
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", IntegrationWarning)  # quad's roundoff notice at 1e-13; it agrees with frame 6 to 1e-16
+        # quad's roundoff notice at 1e-13; it agrees with frame 6 to 1e-16
+        warnings.simplefilter("ignore", IntegrationWarning)
         return sum(quad(arc, a, b, epsabs=0, epsrel=1e-13, limit=200)[0] for a, b in zip(pts[:-1], pts[1:]))
 
 
@@ -181,7 +183,8 @@ def test_ggx_tiny_alpha_at_grazing_finds_its_far_horizon_break(engine):
     """GGX alpha = 1e-4 at mu = 6.05e-5: the arc vanishes at tan(theta_h) = 3.3e4, 1 - tau_x = 1.7e-9, where the half
     vectors beyond tan(theta_h) = 1.45 still carry 4.9e-5 of the albedo.  ``smooth_inverse`` put that break at 1 - tau
     = 6.8e-3, and both engines were 4.7-6.8e-9 off with estimates of 2.5e-9 and 2.8e-10 (found by
-    ``scripts/studies/fuzz_engines.py``).  The 1-D path (frame 6), GGX's default, agreed with this reference to 1e-16."""
+    ``scripts/studies/fuzz_engines.py``).  The 1-D path (frame 6), GGX's default, agreed with this reference to
+    1e-16."""
     alpha, mu = 1e-4, 6.05e-5
     ref = _ggx_half_vector_reference(alpha, mu)
     f = pumpup.load({"type": "ggx", "alpha": alpha})
@@ -189,7 +192,8 @@ def test_ggx_tiny_alpha_at_grazing_finds_its_far_horizon_break(engine):
     assert 1.0 - arc_breaks.horizon_breaks(lobe, mu).max() < 2e-9
     switch = helpers.without_1d() if engine == "nested" else helpers.two_d_only()
     with switch, warnings.catch_warnings():
-        warnings.simplefilter("ignore", AlbedoWarning)  # the budget may run out at rtol 1e-12; the estimate stays honest
+        # the budget may run out at rtol 1e-12; the estimate stays honest
+        warnings.simplefilter("ignore", AlbedoWarning)
         for rtol in (1e-10, 1e-12):
             a, e = pumpup.albedo(f, mu, return_error=True, rtol=rtol)
             assert abs(float(a) - ref) <= float(e) + REF_ERR, (rtol, float(a), ref, float(e))
@@ -381,12 +385,13 @@ def test_kink_breaks_touching_pairs_match_the_reference():
 @pytest.mark.parametrize("alpha,mu,rtol", [(1.42e-3, 1.0, 1e-10), (3e-4, 1.0 - 1e-9, 1e-12), (1e-3, 1.0 - 1e-7, 1e-10),
                                            (1e-3, 0.9999, 1e-10), (2.7e-4, 1.0, 1e-10), (1e-4, 1.0, 1e-10)])
 def test_engines_near_normal_incidence_see_the_shadowing_at_the_horizon(alpha, mu, rtol, engine):
-    """G1(wo) falls to 0 within alpha of the horizon; near normal incidence the arc's integral no longer spreads that over
-    theta_i, and the engines' grids, graded towards the horizon break on the scale of its distance to the end of
+    """G1(wo) falls to 0 within alpha of the horizon; near normal incidence the arc's integral no longer spreads that
+    over theta_i, and the engines' grids, graded towards the horizon break on the scale of its distance to the end of
     the range, did not see it: the nested engine was 1.3-26 x its estimate on the first four cases (issue 14's twentieth
-    session), the 2-D engine 3.3-62 x on five of the six (twenty-first; 2.7e-4 at mu = 1: 2.6e-11 off, estimate 4.1e-13), both
-    found by ``scripts/studies/fuzz_engines.py``.  Both grids are now also graded on alpha's scale (``_nested._alpha_grading``).
-    Reference: the 1-D path (frame 6), which agrees with 30-digit mpmath at mu = 1 (checked here)."""
+    session), the 2-D engine 3.3-62 x on five of the six (twenty-first; 2.7e-4 at mu = 1: 2.6e-11 off, estimate
+    4.1e-13), both found by ``scripts/studies/fuzz_engines.py``.  Both grids are now also graded on alpha's scale
+    (``_nested._alpha_grading``). Reference: the 1-D path (frame 6), which agrees with 30-digit mpmath at mu = 1
+    (checked here)."""
     f = pumpup.load({"type": "ggx", "alpha": alpha})
     ref, eref = pumpup.albedo(f, mu, return_error=True, rtol=1e-13)
     if mu == 1.0:
@@ -401,7 +406,8 @@ def test_engines_near_normal_incidence_see_the_shadowing_at_the_horizon(alpha, m
                 to = 2 * t / (1 - t * t)
                 return 2 / (1 + mp.sqrt(1 + al**2 * to**2)) * 2 * al**2 * t / (al**2 + t**2) ** 2
 
-            pts = sorted({mp.mpf(0), mp.mpf(1), *(al * mp.mpf(10) ** (j / 2) for j in range(-6, 24) if alpha * 10 ** (j / 2) < 1),
+            pts = sorted({mp.mpf(0), mp.mpf(1),
+                          *(al * mp.mpf(10) ** (j / 2) for j in range(-6, 24) if alpha * 10 ** (j / 2) < 1),
                           *(1 - mp.mpf(10) ** -j for j in (12, 9, 6, 4, 3))})
             exact = float(mp.fsum(mp.quad(h, [a, b]) for a, b in zip(pts[:-1], pts[1:])))
         assert abs(float(ref) - exact) <= float(eref) + 1e-16
@@ -423,12 +429,12 @@ def test_power_map_is_continuous_at_its_split(n):
 
 
 def test_2d_engine_sees_a_kink_that_enters_and_leaves_above_the_split():
-    """Torrance-Sparrow D1 (s = 96.6, ior 2.617) at mu = 0.965: the geometry factor's cut 2 cos(alpha) N.wo = wi.h enters
-    the arc at alpha = 0.435 and leaves it at 0.612, both within the kink scan's cell [1/2, 0.5025] of tau (alpha from
-    60 deg to 0.33 rad).  With the map wrong at tau = 1/2 (previous test) the scan missed the first, and the last piece,
-    open only between the two, had no node: the 2-D engine was 1.77e-7 off with an estimate of 1.4e-14 at every rtol
-    and first grid (found by ``scripts/studies/fuzz_engines.py --two-d``).  Reference: a tensor Gauss-Legendre rule in the half
-    vector's spherical coordinates (within 4e-14 of the 1-D path and the nested engine)."""
+    """Torrance-Sparrow D1 (s = 96.6, ior 2.617) at mu = 0.965: the geometry factor's cut 2 cos(alpha) N.wo = wi.h
+    enters the arc at alpha = 0.435 and leaves it at 0.612, both within the kink scan's cell [1/2, 0.5025] of tau (alpha
+    from 60 deg to 0.33 rad).  With the map wrong at tau = 1/2 (previous test) the scan missed the first, and the last
+    piece, open only between the two, had no node: the 2-D engine was 1.77e-7 off with an estimate of 1.4e-14 at every
+    rtol and first grid (found by ``scripts/studies/fuzz_engines.py --two-d``).  Reference: a tensor Gauss-Legendre rule
+    in the half vector's spherical coordinates (within 4e-14 of the 1-D path and the nested engine)."""
     f = pumpup.load({"type": "torrance_sparrow", "d": "D1", "s": 96.59526104151392, "ior": 2.6169635397891735})
     mu = 0.965
     s = math.sqrt(1.0 - mu * mu)
@@ -437,7 +443,8 @@ def test_2d_engine_sees_a_kink_that_enters_and_leaves_above_the_split():
 
     def nodes(a, b, P):
         e = np.linspace(a, b, P + 1)
-        return ((e[1:] + e[:-1])[:, None] / 2 + np.diff(e)[:, None] / 2 * xg).ravel(), (np.diff(e)[:, None] / 2 * wg).ravel()
+        return (((e[1:] + e[:-1])[:, None] / 2 + np.diff(e)[:, None] / 2 * xg).ravel(),
+                (np.diff(e)[:, None] / 2 * wg).ravel())
 
     th, wt = nodes(0.0, 0.95, 160)  # (D1 = cos^96.6 of the half angle: 1e-10 of its peak at 0.95 rad)
     ph, wp = nodes(0.0, math.pi, 160)
@@ -460,15 +467,15 @@ def test_2d_engine_sees_a_kink_that_enters_and_leaves_above_the_split():
         assert abs(float(a) - ref) <= float(e) + 1e-13, (float(a) - ref, float(e))
 
 
-# --- pumped Cook-Torrance: a level of g that is one of the geometry factor's cuts ---------------------------------------
+# --- pumped Cook-Torrance: a level of g that is one of the geometry factor's cuts -------------------------------------
 
 PUMPED_CT = {"type": "pumped", "base": {"type": "cook_torrance", "m": 0.3, "ior": 1.5}, "g": "g2"}
 
 
 def test_a_level_on_a_cut_of_the_model_adds_no_crossings():
     """g's kink N.wo = mu is also Cook-Torrance's kink wo_z - mu: the crossing function of the two is rounding noise,
-    whose sign changes gave 292 breaks at mu = 0.5 (40-60 x the base model's evaluations on the nested engine).  One curve
-    computed twice has no crossing (albedo.COINCIDENT); a level 1e-7 away still crosses the other cuts."""
+    whose sign changes gave 292 breaks at mu = 0.5 (40-60 x the base model's evaluations on the nested engine).  One
+    curve computed twice has no crossing (albedo.COINCIDENT); a level 1e-7 away still crosses the other cuts."""
     lobe = pumpup.load(CT).lobe(0.5)
     mu = np.array([0.5])
     plain = arc_breaks.kink_breaks(lobe, mu, np.zeros((1, 0)))[0]

@@ -6,17 +6,17 @@ import math
 import sys
 import warnings
 
+import helpers
 import numpy as np
 import pytest
 
 import pumpup
+from pumpup.engine import lobe_geometry
 from pumpup.engine import nested as _nested
 from pumpup.engine import polar as _polar
 from pumpup.engine.cubature import NODES, WG, WK, AlbedoWarning, _groups, _integrate_group
 from pumpup.engine.lobe_geometry import kink_coefficients, smooth
-import helpers
 from pumpup.engine.routes import using
-from pumpup.engine import lobe_geometry
 
 
 @pytest.fixture(autouse=True)

@@ -4,10 +4,10 @@ pumpup; tests/data/independent_reference.json holds its output)."""
 
 import json
 
+import helpers
 import pytest
 
 import pumpup
-import helpers
 
 DATA = json.loads((helpers.DATA / "independent_reference.json").read_text())
 DIRECTIONAL = [e for e in DATA["entries"] if e["quantity"] == "directional_albedo" and e["mu"] > 0]

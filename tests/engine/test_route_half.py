@@ -6,14 +6,15 @@ the albedo against the nested and 2-D engines and closed forms."""
 import math
 import warnings
 
+import helpers
 import numpy as np
 import pytest
 
 import pumpup
-from pumpup.engine import polar as _polar
-from pumpup.engine import half_frames as _half_frames, outer_rule as _outer_rule
-import helpers
 from pumpup.core.hints import HalfVectorLobe, PowerLobe, VCavityLobe, WardLobe
+from pumpup.engine import half_frames as _half_frames
+from pumpup.engine import outer_rule as _outer_rule
+from pumpup.engine import polar as _polar
 
 # grazing, the breakpoints' special cases (mu = 1/2: s = cos 30 deg; 1/sqrt(2): cos 2 theta = 0;
 # sqrt(3)/2: s = 1/2, the split of the tail), and ordinary angles
@@ -44,7 +45,8 @@ def _k_half_by_quad(p, mu, u, kind="max"):
         return 4 * c * math.sqrt(nwo) if kind == "root" else 4 * c * nwo / max(mu, nwo) ** p
 
     b, a = s * sa, mu * u
-    cuts = (mu / (2 * u), mu / u) + ((2 * u * mu, 2 * u * mu / (4 * u * u - 1) if u != 0.5 else -9.0) if kind == "vcavity" else ())
+    cuts = (mu / (2 * u), mu / u) + ((2 * u * mu, 2 * u * mu / (4 * u * u - 1) if u != 0.5 else -9.0)
+                                     if kind == "vcavity" else ())
     pts = [math.acos((cv - a) / b) for cv in cuts if b > 0 and abs((cv - a) / b) < 1]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -60,7 +62,8 @@ def test_half_kernel_against_the_geometry_and_its_numpy_twin(rng, p):
         s = math.sqrt((1 - mu) * (1 + mu))
         psi, th = math.atan2(mu, s), math.atan2(s, mu)
         edges = [math.cos(math.pi / 4 + th / 2), math.cos(math.pi / 4 - th / 2), mu]
-        us = np.concatenate([rng.uniform(0, 1, 12), [1.0, 1 - 1e-12], [e * (1 + d) for e in edges for d in (-1e-6, 1e-6)]])
+        us = np.concatenate([rng.uniform(0, 1, 12), [1.0, 1 - 1e-12],
+                             [e * (1 + d) for e in edges for d in (-1e-6, 1e-6)]])
         for u in us[(us > 0) & (us <= 1)]:
             k = _half_frames._k_half(p, mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
             q = _k_half_by_quad(p, mu, float(u))
@@ -81,14 +84,15 @@ def test_ward_kernel_against_the_geometry_and_its_twin(rng):
         s = math.sqrt((1 - mu) * (1 + mu))
         psi, th = math.atan2(mu, s), math.atan2(s, mu)
         edges = [math.cos(math.pi / 4 + th / 2), math.cos(math.pi / 4 - th / 2)]
-        us = np.concatenate([rng.uniform(0, 1, 10), [1.0, 1 - 1e-12], [e * (1 + d) for e in edges for d in (-1e-6, 1e-6)]])
+        us = np.concatenate([rng.uniform(0, 1, 10), [1.0, 1 - 1e-12],
+                             [e * (1 + d) for e in edges for d in (-1e-6, 1e-6)]])
         for u in us[(us > 0) & (us <= 1)]:
             k = _half_frames._k_ward(mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
             q = _k_half_by_quad(0.0, mu, float(u), kind="root")
             assert abs(k - q) <= 1e-13 * max(abs(q), 1.0), (mu, u, k, q)  # (measured: 1.7e-14)
             assert abs(k - _half_frames.ward_integrand_reference(mu, u)[0]) <= 1e-11 * max(abs(q), 1.0), (mu, u)
-    ys = np.concatenate([rng.uniform(0, 1, 300), 10.0 ** rng.uniform(-300, 0, 300), 1 - 10.0 ** rng.uniform(-17, 0, 100),
-                         [1.0, 0.5, 1e-300, 5e-324]])
+    ys = np.concatenate([rng.uniform(0, 1, 300), 10.0 ** rng.uniform(-300, 0, 300),
+                         1 - 10.0 ** rng.uniform(-17, 0, 100), [1.0, 0.5, 1e-300, 5e-324]])
     for y in ys[ys > 0]:
         k, d = _half_frames._complete_kd(float(y))
         assert abs(k - elliprf(0.0, y, 1.0)) <= 2e-15 * elliprf(0.0, y, 1.0), y
@@ -122,8 +126,10 @@ def test_trig_tails_against_mpmath():
     against 50-digit mpmath quadratures of their definitions; and the numpy twin where it does not cancel."""
     mp = pytest.importorskip("mpmath")
     mp.mp.dps = 50
-    defs = [lambda x: mp.quad(lambda t: 1 - mp.cos(t), [0, x]), lambda x: mp.quad(lambda t: mp.cos(t) - mp.cos(x), [0, x]),
-            lambda x: mp.quad(lambda t: (mp.cos(t) - mp.cos(x)) ** 2, [0, x]), lambda x: mp.quad(lambda t: (1 - mp.cos(t)) ** 2, [0, x])]
+    defs = [lambda x: mp.quad(lambda t: 1 - mp.cos(t), [0, x]),
+            lambda x: mp.quad(lambda t: mp.cos(t) - mp.cos(x), [0, x]),
+            lambda x: mp.quad(lambda t: (mp.cos(t) - mp.cos(x)) ** 2, [0, x]),
+            lambda x: mp.quad(lambda t: (1 - mp.cos(t)) ** 2, [0, x])]
     for x in (1e-9, 1e-4, 0.01, 0.3, 0.7, 0.999, 1.0, 1.5, 2.5, math.pi):
         twin = _half_frames.half_moments_reference(x)
         for which, f in enumerate(defs):
@@ -145,18 +151,22 @@ HALF_SPECS = [{"type": "blinn", "n": 16}, {"type": "blinn", "n": 0.5}, {"type": 
               {"type": "ward", "m": 0.1}, {"type": "ward", "m": 0.02}, {"type": "ward", "m": 0.2},
               {"type": "ward", "m": 0.4, "c": 0.6}, {"type": "ward", "m": 1e-4}, {"type": "ward", "m": 5.0},
               # the V-cavity G with F = 1: the azimuth in closed form (a minimum of three lines in wi.h)
-              {"type": "cook_torrance", "m": 0.3}, {"type": "cook_torrance", "m": 0.02}, {"type": "cook_torrance", "m": 2.0},
+              {"type": "cook_torrance", "m": 0.3}, {"type": "cook_torrance", "m": 0.02},
+              {"type": "cook_torrance", "m": 2.0},
               {"type": "torrance_sparrow", "d": "D1", "s": 20}, {"type": "torrance_sparrow", "d": "D1", "s": 0},
-              {"type": "torrance_sparrow", "d": "D1", "s": 200, "b": 3.0}, {"type": "torrance_sparrow", "d": "D4", "s": 0.1}]
+              {"type": "torrance_sparrow", "d": "D1", "s": 200, "b": 3.0},
+              {"type": "torrance_sparrow", "d": "D4", "s": 0.1}]
 
 
-@pytest.mark.parametrize("spec", HALF_SPECS, ids=[f"{s['type']}-{s.get('n', s.get('m', s.get('s')))}" for s in HALF_SPECS])
+@pytest.mark.parametrize("spec", HALF_SPECS,
+                         ids=[f"{s['type']}-{s.get('n', s.get('m', s.get('s')))}" for s in HALF_SPECS])
 def test_blinn_family_against_the_nested_and_two_d_engines(spec):
     """The 1-D path (kind "half") against the nested engine at rtol 1e-12 (the engine these models had before,
     reached by switching off the 1-D path alone) and the 2-D engine, from normal to grazing incidence; at
     rtol 1e-6 and 1e-10 the estimate bounds the difference, and at 1e-10 it meets the tolerance."""
     f = pumpup.load(spec)
-    assert all(helpers.hint_routes(t) and helpers.view(t).kind == "half" for _, t in f.albedo_terms() if t.type != "lambert")
+    assert all(helpers.hint_routes(t) and helpers.view(t).kind == "half"
+               for _, t in f.albedo_terms() if t.type != "lambert")
     mu = np.array(MU)
     with helpers.without_1d(), warnings.catch_warnings():
         warnings.simplefilter("ignore")  # (modified Ward m = 1e-4 misses 1e-12 near grazing: its error is still honest)
@@ -184,14 +194,17 @@ def test_blinn_family_closed_forms():
 def test_blinn_family_evaluations_and_refusals():
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     for spec in ({"type": "blinn", "n": 16}, {"type": "stretched_blinn", "n": 8}, {"type": "modified_ward", "m": 0.1},
-                 {"type": "ward", "m": 0.1}, {"type": "cook_torrance", "m": 0.3}, {"type": "torrance_sparrow", "d": "D1", "s": 20}):
+                 {"type": "ward", "m": 0.1}, {"type": "cook_torrance", "m": 0.3},
+                 {"type": "torrance_sparrow", "d": "D1", "s": 20}):
         _, _, conv, evals = _polar.albedo_1d(pumpup.load(spec), mu, 1e-10, 1e-14, 20000)
         assert conv.all() and evals.mean() < 300 and evals.max() < 1000, (spec, evals.mean(), evals.max())
     for family, args, match in [(HalfVectorLobe, {"n": 5.0, "p": 0.5}, "p must be 0 or 1"),
                                 (HalfVectorLobe, {"n": 0.1, "p": 1.0, "radial": "gauss"}, "radial"),
                                 (HalfVectorLobe, {"n": 0.0, "p": 1.0, "radial": "beckmann"}, "radial"),
-                                (WardLobe, {"m": 0.0}, "m must be"), (VCavityLobe, {"n": 0.1, "radial": "gauss"}, "radial"),
+                                (WardLobe, {"m": 0.0}, "m must be"),
+                                (VCavityLobe, {"n": 0.1, "radial": "gauss"}, "radial"),
                                 (PowerLobe, {"n": 5.0, "p": 1.5}, "p must be"), (PowerLobe, {"n": -1.0}, "n must be")]:
         with pytest.raises(ValueError, match=match):
             family(**args)
-    assert not helpers.hint_routes(pumpup.pump({"type": "stretched_blinn", "n": 8}, g="g1"))  # pumped: the nested engine
+    # pumped: the nested engine
+    assert not helpers.hint_routes(pumpup.pump({"type": "stretched_blinn", "n": 8}, g="g1"))

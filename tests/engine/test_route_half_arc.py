@@ -1,19 +1,24 @@
-"""The half vector's azimuth by a rule on its arc (pumpup.engine.polar frame 4, :func:`pumpup.engine.half_arc._k_numeric`; issue 14,
-seventh session): the Smith microfacet models (GGX, Beckmann; separable or height-correlated G, exact or Walter's G1,
-with or without a Fresnel factor), the V-cavity models with a Fresnel factor (Cook-Torrance, Torrance-Sparrow with
-``ior``) and Schlick's model; and Torrance-Sparrow's D3, whose azimuth is closed-form, under the GGX weight."""
+"""The half vector's azimuth by a rule on its arc (pumpup.engine.polar frame 4,
+:func:`pumpup.engine.half_arc._k_numeric`; issue 14, seventh session): the Smith microfacet models (GGX, Beckmann;
+separable or height-correlated G, exact or Walter's G1, with or without a Fresnel factor), the V-cavity models with a
+Fresnel factor (Cook-Torrance, Torrance-Sparrow with ``ior``) and Schlick's model; and Torrance-Sparrow's D3, whose
+azimuth is closed-form, under the GGX weight."""
 
 import math
 import warnings
 
+import helpers
 import numpy as np
 import pytest
+from helpers import one_d_against_the_other_engines
 
 import pumpup
-from pumpup.engine import half_arc as _half_arc, half_frames as _half_frames, hint_view as _hint_view, lobe_fresnel as _lobe_fresnel, outer_rule as _outer_rule
-from helpers import one_d_against_the_other_engines
-import helpers
 from pumpup.core.hints import AzimuthHint, Fresnel, SchlickLobe, SmithLobe, VCavityLobe
+from pumpup.engine import half_arc as _half_arc
+from pumpup.engine import half_frames as _half_frames
+from pumpup.engine import hint_view as _hint_view
+from pumpup.engine import lobe_fresnel as _lobe_fresnel
+from pumpup.engine import outer_rule as _outer_rule
 
 MU = [1.0, 0.99, 0.9, math.sqrt(3) / 2, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8]
 
@@ -24,11 +29,14 @@ KERNEL_SPECS = [{"type": "ggx", "alpha": 0.1}, {"type": "ggx", "alpha": 0.003},
                 # (Walter's G1 in the correlated G with a Fresnel factor left the 1-D path in issue 14's twenty-first
                 # session: frame 4 was up to 7 x its estimate; tests/models/test_fresnel_total_reflection.py)
                 {"type": "beckmann", "alpha": 1.0, "g1": "walter", "eta": 1.02, "k": 0.01},
-                {"type": "cook_torrance", "m": 0.3, "ior": 1.5}, {"type": "torrance_sparrow", "d": "D1", "s": 20, "ior": 1.001},
+                {"type": "cook_torrance", "m": 0.3, "ior": 1.5},
+                {"type": "torrance_sparrow", "d": "D1", "s": 20, "ior": 1.001},
                 {"type": "schlick", "r": 0.05}, {"type": "schlick", "r": 1e-4, "c": 0.3}]
 
 
-@pytest.mark.parametrize("spec", KERNEL_SPECS, ids=[f"{s['type']}-{s.get('alpha', s.get('m', s.get('s', s.get('r'))))}" for s in KERNEL_SPECS])
+@pytest.mark.parametrize("spec", KERNEL_SPECS,
+                         ids=[f"{s['type']}-{s.get('alpha', s.get('m', s.get('s', s.get('r'))))}"
+                              for s in KERNEL_SPECS])
 def test_numeric_kernel_against_the_geometry(rng, spec):
     """K(u) against its numpy twin, the integral over h's azimuth of the model's own numpy formula (none of the
     kernel's algebra: _half_arc.numeric_integrand_reference), at random u and where K turns: next to the horizon break
@@ -70,12 +78,14 @@ def test_vcavity_rule_with_fresnel_one_is_the_closed_form(rng):
         s = math.sqrt((1 - mu) * (1 + mu))
         psi = math.atan2(mu, s)
         brk = [math.cos(x) for x in _outer_rule._vcavity_breaks(mu, s, psi) if x > 0]
-        us = np.concatenate([rng.uniform(0, 1, 8), [0.5, 1 / math.sqrt(2), mu, 1.0], [b * (1 + d) for b in brk for d in (-1e-7, 1e-7)]])
+        us = np.concatenate([rng.uniform(0, 1, 8), [0.5, 1 / math.sqrt(2), mu, 1.0],
+                             [b * (1 + d) for b in brk for d in (-1e-7, 1e-7)]])
         us = us[(us > 0) & (us <= 1)]
         k, _ = _lobe_fresnel.numeric_integrand(plain, mu, us, rtol=1e-14)
         for u, kv in zip(us, k):
             ref = _half_frames._k_vcavity(mu, s, psi, float(u), math.sqrt((1 - u) * (1 + u)))
-            assert abs(kv - ref) <= 1e-12 * abs(ref) + 1e-14 * mu, (mu, u, kv, ref)  # (as _k_vcavity against quad; K <= 16 pi u mu)
+            # (as _k_vcavity against quad; K <= 16 pi u mu)
+            assert abs(kv - ref) <= 1e-12 * abs(ref) + 1e-14 * mu, (mu, u, kv, ref)
 
 
 NUMERIC_SPECS = [
@@ -83,9 +93,11 @@ NUMERIC_SPECS = [
     {"type": "ggx", "alpha": 0.5, "shadowing": "correlated"}, {"type": "ggx", "alpha": 1.0, "eta": 0.2, "k": 3.0},
     {"type": "beckmann", "alpha": 0.1}, {"type": "beckmann", "alpha": 0.3, "g1": "walter"},
     {"type": "beckmann", "alpha": 0.02, "ior": 1.5},
-    {"type": "beckmann", "alpha": 1.0, "eta": 0.2, "k": 3.0, "g1": "walter"},  # (correlated: the nested engine's, above)
+    # (correlated: the nested engine's, above)
+    {"type": "beckmann", "alpha": 1.0, "eta": 0.2, "k": 3.0, "g1": "walter"},
     {"type": "cook_torrance", "m": 0.3, "ior": 1.5}, {"type": "cook_torrance", "m": 0.6, "ior": 20.0},
-    {"type": "torrance_sparrow", "d": "D4", "s": 0.4, "ior": 1.33}, {"type": "torrance_sparrow", "d": "D1", "s": 20, "ior": 1.001},
+    {"type": "torrance_sparrow", "d": "D4", "s": 0.4, "ior": 1.33},
+    {"type": "torrance_sparrow", "d": "D1", "s": 20, "ior": 1.001},
     # D3 = b / (cos^4 (1 + tan^2 / c3^2)^2): the closed-form V-cavity azimuth under the GGX weight
     {"type": "torrance_sparrow", "d": "D3", "s": 0.3}, {"type": "torrance_sparrow", "d": "D3", "s": 2.0, "b": 0.5},
     # Schlick: the GGX weight with alpha = sqrt(r), 1 / (r + (1 - r) N.V) by the rule on the arc
@@ -94,7 +106,9 @@ NUMERIC_SPECS = [
 ]
 
 
-@pytest.mark.parametrize("spec", NUMERIC_SPECS, ids=[f"{s['type']}-{s.get('alpha', s.get('m', s.get('s', s.get('r'))))}" for s in NUMERIC_SPECS])
+@pytest.mark.parametrize("spec", NUMERIC_SPECS,
+                         ids=[f"{s['type']}-{s.get('alpha', s.get('m', s.get('s', s.get('r'))))}"
+                              for s in NUMERIC_SPECS])
 def test_against_the_nested_and_two_d_engines(spec):
     """The 1-D path against the nested engine at rtol 1e-12 (the engine these models had before, reached by switching
     off the 1-D path alone) and the 2-D engine, from normal to grazing incidence; at rtol 1e-6 and 1e-10 the estimate
@@ -160,7 +174,6 @@ def test_which_models_take_it():
     assert not helpers.hint_routes(pumpup.load({"type": "beckmann", "alpha": 1.5}))
     assert not helpers.hint_routes(pumpup.load({"type": "torrance_sparrow", "d": "D2", "s": 5.0, "ior": 1.5}))
     assert helpers.view(pumpup.load({"type": "ggx", "alpha": 1.0})).smith == (1, 0, 0, 1.0)
-    mu = np.array([0.5, 0.1])
     for family, args, match in [(SmithLobe, {"distribution": "gauss", "alpha": 0.1}, "SmithLobe"),
                                 (SmithLobe, {"distribution": "ggx", "alpha": 0.0}, "SmithLobe"),
                                 (SmithLobe, {"distribution": "ggx", "alpha": 0.1, "g1": "fit"}, "SmithLobe"),
@@ -182,8 +195,8 @@ def test_which_models_take_it():
     ({"type": "schlick", "r": 1e-6}, 1e-5, 45.887293650878604133),
     ({"type": "schlick", "r": 1e-6}, 1e-3, 1.1685049698945183549)])
 def test_against_30_digit_mpmath(spec, mu, ref):
-    """Narrow lobes against 30-digit mpmath values, independent of pumpup (tests/reference/half_mpmath_reference.py, a few
-    minutes each: tanh-sinh over tan(alpha_h) and over h's azimuth), at rtol 1e-10 and 1e-12."""
+    """Narrow lobes against 30-digit mpmath values, independent of pumpup (tests/reference/half_mpmath_reference.py, a
+    few minutes each: tanh-sinh over tan(alpha_h) and over h's azimuth), at rtol 1e-10 and 1e-12."""
     f = pumpup.load(spec)
     for rtol in (1e-10, 1e-12):
         a, e = pumpup.albedo(f, np.array([mu]), return_error=True, rtol=rtol)

@@ -8,15 +8,15 @@ import json
 import math
 import warnings
 
+import helpers
 import numpy as np
 import pytest
 from helpers import phong_albedo_1d
 
 import pumpup
-from pumpup.engine import polar as _polar
-from pumpup.engine import lobe_frame as _lobe_frame
-import helpers
 from pumpup.core.hints import AzimuthHint, PowerLobe
+from pumpup.engine import lobe_frame as _lobe_frame
+from pumpup.engine import polar as _polar
 
 # grazing, the breakpoints' special cases (mu = 1/2: s = cos 30 deg; 1/sqrt(2): cos 2 theta = 0;
 # sqrt(3)/2: s = 1/2, the split of the tail), and ordinary angles
@@ -50,7 +50,8 @@ def test_kernel_integrand_matches_numpy_reference(rng, p):
 
 def _arc_cases():
     """(q, mu, u) where the arc's piece is hardest: T near the Gauss-Jacobi split 4 mu, L = a - b near 0 (t^q's
-    branch point and the pole of the substitution at the same distance), D = T - mu tiny, grazing and normal incidence."""
+    branch point and the pole of the substitution at the same distance), D = T - mu tiny, grazing and normal
+    incidence."""
     cases = []
     for q in (0.01, 0.25, 0.5, 0.75, 0.99):
         for mu in (1.0 - 1e-12, 0.9, 0.5, 0.1, 1e-3, 1e-8, 1e-100):
@@ -65,8 +66,8 @@ def _arc_cases():
 
 def test_arc_piece_and_its_bound_against_mpmath():
     """issue 14's fifteenth session: the arc where N.wo >= mu (p in (0, 1)) by the fewest Gauss-Legendre points in
-    s whose Bernstein-ellipse bound meets the tolerance (``_lobe_frame._arc_power``).  Against 24-digit mpmath at rtol 1e-6
-    .. 1e-14, the returned error bounds the true error, and the piece matches its numpy twin (200 points)."""
+    s whose Bernstein-ellipse bound meets the tolerance (``_lobe_frame._arc_power``).  Against 24-digit mpmath at rtol
+    1e-6 .. 1e-14, the returned error bounds the true error, and the piece matches its numpy twin (200 points)."""
     import mpmath
 
     from pumpup.engine.cubature import NODES, WG, WK
@@ -95,7 +96,8 @@ def test_arc_piece_and_its_bound_against_mpmath():
             worst = max(worst, err / e)
         if a + b <= 4 * mu:  # the whole arc is the piece in s
             assert _lobe_frame._arc_power(q, mu, a, b, d1, beta1, 1e-14, 0.0, NODES, WK, WG, mode_code(), ibuf,
-                                     iwork, jac)[0] == pytest.approx(_lobe_frame.arc_piece_reference(q, mu, a, b, d1), rel=2e-14)
+                                          iwork, jac)[0] == pytest.approx(
+                _lobe_frame.arc_piece_reference(q, mu, a, b, d1), rel=2e-14)
     assert 0.0 < worst <= 1.0
 
 
@@ -139,10 +141,11 @@ def test_against_mpmath_with_honest_error(n, p):
 
 @pytest.mark.parametrize("n", [3, 10, 20])
 def test_nearly_coinciding_breaks_against_mpmath(n):
-    """Near mu = sqrt(3) / 2 the level's break (u = cos 2 theta_i) and the horizon's (u = s) nearly coincide, and each one's
-    square root reaches across the other's (stretched Phong n = 10 at mu = 0.866025 was 3.2e-12 off at rtol 1e-12 with an
-    estimate of 6.6e-13 until issue 14's twelfth session: ``_outer_rule._foreign_roots`` grades the piece next to such a root):
-    against the 30-digit mpmath reference, at rtol 1e-8, 1e-10 and 1e-12, the estimate bounds the error."""
+    """Near mu = sqrt(3) / 2 the level's break (u = cos 2 theta_i) and the horizon's (u = s) nearly coincide, and each
+    one's square root reaches across the other's (stretched Phong n = 10 at mu = 0.866025 was 3.2e-12 off at rtol 1e-12
+    with an estimate of 6.6e-13 until issue 14's twelfth session: ``_outer_rule._foreign_roots`` grades the piece next
+    to such a root): against the 30-digit mpmath reference, at rtol 1e-8, 1e-10 and 1e-12, the estimate bounds the
+    error."""
     m0 = math.sqrt(3) / 2
     mu = m0 * (1.0 + np.array([0.0, -1e-14, 1e-12, -1e-9, 1e-9, -1e-6, 1e-6, -1e-4, 1e-4]))
     refs = [phong_albedo_1d(n, m, stretched=True) for m in mu]
@@ -196,11 +199,13 @@ def test_one_d_agrees_with_the_two_d_engine(spec):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("spec", [dict(type=m.type, **ex) for m in pumpup.registry().values() for ex in m.examples
-                                  if helpers.hint_routes(m(**ex)) or m.type in ("lafortune_sum", "lewis_phong", "phong_shader")],
+                                  if helpers.hint_routes(m(**ex))
+                                  or m.type in ("lafortune_sum", "lewis_phong", "phong_shader")],
                          ids=lambda s: s["type"])
 def test_one_d_agrees_with_the_two_d_engine_on_every_example(spec):
     # the models on the rule on h's arc (frame 4) against the nested engine: the 2-D engine misses GGX alpha = 0.5,
-    # correlated, at mu = 1e-8 by 6.7e-11 with an estimate of 5.5e-11 (30-digit mpmath, tests/engine/test_route_half_arc.py)
+    # correlated, at mu = 1e-8 by 6.7e-11 with an estimate of 5.5e-11 (30-digit mpmath,
+    # tests/engine/test_route_half_arc.py)
     f = pumpup.load(spec)
     mu = np.array(MU)
     a, e = pumpup.albedo(f, mu, return_error=True)
@@ -322,9 +327,10 @@ def test_budget_warns_and_keeps_an_honest_error():
 
 
 def test_jacobi_bound_against_mpmath():
-    """The a-priori bound of the Gauss-Jacobi rules at the arc's end near grazing incidence (``_lobe_frame._jacobi_bound``,
-    issue 14's fifteenth session: it replaced the difference of the two rules as the error) bounds the true error of
-    each rule, against 30-digit mpmath, over q 0.01 .. 0.99, T / mu from 4 to 1e8 and L from -T / 2 down to -1."""
+    """The a-priori bound of the Gauss-Jacobi rules at the arc's end near grazing incidence
+    (``_lobe_frame._jacobi_bound``, issue 14's fifteenth session: it replaced the difference of the two rules as the
+    error) bounds the true error of each rule, against 30-digit mpmath, over q 0.01 .. 0.99, T / mu from 4 to 1e8 and L
+    from -T / 2 down to -1."""
     import mpmath
 
     worst = 0.0
@@ -344,7 +350,8 @@ def test_jacobi_bound_against_mpmath():
     assert worst > 0.0
 
 
-@pytest.mark.parametrize("spec", [{"type": "retro", "n": 10, "p": 0.5}, {"type": "stretched_phong", "n": 20, "p": 0.25}])
+@pytest.mark.parametrize("spec", [{"type": "retro", "n": 10, "p": 0.5},
+                                  {"type": "stretched_phong", "n": 20, "p": 0.25}])
 def test_inner_arc_at_subnormal_mu(spec):
     """mu down to the smallest subnormal: the Gauss-Jacobi bound's ellipse is capped (rho_max overflows there; a
     hypothesis test found retro n = 10, p = 0.5 at mu = 5e-324 with a NaN error): the values and errors are finite and

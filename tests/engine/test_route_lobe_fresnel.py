@@ -1,22 +1,25 @@
-"""The lobe frame with 000 eq. 28's Fresnel factor F(Theta_min) (pumpup.engine.polar frame 5, :func:`pumpup.engine.lobe_fresnel._k_lobe_fresnel`;
-issue 14, eighth session): ``metal``, ``plastic`` with an index, and the ``fresnel`` wrapper over a lobe with p in {0, 1}
-(Phong, stretched Phong, Lafortune, retro, Phong's shader), whose F(max(N.L, N.V)) the rule integrates on the arc
-where N.V >= N.L."""
+"""The lobe frame with 000 eq. 28's Fresnel factor F(Theta_min) (pumpup.engine.polar frame 5,
+:func:`pumpup.engine.lobe_fresnel._k_lobe_fresnel`; issue 14, eighth session): ``metal``, ``plastic`` with an index, and
+the ``fresnel`` wrapper over a lobe with p in {0, 1} (Phong, stretched Phong, Lafortune, retro, Phong's shader), whose
+F(max(N.L, N.V)) the rule integrates on the arc where N.V >= N.L."""
 
 import math
 
+import helpers
 import numpy as np
 import pytest
+from helpers import one_d_against_the_other_engines
 
 import pumpup
-from pumpup.engine import polar as _polar
-from pumpup.engine import chain_frame as _chain_frame, half_arc as _half_arc, lobe_frame as _lobe_frame, lobe_fresnel as _lobe_fresnel
-from pumpup.physics import fresnel as _fresnel_mod
-from helpers import one_d_against_the_other_engines
-import helpers
 from pumpup.core.hints import AzimuthHint, FresnelAtMax, PowerLobe
+from pumpup.engine import chain_frame as _chain_frame
+from pumpup.engine import half_arc as _half_arc
+from pumpup.engine import lobe_frame as _lobe_frame
+from pumpup.engine import lobe_fresnel as _lobe_fresnel
+from pumpup.engine import polar as _polar
 from pumpup.engine.lobe_fresnel import lobe_fresnel_ok
 from pumpup.engine.routes import using
+from pumpup.physics import fresnel as _fresnel_mod
 
 MU = [1.0, 0.99, 0.9, math.sqrt(3) / 2, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8]
 
@@ -51,7 +54,8 @@ def test_kernel_against_scipy_quad(rng, spec):
     x0, y0 = _fresnel_mod.fresnel_branch(spec["eta"], spec.get("k", 0.0))
     for mu in (1.0, 0.7, 0.2, 1e-3):
         th = math.acos(mu)
-        angles = [th - math.acos(min(x0, 1.0)) + d for d in (-2 * y0, 0.0, 2 * y0)] + list(rng.uniform(0, math.pi / 2, 4))
+        angles = ([th - math.acos(min(x0, 1.0)) + d for d in (-2 * y0, 0.0, 2 * y0)]
+                  + list(rng.uniform(0, math.pi / 2, 4)))
         us = np.cos([a for a in angles if 0.0 <= a < math.pi / 2] + [0.0])
         k, e = _lobe_fresnel.numeric_integrand(f, mu, us, rtol=1e-13)
         q = _lobe_fresnel.lobe_fresnel_integrand_reference(f, mu, us)
@@ -68,13 +72,15 @@ def test_against_the_nested_and_two_d_engines(spec):
     one_d_against_the_other_engines(pumpup.load(spec), MU, (1e-6, 1e-8, 1e-10), whole=True)
 
 
-@pytest.mark.parametrize("spec", [s for s in SPECS if s.get("n", s.get("base", {}).get("n", 0)) >= _chain_frame.LOBE_N_MIN],
-                         ids=[i for s, i in zip(SPECS, IDS) if s.get("n", s.get("base", {}).get("n", 0)) >= _chain_frame.LOBE_N_MIN])
+@pytest.mark.parametrize("spec", [s for s in SPECS
+                                  if s.get("n", s.get("base", {}).get("n", 0)) >= _chain_frame.LOBE_N_MIN],
+                         ids=[i for s, i in zip(SPECS, IDS)
+                              if s.get("n", s.get("base", {}).get("n", 0)) >= _chain_frame.LOBE_N_MIN])
 def test_lobe_about_n_against_frame_5(spec):
-    """A lobe with n >= LOBE_N_MIN takes the frame of N (the pumped lobe's, g = 1: the ring table and F(max(mu, N.wo)) per
-    node, issue 14's twelfth session) instead of frame 5 (the lobe frame with a rule on the arc): the two agree within their
-    estimates at rtol 1e-12, and at rtol 1e-6, 1e-8, 1e-10 the frame of N's estimate bounds its distance from frame 5 at
-    1e-12 (less frame 5's own estimate) and meets the tolerance."""
+    """A lobe with n >= LOBE_N_MIN takes the frame of N (the pumped lobe's, g = 1: the ring table and F(max(mu, N.wo))
+    per node, issue 14's twelfth session) instead of frame 5 (the lobe frame with a rule on the arc): the two agree
+    within their estimates at rtol 1e-12, and at rtol 1e-6, 1e-8, 1e-10 the frame of N's estimate bounds its distance
+    from frame 5 at 1e-12 (less frame 5's own estimate) and meets the tolerance."""
     f = _lobe(spec)
     assert helpers.takes_lobe_normal(f.azimuth_hint())
     mu = np.array(MU)
@@ -92,7 +98,8 @@ def test_normal_incidence_is_the_fresnel_factor():
     """At mu = 1 every N.wo <= mu, so F(Theta_min) = F(1) and the albedo of c u^n F / max is F(1) c 2 pi / (n + 2):
     metal's (c = (n + 2) / (2 pi), 000 eq. 6) is F(1) = ((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2) exactly."""
     for n, eta, k in ((20, 0.2, 3.0), (1, 1.5, 0.0), (500, 1.1, 6.0), (0, 0.999, 0.001)):
-        a, e = pumpup.albedo(pumpup.load({"type": "metal", "n": n, "eta": eta, "k": k}), [1.0], return_error=True, rtol=1e-12)
+        a, e = pumpup.albedo(pumpup.load({"type": "metal", "n": n, "eta": eta, "k": k}), [1.0], return_error=True,
+                             rtol=1e-12)
         f1 = ((eta - 1) ** 2 + k * k) / ((eta + 1) ** 2 + k * k)
         assert abs(a[0] - f1) <= e[0] + 4e-16 * f1, (n, eta, k, a[0] - f1, e[0])
 
@@ -106,7 +113,8 @@ def test_which_models_take_it():
     assert not helpers.hint_routes(pumpup.load({"type": "metal", "n": 20, "eta": 0.6}))
     assert not helpers.hint_routes(pumpup.load({"type": "plastic", "n": 20, "eta": 0.6, "ad": 0.0}))
     # a pumped metal keeps its Fresnel factor in the chain frame (a first version dropped it: a pumped gold's albedo was
-    # 2.4, caught by tests/spectral/test_spectral.py), as does the fresnel wrapper of a pumped lobe; not with a near-kink
+    # 2.4, caught by tests/spectral/test_spectral.py), as does the fresnel wrapper of a pumped lobe; not with a
+    # near-kink
     assert helpers.view(pumpup.pump({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0})).fresnel == (0.0, 0.2, 3.0)
     assert not helpers.hint_routes(pumpup.pump({"type": "metal", "n": 20, "eta": 0.6}))
     # about N (g = 1) from n = LOBE_N_MIN on, frame 5 below it; a pumped metal's chain takes its own frame of N
@@ -117,7 +125,6 @@ def test_which_models_take_it():
     for base in ({"type": "stretched_phong", "n": 20, "p": 0.5}, {"type": "lambert"}, {"type": "blinn", "n": 20},
                  {"type": "pumped", "base": {"type": "blinn", "n": 20}}):
         assert not helpers.hint_routes(pumpup.load({"type": "fresnel", "base": base, "eta": 0.2, "k": 3.0})), base
-    mu = np.array([0.5, 0.1])
     # F(max) on a lobe with p outside {0, 1} without a chain, or with a near-kink: no 1-D route
     for p, eta, k in [(0.5, 0.2, 3.0), (1.0, 0.6, 0.0), (1.0, 0.5, 1e-4)]:
         hint = AzimuthHint(PowerLobe(n=5.0, p=p), scale=lambda m: np.ones(np.shape(m)), factors=(FresnelAtMax(eta, k),))
@@ -142,20 +149,23 @@ def test_fresnel_wrapper_of_stretched_phong_is_metal():
     (1, 1.1, 30.0, 0.001, 0.74238552420483239024887086292862664743),  # F's pole near c = 0
     (1, 1.5, 0.0, 0.2, 0.10831605403944787866771866254573111683)])
 def test_metal_against_mpmath(n, eta, k, mu, ref):
-    """metal against 40-digit mpmath values independent of pumpup (tests/reference/metal_mpmath_reference.py: tanh-sinh in the
-    lobe frame about R and in spherical coordinates about N, agreeing to 1e-41), at rtol 1e-8, 1e-10 and 1e-12."""
+    """metal against 40-digit mpmath values independent of pumpup (tests/reference/metal_mpmath_reference.py: tanh-sinh
+    in the lobe frame about R and in spherical coordinates about N, agreeing to 1e-41), at rtol 1e-8, 1e-10 and
+    1e-12."""
     f = pumpup.load({"type": "metal", "n": n, "eta": eta, "k": k})
     for rtol in (1e-8, 1e-10, 1e-12):
         a, e = pumpup.albedo(f, np.array([mu]), return_error=True, rtol=rtol)
         assert abs(a[0] - ref) <= e[0] <= rtol * ref, (rtol, a[0] - ref, e[0])
 
 
-CHAINS = [({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, "g1", 1), ({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, "g2", 2),
-          ({"type": "metal", "n": 5, "eta": 1.1, "k": 30.0}, "g1", 1), ({"type": "metal", "n": 200, "eta": 0.6, "k": 0.3}, "g2", 1),
-          ({"type": "fresnel", "base": {"type": "pumped", "base": {"type": "stretched_phong", "n": 20}}, "eta": 0.2, "k": 3.0},
-           None, 0),
-          ({"type": "fresnel", "base": {"type": "pumped", "base": {"type": "stretched_phong", "n": 20, "p": 0.5}, "g": "g2",
-                                        "levels": 2}, "eta": 0.999, "k": 0.001}, None, 0)]
+CHAINS = [({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, "g1", 1),
+          ({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, "g2", 2),
+          ({"type": "metal", "n": 5, "eta": 1.1, "k": 30.0}, "g1", 1),
+          ({"type": "metal", "n": 200, "eta": 0.6, "k": 0.3}, "g2", 1),
+          ({"type": "fresnel", "base": {"type": "pumped", "base": {"type": "stretched_phong", "n": 20}},
+            "eta": 0.2, "k": 3.0}, None, 0),
+          ({"type": "fresnel", "base": {"type": "pumped", "base": {"type": "stretched_phong", "n": 20, "p": 0.5},
+                                        "g": "g2", "levels": 2}, "eta": 0.999, "k": 0.001}, None, 0)]
 
 
 @pytest.mark.parametrize("spec,g,levels", CHAINS, ids=[f"{s['type']}-{g}-{lv}" for s, g, lv in CHAINS])
@@ -212,7 +222,8 @@ def test_fresnel_mp_is_the_models_fresnel():
     with mp.workdps(30):
         for eta, k in MATERIALS:
             for c in (1.0, 0.7, 0.3, 0.05, 1e-3):
-                assert float(_fresnel_mp(eta, k, mp.mpf(c))) == pytest.approx(float(fresnel(c, eta, k)), rel=1e-13, abs=1e-300)
+                assert float(_fresnel_mp(eta, k, mp.mpf(c))) == pytest.approx(float(fresnel(c, eta, k)), rel=1e-13,
+                                                                              abs=1e-300)
 
 
 def test_brewster_zero_of_the_continued_numerator():
@@ -257,10 +268,10 @@ def _pieces(rng, count):
 
 @pytest.mark.parametrize("eta,k", MATERIALS)
 def test_gauss_piece_and_its_bound_against_mpmath(rng, eta, k):
-    """_lobe_f_piece's n-point rule errs by at most _lobe_f_bound's bound (plus the returned rounding allowance), against
-    30-digit mpmath tanh-sinh of integral F(t) t^q / sqrt((T - t)(t - L)) dt over the piece, F from the complex formula:
-    random pieces (in s beside T and in t), q in {0, 1}, tolerances 1e-6 .. 1e-14 of the piece; and the bound meets the
-    tolerance asked."""
+    """_lobe_f_piece's n-point rule errs by at most _lobe_f_bound's bound (plus the returned rounding allowance),
+    against 30-digit mpmath tanh-sinh of integral F(t) t^q / sqrt((T - t)(t - L)) dt over the piece, F from the complex
+    formula: random pieces (in s beside T and in t), q in {0, 1}, tolerances 1e-6 .. 1e-14 of the piece; and the bound
+    meets the tolerance asked."""
     import mpmath as mp
 
     mpar = _half_arc.numeric_params(pumpup.load({"type": "metal", "n": 5, "eta": eta, "k": k}).azimuth_hint())
@@ -302,7 +313,8 @@ def test_gauss_pieces_against_the_adaptive_rule(spec):
 
 
 def test_gauss_piece_against_its_numpy_twin(rng):
-    """_lobe_f_piece at its bound's n against lobe_f_piece_reference (numpy, 200 points, the complex Fresnel formula)."""
+    """_lobe_f_piece at its bound's n against lobe_f_piece_reference (numpy, 200 points, the complex Fresnel
+    formula)."""
     for eta, k in MATERIALS:
         mpar = _half_arc.numeric_params(pumpup.load({"type": "metal", "n": 5, "eta": eta, "k": k}).azimuth_hint())
         for (mu, top, low, lo, d, first), q in zip(_pieces(rng, 6), [0.0, 1.0] * 3):

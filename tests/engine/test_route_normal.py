@@ -1,36 +1,37 @@
 """Frame 6 (issue 14, ninth session): GGX and Beckmann with F = 1 (either Smith G, exact or Walter's G1) and Schlick's
-model about N, the weight's azimuth in closed form (:func:`pumpup.engine.normal_frame._ggx_ring`, :func:`_beckmann_ring` with
-:func:`_kummer_fast`), one rule over the elevation of wo (:func:`_integrate_n`).
+model about N, the weight's azimuth in closed form (:func:`pumpup.engine.normal_frame._ggx_ring`, :func:`_beckmann_ring`
+with :func:`_kummer_fast`), one rule over the elevation of wo (:func:`_integrate_n`).
 
 Its independent references: scipy's quadrature of Walter's D over the azimuth (the closed form), the model's own
-``eval`` integrated over the azimuth (the integrand), frame 4 (the rule on h's arc these models took before, reached with
-``without_n_frame``: other variables, other cuts, an inner rule), the nested engine where it is honest, and the 30-digit
-mpmath values of tests/engine/test_route_half_arc.py, which now go through frame 6."""
+``eval`` integrated over the azimuth (the integrand), frame 4 (the rule on h's arc these models took before, reached
+with ``without_n_frame``: other variables, other cuts, an inner rule), the nested engine where it is honest, and the
+30-digit mpmath values of tests/engine/test_route_half_arc.py, which now go through frame 6."""
 
 import math
 import warnings
 
+import helpers
 import numpy as np
 import pytest
 
 import pumpup
 from pumpup.engine import normal_frame as _normal_frame
-import helpers
 
 SPECS = [{"type": "ggx", "alpha": a} for a in (1e-8, 1e-4, 0.02, 0.3, 1.0)] + \
         [{"type": "ggx", "alpha": a, "shadowing": "correlated"} for a in (1e-6, 0.01, 0.5)] + \
         [{"type": "schlick", "r": r} for r in (1e-12, 1e-3, 0.2, 1.0)] + [{"type": "schlick", "r": 0.05, "c": 0.3}] + \
         [{"type": "beckmann", "alpha": a} for a in (1e-8, 0.003, 0.1, 1.0)] + \
-        [{"type": "beckmann", "alpha": 0.4, "shadowing": "correlated"}, {"type": "beckmann", "alpha": 0.05, "g1": "walter"},
+        [{"type": "beckmann", "alpha": 0.4, "shadowing": "correlated"},
+         {"type": "beckmann", "alpha": 0.05, "g1": "walter"},
          {"type": "beckmann", "alpha": 0.7, "g1": "walter", "shadowing": "correlated"}]
 IDS = [f"{s['type']}-{s.get('alpha', s.get('r'))}-{s.get('shadowing', '')}" for s in SPECS]
 MU = np.array([1.0, 1.0 - 1e-9, 0.99, 0.9, 0.7, 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8])
 
 
 def _ring_mpmath(a2, mu, d, distribution=1):
-    """The integral of Walter's GGX (``distribution`` 1) or Beckmann (0) D over the azimuth of wo at elevation asin(mu) + d,
-    at 40 digits (mpmath), graded towards the mirror direction (d, the offset from the peak, is what the closed forms take
-    exactly)."""
+    """The integral of Walter's GGX (``distribution`` 1) or Beckmann (0) D over the azimuth of wo at elevation asin(mu)
+    + d, at 40 digits (mpmath), graded towards the mirror direction (d, the offset from the peak, is what the closed
+    forms take exactly)."""
     import mpmath as mp
 
     with mp.workdps(40):
@@ -51,9 +52,9 @@ def _ring_mpmath(a2, mu, d, distribution=1):
 
 @pytest.mark.parametrize("a2", [1e-6, 1e-4, 0.01, 0.25, 0.81, 1.0])
 def test_ring_closed_form_against_mpmath(a2):
-    """The integral of Walter's D over the azimuth of wo in closed form against a 40-digit mpmath quadrature of D itself,
-    at the peak (x = x_mu), beside it, far from it, near the horizon and near the normal.  (scipy's quadrature of D in
-    double precision, ``ring_reference``, is 7e-11 off at a2 = 1e-6, mu = 1e-3.)"""
+    """The integral of Walter's D over the azimuth of wo in closed form against a 40-digit mpmath quadrature of D
+    itself, at the peak (x = x_mu), beside it, far from it, near the horizon and near the normal.  (scipy's quadrature
+    of D in double precision, ``ring_reference``, is 7e-11 off at a2 = 1e-6, mu = 1e-3.)"""
     pytest.importorskip("mpmath")
     for mu in (1.0, 0.95, 0.6, 1e-3):
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -61,9 +62,11 @@ def test_ring_closed_form_against_mpmath(a2):
         for x in (xmu, xmu - 0.5 * math.sqrt(a2), xmu + 2.0 * math.sqrt(a2), 0.3, 1e-3, 0.5 * math.pi - 1e-3):
             if not 0.0 <= x <= 0.5 * math.pi:
                 continue
-            assert _normal_frame._ggx_ring(a2, xmu, xs, x - xmu) == pytest.approx(_ring_mpmath(a2, mu, x - xmu), rel=1e-14), (mu, x)
+            assert _normal_frame._ggx_ring(a2, xmu, xs, x - xmu) == pytest.approx(_ring_mpmath(a2, mu, x - xmu),
+                                                                                   rel=1e-14), (mu, x)
         if a2 >= 0.01:
-            assert _normal_frame._ggx_ring(a2, xmu, xs, 0.3 - xmu) == pytest.approx(_normal_frame.ring_reference(1, a2, mu, 0.3), rel=1e-12)
+            assert _normal_frame._ggx_ring(a2, xmu, xs, 0.3 - xmu) == pytest.approx(
+                _normal_frame.ring_reference(1, a2, mu, 0.3), rel=1e-12)
 
 
 @pytest.mark.parametrize("a2", [1e-6, 1e-4, 0.01, 0.25, 1.0])
@@ -87,8 +90,9 @@ def test_beckmann_ring_against_mpmath(a2):
 
 
 def test_kummer_functions_against_mpmath():
-    """H_j = z^j e^-z 1F1(1/2; j + 1; z): the series and asymptotic sums (_kummer_half) within 10 ulps of 30-digit mpmath,
-    the Chebyshev pieces (_kummer_fast) within 32 ulps of the largest value on their piece, from 0 to 1e6 and at inf."""
+    """H_j = z^j e^-z 1F1(1/2; j + 1; z): the series and asymptotic sums (_kummer_half) within 10 ulps of 30-digit
+    mpmath, the Chebyshev pieces (_kummer_fast) within 32 ulps of the largest value on their piece, from 0 to 1e6 and at
+    inf."""
     mp = pytest.importorskip("mpmath")
     edges = _normal_frame.KUMMER_EDGES
     zs = np.concatenate([np.linspace(0.0, 210.0, 421), [1e-12, 49.99999, 50.0, 199.9999, 1e3, 1e6], edges])
@@ -111,9 +115,10 @@ WIDE = [2, 3, 6, 7, 10, 11, 12, 15, 16, 17, 18, 19]
 
 @pytest.mark.parametrize("spec", [SPECS[i] for i in WIDE], ids=[IDS[i] for i in WIDE])
 def test_integrand_against_the_models_own_eval(spec):
-    """The compiled integrand against the model's public ``eval`` times N.wo integrated over the azimuth by scipy (none of
-    the closed form's algebra), divided by the hint's scale; lobes at least 0.01 wide (for narrower ones ``eval``'s own
-    rounding near the peak, ~ulp / alpha, and scipy's reach 1e-9: the closed form is checked against mpmath above)."""
+    """The compiled integrand against the model's public ``eval`` times N.wo integrated over the azimuth by scipy (none
+    of the closed form's algebra), divided by the hint's scale; lobes at least 0.01 wide (for narrower ones ``eval``'s
+    own rounding near the peak, ~ulp / alpha, and scipy's reach 1e-9: the closed form is checked against mpmath
+    above)."""
     f = pumpup.load(spec)
     for mu in (1.0, 0.8, 0.3, 1e-3):
         xmu = math.asin(mu)
@@ -142,9 +147,10 @@ def _frame_4(f, mu):
 @pytest.mark.parametrize("spec", SPECS, ids=IDS)
 @pytest.mark.parametrize("rtol", [1e-8, 1e-12])
 def test_against_frame_4_and_the_nested_engine(spec, rtol):
-    """Frame 6 against frame 4 at rtol 1e-13 within the summed estimates, from mu = 1 to 1e-300 (frame 4 at 1e-100 there:
-    it stops at HALF_MU_MIN, and the albedo is flat to ~mu near grazing incidence); the estimate within rtol; and where
-    the nested engine is honest (alpha >= 0.01, mu >= 0.2; the nested engine misses narrow lobes) against it too."""
+    """Frame 6 against frame 4 at rtol 1e-13 within the summed estimates, from mu = 1 to 1e-300 (frame 4 at 1e-100
+    there: it stops at HALF_MU_MIN, and the albedo is flat to ~mu near grazing incidence); the estimate within rtol; and
+    where the nested engine is honest (alpha >= 0.01, mu >= 0.2; the nested engine misses narrow lobes) against it
+    too."""
     f = pumpup.load(spec)
     assert helpers.takes_normal(f.azimuth_hint())
     mu = np.concatenate([MU, [1e-100, 1e-300]])
@@ -162,9 +168,9 @@ def test_against_frame_4_and_the_nested_engine(spec, rtol):
 
 
 def test_which_models_take_frame_6():
-    """GGX and Beckmann with F = 1 and alpha <= 1, and Schlick's model (and GGX with a Fresnel factor since the thirteenth
-    session: tests/engine/test_route_normal_fresnel.py); not Beckmann with a Fresnel factor (frame 4) or alpha > 1 (the nested
-    engine), not the V-cavity models."""
+    """GGX and Beckmann with F = 1 and alpha <= 1, and Schlick's model (and GGX with a Fresnel factor since the
+    thirteenth session: tests/engine/test_route_normal_fresnel.py); not Beckmann with a Fresnel factor (frame 4) or
+    alpha > 1 (the nested engine), not the V-cavity models."""
     takes = [{"type": "ggx", "alpha": 0.2}, {"type": "ggx", "alpha": 1.0, "shadowing": "correlated"},
              {"type": "schlick", "r": 0.3}]
     takes += [{"type": "beckmann", "alpha": 0.2}, {"type": "beckmann", "alpha": 1.0, "g1": "walter"}]
@@ -180,11 +186,11 @@ def test_which_models_take_frame_6():
 
 @pytest.mark.parametrize("spec", [SPECS[0], SPECS[5], SPECS[8], SPECS[10]], ids=[IDS[0], IDS[5], IDS[8], IDS[10]])
 def test_cuts_keep_every_piece_off_the_singularities(spec):
-    """The breakpoints are sorted in [0, pi / 2] with 0, pi / 2 and x_mu among them, and every piece lies at least a third
-    of its length from the peak's singularities x_mu +- 2 i atanh(alpha), from B = 0's at pi - x_mu +- 2 i atanh(alpha)
-    and from P(t)'s (or Schlick's pole) near 0: in
-    x, or for a piece off the peak (GGX and Schlick, :data:`pumpup.engine.normal_frame.N_LOG_GRADE`) in u = ln |x - x_mu|, or near x = 0
-    in u = ln x, the variable the engine integrates it in."""
+    """The breakpoints are sorted in [0, pi / 2] with 0, pi / 2 and x_mu among them, and every piece lies at least a
+    third of its length from the peak's singularities x_mu +- 2 i atanh(alpha), from B = 0's at pi - x_mu +- 2 i
+    atanh(alpha) and from P(t)'s (or Schlick's pole) near 0: in x, or for a piece off the peak (GGX and Schlick,
+    :data:`pumpup.engine.normal_frame.N_LOG_GRADE`) in u = ln |x - x_mu|, or near x = 0 in u = ln x, the variable the
+    engine integrates it in."""
     import cmath
 
     f = pumpup.load(spec)
@@ -197,7 +203,8 @@ def test_cuts_keep_every_piece_off_the_singularities(spec):
         assert np.all(np.diff(x) >= 0) and x[0] == 0.0 and x[-1] == 0.5 * math.pi
         assert np.any(np.abs(x - xmu) <= 1e-15)
         # the singularities in d = x - x_mu: the peak's, P(t)'s (or Schlick's pole), B = 0's
-        sing = [complex(0.0, 2.0 * math.atanh(alpha)), complex(-xmu, near0) if hint.schlick is None else complex(-near0 - xmu, 0.0),
+        sing = [complex(0.0, 2.0 * math.atanh(alpha)),
+                complex(-xmu, near0) if hint.schlick is None else complex(-near0 - xmu, 0.0),
                 complex(math.pi - 2.0 * xmu, 2.0 * math.atanh(alpha))]
         for lo, hi, kind in _normal_frame.n_pieces_reference(f, mu):
             if kind:  # u = ln |d| beyond the peak (1) or short of it (2); u = ln x = ln(x_mu + d) near x = 0 (3)
@@ -212,9 +219,10 @@ def test_cuts_keep_every_piece_off_the_singularities(spec):
 
 
 def test_frame_4_at_a_grazing_narrow_lobe_with_a_fresnel_factor():
-    """Frame 4 (GGX with an ior keeps it) at mu = 1e-100, alpha = 1e-8: u^4 underflowed there and the weight divided by 0
-    (ZeroDivisionError out of pumpup.albedo before the ninth session); and its pieces overflowed their arrays at rtol
-    1e-13 (tests/engine/test_polar_boundscheck.py runs that under bounds checking).  The albedo is flat to ~mu near grazing incidence."""
+    """Frame 4 (GGX with an ior keeps it) at mu = 1e-100, alpha = 1e-8: u^4 underflowed there and the weight divided by
+    0 (ZeroDivisionError out of pumpup.albedo before the ninth session); and its pieces overflowed their arrays at rtol
+    1e-13 (tests/engine/test_polar_boundscheck.py runs that under bounds checking).  The albedo is flat to ~mu near
+    grazing incidence."""
     f = pumpup.load({"type": "ggx", "alpha": 1e-8, "ior": 1.5})
     for rtol in (1e-8, 1e-13):
         a, e = pumpup.albedo(f, np.array([1e-100, 1e-50]), return_error=True, rtol=rtol)

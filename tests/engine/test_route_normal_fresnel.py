@@ -1,18 +1,19 @@
-"""Frame 6 with a Fresnel factor (issue 14, thirteenth session): GGX's D times F(wi.h) integrated over the azimuth of wo by
-a product rule whose weights are D's Fourier coefficients in closed form (pumpup.engine.normal_frame._ggx_ring_f), against scipy's
-quadrature of D F on the ring, 40-digit mpmath sums, frame 4 (the rule on h's arc) and the nested engine."""
+"""Frame 6 with a Fresnel factor (issue 14, thirteenth session): GGX's D times F(wi.h) integrated over the azimuth of wo
+by a product rule whose weights are D's Fourier coefficients in closed form (pumpup.engine.normal_frame._ggx_ring_f),
+against scipy's quadrature of D F on the ring, 40-digit mpmath sums, frame 4 (the rule on h's arc) and the nested
+engine."""
 
 import math
 import warnings
 
+import helpers
 import numpy as np
 import pytest
+from helpers import nested_reference
 
 import pumpup
-from pumpup.engine import half_arc as _half_arc, normal_frame as _normal_frame
-
-from helpers import nested_reference
-import helpers
+from pumpup.engine import half_arc as _half_arc
+from pumpup.engine import normal_frame as _normal_frame
 from pumpup.engine.normal_frame import N_FRESNEL_MU_MIN, n_fresnel_ok
 
 #: (ior, eta, k): a dielectric, a glass near 1, a metal, a strong absorber (its pole near c = 0), a weak one
@@ -29,9 +30,9 @@ def _spec(alpha, fresnel, **extra):
 @pytest.mark.parametrize("alpha", [1e-3, 0.1, 0.6, 1.0])
 def test_ring_against_scipy(alpha, fresnel):
     """The ring integral of D F against scipy's adaptive quadrature over the azimuth (``ring_reference``, graded towards
-    the mirror direction), from x = 0 to the normal, at every mu the frame takes: within its own estimate at itol 1e-6 and
-    1e-12, plus 1e-12 of the value for scipy's own error (it integrates at epsrel 1e-13); and with F = 1 (no index) frame
-    6's closed form :func:`_ggx_ring`, within 1e-14."""
+    the mirror direction), from x = 0 to the normal, at every mu the frame takes: within its own estimate at itol 1e-6
+    and 1e-12, plus 1e-12 of the value for scipy's own error (it integrates at epsrel 1e-13); and with F = 1 (no index)
+    frame 6's closed form :func:`_ggx_ring`, within 1e-14."""
     a2 = alpha * alpha
     fv = np.empty(_normal_frame.RING_F_NMAX + 1)
     mp = np.zeros(_half_arc.MP_SIZE)
@@ -83,9 +84,9 @@ MU = np.array([1.0, 0.99, 0.8, 0.5, 0.3, N_FRESNEL_MU_MIN, 0.2, 0.01])
 @pytest.mark.parametrize("alpha,extra", [(1e-4, {}), (0.02, {}), (0.3, {}), (0.5, {"shadowing": "correlated"}),
                                          (1.0, {})])
 def test_albedo_against_frame_4(alpha, extra, fresnel):
-    """The albedo (frame 6 at mu >= N_FRESNEL_MU_MIN, frame 4 below, in one call) against frame 4 at rtol 1e-13 within the
-    summed estimates, at rtol 1e-8 and 1e-12; each estimate within its rtol (or the default atol: the glass near 1 reflects
-    ~1e-9)."""
+    """The albedo (frame 6 at mu >= N_FRESNEL_MU_MIN, frame 4 below, in one call) against frame 4 at rtol 1e-13 within
+    the summed estimates, at rtol 1e-8 and 1e-12; each estimate within its rtol (or the default atol: the glass near 1
+    reflects ~1e-9)."""
     f = pumpup.load(_spec(alpha, fresnel, **extra))
     assert helpers.takes_normal(f.azimuth_hint())
     with helpers.without_normal_frames(), warnings.catch_warnings():
@@ -101,8 +102,8 @@ def test_albedo_against_frame_4(alpha, extra, fresnel):
                                   _spec(0.1, (1.5, 0, 0))])
 def test_albedo_against_the_nested_engine(spec):
     """Against the nested engine at rtol 1e-13 (independent of both 1-D frames) at rtol 1e-10: the estimate bounds the
-    difference (the strong absorber, eta 1.1, k 6, was 2.1 x beyond its estimate while a ring's error came from the ratio
-    of its last two steps alone)."""
+    difference (the strong absorber, eta 1.1, k 6, was 2.1 x beyond its estimate while a ring's error came from the
+    ratio of its last two steps alone)."""
     f = pumpup.load(spec)
     mu = np.array([0.95, 0.7, 0.44412214, 0.41084317, 0.3])
     a, e = pumpup.albedo(f, mu, return_error=True, rtol=1e-10)
@@ -111,18 +112,19 @@ def test_albedo_against_the_nested_engine(spec):
 
 
 def test_integrand_against_the_models_own_eval():
-    """Frame 6's integrand with F (the engine's arithmetic, node by node) against the model's own eval integrated over the
-    azimuth by scipy (``n_integrand_reference``; within 1e-12, as for F = 1: at x = 0.001, mu = 0.9, the two differ by
-    1.1e-13 with F or without it)."""
+    """Frame 6's integrand with F (the engine's arithmetic, node by node) against the model's own eval integrated over
+    the azimuth by scipy (``n_integrand_reference``; within 1e-12, as for F = 1: at x = 0.001, mu = 0.9, the two differ
+    by 1.1e-13 with F or without it)."""
     f = pumpup.load(_spec(0.5, (0, 1.1, 6.0), shadowing="correlated"))
     for mu in (0.41, 0.9):
         x = np.linspace(0.001, 1.5, 7)
-        assert np.allclose(_normal_frame.n_integrand(f, mu, x), _normal_frame.n_integrand_reference(f, mu, x), rtol=1e-12, atol=0.0)
+        assert np.allclose(_normal_frame.n_integrand(f, mu, x), _normal_frame.n_integrand_reference(f, mu, x),
+                           rtol=1e-12, atol=0.0)
 
 
 def test_grazing_incidence_below_frame_4s_range():
-    """mu = 1e-300 with GGX and an index (hypothesis found it: the split handed frame 4's None on): the nested engine takes
-    the model there, as before frame 6 took it, finite and within its estimate of mu = 1e-100's value."""
+    """mu = 1e-300 with GGX and an index (hypothesis found it: the split handed frame 4's None on): the nested engine
+    takes the model there, as before frame 6 took it, finite and within its estimate of mu = 1e-100's value."""
     f = pumpup.load({"type": "ggx", "alpha": 0.1, "ior": 1.5})
     a, e = pumpup.albedo(f, np.array([1e-300, 0.5]), return_error=True, rtol=1e-8)
     b, eb = pumpup.albedo(f, np.array([1e-100]), return_error=True, rtol=1e-8)
@@ -150,7 +152,8 @@ def _normal_incidence_reference(alpha, eta, k, dps=25):
             g1 = 2 / (1 + mp.sqrt(1 + al**2 * to**2))
             return g1 * fres(1 / mp.sqrt(1 + t * t)) * 2 * al**2 * t / (al**2 + t**2) ** 2
 
-        pts = sorted({mp.mpf(0), mp.mpf(1), *(al * mp.mpf(10) ** (j / 2) for j in range(-6, 30) if al * 10 ** (j / 2) < 1),
+        pts = sorted({mp.mpf(0), mp.mpf(1),
+                      *(al * mp.mpf(10) ** (j / 2) for j in range(-6, 30) if al * 10 ** (j / 2) < 1),
                       *(1 - mp.mpf(10) ** -j for j in (12, 9, 6, 4, 3))})
         return float(mp.fsum(mp.quad(f, [a, b]) for a, b in zip(pts[:-1], pts[1:])))
 
@@ -160,8 +163,8 @@ def test_near_kink_conductor_at_normal_incidence(shadowing):
     """eta = 0.271, k = 0.0605: F's branch point lies 0.017 off the real axis at c = 0.9646, a near-kink that frame 4
     (which takes such an index) cut on h's arc only.  At normal incidence wi.h hardly varies on h's circle, so the whole
     near-kink is the outer integrand's, and there was no cut: at mu = 1 GGX alpha 0.003 was 2.4e-11 off with an estimate
-    of 3.5e-12 (rtol 1e-10; found by scripts/studies/fuzz_engines.py).  Now the elevation is cut where an end of the circle's
-    range of wi.h passes x0 (pumpup.engine.outer_rule._pieces)."""
+    of 3.5e-12 (rtol 1e-10; found by scripts/studies/fuzz_engines.py).  Now the elevation is cut where an end of the
+    circle's range of wi.h passes x0 (pumpup.engine.outer_rule._pieces)."""
     eta, k, alpha = 0.27134575896438146, 0.0605363844525441, 0.003000403524851649
     f = pumpup.load({"type": "ggx", "alpha": alpha, "eta": eta, "k": k, "shadowing": shadowing})
     ref = _normal_incidence_reference(alpha, eta, k)  # (at mu = 1 the two shadowings agree: Lambda(N) = 0)
@@ -175,10 +178,11 @@ def test_near_kink_conductor_at_normal_incidence(shadowing):
 
 
 def test_the_frame_4_split_is_per_thread():
-    """GGX with F below N_FRESNEL_MU_MIN takes frame 4 by switching frame 6 off for that call: per thread since issue 14's
-    twenty-second session.  A global switch raced under threads: another thread's mu above it took frame 4 while one had
-    it off (right values, other bits: this test failed 4 times in 4 on 316b97c), and two calls restoring each other's old
-    value could leave it off for good.  Values from three threads at once equal one thread's, bit for bit."""
+    """GGX with F below N_FRESNEL_MU_MIN takes frame 4 by switching frame 6 off for that call: per thread since issue
+    14's twenty-second session.  A global switch raced under threads: another thread's mu above it took frame 4 while
+    one had it off (right values, other bits: this test failed 4 times in 4 on 316b97c), and two calls restoring each
+    other's old value could leave it off for good.  Values from three threads at once equal one thread's, bit for
+    bit."""
     import threading
 
     f = pumpup.load(_spec(0.3, (0, 0.2, 3.0)))

@@ -1,5 +1,5 @@
-"""Pumped GGX, Beckmann (F = 1) and Schlick models on the 1-D path (pumpup/engine/polar.py, frame 6 about N divided by g,
-``_integrate_n`` with ``Polar.chain``): g_1 ... g_k depends on N.wi and N.wo only, so on each ring N.wo = t it is a
+"""Pumped GGX, Beckmann (F = 1) and Schlick models on the 1-D path (pumpup/engine/polar.py, frame 6 about N divided by
+g, ``_integrate_n`` with ``Polar.chain``): g_1 ... g_k depends on N.wi and N.wo only, so on each ring N.wo = t it is a
 constant and the closed-form azimuth of frame 6 still holds; the elevation's rule divides by it.
 
 Checked against the model's own ``eval`` integrated over the azimuth by scipy, against the nested engine at rtol 1e-13
@@ -7,14 +7,13 @@ Checked against the model's own ``eval`` integrated over the azimuth by scipy, a
 and the near-kinks that the levels' tables carry (``Pumped.table_kinks``)."""
 
 
+import helpers
 import numpy as np
 import pytest
-
 from helpers import n_frame_integrand_against_eval, nested_reference, one_d_against_the_other_engines
 
 import pumpup
 from pumpup.engine import polar as _polar
-import helpers
 
 MU = np.array([1.0, 0.999, 0.99, 0.9, 0.7, 0.5, 0.3, 0.1, 0.01, 1e-4, 1e-8])
 
@@ -35,8 +34,8 @@ def test_pumped_microfacet_models_take_frame_6():
         assert hint.chain is not None and helpers.takes_normal(f), spec
         with helpers.without_normal_frames():  # off frame 6 a pumped half-vector model goes to the nested engine
             assert _polar.albedo_1d(f, np.array([0.5]), 1e-8, 0.0, 1000) is None
-    # alpha > 1: the nested engine, as before; with Fresnel at mu >= N_FRESNEL_MU_MIN only since issue 14's twenty-second
-    # session (tests/engine/test_route_normal_pumped_fresnel.py)
+    # alpha > 1: the nested engine, as before; with Fresnel at mu >= N_FRESNEL_MU_MIN only since issue 14's
+    # twenty-second session (tests/engine/test_route_normal_pumped_fresnel.py)
     assert not helpers.hint_routes(pumpup.pump({"type": "ggx", "alpha": 1.5}, g="g1"))
     f = pumpup.pump({"type": "ggx", "alpha": 0.3, "ior": 1.5}, g="g1")
     assert helpers.view(f).chain is not None and not helpers.takes_1d(f)
@@ -75,7 +74,8 @@ def test_near_kinks_of_the_levels_tables():
     knots = np.exp(f.chain()[1].lookup().logx)
     near = knots[np.abs(np.log(knots / diag[0])) < 0.01]
     assert 1 <= len(near) <= 6, near  # its grid does not bunch there (at least 10 knots on each side before the split)
-    assert set(kinks.tolist()) <= set(helpers.view(f).levels(0.5))  # the 1-D path's cuts (the nested engine: the lobe's alone)
+    # the 1-D path's cuts (the nested engine: the lobe's alone)
+    assert set(kinks.tolist()) <= set(helpers.view(f).levels(0.5))
     mu = np.array([0.993068])
     ref, ref_err = nested_reference(f, mu, 1e-13)
     for rtol in (1e-6, 1e-8, 1e-10):

@@ -1,24 +1,23 @@
 """Pumped GGX with a Fresnel factor F(wi.h) (issue 14's twenty-second session): frame 6 (the product rule of D and F on
-each ring, pumpup.engine.normal_frame._ggx_ring_f) divided by the chain's g at each node, at mu >= N_FRESNEL_MU_MIN; the nested engine
-below (frame 4, which takes GGX with F there, has no chain; ``pumpup.engine.polar.one_d_part``).  Before, the nested engine
-took every mu: a 257-point table of 1-level g2 pumped GGX 0.1 with eta 0.2, k 3 took 0.70 s, now 0.28 s
-(``scripts/bench/bench_albedo.py --pumped-f``).
+each ring, pumpup.engine.normal_frame._ggx_ring_f) divided by the chain's g at each node, at mu >= N_FRESNEL_MU_MIN; the
+nested engine below (frame 4, which takes GGX with F there, has no chain; ``pumpup.engine.polar.one_d_part``).  Before,
+the nested engine took every mu: a 257-point table of 1-level g2 pumped GGX 0.1 with eta 0.2, k 3 took 0.70 s, now
+0.28 s (``scripts/bench/bench_albedo.py --pumped-f``).
 
 Checked against the model's own ``eval`` integrated over the azimuth by scipy (the integrand, g included) and the nested
-engine at rtol 1e-13, the estimate bounding the difference at every rtol; the ring's error is divided by g as the node is
-(a pumped g is below 1)."""
+engine at rtol 1e-13, the estimate bounding the difference at every rtol; the ring's error is divided by g as the node
+is (a pumped g is below 1)."""
 
 import warnings
 
+import helpers
 import numpy as np
 import pytest
-
 from helpers import nested_reference
 
 import pumpup
-from pumpup.engine import polar as _polar
 from pumpup.engine import normal_frame as _normal_frame
-import helpers
+from pumpup.engine import polar as _polar
 from pumpup.engine.normal_frame import N_FRESNEL_MU_MIN
 
 SPECS = [
@@ -45,9 +44,12 @@ def test_which_take_frame_6_and_where():
         with helpers.without_normal_frames():
             assert not helpers.hint_routes(pumpup.load(spec))
     # not: a near-kink conductor (frame 6's n_fresnel_ok), Beckmann with F, a 1/E-scaled GGX with F
-    assert not helpers.hint_routes(pumpup.load({"type": "pumped", "base": {"type": "ggx", "alpha": 0.2, "eta": 0.5, "k": 0.002}}))
-    assert not helpers.hint_routes(pumpup.load({"type": "pumped", "base": {"type": "beckmann", "alpha": 0.2, "ior": 1.5}}))
-    assert helpers.one_d_mask(pumpup.load({"type": "ggx", "alpha": 0.2, "ior": 1.5}), MU).all()  # (F(wi.h) unpumped: 1-D at every mu)
+    assert not helpers.hint_routes(pumpup.load({"type": "pumped",
+                                                "base": {"type": "ggx", "alpha": 0.2, "eta": 0.5, "k": 0.002}}))
+    assert not helpers.hint_routes(pumpup.load({"type": "pumped",
+                                                "base": {"type": "beckmann", "alpha": 0.2, "ior": 1.5}}))
+    # (F(wi.h) unpumped: 1-D at every mu)
+    assert helpers.one_d_mask(pumpup.load({"type": "ggx", "alpha": 0.2, "ior": 1.5}), MU).all()
 
 
 @pytest.mark.parametrize("spec", SPECS, ids=IDS)
@@ -92,10 +94,11 @@ def test_a_table_through_both_paths():
 
 
 def test_the_rings_error_is_divided_by_g():
-    """A node's ring error (:func:`pumpup.engine.normal_frame._ggx_ring_f`) enters the rule's error divided by g, as the node's value
-    is: one node at a time (as ``_n_values`` calls the rule), the pumped node's value and error are the plain node's
-    divided by g.  g is below 1: without the division a pumped node's ring error was under-reported by the factor g
-    (issue 14's twenty-second session; the values' tests above do not see a factor of 0.5-1 at their tolerances)."""
+    """A node's ring error (:func:`pumpup.engine.normal_frame._ggx_ring_f`) enters the rule's error divided by g, as the
+    node's value is: one node at a time (as ``_n_values`` calls the rule), the pumped node's value and error are the
+    plain node's divided by g.  g is below 1: without the division a pumped node's ring error was under-reported by the
+    factor g (issue 14's twenty-second session; the values' tests above do not see a factor of 0.5-1 at their
+    tolerances)."""
     import math
 
     f = pumpup.load(SPECS[0])
@@ -108,9 +111,9 @@ def test_the_rings_error_is_divided_by_g():
             d = x - xmu
             g = _normal_frame._n_chain_g(hint.chain, mu, math.sin(x))
             assert 0.0 < g < 1.0
-            plain = _normal_frame._n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, None, None, 1e-6, 0.0, fv,
-                                   0)
-            pumped = _normal_frame._n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, hint.chain, None, 1e-6,
-                                    0.0, fv, 0)
+            plain = _normal_frame._n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, None, None,
+                                          1e-6, 0.0, fv, 0)
+            pumped = _normal_frame._n_rule(mp, mu, xmu, xs, d, d + 1.0, np.zeros(1), one, one, buf, 1, hint.chain, None,
+                                           1e-6, 0.0, fv, 0)
             assert pumped[0] == pytest.approx(plain[0] / g, rel=1e-14)
             assert pumped[1] == pytest.approx(plain[1] / g, rel=1e-12), (mu, x, pumped[1] * g / plain[1])

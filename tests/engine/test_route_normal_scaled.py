@@ -7,20 +7,19 @@ Checked against the model's own ``eval`` integrated over the azimuth by scipy, a
 and the white furnace toward the viewer."""
 
 
+import helpers
 import numpy as np
 import pytest
-
 from helpers import n_frame_integrand_against_eval, one_d_against_the_other_engines
 
 import pumpup
-from pumpup.engine import polar as _polar
 from pumpup.engine import chain_frame as _chain_frame
-import helpers
+from pumpup.engine import polar as _polar
 
 MU = np.array([1.0, 0.999, 0.99, 0.9, 0.7, 0.5, 0.3, 0.1, 0.01, 1e-4, 1e-8])
 
-CASES = [({"type": "ggx", "alpha": 0.3}, 1.0), ({"type": "beckmann", "alpha": 0.1}, 0.5), ({"type": "schlick", "r": 0.2}, 1.0),
-         ({"type": "ggx", "alpha": 0.02, "shadowing": "correlated"}, 1.0)]
+CASES = [({"type": "ggx", "alpha": 0.3}, 1.0), ({"type": "beckmann", "alpha": 0.1}, 0.5),
+         ({"type": "schlick", "r": 0.2}, 1.0), ({"type": "ggx", "alpha": 0.02, "shadowing": "correlated"}, 1.0)]
 
 
 def _scaled(spec, f0):
@@ -40,7 +39,8 @@ def test_scaled_microfacet_models_take_frame_6():
     # a Fresnel factor (frame 4), a Phong lobe, a white of another kind: the nested engine, as before
     assert not helpers.hint_routes(pumpup.compensate({"type": "ggx", "alpha": 0.3, "ior": 1.5}, method="scale"))
     assert not helpers.hint_routes(_scaled({"type": "phong", "n": 5}, 1.0))
-    assert not helpers.hint_routes(pumpup.compensate({"type": "ggx", "alpha": 0.3}, method="kulla_conty"))  # (its terms have theirs)
+    # (its terms have theirs)
+    assert not helpers.hint_routes(pumpup.compensate({"type": "ggx", "alpha": 0.3}, method="kulla_conty"))
     assert not helpers.hint_routes(pumpup.load({"type": "scaled", "base": {"type": "ggx", "alpha": 0.3},
                         "white": {"type": "phong", "n": 5}}))
 
@@ -49,7 +49,8 @@ def test_scaled_microfacet_models_take_frame_6():
 def test_integrand_against_the_models_own_eval(case):
     """The compiled integrand (frame 6's weight times the factor, as the rule computes it) against the scaled model's
     public ``eval`` times N.wo integrated over the azimuth by scipy; and not below the base's (U <= 1: brighter)."""
-    assert n_frame_integrand_against_eval(_scaled(*case), pumpup.load(case[0])) >= 1 - 1e-12  # (U rounds to 1 where E is ~1)
+    # (U rounds to 1 where E is ~1)
+    assert n_frame_integrand_against_eval(_scaled(*case), pumpup.load(case[0])) >= 1 - 1e-12
 
 
 @pytest.mark.parametrize("case", CASES, ids=_id)
@@ -68,7 +69,7 @@ def test_cuts_graded_towards_grazing(monkeypatch):
     mu = 0.9850430162253638
     x = _chain_frame.chain_cuts(helpers.view(f).levels(mu), 0.0, mu)
     assert np.sum(np.sin(x[x > 0]) < 0.125) >= 12  # N.wo = 1/8, 1/32, ... down to 2.5e-9
-    with monkeypatch.context() as m, helpers.without_1d():
+    with monkeypatch.context(), helpers.without_1d():
         ref, ref_err = pumpup.albedo(f, [mu], return_error=True, rtol=1e-13)
     for rtol in (1e-6, 1e-8):
         a, e = pumpup.albedo(f, [mu], return_error=True, rtol=rtol)
@@ -85,9 +86,10 @@ def test_against_the_2d_engine():
 
 
 def test_furnace_toward_the_viewer_is_at_most_one():
-    """With F0 = 1 the scaled model's albedo toward wo (``pumpup.furnace``) is E / U <= 1 within its error, and its albedo
-    toward the light (this path) exceeds the base's: the 1/E factor brightens every ring."""
+    """With F0 = 1 the scaled model's albedo toward wo (``pumpup.furnace``) is E / U <= 1 within its error, and its
+    albedo toward the light (this path) exceeds the base's: the 1/E factor brightens every ring."""
     f = _scaled({"type": "ggx", "alpha": 0.5}, 1.0)
     a, e = pumpup.furnace(f, MU, return_error=True, rtol=1e-9)
     assert np.all(a <= 1.0 + e)
-    assert np.all(pumpup.albedo(f, MU, rtol=1e-9) > pumpup.albedo(pumpup.load({"type": "ggx", "alpha": 0.5}), MU, rtol=1e-9))
+    assert np.all(pumpup.albedo(f, MU, rtol=1e-9)
+                  > pumpup.albedo(pumpup.load({"type": "ggx", "alpha": 0.5}), MU, rtol=1e-9))

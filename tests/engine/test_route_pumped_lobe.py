@@ -9,15 +9,18 @@ integral."""
 import math
 import warnings
 
+import helpers
 import numpy as np
 import pytest
 from scipy.integrate import quad
 from scipy.special import roots_legendre
 
 import pumpup
+from pumpup.engine import chain_frame as _chain_frame
+from pumpup.engine import half_arc as _half_arc
+from pumpup.engine import lobe_frame as _lobe_frame
 from pumpup.engine import nested as _nested
-from pumpup.engine import chain_frame as _chain_frame, half_arc as _half_arc, lobe_frame as _lobe_frame, outer_rule as _outer_rule
-import helpers
+from pumpup.engine import outer_rule as _outer_rule
 
 # (0.8495: a wide piece that one first interval got wrong; 1e-8 and below: the tables' first node, and
 # sin(theta_i) rounding to 1)
@@ -93,7 +96,7 @@ def test_estimate_bounds_the_truth_and_engines_agree(case, monkeypatch):
     """The 1-D path at rtol 1e-8 ... 1e-12 against the nested engine at 1e-13 (the 1-D path switched
     off alone; asserted to run): the difference within the summed estimates."""
     f = _pumped(*case)
-    with monkeypatch.context() as m, helpers.without_1d():
+    with monkeypatch.context(), helpers.without_1d():
         _nested.LAST_EVALS = None
         ref, ref_err = pumpup.albedo(f, MU, return_error=True, rtol=1e-13)
         assert _nested.LAST_EVALS is not None  # the nested engine ran
@@ -192,11 +195,11 @@ def test_chain_cuts():
 
 
 def test_compiled_chain_cuts_are_chain_cuts():
-    """The compiled cuts the engine uses (:func:`pumpup.engine.chain_frame.chain_cut_matrix`) are chain_cuts, value for value: pumped
-    lobes, a pumped metal (F's cuts), a pumped GGX and a 1/E-scaled one (frame 6, n = 0), and a metal's lobe about N (no
-    chain: no levels but mu, no grading for g), from normal incidence to 1e-300; each cut of either within 2 ulps of one of
-    the other (numpy's vectorised arctan2 and the scalar one may differ in the last bit, so a level mu and x_mu can be two
-    cuts in one, one in the other)."""
+    """The compiled cuts the engine uses (:func:`pumpup.engine.chain_frame.chain_cut_matrix`) are chain_cuts, value for
+    value: pumped lobes, a pumped metal (F's cuts), a pumped GGX and a 1/E-scaled one (frame 6, n = 0), and a metal's
+    lobe about N (no chain: no levels but mu, no grading for g), from normal incidence to 1e-300; each cut of either
+    within 2 ulps of one of the other (numpy's vectorised arctan2 and the scalar one may differ in the last bit, so a
+    level mu and x_mu can be two cuts in one, one in the other)."""
 
     def same(a, b):
         return all(np.min(np.abs(b - v)) <= 4.5e-16 for v in a) and all(np.min(np.abs(a - v)) <= 4.5e-16 for v in b)
@@ -212,14 +215,17 @@ def test_compiled_chain_cuts_are_chain_cuts():
         n = 0.0 if hint.kind == "half" else float(hint.n)
         cut, ncut = _chain_frame.chain_cut_matrix(hint.levels, n, mu, fres, chain)
         for q, m in enumerate(mu):
-            assert same(cut[q, :ncut[q]], _chain_frame.chain_cuts(hint.levels(float(m)), n, float(m), fres, chain)), (f, m)
-    # (the compiled kernel's room per mu: 4 fixed, 6 about the peak, 2 x 15 towards x_s, 20 graded, the pi / 16 ones, F's)
+            assert same(cut[q, :ncut[q]],
+                        _chain_frame.chain_cuts(hint.levels(float(m)), n, float(m), fres, chain)), (f, m)
+    # (the compiled kernel's room per mu: 4 fixed, 6 about the peak, 2 x 15 towards x_s, 20 graded,
+    # the pi / 16 ones, F's)
     assert _chain_frame.CHAIN_CUTS_ROOM >= 4 + 6 + 30 + 20 + _chain_frame.X_PIECES - 1 + 3 * _half_arc.LOBE_F_CUTS
     for n in (0.0, 2.0, 20.0, 500.0):
         for eta, k in ((0.2, 3.0), (1.5, 0.0), (1.1, 30.0), (0.6, 0.3), (0.999, 0.001)):
             cut, ncut = _chain_frame.chain_cut_matrix(None, n, mu, (eta, k), chain=False)
             for q, m in enumerate(mu):
-                assert same(cut[q, :ncut[q]], _chain_frame.chain_cuts([], n, float(m), (eta, k), chain=False)), (n, eta, k, m)
+                assert same(cut[q, :ncut[q]],
+                            _chain_frame.chain_cuts([], n, float(m), (eta, k), chain=False)), (n, eta, k, m)
 
 
 def test_pumped_plastic_takes_the_chain_path():

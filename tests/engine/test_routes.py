@@ -2,13 +2,13 @@
 routes it says, as recorded from the engine's own calls; :func:`~pumpup.engine.routes.using` restores the choice it
 changed."""
 
+import helpers
 import numpy as np
 import pytest
 
 import pumpup
 from pumpup.engine import cubature, nested, polar, routes, slope
 from pumpup.engine.routes import current, using
-import helpers
 
 MU = np.array([1.0, 0.7, 0.3, 0.2, 0.05, 1e-4])
 EXAMPLES = [(name, params) for name, cls in pumpup.registry().items() for params in cls.examples]
@@ -20,7 +20,8 @@ def test_the_table_prints_every_route(capsys):
     for route in routes.ROUTES:
         assert route in text, route
     assert set(r.route for r in routes.RULES) <= set(routes.ONE_D_ROUTES)
-    assert capsys.readouterr().out.count("\n") == len(routes.RULES) + 5  # (a header, slope, lobe_axis, the rules, nested, cubature)
+    # (a header, slope, lobe_axis, the rules, nested, cubature)
+    assert capsys.readouterr().out.count("\n") == len(routes.RULES) + 5
 
 
 def _recorded(f, mu, monkeypatch, phi=None):

@@ -1,18 +1,18 @@
-"""Anisotropic Ward in slope space (pumpup.engine.slope, issue 14): the ray integral against scipy, the albedo against the
-independent references (tests/data/independent_ward_aniso.json, the long-double grazing values), the nested engine
+"""Anisotropic Ward in slope space (pumpup.engine.slope, issue 14): the ray integral against scipy, the albedo against
+the independent references (tests/data/independent_ward_aniso.json, the long-double grazing values), the nested engine
 (another parametrisation), Ward's isotropic 1-D path (elliptic integrals) and the model's symmetries."""
 
 import json
 import math
 import warnings
 
+import helpers
 import numpy as np
 import pytest
 
 import pumpup
 from pumpup.engine import slope as _slope
 from pumpup.engine.cubature import AlbedoWarning
-import helpers
 from pumpup.engine.routes import route_names
 
 
@@ -122,9 +122,11 @@ def test_scale_and_atol():
 INDEPENDENT = json.load(open(helpers.DATA / "independent_ward_aniso.json"))["rows"]
 
 
-@pytest.mark.parametrize("row", INDEPENDENT, ids=lambda r: f"{r['params']['ax']}-{r['params']['ay']}-mu{r['mu']}-phi{r['phi']:.3f}")
+@pytest.mark.parametrize("row", INDEPENDENT,
+                         ids=lambda r: f"{r['params']['ax']}-{r['params']['ay']}-mu{r['mu']}-phi{r['phi']:.3f}")
 def test_albedo_against_the_independent_reference(row):
-    # tests/reference/independent_ward_aniso.py: two nested-quad methods written without pumpup, agreeing to 1.2e-13 or better
+    # tests/reference/independent_ward_aniso.py: two nested-quad methods written without pumpup, agreeing to 1.2e-13 or
+    # better
     f = pumpup.load({"type": "ward_aniso", **row["params"]})
     for rtol in (1e-8, 1e-10, 1e-12):
         a, e = pumpup.albedo(f, row["mu"], phi=row["phi"], rtol=rtol, return_error=True)
@@ -135,7 +137,8 @@ def test_albedo_against_the_independent_reference(row):
                          ids=lambda r: f"{r['params']['ax']}-{r['params']['ay']}-mu{r['mu']}-phi{r['phi']:.3f}")
 def test_nested_engine_at_other_azimuths_against_the_independent_reference(row):
     # the nested engine takes wi out of the xz-plane too (turned by phi), since the 2-D engine it was left to missed the
-    # visible tail of a ridge just past a break: (1, 0.001) at mu 0.9877, phi 0.4 was 1.3e-8 off with an estimate of 5e-14
+    # visible tail of a ridge just past a break: (1, 0.001) at mu 0.9877, phi 0.4 was 1.3e-8 off with an estimate of
+    # 5e-14
     f = pumpup.load({"type": "ward_aniso", **row["params"]})
     for rtol in (1e-8, 1e-12):
         a, e = _nested(f, row["mu"], row["phi"], rtol)
@@ -144,9 +147,9 @@ def test_nested_engine_at_other_azimuths_against_the_independent_reference(row):
 
 @pytest.mark.parametrize("mu,value", [(1e-8, 1.2078149107898225), (1e-4, 0.012506657640590035)])
 def test_grazing_narrow_lobe_against_a_long_double_reference(mu, value):
-    # tests/reference/independent_ward_aniso_grazing.py: two cancellation-free methods in long double, written without pumpup,
-    # agreeing to 1e-19 (phi the double below: 5e-17 relative under the values at pi/4 + 0.1, allowed as 1e-16).  At
-    # mu = 1e-8 the nested and 2-D engines (wi turned by phi) give 1.2078149107921772 +- 1.3e-12 and
+    # tests/reference/independent_ward_aniso_grazing.py: two cancellation-free methods in long double, written without
+    # pumpup, agreeing to 1e-19 (phi the double below: 5e-17 relative under the values at pi/4 + 0.1, allowed as 1e-16).
+    # At mu = 1e-8 the nested and 2-D engines (wi turned by phi) give 1.2078149107921772 +- 1.3e-12 and
     # 1.20781491079219 +- 7.5e-13: 2e-12 off, left open (the closing note of issue 14's fourteenth session)
     f = pumpup.load({"type": "ward_aniso", "ax": 0.002, "ay": 0.006})
     for rtol in (1e-10, 1e-12, 1e-13):

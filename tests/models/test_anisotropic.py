@@ -3,11 +3,11 @@
 import json
 import math
 
+import helpers
 import numpy as np
 import pytest
 
 import pumpup
-import helpers
 
 DATA = helpers.DATA / "independent_anisotropic.json"
 ROWS = json.load(open(DATA))["rows"]
@@ -163,7 +163,7 @@ def test_sup_albedo_of_an_isotropic_model_is_its_albedo():
 def loose_tables(monkeypatch):
     import sys
 
-    mod = sys.modules["pumpup.operators.pumping"]  
+    mod = sys.modules["pumpup.operators.pumping"]
     monkeypatch.setattr(mod, "TABLE_RTOL", 1e-7)
     monkeypatch.setattr(mod, "TABLE_INTERP_TOL", 1e-5)
     before = set(mod._TABLES)

@@ -3,15 +3,14 @@ independent implementation and quadrature of tests/reference/ashikhmin_shirley.p
 
 import math
 
+import helpers
 import numpy as np
 import pytest
+from helpers import at_mu, direction_pairs
+from reference import ashikhmin_shirley as ref
 
 import pumpup
 from pumpup.testing import chi2_test
-
-import helpers
-from helpers import at_mu, direction_pairs
-from reference import ashikhmin_shirley as ref
 
 N = np.array([0.0, 0.0, 1.0])
 
@@ -408,8 +407,8 @@ def test_pumpup_sample_uses_the_papers_sampling():
 
 
 def test_the_diffuse_term_is_a_closed_form_term():
-    """The albedo splits into the specular lobe (a half-vector hint, Lobe) and the diffuse term, whose hint is the closed
-    form of an existing family (``ClosedForm``): its albedo is rd (1 - rs) (1 - (1 - mu / 2)^5) exactly."""
+    """The albedo splits into the specular lobe (a half-vector hint, Lobe) and the diffuse term, whose hint is the
+    closed form of an existing family (``ClosedForm``): its albedo is rd (1 - rs) (1 - (1 - mu / 2)^5) exactly."""
     f = pumpup.load({"type": "ashikhmin_shirley", "nu": 100, "nv": 100, "rs": 0.05, "rd": 0.8})
     terms = f.albedo_terms()
     assert len(terms) == 2

@@ -5,11 +5,10 @@ import math
 
 import numpy as np
 import pytest
+from helpers import at_mu, direction_pairs, polar, random_directions
 
 import pumpup
 from pumpup.models.cook_torrance import _g_kinks, fresnel
-
-from helpers import at_mu, direction_pairs, polar, random_directions
 
 MODELS = ["cook_torrance", "torrance_sparrow"]
 CASES = [(name, ex) for name in MODELS for ex in pumpup.registry()[name].examples]

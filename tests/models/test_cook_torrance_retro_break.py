@@ -5,15 +5,14 @@ pumped level's g) have a level there (issue 14's twenty-fifth session)."""
 import contextlib
 import math
 
+import helpers
 import numpy as np
 import pytest
+from helpers import rings
 from scipy.optimize import brentq
 
 import pumpup
 from pumpup.models.cook_torrance import RETRO_BREAK
-
-from helpers import rings
-import helpers
 
 VCAVITY = [{"type": "cook_torrance", "m": 0.538}, {"type": "torrance_sparrow", "d": "D1", "s": 2.0}]
 
@@ -40,7 +39,8 @@ def test_second_derivative_jumps_at_the_retro_break(spec):
 
 def test_g_at_the_retro_direction_is_two_mu_squared():
     """The mechanism: at wo = wi, G = min(1, 2 mu^2) (both of its terms are 2 mu^2 there), read off Cook-Torrance's
-    eval (f(wi, wi) = D(theta_i) G / mu^2, D = exp(-tan^2 / m^2) / (4 pi m^2 cos^4)): below 1 exactly below the break."""
+    eval (f(wi, wi) = D(theta_i) G / mu^2, D = exp(-tan^2 / m^2) / (4 pi m^2 cos^4)): below 1 exactly below the
+    break."""
     m = 0.538
     f = pumpup.load({"type": "cook_torrance", "m": m})
     for mu in (0.5, RETRO_BREAK - 1e-3, RETRO_BREAK + 1e-3, 0.9):
@@ -95,9 +95,9 @@ def test_scaled_cook_torrance_near_the_normal_against_rings(m, mu, engine):
 
 
 def test_pumped_cook_torrance_has_the_break_where_its_bound_leads():
-    """A pumped level's g = max(u(mu), u(N.wo)) has the table's break as a kink where u(N.wo) is the larger (at mu = 0.9,
-    not at 0.5, where u(0.5) is above u(1 / sqrt(2))); at mu = 0.9999 its albedo agrees with the rings (it did before
-    this level too, within 0.31 of its estimate: the check is that the level keeps it so)."""
+    """A pumped level's g = max(u(mu), u(N.wo)) has the table's break as a kink where u(N.wo) is the larger (at mu =
+    0.9, not at 0.5, where u(0.5) is above u(1 / sqrt(2))); at mu = 0.9999 its albedo agrees with the rings (it did
+    before this level too, within 0.31 of its estimate: the check is that the level keeps it so)."""
     f = pumpup.load({"type": "pumped", "base": {"type": "cook_torrance", "m": 0.538}, "g": "g1", "levels": 1})
     up = f.lookup().upper
     assert RETRO_BREAK in f.lookup().table.breaks

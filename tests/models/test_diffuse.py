@@ -2,14 +2,13 @@
 
 import math
 
+import helpers
 import numpy as np
 import pytest
+from helpers import direction_pairs, polar
 from scipy.integrate import quad
 
 import pumpup
-
-from helpers import direction_pairs, polar
-import helpers
 
 N = np.array([0.0, 0.0, 1.0])
 
@@ -181,7 +180,8 @@ def test_minnaert_and_lacquer_albedos_in_closed_form():
         for m, x, ex in zip(mu, a, e):
             ref = 2 * mp.pi * 0.2 * mp.mpf(m) ** (spec["k"] - 1) / (spec["k"] + 1)
             assert abs(x - ref) <= ex, (spec, m, x, ex)
-    for spec in ({"type": "lacquer"}, {"type": "lacquer", "s": 1.5}, {"type": "minnaert", "k": 0.8}, {"type": "minnaert", "k": 2.0}):
+    for spec in ({"type": "lacquer"}, {"type": "lacquer", "s": 1.5}, {"type": "minnaert", "k": 0.8},
+                 {"type": "minnaert", "k": 2.0}):
         f = pumpup.load(spec)
         a, e = pumpup.albedo(f, mu, return_error=True)
         with helpers.without_1d(), warnings.catch_warnings():

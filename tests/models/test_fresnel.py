@@ -9,9 +9,9 @@ import math
 
 import numpy as np
 import pytest
+from helpers import rings
 
 import pumpup
-from helpers import rings
 
 
 def test_fresnel_over_a_sum_takes_its_terms():
@@ -19,20 +19,23 @@ def test_fresnel_over_a_sum_takes_its_terms():
     f = pumpup.load({"type": "fresnel", "base": plastic, "eta": 1.5})
     terms = f.albedo_terms()
     assert [w for w, _ in terms] == [1.0, 0.33]
-    assert [t.spec["base"]["type"] for _, t in terms] == ["plastic", "lambert"] and terms[0][1].spec["base"]["ad"] == 0.0
+    assert ([t.spec["base"]["type"] for _, t in terms] == ["plastic", "lambert"]
+            and terms[0][1].spec["base"]["ad"] == 0.0)
     one = pumpup.load({"type": "fresnel", "base": dict(plastic, ad=0.0), "eta": 1.5})
     assert one.albedo_terms() == [(1.0, one)]
     # a pumped base's terms (parts with no spec of the registry), each with F and its own hint
     pumped = pumpup.load({"type": "fresnel", "base": {"type": "pumped", "base": plastic}, "eta": 1.5})
     assert [t.base.type for _, t in pumped.albedo_terms()] == ["pumped-term", "pumped-term"]
     wi, wo = np.array([[0.6, 0.0, 0.8]] * 3), np.array([[-0.6, 0.0, 0.8], [0.0, 0.6, 0.8], [0.28, 0.0, 0.96]])
-    np.testing.assert_allclose(sum(w * t.eval(wi, wo) for w, t in pumped.albedo_terms()), pumped.eval(wi, wo), rtol=1e-14)
+    np.testing.assert_allclose(sum(w * t.eval(wi, wo) for w, t in pumped.albedo_terms()), pumped.eval(wi, wo),
+                               rtol=1e-14)
 
 
 def test_fresnel_over_a_pumped_plastic_at_the_normal():
     """2-level g1 pumped plastic (n 290, ad 0.40) under F (eta 0.454, k 7.29) at mu = 1: as one term the nested engine
-    gave 0.468 +- 4e-4 and the 2-D engine 0.441 +- 0.011 for 0.959 (scripts/studies/fuzz_engines.py --registry 48).  At wi = N
-    the integrand depends on N.wo alone: the reference is Gauss-Legendre in N.wo, graded towards the lobe at 1."""
+    gave 0.468 +- 4e-4 and the 2-D engine 0.441 +- 0.011 for 0.959 (scripts/studies/fuzz_engines.py --registry 48).  At
+    wi = N the integrand depends on N.wo alone: the reference is Gauss-Legendre in N.wo, graded towards the lobe at
+    1."""
     f = pumpup.load({"type": "fresnel", "base": {"type": "pumped", "base": {"type": "plastic", "n": 289.95982714742524,
                      "eta": 1.5957343463248426, "ad": 0.3995720056517486}, "g": "g1", "levels": 2},
                      "eta": 0.45428694960824667, "k": 7.293438073871147})

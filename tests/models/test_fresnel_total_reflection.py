@@ -8,15 +8,14 @@ checked against an independent quadrature in spherical coordinates about N split
 
 import math
 
+import helpers
 import numpy as np
 import pytest
+from helpers import rings
 
 import pumpup
-from pumpup.operators import pumping
 from pumpup.models.metal import fresnel_levels
-
-from helpers import rings
-import helpers
+from pumpup.operators import pumping
 
 ETA = 0.551
 X0 = math.sqrt(1.0 - ETA * ETA)
@@ -34,7 +33,8 @@ def test_fresnel_levels():
 @pytest.mark.parametrize("spec", [{"type": "metal", "n": 5.0, "eta": ETA},
                                   {"type": "plastic", "n": 5.0, "eta": ETA, "ad": 0.2, "a_s": 0.7},
                                   {"type": "fresnel", "base": {"type": "blinn", "n": 5.0}, "eta": ETA},
-                                  {"type": "mix", "a": {"type": "lambert"}, "b": {"type": "metal", "n": 5.0, "eta": ETA}}],
+                                  {"type": "mix", "a": {"type": "lambert"},
+                                   "b": {"type": "metal", "n": 5.0, "eta": ETA}}],
                          ids=lambda s: s["type"])
 def test_hints_carry_the_kink(spec):
     f = pumpup.load(spec)
@@ -66,7 +66,8 @@ def test_metal_with_total_reflection_and_its_mean():
         s = math.sqrt(1.0 - mu * mu)
 
         def cuts(mo, so, s=s, mu=mu):
-            a, b = mu * mo, s * so  # R.V = b cos(phi_o) + a with phi_o from the mirror side: here R.V = a - b cos(phi_o)
+            # R.V = b cos(phi_o) + a with phi_o from the mirror side: here R.V = a - b cos(phi_o)
+            a, b = mu * mo, s * so
             return [0.0 if a >= b else math.acos(a / b), math.pi]
 
         ref = rings(f, mu, cuts, [mu, X0, s])
@@ -79,7 +80,7 @@ def test_metal_with_total_reflection_and_its_mean():
     assert abs(m - ref) <= em + 1e-12, (m - ref, em)
 
 
-# --- microfacet models: F(wi.h) of a conductor with eta < 1 ------------------------------------------------------------
+# --- microfacet models: F(wi.h) of a conductor with eta < 1 -----------------------------------------------------------
 
 
 def _wih_reference(f, mu, x0, nodes=160):
@@ -126,8 +127,8 @@ def _wih_reference(f, mu, x0, nodes=160):
                                      ({"type": "beckmann", "alpha": 0.1, "eta": ETA}, 0.95)], ids=str)
 def test_microfacet_with_total_reflection(spec, mu):
     """F(wi.h) with eta = 0.551, k = 0 has a square-root kink at wi.h = x0.  Frame 4 of the 1-D path, which took it, was
-    1.0e-7 off with an estimate of 7.9e-13 for GGX 0.3 at mu = 0.05, 1.9e-12 with 2.1e-14 at 0.95, and Beckmann 0.1 at 0.95
-    3.8e-11 with 9.2e-14 (and 19 s); the nested engine, now with the kink in its hint, is its path."""
+    1.0e-7 off with an estimate of 7.9e-13 for GGX 0.3 at mu = 0.05, 1.9e-12 with 2.1e-14 at 0.95, and Beckmann 0.1 at
+    0.95 3.8e-11 with 9.2e-14 (and 19 s); the nested engine, now with the kink in its hint, is its path."""
 
     f = pumpup.load(spec)
     assert not helpers.takes_1d(f) and f.lobe(mu).kinks is not None
@@ -153,9 +154,10 @@ def test_microfacet_paths_by_the_branch_point():
 
 
 def test_he_torrance_below_index_one():
-    """He-Torrance's |F|^2 at the bisector angle (wi.h) with n = 0.6: total reflection below wi.h = 0.8.  The hint carries
-    the kink (the nested engine took 0.8-2.9 s for three values without it, 0.2-0.3 s with it; the 2-D engine 95 s, 0.4 s);
-    the values with and without it agree within their estimates, and the delta's F(mu) puts a kink in the albedo at 0.8."""
+    """He-Torrance's |F|^2 at the bisector angle (wi.h) with n = 0.6: total reflection below wi.h = 0.8.  The hint
+    carries the kink (the nested engine took 0.8-2.9 s for three values without it, 0.2-0.3 s with it; the 2-D engine 95
+    s, 0.4 s); the values with and without it agree within their estimates, and the delta's F(mu) puts a kink in the
+    albedo at 0.8."""
     f = pumpup.load({"type": "he_torrance", "sigma_0": 0.18, "tau": 3.0, "n": 0.6})
     assert f.lobe(0.5).kinks.x0 == pytest.approx(0.8, rel=1e-15) and f.albedo_breaks() == pytest.approx((0.8,))
     assert pumpup.load({"type": "he_torrance", "sigma_0": 0.18, "tau": 3.0, "n": 1.5}).lobe(0.5).kinks is None
@@ -189,7 +191,8 @@ def test_tabulate_splits_at_the_models_own_kink():
 def test_beckmann_walter_correlated_with_fresnel(spec, mu):
     """Walter's G1 (a jump at its switch level) in the height-correlated G with a Fresnel factor: frame 4 was 7 x its
     estimate at rtol 1e-10 (the first case: 1.27e-11 off, estimate 1.8e-12) and 3.8 x at 1e-12 (the second), against the
-    2-D engine at rtol 1e-13 (found by ``scripts/studies/fuzz_engines.py --registry``).  The nested engine takes it now."""
+    2-D engine at rtol 1e-13 (found by ``scripts/studies/fuzz_engines.py --registry``).  The nested engine takes it
+    now."""
 
     f = pumpup.load(spec)
     assert not helpers.takes_1d(f)

@@ -3,6 +3,7 @@ independent brute-force quadrature, reciprocity, bad input, pumping and sampling
 
 import math
 
+import helpers
 import numpy as np
 import pytest
 from scipy.optimize import brentq
@@ -10,7 +11,6 @@ from scipy.special import erfc, gammaln
 
 import pumpup
 from pumpup.models.he_torrance import SERIES_RTOL, effective_sigma, fresnel_unpolarised, shadowing
-import helpers
 
 FIG5 = {"type": "he_torrance", "sigma_0": 0.1, "tau": 1.7}
 
@@ -99,7 +99,8 @@ def brute_albedo(spec, mu, n):
 @pytest.mark.parametrize(
     "spec,mu",
     [(FIG5, 1.0), (FIG5, 0.5), (FIG5, 0.2),
-     ({"type": "he_torrance", "sigma_0": 0.18, "tau": 1.0, "wavelength": 0.4, "n": 1.5, "k": 0.3, "diffuse": 0.2}, 0.7)],
+     ({"type": "he_torrance", "sigma_0": 0.18, "tau": 1.0, "wavelength": 0.4, "n": 1.5, "k": 0.3, "diffuse": 0.2},
+      0.7)],
 )
 def test_albedo_matches_brute_force_quadrature(spec, mu):
     f = pumpup.load(spec)
@@ -229,7 +230,8 @@ def test_agrees_with_westins_reference_implementation():
             assert abs(got - p["f"]) <= 1e-12 * p["f"], (case["spec"], p, got)
             n += 1
         for s in case["specular"]:
-            assert abs(float(f.specular_weight(s["mu"])) - s["weight"]) <= 1e-12 * s["weight"] + 1e-300, (case["spec"], s)
+            assert abs(float(f.specular_weight(s["mu"])) - s["weight"]) <= 1e-12 * s["weight"] + 1e-300, (
+                case["spec"], s)
     assert n >= 20
 
 

@@ -2,14 +2,13 @@
 
 import math
 
+import helpers
 import numpy as np
 import pytest
+from helpers import direction_pairs, polar
 
 import pumpup
 from pumpup.models.lafortune import Lafortune
-
-from helpers import direction_pairs, polar
-import helpers
 
 N = np.array([0.0, 0.0, 1.0])
 
@@ -110,10 +109,10 @@ def test_bad_input_names_the_parameter():
 
 
 def _mp_albedo(spec, mu, phi, dps=20):
-    """Independent reference, straight from 000 eq. 14 (and 15 for p > 0): 20-digit mpmath in spherical coordinates about
-    N, f cos(theta_o) = c (v.wo)_+^n cos(theta_o) with v = (-cx Lx, -cy Ly, cz Lz); the azimuth is measured from v's
-    (v.wo = vz cos(t) + |v_xy| sin(t) cos(psi)), the inner integral runs where v.wo > 0, the outer one is split where
-    the zero set of v.wo starts to cross the ring (tan t = |vz| / |v_xy|)."""
+    """Independent reference, straight from 000 eq. 14 (and 15 for p > 0): 20-digit mpmath in spherical coordinates
+    about N, f cos(theta_o) = c (v.wo)_+^n cos(theta_o) with v = (-cx Lx, -cy Ly, cz Lz); the azimuth is measured from
+    v's (v.wo = vz cos(t) + |v_xy| sin(t) cos(psi)), the inner integral runs where v.wo > 0, the outer one is split
+    where the zero set of v.wo starts to cross the ring (tan t = |vz| / |v_xy|)."""
     import mpmath
 
     with mpmath.workdps(dps):
@@ -132,7 +131,8 @@ def _mp_albedo(spec, mu, phi, dps=20):
 
         tk = mpmath.atan2(abs(vz), r)
         pw = q.get("p", 0.0)  # (000 eq. 15: / max(N.L, N.V)^p, N.V = cos(t); split where cos(t) = mu too)
-        return float(q["c"] * mpmath.quad(lambda t: inner(t) * mpmath.cos(t) * mpmath.sin(t) / max(m, mpmath.cos(t)) ** pw,
+        return float(q["c"] * mpmath.quad(lambda t: (inner(t) * mpmath.cos(t) * mpmath.sin(t)
+                                                     / max(m, mpmath.cos(t)) ** pw),
                                           sorted([0, tk, mpmath.acos(m), mpmath.pi / 2])))
 
 
@@ -150,9 +150,9 @@ AXIS_CASES = [  # (spec, mu, phi)
 def test_p0_lobe_about_its_own_axis_against_mpmath(spec, mu, phi):
     """Issue 14's fifteenth session: a p = 0 lobe is c |v|^n (v^.wo)_+^n, a Phong lobe about v^ = M R / |M R|, so its
     albedo is the 1-D path's about an axis at elevation nu = cz mu / |v| (``Lafortune.lobe_axis``,
-    ``pumpup.engine.polar.axis_albedo``), at every azimuth of wi.  Against the independent mpmath reference at rtol 1e-6,
-    1e-9 and 1e-12 the estimate bounds the error.  (The first two cases are ~1e-7 off by the nested and 2-D engines,
-    which took this model before, with estimates ~1e-11.)"""
+    ``pumpup.engine.polar.axis_albedo``), at every azimuth of wi.  Against the independent mpmath reference at rtol
+    1e-6, 1e-9 and 1e-12 the estimate bounds the error.  (The first two cases are ~1e-7 off by the nested and 2-D
+    engines, which took this model before, with estimates ~1e-11.)"""
     from pumpup.engine.cubature import DEFAULT_ATOL
 
     f = pumpup.load(spec)
@@ -169,7 +169,8 @@ def test_lobe_axis_applies_to_p0_lobes_above_the_horizon_only():
     assert pumpup.load({"type": "lafortune", "n": 10, "cx": 0.8, "cy": 1.2, "p": 0.5}).lobe_axis(mu, phi) is None
     assert pumpup.load({"type": "lafortune", "n": 10, "cx": 0.8, "cz": -1.0}).lobe_axis(mu, phi) is None
     assert pumpup.load({"type": "lafortune", "n": 10}).lobe_axis(mu, phi) is None  # (Phong: the polar hint)
-    n, nu, scale = pumpup.load({"type": "lafortune", "n": 4, "cx": 0.5, "cy": 2.0, "cz": 1.5, "c": 0.2}).lobe_axis(mu, phi)
+    n, nu, scale = pumpup.load({"type": "lafortune", "n": 4, "cx": 0.5, "cy": 2.0, "cz": 1.5,
+                                "c": 0.2}).lobe_axis(mu, phi)
     s = np.sqrt(1 - mu**2)
     v = np.stack([-0.5 * s * np.cos(phi), -2.0 * s * np.sin(phi), 1.5 * mu], axis=-1)
     np.testing.assert_allclose(nu, v[:, 2] / np.linalg.norm(v, axis=-1), rtol=1e-15)

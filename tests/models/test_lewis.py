@@ -5,12 +5,11 @@ import math
 
 import numpy as np
 import pytest
+from helpers import polar
 from scipy.integrate import dblquad, quad
 
 import pumpup
 from pumpup.models.lewis import phong_hs
-
-from helpers import polar
 
 NAME = "lewis_phong"
 EXAMPLES = pumpup.registry()[NAME].examples
@@ -78,7 +77,8 @@ def test_hs_against_mpmath():
             b0 = mp.acos(max(-1, min(1, c)))
             return u**nn * 2 * (m * u * b0 + s * w * mp.sin(b0))
 
-        pts = sorted({mp.mpf(0), s, mp.mpf(1)} | ({s * (1 - mp.mpf(10) / nn), 1 - mp.mpf(10) / nn} if n > 10 else set()))
+        pts = sorted({mp.mpf(0), s, mp.mpf(1)}
+                     | ({s * (1 - mp.mpf(10) / nn), 1 - mp.mpf(10) / nn} if n > 10 else set()))
         exact = mp.quad(g, [p for p in pts if 0 <= p <= 1])
         assert float(phong_hs(mu, n)) == pytest.approx(float(exact), rel=1e-13)
 

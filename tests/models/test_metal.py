@@ -4,11 +4,10 @@ import math
 
 import numpy as np
 import pytest
+from helpers import direction_pairs, polar
 
 import pumpup
 from pumpup.models.metal import _fresnel_real, fresnel, per_channel
-
-from helpers import direction_pairs, polar
 
 N = np.array([0.0, 0.0, 1.0])
 INDICES = [(0.2, 3.0), (0.18, 3.42), (1.37, 1.77), (1.5, 0.0), (1.0001, 0.0), (0.67, 0.0), (1.1, 6.0),

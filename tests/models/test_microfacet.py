@@ -7,15 +7,14 @@ import warnings
 
 import numpy as np
 import pytest
+from helpers import at_mu, direction_pairs, polar
+from reference import independent_microfacet as ind
 from scipy.integrate import quad
 
-from reference import independent_microfacet as ind
 import pumpup
 from pumpup.models.cook_torrance import fresnel as fresnel_dielectric
 from pumpup.models.metal import fresnel as fresnel_complex
 from pumpup.models.microfacet import ndf, smith_g1, smith_lambda, walter_level
-
-from helpers import at_mu, direction_pairs, polar
 
 N = np.array([0.0, 0.0, 1.0])
 

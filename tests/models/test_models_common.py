@@ -5,11 +5,10 @@ import math
 
 import numpy as np
 import pytest
+from helpers import direction_pairs, random_directions
 
 import pumpup
 from pumpup.core import REQUIRED
-
-from helpers import direction_pairs, random_directions
 
 CASES = [
     (name, ex)
@@ -21,7 +20,8 @@ IDS = [f"{name}-{json.dumps(ex, sort_keys=True)}" for name, ex in CASES]
 
 def test_every_model_has_examples():
     # "function" needs a registered callable and "pumped" needs tables: tests/operators/test_pump.py covers it
-    missing = [name for name, cls in pumpup.registry().items() if name not in ("function", "pumped") and not cls.examples]
+    missing = [name for name, cls in pumpup.registry().items()
+               if name not in ("function", "pumped") and not cls.examples]
     assert not missing, f"models without examples (the common tests skip them): {missing}"
 
 

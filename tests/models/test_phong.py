@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup.core import checks as _checks
 from pumpup.core import UNIT_TOL
+from pumpup.core import checks as _checks
 from pumpup.models import phong
 
 EXPONENTS = [0.0, 1.0, 2.0, 20.0, 10.5, 0.25, 5000.0, 65537.0, 1e6]
@@ -72,7 +72,8 @@ def test_rows_kernel_reports_the_first_bad_rows(rng):
         for w in (wi, wo):
             for _ in range(rng.integers(0, 3)):
                 i, k = rng.integers(0, rows), rng.integers(0, 3)
-                w[i, k] = rng.choice([np.nan, np.inf, 1e200, w[i, k] * (1 + rng.choice([-1, 1]) * 10 ** rng.uniform(-7, -3))])
+                w[i, k] = rng.choice([np.nan, np.inf, 1e200,
+                                      w[i, k] * (1 + rng.choice([-1, 1]) * 10 ** rng.uniform(-7, -3))])
         with np.errstate(over="ignore", invalid="ignore"):
             want = tuple(int(np.argmax(b)) if b.any() else -1
                          for b in (_checks.off_unit_reference(wi, UNIT_TOL), _checks.off_unit_reference(wo, UNIT_TOL)))

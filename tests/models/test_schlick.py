@@ -4,10 +4,9 @@ import math
 
 import numpy as np
 import pytest
+from helpers import at_mu, polar, random_directions
 
 import pumpup
-
-from helpers import at_mu, polar, random_directions
 
 mpmath = pytest.importorskip("mpmath")
 

@@ -4,10 +4,9 @@ import math
 
 import numpy as np
 import pytest
+from helpers import at_mu, direction_pairs, polar
 
 import pumpup
-
-from helpers import at_mu, direction_pairs, polar
 
 N = np.array([0.0, 0.0, 1.0])
 

@@ -7,13 +7,13 @@ import json
 import math
 import sys
 
+import helpers
 import numpy as np
 import pytest
+from helpers import at_mu, direction_pairs
 
 import pumpup
 from pumpup.operators.compensate import KullaConty, Scaled, compensation_table
-from helpers import at_mu, direction_pairs
-import helpers
 
 comp = sys.modules["pumpup.operators.compensate"]
 
@@ -91,12 +91,13 @@ def test_deficit_integral_bounds_an_independent_quadrature():
 
 
 @pytest.mark.parametrize("spec", [GGX, {"type": "ggx", "alpha": 0.05}, {"type": "phong", "n": 5},
-                                  {"type": "lambert", "albedo": 0.5}], ids=lambda s: f"{s['type']}-{s.get('alpha', s.get('n'))}")
+                                  {"type": "lambert", "albedo": 0.5}],
+                         ids=lambda s: f"{s['type']}-{s.get('alpha', s.get('n'))}")
 def test_kulla_conty_lobe_in_closed_form(spec):
-    """The lobe's albedo is D(mu) pi I (issue 14, twelfth session; ``_MsLobe.polar``, a constant hint): I against scipy's
-    adaptive quad of the kernels' own 2 D(m) m (an independent method, split at the product table's pieces and D's
-    kinks), within I's error and below the upper bound I_hi; the lobe's albedo against the nested engine at rtol 1e-12
-    within the summed estimates, from mu = 1 to 1e-8 and between the table's nodes."""
+    """The lobe's albedo is D(mu) pi I (issue 14, twelfth session; ``_MsLobe.polar``, a constant hint): I against
+    scipy's adaptive quad of the kernels' own 2 D(m) m (an independent method, split at the product table's pieces and
+    D's kinks), within I's error and below the upper bound I_hi; the lobe's albedo against the nested engine at rtol
+    1e-12 within the summed estimates, from mu = 1 to 1e-8 and between the table's nodes."""
     from scipy.integrate import quad
 
 
@@ -123,11 +124,12 @@ def test_kulla_conty_lobe_in_closed_form(spec):
 @pytest.mark.parametrize("engine", ["nested", "2-D"])
 def test_kulla_conty_lobe_on_the_engines_near_grazing(engine):
     """The Kulla-Conty lobe of Phong n = 987 (f_avg 0.69) near mu = 5.1e-4 on the nested and 2-D engines (the fuzz's
-    reference, scripts/studies/fuzz_engines.py --registry 47): D(N.wo), a spline in log(N.wo), about the normal, was 3.4 x (2-D)
-    and 3.0 x (nested) their estimates at rtol 1e-12 against the closed form D(mu) pi I (checked against scipy's quad
-    above).  The hint's levels N.wo = 10^-k (compensate.TABLE_DECADES) grade the radial variable there."""
+    reference, scripts/studies/fuzz_engines.py --registry 47): D(N.wo), a spline in log(N.wo), about the normal, was 3.4
+    x (2-D) and 3.0 x (nested) their estimates at rtol 1e-12 against the closed form D(mu) pi I (checked against scipy's
+    quad above).  The hint's levels N.wo = 10^-k (compensate.TABLE_DECADES) grade the radial variable there."""
 
-    f = pumpup.load({"type": "kulla_conty", "base": {"type": "phong", "n": 986.5971775489417}, "f_avg": 0.6893058353882096})
+    f = pumpup.load({"type": "kulla_conty", "base": {"type": "phong", "n": 986.5971775489417},
+                     "f_avg": 0.6893058353882096})
     ms = f.albedo_terms()[-1][1]
     assert set(comp.TABLE_DECADES) <= set(ms.lobe(0.5).levels)
     mu = np.linspace(0.000510255, 0.000510265, 9)
@@ -204,8 +206,8 @@ def test_scale_with_f0():
     assert np.all((a > E) & (a < 1))
 
 
-@pytest.mark.parametrize("spec,f0", [(GGX, 1.0), ({"type": "beckmann", "alpha": 0.1}, 0.5), ({"type": "phong", "n": 20}, 1.0),
-                                     ({"type": "schlick", "r": 0.2}, 1.0),
+@pytest.mark.parametrize("spec,f0", [(GGX, 1.0), ({"type": "beckmann", "alpha": 0.1}, 0.5),
+                                     ({"type": "phong", "n": 20}, 1.0), ({"type": "schlick", "r": 0.2}, 1.0),
                                      ({"type": "mix", "a": {"type": "lambert"}, "b": GGX, "m": 0.5}, 1.0)],
                          ids=["ggx", "beckmann-f0.5", "phong", "schlick", "mix"])
 def test_scaled_furnace_toward_the_viewer_in_closed_form(spec, f0):
@@ -215,7 +217,8 @@ def test_scaled_furnace_toward_the_viewer_in_closed_form(spec, f0):
 
     s = pumpup.compensate(spec, method="scale", f0=f0)
     mu = np.concatenate([MU, RNG_MU])
-    np.testing.assert_allclose(s.kernel_factor(mu), s.factor(mu), rtol=1e-14, atol=0)  # compiled look-up and its reference
+    # compiled look-up and its reference
+    np.testing.assert_allclose(s.kernel_factor(mu), s.factor(mu), rtol=1e-14, atol=0)
     for _, t in comp._Transposed(s).albedo_terms():
         assert helpers.hint_routes(t) and helpers.takes_1d(t)
     a, e = pumpup.furnace(s, mu, return_error=True, rtol=1e-12)
@@ -226,8 +229,8 @@ def test_scaled_furnace_toward_the_viewer_in_closed_form(spec, f0):
 
 
 def test_scaled_furnace_of_a_forced_non_reciprocal_base_stays_nested():
-    """Phong's own shader (002, not reciprocal) scaled with ``force``: f(wo, wi) is not s(N.wi) f(wi, wo), so the furnace
-    keeps the nested engine."""
+    """Phong's own shader (002, not reciprocal) scaled with ``force``: f(wo, wi) is not s(N.wi) f(wi, wo), so the
+    furnace keeps the nested engine."""
     s = pumpup.compensate({"type": "phong_shader", "n": 20}, method="scale", force=True)
     assert not s.base.reciprocal and not helpers.hint_routes(comp._Transposed(s))
 
@@ -235,9 +238,10 @@ def test_scaled_furnace_of_a_forced_non_reciprocal_base_stays_nested():
 def test_scaled_lobe_about_the_normal_against_rings():
     """Scaled Lafortune n = 148 (cx = cy = -1, a lobe about the normal's hint) near grazing incidence: 1 / U(N.wo), a
     spline in log(N.wo), has features on every scale of N.wo, all in the nested engine's last first interval of the
-    radial variable.  At rtol 1e-6 it was 1.56 x its estimate at mu = 2.6e-6 and 1.14 x at 0.01 (scripts/studies/fuzz_engines.py
-    --registry 47); the hint's levels at N.wo = 10^-k (compensate.TABLE_DECADES) grade it.  The reference: quad in
-    N.wo between the table's nodes, Gauss-Legendre in the azimuth where the lobe is positive."""
+    radial variable.  At rtol 1e-6 it was 1.56 x its estimate at mu = 2.6e-6 and 1.14 x at 0.01
+    (scripts/studies/fuzz_engines.py --registry 47); the hint's levels at N.wo = 10^-k (compensate.TABLE_DECADES) grade
+    it.  The reference: quad in N.wo between the table's nodes, Gauss-Legendre in the azimuth where the lobe is
+    positive."""
     from helpers import rings
 
     f = pumpup.load({"type": "scaled", "base": {"type": "lafortune", "n": 148.1120358399101, "cx": -1.0, "cy": -1.0,

@@ -4,14 +4,14 @@ controlled radiance, saving and loading, bad input."""
 import json
 import sys
 
+import helpers
 import numpy as np
 import pytest
+from helpers import random_directions
 
 import pumpup
 from pumpup.core import SpecError
-from pumpup.operators.pumping import Pumped, _TABLES
-from helpers import random_directions
-import helpers
+from pumpup.operators.pumping import _TABLES, Pumped
 
 MU = np.array([1.0, 0.95, 0.8, 0.6, 0.4, 0.2, 0.1, 0.03, 1e-2, 1e-3, 1e-5, 1e-8])
 # between the nodes of every table: the interpolant must not let the pumped albedo exceed 1 there
@@ -224,7 +224,8 @@ def test_product_table_of_a_monotone_chain(rng, spec, g):
     """The kernel's fast path divides by G(m), one function of m = max(N.wi, N.wo) for all
     levels: never below the product of the levels' g, above it by at most twice its epsilon (checked
     at 2e5 random m and at every piece's ends), and the kernel evaluates exactly that G."""
-    from pumpup.physics.lookups import CELL_SHIFT as _CELL_SHIFT, float_bits_reference as _bits
+    from pumpup.physics.lookups import CELL_SHIFT as _CELL_SHIFT
+    from pumpup.physics.lookups import float_bits_reference as _bits
 
     f = pumpup.pump(pumpup.load(spec), g=g, levels=3)
     p = f.product()
@@ -317,15 +318,16 @@ def test_product_table_that_cannot_reach_its_tolerance_falls_back(monkeypatch, r
 
 
 def test_pumped_lobe_about_the_normal_against_rings():
-    """g2 pumped Minnaert k = 0.31 at mu = 0.88: g(N.wo) is the base's albedo table below N.wo = mu, a spline in log(N.wo)
-    with features on every scale, which about the normal all lay in the nested (and 2-D) engine's last first interval:
-    4.1 x its estimate at every rtol from 1e-6 to 1e-12.  The hint's levels N.wo = 10^-k (pumping.TABLE_DECADES) grade
-    it.  The reference: f / g is constant on a ring of N.wo, so quad in N.wo between the table's nodes (the rings of
-    :func:`helpers.rings`)."""
+    """g2 pumped Minnaert k = 0.31 at mu = 0.88: g(N.wo) is the base's albedo table below N.wo = mu, a spline in
+    log(N.wo) with features on every scale, which about the normal all lay in the nested (and 2-D) engine's last first
+    interval: 4.1 x its estimate at every rtol from 1e-6 to 1e-12.  The hint's levels N.wo = 10^-k
+    (pumping.TABLE_DECADES) grade it.  The reference: f / g is constant on a ring of N.wo, so quad in N.wo between the
+    table's nodes (the rings of :func:`helpers.rings`)."""
     import math
 
-    from pumpup.operators.pumping import TABLE_DECADES
     from helpers import rings
+
+    from pumpup.operators.pumping import TABLE_DECADES
 
     f = pumpup.load({"type": "pumped", "base": {"type": "minnaert", "k": 0.3089221621228797}, "g": "g2"})
     mu = 0.880332154

@@ -10,9 +10,9 @@ from __future__ import annotations
 import os
 from importlib import metadata
 
+import helpers
 import pytest
 from packaging.requirements import Requirement
-import helpers
 
 tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
 

@@ -11,11 +11,11 @@ import os
 import shutil
 import subprocess
 
+import helpers
 import pytest
 
 import pumpup
 from pumpup.tables.provenance import PROVENANCE_ATTRS, same_data, source_commit
-import helpers
 
 ROOT = str(helpers.ROOT)
 TABLES = os.path.join(ROOT, "tables")

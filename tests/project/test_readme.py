@@ -19,8 +19,8 @@ import subprocess
 import sys
 import textwrap
 
-import pytest
 import helpers
+import pytest
 
 ROOT = str(helpers.ROOT)
 README = os.path.join(ROOT, "README.md")
@@ -162,9 +162,9 @@ def test_expensive_list_names_real_commands():
 
 def test_readme_claims_match_the_code():
     """Item 16: the README's word on the GIL and on where 'divergence all' writes."""
+    from pumpup.cli import build_parser
     from pumpup.engine.cubature import _geometry_kernel
     from pumpup.engine.lobe_geometry import accumulate
-    from pumpup.cli import build_parser
 
     text = "".join(open(path).read() for path in DOCUMENTS)
     assert "hold the GIL" not in text and "kernels release the GIL" in text

@@ -11,16 +11,17 @@ import subprocess
 import sys
 import time
 
+import helpers
 import numpy as np
 import pytest
+from helpers import default_sigint
 
 import pumpup
-from helpers import default_sigint
-import helpers
 
 ROOT = str(helpers.ROOT)
 #: modules that a bare ``import pumpup`` (and ``pumpup --help``) must not load
-HEAVY = ("numba", "scipy", "xarray", "netCDF4", "dask", "matplotlib", "pumpup.core", "pumpup.engine.cubature", "pumpup.engine.polar")
+HEAVY = ("numba", "scipy", "xarray", "netCDF4", "dask", "matplotlib", "pumpup.core", "pumpup.engine.cubature",
+         "pumpup.engine.polar")
 #: runs the console script's code in a subprocess; it writes MARK on stderr once pumpup.cli is imported
 MARK = "<cli imported>"
 CLI = f"import os; from pumpup.cli import console_main; os.write(2, {MARK!r}.encode()); console_main()"
@@ -66,7 +67,8 @@ def test_import_pumpup_loads_nothing_heavy():
 
 def test_help_parses_before_importing_the_library():
     assert _loaded("from pumpup.cli import main\ntry:\n    main(['--help'])\nexcept SystemExit:\n    pass") == []
-    assert _loaded("from pumpup.cli import main\ntry:\n    main(['pump', '--help'])\nexcept SystemExit:\n    pass") == []
+    assert _loaded("from pumpup.cli import main\ntry:\n    main(['pump', '--help'])\n"
+                   "except SystemExit:\n    pass") == []
 
 
 def test_importing_the_engine_compiles_and_calls_no_kernel():
@@ -196,7 +198,8 @@ def test_missing_extra_from_the_api_is_an_import_error():
     assert "IMPORTERROR" in r.stdout and 'pip install "pumpup[spectral]"' in r.stdout
 
 
-@pytest.mark.parametrize("args", [["models"], ["albedo", "phong:n=20", "--mu", *[f"{m / 1000:g}" for m in range(1, 1000)]]])
+@pytest.mark.parametrize("args", [["models"],
+                                  ["albedo", "phong:n=20", "--mu", *[f"{m / 1000:g}" for m in range(1, 1000)]]])
 def test_closed_pipe_prints_nothing(args):
     """``pumpup models | head -1``: the reader is gone before the output is written."""
     read, write = os.pipe()

@@ -53,24 +53,24 @@ def brdf(model, q):
     if model == "ward_aniso":
         ax, ay, c = q["ax"], q["ay"], q.get("c", 1.0)
 
-        def f(l, v):
-            if l[2] <= 0 or v[2] <= 0:
+        def f(L, V):
+            if L[2] <= 0 or V[2] <= 0:
                 return 0.0
-            hz = l[2] + v[2]
-            ex = ((l[0] + v[0]) / hz / ax) ** 2 + ((l[1] + v[1]) / hz / ay) ** 2
-            return c * math.exp(-ex) / (4 * math.pi * ax * ay * math.sqrt(l[2] * v[2]))
+            hz = L[2] + V[2]
+            ex = ((L[0] + V[0]) / hz / ax) ** 2 + ((L[1] + V[1]) / hz / ay) ** 2
+            return c * math.exp(-ex) / (4 * math.pi * ax * ay * math.sqrt(L[2] * V[2]))
         return f
     if model == "lafortune":
         n, cx, cy, cz = q["n"], q.get("cx", 1.0), q.get("cy", 1.0), q.get("cz", 1.0)
         p, c = q.get("p", 0.0), q.get("c", 1.0)
 
-        def f(l, v):
-            if l[2] <= 0 or v[2] <= 0:
+        def f(L, V):
+            if L[2] <= 0 or V[2] <= 0:
                 return 0.0
-            rv = -cx * l[0] * v[0] - cy * l[1] * v[1] + cz * l[2] * v[2]
+            rv = -cx * L[0] * V[0] - cy * L[1] * V[1] + cz * L[2] * V[2]
             if rv <= 0:
                 return 0.0
-            return c * rv ** n / max(l[2], v[2]) ** p
+            return c * rv ** n / max(L[2], V[2]) ** p
         return f
     raise ValueError(model)
 

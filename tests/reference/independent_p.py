@@ -548,9 +548,10 @@ def main(argv=None):
     out = {
         "description": ("Independent reference directional albedos a(mu) of stretched Phong and the retro-reflective "
                         "model with the 1 / max(N.L, N.V)^p factor, general p (computed without pumpup)."),
-        "conventions": ("N=(0,0,1); L=wi=(sqrt(1-mu^2),0,mu); a(mu)=int_H f_r(L,V) (N.V) dw_V; f_r excludes the cosine; "
-                        "stretched_phong f_r=c max(R.V,0)^n/max(N.L,N.V)^p, R=2(N.L)N-L; retro f_r=c max(L.V,0)^n/"
-                        "max(N.L,N.V)^p; c=(n+2)/(2pi); 0 where N.L<=0 or N.V<=0. mu and p are the doubles written. "
+        "conventions": ("N=(0,0,1); L=wi=(sqrt(1-mu^2),0,mu); a(mu)=int_H f_r(L,V) (N.V) dw_V; "
+                        "f_r excludes the cosine; stretched_phong f_r=c max(R.V,0)^n/max(N.L,N.V)^p, R=2(N.L)N-L; "
+                        "retro f_r=c max(L.V,0)^n/max(N.L,N.V)^p; c=(n+2)/(2pi); 0 where N.L<=0 or N.V<=0. "
+                        "mu and p are the doubles written. "
                         "The two models have identical a(mu) (rotation by pi about N maps L to R)."),
         "generated_by": "tests/reference/independent_p.py",
         "software": {"python": platform.python_version(), "mpmath": M.__version__,

@@ -35,18 +35,18 @@ without cancellation: (L+V)_x = (t^2 - mu^2)/(sin(theta_i) + s) + 2 s sin^2(psi/
 """
 import json
 import math
+import multiprocessing as mp
 import os
 import sys
 import time
-import multiprocessing as mp
 
-import numpy as np
+import mpmath
 import numba as nb
+import numpy as np
 from numba import cfunc, types
 from scipy import LowLevelCallable
 from scipy.integrate import quad
 from scipy.optimize import brentq
-import mpmath
 
 PHONG, SPHONG, BLINN, SBLINN, WARD, MWARD, CT = range(7)
 MODEL_ID = {"phong": PHONG, "stretched_phong": SPHONG, "blinn": BLINN,
@@ -419,7 +419,10 @@ def f_cos_direct(model, p, mu, t, psi, dps=40):
         L = mpmath.matrix([sti, 0, mu])
         V = mpmath.matrix([-s * mpmath.cos(psi), s * mpmath.sin(psi), t])
         NL, NV = L[2], V[2]
-        dot = lambda a, b: a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+        def dot(a, b):
+            return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
         if model in (PHONG, SPHONG):
             R = mpmath.matrix([-L[0], -L[1], 2 * NL - L[2]])
             RV = dot(R, V)
@@ -485,22 +488,29 @@ def normal_incidence_1d(model, p, dps=30):
         if model in (PHONG, SPHONG):
             return mpmath.mpf(1)
         if model in (BLINN, SBLINN):  # closed form (the max is 1 at mu = 1)
-            F = lambda u: 2 * u ** (p + 4) / (p + 4) - u ** (p + 2) / (p + 2)
+            def F(u):
+                return 2 * u ** (p + 4) / (p + 4) - u ** (p + 2) / (p + 2)
             return 8 * mpmath.pi * (F(mpmath.mpf(1)) - F(1 / mpmath.sqrt(2)))
         m2 = p * p
-        E = lambda t: mpmath.exp(-(1 - t) / ((1 + t) * m2)) / (4 * mpmath.pi * m2)
+
+        def E(t):
+            return mpmath.exp(-(1 - t) / ((1 + t) * m2)) / (4 * mpmath.pi * m2)
         if model == WARD:
-            g = lambda t: E(t) * mpmath.sqrt(t)
+            def g(t):
+                return E(t) * mpmath.sqrt(t)
         elif model == MWARD:
-            g = lambda t: E(t) * t
+            def g(t):
+                return E(t) * t
         else:  # cos^4(d) = ((1+t)/2)^2, G = min(1, 2t)
-            g = lambda t: E(t) * (2 / (1 + t)) ** 2 * min(1, 2 * t)
+            def g(t):
+                return E(t) * (2 / (1 + t)) ** 2 * min(1, 2 * t)
         return 2 * mpmath.pi * mpmath.quad(g, [0, mpmath.mpf(1) / 2, 1])
 
 
 def blinn_closed_form_normal(n, dps=30):
     with mpmath.workdps(dps):
-        F = lambda u: 2 * u ** (n + 4) / (n + 4) - u ** (n + 2) / (n + 2)
+        def F(u):
+            return 2 * u ** (n + 4) / (n + 4) - u ** (n + 2) / (n + 2)
         return float(8 * mpmath.pi * (F(mpmath.mpf(1)) - F(1 / mpmath.sqrt(2))))
 
 
@@ -670,12 +680,12 @@ def main():
             check=f"000 sec. 6.1.1: {model} n=128 at 90 deg quoted {quoted}",
             a_mu_1em6=r6["value"], a_mu_0=r0["value"], a_times_5_34=r6["value"] * K,
             a_divided_by_5_34=r6["value"] / K, ratio_quoted_over_a=quoted / r6["value"],
-            raw_reading="does not match (a is %.3g)" % r6["value"],
-            scaled_reading="a*5.34 = %.4g vs quoted %.2g" % (r6["value"] * K, quoted),
+            raw_reading=f"does not match (a is {r6['value']:.3g})",
+            scaled_reading=f"a*5.34 = {r6['value'] * K:.4g} vs quoted {quoted:.2g}",
             verdict=("scaled reading (a*5.34) matches to the quoted 2 digits" if round(r6["value"] * K, 4) == quoted
-                     else "scaled reading gives %.3g, i.e. %.2g at 2 digits, not the quoted %.2g "
-                          "(quoted/a = %.3f instead of 5.34); raw reading far off"
-                          % (r6["value"] * K, r6["value"] * K, quoted, quoted / r6["value"]))))
+                     else f"scaled reading gives {r6['value'] * K:.3g}, i.e. {r6['value'] * K:.2g} at 2 digits, "
+                          f"not the quoted {quoted:.2g} (quoted/a = {quoted / r6['value']:.3f} instead of 5.34); "
+                          "raw reading far off")))
         if round(r6["value"] * K, 4) != quoted:
             # smallest mu at which a*5.34 would round to the quoted value
             target = (quoted - 0.05 * 10 ** math.floor(math.log10(quoted))) / K
@@ -691,7 +701,7 @@ def main():
                            mu=r["mu"], numeric=r["value"],
                            a_times_sqrt_mu=r["value"] * math.sqrt(r["mu"]),
                            verdict=("confirmed to the quoted 2 digits" if ok else
-                                    "CONTRADICTED: %.4f rounds to %.1f, not %.1f" % (r["value"], r["value"], quoted))))
+                                    f"CONTRADICTED: {r['value']:.4f} rounds to {r['value']:.1f}, not {quoted:.1f}")))
     # --- 000 Table 3 mean albedos
     for model, n, quoted in (("phong", 1, 0.737), ("phong", 8, 0.676),
                              ("stretched_phong", 1, 0.934), ("stretched_phong", 8, 0.888)):
@@ -700,7 +710,7 @@ def main():
         checks.append(dict(check=f"000 Table 3: mean albedo {model} n={n} quoted {quoted}",
                            numeric=r["value"],
                            verdict=("confirmed to the quoted 3 digits" if ok else
-                                    "CONTRADICTED: %.6f rounds to %.3f" % (r["value"], r["value"]))))
+                                    f"CONTRADICTED: {r['value']:.6f} rounds to {r['value']:.3f}")))
     # --- 000 eq. 26 limit
     for n in (1, 2, 8):
         r = find("stretched_phong", 1e-6, n=n)
@@ -749,15 +759,15 @@ def main():
     with open(out_path, "w") as fh:
         json.dump(doc, fh, indent=1)
     # console summary
-    print("%-16s %-18s %-13s %-22s %-8s" % ("model", "params", "mu", "value", "abs_err"))
+    print(f"{'model':<16} {'params':<18} {'mu':<13} {'value':<22} {'abs_err':<8}")
     for r in results:
         par = ",".join(f"{k}={v}" for k, v in r["params"].items() if k != "c")
-        mu = "mean" if r["mu"] is None else "%.6g" % r["mu"]
-        print("%-16s %-18s %-13s %-22r %-8.1e" % (r["model"], par, mu, r["value"], r["abs_err_estimate"]))
+        mu = "mean" if r["mu"] is None else f"{r['mu']:.6g}"
+        print(f"{r['model']:<16} {par:<18} {mu:<13} {r['value']!r:<22} {r['abs_err_estimate']:<8.1e}")
     for c in checks:
         print("*", c["check"], "->", c["verdict"])
     print("integrand self-test:", selftest)
-    print("wrote", os.path.normpath(out_path), "in %.1f s" % doc["runtime_seconds"])
+    print("wrote", os.path.normpath(out_path), f"in {doc['runtime_seconds']:.1f} s")
 
 
 if __name__ == "__main__":

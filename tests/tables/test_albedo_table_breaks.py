@@ -12,7 +12,8 @@ from pumpup.tables.validate import TableError
 
 def _kinked(mu):
     lx = np.log(mu)
-    return 0.3 + 0.2 * np.abs(lx - np.log(0.6)) + 0.01 * lx**2  # a kink at mu = 0.6, quadratic in log(mu) on either side
+    # a kink at mu = 0.6, quadratic in log(mu) on either side
+    return 0.3 + 0.2 * np.abs(lx - np.log(0.6)) + 0.01 * lx**2
 
 
 def test_a_split_spline_follows_a_kink_the_whole_one_rounds_off():
@@ -115,14 +116,15 @@ def test_a_g1_level_albedo_has_a_kink_where_its_bound_equals_the_bound_at_the_no
     d2 = np.diff(a, 2) / h**2
     left, right = d2[:4], d2[-4:]  # the second differences that do not straddle v0
     assert np.ptp(left) < 0.01 and np.ptp(right) < 0.05 and left.min() - right.max() > 0.3, d2
-    assert v0 in pumpup.pump({"type": "ggx", "alpha": 0.5}, g="g1", levels=2).base.albedo_kinks(*pumping.grid_interior())
+    assert v0 in pumpup.pump({"type": "ggx", "alpha": 0.5}, g="g1",
+                             levels=2).base.albedo_kinks(*pumping.grid_interior())
     assert pumpup.pump({"type": "ggx", "alpha": 0.5}, g="g2", levels=1)._kink_normal() == []
 
 
 def test_two_level_g1_pumped_ward_at_normal_incidence_bounds_its_error():
-    """Rough Ward (m = 0.885, found by ``scripts/studies/fuzz_engines.py --two-d``): before its level-2 table was split at the
-    level-1 kink v = 0.0605 (u(v) = u(1), above), the table bunched 37 nodes between 0.05 and 0.07 and rounded the
-    kink off over 1e-4 in theta_o, and the nested engine was 1.6e-12 off at mu = 1 with an estimate of 8.1e-13 (rtol
+    """Rough Ward (m = 0.885, found by ``scripts/studies/fuzz_engines.py --two-d``): before its level-2 table was split
+    at the level-1 kink v = 0.0605 (u(v) = u(1), above), the table bunched 37 nodes between 0.05 and 0.07 and rounded
+    the kink off over 1e-4 in theta_o, and the nested engine was 1.6e-12 off at mu = 1 with an estimate of 8.1e-13 (rtol
     1e-10).  Reference: at normal incidence the albedo is a 1-D integral over theta_o (scipy's quad, split at every
     level's cut)."""
     from scipy.integrate import quad

@@ -9,13 +9,13 @@ import subprocess
 import sys
 import textwrap
 
+import helpers
 import numpy as np
 import pytest
 import xarray as xr
 
 import pumpup
 from pumpup.tables.validate import TableError
-import helpers
 
 LAMBERT_HALF = {"type": "lambert", "albedo": 0.5}
 

@@ -23,7 +23,7 @@ SPECS = {
 }
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _reference(name):
     f = pumpup.load(SPECS[name])
     kinks = f.albedo_kinks()

@@ -4,13 +4,13 @@ table cannot meet the tolerance."""
 
 import json
 
+import helpers
 import numpy as np
 import pytest
 
 import pumpup
-from pumpup.tables import reuse as _reuse
 from pumpup.sweeps import default_mu
-import helpers
+from pumpup.tables import reuse as _reuse
 
 DATA = json.loads((helpers.DATA / "independent_reference.json").read_text())
 MEAN = [e for e in DATA["entries"] if e["quantity"] == "mean_albedo"]
@@ -56,12 +56,14 @@ def test_an_unresolved_table_falls_back():
 
 
 @pytest.mark.parametrize("spec", [{"type": "phong", "n": 20000}, {"type": "ward", "m": 0.1},
-                                  {"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, {"type": "stretched_phong", "n": 20, "p": 0.5}])
+                                  {"type": "ward_aniso", "ax": 0.1, "ay": 0.3},
+                                  {"type": "stretched_phong", "n": 20, "p": 0.5}])
 def test_the_estimate_bounds_the_error_of_a_barely_resolved_table(spec):
     """The quintic spline's error is the larger difference to the cubic's and to the quintic's through every other node:
     with the cubic's alone, Phong n = 20000 (a feature that the sweep's grid barely resolves) was 1.1e-9 off
     with an estimate of 3.5e-10.  Ward's and anisotropic Ward's steep rise at grazing incidence makes the whole table
-    miss the tolerance: the table is cut short and the rest is computed afresh (scripts/calibration/reuse_calibration.py)."""
+    miss the tolerance: the table is cut short and the rest is computed afresh
+    (scripts/calibration/reuse_calibration.py)."""
     f = pumpup.load(spec)
     pumpup.tabulate(f, mu=MU, progress=False)
     m, e = pumpup.mean_albedo(f, return_error=True)
@@ -98,7 +100,8 @@ def test_only_the_tabulated_object_and_a_proportional_unit_model():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("spec", [{"type": "blinn", "n": 16}, {"type": "ward", "m": 0.3}, {"type": "cook_torrance", "m": 0.3}])
+@pytest.mark.parametrize("spec", [{"type": "blinn", "n": 16}, {"type": "ward", "m": 0.3},
+                                  {"type": "cook_torrance", "m": 0.3}])
 def test_reuse_agrees_with_fresh_two_d_models(spec):
     fresh = pumpup.load(spec)
     m0, e0 = pumpup.mean_albedo(fresh, return_error=True)
@@ -112,10 +115,10 @@ def test_reuse_agrees_with_fresh_two_d_models(spec):
 
 
 def test_a_table_with_nodes_that_share_theta():
-    """Beckmann alpha 0.0052 with Walter's G1: its switch level mu = 0.0083 is a jump of the albedo, and the adaptive grid
-    bisected towards it down to the last bit, 70 nodes that share theta = arccos(mu).  The mean from that table raised
-    scipy's "Expect x to not have duplicates" (found by scripts/studies/fuzz_engines.py --mean); it keeps the last of each now,
-    and agrees with the mean afresh within the two estimates."""
+    """Beckmann alpha 0.0052 with Walter's G1: its switch level mu = 0.0083 is a jump of the albedo, and the adaptive
+    grid bisected towards it down to the last bit, 70 nodes that share theta = arccos(mu).  The mean from that table
+    raised scipy's "Expect x to not have duplicates" (found by scripts/studies/fuzz_engines.py --mean); it keeps the
+    last of each now, and agrees with the mean afresh within the two estimates."""
     f = pumpup.load({"type": "beckmann", "alpha": 0.005184313347496449, "g1": "walter"})
     fresh, e_fresh = pumpup.mean_albedo(f, return_error=True)
     mu = pumpup.tabulate(f).mu.values

@@ -101,8 +101,8 @@ def test_a_jump_of_the_albedo_counts_in_the_margin():
 def test_the_interval_at_the_normal_is_checked_below_its_midpoint():
     """A g1 pumped plastic with n = 5284: its lobe reaches the normal below theta ~ 1 degree, inside the grid's last
     interval [0.9988, 1], whose midpoint in log(mu) lies at theta = 2 degrees.  The table was 3.1e-7 off at mu =
-    0.99995 with a margin of 2.0e-7 (scripts/studies/fuzz_engines.py --tables 43); the checks at 1 - mu = (1 - a) 2^-k count
-    in its interpolation error now."""
+    0.99995 with a margin of 2.0e-7 (scripts/studies/fuzz_engines.py --tables 43); the checks at 1 - mu = (1 - a) 2^-k
+    count in its interpolation error now."""
     spec = {"type": "pumped", "base": {"type": "plastic", "n": 5284.234871880557, "ad": 0.2771143076394261,
                                        "a_s": 0.047413995704811085}, "g": "g1", "levels": 1}
     f = pumpup.load(spec)
@@ -310,8 +310,9 @@ def test_tabulate_bad_threads(threads):
 
 
 def test_a_table_over_mu_and_phi_is_refused_with_one_clear_line():
-    """An anisotropic model's table over (mu, phi) made AlbedoTable.from_dataset fail inside scipy's spline ("len(c)>=n-k-1
-    failed"; found by scripts/studies/fuzz_engines.py --tables); it now names the dimensions, and one azimuth of it is a table."""
+    """An anisotropic model's table over (mu, phi) made AlbedoTable.from_dataset fail inside scipy's spline
+    ("len(c)>=n-k-1 failed"; found by scripts/studies/fuzz_engines.py --tables); it now names the dimensions, and one
+    azimuth of it is a table."""
     f = pumpup.load({"type": "ward_aniso", "ax": 0.2, "ay": 0.3})
     ds = pumpup.tabulate(f, phi=[0.0, 0.5], progress=False, rtol=1e-6)
     with pytest.raises(ValueError, match=r"function of mu alone.*\('mu', 'phi'\).*isel\(phi=0\)"):
