@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 
 import pumpup
-from pumpup.engine import lobe_geometry
 from pumpup.engine import nested as _nested
 from pumpup.engine import polar as _polar
 from pumpup.engine.cubature import NODES, WG, WK, AlbedoWarning, _groups, _integrate_group
