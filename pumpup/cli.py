@@ -14,7 +14,8 @@ import threading
 
 def parse_spec(text: str) -> dict:
     """A model spec from JSON (``'{"type": "phong", "n": 20}'``) or the short form ``phong:n=20,c=1``
-    (:func:`pumpup.core.parse_spec`; a bad one exits with its one-line message)."""
+    (:func:`pumpup.core.parse_spec`; a bad one exits with its one-line message).
+    """
     from pumpup.core import SpecError
     from pumpup.core import parse_spec as _parse
 
@@ -26,7 +27,8 @@ def parse_spec(text: str) -> dict:
 
 def _load(text: str, spectral: bool = False):
     """The model of a SPEC argument; a spectral one (a 'material' or per-wavelength lists, pumpup.spectral)
-    only where the command prints or writes per wavelength (``spectral=True``)."""
+    only where the command prints or writes per wavelength (``spectral=True``).
+    """
     import pumpup
 
     try:
@@ -45,7 +47,8 @@ SPECTRAL_REFUSED = ("this command takes a single-channel model; a spectral spec 
 
 class UsageError(SystemExit):
     """A user error (or an interruption): its one line is already on stderr; the exit status is
-    ``code`` (2, or 130 after Ctrl-C).  ``str()`` gives the message."""
+    ``code`` (2, or 130 after Ctrl-C).  ``str()`` gives the message.
+    """
 
     def __init__(self, message: str, code: int = 2):
         super().__init__(code)
@@ -61,7 +64,8 @@ def _one_line(text: str) -> str:
 
 def check_out(path: str, option: str = "--out") -> None:
     """Exit with one line naming ``path`` unless a file can be written there: its directory exists, is a
-    directory and is writable, and ``path`` is not itself a directory (checked before any work)."""
+    directory and is writable, and ``path`` is not itself a directory (checked before any work).
+    """
     import os
 
     directory = os.path.dirname(os.path.abspath(path))
@@ -79,7 +83,8 @@ def check_out(path: str, option: str = "--out") -> None:
 
 def check_out_dir(path: str, option: str = "--out") -> None:
     """Exit with one line naming ``path`` unless it is a writable directory or can be made one: the
-    nearest existing ancestor is a writable directory (checked before any work)."""
+    nearest existing ancestor is a writable directory (checked before any work).
+    """
     import os
 
     if os.path.exists(path):
@@ -296,7 +301,6 @@ def cmd_pump(args) -> int:
     import numpy as np
 
     import pumpup
-
     from pumpup.operators.pumping import MAX_LEVELS
 
     if not 1 <= args.levels <= MAX_LEVELS:
@@ -363,10 +367,10 @@ def cmd_reproduce(args) -> int:
 
 
 def cmd_divergence(args) -> int:
+    from pumpup.core import check_open_unit
+
     from .divergence import analysis_dataset, divergence, plot
     from .tables.provenance import write_generated
-
-    from pumpup.core import check_open_unit
 
     try:
         check_open_unit("divergence", "--mu-min", args.mu_min)
@@ -763,7 +767,8 @@ class _Parser(argparse.ArgumentParser):
 
 def cmd_render_scene(args) -> int:
     """``pumpup render scene NAME``: the papers' scenes path-traced by Mitsuba 3 (pumpup.scenes); every
-    argument is checked (one line, status 2) before rendering; without mitsuba, the ``render`` extra is named."""
+    argument is checked (one line, status 2) before rendering; without mitsuba, the ``render`` extra is named.
+    """
     import os
 
     from pumpup import scenes
@@ -1018,7 +1023,8 @@ def _interrupted() -> UsageError:
 def _closed_stdout() -> int:
     """Output piped into a reader that has gone (``pumpup models | head -1``): no error line, status 141
     (128 + SIGPIPE, as a shell tool killed by the broken pipe).  stdout goes to /dev/null so that the
-    interpreter's last flush does not complain."""
+    interpreter's last flush does not complain.
+    """
     import os
 
     try:
@@ -1034,7 +1040,8 @@ def main(argv: list[str] | None = None, notify: bool = False) -> int:
     :class:`UsageError`, a SystemExit); Ctrl-C, at any moment of the run, prints one line and exits
     with 130.  The arguments are parsed before the library is imported.  Set PUMPUP_TRACEBACK=1 to
     see the traceback of an error instead.  ``notify``: before numba compiles a kernel that is not in its
-    cache, say so in one line on stderr (when stderr is a terminal; the console script sets it)."""
+    cache, say so in one line on stderr (when stderr is a terminal; the console script sets it).
+    """
     debug = bool(os.environ.get("PUMPUP_TRACEBACK"))
     try:
         args = build_parser().parse_args(argv)
@@ -1068,7 +1075,8 @@ def main(argv: list[str] | None = None, notify: bool = False) -> int:
 
 def _caused_by_interrupt(exc: BaseException) -> bool:
     """Whether a KeyboardInterrupt is in ``exc``'s chain: Ctrl-C while a C extension imports (numpy's import of
-    datetime) surfaces as that module's ImportError."""
+    datetime) surfaces as that module's ImportError.
+    """
     seen = set()
     while exc is not None and id(exc) not in seen:
         if isinstance(exc, KeyboardInterrupt):
@@ -1087,7 +1095,8 @@ def _redeliver_interrupts(hook):
     """An unraisable-exception hook that sends a KeyboardInterrupt on again instead of printing it: Ctrl-C that lands
     in a callback from C (llvmlite's, while numba compiles) cannot propagate there, and Python would print it as
     "Exception ignored" and go on.  The interrupt is sent again 10 ms later, from a timer thread, so that it arrives
-    in ordinary Python code (and again, should it land in a callback once more)."""
+    in ordinary Python code (and again, should it land in a callback once more).
+    """
 
     def unraisable(args) -> None:
         if args.exc_type is not None and issubclass(args.exc_type, KeyboardInterrupt):
@@ -1103,7 +1112,8 @@ def _redeliver_interrupts(hook):
 
 def console_main() -> None:
     """The ``pumpup`` console script: :func:`main`, then an exit in which a late Ctrl-C or a closed pipe
-    prints nothing more (Ctrl-C is ignored once the command has finished and flushed its output)."""
+    prints nothing more (Ctrl-C is ignored once the command has finished and flushed its output).
+    """
     try:
         sys.unraisablehook = _redeliver_interrupts(sys.unraisablehook)
         code = main(notify=True)

@@ -13,8 +13,8 @@ import os
 
 import numpy as np
 
-from .engine.cubature import albedo
 from .core import load
+from .engine.cubature import albedo
 from .operators.pumping import Pumped, pump
 from .tables import atomic_path, max_constant
 

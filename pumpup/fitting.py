@@ -87,7 +87,7 @@ class FitError(SpecError):
 
 
 def view_mus(n_views: int, mu_min: float) -> np.ndarray:
-    """mu of the views: theta uniform in [0, arccos(mu_min)], normal view first."""
+    """The mu of the views: theta uniform in [0, arccos(mu_min)], normal view first."""
     return np.cos(np.linspace(0.0, math.acos(mu_min), n_views))
 
 
@@ -204,7 +204,8 @@ class FitData:
 def relative_errors(brdf: BRDF, data: FitData, rtol: float, scale: float = 1.0, return_albedo: bool = False):
     """(e_f, e_a, bound of e_a from the albedo error estimates) of ``scale * brdf`` on ``data``.
 
-    With ``return_albedo``, also the albedo of ``scale * brdf`` at ``data.mu``."""
+    With ``return_albedo``, also the albedo of ``scale * brdf`` at ``data.mu``.
+    """
     from .engine.cubature import albedo
 
     m = np.asarray(brdf._eval(data.wi[data.region], data.wo[data.region]), dtype=np.float64) * data.cos_l[data.region]
@@ -236,7 +237,8 @@ def _around(v, a, b):
 
 def _zoom(value, v, a0, b0, rounds: int = 9, n: int = 21, shrink: float = 4.0):
     """Maximise value(wl (K, P, 3), v (K, 1, 3)) -> (K, P) by patches in (a, b) around each start,
-    each round ``shrink`` times smaller around the best point so far.  Returns (best, wl*)."""
+    each round ``shrink`` times smaller around the best point so far.  Returns (best, wl*).
+    """
     k = len(v)
     ha = 0.2 * a0 + 0.02  # [rad]: beyond the neighbouring cells of the log-polar grids
     hb = np.where(a0 < 0.05, math.pi, 0.3)  # near the mirror direction: every azimuth
@@ -276,7 +278,8 @@ def sup_brdf_error(target: BRDF, brdf: BRDF, data: FitData, n_start: int = 4, re
     worst grid points), the view's peak refined the same way.  Returns (e_f, worst wi, worst wo).
 
     The grid maximum alone underestimates the supremum where the worst point lies on the
-    region's boundary (common: the tails differ most)."""
+    region's boundary (common: the tails differ most).
+    """
     m = np.asarray(brdf._eval(data.wi, data.wo), dtype=np.float64) * data.cos_l
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # outside the region t may be tiny
         err = np.where(data.t > 0, np.abs(m / np.where(data.t > 0, data.t, 1.0) - 1.0), 0.0)
@@ -330,7 +333,8 @@ def sup_albedo_error(target: BRDF, brdf: BRDF, mu: np.ndarray, a_t: np.ndarray, 
     """e_a refined: the grid maximum of |a / a_t - 1| over ``mu``, then bounded Brent
     maximisation in theta between the neighbours of the worst grid point (when the worst grid
     point is an end of the range and the midpoint towards its neighbour is lower, the end is
-    taken as the maximum).  Returns (e_a, mu*)."""
+    taken as the maximum).  Returns (e_a, mu*).
+    """
     from scipy.optimize import minimize_scalar
 
     from .engine.cubature import albedo
@@ -562,7 +566,7 @@ def _log_scaled(lo: float, hi: float) -> bool:
 
 
 def _best_scale(pairs_q, lo, hi):
-    """argmin over c in [lo, hi] of max_k w_k max_i |c q_ki - 1|, exact (a max of lines).
+    """The argmin over c in [lo, hi] of max_k w_k max_i |c q_ki - 1|, exact (a max of lines).
 
     ``pairs_q`` is a list of (w_k, q_min_k, q_max_k); each term is
     w max(c q_max - 1, 1 - c q_min), so the maximum of 2K lines, convex in c.
@@ -647,7 +651,8 @@ class _Problem:
 
         During the search (``exact`` false) a candidate whose albedo-free lower bound of
         the objective already exceeds the best value found so far returns that bound
-        without computing its albedo (it cannot become the best)."""
+        without computing its albedo (it cannot become the best).
+        """
         key = tuple(values[k] for k in self.names)
         if key in self.cache:
             return self.cache[key]
@@ -702,7 +707,8 @@ class _Problem:
 
     def _scale_range(self, a):
         """The range of the profiled scale; with ``plausible``, capped so that c a <= 1 on the search mu
-        (a: the albedo at c = 1).  None if empty."""
+        (a: the albedo at c = 1).  None if empty.
+        """
         lo, hi = self.bounds[self.profile]
         if self.plausible and a is not None and np.max(a) > 0:
             hi = min(hi, 1.0 / float(np.max(a)))  # energy conservation, 000 eq. 2-3
@@ -761,7 +767,8 @@ class _Problem:
 
 def _local(prob: _Problem, x, width: float, xtol: float):
     """Local min-max refinement from x: bounded Brent on [x - width, x + width] (one parameter) or
-    Nelder-Mead on the max, restarted once from its own result (several)."""
+    Nelder-Mead on the max, restarted once from its own result (several).
+    """
     from scipy.optimize import minimize, minimize_scalar
 
     xb = prob.x_bounds()
@@ -783,7 +790,8 @@ def _local(prob: _Problem, x, width: float, xtol: float):
 
 def _search(prob: _Problem, n_scan: int, seed: int, maxiter: int, xtol: float):
     """Bounded global search (a scan for one parameter, differential evolution for more), then
-    :func:`_local`.  Returns (x, the width of the scan's step)."""
+    :func:`_local`.  Returns (x, the width of the scan's step).
+    """
     from scipy.optimize import differential_evolution
 
     xb = prob.x_bounds()

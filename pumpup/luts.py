@@ -420,7 +420,7 @@ def quantise(values, storage: str) -> np.ndarray:
     v = np.asarray(values, dtype=np.float64)
     if storage == "text6":
         f = np.clip(v, 0.0, 1.0).astype(np.float32)  # saturatef, then std::to_string (printf "%f")
-        return np.array([float(np.float32(float("%f" % float(x)))) for x in f.ravel()]).reshape(v.shape)
+        return np.array([float(np.float32(float(f"{float(x):f}"))) for x in f.ravel()]).reshape(v.shape)
     if storage == "half":
         return v.astype(np.float32).astype(np.float16).astype(np.float64)
     if storage == "float32":
@@ -437,7 +437,8 @@ def quantise(values, storage: str) -> np.ndarray:
 
 def _dense_axis(kind: str, n: int, lo: float, per_cell: int, stride: int) -> np.ndarray:
     """Physical coordinates between the look-up nodes: per_cell points per cell (every
-    ``stride``-th cell), plus the domain ends (the clamped regions)."""
+    ``stride``-th cell), plus the domain ends (the clamped regions).
+    """
     if kind == "texel":
         c = np.arange(0, n - 1, stride)[:, None] + (np.arange(per_cell) + 0.5)[None, :] / per_cell
         u = (c.ravel() + 0.5) / n
@@ -637,9 +638,9 @@ def lut(model="ggx", preset: str = "cycles", *, rtol: float | None = None, eavg:
 def _c_array(name: str, values: np.ndarray, storage: str, per_line: int, qualifier: str = "static") -> str:
     flat = np.asarray(values, dtype=np.float64).ravel()
     if storage == "text6":
-        items = ["%ff" % float(np.float32(x)) for x in np.clip(flat, 0, 1)]
+        items = [f"{float(np.float32(x)):f}f" for x in np.clip(flat, 0, 1)]
     else:
-        items = ["%.9gf" % float(np.float32(x)) for x in flat]
+        items = [f"{float(np.float32(x)):.9g}f" for x in flat]
     lines = []
     for a in range(0, len(items), per_line):
         lines.append("  " + ", ".join(items[a:a + per_line]))

@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .engine.cubature import albedo
 from .core import load
+from .engine.cubature import albedo
 from .published import TABLE2, TABLE3, TABLE4, TEXT, Published, agrees
 from .tables import atomic_path, max_albedo, mean_albedo
 
@@ -76,7 +76,8 @@ def _table2(cache, bar):
 
 def _mean_with_constant(cache, model, n):
     """Mean albedo of the model with its paper constant: (n+2)/(2 pi) for the Phong family,
-    the maximum constant (000 Table 2, computed) for the Blinn family."""
+    the maximum constant (000 Table 2, computed) for the Blinn family.
+    """
     spec = {"type": model, "n": float(n)}
     if model in ("phong", "stretched_phong"):
         return cache.mean_albedo(spec)

@@ -46,8 +46,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, vectorize
 
-from .engine.cubature import check_mu
 from .core import BRDF, Lobe, as_directions
+from .engine.cubature import check_mu
 
 __all__ = ["Strategy", "acceptance", "efficiency_dataset", "mc_albedo", "mc_radiance", "pdf", "plot_efficiency", "sample",
            "second_moment", "strategy"]
@@ -297,7 +297,7 @@ class Strategy:
         return " + ".join(f"{w:g} x {n}" for (w, _, _), n in zip(self.components, self.names))
 
     def sample(self, wo: np.ndarray, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-        """n draws of wi given one wo (shape (3,)): (wi (n, 3), pdf (n,)); rejected draws are 0, 0."""
+        """The n draws of wi given one wo (shape (3,)): (wi (n, 3), pdf (n,)); rejected draws are 0, 0."""
         wi = np.empty((n, 3))
         p = np.empty(n)
         if len(self.components) == 1:
@@ -330,7 +330,8 @@ class Strategy:
 @dataclass(frozen=True)
 class OwnSampling:
     """The sampling density of a model that draws its own directions (:attr:`pumpup.core.BRDF.own_sampler`), with
-    :class:`Strategy`'s interface."""
+    :class:`Strategy`'s interface.
+    """
 
     brdf: BRDF
 
@@ -342,7 +343,7 @@ class OwnSampling:
         return f"1 x {self.names[0]}"
 
     def sample(self, wo: np.ndarray, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-        """n draws of wi given one wo (shape (3,)): (wi (n, 3), pdf (n,)); rejected draws are 0, 0."""
+        """The n draws of wi given one wo (shape (3,)): (wi (n, 3), pdf (n,)); rejected draws are 0, 0."""
         u = rng.random((2, n))
         wi, p = self.brdf.sample_wi(wo, u[0], u[1])
         return np.asarray(wi, dtype=np.float64), np.asarray(p, dtype=np.float64)
@@ -476,7 +477,8 @@ def pdf(brdf: BRDF, wi, wo, *, kind: str = "lobe") -> np.ndarray:
 
 def _weights(f: BRDF, strat: Strategy, w: np.ndarray, n: int, rng, radiance=None, chunk: int = 1 << 20):
     """Mean and standard error of the weights f(wi, w) cos(wi) L(wi) / p(wi) over n draws
-    (rejected draws count as 0), accumulated in chunks with Chan's pairwise update."""
+    (rejected draws count as 0), accumulated in chunks with Chan's pairwise update.
+    """
     count, mean, m2 = 0, 0.0, 0.0
     while count < n:
         m = min(chunk, n - count)
@@ -592,7 +594,7 @@ class _SwappedRoles:
 
 class _MomentIntegrand(BRDF):
     """An integrand h(c, x) whose albedo at c (the engine integrates h cos(theta_x) over x) is a
-    moment of the sampling of x around c (x drawn with density p(x | c) of ``strategy``):
+    moment of the sampling of x around c (x drawn with density p(x | c) of ``strategy``), chosen by ``what``.
 
     * ``what = "second"``: h = f(c, x)^2 cos(theta_x) / p(x | c), albedo E[w^2] of mc_albedo;
     * ``what = "density"``: h = p(x | c) / cos(theta_x), albedo the acceptance probability.
@@ -693,8 +695,8 @@ def efficiency_dataset(ns=EFFICIENCY_N, theta_deg=EFFICIENCY_THETA, mu_grazing: 
     import xarray as xr
 
     from ._version import __version__
-    from .engine.cubature import albedo
     from .core import load
+    from .engine.cubature import albedo
 
     mu = np.concatenate([np.cos(np.radians(np.asarray(theta_deg, dtype=np.float64))), [mu_grazing]])
     models = ("phong", "stretched_phong")

@@ -114,8 +114,7 @@ METALS = {"gold": "Au", "silver": "Ag", "copper": "Cu", "aluminium": "Al"}
 
 def metal_index(colour) -> tuple[list, list]:
     """(eta, k) per RGB channel of a scene metal: its measured index at ``spectral.RGB_WAVELENGTHS``."""
-    from .spectral import optical
-    from .spectral import RGB_WAVELENGTHS
+    from .spectral import RGB_WAVELENGTHS, optical
 
     eta, k = optical.constants(METALS[colour], list(RGB_WAVELENGTHS))
     return [float(x) for x in eta], [float(x) for x in k]
@@ -125,7 +124,8 @@ def metal(colour, n, kind):
     """The measured metal ``colour`` (a :data:`METALS` key) with exponent n, one spec per RGB channel:
     ``kind`` "phong" (F(Theta_min) x reciprocal Phong, 000 eq. 5), "stretched" (000 eq. 28) or "pumped"
     (F(Theta_min) x Phong pumped once with g1, 001 eq. 20; the colour-keeping pumped metal).  A
-    ``pumpup_mix`` material: [(rgb weight, [3 specs])]."""
+    ``pumpup_mix`` material: [(rgb weight, [3 specs])].
+    """
     if kind not in ("phong", "stretched", "pumped"):
         raise ValueError(f"kind must be 'phong', 'stretched' or 'pumped', got {kind!r}")
     eta, k = metal_index(colour)
@@ -392,7 +392,8 @@ def render_scene(name, spp=64, size=256, variant="auto", *, progress=True, out=s
 
 def write_scene(name, rows, out_dir, *, exposure=0.0, variant="", spp=0, exr=True):
     """Write each panel as linear EXR (R, G, B; unless ``exr`` is False) and the side-by-side PNG ``NAME.png``
-    (radiance x 2^exposure, sRGB transfer, clipped at 1); returns the paths."""
+    (radiance x 2^exposure, sRGB transfer, clipped at 1); returns the paths.
+    """
     from matplotlib.figure import Figure
 
     from .render import _atomic, srgb

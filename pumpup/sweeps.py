@@ -33,8 +33,8 @@ from typing import Any
 import numpy as np
 
 from ._version import __version__
-from .engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
 from .core import BRDF, SpecError, load
+from .engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
 
 __all__ = ["SWEEP_KIND", "default_mu", "dimension_name", "sweep"]
 
@@ -242,7 +242,8 @@ class _Parts:
     """The parts directory ``<out>.parts/`` of a sweep, locked (flock on the directory itself) for as
     long as the sweep runs, so that two sweeps to one ``out`` never run at once.  The manifest
     ``sweep.json`` is written with the first finished chunk (a sweep that never started, say its
-    scheduler was unreachable, leaves nothing behind); an existing manifest must match."""
+    scheduler was unreachable, leaves nothing behind); an existing manifest must match.
+    """
 
     def __init__(self, out: str, definition: dict, overwrite: bool = False):
         import fcntl
@@ -295,14 +296,16 @@ class _Parts:
 
     def abandon(self) -> None:
         """After a failure: release the lock; remove the directory if this sweep made it and
-        saved nothing into it."""
+        saved nothing into it.
+        """
         empty = self.created and self.saved == 0 and not any(n.startswith("chunk-") for n in os.listdir(self.directory))
         self.close(remove=empty)
 
 
 def definition_digest(definition: dict) -> str:
     """SHA-256 of what defines a sweep's result (spec, parameters, mu, pump, options): stored in
-    the result's attribute ``sweep_definition_sha256``."""
+    the result's attribute ``sweep_definition_sha256``.
+    """
     import hashlib
 
     def canon(v):  # 1 and 1.0 are the same parameter value
@@ -362,7 +365,8 @@ def warm_kernels(f: BRDF) -> None:
     signature by two threads at once, compile it twice and warn ("Compilation requested for
     previously compiled argument types"), once per sweep.  One value of the innermost base's
     albedo runs every kernel of the engine and the model (a pumped chain's own kernel compiles
-    under numba's lock)."""
+    under numba's lock).
+    """
     from .engine.cubature import albedo
     from .operators.pumping import Pumped
 
@@ -428,7 +432,8 @@ def _run_local(tasks, scheduler: str, workers: int | None, on_done) -> None:
 def _worker_init(parent: int) -> None:  # pragma: no cover - runs in the workers
     """In each worker process: ask the kernel (Linux prctl PR_SET_PDEATHSIG) for SIGTERM when the
     sweep's process dies, so that a killed sweep leaves no workers behind; ignore SIGINT (Ctrl-C
-    goes to the sweep, which ends the workers)."""
+    goes to the sweep, which ends the workers).
+    """
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -746,7 +751,7 @@ def _dataset(spec, base, names, values, grid, pump, opts, arrays):
 
 
 def _write_output(ds, out) -> None:
-    """netCDF (atomic rename of a temporary file) or a zarr store (atomic rename of a temporary directory)."""
+    """A netCDF file (atomic rename of a temporary file) or a zarr store (atomic rename of a temporary directory)."""
     from .tables import write_table
 
     out = os.fspath(out)

@@ -450,7 +450,8 @@ def _pool(observed: np.ndarray, expected: np.ndarray, min_expected: float):
 
 def _pearson(observed: np.ndarray, expected: np.ndarray, min_expected: float):
     """Pearson's statistic after pooling (:func:`_pool`), its degrees of freedom, cells
-    pooled in and out.  A cell with observations but nothing expected makes it infinite."""
+    pooled in and out.  A cell with observations but nothing expected makes it infinite.
+    """
     o, e, pin, pout = _pool(observed, expected, min_expected)
     with np.errstate(divide="ignore", invalid="ignore"):
         terms = np.where(e > 0, (o - e) ** 2 / np.where(e > 0, e, 1.0), np.where(o > 0, np.inf, 0.0))

@@ -45,17 +45,29 @@ measured below the true error (``pumpup.physics.quadrature.MODE_2D`` switches it
 from __future__ import annotations
 
 import math
-import numpy as np
 import warnings
-from dataclasses import dataclass
-from dataclasses import replace
+from dataclasses import dataclass, replace
+
+import numpy as np
 from numba import njit
 
-from ..core import BRDF
-from ..core import Lobe
+from ..core import BRDF, Lobe
 from .arc_breaks import graded, horizon_breaks, kink_breaks
-from .lobe_geometry import NODES, WG, WK, AXES, AXIS_CODE, RADIAL_CODE, accumulate, kink_coefficients, radial_map, radial_map_scalar, rotate_wi, lobe_rounding, smooth
-
+from .lobe_geometry import (
+    AXES,
+    AXIS_CODE,
+    NODES,
+    RADIAL_CODE,
+    WG,
+    WK,
+    accumulate,
+    kink_coefficients,
+    lobe_rounding,
+    radial_map,
+    radial_map_scalar,
+    rotate_wi,
+    smooth,
+)
 
 __all__ = ["albedo", "check_mu", "check_phi", "AlbedoWarning"]
 
@@ -168,7 +180,8 @@ def _geometry_reference(lobe: Lobe, mu, levels, ka, kb, piece, tx, tt):
 @njit(cache=True, nogil=True, inline="always")
 def _sort_interior(x, n):  # pragma: no cover - compiled
     """Insertion sort of x[1:n - 1] in place (the cuts between an arc's two ends x[0] and x[n - 1]: a
-    few, already nearly sorted; no allocation)."""
+    few, already nearly sorted; no allocation).
+    """
     for a in range(2, n - 1):
         val = x[a]
         b = a - 1
@@ -298,7 +311,8 @@ def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
 
     err is the error estimate of the rectangle, |K - G| (or, when ``pumpup.physics.quadrature.MODE_2D``
     asks for it, QUADPACK's calibration of it: not the default, see the module docstring);
-    ex and et, the same for the Gauss rule in x only and in t only, choose the split direction."""
+    ex and et, the same for the Gauss rule in x only and in t only, choose the split direction.
+    """
     from ..physics.quadrature import calibrated_array, mode_code
 
     mode = mode_code(smooth=False)  # raw |K - G| unless pumpup.physics.quadrature.MODE_2D says otherwise
@@ -393,7 +407,8 @@ def _level_end_scales(lobe: Lobe, mu: float, levels: np.ndarray, gx: np.ndarray,
 def _first_rectangles_t(d: np.ndarray, gt: np.ndarray):
     """The first intervals of tau_t of pieces whose upper end has the scale ``d`` (any shape S, see
     :func:`_level_end_scales`): the grid ``gt`` and, where d < D_GRADE, breaks 1 - d 4^k graded
-    towards the end.  Returns (index into S.ravel(), t0, t1)."""
+    towards the end.  Returns (index into S.ravel(), t0, t1).
+    """
     d = d.ravel()
     kk = 4.0 ** np.arange(K_GRADE)
     need = d < D_GRADE
@@ -517,7 +532,8 @@ def _turned_lobe(brdf: BRDF, lobe: Lobe, phi: float) -> Lobe:
     (the "normal" and "half" frames) and the model's anisotropy is aligned with the tangent axes
     (``azimuth_range() == pi / 2``), the model's x and y axes as breakpoints of beta: a lobe that is
     narrow across one axis is a ridge along it, which at phi = 0 lies on the ends of the beta range
-    and otherwise would fall inside a piece unseen (ward_aniso ax = 1000, ay = 1e-6 gave 0 at mu = 1)."""
+    and otherwise would fall inside a piece unseen (ward_aniso ax = 1000, ay = 1e-6 gave 0 at mu = 1).
+    """
     lobe = replace(lobe, symmetric=False)
     rng = brdf.azimuth_range()
     if lobe.axis not in ("normal", "half") or rng is None or abs(rng - math.pi / 2) > 1e-15:
@@ -540,7 +556,8 @@ def _turned_lobe(brdf: BRDF, lobe: Lobe, phi: float) -> Lobe:
 
 def _groups(brdf: BRDF, mu: np.ndarray, phi: np.ndarray | None = None):
     """Group the values of mu by the structure of their Lobe hint (and whether wi leaves the
-    xz-plane: ``phi`` != 0, where the hint's symmetry in beta no longer holds)."""
+    xz-plane: ``phi`` != 0, where the hint's symmetry in beta no longer holds).
+    """
     by_key: dict = {}
     for i, m in enumerate(mu):
         lobe = brdf.lobe(float(m))

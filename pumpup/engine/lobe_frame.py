@@ -7,13 +7,11 @@ from __future__ import annotations
 
 import functools
 import math
+
 import numpy as np
 from numba import njit
 
-from ..physics.quadrature import EPS
-from ..physics.quadrature import calibrated
-from ..physics.quadrature import mode_code
-
+from ..physics.quadrature import EPS, calibrated, mode_code
 
 #: relative rounding error of the 1-D quadrature (per unit of sum |K|): the integrand is a few
 #: elementary functions of u, accurate to a few ulp, summed over a few hundred nodes
@@ -56,7 +54,8 @@ def _arc_rule(q, a, b, lo, hi, nodes, wk, wg, mode, ibuf):  # pragma: no cover -
 @njit(cache=True, nogil=True)
 def _jacobi_sum(q, top, low, c, jt, jw):  # pragma: no cover - compiled
     """integral_0^c t^q / sqrt((top - t)(t - low)) dt by the Gauss-Jacobi rule (nodes ``jt`` on
-    [0, 1], weights ``jw`` for the weight t^q)."""
+    [0, 1], weights ``jw`` for the weight t^q).
+    """
     s = 0.0
     for j in range(jt.shape[0]):
         t = c * jt[j]
@@ -77,7 +76,8 @@ def _jacobi_bound(q, top, low, c, n):  # pragma: no cover - compiled; see the te
     root's cuts lie on the real axis beyond them), so inside the Bernstein ellipse E_rho, |x| <= A = (rho + 1/rho) / 2 <
     min(x_T, -x_L), |g| <= M = 2 / (c sqrt((x_T - A)(-x_L - A))) (computed in t's units, finite as c -> 0).  A Gauss rule with a positive weight errs by at most
     2 W E_(2n-1)(g), W = c^(q+1) / (q + 1) the weight's integral, and E_m(g) <= 2 M rho^-m / (rho - 1) (Trefethen, ATAP
-    Thm 8.2): the bound is 4 W M rho^(1 - 2n) / (rho - 1)."""
+    Thm 8.2): the bound is 4 W M rho^(1 - 2n) / (rho - 1).
+    """
     xt = 2.0 * top / c - 1.0  # (inf where c is tiny: rho is then capped)
     xl = 1.0 - 2.0 * low / c
     r = min(xt, xl)
@@ -91,7 +91,8 @@ def _jacobi_bound(q, top, low, c, n):  # pragma: no cover - compiled; see the te
 @njit(cache=True, nogil=True, inline="always")
 def _tally(val, err, m, tot, e):  # pragma: no cover - compiled
     """(value, error, the interval with the largest error) of an adaptive rule's first m intervals, the
-    sums starting from ``tot`` and ``e``."""
+    sums starting from ``tot`` and ``e``.
+    """
     worst = 0
     for i in range(m):
         tot += val[i]
@@ -137,7 +138,8 @@ def _arc_bound(q, big_t, d, b, c, tol):  # pragma: no cover - compiled; see arc_
     s1) |t| <= T + D c^2 A^2 < 2 T and |t - L| = D |s1^2 - s^2| >= D (s1^2 - c^2 A^2): |F| <= M = (2 T)^q /
     sqrt(D (s1^2 - c^2 A^2)).  The n-point Gauss rule's error is then at most 64 M / (15 (1 - rho^-2) rho^(2 n))
     (Trefethen, Approximation Theory and Approximation Practice, Thm 19.3) times sqrt(D) c.  log(rho) is the smaller of
-    ARC_RHO_BRANCH log(rho_0) and ARC_RHO_POLE log(rho_1), rho_i the ellipse through s_i / c."""
+    ARC_RHO_BRANCH log(rho_0) and ARC_RHO_POLE log(rho_1), rho_i the ellipse through s_i / c.
+    """
     s0sq = big_t / d
     s1sq = 2.0 * b / d
     best_n = GL_MAX + 1
@@ -163,7 +165,8 @@ def _arc_bound(q, big_t, d, b, c, tol):  # pragma: no cover - compiled; see arc_
 @njit(cache=True, nogil=True)
 def _arc_piece(q, big_t, d, b, c, n):  # pragma: no cover - compiled; see arc_piece_reference
     """P = sqrt(D) c integral_-1^1 F(c x) dx by the n-point Gauss-Legendre rule, F even (:func:`_arc_bound`):
-    integral_(T - D c^2)^T t^q / sqrt((T - t)(t - L)) dt with t = T - D s^2, 2 b = T - L."""
+    integral_(T - D c^2)^T t^q / sqrt((T - t)(t - L)) dt with t = T - D s^2, 2 b = T - L.
+    """
     tot = 0.0
     for j in range((n + 1) // 2):
         s2 = c * c * GL_X[n, j] * GL_X[n, j]
@@ -191,7 +194,8 @@ def _arc_power(q, mu, a, b, d1, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iw
     (``rest`` >= 0, H >= beta1 mu^q), its rounding added; about 5 values of t^q per call where the 7/15 rule in beta
     took 15 to 45 (issue 14's fifteenth session).  Should the bound want more than GL_MAX points, the piece is
     the 7/15 rule in beta, globally adaptive on at most INNER_MAX intervals (``iwork``, 4 x INNER_MAX), until
-    the summed calibrated error meets the same tolerance; the error is returned either way."""
+    the summed calibrated error meets the same tolerance; the error is returned either way.
+    """
     if beta1 <= 0.0:
         return 0.0, 0.0
     top = a + b
@@ -242,7 +246,8 @@ def _arc_power(q, mu, a, b, d1, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iw
 
 def arc_piece_reference(q: float, mu: float, a: float, b: float, d1: float, c: float = 1.0) -> float:
     """The arc's piece in s (:func:`_arc_piece`) in plain numpy, for N.wo = a + b cos(beta), d1 = b^2 - (mu - a)^2:
-    P by numpy's 200-point Gauss-Legendre rule in s on [0, c] (c = 1: t from mu to T; the compiled kernel's twin)."""
+    P by numpy's 200-point Gauss-Legendre rule in s on [0, c] (c = 1: t from mu to T; the compiled kernel's twin).
+    """
     d = d1 / (b + (mu - a))  # (mu - a first: b + mu would round b away near mu = 1)
     x, w = np.polynomial.legendre.leggauss(200)
     sx = c * x
@@ -260,7 +265,8 @@ _NO_JACOBI.flags.writeable = False
 def jacobi_rules(q: float) -> np.ndarray:
     """Nodes on [0, 1] and weights of the Gauss-Jacobi rules for integral_0^1 t^q g(t) dt, of
     :data:`JACOBI_ORDERS` (the shorter, the longer: :func:`_arc_power`): rows t, w of the first, t, w of the second
-    (read-only, cached per q: scipy computes them in about 0.1 ms)."""
+    (read-only, cached per q: scipy computes them in about 0.1 ms).
+    """
     from scipy.special import roots_jacobi
 
     lo_n, hi_n = JACOBI_ORDERS
@@ -278,7 +284,8 @@ def _k_closed(p, mu, c2, u, um, sa):  # pragma: no cover - compiled; see integra
     """(K, beta1, below) for u = cos(alpha), um = 1 - u, sa = sin(alpha); c2 = cos(2 theta_i): K is
     the integral over the visible arc of N.wo / max(mu, N.wo)^p in closed form for p in {0, 1} (for
     other p, the p = 1 value); beta1 is the half-arc where N.wo >= mu (p > 0) and ``below`` the
-    integral of N.wo over the half-arc where 0 < N.wo < mu."""
+    integral of N.wo over the half-arc where 0 < N.wo < mu.
+    """
     a = mu * u
     d0 = (sa - mu) * (sa + mu)  # b^2 - a^2 = sin^2(alpha) - mu^2
     if d0 > 0.0:
@@ -309,7 +316,8 @@ def _k_of_u(p, mu, c2, u, um, sa, itol, nodes, wk, wg, mode, ibuf, iwork, jac): 
     """(K(u), its error): K is the integral over the visible arc of N.wo / max(mu, N.wo)^p, for
     u = cos(alpha), um = 1 - u, sa = sin(alpha); c2 = cos(2 theta_i).  Closed form for p in
     {0, 1} (:func:`_k_closed`); for p in (0, 1) the arc where N.wo >= mu by :func:`_arc_power`
-    (relative error ``itol``), the rest in closed form.  The error is 0 for the closed forms."""
+    (relative error ``itol``), the rest in closed form.  The error is 0 for the closed forms.
+    """
     k, beta1, below = _k_closed(p, mu, c2, u, um, sa)
     if p == 0.0 or p == 1.0:
         return k, 0.0
@@ -357,7 +365,8 @@ def integrand_reference(n: float, p: float, mu: float, u: np.ndarray) -> np.ndar
 
 def integrand(n: float, p: float, mu: float, u, rtol: float = 1e-13):
     """(u^n K(u), its error) by the compiled kernel at every u in [0, 1] (for tests and checks;
-    ``rtol`` is the inner rule's relative tolerance for p in (0, 1))."""
+    ``rtol`` is the inner rule's relative tolerance for p in (0, 1)).
+    """
     from .cubature import NODES, WG, WK
 
     u = np.atleast_1d(np.asarray(u, dtype=np.float64))

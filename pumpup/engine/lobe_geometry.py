@@ -7,11 +7,11 @@ rotation of wi out of the xz-plane, the accumulation of f cos(theta_o), and the 
 from __future__ import annotations
 
 import math
+
 import numpy as np
 from numba import njit
 
 from ..core import Lobe
-
 
 # --- Gauss-Kronrod 7/15 nodes and weights on [-1, 1] (QUADPACK qk15) -----------------------
 _XGK = np.array(
@@ -49,7 +49,8 @@ WG[1::2] = 0.5 * np.concatenate([_WG[:-1], _WG[::-1]])
 
 def power_split(k: float) -> tuple[float, float]:
     """(u_s, y_s) of the two-piece power map: the tail cos(alpha) in [0, u_s = 1/2] is
-    integrated in cos(alpha) itself, the peak y = cos^(n+1)(alpha) in [y_s, 1]."""
+    integrated in cos(alpha) itself, the peak y = cos^(n+1)(alpha) in [y_s, 1].
+    """
     return 0.5, 0.5 ** (k + 1.0)
 
 
@@ -114,7 +115,7 @@ AXES = ("normal", "mirror", "retro", "half")
 
 
 def smooth(tau):
-    """x = tau^2 (3 - 2 tau), 1 - x, dx/dtau."""
+    """The values x = tau^2 (3 - 2 tau), 1 - x and dx/dtau."""
     x = tau * tau * (3.0 - 2.0 * tau)
     xc = (1.0 - tau) ** 2 * (1.0 + 2.0 * tau)
     return x, xc, 6.0 * tau * (1.0 - tau)
@@ -173,7 +174,7 @@ def radial_map_scalar(kind, k, x, xc):  # pragma: no cover - compiled; see radia
 
 
 def rotate_wi(w, c, s):
-    """w rotated about N = (0, 0, 1) by the angle with cosine c and sine s (arrays (n,))."""
+    """The direction w rotated about N = (0, 0, 1) by the angle with cosine c and sine s (arrays (n,))."""
     out = np.empty_like(w)
     out[:, 0] = c * w[:, 0] - s * w[:, 1]
     out[:, 1] = s * w[:, 0] + c * w[:, 1]
@@ -183,8 +184,9 @@ def rotate_wi(w, c, s):
 
 @njit(cache=True, nogil=True)
 def accumulate(f, cos_o, weight, total):  # pragma: no cover - compiled
-    """total += f cos(theta_o) weight where all are positive; the index of the first value of f
-    that is negative or not finite (or -1)."""
+    """Compute total += f cos(theta_o) weight where all are positive; the index of the first value of f
+    that is negative or not finite (or -1).
+    """
     for i in range(f.shape[0]):
         v = f[i]
         if not (v >= 0.0 and v < math.inf):
@@ -196,7 +198,8 @@ def accumulate(f, cos_o, weight, total):  # pragma: no cover - compiled
 
 def radial_map_inverse(kind: str, k: float, alpha: float) -> tuple[float, float]:
     """The map variable x of the polar angle alpha, and 1 - x, both to full precision
-    (inverse of :func:`radial_map`)."""
+    (inverse of :func:`radial_map`).
+    """
     ta = math.tan(alpha)
     if kind == "cosine":
         return math.sin(alpha) ** 2, math.cos(alpha) ** 2
@@ -222,7 +225,7 @@ def radial_map_inverse(kind: str, k: float, alpha: float) -> tuple[float, float]
 
 
 def smooth_inverse(x: float, xc: float) -> float:
-    """tau with tau^2 (3 - 2 tau) = x, precise at both ends (the map is symmetric about 1/2)."""
+    """The tau with tau^2 (3 - 2 tau) = x, precise at both ends (the map is symmetric about 1/2)."""
     small = min(x, xc)
     if small < 1e-4:
         # the series tau = t0 (1 + t0 / 3 + ...), t0 = sqrt(small / 3): the closed form below rounds 1 - 2 small, and

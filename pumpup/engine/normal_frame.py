@@ -6,19 +6,18 @@ node; :mod:`pumpup.engine.polar` describes the method.
 from __future__ import annotations
 
 import math
-import numpy as np
 import os
+
+import numpy as np
 from numba import njit
 
 from ..core.hints import AzimuthHint
 from ..physics.fresnel import conductor_scalar as _fresnel_real
 from ..physics.fresnel import fresnel_pole
-from ..physics.lookups import g_levels
-from ..physics.lookups import g_product
+from ..physics.lookups import g_levels, g_product
 from ..physics.lookups import scale_bound as _scale_bound
 from ..physics.microfacet import projected as _projected
-from ..physics.quadrature import calibrated
-from ..physics.quadrature import rule_sums
+from ..physics.quadrature import calibrated, rule_sums
 from .chain_frame import CHAIN_SAFETY
 from .half_arc import SCHLICK, SMITH, _fresnel_at, numeric_params
 from .hint_view import kernel_view
@@ -28,7 +27,7 @@ from .outer_rule import _bisect, _buffers, _status
 
 @njit(cache=True, nogil=True, inline="always")
 def _ggx_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ring_reference
-    """integral over phi in [0, 2 pi) of the GGX weight D = a2 / (pi (1 - (1 - a2) (N.h)^2)^2) (Walter et al. 2007
+    """The integral over phi in [0, 2 pi) of the GGX weight D = a2 / (pi (1 - (1 - a2) (N.h)^2)^2) (Walter et al. 2007
     eq. 33; 000 eq. 36 with a2 = r) on the circle of wo at elevation x = x_mu + d (N.wo = sin x) for wi at elevation x_mu
     (x_s = pi / 2 - x_mu).
 
@@ -40,7 +39,8 @@ def _ggx_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ring_referenc
     >= 0 for a2 <= 1 (no cancellation), no division by m (which vanishes at grazing incidence), and d, the offset from
     the peak, exact where the peak is narrow (a rule in x itself lost ulp(x) / alpha there: GGX alpha = 1e-5 at mu =
     0.9986 was 3e-13 off with an estimate of 9e-14), and cosines near pi / 2 as sines of x_s - ... (cos(x) of a rounded x
-    near pi / 2 lost ulp(pi / 2) / alpha: alpha = 1e-8 at mu = 1 did not converge)."""
+    near pi / 2 lost ulp(pi / 2) / alpha: alpha = 1e-8 at mu = 1 did not converge).
+    """
     tau = math.tan(0.5 * d)
     sy, cy = math.sin(xmu + 0.5 * d), math.sin(xs - 0.5 * d)  # (cos(y) as sin(pi / 2 - y): exact near the normal)
     a = a2 + tau * tau  # (a' - Q) / m^2
@@ -77,7 +77,8 @@ def _ring_f_sums(rho, rn, n, nn, j):  # pragma: no cover - compiled; see ring_f_
     with N = 1 - (nn + 1) z^nn + nn z^(nn + 1) = (1 - z^nn) - nn z^nn w: of size nn^2 |w|^2 where nn |w| is small, from
     terms of size nn |w| (the first form's terms are of size nn: it lost 2e-11 at nn = 128, n = 1).  Its error is then
     about eps (1 + nn |w|) / |w|^2, within a few eps of the sum's scale nn^2 where nn |w| >= 1; below RING_F_DIRECT, term
-    by term."""
+    by term.
+    """
     zn = -rn if n % 2 else rn  # z^nn
     zr, zi = rho * _RING_F_COS[j], rho * _RING_F_SIN[j]
     p, r = (1.0 - rho) + 2.0 * rho * _RING_F_SIN2[j], zi  # 1 - z = p - i r
@@ -127,7 +128,8 @@ def _ggx_ring_f(mp, a2, xmu, xs, d, itol, tol_abs, fv):  # pragma: no cover - co
     max(itol W_N, ``tol_abs``) or N = RING_F_NMAX: |W_N - W_N/2|, times the larger ratio of the last three such steps where
     both are at most RING_F_RATIO (from N = 32: the coefficients then decay geometrically, or faster, so W_N's error is below
     |W_N - W_N/2| times that ratio).  F's singularities limit the decay: c = 0, at psi = +- 2 i asinh(S / sqrt(s cos x)) (so S must not be
-    small: :data:`N_FRESNEL_S_MIN`), and the index's (:func:`n_fresnel_ok`)."""
+    small: :data:`N_FRESNEL_S_MIN`), and the index's (:func:`n_fresnel_ok`).
+    """
     tau = math.tan(0.5 * d)
     sy, cy = math.sin(xmu + 0.5 * d), math.sin(xs - 0.5 * d)
     a = a2 + tau * tau
@@ -186,7 +188,8 @@ def ring_reference(distribution: int, a2: float, mu: float, x: float, fresnel=No
     quadrature of Walter's D over phi (their numpy/scipy twin, for the tests); with ``fresnel`` = (ior, eta, k), D times
     the Fresnel factor F(wi.h) (:func:`_ggx_ring_f`; pumpup.models.cook_torrance.fresnel, pumpup.models.metal.fresnel),
     graded towards the mirror side at the scale of S = sin((x + x_mu) / 2) too (F's branch point at c = 0; without it, at
-    S ~ 0.05, scipy missed the feature by 3e-7, measured against mpmath)."""
+    S ~ 0.05, scipy missed the feature by 3e-7, measured against mpmath).
+    """
     from scipy.integrate import quad
 
     from ..physics.fresnel import fresnel_conductor as conductor
@@ -217,7 +220,8 @@ def ring_reference(distribution: int, a2: float, mu: float, x: float, fresnel=No
 
 def _peak_points(alpha: float) -> list:
     """Breakpoints in the azimuth phi in (0, pi) graded towards the mirror direction phi = pi, where a lobe alpha wide
-    peaks (for scipy's quadrature in the references)."""
+    peaks (for scipy's quadrature in the references).
+    """
     w = alpha * 3.0 ** np.arange(-4, 30)
     return list(math.pi - w[w < math.pi])
 
@@ -230,7 +234,8 @@ KUMMER_ASYMPTOTIC = 50.0
 def _kummer_half(z):  # pragma: no cover - compiled; tested against mpmath.hyp1f1
     """(H0, H1, H2), H_j = z^j e^-z 1F1(1/2; j + 1; z) for z >= 0 (inf included): below KUMMER_ASYMPTOTIC the power series
     (positive terms, DLMF 13.2.2), above it the asymptotic one, z^(j - 1/2) (j! / sqrt(pi)) sum_n (j + 1/2)_n (1/2)_n /
-    (n! z^n) (DLMF 13.7.1; positive terms too, the rest of the function e^-z smaller)."""
+    (n! z^n) (DLMF 13.7.1; positive terms too, the rest of the function e^-z smaller).
+    """
     if z >= KUMMER_ASYMPTOTIC:
         r = 1.0 / math.sqrt(math.pi * z) if z < math.inf else 0.0
         h0 = h1 = h2 = 0.0
@@ -320,7 +325,7 @@ def _kummer_fast(z):  # pragma: no cover - compiled; tested against _kummer_half
 
 @njit(cache=True, nogil=True, inline="always")
 def _beckmann_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ring_reference
-    """integral over phi in [0, 2 pi) of the Beckmann weight D = exp(-tan^2(h) / a2) / (pi a2 cos^4(h)) (Walter et al.
+    """The integral over phi in [0, 2 pi) of the Beckmann weight D = exp(-tan^2(h) / a2) / (pi a2 cos^4(h)) (Walter et al.
     2007 eq. 25) on the circle of wo at elevation x = x_mu + d, for wi at elevation x_mu (x_s = pi / 2 - x_mu).
 
     With X = |wi + wo|^2 = X_min + Q v, v = 1 - cos(psi) (psi = phi - pi, from the plane of incidence's mirror side),
@@ -329,7 +334,8 @@ def _beckmann_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ring_ref
     e^-(tau^2 / a2) / (pi a2) times (1 + tau^2)^2 M0 + 2 (1 + tau^2) a2 kappa M1 + a2^2 kappa^2 M2, M_j = integral of v^j
     e^-(kappa v) over psi = c_j e^-z 1F1(1/2; j + 1; z), z = 2 kappa, c = (2 pi, 2 pi, 3 pi) (v = 2 sin^2(psi / 2)): in
     :func:`_kummer_half`'s H_j, (e^-(tau^2 / a2) / a2) (2 (1 + tau^2)^2 H0 + 2 a2 (1 + tau^2) H1 + (3 / 4) a2^2 H2),
-    every term >= 0."""
+    every term >= 0.
+    """
     tau = math.tan(0.5 * d)
     g = math.exp(-tau * tau / a2)
     if g == 0.0:  # (far in the Gaussian's tail: the rest is finite)
@@ -348,7 +354,8 @@ def _n_value(mp, mu, xmu, xs, d):  # pragma: no cover - compiled; see n_integran
     """Frame 6's integrand at x = x_mu + d: pi a2 cos(x) sin(x) W(x) Gamma(sin x), W the weight's integral over the
     azimuth (:func:`_ggx_ring`, :func:`_beckmann_ring`), Gamma = 1 / (P(mu) P(t)) for the separable Smith G (Walter et al.
     2007 eq. 20), 1 / (t P(mu) + mu P(t) - mu t) for the height-correlated one (Heitz 2014), 1 / (r + (1 - r) t) for
-    Schlick's model (000 eq. 36); P(t) = N.wo / G1(wo) (physics.microfacet.projected, Walter eq. 27, 34), P(mu) in mp[8]."""
+    Schlick's model (000 eq. 36); P(t) = N.wo / G1(wo) (physics.microfacet.projected, Walter eq. 27, 34), P(mu) in mp[8].
+    """
     a2 = mp[4] if mp[0] == SCHLICK else mp[4] * mp[4]
     w = _beckmann_ring(a2, xmu, xs, d) if mp[0] == SMITH and mp[1] == 0.0 else _ggx_ring(a2, xmu, xs, d)
     if w == 0.0:  # (far in the Beckmann weight's tail)
@@ -371,7 +378,8 @@ def _n_times(mp, mu, xmu, xs, d, a2, w):  # pragma: no cover - compiled; see n_i
 @njit(cache=True, nogil=True)
 def _n_incidence(mp, mu):  # pragma: no cover - compiled
     """(x_mu, x_s = pi / 2 - x_mu) of incidence mu, both from atan2 (each exact near its own 0), and P(mu) = mu / G1(mu) into
-    mp[8] for the Smith models (Walter eq. 27, 34)."""
+    mp[8] for the Smith models (Walter eq. 27, 34).
+    """
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     if mp[0] == SMITH:
         mp[8] = _projected(s, 0.0, mu, int(mp[1]), int(mp[2]), mp[4])
@@ -381,7 +389,8 @@ def _n_incidence(mp, mu):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True, inline="always")
 def _n_chain_g(chain, mu, t):  # pragma: no cover - compiled
     """g_1 ... g_k(mu, t) of a pumped chain at N.wo = t, as the chain kernel computes it (``pumpup.physics.lookups.g_product``,
-    ``g_levels``; 001 eq. 16)."""
+    ``g_levels``; 001 eq. 16).
+    """
     if min(mu, t) > chain.product_mlo:
         return g_product(max(mu, t), chain.product_cbase, chain.product_cstart, chain.product_lo, chain.product_rows)
     return g_levels(max(mu, t), min(mu, t), chain.offsets, chain.logx, chain.coef, chain.v0, chain.slope0,
@@ -403,7 +412,8 @@ def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, it
     summed with the Kronrod weights, and into |K - G| before its calibration as far as they can hide it.  ``kind`` 0: the
     variable is d itself; 1 and 2 (a piece off the peak, GGX and Schlick): u = ln |d|, d = e^u or -e^u, the integrand times
     |d| (:data:`N_LOG_GRADE`); 3 (a piece near x = 0, GGX and Schlick): u = ln x, d = e^u - x_mu, the integrand times x
-    (:data:`N_LOG_GRADE`)."""
+    (:data:`N_LOG_GRADE`).
+    """
     h = hi - lo
     ie = 0.0
     noise = 0.0
@@ -452,7 +462,8 @@ def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, it
 @njit(cache=True, nogil=True)
 def _n_values(mp, mu, x, chain, factor):  # pragma: no cover - compiled
     """:func:`_n_value` (divided by the chain's g, or times the scaled model's factor, where ``chain`` or ``factor`` is
-    not None) at the elevations ``x`` (for the tests: the rule's own arithmetic, one node per call)."""
+    not None) at the elevations ``x`` (for the tests: the rule's own arithmetic, one node per call).
+    """
     xmu, xs = _n_incidence(mp, mu)
     out = np.empty(x.shape[0])
     buf = np.empty(1)
@@ -467,7 +478,8 @@ def _n_values(mp, mu, x, chain, factor):  # pragma: no cover - compiled
 def n_params(hint) -> np.ndarray:
     """Frame 6's parameter array: :func:`numeric_params`, and for GGX with a Fresnel factor mp[13] = 1
     (:func:`_ggx_ring_f`) and mp[14] the scale of F's pole near c = 0 (:func:`fresnel_pole`, a conductor's; 0 for a
-    dielectric) for :func:`_n_cuts`; with F(max) = (eta, k) (``KernelView.fmax``) mp[15:18] = 1, eta, k (:func:`_n_rule`)."""
+    dielectric) for :func:`_n_cuts`; with F(max) = (eta, k) (``KernelView.fmax``) mp[15:18] = 1, eta, k (:func:`_n_rule`).
+    """
     if isinstance(hint, AzimuthHint):
         hint = kernel_view(hint)
     mp = numeric_params(hint)
@@ -481,14 +493,16 @@ def n_params(hint) -> np.ndarray:
 
 def n_integrand(brdf, mu: float, x) -> np.ndarray:
     """Frame 6's integrand (:func:`_n_value`, divided by g for a pumped model, times the factor of a 1/E-scaled one) for
-    ``brdf``'s hint at N.wi = ``mu`` and elevations ``x`` of wo, as the engine computes it (for the tests)."""
+    ``brdf``'s hint at N.wi = ``mu`` and elevations ``x`` of wo, as the engine computes it (for the tests).
+    """
     hint = kernel_view(brdf.azimuth_hint())
     return _n_values(n_params(hint), float(mu), np.atleast_1d(np.asarray(x, dtype=float)), hint.chain, hint.factor)
 
 
 def n_integrand_reference(brdf, mu: float, x) -> np.ndarray:
     """Frame 6's integrand (:func:`_n_value`) at elevations ``x`` from the model itself: its BRDF times N.wo integrated over
-    the azimuth of wo by scipy's adaptive quadrature, times cos(x) and divided by the hint's scale (for the tests)."""
+    the azimuth of wo by scipy's adaptive quadrature, times cos(x) and divided by the hint's scale (for the tests).
+    """
     from scipy.integrate import quad
 
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -528,7 +542,8 @@ N_LOG_END = 0.25
 def _n_kind(mp, a, b, xmu):  # pragma: no cover - compiled
     """The variable of frame 6's piece [a, b] of d (:func:`_n_rule`): for GGX and Schlick (not Beckmann's Gaussian) 1 (u =
     ln d) beyond the peak, 2 (u = ln -d) short of it within N_LOG_SIDE x_mu, 3 (u = ln x, x = x_mu + d) near x = 0 within
-    N_LOG_SIDE x_mu but off x = 0 itself (:data:`N_LOG_GRADE`); else 0 (d)."""
+    N_LOG_SIDE x_mu but off x = 0 itself (:data:`N_LOG_GRADE`); else 0 (d).
+    """
     if mp[0] == SMITH and mp[1] == 0.0:
         return 0
     if a > 0.0:
@@ -542,7 +557,8 @@ def _n_kind(mp, a, b, xmu):  # pragma: no cover - compiled
 
 def n_pieces_reference(brdf, mu: float) -> list:
     """Frame 6's pieces for ``brdf``'s hint at N.wi = ``mu``: (lo, hi, kind) in d = x - x_mu, kind as :func:`_n_kind`
-    (for the tests)."""
+    (for the tests).
+    """
     hint = kernel_view(brdf.azimuth_hint())
     mp = n_params(hint)
     cut = np.empty(N_CUTS)
@@ -570,7 +586,8 @@ def _n_cuts(mp, xmu, cut):  # pragma: no cover - compiled; see n_cuts_reference
     atanh(alpha), alpha or r / (1 - r), and x_mu for the correlated G and for Beckmann) and at Walter's switch: every piece
     then lies at least about its own length from the nearest singularity, in the variable it is integrated in.  With a
     Fresnel factor (mp[13], :func:`_ggx_ring_f`) x is also cut where the rings' smallest wi.h, sin((x + x_mu) / 2), is 3^j
-    times the scales of F's pole (mp[14]) and branch point (mp[10])."""
+    times the scales of F's pole (mp[14]) and branch point (mp[10]).
+    """
     half = 0.5 * math.pi
     alpha = math.sqrt(mp[4]) if mp[0] == SCHLICK else mp[4]
     beckmann = mp[0] == SMITH and mp[1] == 0.0
@@ -633,7 +650,8 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
                  err, conv, evals):  # pragma: no cover
     """Frame 6: adaptive 10/21 quadrature over the elevation x = x_mu + d of wo (:func:`_n_rule`) for every mu, from the
     pieces between :func:`_n_cuts` and, for a pumped or a 1/E-scaled model (``chain`` or ``factor`` not None), the
-    elevations ``ecut[q, :necut[q]]`` (:func:`chain_cuts` of the kinks of g or U)."""
+    elevations ``ecut[q, :necut[q]]`` (:func:`chain_cuts` of the kinks of g or U).
+    """
     cap, pk, t0, t1, kv, ke, buf, _, _, itol = _buffers(max_intervals + N_CUTS + ecut.shape[1], nodes, nodes, rtol)
     cut = np.empty(N_CUTS + ecut.shape[1])
     fv = np.empty(RING_F_NMAX + 1)
@@ -706,7 +724,8 @@ def n_fresnel_ok(ior: float, eta: float, k: float) -> bool:
     but c = 0 (the refracted cosine's branch points +- w, w = sqrt(1 - index^2); the parallel reflectance's poles, on the
     physical sheet in the left half-plane, :func:`fresnel_pole`) at least :data:`N_FRESNEL_SING_MIN` from the rings' range
     of c, [:data:`N_FRESNEL_S_MIN`, 1].  A dielectric with ior > 1 has w on the imaginary axis; ior <= 1 (a total
-    reflection's kink at c = w real) and a near-kink conductor (w near the real segment) stay with frame 4."""
+    reflection's kink at c = w real) and a near-kink conductor (w near the real segment) stay with frame 4.
+    """
     if eta > 0.0:
         w = complex(1.0 - (eta * eta - k * k), -2.0 * eta * k) ** 0.5
         x = min(max(abs(w.real), N_FRESNEL_S_MIN), 1.0)

@@ -5,12 +5,12 @@ the globally adaptive rule (:func:`_integrate`); :mod:`pumpup.engine.polar` desc
 from __future__ import annotations
 
 import math
+
 import numpy as np
 from numba import njit
 
 from ..physics.microfacet import projected as _projected
-from ..physics.quadrature import calibrated
-from ..physics.quadrature import rule_sums
+from ..physics.quadrature import calibrated, rule_sums
 from .cubature import NODES as _NODES
 from .cubature import WG as _WG
 from .cubature import WK as _WK
@@ -23,7 +23,8 @@ from .lobe_fresnel import LOBE_F_WIDE, _k_lobe_fresnel, _lobe_f_prepare
 @njit(cache=True, nogil=True)
 def _smoothing(sm, tau):  # pragma: no cover - compiled
     """(x, 1 - x, dx/dtau) of the smoothing substitution on [0, 1]: sm = 0 none, 1 at the left
-    end (x = tau^2), 2 at the right end (1 - x = (1 - tau)^2), 3 at both (x = tau^2 (3 - 2 tau))."""
+    end (x = tau^2), 2 at the right end (1 - x = (1 - tau)^2), 3 at both (x = tau^2 (3 - 2 tau)).
+    """
     tc = 1.0 - tau
     if sm == 0:
         return tau, tc, 1.0
@@ -113,7 +114,8 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
     closed forms p in {0, 1} have a loop of their own, with no call in it (a loop that may call
     :func:`_arc_power` ran 2.5 x slower for them; a pumped lobe has a loop of its own,
     :func:`_integrate_chain`: one integration loop that could call either rule ran 1.45 x slower for
-    them)."""
+    them).
+    """
     h = t1 - t0
     ie = 0.0
     noise = 0.0
@@ -237,7 +239,8 @@ def _foreign_roots(cv, cc, nc, rv, rc, nr, tail):  # pragma: no cover - compiled
     any cut next to it: near mu = sqrt(3) / 2 the level's (u = cos 2 theta_i) and the horizon's (u = s) nearly coincide,
     and the level's root lay 4.5e-6 beyond the end of the peak's piece [0, z_s], where no rule saw it (stretched Phong n =
     10 at mu = 0.866025, rtol 1e-12: 3.2e-12 off with an estimate of 6.6e-13; 40-digit mpmath, the nested engine and the
-    frame of N agree to 1e-15).  Appends to ``cv``, ``cc`` and sorts them; returns their number."""
+    frame of N agree to 1e-15).  Appends to ``cv``, ``cc`` and sorts them; returns their number.
+    """
     m = nc
     for j in range(nr):
         c = rc[j]
@@ -268,7 +271,8 @@ def _foreign_roots(cv, cc, nc, rv, rc, nr, tail):  # pragma: no cover - compiled
 def _graded_cuts(kind, lo, hi, left, k, margin, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
     """Pieces of ``kind`` from lo cut at lo (1 + 4^i) while they fit below hi (and the arrays keep ``margin``
     slots), written from slot k; the first keeps the left smoothing ``left``.  Returns (where the rest of
-    [lo, hi] starts, the next slot, the rest's left smoothing)."""
+    [lo, hi] starts, the next slot, the rest's left smoothing).
+    """
     a = lo
     step = lo  # the first cut at 2 lo
     while a + step < hi - step and k < MAX_PIECES - margin:
@@ -289,7 +293,8 @@ def _vcavity_breaks(mu, s, psi):  # pragma: no cover - compiled
     its lines reaches the top of h's circle (c = 2 u mu at alpha = pi/2 - theta_i = psi; c = mu / u at
     alpha = theta_i) or the top or bottom (c = 2 u mu / (4 u^2 - 1): cos(theta_i -+ alpha) sin(3 alpha) =
     sin(2 alpha) mu, by bisection on (0, pi/3), where it changes sign), and where the crossings meet
-    (alpha = pi/4) or one meets the arc's end mu / (2 u) (alpha = pi/3)."""
+    (alpha = pi/4) or one meets the arc's end mu / (2 u) (alpha = pi/3).
+    """
     th = 0.5 * math.pi - psi
     out = np.zeros(6)
     out[0], out[1], out[2], out[3] = psi, th, 0.25 * math.pi, math.pi / 3.0
@@ -314,7 +319,8 @@ def _vcavity_breaks(mu, s, psi):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True, inline="always")
 def _zr(radial, tb, n):  # pragma: no cover - compiled
     """The peak variable at tan(alpha) = tb under the half frame's Beckmann weight (radial 1: t = tan^2(alpha) / m^2)
-    or GGX weight (radial 2: ln(1 + t))."""
+    or GGX weight (radial 2: ln(1 + t)).
+    """
     t = (tb / n) ** 2
     return t if radial == 1 else math.log1p(t)
 
@@ -324,7 +330,8 @@ def _branch_cuts(ub, zb, kb, m, th_i, x0, y0, st0, radial, n, n1):  # pragma: no
     """:func:`_pieces`' cuts about F's branch point x0 - i y0 (st0 = sqrt(1 - x0^2)): where the arc's (frame 5) or h's
     circle's (frame 4) highest or lowest cosine, cos(theta_i -+ alpha), passes x0 (alpha = |theta_i - theta_0| or theta_i +
     theta_0), and at -+ (y0 / sin(theta_0) / 2) 4^j from there, j < LOBE_F_CUTS, not smoothed (code 3); u = cos(alpha),
-    z by the radial weight (``radial`` 0: -(n + 1) ln u).  Returns the new number of breaks (at most MAX_BREAKS)."""
+    z by the radial weight (``radial`` 0: -(n + 1) ln u).  Returns the new number of breaks (at most MAX_BREAKS).
+    """
     th_0 = math.atan2(st0, x0)
     for ax in (abs(th_i - th_0), th_i + th_0):
         if not 0.0 < ax < 0.5 * math.pi:
@@ -575,7 +582,8 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
 @njit(cache=True, nogil=True, inline="always")
 def _buffers(max_intervals, nodes, inodes, rtol):  # pragma: no cover - compiled
     """The work arrays of the adaptive loop (intervals: piece, ends, value, error; rule values; the
-    inner rule's) and the inner rule's relative tolerance, a small part of the total (rtol / 8)."""
+    inner rule's) and the inner rule's relative tolerance, a small part of the total (rtol / 8).
+    """
     cap = max_intervals + 64
     return (cap, np.empty(cap, np.int64), np.empty(cap), np.empty(cap), np.empty(cap), np.empty(cap),
             np.empty(nodes.shape[0]), np.empty(inodes.shape[0]), np.empty((4, INNER_MAX)),
@@ -586,7 +594,8 @@ def _buffers(max_intervals, nodes, inodes, rtol):  # pragma: no cover - compiled
 def _status(kv, ke, m, left_out, rounding, rtol, atol):  # pragma: no cover - compiled
     """(value, error, rounding error, the interval with the largest error, done) of the first m
     intervals: done when the error meets the tolerance or is below the rounding error of the
-    integrand (refining cannot help there)."""
+    integrand (refining cannot help there).
+    """
     tot = 0.0
     e = left_out
     ab = 0.0
@@ -604,7 +613,8 @@ def _status(kv, ke, m, left_out, rounding, rtol, atol):  # pragma: no cover - co
 @njit(cache=True, nogil=True, inline="always")
 def _bisect(pk, t0, t1, worst, m):  # pragma: no cover - compiled
     """Bisect interval ``worst``: it keeps the lower half, interval m (new) takes the upper; returns
-    (piece, lower end, midpoint, upper end)."""
+    (piece, lower end, midpoint, upper end).
+    """
     i = pk[worst]
     a_, b_ = t0[worst], t1[worst]
     mid = 0.5 * (a_ + b_)
@@ -619,7 +629,8 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
     every mu (without the scale); ``frame`` 0 the lobe frame (:func:`_k_closed`, :func:`_k_of_u`), 1-3 the
     half vector's (:func:`_k_half`, :func:`_k_ward`, :func:`_k_vcavity`; 4 :func:`_k_numeric` with the parameters
     ``mp``, its P(mu) set here per mu), ``radial`` 1 the Beckmann weight, 2 the GGX weight, in place of u^n
-    (:func:`_pieces`)."""
+    (:func:`_pieces`).
+    """
     # (room for every piece's first intervals besides max_intervals bisections: up to PIECES_CAP pieces)
     cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals + PIECES_CAP * n_init, nodes, inodes, rtol)
     kinds = np.empty(PIECES_CAP, np.int64)

@@ -211,17 +211,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.hints import AzimuthHint
-from ..core.hints import PowerLobe
-from ..physics.quadrature import EPS
-from ..physics.quadrature import mode_code
+from ..core.hints import AzimuthHint, PowerLobe
+from ..physics.quadrature import EPS, mode_code
 from .chain_frame import CHAIN_RULE, N_INIT_CHAIN, _integrate_chain, chain_cut_matrix, ring_table
 from .half_arc import numeric_params
 from .hint_view import kernel_view
-from .lobe_frame import N_INIT, ROUNDING, _NO_JACOBI, jacobi_rules
+from .lobe_frame import _NO_JACOBI, N_INIT, ROUNDING, jacobi_rules
 from .normal_frame import _integrate_n, n_params
-from .outer_rule import RULE, _RADIAL, _RULES, _integrate
-
+from .outer_rule import _RADIAL, _RULES, RULE, _integrate
 
 __all__ = ["albedo_1d", "axis_albedo", "run"]
 
@@ -229,7 +226,8 @@ __all__ = ["albedo_1d", "axis_albedo", "run"]
 def run(route: str, hint: AzimuthHint, mu: np.ndarray, rtol: float, atol: float, max_regions: int,
         lobe_fresnel_gauss: bool = True):
     """(value, error, converged, evaluations) of the albedo of ``hint`` at every mu (a 1-D float array) by the 1-D
-    ``route`` the routing table chose for it (:mod:`pumpup.engine.routes`)."""
+    ``route`` the routing table chose for it (:mod:`pumpup.engine.routes`).
+    """
     hint = kernel_view(hint)
     mu = np.ascontiguousarray(mu, dtype=np.float64)
     scale = np.broadcast_to(np.asarray(hint.scale(mu), dtype=np.float64), mu.shape)
@@ -294,7 +292,8 @@ def axis_albedo(n: float, nu: np.ndarray, scale: np.ndarray, rtol: float, atol: 
     (:meth:`pumpup.core.BRDF.lobe_axis`: Lafortune's lobe, 000 eq. 14, at any azimuth of wi).  Without max(N.L, N.V)
     the integrand depends on wi only through A, so the albedo is the ``lobe`` route's p = 0 lobe about R with mu = nu
     (:func:`_k_closed`), times the scale.  The scale's rounding is added to the error: scale ~ |v|^n with |v| from a
-    few roundings, (4 n + 16) eps relative."""
+    few roundings, (4 n + 16) eps relative.
+    """
     hint = AzimuthHint(PowerLobe(n=float(n), p=0.0), scale=lambda m: scale)
     val, err, conv, evals = run("lobe", hint, nu, rtol, atol, max_regions)
     return val, err + (4.0 * n + 16.0) * EPS * np.abs(val), conv, evals
@@ -303,7 +302,8 @@ def axis_albedo(n: float, nu: np.ndarray, scale: np.ndarray, rtol: float, atol: 
 def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int, choice=None):
     """(value, error, converged, evaluations) of the albedo of ``brdf`` (one albedo term) at every mu (a 1-D float
     array) by the 1-D routes the routing table gives its hint (:func:`pumpup.engine.routes.hint_routes`), or None where
-    they leave some mu to the nested or 2-D engines (for the tests and the calibrations)."""
+    they leave some mu to the nested or 2-D engines (for the tests and the calibrations).
+    """
     from .routes import hint_routes
 
     hint = brdf.azimuth_hint()

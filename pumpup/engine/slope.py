@@ -103,7 +103,7 @@ OFFS_CAP = 8 * N_GRADE + 32
 
 @njit(cache=True, nogil=True, inline="always")
 def _ray_f(r, w, b, e2, rm):  # pragma: no cover - compiled; see ray_reference
-    """r e^(-r^2) (1 + r b) sqrt(w (r - r_-)) (1 + r^2 |e|^2)^(-5/2), with w = R - r given (no cancellation)."""
+    """The integrand r e^(-r^2) (1 + r b) sqrt(w (r - r_-)) (1 + r^2 |e|^2)^(-5/2), with w = R - r given (no cancellation)."""
     hz2 = 1.0 / (1.0 + r * r * e2)
     return r * math.exp(-r * r) * (1.0 + r * b) * math.sqrt(w * (r - rm)) * hz2 * hz2 * math.sqrt(hz2)
 
@@ -111,7 +111,8 @@ def _ray_f(r, w, b, e2, rm):  # pragma: no cover - compiled; see ray_reference
 @njit(cache=True, nogil=True)
 def _ray_rule(lo, hi, base, top, b, e2, rm, nodes, wk, wg, mode, buf):  # pragma: no cover - compiled
     """(value, error) of the 10/21 rule on [lo, hi]: in r where ``base`` < 0, else in tau with r = top - base tau^2
-    (the piece next to the horizon r = R = top, base = R - its start)."""
+    (the piece next to the horizon r = R = top, base = R - its start).
+    """
     h = hi - lo
     for j in range(nodes.shape[0]):
         x = lo + h * nodes[j]
@@ -137,7 +138,8 @@ def _roots(b, e2):  # pragma: no cover - compiled
 def _ray(b, e2, itol, tol_abs, nodes, wk, wg, mode, buf, rw):  # pragma: no cover - compiled
     """(J, error, evaluations) of the ray integral (module docstring), globally adaptive: the first pieces below, the
     one next to the horizon in tau where R <= R_MAX, the worst bisected until the error is at most max(itol |J|, tol_abs)
-    or RAY_MAX intervals are used (the error is returned either way)."""
+    or RAY_MAX intervals are used (the error is returned either way).
+    """
     big, rm = _roots(b, e2)
     lo, hi, val, err, kind = rw[0], rw[1], rw[2], rw[3], rw[4]
     top = min(big, R_MAX)
@@ -193,7 +195,8 @@ def _ray(b, e2, itol, tol_abs, nodes, wk, wg, mode, buf, rw):  # pragma: no cove
 @njit(cache=True, nogil=True)
 def _theta_rule(lo, hi, ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes, wk, wg, mode, buf, ibuf, rw):  # pragma: no cover
     """(value, error, sum |K|, evaluations) of the rule over theta (:data:`THETA_RULE`) in [lo, hi] for |e| J(theta),
-    the rays' errors added through the Kronrod weights."""
+    the rays' errors added through the Kronrod weights.
+    """
     h = hi - lo
     inner = 0.0
     evals = 0
@@ -214,7 +217,8 @@ def _theta_rule(lo, hi, ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes, 
 @njit(cache=True, nogil=True)
 def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk, twg, nodes, wk, wg, mode, work, buf, ibuf, rw):  # pragma: no cover
     """(integral of |e| J over theta, error, converged, evaluations) at one wi = (s cos phi, s sin phi, mu); ``atol``
-    applies to this integral (the caller divides by the scale c mu / pi)."""
+    applies to this integral (the caller divides by the scale c mu / pi).
+    """
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     cx = s * math.cos(phi) / mu
     cy = s * math.sin(phi) / mu
@@ -342,9 +346,10 @@ def _slope_all(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk
 
 def slope_albedo(brdf, mu: np.ndarray, phi: np.ndarray, rtol: float, atol: float, max_regions: int):
     """(value, error, converged, evaluations) of the albedo of anisotropic Ward ``brdf`` at every (mu, phi) (1-D float
-    arrays of one length; phi the azimuth of wi from the tangent x axis)."""
-    from .outer_rule import _RULES
+    arrays of one length; phi the azimuth of wi from the tangent x axis).
+    """
     from .lobe_frame import ROUNDING
+    from .outer_rule import _RULES
 
     ax, ay, c = brdf.slope_hint()
     mu = np.ascontiguousarray(mu, dtype=np.float64)
@@ -373,7 +378,8 @@ def ray_integral(b: float, e2: float, rtol: float = 1e-13) -> tuple:
 
 def ray_reference(b: float, e2: float) -> float:
     """J by scipy's adaptive quadrature on [0, min(R, 12)] in r, the horizon's square root taken by the substitution
-    r = R - w^2 (plain numpy and scipy; the tests' reference for :func:`_ray`)."""
+    r = R - w^2 (plain numpy and scipy; the tests' reference for :func:`_ray`).
+    """
     from scipy.integrate import quad
 
     d = math.hypot(b, math.sqrt(e2))

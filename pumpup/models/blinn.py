@@ -13,8 +13,8 @@ import math
 import numpy as np
 from numba import vectorize
 
+from ..core import BRDF, MAX_EXPONENT, Lobe, Param, load, register
 from ._half import tan2_half
-from ..core import MAX_EXPONENT, BRDF, Lobe, Param, load, register
 
 
 def _cos2_delta(wi, wo):
@@ -87,7 +87,8 @@ class Blinn(BRDF):
 
 def _half_hint(n, p, c):
     """The azimuth hint of a lobe c (N.H)^n / max(N.L, N.V)^p, p in {0, 1} (000 eq. 31, 32): the half vector's
-    azimuth about N integrates in closed form."""
+    azimuth about N integrates in closed form.
+    """
     from ..core.hints import AzimuthHint, HalfVectorLobe
 
     return AzimuthHint(HalfVectorLobe(n=n, p=float(p)), scale=lambda mu: np.full(np.shape(mu), c))

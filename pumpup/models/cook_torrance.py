@@ -23,11 +23,11 @@ import math
 import numpy as np
 from numba import vectorize
 
-from ._half import tan2_half
-from ..core import MAX_EXPONENT, MAX_INDEX, MAX_WIDTH, MIN_WIDTH, BRDF, Lobe, Param, SpecError, register
+from ..core import BRDF, MAX_EXPONENT, MAX_INDEX, MAX_WIDTH, MIN_WIDTH, Lobe, Param, SpecError, register
 from ..physics.fresnel import dielectric_reference as _fresnel_reference
 from ..physics.fresnel import dielectric_scalar as _fresnel
 from ..physics.fresnel import fresnel_dielectric as fresnel  # noqa: F401  (pumpup.models.cook_torrance.fresnel)
+from ._half import tan2_half
 
 # ----------------------------------------------------------------------------------------
 # Shared pieces: Fresnel, geometry factor, and the kinks of G for the albedo engine
@@ -72,7 +72,7 @@ def _g_kinks(mu, s, cos_a, sin_a):
 
 
 def _halfway(wi, wo):
-    """t = tan^2 delta, c = V.H and the geometry factor G (001 eq. 10) as arrays."""
+    """The values t = tan^2 delta, c = V.H and the geometry factor G (001 eq. 10) as arrays."""
     s = wi + wo
     lz, vz = wi[..., 2], wo[..., 2]
     qx = s[..., 0] / s[..., 2]  # h_x / h_z

@@ -10,7 +10,7 @@ import math
 import numpy as np
 from numba import vectorize
 
-from ..core import MAX_EXPONENT, BRDF, Lobe, Param, register
+from ..core import BRDF, MAX_EXPONENT, Lobe, Param, register
 
 
 def _up(wi, wo):

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import vectorize
 
-from ..core import MAX_INDEX, MIN_INDEX, BRDF, Param, register
+from ..core import BRDF, MAX_INDEX, MIN_INDEX, Param, register
 from .metal import _fresnel_real, fresnel, fresnel_levels
 
 __all__ = ["FresnelWeighted"]
@@ -98,7 +98,8 @@ class FresnelWeighted(BRDF):
         1.88, ad 0.33) had the specular lobe's hint (the power map about the mirror, n = 34) for its Lambert part too,
         and the engines lost part of it with estimates of 1e-9 (0.2908 for 0.4060 at mu = 0.306, eta 0.232), and over a
         2-level pumped plastic half of it (0.468 for 0.959 at mu = 1; scripts/studies/fuzz_engines.py --registry 47 and 48;
-        issue 14's twenty-fourth session)."""
+        issue 14's twenty-fourth session).
+        """
         terms = self.base.albedo_terms()
         if len(terms) == 1 and terms[0][1] is self.base:
             return [(1.0, self)]
@@ -123,7 +124,8 @@ class FresnelWeighted(BRDF):
 
 class _FresnelTerm(FresnelWeighted):
     """One linear term of the ``fresnel`` wrapper over a sum: F(Theta_min) f_k, f_k any term of the base (a model, or a
-    part of a pumped or compensated model, which has no spec of the registry), with f_k's own hint."""
+    part of a pumped or compensated model, which has no spec of the registry), with f_k's own hint.
+    """
 
     type = "fresnel-term"
 

@@ -94,7 +94,7 @@ import math
 import numpy as np
 from numba import njit, vectorize
 
-from ..core import MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, SpecError, register
+from ..core import BRDF, MAX_INDEX, MIN_INDEX, Lobe, Param, SpecError, register
 from .metal import _fresnel_real, fresnel
 
 #: relative bound on the truncation remainder of the directional-diffuse series
@@ -387,7 +387,7 @@ class HeTorrance(BRDF):
     def _validate(self):
         p = self.p
         if p["n"] is None and p["k"] != 0.0:
-            raise SpecError("he_torrance: parameter 'k' = %g needs the real index 'n' as well" % p["k"])
+            raise SpecError(f"he_torrance: parameter 'k' = {p['k']:g} needs the real index 'n' as well")
         ratio = p["sigma_0"] / p["wavelength"]  # (compared before squaring: a wavelength of 1e-181 overflowed g)
         lim = math.sqrt(G_MAX) / (4 * math.pi)
         if not ratio <= lim:

@@ -17,7 +17,7 @@ import math
 import numpy as np
 from numba import njit, vectorize
 
-from ..core import MAX_EXPONENT, BRDF, Lobe, Param, SpecError, register
+from ..core import BRDF, MAX_EXPONENT, Lobe, Param, SpecError, register
 
 
 def _rv_m(wi, wo, cx, cy, cz):
@@ -90,7 +90,8 @@ _KINKS: dict = {}
 
 def _zero_set_kinks(cx, cz):
     """kinks(mu, s, cos_a, sin_a) -> [(a, b)] of the zero set a + b cos(beta) = 0 of (R.V)_M for wi in the xz-plane
-    (one callable per (cx, cz), so that the hints of all mu group together)."""
+    (one callable per (cx, cz), so that the hints of all mu group together).
+    """
     key = (float(cx), float(cz))
     if key not in _KINKS:
         def kinks(mu, s, ca, sa, cx=key[0], cz=key[1]):
@@ -161,7 +162,8 @@ class Lafortune(BRDF):
     def azimuth_hint(self):
         """The closed-form-azimuth hint (pumpup.engine.polar) where the lobe is isotropic:
         cx = cy = cz = C > 0 gives (R.V)_M = C (R.V) (stretched Phong), cx = cy = -cz, cz = C > 0
-        gives C (L.V) (the retro-reflective lobe); the scale is c C^n (000 eq. 14, 15)."""
+        gives C (L.V) (the retro-reflective lobe); the scale is c C^n (000 eq. 14, 15).
+        """
         from ..core.hints import AzimuthHint, PowerLobe
 
         q = self.p
@@ -177,7 +179,8 @@ class Lafortune(BRDF):
         Phong power lobe about v^ at elevation nu = cz mu / |v|, scaled by c |v|^n (issue 14's fifteenth session: the
         1-D path about v^ at every azimuth of wi, :func:`pumpup.engine.polar.axis_albedo`).  None for p > 0 (max(N.L, N.V)
         depends on mu itself), for cz <= 0 (v^ on or below the horizon), where :meth:`polar` applies, and where nu or
-        the scale is not a positive finite number.  With cx = cy, |v| is taken without phi (the albedo is isotropic)."""
+        the scale is not a positive finite number.  With cx = cy, |v| is taken without phi (the albedo is isotropic).
+        """
         q = self.p
         if q["p"] != 0.0 or not q["cz"] > 0.0 or self.azimuth_hint() is not None:
             return None

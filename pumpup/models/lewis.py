@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import vectorize
 
-from ..core import MAX_EXPONENT, BRDF, Lobe, Param, load, register
+from ..core import BRDF, MAX_EXPONENT, Lobe, Param, load, register
 
 __all__ = ["LewisPhong", "phong_hs"]
 
@@ -191,7 +191,8 @@ class LewisPhong(BRDF):
 
     def azimuth_hint(self):
         """k_rho / H_s(mu) times reciprocal Phong with c = 1 (002 eq. 22), when k_sigma = 1; the
-        H_s is the one :meth:`_eval` divides by (:func:`_hs_at`)."""
+        H_s is the one :meth:`_eval` divides by (:func:`_hs_at`).
+        """
         from ..core.hints import AzimuthHint, PowerLobe
 
         q = self.p

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numba import vectorize
 
-from ..core import MAX_EXPONENT, MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, SpecError, load, register
+from ..core import BRDF, MAX_EXPONENT, MAX_INDEX, MIN_INDEX, Lobe, Param, SpecError, load, register
 from ..physics.fresnel import FRESNEL_LEVEL_Y0, fresnel_levels  # noqa: F401  (re-exported for the models)
 from ..physics.fresnel import conductor_scalar as _fresnel_real
 from ..physics.fresnel import fresnel_conductor as fresnel
@@ -121,7 +121,8 @@ class Metal(BRDF):
 
 def _fresnel_hint(n, c, eta, k):
     """The azimuth hint of c u^n F(eta + i k, Theta_min) / max(N.L, N.V) (000 eq. 28): a power lobe with p = 1 times
-    the factor F(max(N.wi, N.wo))."""
+    the factor F(max(N.wi, N.wo)).
+    """
     from ..core.hints import AzimuthHint, FresnelAtMax, PowerLobe
 
     return AzimuthHint(PowerLobe(n=n, p=1.0), scale=lambda mu: np.full(np.shape(mu), c), factors=(FresnelAtMax(eta, k),))
@@ -161,8 +162,9 @@ _MAX_S_CACHE: dict = {}
 
 
 def _plastic_max_s(n: float, eta) -> float:
-    """max over mu of the albedo of plastic's specular lobe with a_s = 1 (plus its error estimate):
-    ``metal`` with k = 0 (the same kernel, 000 eq. 28-29) or stretched Phong without Fresnel."""
+    """The max over mu of the albedo of plastic's specular lobe with a_s = 1 (plus its error estimate):
+    ``metal`` with k = 0 (the same kernel, 000 eq. 28-29) or stretched Phong without Fresnel.
+    """
     key = (float(n), eta)
     if key not in _MAX_S_CACHE:
         from ..core import service

@@ -44,10 +44,10 @@ from typing import Any
 import numpy as np
 from numba import vectorize
 
-from ..core import MAX_INDEX, MAX_WIDTH, MIN_ALPHA, MIN_INDEX, BRDF, Lobe, Param, SpecError, register
+from ..core import BRDF, MAX_INDEX, MAX_WIDTH, MIN_ALPHA, MIN_INDEX, Lobe, Param, SpecError, register
+from ..physics.microfacet import projected, projected_reference, walter_level
 from ._half import tan2_half
 from .cook_torrance import _IOR, _fresnel, _fresnel_reference
-from ..physics.microfacet import projected, projected_reference, walter_level
 from .metal import _fresnel_real
 from .metal import fresnel as _fresnel_complex
 
@@ -248,7 +248,8 @@ _K = Param(None, lo=0.0, hi=MAX_INDEX, doc="conductor: extinction coefficient (w
 
 class _WiHKink:
     """The Lobe hint's kink wi.h = x0 of a half-vector lobe (:func:`wih_kinks`), a + b cos(beta) = 0
-    with a = mu cos(alpha) - x0, b = s sin(alpha) (a class, not a closure: a BRDF pickles for dask)."""
+    with a = mu cos(alpha) - x0, b = s sin(alpha) (a class, not a closure: a BRDF pickles for dask).
+    """
 
     def __init__(self, x0: float):
         self.x0 = float(x0)
@@ -260,7 +261,8 @@ class _WiHKink:
 def wih_kinks(brdf, eta, k):
     """The ``kinks`` of ``brdf``'s Lobe hint where a Fresnel factor of eta + i k at wi.h (GGX, Beckmann; He-Torrance's
     bisector angle) has a kink or a near-kink, wi.h = x0 (:func:`pumpup.models.metal.fresnel_levels`), or None; one
-    object per BRDF (the engine groups values of mu by it), kept in its ``__dict__``."""
+    object per BRDF (the engine groups values of mu by it), kept in its ``__dict__``.
+    """
     hit = brdf.__dict__.get("_f_kinks", False)
     if hit is False:
         from .metal import fresnel_levels

@@ -13,8 +13,8 @@ import math
 import numpy as np
 from numba import njit, vectorize
 
+from ..core import BRDF, MAX_EXPONENT, Lobe, Param, dot, register
 from ..core.checks import off_unit
-from ..core import MAX_EXPONENT, BRDF, Lobe, Param, dot, register
 
 
 def _phong_c(p):
@@ -50,7 +50,8 @@ _BLOCK = 256
 @njit(cache=True, nogil=True, inline="always")
 def _lit_cos(lx, ly, lz, vx, vy, vz):  # pragma: no cover - compiled
     """R.V where the pair is lit (both above the horizon and R.V > 0, the kernel's tests, which a
-    NaN passes), else 0."""
+    NaN passes), else 0.
+    """
     rv = 2.0 * lz * vz - (lx * vx + ly * vy + lz * vz)  # 000 eq. 9
     return 0.0 if (lz <= 0.0) | (vz <= 0.0) | (rv <= 0.0) else rv
 
@@ -66,7 +67,8 @@ def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compi
     without branches (a third of the pairs are dark, at random: an ``if`` mispredicts) and pow runs
     on them only.  The values are those of ``_phong_kernel`` bit for bit (the same operations,
     c * pow(R.V, n); a NaN gives what it gives there).  Loops index block views from 0: an index
-    s + r kept LLVM from vectorizing them."""
+    s + r kept LLVM from vectorizing them.
+    """
     N = out.shape[0]
     x = np.empty(_BLOCK)  # R.V where lit, else 0
     lit = np.empty(_BLOCK, dtype=np.int64)  # the lit rows of the block
@@ -149,7 +151,8 @@ class Phong(BRDF):
 def _polar_hint(n, p, c, per_mu=None):
     """The closed-form-azimuth hint (pumpup.engine.polar) of a lobe c u^n / max(N.L, N.V)^p, p in [0, 1]
     (closed form for p in {0, 1}, an inner rule on one arc between them); ``per_mu(mu)`` multiplies
-    c (Phong's shader: 1 / mu)."""
+    c (Phong's shader: 1 / mu).
+    """
     from ..core.hints import AzimuthHint, PowerLobe
 
     if per_mu is None:

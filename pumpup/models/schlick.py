@@ -14,8 +14,8 @@ import math
 import numpy as np
 from numba import vectorize
 
+from ..core import BRDF, MIN_WIDTH, Lobe, Param, register
 from ._half import tan2_half
-from ..core import MIN_WIDTH, BRDF, Lobe, Param, register
 
 
 @vectorize(cache=True)

@@ -14,8 +14,8 @@ import math
 import numpy as np
 from numba import vectorize
 
+from ..core import BRDF, MAX_WIDTH, MIN_WIDTH, Lobe, Param, SpecError, register
 from ._half import tan2_half
-from ..core import MAX_WIDTH, MIN_WIDTH, BRDF, Lobe, Param, SpecError, register
 
 
 def _tan2_delta(wi, wo):

@@ -60,7 +60,17 @@ from numba import njit
 
 from ..core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register
 from ..physics.lookups import CELL_SHIFT, float_bits, scale_bound, upper_scalar
-from .pumping import TABLE_DECADES, table_decades, Pumped, _key, _Lookup, _Product, _ProductError, file_tables, from_file
+from .pumping import (
+    TABLE_DECADES,
+    Pumped,
+    _key,
+    _Lookup,
+    _Product,
+    _ProductError,
+    file_tables,
+    from_file,
+    table_decades,
+)
 
 __all__ = ["compensate", "KullaConty", "Scaled", "save_compensated", "load_compensated", "furnace",
            "compensation_table", "METHODS", "fresnel_average"]
@@ -99,8 +109,9 @@ def compensation_table(white: BRDF, progress: bool | None = None):
 @njit(cache=True, nogil=True)
 def _kc_kernel(f, wi, wo, scale, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin,
                cap):  # pragma: no cover - compiled
-    """f += scale D(mu_i) D(mu_o) in place, D = max(0, 1 - U) (KC eq. 1; see the module docstring).
-    The look-up of :func:`scale_bound`, written out.  Tested against :meth:`KullaConty.reference`."""
+    """Compute f += scale D(mu_i) D(mu_o) in place, D = max(0, 1 - U) (KC eq. 1; see the module docstring).
+    The look-up of :func:`scale_bound`, written out.  Tested against :meth:`KullaConty.reference`.
+    """
     last = pcstart.shape[0] - 1
     for k in range(f.shape[0]):
         mi, mo = wi[k, 2], wo[k, 2]
@@ -131,8 +142,9 @@ def _kc_kernel(f, wi, wo, scale, pmlo, pcbase, pcstart, plo, prow, logx, coef, v
 @njit(cache=True, nogil=True)
 def _scale_kernel(f, wi, wo, f0, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin,
                   cap):  # pragma: no cover - compiled
-    """f *= 1 + F0 (1 / U(mu_o) - 1) in place (Turquin eq. 6), the look-up of :func:`scale_bound` written
-    out.  Tested against :meth:`Scaled.reference`."""
+    """Compute f *= 1 + F0 (1 / U(mu_o) - 1) in place (Turquin eq. 6), the look-up of :func:`scale_bound` written
+    out.  Tested against :meth:`Scaled.reference`.
+    """
     last = pcstart.shape[0] - 1
     for k in range(f.shape[0]):
         mi, mo = wi[k, 2], wo[k, 2]
@@ -197,7 +209,8 @@ class _Bound:
         """(I_hi, kinks): an upper bound of I = 2 integral_0^1 D(mu) mu dmu and the mu in (0, 1) where
         D reaches 0 (kinks of the lobe).  Exact on each polynomial piece of the product table (Gauss-
         Legendre of 8 nodes is exact to degree 15; the pieces are split where U crosses 1); below the
-        first piece D <= 1 adds at most mu_min^2."""
+        first piece D <= 1 adds at most mu_min^2.
+        """
         p = self.product
         if p is None:  # pragma: no cover - adaptive quadrature of the spline look-up instead
             from scipy.integrate import quad
@@ -218,7 +231,8 @@ class _Bound:
     def _parts(self) -> tuple:
         """([(piece, t0, t1)], kinks): the smooth parts of the product table's polynomial pieces in t = (m - centre) /
         half (each piece from t = -1 to its end, the last one to m = 1), cut where U = 1 (D's kinks, also returned in m),
-        for Gauss-Legendre (:meth:`_integral`, :meth:`deficit_moment`)."""
+        for Gauss-Legendre (:meth:`_integral`, :meth:`deficit_moment`).
+        """
         p = self.product
         hi = np.concatenate([p.lo[1:-1], [1.0]])
         parts, kinks = [], []
@@ -239,7 +253,8 @@ class _Bound:
         exact there, on D evaluated as the kernels evaluate it, so the error is the rounding of the values (32 eps U per
         node, summed with the weights); below mlo, 0 <= D <= 1 adds between 0 and mlo^2 (half of it is counted, the other
         half is error).  (:meth:`_integral`'s I_hi is an upper bound of the same I.)  Cached; None without a product
-        table."""
+        table.
+        """
         got = getattr(self, "_moment", None)
         if got is not None or self.product is None:
             return got
@@ -500,7 +515,8 @@ class KullaConty(_Compensated):
 
     def sampling_terms(self, mu: float):
         """Terms weighted by their albedo at the conditioning direction: the base's terms share
-        U(mu) >= E(mu), the lobe gets F_ms D(mu) (the deficit), for the sampling mixture."""
+        U(mu) >= E(mu), the lobe gets F_ms D(mu) (the deficit), for the sampling mixture.
+        """
         terms = self.base.albedo_terms()
         w = np.array([abs(x) for x, _ in terms], dtype=float)
         w = w / w.sum() if w.sum() > 0 else np.full(len(terms), 1.0 / len(terms))
@@ -556,7 +572,8 @@ class _MsLobe(BRDF):
         """The lobe's albedo in closed form (:class:`~pumpup.core.hints.ClosedForm`): D(mu) 2 pi integral_0^1 D(t) t dt = D(mu) pi I,
         D the kernels' own (:func:`_deficits`), I by :meth:`_Bound.deficit_moment` (exact on the product table's
         polynomial pieces); the relative error I's, plus 8 ulps for D(mu) pi I itself.  Until issue 14's twelfth session the nested
-        engine integrated it (80 ms for 257 mu, GGX alpha = 0.3)."""
+        engine integrated it (80 ms for 257 mu, GGX alpha = 0.3).
+        """
         from ..core.hints import AzimuthHint, ClosedForm
 
         got = self.kc.bound.deficit_moment()
@@ -572,7 +589,8 @@ class _MsLobe(BRDF):
 
 def _scaled_lobe(b: Lobe, bound) -> Lobe:
     """The hint of a scaled lobe: the base's (``b``), with U's kinks and, about the normal, the levels of
-    :func:`pumpup.operators.pumping.table_decades`."""
+    :func:`pumpup.operators.pumping.table_decades`.
+    """
     return b.with_levels(bound.kinks, table_decades(b))
 
 
@@ -631,7 +649,8 @@ class Scaled(_Compensated):
 
     def kernel_factor(self, mu_o) -> np.ndarray:
         """1 + F0 (1 / U(mu_o) - 1) with U from the kernels' own look-up (:func:`_uppers`; ``factor`` is its numpy
-        reference), for the furnace toward the viewer's closed form (:meth:`_Transposed.polar`)."""
+        reference), for the furnace toward the viewer's closed form (:meth:`_Transposed.polar`).
+        """
         m = np.asarray(mu_o, dtype=np.float64)
         u = _uppers(np.clip(m, 1e-300, 1.0).reshape(-1), *self.bound.args).reshape(m.shape)
         f0 = self.p["f0"]
@@ -664,7 +683,8 @@ class Scaled(_Compensated):
         """The base's hint times 1 + F0 (1 / U(N.wo) - 1) (Turquin eq. 6; :class:`~pumpup.core.hints.InverseAlbedoFactor`),
         a function of N.wo alone, with U's kinks as its levels; None where the base has no hint, or where U is not
         smooth between its kinks: the white model must be a Smith lobe with F = 1, the exact G1 and alpha <= 1, or
-        Schlick's, with no factors of its own."""
+        Schlick's, with no factors of its own.
+        """
         from ..core.hints import InverseAlbedoFactor, SchlickLobe, SmithLobe
 
         hint = self.base.azimuth_hint()
@@ -729,7 +749,8 @@ class _ScaledTerm(BRDF):
 class _Transposed(BRDF):
     """f(wo, wi): its albedo at mu is the white furnace toward a viewer at cos(theta_o) = mu,
     integral f(wi, wo) cos(theta_i) d omega_i.  The hint is the inner one, which is right when f
-    is a reciprocal BRDF times a function of one direction (the scaled BRDF)."""
+    is a reciprocal BRDF times a function of one direction (the scaled BRDF).
+    """
 
     type = "transposed"
     params = {}
@@ -760,7 +781,8 @@ class _Transposed(BRDF):
         f_r(wi, wo) s(N.wo) with f_r reciprocal, so f(wo, wi) = s(N.wi) f_r(wi, wo) and its albedo at mu is s(mu) times
         f_r's (000 eq. 2; s = 1 + F0 (1 / U - 1), Turquin eq. 6): f_r's own hint with its scale times s (as the kernel
         forms it, :meth:`Scaled.kernel_factor`).  None for anything else (the nested engine), or a base forced in
-        without reciprocity.  Until issue 14's twelfth session the nested engine integrated it."""
+        without reciprocity.  Until issue 14's twelfth session the nested engine integrated it.
+        """
         import dataclasses
 
         if isinstance(self.inner, Scaled):
@@ -844,7 +866,8 @@ def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None 
 @functools.singledispatch
 def compensate_model(base: BRDF, method: str, *, f0, f_avg, white, force) -> BRDF:
     """:func:`compensate` of a loaded model, its arguments checked.  Other kinds of model register their own
-    (:mod:`pumpup.spectral`: every wavelength compensated on its own)."""
+    (:mod:`pumpup.spectral`: every wavelength compensated on its own).
+    """
     if method in ("g1", "g2"):
         if f0 is not None or f_avg is not None or white is not None:
             raise SpecError(f"compensate: method {method!r} (pumping) takes no f0, f_avg or white")
@@ -889,9 +912,9 @@ def save_compensated(f: BRDF, path) -> str:
     import xarray as xr
 
     from .._version import __version__
+    from ..tables import write_groups
     from .pumping import _TABLES as PUMP_TABLES
     from .pumping import base_table
-    from ..tables import write_groups
 
     if not isinstance(f, BRDF):
         raise TypeError(f"save_compensated needs a pumpup BRDF, got {type(f).__name__}")
@@ -958,7 +981,7 @@ def load_compensated(path) -> BRDF:
 
 
 def _nodes(f: BRDF):
-    """f and every BRDF nested in its parameters."""
+    """The BRDF f and every BRDF nested in its parameters."""
     yield f
     for v in f.p.values():
         if isinstance(v, BRDF):

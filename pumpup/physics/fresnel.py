@@ -132,7 +132,8 @@ def fresnel_levels(eta: float, k: float, y0_max: float | None = None) -> tuple:
     (:func:`fresnel_branch`) y0 off the axis.  The 1-D path declines such a factor
     (``pumpup.engine.polar.lobe_fresnel_ok``) and the nested engine, blind to the kink, bisected towards it: fresnel over Blinn
     n = 5, eta = 0.551, k = 0 took 0.25-0.41 s per value at rtol 1e-10 (issue 14's twenty-first session,
-    ``scripts/studies/fuzz_engines.py --registry``)."""
+    ``scripts/studies/fuzz_engines.py --registry``).
+    """
     x0, y0 = fresnel_branch(float(eta), float(k))
     return (x0,) if 0.0 < x0 < 1.0 and y0 < (FRESNEL_LEVEL_Y0 if y0_max is None else y0_max) else ()
 
@@ -187,17 +188,19 @@ def fresnel_branch(eta: float, k: float) -> tuple:
     """(x0, y0): the branch point w = sqrt(1 - (eta + i k)^2) = x0 - i y0 of the conductor Fresnel factor F(c)
     (:func:`pumpup.models.metal._fresnel_real`, where the refracted cosine sqrt((eta + i k)^2 - 1 + c^2) vanishes; F is
     analytic in c elsewhere near [0, 1], its other singularities -w and the conjugates as far), x0 = |Re w|,
-    y0 = |Im w|."""
+    y0 = |Im w|.
+    """
     w = complex(1.0 - (eta * eta - k * k), -2.0 * eta * k) ** 0.5
     return abs(w.real), abs(w.imag)
 
 
 def fresnel_pole(eta: float, k: float) -> float:
-    """rho = 1 / |sqrt((eta + i k)^2 + 1)|: F(c)'s parallel reflectance has poles where A c + sin^2 = 0 (A the refracted
+    """The scale rho = 1 / |sqrt((eta + i k)^2 + 1)|: F(c)'s parallel reflectance has poles where A c + sin^2 = 0 (A the refracted
     cosine times the index), c^2 = 1 / ((eta + i k)^2 + 1), in the left half-plane on the physical sheet; for a
     strong absorber (|eta + i k| >> 1) near c = 0, at distance ~rho from the arc's small end (eta = 1.1, k = 30:
     -0.0012 + 0.033 i; a rule blind to it was 1.9e-11 off with an estimate of 4.1e-12 at mu = 1e-3, rtol 1e-10, measured
-    against the nested and 2-D engines): frame 5 grades its arcs towards c = 0 on this scale."""
+    against the nested and 2-D engines): frame 5 grades its arcs towards c = 0 on this scale.
+    """
     return 1.0 / abs(complex(eta * eta - k * k + 1.0, 2.0 * eta * k) ** 0.5)
 
 
@@ -206,7 +209,8 @@ def fresnel_brewster(eta: float, k: float) -> tuple:
     + c^2) continued from the real axis, c_b^2 = 1 / ((eta + i k)^2 + 1) (:func:`_lobe_f_bound`), and whether it was
     found.  On the real axis A is the principal root (Im A^2 = 2 eta k >= 0); from c = Re c_b up to c_b it is the
     principal root, negated where c^2 - w^2 (w^2 = 1 - (eta + i k)^2) crosses the negative real axis on the way
-    (Im (c^2 - w^2) = 2 Re(c) Im(c) - Im w^2 = 0)."""
+    (Im (c^2 - w^2) = 2 Re(c) Im(c) - Im w^2 = 0).
+    """
     e2 = complex(eta * eta - k * k, 2.0 * eta * k)
     cp = 1.0 / cmath.sqrt(e2 + 1.0)
     w2 = 1.0 - e2

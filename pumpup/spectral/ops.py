@@ -35,7 +35,8 @@ SPECTRAL_PUMPED_KIND = "pumpup spectral pumped BRDF"
 def compensate_spectral(base: Spectral, method: str = "kulla_conty", *, f0=None, f_avg=None, white=None,
                         force: bool = False) -> Spectral:
     """:func:`pumpup.compensate` of a spectral BRDF: pumping for ``"g1"``/``"g2"``
-    (:class:`~pumpup.spectral.SpectralPumped`), else :class:`SpectralCompensated`."""
+    (:class:`~pumpup.spectral.SpectralPumped`), else :class:`SpectralCompensated`.
+    """
     if method in ("g1", "g2"):
         if f0 is not None or f_avg is not None or white is not None:
             raise SpecError(f"compensate: method {method!r} (pumping) takes no f0, f_avg or white")
@@ -89,7 +90,7 @@ class SpectralCompensated(Spectral):
         self.models = models
 
     @classmethod
-    def from_spec(cls, spec: dict, load) -> "SpectralCompensated":
+    def from_spec(cls, spec: dict, load) -> SpectralCompensated:
         """Build from ``{"type": "kulla_conty" | "scaled", "base": <spectral spec>, ...}``."""
         kind = spec["type"]
         allowed = {"base", "white", "force", "f_avg" if kind == "kulla_conty" else "f0"}

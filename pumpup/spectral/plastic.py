@@ -25,10 +25,9 @@ from typing import Any
 
 import numpy as np
 
-from . import optical
 from ..core import SpecError
 from ..core import load as _load_scalar
-from . import RGB_WAVELENGTHS, Spectral
+from . import RGB_WAVELENGTHS, Spectral, optical
 
 __all__ = ["SpectralPlastic"]
 
@@ -38,7 +37,8 @@ PLASTIC_KEYS = ("material", "n", "ad", "a_s", "eta", "wavelengths")
 
 def _per_wavelength(name: str, value: Any, m: int) -> list[float]:
     """``value`` as a list of ``m`` numbers: a number is repeated, a list must have length m (its
-    entries are checked by the scalar models)."""
+    entries are checked by the scalar models).
+    """
     if isinstance(value, (list, tuple, np.ndarray)):
         if len(value) != m:
             raise SpecError(f"spectral plastic: parameter {name!r} must be a number or a list of {m} values (one "
@@ -114,7 +114,7 @@ class SpectralPlastic(Spectral):
         self.k = None
 
     @classmethod
-    def from_spec(cls, spec: dict) -> "SpectralPlastic":
+    def from_spec(cls, spec: dict) -> SpectralPlastic:
         """Build from ``{"type": "plastic", "material" | "eta", "n", "ad", "a_s", "wavelengths"}``."""
         kw = {k: v for k, v in spec.items() if k != "type"}
         if "k" in kw:

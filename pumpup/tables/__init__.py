@@ -21,9 +21,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._version import __version__
-from . import reuse as _reuse
-from ..engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
 from ..core import BRDF, check_count, check_open_unit, check_tolerance, provide
+from ..engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
+from . import reuse as _reuse
 
 __all__ = [
     "tabulate",
@@ -172,9 +172,10 @@ class AlbedoTable:
         return 5 if degree == 5 and n >= 6 else 3
 
     @classmethod
-    def from_dataset(cls, ds) -> "AlbedoTable":
+    def from_dataset(cls, ds) -> AlbedoTable:
         """The table of a dataset over mu alone; one over (mu, phi) (an anisotropic model's, ``tabulate(f, phi=...)``)
-        must be cut to one azimuth first (``ds.isel(phi=0)``): before, scipy's spline raised an unreadable error."""
+        must be cut to one azimuth first (``ds.isel(phi=0)``): before, scipy's spline raised an unreadable error.
+        """
         if ds["albedo"].dims != ("mu",):
             raise ValueError(f"an albedo table is a function of mu alone, got a dataset over {ds['albedo'].dims}; "
                              "take one azimuth first, e.g. ds.isel(phi=0)")
@@ -200,20 +201,23 @@ class AlbedoTable:
     def upper(self, mu) -> np.ndarray:
         """An upper bound of the true albedo: interpolant + ``margin`` (2 x interpolation error +
         the largest quadrature error), ``margin_below`` below the first node.  The pumping
-        operator's compiled look-up uses the same margins."""
+        operator's compiled look-up uses the same margins.
+        """
         m = check_mu(mu)
         return self(m) + np.where(m < self.mu[0], self.margin_below, self.margin)
 
     def is_increasing(self) -> bool:
         """True if the spline is non-decreasing on [mu_0, mu_last] (checked exactly: its derivative is
         >= 0 at every breakpoint and at every root of the second derivative).  Then so is
-        :meth:`upper` there, and max(upper(x), upper(y)) = upper(max(x, y)) for x, y >= mu_0."""
+        :meth:`upper` there, and max(upper(x), upper(y)) = upper(max(x, y)) for x, y >= mu_0.
+        """
         return nondecreasing(self._spline)
 
 
 def nondecreasing(spline) -> bool:
     """True if a scipy PPoly is non-decreasing between its first and last breakpoints (exact: its
-    derivative is >= 0 at every breakpoint and at every root of the second derivative)."""
+    derivative is >= 0 at every breakpoint and at every root of the second derivative).
+    """
     d1 = spline.derivative()
     crit = d1.derivative().roots(extrapolate=False)
     pts = np.concatenate([spline.x, crit[np.isfinite(crit)]])
@@ -228,7 +232,8 @@ def nondecreasing(spline) -> bool:
 
 def _near_new_nodes(order: np.ndarray, n_new: int) -> np.ndarray:
     """The intervals to check again after the last ``n_new`` of the nodes (sorted by ``order``) were
-    added: every interval within three nodes of a new one (a new node changes the spline mostly there)."""
+    added: every interval within three nodes of a new one (a new node changes the spline mostly there).
+    """
     is_new = np.concatenate([np.zeros(len(order) - n_new, bool), np.ones(n_new, bool)])[order]
     near = is_new.copy()
     for shift in (1, 2, 3):
@@ -256,7 +261,8 @@ def _near_one(a: float) -> np.ndarray:
 
 def _splittable(mu: np.ndarray) -> np.ndarray:
     """Whether each interval of consecutive nodes has its midpoint (:func:`_midpoints`) strictly inside in log(mu), the
-    spline's variable (whose doubles are coarser than mu's: 3.6e-15 at log(mu) = -18.4, mu's relative step 1.1e-16)."""
+    spline's variable (whose doubles are coarser than mu's: 3.6e-15 at log(mu) = -18.4, mu's relative step 1.1e-16).
+    """
     lx = np.log(mu)
     lm = np.log(_midpoints(mu))
     return (lm > lx[:-1]) & (lm < lx[1:])
@@ -285,7 +291,8 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
     value at the midpoint in log(mu) by more than ``interp_tol`` is bisected, until none does or the grid has
     ``max_points`` nodes; ``interp`` is each column's largest miss over the accepted intervals (all the last misses when
     ``max_points`` stopped it), and over the checks of the last interval at 1 - mu = (1 - a) 2^-k (:func:`_near_one`).
-    ``off_grid``: also over checks of every interval at its thirds in log(mu) (:func:`built_on_tables`)."""
+    ``off_grid``: also over checks of every interval at its thirds in log(mu) (:func:`built_on_tables`).
+    """
     one = val.ndim == 1
     V, E = (val[:, None], err[:, None]) if one else (val, err)
 
@@ -471,7 +478,7 @@ THREADS: int | None = None
 
 
 #: the BRDF objects whose kernels have run in this process (see :func:`_chunked`)
-_WARM: "weakref.WeakSet" = weakref.WeakSet()
+_WARM: weakref.WeakSet = weakref.WeakSet()
 
 
 def _cores() -> int:
@@ -484,7 +491,8 @@ def _cores() -> int:
 
 def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int = 32, phi: float = 0.0):
     """Albedo and error at every mu (at the azimuth ``phi`` of wi), in chunks, on ``threads`` threads
-    (default :data:`THREADS`; every k-th mu to thread k: grazing values, the dear ones, are spread over all)."""
+    (default :data:`THREADS`; every k-th mu to thread k: grazing values, the dear ones, are spread over all).
+    """
     val = np.empty_like(mu)
     err = np.empty_like(mu)
     from ..engine.routes import one_d_everywhere
@@ -585,7 +593,8 @@ def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind, phis=None,
 
 def _umask() -> int:
     """The process's umask, read without changing it where the system tells it (Linux), else by
-    setting and restoring it."""
+    setting and restoring it.
+    """
     try:
         with open("/proc/self/status") as fh:
             for line in fh:
@@ -682,7 +691,8 @@ def write_table(ds, path) -> str:
     """Write a Dataset to netCDF atomically (a temporary file renamed into place), with a
     Fletcher-32 checksum on every numeric variable (:func:`pumpup.tables.validate.checksum_encoding`) and
     a digest of the whole content in the attribute ``pumpup_digest``, which :func:`open_table`
-    checks (:func:`pumpup.tables.validate.content_digest`)."""
+    checks (:func:`pumpup.tables.validate.content_digest`).
+    """
     import xarray as xr
 
     from .validate import checksum_encoding
@@ -707,7 +717,8 @@ def _digested(ds):
 
 def write_groups(path, root, groups) -> str:
     """Write ``root`` and the (name, Dataset) ``groups`` into one netCDF file, atomically, each with
-    its digest and the Fletcher-32 checksums of :func:`write_table` (saved pumped and compensated BRDFs)."""
+    its digest and the Fletcher-32 checksums of :func:`write_table` (saved pumped and compensated BRDFs).
+    """
     from .validate import checksum_encoding
 
     with atomic_path(path) as tmp:
