@@ -116,7 +116,8 @@ def _plain_text(text: str) -> str:
     """A docstring line without reST markup: ``x`` -> x, :func:`~a.b` -> b, *x* -> x."""
     import re
 
-    text = re.sub(r":[a-z]+:`~?([^`]*)`", lambda m: m.group(1).rsplit(".", 1)[-1] if "~" in m.group(0) else m.group(1), text)
+    text = re.sub(r":[a-z]+:`~?([^`]*)`",
+                  lambda m: m.group(1).rsplit(".", 1)[-1] if "~" in m.group(0) else m.group(1), text)
     text = re.sub(r"``([^`]*)``", r"\1", text)
     text = re.sub(r"(?<![\w*])\*([^*\s][^*]*)\*(?![\w*])", r"\1", text)
     return text
@@ -142,7 +143,8 @@ def default_text(param) -> str:
             src = inspect.getsource(d)
         except (OSError, TypeError):
             return "computed"
-        m = re.search(r"return\s+(.*?)(\s+#.*)?$", src.strip(), re.S) or re.search(r"lambda\s+\w+\s*:\s*(.*?)[,)]*$", src)
+        m = (re.search(r"return\s+(.*?)(\s+#.*)?$", src.strip(), re.S)
+             or re.search(r"lambda\s+\w+\s*:\s*(.*?)[,)]*$", src))
         if not m:
             return "computed"
         expr = m.group(1).strip().splitlines()[0]
@@ -167,7 +169,8 @@ def cmd_models(args) -> int:
         params = [(k, p.range_text() if p.kind in ("float", "int", "floats") or p.choices else p.kind,
                    default_text(p), _plain_text(p.doc)) for k, p in cls.params.items()]
         rows.append((name, doc, params))
-    w = [max([len(r[c]) for _, _, ps in rows for r in ps] + [len(h)]) for c, h in enumerate(("name", "range", "default"))]
+    w = [max([len(r[c]) for _, _, ps in rows for r in ps] + [len(h)])
+         for c, h in enumerate(("name", "range", "default"))]
     print(f"    {'parameter':{w[0]}s}  {'range':{w[1]}s}  {'default':{w[2]}s}  meaning")
     for name, doc, params in rows:
         print(f"{name}: {doc}")
@@ -292,8 +295,8 @@ def cmd_check(args) -> int:
     if hasattr(f, "report"):  # a compensated BRDF (pumpup.compensate): its E table and bounds
         print(f.report())
     m = pumpup.max_albedo(f)
-    print(f"max albedo (constant set to 1): {m.albedo:.12g} +- {m.error:.2g} at theta = {m.theta_deg:.6f} +- {m.theta_error:.2g} deg;"
-          f" maximum constant {m.constant:.12g}")
+    print(f"max albedo (constant set to 1): {m.albedo:.12g} +- {m.error:.2g} at theta = {m.theta_deg:.6f} +- "
+          f"{m.theta_error:.2g} deg; maximum constant {m.constant:.12g}")
     return 0 if r.reciprocal else 1
 
 
@@ -314,7 +317,8 @@ def cmd_pump(args) -> int:
         raise SystemExit(f"pumpup: {exc}") from None
     mu = np.array([1.0, 0.5, 0.1, 0.01, 1e-4])
     if getattr(p, "is_spectral", False):  # one row per (mu, wavelength), every level's albedo
-        print(f"{'mu':>8s} {'wavelength':>10s} " + " ".join(f"{'level ' + str(k):>12s}" for k in range(args.levels + 1)))
+        print(f"{'mu':>8s} {'wavelength':>10s} "
+              + " ".join(f"{'level ' + str(k):>12s}" for k in range(args.levels + 1)))
         per = []  # per wavelength: the albedo of levels 0..L, each of shape mu.shape
         for m in p.models:
             chain = m.chain()  # innermost first
@@ -896,7 +900,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="a swept parameter: n=1,2,4 or n=geom:1:1000:64 or p=lin:0:1:64 (required; repeat for more)")
     g = s.add_mutually_exclusive_group()
     g.add_argument("--mu", type=float, nargs="+", help="cos(theta_i) values in (0, 1] (default: use --n-mu)")
-    g.add_argument("--n-mu", type=int, default=257, help="else this many mu, theta uniform in [0, 90) deg (default 257)")
+    g.add_argument("--n-mu", type=int, default=257,
+                   help="else this many mu, theta uniform in [0, 90) deg (default 257)")
     s.add_argument("--pump", metavar="G[:LEVELS]", help="pump each cell's model first, e.g. g2:2 (default: no pumping)")
     s.add_argument("--out", required=True, help="netCDF file, or a zarr store if it ends in .zarr; "
                                                 "finished chunks wait in OUT.parts/ so a rerun resumes (required)")
@@ -904,8 +909,10 @@ def build_parser() -> argparse.ArgumentParser:
                                                           "(default: local threads)")
     g = s.add_mutually_exclusive_group()
     g.add_argument("--threads", dest="local", action="store_const", const="threads", help="local threads (default)")
-    g.add_argument("--processes", dest="local", action="store_const", const="processes", help="local processes (default: threads)")
-    g.add_argument("--serial", dest="local", action="store_const", const="synchronous", help="one cell at a time (default: threads)")
+    g.add_argument("--processes", dest="local", action="store_const", const="processes",
+                   help="local processes (default: threads)")
+    g.add_argument("--serial", dest="local", action="store_const", const="synchronous",
+                   help="one cell at a time (default: threads)")
     s.add_argument("--workers", type=int, help="local threads or processes (default: one per core)")
     s.add_argument("--chunk", type=int, help="cells per chunk along the last parameter (default 8)")
     s.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of the albedo values (default: 1e-10)")
@@ -919,7 +926,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("spec", help="a model SPEC: JSON or short, e.g. ggx:alpha=0.3")
     s.add_argument("--method", choices=("kulla_conty", "scale", "g1", "g2"), default="kulla_conty",
                    help="the compensation (default: kulla_conty)")
-    s.add_argument("--f0", type=float, help="Fresnel F0 in [0, 1] (scale: Turquin's F0; kulla_conty: Schlick F_avg) (default: none)")
+    s.add_argument("--f0", type=float,
+                   help="Fresnel F0 in [0, 1] (scale: Turquin's F0; kulla_conty: Schlick F_avg) (default: none)")
     s.add_argument("--f-avg", type=float, help="kulla_conty: the Fresnel average F_avg in [0, 1] (default: 1)")
     s.add_argument("--force", action="store_true", help="accept a base that is not reciprocal (default: refuse)")
     s.add_argument("--out", help="save the compensated BRDF and its tables to this netCDF file (default: not saved)")
@@ -952,8 +960,10 @@ def build_parser() -> argparse.ArgumentParser:
                                                   "netcdf, exr (required)")
     s.add_argument("--out", required=True, help="the table file (.h for C arrays, .inc, .npy, .nc, .exr) (required)")
     s.add_argument("--rtol", type=float, help="quadrature tolerance of the nodes (default 1e-8; 1e-6 for half floats)")
-    s.add_argument("--max-lookup-error", type=float, help="fail (status 1, saying where) above this look-up error (default: no limit)")
-    s.add_argument("--no-lookup-check", action="store_true", help="skip the look-up error between the nodes (default: measured)")
+    s.add_argument("--max-lookup-error", type=float,
+                   help="fail (status 1, saying where) above this look-up error (default: no limit)")
+    s.add_argument("--no-lookup-check", action="store_true",
+                   help="skip the look-up error between the nodes (default: measured)")
     s.add_argument("--no-eavg", action="store_true", help="skip E_avg (default: computed)")
     s.set_defaults(func=cmd_lut)
     s = sub.add_parser("audit", help="grade a shipped albedo table against pumpup's truth (status 1 beyond --tol)")
@@ -962,10 +972,12 @@ def build_parser() -> argparse.ArgumentParser:
                                                   "netcdf, exr (required)")
     s.add_argument("--model", default="ggx", help="the model the table claims (default ggx with the preset's Smith)")
     s.add_argument("--tol", type=float, help="fail (status 1) if a node is off by more than this (default: no limit)")
-    s.add_argument("--max-lookup-error", type=float, help="fail (status 1) if the look-up error exceeds this (default: no limit)")
+    s.add_argument("--max-lookup-error", type=float,
+                   help="fail (status 1) if the look-up error exceeds this (default: no limit)")
     s.add_argument("--rtol", type=float, default=1e-7, help="quadrature tolerance of the truth (default 1e-7)")
     s.add_argument("--png", help="write an error map here (default: none)")
-    s.add_argument("--no-lookup-check", action="store_true", help="skip the look-up error between the nodes (default: measured)")
+    s.add_argument("--no-lookup-check", action="store_true",
+                   help="skip the look-up error between the nodes (default: measured)")
     s.add_argument("--no-eavg", action="store_true", help="skip the E_avg checks (default: checked)")
     s.set_defaults(func=cmd_audit)
     r = render_sub.add_parser("scene", help="the papers' scenes path-traced by Mitsuba 3 with the pumpup plugin, "
@@ -987,7 +999,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="a free parameter and its range, e.g. n=1:10000 (required; repeat for more)")
     s.add_argument("--fixed", action="append", metavar="NAME=VALUE",
                    help="a parameter held fixed, e.g. p=0.5 (default: the family's defaults)")
-    s.add_argument("--tie", action="append", metavar="NAME=OTHER", help="a parameter equal to another, e.g. cy=cx (default: none)")
+    s.add_argument("--tie", action="append", metavar="NAME=OTHER",
+                   help="a parameter equal to another, e.g. cy=cx (default: none)")
     s.add_argument("--pump", metavar="G[:LEVELS]", help="fit the family pumped up, e.g. g2:2 (default: not pumped)")
     s.add_argument("--method", choices=("perceptual", "least_squares", "both"), default="perceptual",
                    help="the objective (default: perceptual)")

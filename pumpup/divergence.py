@@ -264,7 +264,8 @@ def analysis_dataset(mu_min: float = 1e-8, progress: bool | None = None):
             "albedo": (("model", "mu"), alb, {"long_name": "directional albedo", "units": "1"}),
             "albedo_error": (("model", "mu"), err, {"long_name": "estimated absolute error", "units": "1"}),
             "lower_bound": (("model", "mu"), bound,
-                            {"long_name": "lower bound of 001 eq. 14 (Ward) or eq. 15 (Cook-Torrance, region where G = 1)"}),
+                            {"long_name": "lower bound of 001 eq. 14 (Ward) or eq. 15 "
+                                          "(Cook-Torrance, region where G = 1)"}),
             "k": ("model", k, {"long_name": "fitted exponent: a ~ K mu^(-k) for mu in [1e-8, 1e-5]"}),
             "k_error": ("model", k_err, {"long_name": "uncertainty of k"}),
             "K": ("model", K, {"long_name": "fitted prefactor"}),
@@ -295,8 +296,8 @@ def plot(ds, path):
                           label=f"{name}: {ds.verdict.values[i]}, k = {abs(float(ds.k[i])):.3f}")
         if np.isfinite(ds.lower_bound[i]).any():
             ax.loglog(ds.mu, ds.lower_bound[i], "--", color=line.get_color(), lw=1)
-    ax.set(xlabel="mu = cos(theta_i)", ylabel="albedo", title="Albedo near grazing incidence (dashed: 001 eq. 14/15 bounds)",
-           ylim=(1e-3, 1e3))
+    ax.set(xlabel="mu = cos(theta_i)", ylabel="albedo",
+           title="Albedo near grazing incidence (dashed: 001 eq. 14/15 bounds)", ylim=(1e-3, 1e3))
     ax.invert_xaxis()
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)

@@ -185,7 +185,8 @@ class FitData:
         a_t, a_err = albedo(target, mu, return_error=True, rtol=rtol)
         if np.any(a_t <= 0):
             i = int(np.argmin(a_t))
-            raise FitError(f"fit: the target's albedo is {a_t[i]:g} at mu = {mu[i]:g}; relative albedo error needs a > 0")
+            raise FitError(f"fit: the target's albedo is {a_t[i]:g} at mu = {mu[i]:g}; "
+                           "relative albedo error needs a > 0")
         return cls(wi, wo, view, weight, cos_l, t, region, np.asarray(mu, float), a_t, a_err, lobe_fraction)
 
     def add_pairs(self, target: BRDF, wi: np.ndarray, wo: np.ndarray) -> None:
@@ -436,7 +437,8 @@ class FitResult:
         return float(np.min(self.mu))
 
     def __repr__(self) -> str:
-        free = ", ".join(f"{k} = {v:.6g} in [{self.bounds[k][0]:g}, {self.bounds[k][1]:g}]" for k, v in self.params.items())
+        free = ", ".join(f"{k} = {v:.6g} in [{self.bounds[k][0]:g}, {self.bounds[k][1]:g}]"
+                         for k, v in self.params.items())
         if self.directions_given:
             where = f"over the {self.eval_pairs} given pairs where f_t > 0"
         else:
@@ -919,8 +921,8 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
     for name, v, lo in (("search_rtol", search_rtol, 1e-13), ("final_rtol", final_rtol, 1e-13), ("xtol", xtol, 1e-15)):
         if not (isinstance(v, (int, float)) and lo <= v < 1):
             raise FitError(f"fit: {name} must be in [{lo:g}, 1), got {v!r}")
-    for name, v, lo in (("n_mu", n_mu, 2), ("n_mu_search", n_mu_search, 2), ("n_scan", n_scan, 3), ("maxiter", maxiter, 1),
-                         ("exchange_rounds", exchange_rounds, 0)):
+    for name, v, lo in (("n_mu", n_mu, 2), ("n_mu_search", n_mu_search, 2), ("n_scan", n_scan, 3),
+                         ("maxiter", maxiter, 1), ("exchange_rounds", exchange_rounds, 0)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
             raise FitError(f"fit: {name} must be an integer >= {lo}, got {v!r}")
 
@@ -1017,10 +1019,11 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
         if v <= lo * (1 + 1e-9) + 1e-300 or v >= hi * (1 - 1e-9):
             notes.append(f"{k} = {v:g} is at the edge of its range [{lo:g}, {hi:g}]")
     return FitResult(
-        target=tgt.spec, target_brdf=tgt, family=family, method=method, spec=brdf.spec, brdf=brdf, params=fitted, bounds=bounds,
-        brdf_error=e_f, albedo_error=e_a, albedo_error_bound=bound, worst_pair=(worst_wi, worst_wo), worst_mu=worst_mu,
-        search_objective=search_objective, exchanges=exchanges, plausible=bool(plausible),
-        directions_given=directions is not None, view_mu_min=float(np.min(final.wo[:, 2])), albedo_evaluations=prob.albedo_evaluations, n_mu_search=len(mu_search),
+        target=tgt.spec, target_brdf=tgt, family=family, method=method, spec=brdf.spec, brdf=brdf, params=fitted,
+        bounds=bounds, brdf_error=e_f, albedo_error=e_a, albedo_error_bound=bound, worst_pair=(worst_wi, worst_wo),
+        worst_mu=worst_mu, search_objective=search_objective, exchanges=exchanges, plausible=bool(plausible),
+        directions_given=directions is not None, view_mu_min=float(np.min(final.wo[:, 2])),
+        albedo_evaluations=prob.albedo_evaluations, n_mu_search=len(mu_search),
         objective=max(weights[0] * e_f, weights[1] * e_a), weights=weights, lsq=math.sqrt(lsq_search),
         mu=final.mu, lobe_fraction=lobe_fraction, eval_pairs=int(final.region.sum()),
         eval_views=int(final.view.max()) + 1, max_albedo=float(np.max(a_fit)), evaluations=prob.evaluations,

@@ -707,7 +707,8 @@ def write_lut(ds, path, preset=None) -> str:
             header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage,
                       "pumpup_spec": ds.attrs["spec"], "pumpup_preset": p.name,
                       "pumpup_conventions": "x = mu node i/(n-1) (floor 1e-4), y = rough node, alpha = rough^2"}
-            for k in ("quadrature_error", "quantisation_error", "lookup_error", "lookup_error_mu", "lookup_error_rough"):
+            for k in ("quadrature_error", "quantisation_error", "lookup_error", "lookup_error_mu",
+                      "lookup_error_rough"):
                 if k in ds.attrs:
                     header["pumpup_" + k] = f"{float(ds.attrs[k]):.6g}"
             with OpenEXR.File(header, {k: np.ascontiguousarray(v) for k, v in chans.items()}) as f:
@@ -933,9 +934,9 @@ def _monotonicity(table: np.ndarray, truth: np.ndarray, slack: float, mu, rough)
     return found
 
 
-def audit(path, preset: str = "cycles", model="ggx", *, rtol: float = 1e-7, lookup_check: bool = True, eavg: bool = True,
-          per_cell: int = 1, stride: int | None = None, png: str | None = None, threads: int | None = None,
-          max_regions: int = 200) -> AuditResult:
+def audit(path, preset: str = "cycles", model="ggx", *, rtol: float = 1e-7, lookup_check: bool = True,
+          eavg: bool = True, per_cell: int = 1, stride: int | None = None, png: str | None = None,
+          threads: int | None = None, max_regions: int = 200) -> AuditResult:
     """Grade a shipped table against pumpup's truth, in the preset's conventions.
 
     Reads ``path`` (:func:`read_table`), recomputes every node with ``model`` (default GGX with

@@ -50,8 +50,8 @@ The BSDF
     model divides by the same upper bounds of the albedo tables as pumpup's compiled kernel
     (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`): through pumpup's product table G(m)
     of all levels where it has one (:class:`pumpup.operators.pumping._Product`, piece found from the float64 bits
-    of m = max(N.wi, N.wo)), else level by level, with ``dr.gather`` on the tables; its value is rounded down before the cast to float32
-    (x (1 - 2^-23)), so the exported BSDF is pointwise at most the double-precision one and
+    of m = max(N.wi, N.wo)), else level by level, with ``dr.gather`` on the tables; its value is rounded down before the
+    cast to float32 (x (1 - 2^-23)), so the exported BSDF is pointwise at most the double-precision one and
     keeps its proof of energy conservation (001 eq. 18).
 ``from_mitsuba(bsdf_dict, channel=0, variant=None) -> pumpup BRDF``
     A Mitsuba BSDF as a pumpup BRDF: f_r(wi, wo) = eval(si.wi = wo, wo = wi)[channel] / N.wi,
@@ -919,7 +919,8 @@ def from_mitsuba(bsdf: Any, channel: int = 0, variant: str | None = None, name: 
                 si = dr.zeros(mi.SurfaceInteraction3f, idx.size)
                 si.wi = mi.Vector3f(*(mi.Float(b[idx, i].astype(np.float32)) for i in range(3)))
                 w = mi.Vector3f(*(mi.Float(a[idx, i].astype(np.float32)) for i in range(3)))
-                val = np.asarray(obj.eval(ctx, si, w)[channel] if nch > 1 else obj.eval(ctx, si, w)[0], dtype=np.float64)
+                val = np.asarray(obj.eval(ctx, si, w)[channel] if nch > 1 else obj.eval(ctx, si, w)[0],
+                                 dtype=np.float64)
                 cos = a[idx, 2].astype(np.float32).astype(np.float64)
                 out[idx] = val / cos
             else:

@@ -49,8 +49,8 @@ from numba import njit, vectorize
 from .core import BRDF, Lobe, as_directions
 from .engine.cubature import check_mu
 
-__all__ = ["Strategy", "acceptance", "efficiency_dataset", "mc_albedo", "mc_radiance", "pdf", "plot_efficiency", "sample",
-           "second_moment", "strategy"]
+__all__ = ["Strategy", "acceptance", "efficiency_dataset", "mc_albedo", "mc_radiance", "pdf", "plot_efficiency",
+           "sample", "second_moment", "strategy"]
 
 # component kinds (ints for the compiled kernels)
 COSINE, MIRROR, RETRO, HALF_POWER, HALF_BECKMANN, HALF_GGX = range(6)
@@ -719,7 +719,8 @@ def efficiency_dataset(ns=EFFICIENCY_N, theta_deg=EFFICIENCY_THETA, mu_grazing: 
               "theta": ("mu", theta, {"long_name": "viewing angle theta_V", "units": "degree"})}
     ds = xr.Dataset(
         {
-            "albedo": (dims, out["albedo"], {"long_name": "albedo a(V), the estimator's mean (L_in = 1)", "units": "1"}),
+            "albedo": (dims, out["albedo"], {"long_name": "albedo a(V), the estimator's mean (L_in = 1)",
+                                             "units": "1"}),
             "albedo_error": (dims, out["albedo_error"], {"long_name": "quadrature error estimate of albedo"}),
             "second_moment": (dims, out["second_moment"], {"long_name": "E[w^2], w = f cos(theta_L) / p(L)"}),
             "second_moment_error": (dims, out["second_moment_error"], {"long_name": "quadrature error of E[w^2]"}),
@@ -731,9 +732,10 @@ def efficiency_dataset(ns=EFFICIENCY_N, theta_deg=EFFICIENCY_THETA, mu_grazing: 
             "acceptance_error": (dims, out["acceptance_error"], {"long_name": "quadrature error of acceptance"}),
         },
         coords=coords,
-        attrs={"pumpup_kind": "pumpup sampling efficiency", "title": "Importance sampling efficiency of the Phong lobe (000 sec. 4.2)",
-               "method": "pumpup albedo engine on E[w], E[w^2] and the density (no Monte Carlo)",
-               "rtol": rtol, "sampler": "000 eq. 19-22: R around V with density (n+1)/(2 pi) cos^n, L = mirror of R",
+        attrs={"pumpup_kind": "pumpup sampling efficiency",
+               "title": "Importance sampling efficiency of the Phong lobe (000 sec. 4.2)",
+               "method": "pumpup albedo engine on E[w], E[w^2] and the density (no Monte Carlo)", "rtol": rtol,
+               "sampler": "000 eq. 19-22: R around V with density (n+1)/(2 pi) cos^n, L = mirror of R",
                "pumpup_version": __version__},
     )
     return ds

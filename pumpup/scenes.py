@@ -59,7 +59,8 @@ import time
 
 import numpy as np
 
-__all__ = ["SCENES", "F0", "METALS", "metal_index", "check_scene", "panels", "render_scene", "render_panel", "write_scene"]
+__all__ = ["SCENES", "F0", "METALS", "metal_index", "check_scene", "panels", "render_scene", "render_panel",
+           "write_scene"]
 
 #: normal-incidence reflectance of metals, linear RGB (Hoffman 2010 / Real-Time Rendering 3rd ed., Table 7.3);
 #: the scenes used it before the measured metals (:data:`METALS`); kept for comparison only
@@ -190,7 +191,8 @@ def _mitsuba(variant="auto"):
         raise ImportError("path-traced scenes need Mitsuba 3: install the render extra, "
                           "pip install -e \".[render]\" (or pip install \"pumpup[render]\")") from None
     if variant not in (None, "auto") and not str(variant).endswith("_rgb"):
-        raise ValueError(f"variant must be 'auto' or an RGB Mitsuba variant (scalar_rgb, llvm_ad_rgb, ...), got {variant!r}")
+        raise ValueError("variant must be 'auto' or an RGB Mitsuba variant (scalar_rgb, llvm_ad_rgb, ...), got "
+                         f"{variant!r}")
     v = pm.register(None if variant in (None, "auto") else variant)
     if not v.endswith("_rgb"):  # an earlier mi.set_variant of a mono or spectral variant
         v = pm.register("llvm_ad_rgb")

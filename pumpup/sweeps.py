@@ -118,7 +118,8 @@ def _check_pump(pump: Mapping | None) -> dict | None:
         raise SpecError(f"sweep: pump must be a dict like {{'g': 'g2', 'levels': 2}} or None, got {pump!r}")
     unknown = sorted(set(pump) - set(PUMP_KEYS))
     if unknown:
-        raise SpecError(f"sweep: unknown pump option(s) {', '.join(map(repr, unknown))}; allowed: {', '.join(PUMP_KEYS)}")
+        raise SpecError(f"sweep: unknown pump option(s) {', '.join(map(repr, unknown))}; allowed: "
+                        f"{', '.join(PUMP_KEYS)}")
     out = {"g": "g1", "levels": 1, **{k: _plain(v) for k, v in pump.items()}}
     if out["g"] not in ("g1", "g2"):
         raise SpecError(f"sweep: pump g must be 'g1' or 'g2', got {out['g']!r}")
@@ -137,7 +138,8 @@ def _chunk_shape(names: list[str], shape: tuple[int, ...], chunks) -> tuple[int,
         raise TypeError(f"sweep: chunks must be None, an int or a dict {{parameter: cells}}, got {chunks!r}")
     unknown = sorted(set(chunks) - set(names))
     if unknown:
-        raise ValueError(f"sweep: chunks names {', '.join(map(repr, unknown))}, which are not swept ({', '.join(names)})")
+        raise ValueError(f"sweep: chunks names {', '.join(map(repr, unknown))}, which are not swept "
+                         f"({', '.join(names)})")
     out = []
     for name, n in zip(names, shape):
         c = chunks.get(name, 1 if name != names[-1] else min(n, DEFAULT_CHUNK))
@@ -727,8 +729,9 @@ def _dataset(spec, base, names, values, grid, pump, opts, arrays):
     }
     for n, d in zip(names, dims):
         p = cls.params[n]
-        coords[d] = (d, np.asarray(values[n]), {"parameter": n, "long_name": f"{spec['type']} parameter {n}" + (f": {p.doc}" if p.doc else ""),
-                                                "valid_range": p.range_text()})
+        coords[d] = (d, np.asarray(values[n]),
+                     {"parameter": n, "long_name": f"{spec['type']} parameter {n}" + (f": {p.doc}" if p.doc else ""),
+                      "valid_range": p.range_text()})
     return xr.Dataset(data, coords=coords, attrs={
         "title": f"Directional albedo of {spec['type']} over {', '.join(names)}"
                  + (f", pumped ({pump['g']}, {pump['levels']} levels)" if pump else ""),

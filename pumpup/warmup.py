@@ -14,7 +14,8 @@ import time
 from collections.abc import Callable
 from typing import TextIO
 
-#: the range of a first command's compile on a new machine (2 cores): seconds, as scripts/bench/bench_startup.py measures
+#: the range of a first command's compile on a new machine (2 cores): seconds, as scripts/bench/bench_startup.py
+#: measures
 COLD_SECONDS = (10, 60)
 
 NOTICE = ("pumpup: compiling pumpup's kernels for this machine, once: about {lo}-{hi} s "

@@ -146,13 +146,15 @@ class Param:
             if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool):
                 value = [value]
             if not isinstance(value, (list, tuple, np.ndarray)) or len(value) == 0:
-                raise SpecError(f"{model}: parameter {name!r} must be a non-empty list of numbers in {self.range_text()}, got {value!r}")
+                raise SpecError(f"{model}: parameter {name!r} must be a non-empty list of numbers in "
+                                f"{self.range_text()}, got {value!r}")
             return [self.check_number(model, f"{name}[{i}]", v) for i, v in enumerate(value)]
         if self.kind == "spec":
             if isinstance(value, BRDF):
                 return value
             if not isinstance(value, dict):
-                raise SpecError(f"{model}: parameter {name!r} must be a model spec (a dict with a 'type'), got {value!r}")
+                raise SpecError(f"{model}: parameter {name!r} must be a model spec (a dict with a 'type'), got "
+                                f"{value!r}")
             f = load(value)
             if getattr(f, "is_spectral", False):  # pumped / kulla_conty / scaled over one are spectral themselves
                 raise SpecError(f"{model}: parameter {name!r} must be a single-channel model; a spectral spec (a "
@@ -282,7 +284,9 @@ def add_provider(module: str) -> None:
 
 
 def register_loader(applies: Callable[[Any], bool], loader: Callable[[Any], Any]) -> None:
-    """Let :func:`load` hand every spec for which ``applies(spec)`` is true to ``loader(spec)`` (before the registry)."""
+    """Let :func:`load` hand every spec for which ``applies(spec)`` is true to ``loader(spec)``
+    (before the registry).
+    """
     _LOADERS.append((applies, loader))
 
 
@@ -900,14 +904,15 @@ def from_function(fn: Callable, name: str = "function", reciprocal: bool = True,
     isotropic : bool
         The caller's claim that f does not change when wi and wo turn together about N (it depends on them through
         N.wi, N.wo and wi.wo only): the albedo then does not depend on the azimuth of wi, and pumping tabulates it once
-        instead of bounding its supremum over that azimuth (:func:`pumpup.tables.azimuth.sup_albedo`: 16 tables or more).
-        Checked here: f at :data:`ISOTROPY_PAIRS` random pairs against the same pairs turned by random angles, which
-        must agree within :data:`ISOTROPY_RTOL` (relative); a ValueError names the largest change otherwise.
+        instead of bounding its supremum over that azimuth (:func:`pumpup.tables.azimuth.sup_albedo`: 16 tables or
+        more).  Checked here: f at :data:`ISOTROPY_PAIRS` random pairs against the same pairs turned by random angles,
+        which must agree within :data:`ISOTROPY_RTOL` (relative); a ValueError names the largest change otherwise.
 
     Examples
     --------
     >>> import numpy as np, pumpup
-    >>> f = pumpup.from_function(lambda wi, wo: np.full(np.broadcast_shapes(wi.shape, wo.shape)[:-1], 0.5 / np.pi), name="half_white")
+    >>> f = pumpup.from_function(lambda wi, wo: np.full(np.broadcast_shapes(wi.shape, wo.shape)[:-1], 0.5 / np.pi),
+    ...                          name="half_white")
     >>> float(f.eval([0, 0, 1], [0.6, 0, 0.8])) * np.pi
     0.5
     """
@@ -936,9 +941,9 @@ def from_function(fn: Callable, name: str = "function", reciprocal: bool = True,
         if change.max() > ISOTROPY_RTOL:
             i = int(np.argmax(change))
             _USER_FUNCTIONS.pop(name) if old is None else _USER_FUNCTIONS.__setitem__(name, old)
-            raise ValueError(f"from_function: isotropic=True, but {name!r} changes by {change[i]:.3g} (relative, allowed "
-                             f"{ISOTROPY_RTOL:g}) when wi={wi[i].tolist()}, wo={wo[i].tolist()} turn about N by "
-                             f"{turn[i]:.6g} rad: {float(a[i])!r} against {float(b[i])!r}")
+            raise ValueError(f"from_function: isotropic=True, but {name!r} changes by {change[i]:.3g} (relative, "
+                             f"allowed {ISOTROPY_RTOL:g}) when wi={wi[i].tolist()}, wo={wo[i].tolist()} turn about N "
+                             f"by {turn[i]:.6g} rad: {float(a[i])!r} against {float(b[i])!r}")
     return f
 
 

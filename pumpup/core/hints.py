@@ -3,8 +3,8 @@
 A model whose albedo integral has a closed-form azimuth (or one the engine takes by a rule on known arcs) returns an
 :class:`AzimuthHint` from :meth:`pumpup.core.BRDF.azimuth_hint`: the model's *family* (one of the records below, with
 typed parameters), the constant ``scale(mu)`` in front of it, and the *factors* of N.wo that operators multiply it by.
-The engine's routing table (:mod:`pumpup.engine.routes`) reads the hint and picks the route; a model or an operator never
-names a route.
+The engine's routing table (:mod:`pumpup.engine.routes`) reads the hint and picks the route; a model or an operator
+never names a route.
 
 Families (each a frozen record):
 
@@ -31,8 +31,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 __all__ = [
-    "AshikhminShirleyLobe", "AzimuthHint", "ClosedForm", "DivideByG", "Fresnel", "FresnelAtMax", "HalfVectorLobe", "InverseAlbedoFactor",
-    "PowerLobe", "SchlickLobe", "SmithLobe", "VCavityLobe", "WardLobe",
+    "AshikhminShirleyLobe", "AzimuthHint", "ClosedForm", "DivideByG", "Fresnel", "FresnelAtMax", "HalfVectorLobe",
+    "InverseAlbedoFactor", "PowerLobe", "SchlickLobe", "SmithLobe", "VCavityLobe", "WardLobe",
 ]
 
 RADIAL_WEIGHTS = ("power", "beckmann", "ggx")
@@ -143,9 +143,10 @@ class SmithLobe:
     def __post_init__(self):
         if self.distribution not in ("beckmann", "ggx") or self.g1 not in ("exact", "walter") \
                 or self.shadowing not in ("separable", "correlated") or not self.alpha > 0.0:
-            _bad("SmithLobe", f"needs distribution 'beckmann' or 'ggx', g1 'exact' or 'walter', shadowing 'separable' or "
-                              f"'correlated' and alpha > 0, got {self.distribution!r}, {self.g1!r}, {self.shadowing!r}, "
-                              f"{self.alpha!r}")
+            _bad("SmithLobe",
+                 f"needs distribution 'beckmann' or 'ggx', g1 'exact' or 'walter', shadowing 'separable' or "
+                 f"'correlated' and alpha > 0, got {self.distribution!r}, {self.g1!r}, {self.shadowing!r}, "
+                 f"{self.alpha!r}")
 
 
 @dataclass(frozen=True)

@@ -72,8 +72,8 @@ _END_GAP = 1e-10
 #: two cuts whose crossing function a_j b_k - a_k b_j stays within COINCIDENT eps S_j S_k at every node of the scan
 #: (S a bound of the magnitudes a cut's coefficients are computed from: |a| + |b| of a model's kink, |a0 - u| + |b0| +
 #: |u| of a level N.wo = u, |a0| + |b0| of the horizon) are one curve, computed twice: its "roots" are rounding noise.
-#: A pumped Cook-Torrance has the level N.wo = mu of g2 and g1 (:meth:`pumpup.operators.pumping.Pumped.kink_levels`) and the
-#: geometry factor's kink N.wo = mu (:func:`pumpup.models.cook_torrance._g_kinks`): 292 such breaks at mu = 0.5 gave
+#: A pumped Cook-Torrance has the level N.wo = mu of g2 and g1 (:meth:`pumpup.operators.pumping.Pumped.kink_levels`) and
+#: the geometry factor's kink N.wo = mu (:func:`pumpup.models.cook_torrance._g_kinks`): 292 such breaks at mu = 0.5 gave
 #: the nested engine 448 first intervals where the base model has 25, 40-60 x its evaluations (issue 14's
 #: twenty-fourth session)
 COINCIDENT = 64.0

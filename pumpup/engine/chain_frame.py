@@ -21,9 +21,9 @@ from .lobe_fresnel import LOBE_F_WIDE
 from .outer_rule import _RULES, _bisect, _buffers, _status
 
 #: a lobe with 000 eq. 28's F(Theta_min) (metal, the fresnel wrapper of a lobe) is integrated about N (the pumped lobe's
-#: frame with g = 1, :func:`_integrate_chain`) for n at least this, and in the lobe frame (frame 5) below it, where the ring
-#: table leaves the pieces next to kappa = 1 to quadrature and the elevation is graded towards x_s (measured: n = 1 took 4 x
-#: frame 5's time, n = 7.5 0.8 x, n = 20 0.17 x)
+#: frame with g = 1, :func:`_integrate_chain`) for n at least this, and in the lobe frame (frame 5) below it, where the
+#: ring table leaves the pieces next to kappa = 1 to quadrature and the elevation is graded towards x_s (measured: n = 1
+#: took 4 x frame 5's time, n = 7.5 0.8 x, n = 20 0.17 x)
 LOBE_N_MIN = 8.0  # (RING_SMOOTH_N)
 
 
@@ -259,9 +259,10 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
     start; ``kb``, ``kc``, ``keps`` the ring table of the lobe's exponent (:func:`ring_table`); ``fr`` the Fresnel
     factor's (on, eta, k) (:func:`_x_rule`).
     """
-    # (room for every piece's first intervals besides max_intervals bisections: a pumped metal near grazing incidence has
-    # ~100 pieces, more than the 64 spare slots)
-    cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals + cuts.shape[1] * n_init, nodes, nodes, rtol)
+    # (room for every piece's first intervals besides max_intervals bisections: a pumped metal near grazing incidence
+    # has ~100 pieces, more than the 64 spare slots)
+    cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals + cuts.shape[1] * n_init, nodes, nodes,
+                                                               rtol)
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -275,7 +276,8 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
                 pk[m] = i
                 t0[m] = a_ + (b_ - a_) * j / n_init
                 t1[m] = a_ + (b_ - a_) * (j + 1.0) / n_init if j + 1 < n_init else b_
-                kv[m], ke[m] = _x_rule(n, p, mu, s, t0[m], t1[m], chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr, mode)
+                kv[m], ke[m] = _x_rule(n, p, mu, s, t0[m], t1[m], chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork,
+                                       fr, mode)
                 m += 1
         start = m
         while True:
@@ -285,7 +287,8 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
             if ok or m - start >= max_intervals or m >= cap:
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
-            kv[worst], ke[worst] = _x_rule(n, p, mu, s, a_, mid, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr, mode)
+            kv[worst], ke[worst] = _x_rule(n, p, mu, s, a_, mid, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork,
+                                           fr, mode)
             kv[m], ke[m] = _x_rule(n, p, mu, s, mid, b_, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr, mode)
             m += 1
         val[q] = tot
@@ -302,8 +305,8 @@ def chain_cuts(levels, n: float, mu: float, fresnel=None, chain: bool = True) ->
     n < :data:`RING_SMOOTH_N` a grading towards x_s; with ``fresnel`` = (eta, k), N.wo = x0 -+ y0 3^j about F's branch
     point and rho 3^j towards its pole near 0 (as frame 5's arcs, :func:`_k_lobe_fresnel`; the pole's only where rho <
     :data:`LOBE_F_WIDE`); x = atan2(L, sqrt(1 - L^2)) keeps levels near 1 to full precision.  ``chain`` False (a metal's
-    lobe about N, g = 1): without g's grading in N.wo and the pi / 16 cuts.  The engine computes them compiled, for every
-    mu at once (:func:`chain_cut_matrix`); this is their reference.
+    lobe about N, g = 1): without g's grading in N.wo and the pi / 16 cuts.  The engine computes them compiled, for
+    every mu at once (:func:`chain_cut_matrix`); this is their reference.
     """
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     L = np.asarray(levels, dtype=np.float64).reshape(-1)
@@ -350,10 +353,10 @@ CHAIN_CUTS_ROOM = 96
 
 @njit(cache=True, nogil=True)
 def _chain_cut_matrix(n, mu_arr, lev, nlev, chain, fres, x0, y0, rho):  # pragma: no cover - compiled; see chain_cuts
-    """(cut, ncut): :func:`chain_cuts` for every mu, compiled (it was a quarter to a half of a pumped or 1/E-scaled table's
-    time in Python): the levels ``lev[q, :nlev[q]]``, ``chain`` (g's grading in N.wo and the pi / 16 cuts), with ``fres``
-    F's branch point x0 - i y0 and pole scale rho (:func:`fresnel_branch`, :func:`fresnel_pole`); sorted, duplicates
-    dropped, as chain_cuts (np.unique) has them.
+    """(cut, ncut): :func:`chain_cuts` for every mu, compiled (it was a quarter to a half of a pumped or 1/E-scaled
+    table's time in Python): the levels ``lev[q, :nlev[q]]``, ``chain`` (g's grading in N.wo and the pi / 16 cuts), with
+    ``fres`` F's branch point x0 - i y0 and pole scale rho (:func:`fresnel_branch`, :func:`fresnel_pole`); sorted,
+    duplicates dropped, as chain_cuts (np.unique) has them.
     """
     half = 0.5 * math.pi
     cap = CHAIN_CUTS_ROOM + lev.shape[1]

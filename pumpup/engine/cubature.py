@@ -446,7 +446,8 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
         diff = np.abs(v1 - v2)
         return v2, np.maximum(e1, e2) + diff, c1 & c2 & (diff <= np.maximum(rtol * np.abs(v2), atol))
     P = len(g.mu)
-    n_pieces = 1 + g.levels.shape[1] + (len(g.lobe.kinks(np.array([0.5]), np.array([0.5]), np.array([0.5]), np.array([0.5]))) if g.lobe.kinks else 0)
+    n_pieces = 1 + g.levels.shape[1] + (
+        len(g.lobe.kinks(np.array([0.5]), np.array([0.5]), np.array([0.5]), np.array([0.5]))) if g.lobe.kinks else 0)
     nx = NX_INIT if not g.lobe.generic else (8 if grid is None else grid[0])
     nt = NT_INIT if not g.lobe.generic else (8 if grid is None else grid[1])
     # initial rectangles: nx x nt per piece per problem, with the x grid also split where
@@ -465,7 +466,8 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
         # and, near normal incidence on a microfacet lobe, towards both horizon breaks on the roughness's scale
         # (``pumpup.engine.nested._alpha_grading``: G1(wo) falls to 0 within alpha of the horizon; GGX alpha = 2.7e-4 at
         # mu = 1 was 2.6e-11 off with an estimate of 4.1e-13, 62 x, before)
-        gx = np.unique(np.concatenate([np.linspace(0, 1, nx + 1), graded(breaks), _alpha_grading(g.lobe, float(g.mu[p_]))]))
+        gx = np.unique(np.concatenate([np.linspace(0, 1, nx + 1), graded(breaks),
+                                       _alpha_grading(g.lobe, float(g.mu[p_]))]))
         # and the pieces that end at the cut of a small level graded towards it in tau_t
         # (_level_end_scales: the near-singularity there is invisible to both rules)
         d = _level_end_scales(g.lobe, float(g.mu[p_]), g.levels[p_], gx, n_pieces)
@@ -640,7 +642,8 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     if not isinstance(brdf, BRDF):
         if getattr(brdf, "is_spectral", False):  # pumpup.spectral: one albedo per wavelength, on a trailing axis
             return brdf.albedo(mu, return_error=return_error, rtol=rtol, atol=atol, max_regions=max_regions, phi=phi)
-        raise TypeError(f"albedo needs a pumpup BRDF, got {type(brdf).__name__}; wrap functions with pumpup.from_function")
+        raise TypeError(f"albedo needs a pumpup BRDF, got {type(brdf).__name__}; wrap functions with "
+                        "pumpup.from_function")
     from ..core import check_count, check_tolerance
 
     rtol = check_tolerance("albedo", "rtol", rtol)
@@ -677,7 +680,8 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
             elif route == "nested":
                 v, e, conv = nested.integrate(term, payload, rtol, atol, max_regions)
             elif route == "cubature":
-                v, e, conv = _integrate_group(term, payload, rtol, atol, max_regions, generic_check=choice.generic_check)
+                v, e, conv = _integrate_group(term, payload, rtol, atol, max_regions,
+                                              generic_check=choice.generic_check)
             else:  # the 1-D routes of the model's azimuth hint (pumpup.engine.polar)
                 v, e, conv, _ = polar.run(route, payload, flat[idx], rtol, atol, max_regions, choice.lobe_fresnel_gauss)
             value[idx] += w * v

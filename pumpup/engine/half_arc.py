@@ -22,10 +22,10 @@ from .hint_view import kernel_view
 from .lobe_frame import _tally
 
 #: frame 4 declines a conductor's F(wi.h) whose branch point lies inside (0, 1) closer than this to the real axis (the
-#: routing table leaves it to the nested engine, with the kink wi.h = x0 in the model's Lobe hint).  Measured against the
-#: nested and 2-D engines at rtol 1e-13 (eta 0.551; GGX 0.3, 0.02, Beckmann 0.1; mu 0.05 ... 0.95): frame 4 was up to
-#: 1.3e5 x its estimate for y0 = 0 (k = 0: total reflection below eta = 1) and y0 = 6.6e-13, 18 x for 6.6e-10, within its
-#: estimate from 6.6e-8 up (``scripts/studies/fuzz_engines.py --registry``)
+#: routing table leaves it to the nested engine, with the kink wi.h = x0 in the model's Lobe hint).  Measured against
+#: the nested and 2-D engines at rtol 1e-13 (eta 0.551; GGX 0.3, 0.02, Beckmann 0.1; mu 0.05 ... 0.95): frame 4 was up
+#: to 1.3e5 x its estimate for y0 = 0 (k = 0: total reflection below eta = 1) and y0 = 6.6e-13, 18 x for 6.6e-10, within
+#: its estimate from 6.6e-8 up (``scripts/studies/fuzz_engines.py --registry``)
 ARC_F_Y0_MIN = 1e-6
 
 #: frame 4's models (``mp[0]``): the Smith microfacet models (Beckmann, GGX; ``SmithLobe``), the
@@ -70,7 +70,8 @@ def _phi_numeric(mp, mu, u, c0, d):  # pragma: no cover - compiled; see numeric_
     if mp[0] == ASHIKHMIN:  # AS 2000 eq. 4: 4 c F(c) / (c max(mu, z)) times z, Schlick's F(c) (eq. 5)
         q = 1.0 - c
         return 4.0 * (mp[4] + (1.0 - mp[4]) * (q * q) * (q * q) * q) * min(z, mu) / mu
-    if mp[1] == 1.0:  # GGX: P = (z + sqrt(z^2 + alpha^2 sin^2)) / 2, Walter eq. 34 (physics.microfacet.projected, one sqrt)
+    if mp[1] == 1.0:  # GGX: P = (z + sqrt(z^2 + alpha^2 sin^2)) / 2, Walter eq. 34
+        # (physics.microfacet.projected, one sqrt)
         pz = 0.5 * (z + math.sqrt(z * z + mp[4] * mp[4] * ((1.0 - z) * (1.0 + z))))
     else:
         pz = _projected(math.sqrt((1.0 - z) * (1.0 + z)), 0.0, z, 0, int(mp[2]), mp[4])
@@ -102,7 +103,8 @@ def _delta_at(c, a, b, beta0):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _k_numeric(mp, mu, s, psi, u, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, iwork):  # pragma: no cover - compiled; see numeric_integrand_reference
+def _k_numeric(mp, mu, s, psi, u, sa, itol, tol_abs,  # pragma: no cover - compiled; see numeric_integrand_reference
+               nodes, wk, wg, mode, ibuf, iwork):
     """(K(u), its error) of frame 4: the integral over the azimuth beta of h about N, where N.wo > 0, of
     :func:`_phi_numeric` (4 c F(c) Gamma, which depends on beta through c = wi.h only, as in :func:`_k_half`), by a
     globally adaptive rule (``nodes``, ``wk``, ``wg``: the 7/15 rule) on the arc.
@@ -130,7 +132,8 @@ def _k_numeric(mp, mu, s, psi, u, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, 
     if b > 0.0:
         for j in range(3):
             if mp[0] == VCAVITY_F:
-                cb = 2.0 * u * mu if j == 0 else (mu / u if j == 1 else (2.0 * u * mu / (4.0 * u * u - 1.0) if 4.0 * u * u > 1.0 else -1.0))
+                cb = 2.0 * u * mu if j == 0 else (mu / u if j == 1 else (
+                    2.0 * u * mu / (4.0 * u * u - 1.0) if 4.0 * u * u > 1.0 else -1.0))
             elif mp[0] == ASHIKHMIN:
                 cb = mu / u if j == 0 else -1.0  # N.wo = 2 c u - mu = mu: max(mu, N.wo)'s kink
             else:
@@ -259,7 +262,8 @@ def numeric_params(hint, gauss: bool = True) -> np.ndarray:
     if hint.smith is not None:
         mp[0], mp[1:5] = SMITH, hint.smith
         mp[11] = hint.smith[3]
-        if hint.fresnel[1] > 0.0:  # a conductor's branch point, for :func:`_pieces`' cuts (frame 6 reuses 13, 14: n_params)
+        # a conductor's branch point, for :func:`_pieces`' cuts (frame 6 reuses 13, 14: n_params)
+        if hint.fresnel[1] > 0.0:
             mp[13], mp[14] = fresnel_branch(float(hint.fresnel[1]), float(hint.fresnel[2]))
         if hint.smith[1] == 1:
             from ..physics.microfacet import walter_level

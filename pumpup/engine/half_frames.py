@@ -171,8 +171,8 @@ def _k_ward(mu, s, psi, u, sa):  # pragma: no cover - compiled; see ward_integra
 
     As in :func:`_k_half`, c = wi.h = c0 + d, N.wo = 2 u d, d = e0 + b cos(beta) >= 0 on the arc |beta| <
     beta0: K = 8 sqrt(2 u) (c0 I_1/2 + I_3/2), I_q = integral_0^beta0 d^q d beta, complete elliptic integrals
-    (Carlson's R_F, R_D; :func:`_complete_kd`): with x = sin(beta / 2), d = T - 2 b x^2, T = d(0), on a partial arc (T < 2 b,
-    M = T / (2 b)) I_1/2 = 2 T / sqrt(2 b) (R_F - R_D / 3), I_-1/2 = 2 R_F / sqrt(2 b), the R at (0, 1 - M, 1);
+    (Carlson's R_F, R_D; :func:`_complete_kd`): with x = sin(beta / 2), d = T - 2 b x^2, T = d(0), on a partial arc (T <
+    2 b, M = T / (2 b)) I_1/2 = 2 T / sqrt(2 b) (R_F - R_D / 3), I_-1/2 = 2 R_F / sqrt(2 b), the R at (0, 1 - M, 1);
     on the full circle (k^2 = 2 b / T <= 1) I_1/2 = 2 sqrt(T) E(k^2) = 2 sqrt(T) (R_F - k^2 R_D / 3),
     I_-1/2 = 2 R_F / sqrt(T) at (0, 1 - k^2, 1); and 3 I_3/2 = 4 e0 I_1/2 + (b^2 - e0^2) I_-1/2 (the
     recurrence (q + 1) I_(q+1) = (2q + 1) e0 I_q + q (b^2 - e0^2) I_(q-1), from d/d beta (d^q sin(beta)),
@@ -291,7 +291,8 @@ def vcavity_integrand_reference(mu: float, u) -> np.ndarray:
             c = a + b * math.cos(t)
             return 4.0 * min(c, 2 * uu * mu, 4 * uu * uu * c - 2 * uu * mu) if c > 0.5 * mu / uu else 0.0
 
-        pts = [math.acos((cv - a) / b) for cv in (0.5 * mu / uu, 2 * uu * mu, mu / uu, 2 * uu * mu / (4 * uu * uu - 1) if 4 * uu * uu != 1 else -9.0)
+        pts = [math.acos((cv - a) / b) for cv in (0.5 * mu / uu, 2 * uu * mu, mu / uu,
+                                                  2 * uu * mu / (4 * uu * uu - 1) if 4 * uu * uu != 1 else -9.0)
                if b > 0 and abs((cv - a) / b) < 1]
         return 2.0 * quad(g, 0.0, math.pi, points=pts or None, epsabs=0, epsrel=1e-13, limit=200)[0]
 
@@ -316,7 +317,8 @@ def ward_integrand_reference(mu: float, u: np.ndarray) -> np.ndarray:
         beta0 = math.pi if e0 - b >= 0 else (0.0 if e0 + b <= 0 else math.acos(-e0 / b))
         if beta0 == 0.0:
             return 0.0
-        ih, i3 = (quad(lambda t, q=q: max(e0 + b * math.cos(t), 0.0) ** q, 0.0, beta0, epsabs=0, epsrel=1e-13, limit=200)[0]
+        ih, i3 = (quad(lambda t, q=q: max(e0 + b * math.cos(t), 0.0) ** q, 0.0, beta0, epsabs=0, epsrel=1e-13,
+                       limit=200)[0]
                   for q in (0.5, 1.5))
         return 8.0 * math.sqrt(2.0 * uu) * (c0 * ih + i3)
 

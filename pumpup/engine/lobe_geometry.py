@@ -73,9 +73,9 @@ def radial_map(kind: str, k: float, x: np.ndarray, xc: np.ndarray):
             ca_peak = np.exp(ly)
             sa_peak = np.sqrt(-np.expm1(ly) * (1.0 + ca_peak))
             jac_peak = 2.0 * (1.0 - ys) * ca_peak / ((k + 1.0) * y)
-        # at x = 1/2 itself 1 - (1 - ys) rounds ys off beyond n = 52 (y = 0): alpha is the split's, cos(alpha) = u_s, not
-        # 90 deg (the kink scan samples tau = 1/2 and saw the wrong side there), with the weight 0 the point had before
-        # (it only ends intervals one double wide)
+        # at x = 1/2 itself 1 - (1 - ys) rounds ys off beyond n = 52 (y = 0): alpha is the split's, cos(alpha) = u_s,
+        # not 90 deg (the kink scan samples tau = 1/2 and saw the wrong side there), with the weight 0 the point had
+        # before (it only ends intervals one double wide)
         at_split = ~tail & (y <= 0.0)
         ca_tail = np.where(at_split, us, 2.0 * us * x)
         ca = np.where(tail | at_split, ca_tail, ca_peak)

@@ -48,9 +48,9 @@ the hint already says.  This module integrates the same integrand as a nested qu
 
 The geometry runs in two compiled passes per batch (:func:`_nodes_kernel`: per outer node;
 :func:`_points_kernel`: per point), the model's ``_eval`` once per batch on all points (twice
-where the hint is not even in beta), and two compiled passes (:func:`pumpup.engine.cubature.accumulate`, :func:`_rule_kernel`)
-form the Kronrod and Gauss sums; each has a plain numpy twin (``*_reference``) that the tests compare
-with it.
+where the hint is not even in beta), and two compiled passes (:func:`pumpup.engine.cubature.accumulate`,
+:func:`_rule_kernel`) form the Kronrod and Gauss sums; each has a plain numpy twin (``*_reference``) that the tests
+compare with it.
 
 Groups with wi turned out of the xz-plane (``phi != 0``) are integrated in the frame of wi at phi = 0 and the points
 turned by phi about N before ``_eval``, as the 2-D engine does (issue 14, fourteenth session; before, they were left to
@@ -276,7 +276,8 @@ def _points_reference(axis: str, node, lo, width, t0, t1, mu, s, ca, sa, wr, sm=
 
 
 @njit(cache=True, nogil=True)
-def _points_kernel(axis, node, lo, width, t0, t1, sm, mu, s_n, ca_n, sa_n, wr_n, nodes, wi, wo, weight):  # pragma: no cover
+def _points_kernel(axis, node, lo, width, t0, t1, sm, mu, s_n, ca_n, sa_n, wr_n, nodes, wi, wo,  # pragma: no cover
+                   weight):
     """Compiled twin of :func:`_points_reference` (fills ``wi``, ``wo`` (N, 3), ``weight`` (N))."""
     R = nodes.shape[0]
     for q in range(node.shape[0]):
@@ -431,7 +432,8 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
         v_[:] = 0.0
         _points_kernel(axis, b_node[sl], b_lo[sl], b_w[sl], b_t0[sl], b_t1[sl], sm[sl], mu_n, s_n, ca_n, sa_n, wr_n,
                        inodes, wi_, wo_, w_)
-        if g.phi is not None:  # wi at azimuth phi: the whole configuration turned by phi about N, as the 2-D engine does
+        # wi at azimuth phi: the whole configuration turned by phi about N, as the 2-D engine does
+        if g.phi is not None:
             ph = np.repeat(g.phi[pnode[b_node[sl]]], RI)
             cp, sp = np.cos(ph), np.sin(ph)
         for sign in signs:
@@ -459,9 +461,10 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
 
 
 #: segments per call of :func:`_evaluate`: its block arrays (a dozen of 8 bytes per segment and outer node, more where
-#: the ends are graded) grow with the segments a refinement round adds.  Found by ``scripts/studies/fuzz_engines.py --fmax 22``
-#: (issue 14's twenty-second session): a nested reference at max_regions 200000 grew past 23 GB and the kernel killed
-#: it.  Each segment's values do not depend on the others in its call, so the chunks change no bit
+#: the ends are graded) grow with the segments a refinement round adds.  Found by
+#: ``scripts/studies/fuzz_engines.py --fmax 22`` (issue 14's twenty-second session): a nested reference at max_regions
+#: 200000 grew past 23 GB and the kernel killed it.  Each segment's values do not depend on the others in its call, so
+#: the chunks change no bit
 SEG_CHUNK = 100_000
 
 
@@ -470,7 +473,8 @@ def _evaluate_chunked(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, s
     if len(seg_int) <= SEG_CHUNK:
         return _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i_sub)
     parts = [_evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int[a:a + SEG_CHUNK], seg_piece[a:a + SEG_CHUNK],
-                       seg_t0[a:a + SEG_CHUNK], seg_t1[a:a + SEG_CHUNK], i_sub) for a in range(0, len(seg_int), SEG_CHUNK)]
+                       seg_t0[a:a + SEG_CHUNK], seg_t1[a:a + SEG_CHUNK], i_sub)
+             for a in range(0, len(seg_int), SEG_CHUNK)]
     return (np.concatenate([q[0] for q in parts]), np.concatenate([q[1] for q in parts]),
             np.concatenate([q[2] for q in parts]), sum(q[3] for q in parts))
 
@@ -514,9 +518,9 @@ def _alpha_grading(lobe, mu: float) -> np.ndarray:
     pi/4 -+ theta_i / 2) on its roughness's scale a (GGX's alpha, the sqrt of the "ggx" map's sharpness; Beckmann's m):
     alpha_f -+ (a / 2) 4^k up to 1/4 rad away.  The shadowing G1(wo) falls to 0 where N.wo is within a of the horizon,
     which is (a / 2) in alpha_h from a break; away from normal incidence the arc's integral over beta spreads that over
-    theta_i, but near it the outer integrand has the whole feature next to the break, where the grading towards the break
-    (on the scale of its distance to the end of the range) did not see it: GGX alpha = 1.4e-3 at mu = 1 was 6.4 x its
-    estimate at rtol 1e-10, alpha = 3e-4 at mu = 1 - 1e-9 26 x at 1e-12 (issue 14's twentieth session,
+    theta_i, but near it the outer integrand has the whole feature next to the break, where the grading towards the
+    break (on the scale of its distance to the end of the range) did not see it: GGX alpha = 1.4e-3 at mu = 1 was 6.4 x
+    its estimate at rtol 1e-10, alpha = 3e-4 at mu = 1 - 1e-9 26 x at 1e-12 (issue 14's twentieth session,
     ``scripts/studies/fuzz_engines.py``).
     """
     if lobe.axis != "half" or lobe.radial not in ("ggx", "beckmann"):
@@ -725,7 +729,8 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
         # (x1 - h (1 - v)^2); a child keeps the substitution at the parent's break end only
         hs = i_x1[sp] - i_x0[sp]
         ss = i_sub[sp]
-        xm = np.where(ss == 1, i_x0[sp] + 0.25 * hs, np.where(ss == 2, i_x1[sp] - 0.25 * hs, 0.5 * (i_x0[sp] + i_x1[sp])))
+        xm = np.where(ss == 1, i_x0[sp] + 0.25 * hs, np.where(ss == 2, i_x1[sp] - 0.25 * hs,
+                                                              0.5 * (i_x0[sp] + i_x1[sp])))
         i_sub = np.concatenate([i_sub, ss & 1, ss & 2])
         base = len(i_prob)
         child = np.full(nI, -1)

@@ -3,8 +3,8 @@
 :func:`pumpup.albedo` splits a model into its linear terms (:meth:`pumpup.core.BRDF.albedo_terms`) and, for each term
 and each value of mu, takes the first route of :data:`RULES` that applies:
 
-1. ``slope``: a model with a slope-space hint (:meth:`~pumpup.core.BRDF.slope_hint`, anisotropic Ward), at any azimuth of
-   wi, mu >= :data:`pumpup.engine.slope.MU_MIN` (:mod:`pumpup.engine.slope`).
+1. ``slope``: a model with a slope-space hint (:meth:`~pumpup.core.BRDF.slope_hint`, anisotropic Ward), at any azimuth
+   of wi, mu >= :data:`pumpup.engine.slope.MU_MIN` (:mod:`pumpup.engine.slope`).
 2. ``lobe_axis``: a power lobe about its own axis at any azimuth of wi (:meth:`~pumpup.core.BRDF.lobe_axis`,
    Lafortune's), the ``lobe`` route about that axis.
 3. Where the albedo does not depend on the azimuth of wi (an isotropic model, or phi = 0): the model's
@@ -49,8 +49,8 @@ from .hint_view import HALF_MU_MIN
 from .lobe_fresnel import lobe_fresnel_ok
 from .normal_frame import N_FRESNEL_MU_MIN, n_fresnel_ok
 
-__all__ = ["ENGINES", "ONE_D_ROUTES", "ROUTES", "RULES", "Choice", "current", "describe", "hint_routes", "one_d_everywhere", "plan", "route_names",
-           "using"]
+__all__ = ["ENGINES", "ONE_D_ROUTES", "ROUTES", "RULES", "Choice", "current", "describe", "hint_routes",
+           "one_d_everywhere", "plan", "route_names", "using"]
 
 ENGINES = ("auto", "1d", "nested", "2d")
 
@@ -135,7 +135,8 @@ def _smith_ok(f) -> bool:
         return False
     if f.fresnel is not None and f.g1 == "walter" and f.shadowing == "correlated":
         return False
-    return not (f.fresnel is not None and f.fresnel.eta > 0.0 and fresnel_levels(f.fresnel.eta, f.fresnel.k, ARC_F_Y0_MIN))
+    return not (f.fresnel is not None and f.fresnel.eta > 0.0
+                and fresnel_levels(f.fresnel.eta, f.fresnel.k, ARC_F_Y0_MIN))
 
 
 def _normal_family(f) -> bool:
@@ -237,11 +238,13 @@ RULES = (
     Rule("vcavity", (VCavityLobe,), frozenset(), "F = 1", lambda h: h.family.fresnel is None, "mu >= HALF_MU_MIN",
          lambda h, mu: _half_mu(mu)),
     *(Rule("normal", (SmithLobe, SchlickLobe), frozenset(kinds),
-           "Schlick; GGX or Beckmann, alpha <= 1, F = 1 or GGX's F(wi.h) n_fresnel_ok takes; F(max) without a near-kink",
+           "Schlick; GGX or Beckmann, alpha <= 1, F = 1 or GGX's F(wi.h) n_fresnel_ok takes; "
+           "F(max) without a near-kink",
            _normal, "mu >= N_FRESNEL_MU_MIN with F(wi.h), else all", _normal_mu)
       for kinds in ((), (_D,), (_U,), (_M,), (_D, _M))),
     Rule("half_arc", (SmithLobe, VCavityLobe, AshikhminShirleyLobe), frozenset(),
-         "Smith: alpha <= 1, no Walter G1 in correlated G with F, no near-kink of F(wi.h); V-cavity: with F(wi.h)", _arc, "mu >= HALF_MU_MIN", lambda h, mu: _half_mu(mu)),
+         "Smith: alpha <= 1, no Walter G1 in correlated G with F, no near-kink of F(wi.h); V-cavity: with F(wi.h)",
+         _arc, "mu >= HALF_MU_MIN", lambda h, mu: _half_mu(mu)),
     Rule("lobe_normal", (PowerLobe,), frozenset({_M}), "p in {0, 1}, n >= LOBE_N_MIN, F without a near-kink",
          _lobe_normal),
     Rule("lobe_fresnel", (PowerLobe,), frozenset({_M}), "p in {0, 1}, F without a near-kink", _lobe_fmax),
@@ -350,6 +353,7 @@ def describe() -> str:
         fam = ", ".join(f.__name__ for f in r.families)
         fac = ", ".join(sorted(f.__name__ for f in r.factors)) or "-"
         lines.append(f"{r.route:13s} {fam:32s} {fac:18s} {r.mu_text:11s} {r.when}")
-    lines.append("nested        (BRDF.lobe)                      any                the rest    the lobe hint it supports")
+    lines.append("nested        (BRDF.lobe)                      any                the rest    "
+                 "the lobe hint it supports")
     lines.append("cubature      any BRDF                         any                the rest    -")
     return "\n".join(lines)

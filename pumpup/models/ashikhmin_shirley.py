@@ -285,7 +285,8 @@ class AshikhminShirley(BRDF):
         if nu != nv or rd * (1.0 - rs) != 0.0:
             return None
         norm = math.sqrt((nu + 1.0) * (nv + 1.0)) / (8.0 * math.pi)  # AS 2000 eq. 4
-        return AzimuthHint(AshikhminShirleyLobe(n=float(nu), rs=float(rs)), scale=lambda mu: np.full(np.shape(mu), norm))
+        return AzimuthHint(AshikhminShirleyLobe(n=float(nu), rs=float(rs)),
+                           scale=lambda mu: np.full(np.shape(mu), norm))
 
     def lobe(self, mu):
         # (N.h)^e(phi_h), e = nu cos^2 phi_h + nv sin^2 phi_h, in x = (N.h)^(n+1) ("power" about h) behaves as

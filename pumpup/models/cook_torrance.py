@@ -337,8 +337,8 @@ class TorranceSparrow(BRDF):
             return None  # D2 = b exp(-(c2 alpha)^2) has no weight of the 1-D path: the nested engine
         from ..core.hints import AzimuthHint, Fresnel, VCavityLobe
 
-        # 002 eq. 10: F G D / (pi (N.S)(N.V)); the azimuth of h in closed form for F = 1 (pumpup.engine.polar._k_vcavity),
-        # by a rule on its arc with F(wi.h)
+        # 002 eq. 10: F G D / (pi (N.S)(N.V)); the azimuth of h in closed form for F = 1
+        # (pumpup.engine.polar._k_vcavity), by a rule on its arc with F(wi.h)
         f_at_h = Fresnel(ior=self.p["ior"]) if self.p["ior"] else None
         if d == "D1":  # D = b cos^e(alpha): the power weight u^e
             return AzimuthHint(VCavityLobe(n=e, fresnel=f_at_h), scale=lambda mu: b / (math.pi * np.asarray(mu, float)))

@@ -79,7 +79,8 @@ class Minnaert(BRDF):
         from ..core.hints import AzimuthHint, ClosedForm
 
         k, b = self.p["k"], self.p["b"]
-        return AzimuthHint(ClosedForm(), scale=lambda mu: b * 2.0 * math.pi / (k + 1.0) * np.asarray(mu, float) ** (k - 1.0))
+        return AzimuthHint(ClosedForm(),
+                           scale=lambda mu: b * 2.0 * math.pi / (k + 1.0) * np.asarray(mu, float) ** (k - 1.0))
 
 
 # --- Neumann-Neumann lacquer -----------------------------------------------------------------

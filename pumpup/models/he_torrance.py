@@ -4,9 +4,9 @@ Checked against an independent source (the paper itself was not available here):
 reference implementation (heBRDF, Cornell; as reproduced in github.com/bsdfbenchmark/bbm,
 ``unittest/he/bin/he_westin.cpp``), whose functions are labelled by the paper's equations
 (24, 70, 73-84): every formula below matches it, and so do the values (30 direction pairs to
-1e-13 with Westin's series summed to a relative 1e-17, the specular weight to 1e-14; ``tests/data/he_torrance_westin.json``).
-Two places where sources differ: the shadowing uses the errata's exp(-c^2) factor in Lambda
-(the printed eq. 25 lacks it; bsdfbenchmark's ``he.h`` says so), and D keeps k^2 = (2 pi /
+1e-13 with Westin's series summed to a relative 1e-17, the specular weight to 1e-14;
+``tests/data/he_torrance_westin.json``).  Two places where sources differ: the shadowing uses the errata's exp(-c^2)
+factor in Lambda (the printed eq. 25 lacks it; bsdfbenchmark's ``he.h`` says so), and D keeps k^2 = (2 pi /
 lambda)^2 in v_xy^2 tau^2 / (4 m) as Westin does (a variant without it is dimensionally
 inconsistent with tau in micrometres).  Westin switches to a Beckmann shortcut for g > 18.5;
 pumpup always sums the series.
@@ -451,7 +451,8 @@ class HeTorrance(BRDF):
     def albedo_breaks(self):
         from .metal import fresnel_levels
 
-        return () if self.p["n"] is None else fresnel_levels(self.p["n"], self.p["k"])  # (the delta's F(mu) turns there)
+        # (the delta's F(mu) turns there)
+        return () if self.p["n"] is None else fresnel_levels(self.p["n"], self.p["k"])
 
     def sampling_lobe(self, mu):
         return Lobe(axis="normal", radial="cosine")  # cosine fallback (the delta is not sampled)

@@ -177,9 +177,10 @@ class Lafortune(BRDF):
     def lobe_axis(self, mu, phi):
         """For p = 0 (000 eq. 14): (R.V)_M = v.wo with v = (-cx Lx, -cy Ly, cz Lz), so f = c |v|^n (v^.wo)_+^n, a
         Phong power lobe about v^ at elevation nu = cz mu / |v|, scaled by c |v|^n (issue 14's fifteenth session: the
-        1-D path about v^ at every azimuth of wi, :func:`pumpup.engine.polar.axis_albedo`).  None for p > 0 (max(N.L, N.V)
-        depends on mu itself), for cz <= 0 (v^ on or below the horizon), where :meth:`polar` applies, and where nu or
-        the scale is not a positive finite number.  With cx = cy, |v| is taken without phi (the albedo is isotropic).
+        1-D path about v^ at every azimuth of wi, :func:`pumpup.engine.polar.axis_albedo`).  None for p > 0
+        (max(N.L, N.V) depends on mu itself), for cz <= 0 (v^ on or below the horizon), where :meth:`polar` applies, and
+        where nu or the scale is not a positive finite number.  With cx = cy, |v| is taken without phi
+        (the albedo is isotropic).
         """
         q = self.p
         if q["p"] != 0.0 or not q["cz"] > 0.0 or self.azimuth_hint() is not None:

@@ -125,7 +125,8 @@ def _fresnel_hint(n, c, eta, k):
     """
     from ..core.hints import AzimuthHint, FresnelAtMax, PowerLobe
 
-    return AzimuthHint(PowerLobe(n=n, p=1.0), scale=lambda mu: np.full(np.shape(mu), c), factors=(FresnelAtMax(eta, k),))
+    return AzimuthHint(PowerLobe(n=n, p=1.0), scale=lambda mu: np.full(np.shape(mu), c),
+                       factors=(FresnelAtMax(eta, k),))
 
 
 # --- plastic --------------------------------------------------------------------------------

@@ -177,7 +177,8 @@ class _Bound:
         except _ProductError:  # pragma: no cover - no table has needed it
             self.product = None
         if self.product is not None and self.product.rows.shape[1] != 8:  # pragma: no cover
-            raise AssertionError("the kernels are written for a product table of degree 5 (pumpup.physics.lookups.PRODUCT_DEGREE)")
+            raise AssertionError("the kernels are written for a product table of degree 5 "
+                                 "(pumpup.physics.lookups.PRODUCT_DEGREE)")
         if self.product is None:
             pargs = (math.inf, 0, np.zeros(1, np.int32), np.full(2, math.inf), np.zeros((1, 8)))
         else:
@@ -185,9 +186,10 @@ class _Bound:
             pargs = (p.mlo, p.cbase, p.cstart, p.lo, p.rows)
         self.args = pargs + lk.args()
         self.deficit_integral, kinks = self._integral()
-        #: the kinks of D in (0, 1): where U reaches 1, and the table's breaks (:attr:`pumpup.tables.AlbedoTable.breaks`,
-        #: the spline's split points: the albedo's own, Cook-Torrance's pumpup.models.cook_torrance.RETRO_BREAK, a Fresnel
-        #: factor's total reflection), the levels of every lobe that carries U(N.wo)
+        #: the kinks of D in (0, 1): where U reaches 1, and the table's breaks
+        #: (:attr:`pumpup.tables.AlbedoTable.breaks`, the spline's split points: the albedo's own, Cook-Torrance's
+        #: pumpup.models.cook_torrance.RETRO_BREAK, a Fresnel factor's total reflection), the levels of every lobe that
+        #: carries U(N.wo)
         self.kinks = sorted(set(kinks) | {b for b in table.breaks if 0.0 < b < 1.0})
 
     def upper(self, mu) -> np.ndarray:
@@ -230,8 +232,8 @@ class _Bound:
 
     def _parts(self) -> tuple:
         """([(piece, t0, t1)], kinks): the smooth parts of the product table's polynomial pieces in t = (m - centre) /
-        half (each piece from t = -1 to its end, the last one to m = 1), cut where U = 1 (D's kinks, also returned in m),
-        for Gauss-Legendre (:meth:`_integral`, :meth:`deficit_moment`).
+        half (each piece from t = -1 to its end, the last one to m = 1), cut where U = 1 (D's kinks, also returned in
+        m), for Gauss-Legendre (:meth:`_integral`, :meth:`deficit_moment`).
         """
         p = self.product
         hi = np.concatenate([p.lo[1:-1], [1.0]])
@@ -247,13 +249,13 @@ class _Bound:
         return parts, kinks
 
     def deficit_moment(self) -> tuple | None:
-        """(I, its error): I = 2 integral_0^1 D(m) m dm of the kernels' own D (:func:`_deficits`), the Kulla-Conty lobe's
-        albedo per unit D(mu_i), over pi (the lobe D(mu_i) D(mu_o) reflects D(mu_i) 2 pi integral D(t) t dt).  Above the
-        product table's mlo D is a polynomial of degree 5 in m on each part (:meth:`_parts`): Gauss-Legendre of 8 nodes is
-        exact there, on D evaluated as the kernels evaluate it, so the error is the rounding of the values (32 eps U per
-        node, summed with the weights); below mlo, 0 <= D <= 1 adds between 0 and mlo^2 (half of it is counted, the other
-        half is error).  (:meth:`_integral`'s I_hi is an upper bound of the same I.)  Cached; None without a product
-        table.
+        """(I, its error): I = 2 integral_0^1 D(m) m dm of the kernels' own D (:func:`_deficits`), the Kulla-Conty
+        lobe's albedo per unit D(mu_i), over pi (the lobe D(mu_i) D(mu_o) reflects D(mu_i) 2 pi integral D(t) t dt).
+        Above the product table's mlo D is a polynomial of degree 5 in m on each part (:meth:`_parts`): Gauss-Legendre
+        of 8 nodes is exact there, on D evaluated as the kernels evaluate it, so the error is the rounding of the values
+        (32 eps U per node, summed with the weights); below mlo, 0 <= D <= 1 adds between 0 and mlo^2 (half of it is
+        counted, the other half is error).  (:meth:`_integral`'s I_hi is an upper bound of the same I.)  Cached; None
+        without a product table.
         """
         got = getattr(self, "_moment", None)
         if got is not None or self.product is None:
@@ -462,9 +464,10 @@ class KullaConty(_Compensated):
         if float(np.max(over)) > 1.0:
             i = int(np.argmax(over))
             raise SpecError(
-                f"kulla_conty: the albedo of the base {self.white.type!r} exceeds 1 (E = {value[i]:.9g} +- {error[i]:.2g} "
-                f"at mu = {mu[i]:.3g}, theta = {math.degrees(math.acos(mu[i])):.4f} deg), so 1 - E < 0 would make "
-                "the lobe f_ms negative; use method 'g1' or 'g2' (pumping), which handles such a base")
+                f"kulla_conty: the albedo of the base {self.white.type!r} exceeds 1 (E = {value[i]:.9g} +- "
+                f"{error[i]:.2g} at mu = {mu[i]:.3g}, theta = {math.degrees(math.acos(mu[i])):.4f} deg), "
+                "so 1 - E < 0 would make the lobe f_ms negative; use method 'g1' or 'g2' (pumping), "
+                "which handles such a base")
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
@@ -569,10 +572,10 @@ class _MsLobe(BRDF):
                     symmetric=True)
 
     def azimuth_hint(self):
-        """The lobe's albedo in closed form (:class:`~pumpup.core.hints.ClosedForm`): D(mu) 2 pi integral_0^1 D(t) t dt = D(mu) pi I,
-        D the kernels' own (:func:`_deficits`), I by :meth:`_Bound.deficit_moment` (exact on the product table's
-        polynomial pieces); the relative error I's, plus 8 ulps for D(mu) pi I itself.  Until issue 14's twelfth session the nested
-        engine integrated it (80 ms for 257 mu, GGX alpha = 0.3).
+        """The lobe's albedo in closed form (:class:`~pumpup.core.hints.ClosedForm`): D(mu) 2 pi integral_0^1 D(t) t
+        dt = D(mu) pi I, D the kernels' own (:func:`_deficits`), I by :meth:`_Bound.deficit_moment` (exact on the
+        product table's polynomial pieces); the relative error I's, plus 8 ulps for D(mu) pi I itself.  Until issue 14's
+        twelfth session the nested engine integrated it (80 ms for 257 mu, GGX alpha = 0.3).
         """
         from ..core.hints import AzimuthHint, ClosedForm
 
@@ -680,10 +683,10 @@ class Scaled(_Compensated):
         return _scaled_lobe(self.base.lobe(mu), self.bound)
 
     def azimuth_hint(self):
-        """The base's hint times 1 + F0 (1 / U(N.wo) - 1) (Turquin eq. 6; :class:`~pumpup.core.hints.InverseAlbedoFactor`),
-        a function of N.wo alone, with U's kinks as its levels; None where the base has no hint, or where U is not
-        smooth between its kinks: the white model must be a Smith lobe with F = 1, the exact G1 and alpha <= 1, or
-        Schlick's, with no factors of its own.
+        """The base's hint times 1 + F0 (1 / U(N.wo) - 1) (Turquin eq. 6;
+        :class:`~pumpup.core.hints.InverseAlbedoFactor`), a function of N.wo alone, with U's kinks as its levels; None
+        where the base has no hint, or where U is not smooth between its kinks: the white model must be a Smith lobe
+        with F = 1, the exact G1 and alpha <= 1, or Schlick's, with no factors of its own.
         """
         from ..core.hints import InverseAlbedoFactor, SchlickLobe, SmithLobe
 

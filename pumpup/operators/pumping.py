@@ -353,7 +353,8 @@ class _Product:
             for fn in fns:
                 v = fn(grid)
                 for i in np.nonzero(np.sign(v[:-1]) * np.sign(v[1:]) < 0)[0]:
-                    out.append(brentq(lambda m: float(fn(np.array([m]))[0]), grid[i], grid[i + 1], xtol=1e-300, rtol=1e-15))
+                    out.append(brentq(lambda m: float(fn(np.array([m]))[0]), grid[i], grid[i + 1], xtol=1e-300,
+                                      rtol=1e-15))
         return np.array(out)
 
     def piece(self, m):
@@ -427,23 +428,23 @@ class _Lookup:
         return out.reshape(mu.shape)
 
 
-#: levels N.wo = 10^-k that a lobe about the normal adds where it carries a factor tabulated in log(N.wo) (the nested and
-#: 2-D engines): g of a pumped level (the albedo table of the level below), 1 / U(N.wo) of a scaled model and D(N.wo) of
-#: the Kulla-Conty lobe (``pumpup.compensate``).  Such a spline has features on every scale of N.wo down to its table's
-#: smallest node; about the normal a level is one value of the radial variable, and those scales all lie in the first
-#: grid's last interval, [7/8, 1] (N.wo < 0.21), whose 7- and 15-point rules agreed while both missed.  Scaled Lafortune
-#: n = 148 (cx = cy = -1, cz = 1) at rtol 1e-6 was 1.14-1.56 x its estimate at every mu from 0.01 down to 2.6e-6, the
-#: Kulla-Conty lobe of Phong n = 987 (f_avg 0.69) at rtol 1e-12 3.4 x on the 2-D engine, the fuzz's reference
-#: (scripts/studies/fuzz_engines.py --registry 47), and g2 pumped Minnaert k = 0.31 at mu = 0.88 4.1 x at every rtol from 1e-6 to
-#: 1e-12 (issue 14's twenty-fourth session).  A lobe about another axis has N.wo vary along its arcs, where the estimate
-#: held (levels there cut every arc: 1.2-2.5 x the time)
+#: levels N.wo = 10^-k that a lobe about the normal adds where it carries a factor tabulated in log(N.wo) (the nested
+#: and 2-D engines): g of a pumped level (the albedo table of the level below), 1 / U(N.wo) of a scaled model and
+#: D(N.wo) of the Kulla-Conty lobe (``pumpup.compensate``).  Such a spline has features on every scale of N.wo down to
+#: its table's smallest node; about the normal a level is one value of the radial variable, and those scales all lie in
+#: the first grid's last interval, [7/8, 1] (N.wo < 0.21), whose 7- and 15-point rules agreed while both missed.  Scaled
+#: Lafortune n = 148 (cx = cy = -1, cz = 1) at rtol 1e-6 was 1.14-1.56 x its estimate at every mu from 0.01 down to
+#: 2.6e-6, the Kulla-Conty lobe of Phong n = 987 (f_avg 0.69) at rtol 1e-12 3.4 x on the 2-D engine, the fuzz's
+#: reference (scripts/studies/fuzz_engines.py --registry 47), and g2 pumped Minnaert k = 0.31 at mu = 0.88 4.1 x at
+#: every rtol from 1e-6 to 1e-12 (issue 14's twenty-fourth session).  A lobe about another axis has N.wo vary along its
+#: arcs, where the estimate held (levels there cut every arc: 1.2-2.5 x the time)
 TABLE_DECADES = tuple(10.0 ** -k for k in range(1, 9))
 
 
 def table_decades(b: Lobe) -> set:
-    """:data:`TABLE_DECADES` for a hint ``b`` about the normal, or none: not for another axis, and not for the generic hint
-    of a model without one (about the normal, the cosine map, not symmetric: :func:`pumpup.from_function`'s), which the
-    2-D engine's generic path integrates without trusting it (there the levels cost a pumped user function 12 x the
+    """:data:`TABLE_DECADES` for a hint ``b`` about the normal, or none: not for another axis, and not for the generic
+    hint of a model without one (about the normal, the cosine map, not symmetric: :func:`pumpup.from_function`'s), which
+    the 2-D engine's generic path integrates without trusting it (there the levels cost a pumped user function 12 x the
     time, and its estimate held without them against a ring quadrature).
     """
     return set(TABLE_DECADES) if b.axis == "normal" and not b.generic else set()
@@ -483,8 +484,10 @@ class Pumped(BRDF):
 
     params = {
         "base": Param(kind="spec", doc="the BRDF to pump"),
-        "g": Param("g1", kind="str", choices=("g1", "g2"), doc="g1 = max(a(wi), a(wo)) (001 eq. 20) or g2, also max with N.wi, N.wo (001 eq. 21)"),
-        "levels": Param(1, lo=1, hi=MAX_LEVELS, kind="int", doc="nested pumpings, each dividing by g of the level below"),
+        "g": Param("g1", kind="str", choices=("g1", "g2"),
+                   doc="g1 = max(a(wi), a(wo)) (001 eq. 20) or g2, also max with N.wi, N.wo (001 eq. 21)"),
+        "levels": Param(1, lo=1, hi=MAX_LEVELS, kind="int",
+                        doc="nested pumpings, each dividing by g of the level below"),
         "force": Param(False, kind="bool", doc="pump a base that is not reciprocal"),
     }
     constant = None
@@ -832,10 +835,10 @@ class Pumped(BRDF):
                 found = diag  # u(v) = v, found once (with the threshold below at am <= 1)
             else:
                 # two roots in one cell show no sign change there: where u turns (a non-monotone base, metal's albedo
-                # with a minimum), the cells next to the turn are searched on 16 points each (:meth:`_kink_turns`), and for
-                # k = 0 the cell of mu (a root itself) is split at mu -+ 1e-6 of it: a pumped metal (eta 0.9, k 0.3, n 20)
-                # lost the kink at v = 0.9699 next to mu = 0.9659 and the 1-D path was 5.0e-9 off with an estimate of
-                # 1.0e-9.  The search is compiled (:func:`kink_roots`)
+                # with a minimum), the cells next to the turn are searched on 16 points each (:meth:`_kink_turns`), and
+                # for k = 0 the cell of mu (a root itself) is split at mu -+ 1e-6 of it: a pumped metal
+                # (eta 0.9, k 0.3, n 20) lost the kink at v = 0.9699 next to mu = 0.9659 and the 1-D path was 5.0e-9 off
+                # with an estimate of 1.0e-9.  The search is compiled (:func:`kink_roots`)
                 g, ug = (grid, au) if k == 1 else self._kink_turns()
                 found = [float(v) for v in kink_roots(g, ug, k, am if k == 0 else mu, mu, max(1.0, am), *lk.args())]
             for v in found:
@@ -860,8 +863,8 @@ class Pumped(BRDF):
             if p <= mu <= q and value < lk.cap:
                 out.append(q)
         # the table's breaks (its spline's split points: the base's albedo_breaks, Cook-Torrance's
-        # pumpup.models.cook_torrance.RETRO_BREAK, and a lower level's kinks) are kinks of u(v), so of g where u(v) is its
-        # largest term (issue 14's twenty-fifth session)
+        # pumpup.models.cook_torrance.RETRO_BREAK, and a lower level's kinks) are kinks of u(v), so of g where u(v) is
+        # its largest term (issue 14's twenty-fifth session)
         for v in lk.table.breaks:
             uv = float(up(v))
             if uv >= am * (1 - 1e-12) and (not self.controlled or uv >= max(mu, v) * (1 - 1e-12)):
@@ -873,18 +876,19 @@ class Pumped(BRDF):
         return tuple(levels)
 
     def table_kinks(self) -> tuple:
-        """Values v of N.wo where a level's bound u(v) has a near-kink: a level's table is the albedo of the level below,
-        whose g changes form at incidences that do not depend on wo (where a lower level's bound crosses the diagonal,
-        u(v) = v for g2, or reaches its cap: :meth:`_kink_fixed`), so every higher level's table inherits those kinks.
-        Its spline follows each with knots bunched towards it (the table's refinement), and rounds the kink off between
-        the nearest ones (1e-6 wide at level 1's u(v) = v, v = 0.98814, of a 2-level g2 pumped GGX, alpha 0.1,
-        height-correlated): a feature that no rule on a piece across those knots sees (at mu = 0.993068 6.4e-8 off on
-        one piece of the elevation, 9.6 x its |K - G|; with a cut at the kink but not at the knots, Beckmann alpha 0.3
-        at mu = 0.99888 was 2.1e-12 off on the piece beside it, 4.8 x the estimate).  So these are the kinks and, in
-        every table above them, a graded mesh of the knots of the bunch around each (those closer than a quarter of
-        the table's median spacing in log(v)): on each side the nearest knot, then every knot at least twice as far
-        from the kink as the last one kept, and the bunch's last (the pieces between grow geometrically away from the
-        feature, as for a singularity; every knot of the bunch cost 2 x 50 cuts and 3000 evaluations per mu).
+        """Values v of N.wo where a level's bound u(v) has a near-kink: a level's table is the albedo of the level
+        below, whose g changes form at incidences that do not depend on wo (where a lower level's bound crosses the
+        diagonal, u(v) = v for g2, or reaches its cap: :meth:`_kink_fixed`), so every higher level's table inherits
+        those kinks.  Its spline follows each with knots bunched towards it (the table's refinement), and rounds the
+        kink off between the nearest ones (1e-6 wide at level 1's u(v) = v, v = 0.98814, of a 2-level g2 pumped GGX,
+        alpha 0.1, height-correlated): a feature that no rule on a piece across those knots sees (at mu = 0.993068
+        6.4e-8 off on one piece of the elevation, 9.6 x its |K - G|; with a cut at the kink but not at the knots,
+        Beckmann alpha 0.3 at mu = 0.99888 was 2.1e-12 off on the piece beside it, 4.8 x the estimate).  So these are
+        the kinks and, in every table above them, a graded mesh of the knots of the bunch around each (those closer than
+        a quarter of the table's median spacing in log(v)): on each side the nearest knot, then every knot at least
+        twice as far from the kink as the last one kept, and the bunch's last (the pieces between grow geometrically
+        away from the feature, as for a singularity; every knot of the bunch cost 2 x 50 cuts and 3000 evaluations per
+        mu).
         """
         lk = self.lookup()  # (tied to the bounds they come from, as kink_cache)
         hit = lk.__dict__.get("table_kinks")
@@ -916,9 +920,9 @@ class Pumped(BRDF):
 
     def _polar_levels(self, mu: float) -> tuple:
         """The 1-D path's levels of g at incidence mu: the lobe's (:meth:`lobe`) and :meth:`table_kinks` (the nested
-        engine, whose estimate was calibrated without them, keeps the lobe's alone).  The lobe's levels are every level's
-        :meth:`kink_levels` and the innermost base's lobe levels, gathered here without the Lobe of every level (this
-        runs for every mu of a table, in Python: the Lobes and their sorts took ~15 % of a cached 2-level table).
+        engine, whose estimate was calibrated without them, keeps the lobe's alone).  The lobe's levels are every
+        level's :meth:`kink_levels` and the innermost base's lobe levels, gathered here without the Lobe of every level
+        (this runs for every mu of a table, in Python: the Lobes and their sorts took ~15 % of a cached 2-level table).
         """
         out = set(self.table_kinks())
         cur = self

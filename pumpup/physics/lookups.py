@@ -57,11 +57,11 @@ def upper_array(mu, logx, coef, v0, slope0, margin_lo, margin, cap, out):  # pra
 
 @njit(cache=True, nogil=True)
 def upper_root(lo, hi, kind, target, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
-    """The u in [lo, hi] where the bound U(u) (:func:`upper_scalar`) meets ``target`` (``kind`` 0 or 2) or u itself (1), given
-    a change of sign of the difference at the ends: bisection until the bracket is at most 1e-15 + 4 eps u wide (where
-    scipy's brentq at xtol 1e-15, which :meth:`Pumped._kink_levels` called from Python, stops too); its midpoint.
-    Compiled (issue 14's eighteenth session): the brentq calls took ~60 us each in cProfile, and the per-mu kink search two
-    thirds of a first 2-level pumped GGX table.
+    """The u in [lo, hi] where the bound U(u) (:func:`upper_scalar`) meets ``target`` (``kind`` 0 or 2) or u itself (1),
+    given a change of sign of the difference at the ends: bisection until the bracket is at most 1e-15 + 4 eps u wide
+    (where scipy's brentq at xtol 1e-15, which :meth:`Pumped._kink_levels` called from Python, stops too); its midpoint.
+    Compiled (issue 14's eighteenth session): the brentq calls took ~60 us each in cProfile, and the per-mu kink search
+    two thirds of a first 2-level pumped GGX table.
     """
     flo = upper_scalar(lo, logx, coef, v0, slope0, margin_lo, margin, cap) - (lo if kind == 1 else target)
     while hi - lo > 1e-15 + 8.9e-16 * hi:
@@ -77,12 +77,13 @@ def upper_root(lo, hi, kind, target, logx, coef, v0, slope0, margin_lo, margin, 
 
 
 @njit(cache=True, nogil=True)
-def kink_roots(g, ug, kind, target, mu, scale, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
-    """The roots v of U(v) = ``target`` (``kind`` 0 or 2) or U(v) = v (1) that the grid ``g`` (U's values ``ug``) brackets
-    (:meth:`Pumped._kink_levels`, its search for one k in one compiled pass): differences below 1e-13 ``scale`` count as
-    0 (the rounding of a flat spline: no root), every cell where they change sign gives its root (:func:`upper_root`);
-    for kind 0 the points mu (1 -+ 1e-6) join the grid and the cell between them, which holds the root v = mu itself, is
-    skipped.
+def kink_roots(g, ug, kind, target, mu, scale, logx, coef, v0, slope0, margin_lo, margin,  # pragma: no cover - compiled
+               cap):
+    """The roots v of U(v) = ``target`` (``kind`` 0 or 2) or U(v) = v (1) that the grid ``g`` (U's values ``ug``)
+    brackets (:meth:`Pumped._kink_levels`, its search for one k in one compiled pass): differences below 1e-13 ``scale``
+    count as 0 (the rounding of a flat spline: no root), every cell where they change sign gives its root
+    (:func:`upper_root`); for kind 0 the points mu (1 -+ 1e-6) join the grid and the cell between them, which holds the
+    root v = mu itself, is skipped.
     """
     n = g.shape[0]
     extra = np.empty(2)
@@ -232,7 +233,8 @@ def horner(coef, t):
 
 
 @njit(cache=True, nogil=True)
-def scale_bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover
+def scale_bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin,  # pragma: no cover
+                cap):
     """U(m) >= E(m): above ``pmlo`` the polynomial piece of the product table found from the bits
     of m (pump._Product, scaled up by its 1 + epsilon); below it the table's spline look-up.  The
     kernels below write it out (a call per look-up cost 20 x the look-up; with numba's
@@ -252,7 +254,7 @@ def scale_bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, mar
 #: every level's upper bound (:func:`g_levels`' arguments) and the product table of all levels (:func:`g_product`'s,
 #: with the N.wo above which it applies, ``product_mlo``; inf when there is none)
 GChain = namedtuple("GChain", [
-    "offsets", "logx", "coef", "v0", "slope0", "margin_lo", "cap", "controlled", "increasing", "mu0", "index", "index_lo",
-    "index_h_inv", "product_mlo", "product_cbase", "product_cstart", "product_lo", "product_rows",
+    "offsets", "logx", "coef", "v0", "slope0", "margin_lo", "cap", "controlled", "increasing", "mu0", "index",
+    "index_lo", "index_h_inv", "product_mlo", "product_cbase", "product_cstart", "product_lo", "product_rows",
 ])
 

@@ -256,7 +256,8 @@ class Spectral:
         ds["wavelength"].attrs["units"] = "nm"
         ds["theta"].attrs["units"] = "degree"
         ds.attrs["spec"] = json.dumps(self.spec, sort_keys=True)
-        ds.attrs["title"] = f"Spectral directional albedo of {self.innermost().kind} ({self.material or 'explicit index'})"
+        ds.attrs["title"] = (f"Spectral directional albedo of {self.innermost().kind} "
+                             f"({self.material or 'explicit index'})")
         if getattr(self, "material", None) is not None:
             for key, val in optical.metadata(self.material).items():
                 ds.attrs[f"optical_{key}"] = val
@@ -320,7 +321,8 @@ class SpectralMetal(Spectral):
             raise SpecError("spectral metal: parameter 'n' (the exponent, >= 0) is required")
         if isinstance(wavelengths, str):
             if wavelengths != "rgb":
-                raise SpecError(f"spectral metal: parameter 'wavelengths' must be a list of nm or 'rgb', got {wavelengths!r}")
+                raise SpecError("spectral metal: parameter 'wavelengths' must be a list of nm or 'rgb', got "
+                                f"{wavelengths!r}")
             wavelengths = RGB_WAVELENGTHS
         if material is not None:
             if eta is not None or k is not None:
@@ -410,7 +412,8 @@ class SpectralMetal(Spectral):
     def eval_tabulated(self, wi, wo) -> np.ndarray:
         """:meth:`eval` with F(Theta_min) read from :meth:`fresnel_table` (000 eq. 28's fast path).
 
-        Differs from :meth:`eval` by at most f_r(F = 1) times ``fresnel_table()[1]`` (measured when the table is built; from 9e-9 for Au to 4e-8, the largest over the nine metals at the default wavelengths).
+        Differs from :meth:`eval` by at most f_r(F = 1) times ``fresnel_table()[1]`` (measured when the table is built;
+        from 9e-9 for Au to 4e-8, the largest over the nine metals at the default wavelengths).
         """
         from .kernels import flat_pairs
 
@@ -526,7 +529,8 @@ def to_xyz(values, wavelengths) -> np.ndarray:
     w = optical.check_wavelengths(wavelengths)
     v = np.asarray(values, dtype=np.float64)
     if v.shape[-1:] != w.shape:
-        raise SpecError(f"to_xyz: 'values' must have a last axis of length {w.size} (the wavelengths), got shape {v.shape}")
+        raise SpecError(f"to_xyz: 'values' must have a last axis of length {w.size} (the wavelengths), got shape "
+                        f"{v.shape}")
     flat = v.reshape(-1, w.size)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # colour's notes on interpolating / extrapolating the samples

@@ -142,7 +142,8 @@ def save_spectral_pumped(f: Spectral, path) -> str:
     from ..tables import write_groups
 
     if not isinstance(f, SpectralPumped):
-        raise TypeError(f"save_pumped needs a pumped BRDF (pumpup.pump); got {f!r}, a spectral model that is not pumped")
+        raise TypeError(f"save_pumped needs a pumped BRDF (pumpup.pump); got {f!r}, "
+                        "a spectral model that is not pumped")
     chains = [m.chain() for m in f.models]
     levels = len(chains[0])
     data = {name: ("wavelength", v) for name, v in f.wavelength_variables().items()}

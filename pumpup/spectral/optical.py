@@ -108,7 +108,8 @@ def check_wavelengths(wavelengths: Any, name: str = "wavelengths") -> np.ndarray
     except (TypeError, ValueError):
         raise SpecError(f"parameter {name!r} must be a list of wavelengths in nm (> 0), got {wavelengths!r}") from None
     if w.ndim != 1 or w.size == 0 or not np.all(np.isfinite(w)) or np.any(w <= 0):
-        raise SpecError(f"parameter {name!r} must be a non-empty list of finite wavelengths in nm (> 0), got {wavelengths!r}")
+        raise SpecError(f"parameter {name!r} must be a non-empty list of finite wavelengths in nm (> 0), got "
+                        f"{wavelengths!r}")
     return w
 
 

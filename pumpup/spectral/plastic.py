@@ -78,14 +78,16 @@ class SpectralPlastic(Spectral):
             raise SpecError("spectral plastic: parameter 'n' (the exponent, >= 0) is required")
         if isinstance(wavelengths, str):
             if wavelengths != "rgb":
-                raise SpecError(f"spectral plastic: parameter 'wavelengths' must be a list of nm or 'rgb', got {wavelengths!r}")
+                raise SpecError("spectral plastic: parameter 'wavelengths' must be a list of nm or 'rgb', got "
+                                f"{wavelengths!r}")
             wavelengths = RGB_WAVELENGTHS
         if material is not None:
             if eta is not None:
                 raise SpecError("spectral plastic: give either 'material' or 'eta', not both")
             if isinstance(material, str) and material in optical.MATERIALS:
-                raise SpecError(f"spectral plastic: parameter 'material' = {material!r} is a metal; a plastic (000 eq. 29) "
-                                f"has a dielectric's real index, one of {', '.join(optical.DIELECTRICS)} (or give 'eta')")
+                raise SpecError(f"spectral plastic: parameter 'material' = {material!r} is a metal; "
+                                "a plastic (000 eq. 29) has a dielectric's real index, "
+                                f"one of {', '.join(optical.DIELECTRICS)} (or give 'eta')")
             w = optical.check_wavelengths(optical.DEFAULT_WAVELENGTHS if wavelengths is None else wavelengths)
             etas = [float(e) for e in optical.dielectric_index(material, w)[0]]
         else:

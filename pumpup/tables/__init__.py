@@ -108,8 +108,8 @@ class AlbedoTable:
         if len(mu) < 2:
             raise ValueError("an albedo table needs at least two values of mu")
         if not (len(value) == len(mu) == len(error)):
-            raise ValueError(f"an albedo table needs one value and one error per mu: {len(mu)} mu, {len(value)} values, "
-                             f"{len(error)} errors")
+            raise ValueError(f"an albedo table needs one value and one error per mu: {len(mu)} mu, {len(value)} "
+                             f"values, {len(error)} errors")
         if not np.all((mu > 0) & (mu <= 1)):
             raise ValueError(f"an albedo table's mu must lie in (0, 1], got {mu[~((mu > 0) & (mu <= 1))][:3].tolist()}")
         if not (np.all(np.isfinite(value)) and np.all(np.isfinite(error)) and np.all(error >= 0)):
@@ -268,8 +268,8 @@ def _splittable(mu: np.ndarray) -> np.ndarray:
     return (lm > lx[:-1]) & (lm < lx[1:])
 
 
-#: the models whose BRDF reads pumpup's own albedo tables (pumping's g, compensation's E): :func:`adaptive_grid` also checks
-#: their tables off the dyadic points (:func:`built_on_tables`)
+#: the models whose BRDF reads pumpup's own albedo tables (pumping's g, compensation's E): :func:`adaptive_grid` also
+#: checks their tables off the dyadic points (:func:`built_on_tables`)
 TABLE_MODELS = ("pumped", "kulla_conty", "scaled")
 
 
@@ -287,8 +287,8 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
     ``val``, ``err`` at the nodes ``grid``: (grid, val, err, interp), ``interp`` the interpolation error per column.
 
     ``val``, ``err`` are (n,) or (n, columns) (a table over (mu, phi), or (mu, wavelength)); ``values(mu)`` gives them
-    at new mu.  Every interval where the interpolant (:class:`AlbedoTable`, split at ``breaks``) of any column misses the
-    value at the midpoint in log(mu) by more than ``interp_tol`` is bisected, until none does or the grid has
+    at new mu.  Every interval where the interpolant (:class:`AlbedoTable`, split at ``breaks``) of any column misses
+    the value at the midpoint in log(mu) by more than ``interp_tol`` is bisected, until none does or the grid has
     ``max_points`` nodes; ``interp`` is each column's largest miss over the accepted intervals (all the last misses when
     ``max_points`` stopped it), and over the checks of the last interval at 1 - mu = (1 - a) 2^-k (:func:`_near_one`).
     ``off_grid``: also over checks of every interval at its thirds in log(mu) (:func:`built_on_tables`).
@@ -337,20 +337,20 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
             mids = _midpoints(grid)[todo]
             miss = misses(grid, V, E, mids, column_values(mids)[0])
         interp = np.maximum(interp, miss.max(axis=0))
-    # the interval that ends at mu = 1: its midpoint in log(mu) lies at theta / sqrt(2) of its lower end's theta, so 70 %
-    # of it in theta had no check.  A sharp lobe's pumped level turns there (the lobe reaches the normal below theta ~
-    # its width: pumped plastic n = 5284 was 3.1e-7 off at mu = 0.99995 with a margin of 2.0e-7, found by
-    # scripts/studies/fuzz_engines.py --tables 43), and so does a g2 level whose bound crosses the diagonal within it (a kink
-    # the table's one spline goes across: Pumped.albedo_kinks).  It is checked at 1 - mu = (1 - a) 2^-k too, down to
-    # NEAR_ONE_MIN, and the largest miss there counts (issue 14's twenty-third session)
+    # the interval that ends at mu = 1: its midpoint in log(mu) lies at theta / sqrt(2) of its lower end's theta, so
+    # 70 % of it in theta had no check.  A sharp lobe's pumped level turns there (the lobe reaches the normal below
+    # theta ~ its width: pumped plastic n = 5284 was 3.1e-7 off at mu = 0.99995 with a margin of 2.0e-7, found by
+    # scripts/studies/fuzz_engines.py --tables 43), and so does a g2 level whose bound crosses the diagonal within it (a
+    # kink the table's one spline goes across: Pumped.albedo_kinks).  It is checked at 1 - mu = (1 - a) 2^-k too, down
+    # to NEAR_ONE_MIN, and the largest miss there counts (issue 14's twenty-third session)
     pts = _near_one(grid[-2])
     if off_grid:
         # a model that reads pumpup's own tables (a pumped level's g, a compensation's E) inherits their interpolation
         # error between their nodes, and those nodes are this grid's and its midpoints: a check there is blind to it.
         # Kulla-Conty over Torrance-Sparrow D1 (s 844, ior 1.53) was exact at its nodes and midpoints and 6.0e-8 off at
-        # mu = 0.039 with a margin of 5.9e-9 (scripts/studies/fuzz_engines.py --tables 44; issue 14's twenty-third session).  The
-        # thirds of each interval in log(mu) are no nodes of a dyadic refinement; one third alone left it 1.24 x its
-        # margin (the interval held two of E's pieces), both 0.58 x
+        # mu = 0.039 with a margin of 5.9e-9 (scripts/studies/fuzz_engines.py --tables 44; issue 14's twenty-third
+        # session).  The thirds of each interval in log(mu) are no nodes of a dyadic refinement; one third alone left it
+        # 1.24 x its margin (the interval held two of E's pieces), both 0.58 x
         lx = np.log(grid)
         thirds = np.concatenate([np.exp((2.0 * lx[:-1] + lx[1:]) / 3.0), np.exp((lx[:-1] + 2.0 * lx[1:]) / 3.0)])
         inside = (np.log(thirds) > np.tile(lx[:-1], 2)) & (np.log(thirds) < np.tile(lx[1:], 2))
@@ -582,7 +582,8 @@ def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind, phis=None,
     if breaks is not None and len(breaks):
         # (one break as a number: netCDF reads a one-element array attribute back as a number, and the file's digest
         # must see what is read back)
-        ds.attrs["interpolation_breaks"] = float(breaks[0]) if len(breaks) == 1 else np.asarray(breaks, dtype=np.float64)
+        ds.attrs["interpolation_breaks"] = (float(breaks[0]) if len(breaks) == 1
+                                            else np.asarray(breaks, dtype=np.float64))
         ds.attrs["interpolation"] += "; split at interpolation_breaks, the kinks of the albedo"
     if phi_kind is not None:  # an anisotropic model: say which azimuth of wi the values hold
         from .azimuth import describe_phi

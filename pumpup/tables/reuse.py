@@ -68,8 +68,8 @@ def _spline_weights(theta: np.ndarray, k: int, hi: float) -> np.ndarray:
     return w
 
 
-#: the rules' weights by grid (one grid serves every cell of a sweep), at most _WEIGHTS_KEPT of them (a grid of 257 nodes
-#: has three vectors and, once a table is cut short, three 256 x 257 matrices of interval weights)
+#: the rules' weights by grid (one grid serves every cell of a sweep), at most _WEIGHTS_KEPT of them (a grid of 257
+#: nodes has three vectors and, once a table is cut short, three 256 x 257 matrices of interval weights)
 _WEIGHTS: dict = {}
 _WEIGHTS_KEPT = 48
 
@@ -157,7 +157,8 @@ def mean_from_table(brdf, rtol: float, fresh_part):
     mu, a, e, _ = t
     # nodes a few doubles apart in mu can share theta = arccos(mu) (an adaptive grid that bisected towards a jump of the
     # albedo down to the last bit: Beckmann alpha 0.0052 with Walter's G1, whose switch level is a jump, put 70 nodes at
-    # mu = 0.00829462; the splines refused duplicate nodes, found by scripts/studies/fuzz_engines.py --mean): the last of each
+    # mu = 0.00829462; the splines refused duplicate nodes, found by scripts/studies/fuzz_engines.py --mean): the last
+    # of each
     theta = np.arctan2(np.sqrt((1.0 - mu) * (1.0 + mu)), mu)
     keep = np.r_[theta[:-1] != theta[1:], True]
     mu, a, e = mu[keep], a[keep], e[keep]

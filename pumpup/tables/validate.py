@@ -121,7 +121,8 @@ def spec_attribute(path: str, ds, name: str = "spec") -> dict:
     except json.JSONDecodeError as exc:
         raise TableError(f"{path!r}: attribute {name!r} is not valid JSON: {exc}") from None
     if not isinstance(spec, dict) or not isinstance(spec.get("type"), str):
-        raise TableError(f"{path!r}: attribute {name!r} is not a model spec (a JSON object with a 'type'): {text[:80]!r}")
+        raise TableError(f"{path!r}: attribute {name!r} is not a model spec (a JSON object with a 'type'): "
+                         f"{text[:80]!r}")
     if not _mentions_function(spec):
         try:
             load(spec)
@@ -152,7 +153,8 @@ def _finite_nonnegative(path: str, ds, name: str) -> None:
 def _check_mu(path: str, ds, increasing: bool) -> None:
     mu = np.asarray(ds["mu"].values)
     if mu.ndim != 1 or mu.dtype.kind not in "fiu":
-        raise TableError(f"{path!r}: coordinate 'mu' must be a 1-D numeric array, got shape {mu.shape}, dtype {mu.dtype}")
+        raise TableError(f"{path!r}: coordinate 'mu' must be a 1-D numeric array, got shape {mu.shape}, dtype "
+                         f"{mu.dtype}")
     bad = ~np.isfinite(mu) | (mu <= 0) | (mu > 1)
     if np.any(bad):
         i = int(np.argmax(bad))
