@@ -161,6 +161,9 @@ def default_text(param) -> str:
 
 
 def cmd_models(args) -> int:
+    """``pumpup models``: every registered type with its summary and its parameters' ranges, defaults and meanings;
+    status 0.
+    """
     import pumpup
 
     rows = []
@@ -180,6 +183,9 @@ def cmd_models(args) -> int:
 
 
 def cmd_albedo(args) -> int:
+    """``pumpup albedo SPEC``: the albedo and its error estimate at each mu (``--mu``, ``--theta`` or a default set),
+    per wavelength for a spectral model and per azimuth with ``--phi``; status 0.
+    """
     import numpy as np
 
     import pumpup
@@ -254,6 +260,9 @@ def _albedo_phi(f, mu, args) -> int:
 
 
 def cmd_table(args) -> int:
+    """``pumpup table SPEC --out FILE``: the albedo tabulated on an adaptive grid (over wavelengths for a spectral
+    model, over ``--phi`` for an anisotropic one) and written as netCDF; status 0.
+    """
     import numpy as np
 
     import pumpup
@@ -287,6 +296,9 @@ def cmd_table(args) -> int:
 
 
 def cmd_check(args) -> int:
+    """``pumpup check SPEC``: the reciprocity check, a compensated model's report, and the maximum albedo with the
+    maximum constant; status 0 if reciprocal, else 1.
+    """
     import pumpup
 
     f = _load(args.spec)
@@ -301,6 +313,9 @@ def cmd_check(args) -> int:
 
 
 def cmd_pump(args) -> int:
+    """``pumpup pump SPEC``: the model pumped up ``--levels`` times with ``--g``, the albedo of every level at each mu
+    (per wavelength for a spectral model), and the pumped BRDF saved with ``--out``; status 0.
+    """
     import numpy as np
 
     import pumpup
@@ -344,6 +359,7 @@ def cmd_pump(args) -> int:
 
 
 def cmd_figures(args) -> int:
+    """``pumpup figures``: the pumping figures' data into ``--tables`` and their plots into ``--figures``; status 0."""
     from .figures import make_figures
 
     check_out(args.tables.rstrip("/") + "/x", "--tables")
@@ -354,6 +370,9 @@ def cmd_figures(args) -> int:
 
 
 def cmd_reproduce(args) -> int:
+    """``pumpup reproduce``: the papers' tables regenerated into ``--out`` and compared with the published values;
+    prints the report; status 0.
+    """
     from .reproduce import reproduce
 
     try:  # reproduce checks (and creates) its output directory before any work
@@ -371,6 +390,9 @@ def cmd_reproduce(args) -> int:
 
 
 def cmd_divergence(args) -> int:
+    """``pumpup divergence SPEC``: the albedo down to ``--mu-min`` and the fit a ~ K mu^-k (001 sec. 2.1); SPEC ``all``
+    writes the whole analysis (netCDF and plot); status 0.
+    """
     from pumpup.core import check_open_unit
 
     from .divergence import analysis_dataset, divergence, plot
@@ -430,6 +452,9 @@ def parse_values(text: str) -> tuple[str, list]:
 
 
 def cmd_sweep(args) -> int:
+    """``pumpup sweep SPEC --param ...``: albedo tables over a grid of parameters (pumped with ``--pump``), computed in
+    chunks on dask and written to ``--out``; status 0.
+    """
     import time
 
     import pumpup
@@ -472,6 +497,10 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_mc(args) -> int:
+    """``pumpup mc SPEC``: the Monte Carlo albedo by importance sampling beside the quadrature at each mu, and with
+    ``--chi2`` a chi-square test of the sampler against its density; status 1 if an estimate is 4 standard errors or
+    more off, or the test fails, else 0.
+    """
     import numpy as np
 
     import pumpup
@@ -507,6 +536,9 @@ def cmd_mc(args) -> int:
 
 
 def cmd_compensate(args) -> int:
+    """``pumpup compensate SPEC``: the model energy-compensated by ``--method``, its furnace toward wo = mu beside the
+    base's albedo, and the compensated BRDF saved with ``--out``; user errors exit with status 2.
+    """
     import numpy as np
 
     import pumpup
@@ -557,6 +589,9 @@ def cmd_compensate(args) -> int:
 
 
 def cmd_fit(args) -> int:
+    """``pumpup fit TARGET``: the fit of a model family to a target (:func:`_fit`); user errors are one line on stderr,
+    status 2.
+    """
     try:
         return _fit(args)
     except SystemExit as exc:  # user errors: one line on stderr, status 2
@@ -692,6 +727,10 @@ def _lut_fail(msg: str) -> int:
 
 
 def cmd_lut(args) -> int:
+    """``pumpup lut``: a renderer's albedo look-up table of ``--preset``, computed and written to ``--out``, with its
+    quadrature, storage and look-up errors; status 1 if the look-up error exceeds ``--max-lookup-error``, 2 for a bad
+    argument, else 0.
+    """
     import pumpup
     from pumpup import luts
 
@@ -729,6 +768,9 @@ def cmd_lut(args) -> int:
 
 
 def cmd_audit(args) -> int:
+    """``pumpup audit FILE --preset NAME``: a shipped albedo table graded against pumpup's values
+    (:func:`pumpup.audit`); status 1 beyond ``--tol`` or ``--max-lookup-error``, 2 for a bad argument, else 0.
+    """
     import pumpup
     from pumpup import luts
 
@@ -822,6 +864,7 @@ def cmd_render_scene(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``pumpup`` command, one subcommand per ``cmd_*`` function (its ``func`` default)."""
     p = _Parser(
         prog="pumpup",
         description="Physically plausible BRDFs: accurate albedo, the albedo pumping-up operator, "
@@ -1019,6 +1062,9 @@ QUIET_COMMANDS = ("models", "warmup")
 
 
 def cmd_warmup(args) -> int:
+    """``pumpup warmup``: compile pumpup's kernels into numba's cache (progress on stderr unless
+    ``--quiet``); status 0.
+    """
     from .warmup import warmup
 
     seconds = warmup(progress=None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True)))

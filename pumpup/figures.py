@@ -137,6 +137,9 @@ def eq22_convergence(levels: int = 5):
 
 
 def plot_all(ds, st, outdir):
+    """Plot the pumping figures of ``ds`` (per model and g: albedo, radiance in the mirror direction and across the
+    plane of incidence, level by level) and 000 Fig. 3 of ``st`` into ``outdir``; returns the paths of the PNG files.
+    """
     import matplotlib
 
     matplotlib.use("Agg")

@@ -165,6 +165,11 @@ class FitData:
 
     @classmethod
     def build(cls, target: BRDF, pairs, mu, lobe_fraction, rtol):
+        """The data of a fit: the target's f_t cos(theta_L) on the direction pairs ``pairs`` (001 eq. 3), its lobe
+        region (values at least ``lobe_fraction`` of each view's peak, or all positive ones) and its albedo at ``mu`` to
+        ``rtol``; a FitError where the target cannot be fitted (not single-channel, not finite, zero on every pair, an
+        albedo <= 0).
+        """
         from .engine.cubature import albedo
 
         wi, wo, view, weight = pairs
@@ -434,6 +439,7 @@ class FitResult:
 
     @property
     def mu_min(self) -> float:
+        """The smallest mu at which the final albedo error was measured."""
         return float(np.min(self.mu))
 
     def __repr__(self) -> str:

@@ -91,10 +91,16 @@ class Preset:
 
     @property
     def mu_lookup(self) -> str:
+        """How the renderer reads the mu axis: ``texel`` for a texel-centred axis (Filament's too), else the axis kind
+        itself.
+        """
         return "texel" if self.mu_axis in ("texel", "filament") else self.mu_axis
 
     @property
     def rough_lookup(self) -> str:
+        """How the renderer reads the roughness axis: ``texel`` for a texel-centred axis (Filament's too), else the axis
+        kind itself.
+        """
         return "texel" if self.rough_axis in ("texel", "filament") else self.rough_axis
 
 
@@ -871,6 +877,9 @@ class AuditResult:
         return bool(good)
 
     def report(self) -> str:
+        """The audit for people, a few lines: the worst errors at the nodes, the truth's quadrature error and the
+        format's rounding, E > 1 and monotonicity violations, and the look-up and E_avg checks where they ran.
+        """
         lines = [f"audit of a {self.preset} table ({self.n_nodes} nodes) against pumpup's {json.dumps(self.spec)}",
                  f"  nodes: max |table - E| = {self.max_abs:.3g} at mu = {self.where_abs[0]:.6g}, rough = "
                  f"{self.where_abs[1]:.6g}; max relative {self.max_rel:.3g} at mu = {self.where_rel[0]:.6g}, rough = "

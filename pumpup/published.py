@@ -28,6 +28,7 @@ class Published:
 
     @property
     def value(self) -> float:
+        """The printed number as a float (a fraction such as "2/3" divided out)."""
         if "/" in self.text:
             num, den = self.text.split("/")
             return float(num) / float(den)

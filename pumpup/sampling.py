@@ -291,6 +291,7 @@ class Strategy:
 
     @property
     def names(self) -> list[str]:
+        """The components' names with their parameters, e.g. ``phong lobe (mirror)(20)``, and ``cosine``."""
         return [f"{KIND_NAMES[k]}({s:g})" if k != COSINE else "cosine" for _, k, s in self.components]
 
     def __str__(self) -> str:

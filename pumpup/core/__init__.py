@@ -98,6 +98,9 @@ class Param:
     doc: str = ""
 
     def range_text(self) -> str:
+        """The allowed range as text: ``[lo, hi]`` with an open or infinite end in parentheses, or ``one of ...`` for
+        choices.
+        """
         if self.choices:
             return "one of " + ", ".join(repr(c) for c in self.choices)
         left = "(" if self.lo_open else "["
@@ -111,6 +114,9 @@ class Param:
         return f"{left}{lo}, {hi}{right}"
 
     def check_number(self, model: str, name: str, value: Any) -> float:
+        """``value`` as a float inside the range; otherwise a SpecError naming ``model`` and ``name`` (not a number,
+        beyond the float range, not finite, or out of range).
+        """
         if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
             raise SpecError(f"{model}: parameter {name!r} must be a number in {self.range_text()}, got {value!r}")
         try:
@@ -127,6 +133,9 @@ class Param:
         return v
 
     def check(self, model: str, name: str, value: Any) -> Any:
+        """``value`` checked and converted for the parameter's ``kind`` (float, int, bool, str, floats, or spec, which
+        is loaded); otherwise a SpecError naming ``model`` and ``name``.
+        """
         if self.kind == "float":
             return self.check_number(model, name, value)
         if self.kind == "int":

@@ -55,6 +55,10 @@ def power_split(k: float) -> tuple[float, float]:
 
 
 def radial_map(kind: str, k: float, x: np.ndarray, xc: np.ndarray):
+    """(cos(alpha), sin(alpha), jac) of the radial map ``kind`` of sharpness ``k`` (:class:`pumpup.core.Lobe`) at ``x``,
+    given ``xc`` = 1 - x for precision near x = 1: the polar angle about the lobe's axis, and jac = sin(alpha) d alpha /
+    dx, so that d omega = jac dx d beta.
+    """
     if kind == "cosine":  # sin^2 alpha = x
         ca = np.sqrt(xc)
         sa = np.sqrt(x)
@@ -137,6 +141,7 @@ def kink_coefficients(lobe: Lobe, mu: np.ndarray, x: np.ndarray, xc: np.ndarray)
 
 @njit(cache=True, nogil=True)
 def radial_map_scalar(kind, k, x, xc):  # pragma: no cover - compiled; see radial_map
+    """Compiled scalar twin of :func:`radial_map`, the map given by its code ``kind`` (:data:`RADIAL_CODE`)."""
     if kind == 0:
         ca = math.sqrt(xc)
         return ca, math.sqrt(x), (0.5 / ca if ca > 0 else math.inf)

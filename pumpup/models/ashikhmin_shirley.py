@@ -264,6 +264,7 @@ class AshikhminShirley(BRDF):
         return w / (1.0 + w)
 
     def albedo_terms(self):
+        """The specular term alone, plus the diffuse term rd (1 - rs) apart where it does not vanish."""
         w = self.p["rd"] * (1.0 - self.p["rs"])
         if w == 0.0:  # (rd = 0, or rs = 1 where the diffuse term vanishes)
             return [(1.0, self)]
@@ -289,6 +290,9 @@ class AshikhminShirley(BRDF):
                            scale=lambda mu: np.full(np.shape(mu), norm))
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe about the half vector with the smaller exponent min(nu, nv), a kink at N.wo = mu,
+        and the y axis cut when anisotropic.
+        """
         # (N.h)^e(phi_h), e = nu cos^2 phi_h + nv sin^2 phi_h, in x = (N.h)^(n+1) ("power" about h) behaves as
         # x^((e + 1) / (n + 1) - 1): bounded in every azimuth for n = min(nu, nv) (e >= n), while the larger
         # exponent would make it singular at x = 0 across the wide axis (as WardAniso.lobe explains for its
@@ -301,6 +305,7 @@ class AshikhminShirley(BRDF):
                     kinks=None if nu == nv else _y_axis)
 
     def azimuth_range(self):
+        """None when isotropic (nu = nv), else pi / 2 (the albedo is even in x and in y)."""
         # f is even in the x and y components of k1 + k2 and k1 - k2: a(phi) = a(-phi) = a(pi - phi)
         return None if self.p["nu"] == self.p["nv"] else math.pi / 2
 

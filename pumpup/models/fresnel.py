@@ -74,6 +74,7 @@ class FresnelWeighted(BRDF):
 
     @property
     def base(self) -> BRDF:
+        """The BRDF that F(Theta_min) multiplies."""
         return self.p["base"]
 
     def _eval(self, wi, wo):
@@ -82,6 +83,7 @@ class FresnelWeighted(BRDF):
         return np.where(f != 0.0, f * _fresnel_ufunc(mx, self.p["eta"], self.p["k"]), 0.0)  # 000 eq. 28
 
     def reference(self, wi, wo):
+        """The plain numpy f_r: the base's reference times F(max(N.wi, N.wo)) in complex arithmetic (000 eq. 28)."""
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
         f = np.asarray(self.base.reference(wi, wo), dtype=np.float64)
@@ -89,6 +91,7 @@ class FresnelWeighted(BRDF):
         return np.where(f != 0.0, f * fresnel(mx, self.p["eta"], self.p["k"]), 0.0)  # 000 eq. 28, complex form
 
     def lobe(self, mu):
+        """The base's Lobe hint with the levels N.wo = mu and F's own kink added."""
         # F(max(N.wi, N.wo)) adds a kink at N.wo = mu, and one where F has its own
         return self.base.lobe(mu).with_levels((float(mu),), fresnel_levels(self.p["eta"], self.p["k"]))
 
@@ -106,12 +109,15 @@ class FresnelWeighted(BRDF):
         return [(w, _FresnelTerm(t, self.p["eta"], self.p["k"])) for w, t in terms]
 
     def albedo_breaks(self):
+        """F's kink and the base's breaks, sorted."""
         return tuple(sorted({*fresnel_levels(self.p["eta"], self.p["k"]), *self.base.albedo_breaks()}))
 
     def sampling_lobe(self, mu):
+        """The base's sampling hint (F only rescales the base)."""
         return self.base.sampling_lobe(mu)  # F only rescales the base
 
     def azimuth_range(self):
+        """The base's (F depends on N.wi and N.wo only)."""
         return self.base.azimuth_range()  # F depends on N.wi and N.wo only
 
     def azimuth_hint(self):

@@ -398,6 +398,9 @@ class HeTorrance(BRDF):
             )
 
     def kernel_args(self):
+        """(sigma_0, tau, wavelength, n, k, diffuse, series tolerance) for the compiled kernel, n 0 without a Fresnel
+        factor.
+        """
         p = self.p
         n = 0.0 if p["n"] is None else p["n"]
         return (p["sigma_0"], p["tau"], p["wavelength"], n, p["k"], p["diffuse"], SERIES_RTOL)
@@ -430,6 +433,9 @@ class HeTorrance(BRDF):
 
     # --- hints ---------------------------------------------------------------------------
     def lobe(self, mu):
+        """The Lobe hint: a GGX map about the half vector with the width of the dominant Gaussian, and the kinks of
+        |F|^2 at wi.h.
+        """
         # the Gaussian in v_xy with the dominant m ~ max(1, g) at the mirror direction is
         # exp(-tan^2(theta_h) / m_eff^2), m_eff = sqrt(max(1, g)) / (k tau mu) (module doc)
         p = self.p
@@ -449,10 +455,12 @@ class HeTorrance(BRDF):
         return Lobe(axis="half", radial="ggx", sharpness=m_eff * m_eff, kinks=wih_kinks(self, p["n"], p["k"]))
 
     def albedo_breaks(self):
+        """The kink of the delta lobe's F(mu) where the index is given, else none."""
         from .metal import fresnel_levels
 
         # (the delta's F(mu) turns there)
         return () if self.p["n"] is None else fresnel_levels(self.p["n"], self.p["k"])
 
     def sampling_lobe(self, mu):
+        """The sampling hint: the cosine-weighted hemisphere (the delta lobe is not sampled)."""
         return Lobe(axis="normal", radial="cosine")  # cosine fallback (the delta is not sampled)

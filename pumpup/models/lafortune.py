@@ -156,6 +156,9 @@ class Lafortune(BRDF):
         _check_peak(self.type, q["n"], q["cx"], q["cy"], q["cz"], q["c"])
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe about the mirror direction where cx = cy = cz > 0, else the cosine map about the
+        normal.
+        """
         q = self.p
         return _isotropic_lobe(q["n"], q["cx"], q["cy"], q["cz"], q["p"], mu)
 
@@ -202,6 +205,7 @@ class Lafortune(BRDF):
         return float(q["n"]), nu, scale
 
     def azimuth_range(self):
+        """None when cx = cy, else pi / 2 (the albedo is even in x and in y)."""
         # (R.V)_M is unchanged by x -> -x and by y -> -y of both L and V: a(phi) = a(-phi) = a(pi - phi)
         return None if self.p["cx"] == self.p["cy"] else np.pi / 2
 
@@ -295,6 +299,7 @@ class LafortuneSum(BRDF):
             _check_peak(self.type, n, cx, cy, cz, c, where=f" of lobe {i}")
 
     def kernel_args(self) -> tuple:
+        """The parameter lists as float64 arrays, one entry per lobe, for the compiled kernel."""
         return tuple(np.asarray(self.p[k], dtype=np.float64) for k in self.params)
 
     def _eval(self, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
@@ -306,6 +311,7 @@ class LafortuneSum(BRDF):
         return out.reshape(shape)
 
     def reference(self, wi, wo) -> np.ndarray:
+        """The plain numpy f_r: the sum of the lobes."""
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
         return _sum_reference(wi, wo, *(self.p[k] for k in self.params))
@@ -316,12 +322,17 @@ class LafortuneSum(BRDF):
         return [Lafortune(**dict(zip(keys, vals))) for vals in zip(*(self.p[k] for k in keys))]
 
     def albedo_terms(self):
+        """The lobes as terms of weight 1 (:meth:`lobes`)."""
         return [(1.0, lobe) for lobe in self.lobes()]
 
     def azimuth_range(self):
+        """None when every lobe has cx = cy, else pi / 2."""
         return None if all(x == y for x, y in zip(self.p["cx"], self.p["cy"])) else np.pi / 2
 
     def lobe(self, mu):
+        """The single lobe's hint for one lobe, else the cosine map about the normal (with the kink at N.wo = mu where a
+        p > 0).
+        """
         q = self.p
         if len(q["n"]) == 1:
             return _isotropic_lobe(q["n"][0], q["cx"][0], q["cy"][0], q["cz"][0], q["p"][0], mu)

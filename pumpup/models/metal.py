@@ -109,13 +109,18 @@ class Metal(BRDF):
     reference_fn = staticmethod(_metal_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the mirror direction, with the levels N.wo = mu
+        and F's kink.
+        """
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"],
                     levels=tuple(sorted({float(mu), *fresnel_levels(self.p["eta"], self.p["k"])})))
 
     def albedo_breaks(self):
+        """F's kink or near-kink, where F(max(mu, N.wo)) turns (:func:`fresnel_levels`)."""
         return fresnel_levels(self.p["eta"], self.p["k"])  # F(max(mu, N.wo)) turns at mu = x0 too
 
     def azimuth_hint(self):
+        """The azimuth hint: a power lobe with p = 1 times the factor F(max(N.wi, N.wo)) (000 eq. 28)."""
         return _fresnel_hint(self.p["n"], self.p["c"], self.p["eta"], self.p["k"])
 
 
@@ -252,28 +257,38 @@ class Plastic(BRDF):
             )
 
     def kernel_args(self) -> tuple:
+        """(n, ad, a_s, eta) for the compiled kernel, eta 0 without a Fresnel factor."""
         q = self.p
         return (q["n"], q["ad"], q["a_s"], 0.0 if q["eta"] is None else q["eta"])
 
     def reference(self, wi, wo) -> np.ndarray:
+        """The plain numpy f_r of 000 eq. 29-30."""
         q = self.p
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
         return _plastic_reference(wi, wo, q["n"], q["ad"], q["a_s"], q["eta"])
 
     def albedo_terms(self):
+        """The specular lobe alone, plus the diffuse base ad times a white Lambertian where ad > 0."""
         if self.p["ad"] == 0:
             return [(1.0, self)]
         return [(1.0, self.with_params(ad=0.0)), (self.p["ad"], load({"type": "lambert", "albedo": 1.0}))]
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the mirror direction, with the levels N.wo = mu
+        and F's kink.
+        """
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"],
                     levels=tuple(sorted({float(mu), *self.albedo_breaks()})))
 
     def albedo_breaks(self):
+        """The dielectric's kink of F where ``eta`` is given, else none."""
         return () if self.p["eta"] is None else fresnel_levels(self.p["eta"], 0.0)
 
     def azimuth_hint(self):
+        """The azimuth hint of the specular lobe (000 eq. 29-30: with F(Theta_min) where ``eta`` is given), or None
+        where ad > 0 (the terms are integrated apart).
+        """
         q = self.p
         if q["ad"] != 0:
             return None  # the diffuse part is split off by albedo_terms

@@ -369,6 +369,9 @@ class Beckmann(_Microfacet):
     ]
 
     def lobe(self, mu: float) -> Lobe:
+        """The Lobe hint: a Beckmann lobe of slope alpha about the half vector, with Walter's G1 switch as a level and
+        the kinks of F at wi.h.
+        """
         levels = (walter_level(self.p["alpha"]),) if self.p["g1"] == "walter" else ()
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["alpha"], levels=levels,
                     kinks=wih_kinks(self, self.p["eta"], self.p["k"]))
@@ -425,6 +428,7 @@ class GGX(_Microfacet):
         super().__init__(**kwargs)
 
     def lobe(self, mu: float) -> Lobe:
+        """The Lobe hint: a GGX lobe about the half vector (r = alpha^2, at most 1), with the kinks of F at wi.h."""
         # D = (1 / (pi r)) r^2 / (1 - (1 - r) cos^2)^2 with r = alpha^2: the "ggx" radial map;
         # alpha > 1 peaks at grazing half vectors, where r = 1 (uniform in sin^2) is the neutral map
         return Lobe(axis="half", radial="ggx", sharpness=min(self.p["alpha"] ** 2, 1.0),

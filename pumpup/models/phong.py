@@ -142,9 +142,11 @@ class Phong(BRDF):
     reference_fn = staticmethod(_phong_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the mirror direction."""
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"])
 
     def azimuth_hint(self):
+        """The azimuth hint: the mirror direction's power lobe c (R.V)_+^n, closed-form in the azimuth."""
         return _polar_hint(self.p["n"], 0.0, self.p["c"])
 
 
@@ -219,10 +221,14 @@ class StretchedPhong(BRDF):
     reference_fn = staticmethod(_stretched_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the mirror direction, with a kink at N.wo = mu
+        where p > 0.
+        """
         levels = (mu,) if self.p["p"] > 0 else ()
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"], levels=levels)
 
     def azimuth_hint(self):
+        """The azimuth hint: the mirror direction's power lobe divided by max(N.L, N.V)^p (000 eq. 7, 12)."""
         return _polar_hint(self.p["n"], self.p["p"], self.p["c"])  # 000 eq. 7, 12
 
 
@@ -271,10 +277,14 @@ class Retro(BRDF):
     reference_fn = staticmethod(_retro_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about wi (the retro direction), with a kink at N.wo = mu where p >
+        0.
+        """
         levels = (mu,) if self.p["p"] > 0 else ()
         return Lobe(axis="retro", radial="power", sharpness=self.p["n"], levels=levels)
 
     def azimuth_hint(self):
+        """The azimuth hint: stretched Phong's, as the lobe about wi integrates as the one about R (000 eq. 13)."""
         # around wi, N.wo = mu u + s sqrt(1 - u^2) cos(beta) as around R: the same 1-D integral
         return _polar_hint(self.p["n"], self.p["p"], self.p["c"])  # 000 eq. 13
 
@@ -326,20 +336,26 @@ class PhongShader(BRDF):
     reference_fn = staticmethod(_shader_reference)
 
     def albedo_terms(self):
+        """The specular lobe alone, plus the diffuse term pi k_d times a white Lambertian where k_d > 0."""
         if self.p["kd"] == 0:
             return [(1.0, self)]
         return [(1.0, self.with_params(kd=0.0)), (math.pi * self.p["kd"], load_lambert())]
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the mirror direction."""
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"])
 
     def azimuth_hint(self):
+        """The azimuth hint of the specular lobe k_s (R.V)_+^n / mu (002 eq. 5, 8), or None where k_d > 0 (the terms are
+        integrated apart).
+        """
         if self.p["kd"] != 0:
             return None  # albedo_terms splits off the diffuse part
         return _polar_hint(self.p["n"], 0.0, self.p["ks"], per_mu=lambda mu: 1.0 / mu)  # 002 eq. 5, 8
 
 
 def load_lambert():
+    """A white Lambertian (albedo 1), the diffuse term of :class:`PhongShader`'s albedo."""
     from ..core import load
 
     return load({"type": "lambert", "albedo": 1.0})

@@ -79,9 +79,13 @@ class Schlick(BRDF):
     reference_fn = staticmethod(_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a GGX lobe of r about the half vector (000 eq. 36)."""
         return Lobe(axis="half", radial="ggx", sharpness=self.p["r"])
 
     def azimuth_hint(self):
+        """The azimuth hint: the GGX weight with alpha = sqrt(r) and 1 / (r + (1 - r) N.V) about the normal (000 eq.
+        36).
+        """
         from ..core.hints import AzimuthHint, SchlickLobe
 
         r, c = self.p["r"], self.p["c"]

@@ -483,6 +483,9 @@ class KullaConty(_Compensated):
 
     @property
     def spec(self) -> dict:
+        """The model as a plain-JSON dict: the base, and ``white``, ``f_avg`` and ``force`` where they are not the
+        defaults.
+        """
         out = {"type": "kulla_conty", "base": self.base.spec}
         if self.p["white"] is not None:
             out["white"] = self.p["white"].spec
@@ -496,6 +499,7 @@ class KullaConty(_Compensated):
         return self._run(_kc_kernel, self.scale, wi, wo)
 
     def reference(self, wi, wo):
+        """The plain numpy f_r: the base's reference plus F_ms D(mu_i) D(mu_o) (KC eq. 1), 0 below the horizon."""
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
         f = np.asarray(self.base.reference(wi, wo), dtype=np.float64)
@@ -512,6 +516,7 @@ class KullaConty(_Compensated):
         return self._ms
 
     def albedo_terms(self):
+        """The base's terms, plus the Kulla-Conty lobe D(mu_i) D(mu_o) weighted F_ms where that is positive."""
         terms = list(self.base.albedo_terms())
         ms = self._ms_term()
         return terms + ([(self.scale, ms)] if ms is not None else [])
@@ -531,9 +536,11 @@ class KullaConty(_Compensated):
         return out
 
     def lobe(self, mu: float) -> Lobe:
+        """The base's Lobe hint with the kinks of D (where U reaches 1, and the table's breaks) as levels."""
         return self.base.lobe(mu).with_levels(self.bound.kinks)
 
     def sampling_lobe(self, mu: float) -> Lobe:
+        """The base's sampling hint."""
         return self.base.sampling_lobe(mu)
 
     def report(self) -> str:
@@ -640,6 +647,9 @@ class Scaled(_Compensated):
 
     @property
     def spec(self) -> dict:
+        """The model as a plain-JSON dict: the base, ``f0``, and ``white`` and ``force`` where they are not the
+        defaults.
+        """
         out = {"type": "scaled", "base": self.base.spec, "f0": self.p["f0"]}
         if self.p["white"] is not None:
             out["white"] = self.p["white"].spec
@@ -666,6 +676,9 @@ class Scaled(_Compensated):
         return 1.0 / u if f0 == 1.0 else 1.0 + f0 * (1.0 / u - 1.0)
 
     def reference(self, wi, wo):
+        """The plain numpy f_r: the base's reference times 1 + F0 (1 / U(mu_o) - 1) (Turquin eq. 6), 0 below the
+        horizon.
+        """
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
         f = np.asarray(self.base.reference(wi, wo), dtype=np.float64)
@@ -674,12 +687,14 @@ class Scaled(_Compensated):
         return np.where(up, f * self.factor(np.where(up, mo, 1.0)), 0.0)
 
     def albedo_terms(self):
+        """Itself for a base of one term, else each of the base's terms scaled by the same factor of mu_o."""
         terms = self.base.albedo_terms()
         if len(terms) == 1 and terms[0][1] is self.base:
             return [(1.0, self)]
         return [(w, _ScaledTerm(t, self)) for w, t in terms]
 
     def lobe(self, mu: float) -> Lobe:
+        """The base's Lobe hint with U's kinks and, about the normal, the table's decades as levels."""
         return _scaled_lobe(self.base.lobe(mu), self.bound)
 
     def azimuth_hint(self):
@@ -711,9 +726,11 @@ class Scaled(_Compensated):
                                               levels=lambda mu: tuple(sorted({float(mu), *kinks}))))
 
     def sampling_lobe(self, mu: float) -> Lobe:
+        """The base's sampling hint."""
         return self.base.sampling_lobe(mu)
 
     def report(self) -> str:
+        """One paragraph for ``pumpup check``: the formula, F0, the E table's size and margin, and the furnace bound."""
         t = self.table()
         return (f"scaled: f (1 + F0 (1/E(mu_o) - 1)), F0 = {self.p['f0']:.6g}; not reciprocal by construction; "
                 f"E table of {self.white.type!r}: {len(t.mu)} nodes, margin {t.margin:.2g}; the furnace toward wo is "

@@ -526,14 +526,19 @@ class Pumped(BRDF):
 
     @property
     def base(self) -> BRDF:
+        """The BRDF this level divides by g."""
         return self.p["base"]
 
     @property
     def controlled(self) -> bool:
+        """Whether g is g2 (001 eq. 21: the max also with N.wi and N.wo)."""
         return self.p["g"] == "g2"
 
     @property
     def spec(self) -> dict:
+        """The model as a plain-JSON dict: the base, ``g``, and ``force`` where it is set (several levels are nested
+        pumped specs).
+        """
         out = {"type": "pumped", "base": self.base.spec, "g": self.p["g"]}
         if self.p["force"]:
             out["force"] = True
@@ -552,6 +557,7 @@ class Pumped(BRDF):
         return own if own is not None else base_table(self.base, progress=progress)
 
     def lookup(self) -> _Lookup:
+        """The base table's upper bound in the compiled kernel's form, built once per object (thread-safe)."""
         if self._lookup is None:
             with self._init_lock:  # threads that evaluate a fresh object build it once
                 if self._lookup is None:
@@ -705,6 +711,7 @@ class Pumped(BRDF):
         return f
 
     def reference(self, wi, wo):
+        """The plain numpy f_r: the base's reference divided by g (001 eq. 16)."""
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
         return self.divide(np.asarray(self.base.reference(wi, wo), dtype=np.float64), wi, wo)
@@ -933,9 +940,11 @@ class Pumped(BRDF):
         return tuple(sorted(out))
 
     def lobe(self, mu: float) -> Lobe:
+        """The base's Lobe hint with g's kink levels at ``mu`` and, about the normal, the table's decades."""
         return _divided_lobe(self.base.lobe(mu), self, mu)
 
     def sampling_lobe(self, mu: float) -> Lobe:
+        """The base's sampling hint (f / g has the lobe of f; g only rescales it)."""
         return self.base.sampling_lobe(mu)  # f / g has the lobe of f; g only rescales it
 
     def azimuth_hint(self):
@@ -948,9 +957,11 @@ class Pumped(BRDF):
         return None if hint is None else hint.times(DivideByG(self._chain_args(), self._polar_levels))
 
     def azimuth_range(self):
+        """The base's (g depends on N.wi and N.wo only)."""
         return self.base.azimuth_range()  # g depends on N.wi and N.wo only
 
     def albedo_terms(self):
+        """Itself for a base of one term, else each of the base's terms divided by the same g."""
         terms = self.base.albedo_terms()
         if len(terms) == 1 and terms[0][1] is self.base:
             return [(1.0, self)]

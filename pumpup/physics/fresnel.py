@@ -141,6 +141,9 @@ def fresnel_levels(eta: float, k: float, y0_max: float | None = None) -> tuple:
 
 @njit(cache=True)
 def dielectric_scalar(c, n):  # pragma: no cover - compiled
+    """Compiled unpolarised Fresnel reflectance of a dielectric of relative index ``n`` at the cosine ``c`` (002 sec.
+    3.2), without cancellation for an index near 1; 1 where no index is given (n <= 0).
+    """
     if n <= 0.0:
         return 1.0  # no index of refraction given: F = 1
     n21 = (n - 1.0) * (n + 1.0)

@@ -51,6 +51,7 @@ def upper_log(lm, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no
 
 @njit(cache=True, nogil=True)
 def upper_array(mu, logx, coef, v0, slope0, margin_lo, margin, cap, out):  # pragma: no cover - compiled
+    """Compiled :func:`upper_scalar` at every value of ``mu``, written into ``out``."""
     for k in range(mu.shape[0]):
         out[k] = upper_scalar(mu[k], logx, coef, v0, slope0, margin_lo, margin, cap)
 

@@ -38,6 +38,9 @@ def projected(x, y, z, dist, g1, alpha):  # pragma: no cover - compiled
 
 
 def projected_reference(w, dist, g1, alpha):
+    """Plain numpy twin of :func:`projected`: P = z / G1 of the directions ``w`` (..., 3), GGX for ``dist`` 1 (Walter
+    eq. 34), else Beckmann, exact (``g1`` 0, Walter eq. 27) or Walter's rational fit; P = z at the normal.
+    """
     from scipy.special import erf
 
     x, y, z = w[..., 0], w[..., 1], w[..., 2]

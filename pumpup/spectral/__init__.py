@@ -283,6 +283,7 @@ class SpectralPumped(Spectral):
 
     @property
     def spec(self) -> dict:
+        """The model as a plain-JSON dict: the spectral base, ``g``, ``levels``, and ``force`` where it is set."""
         out = {"type": "pumped", "base": self.base.spec, "g": self.g, "levels": self.levels}
         if self.force:
             out["force"] = True
@@ -664,6 +665,7 @@ class SpectralPumpedLobe(Spectral):
 
     @property
     def spec(self) -> dict:
+        """The model as a plain-JSON dict: the spectral base, ``g`` and ``levels``."""
         return {"type": "pumped_lobe", "base": self.base.spec, "g": self.g, "levels": self.levels}
 
     def __repr__(self) -> str:

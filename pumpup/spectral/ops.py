@@ -105,6 +105,9 @@ class SpectralCompensated(Spectral):
 
     @property
     def spec(self) -> dict:
+        """The model as a plain-JSON dict: a ``kulla_conty`` spec (with ``f_avg`` where given) or a ``scaled`` one
+        (``f0``, 1 by default), with ``white`` and ``force`` where they are set.
+        """
         if self.method == "kulla_conty":
             out: dict[str, Any] = {"type": "kulla_conty", "base": self.base.spec}
             if self.f_avg is not None:

@@ -185,6 +185,9 @@ class AlbedoTable:
                    breaks=np.atleast_1d(ds.attrs.get("interpolation_breaks", [])))
 
     def __call__(self, mu) -> np.ndarray:
+        """The interpolated albedo at ``mu`` (in (0, 1], checked); below the smallest node, the power law through the
+        first two.
+        """
         m = check_mu(mu)
         lm = np.log(m)
         out = self._spline(lm)
