@@ -56,11 +56,14 @@ import json
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .core import BRDF, SpecError, load, registry
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = ["fit", "FitResult", "FitData", "FitError", "lobe_grid", "relative_errors", "plot_fits",
            "DEFAULT_LOBE_FRACTION", "DEFAULT_MU_MIN"]
@@ -817,8 +820,9 @@ def _search(prob: _Problem, n_scan: int, seed: int, maxiter: int, xtol: float):
     return _local(prob, r.x, 0.0, xtol), 0.0
 
 
-def fit(target, family: str, params: dict | None = None, fixed: dict | None = None, pump: dict | None = None,
-        directions=None, mu=None, weights=(1.0, 1.0), method: str = "perceptual", *, ties: dict | None = None,
+def fit(target: BRDF | dict | str, family: str, params: dict | None = None, fixed: dict | None = None,
+        pump: dict | None = None, directions: tuple[ArrayLike, ArrayLike] | None = None, mu: ArrayLike | None = None,
+        weights: tuple[float, float] = (1.0, 1.0), method: str = "perceptual", *, ties: dict | None = None,
         lobe_fraction: float | None = DEFAULT_LOBE_FRACTION, mu_min: float = DEFAULT_MU_MIN,
         n_mu: int = 33, n_mu_search: int = 9, search_rtol: float = 1e-5, final_rtol: float = 1e-9,
         n_scan: int = 16, seed: int = 0, maxiter: int = 20, xtol: float = 1e-9,

@@ -26,10 +26,14 @@ import os
 import re
 import warnings
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .core import BRDF, SpecError, load
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 __all__ = ["PRESETS", "Preset", "LutError", "lut", "audit", "read_table", "write_lut", "lookup", "AuditResult"]
 
@@ -513,10 +517,10 @@ def lookup_error(table, spec: dict, param: str, preset, *, per_cell: int = 1, st
 # --------------------------------------------------------------------------------------------
 
 
-def lut(model="ggx", preset: str = "cycles", *, rtol: float | None = None, eavg: bool | None = None,
-        split: bool | None = None, lookup_check: bool = True, per_cell: int | None = None,
+def lut(model: str | dict | BRDF = "ggx", preset: str = "cycles", *, rtol: float | None = None,
+        eavg: bool | None = None, split: bool | None = None, lookup_check: bool = True, per_cell: int | None = None,
         stride: int | None = None, max_lookup_error: float | None = None, threads: int | None = None,
-        max_regions: int = 200):
+        max_regions: int = 200) -> xr.Dataset:
     """A renderer's albedo table of ``model``, computed exactly, with its errors.
 
     Parameters
@@ -943,9 +947,10 @@ def _monotonicity(table: np.ndarray, truth: np.ndarray, slack: float, mu, rough)
     return found
 
 
-def audit(path, preset: str = "cycles", model="ggx", *, rtol: float = 1e-7, lookup_check: bool = True,
-          eavg: bool = True, per_cell: int = 1, stride: int | None = None, png: str | None = None,
-          threads: int | None = None, max_regions: int = 200) -> AuditResult:
+def audit(path: str | os.PathLike[str], preset: str = "cycles", model: str | dict | BRDF = "ggx", *,
+          rtol: float = 1e-7, lookup_check: bool = True, eavg: bool = True, per_cell: int = 1,
+          stride: int | None = None, png: str | None = None, threads: int | None = None,
+          max_regions: int = 200) -> AuditResult:
     """Grade a shipped table against pumpup's truth, in the preset's conventions.
 
     Reads ``path`` (:func:`read_table`), recomputes every node with ``model`` (default GGX with

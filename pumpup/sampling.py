@@ -41,13 +41,18 @@ about N is L = 2 (N.R) N - R, which is what is implemented (it keeps R.V = cos a
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit, vectorize
 
 from .core import BRDF, Lobe, as_directions
 from .engine.cubature import check_mu
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = ["Strategy", "acceptance", "efficiency_dataset", "mc_albedo", "mc_radiance", "pdf", "plot_efficiency",
            "sample", "second_moment", "strategy"]
@@ -426,7 +431,8 @@ def _check_brdf(brdf) -> BRDF:
     return brdf
 
 
-def sample(brdf: BRDF, wo, n: int, rng=None, *, kind: str = "lobe") -> tuple[np.ndarray, np.ndarray]:
+def sample(brdf: BRDF, wo: ArrayLike, n: int, rng: np.random.Generator | int | None = None, *,
+           kind: str = "lobe") -> tuple[np.ndarray, np.ndarray]:
     """Draw n incidence directions wi for the view direction wo, with their density.
 
     Parameters
@@ -502,7 +508,9 @@ def _weights(f: BRDF, strat: Strategy, w: np.ndarray, n: int, rng, radiance=None
     return mean, math.sqrt(var / n)
 
 
-def mc_radiance(brdf: BRDF, wo, n: int, rng=None, radiance=None, *, kind: str = "lobe") -> tuple[float, float]:
+def mc_radiance(brdf: BRDF, wo: ArrayLike, n: int, rng: np.random.Generator | int | None = None,
+                radiance: Callable[[np.ndarray], ArrayLike] | None = None, *,
+                kind: str = "lobe") -> tuple[float, float]:
     """Monte Carlo estimate of the reflected radiance towards wo (000 eq. 17-18, 23-25).
 
     L_out(wo) = integral of L_in(wi) f_r(wi, wo) cos(theta_i) d omega_i, estimated with n
@@ -529,7 +537,8 @@ def mc_radiance(brdf: BRDF, wo, n: int, rng=None, radiance=None, *, kind: str = 
     return _weights(f, strategy(f, float(w[2]), kind), w, _check_n(n), _check_rng(rng), radiance)
 
 
-def mc_albedo(brdf: BRDF, mu, n: int, rng=None, *, kind: str = "lobe"):
+def mc_albedo(brdf: BRDF, mu: ArrayLike, n: int, rng: np.random.Generator | int | None = None, *,
+              kind: str = "lobe") -> tuple[float, float] | tuple[np.ndarray, np.ndarray]:
     """Monte Carlo estimate of the directional albedo a(mu) and its standard error.
 
     a(mu) = integral of f_r(wi, wo) cos(theta_o) d omega_o with wi = (sqrt(1 - mu^2), 0, mu)

@@ -28,13 +28,17 @@ import shutil
 import sys
 import tempfile
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ._version import __version__
 from .core import BRDF, SpecError, load
 from .engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from numpy.typing import ArrayLike
 
 __all__ = ["SWEEP_KIND", "default_mu", "dimension_name", "sweep"]
 
@@ -480,10 +484,11 @@ def _run_distributed(tasks, client, address: str | None, on_done) -> None:
 # --------------------------------------------------------------------------------------------
 
 
-def sweep(spec: dict | str, params: Mapping[str, Sequence], mu=None, *, pump: Mapping | None = None,
-          client=None, scheduler: str | None = None, workers: int | None = None, chunks=None,
-          out: str | os.PathLike | None = None, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
-          mean: bool = True, maximum: bool = True, progress: bool | None = None, overwrite: bool = False):
+def sweep(spec: dict | str, params: Mapping[str, Sequence], mu: ArrayLike | None = None, *, pump: Mapping | None = None,
+          client: Any = None, scheduler: str | None = None, workers: int | None = None,
+          chunks: int | Mapping[str, int] | None = None, out: str | os.PathLike | None = None,
+          rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL, mean: bool = True, maximum: bool = True,
+          progress: bool | None = None, overwrite: bool = False) -> xr.Dataset:
     """Albedo tables over a grid of model parameters, computed in chunks through dask.
 
     Cell (v_1, ..., v_k) of the grid is the model ``pumpup.load(spec | {p_1: v_1, ...})``

@@ -20,9 +20,14 @@ import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from .hints import AzimuthHint
 
 __all__ = [
     "BRDF",
@@ -237,7 +242,7 @@ class Lobe:
 _REGISTRY: dict[str, type[BRDF]] = {}
 
 
-def register(name: str):
+def register(name: str) -> Callable[[type[BRDF]], type[BRDF]]:
     """Class decorator: make a BRDF class loadable as ``{"type": name, ...}``."""
 
     def deco(cls):
@@ -453,7 +458,7 @@ class BRDF:
         return hash(json.dumps(self.spec, sort_keys=True))
 
     # --- evaluation -------------------------------------------------------------------
-    def eval(self, wi: Any, wo: Any) -> np.ndarray:
+    def eval(self, wi: ArrayLike, wo: ArrayLike) -> np.ndarray:
         """f_r(wi, wo) in 1/sr (no cosine factor), broadcast over the leading axes.
 
         Parameters
@@ -539,7 +544,7 @@ class BRDF:
         """Scalar parameters passed to the compiled kernel after the 6 direction components."""
         return tuple(self.p[k] for k in self.params)
 
-    def reference(self, wi: Any, wo: Any) -> np.ndarray:
+    def reference(self, wi: ArrayLike, wo: ArrayLike) -> np.ndarray:
         """The plain numpy implementation, the readable reference for the kernel."""
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
@@ -577,7 +582,7 @@ class BRDF:
         """Linear decomposition f = sum w_k f_k used by the engine (default: itself)."""
         return [(1.0, self)]
 
-    def albedo_breaks(self) -> tuple:
+    def albedo_breaks(self) -> tuple[float, ...]:
         """Incidences mu in (0, 1) where the albedo a(mu) has a kink, or a jump in a low derivative, that does not
         depend on wo (default: none), for a table's spline to be split there (``pumpup.tabulate``'s ``breaks``, the
         pumping operator's base tables, the compensation tables) and for :func:`pumpup.mean_albedo`'s first intervals
@@ -588,7 +593,7 @@ class BRDF:
         """
         return ()
 
-    def albedo_kinks(self, lo: float = 0.0, hi: float = 1.0) -> list | None:
+    def albedo_kinks(self, lo: float = 0.0, hi: float = 1.0) -> list[float] | None:
         """Every incidence in (lo, hi) where a table of this model's albedo must split its spline: its
         :meth:`albedo_breaks`, sorted, or None where it has none (an operator adds the kinks it makes: a pumped
         level's g changes its form at incidences that do not depend on wo).
@@ -596,7 +601,7 @@ class BRDF:
         out = sorted(v for v in self.albedo_breaks() if lo < v < hi)
         return out or None
 
-    def azimuth_hint(self):
+    def azimuth_hint(self) -> AzimuthHint | None:
         """An :class:`~pumpup.core.hints.AzimuthHint` (the model's family, its scale and factors) when the azimuth of
         the albedo integral is closed-form or a rule on known arcs: the routing table (:mod:`pumpup.engine.routes`) then
         picks a 1-D route for it.  None (the default): the nested quadrature or the 2-D cubature.
@@ -611,19 +616,19 @@ class BRDF:
     #: to the integral exactly; None (the default) for a model without one
     delta_albedo = None
 
-    def sampling_terms(self, mu: float) -> list:
+    def sampling_terms(self, mu: float) -> list[tuple[float, BRDF]]:
         """[(weight, term)] to sample from at incidence mu: the albedo terms (the default), or terms weighted for
         this mu (Kulla-Conty's mixture).
         """
         return self.albedo_terms()
 
-    def slope_hint(self):
+    def slope_hint(self) -> tuple[float, float, float] | None:
         """(a_x, a_y, c) when the albedo is one ray integral per direction in slope space (anisotropic Ward, 000 eq.
         33: the ``slope`` route, :mod:`pumpup.engine.slope`), else None (the default).
         """
         return None
 
-    def lobe_axis(self, mu: np.ndarray, phi: np.ndarray):
+    def lobe_axis(self, mu: np.ndarray, phi: np.ndarray) -> tuple[float, np.ndarray, np.ndarray] | None:
         """(n, nu, scale) when, seen from wi at (mu, phi), the model is a power lobe scale (A.wo)_+^n about an axis A at
         elevation nu = N.A > 0, with no other dependence on wi (the engine then takes the 1-D path about A,
         :func:`pumpup.engine.polar.axis_albedo`), else None (the default).
@@ -897,7 +902,8 @@ ISOTROPY_PAIRS = 2000
 ISOTROPY_RTOL = 1e-9
 
 
-def from_function(fn: Callable, name: str = "function", reciprocal: bool = True, isotropic: bool = False) -> BRDF:
+def from_function(fn: Callable[[np.ndarray, np.ndarray], ArrayLike], name: str = "function", reciprocal: bool = True,
+                  isotropic: bool = False) -> BRDF:
     """Wrap a callable ``fn(wi, wo) -> f_r`` (numpy, broadcasting) as a BRDF.
 
     Parameters

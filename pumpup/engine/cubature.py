@@ -47,6 +47,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -68,6 +69,9 @@ from .lobe_geometry import (
     rotate_wi,
     smooth,
 )
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = ["albedo", "check_mu", "check_phi", "AlbedoWarning"]
 
@@ -584,8 +588,9 @@ def _groups(brdf: BRDF, mu: np.ndarray, phi: np.ndarray | None = None):
             yield idx, _Group(lobe=lobe, mu=mu[idx], levels=lev)
 
 
-def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
-           max_regions: int = 20000, phi=0.0, engine: str | None = None):
+def albedo(brdf: BRDF, mu: ArrayLike, return_error: bool = False, rtol: float = DEFAULT_RTOL,
+           atol: float = DEFAULT_ATOL, max_regions: int = 20000, phi: ArrayLike = 0.0,
+           engine: str | None = None) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """Directional albedo a(mu) of ``brdf`` (000 eq. 2; Lewis's k_rho, 002 eq. 15).
 
     a(mu, phi) = integral over the hemisphere of f_r(wi, wo) cos(theta_o) d omega_o, with

@@ -54,6 +54,7 @@ import functools
 import json
 import math
 import os
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numba import njit
@@ -71,6 +72,9 @@ from .pumping import (
     from_file,
     table_decades,
 )
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = ["compensate", "KullaConty", "Scaled", "save_compensated", "load_compensated", "furnace",
            "compensation_table", "METHODS", "fresnel_average"]
@@ -819,7 +823,8 @@ class _Transposed(BRDF):
 
 
 @functools.singledispatch
-def furnace(f: BRDF, mu, return_error: bool = False, **kw):
+def furnace(f: BRDF, mu: ArrayLike, return_error: bool = False,
+            **kw: Any) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """The white furnace toward a viewer at cos(theta_o) = mu: integral f(wi, wo) cos(theta_i) d omega_i.
 
     For a reciprocal BRDF this is its albedo a(mu) (000 eq. 2); for ``scaled`` it is the
@@ -922,7 +927,7 @@ def _needed_tables(f: BRDF, out: list) -> list:
     return out
 
 
-def save_compensated(f: BRDF, path) -> str:
+def save_compensated(f: BRDF, path: str | os.PathLike[str]) -> str:
     """Write a compensated (or pumped, or any nesting of them) BRDF and all its tables to one netCDF file.
 
     Groups ``table1``, ``table2``, ... hold the tables (attribute ``cache``: "compensate" for
@@ -959,7 +964,7 @@ def save_compensated(f: BRDF, path) -> str:
     return write_groups(path, root, [(f"table{i}", ds) for i, ds in enumerate(groups, start=1)])
 
 
-def load_compensated(path) -> BRDF:
+def load_compensated(path: str | os.PathLike[str]) -> BRDF:
     """Load a BRDF saved by :func:`save_compensated`, without recomputing its tables."""
     from ..tables import AlbedoTable, open_table
 

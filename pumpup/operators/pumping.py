@@ -1046,7 +1046,7 @@ def pump_model(base, g: str, levels: int, force) -> Pumped:
 
 
 @functools.singledispatch
-def save_pumped(f: Pumped, path) -> str:
+def save_pumped(f: Pumped, path: str | os.PathLike[str]) -> str:
     """Write a pumped BRDF and the albedo tables of all its levels to one netCDF file.
 
     Group ``level1`` holds the table of the innermost base, ``level2`` that of the first
@@ -1071,7 +1071,7 @@ def save_pumped(f: Pumped, path) -> str:
     return write_groups(path, root, [(f"level{i}", level.table().dataset) for i, level in enumerate(chain, start=1)])
 
 
-def load_pumped(path) -> Pumped:
+def load_pumped(path: str | os.PathLike[str]) -> Pumped:
     """Load a pumped BRDF saved by :func:`save_pumped`, without recomputing its tables.
 
     The file is validated (:func:`pumpup.open_table` for the root and every level's group; the

@@ -17,6 +17,7 @@ import sys
 import tempfile
 import weakref
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -24,6 +25,10 @@ from .._version import __version__
 from ..core import BRDF, check_count, check_open_unit, check_tolerance, provide
 from ..engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
 from . import reuse as _reuse
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from numpy.typing import ArrayLike
 
 __all__ = [
     "tabulate",
@@ -363,9 +368,10 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
     return grid, (V[:, 0] if one else V), (E[:, 0] if one else E), interp
 
 
-def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
+def tabulate(brdf: BRDF, mu: ArrayLike | None = None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
              interp_tol: float = 1e-7, mu_min: float = 1e-8, max_points: int = 2049, progress: bool | None = None,
-             threads: int | None = None, phi=None, breaks=None):
+             threads: int | None = None, phi: ArrayLike | str | None = None,
+             breaks: ArrayLike | None = None) -> xr.Dataset:
     """Tabulate the directional albedo of ``brdf``.
 
     Parameters
@@ -691,7 +697,7 @@ def atomic_path(path):
         raise
 
 
-def write_table(ds, path) -> str:
+def write_table(ds: xr.Dataset, path: str | os.PathLike[str]) -> str:
     """Write a Dataset to netCDF atomically (a temporary file renamed into place), with a
     Fletcher-32 checksum on every numeric variable (:func:`pumpup.tables.validate.checksum_encoding`) and
     a digest of the whole content in the attribute ``pumpup_digest``, which :func:`open_table`
@@ -733,7 +739,7 @@ def write_groups(path, root, groups) -> str:
     return os.fspath(path)
 
 
-def open_table(path, group: str | None = None):
+def open_table(path: str | os.PathLike[str], group: str | None = None) -> xr.Dataset:
     """Open a netCDF table written by pumpup, fully loaded into memory, and validate it
     (:func:`pumpup.tables.validate.validate_dataset`: variables, coordinates, shapes, finite values,
     mu in (0, 1] strictly increasing, albedo >= 0, a loadable spec; checksums).
@@ -774,7 +780,8 @@ def open_table(path, group: str | None = None):
 # --------------------------------------------------------------------------------------------
 
 
-def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False, max_intervals: int = 400):
+def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False,
+                max_intervals: int = 400) -> float | tuple[float, float]:
     """Mean albedo 2 * integral_0^1 a(mu) mu dmu (000 eq. 33): the albedo under uniform sky light.
 
     Computed by adaptive Gauss-Kronrod (7/15) quadrature over mu with the smoothing
@@ -941,7 +948,7 @@ def _location_error(f, mu0, a0, e0, rtol, lo, hi) -> float:
     return math.degrees(max(math.acos(mu0) - lo_t, hi_t - math.acos(mu0), dmu / s if s > 0 else 0.0))
 
 
-def max_constant(brdf: BRDF, **kw) -> tuple[float, float]:
+def max_constant(brdf: BRDF, **kw: Any) -> tuple[float, float]:
     """The maximum constant of a model and the angle of its albedo maximum.
 
     The constant is 1 / max over mu of the albedo computed with the model's constant
