@@ -95,7 +95,8 @@ def __dir__() -> list[str]:
 
 class _Package(types.ModuleType):
     """The package's module type: the import system's binding of a submodule (``pumpup.albedo``, the
-    module) never replaces the public function of the same name (``pumpup.albedo``, the function)."""
+    module) never replaces the public function of the same name (``pumpup.albedo``, the function).
+    """
 
     def __setattr__(self, name: str, value) -> None:
         if name in _FUNCTIONS_NAMED_LIKE_MODULES and isinstance(value, types.ModuleType):

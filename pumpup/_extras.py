@@ -21,7 +21,8 @@ class MissingExtraError(ImportError):
 
 def require(module: str, feature: str) -> ModuleType:
     """Import ``module`` (a key of :data:`EXTRAS`), or raise :class:`MissingExtraError` naming ``feature``,
-    the extra and the command that installs it."""
+    the extra and the command that installs it.
+    """
     try:
         return importlib.import_module(module)
     except ImportError as exc:

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import importlib
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 
 def submodules(package: str) -> Callable[[str], Any]:
     """A module ``__getattr__`` for ``package`` that imports ``package.name`` when ``name`` is one of its
-    submodules, so that ``pumpup.tables.provenance`` works after ``import pumpup``."""
+    submodules, so that ``pumpup.tables.provenance`` works after ``import pumpup``.
+    """
 
     def __getattr__(name: str) -> Any:
         if name.startswith("__"):

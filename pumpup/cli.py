@@ -14,7 +14,8 @@ import threading
 
 def parse_spec(text: str) -> dict:
     """A model spec from JSON (``'{"type": "phong", "n": 20}'``) or the short form ``phong:n=20,c=1``
-    (:func:`pumpup.core.parse_spec`; a bad one exits with its one-line message)."""
+    (:func:`pumpup.core.parse_spec`; a bad one exits with its one-line message).
+    """
     from pumpup.core import SpecError
     from pumpup.core import parse_spec as _parse
 
@@ -26,7 +27,8 @@ def parse_spec(text: str) -> dict:
 
 def _load(text: str, spectral: bool = False):
     """The model of a SPEC argument; a spectral one (a 'material' or per-wavelength lists, pumpup.spectral)
-    only where the command prints or writes per wavelength (``spectral=True``)."""
+    only where the command prints or writes per wavelength (``spectral=True``).
+    """
     import pumpup
 
     try:
@@ -45,7 +47,8 @@ SPECTRAL_REFUSED = ("this command takes a single-channel model; a spectral spec 
 
 class UsageError(SystemExit):
     """A user error (or an interruption): its one line is already on stderr; the exit status is
-    ``code`` (2, or 130 after Ctrl-C).  ``str()`` gives the message."""
+    ``code`` (2, or 130 after Ctrl-C).  ``str()`` gives the message.
+    """
 
     def __init__(self, message: str, code: int = 2):
         super().__init__(code)
@@ -61,7 +64,8 @@ def _one_line(text: str) -> str:
 
 def check_out(path: str, option: str = "--out") -> None:
     """Exit with one line naming ``path`` unless a file can be written there: its directory exists, is a
-    directory and is writable, and ``path`` is not itself a directory (checked before any work)."""
+    directory and is writable, and ``path`` is not itself a directory (checked before any work).
+    """
     import os
 
     directory = os.path.dirname(os.path.abspath(path))
@@ -79,7 +83,8 @@ def check_out(path: str, option: str = "--out") -> None:
 
 def check_out_dir(path: str, option: str = "--out") -> None:
     """Exit with one line naming ``path`` unless it is a writable directory or can be made one: the
-    nearest existing ancestor is a writable directory (checked before any work)."""
+    nearest existing ancestor is a writable directory (checked before any work).
+    """
     import os
 
     if os.path.exists(path):
@@ -111,7 +116,8 @@ def _plain_text(text: str) -> str:
     """A docstring line without reST markup: ``x`` -> x, :func:`~a.b` -> b, *x* -> x."""
     import re
 
-    text = re.sub(r":[a-z]+:`~?([^`]*)`", lambda m: m.group(1).rsplit(".", 1)[-1] if "~" in m.group(0) else m.group(1), text)
+    text = re.sub(r":[a-z]+:`~?([^`]*)`",
+                  lambda m: m.group(1).rsplit(".", 1)[-1] if "~" in m.group(0) else m.group(1), text)
     text = re.sub(r"``([^`]*)``", r"\1", text)
     text = re.sub(r"(?<![\w*])\*([^*\s][^*]*)\*(?![\w*])", r"\1", text)
     return text
@@ -137,7 +143,8 @@ def default_text(param) -> str:
             src = inspect.getsource(d)
         except (OSError, TypeError):
             return "computed"
-        m = re.search(r"return\s+(.*?)(\s+#.*)?$", src.strip(), re.S) or re.search(r"lambda\s+\w+\s*:\s*(.*?)[,)]*$", src)
+        m = (re.search(r"return\s+(.*?)(\s+#.*)?$", src.strip(), re.S)
+             or re.search(r"lambda\s+\w+\s*:\s*(.*?)[,)]*$", src))
         if not m:
             return "computed"
         expr = m.group(1).strip().splitlines()[0]
@@ -154,6 +161,9 @@ def default_text(param) -> str:
 
 
 def cmd_models(args) -> int:
+    """``pumpup models``: every registered type with its summary and its parameters' ranges, defaults and meanings;
+    status 0.
+    """
     import pumpup
 
     rows = []
@@ -162,7 +172,8 @@ def cmd_models(args) -> int:
         params = [(k, p.range_text() if p.kind in ("float", "int", "floats") or p.choices else p.kind,
                    default_text(p), _plain_text(p.doc)) for k, p in cls.params.items()]
         rows.append((name, doc, params))
-    w = [max([len(r[c]) for _, _, ps in rows for r in ps] + [len(h)]) for c, h in enumerate(("name", "range", "default"))]
+    w = [max([len(r[c]) for _, _, ps in rows for r in ps] + [len(h)])
+         for c, h in enumerate(("name", "range", "default"))]
     print(f"    {'parameter':{w[0]}s}  {'range':{w[1]}s}  {'default':{w[2]}s}  meaning")
     for name, doc, params in rows:
         print(f"{name}: {doc}")
@@ -172,6 +183,9 @@ def cmd_models(args) -> int:
 
 
 def cmd_albedo(args) -> int:
+    """``pumpup albedo SPEC``: the albedo and its error estimate at each mu (``--mu``, ``--theta`` or a default set),
+    per wavelength for a spectral model and per azimuth with ``--phi``; status 0.
+    """
     import numpy as np
 
     import pumpup
@@ -246,6 +260,9 @@ def _albedo_phi(f, mu, args) -> int:
 
 
 def cmd_table(args) -> int:
+    """``pumpup table SPEC --out FILE``: the albedo tabulated on an adaptive grid (over wavelengths for a spectral
+    model, over ``--phi`` for an anisotropic one) and written as netCDF; status 0.
+    """
     import numpy as np
 
     import pumpup
@@ -279,6 +296,9 @@ def cmd_table(args) -> int:
 
 
 def cmd_check(args) -> int:
+    """``pumpup check SPEC``: the reciprocity check, a compensated model's report, and the maximum albedo with the
+    maximum constant; status 0 if reciprocal, else 1.
+    """
     import pumpup
 
     f = _load(args.spec)
@@ -287,16 +307,18 @@ def cmd_check(args) -> int:
     if hasattr(f, "report"):  # a compensated BRDF (pumpup.compensate): its E table and bounds
         print(f.report())
     m = pumpup.max_albedo(f)
-    print(f"max albedo (constant set to 1): {m.albedo:.12g} +- {m.error:.2g} at theta = {m.theta_deg:.6f} +- {m.theta_error:.2g} deg;"
-          f" maximum constant {m.constant:.12g}")
+    print(f"max albedo (constant set to 1): {m.albedo:.12g} +- {m.error:.2g} at theta = {m.theta_deg:.6f} +- "
+          f"{m.theta_error:.2g} deg; maximum constant {m.constant:.12g}")
     return 0 if r.reciprocal else 1
 
 
 def cmd_pump(args) -> int:
+    """``pumpup pump SPEC``: the model pumped up ``--levels`` times with ``--g``, the albedo of every level at each mu
+    (per wavelength for a spectral model), and the pumped BRDF saved with ``--out``; status 0.
+    """
     import numpy as np
 
     import pumpup
-
     from pumpup.operators.pumping import MAX_LEVELS
 
     if not 1 <= args.levels <= MAX_LEVELS:
@@ -310,7 +332,8 @@ def cmd_pump(args) -> int:
         raise SystemExit(f"pumpup: {exc}") from None
     mu = np.array([1.0, 0.5, 0.1, 0.01, 1e-4])
     if getattr(p, "is_spectral", False):  # one row per (mu, wavelength), every level's albedo
-        print(f"{'mu':>8s} {'wavelength':>10s} " + " ".join(f"{'level ' + str(k):>12s}" for k in range(args.levels + 1)))
+        print(f"{'mu':>8s} {'wavelength':>10s} "
+              + " ".join(f"{'level ' + str(k):>12s}" for k in range(args.levels + 1)))
         per = []  # per wavelength: the albedo of levels 0..L, each of shape mu.shape
         for m in p.models:
             chain = m.chain()  # innermost first
@@ -336,6 +359,7 @@ def cmd_pump(args) -> int:
 
 
 def cmd_figures(args) -> int:
+    """``pumpup figures``: the pumping figures' data into ``--tables`` and their plots into ``--figures``; status 0."""
     from .figures import make_figures
 
     check_out(args.tables.rstrip("/") + "/x", "--tables")
@@ -346,6 +370,9 @@ def cmd_figures(args) -> int:
 
 
 def cmd_reproduce(args) -> int:
+    """``pumpup reproduce``: the papers' tables regenerated into ``--out`` and compared with the published values;
+    prints the report; status 0.
+    """
     from .reproduce import reproduce
 
     try:  # reproduce checks (and creates) its output directory before any work
@@ -363,10 +390,13 @@ def cmd_reproduce(args) -> int:
 
 
 def cmd_divergence(args) -> int:
+    """``pumpup divergence SPEC``: the albedo down to ``--mu-min`` and the fit a ~ K mu^-k (001 sec. 2.1); SPEC ``all``
+    writes the whole analysis (netCDF and plot); status 0.
+    """
+    from pumpup.core import check_open_unit
+
     from .divergence import analysis_dataset, divergence, plot
     from .tables.provenance import write_generated
-
-    from pumpup.core import check_open_unit
 
     try:
         check_open_unit("divergence", "--mu-min", args.mu_min)
@@ -422,6 +452,9 @@ def parse_values(text: str) -> tuple[str, list]:
 
 
 def cmd_sweep(args) -> int:
+    """``pumpup sweep SPEC --param ...``: albedo tables over a grid of parameters (pumped with ``--pump``), computed in
+    chunks on dask and written to ``--out``; status 0.
+    """
     import time
 
     import pumpup
@@ -464,6 +497,10 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_mc(args) -> int:
+    """``pumpup mc SPEC``: the Monte Carlo albedo by importance sampling beside the quadrature at each mu, and with
+    ``--chi2`` a chi-square test of the sampler against its density; status 1 if an estimate is 4 standard errors or
+    more off, or the test fails, else 0.
+    """
     import numpy as np
 
     import pumpup
@@ -499,6 +536,9 @@ def cmd_mc(args) -> int:
 
 
 def cmd_compensate(args) -> int:
+    """``pumpup compensate SPEC``: the model energy-compensated by ``--method``, its furnace toward wo = mu beside the
+    base's albedo, and the compensated BRDF saved with ``--out``; user errors exit with status 2.
+    """
     import numpy as np
 
     import pumpup
@@ -549,6 +589,9 @@ def cmd_compensate(args) -> int:
 
 
 def cmd_fit(args) -> int:
+    """``pumpup fit TARGET``: the fit of a model family to a target (:func:`_fit`); user errors are one line on stderr,
+    status 2.
+    """
     try:
         return _fit(args)
     except SystemExit as exc:  # user errors: one line on stderr, status 2
@@ -684,6 +727,10 @@ def _lut_fail(msg: str) -> int:
 
 
 def cmd_lut(args) -> int:
+    """``pumpup lut``: a renderer's albedo look-up table of ``--preset``, computed and written to ``--out``, with its
+    quadrature, storage and look-up errors; status 1 if the look-up error exceeds ``--max-lookup-error``, 2 for a bad
+    argument, else 0.
+    """
     import pumpup
     from pumpup import luts
 
@@ -721,6 +768,9 @@ def cmd_lut(args) -> int:
 
 
 def cmd_audit(args) -> int:
+    """``pumpup audit FILE --preset NAME``: a shipped albedo table graded against pumpup's values
+    (:func:`pumpup.audit`); status 1 beyond ``--tol`` or ``--max-lookup-error``, 2 for a bad argument, else 0.
+    """
     import pumpup
     from pumpup import luts
 
@@ -763,7 +813,8 @@ class _Parser(argparse.ArgumentParser):
 
 def cmd_render_scene(args) -> int:
     """``pumpup render scene NAME``: the papers' scenes path-traced by Mitsuba 3 (pumpup.scenes); every
-    argument is checked (one line, status 2) before rendering; without mitsuba, the ``render`` extra is named."""
+    argument is checked (one line, status 2) before rendering; without mitsuba, the ``render`` extra is named.
+    """
     import os
 
     from pumpup import scenes
@@ -813,6 +864,7 @@ def cmd_render_scene(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``pumpup`` command, one subcommand per ``cmd_*`` function (its ``func`` default)."""
     p = _Parser(
         prog="pumpup",
         description="Physically plausible BRDFs: accurate albedo, the albedo pumping-up operator, "
@@ -891,7 +943,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="a swept parameter: n=1,2,4 or n=geom:1:1000:64 or p=lin:0:1:64 (required; repeat for more)")
     g = s.add_mutually_exclusive_group()
     g.add_argument("--mu", type=float, nargs="+", help="cos(theta_i) values in (0, 1] (default: use --n-mu)")
-    g.add_argument("--n-mu", type=int, default=257, help="else this many mu, theta uniform in [0, 90) deg (default 257)")
+    g.add_argument("--n-mu", type=int, default=257,
+                   help="else this many mu, theta uniform in [0, 90) deg (default 257)")
     s.add_argument("--pump", metavar="G[:LEVELS]", help="pump each cell's model first, e.g. g2:2 (default: no pumping)")
     s.add_argument("--out", required=True, help="netCDF file, or a zarr store if it ends in .zarr; "
                                                 "finished chunks wait in OUT.parts/ so a rerun resumes (required)")
@@ -899,8 +952,10 @@ def build_parser() -> argparse.ArgumentParser:
                                                           "(default: local threads)")
     g = s.add_mutually_exclusive_group()
     g.add_argument("--threads", dest="local", action="store_const", const="threads", help="local threads (default)")
-    g.add_argument("--processes", dest="local", action="store_const", const="processes", help="local processes (default: threads)")
-    g.add_argument("--serial", dest="local", action="store_const", const="synchronous", help="one cell at a time (default: threads)")
+    g.add_argument("--processes", dest="local", action="store_const", const="processes",
+                   help="local processes (default: threads)")
+    g.add_argument("--serial", dest="local", action="store_const", const="synchronous",
+                   help="one cell at a time (default: threads)")
     s.add_argument("--workers", type=int, help="local threads or processes (default: one per core)")
     s.add_argument("--chunk", type=int, help="cells per chunk along the last parameter (default 8)")
     s.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of the albedo values (default: 1e-10)")
@@ -914,7 +969,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("spec", help="a model SPEC: JSON or short, e.g. ggx:alpha=0.3")
     s.add_argument("--method", choices=("kulla_conty", "scale", "g1", "g2"), default="kulla_conty",
                    help="the compensation (default: kulla_conty)")
-    s.add_argument("--f0", type=float, help="Fresnel F0 in [0, 1] (scale: Turquin's F0; kulla_conty: Schlick F_avg) (default: none)")
+    s.add_argument("--f0", type=float,
+                   help="Fresnel F0 in [0, 1] (scale: Turquin's F0; kulla_conty: Schlick F_avg) (default: none)")
     s.add_argument("--f-avg", type=float, help="kulla_conty: the Fresnel average F_avg in [0, 1] (default: 1)")
     s.add_argument("--force", action="store_true", help="accept a base that is not reciprocal (default: refuse)")
     s.add_argument("--out", help="save the compensated BRDF and its tables to this netCDF file (default: not saved)")
@@ -947,8 +1003,10 @@ def build_parser() -> argparse.ArgumentParser:
                                                   "netcdf, exr (required)")
     s.add_argument("--out", required=True, help="the table file (.h for C arrays, .inc, .npy, .nc, .exr) (required)")
     s.add_argument("--rtol", type=float, help="quadrature tolerance of the nodes (default 1e-8; 1e-6 for half floats)")
-    s.add_argument("--max-lookup-error", type=float, help="fail (status 1, saying where) above this look-up error (default: no limit)")
-    s.add_argument("--no-lookup-check", action="store_true", help="skip the look-up error between the nodes (default: measured)")
+    s.add_argument("--max-lookup-error", type=float,
+                   help="fail (status 1, saying where) above this look-up error (default: no limit)")
+    s.add_argument("--no-lookup-check", action="store_true",
+                   help="skip the look-up error between the nodes (default: measured)")
     s.add_argument("--no-eavg", action="store_true", help="skip E_avg (default: computed)")
     s.set_defaults(func=cmd_lut)
     s = sub.add_parser("audit", help="grade a shipped albedo table against pumpup's truth (status 1 beyond --tol)")
@@ -957,10 +1015,12 @@ def build_parser() -> argparse.ArgumentParser:
                                                   "netcdf, exr (required)")
     s.add_argument("--model", default="ggx", help="the model the table claims (default ggx with the preset's Smith)")
     s.add_argument("--tol", type=float, help="fail (status 1) if a node is off by more than this (default: no limit)")
-    s.add_argument("--max-lookup-error", type=float, help="fail (status 1) if the look-up error exceeds this (default: no limit)")
+    s.add_argument("--max-lookup-error", type=float,
+                   help="fail (status 1) if the look-up error exceeds this (default: no limit)")
     s.add_argument("--rtol", type=float, default=1e-7, help="quadrature tolerance of the truth (default 1e-7)")
     s.add_argument("--png", help="write an error map here (default: none)")
-    s.add_argument("--no-lookup-check", action="store_true", help="skip the look-up error between the nodes (default: measured)")
+    s.add_argument("--no-lookup-check", action="store_true",
+                   help="skip the look-up error between the nodes (default: measured)")
     s.add_argument("--no-eavg", action="store_true", help="skip the E_avg checks (default: checked)")
     s.set_defaults(func=cmd_audit)
     r = render_sub.add_parser("scene", help="the papers' scenes path-traced by Mitsuba 3 with the pumpup plugin, "
@@ -982,7 +1042,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="a free parameter and its range, e.g. n=1:10000 (required; repeat for more)")
     s.add_argument("--fixed", action="append", metavar="NAME=VALUE",
                    help="a parameter held fixed, e.g. p=0.5 (default: the family's defaults)")
-    s.add_argument("--tie", action="append", metavar="NAME=OTHER", help="a parameter equal to another, e.g. cy=cx (default: none)")
+    s.add_argument("--tie", action="append", metavar="NAME=OTHER",
+                   help="a parameter equal to another, e.g. cy=cx (default: none)")
     s.add_argument("--pump", metavar="G[:LEVELS]", help="fit the family pumped up, e.g. g2:2 (default: not pumped)")
     s.add_argument("--method", choices=("perceptual", "least_squares", "both"), default="perceptual",
                    help="the objective (default: perceptual)")
@@ -1001,6 +1062,9 @@ QUIET_COMMANDS = ("models", "warmup")
 
 
 def cmd_warmup(args) -> int:
+    """``pumpup warmup``: compile pumpup's kernels into numba's cache (progress on stderr unless
+    ``--quiet``); status 0.
+    """
     from .warmup import warmup
 
     seconds = warmup(progress=None if args.quiet else (lambda line: print(line, file=sys.stderr, flush=True)))
@@ -1018,7 +1082,8 @@ def _interrupted() -> UsageError:
 def _closed_stdout() -> int:
     """Output piped into a reader that has gone (``pumpup models | head -1``): no error line, status 141
     (128 + SIGPIPE, as a shell tool killed by the broken pipe).  stdout goes to /dev/null so that the
-    interpreter's last flush does not complain."""
+    interpreter's last flush does not complain.
+    """
     import os
 
     try:
@@ -1034,7 +1099,8 @@ def main(argv: list[str] | None = None, notify: bool = False) -> int:
     :class:`UsageError`, a SystemExit); Ctrl-C, at any moment of the run, prints one line and exits
     with 130.  The arguments are parsed before the library is imported.  Set PUMPUP_TRACEBACK=1 to
     see the traceback of an error instead.  ``notify``: before numba compiles a kernel that is not in its
-    cache, say so in one line on stderr (when stderr is a terminal; the console script sets it)."""
+    cache, say so in one line on stderr (when stderr is a terminal; the console script sets it).
+    """
     debug = bool(os.environ.get("PUMPUP_TRACEBACK"))
     try:
         args = build_parser().parse_args(argv)
@@ -1068,7 +1134,8 @@ def main(argv: list[str] | None = None, notify: bool = False) -> int:
 
 def _caused_by_interrupt(exc: BaseException) -> bool:
     """Whether a KeyboardInterrupt is in ``exc``'s chain: Ctrl-C while a C extension imports (numpy's import of
-    datetime) surfaces as that module's ImportError."""
+    datetime) surfaces as that module's ImportError.
+    """
     seen = set()
     while exc is not None and id(exc) not in seen:
         if isinstance(exc, KeyboardInterrupt):
@@ -1087,7 +1154,8 @@ def _redeliver_interrupts(hook):
     """An unraisable-exception hook that sends a KeyboardInterrupt on again instead of printing it: Ctrl-C that lands
     in a callback from C (llvmlite's, while numba compiles) cannot propagate there, and Python would print it as
     "Exception ignored" and go on.  The interrupt is sent again 10 ms later, from a timer thread, so that it arrives
-    in ordinary Python code (and again, should it land in a callback once more)."""
+    in ordinary Python code (and again, should it land in a callback once more).
+    """
 
     def unraisable(args) -> None:
         if args.exc_type is not None and issubclass(args.exc_type, KeyboardInterrupt):
@@ -1103,7 +1171,8 @@ def _redeliver_interrupts(hook):
 
 def console_main() -> None:
     """The ``pumpup`` console script: :func:`main`, then an exit in which a late Ctrl-C or a closed pipe
-    prints nothing more (Ctrl-C is ignored once the command has finished and flushed its output)."""
+    prints nothing more (Ctrl-C is ignored once the command has finished and flushed its output).
+    """
     try:
         sys.unraisablehook = _redeliver_interrupts(sys.unraisablehook)
         code = main(notify=True)

@@ -45,8 +45,8 @@ CHANGED = (
     "Since 1999: every model is a compiled, vectorised kernel called once per batch, so the fixed "
     "per-call overhead that dominated the cheap models' cost is shared by the batch and the ratios "
     "shrink towards the ratio of arithmetic; the Fresnel term, an unconditional handful of "
-    "operations, adds a constant cost (the row with ior 1.5); He-Torrance's cost is its series (about g + a few sqrt(g) "
-    "terms, each an exp), its Newton solve for the effective roughness and two erfc, not a table "
+    "operations, adds a constant cost (the row with ior 1.5); He-Torrance's cost is its series (about g + a few "
+    "sqrt(g) terms, each an exp), its Newton solve for the effective roughness and two erfc, not a table "
     "look-up, and it has no importance sampling (the cosine fallback)."
 )
 
@@ -115,7 +115,8 @@ def report(result: dict | None = None, **kw) -> str:
     e = r["cook_torrance_fresnel"]["eval"]
     lines.append(f"| cook_torrance with Fresnel (ior 1.5; not in 000) | - | {e / base:.2f} | {1 / e:.3g} |")
     lines += ["", "Table 5: cost of one Monte Carlo radiance sample (sampling + evaluation) relative to Phong.", "",
-              "| model | published minutes | published / Phong | measured / Phong | samples/s |", "|---|---|---|---|---|"]
+              "| model | published minutes | published / Phong | measured / Phong | samples/s |",
+              "|---|---|---|---|---|"]
     base = r["phong"]["sample"]
     for name, pub in TABLE5.items():
         lines.append(f"| {name} | {pub:g} | {pub / TABLE5['phong']:.2f} | {r[name]['sample'] / base:.2f} | "

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .engine.cubature import albedo
 from .core import BRDF, load
+from .engine.cubature import albedo
 
 __all__ = ["divergence", "DivergenceResult", "ward_bound", "cook_torrance_bound", "analysis_dataset", "MODELS"]
 
@@ -37,7 +37,7 @@ MODELS = {
 
 
 def grid(mu_min: float = 1e-8, per_decade: int = 4) -> np.ndarray:
-    """mu uniform in theta from 0 to 84 degrees, then logarithmic from 0.1 down to mu_min."""
+    """Values of mu uniform in theta from 0 to 84 degrees, then logarithmic from 0.1 down to mu_min."""
     far = np.cos(np.radians(np.linspace(0.0, 84.0, 15)))
     near = np.logspace(-1, math.log10(mu_min), int(round(per_decade * math.log10(0.1 / mu_min))) + 1)
     return np.unique(np.concatenate([far, near]))[::-1]
@@ -114,7 +114,7 @@ def divergence(brdf: BRDF | dict, mu_min: float = 1e-8, window: tuple[float, flo
 
 @functools.lru_cache(maxsize=8)
 def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """numpy's n-point Gauss-Legendre rule on [-1, 1], built once per n (read-only arrays)."""
+    """The n-point Gauss-Legendre rule of numpy on [-1, 1], built once per n (read-only arrays)."""
     x, w = np.polynomial.legendre.leggauss(n)
     x.flags.writeable = False
     w.flags.writeable = False
@@ -145,7 +145,7 @@ def _cap_integral(mu: float, delta0: float, weight, phi_limits, n: int = 96) -> 
 
 
 def _visible(mu: float, d: float) -> tuple[float, float]:
-    """phi range [0, phi0] where V = 2 (L.H) H - L is above the horizon: N.V = s sin 2d cos phi + mu cos 2d."""
+    """The phi range [0, phi0] where V = 2 (L.H) H - L is above the horizon: N.V = s sin 2d cos phi + mu cos 2d."""
     s = math.sqrt((1 - mu) * (1 + mu))
     b = s * math.sin(2 * d)
     a = mu * math.cos(2 * d)
@@ -264,7 +264,8 @@ def analysis_dataset(mu_min: float = 1e-8, progress: bool | None = None):
             "albedo": (("model", "mu"), alb, {"long_name": "directional albedo", "units": "1"}),
             "albedo_error": (("model", "mu"), err, {"long_name": "estimated absolute error", "units": "1"}),
             "lower_bound": (("model", "mu"), bound,
-                            {"long_name": "lower bound of 001 eq. 14 (Ward) or eq. 15 (Cook-Torrance, region where G = 1)"}),
+                            {"long_name": "lower bound of 001 eq. 14 (Ward) or eq. 15 "
+                                          "(Cook-Torrance, region where G = 1)"}),
             "k": ("model", k, {"long_name": "fitted exponent: a ~ K mu^(-k) for mu in [1e-8, 1e-5]"}),
             "k_error": ("model", k_err, {"long_name": "uncertainty of k"}),
             "K": ("model", K, {"long_name": "fitted prefactor"}),
@@ -295,8 +296,8 @@ def plot(ds, path):
                           label=f"{name}: {ds.verdict.values[i]}, k = {abs(float(ds.k[i])):.3f}")
         if np.isfinite(ds.lower_bound[i]).any():
             ax.loglog(ds.mu, ds.lower_bound[i], "--", color=line.get_color(), lw=1)
-    ax.set(xlabel="mu = cos(theta_i)", ylabel="albedo", title="Albedo near grazing incidence (dashed: 001 eq. 14/15 bounds)",
-           ylim=(1e-3, 1e3))
+    ax.set(xlabel="mu = cos(theta_i)", ylabel="albedo",
+           title="Albedo near grazing incidence (dashed: 001 eq. 14/15 bounds)", ylim=(1e-3, 1e3))
     ax.invert_xaxis()
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)

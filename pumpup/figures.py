@@ -13,8 +13,8 @@ import os
 
 import numpy as np
 
-from .engine.cubature import albedo
 from .core import load
+from .engine.cubature import albedo
 from .operators.pumping import Pumped, pump
 from .tables import atomic_path, max_constant
 
@@ -66,10 +66,11 @@ def pumping_dataset(progress: bool | None = None):
             "albedo": (("model", "g", "level", "theta"), alb, {"long_name": "directional albedo", "units": "1"}),
             "albedo_error": (("model", "g", "level", "theta"), alb_err, {"long_name": "estimated error", "units": "1"}),
             "mirror_radiance": (("model", "g", "level", "theta"), mirror,
-                                {"long_name": "radiance f(L, R) cos(theta_L) in the mirror direction, point light 4 pi at distance 1",
-                                 "units": "1"}),
+                                {"long_name": "radiance f(L, R) cos(theta_L) in the mirror direction, "
+                                              "point light 4 pi at distance 1", "units": "1"}),
             "plane_radiance": (("model", "g", "level", "theta_in", "theta_out"), plane,
-                               {"long_name": "radiance f(L, V) cos(theta_L) across the plane of incidence", "units": "1"}),
+                               {"long_name": "radiance f(L, V) cos(theta_L) across the plane of incidence",
+                                "units": "1"}),
         },
         coords={
             "model": list(bases),
@@ -77,7 +78,8 @@ def pumping_dataset(progress: bool | None = None):
             "level": ("level", np.arange(4), {"long_name": "pumping level (0 = original)"}),
             "theta": ("theta", THETA, {"long_name": "incidence angle", "units": "degree"}),
             "theta_in": ("theta_in", THETA_IN, {"long_name": "incidence angle", "units": "degree"}),
-            "theta_out": ("theta_out", THETA_OUT, {"long_name": "viewing angle in the plane of incidence (+: mirror side)",
+            "theta_out": ("theta_out", THETA_OUT,
+                          {"long_name": "viewing angle in the plane of incidence (+: mirror side)",
                                                    "units": "degree"}),
         },
         attrs={"pumpup_kind": "pumpup figure data", "title": "001 Figures 3-6: pumped Phong and Blinn, n = 20",
@@ -99,7 +101,8 @@ def stretched_dataset():
         {"albedo": (("n", "theta"), a, {"long_name": "directional albedo", "units": "1"}),
          "albedo_error": (("n", "theta"), e, {"long_name": "estimated error", "units": "1"})},
         coords={"n": STRETCHED_N, "theta": ("theta", THETA, {"units": "degree"})},
-        attrs={"pumpup_kind": "pumpup figure data", "title": "000 Figure 3: albedo of stretched Phong, c = (n+2)/(2 pi)"},
+        attrs={"pumpup_kind": "pumpup figure data",
+               "title": "000 Figure 3: albedo of stretched Phong, c = (n+2)/(2 pi)"},
     )
 
 
@@ -134,6 +137,9 @@ def eq22_convergence(levels: int = 5):
 
 
 def plot_all(ds, st, outdir):
+    """Plot the pumping figures of ``ds`` (per model and g: albedo, radiance in the mirror direction and across the
+    plane of incidence, level by level) and 000 Fig. 3 of ``st`` into ``outdir``; returns the paths of the PNG files.
+    """
     import matplotlib
 
     matplotlib.use("Agg")

@@ -56,11 +56,14 @@ import json
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .core import BRDF, SpecError, load, registry
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = ["fit", "FitResult", "FitData", "FitError", "lobe_grid", "relative_errors", "plot_fits",
            "DEFAULT_LOBE_FRACTION", "DEFAULT_MU_MIN"]
@@ -87,7 +90,7 @@ class FitError(SpecError):
 
 
 def view_mus(n_views: int, mu_min: float) -> np.ndarray:
-    """mu of the views: theta uniform in [0, arccos(mu_min)], normal view first."""
+    """The mu of the views: theta uniform in [0, arccos(mu_min)], normal view first."""
     return np.cos(np.linspace(0.0, math.acos(mu_min), n_views))
 
 
@@ -165,6 +168,11 @@ class FitData:
 
     @classmethod
     def build(cls, target: BRDF, pairs, mu, lobe_fraction, rtol):
+        """The data of a fit: the target's f_t cos(theta_L) on the direction pairs ``pairs`` (001 eq. 3), its lobe
+        region (values at least ``lobe_fraction`` of each view's peak, or all positive ones) and its albedo at ``mu`` to
+        ``rtol``; a FitError where the target cannot be fitted (not single-channel, not finite, zero on every pair, an
+        albedo <= 0).
+        """
         from .engine.cubature import albedo
 
         wi, wo, view, weight = pairs
@@ -185,7 +193,8 @@ class FitData:
         a_t, a_err = albedo(target, mu, return_error=True, rtol=rtol)
         if np.any(a_t <= 0):
             i = int(np.argmin(a_t))
-            raise FitError(f"fit: the target's albedo is {a_t[i]:g} at mu = {mu[i]:g}; relative albedo error needs a > 0")
+            raise FitError(f"fit: the target's albedo is {a_t[i]:g} at mu = {mu[i]:g}; "
+                           "relative albedo error needs a > 0")
         return cls(wi, wo, view, weight, cos_l, t, region, np.asarray(mu, float), a_t, a_err, lobe_fraction)
 
     def add_pairs(self, target: BRDF, wi: np.ndarray, wo: np.ndarray) -> None:
@@ -204,7 +213,8 @@ class FitData:
 def relative_errors(brdf: BRDF, data: FitData, rtol: float, scale: float = 1.0, return_albedo: bool = False):
     """(e_f, e_a, bound of e_a from the albedo error estimates) of ``scale * brdf`` on ``data``.
 
-    With ``return_albedo``, also the albedo of ``scale * brdf`` at ``data.mu``."""
+    With ``return_albedo``, also the albedo of ``scale * brdf`` at ``data.mu``.
+    """
     from .engine.cubature import albedo
 
     m = np.asarray(brdf._eval(data.wi[data.region], data.wo[data.region]), dtype=np.float64) * data.cos_l[data.region]
@@ -236,7 +246,8 @@ def _around(v, a, b):
 
 def _zoom(value, v, a0, b0, rounds: int = 9, n: int = 21, shrink: float = 4.0):
     """Maximise value(wl (K, P, 3), v (K, 1, 3)) -> (K, P) by patches in (a, b) around each start,
-    each round ``shrink`` times smaller around the best point so far.  Returns (best, wl*)."""
+    each round ``shrink`` times smaller around the best point so far.  Returns (best, wl*).
+    """
     k = len(v)
     ha = 0.2 * a0 + 0.02  # [rad]: beyond the neighbouring cells of the log-polar grids
     hb = np.where(a0 < 0.05, math.pi, 0.3)  # near the mirror direction: every azimuth
@@ -276,7 +287,8 @@ def sup_brdf_error(target: BRDF, brdf: BRDF, data: FitData, n_start: int = 4, re
     worst grid points), the view's peak refined the same way.  Returns (e_f, worst wi, worst wo).
 
     The grid maximum alone underestimates the supremum where the worst point lies on the
-    region's boundary (common: the tails differ most)."""
+    region's boundary (common: the tails differ most).
+    """
     m = np.asarray(brdf._eval(data.wi, data.wo), dtype=np.float64) * data.cos_l
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # outside the region t may be tiny
         err = np.where(data.t > 0, np.abs(m / np.where(data.t > 0, data.t, 1.0) - 1.0), 0.0)
@@ -330,7 +342,8 @@ def sup_albedo_error(target: BRDF, brdf: BRDF, mu: np.ndarray, a_t: np.ndarray, 
     """e_a refined: the grid maximum of |a / a_t - 1| over ``mu``, then bounded Brent
     maximisation in theta between the neighbours of the worst grid point (when the worst grid
     point is an end of the range and the midpoint towards its neighbour is lower, the end is
-    taken as the maximum).  Returns (e_a, mu*)."""
+    taken as the maximum).  Returns (e_a, mu*).
+    """
     from scipy.optimize import minimize_scalar
 
     from .engine.cubature import albedo
@@ -429,10 +442,12 @@ class FitResult:
 
     @property
     def mu_min(self) -> float:
+        """The smallest mu at which the final albedo error was measured."""
         return float(np.min(self.mu))
 
     def __repr__(self) -> str:
-        free = ", ".join(f"{k} = {v:.6g} in [{self.bounds[k][0]:g}, {self.bounds[k][1]:g}]" for k, v in self.params.items())
+        free = ", ".join(f"{k} = {v:.6g} in [{self.bounds[k][0]:g}, {self.bounds[k][1]:g}]"
+                         for k, v in self.params.items())
         if self.directions_given:
             where = f"over the {self.eval_pairs} given pairs where f_t > 0"
         else:
@@ -562,7 +577,7 @@ def _log_scaled(lo: float, hi: float) -> bool:
 
 
 def _best_scale(pairs_q, lo, hi):
-    """argmin over c in [lo, hi] of max_k w_k max_i |c q_ki - 1|, exact (a max of lines).
+    """The argmin over c in [lo, hi] of max_k w_k max_i |c q_ki - 1|, exact (a max of lines).
 
     ``pairs_q`` is a list of (w_k, q_min_k, q_max_k); each term is
     w max(c q_max - 1, 1 - c q_min), so the maximum of 2K lines, convex in c.
@@ -647,7 +662,8 @@ class _Problem:
 
         During the search (``exact`` false) a candidate whose albedo-free lower bound of
         the objective already exceeds the best value found so far returns that bound
-        without computing its albedo (it cannot become the best)."""
+        without computing its albedo (it cannot become the best).
+        """
         key = tuple(values[k] for k in self.names)
         if key in self.cache:
             return self.cache[key]
@@ -702,7 +718,8 @@ class _Problem:
 
     def _scale_range(self, a):
         """The range of the profiled scale; with ``plausible``, capped so that c a <= 1 on the search mu
-        (a: the albedo at c = 1).  None if empty."""
+        (a: the albedo at c = 1).  None if empty.
+        """
         lo, hi = self.bounds[self.profile]
         if self.plausible and a is not None and np.max(a) > 0:
             hi = min(hi, 1.0 / float(np.max(a)))  # energy conservation, 000 eq. 2-3
@@ -761,7 +778,8 @@ class _Problem:
 
 def _local(prob: _Problem, x, width: float, xtol: float):
     """Local min-max refinement from x: bounded Brent on [x - width, x + width] (one parameter) or
-    Nelder-Mead on the max, restarted once from its own result (several)."""
+    Nelder-Mead on the max, restarted once from its own result (several).
+    """
     from scipy.optimize import minimize, minimize_scalar
 
     xb = prob.x_bounds()
@@ -783,7 +801,8 @@ def _local(prob: _Problem, x, width: float, xtol: float):
 
 def _search(prob: _Problem, n_scan: int, seed: int, maxiter: int, xtol: float):
     """Bounded global search (a scan for one parameter, differential evolution for more), then
-    :func:`_local`.  Returns (x, the width of the scan's step)."""
+    :func:`_local`.  Returns (x, the width of the scan's step).
+    """
     from scipy.optimize import differential_evolution
 
     xb = prob.x_bounds()
@@ -801,8 +820,9 @@ def _search(prob: _Problem, n_scan: int, seed: int, maxiter: int, xtol: float):
     return _local(prob, r.x, 0.0, xtol), 0.0
 
 
-def fit(target, family: str, params: dict | None = None, fixed: dict | None = None, pump: dict | None = None,
-        directions=None, mu=None, weights=(1.0, 1.0), method: str = "perceptual", *, ties: dict | None = None,
+def fit(target: BRDF | dict | str, family: str, params: dict | None = None, fixed: dict | None = None,
+        pump: dict | None = None, directions: tuple[ArrayLike, ArrayLike] | None = None, mu: ArrayLike | None = None,
+        weights: tuple[float, float] = (1.0, 1.0), method: str = "perceptual", *, ties: dict | None = None,
         lobe_fraction: float | None = DEFAULT_LOBE_FRACTION, mu_min: float = DEFAULT_MU_MIN,
         n_mu: int = 33, n_mu_search: int = 9, search_rtol: float = 1e-5, final_rtol: float = 1e-9,
         n_scan: int = 16, seed: int = 0, maxiter: int = 20, xtol: float = 1e-9,
@@ -911,8 +931,8 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
     for name, v, lo in (("search_rtol", search_rtol, 1e-13), ("final_rtol", final_rtol, 1e-13), ("xtol", xtol, 1e-15)):
         if not (isinstance(v, (int, float)) and lo <= v < 1):
             raise FitError(f"fit: {name} must be in [{lo:g}, 1), got {v!r}")
-    for name, v, lo in (("n_mu", n_mu, 2), ("n_mu_search", n_mu_search, 2), ("n_scan", n_scan, 3), ("maxiter", maxiter, 1),
-                         ("exchange_rounds", exchange_rounds, 0)):
+    for name, v, lo in (("n_mu", n_mu, 2), ("n_mu_search", n_mu_search, 2), ("n_scan", n_scan, 3),
+                         ("maxiter", maxiter, 1), ("exchange_rounds", exchange_rounds, 0)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
             raise FitError(f"fit: {name} must be an integer >= {lo}, got {v!r}")
 
@@ -1009,10 +1029,11 @@ def fit(target, family: str, params: dict | None = None, fixed: dict | None = No
         if v <= lo * (1 + 1e-9) + 1e-300 or v >= hi * (1 - 1e-9):
             notes.append(f"{k} = {v:g} is at the edge of its range [{lo:g}, {hi:g}]")
     return FitResult(
-        target=tgt.spec, target_brdf=tgt, family=family, method=method, spec=brdf.spec, brdf=brdf, params=fitted, bounds=bounds,
-        brdf_error=e_f, albedo_error=e_a, albedo_error_bound=bound, worst_pair=(worst_wi, worst_wo), worst_mu=worst_mu,
-        search_objective=search_objective, exchanges=exchanges, plausible=bool(plausible),
-        directions_given=directions is not None, view_mu_min=float(np.min(final.wo[:, 2])), albedo_evaluations=prob.albedo_evaluations, n_mu_search=len(mu_search),
+        target=tgt.spec, target_brdf=tgt, family=family, method=method, spec=brdf.spec, brdf=brdf, params=fitted,
+        bounds=bounds, brdf_error=e_f, albedo_error=e_a, albedo_error_bound=bound, worst_pair=(worst_wi, worst_wo),
+        worst_mu=worst_mu, search_objective=search_objective, exchanges=exchanges, plausible=bool(plausible),
+        directions_given=directions is not None, view_mu_min=float(np.min(final.wo[:, 2])),
+        albedo_evaluations=prob.albedo_evaluations, n_mu_search=len(mu_search),
         objective=max(weights[0] * e_f, weights[1] * e_a), weights=weights, lsq=math.sqrt(lsq_search),
         mu=final.mu, lobe_fraction=lobe_fraction, eval_pairs=int(final.region.sum()),
         eval_views=int(final.view.max()) + 1, max_albedo=float(np.max(a_fit)), evaluations=prob.evaluations,

@@ -26,10 +26,14 @@ import os
 import re
 import warnings
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .core import BRDF, SpecError, load
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 __all__ = ["PRESETS", "Preset", "LutError", "lut", "audit", "read_table", "write_lut", "lookup", "AuditResult"]
 
@@ -91,10 +95,16 @@ class Preset:
 
     @property
     def mu_lookup(self) -> str:
+        """How the renderer reads the mu axis: ``texel`` for a texel-centred axis (Filament's too), else the axis kind
+        itself.
+        """
         return "texel" if self.mu_axis in ("texel", "filament") else self.mu_axis
 
     @property
     def rough_lookup(self) -> str:
+        """How the renderer reads the roughness axis: ``texel`` for a texel-centred axis (Filament's too), else the axis
+        kind itself.
+        """
         return "texel" if self.rough_axis in ("texel", "filament") else self.rough_axis
 
 
@@ -420,7 +430,7 @@ def quantise(values, storage: str) -> np.ndarray:
     v = np.asarray(values, dtype=np.float64)
     if storage == "text6":
         f = np.clip(v, 0.0, 1.0).astype(np.float32)  # saturatef, then std::to_string (printf "%f")
-        return np.array([float(np.float32(float("%f" % float(x)))) for x in f.ravel()]).reshape(v.shape)
+        return np.array([float(np.float32(float(f"{float(x):f}"))) for x in f.ravel()]).reshape(v.shape)
     if storage == "half":
         return v.astype(np.float32).astype(np.float16).astype(np.float64)
     if storage == "float32":
@@ -437,7 +447,8 @@ def quantise(values, storage: str) -> np.ndarray:
 
 def _dense_axis(kind: str, n: int, lo: float, per_cell: int, stride: int) -> np.ndarray:
     """Physical coordinates between the look-up nodes: per_cell points per cell (every
-    ``stride``-th cell), plus the domain ends (the clamped regions)."""
+    ``stride``-th cell), plus the domain ends (the clamped regions).
+    """
     if kind == "texel":
         c = np.arange(0, n - 1, stride)[:, None] + (np.arange(per_cell) + 0.5)[None, :] / per_cell
         u = (c.ravel() + 0.5) / n
@@ -506,10 +517,10 @@ def lookup_error(table, spec: dict, param: str, preset, *, per_cell: int = 1, st
 # --------------------------------------------------------------------------------------------
 
 
-def lut(model="ggx", preset: str = "cycles", *, rtol: float | None = None, eavg: bool | None = None,
-        split: bool | None = None, lookup_check: bool = True, per_cell: int | None = None,
+def lut(model: str | dict | BRDF = "ggx", preset: str = "cycles", *, rtol: float | None = None,
+        eavg: bool | None = None, split: bool | None = None, lookup_check: bool = True, per_cell: int | None = None,
         stride: int | None = None, max_lookup_error: float | None = None, threads: int | None = None,
-        max_regions: int = 200):
+        max_regions: int = 200) -> xr.Dataset:
     """A renderer's albedo table of ``model``, computed exactly, with its errors.
 
     Parameters
@@ -637,9 +648,9 @@ def lut(model="ggx", preset: str = "cycles", *, rtol: float | None = None, eavg:
 def _c_array(name: str, values: np.ndarray, storage: str, per_line: int, qualifier: str = "static") -> str:
     flat = np.asarray(values, dtype=np.float64).ravel()
     if storage == "text6":
-        items = ["%ff" % float(np.float32(x)) for x in np.clip(flat, 0, 1)]
+        items = [f"{float(np.float32(x)):f}f" for x in np.clip(flat, 0, 1)]
     else:
-        items = ["%.9gf" % float(np.float32(x)) for x in flat]
+        items = [f"{float(np.float32(x)):.9g}f" for x in flat]
     lines = []
     for a in range(0, len(items), per_line):
         lines.append("  " + ", ".join(items[a:a + per_line]))
@@ -706,7 +717,8 @@ def write_lut(ds, path, preset=None) -> str:
             header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage,
                       "pumpup_spec": ds.attrs["spec"], "pumpup_preset": p.name,
                       "pumpup_conventions": "x = mu node i/(n-1) (floor 1e-4), y = rough node, alpha = rough^2"}
-            for k in ("quadrature_error", "quantisation_error", "lookup_error", "lookup_error_mu", "lookup_error_rough"):
+            for k in ("quadrature_error", "quantisation_error", "lookup_error", "lookup_error_mu",
+                      "lookup_error_rough"):
                 if k in ds.attrs:
                     header["pumpup_" + k] = f"{float(ds.attrs[k]):.6g}"
             with OpenEXR.File(header, {k: np.ascontiguousarray(v) for k, v in chans.items()}) as f:
@@ -869,6 +881,9 @@ class AuditResult:
         return bool(good)
 
     def report(self) -> str:
+        """The audit for people, a few lines: the worst errors at the nodes, the truth's quadrature error and the
+        format's rounding, E > 1 and monotonicity violations, and the look-up and E_avg checks where they ran.
+        """
         lines = [f"audit of a {self.preset} table ({self.n_nodes} nodes) against pumpup's {json.dumps(self.spec)}",
                  f"  nodes: max |table - E| = {self.max_abs:.3g} at mu = {self.where_abs[0]:.6g}, rough = "
                  f"{self.where_abs[1]:.6g}; max relative {self.max_rel:.3g} at mu = {self.where_rel[0]:.6g}, rough = "
@@ -932,8 +947,9 @@ def _monotonicity(table: np.ndarray, truth: np.ndarray, slack: float, mu, rough)
     return found
 
 
-def audit(path, preset: str = "cycles", model="ggx", *, rtol: float = 1e-7, lookup_check: bool = True, eavg: bool = True,
-          per_cell: int = 1, stride: int | None = None, png: str | None = None, threads: int | None = None,
+def audit(path: str | os.PathLike[str], preset: str = "cycles", model: str | dict | BRDF = "ggx", *,
+          rtol: float = 1e-7, lookup_check: bool = True, eavg: bool = True, per_cell: int = 1,
+          stride: int | None = None, png: str | None = None, threads: int | None = None,
           max_regions: int = 200) -> AuditResult:
     """Grade a shipped table against pumpup's truth, in the preset's conventions.
 

@@ -50,8 +50,8 @@ The BSDF
     model divides by the same upper bounds of the albedo tables as pumpup's compiled kernel
     (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`): through pumpup's product table G(m)
     of all levels where it has one (:class:`pumpup.operators.pumping._Product`, piece found from the float64 bits
-    of m = max(N.wi, N.wo)), else level by level, with ``dr.gather`` on the tables; its value is rounded down before the cast to float32
-    (x (1 - 2^-23)), so the exported BSDF is pointwise at most the double-precision one and
+    of m = max(N.wi, N.wo)), else level by level, with ``dr.gather`` on the tables; its value is rounded down before the
+    cast to float32 (x (1 - 2^-23)), so the exported BSDF is pointwise at most the double-precision one and
     keeps its proof of energy conservation (001 eq. 18).
 ``from_mitsuba(bsdf_dict, channel=0, variant=None) -> pumpup BRDF``
     A Mitsuba BSDF as a pumpup BRDF: f_r(wi, wo) = eval(si.wi = wo, wo = wi)[channel] / N.wi,
@@ -86,15 +86,14 @@ import subprocess
 import sys
 from typing import Any
 
-from ._extras import require
-
-mi = require("mitsuba", "pumpup.mitsuba (Mitsuba 3)")
-dr = require("drjit", "pumpup.mitsuba (Mitsuba 3)")
-
 import numpy as np
 
 from . import sampling as _sampling
+from ._extras import require
 from .core import BRDF, SpecError, from_function, load
+
+mi = require("mitsuba", "pumpup.mitsuba (Mitsuba 3)")
+dr = require("drjit", "pumpup.mitsuba (Mitsuba 3)")
 
 __all__ = ["register", "probe", "choose_variant", "bsdf_dict", "load_dict", "from_mitsuba", "SUPPORTED",
            "DEFAULT_VARIANT", "FALLBACK_VARIANT"]
@@ -202,7 +201,7 @@ def _f64(x):
 
 
 def _div(a, b):
-    """a / b that never raises (Python floats raise on / 0; lanes with b = 0 are masked by the caller)."""
+    """The quotient a / b that never raises (Python floats raise on / 0; lanes with b = 0 are masked by the caller)."""
     return a * dr.rcp(b)
 
 
@@ -224,7 +223,7 @@ def _int(v):
 
 
 # ----------------------------------------------------------------------------------------
-# Dr.Jit versions of the models: k(l, v, *brdf.kernel_args()) with l = wi, v = wo as
+# Dr.Jit versions of the models: k(wl, v, *brdf.kernel_args()) with wl = wi, v = wo as
 # (x, y, z) tuples of Float64, beside the numba kernels they mirror (same formulas, same order)
 # ----------------------------------------------------------------------------------------
 
@@ -233,11 +232,11 @@ def _dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-def _tan2_half(l, v):
+def _tan2_half(wl, v):
     """tan^2 delta from S = L + V (pumpup.models._half.tan2_half)."""
-    sz = l[2] + v[2]
-    qx = _div(l[0] + v[0], sz)
-    qy = _div(l[1] + v[1], sz)
+    sz = wl[2] + v[2]
+    qx = _div(wl[0] + v[0], sz)
+    qy = _div(wl[1] + v[1], sz)
     return qx * qx + qy * qy
 
 
@@ -273,12 +272,12 @@ def _fresnel_conductor(c, eta, k):
     return 0.5 * (rs + rp)
 
 
-def _dr_lambert(l, v, albedo):
-    return albedo * _INV_PI + 0.0 * l[2]
+def _dr_lambert(wl, v, albedo):
+    return albedo * _INV_PI + 0.0 * wl[2]
 
 
-def _dr_phong(l, v, n, c):
-    rv = 2.0 * l[2] * v[2] - _dot(l, v)  # 000 eq. 9
+def _dr_phong(wl, v, n, c):
+    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)  # 000 eq. 9
     return dr.select(rv > 0, c * _pow_pos(rv, n), 0.0)  # 000 eq. 5
 
 
@@ -286,77 +285,77 @@ def _den_p(mx, p):
     return mx if p == 1.0 else (1.0 + 0.0 * mx if p == 0.0 else dr.power(mx, p))
 
 
-def _dr_stretched_phong(l, v, n, p, c):
-    rv = 2.0 * l[2] * v[2] - _dot(l, v)  # 000 eq. 9
-    mx = dr.maximum(l[2], v[2])
+def _dr_stretched_phong(wl, v, n, p, c):
+    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)  # 000 eq. 9
+    mx = dr.maximum(wl[2], v[2])
     return dr.select(rv > 0, _div(c * _pow_pos(rv, n), _den_p(mx, p)), 0.0)  # 000 eq. 10, 12
 
 
-def _dr_retro(l, v, n, p, c):
-    lv = _dot(l, v)
-    mx = dr.maximum(l[2], v[2])
+def _dr_retro(wl, v, n, p, c):
+    lv = _dot(wl, v)
+    mx = dr.maximum(wl[2], v[2])
     return dr.select(lv > 0, _div(c * _pow_pos(lv, n), dr.power(mx, p)), 0.0)  # 000 eq. 13
 
 
-def _dr_phong_shader(l, v, n, ks, kd):
-    rv = 2.0 * l[2] * v[2] - _dot(l, v)
-    return kd + dr.select(rv > 0, _div(ks * _pow_pos(rv, n), l[2]), 0.0)  # 002 eq. 5, 8
+def _dr_phong_shader(wl, v, n, ks, kd):
+    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)
+    return kd + dr.select(rv > 0, _div(ks * _pow_pos(rv, n), wl[2]), 0.0)  # 002 eq. 5, 8
 
 
-def _dr_blinn(l, v, n, c):
-    cos2 = dr.rcp(1.0 + _tan2_half(l, v))  # (N.H)^2
+def _dr_blinn(wl, v, n, c):
+    cos2 = dr.rcp(1.0 + _tan2_half(wl, v))  # (N.H)^2
     return c * _pow_pos(cos2, 0.5 * n)  # 000 eq. 31
 
 
-def _dr_stretched_blinn(l, v, n, c):
-    cos2 = dr.rcp(1.0 + _tan2_half(l, v))
-    return _div(c * _pow_pos(cos2, 0.5 * n), dr.maximum(l[2], v[2]))  # 000 eq. 32
+def _dr_stretched_blinn(wl, v, n, c):
+    cos2 = dr.rcp(1.0 + _tan2_half(wl, v))
+    return _div(c * _pow_pos(cos2, 0.5 * n), dr.maximum(wl[2], v[2]))  # 000 eq. 32
 
 
-def _dr_phong_blinn(l, v, n, ks, kd):
-    cos2 = dr.rcp(1.0 + _tan2_half(l, v))
+def _dr_phong_blinn(wl, v, n, ks, kd):
+    cos2 = dr.rcp(1.0 + _tan2_half(wl, v))
     return kd + ks * _pow_pos(cos2, 0.5 * n)  # 002 eq. 24, 6
 
 
-def _dr_ward(l, v, m, c):
-    t2 = _tan2_half(l, v)
-    den = 4.0 * math.pi * m * m * (dr.sqrt(dr.maximum(l[2], 0.0)) * dr.sqrt(dr.maximum(v[2], 0.0)))
+def _dr_ward(wl, v, m, c):
+    t2 = _tan2_half(wl, v)
+    den = 4.0 * math.pi * m * m * (dr.sqrt(dr.maximum(wl[2], 0.0)) * dr.sqrt(dr.maximum(v[2], 0.0)))
     return _div(c * dr.exp(-t2 / (m * m)), den)  # 000 eq. 34, 001 eq. 8
 
 
-def _dr_modified_ward(l, v, m, c):
-    t2 = _tan2_half(l, v)
-    return _div(c * dr.exp(-t2 / (m * m)), 4.0 * math.pi * m * m * dr.maximum(l[2], v[2]))  # 000 eq. 35
+def _dr_modified_ward(wl, v, m, c):
+    t2 = _tan2_half(wl, v)
+    return _div(c * dr.exp(-t2 / (m * m)), 4.0 * math.pi * m * m * dr.maximum(wl[2], v[2]))  # 000 eq. 35
 
 
-def _dr_ward_aniso(l, v, ax, ay, c):
-    sz = l[2] + v[2]
-    qx = _div(l[0] + v[0], sz)  # h_x / h_z
-    qy = _div(l[1] + v[1], sz)  # h_y / h_z
+def _dr_ward_aniso(wl, v, ax, ay, c):
+    sz = wl[2] + v[2]
+    qx = _div(wl[0] + v[0], sz)  # h_x / h_z
+    qy = _div(wl[1] + v[1], sz)  # h_y / h_z
     e = (qx / ax) ** 2 + (qy / ay) ** 2
-    den = 4.0 * math.pi * ax * ay * (dr.sqrt(dr.maximum(l[2], 0.0)) * dr.sqrt(dr.maximum(v[2], 0.0)))
+    den = 4.0 * math.pi * ax * ay * (dr.sqrt(dr.maximum(wl[2], 0.0)) * dr.sqrt(dr.maximum(v[2], 0.0)))
     return _div(c * dr.exp(-e), den)  # Ward 1992 (isotropic: 000 eq. 34)
 
 
-def _dr_schlick(l, v, r, c):
-    t = _tan2_half(l, v)
+def _dr_schlick(wl, v, r, c):
+    t = _tan2_half(wl, v)
     cos2 = dr.rcp(1.0 + t)
     sin2 = dr.select(t <= 1.0, t * cos2, 1.0 - cos2)
     d = r + (1.0 - r) * sin2  # 1 - (1 - r)(N.H)^2
-    gl = r + (1.0 - r) * l[2]
+    gl = r + (1.0 - r) * wl[2]
     gv = r + (1.0 - r) * v[2]
     return c / (4.0 * math.pi) * _div(_div(r, d * d), gl * gv)  # 000 eq. 36
 
 
-def _dr_cook_torrance(l, v, m, ior):
-    s = (l[0] + v[0], l[1] + v[1], l[2] + v[2])
-    t = _tan2_half(l, v)
+def _dr_cook_torrance(wl, v, m, ior):
+    s = (wl[0] + v[0], wl[1] + v[1], wl[2] + v[2])
+    t = _tan2_half(wl, v)
     e = dr.exp(-t / (m * m))
     d = e * ((1.0 + t) * (1.0 + t)) / (4.0 * math.pi * m * m)  # 001 eq. 9
-    g = dr.minimum(1.0, _div(4.0 * dr.minimum(l[2], v[2]), s[2] * (1.0 + t)))  # 001 eq. 10
+    g = dr.minimum(1.0, _div(4.0 * dr.minimum(wl[2], v[2]), s[2] * (1.0 + t)))  # 001 eq. 10
     c = 0.5 * dr.sqrt(_dot(s, s))  # V.H
     f = _fresnel_dielectric(c, ior) if ior > 0 else 1.0
-    return _div(f * d * g, l[2] * v[2])  # 001 eq. 9
+    return _div(f * d * g, wl[2] * v[2])  # 001 eq. 9
 
 
 def _projected(w, dist, g1, alpha):
@@ -373,9 +372,9 @@ def _projected(w, dist, g1, alpha):
     return dr.select(s == 0.0, z, p)
 
 
-def _dr_microfacet(l, v, dist, alpha, shadowing, g1, ior, eta, k):
-    s = (l[0] + v[0], l[1] + v[1], l[2] + v[2])
-    t = _tan2_half(l, v)
+def _dr_microfacet(wl, v, dist, alpha, shadowing, g1, ior, eta, k):
+    s = (wl[0] + v[0], wl[1] + v[1], wl[2] + v[2])
+    t = _tan2_half(wl, v)
     a2 = alpha * alpha
     if dist == 0:
         d = dr.exp(-t / a2) * ((1.0 + t) * (1.0 + t)) / (math.pi * a2)  # Walter eq. 25
@@ -391,22 +390,22 @@ def _dr_microfacet(l, v, dist, alpha, shadowing, g1, ior, eta, k):
         f = _fresnel_dielectric(c, ior)
     else:
         f = 1.0
-    pl = _projected(l, dist, g1, alpha)
+    pl = _projected(wl, dist, g1, alpha)
     pv = _projected(v, dist, g1, alpha)
     if shadowing == 0:
         return _div(d * f, 4.0 * pl * pv)  # Walter eq. 20, separable Smith
-    return _div(d * f, 4.0 * (v[2] * pl + l[2] * pv - l[2] * v[2]))  # Heitz 2014, height-correlated
+    return _div(d * f, 4.0 * (v[2] * pl + wl[2] * pv - wl[2] * v[2]))  # Heitz 2014, height-correlated
 
 
-def _dr_metal(l, v, n, eta, k, c):
-    rv = 2.0 * l[2] * v[2] - _dot(l, v)  # 000 eq. 9
-    mx = dr.maximum(l[2], v[2])
+def _dr_metal(wl, v, n, eta, k, c):
+    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)  # 000 eq. 9
+    mx = dr.maximum(wl[2], v[2])
     return dr.select(rv > 0, _div(c * _pow_pos(rv, n), mx) * _fresnel_conductor(mx, eta, k), 0.0)  # 000 eq. 28
 
 
-def _dr_plastic(l, v, n, ad, a_s, eta):
-    rv = 2.0 * l[2] * v[2] - _dot(l, v)
-    mx = dr.maximum(l[2], v[2])
+def _dr_plastic(wl, v, n, ad, a_s, eta):
+    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)
+    mx = dr.maximum(wl[2], v[2])
     fr = _fresnel_conductor(mx, eta, 0.0) if eta > 0.0 else 1.0  # 000 eq. 30
     spec = _div(a_s * (n + 2.0) / (2.0 * math.pi) * _pow_pos(rv, n), mx) * fr  # 000 eq. 29
     return ad / math.pi + dr.select(rv > 0, spec, 0.0)
@@ -426,7 +425,8 @@ SUPPORTED = tuple(sorted(set(_KERNELS) | {"pumped", "fresnel"}))
 
 class _Level:
     """One pumping level in Dr.Jit: the upper bound u(mu) of :func:`pumpup.physics.lookups.upper_scalar` on
-    the same arrays (:class:`pumpup.operators.pumping._Lookup`), found by a binary search of fixed length."""
+    the same arrays (:class:`pumpup.operators.pumping._Lookup`), found by a binary search of fixed length.
+    """
 
     def __init__(self, lookup, controlled: bool):
         lk = lookup
@@ -474,7 +474,8 @@ class _Level:
 class _ProductG:
     """The chain kernel's fast path in Dr.Jit: G(m) = g_1 ... g_k as one piecewise quintic in
     m = max(N.wi, N.wo) (:class:`pumpup.operators.pumping._Product`, the same pieces and coefficients, already scaled
-    up by 1 + epsilon), the piece found from the float64 bits of m, for min(N.wi, N.wo) > ``mlo``."""
+    up by 1 + epsilon), the piece found from the float64 bits of m, for min(N.wi, N.wo) > ``mlo``.
+    """
 
     def __init__(self, prod):
         from .physics.lookups import CELL_SHIFT, float_bits_reference
@@ -514,7 +515,7 @@ class _ProductG:
 
 
 class _DrModel:
-    """A pumpup BRDF translated to Dr.Jit: ``f(l, v)`` in Float64, and its sampling strategy."""
+    """A pumpup BRDF translated to Dr.Jit: ``f(wl, v)`` in Float64, and its sampling strategy."""
 
     #: pumped values are multiplied by this before the cast to float32 (rounded down)
     ROUND_DOWN = 1.0 - 2.0**-23
@@ -561,14 +562,14 @@ class _DrModel:
             return self.product(dr.maximum(mi_, mo)) if fast else by_levels(mi_, mo)
         return dr.if_stmt((mi_, mo), fast, lambda a, b: self.product(dr.maximum(a, b)), by_levels)
 
-    def f(self, l, v):
-        val = self.kernel(l, v, *self.args)
+    def f(self, wl, v):
+        val = self.kernel(wl, v, *self.args)
         if self.fresnel is not None:  # 000 eq. 28's factor F(Theta_min), before the rounding down below
-            val = val * _fresnel_conductor(dr.maximum(l[2], v[2]), *self.fresnel)
+            val = val * _fresnel_conductor(dr.maximum(wl[2], v[2]), *self.fresnel)
         if self.levels:
-            g = self.g(dr.maximum(l[2], 1e-300), dr.maximum(v[2], 1e-300))
+            g = self.g(dr.maximum(wl[2], 1e-300), dr.maximum(v[2], 1e-300))
             val = _div(val, g) * self.ROUND_DOWN  # 001 eq. 16, all levels
-        return dr.select((l[2] > 0) & (v[2] > 0), val, 0.0)
+        return dr.select((wl[2] > 0) & (v[2] > 0), val, 0.0)
 
 
 # ----------------------------------------------------------------------------------------
@@ -621,18 +622,18 @@ def _comp_sample(kind, k, v, u1, u2):
     return w, (d > 0.0) & (w[2] > 0.0) & (u1 > 0.0)
 
 
-def _comp_pdf(kind, k, l, v):
-    """pumpup.sampling._pdf_kernel: density [1/sr] of wi = l given wo = v for one component."""
+def _comp_pdf(kind, k, wl, v):
+    """pumpup.sampling._pdf_kernel: density [1/sr] of wi = wl given wo = v for one component."""
     C = _sampling
     if kind == C.COSINE:
-        p = l[2] * _INV_PI
+        p = wl[2] * _INV_PI
     elif kind in (C.MIRROR, C.RETRO):
-        rx, ry = (-l[0], -l[1]) if kind == C.MIRROR else (l[0], l[1])
-        dx, dy, dz = rx - v[0], ry - v[1], l[2] - v[2]
+        rx, ry = (-wl[0], -wl[1]) if kind == C.MIRROR else (wl[0], wl[1])
+        dx, dy, dz = rx - v[0], ry - v[1], wl[2] - v[2]
         h = 0.5 * (dx * dx + dy * dy + dz * dz)  # 1 - R.V without cancellation
         p = dr.select(h < 1.0, (k + 1.0) * _INV_2PI * dr.exp(k * dr.log(dr.maximum(1.0 - h, 1e-300))), 0.0)
     else:
-        s = (l[0] + v[0], l[1] + v[1], l[2] + v[2])
+        s = (wl[0] + v[0], wl[1] + v[1], wl[2] + v[2])
         n = dr.sqrt(_dot(s, s))
         t2 = _div(s[0] * s[0] + s[1] * s[1], s[2] * s[2])
         ch = _div(s[2], n)
@@ -644,13 +645,13 @@ def _comp_pdf(kind, k, l, v):
             q = k + t2
             ph = _div(k, math.pi * ch * ch * ch * q * q)
         p = dr.select(n > 0.0, _div(ph, 2.0 * n), 0.0)
-    return dr.select((l[2] > 0.0) & (v[2] > 0.0), p, 0.0)
+    return dr.select((wl[2] > 0.0) & (v[2] > 0.0), p, 0.0)
 
 
-def _mixture_pdf(components, l, v):
+def _mixture_pdf(components, wl, v):
     out = 0.0
     for w, kind, k in components:
-        out = out + w * _comp_pdf(kind, k, l, v)
+        out = out + w * _comp_pdf(kind, k, wl, v)
     return out
 
 
@@ -719,9 +720,9 @@ def _plugin_class():
             self.m_components = [self.m_flags]
             self.spec = spec
 
-        # l: pumpup's wi (Mitsuba's wo, towards the light); v: pumpup's wo (Mitsuba's si.wi)
-        def _values(self, l, v):
-            vals = [m.f(l, v) for m in self.models]
+        # wl: pumpup's wi (Mitsuba's wo, towards the light); v: pumpup's wo (Mitsuba's si.wi)
+        def _values(self, wl, v):
+            vals = [m.f(wl, v) for m in self.models]
             return vals
 
         def _color(self, vals, cos):
@@ -732,21 +733,21 @@ def _plugin_class():
         @staticmethod
         def _dirs(si_wi, wo):
             v = (_f64(si_wi.x), _f64(si_wi.y), _f64(si_wi.z))
-            l = (_f64(wo.x), _f64(wo.y), _f64(wo.z))
-            return l, v
+            wl = (_f64(wo.x), _f64(wo.y), _f64(wo.z))
+            return wl, v
 
         def eval(self, ctx, si, wo, active=True):
-            l, v = self._dirs(si.wi, wo)
-            up = (l[2] > 0) & (v[2] > 0)
-            vals = [dr.select(up, x, 0.0) for x in self._values(l, v)]
-            out = self._color(vals, dr.maximum(l[2], 0.0))  # Mitsuba's eval includes cos(theta_o)
+            wl, v = self._dirs(si.wi, wo)
+            up = (wl[2] > 0) & (v[2] > 0)
+            vals = [dr.select(up, x, 0.0) for x in self._values(wl, v)]
+            out = self._color(vals, dr.maximum(wl[2], 0.0))  # Mitsuba's eval includes cos(theta_o)
             if not ctx.is_enabled(mi.BSDFFlags.GlossyReflection) and not ctx.is_enabled(mi.BSDFFlags.DiffuseReflection):
                 return mi.Spectrum(0.0)
             return dr.select(active, out, 0.0) if _jit() else (out if active else mi.Spectrum(0.0))
 
         def pdf(self, ctx, si, wo, active=True):
-            l, v = self._dirs(si.wi, wo)
-            p = mi.Float(_mixture_pdf(self.components, l, v))
+            wl, v = self._dirs(si.wi, wo)
+            p = mi.Float(_mixture_pdf(self.components, wl, v))
             return dr.select(active, p, 0.0) if _jit() else (p if active else 0.0)
 
         def eval_pdf(self, ctx, si, wo, active=True):
@@ -774,12 +775,12 @@ def _plugin_class():
                 wo = dr.select(ok, dr.normalize(wo), mi.Vector3f(0.0, 0.0, 1.0))
             else:
                 wo = dr.normalize(wo) if ok else mi.Vector3f(0.0, 0.0, 1.0)
-            l = (_f64(wo.x), _f64(wo.y), _f64(wo.z))
-            ok = ok & (l[2] > 0.0)
-            p = _mixture_pdf(self.components, l, v)
+            wl = (_f64(wo.x), _f64(wo.y), _f64(wo.z))
+            ok = ok & (wl[2] > 0.0)
+            p = _mixture_pdf(self.components, wl, v)
             ok = ok & (p > 0.0)
-            vals = self._values(l, v)
-            weight = self._color([dr.select(ok, _div(x, dr.maximum(p, 1e-300)), 0.0) for x in vals], l[2])
+            vals = self._values(wl, v)
+            weight = self._color([dr.select(ok, _div(x, dr.maximum(p, 1e-300)), 0.0) for x in vals], wl[2])
             bs.wo = wo
             bs.pdf = mi.Float(dr.select(ok, p, 0.0))
             bs.eta = 1.0
@@ -831,7 +832,8 @@ def register(variant: str | None = None) -> str:
 
 def bsdf_dict(spec: Any) -> dict:
     """``{"type": "pumpup", "spec": "<JSON>"}`` for ``mi.load_dict`` (spec: a dict, a BRDF, a list of
-    three per-channel specs, or a string)."""
+    three per-channel specs, or a string).
+    """
     if isinstance(spec, BRDF):
         spec = spec.spec
     if isinstance(spec, list):
@@ -917,7 +919,8 @@ def from_mitsuba(bsdf: Any, channel: int = 0, variant: str | None = None, name: 
                 si = dr.zeros(mi.SurfaceInteraction3f, idx.size)
                 si.wi = mi.Vector3f(*(mi.Float(b[idx, i].astype(np.float32)) for i in range(3)))
                 w = mi.Vector3f(*(mi.Float(a[idx, i].astype(np.float32)) for i in range(3)))
-                val = np.asarray(obj.eval(ctx, si, w)[channel] if nch > 1 else obj.eval(ctx, si, w)[0], dtype=np.float64)
+                val = np.asarray(obj.eval(ctx, si, w)[channel] if nch > 1 else obj.eval(ctx, si, w)[0],
+                                 dtype=np.float64)
                 cos = a[idx, 2].astype(np.float32).astype(np.float64)
                 out[idx] = val / cos
             else:

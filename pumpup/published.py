@@ -28,6 +28,7 @@ class Published:
 
     @property
     def value(self) -> float:
+        """The printed number as a float (a fraction such as "2/3" divided out)."""
         if "/" in self.text:
             num, den = self.text.split("/")
             return float(num) / float(den)
@@ -35,10 +36,10 @@ class Published:
 
 
 def agrees(computed: float, published: Published, error: float = 0.0) -> bool:
-    """Does ``computed`` (with its error estimate ``error``) match the printed value to the printed rounding: does some
-    value within ``error`` of it round to the printed string, half a unit of the last printed digit either way (the
-    ends included: 000 printed Phong n = 4's exact 0.6875 as 0.688, and a computed 0.6875 - 1e-16 rounds the other way;
-    issue 14's twentieth session)?
+    """Whether ``computed`` (with its error estimate ``error``) matches the printed value to the printed rounding:
+    whether some value within ``error`` of it rounds to the printed string, half a unit of the last printed digit
+    either way (the ends included: 000 printed Phong n = 4's exact 0.6875 as 0.688, and a computed 0.6875 - 1e-16
+    rounds the other way; issue 14's twentieth session).
 
     "0.350" has 3 decimals; "20.6" has 1; "7.8e-3" has 2 significant digits.
     """

@@ -238,6 +238,7 @@ class Image:
 
     @property
     def size(self) -> int:
+        """The image's width and height in pixels."""
         return int(self.mask.shape[0])
 
     def header(self) -> dict:

@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .engine.cubature import albedo
 from .core import load
+from .engine.cubature import albedo
 from .published import TABLE2, TABLE3, TABLE4, TEXT, Published, agrees
 from .tables import atomic_path, max_albedo, mean_albedo
 
@@ -76,7 +76,8 @@ def _table2(cache, bar):
 
 def _mean_with_constant(cache, model, n):
     """Mean albedo of the model with its paper constant: (n+2)/(2 pi) for the Phong family,
-    the maximum constant (000 Table 2, computed) for the Blinn family."""
+    the maximum constant (000 Table 2, computed) for the Blinn family.
+    """
     spec = {"type": model, "n": float(n)}
     if model in ("phong", "stretched_phong"):
         return cache.mean_albedo(spec)
@@ -214,7 +215,8 @@ def report(datasets: dict) -> str:
     lines = ["# pumpup reproduce: the papers' tables against the published values", ""]
     bad = []
     for name, ds in datasets.items():
-        lines += [f"## {ds.attrs['title']}", "", "| row | column | published | computed | agrees |", "|---|---|---|---|---|"]
+        lines += [f"## {ds.attrs['title']}", "", "| row | column | published | computed | agrees |",
+                  "|---|---|---|---|---|"]
         for i in range(ds.sizes["entry"]):
             e = ds.isel(entry=i)
             ok = bool(e.agrees)
@@ -246,7 +248,8 @@ def _divergence_report(ds) -> str:
     for i, name in enumerate(ds.model.values):
         lines.append(f"| {name} | {ds.verdict.values[i]} | {float(ds.k[i]):.5f} ± {float(ds.k_error[i]):.1g} | "
                      f"{float(ds.albedo[i, -1]):.6g} |")
-    lines += ["", "001 claims that Ward and Cook-Torrance diverge; see docs/user-guide.md for why Cook-Torrance does not.", ""]
+    lines += ["", ("001 claims that Ward and Cook-Torrance diverge; "
+                   "see docs/user-guide.md for why Cook-Torrance does not."), ""]
     return "\n".join(lines)
 
 
@@ -255,8 +258,8 @@ def reproduce(out: str = "tables", only: list[str] | None = None, progress: bool
 
     Besides :data:`TABLES`, ``divergence`` runs the divergence analysis
     (:func:`pumpup.divergence.analysis_dataset`) into ``<out>/divergence.nc`` and
-    ``<out>/divergence.png``. ``costs`` (only when named in ``only``: its timings change from run to run) measures 000 Tables 1 and 5
-    on this machine (:mod:`pumpup.costs`) into a section of ``report.md``.
+    ``<out>/divergence.png``. ``costs`` (only when named in ``only``: its timings change from run to run) measures
+    000 Tables 1 and 5 on this machine (:mod:`pumpup.costs`) into a section of ``report.md``.
     """
     choices = list(TABLES) + [DIVERGENCE, COSTS]
     # costs are timings of this machine: only on request, so a default run leaves the checkout as it was

@@ -41,16 +41,21 @@ about N is L = 2 (N.R) N - R, which is what is implemented (it keeps R.V = cos a
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit, vectorize
 
-from .engine.cubature import check_mu
 from .core import BRDF, Lobe, as_directions
+from .engine.cubature import check_mu
 
-__all__ = ["Strategy", "acceptance", "efficiency_dataset", "mc_albedo", "mc_radiance", "pdf", "plot_efficiency", "sample",
-           "second_moment", "strategy"]
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+__all__ = ["Strategy", "acceptance", "efficiency_dataset", "mc_albedo", "mc_radiance", "pdf", "plot_efficiency",
+           "sample", "second_moment", "strategy"]
 
 # component kinds (ints for the compiled kernels)
 COSINE, MIRROR, RETRO, HALF_POWER, HALF_BECKMANN, HALF_GGX = range(6)
@@ -291,13 +296,14 @@ class Strategy:
 
     @property
     def names(self) -> list[str]:
+        """The components' names with their parameters, e.g. ``phong lobe (mirror)(20)``, and ``cosine``."""
         return [f"{KIND_NAMES[k]}({s:g})" if k != COSINE else "cosine" for _, k, s in self.components]
 
     def __str__(self) -> str:
         return " + ".join(f"{w:g} x {n}" for (w, _, _), n in zip(self.components, self.names))
 
     def sample(self, wo: np.ndarray, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-        """n draws of wi given one wo (shape (3,)): (wi (n, 3), pdf (n,)); rejected draws are 0, 0."""
+        """The n draws of wi given one wo (shape (3,)): (wi (n, 3), pdf (n,)); rejected draws are 0, 0."""
         wi = np.empty((n, 3))
         p = np.empty(n)
         if len(self.components) == 1:
@@ -330,7 +336,8 @@ class Strategy:
 @dataclass(frozen=True)
 class OwnSampling:
     """The sampling density of a model that draws its own directions (:attr:`pumpup.core.BRDF.own_sampler`), with
-    :class:`Strategy`'s interface."""
+    :class:`Strategy`'s interface.
+    """
 
     brdf: BRDF
 
@@ -342,7 +349,7 @@ class OwnSampling:
         return f"1 x {self.names[0]}"
 
     def sample(self, wo: np.ndarray, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-        """n draws of wi given one wo (shape (3,)): (wi (n, 3), pdf (n,)); rejected draws are 0, 0."""
+        """The n draws of wi given one wo (shape (3,)): (wi (n, 3), pdf (n,)); rejected draws are 0, 0."""
         u = rng.random((2, n))
         wi, p = self.brdf.sample_wi(wo, u[0], u[1])
         return np.asarray(wi, dtype=np.float64), np.asarray(p, dtype=np.float64)
@@ -424,7 +431,8 @@ def _check_brdf(brdf) -> BRDF:
     return brdf
 
 
-def sample(brdf: BRDF, wo, n: int, rng=None, *, kind: str = "lobe") -> tuple[np.ndarray, np.ndarray]:
+def sample(brdf: BRDF, wo: ArrayLike, n: int, rng: np.random.Generator | int | None = None, *,
+           kind: str = "lobe") -> tuple[np.ndarray, np.ndarray]:
     """Draw n incidence directions wi for the view direction wo, with their density.
 
     Parameters
@@ -476,7 +484,8 @@ def pdf(brdf: BRDF, wi, wo, *, kind: str = "lobe") -> np.ndarray:
 
 def _weights(f: BRDF, strat: Strategy, w: np.ndarray, n: int, rng, radiance=None, chunk: int = 1 << 20):
     """Mean and standard error of the weights f(wi, w) cos(wi) L(wi) / p(wi) over n draws
-    (rejected draws count as 0), accumulated in chunks with Chan's pairwise update."""
+    (rejected draws count as 0), accumulated in chunks with Chan's pairwise update.
+    """
     count, mean, m2 = 0, 0.0, 0.0
     while count < n:
         m = min(chunk, n - count)
@@ -499,7 +508,9 @@ def _weights(f: BRDF, strat: Strategy, w: np.ndarray, n: int, rng, radiance=None
     return mean, math.sqrt(var / n)
 
 
-def mc_radiance(brdf: BRDF, wo, n: int, rng=None, radiance=None, *, kind: str = "lobe") -> tuple[float, float]:
+def mc_radiance(brdf: BRDF, wo: ArrayLike, n: int, rng: np.random.Generator | int | None = None,
+                radiance: Callable[[np.ndarray], ArrayLike] | None = None, *,
+                kind: str = "lobe") -> tuple[float, float]:
     """Monte Carlo estimate of the reflected radiance towards wo (000 eq. 17-18, 23-25).
 
     L_out(wo) = integral of L_in(wi) f_r(wi, wo) cos(theta_i) d omega_i, estimated with n
@@ -526,7 +537,8 @@ def mc_radiance(brdf: BRDF, wo, n: int, rng=None, radiance=None, *, kind: str = 
     return _weights(f, strategy(f, float(w[2]), kind), w, _check_n(n), _check_rng(rng), radiance)
 
 
-def mc_albedo(brdf: BRDF, mu, n: int, rng=None, *, kind: str = "lobe"):
+def mc_albedo(brdf: BRDF, mu: ArrayLike, n: int, rng: np.random.Generator | int | None = None, *,
+              kind: str = "lobe") -> tuple[float, float] | tuple[np.ndarray, np.ndarray]:
     """Monte Carlo estimate of the directional albedo a(mu) and its standard error.
 
     a(mu) = integral of f_r(wi, wo) cos(theta_o) d omega_o with wi = (sqrt(1 - mu^2), 0, mu)
@@ -592,7 +604,7 @@ class _SwappedRoles:
 
 class _MomentIntegrand(BRDF):
     """An integrand h(c, x) whose albedo at c (the engine integrates h cos(theta_x) over x) is a
-    moment of the sampling of x around c (x drawn with density p(x | c) of ``strategy``):
+    moment of the sampling of x around c (x drawn with density p(x | c) of ``strategy``), chosen by ``what``.
 
     * ``what = "second"``: h = f(c, x)^2 cos(theta_x) / p(x | c), albedo E[w^2] of mc_albedo;
     * ``what = "density"``: h = p(x | c) / cos(theta_x), albedo the acceptance probability.
@@ -693,8 +705,8 @@ def efficiency_dataset(ns=EFFICIENCY_N, theta_deg=EFFICIENCY_THETA, mu_grazing: 
     import xarray as xr
 
     from ._version import __version__
-    from .engine.cubature import albedo
     from .core import load
+    from .engine.cubature import albedo
 
     mu = np.concatenate([np.cos(np.radians(np.asarray(theta_deg, dtype=np.float64))), [mu_grazing]])
     models = ("phong", "stretched_phong")
@@ -717,7 +729,8 @@ def efficiency_dataset(ns=EFFICIENCY_N, theta_deg=EFFICIENCY_THETA, mu_grazing: 
               "theta": ("mu", theta, {"long_name": "viewing angle theta_V", "units": "degree"})}
     ds = xr.Dataset(
         {
-            "albedo": (dims, out["albedo"], {"long_name": "albedo a(V), the estimator's mean (L_in = 1)", "units": "1"}),
+            "albedo": (dims, out["albedo"], {"long_name": "albedo a(V), the estimator's mean (L_in = 1)",
+                                             "units": "1"}),
             "albedo_error": (dims, out["albedo_error"], {"long_name": "quadrature error estimate of albedo"}),
             "second_moment": (dims, out["second_moment"], {"long_name": "E[w^2], w = f cos(theta_L) / p(L)"}),
             "second_moment_error": (dims, out["second_moment_error"], {"long_name": "quadrature error of E[w^2]"}),
@@ -729,9 +742,10 @@ def efficiency_dataset(ns=EFFICIENCY_N, theta_deg=EFFICIENCY_THETA, mu_grazing: 
             "acceptance_error": (dims, out["acceptance_error"], {"long_name": "quadrature error of acceptance"}),
         },
         coords=coords,
-        attrs={"pumpup_kind": "pumpup sampling efficiency", "title": "Importance sampling efficiency of the Phong lobe (000 sec. 4.2)",
-               "method": "pumpup albedo engine on E[w], E[w^2] and the density (no Monte Carlo)",
-               "rtol": rtol, "sampler": "000 eq. 19-22: R around V with density (n+1)/(2 pi) cos^n, L = mirror of R",
+        attrs={"pumpup_kind": "pumpup sampling efficiency",
+               "title": "Importance sampling efficiency of the Phong lobe (000 sec. 4.2)",
+               "method": "pumpup albedo engine on E[w], E[w^2] and the density (no Monte Carlo)", "rtol": rtol,
+               "sampler": "000 eq. 19-22: R around V with density (n+1)/(2 pi) cos^n, L = mirror of R",
                "pumpup_version": __version__},
     )
     return ds

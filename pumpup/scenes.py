@@ -59,7 +59,8 @@ import time
 
 import numpy as np
 
-__all__ = ["SCENES", "F0", "METALS", "metal_index", "check_scene", "panels", "render_scene", "render_panel", "write_scene"]
+__all__ = ["SCENES", "F0", "METALS", "metal_index", "check_scene", "panels", "render_scene", "render_panel",
+           "write_scene"]
 
 #: normal-incidence reflectance of metals, linear RGB (Hoffman 2010 / Real-Time Rendering 3rd ed., Table 7.3);
 #: the scenes used it before the measured metals (:data:`METALS`); kept for comparison only
@@ -114,8 +115,7 @@ METALS = {"gold": "Au", "silver": "Ag", "copper": "Cu", "aluminium": "Al"}
 
 def metal_index(colour) -> tuple[list, list]:
     """(eta, k) per RGB channel of a scene metal: its measured index at ``spectral.RGB_WAVELENGTHS``."""
-    from .spectral import optical
-    from .spectral import RGB_WAVELENGTHS
+    from .spectral import RGB_WAVELENGTHS, optical
 
     eta, k = optical.constants(METALS[colour], list(RGB_WAVELENGTHS))
     return [float(x) for x in eta], [float(x) for x in k]
@@ -125,7 +125,8 @@ def metal(colour, n, kind):
     """The measured metal ``colour`` (a :data:`METALS` key) with exponent n, one spec per RGB channel:
     ``kind`` "phong" (F(Theta_min) x reciprocal Phong, 000 eq. 5), "stretched" (000 eq. 28) or "pumped"
     (F(Theta_min) x Phong pumped once with g1, 001 eq. 20; the colour-keeping pumped metal).  A
-    ``pumpup_mix`` material: [(rgb weight, [3 specs])]."""
+    ``pumpup_mix`` material: [(rgb weight, [3 specs])].
+    """
     if kind not in ("phong", "stretched", "pumped"):
         raise ValueError(f"kind must be 'phong', 'stretched' or 'pumped', got {kind!r}")
     eta, k = metal_index(colour)
@@ -190,7 +191,8 @@ def _mitsuba(variant="auto"):
         raise ImportError("path-traced scenes need Mitsuba 3: install the render extra, "
                           "pip install -e \".[render]\" (or pip install \"pumpup[render]\")") from None
     if variant not in (None, "auto") and not str(variant).endswith("_rgb"):
-        raise ValueError(f"variant must be 'auto' or an RGB Mitsuba variant (scalar_rgb, llvm_ad_rgb, ...), got {variant!r}")
+        raise ValueError("variant must be 'auto' or an RGB Mitsuba variant (scalar_rgb, llvm_ad_rgb, ...), got "
+                         f"{variant!r}")
     v = pm.register(None if variant in (None, "auto") else variant)
     if not v.endswith("_rgb"):  # an earlier mi.set_variant of a mono or spectral variant
         v = pm.register("llvm_ad_rgb")
@@ -392,7 +394,8 @@ def render_scene(name, spp=64, size=256, variant="auto", *, progress=True, out=s
 
 def write_scene(name, rows, out_dir, *, exposure=0.0, variant="", spp=0, exr=True):
     """Write each panel as linear EXR (R, G, B; unless ``exr`` is False) and the side-by-side PNG ``NAME.png``
-    (radiance x 2^exposure, sRGB transfer, clipped at 1); returns the paths."""
+    (radiance x 2^exposure, sRGB transfer, clipped at 1); returns the paths.
+    """
     from matplotlib.figure import Figure
 
     from .render import _atomic, srgb

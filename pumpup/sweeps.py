@@ -28,13 +28,17 @@ import shutil
 import sys
 import tempfile
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ._version import __version__
-from .engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
 from .core import BRDF, SpecError, load
+from .engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from numpy.typing import ArrayLike
 
 __all__ = ["SWEEP_KIND", "default_mu", "dimension_name", "sweep"]
 
@@ -118,7 +122,8 @@ def _check_pump(pump: Mapping | None) -> dict | None:
         raise SpecError(f"sweep: pump must be a dict like {{'g': 'g2', 'levels': 2}} or None, got {pump!r}")
     unknown = sorted(set(pump) - set(PUMP_KEYS))
     if unknown:
-        raise SpecError(f"sweep: unknown pump option(s) {', '.join(map(repr, unknown))}; allowed: {', '.join(PUMP_KEYS)}")
+        raise SpecError(f"sweep: unknown pump option(s) {', '.join(map(repr, unknown))}; allowed: "
+                        f"{', '.join(PUMP_KEYS)}")
     out = {"g": "g1", "levels": 1, **{k: _plain(v) for k, v in pump.items()}}
     if out["g"] not in ("g1", "g2"):
         raise SpecError(f"sweep: pump g must be 'g1' or 'g2', got {out['g']!r}")
@@ -137,7 +142,8 @@ def _chunk_shape(names: list[str], shape: tuple[int, ...], chunks) -> tuple[int,
         raise TypeError(f"sweep: chunks must be None, an int or a dict {{parameter: cells}}, got {chunks!r}")
     unknown = sorted(set(chunks) - set(names))
     if unknown:
-        raise ValueError(f"sweep: chunks names {', '.join(map(repr, unknown))}, which are not swept ({', '.join(names)})")
+        raise ValueError(f"sweep: chunks names {', '.join(map(repr, unknown))}, which are not swept "
+                         f"({', '.join(names)})")
     out = []
     for name, n in zip(names, shape):
         c = chunks.get(name, 1 if name != names[-1] else min(n, DEFAULT_CHUNK))
@@ -242,7 +248,8 @@ class _Parts:
     """The parts directory ``<out>.parts/`` of a sweep, locked (flock on the directory itself) for as
     long as the sweep runs, so that two sweeps to one ``out`` never run at once.  The manifest
     ``sweep.json`` is written with the first finished chunk (a sweep that never started, say its
-    scheduler was unreachable, leaves nothing behind); an existing manifest must match."""
+    scheduler was unreachable, leaves nothing behind); an existing manifest must match.
+    """
 
     def __init__(self, out: str, definition: dict, overwrite: bool = False):
         import fcntl
@@ -295,14 +302,16 @@ class _Parts:
 
     def abandon(self) -> None:
         """After a failure: release the lock; remove the directory if this sweep made it and
-        saved nothing into it."""
+        saved nothing into it.
+        """
         empty = self.created and self.saved == 0 and not any(n.startswith("chunk-") for n in os.listdir(self.directory))
         self.close(remove=empty)
 
 
 def definition_digest(definition: dict) -> str:
     """SHA-256 of what defines a sweep's result (spec, parameters, mu, pump, options): stored in
-    the result's attribute ``sweep_definition_sha256``."""
+    the result's attribute ``sweep_definition_sha256``.
+    """
     import hashlib
 
     def canon(v):  # 1 and 1.0 are the same parameter value
@@ -362,7 +371,8 @@ def warm_kernels(f: BRDF) -> None:
     signature by two threads at once, compile it twice and warn ("Compilation requested for
     previously compiled argument types"), once per sweep.  One value of the innermost base's
     albedo runs every kernel of the engine and the model (a pumped chain's own kernel compiles
-    under numba's lock)."""
+    under numba's lock).
+    """
     from .engine.cubature import albedo
     from .operators.pumping import Pumped
 
@@ -428,7 +438,8 @@ def _run_local(tasks, scheduler: str, workers: int | None, on_done) -> None:
 def _worker_init(parent: int) -> None:  # pragma: no cover - runs in the workers
     """In each worker process: ask the kernel (Linux prctl PR_SET_PDEATHSIG) for SIGTERM when the
     sweep's process dies, so that a killed sweep leaves no workers behind; ignore SIGINT (Ctrl-C
-    goes to the sweep, which ends the workers)."""
+    goes to the sweep, which ends the workers).
+    """
     import signal
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -473,10 +484,11 @@ def _run_distributed(tasks, client, address: str | None, on_done) -> None:
 # --------------------------------------------------------------------------------------------
 
 
-def sweep(spec: dict | str, params: Mapping[str, Sequence], mu=None, *, pump: Mapping | None = None,
-          client=None, scheduler: str | None = None, workers: int | None = None, chunks=None,
-          out: str | os.PathLike | None = None, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
-          mean: bool = True, maximum: bool = True, progress: bool | None = None, overwrite: bool = False):
+def sweep(spec: dict | str, params: Mapping[str, Sequence], mu: ArrayLike | None = None, *, pump: Mapping | None = None,
+          client: Any = None, scheduler: str | None = None, workers: int | None = None,
+          chunks: int | Mapping[str, int] | None = None, out: str | os.PathLike | None = None,
+          rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL, mean: bool = True, maximum: bool = True,
+          progress: bool | None = None, overwrite: bool = False) -> xr.Dataset:
     """Albedo tables over a grid of model parameters, computed in chunks through dask.
 
     Cell (v_1, ..., v_k) of the grid is the model ``pumpup.load(spec | {p_1: v_1, ...})``
@@ -722,8 +734,9 @@ def _dataset(spec, base, names, values, grid, pump, opts, arrays):
     }
     for n, d in zip(names, dims):
         p = cls.params[n]
-        coords[d] = (d, np.asarray(values[n]), {"parameter": n, "long_name": f"{spec['type']} parameter {n}" + (f": {p.doc}" if p.doc else ""),
-                                                "valid_range": p.range_text()})
+        coords[d] = (d, np.asarray(values[n]),
+                     {"parameter": n, "long_name": f"{spec['type']} parameter {n}" + (f": {p.doc}" if p.doc else ""),
+                      "valid_range": p.range_text()})
     return xr.Dataset(data, coords=coords, attrs={
         "title": f"Directional albedo of {spec['type']} over {', '.join(names)}"
                  + (f", pumped ({pump['g']}, {pump['levels']} levels)" if pump else ""),
@@ -746,7 +759,7 @@ def _dataset(spec, base, names, values, grid, pump, opts, arrays):
 
 
 def _write_output(ds, out) -> None:
-    """netCDF (atomic rename of a temporary file) or a zarr store (atomic rename of a temporary directory)."""
+    """A netCDF file (atomic rename of a temporary file) or a zarr store (atomic rename of a temporary directory)."""
     from .tables import write_table
 
     out = os.fspath(out)

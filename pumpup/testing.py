@@ -245,7 +245,8 @@ class Chi2Result:
 def _check_args(wo, n_samples, n_theta, n_phi, alpha, min_expected, ires, max_depth, pdf_rtol):
     wo = np.asarray(wo, dtype=float)
     if wo.ndim not in (1, 2) or wo.shape[-1] != 3 or wo.size == 0:
-        raise ValueError(f"wo must be a unit 3-vector (shape (3,)) or an array of them (shape (k, 3)); got shape {wo.shape}")
+        raise ValueError("wo must be a unit 3-vector (shape (3,)) or an array of them (shape (k, 3)); got shape "
+                         f"{wo.shape}")
     wo = np.atleast_2d(wo)
     if not np.all(np.isfinite(wo)):
         raise ValueError("wo must be finite")
@@ -450,7 +451,8 @@ def _pool(observed: np.ndarray, expected: np.ndarray, min_expected: float):
 
 def _pearson(observed: np.ndarray, expected: np.ndarray, min_expected: float):
     """Pearson's statistic after pooling (:func:`_pool`), its degrees of freedom, cells
-    pooled in and out.  A cell with observations but nothing expected makes it infinite."""
+    pooled in and out.  A cell with observations but nothing expected makes it infinite.
+    """
     o, e, pin, pout = _pool(observed, expected, min_expected)
     with np.errstate(divide="ignore", invalid="ignore"):
         terms = np.where(e > 0, (o - e) ** 2 / np.where(e > 0, e, 1.0), np.where(o > 0, np.inf, 0.0))
@@ -594,9 +596,9 @@ def chi2_test(
     shape = (k, n_theta, n_phi)
     res = {
         "p_values": np.full(k, np.nan), "statistics": np.full(k, np.nan), "dofs": np.zeros(k, dtype=int),
-        "passed_each": np.zeros(k, dtype=bool), "observed": np.zeros(shape, dtype=np.int64), "expected": np.zeros(shape),
-        "observed_rejected": np.zeros(k, dtype=np.int64), "expected_rejected": np.zeros(k), "pdf_integral": np.zeros(k),
-        "integration_error": np.zeros(k), "pdf_mismatches": np.zeros(k, dtype=np.int64),
+        "passed_each": np.zeros(k, dtype=bool), "observed": np.zeros(shape, dtype=np.int64),
+        "expected": np.zeros(shape), "observed_rejected": np.zeros(k, dtype=np.int64), "expected_rejected": np.zeros(k),
+        "pdf_integral": np.zeros(k), "integration_error": np.zeros(k), "pdf_mismatches": np.zeros(k, dtype=np.int64),
         "pooled_in": np.zeros(k, dtype=np.int64), "pooled_out": np.zeros(k, dtype=np.int64),
     }
     messages = []

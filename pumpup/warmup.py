@@ -11,9 +11,11 @@ from __future__ import annotations
 
 import sys
 import time
-from typing import Callable, TextIO
+from collections.abc import Callable
+from typing import TextIO
 
-#: the range of a first command's compile on a new machine (2 cores): seconds, as scripts/bench/bench_startup.py measures
+#: the range of a first command's compile on a new machine (2 cores): seconds, as scripts/bench/bench_startup.py
+#: measures
 COLD_SECONDS = (10, 60)
 
 NOTICE = ("pumpup: compiling pumpup's kernels for this machine, once: about {lo}-{hi} s "
@@ -25,7 +27,8 @@ _installed = False
 
 def notify_compiles(stream: TextIO | None = None) -> None:
     """Print :data:`NOTICE` on ``stream`` (stderr) once per process, before numba compiles a pumpup kernel
-    that is not in its on-disk cache.  Loading a cached kernel says nothing.  Imports numba."""
+    that is not in its on-disk cache.  Loading a cached kernel says nothing.  Imports numba.
+    """
     global _installed
     if _installed:
         return
@@ -51,7 +54,8 @@ def notify_compiles(stream: TextIO | None = None) -> None:
 
 def warmup_steps() -> list[tuple[str, Callable[[], object]]]:
     """(what, thunk) pairs that together compile the kernels of every command: the albedo of every
-    registered model's examples, tables, pumping (g1, g2, nested), compensation, sampling."""
+    registered model's examples, tables, pumping (g1, g2, nested), compensation, sampling.
+    """
     import numpy as np
 
     import pumpup
@@ -79,7 +83,8 @@ def warmup(progress: Callable[[str], None] | None = None) -> float:
     """Compile (or load from the cache) the kernels of every command; returns the seconds it took.
 
     ``progress`` is called with a line per step (``None``: silent).  A second call, or a call on a
-    machine whose cache is already full, takes a few seconds."""
+    machine whose cache is already full, takes a few seconds.
+    """
     t0 = time.perf_counter()
     steps = warmup_steps()
     for i, (what, thunk) in enumerate(steps, 1):

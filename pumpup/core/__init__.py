@@ -18,10 +18,16 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any, Callable, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from .hints import AzimuthHint
 
 __all__ = [
     "BRDF",
@@ -97,6 +103,9 @@ class Param:
     doc: str = ""
 
     def range_text(self) -> str:
+        """The allowed range as text: ``[lo, hi]`` with an open or infinite end in parentheses, or ``one of ...`` for
+        choices.
+        """
         if self.choices:
             return "one of " + ", ".join(repr(c) for c in self.choices)
         left = "(" if self.lo_open else "["
@@ -110,6 +119,9 @@ class Param:
         return f"{left}{lo}, {hi}{right}"
 
     def check_number(self, model: str, name: str, value: Any) -> float:
+        """``value`` as a float inside the range; otherwise a SpecError naming ``model`` and ``name`` (not a number,
+        beyond the float range, not finite, or out of range).
+        """
         if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
             raise SpecError(f"{model}: parameter {name!r} must be a number in {self.range_text()}, got {value!r}")
         try:
@@ -126,6 +138,9 @@ class Param:
         return v
 
     def check(self, model: str, name: str, value: Any) -> Any:
+        """``value`` checked and converted for the parameter's ``kind`` (float, int, bool, str, floats, or spec, which
+        is loaded); otherwise a SpecError naming ``model`` and ``name``.
+        """
         if self.kind == "float":
             return self.check_number(model, name, value)
         if self.kind == "int":
@@ -145,13 +160,15 @@ class Param:
             if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool):
                 value = [value]
             if not isinstance(value, (list, tuple, np.ndarray)) or len(value) == 0:
-                raise SpecError(f"{model}: parameter {name!r} must be a non-empty list of numbers in {self.range_text()}, got {value!r}")
+                raise SpecError(f"{model}: parameter {name!r} must be a non-empty list of numbers in "
+                                f"{self.range_text()}, got {value!r}")
             return [self.check_number(model, f"{name}[{i}]", v) for i, v in enumerate(value)]
         if self.kind == "spec":
             if isinstance(value, BRDF):
                 return value
             if not isinstance(value, dict):
-                raise SpecError(f"{model}: parameter {name!r} must be a model spec (a dict with a 'type'), got {value!r}")
+                raise SpecError(f"{model}: parameter {name!r} must be a model spec (a dict with a 'type'), got "
+                                f"{value!r}")
             f = load(value)
             if getattr(f, "is_spectral", False):  # pumped / kulla_conty / scaled over one are spectral themselves
                 raise SpecError(f"{model}: parameter {name!r} must be a single-channel model; a spectral spec (a "
@@ -207,12 +224,14 @@ class Lobe:
     @property
     def generic(self) -> bool:
         """Whether this is the hint of a model without one (:meth:`BRDF.lobe`'s default: about the normal, the cosine
-        map, not symmetric), which the 2-D engine's generic path integrates without trusting it."""
+        map, not symmetric), which the 2-D engine's generic path integrates without trusting it.
+        """
         return self.axis == "normal" and self.radial == "cosine" and not self.symmetric
 
-    def with_levels(self, *more) -> "Lobe":
-        """This hint with the levels of each iterable in ``more`` added (a factor of N.wo that the model multiplies
-        its base by: a pumped level's g, a scaled model's 1 / U, a Fresnel factor's F(Theta_min))."""
+    def with_levels(self, *more) -> Lobe:
+        """The same hint with the levels of each iterable in ``more`` added (a factor of N.wo that the model multiplies
+        its base by: a pumped level's g, a scaled model's 1 / U, a Fresnel factor's F(Theta_min)).
+        """
         return replace(self, levels=tuple(sorted(set(self.levels).union(*more))))
 
 
@@ -220,10 +239,10 @@ class Lobe:
 # The BRDF base class and the registry
 # ----------------------------------------------------------------------------------------
 
-_REGISTRY: dict[str, type["BRDF"]] = {}
+_REGISTRY: dict[str, type[BRDF]] = {}
 
 
-def register(name: str):
+def register(name: str) -> Callable[[type[BRDF]], type[BRDF]]:
     """Class decorator: make a BRDF class loadable as ``{"type": name, ...}``."""
 
     def deco(cls):
@@ -236,7 +255,7 @@ def register(name: str):
     return deco
 
 
-def registry() -> dict[str, type["BRDF"]]:
+def registry() -> dict[str, type[BRDF]]:
     """The registered model types, name -> class (a copy), in registration order."""
     _ensure_models()
     return dict(_REGISTRY)
@@ -279,14 +298,17 @@ def add_provider(module: str) -> None:
 
 
 def register_loader(applies: Callable[[Any], bool], loader: Callable[[Any], Any]) -> None:
-    """Let :func:`load` hand every spec for which ``applies(spec)`` is true to ``loader(spec)`` (before the registry)."""
+    """Let :func:`load` hand every spec for which ``applies(spec)`` is true to ``loader(spec)``
+    (before the registry).
+    """
     _LOADERS.append((applies, loader))
 
 
 def _ensure_models() -> None:
     """Import the provider modules (the package root's ``PROVIDERS`` first): their types register.  An imported one
     costs a look-up in ``sys.modules``; one that another thread is importing is waited for (the import lock), so no
-    thread sees a registry half filled."""
+    thread sees a registry half filled.
+    """
     global _PROVIDED
     if _PROVIDED:
         return
@@ -305,7 +327,8 @@ def _ensure_models() -> None:
 def slabs(shape: tuple, block: int):
     """Index tuples that cut an array of ``shape`` into pieces of about ``block`` elements or fewer
     along its leading axes (a whole trailing axis longer than ``block`` is cut too): indexing a
-    broadcast view with one of them gives a view whose copy costs at most a block."""
+    broadcast view with one of them gives a view whose copy costs at most a block.
+    """
     if not shape:
         yield ()
         return
@@ -324,7 +347,8 @@ def as_directions(w: Any, name: str) -> np.ndarray:
     """Check that ``w`` holds unit 3-vectors on its last axis; return it as float64.
 
     The check is one compiled pass (``pumpup.core.checks.first_bad``) with no temporaries, so its memory
-    does not grow with the array (the numpy check once allocated 1.5 GB for 1e8 directions)."""
+    does not grow with the array (the numpy check once allocated 1.5 GB for 1e8 directions).
+    """
     a = _as_vectors(w, name)
     check_directions(a, name)
     return a
@@ -332,7 +356,8 @@ def as_directions(w: Any, name: str) -> np.ndarray:
 
 def _as_vectors(w: Any, name: str) -> np.ndarray:
     """``w`` as a float64 array of 3-vectors on the last axis (no copy when it already is one); its
-    values are not looked at (:func:`check_directions` does that)."""
+    values are not looked at (:func:`check_directions` does that).
+    """
     try:
         a = np.asarray(w, dtype=np.float64)
     except (TypeError, ValueError) as exc:
@@ -344,7 +369,8 @@ def _as_vectors(w: Any, name: str) -> np.ndarray:
 
 def check_directions(a: np.ndarray, name: str) -> None:
     """Raise the ValueError of :func:`as_directions` (naming ``name``) if a row of the float64
-    array ``a`` (..., 3) is not finite or not of unit length within ``UNIT_TOL``."""
+    array ``a`` (..., 3) is not finite or not of unit length within ``UNIT_TOL``.
+    """
     from .checks import first_bad  # finiteness and unit length in one compiled pass
 
     lead = a.shape[:-1]
@@ -416,7 +442,7 @@ class BRDF:
             out[k] = v.spec if isinstance(v, BRDF) else v
         return out
 
-    def with_params(self, **changes: Any) -> "BRDF":
+    def with_params(self, **changes: Any) -> BRDF:
         """A copy of this model with some parameters changed."""
         s = self.spec
         s.update(changes)
@@ -432,7 +458,7 @@ class BRDF:
         return hash(json.dumps(self.spec, sort_keys=True))
 
     # --- evaluation -------------------------------------------------------------------
-    def eval(self, wi: Any, wo: Any) -> np.ndarray:
+    def eval(self, wi: ArrayLike, wo: ArrayLike) -> np.ndarray:
         """f_r(wi, wo) in 1/sr (no cosine factor), broadcast over the leading axes.
 
         Parameters
@@ -494,7 +520,8 @@ class BRDF:
     def _rows(self, wi: np.ndarray, wo: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         """(wi, wo) as (N, 3) views for ``rows_kernel``, or None to take the broadcasting kernel (no
         rows kernel, shapes that differ, a single vector, an argument that is not a C-contiguous float64
-        array)."""
+        array).
+        """
         if self.rows_kernel is None or not (isinstance(wi, np.ndarray) and isinstance(wo, np.ndarray)):
             return None
         if type(self)._eval is not BRDF._eval:  # a subclass that evaluates otherwise is never bypassed
@@ -517,7 +544,7 @@ class BRDF:
         """Scalar parameters passed to the compiled kernel after the 6 direction components."""
         return tuple(self.p[k] for k in self.params)
 
-    def reference(self, wi: Any, wo: Any) -> np.ndarray:
+    def reference(self, wi: ArrayLike, wo: ArrayLike) -> np.ndarray:
         """The plain numpy implementation, the readable reference for the kernel."""
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
@@ -533,7 +560,8 @@ class BRDF:
 
         Override where the quadrature hint's lobe has lighter tails than f (the weights
         f cos / p would then grow without bound): the sampling density must not fall off
-        faster than f."""
+        faster than f.
+        """
         return self.lobe(mu)
 
     #: True where the model draws its own incidence directions (:meth:`sample_wi`, :meth:`pdf_wi`, e.g. a paper's
@@ -542,38 +570,42 @@ class BRDF:
 
     def sample_wi(self, wo: np.ndarray, u1: np.ndarray, u2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The model's own sampling (where :attr:`own_sampler`): wi of shape (n, 3) drawn for one ``wo`` (3,) from the
-        uniform numbers ``u1``, ``u2`` (n,), and their density [1/sr]; a rejected draw is wi = 0 with density 0."""
+        uniform numbers ``u1``, ``u2`` (n,), and their density [1/sr]; a rejected draw is wi = 0 with density 0.
+        """
         raise NotImplementedError(f"{type(self).__name__} has no sampler of its own (own_sampler is False)")
 
     def pdf_wi(self, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
         """The density [1/sr] with which :meth:`sample_wi` draws ``wi`` (any leading shape) given ``wo`` (3,)."""
         raise NotImplementedError(f"{type(self).__name__} has no sampler of its own (own_sampler is False)")
 
-    def albedo_terms(self) -> list[tuple[float, "BRDF"]]:
+    def albedo_terms(self) -> list[tuple[float, BRDF]]:
         """Linear decomposition f = sum w_k f_k used by the engine (default: itself)."""
         return [(1.0, self)]
 
-    def albedo_breaks(self) -> tuple:
+    def albedo_breaks(self) -> tuple[float, ...]:
         """Incidences mu in (0, 1) where the albedo a(mu) has a kink, or a jump in a low derivative, that does not
         depend on wo (default: none), for a table's spline to be split there (``pumpup.tabulate``'s ``breaks``, the
         pumping operator's base tables, the compensation tables) and for :func:`pumpup.mean_albedo`'s first intervals
         to end there: a Fresnel factor's total reflection (:func:`pumpup.models.metal.fresnel_levels`), the jump of a''
         at mu = 1 / sqrt(2) of 001 eq. 10's geometry factor (:data:`pumpup.models.cook_torrance.RETRO_BREAK`).  A lobe
         that carries such a table in N.wo has a level at each (a pumped level's g, a 1/E scaling's U).  A pumped level's
-        own kinks come from the pumping operator (:meth:`albedo_kinks`)."""
+        own kinks come from the pumping operator (:meth:`albedo_kinks`).
+        """
         return ()
 
-    def albedo_kinks(self, lo: float = 0.0, hi: float = 1.0) -> list | None:
+    def albedo_kinks(self, lo: float = 0.0, hi: float = 1.0) -> list[float] | None:
         """Every incidence in (lo, hi) where a table of this model's albedo must split its spline: its
         :meth:`albedo_breaks`, sorted, or None where it has none (an operator adds the kinks it makes: a pumped
-        level's g changes its form at incidences that do not depend on wo)."""
+        level's g changes its form at incidences that do not depend on wo).
+        """
         out = sorted(v for v in self.albedo_breaks() if lo < v < hi)
         return out or None
 
-    def azimuth_hint(self):
+    def azimuth_hint(self) -> AzimuthHint | None:
         """An :class:`~pumpup.core.hints.AzimuthHint` (the model's family, its scale and factors) when the azimuth of
         the albedo integral is closed-form or a rule on known arcs: the routing table (:mod:`pumpup.engine.routes`) then
-        picks a 1-D route for it.  None (the default): the nested quadrature or the 2-D cubature."""
+        picks a 1-D route for it.  None (the default): the nested quadrature or the 2-D cubature.
+        """
         return None
 
     #: the relative error of :meth:`eval` where it is a truncated series (He-Torrance's), added to the albedo's error
@@ -584,27 +616,31 @@ class BRDF:
     #: to the integral exactly; None (the default) for a model without one
     delta_albedo = None
 
-    def sampling_terms(self, mu: float) -> list:
+    def sampling_terms(self, mu: float) -> list[tuple[float, BRDF]]:
         """[(weight, term)] to sample from at incidence mu: the albedo terms (the default), or terms weighted for
-        this mu (Kulla-Conty's mixture)."""
+        this mu (Kulla-Conty's mixture).
+        """
         return self.albedo_terms()
 
-    def slope_hint(self):
+    def slope_hint(self) -> tuple[float, float, float] | None:
         """(a_x, a_y, c) when the albedo is one ray integral per direction in slope space (anisotropic Ward, 000 eq.
-        33: the ``slope`` route, :mod:`pumpup.engine.slope`), else None (the default)."""
+        33: the ``slope`` route, :mod:`pumpup.engine.slope`), else None (the default).
+        """
         return None
 
-    def lobe_axis(self, mu: np.ndarray, phi: np.ndarray):
+    def lobe_axis(self, mu: np.ndarray, phi: np.ndarray) -> tuple[float, np.ndarray, np.ndarray] | None:
         """(n, nu, scale) when, seen from wi at (mu, phi), the model is a power lobe scale (A.wo)_+^n about an axis A at
         elevation nu = N.A > 0, with no other dependence on wi (the engine then takes the 1-D path about A,
-        :func:`pumpup.engine.polar.axis_albedo`), else None (the default)."""
+        :func:`pumpup.engine.polar.axis_albedo`), else None (the default).
+        """
         return None
 
     def azimuth_range(self) -> float | None:
         """None if the albedo does not depend on the azimuth phi of wi (an isotropic model, the
         default); otherwise the length P of an interval [0, P] of phi on which a(mu, phi) takes
         all its values: pi / 2 for a model that is symmetric under the reflections y -> -y and
-        x -> -x (anisotropy aligned with the tangent axes), 2 pi when nothing is known."""
+        x -> -x (anisotropy aligned with the tangent axes), 2 pi when nothing is known.
+        """
         return None
 
 
@@ -614,7 +650,7 @@ def split(w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a . b over the last axis, summed x + y + z in the same order as the numba kernels."""
+    """The dot product a . b over the last axis, summed x + y + z in the same order as the numba kernels."""
     return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
 
 
@@ -665,7 +701,8 @@ _SPECTRAL_LISTS = ("eta", "k", "ad", "a_s")
 def is_spectral_spec(spec: Any) -> bool:
     """True for a spec that :mod:`pumpup.spectral` builds: a ``metal`` or ``plastic`` with a
     ``material``, ``wavelengths`` or a per-wavelength list (``eta``, ``k``, ``ad``, ``a_s``), or a
-    ``pumped`` / ``kulla_conty`` / ``scaled`` spec whose base is one (or a spectral object)."""
+    ``pumped`` / ``kulla_conty`` / ``scaled`` spec whose base is one (or a spectral object).
+    """
     if getattr(spec, "is_spectral", False):
         return True
     if not isinstance(spec, dict):
@@ -721,7 +758,8 @@ def parse_spec(text: str) -> dict:
 
 def _split_items(text: str) -> list[str]:
     """``text`` cut at the commas outside brackets, so a short-form value may be a JSON list
-    (``"metal:n=20,eta=[0.2,0.4],k=[3,2],wavelengths=[650,550]"``)."""
+    (``"metal:n=20,eta=[0.2,0.4],k=[3,2],wavelengths=[650,550]"``).
+    """
     items, depth, start = [], 0, 0
     for i, ch in enumerate(text):
         if ch in "[{":
@@ -741,7 +779,7 @@ def _split_items(text: str) -> list[str]:
 
 
 def _show(value: Any) -> str:
-    """repr of a value, shortened to about 40 characters (an int of 400 digits names its length)."""
+    """The repr of a value, shortened to about 40 characters (an int of 400 digits names its length)."""
     r = repr(value)
     return r if len(r) <= 40 else f"{r[:20]}... ({len(r)} characters)"
 
@@ -760,7 +798,8 @@ def _as_real(func: str, name: str, value: Any, what: str) -> float:
 
 def check_tolerance(func: str, name: str, value: Any, hi: float = 1.0, zero: bool = False) -> float:
     """A tolerance (``rtol``, ``atol``, ...): a finite number in (0, hi] (``zero``: [0, hi], for an
-    absolute tolerance that may be switched off); else a SpecError naming it."""
+    absolute tolerance that may be switched off); else a SpecError naming it.
+    """
     what = f"a finite number in {'[' if zero else '('}0, {hi:g}]"
     v = _as_real(func, name, value, what)
     if not (0 <= v if zero else 0 < v) or not v <= hi:
@@ -863,7 +902,8 @@ ISOTROPY_PAIRS = 2000
 ISOTROPY_RTOL = 1e-9
 
 
-def from_function(fn: Callable, name: str = "function", reciprocal: bool = True, isotropic: bool = False) -> BRDF:
+def from_function(fn: Callable[[np.ndarray, np.ndarray], ArrayLike], name: str = "function", reciprocal: bool = True,
+                  isotropic: bool = False) -> BRDF:
     """Wrap a callable ``fn(wi, wo) -> f_r`` (numpy, broadcasting) as a BRDF.
 
     Parameters
@@ -879,14 +919,15 @@ def from_function(fn: Callable, name: str = "function", reciprocal: bool = True,
     isotropic : bool
         The caller's claim that f does not change when wi and wo turn together about N (it depends on them through
         N.wi, N.wo and wi.wo only): the albedo then does not depend on the azimuth of wi, and pumping tabulates it once
-        instead of bounding its supremum over that azimuth (:func:`pumpup.tables.azimuth.sup_albedo`: 16 tables or more).
-        Checked here: f at :data:`ISOTROPY_PAIRS` random pairs against the same pairs turned by random angles, which
-        must agree within :data:`ISOTROPY_RTOL` (relative); a ValueError names the largest change otherwise.
+        instead of bounding its supremum over that azimuth (:func:`pumpup.tables.azimuth.sup_albedo`: 16 tables or
+        more).  Checked here: f at :data:`ISOTROPY_PAIRS` random pairs against the same pairs turned by random angles,
+        which must agree within :data:`ISOTROPY_RTOL` (relative); a ValueError names the largest change otherwise.
 
     Examples
     --------
     >>> import numpy as np, pumpup
-    >>> f = pumpup.from_function(lambda wi, wo: np.full(np.broadcast_shapes(wi.shape, wo.shape)[:-1], 0.5 / np.pi), name="half_white")
+    >>> f = pumpup.from_function(lambda wi, wo: np.full(np.broadcast_shapes(wi.shape, wo.shape)[:-1], 0.5 / np.pi),
+    ...                          name="half_white")
     >>> float(f.eval([0, 0, 1], [0.6, 0, 0.8])) * np.pi
     0.5
     """
@@ -915,9 +956,9 @@ def from_function(fn: Callable, name: str = "function", reciprocal: bool = True,
         if change.max() > ISOTROPY_RTOL:
             i = int(np.argmax(change))
             _USER_FUNCTIONS.pop(name) if old is None else _USER_FUNCTIONS.__setitem__(name, old)
-            raise ValueError(f"from_function: isotropic=True, but {name!r} changes by {change[i]:.3g} (relative, allowed "
-                             f"{ISOTROPY_RTOL:g}) when wi={wi[i].tolist()}, wo={wo[i].tolist()} turn about N by "
-                             f"{turn[i]:.6g} rad: {float(a[i])!r} against {float(b[i])!r}")
+            raise ValueError(f"from_function: isotropic=True, but {name!r} changes by {change[i]:.3g} (relative, "
+                             f"allowed {ISOTROPY_RTOL:g}) when wi={wi[i].tolist()}, wo={wo[i].tolist()} turn about N "
+                             f"by {turn[i]:.6g} rad: {float(a[i])!r} against {float(b[i])!r}")
     return f
 
 

@@ -20,7 +20,8 @@ from numba import njit
 @njit(cache=True, nogil=True)
 def _first_bad(a, tol):  # pragma: no cover - compiled; see first_bad_reference
     """(row of the first non-finite component or -1, row of the first |w| off 1 by more than tol or
-    -1; -1 when a row is not finite) of an (N, 3) array, in one pass."""
+    -1; -1 when a row is not finite) of an (N, 3) array, in one pass.
+    """
     bad_norm = -1
     lo2 = (1.0 - tol) * (1.0 - tol)  # |w| in [1 - tol, 1 + tol]  <=>  |w|^2 in [lo2, hi2]
     hi2 = (1.0 + tol) * (1.0 + tol)
@@ -38,7 +39,8 @@ def _first_bad(a, tol):  # pragma: no cover - compiled; see first_bad_reference
 @njit(cache=True, nogil=True, inline="always")
 def off_unit(x, y, z, lo2, hi2):  # pragma: no cover - compiled; see off_unit_reference
     """True where |(x, y, z)|^2 is outside [lo2, hi2] (|w| off 1 by more than the tolerance), and
-    for every row with a NaN or an infinity (the comparisons fail)."""
+    for every row with a NaN or an infinity (the comparisons fail).
+    """
     n2 = x * x + y * y + z * z
     return not ((lo2 <= n2) & (n2 <= hi2))  # `&`, not `and`: no branch, the calling loops stay vectorized
 
@@ -67,7 +69,8 @@ def first_bad_reference(a: np.ndarray, tol: float) -> tuple[int, int]:
 
 def first_bad(a: np.ndarray, tol: float) -> tuple[int, int]:
     """(first non-finite row, first non-unit row), -1 where none, of the rows of ``a`` (..., 3),
-    counted in C order over the leading axes."""
+    counted in C order over the leading axes.
+    """
     flat = a.reshape(-1, 3)
     if not flat.flags.c_contiguous:
         flat = np.ascontiguousarray(flat)

@@ -3,8 +3,8 @@
 A model whose albedo integral has a closed-form azimuth (or one the engine takes by a rule on known arcs) returns an
 :class:`AzimuthHint` from :meth:`pumpup.core.BRDF.azimuth_hint`: the model's *family* (one of the records below, with
 typed parameters), the constant ``scale(mu)`` in front of it, and the *factors* of N.wo that operators multiply it by.
-The engine's routing table (:mod:`pumpup.engine.routes`) reads the hint and picks the route; a model or an operator never
-names a route.
+The engine's routing table (:mod:`pumpup.engine.routes`) reads the hint and picks the route; a model or an operator
+never names a route.
 
 Families (each a frozen record):
 
@@ -29,11 +29,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Union
 
 __all__ = [
-    "AshikhminShirleyLobe", "AzimuthHint", "ClosedForm", "DivideByG", "Fresnel", "FresnelAtMax", "HalfVectorLobe", "InverseAlbedoFactor",
-    "PowerLobe", "SchlickLobe", "SmithLobe", "VCavityLobe", "WardLobe",
+    "AshikhminShirleyLobe", "AzimuthHint", "ClosedForm", "DivideByG", "Fresnel", "FresnelAtMax", "HalfVectorLobe",
+    "InverseAlbedoFactor", "PowerLobe", "SchlickLobe", "SmithLobe", "VCavityLobe", "WardLobe",
 ]
 
 RADIAL_WEIGHTS = ("power", "beckmann", "ggx")
@@ -59,7 +58,8 @@ class Fresnel:
 @dataclass(frozen=True)
 class ClosedForm:
     """a(mu) = scale(mu) exactly; ``ulps`` the relative error of the scale in units of eps (or ``ulps(mu)``), as
-    bounded and measured for each closed form."""
+    bounded and measured for each closed form.
+    """
 
     ulps: float | Callable = 4.0
 
@@ -67,7 +67,8 @@ class ClosedForm:
 @dataclass(frozen=True)
 class PowerLobe:
     """u^n / max(N.wi, N.wo)^p with u = (R.wo)_+, R the mirror direction of wi (or wi itself: the integral is the
-    same), n >= 0, p in [0, 1]."""
+    same), n >= 0, p in [0, 1].
+    """
 
     n: float
     p: float = 0.0
@@ -83,7 +84,8 @@ class PowerLobe:
 class HalfVectorLobe:
     """w(N.h) / max(N.wi, N.wo)^p, p in {0, 1}: w = (N.h)^n ("power", the Blinn family, 000 eq. 31, 32), or the
     Beckmann weight exp(-tan^2(alpha) / n^2) (modified Ward, 000 eq. 35), or the GGX weight
-    1 / (1 + tan^2(alpha) / n^2)^2 (Walter et al. 2007 eq. 33)."""
+    1 / (1 + tan^2(alpha) / n^2)^2 (Walter et al. 2007 eq. 33).
+    """
 
     n: float
     p: float = 0.0
@@ -99,7 +101,8 @@ class HalfVectorLobe:
 @dataclass(frozen=True)
 class WardLobe:
     """Ward's lobe (000 eq. 34): the Beckmann weight exp(-tan^2(alpha) / m^2) divided by sqrt(N.wo) (its 1 / sqrt(N.wi)
-    in the scale)."""
+    in the scale).
+    """
 
     m: float
 
@@ -112,7 +115,8 @@ class WardLobe:
 class VCavityLobe:
     """The V-cavity microfacet model's D G F / (N.wi N.wo) (Cook-Torrance, 001 eq. 9-10; Torrance-Sparrow, 002 eq.
     10): D the radial weight of exponent or width ``n`` (with the Beckmann weight D's 1 / cos^4), F = 1 or ``fresnel``
-    at wi.h, 1 / N.wi in the scale."""
+    at wi.h, 1 / N.wi in the scale.
+    """
 
     n: float
     radial: str = "power"
@@ -127,7 +131,8 @@ class VCavityLobe:
 class SmithLobe:
     """A Smith microfacet model's D F G / (4 N.wi N.wo) (Walter et al. 2007 eq. 20): ``distribution`` "beckmann" or
     "ggx" of roughness ``alpha``, G1 "exact" or Walter's fit ("walter"), shadowing "separable" or "correlated", F = 1
-    or ``fresnel`` at wi.h; D's 1 / (pi alpha^2) and the 1 / 4 in the scale."""
+    or ``fresnel`` at wi.h; D's 1 / (pi alpha^2) and the 1 / 4 in the scale.
+    """
 
     distribution: str
     alpha: float
@@ -138,15 +143,17 @@ class SmithLobe:
     def __post_init__(self):
         if self.distribution not in ("beckmann", "ggx") or self.g1 not in ("exact", "walter") \
                 or self.shadowing not in ("separable", "correlated") or not self.alpha > 0.0:
-            _bad("SmithLobe", f"needs distribution 'beckmann' or 'ggx', g1 'exact' or 'walter', shadowing 'separable' or "
-                              f"'correlated' and alpha > 0, got {self.distribution!r}, {self.g1!r}, {self.shadowing!r}, "
-                              f"{self.alpha!r}")
+            _bad("SmithLobe",
+                 f"needs distribution 'beckmann' or 'ggx', g1 'exact' or 'walter', shadowing 'separable' or "
+                 f"'correlated' and alpha > 0, got {self.distribution!r}, {self.g1!r}, {self.shadowing!r}, "
+                 f"{self.alpha!r}")
 
 
 @dataclass(frozen=True)
 class SchlickLobe:
     """Schlick's model (000 eq. 36) with r in (0, 1]: the GGX weight with alpha = sqrt(r) and
-    1 / (r + (1 - r) N.wo) (its 1 / (r + (1 - r) N.wi) in the scale)."""
+    1 / (r + (1 - r) N.wo) (its 1 / (r + (1 - r) N.wi) in the scale).
+    """
 
     r: float
 
@@ -158,7 +165,8 @@ class SchlickLobe:
 @dataclass(frozen=True)
 class AshikhminShirleyLobe:
     """Ashikhmin and Shirley's isotropic lobe (N.h)^n F(wi.h) / ((wi.h) max(N.wi, N.wo)) with Schlick's
-    F(c) = rs + (1 - rs) (1 - c)^5 (AS 2000 eq. 4, 5); sqrt((nu + 1)(nv + 1)) / (8 pi) in the scale."""
+    F(c) = rs + (1 - rs) (1 - c)^5 (AS 2000 eq. 4, 5); sqrt((nu + 1)(nv + 1)) / (8 pi) in the scale.
+    """
 
     n: float
     rs: float
@@ -168,14 +176,15 @@ class AshikhminShirleyLobe:
             _bad("AshikhminShirleyLobe", f"needs n >= 0 and rs in [0, 1], got n={self.n!r}, rs={self.rs!r}")
 
 
-Family = Union[ClosedForm, PowerLobe, HalfVectorLobe, WardLobe, VCavityLobe, SmithLobe, SchlickLobe,
-               AshikhminShirleyLobe]
+Family = (ClosedForm | PowerLobe | HalfVectorLobe | WardLobe | VCavityLobe | SmithLobe | SchlickLobe
+          | AshikhminShirleyLobe)
 
 
 @dataclass(frozen=True)
 class DivideByG:
     """Pumping's divisor g_1 ... g_k (mu, N.wo) (001 eq. 16): ``lookups``, the compiled look-ups of every level's
-    bound (:class:`pumpup.physics.lookups.GChain`), and ``levels(mu)``, the values of N.wo where g has a kink."""
+    bound (:class:`pumpup.physics.lookups.GChain`), and ``levels(mu)``, the values of N.wo where g has a kink.
+    """
 
     lookups: tuple
     levels: Callable = field(compare=False)
@@ -184,7 +193,8 @@ class DivideByG:
 @dataclass(frozen=True)
 class InverseAlbedoFactor:
     """1/E compensation's factor 1 + f0 (1 / U(N.wo) - 1) (Turquin eq. 6): ``bound``, the arguments of the compiled
-    look-up U (a bounded spline of the white model's albedo), and ``levels(mu)``, U's kinks."""
+    look-up U (a bounded spline of the white model's albedo), and ``levels(mu)``, U's kinks.
+    """
 
     f0: float
     bound: tuple
@@ -199,14 +209,15 @@ class FresnelAtMax:
     k: float
 
 
-Factor = Union[DivideByG, InverseAlbedoFactor, FresnelAtMax]
+Factor = DivideByG | InverseAlbedoFactor | FresnelAtMax
 
 
 @dataclass(frozen=True)
 class AzimuthHint:
     """A model's family, its constant ``scale(mu)`` (an array of the shape of mu) and the factors of N.wo operators
     multiply it by.  The albedo is scale(mu) times the family's integral with the factors (for :class:`ClosedForm`,
-    scale(mu) itself)."""
+    scale(mu) itself).
+    """
 
     family: Family
     scale: Callable
@@ -222,5 +233,5 @@ class AzimuthHint:
         return next((f for f in self.factors if isinstance(f, kind)), None)
 
     def times(self, factor) -> AzimuthHint:
-        """This hint with one more factor."""
+        """The same hint with one more factor."""
         return replace(self, factors=(*self.factors, factor))

@@ -6,12 +6,20 @@ plain numpy reference (:func:`kink_breaks_reference`); :mod:`pumpup.engine.cubat
 from __future__ import annotations
 
 import math
+
 import numpy as np
 from numba import njit
 
 from ..core import Lobe
-from .lobe_geometry import AXIS_CODE, RADIAL_CODE, radial_map, radial_map_inverse, radial_map_scalar, smooth, smooth_inverse
-
+from .lobe_geometry import (
+    AXIS_CODE,
+    RADIAL_CODE,
+    radial_map,
+    radial_map_inverse,
+    radial_map_scalar,
+    smooth,
+    smooth_inverse,
+)
 
 #: horizon breaks whose map variable x or 1 - x is below this are the end itself (horizon_breaks)
 _BREAK_MIN = 1e-30
@@ -46,7 +54,8 @@ def tau_of_angle(lobe: Lobe, alpha: float) -> float | None:
     :data:`_BREAK_MIN`: x is the radial weight's measure, and a break there closes a region that weighs nothing (below x
     the integrand per unit x is at most about 1 / mu; beyond 1 - x, GGX's tail, about alpha / (mu sqrt(1 - x));
     Cook-Torrance m = 0.2 at mu = 0.359: x = 1.7e-315 put a break at tau_x = 2.4e-158, where the map's Jacobian
-    k^2 cos^3 / (2 x) overflowed; a break at 3e-56 would cost the nested engine 46 graded intervals)."""
+    k^2 cos^3 / (2 x) overflowed; a break at 3e-56 would cost the nested engine 46 graded intervals).
+    """
     x, xc = radial_map_inverse(lobe.radial, lobe.sharpness, alpha)
     return smooth_inverse(x, xc) if x > _BREAK_MIN and xc > _BREAK_MIN**2 else None
 
@@ -63,8 +72,8 @@ _END_GAP = 1e-10
 #: two cuts whose crossing function a_j b_k - a_k b_j stays within COINCIDENT eps S_j S_k at every node of the scan
 #: (S a bound of the magnitudes a cut's coefficients are computed from: |a| + |b| of a model's kink, |a0 - u| + |b0| +
 #: |u| of a level N.wo = u, |a0| + |b0| of the horizon) are one curve, computed twice: its "roots" are rounding noise.
-#: A pumped Cook-Torrance has the level N.wo = mu of g2 and g1 (:meth:`pumpup.operators.pumping.Pumped.kink_levels`) and the
-#: geometry factor's kink N.wo = mu (:func:`pumpup.models.cook_torrance._g_kinks`): 292 such breaks at mu = 0.5 gave
+#: A pumped Cook-Torrance has the level N.wo = mu of g2 and g1 (:meth:`pumpup.operators.pumping.Pumped.kink_levels`) and
+#: the geometry factor's kink N.wo = mu (:func:`pumpup.models.cook_torrance._g_kinks`): 292 such breaks at mu = 0.5 gave
 #: the nested engine 448 first intervals where the base model has 25, 40-60 x its evaluations (issue 14's
 #: twenty-fourth session)
 COINCIDENT = 64.0
@@ -86,7 +95,8 @@ def kink_breaks_reference(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossi
 
     def values(p_sel, tau):
         """(A, B): (n_cuts + 1, n) coefficients a + b cos(beta) of the cuts (the levels N.wo = u, then
-        the model's kinks) and, last, of the horizon N.wo = 0, for problems p_sel at tau."""
+        the model's kinks) and, last, of the horizon N.wo = 0, for problems p_sel at tau.
+        """
         m, lev = mu[p_sel], levels[p_sel]
         with np.errstate(all="ignore"):
             s = np.sqrt((1.0 - m) * (1.0 + m))
@@ -123,7 +133,7 @@ def kink_breaks_reference(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossi
     F = len(funcs)
 
     def h_rows(rows, tau):
-        """the function of each row (function rows // P, problem rows % P) at tau"""
+        """The function of each row (function rows // P, problem rows % P) at tau."""
         f_ = rows // P
         a_, b_ = values(rows % P, tau)
         i = np.arange(len(rows))
@@ -167,7 +177,8 @@ _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 def _roots_reference(h: np.ndarray, h_at) -> tuple[np.ndarray, np.ndarray]:
     """(problem, tau) of the roots of a function sampled as ``h`` (P, G) on ``_TAU_SCAN``, with
     ``h_at(p, tau)`` to evaluate it: every sign change between scan nodes and every pair of roots
-    around a local minimum of |h| (:func:`_touching_pairs_reference`), refined by bisection."""
+    around a local minimum of |h| (:func:`_touching_pairs_reference`), refined by bisection.
+    """
     ok = np.isfinite(h)
     p_idx, i_idx = np.nonzero(ok[:, :-1] & ok[:, 1:] & (np.sign(h[:, :-1]) * np.sign(h[:, 1:]) < 0))
     lo, hi = _TAU_SCAN[i_idx].copy(), _TAU_SCAN[i_idx + 1].copy()
@@ -252,7 +263,8 @@ _CHUNK = 8192
 @njit(cache=True, nogil=True)
 def _horizon_ab(axis, m, s, ca, sa):  # pragma: no cover - compiled
     """(a0, b0): N.wo = a0 + b0 cos(beta) on the arc around the lobe axis (``values`` of
-    :func:`kink_breaks_reference`, the same operations in the same order)."""
+    :func:`kink_breaks_reference`, the same operations in the same order).
+    """
     if axis == 0:  # normal
         return ca, 0.0
     if axis == 1 or axis == 2:  # mirror, retro
@@ -263,7 +275,8 @@ def _horizon_ab(axis, m, s, ca, sa):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True)
 def _cut_ab(c, L, K, a0, b0, lev, KA, KB, i):  # pragma: no cover - compiled
     """(a, b) of cut c: a level N.wo = lev[c] (c < L), the model's kink c - L (its coefficients in
-    column i of KA, KB), or the horizon (c = L + K)."""
+    column i of KA, KB), or the horizon (c = L + K).
+    """
     if c < L:
         return a0 - lev[c], b0
     if c < L + K:
@@ -276,7 +289,8 @@ def _scan_row(kind, j, k, sign, L, K, a0, b0, lev, KA, KB, base, h):  # pragma: 
     """The kink function (``kind``, cuts j and k, ``sign``; as :func:`_kink_h`) of one problem at the G
     nodes of the scan, into h: a0, b0 (G,) its horizon there, lev its levels, the model's kinks in
     columns base + g of KA, KB; one loop for each kind of cut j (and k), so that every loop vectorises
-    (the cuts of a crossing: j is a kink of the model, k a level, a kink or the horizon)."""
+    (the cuts of a crossing: j is a kink of the model, k a level, a kink or the horizon).
+    """
     G = h.shape[0]
     if kind == 0:
         if j < L:
@@ -309,7 +323,8 @@ def _scan_row(kind, j, k, sign, L, K, a0, b0, lev, KA, KB, base, h):  # pragma: 
 def _coincident(j, k, L, K, a0, b0, lev, KA, KB, base, h):  # pragma: no cover - compiled
     """Whether the crossing function of cuts j (a kink of the model) and k, ``h`` on the G nodes of the scan (from
     :func:`_scan_row`), is within rounding of 0 at every node where it is finite: the two cuts are one curve
-    (:data:`COINCIDENT`, the test of :func:`kink_breaks_reference`)."""
+    (:data:`COINCIDENT`, the test of :func:`kink_breaks_reference`).
+    """
     tol = COINCIDENT * _EPS
     for g in range(h.shape[0]):
         x = h[g]
@@ -331,7 +346,8 @@ def _coincident(j, k, L, K, a0, b0, lev, KA, KB, base, h):  # pragma: no cover -
 @njit(cache=True, nogil=True)
 def _kink_h(kind, j, k, sign, aj, bj, ak, bk):  # pragma: no cover - compiled
     """A kink function: a_j - sign b_j (kind 0: cut j enters or leaves the arc) or a_j b_k - a_k b_j
-    (kind 1: cuts j and k cross)."""
+    (kind 1: cuts j and k cross).
+    """
     if kind == 0:
         return aj - sign * bj
     return aj * bk - ak * bj
@@ -343,7 +359,8 @@ def _prepare_points(prob, tau, mu, s_p, radial, k, m, s, x, xc, ca, sa, rest):  
     of the problem, x and 1 - x of :func:`smooth`, and cos(alpha), sin(alpha) of :func:`radial_map`
     where the map is exact arithmetic and square roots (the cosine and GGX maps, the power map's
     tail x < 1/2: :func:`radial_map_scalar` gives numpy's bits there); ``rest`` marks the others (logs
-    and exponentials, left to numpy).  Returns how many those are."""
+    and exponentials, left to numpy).  Returns how many those are.
+    """
     n_rest = 0
     for i in range(prob.shape[0]):
         m[i] = mu[prob[i]]
@@ -376,7 +393,8 @@ def _cut_pair(f, p_, i, L, K, axis, m, s, ca, sa, KA, KB, levels, fj, fk):  # pr
 @njit(cache=True, nogil=True)
 def _kink_h_points(func, prob, L, K, axis, m, s, ca, sa, KA, KB, levels, kind, fj, fk, fs, out):  # pragma: no cover
     """The kink function ``func[i]`` of problem ``prob[i]`` at every point i (``h_rows`` of
-    :func:`kink_breaks_reference`)."""
+    :func:`kink_breaks_reference`).
+    """
     for i in range(func.shape[0]):
         f = func[i]
         aj, bj, ak, bk = _cut_pair(f, prob[i], i, L, K, axis, m, s, ca, sa, KA, KB, levels, fj, fk)
@@ -386,7 +404,8 @@ def _kink_h_points(func, prob, L, K, axis, m, s, ca, sa, KA, KB, levels, kind, f
 @njit(cache=True, nogil=True)
 def _crossings_on_arc(func, prob, L, K, axis, m, s, ca, sa, KA, KB, levels, fj, fk, out):  # pragma: no cover
     """Whether both cuts of function ``func[i]`` of problem ``prob[i]`` are on the arc (|a| <= |b|)
-    at point i."""
+    at point i.
+    """
     for i in range(func.shape[0]):
         aj, bj, ak, bk = _cut_pair(func[i], prob[i], i, L, K, axis, m, s, ca, sa, KA, KB, levels, fj, fk)
         out[i] = (abs(aj) <= abs(bj)) & (abs(ak) <= abs(bk))
@@ -407,7 +426,8 @@ def _scan_kernel(n_prob, p0, G, L, K, axis, mu, s_p, ca, sa, levels, KA, KB, kin
     candidates (row, interior node i, sign of h there, h at node i - 1), in the order of
     ``np.nonzero`` in :func:`_roots_reference` and :func:`_touching_pairs_reference` (for all
     problems at once: after a stable sort by row), as many as the arrays hold.  Returns the two
-    counts (the arrays were too short where they exceed them)."""
+    counts (the arrays were too short where they exceed them).
+    """
     P = mu.shape[0]
     A0 = np.empty((P, G))
     B0 = np.empty((P, G))
@@ -456,9 +476,10 @@ def _scan_kernel(n_prob, p0, G, L, K, axis, mu, s_p, ca, sa, levels, KA, KB, kin
 
 @njit(cache=True, nogil=True)
 def _bisect_points(lo, hi, pts):  # pragma: no cover - compiled
-    """pts (n, 2^d - 1): the midpoints of the next d bisection steps of every bracket [lo, hi] for
+    """Fills ``pts`` (n, 2^d - 1) with the midpoints of the next d bisection steps of every bracket [lo, hi] for
     either outcome of each step, as a heap (node q's children: 2 q + 1 where the root is above the
-    midpoint, 2 q + 2 where below)."""
+    midpoint, 2 q + 2 where below).
+    """
     nn = pts.shape[1]
     tlo = np.empty(nn)
     thi = np.empty(nn)
@@ -480,7 +501,8 @@ def _bisect_points(lo, hi, pts):  # pragma: no cover - compiled
 def _bisect_walk(lo, hi, h_lo, rem, pts, hv):  # pragma: no cover - compiled
     """Up to d steps of bisection of every bracket with the values ``hv`` at the points of
     :func:`_bisect_points` (as the loop of :func:`_roots_reference`); ``rem`` counts the steps left,
-    and is set to 0 where a step changes nothing (lo and hi adjacent: so would every later step)."""
+    and is set to 0 where a step changes nothing (lo and hi adjacent: so would every later step).
+    """
     depth = 0
     while (1 << (depth + 1)) - 1 <= pts.shape[1]:
         depth += 1
@@ -506,9 +528,10 @@ def _bisect_walk(lo, hi, h_lo, rem, pts, hv):  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True)
 def _golden_points(a, b, pts):  # pragma: no cover - compiled
-    """pts (n, 2 (2^d - 1)): the points x1, x2 of the next d steps of the golden-section search of
+    """Fills ``pts`` (n, 2 (2^d - 1)) with the points x1, x2 of the next d steps of the golden-section search of
     every [a, b] for either outcome of each step (a heap as in :func:`_bisect_points`; child 2 q + 1
-    keeps the left part [a, x2], child 2 q + 2 the right part [x1, b])."""
+    keeps the left part [a, x2], child 2 q + 2 the right part [x1, b]).
+    """
     nn = pts.shape[1] // 2
     ta = np.empty(nn)
     tb = np.empty(nn)
@@ -533,7 +556,8 @@ def _golden_walk(a, b, s0, rem, pts, hv, found, h_found):  # pragma: no cover - 
     """Up to d steps of the golden-section search of every candidate with the values ``hv`` at the
     points of :func:`_golden_points` (as the loop of :func:`_touching_pairs_reference`): the first
     point where sign(h_i) h < 0 (x1 before x2) is ``found`` (h there in ``h_found``), and ``rem``, the
-    steps left, is set to 0."""
+    steps left, is set to 0.
+    """
     depth = 0
     while (1 << (depth + 1)) - 1 <= pts.shape[1] // 2:
         depth += 1
@@ -577,7 +601,8 @@ def _refine(h_at, b_row, b_lo, b_hi, b_h, c_row, c_lo, c_hi, c_s0, c_h):
 
     All searches advance together, one call of ``h_at`` per round; a bracket whose step changes
     nothing (adjacent floats) is done, a candidate is done when found, and its two brackets start
-    at the next round."""
+    at the next round.
+    """
     nb0, nc = len(b_row), len(c_row)
     rows, lo, hi, h_lo = b_row.copy(), b_lo.copy(), b_hi.copy(), b_h.copy()
     rem = np.full(nb0, _BISECT_STEPS, np.int64)
@@ -672,7 +697,7 @@ def kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool 
         s_p = np.sqrt((1.0 - mu) * (1.0 + mu))
 
     def kink_coefficients(m, s, ca, sa, KA, KB):
-        """the model's kinks at the points (numpy: ``Lobe.kinks`` is the model's) into KA, KB (K, n)"""
+        """The model's kinks at the points (numpy: ``Lobe.kinks`` is the model's) into KA, KB (K, n)."""
         if K:
             with np.errstate(all="ignore"):
                 for q, (a, b) in enumerate(lobe.kinks(m, s, ca, sa)):
@@ -714,7 +739,7 @@ def kink_breaks(lobe: Lobe, mu: np.ndarray, levels: np.ndarray, crossings: bool 
     buf_k = np.empty((2, K, n_buf))  # the model's kinks
 
     def at_points(prob, tau):
-        """(m, s, ca, sa, KA, KB) at the points (problem prob, tau); at most _CHUNK of them"""
+        """(m, s, ca, sa, KA, KB) at the points (problem prob, tau); at most _CHUNK of them."""
         n = len(prob)
         m, s, x, xc, ca, sa = buf_v[:, :n]
         rest = buf_rest[:n]

@@ -7,34 +7,31 @@ from __future__ import annotations
 
 import functools
 import math
+
 import numpy as np
 from numba import njit
 
 from ..physics.fresnel import conductor_scalar as _fresnel_real
-from ..physics.fresnel import fresnel_branch
-from ..physics.fresnel import fresnel_pole
-from ..physics.lookups import g_levels
-from ..physics.lookups import g_product
-from ..physics.quadrature import EPS
-from ..physics.quadrature import calibrated
-from ..physics.quadrature import rule_sums
+from ..physics.fresnel import fresnel_branch, fresnel_pole
+from ..physics.lookups import g_levels, g_product
+from ..physics.quadrature import EPS, calibrated, rule_sums
 from .half_arc import LOBE_F_CUTS
 from .lobe_frame import INNER_MAX, _tally
 from .lobe_fresnel import LOBE_F_WIDE
 from .outer_rule import _RULES, _bisect, _buffers, _status
 
-
 #: a lobe with 000 eq. 28's F(Theta_min) (metal, the fresnel wrapper of a lobe) is integrated about N (the pumped lobe's
-#: frame with g = 1, :func:`_integrate_chain`) for n at least this, and in the lobe frame (frame 5) below it, where the ring
-#: table leaves the pieces next to kappa = 1 to quadrature and the elevation is graded towards x_s (measured: n = 1 took 4 x
-#: frame 5's time, n = 7.5 0.8 x, n = 20 0.17 x)
+#: frame with g = 1, :func:`_integrate_chain`) for n at least this, and in the lobe frame (frame 5) below it, where the
+#: ring table leaves the pieces next to kappa = 1 to quadrature and the elevation is graded towards x_s (measured: n = 1
+#: took 4 x frame 5's time, n = 7.5 0.8 x, n = 20 0.17 x)
 LOBE_N_MIN = 8.0  # (RING_SMOOTH_N)
 
 
 @njit(cache=True, nogil=True, inline="always")
 def _ring_f(n, kappa, phi):  # pragma: no cover - compiled
     """(1 - kappa sin^2(phi / 2))_+^n as exp(n log1p(-kappa sin^2(phi / 2))): accurate for any n (a power
-    of A + B cos(phi) lost n ulp, 2.2e-13 for n = 2000, measured)."""
+    of A + B cos(phi) lost n ulp, 2.2e-13 for n = 2000, measured).
+    """
     sp = math.sin(0.5 * phi)
     omu = kappa * sp * sp
     return math.exp(n * math.log1p(-omu)) if omu < 1.0 else 0.0
@@ -60,7 +57,8 @@ def _ring_quad(n, kappa, itol, nodes, wk, wg, ibuf, iwork):  # pragma: no cover 
     The half-arc is cut at sigma (1, 2, 3, 4, 6, 8, 11, 15, ...) until the rest is at most
     (phi0 - c) f(c) <= 1e-18 sigma f(sigma) (f decreases: a bound, added to the error, its value left
     out): a rule on a piece that starts several widths out sees zeros at its nodes (n = 1e6,
-    kappa = 0.95, with one piece beyond 4 sigma: 6.3e-5 off, estimate 2.6e-15)."""
+    kappa = 0.95, with one piece beyond 4 sigma: 6.3e-5 off, estimate 2.6e-15).
+    """
     phi0 = math.pi if kappa <= 1.0 else 2.0 * math.asin(1.0 / math.sqrt(kappa))
     if n == 0.0:
         return 2.0 * phi0, 8.0 * EPS * phi0
@@ -112,7 +110,8 @@ def _ring_values(n, kappa, itol, nodes, wk, wg):  # pragma: no cover - compiled
 def _ring_at(kappa, kb, kc, keps):  # pragma: no cover - compiled
     """(V(kappa), its error) from the table of :func:`ring_table`: the piece by bisection of the
     breaks ``kb``, its Chebyshev series ``kc[piece]`` by Clenshaw's recurrence.  Inlined where it is
-    called."""
+    called.
+    """
     a = 0
     b = kb.shape[0] - 1
     while b - a > 1:
@@ -152,7 +151,8 @@ def ring_table(n: float) -> tuple:
     twice its largest miss, plus the values' own quadrature error (:data:`RING_QUAD_RTOL`), plus 4 ulp.  Near
     kappa = 1, where the arc stops being the whole circle, V has a term |kappa - 1|^(n + 1/2): a
     piece narrower than :data:`RING_MIN_WIDTH` that still misses gets the error -1, which tells the
-    kernel to compute V there by quadrature.  Cached per n."""
+    kernel to compute V there by quadrature.  Cached per n.
+    """
     n = float(n)
     deg = RING_DEGREE
     if n == 0.0:  # (V = 2 phi0 in closed form, :func:`_x_rule`: no table)
@@ -201,7 +201,8 @@ def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, 
     the ring table (:func:`ring_table`, its errors summed with the Kronrod weights); with ``fr`` = (1, eta, k) times
     000 eq. 28's F(max(mu, t)) (a pumped metal, or the fresnel wrapper of a pumped lobe).  Without a chain (None: g = 1,
     a metal's lobe, :func:`chain_cut_matrix`) the error is QUADPACK's calibration of |K - G| (``mode``) instead of
-    CHAIN_SAFETY |K - G| (which is for g's splines)."""
+    CHAIN_SAFETY |K - G| (which is for g's splines).
+    """
     h = hi - lo
     ie = 0.0
     xmu = math.atan2(mu, s)
@@ -256,10 +257,12 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
     """Adaptive 10/21 quadrature over the elevation of wo of a pumped lobe (:func:`_x_rule`) for every
     mu, from the pieces between ``cuts[q, :ncut[q]]`` (:func:`chain_cuts`), each ``n_init`` intervals to
     start; ``kb``, ``kc``, ``keps`` the ring table of the lobe's exponent (:func:`ring_table`); ``fr`` the Fresnel
-    factor's (on, eta, k) (:func:`_x_rule`)."""
-    # (room for every piece's first intervals besides max_intervals bisections: a pumped metal near grazing incidence has
-    # ~100 pieces, more than the 64 spare slots)
-    cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals + cuts.shape[1] * n_init, nodes, nodes, rtol)
+    factor's (on, eta, k) (:func:`_x_rule`).
+    """
+    # (room for every piece's first intervals besides max_intervals bisections: a pumped metal near grazing incidence
+    # has ~100 pieces, more than the 64 spare slots)
+    cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals + cuts.shape[1] * n_init, nodes, nodes,
+                                                               rtol)
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -273,7 +276,8 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
                 pk[m] = i
                 t0[m] = a_ + (b_ - a_) * j / n_init
                 t1[m] = a_ + (b_ - a_) * (j + 1.0) / n_init if j + 1 < n_init else b_
-                kv[m], ke[m] = _x_rule(n, p, mu, s, t0[m], t1[m], chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr, mode)
+                kv[m], ke[m] = _x_rule(n, p, mu, s, t0[m], t1[m], chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork,
+                                       fr, mode)
                 m += 1
         start = m
         while True:
@@ -283,7 +287,8 @@ def _integrate_chain(n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, node
             if ok or m - start >= max_intervals or m >= cap:
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
-            kv[worst], ke[worst] = _x_rule(n, p, mu, s, a_, mid, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr, mode)
+            kv[worst], ke[worst] = _x_rule(n, p, mu, s, a_, mid, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork,
+                                           fr, mode)
             kv[m], ke[m] = _x_rule(n, p, mu, s, mid, b_, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, iwork, fr, mode)
             m += 1
         val[q] = tot
@@ -300,8 +305,9 @@ def chain_cuts(levels, n: float, mu: float, fresnel=None, chain: bool = True) ->
     n < :data:`RING_SMOOTH_N` a grading towards x_s; with ``fresnel`` = (eta, k), N.wo = x0 -+ y0 3^j about F's branch
     point and rho 3^j towards its pole near 0 (as frame 5's arcs, :func:`_k_lobe_fresnel`; the pole's only where rho <
     :data:`LOBE_F_WIDE`); x = atan2(L, sqrt(1 - L^2)) keeps levels near 1 to full precision.  ``chain`` False (a metal's
-    lobe about N, g = 1): without g's grading in N.wo and the pi / 16 cuts.  The engine computes them compiled, for every
-    mu at once (:func:`chain_cut_matrix`); this is their reference."""
+    lobe about N, g = 1): without g's grading in N.wo and the pi / 16 cuts.  The engine computes them compiled, for
+    every mu at once (:func:`chain_cut_matrix`); this is their reference.
+    """
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     L = np.asarray(levels, dtype=np.float64).reshape(-1)
     L = L[(L > 0.0) & (L < 1.0)]
@@ -347,10 +353,11 @@ CHAIN_CUTS_ROOM = 96
 
 @njit(cache=True, nogil=True)
 def _chain_cut_matrix(n, mu_arr, lev, nlev, chain, fres, x0, y0, rho):  # pragma: no cover - compiled; see chain_cuts
-    """(cut, ncut): :func:`chain_cuts` for every mu, compiled (it was a quarter to a half of a pumped or 1/E-scaled table's
-    time in Python): the levels ``lev[q, :nlev[q]]``, ``chain`` (g's grading in N.wo and the pi / 16 cuts), with ``fres``
-    F's branch point x0 - i y0 and pole scale rho (:func:`fresnel_branch`, :func:`fresnel_pole`); sorted, duplicates
-    dropped, as chain_cuts (np.unique) has them."""
+    """(cut, ncut): :func:`chain_cuts` for every mu, compiled (it was a quarter to a half of a pumped or 1/E-scaled
+    table's time in Python): the levels ``lev[q, :nlev[q]]``, ``chain`` (g's grading in N.wo and the pi / 16 cuts), with
+    ``fres`` F's branch point x0 - i y0 and pole scale rho (:func:`fresnel_branch`, :func:`fresnel_pole`); sorted,
+    duplicates dropped, as chain_cuts (np.unique) has them.
+    """
     half = 0.5 * math.pi
     cap = CHAIN_CUTS_ROOM + lev.shape[1]
     cut = np.zeros((mu_arr.shape[0], cap))
@@ -411,7 +418,8 @@ def _chain_cut_matrix(n, mu_arr, lev, nlev, chain, fres, x0, y0, rho):  # pragma
 
 def chain_cut_matrix(levels, n: float, mu: np.ndarray, fresnel=None, chain: bool = True) -> tuple:
     """(cut, ncut): :func:`chain_cuts` (``levels(mu)`` or, with None, no levels) at every mu, by the compiled
-    :func:`_chain_cut_matrix`."""
+    :func:`_chain_cut_matrix`.
+    """
     mu = np.ascontiguousarray(mu, dtype=np.float64)
     if levels is None:
         lev, nlev = np.zeros((mu.size, 0)), np.zeros(mu.size, np.int64)

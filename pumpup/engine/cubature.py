@@ -45,17 +45,33 @@ measured below the true error (``pumpup.physics.quadrature.MODE_2D`` switches it
 from __future__ import annotations
 
 import math
-import numpy as np
 import warnings
-from dataclasses import dataclass
-from dataclasses import replace
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+import numpy as np
 from numba import njit
 
-from ..core import BRDF
-from ..core import Lobe
+from ..core import BRDF, Lobe
 from .arc_breaks import graded, horizon_breaks, kink_breaks
-from .lobe_geometry import NODES, WG, WK, AXES, AXIS_CODE, RADIAL_CODE, accumulate, kink_coefficients, radial_map, radial_map_scalar, rotate_wi, lobe_rounding, smooth
+from .lobe_geometry import (
+    AXES,
+    AXIS_CODE,
+    NODES,
+    RADIAL_CODE,
+    WG,
+    WK,
+    accumulate,
+    kink_coefficients,
+    lobe_rounding,
+    radial_map,
+    radial_map_scalar,
+    rotate_wi,
+    smooth,
+)
 
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = ["albedo", "check_mu", "check_phi", "AlbedoWarning"]
 
@@ -168,7 +184,8 @@ def _geometry_reference(lobe: Lobe, mu, levels, ka, kb, piece, tx, tt):
 @njit(cache=True, nogil=True, inline="always")
 def _sort_interior(x, n):  # pragma: no cover - compiled
     """Insertion sort of x[1:n - 1] in place (the cuts between an arc's two ends x[0] and x[n - 1]: a
-    few, already nearly sorted; no allocation)."""
+    few, already nearly sorted; no allocation).
+    """
     for a in range(2, n - 1):
         val = x[a]
         b = a - 1
@@ -298,7 +315,8 @@ def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
 
     err is the error estimate of the rectangle, |K - G| (or, when ``pumpup.physics.quadrature.MODE_2D``
     asks for it, QUADPACK's calibration of it: not the default, see the module docstring);
-    ex and et, the same for the Gauss rule in x only and in t only, choose the split direction."""
+    ex and et, the same for the Gauss rule in x only and in t only, choose the split direction.
+    """
     from ..physics.quadrature import calibrated_array, mode_code
 
     mode = mode_code(smooth=False)  # raw |K - G| unless pumpup.physics.quadrature.MODE_2D says otherwise
@@ -393,7 +411,8 @@ def _level_end_scales(lobe: Lobe, mu: float, levels: np.ndarray, gx: np.ndarray,
 def _first_rectangles_t(d: np.ndarray, gt: np.ndarray):
     """The first intervals of tau_t of pieces whose upper end has the scale ``d`` (any shape S, see
     :func:`_level_end_scales`): the grid ``gt`` and, where d < D_GRADE, breaks 1 - d 4^k graded
-    towards the end.  Returns (index into S.ravel(), t0, t1)."""
+    towards the end.  Returns (index into S.ravel(), t0, t1).
+    """
     d = d.ravel()
     kk = 4.0 ** np.arange(K_GRADE)
     need = d < D_GRADE
@@ -431,7 +450,8 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
         diff = np.abs(v1 - v2)
         return v2, np.maximum(e1, e2) + diff, c1 & c2 & (diff <= np.maximum(rtol * np.abs(v2), atol))
     P = len(g.mu)
-    n_pieces = 1 + g.levels.shape[1] + (len(g.lobe.kinks(np.array([0.5]), np.array([0.5]), np.array([0.5]), np.array([0.5]))) if g.lobe.kinks else 0)
+    n_pieces = 1 + g.levels.shape[1] + (
+        len(g.lobe.kinks(np.array([0.5]), np.array([0.5]), np.array([0.5]), np.array([0.5]))) if g.lobe.kinks else 0)
     nx = NX_INIT if not g.lobe.generic else (8 if grid is None else grid[0])
     nt = NT_INIT if not g.lobe.generic else (8 if grid is None else grid[1])
     # initial rectangles: nx x nt per piece per problem, with the x grid also split where
@@ -450,7 +470,8 @@ def _integrate_group(brdf: BRDF, g: _Group, rtol: float, atol: float, max_region
         # and, near normal incidence on a microfacet lobe, towards both horizon breaks on the roughness's scale
         # (``pumpup.engine.nested._alpha_grading``: G1(wo) falls to 0 within alpha of the horizon; GGX alpha = 2.7e-4 at
         # mu = 1 was 2.6e-11 off with an estimate of 4.1e-13, 62 x, before)
-        gx = np.unique(np.concatenate([np.linspace(0, 1, nx + 1), graded(breaks), _alpha_grading(g.lobe, float(g.mu[p_]))]))
+        gx = np.unique(np.concatenate([np.linspace(0, 1, nx + 1), graded(breaks),
+                                       _alpha_grading(g.lobe, float(g.mu[p_]))]))
         # and the pieces that end at the cut of a small level graded towards it in tau_t
         # (_level_end_scales: the near-singularity there is invisible to both rules)
         d = _level_end_scales(g.lobe, float(g.mu[p_]), g.levels[p_], gx, n_pieces)
@@ -517,7 +538,8 @@ def _turned_lobe(brdf: BRDF, lobe: Lobe, phi: float) -> Lobe:
     (the "normal" and "half" frames) and the model's anisotropy is aligned with the tangent axes
     (``azimuth_range() == pi / 2``), the model's x and y axes as breakpoints of beta: a lobe that is
     narrow across one axis is a ridge along it, which at phi = 0 lies on the ends of the beta range
-    and otherwise would fall inside a piece unseen (ward_aniso ax = 1000, ay = 1e-6 gave 0 at mu = 1)."""
+    and otherwise would fall inside a piece unseen (ward_aniso ax = 1000, ay = 1e-6 gave 0 at mu = 1).
+    """
     lobe = replace(lobe, symmetric=False)
     rng = brdf.azimuth_range()
     if lobe.axis not in ("normal", "half") or rng is None or abs(rng - math.pi / 2) > 1e-15:
@@ -540,7 +562,8 @@ def _turned_lobe(brdf: BRDF, lobe: Lobe, phi: float) -> Lobe:
 
 def _groups(brdf: BRDF, mu: np.ndarray, phi: np.ndarray | None = None):
     """Group the values of mu by the structure of their Lobe hint (and whether wi leaves the
-    xz-plane: ``phi`` != 0, where the hint's symmetry in beta no longer holds)."""
+    xz-plane: ``phi`` != 0, where the hint's symmetry in beta no longer holds).
+    """
     by_key: dict = {}
     for i, m in enumerate(mu):
         lobe = brdf.lobe(float(m))
@@ -565,8 +588,9 @@ def _groups(brdf: BRDF, mu: np.ndarray, phi: np.ndarray | None = None):
             yield idx, _Group(lobe=lobe, mu=mu[idx], levels=lev)
 
 
-def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
-           max_regions: int = 20000, phi=0.0, engine: str | None = None):
+def albedo(brdf: BRDF, mu: ArrayLike, return_error: bool = False, rtol: float = DEFAULT_RTOL,
+           atol: float = DEFAULT_ATOL, max_regions: int = 20000, phi: ArrayLike = 0.0,
+           engine: str | None = None) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """Directional albedo a(mu) of ``brdf`` (000 eq. 2; Lewis's k_rho, 002 eq. 15).
 
     a(mu, phi) = integral over the hemisphere of f_r(wi, wo) cos(theta_o) d omega_o, with
@@ -623,7 +647,8 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
     if not isinstance(brdf, BRDF):
         if getattr(brdf, "is_spectral", False):  # pumpup.spectral: one albedo per wavelength, on a trailing axis
             return brdf.albedo(mu, return_error=return_error, rtol=rtol, atol=atol, max_regions=max_regions, phi=phi)
-        raise TypeError(f"albedo needs a pumpup BRDF, got {type(brdf).__name__}; wrap functions with pumpup.from_function")
+        raise TypeError(f"albedo needs a pumpup BRDF, got {type(brdf).__name__}; wrap functions with "
+                        "pumpup.from_function")
     from ..core import check_count, check_tolerance
 
     rtol = check_tolerance("albedo", "rtol", rtol)
@@ -660,7 +685,8 @@ def albedo(brdf: BRDF, mu, return_error: bool = False, rtol: float = DEFAULT_RTO
             elif route == "nested":
                 v, e, conv = nested.integrate(term, payload, rtol, atol, max_regions)
             elif route == "cubature":
-                v, e, conv = _integrate_group(term, payload, rtol, atol, max_regions, generic_check=choice.generic_check)
+                v, e, conv = _integrate_group(term, payload, rtol, atol, max_regions,
+                                              generic_check=choice.generic_check)
             else:  # the 1-D routes of the model's azimuth hint (pumpup.engine.polar)
                 v, e, conv, _ = polar.run(route, payload, flat[idx], rtol, atol, max_regions, choice.lobe_fresnel_gauss)
             value[idx] += w * v

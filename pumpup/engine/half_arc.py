@@ -6,29 +6,26 @@ V-cavity with a Fresnel factor, Schlick's and Ashikhmin-Shirley's lobes), and th
 from __future__ import annotations
 
 import math
-import numpy as np
 import warnings
+
+import numpy as np
 from numba import njit
 
 from ..core.hints import AzimuthHint
 from ..physics.fresnel import conductor_scalar as _fresnel_real
 from ..physics.fresnel import dielectric_scalar as _fresnel
-from ..physics.fresnel import fresnel_branch
-from ..physics.fresnel import fresnel_brewster
-from ..physics.fresnel import fresnel_pole
+from ..physics.fresnel import fresnel_branch, fresnel_brewster, fresnel_pole
 from ..physics.microfacet import projected as _projected
-from ..physics.quadrature import calibrated
-from ..physics.quadrature import rule_sums
+from ..physics.quadrature import calibrated, rule_sums
 from .half_frames import _half_arc
 from .hint_view import kernel_view
 from .lobe_frame import _tally
 
-
 #: frame 4 declines a conductor's F(wi.h) whose branch point lies inside (0, 1) closer than this to the real axis (the
-#: routing table leaves it to the nested engine, with the kink wi.h = x0 in the model's Lobe hint).  Measured against the
-#: nested and 2-D engines at rtol 1e-13 (eta 0.551; GGX 0.3, 0.02, Beckmann 0.1; mu 0.05 ... 0.95): frame 4 was up to
-#: 1.3e5 x its estimate for y0 = 0 (k = 0: total reflection below eta = 1) and y0 = 6.6e-13, 18 x for 6.6e-10, within its
-#: estimate from 6.6e-8 up (``scripts/studies/fuzz_engines.py --registry``)
+#: routing table leaves it to the nested engine, with the kink wi.h = x0 in the model's Lobe hint).  Measured against
+#: the nested and 2-D engines at rtol 1e-13 (eta 0.551; GGX 0.3, 0.02, Beckmann 0.1; mu 0.05 ... 0.95): frame 4 was up
+#: to 1.3e5 x its estimate for y0 = 0 (k = 0: total reflection below eta = 1) and y0 = 6.6e-13, 18 x for 6.6e-10, within
+#: its estimate from 6.6e-8 up (``scripts/studies/fuzz_engines.py --registry``)
 ARC_F_Y0_MIN = 1e-6
 
 #: frame 4's models (``mp[0]``): the Smith microfacet models (Beckmann, GGX; ``SmithLobe``), the
@@ -40,7 +37,8 @@ SMITH, VCAVITY_F, SCHLICK, LOBE_F, ASHIKHMIN = 0, 1, 2, 3, 4
 def fresnel_scale(ior: float, eta: float, k: float) -> float:
     """c_F: the Fresnel factor F(c) has its singularities where c^2 = 1 - index^2, |c| = c_F = sqrt(|1 - index^2|)
     (a dielectric's real ior, or a conductor's eta + i k), which near an index of 1 come close to the arc's small c;
-    :func:`_k_numeric` cuts the arc at c = c_F 3^k there.  inf without a Fresnel factor."""
+    :func:`_k_numeric` cuts the arc at c = c_F 3^k there.  inf without a Fresnel factor.
+    """
     if eta > 0.0:
         return math.sqrt(abs(1.0 - complex(eta, k) ** 2))
     return math.sqrt((ior - 1.0) * (ior + 1.0)) if ior > 0.0 else math.inf
@@ -49,7 +47,8 @@ def fresnel_scale(ior: float, eta: float, k: float) -> float:
 @njit(cache=True, nogil=True, inline="always")
 def _fresnel_at(mp, c):  # pragma: no cover - compiled
     """The Fresnel factor at wi.h = c of frames 4 and 6: the conductor's (eta, k = mp[6], mp[7]; metal.py) or the
-    dielectric's (ior = mp[5], 1 when ior <= 0; cook_torrance.py)."""
+    dielectric's (ior = mp[5], 1 when ior <= 0; cook_torrance.py).
+    """
     return _fresnel_real(c, mp[6], mp[7]) if mp[6] > 0.0 else _fresnel(c, mp[5])
 
 
@@ -59,7 +58,8 @@ def _phi_numeric(mp, mu, u, c0, d):  # pragma: no cover - compiled; see numeric_
     Smith models (G = G1(mu) G1(z) = mu z / (P(mu) P(z)), Walter et al. 2007 eq. 20; or the height-correlated
     mu z / (z P(mu) + mu P(z) - mu z), Heitz 2014; P(w) = N.w / G1(w), pumpup.models.microfacet), Gamma = G =
     min(1, 2 u mu / c, 2 u z / c) for the V-cavity (001 eq. 10); F the dielectric (ior, 002 sec. 3.2) or conductor
-    (eta, k) Fresnel factor at c, or 1."""
+    (eta, k) Fresnel factor at c, or 1.
+    """
     c = c0 + d
     z = 2.0 * u * d
     f = _fresnel_at(mp, c)
@@ -70,7 +70,8 @@ def _phi_numeric(mp, mu, u, c0, d):  # pragma: no cover - compiled; see numeric_
     if mp[0] == ASHIKHMIN:  # AS 2000 eq. 4: 4 c F(c) / (c max(mu, z)) times z, Schlick's F(c) (eq. 5)
         q = 1.0 - c
         return 4.0 * (mp[4] + (1.0 - mp[4]) * (q * q) * (q * q) * q) * min(z, mu) / mu
-    if mp[1] == 1.0:  # GGX: P = (z + sqrt(z^2 + alpha^2 sin^2)) / 2, Walter eq. 34 (physics.microfacet.projected, one sqrt)
+    if mp[1] == 1.0:  # GGX: P = (z + sqrt(z^2 + alpha^2 sin^2)) / 2, Walter eq. 34
+        # (physics.microfacet.projected, one sqrt)
         pz = 0.5 * (z + math.sqrt(z * z + mp[4] * mp[4] * ((1.0 - z) * (1.0 + z))))
     else:
         pz = _projected(math.sqrt((1.0 - z) * (1.0 + z)), 0.0, z, 0, int(mp[2]), mp[4])
@@ -82,7 +83,8 @@ def _phi_numeric(mp, mu, u, c0, d):  # pragma: no cover - compiled; see numeric_
 @njit(cache=True, nogil=True)
 def _delta_rule(mp, mu, u, c0, low, sb0, q, lo, hi, nodes, wk, wg, mode, ibuf):  # pragma: no cover - compiled
     """(value, error) of the rule on delta in [lo, hi] for :func:`_phi_numeric` at d = low + sb0 sin(delta) +
-    2 q sin^2(delta / 2) (:func:`_k_numeric`)."""
+    2 q sin^2(delta / 2) (:func:`_k_numeric`).
+    """
     h = hi - lo
     for j in range(nodes.shape[0]):
         x = 0.5 * (lo + h * nodes[j])
@@ -95,13 +97,14 @@ def _delta_rule(mp, mu, u, c0, low, sb0, q, lo, hi, nodes, wk, wg, mode, ibuf): 
 
 @njit(cache=True, nogil=True, inline="always")
 def _delta_at(c, a, b, beta0):  # pragma: no cover - compiled
-    """delta = beta0 - beta where wi.h = a + b cos(beta) = c (at most beta0)."""
+    """The angle delta = beta0 - beta where wi.h = a + b cos(beta) = c (at most beta0)."""
     x = c - a
     return min(beta0 - math.atan2(math.sqrt(max(0.0, (b - x) * (b + x))), x), beta0)
 
 
 @njit(cache=True, nogil=True)
-def _k_numeric(mp, mu, s, psi, u, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, iwork):  # pragma: no cover - compiled; see numeric_integrand_reference
+def _k_numeric(mp, mu, s, psi, u, sa, itol, tol_abs,  # pragma: no cover - compiled; see numeric_integrand_reference
+               nodes, wk, wg, mode, ibuf, iwork):
     """(K(u), its error) of frame 4: the integral over the azimuth beta of h about N, where N.wo > 0, of
     :func:`_phi_numeric` (4 c F(c) Gamma, which depends on beta through c = wi.h only, as in :func:`_k_half`), by a
     globally adaptive rule (``nodes``, ``wk``, ``wg``: the 7/15 rule) on the arc.
@@ -114,7 +117,8 @@ def _k_numeric(mp, mu, s, psi, u, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, 
     where a factor has a singularity near it (N.wo = z_c 3^k, c = c_c 3^k, below).  The interval with the largest
     error is bisected until the summed error (QUADPACK's calibration: the integrand is analytic on every piece) is at
     most max(``itol`` |K|, ``tol_abs``) or INNER_MAX intervals are used; the error is returned either way.  Both signs
-    of beta: 2 x."""
+    of beta: 2 x.
+    """
     live, b, c0, e0, sb0, beta0, low, _, _ = _half_arc(mu, s, psi, u, sa)
     if not live:
         return 0.0, 0.0
@@ -128,7 +132,8 @@ def _k_numeric(mp, mu, s, psi, u, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, 
     if b > 0.0:
         for j in range(3):
             if mp[0] == VCAVITY_F:
-                cb = 2.0 * u * mu if j == 0 else (mu / u if j == 1 else (2.0 * u * mu / (4.0 * u * u - 1.0) if 4.0 * u * u > 1.0 else -1.0))
+                cb = 2.0 * u * mu if j == 0 else (mu / u if j == 1 else (
+                    2.0 * u * mu / (4.0 * u * u - 1.0) if 4.0 * u * u > 1.0 else -1.0))
             elif mp[0] == ASHIKHMIN:
                 cb = mu / u if j == 0 else -1.0  # N.wo = 2 c u - mu = mu: max(mu, N.wo)'s kink
             else:
@@ -202,7 +207,8 @@ def numeric_integrand_reference(brdf, mu: float, u) -> np.ndarray:
     """Plain twin of :func:`_k_numeric`: K(u) from the model's own numpy formula (``BRDF.reference`` at
     wo = 2 (wi.h) h - wi), integral over h's azimuth of 4 (wi.h) N.wo f_r where N.wo > 0 by scipy's QUADPACK (split at
     the arc's end, Walter's switch and the V-cavity's crossings), divided by the hint's scale and radial factor
-    (w(t) / u^4 under the Beckmann and GGX weights, u^n under the power weight)."""
+    (w(t) / u^4 under the Beckmann and GGX weights, u^n under the power weight).
+    """
     from scipy.integrate import quad
 
     hint = kernel_view(brdf.azimuth_hint())
@@ -243,7 +249,8 @@ def numeric_params(hint, gauss: bool = True) -> np.ndarray:
     """Frame 4's parameter array ``mp`` (:data:`MP_SIZE` slots) of a :class:`KernelView` with ``smith`` or a V-cavity
     lobe with ``fresnel`` (zeros but the Walter level -1 otherwise); P(mu) is set per mu by :func:`_integrate`.
     ``gauss``: frame 5 takes its arcs by Gauss-Legendre pieces with an a-priori bound where they apply
-    (:func:`_lobe_f_gauss`), else by the adaptive 7/15 rule alone (``mp[20]``).  An AzimuthHint is viewed first."""
+    (:func:`_lobe_f_gauss`), else by the adaptive 7/15 rule alone (``mp[20]``).  An AzimuthHint is viewed first.
+    """
     if isinstance(hint, AzimuthHint):
         hint = kernel_view(hint)
     mp = np.zeros(MP_SIZE)
@@ -255,7 +262,8 @@ def numeric_params(hint, gauss: bool = True) -> np.ndarray:
     if hint.smith is not None:
         mp[0], mp[1:5] = SMITH, hint.smith
         mp[11] = hint.smith[3]
-        if hint.fresnel[1] > 0.0:  # a conductor's branch point, for :func:`_pieces`' cuts (frame 6 reuses 13, 14: n_params)
+        # a conductor's branch point, for :func:`_pieces`' cuts (frame 6 reuses 13, 14: n_params)
+        if hint.fresnel[1] > 0.0:
             mp[13], mp[14] = fresnel_branch(float(hint.fresnel[1]), float(hint.fresnel[2]))
         if hint.smith[1] == 1:
             from ..physics.microfacet import walter_level

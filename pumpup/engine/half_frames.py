@@ -6,8 +6,9 @@ the method.
 from __future__ import annotations
 
 import math
-import numpy as np
 import warnings
+
+import numpy as np
 from numba import njit
 
 from ..physics.quadrature import EPS
@@ -16,9 +17,9 @@ from ..physics.quadrature import EPS
 @njit(cache=True, nogil=True)
 def _trig_tail(x, which):  # pragma: no cover - compiled; see half_moments_reference
     """Integrals of trigonometric polynomials that cancel to high order at small x, by their series
-    below x = 1 and in closed form above (where at most a digit cancels):
+    below x = 1 and in closed form above (where at most a digit cancels).
 
-    which 0: x - sin(x);  1: F1 = integral_0^x (cos(t) - cos(x)) dt = sin(x) - x cos(x);
+    ``which`` 0: x - sin(x);  1: F1 = integral_0^x (cos(t) - cos(x)) dt = sin(x) - x cos(x);
     2: F2 = integral_0^x (cos(t) - cos(x))^2 dt;  3: R2 = integral_0^x (1 - cos(t))^2 dt.
     """
     if x >= 1.0:
@@ -57,7 +58,8 @@ def _arc_moments(e, sb, b, beta):  # pragma: no cover - compiled; see half_momen
     """(J1, J2) = integral_0^beta (d, d^2) d beta' for d = c - c_e = e + b cos(beta') >= 0 on the arc, where
     cos(beta) = -e / b, sb = b sin(beta) (sb = 0 and beta = pi for a full circle): J1 = sb + beta e,
     J2 = beta (e^2 + b^2 / 2) + 3/2 e sb, by their series b F1(beta), b^2 F2(beta) below beta = 1 (where
-    e is near -b and the closed forms cancel)."""
+    e is near -b and the closed forms cancel).
+    """
     if beta < 1.0:
         return b * _trig_tail(beta, 1), b * b * _trig_tail(beta, 2)
     return sb + beta * e, beta * (e * e + 0.5 * b * b) + 1.5 * e * sb
@@ -71,7 +73,8 @@ def _half_arc(mu, s, psi, u, sa):  # pragma: no cover - compiled; see the kernel
     on the full circle (2 alpha <= psi, or b = 0) sb0 = 0, beta0 = pi and low = d(pi) = a - b - c0, else
     sb0 = b sin(beta0) = sqrt(sin(2 alpha + psi) sin(2 alpha - psi)) / (2 u), each sine with its angle written
     as a difference of small exact angles near its zero (alpha' = pi/2 - alpha), and low = 0; and those two
-    sines, f1 = 2 u T with T = d(0) = a + b - c0 and f2 = 2 u (b - e0) (0 on the full circle): nine values."""
+    sines, f1 = 2 u T with T = d(0) = a + b - c0 and f2 = 2 u (b - e0) (0 on the full circle): nine values.
+    """
     al = math.atan2(sa, u)
     alc = math.atan2(u, sa)  # pi/2 - alpha, exact where u is small
     if u <= 0.0 or 2.0 * alc <= psi:  # 2 alpha + psi >= pi: the whole circle of h sends wo below the horizon
@@ -138,7 +141,8 @@ def _complete_kd(y):  # pragma: no cover - compiled; tested against scipy.specia
     c_(n+1) = (a_n - g_n) / 2 = c_n^2 / (4 a_(n+1)) (c_1 = m / (2 (1 + sqrt(y))): no cancellation), K = pi / (2 AGM),
     K - E = K sum_(n>=0) 2^(n-1) c_n^2 with c_0^2 = m, so D = K (1/2 + sum_(n>=1) 2^(n-1) c_n^2 / m), a sum of
     positive terms.  Quadratic convergence: at most about 10 steps of one square root each for y down to 1e-300
-    (issue 14's fifteenth session: Carlson's duplication, 170 ns per pair, took most of Ward's K(u))."""
+    (issue 14's fifteenth session: Carlson's duplication, 170 ns per pair, took most of Ward's K(u)).
+    """
     m = 1.0 - y
     kc = math.sqrt(y)
     a = 0.5 * (1.0 + kc)
@@ -167,8 +171,8 @@ def _k_ward(mu, s, psi, u, sa):  # pragma: no cover - compiled; see ward_integra
 
     As in :func:`_k_half`, c = wi.h = c0 + d, N.wo = 2 u d, d = e0 + b cos(beta) >= 0 on the arc |beta| <
     beta0: K = 8 sqrt(2 u) (c0 I_1/2 + I_3/2), I_q = integral_0^beta0 d^q d beta, complete elliptic integrals
-    (Carlson's R_F, R_D; :func:`_complete_kd`): with x = sin(beta / 2), d = T - 2 b x^2, T = d(0), on a partial arc (T < 2 b,
-    M = T / (2 b)) I_1/2 = 2 T / sqrt(2 b) (R_F - R_D / 3), I_-1/2 = 2 R_F / sqrt(2 b), the R at (0, 1 - M, 1);
+    (Carlson's R_F, R_D; :func:`_complete_kd`): with x = sin(beta / 2), d = T - 2 b x^2, T = d(0), on a partial arc (T <
+    2 b, M = T / (2 b)) I_1/2 = 2 T / sqrt(2 b) (R_F - R_D / 3), I_-1/2 = 2 R_F / sqrt(2 b), the R at (0, 1 - M, 1);
     on the full circle (k^2 = 2 b / T <= 1) I_1/2 = 2 sqrt(T) E(k^2) = 2 sqrt(T) (R_F - k^2 R_D / 3),
     I_-1/2 = 2 R_F / sqrt(T) at (0, 1 - k^2, 1); and 3 I_3/2 = 4 e0 I_1/2 + (b^2 - e0^2) I_-1/2 (the
     recurrence (q + 1) I_(q+1) = (2q + 1) e0 I_q + q (b^2 - e0^2) I_(q-1), from d/d beta (d^q sin(beta)),
@@ -272,8 +276,8 @@ def _k_vcavity(mu, s, psi, u, sa):  # pragma: no cover - compiled; see vcavity_i
 
 def vcavity_integrand_reference(mu: float, u) -> np.ndarray:
     """Plain twin of :func:`_k_vcavity` by scipy's QUADPACK over beta of 4 min(c, 2 u mu, 4 u^2 c - 2 u mu)
-    where c > mu / (2 u) (split at the lines' crossings)."""
-
+    where c > mu / (2 u) (split at the lines' crossings).
+    """
     from scipy.integrate import quad
 
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -287,7 +291,8 @@ def vcavity_integrand_reference(mu: float, u) -> np.ndarray:
             c = a + b * math.cos(t)
             return 4.0 * min(c, 2 * uu * mu, 4 * uu * uu * c - 2 * uu * mu) if c > 0.5 * mu / uu else 0.0
 
-        pts = [math.acos((cv - a) / b) for cv in (0.5 * mu / uu, 2 * uu * mu, mu / uu, 2 * uu * mu / (4 * uu * uu - 1) if 4 * uu * uu != 1 else -9.0)
+        pts = [math.acos((cv - a) / b) for cv in (0.5 * mu / uu, 2 * uu * mu, mu / uu,
+                                                  2 * uu * mu / (4 * uu * uu - 1) if 4 * uu * uu != 1 else -9.0)
                if b > 0 and abs((cv - a) / b) < 1]
         return 2.0 * quad(g, 0.0, math.pi, points=pts or None, epsabs=0, epsrel=1e-13, limit=200)[0]
 
@@ -298,8 +303,8 @@ def vcavity_integrand_reference(mu: float, u) -> np.ndarray:
 
 def ward_integrand_reference(mu: float, u: np.ndarray) -> np.ndarray:
     """Plain numpy K(u) of :func:`_k_ward`: the arc integrals I_q = integral_0^beta0 (e0 + b cos(beta))^q
-    d beta by scipy's QUADPACK (beta0 from arccos), K = 8 sqrt(2 u) (c0 I_1/2 + I_3/2)."""
-
+    d beta by scipy's QUADPACK (beta0 from arccos), K = 8 sqrt(2 u) (c0 I_1/2 + I_3/2).
+    """
     from scipy.integrate import quad
 
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -312,7 +317,8 @@ def ward_integrand_reference(mu: float, u: np.ndarray) -> np.ndarray:
         beta0 = math.pi if e0 - b >= 0 else (0.0 if e0 + b <= 0 else math.acos(-e0 / b))
         if beta0 == 0.0:
             return 0.0
-        ih, i3 = (quad(lambda t, q=q: max(e0 + b * math.cos(t), 0.0) ** q, 0.0, beta0, epsabs=0, epsrel=1e-13, limit=200)[0]
+        ih, i3 = (quad(lambda t, q=q: max(e0 + b * math.cos(t), 0.0) ** q, 0.0, beta0, epsabs=0, epsrel=1e-13,
+                       limit=200)[0]
                   for q in (0.5, 1.5))
         return 8.0 * math.sqrt(2.0 * uu) * (c0 * ih + i3)
 
@@ -323,7 +329,8 @@ def ward_integrand_reference(mu: float, u: np.ndarray) -> np.ndarray:
 
 def half_moments_reference(x):
     """Plain numpy twins of :func:`_trig_tail`'s four functions, in closed form (exact in exact arithmetic;
-    the tests compare them with the series at x >= 1e-2, where these lose at most ~10 digits of 16)."""
+    the tests compare them with the series at x >= 1e-2, where these lose at most ~10 digits of 16).
+    """
     x = np.asarray(x, dtype=np.float64)
     return (x - np.sin(x), np.sin(x) - x * np.cos(x), x * (0.5 + np.cos(x) ** 2) - 1.5 * np.sin(x) * np.cos(x),
             1.5 * x - 2.0 * np.sin(x) + 0.25 * np.sin(2.0 * x))
@@ -333,7 +340,8 @@ def half_integrand_reference(p: float, mu: float, u: np.ndarray) -> np.ndarray:
     """Plain numpy K(u) of the half-vector frame (the readable twin of :func:`_k_half`), from the
     antiderivatives in beta of c and c^2 with beta from arccos:
     integral_0^beta (a + b cos t)^k dt = a beta + b sin(beta) (k = 1),
-    a^2 beta + 2 a b sin(beta) + b^2 (beta / 2 + sin(2 beta) / 4) (k = 2)."""
+    a^2 beta + 2 a b sin(beta) + b^2 (beta / 2 + sin(2 beta) / 4) (k = 2).
+    """
     u = np.asarray(u, dtype=np.float64)
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     a = mu * u

@@ -7,18 +7,19 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from ..core.hints import AshikhminShirleyLobe
-from ..core.hints import AzimuthHint
-from ..core.hints import ClosedForm
-from ..core.hints import DivideByG
-from ..core.hints import HalfVectorLobe
-from ..core.hints import InverseAlbedoFactor
-from ..core.hints import PowerLobe
-from ..core.hints import SchlickLobe
-from ..core.hints import SmithLobe
-from ..core.hints import VCavityLobe
-from ..core.hints import WardLobe
-
+from ..core.hints import (
+    AshikhminShirleyLobe,
+    AzimuthHint,
+    ClosedForm,
+    DivideByG,
+    HalfVectorLobe,
+    InverseAlbedoFactor,
+    PowerLobe,
+    SchlickLobe,
+    SmithLobe,
+    VCavityLobe,
+    WardLobe,
+)
 
 #: the half-vector frames take mu >= this (below it mu / (2 u), tan^2(psi / 2) m^2 and their kin underflow; the nested
 #: engine takes such values)
@@ -35,7 +36,8 @@ class KernelView:
     weight, Ward's ``sqrt_cos``, the V-cavity's ``vcavity``, Smith's codes ``smith`` = (distribution, G1, shadowing,
     alpha), the Fresnel factor ``fresnel`` = (ior, eta, k) at wi.h (or, for a lobe, F(max) of (0, eta, k)),
     Schlick's ``schlick``; and the factors: ``chain`` (pumping's look-ups), ``factor`` (1/E's (f0, *U's arguments)),
-    ``fmax`` (F(max) of (eta, k) on a half-vector family), ``levels`` (the kinks of g or U in N.wo)."""
+    ``fmax`` (F(max) of (eta, k) on a half-vector family), ``levels`` (the kinks of g or U in N.wo).
+    """
 
     scale: object
     kind: str = "lobe"
@@ -59,7 +61,11 @@ def kernel_view(hint: AzimuthHint) -> KernelView:
     """The kernels' view of ``hint``: its family's parameters and its factors as the compiled routes take them."""
     f = hint.family
     out = {"scale": hint.scale}
-    fres = (lambda fr: (0.0, 0.0, 0.0) if fr is None else (float(fr.ior), float(fr.eta), float(fr.k)))
+
+    def fres(fr):
+        """A Fresnel factor's (ior, eta, k) as floats, or zeros without one."""
+        return (0.0, 0.0, 0.0) if fr is None else (float(fr.ior), float(fr.eta), float(fr.k))
+
     if isinstance(f, ClosedForm):
         out.update(kind="constant", ulps=f.ulps)
     elif isinstance(f, PowerLobe):

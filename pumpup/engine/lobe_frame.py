@@ -7,13 +7,11 @@ from __future__ import annotations
 
 import functools
 import math
+
 import numpy as np
 from numba import njit
 
-from ..physics.quadrature import EPS
-from ..physics.quadrature import calibrated
-from ..physics.quadrature import mode_code
-
+from ..physics.quadrature import EPS, calibrated, mode_code
 
 #: relative rounding error of the 1-D quadrature (per unit of sum |K|): the integrand is a few
 #: elementary functions of u, accurate to a few ulp, summed over a few hundred nodes
@@ -29,7 +27,8 @@ INNER_MAX = 64
 #: the inner rule's relative tolerance is rtol / 8, but not below this (its rounding floor is
 #: QUADPACK's 50 eps of the integral)
 INNER_RTOL_MIN = 1e-14
-#: the orders of the Gauss-Jacobi rules on the arc's end near grazing incidence (:func:`_arc_power`, :func:`_jacobi_bound`)
+#: the orders of the Gauss-Jacobi rules on the arc's end near grazing incidence (:func:`_arc_power`,
+#: :func:`_jacobi_bound`)
 JACOBI_ORDERS = (10, 14)
 
 
@@ -56,7 +55,8 @@ def _arc_rule(q, a, b, lo, hi, nodes, wk, wg, mode, ibuf):  # pragma: no cover -
 @njit(cache=True, nogil=True)
 def _jacobi_sum(q, top, low, c, jt, jw):  # pragma: no cover - compiled
     """integral_0^c t^q / sqrt((top - t)(t - low)) dt by the Gauss-Jacobi rule (nodes ``jt`` on
-    [0, 1], weights ``jw`` for the weight t^q)."""
+    [0, 1], weights ``jw`` for the weight t^q).
+    """
     s = 0.0
     for j in range(jt.shape[0]):
         t = c * jt[j]
@@ -64,26 +64,29 @@ def _jacobi_sum(q, top, low, c, jt, jw):  # pragma: no cover - compiled
     return c ** (q + 1.0) * s
 
 
-#: the Bernstein ellipse of :func:`_jacobi_bound`: log(rho) = JACOBI_RHO log(rho_max), at most JACOBI_LOG_RHO_CAP (rho_max
-#: overflows where c = mu is subnormal: a hypothesis test found mu = 5e-324 giving a NaN error)
+#: the Bernstein ellipse of :func:`_jacobi_bound`: log(rho) = JACOBI_RHO log(rho_max), at most JACOBI_LOG_RHO_CAP
+#: (rho_max overflows where c = mu is subnormal: a hypothesis test found mu = 5e-324 giving a NaN error)
 JACOBI_RHO = 0.95
 JACOBI_LOG_RHO_CAP = math.log(1e4)
 
 
 @njit(cache=True, nogil=True)
 def _jacobi_bound(q, top, low, c, n):  # pragma: no cover - compiled; see the tests' mpmath check
-    """A bound of the n-point Gauss-Jacobi rule's error in :func:`_jacobi_sum` (low < 0 < c < top).  With t = c (1 + x) / 2,
-    g(t) = ((top - t)(t - low))^-1/2 is analytic but at x_T = 2 top / c - 1 > 1 and x_L = 2 low / c - 1 < -1 (the square
-    root's cuts lie on the real axis beyond them), so inside the Bernstein ellipse E_rho, |x| <= A = (rho + 1/rho) / 2 <
-    min(x_T, -x_L), |g| <= M = 2 / (c sqrt((x_T - A)(-x_L - A))) (computed in t's units, finite as c -> 0).  A Gauss rule with a positive weight errs by at most
-    2 W E_(2n-1)(g), W = c^(q+1) / (q + 1) the weight's integral, and E_m(g) <= 2 M rho^-m / (rho - 1) (Trefethen, ATAP
-    Thm 8.2): the bound is 4 W M rho^(1 - 2n) / (rho - 1)."""
+    """A bound of the n-point Gauss-Jacobi rule's error in :func:`_jacobi_sum` (low < 0 < c < top).  With t = c (1 + x)
+    / 2, g(t) = ((top - t)(t - low))^-1/2 is analytic but at x_T = 2 top / c - 1 > 1 and x_L = 2 low / c - 1 < -1 (the
+    square root's cuts lie on the real axis beyond them), so inside the Bernstein ellipse E_rho, |x| <= A =
+    (rho + 1/rho) / 2 < min(x_T, -x_L), |g| <= M = 2 / (c sqrt((x_T - A)(-x_L - A))) (computed in t's units, finite as
+    c -> 0).  A Gauss rule with a positive weight errs by at most 2 W E_(2n-1)(g), W = c^(q+1) / (q + 1) the weight's
+    integral, and E_m(g) <= 2 M rho^-m / (rho - 1) (Trefethen, ATAP Thm 8.2): the bound is 4 W M rho^(1 - 2n) /
+    (rho - 1).
+    """
     xt = 2.0 * top / c - 1.0  # (inf where c is tiny: rho is then capped)
     xl = 1.0 - 2.0 * low / c
     r = min(xt, xl)
     rho = math.exp(min(JACOBI_RHO * math.log(r + math.sqrt((r - 1.0) * (r + 1.0))), JACOBI_LOG_RHO_CAP))
     big_a = 0.5 * (rho + 1.0 / rho)
-    # M in t's units: the ellipse's ends lie at t = c (1 -+ A) / 2, so |T - t| >= T - c (1 + A) / 2 and |t - L| >= -L - c (A - 1) / 2
+    # M in t's units: the ellipse's ends lie at t = c (1 -+ A) / 2, so |T - t| >= T - c (1 + A) / 2 and |t - L| >= -L -
+    # c (A - 1) / 2
     m = 1.0 / math.sqrt((top - 0.5 * c * (1.0 + big_a)) * (-low - 0.5 * c * (big_a - 1.0)))
     return 4.0 * c ** (q + 1.0) / (q + 1.0) * m * rho ** (1.0 - 2.0 * n) / (rho - 1.0)
 
@@ -91,7 +94,8 @@ def _jacobi_bound(q, top, low, c, n):  # pragma: no cover - compiled; see the te
 @njit(cache=True, nogil=True, inline="always")
 def _tally(val, err, m, tot, e):  # pragma: no cover - compiled
     """(value, error, the interval with the largest error) of an adaptive rule's first m intervals, the
-    sums starting from ``tot`` and ``e``."""
+    sums starting from ``tot`` and ``e``.
+    """
     worst = 0
     for i in range(m):
         tot += val[i]
@@ -122,8 +126,8 @@ def _gl_tables():
 GL_X, GL_W = _gl_tables()
 #: the Bernstein ellipse of the piece's bound (:func:`_arc_bound`): log(rho) at most ARC_RHO_BRANCH times that of the
 #: ellipse through t^q's branch point (the integrand stays bounded up to it) and ARC_RHO_POLE times that through the
-#: pole of (t - L)^-1/2.  Measured over a 257-point table's nodes (q 0.1, 0.5, 0.9; itol 1.25e-7 .. 1.25e-13): 0.03 % more
-#: values than the best of eight ellipses from 0.5 to 0.999 per call
+#: pole of (t - L)^-1/2.  Measured over a 257-point table's nodes (q 0.1, 0.5, 0.9; itol 1.25e-7 .. 1.25e-13): 0.03 %
+#: more values than the best of eight ellipses from 0.5 to 0.999 per call
 ARC_RHO_BRANCH = 0.999
 ARC_RHO_POLE = 0.99
 
@@ -133,11 +137,12 @@ def _arc_bound(q, big_t, d, b, c, tol):  # pragma: no cover - compiled; see arc_
     """(n, bound): the fewest Gauss-Legendre points (at most GL_MAX; GL_MAX + 1 if none suffices) whose error on
     P = sqrt(D) c integral_-1^1 F(c x) dx, F(s) = t^q (t - L)^-1/2, t = T - D s^2, is at most ``tol``, and that error
     bound.  F is analytic but where t = 0 (s^2 = s0^2 = T / D, t^q's branch point) or t = L (s^2 = s1^2 = 2 b / D,
-    a pole of order 1/2): inside the Bernstein ellipse E_rho of x, |x| <= A = (rho + 1 / rho) / 2, so where c A < min(s0,
-    s1) |t| <= T + D c^2 A^2 < 2 T and |t - L| = D |s1^2 - s^2| >= D (s1^2 - c^2 A^2): |F| <= M = (2 T)^q /
+    a pole of order 1/2): inside the Bernstein ellipse E_rho of x, |x| <= A = (rho + 1 / rho) / 2, so where c A <
+    min(s0, s1) |t| <= T + D c^2 A^2 < 2 T and |t - L| = D |s1^2 - s^2| >= D (s1^2 - c^2 A^2): |F| <= M = (2 T)^q /
     sqrt(D (s1^2 - c^2 A^2)).  The n-point Gauss rule's error is then at most 64 M / (15 (1 - rho^-2) rho^(2 n))
     (Trefethen, Approximation Theory and Approximation Practice, Thm 19.3) times sqrt(D) c.  log(rho) is the smaller of
-    ARC_RHO_BRANCH log(rho_0) and ARC_RHO_POLE log(rho_1), rho_i the ellipse through s_i / c."""
+    ARC_RHO_BRANCH log(rho_0) and ARC_RHO_POLE log(rho_1), rho_i the ellipse through s_i / c.
+    """
     s0sq = big_t / d
     s1sq = 2.0 * b / d
     best_n = GL_MAX + 1
@@ -163,7 +168,8 @@ def _arc_bound(q, big_t, d, b, c, tol):  # pragma: no cover - compiled; see arc_
 @njit(cache=True, nogil=True)
 def _arc_piece(q, big_t, d, b, c, n):  # pragma: no cover - compiled; see arc_piece_reference
     """P = sqrt(D) c integral_-1^1 F(c x) dx by the n-point Gauss-Legendre rule, F even (:func:`_arc_bound`):
-    integral_(T - D c^2)^T t^q / sqrt((T - t)(t - L)) dt with t = T - D s^2, 2 b = T - L."""
+    integral_(T - D c^2)^T t^q / sqrt((T - t)(t - L)) dt with t = T - D s^2, 2 b = T - L.
+    """
     tot = 0.0
     for j in range((n + 1) // 2):
         s2 = c * c * GL_X[n, j] * GL_X[n, j]
@@ -173,7 +179,8 @@ def _arc_piece(q, big_t, d, b, c, n):  # pragma: no cover - compiled; see arc_pi
 
 
 @njit(cache=True, nogil=True)
-def _arc_power(q, mu, a, b, d1, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iwork, jac):  # pragma: no cover - compiled
+def _arc_power(q, mu, a, b, d1, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iwork,  # pragma: no cover - compiled
+               jac):
     """(H, error) of H = integral_0^beta1 (a + b cos beta)^q d beta, q = 1 - p in (0, 1): the arc
     where N.wo = a + b cos beta >= mu (000 eq. 12's max(N.L, N.V) = N.wo there); d1 = b^2 - (mu - a)^2.
 
@@ -191,7 +198,8 @@ def _arc_power(q, mu, a, b, d1, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iw
     (``rest`` >= 0, H >= beta1 mu^q), its rounding added; about 5 values of t^q per call where the 7/15 rule in beta
     took 15 to 45 (issue 14's fifteenth session).  Should the bound want more than GL_MAX points, the piece is
     the 7/15 rule in beta, globally adaptive on at most INNER_MAX intervals (``iwork``, 4 x INNER_MAX), until
-    the summed calibrated error meets the same tolerance; the error is returned either way."""
+    the summed calibrated error meets the same tolerance; the error is returned either way.
+    """
     if beta1 <= 0.0:
         return 0.0, 0.0
     top = a + b
@@ -210,7 +218,8 @@ def _arc_power(q, mu, a, b, d1, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iw
         tol0 = rtol * (rest + low_h)
         e1 = _jacobi_bound(q, top, low, half, n1) + _jacobi_bound(q, top, low, mu, n1)
         if e1 <= 0.5 * tol0:
-            fixed = _jacobi_sum(q, top, low, half, jac[0, :n1], jac[1, :n1]) - _jacobi_sum(q, top, low, mu, jac[0, :n1], jac[1, :n1])
+            fixed = (_jacobi_sum(q, top, low, half, jac[0, :n1], jac[1, :n1])
+                     - _jacobi_sum(q, top, low, mu, jac[0, :n1], jac[1, :n1]))
         else:
             fixed = _jacobi_sum(q, top, low, half, jac[2], jac[3]) - _jacobi_sum(q, top, low, mu, jac[2], jac[3])
             e1 = _jacobi_bound(q, top, low, half, n2) + _jacobi_bound(q, top, low, mu, n2)
@@ -242,7 +251,8 @@ def _arc_power(q, mu, a, b, d1, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iw
 
 def arc_piece_reference(q: float, mu: float, a: float, b: float, d1: float, c: float = 1.0) -> float:
     """The arc's piece in s (:func:`_arc_piece`) in plain numpy, for N.wo = a + b cos(beta), d1 = b^2 - (mu - a)^2:
-    P by numpy's 200-point Gauss-Legendre rule in s on [0, c] (c = 1: t from mu to T; the compiled kernel's twin)."""
+    P by numpy's 200-point Gauss-Legendre rule in s on [0, c] (c = 1: t from mu to T; the compiled kernel's twin).
+    """
     d = d1 / (b + (mu - a))  # (mu - a first: b + mu would round b away near mu = 1)
     x, w = np.polynomial.legendre.leggauss(200)
     sx = c * x
@@ -260,7 +270,8 @@ _NO_JACOBI.flags.writeable = False
 def jacobi_rules(q: float) -> np.ndarray:
     """Nodes on [0, 1] and weights of the Gauss-Jacobi rules for integral_0^1 t^q g(t) dt, of
     :data:`JACOBI_ORDERS` (the shorter, the longer: :func:`_arc_power`): rows t, w of the first, t, w of the second
-    (read-only, cached per q: scipy computes them in about 0.1 ms)."""
+    (read-only, cached per q: scipy computes them in about 0.1 ms).
+    """
     from scipy.special import roots_jacobi
 
     lo_n, hi_n = JACOBI_ORDERS
@@ -278,7 +289,8 @@ def _k_closed(p, mu, c2, u, um, sa):  # pragma: no cover - compiled; see integra
     """(K, beta1, below) for u = cos(alpha), um = 1 - u, sa = sin(alpha); c2 = cos(2 theta_i): K is
     the integral over the visible arc of N.wo / max(mu, N.wo)^p in closed form for p in {0, 1} (for
     other p, the p = 1 value); beta1 is the half-arc where N.wo >= mu (p > 0) and ``below`` the
-    integral of N.wo over the half-arc where 0 < N.wo < mu."""
+    integral of N.wo over the half-arc where 0 < N.wo < mu.
+    """
     a = mu * u
     d0 = (sa - mu) * (sa + mu)  # b^2 - a^2 = sin^2(alpha) - mu^2
     if d0 > 0.0:
@@ -305,11 +317,13 @@ def _k_closed(p, mu, c2, u, um, sa):  # pragma: no cover - compiled; see integra
 
 
 @njit(cache=True, nogil=True, inline="always")  # (a call passes 6 arrays, with reference counts, per node)
-def _k_of_u(p, mu, c2, u, um, sa, itol, nodes, wk, wg, mode, ibuf, iwork, jac):  # pragma: no cover - compiled; see integrand_reference
+def _k_of_u(p, mu, c2, u, um, sa, itol, nodes, wk, wg, mode,  # pragma: no cover - compiled; see integrand_reference
+            ibuf, iwork, jac):
     """(K(u), its error): K is the integral over the visible arc of N.wo / max(mu, N.wo)^p, for
     u = cos(alpha), um = 1 - u, sa = sin(alpha); c2 = cos(2 theta_i).  Closed form for p in
     {0, 1} (:func:`_k_closed`); for p in (0, 1) the arc where N.wo >= mu by :func:`_arc_power`
-    (relative error ``itol``), the rest in closed form.  The error is 0 for the closed forms."""
+    (relative error ``itol``), the rest in closed form.  The error is 0 for the closed forms.
+    """
     k, beta1, below = _k_closed(p, mu, c2, u, um, sa)
     if p == 0.0 or p == 1.0:
         return k, 0.0
@@ -357,7 +371,8 @@ def integrand_reference(n: float, p: float, mu: float, u: np.ndarray) -> np.ndar
 
 def integrand(n: float, p: float, mu: float, u, rtol: float = 1e-13):
     """(u^n K(u), its error) by the compiled kernel at every u in [0, 1] (for tests and checks;
-    ``rtol`` is the inner rule's relative tolerance for p in (0, 1))."""
+    ``rtol`` is the inner rule's relative tolerance for p in (0, 1)).
+    """
     from .cubature import NODES, WG, WK
 
     u = np.atleast_1d(np.asarray(u, dtype=np.float64))

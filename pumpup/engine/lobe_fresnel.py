@@ -6,16 +6,14 @@ describes the method.
 from __future__ import annotations
 
 import math
+
 import numpy as np
 from numba import njit
 
 from ..physics.fresnel import conductor_scalar as _fresnel_real
 from ..physics.fresnel import fresnel_branch
 from ..physics.microfacet import projected as _projected
-from ..physics.quadrature import EPS
-from ..physics.quadrature import calibrated
-from ..physics.quadrature import mode_code
-from ..physics.quadrature import rule_sums
+from ..physics.quadrature import EPS, calibrated, mode_code, rule_sums
 from .cubature import NODES as _NODES
 from .cubature import WG as _WG
 from .cubature import WK as _WK
@@ -23,14 +21,14 @@ from .half_arc import LOBE_F, LOBE_F_CUTS, SMITH, _k_numeric, numeric_params
 from .hint_view import kernel_view
 from .lobe_frame import GL_MAX, GL_W, GL_X, INNER_MAX, _k_closed, _tally
 
-
-#: frame 5 refuses (the nested engine takes the model) where the Fresnel factor's branch point w = sqrt(1 - (eta + i k)^2)
-#: lies closer than this to the real axis but off it (a near-kink: graded cuts would need log(1 / Im w) pieces per arc),
-#: or on it inside (0, 1) (a dielectric's total reflection below eta = 1: F = 1 up to a square-root kink)
+#: frame 5 refuses (the nested engine takes the model) where the Fresnel factor's branch point w = sqrt(1 -
+#: (eta + i k)^2) lies closer than this to the real axis but off it (a near-kink: graded cuts would need log(1 / Im w)
+#: pieces per arc), or on it inside (0, 1) (a dielectric's total reflection below eta = 1: F = 1 up to a square-root
+#: kink)
 LOBE_F_Y0_MIN = 1e-3
-#: the pumped lobe's frame of N takes F(Theta_min) only where its branch point lies at least this far from the real axis (or
-#: beyond 1): a pumped metal's g then has the near-kink too, on a spline whose nodes no cut marks (eta 0.3, k 0.01, n 20,
-#: g1: Im w = 0.0031, 1.7 x the estimate at mu = 0.96, rtol 1e-10, against the nested and 2-D engines)
+#: the pumped lobe's frame of N takes F(Theta_min) only where its branch point lies at least this far from the real axis
+#: (or beyond 1): a pumped metal's g then has the near-kink too, on a spline whose nodes no cut marks (eta 0.3, k 0.01,
+#: n 20, g1: Im w = 0.0031, 1.7 x the estimate at mu = 0.96, rtol 1e-10, against the nested and 2-D engines)
 CHAIN_F_Y0_MIN = 1e-2
 
 #: no cuts in alpha (:func:`_pieces`) where the feature's scale there is at least this (rad): the outer rule's first
@@ -40,7 +38,8 @@ LOBE_F_WIDE = 0.25
 
 def lobe_fresnel_ok(eta: float, k: float, chain: bool = False) -> bool:
     """Whether frame 5 (``chain``: the pumped lobe's frame of N) takes the Fresnel factor of (eta, k)
-    (:data:`LOBE_F_Y0_MIN`, :data:`CHAIN_F_Y0_MIN`)."""
+    (:data:`LOBE_F_Y0_MIN`, :data:`CHAIN_F_Y0_MIN`).
+    """
     x0, y0 = fresnel_branch(eta, k)
     if y0 == 0.0:
         return x0 == 0.0 or x0 >= 1.0  # on the real axis: only outside (0, 1) (eta = 1, k = 0: F = 0)
@@ -49,7 +48,9 @@ def lobe_fresnel_ok(eta: float, k: float, chain: bool = False) -> bool:
 
 @njit(cache=True, nogil=True)
 def _lobe_rule(mp, q, a, b, lo, hi, nodes, wk, wg, mode, ibuf):  # pragma: no cover - compiled
-    """(value, error) of the rule on beta in [lo, hi] for F(t) t^q, t = N.wo = a + b cos(beta) (:func:`_k_lobe_fresnel`)."""
+    """(value, error) of the rule on beta in [lo, hi] for F(t) t^q, t = N.wo = a + b cos(beta)
+    (:func:`_k_lobe_fresnel`).
+    """
     h = hi - lo
     for j in range(nodes.shape[0]):
         t = a + b * math.cos(lo + h * nodes[j])
@@ -60,7 +61,7 @@ def _lobe_rule(mp, q, a, b, lo, hi, nodes, wk, wg, mode, ibuf):  # pragma: no co
 
 @njit(cache=True, nogil=True, inline="always")
 def _beta_at(t, top, b):  # pragma: no cover - compiled
-    """beta where a + b cos(beta) = t, from top - t = 2 b sin^2(beta / 2) (no cancellation near beta = 0)."""
+    """The angle beta where a + b cos(beta) = t, from top - t = 2 b sin^2(beta / 2) (no cancellation near beta = 0)."""
     return 2.0 * math.asin(min(1.0, math.sqrt(max(0.0, (top - t) / (2.0 * b)))))
 
 
@@ -76,7 +77,8 @@ LOBE_F_MERGE = 0.25
 @njit(cache=True, nogil=True, inline="always")
 def _sqrt_re(x, y):  # pragma: no cover - compiled
     """Re sqrt(x + i y), the principal root, without cancellation: sqrt((r + x) / 2), or |y| / sqrt(2 (r - x)) for x < 0
-    (r = |x + i y|; 0 for a negative real x)."""
+    (r = |x + i y|; 0 for a negative real x).
+    """
     r = math.sqrt(x * x + y * y)
     return math.sqrt(0.5 * (r + x)) if x >= 0.0 else abs(y) / math.sqrt(2.0 * (r - x))
 
@@ -84,25 +86,27 @@ def _sqrt_re(x, y):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True, inline="always")
 def _focal_sum(zr, zi, lo, hi):  # pragma: no cover - compiled
     """(|z - lo| + |z - hi|) / 2 for z = zr + i zi: the semi-major axis of the Bernstein ellipse of [lo, hi] through z
-    (its parameter R = A + sqrt(A^2 - 1) for A = that over h = (hi - lo) / 2).  For t in the ellipse whose semi-major axis
-    is h A_R, gap(z) = this - h A_R is a lower bound of |t - z| (not positive: z may lie inside): in elliptic
+    (its parameter R = A + sqrt(A^2 - 1) for A = that over h = (hi - lo) / 2).  For t in the ellipse whose semi-major
+    axis is h A_R, gap(z) = this - h A_R is a lower bound of |t - z| (not positive: z may lie inside): in elliptic
     coordinates t = m + h cosh(xi + i theta), |dt| >= h sinh(xi) d xi = h d(cosh xi), and a path from t to z crosses the
-    confocal ellipses from t's to z's."""
+    confocal ellipses from t's to z's.
+    """
     return 0.5 * (math.sqrt((zr - lo) * (zr - lo) + zi * zi) + math.sqrt((zr - hi) * (zr - hi) + zi * zi))
 
 
 @njit(cache=True, nogil=True)
 def _lobe_f_bound(mp, q, lo, d, top, low, first, tol):  # pragma: no cover - compiled; see the tests' mpmath check
-    """(n, bound, values): the Gauss-Legendre rule (n <= GL_MAX points; GL_MAX + 1 if none suffices) of the fewest values
-    whose error on a piece [lo, lo + d] of frame 5's arc (:func:`_lobe_f_gauss`) is at most ``tol``, and its bound.
+    """(n, bound, values): the Gauss-Legendre rule (n <= GL_MAX points; GL_MAX + 1 if none suffices) of the fewest
+    values whose error on a piece [lo, lo + d] of frame 5's arc (:func:`_lobe_f_gauss`) is at most ``tol``, and its
+    bound.
 
     The piece is integral G(t) dt, G = F(t) t^q / sqrt((T - t)(t - L)), F the conductor Fresnel factor of
     e = eta + i k (``mp[6]``, ``mp[7]``; 000 eq. 28), T = ``top``, L = ``low``.  ``first``: lo + d = T, by s with
-    t = T - d s^2, s in [-1, 1]: sqrt(d) integral F t^q / sqrt(t - L) ds, even in s, whose Bernstein ellipse of parameter
-    r maps onto t's of [lo, T] with R = r^2; else in t itself.  The n-point rule errs by at most 64 M / (15 (1 - r^-2)
-    r^(2 n)) times the length factor (Trefethen, ATAP Thm 19.3), M a bound of the integrand on the ellipse, which must
-    avoid F's branch points +-w, +-conj(w) (w^2 = 1 - e^2; x0, y0 = ``mp[13]``, ``mp[14]``: :func:`fresnel_branch`),
-    L and (in t) T.
+    t = T - d s^2, s in [-1, 1]: sqrt(d) integral F t^q / sqrt(t - L) ds, even in s, whose Bernstein ellipse of
+    parameter r maps onto t's of [lo, T] with R = r^2; else in t itself.  The n-point rule errs by at most 64 M / (15
+    (1 - r^-2) r^(2 n)) times the length factor (Trefethen, ATAP Thm 19.3), M a bound of the integrand on the ellipse,
+    which must avoid F's branch points +-w, +-conj(w) (w^2 = 1 - e^2; x0, y0 = ``mp[13]``, ``mp[14]``:
+    :func:`fresnel_branch`), L and (in t) T.
 
     M on the t-ellipse E_R of [lo, hi] (semi-axes h A_R, h B_R about m).  Every bound holds for either sign of the
     refracted cosine A = sqrt(e^2 - 1 + t^2), so for F's continuation, whatever its branch:
@@ -121,7 +125,8 @@ def _lobe_f_bound(mp, q, lo, d, top, low, first, tol):  # pragma: no cover - com
       |D| >= |e^2 + 1| gap(-c_b) / max |N'|: no loss at Brewster's angle;
     - |t - L|, |T - t| >= gap(L), gap(T).
     log(R) is the first of LOBE_F_FRACTIONS of log(R_max) that gives a rule; ``values`` is (n + 1) // 2 for ``first``,
-    n else."""
+    n else.
+    """
     eta, k, x0, y0 = mp[6], mp[7], mp[13], mp[14]
     h = 0.5 * d  # (d = hi - lo; for ``first`` T - lo without cancellation)
     m = lo + h
@@ -177,7 +182,8 @@ def _lobe_f_bound(mp, q, lo, d, top, low, first, tol):  # pragma: no cover - com
                 tau2 = m + ha2
                 dw2, dmw2 = s_w - ha2, s_mw - ha2
                 if dw2 > 0.0 and dmw2 > 0.0:
-                    d_low = max(d_low, ep1 * dm / (math.sqrt(tau2 * tau2 + w2) + tau2 * tau2 / math.sqrt(dw2 * dmw2) + 2.0 * tau2))
+                    d_low = max(d_low, ep1 * dm / (math.sqrt(tau2 * tau2 + w2) + tau2 * tau2 / math.sqrt(dw2 * dmw2)
+                                                   + 2.0 * tau2))
         if not (d_low > 0.0 and rs < math.inf):
             continue
         big_m = 0.5 * rs * rs * (1.0 + (nmax / d_low) ** 2) * (tau if q == 1.0 else 1.0) / math.sqrt(dl * dt)
@@ -198,8 +204,9 @@ def _lobe_f_bound(mp, q, lo, d, top, low, first, tol):  # pragma: no cover - com
 
 @njit(cache=True, nogil=True)
 def _lobe_f_piece(eta, k, q, lo, d, top, low, first, n):  # pragma: no cover - compiled; see lobe_f_piece_reference
-    """integral_lo^(lo + d) F(t) t^q / sqrt((T - t)(t - L)) dt by the n-point Gauss-Legendre rule (:func:`_lobe_f_bound`):
-    ``first`` (lo + d = T) in s, t = T - d s^2, else in t."""
+    """integral_lo^(lo + d) F(t) t^q / sqrt((T - t)(t - L)) dt by the n-point Gauss-Legendre rule
+    (:func:`_lobe_f_bound`): ``first`` (lo + d = T) in s, t = T - d s^2, else in t.
+    """
     tot = 0.0
     if first:
         for j in range((n + 1) // 2):
@@ -222,10 +229,12 @@ def _lobe_f_piece(eta, k, q, lo, d, top, low, first, n):  # pragma: no cover - c
     return h * tot
 
 
-def lobe_f_piece_reference(eta: float, k: float, q: float, lo: float, d: float, top: float, low: float, first: bool) -> float:
+def lobe_f_piece_reference(eta: float, k: float, q: float, lo: float, d: float, top: float, low: float,
+                           first: bool) -> float:
     """Plain twin of :func:`_lobe_f_piece`: integral_lo^(lo + d) F(t) t^q / sqrt((T - t)(t - L)) dt by numpy's 200-point
     Gauss-Legendre rule in the same variable (s for ``first``, else t), F the complex-arithmetic
-    :func:`pumpup.models.metal.fresnel`."""
+    :func:`pumpup.models.metal.fresnel`.
+    """
     from ..physics.fresnel import fresnel_conductor as fresnel
 
     x, w = np.polynomial.legendre.leggauss(200)
@@ -242,7 +251,8 @@ def _lobe_f_gauss(mp, q, mu, a, b, d, beta1, tol, cut):  # pragma: no cover - co
     :func:`_k_lobe_fresnel`), d = T - mu, by Gauss-Legendre rules with an a-priori bound (:func:`_lobe_f_bound`) on the
     pieces between frame 5's cuts (``cut``: falling t in (mu, T)), each at the tolerance ``tol`` times its share of
     [mu, T]; the error is the bounds plus (n + 64) eps of rounding per piece.  (0, -1) where a piece would want more
-    than GL_MAX points: the caller then takes the adaptive rule."""
+    than GL_MAX points: the caller then takes the adaptive rule.
+    """
     eta, k = mp[6], mp[7]
     top = a + b
     low = a - b
@@ -286,7 +296,8 @@ _POW3 = 3.0 ** np.arange(LOBE_F_CUTS)
 def _lobe_f_cuts(mp, mu, out):  # pragma: no cover - compiled
     """Frame 5's cuts of the arcs t = N.wo in (mu, 1] (:func:`_k_lobe_fresnel`) into ``out``, falling, and their number:
     t = x0 + y0 3^j (j falling), x0 - y0 3^j (j rising), j < LOBE_F_CUTS, about F's branch point (``mp[13]``,
-    ``mp[14]``), and rho 3^j (j falling) from max(rho, 3 mu), rho the distance of its pole near 0 (``mp[15]``)."""
+    ``mp[14]``), and rho 3^j (j falling) from max(rho, 3 mu), rho the distance of its pole near 0 (``mp[15]``).
+    """
     x0, y0 = mp[13], mp[14]
     rho = mp[15]
     r0 = rho if 3.0 * mu <= rho else 3.0 * mu
@@ -314,14 +325,16 @@ def _lobe_f_cuts(mp, mu, out):  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True)
 def _lobe_f_prepare(mp, mu):  # pragma: no cover - compiled
-    """Frame 5's per-mu quantities in ``mp``: F(mu) (``mp[21]``), the arc's cuts in (mu, 1] (:func:`_lobe_f_cuts`, at most
-    3 LOBE_F_CUTS, falling: ``mp[23:]``) and their number (``mp[22]``); every node's arc takes those below its top."""
+    """Frame 5's per-mu quantities in ``mp``: F(mu) (``mp[21]``), the arc's cuts in (mu, 1] (:func:`_lobe_f_cuts`, at
+    most 3 LOBE_F_CUTS, falling: ``mp[23:]``) and their number (``mp[22]``); every node's arc takes those below its top.
+    """
     mp[21] = _fresnel_real(mu, mp[6], mp[7])
     mp[22] = _lobe_f_cuts(mp, mu, mp[23:])
 
 
 @njit(cache=True, nogil=True)
-def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol, tol_abs, nodes, wk, wg, mode, ibuf, iwork):  # pragma: no cover - compiled; see lobe_fresnel_integrand_reference
+def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol,  # pragma: no cover - compiled; see lobe_fresnel_integrand_reference
+                    tol_abs, nodes, wk, wg, mode, ibuf, iwork):
     """(K(u), its error) of frame 5: the integral over the visible arc of N.wo F(max(mu, N.wo)) / max(mu, N.wo)^p,
     p in {0, 1}, for u = cos(alpha) about R (or wi), um = 1 - u, sa = sin(alpha), c2 = cos(2 theta_i); F the conductor
     Fresnel factor of (eta, k) = (``mp[6]``, ``mp[7]``), 000 eq. 28.
@@ -333,9 +346,10 @@ def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol, tol_abs, nodes, wk, wg, mode
     piece then lies about its own length from them; computed once per mu, :func:`_lobe_f_prepare`) and its pieces taken
     by Gauss-Legendre rules with an a-priori bound (:func:`_lobe_f_gauss`; issue 14's sixteenth session) at max(``itol``
     times a guess of K's lower bound, ``tol_abs`` / 2).  Where a piece would want more than GL_MAX points (or with
-    ``using(lobe_fresnel_gauss=False)``) the arc is the globally adaptive 7/15 rule in beta, from the same cuts, the interval
-    with the largest error bisected until the summed error (QUADPACK's calibration) is at most max(``itol`` |K|,
-    ``tol_abs``) or INNER_MAX intervals are used; the error is returned either way.  Both signs of beta: 2 x."""
+    ``using(lobe_fresnel_gauss=False)``) the arc is the globally adaptive 7/15 rule in beta, from the same cuts, the
+    interval with the largest error bisected until the summed error (QUADPACK's calibration) is at most max(``itol``
+    |K|, ``tol_abs``) or INNER_MAX intervals are used; the error is returned either way.  Both signs of beta: 2 x.
+    """
     _, beta1, below = _k_closed(1.0, mu, c2, u, um, sa)
     fm = mp[21]  # F(mu) (:func:`_lobe_f_prepare`)
     closed = below * fm / (mu if p == 1.0 else 1.0)
@@ -388,7 +402,8 @@ def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol, tol_abs, nodes, wk, wg, mode
 def lobe_fresnel_integrand_reference(brdf, mu: float, u) -> np.ndarray:
     """Frame 5's K(u) (:func:`_k_lobe_fresnel`) for ``brdf``'s hint, independently: scipy's ``quad`` over the azimuth
     beta in [0, pi] of N.wo F(max(mu, N.wo)) / max(mu, N.wo)^p where N.wo = mu u + s sin(alpha) cos(beta) > 0, with F
-    the complex-arithmetic :func:`pumpup.models.metal.fresnel`, the arcs' ends as the rule's points; times 2."""
+    the complex-arithmetic :func:`pumpup.models.metal.fresnel`, the arcs' ends as the rule's points; times 2.
+    """
     from scipy.integrate import quad
 
     from ..physics.fresnel import fresnel_conductor as fresnel
@@ -415,7 +430,8 @@ def lobe_fresnel_integrand_reference(brdf, mu: float, u) -> np.ndarray:
 def numeric_integrand(brdf, mu: float, u, rtol: float = 1e-13):
     """(K(u), error) of frame 4 (:func:`_k_numeric`, ``u`` the values of N.h) or, for a lobe hint with a Fresnel factor,
     frame 5 (:func:`_k_lobe_fresnel`, ``u`` the values of cos(alpha) about R) for ``brdf``'s hint at N.wi = ``mu``, at
-    relative tolerance ``rtol`` (the kernels as the engine calls them; for the tests)."""
+    relative tolerance ``rtol`` (the kernels as the engine calls them; for the tests).
+    """
     hint = kernel_view(brdf.azimuth_hint())
     mp = numeric_params(hint)
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -429,8 +445,8 @@ def numeric_integrand(brdf, mu: float, u, rtol: float = 1e-13):
     for i, v in enumerate(u):
         sa = math.sqrt((1.0 - v) * (1.0 + v))
         if mp[0] == LOBE_F:
-            val[i], err[i] = _k_lobe_fresnel(mp, float(hint.p), mu, (mu - s) * (mu + s), float(v), 1.0 - float(v), sa, rtol,
-                                             0.0, _NODES, _WK, _WG, mode_code(), ibuf, iwork)
+            val[i], err[i] = _k_lobe_fresnel(mp, float(hint.p), mu, (mu - s) * (mu + s), float(v), 1.0 - float(v), sa,
+                                             rtol, 0.0, _NODES, _WK, _WG, mode_code(), ibuf, iwork)
         else:
             val[i], err[i] = _k_numeric(mp, mu, s, math.atan2(mu, s), float(v), sa, rtol, 0.0, _NODES, _WK, _WG,
                                         mode_code(), ibuf, iwork)

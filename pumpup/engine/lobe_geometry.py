@@ -7,11 +7,11 @@ rotation of wi out of the xz-plane, the accumulation of f cos(theta_o), and the 
 from __future__ import annotations
 
 import math
+
 import numpy as np
 from numba import njit
 
 from ..core import Lobe
-
 
 # --- Gauss-Kronrod 7/15 nodes and weights on [-1, 1] (QUADPACK qk15) -----------------------
 _XGK = np.array(
@@ -49,11 +49,16 @@ WG[1::2] = 0.5 * np.concatenate([_WG[:-1], _WG[::-1]])
 
 def power_split(k: float) -> tuple[float, float]:
     """(u_s, y_s) of the two-piece power map: the tail cos(alpha) in [0, u_s = 1/2] is
-    integrated in cos(alpha) itself, the peak y = cos^(n+1)(alpha) in [y_s, 1]."""
+    integrated in cos(alpha) itself, the peak y = cos^(n+1)(alpha) in [y_s, 1].
+    """
     return 0.5, 0.5 ** (k + 1.0)
 
 
 def radial_map(kind: str, k: float, x: np.ndarray, xc: np.ndarray):
+    """(cos(alpha), sin(alpha), jac) of the radial map ``kind`` of sharpness ``k`` (:class:`pumpup.core.Lobe`) at ``x``,
+    given ``xc`` = 1 - x for precision near x = 1: the polar angle about the lobe's axis, and jac = sin(alpha) d alpha /
+    dx, so that d omega = jac dx d beta.
+    """
     if kind == "cosine":  # sin^2 alpha = x
         ca = np.sqrt(xc)
         sa = np.sqrt(x)
@@ -72,9 +77,9 @@ def radial_map(kind: str, k: float, x: np.ndarray, xc: np.ndarray):
             ca_peak = np.exp(ly)
             sa_peak = np.sqrt(-np.expm1(ly) * (1.0 + ca_peak))
             jac_peak = 2.0 * (1.0 - ys) * ca_peak / ((k + 1.0) * y)
-        # at x = 1/2 itself 1 - (1 - ys) rounds ys off beyond n = 52 (y = 0): alpha is the split's, cos(alpha) = u_s, not
-        # 90 deg (the kink scan samples tau = 1/2 and saw the wrong side there), with the weight 0 the point had before
-        # (it only ends intervals one double wide)
+        # at x = 1/2 itself 1 - (1 - ys) rounds ys off beyond n = 52 (y = 0): alpha is the split's, cos(alpha) = u_s,
+        # not 90 deg (the kink scan samples tau = 1/2 and saw the wrong side there), with the weight 0 the point had
+        # before (it only ends intervals one double wide)
         at_split = ~tail & (y <= 0.0)
         ca_tail = np.where(at_split, us, 2.0 * us * x)
         ca = np.where(tail | at_split, ca_tail, ca_peak)
@@ -114,7 +119,7 @@ AXES = ("normal", "mirror", "retro", "half")
 
 
 def smooth(tau):
-    """x = tau^2 (3 - 2 tau), 1 - x, dx/dtau."""
+    """The values x = tau^2 (3 - 2 tau), 1 - x and dx/dtau."""
     x = tau * tau * (3.0 - 2.0 * tau)
     xc = (1.0 - tau) ** 2 * (1.0 + 2.0 * tau)
     return x, xc, 6.0 * tau * (1.0 - tau)
@@ -136,6 +141,7 @@ def kink_coefficients(lobe: Lobe, mu: np.ndarray, x: np.ndarray, xc: np.ndarray)
 
 @njit(cache=True, nogil=True)
 def radial_map_scalar(kind, k, x, xc):  # pragma: no cover - compiled; see radial_map
+    """Compiled scalar twin of :func:`radial_map`, the map given by its code ``kind`` (:data:`RADIAL_CODE`)."""
     if kind == 0:
         ca = math.sqrt(xc)
         return ca, math.sqrt(x), (0.5 / ca if ca > 0 else math.inf)
@@ -173,7 +179,7 @@ def radial_map_scalar(kind, k, x, xc):  # pragma: no cover - compiled; see radia
 
 
 def rotate_wi(w, c, s):
-    """w rotated about N = (0, 0, 1) by the angle with cosine c and sine s (arrays (n,))."""
+    """The direction w rotated about N = (0, 0, 1) by the angle with cosine c and sine s (arrays (n,))."""
     out = np.empty_like(w)
     out[:, 0] = c * w[:, 0] - s * w[:, 1]
     out[:, 1] = s * w[:, 0] + c * w[:, 1]
@@ -183,8 +189,9 @@ def rotate_wi(w, c, s):
 
 @njit(cache=True, nogil=True)
 def accumulate(f, cos_o, weight, total):  # pragma: no cover - compiled
-    """total += f cos(theta_o) weight where all are positive; the index of the first value of f
-    that is negative or not finite (or -1)."""
+    """Compute total += f cos(theta_o) weight where all are positive; the index of the first value of f
+    that is negative or not finite (or -1).
+    """
     for i in range(f.shape[0]):
         v = f[i]
         if not (v >= 0.0 and v < math.inf):
@@ -196,7 +203,8 @@ def accumulate(f, cos_o, weight, total):  # pragma: no cover - compiled
 
 def radial_map_inverse(kind: str, k: float, alpha: float) -> tuple[float, float]:
     """The map variable x of the polar angle alpha, and 1 - x, both to full precision
-    (inverse of :func:`radial_map`)."""
+    (inverse of :func:`radial_map`).
+    """
     ta = math.tan(alpha)
     if kind == "cosine":
         return math.sin(alpha) ** 2, math.cos(alpha) ** 2
@@ -222,7 +230,7 @@ def radial_map_inverse(kind: str, k: float, alpha: float) -> tuple[float, float]
 
 
 def smooth_inverse(x: float, xc: float) -> float:
-    """tau with tau^2 (3 - 2 tau) = x, precise at both ends (the map is symmetric about 1/2)."""
+    """The tau with tau^2 (3 - 2 tau) = x, precise at both ends (the map is symmetric about 1/2)."""
     small = min(x, xc)
     if small < 1e-4:
         # the series tau = t0 (1 + t0 / 3 + ...), t0 = sqrt(small / 3): the closed form below rounds 1 - 2 small, and

@@ -48,9 +48,9 @@ the hint already says.  This module integrates the same integrand as a nested qu
 
 The geometry runs in two compiled passes per batch (:func:`_nodes_kernel`: per outer node;
 :func:`_points_kernel`: per point), the model's ``_eval`` once per batch on all points (twice
-where the hint is not even in beta), and two compiled passes (:func:`pumpup.engine.cubature.accumulate`, :func:`_rule_kernel`)
-form the Kronrod and Gauss sums; each has a plain numpy twin (``*_reference``) that the tests compare
-with it.
+where the hint is not even in beta), and two compiled passes (:func:`pumpup.engine.cubature.accumulate`,
+:func:`_rule_kernel`) form the Kronrod and Gauss sums; each has a plain numpy twin (``*_reference``) that the tests
+compare with it.
 
 Groups with wi turned out of the xz-plane (``phi != 0``) are integrated in the frame of wi at phi = 0 and the points
 turned by phi about N before ``_eval``, as the 2-D engine does (issue 14, fourteenth session; before, they were left to
@@ -120,13 +120,15 @@ def inner_error(kronrod, gauss):
     """Error estimate of one inner sub-interval at one outer node: |K - G| of the 15-point Kronrod
     rule and its embedded 7-point Gauss rule.  QUADPACK's calibration of it (``pumpup.physics.quadrature``)
     was measured here too and under-reported (modified_ward m = 0.1 at mu = 0.2, rtol 1e-10: true
-    error 2.4 x the estimate), so the raw difference stays."""
+    error 2.4 x the estimate), so the raw difference stays.
+    """
     return np.abs(kronrod - gauss)
 
 
 def interval_error(kronrod, gauss, inner):
     """Error estimate of outer intervals: |K - G| of the outer rule plus the inner errors carried
-    through the outer weights (an upper bound of the integral of |I_h - I|)."""
+    through the outer weights (an upper bound of the integral of |I_h - I|).
+    """
     return np.abs(kronrod - gauss) + inner
 
 
@@ -236,7 +238,8 @@ def _nodes_kernel(axis, radial, k, mu, levels, ka, kb, tx, s_o, ca_o, sa_o, wr_o
 
 def _end_map(sm, v):
     """t(v) and dt/dv of the inner substitution: 0 none, 1 t = v^2 (square-root end at beta = lo),
-    2 t = 1 - (1 - v)^2 (at beta = lo + width), 3 t = v^2 (3 - 2 v) (both)."""
+    2 t = 1 - (1 - v)^2 (at beta = lo + width), 3 t = v^2 (3 - 2 v) (both).
+    """
     sm = np.broadcast_to(np.asarray(sm)[..., None] if np.ndim(sm) else sm, v.shape)
     t = np.where(sm == 0, v, np.where(sm == 1, v * v, np.where(sm == 2, 1.0 - (1.0 - v) ** 2, v * v * (3.0 - 2.0 * v))))
     dt = np.where(sm == 0, 1.0, np.where(sm == 1, 2.0 * v, np.where(sm == 2, 2.0 * (1.0 - v), 6.0 * v * (1.0 - v))))
@@ -246,7 +249,8 @@ def _end_map(sm, v):
 def _points_reference(axis: str, node, lo, width, t0, t1, mu, s, ca, sa, wr, sm=3):
     """Plain numpy twin of :func:`_points_kernel`: (wi, wo, weight) of the 15 inner nodes of every
     segment (sub-interval [t0, t1] of v on the piece [lo, lo + width] of beta at outer node
-    ``node``); ``weight`` is d omega_o per d tau_x d v, including the width of [t0, t1]."""
+    ``node``); ``weight`` is d omega_o per d tau_x d v, including the width of [t0, t1].
+    """
     v = t0[:, None] + (t1 - t0)[:, None] * NODES[None, :]
     t, dt = _end_map(sm, v)
     j = np.broadcast_to(node[:, None], v.shape)
@@ -272,7 +276,8 @@ def _points_reference(axis: str, node, lo, width, t0, t1, mu, s, ca, sa, wr, sm=
 
 
 @njit(cache=True, nogil=True)
-def _points_kernel(axis, node, lo, width, t0, t1, sm, mu, s_n, ca_n, sa_n, wr_n, nodes, wi, wo, weight):  # pragma: no cover
+def _points_kernel(axis, node, lo, width, t0, t1, sm, mu, s_n, ca_n, sa_n, wr_n, nodes, wi, wo,  # pragma: no cover
+                   weight):
     """Compiled twin of :func:`_points_reference` (fills ``wi``, ``wo`` (N, 3), ``weight`` (N))."""
     R = nodes.shape[0]
     for q in range(node.shape[0]):
@@ -321,7 +326,8 @@ def _points_kernel(axis, node, lo, width, t0, t1, sm, mu, s_n, ca_n, sa_n, wr_n,
 
 def _values_reference(f, cos_o, weight):
     """Plain numpy twin of :func:`pumpup.engine.cubature.accumulate` as this module uses it (on zeros): f cos(theta_o)
-    weight where all three are positive."""
+    weight where all three are positive.
+    """
     return np.where((f > 0) & (cos_o > 0) & (weight > 0), f * cos_o * weight, 0.0)
 
 
@@ -352,7 +358,8 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
     (indices into ``i_prob``, ``i_x0``, ``i_x1``) at the 15 outer nodes of their interval: per segment
     its share of the outer Kronrod and Gauss sums, its inner error carried through the outer Kronrod
     weights, and the sum of |values| (all including the interval width); and the evaluations per
-    problem."""
+    problem.
+    """
     lobe = g.lobe
     RO, RI = len(_OUTER[0]), len(_INNER[0])
     onodes, owk, owg = _OUTER
@@ -425,7 +432,8 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
         v_[:] = 0.0
         _points_kernel(axis, b_node[sl], b_lo[sl], b_w[sl], b_t0[sl], b_t1[sl], sm[sl], mu_n, s_n, ca_n, sa_n, wr_n,
                        inodes, wi_, wo_, w_)
-        if g.phi is not None:  # wi at azimuth phi: the whole configuration turned by phi about N, as the 2-D engine does
+        # wi at azimuth phi: the whole configuration turned by phi about N, as the 2-D engine does
+        if g.phi is not None:
             ph = np.repeat(g.phi[pnode[b_node[sl]]], RI)
             cp, sp = np.cos(ph), np.sin(ph)
         for sign in signs:
@@ -453,9 +461,10 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
 
 
 #: segments per call of :func:`_evaluate`: its block arrays (a dozen of 8 bytes per segment and outer node, more where
-#: the ends are graded) grow with the segments a refinement round adds.  Found by ``scripts/studies/fuzz_engines.py --fmax 22``
-#: (issue 14's twenty-second session): a nested reference at max_regions 200000 grew past 23 GB and the kernel killed
-#: it.  Each segment's values do not depend on the others in its call, so the chunks change no bit
+#: the ends are graded) grow with the segments a refinement round adds.  Found by
+#: ``scripts/studies/fuzz_engines.py --fmax 22`` (issue 14's twenty-second session): a nested reference at max_regions
+#: 200000 grew past 23 GB and the kernel killed it.  Each segment's values do not depend on the others in its call, so
+#: the chunks change no bit
 SEG_CHUNK = 100_000
 
 
@@ -464,7 +473,8 @@ def _evaluate_chunked(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, s
     if len(seg_int) <= SEG_CHUNK:
         return _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i_sub)
     parts = [_evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int[a:a + SEG_CHUNK], seg_piece[a:a + SEG_CHUNK],
-                       seg_t0[a:a + SEG_CHUNK], seg_t1[a:a + SEG_CHUNK], i_sub) for a in range(0, len(seg_int), SEG_CHUNK)]
+                       seg_t0[a:a + SEG_CHUNK], seg_t1[a:a + SEG_CHUNK], i_sub)
+             for a in range(0, len(seg_int), SEG_CHUNK)]
     return (np.concatenate([q[0] for q in parts]), np.concatenate([q[1] for q in parts]),
             np.concatenate([q[2] for q in parts]), sum(q[3] for q in parts))
 
@@ -484,7 +494,8 @@ def _graded_coarse(points: np.ndarray) -> np.ndarray:
     """Breakpoints with a grid graded geometrically towards each, as ``pumpup.engine.cubature.graded`` but
     with steps d 16^k: the outer rule's |K - G| sees the variation on one step (measured on the
     tests' references), and a break 7e-18 from an end (Cook-Torrance's second horizon at mu = 0.5)
-    costs 14 intervals instead of 27."""
+    costs 14 intervals instead of 27.
+    """
     out = list(points)
     for t in points:
         d = min(t, 1.0 - t)
@@ -507,10 +518,11 @@ def _alpha_grading(lobe, mu: float) -> np.ndarray:
     pi/4 -+ theta_i / 2) on its roughness's scale a (GGX's alpha, the sqrt of the "ggx" map's sharpness; Beckmann's m):
     alpha_f -+ (a / 2) 4^k up to 1/4 rad away.  The shadowing G1(wo) falls to 0 where N.wo is within a of the horizon,
     which is (a / 2) in alpha_h from a break; away from normal incidence the arc's integral over beta spreads that over
-    theta_i, but near it the outer integrand has the whole feature next to the break, where the grading towards the break
-    (on the scale of its distance to the end of the range) did not see it: GGX alpha = 1.4e-3 at mu = 1 was 6.4 x its
-    estimate at rtol 1e-10, alpha = 3e-4 at mu = 1 - 1e-9 26 x at 1e-12 (issue 14's twentieth session,
-    ``scripts/studies/fuzz_engines.py``)."""
+    theta_i, but near it the outer integrand has the whole feature next to the break, where the grading towards the
+    break (on the scale of its distance to the end of the range) did not see it: GGX alpha = 1.4e-3 at mu = 1 was 6.4 x
+    its estimate at rtol 1e-10, alpha = 3e-4 at mu = 1 - 1e-9 26 x at 1e-12 (issue 14's twentieth session,
+    ``scripts/studies/fuzz_engines.py``).
+    """
     if lobe.axis != "half" or lobe.radial not in ("ggx", "beckmann"):
         return np.array([])
     a = math.sqrt(lobe.sharpness) if lobe.radial == "ggx" else float(lobe.sharpness)
@@ -533,7 +545,8 @@ def _alpha_grading(lobe, mu: float) -> np.ndarray:
 def _merged(breaks: np.ndarray) -> np.ndarray:
     """The sorted breaks with those within 1e-12 of their distance to the nearer end of [0, 1] of the
     previous one dropped: three cuts of Cook-Torrance's geometry factor cross at one point (m = 0.4,
-    mu = 0.1: tau_x = 0.0255861562 three times, 1e-17 apart), and each interval costs a full rule."""
+    mu = 0.1: tau_x = 0.0255861562 three times, 1e-17 apart), and each interval costs a full rule.
+    """
     b = np.sort(breaks)
     if len(b) < 2:
         return b
@@ -637,7 +650,8 @@ def _weighted_columns(F: np.ndarray, w: np.ndarray) -> np.ndarray:
 
 def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
     """a(mu) of the group ``g`` by nested quadrature: (value, error, converged) per problem, as
-    ``pumpup.engine.cubature._integrate_group`` returns them."""
+    ``pumpup.engine.cubature._integrate_group`` returns them.
+    """
     global LAST_EVALS
     P = len(g.mu)
     n_pieces = 1 + g.levels.shape[1] + (len(g.lobe.kinks(np.array([0.5]), np.array([0.5]), np.array([0.5]),
@@ -663,8 +677,12 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
     s_t0 = np.tile(grid[:-1], nI * n_pieces)
     s_t1 = np.tile(grid[1:], nI * n_pieces)
     s_v, s_e, s_a, evals = _evaluate_chunked(brdf, g, i_prob, i_x0, i_x1, s_int, s_piece, s_t0, s_t1, i_sub)
+
     # the budget counts outer intervals, an interval with m sub-intervals per piece m times
-    seg_count = lambda: np.bincount(i_prob[s_int], minlength=P) / n_pieces
+    def seg_count():
+        """The outer intervals of each problem, read from the arrays of the current round."""
+        return np.bincount(i_prob[s_int], minlength=P) / n_pieces
+
     budget = max_regions + seg_count()
     rounding = lobe_rounding(g.lobe)
     while True:
@@ -711,7 +729,8 @@ def integrate(brdf, g, rtol: float, atol: float, max_regions: int):
         # (x1 - h (1 - v)^2); a child keeps the substitution at the parent's break end only
         hs = i_x1[sp] - i_x0[sp]
         ss = i_sub[sp]
-        xm = np.where(ss == 1, i_x0[sp] + 0.25 * hs, np.where(ss == 2, i_x1[sp] - 0.25 * hs, 0.5 * (i_x0[sp] + i_x1[sp])))
+        xm = np.where(ss == 1, i_x0[sp] + 0.25 * hs, np.where(ss == 2, i_x1[sp] - 0.25 * hs,
+                                                              0.5 * (i_x0[sp] + i_x1[sp])))
         i_sub = np.concatenate([i_sub, ss & 1, ss & 2])
         base = len(i_prob)
         child = np.full(nI, -1)

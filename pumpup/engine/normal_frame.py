@@ -6,19 +6,18 @@ node; :mod:`pumpup.engine.polar` describes the method.
 from __future__ import annotations
 
 import math
-import numpy as np
 import os
+
+import numpy as np
 from numba import njit
 
 from ..core.hints import AzimuthHint
 from ..physics.fresnel import conductor_scalar as _fresnel_real
 from ..physics.fresnel import fresnel_pole
-from ..physics.lookups import g_levels
-from ..physics.lookups import g_product
+from ..physics.lookups import g_levels, g_product
 from ..physics.lookups import scale_bound as _scale_bound
 from ..physics.microfacet import projected as _projected
-from ..physics.quadrature import calibrated
-from ..physics.quadrature import rule_sums
+from ..physics.quadrature import calibrated, rule_sums
 from .chain_frame import CHAIN_SAFETY
 from .half_arc import SCHLICK, SMITH, _fresnel_at, numeric_params
 from .hint_view import kernel_view
@@ -28,19 +27,20 @@ from .outer_rule import _bisect, _buffers, _status
 
 @njit(cache=True, nogil=True, inline="always")
 def _ggx_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ring_reference
-    """integral over phi in [0, 2 pi) of the GGX weight D = a2 / (pi (1 - (1 - a2) (N.h)^2)^2) (Walter et al. 2007
-    eq. 33; 000 eq. 36 with a2 = r) on the circle of wo at elevation x = x_mu + d (N.wo = sin x) for wi at elevation x_mu
-    (x_s = pi / 2 - x_mu).
+    """The integral over phi in [0, 2 pi) of the GGX weight D = a2 / (pi (1 - (1 - a2) (N.h)^2)^2) (Walter et al. 2007
+    eq. 33; 000 eq. 36 with a2 = r) on the circle of wo at elevation x = x_mu + d (N.wo = sin x) for wi at elevation
+    x_mu (x_s = pi / 2 - x_mu).
 
-    With X = |wi + wo|^2 = P0 + Q cos(phi) and (N.h)^2 = m^2 / X, m = N.wi + N.wo, D = (a2 / pi) X^2 / (X - k)^2, k = (1 - a2)
-    m^2, and the integral of (1 + k / Y)^2 over phi, Y = X - k = a' + Q cos(phi), is 2 pi (1 + 2 k / R + k^2 a' / R^3),
-    R^2 = (a' - Q)(a' + Q).  Both factors are sums of squares: a' - Q = m^2 (a2 + tan^2(d / 2)), a' + Q = 4 cos^2(d / 2)
-    (a2 S^2 + C^2), S, C = sin, cos((x + x_mu) / 2), m = 2 S cos(d / 2); so, with A = a2 + tan^2(d / 2) and B = a2 S^2 +
-    C^2, the integral is 2 a2 (1 + 2 (1 - a2) S / sqrt(A B) + (1 - a2)^2 S (S^2 A + B) / (2 (A B)^(3/2))): every term
-    >= 0 for a2 <= 1 (no cancellation), no division by m (which vanishes at grazing incidence), and d, the offset from
-    the peak, exact where the peak is narrow (a rule in x itself lost ulp(x) / alpha there: GGX alpha = 1e-5 at mu =
-    0.9986 was 3e-13 off with an estimate of 9e-14), and cosines near pi / 2 as sines of x_s - ... (cos(x) of a rounded x
-    near pi / 2 lost ulp(pi / 2) / alpha: alpha = 1e-8 at mu = 1 did not converge)."""
+    With X = |wi + wo|^2 = P0 + Q cos(phi) and (N.h)^2 = m^2 / X, m = N.wi + N.wo, D = (a2 / pi) X^2 / (X - k)^2, k =
+    (1 - a2) m^2, and the integral of (1 + k / Y)^2 over phi, Y = X - k = a' + Q cos(phi), is 2 pi (1 + 2 k / R + k^2 a'
+    / R^3), R^2 = (a' - Q)(a' + Q).  Both factors are sums of squares: a' - Q = m^2 (a2 + tan^2(d / 2)), a' + Q = 4
+    cos^2(d / 2) (a2 S^2 + C^2), S, C = sin, cos((x + x_mu) / 2), m = 2 S cos(d / 2); so, with A = a2 + tan^2(d / 2) and
+    B = a2 S^2 + C^2, the integral is 2 a2 (1 + 2 (1 - a2) S / sqrt(A B) + (1 - a2)^2 S (S^2 A + B) / (2 (A B)^(3/2))):
+    every term >= 0 for a2 <= 1 (no cancellation), no division by m (which vanishes at grazing incidence), and d, the
+    offset from the peak, exact where the peak is narrow (a rule in x itself lost ulp(x) / alpha there: GGX alpha = 1e-5
+    at mu = 0.9986 was 3e-13 off with an estimate of 9e-14), and cosines near pi / 2 as sines of x_s - ... (cos(x) of a
+    rounded x near pi / 2 lost ulp(pi / 2) / alpha: alpha = 1e-8 at mu = 1 did not converge).
+    """
     tau = math.tan(0.5 * d)
     sy, cy = math.sin(xmu + 0.5 * d), math.sin(xs - 0.5 * d)  # (cos(y) as sin(pi / 2 - y): exact near the normal)
     a = a2 + tau * tau  # (a' - Q) / m^2
@@ -54,13 +54,14 @@ def _ggx_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ring_referenc
 #: RING_F_N0 + 1 to at most RING_F_NMAX + 1 on [0, pi]
 RING_F_N0 = 16
 RING_F_NMAX = 128
-#: ... and takes |W_N - W_N/2| times the larger ratio of the last three such steps as W_N's error where both ratios are at most
-#: this (geometric decay of F's coefficients; with the last ratio alone, from N = 16 on, it was 1100 x below the true error
-#: of a strong absorber, eta 1.1, k 6, at itol 1e-6: measured by scripts/calibration/ring_fresnel_calibration.py)
+#: ... and takes |W_N - W_N/2| times the larger ratio of the last three such steps as W_N's error where both ratios are
+#: at most this (geometric decay of F's coefficients; with the last ratio alone, from N = 16 on, it was 1100 x below the
+#: true error of a strong absorber, eta 1.1, k 6, at itol 1e-6: measured by
+#: scripts/calibration/ring_fresnel_calibration.py)
 RING_F_RATIO = 0.5
-#: :func:`_ring_f_sums` sums term by term where nn |1 - z| is below this (at most the sample n = 0, where 1 - rho < 2 / nn:
-#: n >= 1 has |1 - z| >= rho sin(pi / nn)); until issue 14's twenty-third session, where |1 - z| < 0.25, up to ~nn / 12
-#: samples of nn + 1 terms each, a quarter of GGX alpha 0.02 with ior 1.5's table time
+#: :func:`_ring_f_sums` sums term by term where nn |1 - z| is below this (at most the sample n = 0, where 1 - rho < 2 /
+#: nn: n >= 1 has |1 - z| >= rho sin(pi / nn)); until issue 14's twenty-third session, where |1 - z| < 0.25, up to ~nn /
+#: 12 samples of nn + 1 terms each, a quarter of GGX alpha 0.02 with ior 1.5's table time
 RING_F_DIRECT = 2.0
 #: sin^2(psi / 2) at psi = j pi / RING_F_NMAX (the finest level's samples; a coarser level takes every stride-th)
 _RING_F_SIN2 = np.sin(0.5 * np.pi * np.arange(RING_F_NMAX + 1) / RING_F_NMAX) ** 2
@@ -71,13 +72,14 @@ _RING_F_SIN = np.sin(np.pi * np.arange(RING_F_NMAX + 1) / RING_F_NMAX)
 
 @njit(cache=True, nogil=True, inline="always")
 def _ring_f_sums(rho, rn, n, nn, j):  # pragma: no cover - compiled; see ring_f_sums_reference
-    """(C0, C1) = the sums over k = 0 .. nn, the first and last halved, of rho^k cos(k theta) and k rho^k cos(k theta) at
-    theta = n pi / nn = j pi / RING_F_NMAX (``rn`` = rho^nn): geometric sums in z = rho e^(i theta), z^nn = (-1)^n rho^nn
-    real, 1 - z = w = (1 - rho) + 2 rho sin^2(theta / 2) - i rho sin(theta) without cancellation.  sum k z^k = z N / w^2
-    with N = 1 - (nn + 1) z^nn + nn z^(nn + 1) = (1 - z^nn) - nn z^nn w: of size nn^2 |w|^2 where nn |w| is small, from
-    terms of size nn |w| (the first form's terms are of size nn: it lost 2e-11 at nn = 128, n = 1).  Its error is then
-    about eps (1 + nn |w|) / |w|^2, within a few eps of the sum's scale nn^2 where nn |w| >= 1; below RING_F_DIRECT, term
-    by term."""
+    """(C0, C1) = the sums over k = 0 .. nn, the first and last halved, of rho^k cos(k theta) and k rho^k cos(k theta)
+    at theta = n pi / nn = j pi / RING_F_NMAX (``rn`` = rho^nn): geometric sums in z = rho e^(i theta), z^nn = (-1)^n
+    rho^nn real, 1 - z = w = (1 - rho) + 2 rho sin^2(theta / 2) - i rho sin(theta) without cancellation.  sum k z^k = z
+    N / w^2 with N = 1 - (nn + 1) z^nn + nn z^(nn + 1) = (1 - z^nn) - nn z^nn w: of size nn^2 |w|^2 where nn |w| is
+    small, from terms of size nn |w| (the first form's terms are of size nn: it lost 2e-11 at nn = 128, n = 1).  Its
+    error is then about eps (1 + nn |w|) / |w|^2, within a few eps of the sum's scale nn^2 where nn |w| >= 1; below
+    RING_F_DIRECT, term by term.
+    """
     zn = -rn if n % 2 else rn  # z^nn
     zr, zi = rho * _RING_F_COS[j], rho * _RING_F_SIN[j]
     p, r = (1.0 - rho) + 2.0 * rho * _RING_F_SIN2[j], zi  # 1 - z = p - i r
@@ -114,20 +116,22 @@ def ring_f_sums_reference(rho: float, n: int, nn: int) -> tuple:
 
 @njit(cache=True, nogil=True)
 def _ggx_ring_f(mp, a2, xmu, xs, d, itol, tol_abs, fv):  # pragma: no cover - compiled; see ring_reference
-    """(W, its error, F's samples): the integral over phi of the GGX weight D times the Fresnel factor F(wi.h) on the circle
-    of wo at x = x_mu + d (:func:`_ggx_ring` with F; ``fv`` a work array of RING_F_NMAX + 1 values).
+    """(W, its error, F's samples): the integral over phi of the GGX weight D times the Fresnel factor F(wi.h) on the
+    circle of wo at x = x_mu + d (:func:`_ggx_ring` with F; ``fv`` a work array of RING_F_NMAX + 1 values).
 
     On the circle, measured from the mirror side (psi = phi - pi), D = (a2 / pi)(1 + k / Y)^2 with Y = a' - Q cos(psi)
-    (:func:`_ggx_ring`), whose Fourier cosine coefficients are closed forms: with rho = (sqrt(B) - S sqrt(A)) / (sqrt(B) +
-    S sqrt(A)) (= (a' - R) / Q, no cancellation), the integral of D cos(k psi) is M_k = 2 a2 (delta_k0 + rho^k (2 k1 + t2 +
-    k k1^2)), k1 = k / R = (1 - a2) S / sqrt(A B), t2 = k^2 a' / R^3 (M_0 is :func:`_ggx_ring`).  F depends on psi through
-    c = wi.h = sqrt(S^2 + s cos(x) sin^2(psi / 2)) only, smooth and periodic: its cosine interpolant at psi = n pi / N
-    (Chebyshev-Lobatto in cos psi) integrates against D exactly from the M_k, sum'' a_k M_k = (4 a2 / N) sum''_n F_n (1/2 +
-    (2 k1 + t2) C0_n + k1^2 C1_n) (:func:`_ring_f_sums`).  N doubles from RING_F_N0 until W_N's error is at most
-    max(itol W_N, ``tol_abs``) or N = RING_F_NMAX: |W_N - W_N/2|, times the larger ratio of the last three such steps where
-    both are at most RING_F_RATIO (from N = 32: the coefficients then decay geometrically, or faster, so W_N's error is below
-    |W_N - W_N/2| times that ratio).  F's singularities limit the decay: c = 0, at psi = +- 2 i asinh(S / sqrt(s cos x)) (so S must not be
-    small: :data:`N_FRESNEL_S_MIN`), and the index's (:func:`n_fresnel_ok`)."""
+    (:func:`_ggx_ring`), whose Fourier cosine coefficients are closed forms: with rho = (sqrt(B) - S sqrt(A)) /
+    (sqrt(B) + S sqrt(A)) (= (a' - R) / Q, no cancellation), the integral of D cos(k psi) is M_k = 2 a2 (delta_k0 +
+    rho^k (2 k1 + t2 + k k1^2)), k1 = k / R = (1 - a2) S / sqrt(A B), t2 = k^2 a' / R^3 (M_0 is :func:`_ggx_ring`).  F
+    depends on psi through c = wi.h = sqrt(S^2 + s cos(x) sin^2(psi / 2)) only, smooth and periodic: its cosine
+    interpolant at psi = n pi / N (Chebyshev-Lobatto in cos psi) integrates against D exactly from the M_k, sum'' a_k
+    M_k = (4 a2 / N) sum''_n F_n (1/2 + (2 k1 + t2) C0_n + k1^2 C1_n) (:func:`_ring_f_sums`).  N doubles from RING_F_N0
+    until W_N's error is at most max(itol W_N, ``tol_abs``) or N = RING_F_NMAX: |W_N - W_N/2|, times the larger ratio of
+    the last three such steps where both are at most RING_F_RATIO (from N = 32: the coefficients then decay
+    geometrically, or faster, so W_N's error is below |W_N - W_N/2| times that ratio).  F's singularities limit the
+    decay: c = 0, at psi = +- 2 i asinh(S / sqrt(s cos x)) (so S must not be small: :data:`N_FRESNEL_S_MIN`), and the
+    index's (:func:`n_fresnel_ok`).
+    """
     tau = math.tan(0.5 * d)
     sy, cy = math.sin(xmu + 0.5 * d), math.sin(xs - 0.5 * d)
     a = a2 + tau * tau
@@ -150,8 +154,8 @@ def _ggx_ring_f(mp, a2, xmu, xs, d, itol, tol_abs, fv):  # pragma: no cover - co
     while True:
         w = _ring_f_level(fv, rho, al, be, nn, stride)
         e = abs(w - prev)
-        # where the last three steps shrink, each by RING_F_RATIO at least (from N = 32 on: W_8 - W_4, W_16 - W_8, W_32 -
-        # W_16), |W_N - W_N/2| times the larger of their two ratios; else |W_N - W_N/2|
+        # where the last three steps shrink, each by RING_F_RATIO at least (from N = 32 on: W_8 - W_4, W_16 - W_8,
+        # W_32 - W_16), |W_N - W_N/2| times the larger of their two ratios; else |W_N - W_N/2|
         ratio = max(e / step, step / step2) if step > 0.0 and step2 > 0.0 else 1.0
         est = e * ratio if ratio <= RING_F_RATIO else e
         if est <= max(itol * w, tol_abs / (4.0 * a2)) or nn >= RING_F_NMAX:
@@ -185,8 +189,9 @@ def ring_reference(distribution: int, a2: float, mu: float, x: float, fresnel=No
     """:func:`_ggx_ring` (``distribution`` 1) or :func:`_beckmann_ring` (0) at elevation ``x`` by scipy's adaptive
     quadrature of Walter's D over phi (their numpy/scipy twin, for the tests); with ``fresnel`` = (ior, eta, k), D times
     the Fresnel factor F(wi.h) (:func:`_ggx_ring_f`; pumpup.models.cook_torrance.fresnel, pumpup.models.metal.fresnel),
-    graded towards the mirror side at the scale of S = sin((x + x_mu) / 2) too (F's branch point at c = 0; without it, at
-    S ~ 0.05, scipy missed the feature by 3e-7, measured against mpmath)."""
+    graded towards the mirror side at the scale of S = sin((x + x_mu) / 2) too (F's branch point at c = 0; without it,
+    at S ~ 0.05, scipy missed the feature by 3e-7, measured against mpmath).
+    """
     from scipy.integrate import quad
 
     from ..physics.fresnel import fresnel_conductor as conductor
@@ -217,7 +222,8 @@ def ring_reference(distribution: int, a2: float, mu: float, x: float, fresnel=No
 
 def _peak_points(alpha: float) -> list:
     """Breakpoints in the azimuth phi in (0, pi) graded towards the mirror direction phi = pi, where a lobe alpha wide
-    peaks (for scipy's quadrature in the references)."""
+    peaks (for scipy's quadrature in the references).
+    """
     w = alpha * 3.0 ** np.arange(-4, 30)
     return list(math.pi - w[w < math.pi])
 
@@ -228,9 +234,10 @@ KUMMER_ASYMPTOTIC = 50.0
 
 @njit(cache=True, nogil=True)
 def _kummer_half(z):  # pragma: no cover - compiled; tested against mpmath.hyp1f1
-    """(H0, H1, H2), H_j = z^j e^-z 1F1(1/2; j + 1; z) for z >= 0 (inf included): below KUMMER_ASYMPTOTIC the power series
-    (positive terms, DLMF 13.2.2), above it the asymptotic one, z^(j - 1/2) (j! / sqrt(pi)) sum_n (j + 1/2)_n (1/2)_n /
-    (n! z^n) (DLMF 13.7.1; positive terms too, the rest of the function e^-z smaller)."""
+    """(H0, H1, H2), H_j = z^j e^-z 1F1(1/2; j + 1; z) for z >= 0 (inf included): below KUMMER_ASYMPTOTIC the power
+    series (positive terms, DLMF 13.2.2), above it the asymptotic one, z^(j - 1/2) (j! / sqrt(pi)) sum_n (j + 1/2)_n
+    (1/2)_n / (n! z^n) (DLMF 13.7.1; positive terms too, the rest of the function e^-z smaller).
+    """
     if z >= KUMMER_ASYMPTOTIC:
         r = 1.0 / math.sqrt(math.pi * z) if z < math.inf else 0.0
         h0 = h1 = h2 = 0.0
@@ -320,16 +327,17 @@ def _kummer_fast(z):  # pragma: no cover - compiled; tested against _kummer_half
 
 @njit(cache=True, nogil=True, inline="always")
 def _beckmann_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ring_reference
-    """integral over phi in [0, 2 pi) of the Beckmann weight D = exp(-tan^2(h) / a2) / (pi a2 cos^4(h)) (Walter et al.
-    2007 eq. 25) on the circle of wo at elevation x = x_mu + d, for wi at elevation x_mu (x_s = pi / 2 - x_mu).
+    """The integral over phi in [0, 2 pi) of the Beckmann weight D = exp(-tan^2(h) / a2) / (pi a2 cos^4(h)) (Walter et
+    al. 2007 eq. 25) on the circle of wo at elevation x = x_mu + d, for wi at elevation x_mu (x_s = pi / 2 - x_mu).
 
     With X = |wi + wo|^2 = X_min + Q v, v = 1 - cos(psi) (psi = phi - pi, from the plane of incidence's mirror side),
-    X_min = m^2 (1 + tan^2(d / 2)), Q = 2 sin(theta_i) cos(x), m = N.wi + N.wo: tan^2(h) = X / m^2 - 1 = tau^2 + (Q / m^2) v
-    (tau = tan(d / 2)) and 1 / cos^4 = X^2 / m^4 = (1 + tau^2 + a2 kappa v)^2, kappa = Q / (m^2 a2), so the integral is
-    e^-(tau^2 / a2) / (pi a2) times (1 + tau^2)^2 M0 + 2 (1 + tau^2) a2 kappa M1 + a2^2 kappa^2 M2, M_j = integral of v^j
-    e^-(kappa v) over psi = c_j e^-z 1F1(1/2; j + 1; z), z = 2 kappa, c = (2 pi, 2 pi, 3 pi) (v = 2 sin^2(psi / 2)): in
-    :func:`_kummer_half`'s H_j, (e^-(tau^2 / a2) / a2) (2 (1 + tau^2)^2 H0 + 2 a2 (1 + tau^2) H1 + (3 / 4) a2^2 H2),
-    every term >= 0."""
+    X_min = m^2 (1 + tan^2(d / 2)), Q = 2 sin(theta_i) cos(x), m = N.wi + N.wo: tan^2(h) = X / m^2 - 1 = tau^2 +
+    (Q / m^2) v (tau = tan(d / 2)) and 1 / cos^4 = X^2 / m^4 = (1 + tau^2 + a2 kappa v)^2, kappa = Q / (m^2 a2), so the
+    integral is e^-(tau^2 / a2) / (pi a2) times (1 + tau^2)^2 M0 + 2 (1 + tau^2) a2 kappa M1 + a2^2 kappa^2 M2, M_j =
+    integral of v^j e^-(kappa v) over psi = c_j e^-z 1F1(1/2; j + 1; z), z = 2 kappa, c = (2 pi, 2 pi, 3 pi) (v = 2
+    sin^2(psi / 2)): in :func:`_kummer_half`'s H_j, (e^-(tau^2 / a2) / a2) (2 (1 + tau^2)^2 H0 + 2 a2 (1 + tau^2) H1 +
+    (3 / 4) a2^2 H2), every term >= 0.
+    """
     tau = math.tan(0.5 * d)
     g = math.exp(-tau * tau / a2)
     if g == 0.0:  # (far in the Gaussian's tail: the rest is finite)
@@ -346,9 +354,11 @@ def _beckmann_ring(a2, xmu, xs, d):  # pragma: no cover - compiled; see ring_ref
 @njit(cache=True, nogil=True, inline="always")
 def _n_value(mp, mu, xmu, xs, d):  # pragma: no cover - compiled; see n_integrand_reference
     """Frame 6's integrand at x = x_mu + d: pi a2 cos(x) sin(x) W(x) Gamma(sin x), W the weight's integral over the
-    azimuth (:func:`_ggx_ring`, :func:`_beckmann_ring`), Gamma = 1 / (P(mu) P(t)) for the separable Smith G (Walter et al.
-    2007 eq. 20), 1 / (t P(mu) + mu P(t) - mu t) for the height-correlated one (Heitz 2014), 1 / (r + (1 - r) t) for
-    Schlick's model (000 eq. 36); P(t) = N.wo / G1(wo) (physics.microfacet.projected, Walter eq. 27, 34), P(mu) in mp[8]."""
+    azimuth (:func:`_ggx_ring`, :func:`_beckmann_ring`), Gamma = 1 / (P(mu) P(t)) for the separable Smith G (Walter et
+    al. 2007 eq. 20), 1 / (t P(mu) + mu P(t) - mu t) for the height-correlated one (Heitz 2014), 1 / (r + (1 - r) t) for
+    Schlick's model (000 eq. 36); P(t) = N.wo / G1(wo) (physics.microfacet.projected, Walter eq. 27, 34), P(mu) in
+    mp[8].
+    """
     a2 = mp[4] if mp[0] == SCHLICK else mp[4] * mp[4]
     w = _beckmann_ring(a2, xmu, xs, d) if mp[0] == SMITH and mp[1] == 0.0 else _ggx_ring(a2, xmu, xs, d)
     if w == 0.0:  # (far in the Beckmann weight's tail)
@@ -370,8 +380,9 @@ def _n_times(mp, mu, xmu, xs, d, a2, w):  # pragma: no cover - compiled; see n_i
 
 @njit(cache=True, nogil=True)
 def _n_incidence(mp, mu):  # pragma: no cover - compiled
-    """(x_mu, x_s = pi / 2 - x_mu) of incidence mu, both from atan2 (each exact near its own 0), and P(mu) = mu / G1(mu) into
-    mp[8] for the Smith models (Walter eq. 27, 34)."""
+    """(x_mu, x_s = pi / 2 - x_mu) of incidence mu, both from atan2 (each exact near its own 0), and P(mu) = mu / G1(mu)
+    into mp[8] for the Smith models (Walter eq. 27, 34).
+    """
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     if mp[0] == SMITH:
         mp[8] = _projected(s, 0.0, mu, int(mp[1]), int(mp[2]), mp[4])
@@ -380,8 +391,9 @@ def _n_incidence(mp, mu):  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True, inline="always")
 def _n_chain_g(chain, mu, t):  # pragma: no cover - compiled
-    """g_1 ... g_k(mu, t) of a pumped chain at N.wo = t, as the chain kernel computes it (``pumpup.physics.lookups.g_product``,
-    ``g_levels``; 001 eq. 16)."""
+    """g_1 ... g_k(mu, t) of a pumped chain at N.wo = t, as the chain kernel computes it
+    (``pumpup.physics.lookups.g_product``, ``g_levels``; 001 eq. 16).
+    """
     if min(mu, t) > chain.product_mlo:
         return g_product(max(mu, t), chain.product_cbase, chain.product_cstart, chain.product_lo, chain.product_rows)
     return g_levels(max(mu, t), min(mu, t), chain.offsets, chain.logx, chain.coef, chain.v0, chain.slope0,
@@ -390,20 +402,22 @@ def _n_chain_g(chain, mu, t):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv, kind):  # pragma: no cover - compiled
+def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, itol, iacc,  # pragma: no cover - compiled
+            fv, kind):
     """(value, error) of the rule on d = x - x_mu in [lo, hi] of :func:`_n_value`; with a pumped chain (``chain`` not
-    None, :meth:`pumpup.operators.pumping.Pumped._chain_args`) divided by g_1 ... g_k(mu, N.wo) exactly as the chain kernel divides
-    by it (001 eq. 16; written out as in :func:`_x_rule`; first times F(max(mu, N.wo)) where mp[15] = 1, ``FresnelAtMax``,
-    analytic between the cuts), or with a 1/E-scaled model's ``factor`` (not None: F0 and
-    :attr:`pumpup.operators.compensate._Bound.args`) times 1 + F0 (1 / U(N.wo) - 1) as its kernel multiplies (Turquin eq. 6,
-    :func:`pumpup.operators.compensate._scale_kernel`); its error then the larger of QUADPACK's calibration (for the weight's peak,
-    as without g) and CHAIN_SAFETY |K - G| (for the splines of g or U, which are not analytic: :data:`CHAIN_SAFETY`).
-    With a Fresnel factor (mp[13] = 1, GGX) the ring is :func:`_ggx_ring_f` at relative tolerance ``itol`` or absolute
-    ``iacc`` / the node's factor (``fv`` its work array), and its errors are taken as frame 4 takes K's (:func:`_gk`):
-    summed with the Kronrod weights, and into |K - G| before its calibration as far as they can hide it.  ``kind`` 0: the
-    variable is d itself; 1 and 2 (a piece off the peak, GGX and Schlick): u = ln |d|, d = e^u or -e^u, the integrand times
-    |d| (:data:`N_LOG_GRADE`); 3 (a piece near x = 0, GGX and Schlick): u = ln x, d = e^u - x_mu, the integrand times x
-    (:data:`N_LOG_GRADE`)."""
+    None, :meth:`pumpup.operators.pumping.Pumped._chain_args`) divided by g_1 ... g_k(mu, N.wo) exactly as the chain
+    kernel divides by it (001 eq. 16; written out as in :func:`_x_rule`; first times F(max(mu, N.wo)) where mp[15] = 1,
+    ``FresnelAtMax``, analytic between the cuts), or with a 1/E-scaled model's ``factor`` (not None: F0 and
+    :attr:`pumpup.operators.compensate._Bound.args`) times 1 + F0 (1 / U(N.wo) - 1) as its kernel multiplies (Turquin
+    eq. 6, :func:`pumpup.operators.compensate._scale_kernel`); its error then the larger of QUADPACK's calibration (for
+    the weight's peak, as without g) and CHAIN_SAFETY |K - G| (for the splines of g or U, which are not analytic:
+    :data:`CHAIN_SAFETY`).  With a Fresnel factor (mp[13] = 1, GGX) the ring is :func:`_ggx_ring_f` at relative
+    tolerance ``itol`` or absolute ``iacc`` / the node's factor (``fv`` its work array), and its errors are taken as
+    frame 4 takes K's (:func:`_gk`): summed with the Kronrod weights, and into |K - G| before its calibration as far as
+    they can hide it.  ``kind`` 0: the variable is d itself; 1 and 2 (a piece off the peak, GGX and Schlick): u = ln
+    |d|, d = e^u or -e^u, the integrand times |d| (:data:`N_LOG_GRADE`); 3 (a piece near x = 0, GGX and Schlick): u = ln
+    x, d = e^u - x_mu, the integrand times x (:data:`N_LOG_GRADE`).
+    """
     h = hi - lo
     ie = 0.0
     noise = 0.0
@@ -452,7 +466,8 @@ def _n_rule(mp, mu, xmu, xs, lo, hi, nodes, wk, wg, buf, mode, chain, factor, it
 @njit(cache=True, nogil=True)
 def _n_values(mp, mu, x, chain, factor):  # pragma: no cover - compiled
     """:func:`_n_value` (divided by the chain's g, or times the scaled model's factor, where ``chain`` or ``factor`` is
-    not None) at the elevations ``x`` (for the tests: the rule's own arithmetic, one node per call)."""
+    not None) at the elevations ``x`` (for the tests: the rule's own arithmetic, one node per call).
+    """
     xmu, xs = _n_incidence(mp, mu)
     out = np.empty(x.shape[0])
     buf = np.empty(1)
@@ -467,7 +482,9 @@ def _n_values(mp, mu, x, chain, factor):  # pragma: no cover - compiled
 def n_params(hint) -> np.ndarray:
     """Frame 6's parameter array: :func:`numeric_params`, and for GGX with a Fresnel factor mp[13] = 1
     (:func:`_ggx_ring_f`) and mp[14] the scale of F's pole near c = 0 (:func:`fresnel_pole`, a conductor's; 0 for a
-    dielectric) for :func:`_n_cuts`; with F(max) = (eta, k) (``KernelView.fmax``) mp[15:18] = 1, eta, k (:func:`_n_rule`)."""
+    dielectric) for :func:`_n_cuts`; with F(max) = (eta, k) (``KernelView.fmax``) mp[15:18] = 1, eta, k
+    (:func:`_n_rule`).
+    """
     if isinstance(hint, AzimuthHint):
         hint = kernel_view(hint)
     mp = numeric_params(hint)
@@ -481,14 +498,16 @@ def n_params(hint) -> np.ndarray:
 
 def n_integrand(brdf, mu: float, x) -> np.ndarray:
     """Frame 6's integrand (:func:`_n_value`, divided by g for a pumped model, times the factor of a 1/E-scaled one) for
-    ``brdf``'s hint at N.wi = ``mu`` and elevations ``x`` of wo, as the engine computes it (for the tests)."""
+    ``brdf``'s hint at N.wi = ``mu`` and elevations ``x`` of wo, as the engine computes it (for the tests).
+    """
     hint = kernel_view(brdf.azimuth_hint())
     return _n_values(n_params(hint), float(mu), np.atleast_1d(np.asarray(x, dtype=float)), hint.chain, hint.factor)
 
 
 def n_integrand_reference(brdf, mu: float, x) -> np.ndarray:
-    """Frame 6's integrand (:func:`_n_value`) at elevations ``x`` from the model itself: its BRDF times N.wo integrated over
-    the azimuth of wo by scipy's adaptive quadrature, times cos(x) and divided by the hint's scale (for the tests)."""
+    """Frame 6's integrand (:func:`_n_value`) at elevations ``x`` from the model itself: its BRDF times N.wo integrated
+    over the azimuth of wo by scipy's adaptive quadrature, times cos(x) and divided by the hint's scale (for the tests).
+    """
     from scipy.integrate import quad
 
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -508,16 +527,17 @@ def n_integrand_reference(brdf, mu: float, x) -> np.ndarray:
 
 
 #: frame 6 grades GGX's and Schlick's peak by this factor per cut, and integrates every piece off the peak in u = ln |d|
-#: (:func:`_n_rule`): there the singularities at d = +- 2 i atanh(alpha) lie pi / 2 from the real axis whatever |d|, so a
-#: piece [a, 27 a] (length ln 27 = 3.3 in u) is as far from them, relative to its length, as [a, 3 a] is in d (0.52 of it
-#: instead of 0.5); GGX alpha = 1e-8 at mu = 1/2 took 34 graded pieces in d, now 14
+#: (:func:`_n_rule`): there the singularities at d = +- 2 i atanh(alpha) lie pi / 2 from the real axis whatever |d|, so
+#: a piece [a, 27 a] (length ln 27 = 3.3 in u) is as far from them, relative to its length, as [a, 3 a] is in d (0.52 of
+#: it instead of 0.5); GGX alpha = 1e-8 at mu = 1/2 took 34 graded pieces in d, now 14
 N_LOG_GRADE = 27.0
 #: ... on the side short of the peak only for |d| <= this times x_mu: towards x = 0, P(t)'s singularity (or Schlick's
 #: pole) lies near d = -x_mu, ln 8 = 2.1 from u = ln(x_mu / 8) (at 1/2 a piece came within 0.23 of its length in u of
 #: it, on the cuts at mu = 1; tests/engine/test_route_normal.py checks every piece in the variable it is integrated in)
-#: ... and from x = 0 up to this times x_mu, by N_LOG_GRADE in u = ln x (:func:`_n_kind` 3; issue 14's eighteenth session):
-#: P(t)'s singularities at x = +- i atanh(alpha) lie pi / 2 from the real u axis whatever x (Schlick's pole at x ~ -r / (1 -
-#: r), pi), the peak's ln 8 beyond the last piece (GGX alpha = 1e-8 had 17 pieces graded by 3 in x there, now 6)
+#: ... and from x = 0 up to this times x_mu, by N_LOG_GRADE in u = ln x (:func:`_n_kind` 3; issue 14's eighteenth
+#: session): P(t)'s singularities at x = +- i atanh(alpha) lie pi / 2 from the real u axis whatever x (Schlick's pole at
+#: x ~ -r / (1 - r), pi), the peak's ln 8 beyond the last piece (GGX alpha = 1e-8 had 17 pieces graded by 3 in x there,
+#: now 6)
 N_LOG_SIDE = 0.125
 #: ... and beyond it up to this times the range's end pi / 2 - x_mu (the weight's singularity at x = pi - x_mu + - 2 i
 #: atanh(alpha), where B = 0, lies ln 2 beyond that end in u), then by 3 in u
@@ -526,9 +546,10 @@ N_LOG_END = 0.25
 
 @njit(cache=True, nogil=True, inline="always")
 def _n_kind(mp, a, b, xmu):  # pragma: no cover - compiled
-    """The variable of frame 6's piece [a, b] of d (:func:`_n_rule`): for GGX and Schlick (not Beckmann's Gaussian) 1 (u =
-    ln d) beyond the peak, 2 (u = ln -d) short of it within N_LOG_SIDE x_mu, 3 (u = ln x, x = x_mu + d) near x = 0 within
-    N_LOG_SIDE x_mu but off x = 0 itself (:data:`N_LOG_GRADE`); else 0 (d)."""
+    """The variable of frame 6's piece [a, b] of d (:func:`_n_rule`): for GGX and Schlick (not Beckmann's Gaussian) 1
+    (u = ln d) beyond the peak, 2 (u = ln -d) short of it within N_LOG_SIDE x_mu, 3 (u = ln x, x = x_mu + d) near x = 0
+    within N_LOG_SIDE x_mu but off x = 0 itself (:data:`N_LOG_GRADE`); else 0 (d).
+    """
     if mp[0] == SMITH and mp[1] == 0.0:
         return 0
     if a > 0.0:
@@ -542,7 +563,8 @@ def _n_kind(mp, a, b, xmu):  # pragma: no cover - compiled
 
 def n_pieces_reference(brdf, mu: float) -> list:
     """Frame 6's pieces for ``brdf``'s hint at N.wi = ``mu``: (lo, hi, kind) in d = x - x_mu, kind as :func:`_n_kind`
-    (for the tests)."""
+    (for the tests).
+    """
     hint = kernel_view(brdf.azimuth_hint())
     mp = n_params(hint)
     cut = np.empty(N_CUTS)
@@ -559,18 +581,19 @@ N_CUTS = 96
 @njit(cache=True, nogil=True)
 def _n_cuts(mp, xmu, cut):  # pragma: no cover - compiled; see n_cuts_reference
     """The breakpoints of frame 6's d = x - x_mu at incidence x_mu, sorted, into ``cut``; returns their number.  The
-    integrand's singularities near x in [0, pi / 2] (:func:`_ggx_ring`, :func:`_n_value`): the weight's at x = x_mu +- 2 i
-    atanh(alpha) (A = 0) and at pi - x_mu +- 2 i atanh(alpha) (B = 0, as far beyond pi / 2 as x_mu is short of it); P(t)'s
-    branch point at x = +- i atanh(alpha) (sin^2 x + alpha^2 cos^2 x = 0); Schlick's pole at sin x = -r / (1 - r); the
-    height-correlated G's pole at x = -x_mu (t P(mu) + mu P(t) - mu t = 0 at t = -mu).  The Beckmann weight
-    (:func:`_beckmann_ring`) is a Gaussian 2 alpha wide in d, its kappa has a pole where N.wi + N.wo = 0 (x = -x_mu), and
-    its P(t) turns on the scale alpha near x = 0 (erf(tan(x) / alpha)); Walter's rational G1 jumps at N.wo = mp[9].  So d
-    is cut at 0 and +- 2 atanh(alpha) 3^j (Beckmann: +- 2 alpha 3^j; GGX and Schlick 27^j, in u = ln |d|, up to x_mu / 8
-    short of the peak and a quarter of the range's end beyond it, :data:`N_LOG_GRADE`), and x at z 3^j from 0 (z =
-    atanh(alpha), alpha or r / (1 - r), and x_mu for the correlated G and for Beckmann) and at Walter's switch: every piece
-    then lies at least about its own length from the nearest singularity, in the variable it is integrated in.  With a
-    Fresnel factor (mp[13], :func:`_ggx_ring_f`) x is also cut where the rings' smallest wi.h, sin((x + x_mu) / 2), is 3^j
-    times the scales of F's pole (mp[14]) and branch point (mp[10])."""
+    integrand's singularities near x in [0, pi / 2] (:func:`_ggx_ring`, :func:`_n_value`): the weight's at x = x_mu +- 2
+    i atanh(alpha) (A = 0) and at pi - x_mu +- 2 i atanh(alpha) (B = 0, as far beyond pi / 2 as x_mu is short of it);
+    P(t)'s branch point at x = +- i atanh(alpha) (sin^2 x + alpha^2 cos^2 x = 0); Schlick's pole at sin x = -r /
+    (1 - r); the height-correlated G's pole at x = -x_mu (t P(mu) + mu P(t) - mu t = 0 at t = -mu).  The Beckmann weight
+    (:func:`_beckmann_ring`) is a Gaussian 2 alpha wide in d, its kappa has a pole where N.wi + N.wo = 0 (x = -x_mu),
+    and its P(t) turns on the scale alpha near x = 0 (erf(tan(x) / alpha)); Walter's rational G1 jumps at N.wo = mp[9].
+    So d is cut at 0 and +- 2 atanh(alpha) 3^j (Beckmann: +- 2 alpha 3^j; GGX and Schlick 27^j, in u = ln |d|, up to
+    x_mu / 8 short of the peak and a quarter of the range's end beyond it, :data:`N_LOG_GRADE`), and x at z 3^j from 0
+    (z = atanh(alpha), alpha or r / (1 - r), and x_mu for the correlated G and for Beckmann) and at Walter's switch:
+    every piece then lies at least about its own length from the nearest singularity, in the variable it is integrated
+    in.  With a Fresnel factor (mp[13], :func:`_ggx_ring_f`) x is also cut where the rings' smallest wi.h,
+    sin((x + x_mu) / 2), is 3^j times the scales of F's pole (mp[14]) and branch point (mp[10]).
+    """
     half = 0.5 * math.pi
     alpha = math.sqrt(mp[4]) if mp[0] == SCHLICK else mp[4]
     beckmann = mp[0] == SMITH and mp[1] == 0.0
@@ -580,7 +603,8 @@ def _n_cuts(mp, xmu, cut):  # pragma: no cover - compiled; see n_cuts_reference
         cut[m] = math.asin(mp[9]) - xmu
         m += 1
     d0 = 2.0 * alpha if beckmann else (2.0 * math.atanh(alpha) if alpha < 1.0 else math.inf)
-    for side in range(2):  # beyond the peak (d > 0), then short of it; GGX and Schlick in u = ln |d| (:data:`N_LOG_GRADE`)
+    # beyond the peak (d > 0), then short of it; GGX and Schlick in u = ln |d| (:data:`N_LOG_GRADE`)
+    for side in range(2):
         end = half - xmu if side == 0 else xmu
         top = end * (N_LOG_END if side == 0 else N_LOG_SIDE)  # (where the log grading stops)
         d = d0
@@ -588,7 +612,8 @@ def _n_cuts(mp, xmu, cut):  # pragma: no cover - compiled; see n_cuts_reference
             cut[m] = d if side == 0 else -d
             m += 1
             d = 3.0 * d if beckmann or d >= top else min(N_LOG_GRADE * d, top)
-    top = 0.0 if beckmann else N_LOG_SIDE * xmu  # (GGX, Schlick: by N_LOG_GRADE in u = ln x up to there, :func:`_n_kind`)
+    # (GGX, Schlick: by N_LOG_GRADE in u = ln x up to there, :func:`_n_kind`)
+    top = 0.0 if beckmann else N_LOG_SIDE * xmu
     for which in range(2):
         if which == 0:
             if mp[0] == SCHLICK:
@@ -601,7 +626,8 @@ def _n_cuts(mp, xmu, cut):  # pragma: no cover - compiled; see n_cuts_reference
             cut[m] = d - xmu
             m += 1
             d = min(N_LOG_GRADE * d, top) if which == 0 and d < top else 3.0 * d
-    if mp[13] > 0.0:  # GGX with F (:func:`_ggx_ring_f`): the rings' smallest wi.h, S = sin((x + x_mu) / 2), at F's scales
+    # GGX with F (:func:`_ggx_ring_f`): the rings' smallest wi.h, S = sin((x + x_mu) / 2), at F's scales
+    if mp[13] > 0.0:
         for which in range(2):  # (the parallel reflectance's pole, the refracted cosine's branch point: mp[14], mp[10])
             z = mp[14] if which == 0 else mp[10]
             if not 0.0 < z < 1.0:
@@ -629,11 +655,12 @@ def n_cuts_reference(brdf, mu: float) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True)
-def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, chain, factor, ecut, necut, val,
-                 err, conv, evals):  # pragma: no cover
+def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, chain, factor, ecut, necut,
+                 val, err, conv, evals):  # pragma: no cover
     """Frame 6: adaptive 10/21 quadrature over the elevation x = x_mu + d of wo (:func:`_n_rule`) for every mu, from the
     pieces between :func:`_n_cuts` and, for a pumped or a 1/E-scaled model (``chain`` or ``factor`` not None), the
-    elevations ``ecut[q, :necut[q]]`` (:func:`chain_cuts` of the kinks of g or U)."""
+    elevations ``ecut[q, :necut[q]]`` (:func:`chain_cuts` of the kinks of g or U).
+    """
     cap, pk, t0, t1, kv, ke, buf, _, _, itol = _buffers(max_intervals + N_CUTS + ecut.shape[1], nodes, nodes, rtol)
     cut = np.empty(N_CUTS + ecut.shape[1])
     fv = np.empty(RING_F_NMAX + 1)
@@ -647,8 +674,8 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
             nc += 1
         cut[:nc].sort()
         # a ring's absolute tolerance iacc / (the node's factor), iacc = itol times a lower bound of the integral so far
-        # over the pieces' total length in their variables (d or ln |d|): its share of the sum is then at most itol times
-        # that bound (as :func:`_integrate`)
+        # over the pieces' total length in their variables (d or ln |d|): its share of the sum is then at most itol
+        # times that bound (as :func:`_integrate`)
         m = 0
         length = 0.0  # (of the pieces in their variables)
         for i in range(nc - 1):
@@ -672,17 +699,19 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
         start = m
         while True:
             tot, e, r, worst, ok = _status(kv, ke, m, 0.0, rounding, rtol, atol_arr[q])
-            if chain is not None or factor is not None:  # (as :func:`_integrate_chain`: the reported error within the tolerance)
+            # (as :func:`_integrate_chain`: the reported error within the tolerance)
+            if chain is not None or factor is not None:
                 ok = ok and (e <= r or e + r <= max(rtol * abs(tot), atol_arr[q]))
             if ok or m - start >= max_intervals or m >= cap:
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
             kd[m] = kd[worst]
             iacc = itol * max(tot - e, 0.0) / length
-            kv[worst], ke[worst], nf = _n_rule(mp, mu, xmu, xs, a_, mid, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv,
-                                               kd[worst])
+            kv[worst], ke[worst], nf = _n_rule(mp, mu, xmu, xs, a_, mid, nodes, wk, wg, buf, mode, chain, factor, itol,
+                                               iacc, fv, kd[worst])
             ns += nf
-            kv[m], ke[m], nf = _n_rule(mp, mu, xmu, xs, mid, b_, nodes, wk, wg, buf, mode, chain, factor, itol, iacc, fv, kd[m])
+            kv[m], ke[m], nf = _n_rule(mp, mu, xmu, xs, mid, b_, nodes, wk, wg, buf, mode, chain, factor, itol, iacc,
+                                       fv, kd[m])
             ns += nf
             m += 1
         val[q] = tot
@@ -693,8 +722,8 @@ def _integrate_n(mp, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk,
 
 #: frame 6 takes GGX with a Fresnel factor (:func:`_ggx_ring_f`) at the incidences where every ring's smallest wi.h, S =
 #: sin((x + x_mu) / 2), is at least this (mu >= :data:`N_FRESNEL_MU_MIN`): F(c) has a square-root branch point at c = 0,
-#: which for S below ~0.1 lies too close for the ring's RING_F_NMAX + 1 samples (measured: S = 0.05 was 1e-7 off at N = 64);
-#: frame 4 takes the incidences below it
+#: which for S below ~0.1 lies too close for the ring's RING_F_NMAX + 1 samples (measured: S = 0.05 was 1e-7 off at N =
+#: 64); frame 4 takes the incidences below it
 N_FRESNEL_S_MIN = 0.125
 N_FRESNEL_MU_MIN = math.sin(2.0 * math.asin(N_FRESNEL_S_MIN))
 #: ... and an index whose F(c) has no other singularity within this of [N_FRESNEL_S_MIN, 1] (:func:`n_fresnel_ok`)
@@ -702,11 +731,13 @@ N_FRESNEL_SING_MIN = 0.1
 
 
 def n_fresnel_ok(ior: float, eta: float, k: float) -> bool:
-    """Whether frame 6 takes the Fresnel factor of a dielectric ``ior`` or a conductor (``eta``, ``k``): F(c)'s singularities
-    but c = 0 (the refracted cosine's branch points +- w, w = sqrt(1 - index^2); the parallel reflectance's poles, on the
-    physical sheet in the left half-plane, :func:`fresnel_pole`) at least :data:`N_FRESNEL_SING_MIN` from the rings' range
-    of c, [:data:`N_FRESNEL_S_MIN`, 1].  A dielectric with ior > 1 has w on the imaginary axis; ior <= 1 (a total
-    reflection's kink at c = w real) and a near-kink conductor (w near the real segment) stay with frame 4."""
+    """Whether frame 6 takes the Fresnel factor of a dielectric ``ior`` or a conductor (``eta``, ``k``): F(c)'s
+    singularities but c = 0 (the refracted cosine's branch points +- w, w = sqrt(1 - index^2); the parallel
+    reflectance's poles, on the physical sheet in the left half-plane, :func:`fresnel_pole`) at least
+    :data:`N_FRESNEL_SING_MIN` from the rings' range of c, [:data:`N_FRESNEL_S_MIN`, 1].  A dielectric with ior > 1 has
+    w on the imaginary axis; ior <= 1 (a total reflection's kink at c = w real) and a near-kink conductor
+    (w near the real segment) stay with frame 4.
+    """
     if eta > 0.0:
         w = complex(1.0 - (eta * eta - k * k), -2.0 * eta * k) ** 0.5
         x = min(max(abs(w.real), N_FRESNEL_S_MIN), 1.0)

@@ -5,12 +5,12 @@ the globally adaptive rule (:func:`_integrate`); :mod:`pumpup.engine.polar` desc
 from __future__ import annotations
 
 import math
+
 import numpy as np
 from numba import njit
 
 from ..physics.microfacet import projected as _projected
-from ..physics.quadrature import calibrated
-from ..physics.quadrature import rule_sums
+from ..physics.quadrature import calibrated, rule_sums
 from .cubature import NODES as _NODES
 from .cubature import WG as _WG
 from .cubature import WK as _WK
@@ -23,7 +23,8 @@ from .lobe_fresnel import LOBE_F_WIDE, _k_lobe_fresnel, _lobe_f_prepare
 @njit(cache=True, nogil=True)
 def _smoothing(sm, tau):  # pragma: no cover - compiled
     """(x, 1 - x, dx/dtau) of the smoothing substitution on [0, 1]: sm = 0 none, 1 at the left
-    end (x = tau^2), 2 at the right end (1 - x = (1 - tau)^2), 3 at both (x = tau^2 (3 - 2 tau))."""
+    end (x = tau^2), 2 at the right end (1 - x = (1 - tau)^2), 3 at both (x = tau^2 (3 - 2 tau)).
+    """
     tc = 1.0 - tau
     if sm == 0:
         return tau, tc, 1.0
@@ -104,16 +105,18 @@ RULE = "gk21"
 
 
 @njit(cache=True, nogil=True)
-def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc):  # pragma: no cover
+def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes,  # pragma: no cover
+        iwk, iwg, ibuf, iwork, jac, mp, iacc):
     """(K, error) of the rule on [t0, t1]; the error is :func:`pumpup.physics.quadrature.calibrated` of
     |K - G| (``mode`` 1) or |K - G| itself (0), plus for p in (0, 1) and frame 4 the inner errors of the
     integrand's values (the inner rule ``inodes``, ``iwk``, ``iwg`` at relative tolerance
     ``itol``; frame 4 also at absolute tolerance ``iacc`` / the node's factor, :func:`_integrate`) summed with
-    the Kronrod weights (frame 4: and |K - G| raised by what they can hide of it before its calibration); ``buf`` holds the values (one per node).  The
-    closed forms p in {0, 1} have a loop of their own, with no call in it (a loop that may call
-    :func:`_arc_power` ran 2.5 x slower for them; a pumped lobe has a loop of its own,
+    the Kronrod weights (frame 4: and |K - G| raised by what they can hide of it before its calibration); ``buf`` holds
+    the values (one per node).  The closed forms p in {0, 1} have a loop of their own, with no call in it (a loop that
+    may call :func:`_arc_power` ran 2.5 x slower for them; a pumped lobe has a loop of its own,
     :func:`_integrate_chain`: one integration loop that could call either rule ran 1.45 x slower for
-    them)."""
+    them).
+    """
     h = t1 - t0
     ie = 0.0
     noise = 0.0
@@ -136,16 +139,17 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
                 buf[j] = 0.0
                 continue
             if kind >= 2:
-                # (u^4 underflows below u ~ 1e-81, near grazing incidence, mu < 1e-80: GGX alpha = 1e-8 with an ior at mu =
-                # 1e-100 divided by 0 (the ninth session).  Where u^3 underflows too, below 1e-108, the weight's value there
-                # is below 1e-96 K (GGX's e^-z (m^2 / 2) / u ~ m^4 u / 2, Beckmann's e^-t = 0): left out)
+                # (u^4 underflows below u ~ 1e-81, near grazing incidence, mu < 1e-80: GGX alpha = 1e-8 with an ior at
+                # mu = 1e-100 divided by 0 (the ninth session).  Where u^3 underflows too, below 1e-108, the weight's
+                # value there is below 1e-96 K (GGX's e^-z (m^2 / 2) / u ~ m^4 u / 2, Beckmann's e^-t = 0): left out)
                 u3 = u * u * u
                 fac = fac / (u3 * u) if u3 * u > 0.0 else (fac / u3 / u if u3 > 0.0 else 0.0)
             # K's error may be itol |K| or iacc / fac: the second's share of the sum is at most itol times the
             # integral's lower bound so far (iacc, :func:`_integrate`).  Where that exceeds K's bound (0 <= K <= kmax:
             # 8 pi / P(mu) for the Smith models, 16 pi u mu for the V-cavity, 8 pi for Schlick's; F <= 1), K = 0 with
             # the error kmax (far in the weight's tail: a narrow GGX lobe's nodes beyond the horizon break)
-            kmax = 8.0 * math.pi / mp[8] if mp[0] == SMITH else (16.0 * math.pi * u * mu if mp[0] == VCAVITY_F else 8.0 * math.pi)
+            kmax = 8.0 * math.pi / mp[8] if mp[0] == SMITH else (16.0 * math.pi * u * mu if mp[0] == VCAVITY_F
+                                                                 else 8.0 * math.pi)
             if iacc >= kmax * fac:
                 k, e = 0.0, kmax
             else:
@@ -198,17 +202,18 @@ MAX_BREAKS = 96
 #: the most graded pieces :func:`_pieces` makes (:func:`_graded_cuts` stops there; 4 tail, the graded cuts above the
 #: horizon break, 3 peak; frame 4's cuts)
 MAX_PIECES = 128
-#: the size of :func:`_pieces`'s arrays: MAX_PIECES graded ones and the pieces between every two breaks of the tail and the
-#: peak, which come after them (with 128 slots in all, a narrow GGX lobe at grazing incidence, alpha = 1e-8 at mu = 1e-100
-#: and rtol 1e-13 on frame 4, wrote past the end: found in the ninth session by NUMBA_BOUNDSCHECK=1)
+#: the size of :func:`_pieces`'s arrays: MAX_PIECES graded ones and the pieces between every two breaks of the tail and
+#: the peak, which come after them (with 128 slots in all, a narrow GGX lobe at grazing incidence, alpha = 1e-8 at mu =
+#: 1e-100 and rtol 1e-13 on frame 4, wrote past the end: found in the ninth session by NUMBA_BOUNDSCHECK=1)
 #: the most cuts :func:`_foreign_roots` adds to the tail's or the peak's breaks
 FOREIGN_CUTS = 64
-#: a piece is graded where a break's root lies beyond its end closer than this fraction of its length (:func:`_foreign_roots`:
-#: farther, the 10-point Gauss rule's error is at least 1e-3 of the piece, and the calibrated estimate is then the whole |K - G|)
+#: a piece is graded where a break's root lies beyond its end closer than this fraction of its length
+#: (:func:`_foreign_roots`: farther, the 10-point Gauss rule's error is at least 1e-3 of the piece, and the calibrated
+#: estimate is then the whole |K - G|)
 FOREIGN_NEAR = 1.0 / 64.0
-#: the split of tail (u) and peak (z) of :func:`_pieces`: the first of these without a break within SPLIT_CLEAR (else the one
-#: farthest from them), so that no range's end lies next to a break it is not (the V-cavity's alpha = pi / 3 is an ulp above
-#: 1/2; the level cos 2 theta_i passes 1/2 at mu = sqrt(3) / 2, where the horizon's s does)
+#: the split of tail (u) and peak (z) of :func:`_pieces`: the first of these without a break within SPLIT_CLEAR (else
+#: the one farthest from them), so that no range's end lies next to a break it is not (the V-cavity's alpha = pi / 3 is
+#: an ulp above 1/2; the level cos 2 theta_i passes 1/2 at mu = sqrt(3) / 2, where the horizon's s does)
 SPLITS = (0.5, 0.45, 0.55, 0.4, 0.6)
 SPLIT_CLEAR = 0.02
 PIECES_CAP = MAX_PIECES + 2 * (MAX_BREAKS + 4 + FOREIGN_CUTS)
@@ -231,13 +236,14 @@ def _sorted_cuts(cv, cc, m):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True)
 def _foreign_roots(cv, cc, nc, rv, rc, nr, tail):  # pragma: no cover - compiled
     """Cuts (code 3) grading a piece between the cuts ``cv[:nc]`` towards its end where the square root of a break
-    (``rv[:nr]``, codes ``rc``: every break, in the range or beyond it) lies beyond that end, closer than FOREIGN_NEAR of
-    the piece's length: at that end -+ d 4^i (d the distance) over the piece's half next to it.  A break's root lies on one
-    side of it (in u, ``tail``: code 0 below, 1 above, 2 both; in z = -(n + 1) ln u the other way round) and reaches across
-    any cut next to it: near mu = sqrt(3) / 2 the level's (u = cos 2 theta_i) and the horizon's (u = s) nearly coincide,
-    and the level's root lay 4.5e-6 beyond the end of the peak's piece [0, z_s], where no rule saw it (stretched Phong n =
-    10 at mu = 0.866025, rtol 1e-12: 3.2e-12 off with an estimate of 6.6e-13; 40-digit mpmath, the nested engine and the
-    frame of N agree to 1e-15).  Appends to ``cv``, ``cc`` and sorts them; returns their number."""
+    (``rv[:nr]``, codes ``rc``: every break, in the range or beyond it) lies beyond that end, closer than FOREIGN_NEAR
+    of the piece's length: at that end -+ d 4^i (d the distance) over the piece's half next to it.  A break's root lies
+    on one side of it (in u, ``tail``: code 0 below, 1 above, 2 both; in z = -(n + 1) ln u the other way round) and
+    reaches across any cut next to it: near mu = sqrt(3) / 2 the level's (u = cos 2 theta_i) and the horizon's (u = s)
+    nearly coincide, and the level's root lay 4.5e-6 beyond the end of the peak's piece [0, z_s], where no rule saw it
+    (stretched Phong n = 10 at mu = 0.866025, rtol 1e-12: 3.2e-12 off with an estimate of 6.6e-13; 40-digit mpmath, the
+    nested engine and the frame of N agree to 1e-15).  Appends to ``cv``, ``cc`` and sorts them; returns their number.
+    """
     m = nc
     for j in range(nr):
         c = rc[j]
@@ -268,7 +274,8 @@ def _foreign_roots(cv, cc, nc, rv, rc, nr, tail):  # pragma: no cover - compiled
 def _graded_cuts(kind, lo, hi, left, k, margin, kinds, sms, v0, w, v1):  # pragma: no cover - compiled
     """Pieces of ``kind`` from lo cut at lo (1 + 4^i) while they fit below hi (and the arrays keep ``margin``
     slots), written from slot k; the first keeps the left smoothing ``left``.  Returns (where the rest of
-    [lo, hi] starts, the next slot, the rest's left smoothing)."""
+    [lo, hi] starts, the next slot, the rest's left smoothing).
+    """
     a = lo
     step = lo  # the first cut at 2 lo
     while a + step < hi - step and k < MAX_PIECES - margin:
@@ -289,7 +296,8 @@ def _vcavity_breaks(mu, s, psi):  # pragma: no cover - compiled
     its lines reaches the top of h's circle (c = 2 u mu at alpha = pi/2 - theta_i = psi; c = mu / u at
     alpha = theta_i) or the top or bottom (c = 2 u mu / (4 u^2 - 1): cos(theta_i -+ alpha) sin(3 alpha) =
     sin(2 alpha) mu, by bisection on (0, pi/3), where it changes sign), and where the crossings meet
-    (alpha = pi/4) or one meets the arc's end mu / (2 u) (alpha = pi/3)."""
+    (alpha = pi/4) or one meets the arc's end mu / (2 u) (alpha = pi/3).
+    """
     th = 0.5 * math.pi - psi
     out = np.zeros(6)
     out[0], out[1], out[2], out[3] = psi, th, 0.25 * math.pi, math.pi / 3.0
@@ -314,7 +322,8 @@ def _vcavity_breaks(mu, s, psi):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True, inline="always")
 def _zr(radial, tb, n):  # pragma: no cover - compiled
     """The peak variable at tan(alpha) = tb under the half frame's Beckmann weight (radial 1: t = tan^2(alpha) / m^2)
-    or GGX weight (radial 2: ln(1 + t))."""
+    or GGX weight (radial 2: ln(1 + t)).
+    """
     t = (tb / n) ** 2
     return t if radial == 1 else math.log1p(t)
 
@@ -322,9 +331,11 @@ def _zr(radial, tb, n):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True, inline="always")
 def _branch_cuts(ub, zb, kb, m, th_i, x0, y0, st0, radial, n, n1):  # pragma: no cover - compiled
     """:func:`_pieces`' cuts about F's branch point x0 - i y0 (st0 = sqrt(1 - x0^2)): where the arc's (frame 5) or h's
-    circle's (frame 4) highest or lowest cosine, cos(theta_i -+ alpha), passes x0 (alpha = |theta_i - theta_0| or theta_i +
-    theta_0), and at -+ (y0 / sin(theta_0) / 2) 4^j from there, j < LOBE_F_CUTS, not smoothed (code 3); u = cos(alpha),
-    z by the radial weight (``radial`` 0: -(n + 1) ln u).  Returns the new number of breaks (at most MAX_BREAKS)."""
+    circle's (frame 4) highest or lowest cosine, cos(theta_i -+ alpha), passes x0 (alpha = |theta_i - theta_0| or
+    theta_i + theta_0), and at -+ (y0 / sin(theta_0) / 2) 4^j from there, j < LOBE_F_CUTS, not smoothed (code 3); u =
+    cos(alpha), z by the radial weight (``radial`` 0: -(n + 1) ln u).  Returns the new number of breaks
+    (at most MAX_BREAKS).
+    """
     th_0 = math.atan2(st0, x0)
     for ax in (abs(th_i - th_0), th_i + th_0):
         if not 0.0 < ax < 0.5 * math.pi:
@@ -352,9 +363,9 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
     the arc) and cos 2 theta_i (the level mu leaves it, p > 0); in the half-vector frame (1,
     :func:`_k_half`; 2, :func:`_k_ward`; 3, :func:`_k_vcavity`), u = cos(pi/4 - theta_i/2) (the horizon starts
     to cut h's circle), cos(theta_i) (the level mu leaves it, p > 0), u_lo = cos(pi/4 + theta_i/2), below which
-    no h sends wo above the horizon (the range starts there), and for frame 3 :func:`_vcavity_breaks`.  kind 0: u in [v0, v1 = v0 + w] (u <= 1/2); kind 1:
-    z = -(n + 1) ln u in [v0, v1].  Where exp(-Z_MAX / (n + 1)) > 1/2 the range of u below it is left
-    out (its bound is returned).  With ``radial`` 1 (the half frame's Beckmann weight, ``n`` = m) the
+    no h sends wo above the horizon (the range starts there), and for frame 3 :func:`_vcavity_breaks`.  kind 0: u in
+    [v0, v1 = v0 + w] (u <= 1/2); kind 1: z = -(n + 1) ln u in [v0, v1].  Where exp(-Z_MAX / (n + 1)) > 1/2 the range of
+    u below it is left out (its bound is returned).  With ``radial`` 1 (the half frame's Beckmann weight, ``n`` = m) the
     whole range is kind 2, t = tan^2(alpha) / m^2 in [0, Z_MAX] (:func:`_u_at`), cut at the same breaks; with
     ``radial`` 2 (the GGX weight, ``n`` = alpha) kind 3, z = ln(1 + t) up to u_lo (the weight e^-z dz leaves no
     tail to cut).  Frame 4 (:func:`_k_numeric`, parameters ``mp``) has the V-cavity's breaks for its V-cavity model,
@@ -391,9 +402,9 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
             if not (x0 < 1.0 and x0 + 2.0 * y0 > mu and y0 < LOBE_F_WIDE * st0):
                 continue
             # K(u) turns where the arc's highest or lowest N.wo, cos(theta_i -+ alpha), passes F's branch point's x0
-            # (alpha = |theta_i - theta_0| or theta_i + theta_0), on the scale y0 / sin(theta_0) in alpha: cuts there and
-            # at -+ (that scale / 2) 4^j, not smoothed (code 3), as frame 4's (a first rule on a wide piece may not see it;
-            # one on the scale LOBE_F_WIDE or wider does)
+            # (alpha = |theta_i - theta_0| or theta_i + theta_0), on the scale y0 / sin(theta_0) in alpha: cuts there
+            # and at -+ (that scale / 2) 4^j, not smoothed (code 3), as frame 4's (a first rule on a wide piece may not
+            # see it; one on the scale LOBE_F_WIDE or wider does)
             m = _branch_cuts(ub, zb, kb, m, math.atan2(s, mu), x0, y0, st0, 0, n, n1)
     else:
         psi = math.atan2(mu, s)  # pi / 2 - theta_i, exact near grazing incidence
@@ -431,13 +442,14 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
                     zb[m] = _zr(radial, math.tan(ab), n) if radial else -n1 * math.log1p(-2.0 * math.sin(0.5 * ab) ** 2)
                     m += 1
         if frame == 4 and mp[0] == SMITH:
-            # a conductor's F(c) whose branch point w = x0 - i y0 lies near the real axis inside (0, 1) (eta < 1, small k:
-            # a near-kink at c = x0): h's circle at alpha has c = wi.h in [cos(alpha + theta_i), cos(alpha - theta_i)], so
-            # K(u) turns where an end of that range passes x0, at alpha = |theta_i -+ theta_0|, on the scale y0 / sin(theta_0)
-            # in alpha; near normal incidence c hardly varies on the circle and the whole near-kink is K's.  Cuts there
-            # and at -+ (that scale / 2) 4^j, not smoothed (code 3), as frame 5's in the lobe frame.  Without them GGX
-            # alpha = 0.003 with eta 0.271, k 0.0605 at mu = 1 was 2.4e-11 off with an estimate of 3.5e-12 (rtol 1e-10;
-            # issue 14's twentieth session, scripts/studies/fuzz_engines.py)
+            # a conductor's F(c) whose branch point w = x0 - i y0 lies near the real axis inside (0, 1) (eta < 1, small
+            # k: a near-kink at c = x0): h's circle at alpha has c = wi.h in [cos(alpha + theta_i),
+            # cos(alpha - theta_i)], so K(u) turns where an end of that range passes x0, at alpha =
+            # |theta_i -+ theta_0|, on the scale y0 / sin(theta_0) in alpha; near normal incidence c hardly varies on
+            # the circle and the whole near-kink is K's.  Cuts there and at -+ (that scale / 2) 4^j, not smoothed
+            # (code 3), as frame 5's in the lobe frame.  Without them GGX alpha = 0.003 with eta 0.271, k 0.0605 at mu =
+            # 1 was 2.4e-11 off with an estimate of 3.5e-12 (rtol 1e-10; issue 14's twentieth session,
+            # scripts/studies/fuzz_engines.py)
             x0, y0 = mp[13], mp[14]
             st0 = math.sqrt((1.0 - x0) * (1.0 + x0)) if 0.0 < x0 < 1.0 else 0.0
             if st0 > 0.0 and y0 < x0 and y0 < LOBE_F_WIDE * st0:
@@ -449,10 +461,10 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
             t_half = (math.tan(0.25 * psi) / n) ** 2
             tail = (1.0 / (1.0 + t_half) if radial == 2 else math.exp(-t_half)) / mu
         if tail > 1e-3 * mp[12]:
-            # K(u) turns on the scale alpha (P's, :func:`_k_numeric`; Schlick's r / (1 - r)) where the lowest N.wo on h's circle,
-            # sin(psi - 2 alpha_h) / (2 u) ~ alpha_f - alpha_h, nears 0 (the horizon break alpha_f = psi / 2, from both
-            # sides) and where the arc's highest N.wo does (alpha_lo = pi / 2 - psi / 2): a first rule on a piece
-            # hundreds of times wider did not see it (GGX alpha = 0.001, mu = 0.59: 1.6e-10 off at rtol 1e-12, the
+            # K(u) turns on the scale alpha (P's, :func:`_k_numeric`; Schlick's r / (1 - r)) where the lowest N.wo on
+            # h's circle, sin(psi - 2 alpha_h) / (2 u) ~ alpha_f - alpha_h, nears 0 (the horizon break alpha_f = psi /
+            # 2, from both sides) and where the arc's highest N.wo does (alpha_lo = pi / 2 - psi / 2): a first rule on a
+            # piece hundreds of times wider did not see it (GGX alpha = 0.001, mu = 0.59: 1.6e-10 off at rtol 1e-12, the
             # estimate 6e-13), so these get cuts at alpha_f -+ (alpha / 2) 4^k and alpha_lo - (alpha / 2) 4^k,
             # without smoothing (code 3), up to the middle of [alpha_f, alpha_lo]
             a_f, a_lo = 0.5 * psi, 0.5 * math.pi - 0.5 * psi
@@ -461,7 +473,8 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
                 off = 0.5 * mp[11]
                 for _ in range(16):
                     ab = a_f - off if side == 0 else (a_f + off if side == 1 else a_lo - off)
-                    if (side == 0 and ab <= 0.0) or (side == 1 and ab >= a_mid) or (side == 2 and ab <= a_mid) or m >= MAX_BREAKS:
+                    if ((side == 0 and ab <= 0.0) or (side == 1 and ab >= a_mid) or (side == 2 and ab <= a_mid)
+                            or m >= MAX_BREAKS):
                         break
                     ub[m], kb[m] = math.cos(ab), 3
                     zb[m] = _zr(radial, math.tan(ab), n)
@@ -550,15 +563,16 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
             k += 1
     # beyond Z_MAX: K <= 2 pi in the lobe frame, <= 8 pi in the half-vector frame (4 (wi.h) N.wo / max^p <= 4);
     # with the Beckmann weight, integral_Z^inf e^-t 8 pi (m^2 / 2) u^3 dt, u^3 <= (1 + m^2 Z)^(-3/2) there
-    # the V-cavity's K <= 16 pi u mu (c G <= 2 u mu): under the Beckmann weight e^-t (m^2 / 2) u^3 K / u^4 <= 8 pi m^2 mu
-    # e^-t; under u^n, integral_0^uz u^(n+1) 16 pi mu du
+    # the V-cavity's K <= 16 pi u mu (c G <= 2 u mu): under the Beckmann weight e^-t (m^2 / 2) u^3 K / u^4 <= 8 pi m^2
+    # mu e^-t; under u^n, integral_0^uz u^(n+1) 16 pi mu du
     if radial == 2:
         left_out = 0.0  # the range ends at u_lo
     elif radial == 1 and frame == 4 and mp[0] == SMITH:
         # K <= 8 pi / P(mu) (4 c F Gamma <= 4 G / mu <= 4 / P(mu)), and (m^2 / 2) u^3 K / u^4 with
         # 1 / u = sqrt(1 + m^2 t) <= A + B (t - Z), A = sqrt(1 + m^2 Z), B = m^2 / (2 A) (concave)
         big_a = math.sqrt(1.0 + n * n * Z_MAX)
-        left_out = 4.0 * math.pi * n * n * math.exp(-Z_MAX) * (big_a + 0.5 * n * n / big_a) / mp[8] if k_end == -1 else 0.0
+        left_out = (4.0 * math.pi * n * n * math.exp(-Z_MAX) * (big_a + 0.5 * n * n / big_a) / mp[8] if k_end == -1
+                    else 0.0)
     elif frame == 5:  # K <= 2 pi, as in the lobe frame
         left_out = 2.0 * math.pi * math.exp(-Z_MAX) / n1 if skip and k_end == -1 else 0.0
     elif radial == 1 and frame >= 3:
@@ -575,7 +589,8 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
 @njit(cache=True, nogil=True, inline="always")
 def _buffers(max_intervals, nodes, inodes, rtol):  # pragma: no cover - compiled
     """The work arrays of the adaptive loop (intervals: piece, ends, value, error; rule values; the
-    inner rule's) and the inner rule's relative tolerance, a small part of the total (rtol / 8)."""
+    inner rule's) and the inner rule's relative tolerance, a small part of the total (rtol / 8).
+    """
     cap = max_intervals + 64
     return (cap, np.empty(cap, np.int64), np.empty(cap), np.empty(cap), np.empty(cap), np.empty(cap),
             np.empty(nodes.shape[0]), np.empty(inodes.shape[0]), np.empty((4, INNER_MAX)),
@@ -586,7 +601,8 @@ def _buffers(max_intervals, nodes, inodes, rtol):  # pragma: no cover - compiled
 def _status(kv, ke, m, left_out, rounding, rtol, atol):  # pragma: no cover - compiled
     """(value, error, rounding error, the interval with the largest error, done) of the first m
     intervals: done when the error meets the tolerance or is below the rounding error of the
-    integrand (refining cannot help there)."""
+    integrand (refining cannot help there).
+    """
     tot = 0.0
     e = left_out
     ab = 0.0
@@ -604,7 +620,8 @@ def _status(kv, ke, m, left_out, rounding, rtol, atol):  # pragma: no cover - co
 @njit(cache=True, nogil=True, inline="always")
 def _bisect(pk, t0, t1, worst, m):  # pragma: no cover - compiled
     """Bisect interval ``worst``: it keeps the lower half, interval m (new) takes the upper; returns
-    (piece, lower end, midpoint, upper end)."""
+    (piece, lower end, midpoint, upper end).
+    """
     i = pk[worst]
     a_, b_ = t0[worst], t1[worst]
     mid = 0.5 * (a_ + b_)
@@ -614,12 +631,14 @@ def _bisect(pk, t0, t1, worst, m):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
-def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg, mode, n_init, inodes, iwk, iwg, jac, mp, val, err, conv, evals):  # pragma: no cover
+def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg,  # pragma: no cover
+               mode, n_init, inodes, iwk, iwg, jac, mp, val, err, conv, evals):
     """Adaptive Gauss-Kronrod (the rule ``nodes``, ``wk``, ``wg``) of integral u^n K(u) du for
     every mu (without the scale); ``frame`` 0 the lobe frame (:func:`_k_closed`, :func:`_k_of_u`), 1-3 the
     half vector's (:func:`_k_half`, :func:`_k_ward`, :func:`_k_vcavity`; 4 :func:`_k_numeric` with the parameters
     ``mp``, its P(mu) set here per mu), ``radial`` 1 the Beckmann weight, 2 the GGX weight, in place of u^n
-    (:func:`_pieces`)."""
+    (:func:`_pieces`).
+    """
     # (room for every piece's first intervals besides max_intervals bisections: up to PIECES_CAP pieces)
     cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals + PIECES_CAP * n_init, nodes, inodes, rtol)
     kinds = np.empty(PIECES_CAP, np.int64)
@@ -651,7 +670,8 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
                 pk[m] = i
                 t0[m] = j / n_init
                 t1[m] = (j + 1.0) / n_init
-                kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
+                kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk,
+                                   wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
                 acc += max(kv[m] - ke[m], 0.0)
                 m += 1
         start = m
@@ -661,8 +681,10 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
             iacc = itol * max(tot - e, 0.0) / live
-            kv[worst], ke[worst] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
-            kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
+            kv[worst], ke[worst] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk,
+                                       wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
+            kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode,
+                               buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
             m += 1
         val[q] = tot
         err[q] = e + r

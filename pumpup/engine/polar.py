@@ -103,16 +103,16 @@ c exp(-tan^2(alpha) / m^2) / (4 pi m^2 max(N.L, N.V))) is stretched Blinn's azim
 ``HalfVectorLobe(radial="beckmann")`` integrates it in t = tan^2(alpha) / m^2 (weight e^-t, :func:`_u_at` kind 2) up to
 Z_MAX or the break of u_lo, cut at the same breaks.  Ward's model (000 eq. 34, sqrt(N.L N.V) in the
 denominator; ``WardLobe``) has 4 (wi.h) sqrt(N.wo) on the arc instead: complete elliptic integrals
-(:func:`_k_ward`, Carlson's R_F and R_D by the arithmetic-geometric mean), with 1 / sqrt(mu) in the scale; its K has a logarithmic term where
-h's circle starts to be cut, so Ward keeps the raw |K - G| (QUADPACK's calibration measured 4.4 x below the
-true error there).  The V-cavity microfacet models with F = 1 (Cook-Torrance, 001 eq. 9-10; Torrance-Sparrow
+(:func:`_k_ward`, Carlson's R_F and R_D by the arithmetic-geometric mean), with 1 / sqrt(mu) in the scale; its K has a
+logarithmic term where h's circle starts to be cut, so Ward keeps the raw |K - G| (QUADPACK's calibration measured 4.4 x
+below the true error there).  The V-cavity microfacet models with F = 1 (Cook-Torrance, 001 eq. 9-10; Torrance-Sparrow
 with D1 or D4, 002 eq. 10; ``VCavityLobe``) integrate 4 c G = 4 min(c, 2 u mu, 2 u N.wo) on the arc: a
 minimum of three lines in c, so each range of c between their crossings contributes its arc length and its
 integral of c (:func:`_k_vcavity`, with cancellation-free differences: near grazing incidence the integrand lives
-on arcs of width ~mu), and the pieces' changes in u are breaks (:func:`_vcavity_breaks`); Torrance-Sparrow's D3 = b / (cos^4 (1 + tan^2 /
-c3^2)^2) is the same azimuth under the GGX weight (``radial="ggx"``: z = ln(1 + tan^2(alpha) / m^2), weight
-e^-z dz, :func:`_u_at` kind 3).  Pumped Blinn BRDFs stay on the nested engine (``Pumped.polar`` takes lobes about R
-only).
+on arcs of width ~mu), and the pieces' changes in u are breaks (:func:`_vcavity_breaks`); Torrance-Sparrow's D3 = b /
+(cos^4 (1 + tan^2 / c3^2)^2) is the same azimuth under the GGX weight (``radial="ggx"``: z = ln(1 + tan^2(alpha) / m^2),
+weight e^-z dz, :func:`_u_at` kind 3).  Pumped Blinn BRDFs stay on the nested engine (``Pumped.polar`` takes lobes about
+R only).
 
 Where the integrand over beta is a function of c alone but has no elementary integral (frame 4, :func:`_k_numeric`)
 the arc is integrated by a rule: the Smith microfacet models (GGX, Beckmann, alpha <= 1: 4 c F(c) G / mu with
@@ -127,9 +127,9 @@ so that each piece lies its own length from it.  The outer variable is cut at th
 the horizon break and the range's end, :func:`_pieces`).  Each K carries its error (relative ``itol``, or an absolute
 share of the integral's lower bound so far), added to the outer estimate through the Kronrod weights and into |K - G|
 before its calibration.  GGX alpha = 0.001 showed why the cuts are needed: without the outer ones the first version was
-1.6e-10 off at rtol 1e-12 with an estimate of 6e-13 (30-digit mpmath, ``tests/reference/half_mpmath_reference.py``, and the
-nested engine agree).  alpha > 1 (P then has a singularity near N.wo = 1, which is not graded) and Torrance-Sparrow's
-D2 stay on the nested engine.
+1.6e-10 off at rtol 1e-12 with an estimate of 6e-13 (30-digit mpmath, ``tests/reference/half_mpmath_reference.py``, and
+the nested engine agree).  alpha > 1 (P then has a singularity near N.wo = 1, which is not graded) and
+Torrance-Sparrow's D2 stay on the nested engine.
 
 000 eq. 28's Fresnel factor F(Theta_min) = F(max(N.L, N.V)) (metal, plastic with an index, the ``fresnel`` wrapper of a
 lobe with p in {0, 1}; ``PowerLobe`` with ``FresnelAtMax``) takes the lobe frame with a rule on the arc (frame 5,
@@ -137,17 +137,18 @@ lobe with p in {0, 1}; ``PowerLobe`` with ``FresnelAtMax``) takes the lobe frame
 where N.wo = t >= mu the integrand F(t) t^(1 - p) is integrated by Gauss-Legendre rules with an a-priori bound on
 Bernstein ellipses (:func:`_lobe_f_gauss`, since issue 14's sixteenth session; the adaptive 7/15 rule in beta where they
 would want too many points), cut at t = x0 -+
-y0 3^j about F's branch point w = sqrt(1 - (eta + i k)^2) = x0 - i y0 (:func:`fresnel_branch`) and at t = rho 3^j towards
-the pole of its parallel reflectance near c = 0 (rho = 1 / |sqrt((eta + i k)^2 + 1)|, :func:`fresnel_pole`: a strong
-absorber's, eta 1.1, k 30, sits at -0.0012 + 0.033 i); the outer variable is cut where the arc's ends pass those points
-(features narrower than :data:`LOBE_F_WIDE`).  A near-kink (Im w < :data:`LOBE_F_Y0_MIN`, or w real in (0, 1): a
+y0 3^j about F's branch point w = sqrt(1 - (eta + i k)^2) = x0 - i y0 (:func:`fresnel_branch`) and at t = rho 3^j
+towards the pole of its parallel reflectance near c = 0 (rho = 1 / |sqrt((eta + i k)^2 + 1)|, :func:`fresnel_pole`: a
+strong absorber's, eta 1.1, k 30, sits at -0.0012 + 0.033 i); the outer variable is cut where the arc's ends pass those
+points (features narrower than :data:`LOBE_F_WIDE`).  A near-kink (Im w < :data:`LOBE_F_Y0_MIN`, or w real in (0, 1): a
 dielectric's total reflection below eta = 1) stays on the nested engine.  A pumped metal, and the fresnel wrapper of a
 pumped lobe, multiply the pumped lobe's frame of N by F(max(mu, N.wo)) (:func:`_x_rule`, cut likewise by
-:func:`chain_cuts`; Im w >= :data:`CHAIN_F_Y0_MIN` there).  Since issue 14's twelfth session a lobe with n >= :data:`LOBE_N_MIN`
-takes that frame too, with g = 1 (:func:`takes_lobe_n_frame`; its cuts :func:`chain_cut_matrix`, compiled, and QUADPACK's
-calibration instead of CHAIN_SAFETY |K - G|): F is then one factor per node of the elevation instead of a rule on every
-arc, 60-400 evaluations per mu instead of 15 per arc times ~110 arcs (metal n = 20, eta 0.2, k 3: 5.5 ms for 257 mu
-instead of 60 ms); below n = 8 the ring table leaves the pieces next to kappa = 1 to quadrature, and frame 5 is faster.
+:func:`chain_cuts`; Im w >= :data:`CHAIN_F_Y0_MIN` there).  Since issue 14's twelfth session a lobe with n >=
+:data:`LOBE_N_MIN` takes that frame too, with g = 1 (:func:`takes_lobe_n_frame`; its cuts :func:`chain_cut_matrix`,
+compiled, and QUADPACK's calibration instead of CHAIN_SAFETY |K - G|): F is then one factor per node of the elevation
+instead of a rule on every arc, 60-400 evaluations per mu instead of 15 per arc times ~110 arcs (metal n = 20, eta 0.2,
+k 3: 5.5 ms for 257 mu instead of 60 ms); below n = 8 the ring table leaves the pieces next to kappa = 1 to quadrature,
+and frame 5 is faster.
 
 GGX and Beckmann with F = 1 and alpha <= 1 (either Smith G, exact or Walter's G1) and Schlick's model take the frame of
 N instead (frame 6, :func:`_integrate_n`): for wo at elevation x (N.wo = t = sin x) their G and 1 / (N.L N.V) depend on
@@ -162,34 +163,35 @@ axis: the peak's (x_mu +- 2 i atanh(alpha) for GGX; Beckmann's Gaussian 2 alpha 
 exact where the peak is narrow), P(t)'s at +- i atanh(alpha) (GGX) or its turn on the scale alpha (Beckmann), Schlick's
 pole at sin x = -r / (1 - r), the pole at x = -x_mu of the height-correlated G and of Beckmann's kappa, Walter's switch
 (:func:`_n_cuts`); 10/21 Gauss-Kronrod with QUADPACK's calibration.  Since issue 14's thirteenth session GGX's and
-Schlick's pieces off the peak are integrated in u = ln |d| and graded by 27 instead of 3 (:data:`N_LOG_GRADE`: the peak's
-singularities lie pi / 2 from the real u axis whatever |d|; GGX alpha = 1e-8 took 1099 evaluations per mu, then 803),
-and since its eighteenth the pieces from x = 0 up to x_mu / 8 in u = ln x, graded by 27 too (P(t)'s singularities lie
-pi / 2 from that axis; alpha = 1e-8: 608 evaluations per mu, a 257-point table in 15 ms instead of 19-23).
+Schlick's pieces off the peak are integrated in u = ln |d| and graded by 27 instead of 3 (:data:`N_LOG_GRADE`: the
+peak's singularities lie pi / 2 from the real u axis whatever |d|; GGX alpha = 1e-8 took 1099 evaluations per mu, then
+803), and since its eighteenth the pieces from x = 0 up to x_mu / 8 in u = ln x, graded by 27 too (P(t)'s singularities
+lie pi / 2 from that axis; alpha = 1e-8: 608 evaluations per mu, a 257-point table in 15 ms instead of 19-23).
 No inner rule: 41-184 evaluations per mu for alpha
->= 0.1, a 257-point table in 0.7-2.6 ms for GGX and Schlick (frame 4 took 20-70 ms), 4-12 ms for Beckmann (frame 4: 45-200
-ms), and mu down to the smallest double.  ``scripts/calibration/n_frame_calibration.py`` measures it against frame 4
-(``using(without={"normal", "lobe_normal"})``, :mod:`pumpup.engine.routes`) at rtol 1e-13 over 45 models, 64 mu and rtol 1e-6 ... 1e-12: at most 4e-5 of the estimate beyond
-that reference's own error.
+>= 0.1, a 257-point table in 0.7-2.6 ms for GGX and Schlick (frame 4 took 20-70 ms), 4-12 ms for Beckmann (frame 4:
+45-200 ms), and mu down to the smallest double.  ``scripts/calibration/n_frame_calibration.py`` measures it against
+frame 4 (``using(without={"normal", "lobe_normal"})``, :mod:`pumpup.engine.routes`) at rtol 1e-13 over 45 models, 64 mu
+and rtol 1e-6 ... 1e-12: at most 4e-5 of the estimate beyond that reference's own error.
 
-GGX with a Fresnel factor takes frame 6 too since issue 14's thirteenth session (:func:`_ggx_ring_f`).  On the ring F(wi.h)
-depends on the azimuth, through c = wi.h = sqrt(S^2 + s cos(x) sin^2(psi / 2)) (psi from the mirror side, S = sin((x +
-x_mu) / 2) the ring's smallest c), and has no closed form against D; but D's Fourier cosine coefficients do, M_k = 2 a2
-(delta_k0 + rho^k (2 k1 + t2 + k k1^2)) (the terms of :func:`_ggx_ring`, rho = (a' - R) / Q), so F's cosine interpolant
-at psi = n pi / N integrates against D exactly: a product rule whose weights are geometric sums in rho e^(i psi_n)
-(:func:`_ring_f_sums`), however narrow the peak.  N doubles from 16 to at most 128; the ring's error is |W_N - W_N/2|, or
-that times the larger ratio of the last three such steps where both are below 1/2 (the last ratio alone, from N = 16, was
-1100 x below the true error of a strong absorber at itol 1e-6).  The ring's tolerance is frame 4's: relative, or a share
-of the integral's lower bound so far, and its errors enter the outer estimate as frame 4's K do.  F(c) has a square-root
-branch point at c = 0 (it is not even in c), at psi = +- 2 i asinh(S / sqrt(s cos x)) on the ring, so the product rule
-needs S not small: frame 6 takes mu >= :data:`N_FRESNEL_MU_MIN` = 0.248 (S >= 1/8 on every ring), frame 4 the rest of a
-table, and an index whose other singularities (the refracted cosine's branch points) lie at least 0.1 from [1/8, 1]
-(:func:`n_fresnel_ok`: not a near-kink conductor; a dielectric's lie on the imaginary axis).  The elevation is cut where
-S passes 3^j times the scale of F's pole near c = 0 (:func:`fresnel_pole`) and of its branch point.  17-129 F values per
-ring (27-35 on average), 1.3-1.9 us; the 216 mu >= 0.248 of a 257-point table at rtol 1e-10 took 39-111 ms where frame 4
-takes 87-196 ms (GGX alpha 0.3 with eta 0.2, k 3; alpha 0.02 with ior 1.5), and the 41 below 0.248 stay at frame 4's
-35-50 ms (``scripts/bench/bench_albedo.py --nframe-f``).  Not taken: a rule per ring for S < 1/8 (adaptive 10/21 in psi graded
-at D's and F's scales, measured at ~400 evaluations per ring: no faster than frame 4 there); pumped or 1/E-scaled GGX with
+GGX with a Fresnel factor takes frame 6 too since issue 14's thirteenth session (:func:`_ggx_ring_f`).  On the ring
+F(wi.h) depends on the azimuth, through c = wi.h = sqrt(S^2 + s cos(x) sin^2(psi / 2)) (psi from the mirror side, S =
+sin((x + x_mu) / 2) the ring's smallest c), and has no closed form against D; but D's Fourier cosine coefficients do,
+M_k = 2 a2 (delta_k0 + rho^k (2 k1 + t2 + k k1^2)) (the terms of :func:`_ggx_ring`, rho = (a' - R) / Q), so F's cosine
+interpolant at psi = n pi / N integrates against D exactly: a product rule whose weights are geometric sums in rho
+e^(i psi_n) (:func:`_ring_f_sums`), however narrow the peak.  N doubles from 16 to at most 128; the ring's error is
+|W_N - W_N/2|, or that times the larger ratio of the last three such steps where both are below 1/2 (the last ratio
+alone, from N = 16, was 1100 x below the true error of a strong absorber at itol 1e-6).  The ring's tolerance is frame
+4's: relative, or a share of the integral's lower bound so far, and its errors enter the outer estimate as frame 4's K
+do.  F(c) has a square-root branch point at c = 0 (it is not even in c), at psi = +- 2 i asinh(S / sqrt(s cos x)) on the
+ring, so the product rule needs S not small: frame 6 takes mu >= :data:`N_FRESNEL_MU_MIN` = 0.248
+(S >= 1/8 on every ring), frame 4 the rest of a table, and an index whose other singularities (the refracted cosine's
+branch points) lie at least 0.1 from [1/8, 1] (:func:`n_fresnel_ok`: not a near-kink conductor; a dielectric's lie on
+the imaginary axis).  The elevation is cut where S passes 3^j times the scale of F's pole near c = 0
+(:func:`fresnel_pole`) and of its branch point.  17-129 F values per ring (27-35 on average), 1.3-1.9 us; the 216 mu >=
+0.248 of a 257-point table at rtol 1e-10 took 39-111 ms where frame 4 takes 87-196 ms (GGX alpha 0.3 with eta 0.2, k 3;
+alpha 0.02 with ior 1.5), and the 41 below 0.248 stay at frame 4's 35-50 ms
+(``scripts/bench/bench_albedo.py --nframe-f``).  Not taken: a rule per ring for S < 1/8 (adaptive 10/21 in psi graded at
+D's and F's scales, measured at ~400 evaluations per ring: no faster than frame 4 there); pumped or 1/E-scaled GGX with
 F (the nested engine, as before: frame 4 below 0.248 has no chain); Beckmann with F (frame 4: its ring's Fourier
 coefficients are Bessel functions e^-kappa I_k(kappa), not attempted).
 
@@ -211,17 +213,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.hints import AzimuthHint
-from ..core.hints import PowerLobe
-from ..physics.quadrature import EPS
-from ..physics.quadrature import mode_code
+from ..core.hints import AzimuthHint, PowerLobe
+from ..physics.quadrature import EPS, mode_code
 from .chain_frame import CHAIN_RULE, N_INIT_CHAIN, _integrate_chain, chain_cut_matrix, ring_table
 from .half_arc import numeric_params
 from .hint_view import kernel_view
-from .lobe_frame import N_INIT, ROUNDING, _NO_JACOBI, jacobi_rules
+from .lobe_frame import _NO_JACOBI, N_INIT, ROUNDING, jacobi_rules
 from .normal_frame import _integrate_n, n_params
-from .outer_rule import RULE, _RADIAL, _RULES, _integrate
-
+from .outer_rule import _RADIAL, _RULES, RULE, _integrate
 
 __all__ = ["albedo_1d", "axis_albedo", "run"]
 
@@ -229,7 +228,8 @@ __all__ = ["albedo_1d", "axis_albedo", "run"]
 def run(route: str, hint: AzimuthHint, mu: np.ndarray, rtol: float, atol: float, max_regions: int,
         lobe_fresnel_gauss: bool = True):
     """(value, error, converged, evaluations) of the albedo of ``hint`` at every mu (a 1-D float array) by the 1-D
-    ``route`` the routing table chose for it (:mod:`pumpup.engine.routes`)."""
+    ``route`` the routing table chose for it (:mod:`pumpup.engine.routes`).
+    """
     hint = kernel_view(hint)
     mu = np.ascontiguousarray(mu, dtype=np.float64)
     scale = np.broadcast_to(np.asarray(hint.scale(mu), dtype=np.float64), mu.shape)
@@ -294,7 +294,8 @@ def axis_albedo(n: float, nu: np.ndarray, scale: np.ndarray, rtol: float, atol: 
     (:meth:`pumpup.core.BRDF.lobe_axis`: Lafortune's lobe, 000 eq. 14, at any azimuth of wi).  Without max(N.L, N.V)
     the integrand depends on wi only through A, so the albedo is the ``lobe`` route's p = 0 lobe about R with mu = nu
     (:func:`_k_closed`), times the scale.  The scale's rounding is added to the error: scale ~ |v|^n with |v| from a
-    few roundings, (4 n + 16) eps relative."""
+    few roundings, (4 n + 16) eps relative.
+    """
     hint = AzimuthHint(PowerLobe(n=float(n), p=0.0), scale=lambda m: scale)
     val, err, conv, evals = run("lobe", hint, nu, rtol, atol, max_regions)
     return val, err + (4.0 * n + 16.0) * EPS * np.abs(val), conv, evals
@@ -303,7 +304,8 @@ def axis_albedo(n: float, nu: np.ndarray, scale: np.ndarray, rtol: float, atol: 
 def albedo_1d(brdf, mu: np.ndarray, rtol: float, atol: float, max_regions: int, choice=None):
     """(value, error, converged, evaluations) of the albedo of ``brdf`` (one albedo term) at every mu (a 1-D float
     array) by the 1-D routes the routing table gives its hint (:func:`pumpup.engine.routes.hint_routes`), or None where
-    they leave some mu to the nested or 2-D engines (for the tests and the calibrations)."""
+    they leave some mu to the nested or 2-D engines (for the tests and the calibrations).
+    """
     from .routes import hint_routes
 
     hint = brdf.azimuth_hint()

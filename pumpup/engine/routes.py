@@ -3,8 +3,8 @@
 :func:`pumpup.albedo` splits a model into its linear terms (:meth:`pumpup.core.BRDF.albedo_terms`) and, for each term
 and each value of mu, takes the first route of :data:`RULES` that applies:
 
-1. ``slope``: a model with a slope-space hint (:meth:`~pumpup.core.BRDF.slope_hint`, anisotropic Ward), at any azimuth of
-   wi, mu >= :data:`pumpup.engine.slope.MU_MIN` (:mod:`pumpup.engine.slope`).
+1. ``slope``: a model with a slope-space hint (:meth:`~pumpup.core.BRDF.slope_hint`, anisotropic Ward), at any azimuth
+   of wi, mu >= :data:`pumpup.engine.slope.MU_MIN` (:mod:`pumpup.engine.slope`).
 2. ``lobe_axis``: a power lobe about its own axis at any azimuth of wi (:meth:`~pumpup.core.BRDF.lobe_axis`,
    Lafortune's), the ``lobe`` route about that axis.
 3. Where the albedo does not depend on the azimuth of wi (an isotropic model, or phi = 0): the model's
@@ -29,18 +29,28 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.hints import (
-    AshikhminShirleyLobe, AzimuthHint, ClosedForm, DivideByG, FresnelAtMax, HalfVectorLobe, InverseAlbedoFactor, PowerLobe, SchlickLobe,
-    SmithLobe, VCavityLobe, WardLobe,
+    AshikhminShirleyLobe,
+    AzimuthHint,
+    ClosedForm,
+    DivideByG,
+    FresnelAtMax,
+    HalfVectorLobe,
+    InverseAlbedoFactor,
+    PowerLobe,
+    SchlickLobe,
+    SmithLobe,
+    VCavityLobe,
+    WardLobe,
 )
 from ..physics.fresnel import fresnel_levels
+from .chain_frame import LOBE_N_MIN
 from .half_arc import ARC_F_Y0_MIN
 from .hint_view import HALF_MU_MIN
-from .chain_frame import LOBE_N_MIN
-from .normal_frame import N_FRESNEL_MU_MIN, n_fresnel_ok
 from .lobe_fresnel import lobe_fresnel_ok
+from .normal_frame import N_FRESNEL_MU_MIN, n_fresnel_ok
 
-__all__ = ["ENGINES", "ONE_D_ROUTES", "ROUTES", "RULES", "Choice", "current", "describe", "hint_routes", "one_d_everywhere", "plan", "route_names",
-           "using"]
+__all__ = ["ENGINES", "ONE_D_ROUTES", "ROUTES", "RULES", "Choice", "current", "describe", "hint_routes",
+           "one_d_everywhere", "plan", "route_names", "using"]
 
 ENGINES = ("auto", "1d", "nested", "2d")
 
@@ -56,7 +66,8 @@ class Choice:
     """Which routes the engine may take: ``engine`` one of :data:`ENGINES`; ``without``, route names left out (the
     tests' and calibrations' second route for a model); ``lobe_fresnel_gauss``: the ``lobe_fresnel`` route's arcs by
     Gauss-Legendre pieces with an a-priori bound (else the adaptive 7/15 rule); ``generic_check``: the 2-D cubature
-    checks a user function's kinks on a grid first."""
+    checks a user function's kinks on a grid first.
+    """
 
     engine: str = "auto"
     without: frozenset = frozenset()
@@ -93,7 +104,8 @@ def current() -> Choice:
 def using(engine: str | None = None, without=(), **options):
     """Within the block (in this thread or task only), :func:`pumpup.albedo` and everything built on it (tables,
     pumping, compensation) route by ``engine`` and leave out the routes ``without``; ``options`` set
-    :class:`Choice`'s other fields.  Blocks nest: the inner one adds to the outer one's ``without``."""
+    :class:`Choice`'s other fields.  Blocks nest: the inner one adds to the outer one's ``without``.
+    """
     old = _CHOICE.get()
     bad = set(without) - set(ROUTES)
     if bad:
@@ -117,17 +129,20 @@ def _smith_ok(f) -> bool:
     """Whether any 1-D route takes a Smith lobe: alpha <= 1 (rougher, P(N.wo) has a singularity near N.wo = 1 that no
     route grades: GGX's branch point at alpha / sqrt(alpha^2 - 1)); not Walter's G1 in the height-correlated G with a
     Fresnel factor (G1's jump at the switch level: the rule on h's arc was up to 7 x its estimate against the 2-D engine
-    at rtol 1e-13, alpha 0.0032, ior 1.917, mu 1.75e-6); not a conductor's near-kink at wi.h (:data:`ARC_F_Y0_MIN`)."""
+    at rtol 1e-13, alpha 0.0032, ior 1.917, mu 1.75e-6); not a conductor's near-kink at wi.h (:data:`ARC_F_Y0_MIN`).
+    """
     if not f.alpha <= 1.0:
         return False
     if f.fresnel is not None and f.g1 == "walter" and f.shadowing == "correlated":
         return False
-    return not (f.fresnel is not None and f.fresnel.eta > 0.0 and fresnel_levels(f.fresnel.eta, f.fresnel.k, ARC_F_Y0_MIN))
+    return not (f.fresnel is not None and f.fresnel.eta > 0.0
+                and fresnel_levels(f.fresnel.eta, f.fresnel.k, ARC_F_Y0_MIN))
 
 
 def _normal_family(f) -> bool:
     """Whether the ``normal`` route takes the family ``f`` with no factor: Schlick's model, GGX and Beckmann with
-    F = 1, GGX with a Fresnel factor :func:`n_fresnel_ok` takes."""
+    F = 1, GGX with a Fresnel factor :func:`n_fresnel_ok` takes.
+    """
     if isinstance(f, SchlickLobe):
         return True
     if not isinstance(f, SmithLobe) or not _smith_ok(f):
@@ -157,7 +172,8 @@ def _fresnel_at_h(hint: AzimuthHint) -> bool:
 
 def _arc(hint: AzimuthHint) -> bool:
     """The ``half_arc`` route's condition: a Smith lobe any route takes (:func:`_smith_ok`), a V-cavity lobe with F, or
-    Ashikhmin and Shirley's lobe."""
+    Ashikhmin and Shirley's lobe.
+    """
     f = hint.family
     if isinstance(f, AshikhminShirleyLobe):
         return True
@@ -199,7 +215,8 @@ def _always(hint) -> bool:
 class Rule:
     """One row of the routing table: the ``families`` and the set of factor kinds (``factors``) it matches, its
     ``condition`` on the hint (``when`` says it in words), the values of mu it takes (``mu_range(hint, mu)`` -> a mask;
-    ``mu_text`` in words), and the ``route``."""
+    ``mu_text`` in words), and the ``route``.
+    """
 
     route: str
     families: tuple
@@ -221,11 +238,13 @@ RULES = (
     Rule("vcavity", (VCavityLobe,), frozenset(), "F = 1", lambda h: h.family.fresnel is None, "mu >= HALF_MU_MIN",
          lambda h, mu: _half_mu(mu)),
     *(Rule("normal", (SmithLobe, SchlickLobe), frozenset(kinds),
-           "Schlick; GGX or Beckmann, alpha <= 1, F = 1 or GGX's F(wi.h) n_fresnel_ok takes; F(max) without a near-kink",
+           "Schlick; GGX or Beckmann, alpha <= 1, F = 1 or GGX's F(wi.h) n_fresnel_ok takes; "
+           "F(max) without a near-kink",
            _normal, "mu >= N_FRESNEL_MU_MIN with F(wi.h), else all", _normal_mu)
       for kinds in ((), (_D,), (_U,), (_M,), (_D, _M))),
     Rule("half_arc", (SmithLobe, VCavityLobe, AshikhminShirleyLobe), frozenset(),
-         "Smith: alpha <= 1, no Walter G1 in correlated G with F, no near-kink of F(wi.h); V-cavity: with F(wi.h)", _arc, "mu >= HALF_MU_MIN", lambda h, mu: _half_mu(mu)),
+         "Smith: alpha <= 1, no Walter G1 in correlated G with F, no near-kink of F(wi.h); V-cavity: with F(wi.h)",
+         _arc, "mu >= HALF_MU_MIN", lambda h, mu: _half_mu(mu)),
     Rule("lobe_normal", (PowerLobe,), frozenset({_M}), "p in {0, 1}, n >= LOBE_N_MIN, F without a near-kink",
          _lobe_normal),
     Rule("lobe_fresnel", (PowerLobe,), frozenset({_M}), "p in {0, 1}, F without a near-kink", _lobe_fmax),
@@ -242,7 +261,8 @@ def _matches(rule: Rule, hint: AzimuthHint) -> bool:
 
 def hint_routes(hint: AzimuthHint | None, mu: np.ndarray, choice: Choice | None = None) -> list:
     """[(route, mask)] for the values of mu (a 1-D array) an :class:`~pumpup.core.hints.AzimuthHint` takes by 1-D
-    routes, in :data:`RULES`' order; the values in no mask are left to the nested quadrature or the 2-D cubature."""
+    routes, in :data:`RULES`' order; the values in no mask are left to the nested quadrature or the 2-D cubature.
+    """
     choice = current() if choice is None else choice
     out = []
     if hint is None:
@@ -270,7 +290,8 @@ def one_d_everywhere(brdf, mu: np.ndarray, choice: Choice | None = None) -> bool
 def plan(brdf, mu: np.ndarray, phi: np.ndarray | None = None, choice: Choice | None = None) -> list:
     """The routes of one albedo term ``brdf`` (a :class:`~pumpup.core.BRDF` with no linear parts) at every mu (a 1-D
     array), wi at azimuth ``phi`` (None: 0): [(route, indices into mu, payload)], payload the hint for the 1-D routes
-    and the lobe group for ``nested`` and ``cubature``."""
+    and the lobe group for ``nested`` and ``cubature``.
+    """
     from . import cubature, nested, slope
 
     choice = current() if choice is None else choice
@@ -310,7 +331,8 @@ def plan(brdf, mu: np.ndarray, phi: np.ndarray | None = None, choice: Choice | N
 
 def route_names(brdf, mu, phi=None, choice: Choice | None = None) -> np.ndarray:
     """The route of every value of mu for a BRDF's first albedo term with more than one route, as an array of route
-    names per (term, mu): shape (terms, len(mu))."""
+    names per (term, mu): shape (terms, len(mu)).
+    """
     from .cubature import check_mu
 
     mu = np.asarray(check_mu(mu), dtype=np.float64).reshape(-1)
@@ -331,6 +353,7 @@ def describe() -> str:
         fam = ", ".join(f.__name__ for f in r.families)
         fac = ", ".join(sorted(f.__name__ for f in r.factors)) or "-"
         lines.append(f"{r.route:13s} {fam:32s} {fac:18s} {r.mu_text:11s} {r.when}")
-    lines.append("nested        (BRDF.lobe)                      any                the rest    the lobe hint it supports")
+    lines.append("nested        (BRDF.lobe)                      any                the rest    "
+                 "the lobe hint it supports")
     lines.append("cubature      any BRDF                         any                the rest    -")
     return "\n".join(lines)

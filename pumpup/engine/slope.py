@@ -24,35 +24,35 @@ R > 0 > r_- the roots (1 / (|e|^2 r^2 - 2 b r - 1) = 0, computed without cancell
 
 The ray ends at the horizon with a square root: the piece next to R is integrated in tau, r = R - (R - lo) tau^2, which
 makes it analytic.  Beyond r = a = :data:`R_MAX` (when R is larger) the Gaussian leaves at most
-sqrt(R (1 + |r_-| / a)) (I(1.5) + |b| I(2.5)), I(k) = integral_a^inf r^k e^(-r^2) dr <= a^(k - 1) e^(-a^2) / (2 (1 - (k - 1)
-/ (2 a^2))) (bound 1 + r b by 1 + r |b|, (R - r)(r - r_-) by R r (1 + |r_-| / a) and h_z by 1), which is added to the
-ray's error.  (A first bound, (R - r_-) / 2 for the square root, was e^-40 sqrt(R) of J: near grazing incidence, where R
-reaches 1e100, it never let the rays converge.)  The ray's first pieces are graded by 4 from twice the scale of the
-singularities next to r = 0 (r_-, and h_z's pole at r = i / |e| of a wide lobe) up to :data:`RAY_CUTS`, the Gaussian's
-scale; each piece is adaptive 10/21 Gauss-Kronrod (the worst bisected) to a relative tolerance or an absolute share of the
-albedo's lower bound so far.
+sqrt(R (1 + |r_-| / a)) (I(1.5) + |b| I(2.5)), I(k) = integral_a^inf r^k e^(-r^2) dr <= a^(k - 1) e^(-a^2) / (2 (1 -
+(k - 1) / (2 a^2))) (bound 1 + r b by 1 + r |b|, (R - r)(r - r_-) by R r (1 + |r_-| / a) and h_z by 1), which is added
+to the ray's error.  (A first bound, (R - r_-) / 2 for the square root, was e^-40 sqrt(R) of J: near grazing incidence,
+where R reaches 1e100, it never let the rays converge.)  The ray's first pieces are graded by 4 from twice the scale of
+the singularities next to r = 0 (r_-, and h_z's pole at r = i / |e| of a wide lobe) up to :data:`RAY_CUTS`, the
+Gaussian's scale; each piece is adaptive 10/21 Gauss-Kronrod (the worst bisected) to a relative tolerance or an absolute
+share of the albedo's lower bound so far.
 
 J(theta) is analytic and periodic; the rule over theta is globally adaptive 7/15 Gauss-Kronrod over the turn, the rays'
-errors added through the Kronrod weights as frame 4 does (:func:`pumpup.engine.polar._k_numeric`).  Near grazing incidence the
-disc's edge nearest to h = N, m* = -(cos phi, sin phi)(1 - s) / mu, comes within the Gaussian: in the stretched plane it
-is a line at the distance ``edge`` = mu / ((1 + s) a_x a_y |T|), T = (-sin phi / a_x, cos phi / a_y) its direction.  A ray
-at an angle delta from it meets it at R ~ edge / sin(delta), so J changes from its value near the edge to the full
-Gaussian within a few times ``edge`` of the edge's parallels tpar and tpar + pi (which are th0 +- pi / 2, th0 the
-direction of m*, only where a_x = a_y); beyond a parallel r_- sweeps through the Gaussian in the same way, r_- R = -1 /
-|e|^2.  So the first cuts are th0 + pi, the parallels, and from each parallel cuts graded by 4 from ``edge`` / 8 on both
-sides (:data:`EDGE_GRADE`), where ``edge`` < :data:`EDGE_MAX`.  Found by the calibration: cuts at th0 +- pi / 2 left
-a_x / a_y = 1000 at mu = 1e-4 4e-7 off, and cuts on the near side only (0.05, 0.5) at mu = 0.003 8.4e-13 off with an
-estimate of 5e-13.  Where wi lies in the plane of a tangent axis (phi = 0 or pi / 2, and isotropic models, which take
-phi = 0) J is even about th0 and half the turn is integrated.  The estimate per interval, of the rays and of theta, is
-QUADPACK's calibration of |K - G| (:func:`pumpup.physics.quadrature.calibrated`), plus the rounding term
-:data:`pumpup.engine.polar.ROUNDING` times the sum of |K|.
+errors added through the Kronrod weights as frame 4 does (:func:`pumpup.engine.polar._k_numeric`).  Near grazing
+incidence the disc's edge nearest to h = N, m* = -(cos phi, sin phi)(1 - s) / mu, comes within the Gaussian: in the
+stretched plane it is a line at the distance ``edge`` = mu / ((1 + s) a_x a_y |T|), T = (-sin phi / a_x, cos phi / a_y)
+its direction.  A ray at an angle delta from it meets it at R ~ edge / sin(delta), so J changes from its value near the
+edge to the full Gaussian within a few times ``edge`` of the edge's parallels tpar and tpar + pi (which are th0 +- pi /
+2, th0 the direction of m*, only where a_x = a_y); beyond a parallel r_- sweeps through the Gaussian in the same way,
+r_- R = -1 / |e|^2.  So the first cuts are th0 + pi, the parallels, and from each parallel cuts graded by 4 from
+``edge`` / 8 on both sides (:data:`EDGE_GRADE`), where ``edge`` < :data:`EDGE_MAX`.  Found by the calibration: cuts at
+th0 +- pi / 2 left a_x / a_y = 1000 at mu = 1e-4 4e-7 off, and cuts on the near side only (0.05, 0.5) at mu = 0.003
+8.4e-13 off with an estimate of 5e-13.  Where wi lies in the plane of a tangent axis (phi = 0 or pi / 2, and isotropic
+models, which take phi = 0) J is even about th0 and half the turn is integrated.  The estimate per interval, of the rays
+and of theta, is QUADPACK's calibration of |K - G| (:func:`pumpup.physics.quadrature.calibrated`), plus the rounding
+term :data:`pumpup.engine.polar.ROUNDING` times the sum of |K|.
 
-Checked in ``tests/engine/test_slope.py`` against ``tests/data/independent_ward_aniso.json`` (two nested-quad methods written
-without pumpup, ``tests/reference/independent_ward_aniso.py``), against the nested engine at rtol 1e-13 (the half vector's polar
-angle and azimuth), against Ward's isotropic 1-D path (complete elliptic integrals) at a_x = a_y, and the ray integral
-against scipy's quadrature (:func:`ray_reference`); ``scripts/calibration/slope_calibration.py`` over 9 pairs of slopes x 14 mu x 4
-azimuths x 4 rtol.  At a_x / a_y = 1000 the nested engine is off by up to 1.3e-8 with estimates of 5e-14, where the slope
-path agrees with both independent methods.
+Checked in ``tests/engine/test_slope.py`` against ``tests/data/independent_ward_aniso.json`` (two nested-quad methods
+written without pumpup, ``tests/reference/independent_ward_aniso.py``), against the nested engine at rtol 1e-13 (the
+half vector's polar angle and azimuth), against Ward's isotropic 1-D path (complete elliptic integrals) at a_x = a_y,
+and the ray integral against scipy's quadrature (:func:`ray_reference`); ``scripts/calibration/slope_calibration.py``
+over 9 pairs of slopes x 14 mu x 4 azimuths x 4 rtol.  At a_x / a_y = 1000 the nested engine is off by up to 1.3e-8 with
+estimates of 5e-14, where the slope path agrees with both independent methods.
 """
 
 from __future__ import annotations
@@ -70,14 +70,15 @@ __all__ = ["slope_albedo", "ray_reference", "ray_integral"]
 #: the ray's cut: e^(-R_MAX^2) = e^-40, as the 1-D path's Z_MAX (beyond it a bound joins the error)
 R_MAX = math.sqrt(40.0)
 
-#: the smallest mu the slope path takes (below it the nested engine, as before): c = (wi_x, wi_y) / mu and the roots stay
-#: far from overflow
+#: the smallest mu the slope path takes (below it the nested engine, as before): c = (wi_x, wi_y) / mu and the roots
+#: stay far from overflow
 MU_MIN = 1e-100
 
 #: the most intervals of one ray
 RAY_MAX = 64
 #: the ray's cuts on the Gaussian's scale (measured: with the graded cuts below them, one 10/21 rule per piece is within
-#: 1.1e-11 of scipy's ray integral over 7 pairs of slopes x 8 mu x 23 theta; two pieces [0, R/2], [R/2, R] were 2e-4 off)
+#: 1.1e-11 of scipy's ray integral over 7 pairs of slopes x 8 mu x 23 theta; two pieces [0, R/2], [R/2, R] were 2e-4
+#: off)
 RAY_CUTS = np.array([1.6, 3.2])
 #: the smallest relative tolerance of a ray: its estimate has the floor 50 eps of every piece (QUADPACK's), and below
 #: about that a ray bisected to RAY_MAX intervals (rtol 3e-14: 7e8 evaluations for one mu)
@@ -103,7 +104,9 @@ OFFS_CAP = 8 * N_GRADE + 32
 
 @njit(cache=True, nogil=True, inline="always")
 def _ray_f(r, w, b, e2, rm):  # pragma: no cover - compiled; see ray_reference
-    """r e^(-r^2) (1 + r b) sqrt(w (r - r_-)) (1 + r^2 |e|^2)^(-5/2), with w = R - r given (no cancellation)."""
+    """The integrand r e^(-r^2) (1 + r b) sqrt(w (r - r_-)) (1 + r^2 |e|^2)^(-5/2), with w = R - r given
+    (no cancellation).
+    """
     hz2 = 1.0 / (1.0 + r * r * e2)
     return r * math.exp(-r * r) * (1.0 + r * b) * math.sqrt(w * (r - rm)) * hz2 * hz2 * math.sqrt(hz2)
 
@@ -111,7 +114,8 @@ def _ray_f(r, w, b, e2, rm):  # pragma: no cover - compiled; see ray_reference
 @njit(cache=True, nogil=True)
 def _ray_rule(lo, hi, base, top, b, e2, rm, nodes, wk, wg, mode, buf):  # pragma: no cover - compiled
     """(value, error) of the 10/21 rule on [lo, hi]: in r where ``base`` < 0, else in tau with r = top - base tau^2
-    (the piece next to the horizon r = R = top, base = R - its start)."""
+    (the piece next to the horizon r = R = top, base = R - its start).
+    """
     h = hi - lo
     for j in range(nodes.shape[0]):
         x = lo + h * nodes[j]
@@ -136,8 +140,9 @@ def _roots(b, e2):  # pragma: no cover - compiled
 @njit(cache=True, nogil=True)
 def _ray(b, e2, itol, tol_abs, nodes, wk, wg, mode, buf, rw):  # pragma: no cover - compiled
     """(J, error, evaluations) of the ray integral (module docstring), globally adaptive: the first pieces below, the
-    one next to the horizon in tau where R <= R_MAX, the worst bisected until the error is at most max(itol |J|, tol_abs)
-    or RAY_MAX intervals are used (the error is returned either way)."""
+    one next to the horizon in tau where R <= R_MAX, the worst bisected until the error is at most
+    max(itol |J|, tol_abs) or RAY_MAX intervals are used (the error is returned either way).
+    """
     big, rm = _roots(b, e2)
     lo, hi, val, err, kind = rw[0], rw[1], rw[2], rw[3], rw[4]
     top = min(big, R_MAX)
@@ -191,9 +196,11 @@ def _ray(b, e2, itol, tol_abs, nodes, wk, wg, mode, buf, rw):  # pragma: no cove
 
 
 @njit(cache=True, nogil=True)
-def _theta_rule(lo, hi, ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes, wk, wg, mode, buf, ibuf, rw):  # pragma: no cover
+def _theta_rule(lo, hi, ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes, wk, wg, mode, buf,  # pragma: no cover
+                ibuf, rw):
     """(value, error, sum |K|, evaluations) of the rule over theta (:data:`THETA_RULE`) in [lo, hi] for |e| J(theta),
-    the rays' errors added through the Kronrod weights."""
+    the rays' errors added through the Kronrod weights.
+    """
     h = hi - lo
     inner = 0.0
     evals = 0
@@ -212,9 +219,11 @@ def _theta_rule(lo, hi, ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes, 
 
 
 @njit(cache=True, nogil=True)
-def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk, twg, nodes, wk, wg, mode, work, buf, ibuf, rw):  # pragma: no cover
+def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk, twg, nodes, wk,  # pragma: no cover
+               wg, mode, work, buf, ibuf, rw):
     """(integral of |e| J over theta, error, converged, evaluations) at one wi = (s cos phi, s sin phi, mu); ``atol``
-    applies to this integral (the caller divides by the scale c mu / pi)."""
+    applies to this integral (the caller divides by the scale c mu / pi).
+    """
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
     cx = s * math.cos(phi) / mu
     cy = s * math.sin(phi) / mu
@@ -262,9 +271,9 @@ def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk
     # |e|^2 = a_x^2 cos^2(theta) + a_y^2 sin^2(theta) vanishes at theta = theta_a +- i atanh(a_min / a_max), theta_a the
     # direction of the smaller slope's axis (pi / 2 and 3 pi / 2 where a_y < a_x): |e| J(theta) has a branch point that
     # close to the real axis.  The rule's 7 and 15 points on an interval ending near theta_a agreed while both missed:
-    # a_x = 0.743, a_y = 0.0149 at mu = 1 (phi = 5.898) was 8.0e-10 off with an estimate of 4.7e-11 at rtol 1e-8, 72 x at
-    # mu = 1 - 1e-9 and rtol 1e-10 (scripts/studies/fuzz_engines.py --registry 47; issue 14's twenty-fourth session).  Cuts at
-    # theta_a and graded by EDGE_FACTOR from the branch point's distance on both sides
+    # a_x = 0.743, a_y = 0.0149 at mu = 1 (phi = 5.898) was 8.0e-10 off with an estimate of 4.7e-11 at rtol 1e-8, 72 x
+    # at mu = 1 - 1e-9 and rtol 1e-10 (scripts/studies/fuzz_engines.py --registry 47; issue 14's twenty-fourth session).
+    # Cuts at theta_a and graded by EDGE_FACTOR from the branch point's distance on both sides
     if ax != ay:
         dist = math.atanh(min(ax, ay) / max(ax, ay))
         for j in range(2):
@@ -291,13 +300,14 @@ def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk
     offs[:n].sort()
     itol = max(0.25 * rtol, RAY_ITOL_MIN)
     evals = 0
-    # the rays' share of the tolerance: over the turn, at most a quarter of atol, or of rtol times the lower bound so far
+    # the rays' share of the tolerance: over the turn, at most a quarter of atol, or of rtol times the lower bound so
+    # far
     tol_abs = 0.25 * atol / (2.0 * math.pi)
     for i in range(n - 1):
         lo[i] = th0 + offs[i]
         hi[i] = th0 + offs[i + 1]
-        val[i], err[i], ab[i], ne = _theta_rule(lo[i], hi[i], ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes, wk,
-                                                wg, mode, buf, ibuf, rw)
+        val[i], err[i], ab[i], ne = _theta_rule(lo[i], hi[i], ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes,
+                                                wk, wg, mode, buf, ibuf, rw)
         evals += ne
     m = n - 1
     while True:
@@ -321,16 +331,18 @@ def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk
         c = 0.5 * (lo[worst] + hi[worst])
         lo[m], hi[m] = c, hi[worst]
         hi[worst] = c
-        val[worst], err[worst], ab[worst], ne = _theta_rule(lo[worst], c, ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes,
-                                                            wk, wg, mode, buf, ibuf, rw)
+        val[worst], err[worst], ab[worst], ne = _theta_rule(lo[worst], c, ax, ay, cx, cy, itol, tol_abs, tnodes, twk,
+                                                            twg, nodes, wk, wg, mode, buf, ibuf, rw)
         evals += ne
-        val[m], err[m], ab[m], ne = _theta_rule(c, hi[m], ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes, wk, wg, mode, buf, ibuf, rw)
+        val[m], err[m], ab[m], ne = _theta_rule(c, hi[m], ax, ay, cx, cy, itol, tol_abs, tnodes, twk, twg, nodes, wk,
+                                                wg, mode, buf, ibuf, rw)
         evals += ne
         m += 1
 
 
 @njit(cache=True, nogil=True)
-def _slope_all(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk, twg, nodes, wk, wg, mode, val, err, conv, evals):  # pragma: no cover
+def _slope_all(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk, twg, nodes, wk,  # pragma: no cover
+               wg, mode, val, err, conv, evals):
     work = np.empty((5, max(max_intervals, OFFS_CAP) + 1))
     buf = np.empty(tnodes.shape[0])
     ibuf = np.empty(nodes.shape[0])
@@ -342,9 +354,10 @@ def _slope_all(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk
 
 def slope_albedo(brdf, mu: np.ndarray, phi: np.ndarray, rtol: float, atol: float, max_regions: int):
     """(value, error, converged, evaluations) of the albedo of anisotropic Ward ``brdf`` at every (mu, phi) (1-D float
-    arrays of one length; phi the azimuth of wi from the tangent x axis)."""
-    from .outer_rule import _RULES
+    arrays of one length; phi the azimuth of wi from the tangent x axis).
+    """
     from .lobe_frame import ROUNDING
+    from .outer_rule import _RULES
 
     ax, ay, c = brdf.slope_hint()
     mu = np.ascontiguousarray(mu, dtype=np.float64)
@@ -368,12 +381,14 @@ def ray_integral(b: float, e2: float, rtol: float = 1e-13) -> tuple:
     from .outer_rule import _RULES
 
     nodes, wk, wg = _RULES[RAY_RULE]
-    return _ray(float(b), float(e2), float(rtol), 0.0, nodes, wk, wg, mode_code(), np.empty(len(nodes)), np.empty((5, RAY_MAX)))
+    return _ray(float(b), float(e2), float(rtol), 0.0, nodes, wk, wg, mode_code(), np.empty(len(nodes)),
+                np.empty((5, RAY_MAX)))
 
 
 def ray_reference(b: float, e2: float) -> float:
     """J by scipy's adaptive quadrature on [0, min(R, 12)] in r, the horizon's square root taken by the substitution
-    r = R - w^2 (plain numpy and scipy; the tests' reference for :func:`_ray`)."""
+    r = R - w^2 (plain numpy and scipy; the tests' reference for :func:`_ray`).
+    """
     from scipy.integrate import quad
 
     d = math.hypot(b, math.sqrt(e2))

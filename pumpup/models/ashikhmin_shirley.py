@@ -21,7 +21,7 @@ import math
 import numpy as np
 from numba import njit, vectorize
 
-from ..core import MAX_EXPONENT, BRDF, Lobe, Param, register
+from ..core import BRDF, MAX_EXPONENT, Lobe, Param, register
 
 
 @njit(cache=True, inline="always")
@@ -167,7 +167,8 @@ class _Diffuse(BRDF):
     """The diffuse term of AS 2000 eq. 5 with rd (1 - rs) = 1 [1/sr] (one linear term of
     :meth:`AshikhminShirley.albedo_terms`; not registered: it is not a model of its own).
 
-    Its albedo is closed-form (:func:`diffuse_albedo`), and it is isotropic."""
+    Its albedo is closed-form (:func:`diffuse_albedo`), and it is isotropic.
+    """
 
     type = "ashikhmin_shirley-diffuse"
     params = {}
@@ -257,11 +258,13 @@ class AshikhminShirley(BRDF):
         """P_d = rd (1 - rs) / (1 + rd (1 - rs)): the diffuse term's albedo bound rd (1 - rs) against 1,
         the bound of the specular term's albedo (F <= 1); at most 1/2 (rd = 1, rs = 0), where pbrt-v3's
         FresnelBlend (this model) always takes 1/2; 0 when rd = 0 or rs = 1 (no diffuse term).  The
-        same weights as :meth:`albedo_terms`, so ``pumpup.sample`` mixes its strategies alike."""
+        same weights as :meth:`albedo_terms`, so ``pumpup.sample`` mixes its strategies alike.
+        """
         w = self.p["rd"] * (1.0 - self.p["rs"])
         return w / (1.0 + w)
 
     def albedo_terms(self):
+        """The specular term alone, plus the diffuse term rd (1 - rs) apart where it does not vanish."""
         w = self.p["rd"] * (1.0 - self.p["rs"])
         if w == 0.0:  # (rd = 0, or rs = 1 where the diffuse term vanishes)
             return [(1.0, self)]
@@ -275,16 +278,21 @@ class AshikhminShirley(BRDF):
         """Isotropic with no diffuse term: Ashikhmin and Shirley's family (AS 2000 eq. 4), whose albedo in half-vector
         coordinates is (n + 1) / (8 pi) times the integral of (N.h)^n 4 F(wi.h) N.wo / max(N.wi, N.wo) over h (the
         1 / (h.k) cancels the Jacobian 4 (wo.h)); None otherwise (anisotropic: the nested engine; a diffuse term: the
-        terms have their own)."""
+        terms have their own).
+        """
         from ..core.hints import AshikhminShirleyLobe, AzimuthHint
 
         nu, nv, rs, rd = self.p["nu"], self.p["nv"], self.p["rs"], self.p["rd"]
         if nu != nv or rd * (1.0 - rs) != 0.0:
             return None
         norm = math.sqrt((nu + 1.0) * (nv + 1.0)) / (8.0 * math.pi)  # AS 2000 eq. 4
-        return AzimuthHint(AshikhminShirleyLobe(n=float(nu), rs=float(rs)), scale=lambda mu: np.full(np.shape(mu), norm))
+        return AzimuthHint(AshikhminShirleyLobe(n=float(nu), rs=float(rs)),
+                           scale=lambda mu: np.full(np.shape(mu), norm))
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe about the half vector with the smaller exponent min(nu, nv), a kink at N.wo = mu,
+        and the y axis cut when anisotropic.
+        """
         # (N.h)^e(phi_h), e = nu cos^2 phi_h + nv sin^2 phi_h, in x = (N.h)^(n+1) ("power" about h) behaves as
         # x^((e + 1) / (n + 1) - 1): bounded in every azimuth for n = min(nu, nv) (e >= n), while the larger
         # exponent would make it singular at x = 0 across the wide axis (as WardAniso.lobe explains for its
@@ -297,6 +305,7 @@ class AshikhminShirley(BRDF):
                     kinks=None if nu == nv else _y_axis)
 
     def azimuth_range(self):
+        """None when isotropic (nu = nv), else pi / 2 (the albedo is even in x and in y)."""
         # f is even in the x and y components of k1 + k2 and k1 - k2: a(phi) = a(-phi) = a(pi - phi)
         return None if self.p["nu"] == self.p["nv"] else math.pi / 2
 
@@ -387,7 +396,8 @@ class AshikhminShirley(BRDF):
         """The density [1/sr] of :meth:`sample_wi`'s wi given wo: (1 - P_d) p_h(h) / (4 (wo.h)) + P_d N.wi / pi,
         P_d = :meth:`diffuse_probability`, h = (wi + wo) / |wi + wo|; 0 where wi or wo is at or below the horizon.
 
-        Broadcasts over the leading axes of ``wi`` and ``wo`` (directions on the last axis)."""
+        Broadcasts over the leading axes of ``wi`` and ``wo`` (directions on the last axis).
+        """
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
         nu, nv = self.p["nu"], self.p["nv"]

@@ -13,8 +13,8 @@ import math
 import numpy as np
 from numba import vectorize
 
+from ..core import BRDF, MAX_EXPONENT, Lobe, Param, load, register
 from ._half import tan2_half
-from ..core import MAX_EXPONENT, BRDF, Lobe, Param, load, register
 
 
 def _cos2_delta(wi, wo):
@@ -79,15 +79,18 @@ class Blinn(BRDF):
     reference_fn = staticmethod(_blinn_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the half vector."""
         return Lobe(axis="half", radial="power", sharpness=self.p["n"])
 
     def azimuth_hint(self):
+        """The azimuth hint: the half vector's power lobe c (N.H)^n, closed-form in the azimuth (000 eq. 31)."""
         return _half_hint(self.p["n"], 0.0, self.p["c"])  # 000 eq. 31
 
 
 def _half_hint(n, p, c):
     """The azimuth hint of a lobe c (N.H)^n / max(N.L, N.V)^p, p in {0, 1} (000 eq. 31, 32): the half vector's
-    azimuth about N integrates in closed form."""
+    azimuth about N integrates in closed form.
+    """
     from ..core.hints import AzimuthHint, HalfVectorLobe
 
     return AzimuthHint(HalfVectorLobe(n=n, p=float(p)), scale=lambda mu: np.full(np.shape(mu), c))
@@ -145,9 +148,11 @@ class StretchedBlinn(BRDF):
     reference_fn = staticmethod(_stretched_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the half vector, with max(N.L, N.V)'s kink at N.wo = mu."""
         return Lobe(axis="half", radial="power", sharpness=self.p["n"], levels=(mu,))
 
     def azimuth_hint(self):
+        """The azimuth hint: the half vector's power lobe divided by max(N.L, N.V), p = 1 (000 eq. 32)."""
         return _half_hint(self.p["n"], 1.0, self.p["c"])  # 000 eq. 32
 
 
@@ -204,14 +209,19 @@ class PhongBlinn(BRDF):
     reference_fn = staticmethod(_phong_blinn_reference)
 
     def albedo_terms(self):
+        """The specular lobe alone, plus the diffuse term pi k_d times a white Lambertian where k_d > 0."""
         if self.p["kd"] == 0:
             return [(1.0, self)]
         return [(1.0, self.with_params(kd=0.0)), (math.pi * self.p["kd"], load({"type": "lambert", "albedo": 1.0}))]
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the half vector."""
         return Lobe(axis="half", radial="power", sharpness=self.p["n"])
 
     def azimuth_hint(self):
+        """The azimuth hint of the specular lobe k_s (N.H)^n (002 eq. 24), or None where k_d > 0 (the terms are
+        integrated apart).
+        """
         if self.p["kd"] != 0:
             return None  # albedo_terms splits off the diffuse part
         return _half_hint(self.p["n"], 0.0, self.p["ks"])  # 002 eq. 24

@@ -23,11 +23,11 @@ import math
 import numpy as np
 from numba import vectorize
 
-from ._half import tan2_half
-from ..core import MAX_EXPONENT, MAX_INDEX, MAX_WIDTH, MIN_WIDTH, BRDF, Lobe, Param, SpecError, register
+from ..core import BRDF, MAX_EXPONENT, MAX_INDEX, MAX_WIDTH, MIN_WIDTH, Lobe, Param, SpecError, register
 from ..physics.fresnel import dielectric_reference as _fresnel_reference
 from ..physics.fresnel import dielectric_scalar as _fresnel
 from ..physics.fresnel import fresnel_dielectric as fresnel  # noqa: F401  (pumpup.models.cook_torrance.fresnel)
+from ._half import tan2_half
 
 # ----------------------------------------------------------------------------------------
 # Shared pieces: Fresnel, geometry factor, and the kinks of G for the albedo engine
@@ -72,7 +72,7 @@ def _g_kinks(mu, s, cos_a, sin_a):
 
 
 def _halfway(wi, wo):
-    """t = tan^2 delta, c = V.H and the geometry factor G (001 eq. 10) as arrays."""
+    """The values t = tan^2 delta, c = V.H and the geometry factor G (001 eq. 10) as arrays."""
     s = wi + wo
     lz, vz = wi[..., 2], wo[..., 2]
     qx = s[..., 0] / s[..., 2]  # h_x / h_z
@@ -161,15 +161,21 @@ class CookTorrance(BRDF):
     reference_fn = staticmethod(_ct_reference)
 
     def kernel_args(self):
+        """(m, ior) for the compiled kernel, ior 0 without a Fresnel factor."""
         return (self.p["m"], _ior_arg(self.p["ior"]))
 
     def albedo_breaks(self):
+        """(:data:`RETRO_BREAK`,): the geometry factor G (001 eq. 10) kinks the albedo at mu = 1 / sqrt(2)."""
         return (RETRO_BREAK,)  # G's two terms meet the level N.wo = mu at wo = wi there
 
     def lobe(self, mu):
+        """The Lobe hint: a Beckmann lobe of slope m about the half vector, cut where G switches branch."""
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"], kinks=_g_kinks)
 
     def azimuth_hint(self):
+        """The azimuth hint: the V-cavity lobe under the Beckmann weight, with the Fresnel factor F(wi.h) where ``ior``
+        is given (001 eq. 9).
+        """
         from ..core.hints import AzimuthHint, Fresnel, VCavityLobe
 
         m = self.p["m"]
@@ -314,12 +320,17 @@ class TorranceSparrow(BRDF):
             )
 
     def kernel_args(self):
+        """(D's code 1-4, s, b, ior) for the compiled kernel, ior 0 without a Fresnel factor."""
         return (_D_CODES[self.p["d"]], self.p["s"], self.p["b"], _ior_arg(self.p["ior"]))
 
     def albedo_breaks(self):
+        """(:data:`RETRO_BREAK`,): the geometry factor G kinks the albedo at mu = 1 / sqrt(2)."""
         return (RETRO_BREAK,)  # G's two terms meet the level N.wo = mu at wo = wi there
 
     def lobe(self, mu):
+        """The Lobe hint about the half vector, the radial map of D (D1 power, D2 Gaussian, D3 GGX, D4 Beckmann), cut
+        where G switches branch.
+        """
         d, s = self.p["d"], self.p["s"]
         if d == "D1":
             return Lobe(axis="half", radial="power", sharpness=s, kinks=_g_kinks)
@@ -332,13 +343,16 @@ class TorranceSparrow(BRDF):
         return Lobe(axis="half", radial="beckmann", sharpness=s, kinks=_g_kinks)
 
     def azimuth_hint(self):
+        """The azimuth hint: the V-cavity lobe under D's weight (002 eq. 10), or None for D2, which the nested engine
+        integrates.
+        """
         d, e, b = self.p["d"], self.p["s"], self.p["b"]
         if d == "D2":
             return None  # D2 = b exp(-(c2 alpha)^2) has no weight of the 1-D path: the nested engine
         from ..core.hints import AzimuthHint, Fresnel, VCavityLobe
 
-        # 002 eq. 10: F G D / (pi (N.S)(N.V)); the azimuth of h in closed form for F = 1 (pumpup.engine.polar._k_vcavity),
-        # by a rule on its arc with F(wi.h)
+        # 002 eq. 10: F G D / (pi (N.S)(N.V)); the azimuth of h in closed form for F = 1
+        # (pumpup.engine.polar._k_vcavity), by a rule on its arc with F(wi.h)
         f_at_h = Fresnel(ior=self.p["ior"]) if self.p["ior"] else None
         if d == "D1":  # D = b cos^e(alpha): the power weight u^e
             return AzimuthHint(VCavityLobe(n=e, fresnel=f_at_h), scale=lambda mu: b / (math.pi * np.asarray(mu, float)))

@@ -10,7 +10,7 @@ import math
 import numpy as np
 from numba import vectorize
 
-from ..core import MAX_EXPONENT, BRDF, Lobe, Param, register
+from ..core import BRDF, MAX_EXPONENT, Lobe, Param, register
 
 
 def _up(wi, wo):
@@ -73,13 +73,16 @@ class Minnaert(BRDF):
     reference_fn = staticmethod(_minnaert_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: the cosine map about the normal, even in the azimuth."""
         return Lobe(axis="normal", radial="cosine", symmetric=True)
 
     def azimuth_hint(self):
+        """The azimuth hint: a closed form, a(mu) = 2 pi b mu^(k-1) / (k + 1)."""
         from ..core.hints import AzimuthHint, ClosedForm
 
         k, b = self.p["k"], self.p["b"]
-        return AzimuthHint(ClosedForm(), scale=lambda mu: b * 2.0 * math.pi / (k + 1.0) * np.asarray(mu, float) ** (k - 1.0))
+        return AzimuthHint(ClosedForm(),
+                           scale=lambda mu: b * 2.0 * math.pi / (k + 1.0) * np.asarray(mu, float) ** (k - 1.0))
 
 
 # --- Neumann-Neumann lacquer -----------------------------------------------------------------
@@ -136,9 +139,13 @@ class Lacquer(BRDF):
     reference_fn = staticmethod(_lacquer_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: the cosine map about the normal, even in the azimuth."""
         return Lobe(axis="normal", radial="cosine", symmetric=True)
 
     def azimuth_hint(self):
+        """The azimuth hint: a closed form, a(mu) = 2 pi c e^(-s/mu) E_3(s) (pi c for s = 0), with its rounding error in
+        ulps.
+        """
         from scipy.special import expn
 
         from ..core.hints import AzimuthHint, ClosedForm
@@ -233,10 +240,12 @@ class OrenNayar(BRDF):
     reference_fn = staticmethod(_on_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: the cosine map about the normal, with the kink at N.wo = mu where alpha and beta swap."""
         # alpha and beta swap where N.wo = mu: a kink at wo_z = mu
         return Lobe(axis="normal", radial="cosine", levels=(mu,), symmetric=True)
 
     def azimuth_hint(self):
+        """The azimuth hint: the closed form of :func:`oren_nayar_albedo`."""
         from ..core.hints import AzimuthHint, ClosedForm
 
         rho, sigma = self.p["albedo"], self.p["sigma"]

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import vectorize
 
-from ..core import MAX_INDEX, MIN_INDEX, BRDF, Param, register
+from ..core import BRDF, MAX_INDEX, MIN_INDEX, Param, register
 from .metal import _fresnel_real, fresnel, fresnel_levels
 
 __all__ = ["FresnelWeighted"]
@@ -74,6 +74,7 @@ class FresnelWeighted(BRDF):
 
     @property
     def base(self) -> BRDF:
+        """The BRDF that F(Theta_min) multiplies."""
         return self.p["base"]
 
     def _eval(self, wi, wo):
@@ -82,6 +83,7 @@ class FresnelWeighted(BRDF):
         return np.where(f != 0.0, f * _fresnel_ufunc(mx, self.p["eta"], self.p["k"]), 0.0)  # 000 eq. 28
 
     def reference(self, wi, wo):
+        """The plain numpy f_r: the base's reference times F(max(N.wi, N.wo)) in complex arithmetic (000 eq. 28)."""
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
         f = np.asarray(self.base.reference(wi, wo), dtype=np.float64)
@@ -89,6 +91,7 @@ class FresnelWeighted(BRDF):
         return np.where(f != 0.0, f * fresnel(mx, self.p["eta"], self.p["k"]), 0.0)  # 000 eq. 28, complex form
 
     def lobe(self, mu):
+        """The base's Lobe hint with the levels N.wo = mu and F's own kink added."""
         # F(max(N.wi, N.wo)) adds a kink at N.wo = mu, and one where F has its own
         return self.base.lobe(mu).with_levels((float(mu),), fresnel_levels(self.p["eta"], self.p["k"]))
 
@@ -97,20 +100,24 @@ class FresnelWeighted(BRDF):
         hint (:class:`_FresnelTerm`); itself where the base is one term.  As one term, fresnel over plastic (n 34.4, eta
         1.88, ad 0.33) had the specular lobe's hint (the power map about the mirror, n = 34) for its Lambert part too,
         and the engines lost part of it with estimates of 1e-9 (0.2908 for 0.4060 at mu = 0.306, eta 0.232), and over a
-        2-level pumped plastic half of it (0.468 for 0.959 at mu = 1; scripts/studies/fuzz_engines.py --registry 47 and 48;
-        issue 14's twenty-fourth session)."""
+        2-level pumped plastic half of it (0.468 for 0.959 at mu = 1; scripts/studies/fuzz_engines.py --registry 47 and
+        48; issue 14's twenty-fourth session).
+        """
         terms = self.base.albedo_terms()
         if len(terms) == 1 and terms[0][1] is self.base:
             return [(1.0, self)]
         return [(w, _FresnelTerm(t, self.p["eta"], self.p["k"])) for w, t in terms]
 
     def albedo_breaks(self):
+        """F's kink and the base's breaks, sorted."""
         return tuple(sorted({*fresnel_levels(self.p["eta"], self.p["k"]), *self.base.albedo_breaks()}))
 
     def sampling_lobe(self, mu):
+        """The base's sampling hint (F only rescales the base)."""
         return self.base.sampling_lobe(mu)  # F only rescales the base
 
     def azimuth_range(self):
+        """The base's (F depends on N.wi and N.wo only)."""
         return self.base.azimuth_range()  # F depends on N.wi and N.wo only
 
     def azimuth_hint(self):
@@ -123,7 +130,8 @@ class FresnelWeighted(BRDF):
 
 class _FresnelTerm(FresnelWeighted):
     """One linear term of the ``fresnel`` wrapper over a sum: F(Theta_min) f_k, f_k any term of the base (a model, or a
-    part of a pumped or compensated model, which has no spec of the registry), with f_k's own hint."""
+    part of a pumped or compensated model, which has no spec of the registry), with f_k's own hint.
+    """
 
     type = "fresnel-term"
 

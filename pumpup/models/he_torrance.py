@@ -4,9 +4,9 @@ Checked against an independent source (the paper itself was not available here):
 reference implementation (heBRDF, Cornell; as reproduced in github.com/bsdfbenchmark/bbm,
 ``unittest/he/bin/he_westin.cpp``), whose functions are labelled by the paper's equations
 (24, 70, 73-84): every formula below matches it, and so do the values (30 direction pairs to
-1e-13 with Westin's series summed to a relative 1e-17, the specular weight to 1e-14; ``tests/data/he_torrance_westin.json``).
-Two places where sources differ: the shadowing uses the errata's exp(-c^2) factor in Lambda
-(the printed eq. 25 lacks it; bsdfbenchmark's ``he.h`` says so), and D keeps k^2 = (2 pi /
+1e-13 with Westin's series summed to a relative 1e-17, the specular weight to 1e-14;
+``tests/data/he_torrance_westin.json``).  Two places where sources differ: the shadowing uses the errata's exp(-c^2)
+factor in Lambda (the printed eq. 25 lacks it; bsdfbenchmark's ``he.h`` says so), and D keeps k^2 = (2 pi /
 lambda)^2 in v_xy^2 tau^2 / (4 m) as Westin does (a variant without it is dimensionally
 inconsistent with tau in micrometres).  Westin switches to a Beckmann shortcut for g > 18.5;
 pumpup always sums the series.
@@ -94,7 +94,7 @@ import math
 import numpy as np
 from numba import njit, vectorize
 
-from ..core import MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, SpecError, register
+from ..core import BRDF, MAX_INDEX, MIN_INDEX, Lobe, Param, SpecError, register
 from .metal import _fresnel_real, fresnel
 
 #: relative bound on the truncation remainder of the directional-diffuse series
@@ -387,7 +387,7 @@ class HeTorrance(BRDF):
     def _validate(self):
         p = self.p
         if p["n"] is None and p["k"] != 0.0:
-            raise SpecError("he_torrance: parameter 'k' = %g needs the real index 'n' as well" % p["k"])
+            raise SpecError(f"he_torrance: parameter 'k' = {p['k']:g} needs the real index 'n' as well")
         ratio = p["sigma_0"] / p["wavelength"]  # (compared before squaring: a wavelength of 1e-181 overflowed g)
         lim = math.sqrt(G_MAX) / (4 * math.pi)
         if not ratio <= lim:
@@ -398,6 +398,9 @@ class HeTorrance(BRDF):
             )
 
     def kernel_args(self):
+        """(sigma_0, tau, wavelength, n, k, diffuse, series tolerance) for the compiled kernel, n 0 without a Fresnel
+        factor.
+        """
         p = self.p
         n = 0.0 if p["n"] is None else p["n"]
         return (p["sigma_0"], p["tau"], p["wavelength"], n, p["k"], p["diffuse"], SERIES_RTOL)
@@ -430,6 +433,9 @@ class HeTorrance(BRDF):
 
     # --- hints ---------------------------------------------------------------------------
     def lobe(self, mu):
+        """The Lobe hint: a GGX map about the half vector with the width of the dominant Gaussian, and the kinks of
+        |F|^2 at wi.h.
+        """
         # the Gaussian in v_xy with the dominant m ~ max(1, g) at the mirror direction is
         # exp(-tan^2(theta_h) / m_eff^2), m_eff = sqrt(max(1, g)) / (k tau mu) (module doc)
         p = self.p
@@ -449,9 +455,12 @@ class HeTorrance(BRDF):
         return Lobe(axis="half", radial="ggx", sharpness=m_eff * m_eff, kinks=wih_kinks(self, p["n"], p["k"]))
 
     def albedo_breaks(self):
+        """The kink of the delta lobe's F(mu) where the index is given, else none."""
         from .metal import fresnel_levels
 
-        return () if self.p["n"] is None else fresnel_levels(self.p["n"], self.p["k"])  # (the delta's F(mu) turns there)
+        # (the delta's F(mu) turns there)
+        return () if self.p["n"] is None else fresnel_levels(self.p["n"], self.p["k"])
 
     def sampling_lobe(self, mu):
+        """The sampling hint: the cosine-weighted hemisphere (the delta lobe is not sampled)."""
         return Lobe(axis="normal", radial="cosine")  # cosine fallback (the delta is not sampled)

@@ -17,7 +17,7 @@ import math
 import numpy as np
 from numba import njit, vectorize
 
-from ..core import MAX_EXPONENT, BRDF, Lobe, Param, SpecError, register
+from ..core import BRDF, MAX_EXPONENT, Lobe, Param, SpecError, register
 
 
 def _rv_m(wi, wo, cx, cy, cz):
@@ -90,7 +90,8 @@ _KINKS: dict = {}
 
 def _zero_set_kinks(cx, cz):
     """kinks(mu, s, cos_a, sin_a) -> [(a, b)] of the zero set a + b cos(beta) = 0 of (R.V)_M for wi in the xz-plane
-    (one callable per (cx, cz), so that the hints of all mu group together)."""
+    (one callable per (cx, cz), so that the hints of all mu group together).
+    """
     key = (float(cx), float(cz))
     if key not in _KINKS:
         def kinks(mu, s, ca, sa, cx=key[0], cz=key[1]):
@@ -155,13 +156,17 @@ class Lafortune(BRDF):
         _check_peak(self.type, q["n"], q["cx"], q["cy"], q["cz"], q["c"])
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe about the mirror direction where cx = cy = cz > 0, else the cosine map about the
+        normal.
+        """
         q = self.p
         return _isotropic_lobe(q["n"], q["cx"], q["cy"], q["cz"], q["p"], mu)
 
     def azimuth_hint(self):
         """The closed-form-azimuth hint (pumpup.engine.polar) where the lobe is isotropic:
         cx = cy = cz = C > 0 gives (R.V)_M = C (R.V) (stretched Phong), cx = cy = -cz, cz = C > 0
-        gives C (L.V) (the retro-reflective lobe); the scale is c C^n (000 eq. 14, 15)."""
+        gives C (L.V) (the retro-reflective lobe); the scale is c C^n (000 eq. 14, 15).
+        """
         from ..core.hints import AzimuthHint, PowerLobe
 
         q = self.p
@@ -175,9 +180,11 @@ class Lafortune(BRDF):
     def lobe_axis(self, mu, phi):
         """For p = 0 (000 eq. 14): (R.V)_M = v.wo with v = (-cx Lx, -cy Ly, cz Lz), so f = c |v|^n (v^.wo)_+^n, a
         Phong power lobe about v^ at elevation nu = cz mu / |v|, scaled by c |v|^n (issue 14's fifteenth session: the
-        1-D path about v^ at every azimuth of wi, :func:`pumpup.engine.polar.axis_albedo`).  None for p > 0 (max(N.L, N.V)
-        depends on mu itself), for cz <= 0 (v^ on or below the horizon), where :meth:`polar` applies, and where nu or
-        the scale is not a positive finite number.  With cx = cy, |v| is taken without phi (the albedo is isotropic)."""
+        1-D path about v^ at every azimuth of wi, :func:`pumpup.engine.polar.axis_albedo`).  None for p > 0
+        (max(N.L, N.V) depends on mu itself), for cz <= 0 (v^ on or below the horizon), where :meth:`polar` applies, and
+        where nu or the scale is not a positive finite number.  With cx = cy, |v| is taken without phi
+        (the albedo is isotropic).
+        """
         q = self.p
         if q["p"] != 0.0 or not q["cz"] > 0.0 or self.azimuth_hint() is not None:
             return None
@@ -198,6 +205,7 @@ class Lafortune(BRDF):
         return float(q["n"]), nu, scale
 
     def azimuth_range(self):
+        """None when cx = cy, else pi / 2 (the albedo is even in x and in y)."""
         # (R.V)_M is unchanged by x -> -x and by y -> -y of both L and V: a(phi) = a(-phi) = a(pi - phi)
         return None if self.p["cx"] == self.p["cy"] else np.pi / 2
 
@@ -291,6 +299,7 @@ class LafortuneSum(BRDF):
             _check_peak(self.type, n, cx, cy, cz, c, where=f" of lobe {i}")
 
     def kernel_args(self) -> tuple:
+        """The parameter lists as float64 arrays, one entry per lobe, for the compiled kernel."""
         return tuple(np.asarray(self.p[k], dtype=np.float64) for k in self.params)
 
     def _eval(self, wi: np.ndarray, wo: np.ndarray) -> np.ndarray:
@@ -302,6 +311,7 @@ class LafortuneSum(BRDF):
         return out.reshape(shape)
 
     def reference(self, wi, wo) -> np.ndarray:
+        """The plain numpy f_r: the sum of the lobes."""
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
         return _sum_reference(wi, wo, *(self.p[k] for k in self.params))
@@ -312,12 +322,17 @@ class LafortuneSum(BRDF):
         return [Lafortune(**dict(zip(keys, vals))) for vals in zip(*(self.p[k] for k in keys))]
 
     def albedo_terms(self):
+        """The lobes as terms of weight 1 (:meth:`lobes`)."""
         return [(1.0, lobe) for lobe in self.lobes()]
 
     def azimuth_range(self):
+        """None when every lobe has cx = cy, else pi / 2."""
         return None if all(x == y for x, y in zip(self.p["cx"], self.p["cy"])) else np.pi / 2
 
     def lobe(self, mu):
+        """The single lobe's hint for one lobe, else the cosine map about the normal (with the kink at N.wo = mu where a
+        p > 0).
+        """
         q = self.p
         if len(q["n"]) == 1:
             return _isotropic_lobe(q["n"][0], q["cx"][0], q["cy"][0], q["cz"][0], q["p"][0], mu)

@@ -45,9 +45,11 @@ class Lambert(BRDF):
     reference_fn = staticmethod(_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: the cosine map about the normal, exact for a constant f_r."""
         return Lobe(axis="normal", radial="cosine")
 
     def azimuth_hint(self):
+        """The azimuth hint: a closed form, a(mu) = albedo at every incidence."""
         from ..core.hints import AzimuthHint, ClosedForm
 
         a = self.p["albedo"]

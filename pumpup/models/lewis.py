@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import vectorize
 
-from ..core import MAX_EXPONENT, BRDF, Lobe, Param, load, register
+from ..core import BRDF, MAX_EXPONENT, Lobe, Param, load, register
 
 __all__ = ["LewisPhong", "phong_hs"]
 
@@ -180,6 +180,9 @@ class LewisPhong(BRDF):
                        q["n"], q["k_rho"], q["k_sigma"], hs)
 
     def albedo_terms(self):
+        """The specular term with k_rho = k_sigma = 1, weighted k_rho k_sigma, and a white Lambertian weighted k_rho (1
+        - k_sigma); either alone where the other vanishes.
+        """
         q = self.p
         if q["k_sigma"] == 1:
             return [(1.0, self)]
@@ -191,7 +194,8 @@ class LewisPhong(BRDF):
 
     def azimuth_hint(self):
         """k_rho / H_s(mu) times reciprocal Phong with c = 1 (002 eq. 22), when k_sigma = 1; the
-        H_s is the one :meth:`_eval` divides by (:func:`_hs_at`)."""
+        H_s is the one :meth:`_eval` divides by (:func:`_hs_at`).
+        """
         from ..core.hints import AzimuthHint, PowerLobe
 
         q = self.p
@@ -200,6 +204,9 @@ class LewisPhong(BRDF):
         return AzimuthHint(PowerLobe(n=q["n"], p=0.0), scale=lambda mu: q["k_rho"] / _hs_at(np.asarray(mu), q["n"]))
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the mirror direction for the pure specular term, else no
+        knowledge.
+        """
         if self.p["k_sigma"] == 1:
             return Lobe(axis="mirror", radial="power", sharpness=self.p["n"])
         return super().lobe(mu)

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 from numba import vectorize
 
-from ..core import MAX_EXPONENT, MAX_INDEX, MIN_INDEX, BRDF, Lobe, Param, SpecError, load, register
+from ..core import BRDF, MAX_EXPONENT, MAX_INDEX, MIN_INDEX, Lobe, Param, SpecError, load, register
 from ..physics.fresnel import FRESNEL_LEVEL_Y0, fresnel_levels  # noqa: F401  (re-exported for the models)
 from ..physics.fresnel import conductor_scalar as _fresnel_real
 from ..physics.fresnel import fresnel_conductor as fresnel
@@ -109,22 +109,29 @@ class Metal(BRDF):
     reference_fn = staticmethod(_metal_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the mirror direction, with the levels N.wo = mu
+        and F's kink.
+        """
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"],
                     levels=tuple(sorted({float(mu), *fresnel_levels(self.p["eta"], self.p["k"])})))
 
     def albedo_breaks(self):
+        """F's kink or near-kink, where F(max(mu, N.wo)) turns (:func:`fresnel_levels`)."""
         return fresnel_levels(self.p["eta"], self.p["k"])  # F(max(mu, N.wo)) turns at mu = x0 too
 
     def azimuth_hint(self):
+        """The azimuth hint: a power lobe with p = 1 times the factor F(max(N.wi, N.wo)) (000 eq. 28)."""
         return _fresnel_hint(self.p["n"], self.p["c"], self.p["eta"], self.p["k"])
 
 
 def _fresnel_hint(n, c, eta, k):
     """The azimuth hint of c u^n F(eta + i k, Theta_min) / max(N.L, N.V) (000 eq. 28): a power lobe with p = 1 times
-    the factor F(max(N.wi, N.wo))."""
+    the factor F(max(N.wi, N.wo)).
+    """
     from ..core.hints import AzimuthHint, FresnelAtMax, PowerLobe
 
-    return AzimuthHint(PowerLobe(n=n, p=1.0), scale=lambda mu: np.full(np.shape(mu), c), factors=(FresnelAtMax(eta, k),))
+    return AzimuthHint(PowerLobe(n=n, p=1.0), scale=lambda mu: np.full(np.shape(mu), c),
+                       factors=(FresnelAtMax(eta, k),))
 
 
 # --- plastic --------------------------------------------------------------------------------
@@ -161,8 +168,9 @@ _MAX_S_CACHE: dict = {}
 
 
 def _plastic_max_s(n: float, eta) -> float:
-    """max over mu of the albedo of plastic's specular lobe with a_s = 1 (plus its error estimate):
-    ``metal`` with k = 0 (the same kernel, 000 eq. 28-29) or stretched Phong without Fresnel."""
+    """The max over mu of the albedo of plastic's specular lobe with a_s = 1 (plus its error estimate):
+    ``metal`` with k = 0 (the same kernel, 000 eq. 28-29) or stretched Phong without Fresnel.
+    """
     key = (float(n), eta)
     if key not in _MAX_S_CACHE:
         from ..core import service
@@ -249,28 +257,38 @@ class Plastic(BRDF):
             )
 
     def kernel_args(self) -> tuple:
+        """(n, ad, a_s, eta) for the compiled kernel, eta 0 without a Fresnel factor."""
         q = self.p
         return (q["n"], q["ad"], q["a_s"], 0.0 if q["eta"] is None else q["eta"])
 
     def reference(self, wi, wo) -> np.ndarray:
+        """The plain numpy f_r of 000 eq. 29-30."""
         q = self.p
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
         return _plastic_reference(wi, wo, q["n"], q["ad"], q["a_s"], q["eta"])
 
     def albedo_terms(self):
+        """The specular lobe alone, plus the diffuse base ad times a white Lambertian where ad > 0."""
         if self.p["ad"] == 0:
             return [(1.0, self)]
         return [(1.0, self.with_params(ad=0.0)), (self.p["ad"], load({"type": "lambert", "albedo": 1.0}))]
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the mirror direction, with the levels N.wo = mu
+        and F's kink.
+        """
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"],
                     levels=tuple(sorted({float(mu), *self.albedo_breaks()})))
 
     def albedo_breaks(self):
+        """The dielectric's kink of F where ``eta`` is given, else none."""
         return () if self.p["eta"] is None else fresnel_levels(self.p["eta"], 0.0)
 
     def azimuth_hint(self):
+        """The azimuth hint of the specular lobe (000 eq. 29-30: with F(Theta_min) where ``eta`` is given), or None
+        where ad > 0 (the terms are integrated apart).
+        """
         q = self.p
         if q["ad"] != 0:
             return None  # the diffuse part is split off by albedo_terms

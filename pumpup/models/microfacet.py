@@ -44,10 +44,10 @@ from typing import Any
 import numpy as np
 from numba import vectorize
 
-from ..core import MAX_INDEX, MAX_WIDTH, MIN_ALPHA, MIN_INDEX, BRDF, Lobe, Param, SpecError, register
+from ..core import BRDF, MAX_INDEX, MAX_WIDTH, MIN_ALPHA, MIN_INDEX, Lobe, Param, SpecError, register
+from ..physics.microfacet import projected, projected_reference, walter_level
 from ._half import tan2_half
 from .cook_torrance import _IOR, _fresnel, _fresnel_reference
-from ..physics.microfacet import projected, projected_reference, walter_level
 from .metal import _fresnel_real
 from .metal import fresnel as _fresnel_complex
 
@@ -248,7 +248,8 @@ _K = Param(None, lo=0.0, hi=MAX_INDEX, doc="conductor: extinction coefficient (w
 
 class _WiHKink:
     """The Lobe hint's kink wi.h = x0 of a half-vector lobe (:func:`wih_kinks`), a + b cos(beta) = 0
-    with a = mu cos(alpha) - x0, b = s sin(alpha) (a class, not a closure: a BRDF pickles for dask)."""
+    with a = mu cos(alpha) - x0, b = s sin(alpha) (a class, not a closure: a BRDF pickles for dask).
+    """
 
     def __init__(self, x0: float):
         self.x0 = float(x0)
@@ -260,7 +261,8 @@ class _WiHKink:
 def wih_kinks(brdf, eta, k):
     """The ``kinks`` of ``brdf``'s Lobe hint where a Fresnel factor of eta + i k at wi.h (GGX, Beckmann; He-Torrance's
     bisector angle) has a kink or a near-kink, wi.h = x0 (:func:`pumpup.models.metal.fresnel_levels`), or None; one
-    object per BRDF (the engine groups values of mu by it), kept in its ``__dict__``."""
+    object per BRDF (the engine groups values of mu by it), kept in its ``__dict__``.
+    """
     hit = brdf.__dict__.get("_f_kinks", False)
     if hit is False:
         from .metal import fresnel_levels
@@ -367,6 +369,9 @@ class Beckmann(_Microfacet):
     ]
 
     def lobe(self, mu: float) -> Lobe:
+        """The Lobe hint: a Beckmann lobe of slope alpha about the half vector, with Walter's G1 switch as a level and
+        the kinks of F at wi.h.
+        """
         levels = (walter_level(self.p["alpha"]),) if self.p["g1"] == "walter" else ()
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["alpha"], levels=levels,
                     kinks=wih_kinks(self, self.p["eta"], self.p["k"]))
@@ -423,6 +428,7 @@ class GGX(_Microfacet):
         super().__init__(**kwargs)
 
     def lobe(self, mu: float) -> Lobe:
+        """The Lobe hint: a GGX lobe about the half vector (r = alpha^2, at most 1), with the kinks of F at wi.h."""
         # D = (1 / (pi r)) r^2 / (1 - (1 - r) cos^2)^2 with r = alpha^2: the "ggx" radial map;
         # alpha > 1 peaks at grazing half vectors, where r = 1 (uniform in sin^2) is the neutral map
         return Lobe(axis="half", radial="ggx", sharpness=min(self.p["alpha"] ** 2, 1.0),

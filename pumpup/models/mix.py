@@ -59,13 +59,16 @@ class Mix(BRDF):
         return np.broadcast_to((1.0 - m) * fa + m * fb, shape).copy()
 
     def reference(self, wi, wo):
+        """The plain numpy f_r: (1 - m) a + m b from the two references."""
         m = self.p["m"]
         return (1.0 - m) * np.asarray(self.p["a"].reference(wi, wo)) + m * np.asarray(self.p["b"].reference(wi, wo))
 
     def albedo_breaks(self):
+        """The breaks of both BRDFs, sorted."""
         return tuple(sorted({*self.p["a"].albedo_breaks(), *self.p["b"].albedo_breaks()}))
 
     def albedo_terms(self):
+        """The terms of a weighted 1 - m and those of b weighted m (a term of weight 0 left out)."""
         m = self.p["m"]
         out = []
         if m < 1:

@@ -13,8 +13,8 @@ import math
 import numpy as np
 from numba import njit, vectorize
 
+from ..core import BRDF, MAX_EXPONENT, Lobe, Param, dot, register
 from ..core.checks import off_unit
-from ..core import MAX_EXPONENT, BRDF, Lobe, Param, dot, register
 
 
 def _phong_c(p):
@@ -50,7 +50,8 @@ _BLOCK = 256
 @njit(cache=True, nogil=True, inline="always")
 def _lit_cos(lx, ly, lz, vx, vy, vz):  # pragma: no cover - compiled
     """R.V where the pair is lit (both above the horizon and R.V > 0, the kernel's tests, which a
-    NaN passes), else 0."""
+    NaN passes), else 0.
+    """
     rv = 2.0 * lz * vz - (lx * vx + ly * vy + lz * vz)  # 000 eq. 9
     return 0.0 if (lz <= 0.0) | (vz <= 0.0) | (rv <= 0.0) else rv
 
@@ -66,7 +67,8 @@ def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compi
     without branches (a third of the pairs are dark, at random: an ``if`` mispredicts) and pow runs
     on them only.  The values are those of ``_phong_kernel`` bit for bit (the same operations,
     c * pow(R.V, n); a NaN gives what it gives there).  Loops index block views from 0: an index
-    s + r kept LLVM from vectorizing them."""
+    s + r kept LLVM from vectorizing them.
+    """
     N = out.shape[0]
     x = np.empty(_BLOCK)  # R.V where lit, else 0
     lit = np.empty(_BLOCK, dtype=np.int64)  # the lit rows of the block
@@ -140,16 +142,19 @@ class Phong(BRDF):
     reference_fn = staticmethod(_phong_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the mirror direction."""
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"])
 
     def azimuth_hint(self):
+        """The azimuth hint: the mirror direction's power lobe c (R.V)_+^n, closed-form in the azimuth."""
         return _polar_hint(self.p["n"], 0.0, self.p["c"])
 
 
 def _polar_hint(n, p, c, per_mu=None):
     """The closed-form-azimuth hint (pumpup.engine.polar) of a lobe c u^n / max(N.L, N.V)^p, p in [0, 1]
     (closed form for p in {0, 1}, an inner rule on one arc between them); ``per_mu(mu)`` multiplies
-    c (Phong's shader: 1 / mu)."""
+    c (Phong's shader: 1 / mu).
+    """
     from ..core.hints import AzimuthHint, PowerLobe
 
     if per_mu is None:
@@ -216,10 +221,14 @@ class StretchedPhong(BRDF):
     reference_fn = staticmethod(_stretched_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the mirror direction, with a kink at N.wo = mu
+        where p > 0.
+        """
         levels = (mu,) if self.p["p"] > 0 else ()
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"], levels=levels)
 
     def azimuth_hint(self):
+        """The azimuth hint: the mirror direction's power lobe divided by max(N.L, N.V)^p (000 eq. 7, 12)."""
         return _polar_hint(self.p["n"], self.p["p"], self.p["c"])  # 000 eq. 7, 12
 
 
@@ -268,10 +277,14 @@ class Retro(BRDF):
     reference_fn = staticmethod(_retro_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about wi (the retro direction), with a kink at N.wo = mu where p >
+        0.
+        """
         levels = (mu,) if self.p["p"] > 0 else ()
         return Lobe(axis="retro", radial="power", sharpness=self.p["n"], levels=levels)
 
     def azimuth_hint(self):
+        """The azimuth hint: stretched Phong's, as the lobe about wi integrates as the one about R (000 eq. 13)."""
         # around wi, N.wo = mu u + s sqrt(1 - u^2) cos(beta) as around R: the same 1-D integral
         return _polar_hint(self.p["n"], self.p["p"], self.p["c"])  # 000 eq. 13
 
@@ -323,20 +336,26 @@ class PhongShader(BRDF):
     reference_fn = staticmethod(_shader_reference)
 
     def albedo_terms(self):
+        """The specular lobe alone, plus the diffuse term pi k_d times a white Lambertian where k_d > 0."""
         if self.p["kd"] == 0:
             return [(1.0, self)]
         return [(1.0, self.with_params(kd=0.0)), (math.pi * self.p["kd"], load_lambert())]
 
     def lobe(self, mu):
+        """The Lobe hint: a power lobe of exponent n about the mirror direction."""
         return Lobe(axis="mirror", radial="power", sharpness=self.p["n"])
 
     def azimuth_hint(self):
+        """The azimuth hint of the specular lobe k_s (R.V)_+^n / mu (002 eq. 5, 8), or None where k_d > 0 (the terms are
+        integrated apart).
+        """
         if self.p["kd"] != 0:
             return None  # albedo_terms splits off the diffuse part
         return _polar_hint(self.p["n"], 0.0, self.p["ks"], per_mu=lambda mu: 1.0 / mu)  # 002 eq. 5, 8
 
 
 def load_lambert():
+    """A white Lambertian (albedo 1), the diffuse term of :class:`PhongShader`'s albedo."""
     from ..core import load
 
     return load({"type": "lambert", "albedo": 1.0})

@@ -14,8 +14,8 @@ import math
 import numpy as np
 from numba import vectorize
 
+from ..core import BRDF, MIN_WIDTH, Lobe, Param, register
 from ._half import tan2_half
-from ..core import MIN_WIDTH, BRDF, Lobe, Param, register
 
 
 @vectorize(cache=True)
@@ -79,13 +79,18 @@ class Schlick(BRDF):
     reference_fn = staticmethod(_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a GGX lobe of r about the half vector (000 eq. 36)."""
         return Lobe(axis="half", radial="ggx", sharpness=self.p["r"])
 
     def azimuth_hint(self):
+        """The azimuth hint: the GGX weight with alpha = sqrt(r) and 1 / (r + (1 - r) N.V) about the normal (000 eq.
+        36).
+        """
         from ..core.hints import AzimuthHint, SchlickLobe
 
         r, c = self.p["r"], self.p["c"]
         # 000 eq. 36: r / (1 - (1 - r) cos^2)^2 = 1 / (r cos^4 (1 + tan^2 / r)^2), the GGX weight with alpha = sqrt(r);
-        # 1 / (r + (1 - r) N.V) about N, the weight's azimuth in closed form (pumpup.engine.polar._integrate_n), the rest in the scale
+        # 1 / (r + (1 - r) N.V) about N, the weight's azimuth in closed form (pumpup.engine.polar._integrate_n), the
+        # rest in the scale
         return AzimuthHint(SchlickLobe(r=r),
                            scale=lambda mu: c / (4.0 * math.pi * r * (r + (1.0 - r) * np.asarray(mu, float))))

@@ -14,8 +14,8 @@ import math
 import numpy as np
 from numba import vectorize
 
+from ..core import BRDF, MAX_WIDTH, MIN_WIDTH, Lobe, Param, SpecError, register
 from ._half import tan2_half
-from ..core import MAX_WIDTH, MIN_WIDTH, BRDF, Lobe, Param, SpecError, register
 
 
 def _tan2_delta(wi, wo):
@@ -82,9 +82,11 @@ class Ward(BRDF):
     reference_fn = staticmethod(_ward_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a Beckmann lobe of slope m about the half vector."""
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"])
 
     def azimuth_hint(self):
+        """The azimuth hint: Ward's lobe, the half vector's azimuth by complete elliptic integrals (000 eq. 34)."""
         from ..core.hints import AzimuthHint, WardLobe
 
         m, c = self.p["m"], self.p["c"]
@@ -173,6 +175,9 @@ class WardAniso(BRDF):
             )
 
     def lobe(self, mu):
+        """The Lobe hint: a Beckmann lobe about the half vector with the wider slope max(ax, ay), the y axis cut when
+        anisotropic.
+        """
         # the wider of the two slopes: in x = exp(-tan^2 delta / m^2) the integrand behaves as
         # x^(p - 1), p = m^2 (cos^2 phi_h / ax^2 + sin^2 phi_h / ay^2), times a bounded factor;
         # m = max(ax, ay) makes p >= 1 in every azimuth, so it is bounded.  The narrower slope
@@ -186,6 +191,7 @@ class WardAniso(BRDF):
                     kinks=None if self.p["ax"] == self.p["ay"] else _y_axis)
 
     def azimuth_range(self):
+        """None when isotropic (ax = ay), else pi / 2 (the albedo is even in x and in y)."""
         # f is even in the x and y components of L + V: a(phi) = a(-phi) = a(pi - phi)
         return None if self.p["ax"] == self.p["ay"] else math.pi / 2
 
@@ -194,6 +200,7 @@ class WardAniso(BRDF):
         return self.p["ax"], self.p["ay"], self.p["c"]
 
     def sampling_lobe(self, mu):
+        """The sampling hint: a Beckmann lobe with the wider slope, so that the weights f cos / p stay bounded."""
         # the wider of the two slopes: a Beckmann density with the narrower one falls off faster
         # than f across the wide axis, and the weights f cos / p would be unbounded
         return Lobe(axis="half", radial="beckmann", sharpness=max(self.p["ax"], self.p["ay"]), symmetric=True)
@@ -252,9 +259,13 @@ class ModifiedWard(BRDF):
     reference_fn = staticmethod(_modified_reference)
 
     def lobe(self, mu):
+        """The Lobe hint: a Beckmann lobe of slope m about the half vector, with max(N.L, N.V)'s kink at N.wo = mu."""
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"], levels=(mu,))
 
     def azimuth_hint(self):
+        """The azimuth hint: a Beckmann half-vector lobe divided by max(N.L, N.V), closed-form in the azimuth (000 eq.
+        35).
+        """
         from ..core.hints import AzimuthHint, HalfVectorLobe
 
         m, c = self.p["m"], self.p["c"]

@@ -1,5 +1,6 @@
 """Operators that take a BRDF and return a BRDF: the albedo pumping-up operator (:mod:`.pumping`) and energy
-compensation (:mod:`.compensate`)."""
+compensation (:mod:`.compensate`).
+"""
 
 from .._lazy import submodules
 

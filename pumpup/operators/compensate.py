@@ -54,13 +54,27 @@ import functools
 import json
 import math
 import os
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numba import njit
 
 from ..core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register
 from ..physics.lookups import CELL_SHIFT, float_bits, scale_bound, upper_scalar
-from .pumping import TABLE_DECADES, table_decades, Pumped, _key, _Lookup, _Product, _ProductError, file_tables, from_file
+from .pumping import (
+    TABLE_DECADES,
+    Pumped,
+    _key,
+    _Lookup,
+    _Product,
+    _ProductError,
+    file_tables,
+    from_file,
+    table_decades,
+)
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = ["compensate", "KullaConty", "Scaled", "save_compensated", "load_compensated", "furnace",
            "compensation_table", "METHODS", "fresnel_average"]
@@ -99,8 +113,9 @@ def compensation_table(white: BRDF, progress: bool | None = None):
 @njit(cache=True, nogil=True)
 def _kc_kernel(f, wi, wo, scale, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin,
                cap):  # pragma: no cover - compiled
-    """f += scale D(mu_i) D(mu_o) in place, D = max(0, 1 - U) (KC eq. 1; see the module docstring).
-    The look-up of :func:`scale_bound`, written out.  Tested against :meth:`KullaConty.reference`."""
+    """Compute f += scale D(mu_i) D(mu_o) in place, D = max(0, 1 - U) (KC eq. 1; see the module docstring).
+    The look-up of :func:`scale_bound`, written out.  Tested against :meth:`KullaConty.reference`.
+    """
     last = pcstart.shape[0] - 1
     for k in range(f.shape[0]):
         mi, mo = wi[k, 2], wo[k, 2]
@@ -131,8 +146,9 @@ def _kc_kernel(f, wi, wo, scale, pmlo, pcbase, pcstart, plo, prow, logx, coef, v
 @njit(cache=True, nogil=True)
 def _scale_kernel(f, wi, wo, f0, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin,
                   cap):  # pragma: no cover - compiled
-    """f *= 1 + F0 (1 / U(mu_o) - 1) in place (Turquin eq. 6), the look-up of :func:`scale_bound` written
-    out.  Tested against :meth:`Scaled.reference`."""
+    """Compute f *= 1 + F0 (1 / U(mu_o) - 1) in place (Turquin eq. 6), the look-up of :func:`scale_bound` written
+    out.  Tested against :meth:`Scaled.reference`.
+    """
     last = pcstart.shape[0] - 1
     for k in range(f.shape[0]):
         mi, mo = wi[k, 2], wo[k, 2]
@@ -165,7 +181,8 @@ class _Bound:
         except _ProductError:  # pragma: no cover - no table has needed it
             self.product = None
         if self.product is not None and self.product.rows.shape[1] != 8:  # pragma: no cover
-            raise AssertionError("the kernels are written for a product table of degree 5 (pumpup.physics.lookups.PRODUCT_DEGREE)")
+            raise AssertionError("the kernels are written for a product table of degree 5 "
+                                 "(pumpup.physics.lookups.PRODUCT_DEGREE)")
         if self.product is None:
             pargs = (math.inf, 0, np.zeros(1, np.int32), np.full(2, math.inf), np.zeros((1, 8)))
         else:
@@ -173,9 +190,10 @@ class _Bound:
             pargs = (p.mlo, p.cbase, p.cstart, p.lo, p.rows)
         self.args = pargs + lk.args()
         self.deficit_integral, kinks = self._integral()
-        #: the kinks of D in (0, 1): where U reaches 1, and the table's breaks (:attr:`pumpup.tables.AlbedoTable.breaks`,
-        #: the spline's split points: the albedo's own, Cook-Torrance's pumpup.models.cook_torrance.RETRO_BREAK, a Fresnel
-        #: factor's total reflection), the levels of every lobe that carries U(N.wo)
+        #: the kinks of D in (0, 1): where U reaches 1, and the table's breaks
+        #: (:attr:`pumpup.tables.AlbedoTable.breaks`, the spline's split points: the albedo's own, Cook-Torrance's
+        #: pumpup.models.cook_torrance.RETRO_BREAK, a Fresnel factor's total reflection), the levels of every lobe that
+        #: carries U(N.wo)
         self.kinks = sorted(set(kinks) | {b for b in table.breaks if 0.0 < b < 1.0})
 
     def upper(self, mu) -> np.ndarray:
@@ -197,7 +215,8 @@ class _Bound:
         """(I_hi, kinks): an upper bound of I = 2 integral_0^1 D(mu) mu dmu and the mu in (0, 1) where
         D reaches 0 (kinks of the lobe).  Exact on each polynomial piece of the product table (Gauss-
         Legendre of 8 nodes is exact to degree 15; the pieces are split where U crosses 1); below the
-        first piece D <= 1 adds at most mu_min^2."""
+        first piece D <= 1 adds at most mu_min^2.
+        """
         p = self.product
         if p is None:  # pragma: no cover - adaptive quadrature of the spline look-up instead
             from scipy.integrate import quad
@@ -217,8 +236,9 @@ class _Bound:
 
     def _parts(self) -> tuple:
         """([(piece, t0, t1)], kinks): the smooth parts of the product table's polynomial pieces in t = (m - centre) /
-        half (each piece from t = -1 to its end, the last one to m = 1), cut where U = 1 (D's kinks, also returned in m),
-        for Gauss-Legendre (:meth:`_integral`, :meth:`deficit_moment`)."""
+        half (each piece from t = -1 to its end, the last one to m = 1), cut where U = 1 (D's kinks, also returned in
+        m), for Gauss-Legendre (:meth:`_integral`, :meth:`deficit_moment`).
+        """
         p = self.product
         hi = np.concatenate([p.lo[1:-1], [1.0]])
         parts, kinks = [], []
@@ -233,13 +253,14 @@ class _Bound:
         return parts, kinks
 
     def deficit_moment(self) -> tuple | None:
-        """(I, its error): I = 2 integral_0^1 D(m) m dm of the kernels' own D (:func:`_deficits`), the Kulla-Conty lobe's
-        albedo per unit D(mu_i), over pi (the lobe D(mu_i) D(mu_o) reflects D(mu_i) 2 pi integral D(t) t dt).  Above the
-        product table's mlo D is a polynomial of degree 5 in m on each part (:meth:`_parts`): Gauss-Legendre of 8 nodes is
-        exact there, on D evaluated as the kernels evaluate it, so the error is the rounding of the values (32 eps U per
-        node, summed with the weights); below mlo, 0 <= D <= 1 adds between 0 and mlo^2 (half of it is counted, the other
-        half is error).  (:meth:`_integral`'s I_hi is an upper bound of the same I.)  Cached; None without a product
-        table."""
+        """(I, its error): I = 2 integral_0^1 D(m) m dm of the kernels' own D (:func:`_deficits`), the Kulla-Conty
+        lobe's albedo per unit D(mu_i), over pi (the lobe D(mu_i) D(mu_o) reflects D(mu_i) 2 pi integral D(t) t dt).
+        Above the product table's mlo D is a polynomial of degree 5 in m on each part (:meth:`_parts`): Gauss-Legendre
+        of 8 nodes is exact there, on D evaluated as the kernels evaluate it, so the error is the rounding of the values
+        (32 eps U per node, summed with the weights); below mlo, 0 <= D <= 1 adds between 0 and mlo^2 (half of it is
+        counted, the other half is error).  (:meth:`_integral`'s I_hi is an upper bound of the same I.)  Cached; None
+        without a product table.
+        """
         got = getattr(self, "_moment", None)
         if got is not None or self.product is None:
             return got
@@ -447,9 +468,10 @@ class KullaConty(_Compensated):
         if float(np.max(over)) > 1.0:
             i = int(np.argmax(over))
             raise SpecError(
-                f"kulla_conty: the albedo of the base {self.white.type!r} exceeds 1 (E = {value[i]:.9g} +- {error[i]:.2g} "
-                f"at mu = {mu[i]:.3g}, theta = {math.degrees(math.acos(mu[i])):.4f} deg), so 1 - E < 0 would make "
-                "the lobe f_ms negative; use method 'g1' or 'g2' (pumping), which handles such a base")
+                f"kulla_conty: the albedo of the base {self.white.type!r} exceeds 1 (E = {value[i]:.9g} +- "
+                f"{error[i]:.2g} at mu = {mu[i]:.3g}, theta = {math.degrees(math.acos(mu[i])):.4f} deg), "
+                "so 1 - E < 0 would make the lobe f_ms negative; use method 'g1' or 'g2' (pumping), "
+                "which handles such a base")
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
@@ -465,6 +487,9 @@ class KullaConty(_Compensated):
 
     @property
     def spec(self) -> dict:
+        """The model as a plain-JSON dict: the base, and ``white``, ``f_avg`` and ``force`` where they are not the
+        defaults.
+        """
         out = {"type": "kulla_conty", "base": self.base.spec}
         if self.p["white"] is not None:
             out["white"] = self.p["white"].spec
@@ -478,6 +503,7 @@ class KullaConty(_Compensated):
         return self._run(_kc_kernel, self.scale, wi, wo)
 
     def reference(self, wi, wo):
+        """The plain numpy f_r: the base's reference plus F_ms D(mu_i) D(mu_o) (KC eq. 1), 0 below the horizon."""
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
         f = np.asarray(self.base.reference(wi, wo), dtype=np.float64)
@@ -494,13 +520,15 @@ class KullaConty(_Compensated):
         return self._ms
 
     def albedo_terms(self):
+        """The base's terms, plus the Kulla-Conty lobe D(mu_i) D(mu_o) weighted F_ms where that is positive."""
         terms = list(self.base.albedo_terms())
         ms = self._ms_term()
         return terms + ([(self.scale, ms)] if ms is not None else [])
 
     def sampling_terms(self, mu: float):
         """Terms weighted by their albedo at the conditioning direction: the base's terms share
-        U(mu) >= E(mu), the lobe gets F_ms D(mu) (the deficit), for the sampling mixture."""
+        U(mu) >= E(mu), the lobe gets F_ms D(mu) (the deficit), for the sampling mixture.
+        """
         terms = self.base.albedo_terms()
         w = np.array([abs(x) for x, _ in terms], dtype=float)
         w = w / w.sum() if w.sum() > 0 else np.full(len(terms), 1.0 / len(terms))
@@ -512,9 +540,11 @@ class KullaConty(_Compensated):
         return out
 
     def lobe(self, mu: float) -> Lobe:
+        """The base's Lobe hint with the kinks of D (where U reaches 1, and the table's breaks) as levels."""
         return self.base.lobe(mu).with_levels(self.bound.kinks)
 
     def sampling_lobe(self, mu: float) -> Lobe:
+        """The base's sampling hint."""
         return self.base.sampling_lobe(mu)
 
     def report(self) -> str:
@@ -553,10 +583,11 @@ class _MsLobe(BRDF):
                     symmetric=True)
 
     def azimuth_hint(self):
-        """The lobe's albedo in closed form (:class:`~pumpup.core.hints.ClosedForm`): D(mu) 2 pi integral_0^1 D(t) t dt = D(mu) pi I,
-        D the kernels' own (:func:`_deficits`), I by :meth:`_Bound.deficit_moment` (exact on the product table's
-        polynomial pieces); the relative error I's, plus 8 ulps for D(mu) pi I itself.  Until issue 14's twelfth session the nested
-        engine integrated it (80 ms for 257 mu, GGX alpha = 0.3)."""
+        """The lobe's albedo in closed form (:class:`~pumpup.core.hints.ClosedForm`): D(mu) 2 pi integral_0^1 D(t) t
+        dt = D(mu) pi I, D the kernels' own (:func:`_deficits`), I by :meth:`_Bound.deficit_moment` (exact on the
+        product table's polynomial pieces); the relative error I's, plus 8 ulps for D(mu) pi I itself.  Until issue 14's
+        twelfth session the nested engine integrated it (80 ms for 257 mu, GGX alpha = 0.3).
+        """
         from ..core.hints import AzimuthHint, ClosedForm
 
         got = self.kc.bound.deficit_moment()
@@ -572,7 +603,8 @@ class _MsLobe(BRDF):
 
 def _scaled_lobe(b: Lobe, bound) -> Lobe:
     """The hint of a scaled lobe: the base's (``b``), with U's kinks and, about the normal, the levels of
-    :func:`pumpup.operators.pumping.table_decades`."""
+    :func:`pumpup.operators.pumping.table_decades`.
+    """
     return b.with_levels(bound.kinks, table_decades(b))
 
 
@@ -619,6 +651,9 @@ class Scaled(_Compensated):
 
     @property
     def spec(self) -> dict:
+        """The model as a plain-JSON dict: the base, ``f0``, and ``white`` and ``force`` where they are not the
+        defaults.
+        """
         out = {"type": "scaled", "base": self.base.spec, "f0": self.p["f0"]}
         if self.p["white"] is not None:
             out["white"] = self.p["white"].spec
@@ -631,7 +666,8 @@ class Scaled(_Compensated):
 
     def kernel_factor(self, mu_o) -> np.ndarray:
         """1 + F0 (1 / U(mu_o) - 1) with U from the kernels' own look-up (:func:`_uppers`; ``factor`` is its numpy
-        reference), for the furnace toward the viewer's closed form (:meth:`_Transposed.polar`)."""
+        reference), for the furnace toward the viewer's closed form (:meth:`_Transposed.polar`).
+        """
         m = np.asarray(mu_o, dtype=np.float64)
         u = _uppers(np.clip(m, 1e-300, 1.0).reshape(-1), *self.bound.args).reshape(m.shape)
         f0 = self.p["f0"]
@@ -644,6 +680,9 @@ class Scaled(_Compensated):
         return 1.0 / u if f0 == 1.0 else 1.0 + f0 * (1.0 / u - 1.0)
 
     def reference(self, wi, wo):
+        """The plain numpy f_r: the base's reference times 1 + F0 (1 / U(mu_o) - 1) (Turquin eq. 6), 0 below the
+        horizon.
+        """
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
         f = np.asarray(self.base.reference(wi, wo), dtype=np.float64)
@@ -652,19 +691,22 @@ class Scaled(_Compensated):
         return np.where(up, f * self.factor(np.where(up, mo, 1.0)), 0.0)
 
     def albedo_terms(self):
+        """Itself for a base of one term, else each of the base's terms scaled by the same factor of mu_o."""
         terms = self.base.albedo_terms()
         if len(terms) == 1 and terms[0][1] is self.base:
             return [(1.0, self)]
         return [(w, _ScaledTerm(t, self)) for w, t in terms]
 
     def lobe(self, mu: float) -> Lobe:
+        """The base's Lobe hint with U's kinks and, about the normal, the table's decades as levels."""
         return _scaled_lobe(self.base.lobe(mu), self.bound)
 
     def azimuth_hint(self):
-        """The base's hint times 1 + F0 (1 / U(N.wo) - 1) (Turquin eq. 6; :class:`~pumpup.core.hints.InverseAlbedoFactor`),
-        a function of N.wo alone, with U's kinks as its levels; None where the base has no hint, or where U is not
-        smooth between its kinks: the white model must be a Smith lobe with F = 1, the exact G1 and alpha <= 1, or
-        Schlick's, with no factors of its own."""
+        """The base's hint times 1 + F0 (1 / U(N.wo) - 1) (Turquin eq. 6;
+        :class:`~pumpup.core.hints.InverseAlbedoFactor`), a function of N.wo alone, with U's kinks as its levels; None
+        where the base has no hint, or where U is not smooth between its kinks: the white model must be a Smith lobe
+        with F = 1, the exact G1 and alpha <= 1, or Schlick's, with no factors of its own.
+        """
         from ..core.hints import InverseAlbedoFactor, SchlickLobe, SmithLobe
 
         hint = self.base.azimuth_hint()
@@ -688,9 +730,11 @@ class Scaled(_Compensated):
                                               levels=lambda mu: tuple(sorted({float(mu), *kinks}))))
 
     def sampling_lobe(self, mu: float) -> Lobe:
+        """The base's sampling hint."""
         return self.base.sampling_lobe(mu)
 
     def report(self) -> str:
+        """One paragraph for ``pumpup check``: the formula, F0, the E table's size and margin, and the furnace bound."""
         t = self.table()
         return (f"scaled: f (1 + F0 (1/E(mu_o) - 1)), F0 = {self.p['f0']:.6g}; not reciprocal by construction; "
                 f"E table of {self.white.type!r}: {len(t.mu)} nodes, margin {t.margin:.2g}; the furnace toward wo is "
@@ -729,7 +773,8 @@ class _ScaledTerm(BRDF):
 class _Transposed(BRDF):
     """f(wo, wi): its albedo at mu is the white furnace toward a viewer at cos(theta_o) = mu,
     integral f(wi, wo) cos(theta_i) d omega_i.  The hint is the inner one, which is right when f
-    is a reciprocal BRDF times a function of one direction (the scaled BRDF)."""
+    is a reciprocal BRDF times a function of one direction (the scaled BRDF).
+    """
 
     type = "transposed"
     params = {}
@@ -760,7 +805,8 @@ class _Transposed(BRDF):
         f_r(wi, wo) s(N.wo) with f_r reciprocal, so f(wo, wi) = s(N.wi) f_r(wi, wo) and its albedo at mu is s(mu) times
         f_r's (000 eq. 2; s = 1 + F0 (1 / U - 1), Turquin eq. 6): f_r's own hint with its scale times s (as the kernel
         forms it, :meth:`Scaled.kernel_factor`).  None for anything else (the nested engine), or a base forced in
-        without reciprocity.  Until issue 14's twelfth session the nested engine integrated it."""
+        without reciprocity.  Until issue 14's twelfth session the nested engine integrated it.
+        """
         import dataclasses
 
         if isinstance(self.inner, Scaled):
@@ -777,7 +823,8 @@ class _Transposed(BRDF):
 
 
 @functools.singledispatch
-def furnace(f: BRDF, mu, return_error: bool = False, **kw):
+def furnace(f: BRDF, mu: ArrayLike, return_error: bool = False,
+            **kw: Any) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """The white furnace toward a viewer at cos(theta_o) = mu: integral f(wi, wo) cos(theta_i) d omega_i.
 
     For a reciprocal BRDF this is its albedo a(mu) (000 eq. 2); for ``scaled`` it is the
@@ -844,7 +891,8 @@ def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None 
 @functools.singledispatch
 def compensate_model(base: BRDF, method: str, *, f0, f_avg, white, force) -> BRDF:
     """:func:`compensate` of a loaded model, its arguments checked.  Other kinds of model register their own
-    (:mod:`pumpup.spectral`: every wavelength compensated on its own)."""
+    (:mod:`pumpup.spectral`: every wavelength compensated on its own).
+    """
     if method in ("g1", "g2"):
         if f0 is not None or f_avg is not None or white is not None:
             raise SpecError(f"compensate: method {method!r} (pumping) takes no f0, f_avg or white")
@@ -879,7 +927,7 @@ def _needed_tables(f: BRDF, out: list) -> list:
     return out
 
 
-def save_compensated(f: BRDF, path) -> str:
+def save_compensated(f: BRDF, path: str | os.PathLike[str]) -> str:
     """Write a compensated (or pumped, or any nesting of them) BRDF and all its tables to one netCDF file.
 
     Groups ``table1``, ``table2``, ... hold the tables (attribute ``cache``: "compensate" for
@@ -889,9 +937,9 @@ def save_compensated(f: BRDF, path) -> str:
     import xarray as xr
 
     from .._version import __version__
+    from ..tables import write_groups
     from .pumping import _TABLES as PUMP_TABLES
     from .pumping import base_table
-    from ..tables import write_groups
 
     if not isinstance(f, BRDF):
         raise TypeError(f"save_compensated needs a pumpup BRDF, got {type(f).__name__}")
@@ -916,7 +964,7 @@ def save_compensated(f: BRDF, path) -> str:
     return write_groups(path, root, [(f"table{i}", ds) for i, ds in enumerate(groups, start=1)])
 
 
-def load_compensated(path) -> BRDF:
+def load_compensated(path: str | os.PathLike[str]) -> BRDF:
     """Load a BRDF saved by :func:`save_compensated`, without recomputing its tables."""
     from ..tables import AlbedoTable, open_table
 
@@ -958,7 +1006,7 @@ def load_compensated(path) -> BRDF:
 
 
 def _nodes(f: BRDF):
-    """f and every BRDF nested in its parameters."""
+    """The BRDF f and every BRDF nested in its parameters."""
     yield f
     for v in f.p.values():
         if isinstance(v, BRDF):

@@ -24,7 +24,18 @@ import numpy as np
 from numba import njit
 
 from ..core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register, registry
-from ..physics.lookups import CELL_SHIFT, GChain, float_bits_reference, g_levels, g_product, horner, INDEX_CELLS, kink_roots, PRODUCT_DEGREE, upper_array
+from ..physics.lookups import (
+    CELL_SHIFT,
+    INDEX_CELLS,
+    PRODUCT_DEGREE,
+    GChain,
+    float_bits_reference,
+    g_levels,
+    g_product,
+    horner,
+    kink_roots,
+    upper_array,
+)
 
 __all__ = ["pump", "Pumped", "save_pumped", "load_pumped", "base_table", "pump_model", "FILE_KINDS"]
 
@@ -60,7 +71,8 @@ _FILE = threading.local()
 class file_tables:
     """Within this context (one thread), :func:`base_table` and the compensation tables come from
     ``tables`` ({(kind, key): AlbedoTable}, kind "pump" or "compensate") and never enter the session's
-    shared caches: a file's tables serve only the objects built from that file (issue 13 item 5)."""
+    shared caches: a file's tables serve only the objects built from that file (issue 13 item 5).
+    """
 
     def __init__(self, tables: dict):
         self.tables = tables
@@ -113,7 +125,8 @@ def base_table(base: BRDF, progress: bool | None = None):
 
 def grid_interior() -> tuple[float, float]:
     """The second and the next-to-last node of the grid a table starts from (:func:`pumpup.tables.default_grid`): only
-    kinks between them split a base table (:meth:`Pumped.albedo_kinks`)."""
+    kinks between them split a base table (:meth:`Pumped.albedo_kinks`).
+    """
     from ..tables import default_grid
 
     grid = default_grid()
@@ -122,7 +135,8 @@ def grid_interior() -> tuple[float, float]:
 
 def _sign_roots(grid, vals, fn) -> list:
     """The roots of ``fn`` in every cell of ``grid`` where ``vals`` (fn on the grid) changes sign (scipy's brentq, xtol
-    1e-15)."""
+    1e-15).
+    """
     from scipy.optimize import brentq
 
     idx = np.nonzero(np.sign(vals[:-1]) * np.sign(vals[1:]) < 0)[0]
@@ -140,7 +154,8 @@ def _lock_for(key: str) -> threading.Lock:
 
 def _uses_file_tables(brdf: BRDF) -> bool:
     """True if ``brdf`` is a pumped chain with a level whose table came from a file (load_pumped):
-    what is computed from it must not enter the shared cache."""
+    what is computed from it must not enter the shared cache.
+    """
     cur = brdf
     while isinstance(cur, Pumped):
         if cur._own_table is not None:
@@ -338,12 +353,14 @@ class _Product:
             for fn in fns:
                 v = fn(grid)
                 for i in np.nonzero(np.sign(v[:-1]) * np.sign(v[1:]) < 0)[0]:
-                    out.append(brentq(lambda m: float(fn(np.array([m]))[0]), grid[i], grid[i + 1], xtol=1e-300, rtol=1e-15))
+                    out.append(brentq(lambda m: float(fn(np.array([m]))[0]), grid[i], grid[i + 1], xtol=1e-300,
+                                      rtol=1e-15))
         return np.array(out)
 
     def piece(self, m):
         """The piece that holds m (> mlo), found as the kernel finds it: the cell from the bits of
-        m, then forward."""
+        m, then forward.
+        """
         m = np.asarray(m, dtype=np.float64)
         c = np.minimum((float_bits_reference(m) >> CELL_SHIFT) - self.cbase, len(self.cstart) - 1)
         s = self.cstart[c]
@@ -402,7 +419,8 @@ class _Lookup:
 
     def upper(self, mu, capped: bool = True):
         """Upper bound of the base's albedo at ``mu`` (any shape), as the kernel sees it (without
-        the cap at 1 if not ``capped``)."""
+        the cap at 1 if not ``capped``).
+        """
         mu = np.asarray(mu, dtype=np.float64)
         out = np.empty(mu.size)
         args = self.args() if capped else self.args()[:-1] + (math.inf,)
@@ -410,30 +428,32 @@ class _Lookup:
         return out.reshape(mu.shape)
 
 
-#: levels N.wo = 10^-k that a lobe about the normal adds where it carries a factor tabulated in log(N.wo) (the nested and
-#: 2-D engines): g of a pumped level (the albedo table of the level below), 1 / U(N.wo) of a scaled model and D(N.wo) of
-#: the Kulla-Conty lobe (``pumpup.compensate``).  Such a spline has features on every scale of N.wo down to its table's
-#: smallest node; about the normal a level is one value of the radial variable, and those scales all lie in the first
-#: grid's last interval, [7/8, 1] (N.wo < 0.21), whose 7- and 15-point rules agreed while both missed.  Scaled Lafortune
-#: n = 148 (cx = cy = -1, cz = 1) at rtol 1e-6 was 1.14-1.56 x its estimate at every mu from 0.01 down to 2.6e-6, the
-#: Kulla-Conty lobe of Phong n = 987 (f_avg 0.69) at rtol 1e-12 3.4 x on the 2-D engine, the fuzz's reference
-#: (scripts/studies/fuzz_engines.py --registry 47), and g2 pumped Minnaert k = 0.31 at mu = 0.88 4.1 x at every rtol from 1e-6 to
-#: 1e-12 (issue 14's twenty-fourth session).  A lobe about another axis has N.wo vary along its arcs, where the estimate
-#: held (levels there cut every arc: 1.2-2.5 x the time)
+#: levels N.wo = 10^-k that a lobe about the normal adds where it carries a factor tabulated in log(N.wo) (the nested
+#: and 2-D engines): g of a pumped level (the albedo table of the level below), 1 / U(N.wo) of a scaled model and
+#: D(N.wo) of the Kulla-Conty lobe (``pumpup.compensate``).  Such a spline has features on every scale of N.wo down to
+#: its table's smallest node; about the normal a level is one value of the radial variable, and those scales all lie in
+#: the first grid's last interval, [7/8, 1] (N.wo < 0.21), whose 7- and 15-point rules agreed while both missed.  Scaled
+#: Lafortune n = 148 (cx = cy = -1, cz = 1) at rtol 1e-6 was 1.14-1.56 x its estimate at every mu from 0.01 down to
+#: 2.6e-6, the Kulla-Conty lobe of Phong n = 987 (f_avg 0.69) at rtol 1e-12 3.4 x on the 2-D engine, the fuzz's
+#: reference (scripts/studies/fuzz_engines.py --registry 47), and g2 pumped Minnaert k = 0.31 at mu = 0.88 4.1 x at
+#: every rtol from 1e-6 to 1e-12 (issue 14's twenty-fourth session).  A lobe about another axis has N.wo vary along its
+#: arcs, where the estimate held (levels there cut every arc: 1.2-2.5 x the time)
 TABLE_DECADES = tuple(10.0 ** -k for k in range(1, 9))
 
 
 def table_decades(b: Lobe) -> set:
-    """:data:`TABLE_DECADES` for a hint ``b`` about the normal, or none: not for another axis, and not for the generic hint
-    of a model without one (about the normal, the cosine map, not symmetric: :func:`pumpup.from_function`'s), which the
-    2-D engine's generic path integrates without trusting it (there the levels cost a pumped user function 12 x the
-    time, and its estimate held without them against a ring quadrature)."""
+    """:data:`TABLE_DECADES` for a hint ``b`` about the normal, or none: not for another axis, and not for the generic
+    hint of a model without one (about the normal, the cosine map, not symmetric: :func:`pumpup.from_function`'s), which
+    the 2-D engine's generic path integrates without trusting it (there the levels cost a pumped user function 12 x the
+    time, and its estimate held without them against a ring quadrature).
+    """
     return set(TABLE_DECADES) if b.axis == "normal" and not b.generic else set()
 
 
-def _divided_lobe(b: Lobe, pumped: "Pumped", mu: float) -> Lobe:
+def _divided_lobe(b: Lobe, pumped: Pumped, mu: float) -> Lobe:
     """The hint of f / g for the hint ``b`` of f (a pumped model's base, or one term of its sum): b with g's kink levels
-    at incidence ``mu`` and, about the normal, :func:`table_decades` (g is a table in log(N.wo))."""
+    at incidence ``mu`` and, about the normal, :func:`table_decades` (g is a table in log(N.wo)).
+    """
     return b.with_levels(pumped.kink_levels(mu), table_decades(b))
 
 
@@ -464,8 +484,10 @@ class Pumped(BRDF):
 
     params = {
         "base": Param(kind="spec", doc="the BRDF to pump"),
-        "g": Param("g1", kind="str", choices=("g1", "g2"), doc="g1 = max(a(wi), a(wo)) (001 eq. 20) or g2, also max with N.wi, N.wo (001 eq. 21)"),
-        "levels": Param(1, lo=1, hi=MAX_LEVELS, kind="int", doc="nested pumpings, each dividing by g of the level below"),
+        "g": Param("g1", kind="str", choices=("g1", "g2"),
+                   doc="g1 = max(a(wi), a(wo)) (001 eq. 20) or g2, also max with N.wi, N.wo (001 eq. 21)"),
+        "levels": Param(1, lo=1, hi=MAX_LEVELS, kind="int",
+                        doc="nested pumpings, each dividing by g of the level below"),
         "force": Param(False, kind="bool", doc="pump a base that is not reciprocal"),
     }
     constant = None
@@ -504,14 +526,19 @@ class Pumped(BRDF):
 
     @property
     def base(self) -> BRDF:
+        """The BRDF this level divides by g."""
         return self.p["base"]
 
     @property
     def controlled(self) -> bool:
+        """Whether g is g2 (001 eq. 21: the max also with N.wi and N.wo)."""
         return self.p["g"] == "g2"
 
     @property
     def spec(self) -> dict:
+        """The model as a plain-JSON dict: the base, ``g``, and ``force`` where it is set (several levels are nested
+        pumped specs).
+        """
         out = {"type": "pumped", "base": self.base.spec, "g": self.p["g"]}
         if self.p["force"]:
             out["force"] = True
@@ -524,11 +551,13 @@ class Pumped(BRDF):
 
     def table(self, progress: bool | None = None):
         """The albedo table of the base (the a in g): its own if it was loaded from a file
-        (:func:`load_pumped`), else the session's shared one (:func:`base_table`)."""
+        (:func:`load_pumped`), else the session's shared one (:func:`base_table`).
+        """
         own = getattr(self, "_own_table", None)
         return own if own is not None else base_table(self.base, progress=progress)
 
     def lookup(self) -> _Lookup:
+        """The base table's upper bound in the compiled kernel's form, built once per object (thread-safe)."""
         if self._lookup is None:
             with self._init_lock:  # threads that evaluate a fresh object build it once
                 if self._lookup is None:
@@ -544,7 +573,7 @@ class Pumped(BRDF):
         return g
 
     def divide(self, fbase, wi, wo) -> np.ndarray:
-        """f / g (001 eq. 16) in plain numpy: the readable reference for :func:`_chain_kernel`."""
+        """The quotient f / g (001 eq. 16) in plain numpy: the readable reference for :func:`_chain_kernel`."""
         mi = np.broadcast_to(wi[..., 2], fbase.shape)
         mo = np.broadcast_to(wo[..., 2], fbase.shape)
         up = (fbase > 0) & (mi > 0) & (mo > 0)
@@ -576,7 +605,7 @@ class Pumped(BRDF):
         """The base's relative error of eval (a truncated series), unchanged by the division by g."""
         return self.base.eval_rtol
 
-    def chain(self) -> list["Pumped"]:
+    def chain(self) -> list[Pumped]:
         """The pumped levels from the innermost (level 1) to this one."""
         levels = [self]
         while isinstance(levels[-1].base, Pumped):
@@ -617,9 +646,10 @@ class Pumped(BRDF):
             index, lo, 1.0 / h, *self._product_args(),
         )
 
-    def product(self) -> "_Product | None":
+    def product(self) -> _Product | None:
         """The fast path's table of the product of all levels' g (None unless every level's bound
-        increases and the table reaches its tolerance; the kernel then looks up level by level)."""
+        increases and the table reaches its tolerance; the kernel then looks up level by level).
+        """
         if not hasattr(self, "_product"):
             with self._init_lock:  # another thread must not see a half-decided None (a race once
                 if not hasattr(self, "_product"):  # made threaded values differ by 3e-14)
@@ -681,6 +711,7 @@ class Pumped(BRDF):
         return f
 
     def reference(self, wi, wo):
+        """The plain numpy f_r: the base's reference divided by g (001 eq. 16)."""
         wi = np.asarray(wi, dtype=np.float64)
         wo = np.asarray(wo, dtype=np.float64)
         return self.divide(np.asarray(self.base.reference(wi, wo), dtype=np.float64), wi, wo)
@@ -708,7 +739,8 @@ class Pumped(BRDF):
     def _kink_fixed(self):
         """What :meth:`_kink_levels` needs at every mu, computed once per bound: the grid of the
         root search (the table's nodes and their midpoints), the bound on it, and the kinks that do not
-        depend on mu: v where u(v) = v (g2) and where u(v) reaches its cap."""
+        depend on mu: v where u(v) = v (g2) and where u(v) reaches its cap.
+        """
         lk = self.lookup()
         hit = lk.__dict__.get("kink_fixed")
         if hit is not None:
@@ -735,7 +767,8 @@ class Pumped(BRDF):
         below).  Only a bound that is not monotone has one (rough Ward's albedo falls from mu = 1 and rises again at
         grazing; a metal's has a minimum).  Issue 14's twentieth session: a 2-level g1 pumped Ward m = 0.885 had its
         level-2 table bunch 37 nodes between v = 0.05 and 0.07 (4 with the break) and round the kink at 0.0605 off,
-        and the nested engine was 1.6e-12 off at mu = 1 with an estimate of 8.1e-13."""
+        and the nested engine was 1.6e-12 off at mu = 1 with an estimate of 8.1e-13.
+        """
         lk = self.lookup()
         hit = lk.__dict__.get("kink_normal")
         if hit is None:
@@ -763,7 +796,8 @@ class Pumped(BRDF):
         it starts from (:func:`grid_interior`): Phong's, Beckmann's and stretched Phong's levels cross the diagonal
         within 3e-4 of mu = 1, inside the grid's last interval, where a piece of two or three nodes made a 3-level g2
         pumped Phong's third bound dip; those keep the one spline, and :meth:`table_kinks`' cuts at the knots bunched
-        around them.  :func:`pumpup.mean_albedo`'s first intervals end at every kink in (0, 1)."""
+        around them.  :func:`pumpup.mean_albedo`'s first intervals end at every kink in (0, 1).
+        """
         chain = self.chain()
         out = {v for v in chain[0].base.albedo_breaks() if lo < v < hi}  # the innermost base's
         for lev in chain:
@@ -772,14 +806,16 @@ class Pumped(BRDF):
 
     def _albedo_kinks(self) -> list:
         """The incidences where this level's albedo has a kink that does not depend on wo: its bound crosses the
-        diagonal or reaches its cap (:meth:`_kink_fixed`), or equals its value at the normal (:meth:`_kink_normal`)."""
+        diagonal or reaches its cap (:meth:`_kink_fixed`), or equals its value at the normal (:meth:`_kink_normal`).
+        """
         _, _, diag, caps = self._kink_fixed()
         return [float(v) for v in (*diag, *caps, *self._kink_normal())]
 
     def _kink_turns(self):
         """The root search's grid with the cells next to every turn of the bound on it split into 16 (those of a
         non-monotone base, metal's albedo with a minimum), and the bound there; once per bound (per mu it was 60 % of
-        a 3-level g2 pumped GGX's build, 19,000 ``linspace`` calls)."""
+        a 3-level g2 pumped GGX's build, 19,000 ``linspace`` calls).
+        """
         lk = self.lookup()
         hit = lk.__dict__.get("kink_turns")
         if hit is None:
@@ -806,10 +842,10 @@ class Pumped(BRDF):
                 found = diag  # u(v) = v, found once (with the threshold below at am <= 1)
             else:
                 # two roots in one cell show no sign change there: where u turns (a non-monotone base, metal's albedo
-                # with a minimum), the cells next to the turn are searched on 16 points each (:meth:`_kink_turns`), and for
-                # k = 0 the cell of mu (a root itself) is split at mu -+ 1e-6 of it: a pumped metal (eta 0.9, k 0.3, n 20)
-                # lost the kink at v = 0.9699 next to mu = 0.9659 and the 1-D path was 5.0e-9 off with an estimate of
-                # 1.0e-9.  The search is compiled (:func:`kink_roots`)
+                # with a minimum), the cells next to the turn are searched on 16 points each (:meth:`_kink_turns`), and
+                # for k = 0 the cell of mu (a root itself) is split at mu -+ 1e-6 of it: a pumped metal
+                # (eta 0.9, k 0.3, n 20) lost the kink at v = 0.9699 next to mu = 0.9659 and the 1-D path was 5.0e-9 off
+                # with an estimate of 1.0e-9.  The search is compiled (:func:`kink_roots`)
                 g, ug = (grid, au) if k == 1 else self._kink_turns()
                 found = [float(v) for v in kink_roots(g, ug, k, am if k == 0 else mu, mu, max(1.0, am), *lk.args())]
             for v in found:
@@ -834,8 +870,8 @@ class Pumped(BRDF):
             if p <= mu <= q and value < lk.cap:
                 out.append(q)
         # the table's breaks (its spline's split points: the base's albedo_breaks, Cook-Torrance's
-        # pumpup.models.cook_torrance.RETRO_BREAK, and a lower level's kinks) are kinks of u(v), so of g where u(v) is its
-        # largest term (issue 14's twenty-fifth session)
+        # pumpup.models.cook_torrance.RETRO_BREAK, and a lower level's kinks) are kinks of u(v), so of g where u(v) is
+        # its largest term (issue 14's twenty-fifth session)
         for v in lk.table.breaks:
             uv = float(up(v))
             if uv >= am * (1 - 1e-12) and (not self.controlled or uv >= max(mu, v) * (1 - 1e-12)):
@@ -847,18 +883,20 @@ class Pumped(BRDF):
         return tuple(levels)
 
     def table_kinks(self) -> tuple:
-        """Values v of N.wo where a level's bound u(v) has a near-kink: a level's table is the albedo of the level below,
-        whose g changes form at incidences that do not depend on wo (where a lower level's bound crosses the diagonal,
-        u(v) = v for g2, or reaches its cap: :meth:`_kink_fixed`), so every higher level's table inherits those kinks.
-        Its spline follows each with knots bunched towards it (the table's refinement), and rounds the kink off between
-        the nearest ones (1e-6 wide at level 1's u(v) = v, v = 0.98814, of a 2-level g2 pumped GGX, alpha 0.1,
-        height-correlated): a feature that no rule on a piece across those knots sees (at mu = 0.993068 6.4e-8 off on
-        one piece of the elevation, 9.6 x its |K - G|; with a cut at the kink but not at the knots, Beckmann alpha 0.3
-        at mu = 0.99888 was 2.1e-12 off on the piece beside it, 4.8 x the estimate).  So these are the kinks and, in
-        every table above them, a graded mesh of the knots of the bunch around each (those closer than a quarter of
-        the table's median spacing in log(v)): on each side the nearest knot, then every knot at least twice as far
-        from the kink as the last one kept, and the bunch's last (the pieces between grow geometrically away from the
-        feature, as for a singularity; every knot of the bunch cost 2 x 50 cuts and 3000 evaluations per mu)."""
+        """Values v of N.wo where a level's bound u(v) has a near-kink: a level's table is the albedo of the level
+        below, whose g changes form at incidences that do not depend on wo (where a lower level's bound crosses the
+        diagonal, u(v) = v for g2, or reaches its cap: :meth:`_kink_fixed`), so every higher level's table inherits
+        those kinks.  Its spline follows each with knots bunched towards it (the table's refinement), and rounds the
+        kink off between the nearest ones (1e-6 wide at level 1's u(v) = v, v = 0.98814, of a 2-level g2 pumped GGX,
+        alpha 0.1, height-correlated): a feature that no rule on a piece across those knots sees (at mu = 0.993068
+        6.4e-8 off on one piece of the elevation, 9.6 x its |K - G|; with a cut at the kink but not at the knots,
+        Beckmann alpha 0.3 at mu = 0.99888 was 2.1e-12 off on the piece beside it, 4.8 x the estimate).  So these are
+        the kinks and, in every table above them, a graded mesh of the knots of the bunch around each (those closer than
+        a quarter of the table's median spacing in log(v)): on each side the nearest knot, then every knot at least
+        twice as far from the kink as the last one kept, and the bunch's last (the pieces between grow geometrically
+        away from the feature, as for a singularity; every knot of the bunch cost 2 x 50 cuts and 3000 evaluations per
+        mu).
+        """
         lk = self.lookup()  # (tied to the bounds they come from, as kink_cache)
         hit = lk.__dict__.get("table_kinks")
         if hit is None:
@@ -889,9 +927,10 @@ class Pumped(BRDF):
 
     def _polar_levels(self, mu: float) -> tuple:
         """The 1-D path's levels of g at incidence mu: the lobe's (:meth:`lobe`) and :meth:`table_kinks` (the nested
-        engine, whose estimate was calibrated without them, keeps the lobe's alone).  The lobe's levels are every level's
-        :meth:`kink_levels` and the innermost base's lobe levels, gathered here without the Lobe of every level (this
-        runs for every mu of a table, in Python: the Lobes and their sorts took ~15 % of a cached 2-level table)."""
+        engine, whose estimate was calibrated without them, keeps the lobe's alone).  The lobe's levels are every
+        level's :meth:`kink_levels` and the innermost base's lobe levels, gathered here without the Lobe of every level
+        (this runs for every mu of a table, in Python: the Lobes and their sorts took ~15 % of a cached 2-level table).
+        """
         out = set(self.table_kinks())
         cur = self
         while isinstance(cur, Pumped):
@@ -901,23 +940,28 @@ class Pumped(BRDF):
         return tuple(sorted(out))
 
     def lobe(self, mu: float) -> Lobe:
+        """The base's Lobe hint with g's kink levels at ``mu`` and, about the normal, the table's decades."""
         return _divided_lobe(self.base.lobe(mu), self, mu)
 
     def sampling_lobe(self, mu: float) -> Lobe:
+        """The base's sampling hint (f / g has the lobe of f; g only rescales it)."""
         return self.base.sampling_lobe(mu)  # f / g has the lobe of f; g only rescales it
 
     def azimuth_hint(self):
         """The innermost base's hint divided by g_1 ... g_k (mu, N.wo) (001 eq. 16), a function of N.wo for a fixed wi,
-        with g's kinks (:class:`~pumpup.core.hints.DivideByG`); None where the base has no hint."""
+        with g's kinks (:class:`~pumpup.core.hints.DivideByG`); None where the base has no hint.
+        """
         from ..core.hints import DivideByG
 
         hint = self.chain()[0].base.azimuth_hint()
         return None if hint is None else hint.times(DivideByG(self._chain_args(), self._polar_levels))
 
     def azimuth_range(self):
+        """The base's (g depends on N.wi and N.wo only)."""
         return self.base.azimuth_range()  # g depends on N.wi and N.wo only
 
     def albedo_terms(self):
+        """Itself for a base of one term, else each of the base's terms divided by the same g."""
         terms = self.base.albedo_terms()
         if len(terms) == 1 and terms[0][1] is self.base:
             return [(1.0, self)]
@@ -993,7 +1037,8 @@ def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False)
 @functools.singledispatch
 def pump_model(base, g: str, levels: int, force) -> Pumped:
     """:func:`pump` of a loaded model, its arguments checked: a :class:`Pumped`.  Other kinds of model register their
-    own (:mod:`pumpup.spectral`: each wavelength divided by its own g)."""
+    own (:mod:`pumpup.spectral`: each wavelength divided by its own g).
+    """
     return Pumped(base=base, g=g, levels=levels, force=force)
 
 
@@ -1001,7 +1046,7 @@ def pump_model(base, g: str, levels: int, force) -> Pumped:
 
 
 @functools.singledispatch
-def save_pumped(f: Pumped, path) -> str:
+def save_pumped(f: Pumped, path: str | os.PathLike[str]) -> str:
     """Write a pumped BRDF and the albedo tables of all its levels to one netCDF file.
 
     Group ``level1`` holds the table of the innermost base, ``level2`` that of the first
@@ -1026,7 +1071,7 @@ def save_pumped(f: Pumped, path) -> str:
     return write_groups(path, root, [(f"level{i}", level.table().dataset) for i, level in enumerate(chain, start=1)])
 
 
-def load_pumped(path) -> Pumped:
+def load_pumped(path: str | os.PathLike[str]) -> Pumped:
     """Load a pumped BRDF saved by :func:`save_pumped`, without recomputing its tables.
 
     The file is validated (:func:`pumpup.open_table` for the root and every level's group; the
@@ -1066,10 +1111,11 @@ def load_pumped(path) -> Pumped:
     return f
 
 
-def attach_level_table(path, where: str, group: str, level: "Pumped", what: str) -> None:
+def attach_level_table(path, where: str, group: str, level: Pumped, what: str) -> None:
     """Read the albedo table in ``group`` of a saved pumped file, check that it is the table of
     ``level``'s base (``what`` names the level in the message) and make it that object's own table;
-    every problem is one :class:`TableError` naming the file and the group."""
+    every problem is one :class:`TableError` naming the file and the group.
+    """
     from ..tables import AlbedoTable, open_table
     from ..tables.validate import TableError
 

@@ -1,5 +1,6 @@
 """What the models, the engine and the renderer plugins share: quadrature rules and their error calibration
-(:mod:`.quadrature`)."""
+(:mod:`.quadrature`).
+"""
 
 from .._lazy import submodules
 

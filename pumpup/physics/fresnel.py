@@ -90,13 +90,14 @@ def fresnel_conductor(cos_i, eta, k=0.0):
     # cancellation of e^2 - sin^2 near e = 1 at grazing incidence (eta 1, c = 1e-8 gave F = 0.039 for 0)
     e21 = (e - 1.0) * (e + 1.0)  # e^2 - 1
     cos_t = np.sqrt((e21 + c * c) / (e * e))
-    # the Fresnel equations (pbrt-v4 FrComplex) r_par = (e c - cos_t) / (e c + cos_t), r_perp = (c - e cos_t) / (c + e cos_t);
-    # near e = 1, where both are small, over their denominators squared: (e^2 c)^2 - (e cos_t)^2 = (e^2 - 1)((e^2 + 1) c^2 - 1),
-    # c^2 - (e cos_t)^2 = 1 - e^2 (no cancellation; r_par's form loses digits near a dielectric's total reflection, so
-    # only where |e^2 - 1| < 1/2)
+    # the Fresnel equations (pbrt-v4 FrComplex) r_par = (e c - cos_t) / (e c + cos_t), r_perp = (c - e cos_t) /
+    # (c + e cos_t); near e = 1, where both are small, over their denominators squared: (e^2 c)^2 - (e cos_t)^2 =
+    # (e^2 - 1)((e^2 + 1) c^2 - 1), c^2 - (e cos_t)^2 = 1 - e^2 (no cancellation; r_par's form loses digits near a
+    # dielectric's total reflection, so only where |e^2 - 1| < 1/2)
     near = np.abs(e21) < 0.5
     with np.errstate(divide="ignore", invalid="ignore"):
-        r_par = np.where(e21 == 0.0, 0.0, np.where(near, e21 * ((e21 + 2.0) * c * c - 1.0) / (e * e * c + e * cos_t) ** 2,
+        r_par = np.where(e21 == 0.0, 0.0, np.where(near,
+                                                   e21 * ((e21 + 2.0) * c * c - 1.0) / (e * e * c + e * cos_t) ** 2,
                                                    (e * c - cos_t) / (e * c + cos_t)))
         r_perp = np.where(e21 == 0.0, 0.0, -e21 / (c + e * cos_t) ** 2)  # (e = 1: no reflection, c = 0 its limit)
     return 0.5 * (np.abs(r_par) ** 2 + np.abs(r_perp) ** 2)
@@ -124,21 +125,25 @@ FRESNEL_LEVEL_Y0 = 0.05
 
 
 def fresnel_levels(eta: float, k: float, y0_max: float | None = None) -> tuple:
-    """The level N.wo = x0 where F(eta + i k, max(N.wi, N.wo)) has a kink or a near-kink, for a model's ``Lobe`` hint: ()
-    or (x0,): the branch point's real part inside (0, 1), its imaginary part below ``y0_max`` (default
+    """The level N.wo = x0 where F(eta + i k, max(N.wi, N.wo)) has a kink or a near-kink, for a model's ``Lobe`` hint:
+    () or (x0,): the branch point's real part inside (0, 1), its imaginary part below ``y0_max`` (default
     :data:`FRESNEL_LEVEL_Y0`; ``pumpup.models.microfacet`` asks with its own threshold whether frame 4 declines).  Below
-    eta = 1 with k = 0 (a dielectric seen from the denser side) F = 1 up to cos = x0 = sqrt(1 - eta^2), total reflection,
-    with a square-root kink there; a small k makes it a near-kink, the branch point sqrt(1 - (eta + i k)^2) = x0 - i y0
-    (:func:`fresnel_branch`) y0 off the axis.  The 1-D path declines such a factor
-    (``pumpup.engine.polar.lobe_fresnel_ok``) and the nested engine, blind to the kink, bisected towards it: fresnel over Blinn
-    n = 5, eta = 0.551, k = 0 took 0.25-0.41 s per value at rtol 1e-10 (issue 14's twenty-first session,
-    ``scripts/studies/fuzz_engines.py --registry``)."""
+    eta = 1 with k = 0 (a dielectric seen from the denser side) F = 1 up to cos = x0 = sqrt(1 - eta^2), total
+    reflection, with a square-root kink there; a small k makes it a near-kink, the branch point sqrt(1 -
+    (eta + i k)^2) = x0 - i y0 (:func:`fresnel_branch`) y0 off the axis.  The 1-D path declines such a factor
+    (``pumpup.engine.polar.lobe_fresnel_ok``) and the nested engine, blind to the kink, bisected towards it: fresnel
+    over Blinn n = 5, eta = 0.551, k = 0 took 0.25-0.41 s per value at rtol 1e-10 (issue 14's twenty-first session,
+    ``scripts/studies/fuzz_engines.py --registry``).
+    """
     x0, y0 = fresnel_branch(float(eta), float(k))
     return (x0,) if 0.0 < x0 < 1.0 and y0 < (FRESNEL_LEVEL_Y0 if y0_max is None else y0_max) else ()
 
 
 @njit(cache=True)
 def dielectric_scalar(c, n):  # pragma: no cover - compiled
+    """Compiled unpolarised Fresnel reflectance of a dielectric of relative index ``n`` at the cosine ``c`` (002 sec.
+    3.2), without cancellation for an index near 1; 1 where no index is given (n <= 0).
+    """
     if n <= 0.0:
         return 1.0  # no index of refraction given: F = 1
     n21 = (n - 1.0) * (n + 1.0)
@@ -187,26 +192,30 @@ def fresnel_branch(eta: float, k: float) -> tuple:
     """(x0, y0): the branch point w = sqrt(1 - (eta + i k)^2) = x0 - i y0 of the conductor Fresnel factor F(c)
     (:func:`pumpup.models.metal._fresnel_real`, where the refracted cosine sqrt((eta + i k)^2 - 1 + c^2) vanishes; F is
     analytic in c elsewhere near [0, 1], its other singularities -w and the conjugates as far), x0 = |Re w|,
-    y0 = |Im w|."""
+    y0 = |Im w|.
+    """
     w = complex(1.0 - (eta * eta - k * k), -2.0 * eta * k) ** 0.5
     return abs(w.real), abs(w.imag)
 
 
 def fresnel_pole(eta: float, k: float) -> float:
-    """rho = 1 / |sqrt((eta + i k)^2 + 1)|: F(c)'s parallel reflectance has poles where A c + sin^2 = 0 (A the refracted
-    cosine times the index), c^2 = 1 / ((eta + i k)^2 + 1), in the left half-plane on the physical sheet; for a
-    strong absorber (|eta + i k| >> 1) near c = 0, at distance ~rho from the arc's small end (eta = 1.1, k = 30:
+    """The scale rho = 1 / |sqrt((eta + i k)^2 + 1)|: F(c)'s parallel reflectance has poles where A c + sin^2 = 0 (A the
+    refracted cosine times the index), c^2 = 1 / ((eta + i k)^2 + 1), in the left half-plane on the physical sheet; for
+    a strong absorber (|eta + i k| >> 1) near c = 0, at distance ~rho from the arc's small end (eta = 1.1, k = 30:
     -0.0012 + 0.033 i; a rule blind to it was 1.9e-11 off with an estimate of 4.1e-12 at mu = 1e-3, rtol 1e-10, measured
-    against the nested and 2-D engines): frame 5 grades its arcs towards c = 0 on this scale."""
+    against the nested and 2-D engines): frame 5 grades its arcs towards c = 0 on this scale.
+    """
     return 1.0 / abs(complex(eta * eta - k * k + 1.0, 2.0 * eta * k) ** 0.5)
 
 
 def fresnel_brewster(eta: float, k: float) -> tuple:
-    """(c_b, ok): Brewster's zero c_b of the parallel reflectance's numerator N = A c - (1 - c^2), A = sqrt((eta + i k)^2 - 1
+    """(c_b, ok): Brewster's zero c_b of the parallel reflectance's numerator N = A c - (1 - c^2), A =
+    sqrt((eta + i k)^2 - 1
     + c^2) continued from the real axis, c_b^2 = 1 / ((eta + i k)^2 + 1) (:func:`_lobe_f_bound`), and whether it was
     found.  On the real axis A is the principal root (Im A^2 = 2 eta k >= 0); from c = Re c_b up to c_b it is the
     principal root, negated where c^2 - w^2 (w^2 = 1 - (eta + i k)^2) crosses the negative real axis on the way
-    (Im (c^2 - w^2) = 2 Re(c) Im(c) - Im w^2 = 0)."""
+    (Im (c^2 - w^2) = 2 Re(c) Im(c) - Im w^2 = 0).
+    """
     e2 = complex(eta * eta - k * k, 2.0 * eta * k)
     cp = 1.0 / cmath.sqrt(e2 + 1.0)
     w2 = 1.0 - e2

@@ -20,7 +20,8 @@ from numba.extending import intrinsic
 @njit(cache=True, nogil=True)
 def upper_scalar(mu, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
     """Upper bound of a(mu): the table's spline piece in log(mu) (power law below the first node) + margin,
-    at most ``cap``."""
+    at most ``cap``.
+    """
     return upper_log(math.log(mu), logx, coef, v0, slope0, margin_lo, margin, cap)
 
 
@@ -50,17 +51,19 @@ def upper_log(lm, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no
 
 @njit(cache=True, nogil=True)
 def upper_array(mu, logx, coef, v0, slope0, margin_lo, margin, cap, out):  # pragma: no cover - compiled
+    """Compiled :func:`upper_scalar` at every value of ``mu``, written into ``out``."""
     for k in range(mu.shape[0]):
         out[k] = upper_scalar(mu[k], logx, coef, v0, slope0, margin_lo, margin, cap)
 
 
 @njit(cache=True, nogil=True)
 def upper_root(lo, hi, kind, target, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
-    """u in [lo, hi] where the bound U(u) (:func:`upper_scalar`) meets ``target`` (``kind`` 0 or 2) or u itself (1), given
-    a change of sign of the difference at the ends: bisection until the bracket is at most 1e-15 + 4 eps u wide (where
-    scipy's brentq at xtol 1e-15, which :meth:`Pumped._kink_levels` called from Python, stops too); its midpoint.
-    Compiled (issue 14's eighteenth session): the brentq calls took ~60 us each in cProfile, and the per-mu kink search two
-    thirds of a first 2-level pumped GGX table."""
+    """The u in [lo, hi] where the bound U(u) (:func:`upper_scalar`) meets ``target`` (``kind`` 0 or 2) or u itself (1),
+    given a change of sign of the difference at the ends: bisection until the bracket is at most 1e-15 + 4 eps u wide
+    (where scipy's brentq at xtol 1e-15, which :meth:`Pumped._kink_levels` called from Python, stops too); its midpoint.
+    Compiled (issue 14's eighteenth session): the brentq calls took ~60 us each in cProfile, and the per-mu kink search
+    two thirds of a first 2-level pumped GGX table.
+    """
     flo = upper_scalar(lo, logx, coef, v0, slope0, margin_lo, margin, cap) - (lo if kind == 1 else target)
     while hi - lo > 1e-15 + 8.9e-16 * hi:
         mid = 0.5 * (lo + hi)
@@ -75,12 +78,14 @@ def upper_root(lo, hi, kind, target, logx, coef, v0, slope0, margin_lo, margin, 
 
 
 @njit(cache=True, nogil=True)
-def kink_roots(g, ug, kind, target, mu, scale, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
-    """The roots v of U(v) = ``target`` (``kind`` 0 or 2) or U(v) = v (1) that the grid ``g`` (U's values ``ug``) brackets
-    (:meth:`Pumped._kink_levels`, its search for one k in one compiled pass): differences below 1e-13 ``scale`` count as
-    0 (the rounding of a flat spline: no root), every cell where they change sign gives its root (:func:`upper_root`);
-    for kind 0 the points mu (1 -+ 1e-6) join the grid and the cell between them, which holds the root v = mu itself, is
-    skipped."""
+def kink_roots(g, ug, kind, target, mu, scale, logx, coef, v0, slope0, margin_lo, margin,  # pragma: no cover - compiled
+               cap):
+    """The roots v of U(v) = ``target`` (``kind`` 0 or 2) or U(v) = v (1) that the grid ``g`` (U's values ``ug``)
+    brackets (:meth:`Pumped._kink_levels`, its search for one k in one compiled pass): differences below 1e-13 ``scale``
+    count as 0 (the rounding of a flat spline: no root), every cell where they change sign gives its root
+    (:func:`upper_root`); for kind 0 the points mu (1 -+ 1e-6) join the grid and the cell between them, which holds the
+    root v = mu itself, is skipped.
+    """
     n = g.shape[0]
     extra = np.empty(2)
     ne = 0
@@ -136,7 +141,8 @@ PRODUCT_DEGREE = 5
 @intrinsic
 def float_bits(typingctx, x):  # pragma: no cover - compiled
     """The IEEE-754 bits of a float64 as an int64 (a free bit cast; for x > 0 the bits increase
-    with x, and ``bits >> CELL_SHIFT`` numbers the cells of :class:`_Product`)."""
+    with x, and ``bits >> CELL_SHIFT`` numbers the cells of :class:`_Product`).
+    """
     if not isinstance(x, types.Float):
         return None
 
@@ -147,7 +153,7 @@ def float_bits(typingctx, x):  # pragma: no cover - compiled
 
 
 def float_bits_reference(x) -> np.ndarray:
-    """numpy reference of :func:`float_bits`."""
+    """The numpy reference of :func:`float_bits`."""
     return np.asarray(x, dtype=np.float64).view(np.int64)
 
 
@@ -156,7 +162,8 @@ def g_product(mmax, pcbase, pcstart, plo, prow):  # pragma: no cover - compiled
     """The chain kernel's fast path: g_1 g_2 ... g_k as one function of mmax = max(N.wi, N.wo)
     (:class:`_Product`; mmax above its ``mlo``): the piece found from the bits of mmax (no logarithm),
     evaluated by Horner's rule; ``prow[s]`` holds the piece's coefficients, centre and inverse
-    half-width (one cache line).  Inlined where it is called."""
+    half-width (one cache line).  Inlined where it is called.
+    """
     last_cell = pcstart.shape[0] - 1
     deg = prow.shape[1] - 3
     s = pcstart[min((float_bits(mmax) >> CELL_SHIFT) - pcbase, last_cell)]
@@ -179,7 +186,8 @@ def g_levels(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, contro
     """The product of all levels' g (001 eq. 20, 21) at N.wi, N.wo with max ``mmax`` and min ``mmin``
     (both > 0), level by level: each level's upper bound looked up (spline piece in log(mu), power
     law below its first node, at most its cap).  Inlined where it is called (a call per look-up
-    cost 20 x the look-up, measured)."""
+    cost 20 x the look-up, measured).
+    """
     ncell = index.shape[1]
     lmax = math.log(mmax)
     lmin = 1.0  # log(mmin), taken only when needed (it is <= 0)
@@ -226,12 +234,14 @@ def horner(coef, t):
 
 
 @njit(cache=True, nogil=True)
-def scale_bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover
+def scale_bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin,  # pragma: no cover
+                cap):
     """U(m) >= E(m): above ``pmlo`` the polynomial piece of the product table found from the bits
     of m (pump._Product, scaled up by its 1 + epsilon); below it the table's spline look-up.  The
     kernels below write it out (a call per look-up cost 20 x the look-up; with numba's
     ``inline="always"`` Kulla-Conty evaluated at 3.5 x its base against 1.35 x written out, measured
-    with scripts/bench/bench_compensate.py in one sitting)."""
+    with scripts/bench/bench_compensate.py in one sitting).
+    """
     if m > pmlo:
         s = pcstart[min((float_bits(m) >> CELL_SHIFT) - pcbase, pcstart.shape[0] - 1)]
         while m >= plo[s + 1]:
@@ -245,7 +255,7 @@ def scale_bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, mar
 #: every level's upper bound (:func:`g_levels`' arguments) and the product table of all levels (:func:`g_product`'s,
 #: with the N.wo above which it applies, ``product_mlo``; inf when there is none)
 GChain = namedtuple("GChain", [
-    "offsets", "logx", "coef", "v0", "slope0", "margin_lo", "cap", "controlled", "increasing", "mu0", "index", "index_lo",
-    "index_h_inv", "product_mlo", "product_cbase", "product_cstart", "product_lo", "product_rows",
+    "offsets", "logx", "coef", "v0", "slope0", "margin_lo", "cap", "controlled", "increasing", "mu0", "index",
+    "index_lo", "index_h_inv", "product_mlo", "product_cbase", "product_cstart", "product_lo", "product_rows",
 ])
 

@@ -1,7 +1,7 @@
 """Smith's shadowing for the Beckmann and GGX microfacet distributions (Walter et al. 2007; Heitz 2014), shared by the
-microfacet models and the albedo engine: the projected area P = z (1 + Lambda) = z / G1 of a direction (x, y, z), compiled
-(:func:`projected`) and in plain numpy (:func:`projected_reference`), and where Walter's rational G1 switches to 1
-(:func:`walter_level`).
+microfacet models and the albedo engine: the projected area P = z (1 + Lambda) = z / G1 of a direction (x, y, z),
+compiled (:func:`projected`) and in plain numpy (:func:`projected_reference`), and where Walter's rational G1 switches
+to 1 (:func:`walter_level`).
 """
 
 from __future__ import annotations
@@ -23,8 +23,10 @@ def projected(x, y, z, dist, g1, alpha):  # pragma: no cover - compiled
     """P = z (1 + Lambda) = z / G1 for a direction (x, y, z) with z > 0 (see the module docstring)."""
     s = math.sqrt(x * x + y * y)  # sin theta (times |w|)
     if dist == 1:  # z / G1, G1 = 2 / (1 + sqrt(1 + alpha^2 tan^2)), Walter eq. 34
-        w = alpha * s  # (a unit vector, MIN_ALPHA <= alpha <= MAX_WIDTH: z^2 + w^2 neither overflows nor underflows, so a
-        return 0.5 * (z + math.sqrt(z * z + w * w))  # plain root instead of math.hypot, which took ~20 ns a call)
+        # (a unit vector, MIN_ALPHA <= alpha <= MAX_WIDTH: z^2 + w^2 neither overflows nor underflows, so a plain root
+        # instead of math.hypot, which took ~20 ns a call)
+        w = alpha * s
+        return 0.5 * (z + math.sqrt(z * z + w * w))
     if s == 0.0:
         return z  # normal incidence: Lambda = 0
     a = z / (alpha * s)  # a = 1 / (alpha tan theta), Walter eq. 27
@@ -36,6 +38,9 @@ def projected(x, y, z, dist, g1, alpha):  # pragma: no cover - compiled
 
 
 def projected_reference(w, dist, g1, alpha):
+    """Plain numpy twin of :func:`projected`: P = z / G1 of the directions ``w`` (..., 3), GGX for ``dist`` 1 (Walter
+    eq. 34), else Beckmann, exact (``g1`` 0, Walter eq. 27) or Walter's rational fit; P = z at the normal.
+    """
     from scipy.special import erf
 
     x, y, z = w[..., 0], w[..., 1], w[..., 2]

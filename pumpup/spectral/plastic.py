@@ -25,10 +25,9 @@ from typing import Any
 
 import numpy as np
 
-from . import optical
 from ..core import SpecError
 from ..core import load as _load_scalar
-from . import RGB_WAVELENGTHS, Spectral
+from . import RGB_WAVELENGTHS, Spectral, optical
 
 __all__ = ["SpectralPlastic"]
 
@@ -38,7 +37,8 @@ PLASTIC_KEYS = ("material", "n", "ad", "a_s", "eta", "wavelengths")
 
 def _per_wavelength(name: str, value: Any, m: int) -> list[float]:
     """``value`` as a list of ``m`` numbers: a number is repeated, a list must have length m (its
-    entries are checked by the scalar models)."""
+    entries are checked by the scalar models).
+    """
     if isinstance(value, (list, tuple, np.ndarray)):
         if len(value) != m:
             raise SpecError(f"spectral plastic: parameter {name!r} must be a number or a list of {m} values (one "
@@ -78,14 +78,16 @@ class SpectralPlastic(Spectral):
             raise SpecError("spectral plastic: parameter 'n' (the exponent, >= 0) is required")
         if isinstance(wavelengths, str):
             if wavelengths != "rgb":
-                raise SpecError(f"spectral plastic: parameter 'wavelengths' must be a list of nm or 'rgb', got {wavelengths!r}")
+                raise SpecError("spectral plastic: parameter 'wavelengths' must be a list of nm or 'rgb', got "
+                                f"{wavelengths!r}")
             wavelengths = RGB_WAVELENGTHS
         if material is not None:
             if eta is not None:
                 raise SpecError("spectral plastic: give either 'material' or 'eta', not both")
             if isinstance(material, str) and material in optical.MATERIALS:
-                raise SpecError(f"spectral plastic: parameter 'material' = {material!r} is a metal; a plastic (000 eq. 29) "
-                                f"has a dielectric's real index, one of {', '.join(optical.DIELECTRICS)} (or give 'eta')")
+                raise SpecError(f"spectral plastic: parameter 'material' = {material!r} is a metal; "
+                                "a plastic (000 eq. 29) has a dielectric's real index, "
+                                f"one of {', '.join(optical.DIELECTRICS)} (or give 'eta')")
             w = optical.check_wavelengths(optical.DEFAULT_WAVELENGTHS if wavelengths is None else wavelengths)
             etas = [float(e) for e in optical.dielectric_index(material, w)[0]]
         else:
@@ -114,7 +116,7 @@ class SpectralPlastic(Spectral):
         self.k = None
 
     @classmethod
-    def from_spec(cls, spec: dict) -> "SpectralPlastic":
+    def from_spec(cls, spec: dict) -> SpectralPlastic:
         """Build from ``{"type": "plastic", "material" | "eta", "n", "ad", "a_s", "wavelengths"}``."""
         kw = {k: v for k, v in spec.items() if k != "type"}
         if "k" in kw:

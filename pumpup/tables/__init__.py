@@ -17,13 +17,18 @@ import sys
 import tempfile
 import weakref
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .._version import __version__
-from . import reuse as _reuse
-from ..engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
 from ..core import BRDF, check_count, check_open_unit, check_tolerance, provide
+from ..engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
+from . import reuse as _reuse
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from numpy.typing import ArrayLike
 
 __all__ = [
     "tabulate",
@@ -108,8 +113,8 @@ class AlbedoTable:
         if len(mu) < 2:
             raise ValueError("an albedo table needs at least two values of mu")
         if not (len(value) == len(mu) == len(error)):
-            raise ValueError(f"an albedo table needs one value and one error per mu: {len(mu)} mu, {len(value)} values, "
-                             f"{len(error)} errors")
+            raise ValueError(f"an albedo table needs one value and one error per mu: {len(mu)} mu, {len(value)} "
+                             f"values, {len(error)} errors")
         if not np.all((mu > 0) & (mu <= 1)):
             raise ValueError(f"an albedo table's mu must lie in (0, 1], got {mu[~((mu > 0) & (mu <= 1))][:3].tolist()}")
         if not (np.all(np.isfinite(value)) and np.all(np.isfinite(error)) and np.all(error >= 0)):
@@ -172,9 +177,10 @@ class AlbedoTable:
         return 5 if degree == 5 and n >= 6 else 3
 
     @classmethod
-    def from_dataset(cls, ds) -> "AlbedoTable":
+    def from_dataset(cls, ds) -> AlbedoTable:
         """The table of a dataset over mu alone; one over (mu, phi) (an anisotropic model's, ``tabulate(f, phi=...)``)
-        must be cut to one azimuth first (``ds.isel(phi=0)``): before, scipy's spline raised an unreadable error."""
+        must be cut to one azimuth first (``ds.isel(phi=0)``): before, scipy's spline raised an unreadable error.
+        """
         if ds["albedo"].dims != ("mu",):
             raise ValueError(f"an albedo table is a function of mu alone, got a dataset over {ds['albedo'].dims}; "
                              "take one azimuth first, e.g. ds.isel(phi=0)")
@@ -184,6 +190,9 @@ class AlbedoTable:
                    breaks=np.atleast_1d(ds.attrs.get("interpolation_breaks", [])))
 
     def __call__(self, mu) -> np.ndarray:
+        """The interpolated albedo at ``mu`` (in (0, 1], checked); below the smallest node, the power law through the
+        first two.
+        """
         m = check_mu(mu)
         lm = np.log(m)
         out = self._spline(lm)
@@ -200,20 +209,23 @@ class AlbedoTable:
     def upper(self, mu) -> np.ndarray:
         """An upper bound of the true albedo: interpolant + ``margin`` (2 x interpolation error +
         the largest quadrature error), ``margin_below`` below the first node.  The pumping
-        operator's compiled look-up uses the same margins."""
+        operator's compiled look-up uses the same margins.
+        """
         m = check_mu(mu)
         return self(m) + np.where(m < self.mu[0], self.margin_below, self.margin)
 
     def is_increasing(self) -> bool:
         """True if the spline is non-decreasing on [mu_0, mu_last] (checked exactly: its derivative is
         >= 0 at every breakpoint and at every root of the second derivative).  Then so is
-        :meth:`upper` there, and max(upper(x), upper(y)) = upper(max(x, y)) for x, y >= mu_0."""
+        :meth:`upper` there, and max(upper(x), upper(y)) = upper(max(x, y)) for x, y >= mu_0.
+        """
         return nondecreasing(self._spline)
 
 
 def nondecreasing(spline) -> bool:
     """True if a scipy PPoly is non-decreasing between its first and last breakpoints (exact: its
-    derivative is >= 0 at every breakpoint and at every root of the second derivative)."""
+    derivative is >= 0 at every breakpoint and at every root of the second derivative).
+    """
     d1 = spline.derivative()
     crit = d1.derivative().roots(extrapolate=False)
     pts = np.concatenate([spline.x, crit[np.isfinite(crit)]])
@@ -228,7 +240,8 @@ def nondecreasing(spline) -> bool:
 
 def _near_new_nodes(order: np.ndarray, n_new: int) -> np.ndarray:
     """The intervals to check again after the last ``n_new`` of the nodes (sorted by ``order``) were
-    added: every interval within three nodes of a new one (a new node changes the spline mostly there)."""
+    added: every interval within three nodes of a new one (a new node changes the spline mostly there).
+    """
     is_new = np.concatenate([np.zeros(len(order) - n_new, bool), np.ones(n_new, bool)])[order]
     near = is_new.copy()
     for shift in (1, 2, 3):
@@ -256,14 +269,15 @@ def _near_one(a: float) -> np.ndarray:
 
 def _splittable(mu: np.ndarray) -> np.ndarray:
     """Whether each interval of consecutive nodes has its midpoint (:func:`_midpoints`) strictly inside in log(mu), the
-    spline's variable (whose doubles are coarser than mu's: 3.6e-15 at log(mu) = -18.4, mu's relative step 1.1e-16)."""
+    spline's variable (whose doubles are coarser than mu's: 3.6e-15 at log(mu) = -18.4, mu's relative step 1.1e-16).
+    """
     lx = np.log(mu)
     lm = np.log(_midpoints(mu))
     return (lm > lx[:-1]) & (lm < lx[1:])
 
 
-#: the models whose BRDF reads pumpup's own albedo tables (pumping's g, compensation's E): :func:`adaptive_grid` also checks
-#: their tables off the dyadic points (:func:`built_on_tables`)
+#: the models whose BRDF reads pumpup's own albedo tables (pumping's g, compensation's E): :func:`adaptive_grid` also
+#: checks their tables off the dyadic points (:func:`built_on_tables`)
 TABLE_MODELS = ("pumped", "kulla_conty", "scaled")
 
 
@@ -281,11 +295,12 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
     ``val``, ``err`` at the nodes ``grid``: (grid, val, err, interp), ``interp`` the interpolation error per column.
 
     ``val``, ``err`` are (n,) or (n, columns) (a table over (mu, phi), or (mu, wavelength)); ``values(mu)`` gives them
-    at new mu.  Every interval where the interpolant (:class:`AlbedoTable`, split at ``breaks``) of any column misses the
-    value at the midpoint in log(mu) by more than ``interp_tol`` is bisected, until none does or the grid has
+    at new mu.  Every interval where the interpolant (:class:`AlbedoTable`, split at ``breaks``) of any column misses
+    the value at the midpoint in log(mu) by more than ``interp_tol`` is bisected, until none does or the grid has
     ``max_points`` nodes; ``interp`` is each column's largest miss over the accepted intervals (all the last misses when
     ``max_points`` stopped it), and over the checks of the last interval at 1 - mu = (1 - a) 2^-k (:func:`_near_one`).
-    ``off_grid``: also over checks of every interval at its thirds in log(mu) (:func:`built_on_tables`)."""
+    ``off_grid``: also over checks of every interval at its thirds in log(mu) (:func:`built_on_tables`).
+    """
     one = val.ndim == 1
     V, E = (val[:, None], err[:, None]) if one else (val, err)
 
@@ -330,20 +345,20 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
             mids = _midpoints(grid)[todo]
             miss = misses(grid, V, E, mids, column_values(mids)[0])
         interp = np.maximum(interp, miss.max(axis=0))
-    # the interval that ends at mu = 1: its midpoint in log(mu) lies at theta / sqrt(2) of its lower end's theta, so 70 %
-    # of it in theta had no check.  A sharp lobe's pumped level turns there (the lobe reaches the normal below theta ~
-    # its width: pumped plastic n = 5284 was 3.1e-7 off at mu = 0.99995 with a margin of 2.0e-7, found by
-    # scripts/studies/fuzz_engines.py --tables 43), and so does a g2 level whose bound crosses the diagonal within it (a kink
-    # the table's one spline goes across: Pumped.albedo_kinks).  It is checked at 1 - mu = (1 - a) 2^-k too, down to
-    # NEAR_ONE_MIN, and the largest miss there counts (issue 14's twenty-third session)
+    # the interval that ends at mu = 1: its midpoint in log(mu) lies at theta / sqrt(2) of its lower end's theta, so
+    # 70 % of it in theta had no check.  A sharp lobe's pumped level turns there (the lobe reaches the normal below
+    # theta ~ its width: pumped plastic n = 5284 was 3.1e-7 off at mu = 0.99995 with a margin of 2.0e-7, found by
+    # scripts/studies/fuzz_engines.py --tables 43), and so does a g2 level whose bound crosses the diagonal within it (a
+    # kink the table's one spline goes across: Pumped.albedo_kinks).  It is checked at 1 - mu = (1 - a) 2^-k too, down
+    # to NEAR_ONE_MIN, and the largest miss there counts (issue 14's twenty-third session)
     pts = _near_one(grid[-2])
     if off_grid:
         # a model that reads pumpup's own tables (a pumped level's g, a compensation's E) inherits their interpolation
         # error between their nodes, and those nodes are this grid's and its midpoints: a check there is blind to it.
         # Kulla-Conty over Torrance-Sparrow D1 (s 844, ior 1.53) was exact at its nodes and midpoints and 6.0e-8 off at
-        # mu = 0.039 with a margin of 5.9e-9 (scripts/studies/fuzz_engines.py --tables 44; issue 14's twenty-third session).  The
-        # thirds of each interval in log(mu) are no nodes of a dyadic refinement; one third alone left it 1.24 x its
-        # margin (the interval held two of E's pieces), both 0.58 x
+        # mu = 0.039 with a margin of 5.9e-9 (scripts/studies/fuzz_engines.py --tables 44; issue 14's twenty-third
+        # session).  The thirds of each interval in log(mu) are no nodes of a dyadic refinement; one third alone left it
+        # 1.24 x its margin (the interval held two of E's pieces), both 0.58 x
         lx = np.log(grid)
         thirds = np.concatenate([np.exp((2.0 * lx[:-1] + lx[1:]) / 3.0), np.exp((lx[:-1] + 2.0 * lx[1:]) / 3.0)])
         inside = (np.log(thirds) > np.tile(lx[:-1], 2)) & (np.log(thirds) < np.tile(lx[1:], 2))
@@ -353,9 +368,10 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
     return grid, (V[:, 0] if one else V), (E[:, 0] if one else E), interp
 
 
-def tabulate(brdf: BRDF, mu=None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
+def tabulate(brdf: BRDF, mu: ArrayLike | None = None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
              interp_tol: float = 1e-7, mu_min: float = 1e-8, max_points: int = 2049, progress: bool | None = None,
-             threads: int | None = None, phi=None, breaks=None):
+             threads: int | None = None, phi: ArrayLike | str | None = None,
+             breaks: ArrayLike | None = None) -> xr.Dataset:
     """Tabulate the directional albedo of ``brdf``.
 
     Parameters
@@ -471,7 +487,7 @@ THREADS: int | None = None
 
 
 #: the BRDF objects whose kernels have run in this process (see :func:`_chunked`)
-_WARM: "weakref.WeakSet" = weakref.WeakSet()
+_WARM: weakref.WeakSet = weakref.WeakSet()
 
 
 def _cores() -> int:
@@ -484,7 +500,8 @@ def _cores() -> int:
 
 def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int = 32, phi: float = 0.0):
     """Albedo and error at every mu (at the azimuth ``phi`` of wi), in chunks, on ``threads`` threads
-    (default :data:`THREADS`; every k-th mu to thread k: grazing values, the dear ones, are spread over all)."""
+    (default :data:`THREADS`; every k-th mu to thread k: grazing values, the dear ones, are spread over all).
+    """
     val = np.empty_like(mu)
     err = np.empty_like(mu)
     from ..engine.routes import one_d_everywhere
@@ -574,7 +591,8 @@ def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind, phis=None,
     if breaks is not None and len(breaks):
         # (one break as a number: netCDF reads a one-element array attribute back as a number, and the file's digest
         # must see what is read back)
-        ds.attrs["interpolation_breaks"] = float(breaks[0]) if len(breaks) == 1 else np.asarray(breaks, dtype=np.float64)
+        ds.attrs["interpolation_breaks"] = (float(breaks[0]) if len(breaks) == 1
+                                            else np.asarray(breaks, dtype=np.float64))
         ds.attrs["interpolation"] += "; split at interpolation_breaks, the kinks of the albedo"
     if phi_kind is not None:  # an anisotropic model: say which azimuth of wi the values hold
         from .azimuth import describe_phi
@@ -585,7 +603,8 @@ def _dataset(brdf, mu, val, err, rtol, atol, interp_error, grid_kind, phis=None,
 
 def _umask() -> int:
     """The process's umask, read without changing it where the system tells it (Linux), else by
-    setting and restoring it."""
+    setting and restoring it.
+    """
     try:
         with open("/proc/self/status") as fh:
             for line in fh:
@@ -678,11 +697,12 @@ def atomic_path(path):
         raise
 
 
-def write_table(ds, path) -> str:
+def write_table(ds: xr.Dataset, path: str | os.PathLike[str]) -> str:
     """Write a Dataset to netCDF atomically (a temporary file renamed into place), with a
     Fletcher-32 checksum on every numeric variable (:func:`pumpup.tables.validate.checksum_encoding`) and
     a digest of the whole content in the attribute ``pumpup_digest``, which :func:`open_table`
-    checks (:func:`pumpup.tables.validate.content_digest`)."""
+    checks (:func:`pumpup.tables.validate.content_digest`).
+    """
     import xarray as xr
 
     from .validate import checksum_encoding
@@ -707,7 +727,8 @@ def _digested(ds):
 
 def write_groups(path, root, groups) -> str:
     """Write ``root`` and the (name, Dataset) ``groups`` into one netCDF file, atomically, each with
-    its digest and the Fletcher-32 checksums of :func:`write_table` (saved pumped and compensated BRDFs)."""
+    its digest and the Fletcher-32 checksums of :func:`write_table` (saved pumped and compensated BRDFs).
+    """
     from .validate import checksum_encoding
 
     with atomic_path(path) as tmp:
@@ -718,7 +739,7 @@ def write_groups(path, root, groups) -> str:
     return os.fspath(path)
 
 
-def open_table(path, group: str | None = None):
+def open_table(path: str | os.PathLike[str], group: str | None = None) -> xr.Dataset:
     """Open a netCDF table written by pumpup, fully loaded into memory, and validate it
     (:func:`pumpup.tables.validate.validate_dataset`: variables, coordinates, shapes, finite values,
     mu in (0, 1] strictly increasing, albedo >= 0, a loadable spec; checksums).
@@ -759,7 +780,8 @@ def open_table(path, group: str | None = None):
 # --------------------------------------------------------------------------------------------
 
 
-def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False, max_intervals: int = 400):
+def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False,
+                max_intervals: int = 400) -> float | tuple[float, float]:
     """Mean albedo 2 * integral_0^1 a(mu) mu dmu (000 eq. 33): the albedo under uniform sky light.
 
     Computed by adaptive Gauss-Kronrod (7/15) quadrature over mu with the smoothing
@@ -926,7 +948,7 @@ def _location_error(f, mu0, a0, e0, rtol, lo, hi) -> float:
     return math.degrees(max(math.acos(mu0) - lo_t, hi_t - math.acos(mu0), dmu / s if s > 0 else 0.0))
 
 
-def max_constant(brdf: BRDF, **kw) -> tuple[float, float]:
+def max_constant(brdf: BRDF, **kw: Any) -> tuple[float, float]:
     """The maximum constant of a model and the angle of its albedo maximum.
 
     The constant is 1 / max over mu of the albedo computed with the model's constant

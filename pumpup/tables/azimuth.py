@@ -40,8 +40,8 @@ import math
 
 import numpy as np
 
-from ..engine.cubature import check_phi
 from ..core import BRDF
+from ..engine.cubature import check_phi
 
 __all__ = ["sup_albedo", "J_START", "J_MAX", "SAFETY"]
 
@@ -62,7 +62,8 @@ class _NoBar:
 
 def _trig_up(v: np.ndarray, factor: int) -> np.ndarray:
     """The trigonometric interpolant of the periodic samples v (..., N), at N * factor
-    equispaced points of the same period (the first at the first sample)."""
+    equispaced points of the same period (the first at the first sample).
+    """
     n = v.shape[-1]
     spec = np.fft.rfft(v, axis=-1)
     if n % 2 == 0:
@@ -75,7 +76,8 @@ def _trig_up(v: np.ndarray, factor: int) -> np.ndarray:
 
 def _period(nodes: np.ndarray, symmetric: bool) -> np.ndarray:
     """Samples on one full period from the nodes (..., J + 1) on [0, P] (even extension) or
-    the nodes (..., 2 J) on [0, 2 pi)."""
+    the nodes (..., 2 J) on [0, 2 pi).
+    """
     if symmetric:
         return np.concatenate([nodes, nodes[..., -2:0:-1]], axis=-1)
     return nodes
@@ -182,7 +184,8 @@ def table_values(brdf: BRDF, phi, rtol, atol, threads, interp_tol):
     """For :func:`pumpup.tabulate`: (values(mu, bar) -> (val, err), phis or None, phi_kind or None).
 
     ``val`` is (n,) for a table over mu, (n, k) for one over (mu, phi); ``phi_kind`` is what
-    the attributes of a table over mu of an anisotropic model say: 0.0 or "sup"."""
+    the attributes of a table over mu of an anisotropic model say: 0.0 or "sup".
+    """
     from . import _chunked
 
     aniso = brdf.azimuth_range() is not None

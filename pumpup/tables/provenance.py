@@ -33,7 +33,8 @@ def _git(*args: str) -> str | None:
 @functools.lru_cache(maxsize=1)
 def source_commit() -> str:
     """The commit of the code in this checkout (``<hash>``, ``<hash>-dirty`` if ``pumpup/`` or
-    ``scripts/`` differ from it), or ``unknown`` when pumpup is not run from a git checkout."""
+    ``scripts/`` differ from it), or ``unknown`` when pumpup is not run from a git checkout.
+    """
     if not os.path.isdir(os.path.join(_ROOT, ".git")) and not os.path.isfile(os.path.join(_ROOT, ".git")):
         return "unknown"
     head = _git("rev-parse", "HEAD")
@@ -45,7 +46,8 @@ def source_commit() -> str:
 
 def same_data(a, b) -> bool:
     """True if two Datasets hold the same variables, coordinates, values (bit for bit) and
-    attributes, apart from :data:`PROVENANCE_ATTRS`."""
+    attributes, apart from :data:`PROVENANCE_ATTRS`.
+    """
     import xarray as xr
 
     def strip(ds):

@@ -53,8 +53,9 @@ def recall(brdf):
 
 
 def _spline_weights(theta: np.ndarray, k: int, hi: float) -> np.ndarray:
-    """w with integral_0^hi S(theta) = w . values for the interpolating spline S of degree k
-    (not-a-knot) through the nodes theta (increasing, theta[0] = 0, theta[-1] = hi)."""
+    """The weights w with integral_0^hi S(theta) = w . values for the interpolating spline S of degree k
+    (not-a-knot) through the nodes theta (increasing, theta[0] = 0, theta[-1] = hi).
+    """
     key = (theta.tobytes(), k, hi)
     w = _WEIGHTS.get(key)
     if w is None:
@@ -67,8 +68,8 @@ def _spline_weights(theta: np.ndarray, k: int, hi: float) -> np.ndarray:
     return w
 
 
-#: the rules' weights by grid (one grid serves every cell of a sweep), at most _WEIGHTS_KEPT of them (a grid of 257 nodes
-#: has three vectors and, once a table is cut short, three 256 x 257 matrices of interval weights)
+#: the rules' weights by grid (one grid serves every cell of a sweep), at most _WEIGHTS_KEPT of them (a grid of 257
+#: nodes has three vectors and, once a table is cut short, three 256 x 257 matrices of interval weights)
 _WEIGHTS: dict = {}
 _WEIGHTS_KEPT = 48
 
@@ -92,7 +93,8 @@ def _spline_part(mu, a, e):
     """(i5, error, propagated, theta, g, ge) of the table (increasing mu, mu[-1] = 1): the quintic spline's integral
     of g = a sin(2 theta) over [0, theta(mu[0])], its error (the larger difference to the cubic spline's and to the
     quintic's through every other node: the module docstring), the table's errors ge = e sin(2 theta) through the
-    quintic's absolute weights, and the nodes theta (increasing from 0) with g and ge there."""
+    quintic's absolute weights, and the nodes theta (increasing from 0) with g and ge there.
+    """
     s = np.sqrt((1.0 - mu) * (1.0 + mu))
     theta = np.arctan2(s, mu)[::-1]  # increasing from 0
     g = (2.0 * mu * s * a)[::-1]  # a sin(2 theta)
@@ -108,7 +110,8 @@ def _spline_part(mu, a, e):
 def _first_unresolved(theta: np.ndarray, g: np.ndarray, ge: np.ndarray, budget: float) -> int:
     """The index (in theta) of the first interval among those whose local estimates, the largest first, must leave
     the table for the rest to be within budget / 4: per interval, the larger difference of the quintic spline's
-    integral to the cubic's and to the coarser quintic's (:func:`_spline_part`), plus the propagated table errors."""
+    integral to the cubic's and to the coarser quintic's (:func:`_spline_part`), plus the propagated table errors.
+    """
     c = _coarse(len(theta))
     d5 = _interval_weights(theta, theta, 5)
     diff = np.maximum(np.abs((d5 - _interval_weights(theta, theta, 3)) @ g),
@@ -122,7 +125,8 @@ def _first_unresolved(theta: np.ndarray, g: np.ndarray, ge: np.ndarray, budget: 
 
 def _interval_weights(nodes: np.ndarray, theta: np.ndarray, k: int) -> np.ndarray:
     """W with row i . values = the integral over [theta_i, theta_(i+1)] of the interpolating spline of degree k
-    (not-a-knot) through ``nodes`` (increasing; the values at them)."""
+    (not-a-knot) through ``nodes`` (increasing; the values at them).
+    """
     key = (nodes.tobytes(), theta.tobytes(), k, "intervals")
     w = _WEIGHTS.get(key)
     if w is None:
@@ -153,7 +157,8 @@ def mean_from_table(brdf, rtol: float, fresh_part):
     mu, a, e, _ = t
     # nodes a few doubles apart in mu can share theta = arccos(mu) (an adaptive grid that bisected towards a jump of the
     # albedo down to the last bit: Beckmann alpha 0.0052 with Walter's G1, whose switch level is a jump, put 70 nodes at
-    # mu = 0.00829462; the splines refused duplicate nodes, found by scripts/studies/fuzz_engines.py --mean): the last of each
+    # mu = 0.00829462; the splines refused duplicate nodes, found by scripts/studies/fuzz_engines.py --mean): the last
+    # of each
     theta = np.arctan2(np.sqrt((1.0 - mu) * (1.0 + mu)), mu)
     keep = np.r_[theta[:-1] != theta[1:], True]
     mu, a, e = mu[keep], a[keep], e[keep]
@@ -171,7 +176,8 @@ def mean_from_table(brdf, rtol: float, fresh_part):
 
 def _mean_of(mu, a, e, rtol, fresh_part):
     """((mean, error) or None, the mean, theta, g, ge) from the table (mu, a, e) and ``fresh_part`` below mu[0]
-    (:func:`_spline_part`'s nodes and values)."""
+    (:func:`_spline_part`'s nodes and values).
+    """
     i5, spline_err, propagated, theta, g, ge = _spline_part(mu, a, e)
     low, low_err = fresh_part(float(mu[0]), abs(i5))
     total = i5 + low
@@ -180,7 +186,7 @@ def _mean_of(mu, a, e, rtol, fresh_part):
 
 
 def proportional_factor(brdf, unit, rng_seed: int = 7) -> float | None:
-    """k with unit = k * brdf, measured on random pairs of directions (relative 1e-13), or None."""
+    """The factor k with unit = k * brdf, measured on random pairs of directions (relative 1e-13), or None."""
     if unit is brdf:
         return 1.0
     rng = np.random.default_rng(rng_seed)
@@ -204,7 +210,8 @@ def proportional_factor(brdf, unit, rng_seed: int = 7) -> float | None:
 def scan_from_table(brdf, unit, scan_mu: np.ndarray, mu_min: float, fresh):
     """(mu, albedo, error) to stand for max_albedo's scan of ``unit`` (the model with its constant
     set to 1): the table nodes of ``brdf`` in [mu_min, 1] scaled by the measured factor, and
-    ``fresh(mu)`` at the scan points below the table; or None."""
+    ``fresh(mu)`` at the scan points below the table; or None.
+    """
     t = recall(brdf)
     if t is None:
         return None
@@ -233,7 +240,8 @@ def fresh_low(brdf, mu_min: float, abs_tol: float, rtol: float, max_intervals: i
     The propagated part is sum 2 e(mu) mu w <= 2 max(e) mu_min integral w = 2 max(e) mu_min^2, so the
     absolute tolerance keeps it below abs_tol / 2 however small a(mu) is relative to the mean: near
     grazing incidence, where the values cost most, a cell's mean asks them for about 1e-6 instead of
-    rtol / 10 (the p-model's cell: issue 14)."""
+    rtol / 10 (the p-model's cell: issue 14).
+    """
     from ..engine.cubature import NODES, WG, WK, albedo
 
     atol = max(1e-15, abs_tol / (4.0 * mu_min * mu_min))

@@ -39,12 +39,14 @@ DIGEST_ATTR = "pumpup_digest"
 
 class TableError(ValueError):
     """A file is not a valid pumpup table: damaged, edited or of another kind (the message names
-    the file and what is wrong)."""
+    the file and what is wrong).
+    """
 
 
 def checksum_encoding(ds) -> dict:
     """netCDF4 encoding that stores a Fletcher-32 checksum with every numeric variable of ``ds``
-    (data variables and coordinates of at least one dimension)."""
+    (data variables and coordinates of at least one dimension).
+    """
     enc = {}
     for name, var in {**ds.coords, **ds.data_vars}.items():
         if var.ndim >= 1 and var.dtype.kind in "fiub":
@@ -69,7 +71,8 @@ def content_digest(ds) -> str:
     and every variable's name, dimensions, attributes and values.  Stored as the attribute
     :data:`DIGEST_ATTR` by :func:`pumpup.write_table`, checked by :func:`pumpup.open_table`, so an
     edited attribute or value is detected as well as a flipped byte (HDF5's checksums cover the
-    data only)."""
+    data only).
+    """
     import hashlib
 
     h = hashlib.sha256()
@@ -118,7 +121,8 @@ def spec_attribute(path: str, ds, name: str = "spec") -> dict:
     except json.JSONDecodeError as exc:
         raise TableError(f"{path!r}: attribute {name!r} is not valid JSON: {exc}") from None
     if not isinstance(spec, dict) or not isinstance(spec.get("type"), str):
-        raise TableError(f"{path!r}: attribute {name!r} is not a model spec (a JSON object with a 'type'): {text[:80]!r}")
+        raise TableError(f"{path!r}: attribute {name!r} is not a model spec (a JSON object with a 'type'): "
+                         f"{text[:80]!r}")
     if not _mentions_function(spec):
         try:
             load(spec)
@@ -149,7 +153,8 @@ def _finite_nonnegative(path: str, ds, name: str) -> None:
 def _check_mu(path: str, ds, increasing: bool) -> None:
     mu = np.asarray(ds["mu"].values)
     if mu.ndim != 1 or mu.dtype.kind not in "fiu":
-        raise TableError(f"{path!r}: coordinate 'mu' must be a 1-D numeric array, got shape {mu.shape}, dtype {mu.dtype}")
+        raise TableError(f"{path!r}: coordinate 'mu' must be a 1-D numeric array, got shape {mu.shape}, dtype "
+                         f"{mu.dtype}")
     bad = ~np.isfinite(mu) | (mu <= 0) | (mu > 1)
     if np.any(bad):
         i = int(np.argmax(bad))
@@ -180,7 +185,8 @@ def _check_albedo_vars(path: str, ds) -> None:
 
 def validate_dataset(ds, path: str) -> None:
     """Check a Dataset read from ``path`` by its ``pumpup_kind``; raise :class:`TableError` if it
-    is not what pumpup wrote."""
+    is not what pumpup wrote.
+    """
     from . import TABLE_KIND
 
     path = os.fspath(path)
