@@ -48,6 +48,9 @@ The albedo of each candidate is the cost.  During the search it is computed with
 ``search_rtol`` (default 1e-5) on ``n_mu_search`` values of mu; the errors reported in the
 result are recomputed afterwards at ``final_rtol`` (default 1e-9) on ``n_mu`` values, with
 the bound of that recomputation (``albedo_error_bound``).
+
+This module is over 1,000 lines because the objective, its sampling of directions and the fits of each model family
+share the same residual and its weights.
 """
 
 from __future__ import annotations

@@ -12,6 +12,9 @@ Conventions (every model in pumpup follows them)
 * ``mu`` is cos(theta_i).  Directional albedo
   a(mu) = integral over the hemisphere of f_r(wi, wo) cos(theta_o) d omega_o
   (000 eq. 2; 002 eq. 15).
+
+This module is over 1,000 lines because ``BRDF``, ``Param`` and the registry are one unit: ``load`` builds a BRDF
+from its type's ``Param`` declarations and ``BRDF.spec`` gives back the dict ``load`` reads.
 """
 
 from __future__ import annotations
@@ -615,6 +618,12 @@ class BRDF:
     #: ``delta_albedo(mu)``: the albedo of a delta lobe in the mirror direction (He-Torrance's specular part), added
     #: to the integral exactly; None (the default) for a model without one
     delta_albedo = None
+
+    def fresnel_one(self) -> BRDF | None:
+        """The same model with its Fresnel factor set to 1, the white model whose albedo E energy compensation
+        tabulates (Kulla-Conty, 1/E), or None for a model without a Fresnel factor (the default).
+        """
+        return None
 
     def sampling_terms(self, mu: float) -> list[tuple[float, BRDF]]:
         """[(weight, term)] to sample from at incidence mu: the albedo terms (the default), or terms weighted for

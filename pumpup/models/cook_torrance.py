@@ -172,6 +172,10 @@ class CookTorrance(BRDF):
         """The Lobe hint: a Beckmann lobe of slope m about the half vector, cut where G switches branch."""
         return Lobe(axis="half", radial="beckmann", sharpness=self.p["m"], kinks=_g_kinks)
 
+    def fresnel_one(self):
+        """The same model with F = 1 (no ior), or None without a Fresnel factor."""
+        return None if self.p["ior"] is None else self.with_params(ior=None)
+
     def azimuth_hint(self):
         """The azimuth hint: the V-cavity lobe under the Beckmann weight, with the Fresnel factor F(wi.h) where ``ior``
         is given (001 eq. 9).
@@ -341,6 +345,10 @@ class TorranceSparrow(BRDF):
             # grazing half vectors, where r = 1 (uniform in sin^2 alpha) is the neutral map
             return Lobe(axis="half", radial="ggx", sharpness=min(s * s, 1.0), kinks=_g_kinks)
         return Lobe(axis="half", radial="beckmann", sharpness=s, kinks=_g_kinks)
+
+    def fresnel_one(self):
+        """The same model with F = 1 (no ior), or None without a Fresnel factor."""
+        return None if self.p["ior"] is None else self.with_params(ior=None)
 
     def azimuth_hint(self):
         """The azimuth hint: the V-cavity lobe under D's weight (002 eq. 10), or None for D2, which the nested engine

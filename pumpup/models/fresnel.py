@@ -120,6 +120,10 @@ class FresnelWeighted(BRDF):
         """The base's (F depends on N.wi and N.wo only)."""
         return self.base.azimuth_range()  # F depends on N.wi and N.wo only
 
+    def fresnel_one(self):
+        """The base: this wrapper with F = 1."""
+        return self.base
+
     def azimuth_hint(self):
         """The base's hint times F(max(N.wi, N.wo)) (000 eq. 28), or None without one."""
         from ..core.hints import FresnelAtMax

@@ -119,6 +119,12 @@ class Metal(BRDF):
         """F's kink or near-kink, where F(max(mu, N.wo)) turns (:func:`fresnel_levels`)."""
         return fresnel_levels(self.p["eta"], self.p["k"])  # F(max(mu, N.wo)) turns at mu = x0 too
 
+    def fresnel_one(self):
+        """000 eq. 28 with F = 1: the stretched Phong lobe with p = 1 (000 eq. 12), or None without an index."""
+        if self.p["eta"] is None:
+            return None
+        return load({"type": "stretched_phong", "n": self.p["n"], "p": 1.0, "c": self.p["c"]})
+
     def azimuth_hint(self):
         """The azimuth hint: a power lobe with p = 1 times the factor F(max(N.wi, N.wo)) (000 eq. 28)."""
         return _fresnel_hint(self.p["n"], self.p["c"], self.p["eta"], self.p["k"])
@@ -284,6 +290,10 @@ class Plastic(BRDF):
     def albedo_breaks(self):
         """The dielectric's kink of F where ``eta`` is given, else none."""
         return () if self.p["eta"] is None else fresnel_levels(self.p["eta"], 0.0)
+
+    def fresnel_one(self):
+        """The same plastic with F = 1 (no eta), or None without an index."""
+        return None if self.p["eta"] is None else self.with_params(eta=None)
 
     def azimuth_hint(self):
         """The azimuth hint of the specular lobe (000 eq. 29-30: with F(Theta_min) where ``eta`` is given), or None

@@ -302,6 +302,12 @@ class _Microfacet(BRDF):
             0.0 if p["k"] is None else p["k"],
         )
 
+    def fresnel_one(self):
+        """The same distribution and G with F = 1 (no ior, no conductor), or None without a Fresnel factor."""
+        if self.p["ior"] is None and self.p["eta"] is None:
+            return None
+        return self.with_params(ior=None, eta=None, k=None)
+
     def azimuth_hint(self):
         from ..core.hints import AzimuthHint, Fresnel, SmithLobe
 

@@ -46,6 +46,9 @@ whose albedo exceeds 1 beyond its error (Ward near grazing) would need D < 0 (f_
 
 For ``scaled`` the same upper bound U goes into 1 / U(mu_o), so the furnace toward wo is
 E / U <= 1, and 1 - E / U <= (U - E) / E.
+
+This module is over 1,000 lines because Kulla-Conty and the 1/E scaling share their white model, its tabulated
+albedo E and the compiled look-ups of E and its average.
 """
 
 from __future__ import annotations
@@ -320,16 +323,6 @@ def fresnel_average(base: BRDF, nodes: int = 64) -> float:
 
         fr = fresnel(mu, p["ior"])
     return float(np.clip(np.sum(w * 0.5 * 2.0 * fr * mu), 0.0, 1.0))
-
-
-def _white_of(base: BRDF) -> BRDF | None:
-    """The Fresnel-1 version of a microfacet model with a Fresnel factor (None if it has none)."""
-    p = base.p
-    if ("ior" in p or "eta" in p) and (p.get("ior") is not None or p.get("eta") is not None):
-        if base.type == "metal":  # 000 eq. 28 with F = 1 is the stretched Phong lobe, 000 eq. 12 with p = 1
-            return load({"type": "stretched_phong", "n": p["n"], "p": 1.0, "c": p["c"]})
-        return base.with_params(**{k: None for k in ("ior", "eta", "k") if k in p})  # plastic has no k
-    return None
 
 
 class _Compensated(BRDF):
@@ -897,7 +890,7 @@ def compensate_model(base: BRDF, method: str, *, f0, f_avg, white, force) -> BRD
         if f0 is not None or f_avg is not None or white is not None:
             raise SpecError(f"compensate: method {method!r} (pumping) takes no f0, f_avg or white")
         return Pumped(base=base, g=method, force=bool(force))
-    w = load(white) if white is not None else _white_of(base)
+    w = load(white) if white is not None else base.fresnel_one()
     spec: dict = {"base": base}
     if w is not None:
         spec["white"] = w

@@ -10,6 +10,9 @@ max(a(L), a(V)) <= g <= 1 (001 eq. 17), its albedo satisfies a(L) <= a*(L) <= 1
 of the tabulated albedo (interpolant + measured interpolation error + quadrature error),
 never by a value that could dip below it.  A pumped BRDF is an ordinary BRDF: it
 evaluates, tabulates, pumps again and round-trips through its spec.
+
+This module is over 1,000 lines because ``Pumped``, its compiled chain kernel, the chain's look-up layout
+(:class:`pumpup.physics.lookups.GChain`) and the pumped-table file format describe one object.
 """
 
 from __future__ import annotations

@@ -486,3 +486,30 @@ def test_scaled_beckmann_with_walters_g1_takes_the_nested_engine():
         for rtol in (1e-8, 1e-10):
             a, e = pumpup.albedo(f, mu, rtol=rtol, return_error=True)
             assert abs(float(a) - ref) <= float(e) + 1e-14, (alpha, mu, rtol, float(a), ref, float(e))
+
+
+def test_the_fresnel_one_version_is_declared_by_each_model_with_a_fresnel_factor():
+    """BRDF.fresnel_one: the white model energy compensation tabulates.  Each model with a Fresnel factor declares it
+    (the same model with F = 1), a model without one gives None, and compensating the fresnel wrapper tabulates its
+    base."""
+    from pumpup.physics.fresnel import fresnel_conductor
+
+    cases = [({"type": "ggx", "alpha": 0.3, "ior": 1.5}, {"type": "ggx", "alpha": 0.3}),
+             ({"type": "beckmann", "alpha": 0.2, "eta": 0.2, "k": 3.0}, {"type": "beckmann", "alpha": 0.2}),
+             ({"type": "cook_torrance", "m": 0.3, "ior": 1.5}, {"type": "cook_torrance", "m": 0.3}),
+             ({"type": "torrance_sparrow", "d": "D1", "s": 20, "ior": 1.5},
+              {"type": "torrance_sparrow", "d": "D1", "s": 20}),
+             ({"type": "plastic", "n": 20, "eta": 1.5}, {"type": "plastic", "n": 20}),
+             ({"type": "fresnel", "base": {"type": "phong", "n": 20}, "eta": 0.2, "k": 3.0},
+              {"type": "phong", "n": 20})]
+    for spec, white in cases:
+        assert pumpup.load(spec).fresnel_one() == pumpup.load(white), spec
+    for spec in ({"type": "ggx", "alpha": 0.3}, {"type": "phong", "n": 20}, {"type": "lambert"}):
+        assert pumpup.load(spec).fresnel_one() is None, spec
+    metal = pumpup.load({"type": "metal", "n": 20, "eta": 0.2, "k": 3.0})
+    wi = np.array([[0.6, 0.0, 0.8], [0.0, 0.28, 0.96]])
+    wo = np.array([[-0.5, 0.1, np.sqrt(0.74)], [0.3, -0.2, np.sqrt(0.87)]])
+    f_max = fresnel_conductor(np.maximum(wi[:, 2], wo[:, 2]), 0.2, 3.0)  # 000 eq. 28
+    np.testing.assert_allclose(metal.eval(wi, wo), metal.fresnel_one().eval(wi, wo) * f_max, rtol=1e-13)
+    wrapped = {"type": "fresnel", "base": {"type": "ggx", "alpha": 0.3}, "eta": 0.2, "k": 3.0}
+    assert pumpup.compensate(wrapped, method="scale").white == pumpup.load({"type": "ggx", "alpha": 0.3})
