@@ -330,8 +330,8 @@ def plan(brdf, mu: np.ndarray, phi: np.ndarray | None = None, choice: Choice | N
 
 
 def route_names(brdf, mu, phi=None, choice: Choice | None = None) -> np.ndarray:
-    """The route of every value of mu for a BRDF's first albedo term with more than one route, as an array of route
-    names per (term, mu): shape (terms, len(mu)).
+    """The route that integrates each albedo term of ``brdf`` at each value of ``mu`` (wi at azimuth ``phi``): an array
+    of route names of shape (terms, len(mu)).
     """
     from .cubature import check_mu
 
