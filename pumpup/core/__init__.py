@@ -663,6 +663,24 @@ def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
 
 
+#: the deepest nesting of a spec (dicts and lists within each other) that :func:`load` reads: 64 pumping levels of a
+#: model with a nested base, far beyond any use, and far below Python's recursion limit
+MAX_SPEC_DEPTH = 64
+
+
+def _check_depth(spec: Any) -> None:
+    """A SpecError if ``spec`` nests dicts and lists more than :data:`MAX_SPEC_DEPTH` deep (walked without
+    recursion).
+    """
+    stack = [(spec, 1)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > MAX_SPEC_DEPTH:
+            raise SpecError(f"a spec may nest at most {MAX_SPEC_DEPTH} levels deep (dicts and lists within each other)")
+        children = node.values() if isinstance(node, dict) else node
+        stack.extend((c, depth + 1) for c in children if isinstance(c, (dict, list, tuple)))
+
+
 def load(spec: Any) -> BRDF:
     """Build a BRDF from a spec: a dict ``{"type": name, param: value, ...}``, its JSON text, or
     the short form of the command line, ``"phong:n=20,c=1"`` (:func:`parse_spec`).
@@ -684,6 +702,7 @@ def load(spec: Any) -> BRDF:
         spec = parse_spec(spec)
     if not isinstance(spec, dict):
         raise SpecError(f"a spec must be a dict with a 'type' key, got {type(spec).__name__}")
+    _check_depth(spec)
     if "type" not in spec:
         raise SpecError(f"a spec needs a 'type' key; known types: {', '.join(_REGISTRY)}")
     bad_keys = [k for k in spec if not isinstance(k, str)]

@@ -45,6 +45,7 @@ measured below the true error (``pumpup.physics.quadrature.MODE_2D`` switches it
 from __future__ import annotations
 
 import math
+import reprlib
 import warnings
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
@@ -89,10 +90,10 @@ class AlbedoWarning(UserWarning):
 
 def check_mu(mu) -> np.ndarray:
     """``mu`` as a float64 array, or a ValueError that says which value is outside (0, 1]."""
-    try:
-        m = np.asarray(mu, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"mu must be a number or an array of numbers in (0, 1], got {mu!r}") from None
+    raw = None if isinstance(mu, (str, bytes)) else np.asarray(mu)
+    if raw is None or raw.dtype.kind not in "fiu":  # (a string, True, None, a nested list of mixed kinds)
+        raise ValueError(f"mu must be a number or an array of numbers in (0, 1], got {reprlib.repr(mu)}")
+    m = raw.astype(np.float64)
     if ((m > 0) & (m <= 1)).all():  # (NaN fails both comparisons, inf the second: one pass where all is well)
         return m
     bad = ~np.isfinite(m) | (m <= 0) | (m > 1)
@@ -109,9 +110,12 @@ def check_phi(phi) -> np.ndarray:
         return np.asarray(phi)
     if isinstance(phi, (str, bytes)) or phi is None:
         raise ValueError(f"phi (the azimuth of wi, in radians) must be a finite number, got {phi!r}")
+    if isinstance(phi, (bool, np.bool_)) or np.asarray(phi).dtype.kind not in "fiu":
+        raise ValueError(f"phi (the azimuth of wi, in radians) must be a finite number or an array of them, "
+                         f"got {reprlib.repr(phi)}")
     try:
         p = np.asarray(phi, dtype=np.float64)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ValueError(f"phi (the azimuth of wi, in radians) must be a finite number or an array of them, "
                          f"got {phi!r}") from None
     if not np.all(np.isfinite(p)):

@@ -389,6 +389,13 @@ class _Lookup:
         from ..tables import nondecreasing
 
         t = table
+        if not float(np.max(t.value)) > 0.0:
+            import json
+
+            name = json.dumps(t.spec) if t.spec else "the model"
+            raise SpecError(f"{name} reflects nothing (its albedo is 0 at every incidence): pumping's g and 1/E "
+                            "compensation divide by its albedo, so it can be neither a pumping base nor a compensation "
+                            "white (pumping it would give 0 again)")
         self.margin, self.margin_lo = t.margin, t.margin_below  # as in AlbedoTable.upper
         x, c = t._spline.x, t._spline.c  # the breakpoints of the spline pieces, in log(mu)
         self.increasing = t.is_increasing()

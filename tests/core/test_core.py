@@ -1,5 +1,7 @@
 """The BRDF interface: specs, registry, input checks, user functions, reciprocity check."""
 
+import json
+
 import helpers
 import numpy as np
 import pytest
@@ -220,3 +222,17 @@ def test_short_spec_in_load_pump_and_sweep():
                        ("{not json", "not valid JSON"), ("[1, 2]", "unknown model type")]:
         with pytest.raises(SpecError, match=match):
             pumpup.load(bad)
+
+
+def test_a_spec_nested_too_deep_is_refused_in_one_line():
+    spec = {"type": "lambert"}
+    for _ in range(500):
+        spec = {"type": "pumped", "base": spec}
+    with pytest.raises(pumpup.SpecError, match="at most 64 levels deep"):
+        pumpup.load(spec)
+    with pytest.raises(pumpup.SpecError, match="at most 64 levels deep"):
+        pumpup.load(json.dumps(spec))
+    ok = {"type": "lambert"}
+    for _ in range(20):
+        ok = {"type": "pumped", "base": ok}
+    assert pumpup.load(ok).depth == 20

@@ -239,3 +239,15 @@ PHONG = pumpup.load({"type": "phong", "n": 20})
 def test_albedo_engine_arguments(kw, name):
     with pytest.raises(SpecError, match=rf"albedo: {name} must be"):
         pumpup.albedo(PHONG, 0.5, **kw)
+
+
+@pytest.mark.parametrize("mu", ["0.5", b"0.5", True, None, 10**400, [0.5, "x"]], ids=str)
+def test_mu_that_is_not_a_number_is_refused_in_one_line(mu):
+    with pytest.raises(ValueError, match="^mu must be a number or an array of numbers in \\(0, 1\\], got "):
+        pumpup.albedo(pumpup.load({"type": "lambert"}), mu)
+
+
+@pytest.mark.parametrize("phi", ["0.5", True, 10**400, float("inf")], ids=str)
+def test_phi_that_is_not_a_finite_number_is_refused_in_one_line(phi):
+    with pytest.raises(ValueError, match="^phi \\(the azimuth of wi, in radians\\) must be"):
+        pumpup.albedo(pumpup.load({"type": "ward_aniso", "ax": 0.1, "ay": 0.3}), 0.5, phi=phi)

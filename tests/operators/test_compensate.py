@@ -513,3 +513,8 @@ def test_the_fresnel_one_version_is_declared_by_each_model_with_a_fresnel_factor
     np.testing.assert_allclose(metal.eval(wi, wo), metal.fresnel_one().eval(wi, wo) * f_max, rtol=1e-13)
     wrapped = {"type": "fresnel", "base": {"type": "ggx", "alpha": 0.3}, "eta": 0.2, "k": 3.0}
     assert pumpup.compensate(wrapped, method="scale").white == pumpup.load({"type": "ggx", "alpha": 0.3})
+
+
+def test_a_white_that_reflects_nothing_is_refused_in_one_line():
+    with pytest.raises(pumpup.SpecError, match="reflects nothing"):
+        pumpup.compensate({"type": "ggx", "alpha": 0.3}, white={"type": "lambert", "albedo": 0.0})

@@ -355,3 +355,11 @@ def test_pump_levels(levels):
 def test_pumped_spec_levels(levels):
     with pytest.raises(SpecError, match="'levels'"):
         pumpup.load({"type": "pumped", "base": {"type": "phong", "n": 2}, "levels": levels})
+
+
+@pytest.mark.parametrize("base", [{"type": "lambert", "albedo": 0.0}, {"type": "phong", "n": 20, "c": 0.0}], ids=str)
+def test_a_base_that_reflects_nothing_is_refused_in_one_line(base):
+    """g1 divides by the base's albedo, 0 everywhere; pumping zero would give zero again: refused, naming the base."""
+    for g in ("g1", "g2"):
+        with pytest.raises(pumpup.SpecError, match="reflects nothing"):
+            pumpup.albedo(pumpup.pump(base, g=g), [0.5])
