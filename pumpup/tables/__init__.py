@@ -13,6 +13,7 @@ import contextlib
 import json
 import math
 import os
+import reprlib
 import sys
 import tempfile
 import weakref
@@ -426,8 +427,9 @@ def tabulate(brdf: BRDF, mu: ArrayLike | None = None, *, rtol: float = DEFAULT_R
     >>> ds["albedo"].values.round(12).tolist()
     [0.5, 0.5, 0.5]
     """
-    if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1):
-        raise ValueError(f"tabulate: threads must be an integer >= 1, got {threads!r}")
+    if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer))
+                                or not 1 <= threads <= MAX_THREADS):
+        raise ValueError(f"tabulate: threads must be an integer in [1, {MAX_THREADS}], got {reprlib.repr(threads)}")
     if getattr(brdf, "is_spectral", False):  # pumpup.spectral: dims (mu, wavelength)
         return brdf.tabulate(mu=mu, rtol=rtol, atol=atol, interp_tol=interp_tol, mu_min=mu_min, max_points=max_points,
                              progress=progress, threads=threads, phi=phi)
@@ -488,6 +490,10 @@ THREADS: int | None = None
 
 #: the BRDF objects whose kernels have run in this process (see :func:`_chunked`)
 _WARM: weakref.WeakSet = weakref.WeakSet()
+
+
+#: the most threads :func:`tabulate` accepts (each holds its own work arrays)
+MAX_THREADS = 1024
 
 
 def _cores() -> int:
