@@ -57,6 +57,7 @@ import functools
 import json
 import math
 import os
+import reprlib
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -376,7 +377,7 @@ class _Compensated(BRDF):
             if not (r.reciprocal and f.reciprocal):
                 if not self.p["force"]:
                     raise SpecError(f"{model}: the {name} {f.type!r} is not reciprocal ({r}); {why}. "
-                                    "Pass force=True to compensate it anyway.")
+                                    "Pass force=True (--force on the command line) to compensate it anyway.")
                 ok = False
         return ok
 
@@ -874,8 +875,8 @@ def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None 
         raise SpecError(f"compensate: method must be one of {', '.join(map(repr, METHODS))}; got {method!r}")
     for name, v in (("f0", f0), ("f_avg", f_avg)):
         if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating))
-                              or not 0.0 <= float(v) <= 1.0):
-            raise SpecError(f"compensate: {name} must be a number in [0, 1], got {v!r}")
+                              or not 0.0 <= v <= 1.0):  # (v itself: float() of 10**400 overflows)
+            raise SpecError(f"compensate: {name} must be a number in [0, 1], got {reprlib.repr(v)}")
     if not isinstance(force, (bool, np.bool_)):
         raise SpecError(f"compensate: force must be true or false, got {force!r}")
     return compensate_model(load(f), method, f0=f0, f_avg=f_avg, white=white, force=force)
@@ -890,6 +891,7 @@ def compensate_model(base: BRDF, method: str, *, f0, f_avg, white, force) -> BRD
         if f0 is not None or f_avg is not None or white is not None:
             raise SpecError(f"compensate: method {method!r} (pumping) takes no f0, f_avg or white")
         return Pumped(base=base, g=method, force=bool(force))
+    f0 = None if f0 is None else float(f0)  # (checked by compensate: a number in [0, 1])
     w = load(white) if white is not None else base.fresnel_one()
     spec: dict = {"base": base}
     if w is not None:
@@ -899,10 +901,10 @@ def compensate_model(base: BRDF, method: str, *, f0, f_avg, white, force) -> BRD
     if method == "scale":
         if f_avg is not None:
             raise SpecError("compensate: f_avg belongs to method 'kulla_conty'; method 'scale' takes f0")
-        return Scaled(**spec, f0=1.0 if f0 is None else float(f0))
+        return Scaled(**spec, f0=1.0 if f0 is None else f0)
     if f_avg is None:
-        f_avg = (20.0 * float(f0) + 1.0) / 21.0 if f0 is not None else fresnel_average(base)
-    return KullaConty(**spec, f_avg=float(f_avg))
+        f_avg = (20.0 * f0 + 1.0) / 21.0 if f0 is not None else fresnel_average(base)
+    return KullaConty(**spec, f_avg=f_avg)
 
 
 # --- saving and loading: the spec and every table it needs, one netCDF file -----------------

@@ -519,7 +519,7 @@ class Pumped(BRDF):
             if not self.reciprocal and not self.p["force"]:
                 raise SpecError(
                     f"pumped: the base {base.type!r} is not reciprocal ({r}); pumping needs a symmetric "
-                    "BRDF (001 sec. 3). Pass force=True to pump it anyway."
+                    "BRDF (001 sec. 3). Pass force=True (--force on the command line) to pump it anyway."
                 )
         self._lookup = None
         self._own_table = None  # a table loaded from a file serves this object only (load_pumped)

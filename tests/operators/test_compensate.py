@@ -518,3 +518,10 @@ def test_the_fresnel_one_version_is_declared_by_each_model_with_a_fresnel_factor
 def test_a_white_that_reflects_nothing_is_refused_in_one_line():
     with pytest.raises(pumpup.SpecError, match="reflects nothing"):
         pumpup.compensate({"type": "ggx", "alpha": 0.3}, white={"type": "lambert", "albedo": 0.0})
+
+
+@pytest.mark.parametrize("name", ["f0", "f_avg"])
+def test_an_f0_or_f_avg_beyond_the_float_range_is_refused_in_one_line(name):
+    method = "scale" if name == "f0" else "kulla_conty"
+    with pytest.raises(pumpup.SpecError, match=f"^compensate: {name} must be a number in \\[0, 1\\], got 1000"):
+        pumpup.compensate({"type": "ggx", "alpha": 0.3}, method=method, **{name: 10**400})
