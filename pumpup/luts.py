@@ -866,6 +866,8 @@ class AuditResult:
     where_rel: tuple
     truth_error: float
     quantisation_bound: float
+    #: nodes where E exceeds 1 by more than the format's rounding plus the truth's error (less is rounding, not a
+    #: violation of energy conservation)
     above_one: int
     monotonicity: list = field(default_factory=list)
     lookup: dict | None = None
@@ -986,7 +988,7 @@ def audit(path: str | os.PathLike[str], preset: str = "cycles", model: str | dic
         preset=p.name, spec={**spec, param: "rough^2"}, n_nodes=int(E.size), max_abs=float(abs(diff[i, j])),
         where_abs=(float(mu[i]), float(rough[j])), max_rel=float(rel[k, m]), where_rel=(float(mu[k]), float(rough[m])),
         truth_error=float(tr["E_error"].max()), quantisation_bound=STORAGE_BOUND[p.storage],
-        above_one=int(np.count_nonzero(E > 1.0)), monotonicity=_monotonicity(E, tr["E"], slack, mu, rough),
+        above_one=int(np.count_nonzero(E - 1.0 > slack)), monotonicity=_monotonicity(E, tr["E"], slack, mu, rough),
         error_map=diff, truth=tr["E"], table=E, mu=mu, rough=rough)
     if eavg and "E_avg" in tab:
         own = _own_eavg(E, p)

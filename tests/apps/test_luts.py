@@ -349,3 +349,20 @@ def test_appleseed_layout_rows_are_roughness(tmp_path):
     luts.write_lut(ds, tmp_path / "b.cpp", preset=p)
     assert "extern const float g_glossy_ggx_albedo_table[15]" in (tmp_path / "b.cpp").read_text()
     assert luts.read_table(tmp_path / "b.cpp", p)["E"] == pytest.approx(ds["E"].values, abs=6e-7)
+
+
+def test_audit_counts_e_above_one_beyond_rounding_only(monkeypatch, tmp_path):
+    """A node 2.2e-16 above 1 is rounding (within the format's bound and the truth's error), not a violation of energy
+    conservation; a node 1e-3 above 1 is one."""
+    path = str(tmp_path / "t.h")
+    luts.write_lut(pumpup.lut("ggx", preset="bsdl", lookup_check=False), path)
+    real = luts.read_table
+
+    def edited(path, preset):
+        tab = real(path, preset)
+        E = np.array(tab["E"], dtype=float)
+        E[0, 0], E[1, 1] = 1.0 + 2.2e-16, 1.001
+        return {**tab, "E": E}
+
+    monkeypatch.setattr(luts, "read_table", edited)
+    assert pumpup.audit(path, preset="bsdl", lookup_check=False, eavg=False).above_one == 1
