@@ -792,8 +792,10 @@ def read_table(path, preset) -> dict:
     """
     p = _preset(preset)
     path = os.fspath(path)
-    if not os.path.isfile(path):
+    if not os.path.exists(path):
         raise LutError(f"no such file: {path!r}")
+    if not os.path.isfile(path):  # (a FIFO would block the reader forever)
+        raise LutError(f"{path!r} is not a regular file (a directory, a FIFO or a device): tables are read from files")
     try:
         if p.fmt == "c":
             return _read_c(path, p)

@@ -14,6 +14,7 @@ import json
 import math
 import os
 import reprlib
+import stat
 import sys
 import tempfile
 import weakref
@@ -765,6 +766,9 @@ def open_table(path: str | os.PathLike[str], group: str | None = None) -> xr.Dat
     path = os.fspath(path)
     if not os.path.exists(path):
         raise FileNotFoundError(f"no such table: {path!r}")
+    if not stat.S_ISREG(os.stat(path).st_mode):  # (a FIFO would block the reader forever)
+        raise TableError(f"{path!r} is not a regular file (a directory, a FIFO or a device): tables are read from "
+                         "files")
     where = path if group is None else f"{path}, group {group!r}"
     try:
         with xr.open_dataset(path, engine="netcdf4", group=group) as ds:

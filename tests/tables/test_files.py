@@ -283,3 +283,18 @@ def test_a_killed_write_leaves_no_temporary_behind(tmp_path):
     live.write_bytes(b"")  # a live process's temporary of this target: not touched
     pumpup.write_table(pumpup.tabulate(pumpup.load(LAMBERT_HALF), mu=[0.5, 1.0]), target)
     assert sorted(os.listdir(tmp_path)) == sorted(["big.nc", mine.name, live.name])
+
+
+def test_a_fifo_or_a_directory_at_a_table_path_is_refused_at_once(tmp_path):
+    """A FIFO would block the netCDF reader forever: open_table, load_pumped and audit refuse non-regular files in one
+    line, within a second."""
+    import time
+
+    fifo = tmp_path / "table.nc"
+    os.mkfifo(fifo)
+    start = time.monotonic()
+    for call in (lambda: pumpup.open_table(fifo), lambda: pumpup.load_pumped(fifo), lambda: pumpup.open_table(tmp_path),
+                 lambda: pumpup.audit(fifo, preset="bsdl", lookup_check=False)):
+        with pytest.raises(ValueError, match="is not a regular file"):
+            call()
+    assert time.monotonic() - start < 1.0
