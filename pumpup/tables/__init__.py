@@ -746,10 +746,12 @@ def write_groups(path, root, groups) -> str:
     return os.fspath(path)
 
 
-def open_table(path: str | os.PathLike[str], group: str | None = None) -> xr.Dataset:
+def open_table(path: str | os.PathLike[str], group: str | None = None, *,
+               require_digest: bool = True) -> xr.Dataset:
     """Open a netCDF table written by pumpup, fully loaded into memory, and validate it
     (:func:`pumpup.tables.validate.validate_dataset`: variables, coordinates, shapes, finite values,
-    mu in (0, 1] strictly increasing, albedo >= 0, a loadable spec; checksums).
+    mu in (0, 1] strictly increasing, albedo >= 0, a loadable spec; the checksum, which every file pumpup writes
+    carries: ``require_digest=False`` reads a file without one, from another tool).
 
     Raises
     ------
@@ -778,7 +780,7 @@ def open_table(path: str | os.PathLike[str], group: str | None = None) -> xr.Dat
     except Exception as exc:  # netCDF/HDF5 raise OSError, RuntimeError, KeyError, AttributeError, ... on damage
         raise TableError(f"{where!r} is not a readable netCDF file (damaged or another format): "
                          f"{type(exc).__name__}: {exc}") from None
-    validate_dataset(ds, where)
+    validate_dataset(ds, where, require_digest=require_digest)
     from .validate import DIGEST_ATTR
 
     ds.attrs.pop(DIGEST_ATTR, None)  # verified; the Dataset is what was written

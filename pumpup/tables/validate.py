@@ -183,21 +183,26 @@ def _check_albedo_vars(path: str, ds) -> None:
     _finite_nonnegative(path, ds, "albedo_error")
 
 
-def validate_dataset(ds, path: str) -> None:
+def validate_dataset(ds, path: str, require_digest: bool = True) -> None:
     """Check a Dataset read from ``path`` by its ``pumpup_kind``; raise :class:`TableError` if it
-    is not what pumpup wrote.
+    is not what pumpup wrote.  Every file pumpup writes carries its checksum (:data:`DIGEST_ATTR`); one without it is
+    refused unless ``require_digest`` is False (a file written by another tool).
     """
     from . import TABLE_KIND
 
     path = os.fspath(path)
+    kind = ds.attrs.get("pumpup_kind")
+    if not isinstance(kind, str) or not kind.startswith("pumpup"):
+        raise TableError(f"{path!r} is a netCDF file but not a pumpup table (no 'pumpup_kind' attribute)")
+    if require_digest and DIGEST_ATTR not in ds.attrs:
+        raise TableError(f"{path!r} has no checksum (attribute {DIGEST_ATTR!r}): pumpup writes one with every "
+                         "file, so this one was edited or written by another tool (open_table(..., "
+                         "require_digest=False) reads it unchecked)")
     if DIGEST_ATTR in ds.attrs:
         stored = ds.attrs[DIGEST_ATTR]
         if not isinstance(stored, str) or stored != content_digest(ds):
             raise TableError(f"{path!r}: its content does not match the checksum pumpup wrote with it "
                              f"(attribute {DIGEST_ATTR!r}): the file was damaged or edited")
-    kind = ds.attrs.get("pumpup_kind")
-    if not isinstance(kind, str) or not kind.startswith("pumpup"):
-        raise TableError(f"{path!r} is a netCDF file but not a pumpup table (no 'pumpup_kind' attribute)")
     if kind == TABLE_KIND:
         _check_albedo_vars(path, ds)
         _check_mu(path, ds, increasing=True)

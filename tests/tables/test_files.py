@@ -64,7 +64,7 @@ def test_open_table_refuses_what_is_not_a_table(tmp_path, table_file):
     for k, (what, bad, match) in enumerate(_variants(ds)):
         path = _write_raw(bad, tmp_path / f"bad{k}.nc")
         with pytest.raises(TableError, match=match) as exc:
-            pumpup.open_table(path)
+            pumpup.open_table(path, require_digest=False)  # (the checks behind the checksum)
         assert str(path) in str(exc.value), what
     assert issubclass(TableError, ValueError)
 
@@ -145,8 +145,12 @@ def _edit_group(src, dst, group, fn):
     r = fn(d)
     d = r if isinstance(r, xr.Dataset) else d
     d.attrs.pop("pumpup_digest", None)
-    if group is None:
+    if group is None:  # consistent with its digest too: the deeper checks must catch it
         import netCDF4
+
+        from pumpup.tables.validate import content_digest
+
+        d.attrs["pumpup_digest"] = content_digest(d)
 
         with netCDF4.Dataset(dst, "a") as nc:
             for k in list(nc.ncattrs()):
@@ -298,3 +302,18 @@ def test_a_fifo_or_a_directory_at_a_table_path_is_refused_at_once(tmp_path):
         with pytest.raises(ValueError, match="is not a regular file"):
             call()
     assert time.monotonic() - start < 1.0
+
+
+def test_a_file_without_its_checksum_is_refused_unless_asked(tmp_path):
+    """Every file pumpup writes carries its checksum; deleting it (and editing the albedo) is refused, and
+    ``require_digest=False`` reads a file from another tool unchecked."""
+    path = tmp_path / "t.nc"
+    pumpup.write_table(pumpup.tabulate(pumpup.load({"type": "phong", "n": 20}), rtol=1e-8), path)
+    import netCDF4
+
+    with netCDF4.Dataset(path, "a") as nc:
+        nc.delncattr("pumpup_digest")
+        nc["albedo"][0] = 1.083
+    with pytest.raises(ValueError, match="has no checksum"):
+        pumpup.open_table(path)
+    assert float(pumpup.open_table(path, require_digest=False)["albedo"][0]) == 1.083
