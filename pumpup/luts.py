@@ -781,6 +781,32 @@ def _read_filament(path: str, p: Preset) -> dict:
     return {"E": half[..., 1].T.copy(), "B": half[..., 0].T.copy()}
 
 
+#: the largest text table (a C array, Filament's header) :func:`read_table` scans: the time to read it is bounded by
+#: the size, and renderers ship a few hundred kB (Cycles' shader tables, 287 kB)
+MAX_TEXT_BYTES = 8 * 2**20
+
+
+def _check_npy_header(path: str, p: Preset) -> None:
+    """A LutError unless the .npy file's header declares a (n_rough, n_mu, 1 or 2) array whose bytes the file holds:
+    checked before any array is allocated (a damaged header may declare terabytes).
+    """
+    try:
+        with open(path, "rb") as fh:
+            version = np.lib.format.read_magic(fh)
+            fmt = np.lib.format
+            read_header = fmt.read_array_header_1_0 if version == (1, 0) else fmt.read_array_header_2_0
+            shape, _, dtype = read_header(fh)
+            offset = fh.tell()
+    except (ValueError, OSError, EOFError, SyntaxError) as exc:
+        raise LutError(f"{path!r} is not a readable .npy file: {exc}") from None
+    if len(shape) != 3 or tuple(shape[:2]) != (p.n_rough, p.n_mu) or shape[2] not in (1, 2):
+        raise LutError(f"{path!r}: array of shape {shape}; preset {p.name} needs ({p.n_rough}, {p.n_mu}, 1 or 2)")
+    need = offset + int(np.prod(shape)) * dtype.itemsize
+    if os.path.getsize(path) < need:
+        raise LutError(f"{path!r} is truncated: its header declares {need} bytes, the file holds "
+                       f"{os.path.getsize(path)}")
+
+
 def read_table(path, preset) -> dict:
     """Read a table file in a preset's format: a dict with ``E`` (n_mu, n_rough) as E values
     (1 - E tables converted), and ``E_avg`` (n_rough,) / ``B`` where the file has them.
@@ -796,15 +822,19 @@ def read_table(path, preset) -> dict:
         raise LutError(f"no such file: {path!r}")
     if not os.path.isfile(path):  # (a FIFO would block the reader forever)
         raise LutError(f"{path!r} is not a regular file (a directory, a FIFO or a device): tables are read from files")
+    if p.fmt in ("c", "filament") and os.path.getsize(path) > MAX_TEXT_BYTES:
+        raise LutError(f"{path!r} holds {os.path.getsize(path)} bytes; a text table of preset {p.name} is read up to "
+                       f"{MAX_TEXT_BYTES} (renderers ship a few hundred kB: Cycles' shader tables, 287 kB)")
     try:
         if p.fmt == "c":
             return _read_c(path, p)
         if p.fmt == "filament":
             return _read_filament(path, p)
         if p.fmt == "npy":
+            _check_npy_header(path, p)
             try:
                 arr = np.load(path, allow_pickle=False)
-            except (ValueError, OSError) as exc:
+            except (ValueError, OSError, EOFError) as exc:
                 raise LutError(f"{path!r} is not a readable .npy file: {exc}") from None
             if arr.ndim != 3 or arr.shape[:2] != (p.n_rough, p.n_mu) or arr.shape[2] < 1:
                 raise LutError(f"{path!r}: array of shape {arr.shape}; preset {p.name} needs "

@@ -366,3 +366,28 @@ def test_audit_counts_e_above_one_beyond_rounding_only(monkeypatch, tmp_path):
 
     monkeypatch.setattr(luts, "read_table", edited)
     assert pumpup.audit(path, preset="bsdl", lookup_check=False, eavg=False).above_one == 1
+
+
+def test_damaged_or_oversized_table_files_are_refused_before_reading(tmp_path):
+    """An empty .npy, a header that declares terabytes, a truncated array and a 60 MB C file of commas: one LutError
+    each, before any array is allocated or any text scanned (the commas took 29 s, the header a MemoryError)."""
+    import time
+
+    p = luts.PRESETS["mitsuba"]
+    empty = tmp_path / "empty.npy"
+    empty.write_bytes(b"")
+    huge, short = tmp_path / "huge.npy", tmp_path / "short.npy"
+    with open(huge, "wb") as fh:
+        np.lib.format.write_array_header_1_0(fh, {"descr": "<f8", "fortran_order": False, "shape": (10**6, 10**6, 1)})
+    with open(short, "wb") as fh:
+        np.lib.format.write_array_header_1_0(fh, {"descr": "<f8", "fortran_order": False,
+                                                  "shape": (p.n_rough, p.n_mu, 1)})
+        fh.write(b"\0" * 100)
+    commas = tmp_path / "commas.h"
+    commas.write_bytes(b"," * (60 * 2**20))
+    start = time.monotonic()
+    for path, preset, match in ((empty, "mitsuba", "not a readable .npy"), (huge, "mitsuba", "needs \\(32, 32"),
+                                (short, "mitsuba", "is truncated"), (commas, "cycles", "is read up to")):
+        with pytest.raises(luts.LutError, match=match):
+            luts.read_table(path, preset)
+    assert time.monotonic() - start < 1.0
