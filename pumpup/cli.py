@@ -67,21 +67,21 @@ def _one_line(text: str) -> str:
 
 
 def check_out(path: str, option: str = "--out") -> None:
-    """Exit with one line naming ``path`` unless a file can be written there: its directory exists, is a
-    directory and is writable, and ``path`` is not itself a directory (checked before any work).
+    """Exit with one line naming ``path`` unless a file can be written there (checked before any work:
+    :func:`pumpup.tables.check_output_path`; a ``.zarr`` store may be a directory).
     """
     import os
 
-    directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.exists(directory):
-        raise SystemExit(f"pumpup: {option} {path}: directory {directory!r} does not exist")
-    if not os.path.isdir(directory):
-        raise SystemExit(f"pumpup: {option} {path}: {directory!r} is not a directory")
-    if not os.access(directory, os.W_OK):
-        raise SystemExit(f"pumpup: {option} {path}: directory {directory!r} is not writable")
-    if os.path.isdir(path) and not path.rstrip("/").endswith(".zarr"):
-        raise SystemExit(f"pumpup: {option} {path}: is a directory")
-    if os.path.exists(path) and not os.access(path, os.W_OK):
+    from .tables import check_output_path
+
+    try:
+        if path.rstrip("/").endswith(".zarr"):  # a store is a directory: its parent must take it
+            check_output_path(path.rstrip("/") + ".probe")
+        else:
+            check_output_path(path)
+    except OSError as exc:
+        raise SystemExit(f"pumpup: {option} {path}: {exc}") from None
+    if os.path.exists(path) and not os.path.isdir(path) and not os.access(path, os.W_OK):
         raise SystemExit(f"pumpup: {option} {path}: the file is not writable")
 
 

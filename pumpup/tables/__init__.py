@@ -670,6 +670,37 @@ def _fsync_path(path: str, directory: bool = False) -> None:
         os.close(fd)
 
 
+def check_output_path(path) -> str:
+    """``path`` as a string if a file can be written there, else an OSError naming it, before any work: not empty, not
+    a directory (nor ending with a separator), a name the file system allows, and a directory that exists and takes a
+    new file (probed with a hidden temporary: a read-only mount or ``/proc`` pass the permission bits).
+    """
+    path = os.fspath(path)
+    if not path:
+        raise OSError("cannot write to an empty path: give a file name")
+    if path.endswith(os.sep) or os.path.isdir(path):
+        raise OSError(f"cannot write {path!r}: it names a directory; give a file name")
+    directory = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(directory):
+        raise OSError(f"cannot write {path!r}: directory {directory!r} does not exist")
+    if not os.access(directory, os.W_OK):
+        raise OSError(f"cannot write {path!r}: directory {directory!r} is not writable")
+    try:
+        name_max = os.pathconf(directory, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        name_max = 255
+    if len(os.fsencode(os.path.basename(path))) > name_max - 24:  # (room for the temporary's prefix and suffix)
+        raise OSError(f"cannot write {path!r}: its name is {len(os.path.basename(path))} characters long; this file "
+                      f"system allows {name_max} (less the {24} a temporary file adds)")
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".pumpup-probe.", dir=directory)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise OSError(f"cannot write {path!r}: directory {directory!r} takes no new file ({exc.strerror})") from None
+    return path
+
+
 @contextlib.contextmanager
 def atomic_path(path):
     """Yield a temporary file beside ``path``; rename it into place only if the block succeeds.
@@ -679,14 +710,8 @@ def atomic_path(path):
     permissions the user's umask gives a new file (0666 & ~umask), also when it replaces one, and
     its data reach the disk (fsync) before the rename.
     """
-    path = os.fspath(path)
+    path = check_output_path(path)
     directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise OSError(f"cannot write {path!r}: directory {directory!r} does not exist")
-    if not os.access(directory, os.W_OK):
-        raise OSError(f"cannot write {path!r}: directory {directory!r} is not writable")
-    if os.path.isdir(path):
-        raise OSError(f"cannot write {path!r}: it is a directory")
     for stale in stale_temporaries(path):
         with contextlib.suppress(OSError):
             os.unlink(stale)

@@ -348,3 +348,25 @@ def test_mean_and_max_albedo_arguments():
         pumpup.max_albedo(PHONG, rtol=float("nan"))
     with pytest.raises(TypeError, match="tabulate needs a pumpup BRDF"):
         pumpup.tabulate({"type": "phong", "n": 20})
+
+
+@pytest.mark.parametrize("name, match", [("", "empty path"), ("sub/", "names a directory"),
+                                         ("/proc/x.nc", "takes no new file"), ("a" * 300 + ".nc", "characters long")],
+                         ids=str)
+def test_output_paths_are_checked_before_writing(tmp_path, name, match):
+    """An empty name, a trailing separator, a directory that takes no file (/proc) and a name too long for the file
+    system: one OSError naming the user's path (not a hidden temporary), before anything is written; the command line
+    exits 2 with one line before it computes."""
+    import subprocess
+    import sys
+
+    (tmp_path / "sub").mkdir()
+    path = name if name.startswith("/") or not name else str(tmp_path / name)
+    ds = pumpup.tabulate(pumpup.load({"type": "lambert"}), mu=[0.5, 1.0])
+    with pytest.raises(OSError, match=match) as exc:
+        pumpup.write_table(ds, path)
+    assert ".tmp" not in str(exc.value) and (not path or repr(path) in str(exc.value))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["sub"]
+    run = subprocess.run([sys.executable, "-m", "pumpup.cli", "table", "phong:n=20", "--out", path],
+                         capture_output=True, text=True, timeout=60)
+    assert run.returncode == 2 and len(run.stderr.strip().splitlines()) == 1 and match in run.stderr, run.stderr
