@@ -638,11 +638,13 @@ def _pid_alive(pid: int) -> bool:
 _TMP_SUFFIX = ".pumpup-tmp"
 
 
-def stale_temporaries(path) -> list[str]:
-    """Temporary files of ``path`` left by writes that were killed (their process is gone)."""
+def stale_temporaries(path, any_target: bool = False) -> list[str]:
+    """Temporary files of ``path`` (``any_target``: of any file in its directory) left by writes that were killed
+    (their process is gone).  A temporary is named ``.<target>.<pid>.<random>`` plus :data:`_TMP_SUFFIX`.
+    """
     path = os.fspath(path)
     directory = os.path.dirname(os.path.abspath(path))
-    prefix = "." + os.path.basename(path) + "."
+    prefix = "." if any_target else "." + os.path.basename(path) + "."
     out = []
     try:
         names = os.listdir(directory)
@@ -651,7 +653,8 @@ def stale_temporaries(path) -> list[str]:
     for name in names:
         if not (name.startswith(prefix) and name.endswith(_TMP_SUFFIX)):
             continue
-        pid = name[len(prefix):-len(_TMP_SUFFIX)].split(".")[0]
+        parts = name[:-len(_TMP_SUFFIX)].rsplit(".", 2)  # [".<target>", "<pid>", "<random>"]
+        pid = parts[1] if len(parts) == 3 else ""
         if pid.isdigit() and not _pid_alive(int(pid)):
             out.append(os.path.join(directory, name))
     return out
@@ -706,13 +709,13 @@ def atomic_path(path):
     """Yield a temporary file beside ``path``; rename it into place only if the block succeeds.
 
     An interrupted write never leaves a half file at ``path`` (nor a temporary one; one left by a
-    process that was killed is removed by the next write of the same target).  The file gets the
+    process that was killed is removed by the next pumpup write in the same directory).  The file gets the
     permissions the user's umask gives a new file (0666 & ~umask), also when it replaces one, and
     its data reach the disk (fsync) before the rename.
     """
     path = check_output_path(path)
     directory = os.path.dirname(os.path.abspath(path))
-    for stale in stale_temporaries(path):
+    for stale in stale_temporaries(path, any_target=True):  # (a killed write's, of any file here)
         with contextlib.suppress(OSError):
             os.unlink(stale)
     fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(path)}.{os.getpid()}.", suffix=_TMP_SUFFIX, dir=directory)

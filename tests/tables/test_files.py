@@ -317,3 +317,16 @@ def test_a_file_without_its_checksum_is_refused_unless_asked(tmp_path):
     with pytest.raises(ValueError, match="has no checksum"):
         pumpup.open_table(path)
     assert float(pumpup.open_table(path, require_digest=False)["albedo"][0]) == 1.083
+
+
+def test_a_killed_writes_temporary_is_removed_by_the_next_write_in_its_directory(tmp_path):
+    """A temporary left by a write whose process is gone is removed by the next pumpup write in the same directory, of
+    any file; one of a live process (this one) is left alone."""
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    pid = int(dead.stdout)
+    stale = tmp_path / f".other.nc.{pid}.abc123.pumpup-tmp"
+    live = tmp_path / f".other.nc.{os.getpid()}.xyz789.pumpup-tmp"
+    stale.write_bytes(b"half")
+    live.write_bytes(b"half")
+    pumpup.write_table(pumpup.tabulate(pumpup.load({"type": "lambert"}), mu=[0.5, 1.0]), tmp_path / "t.nc")
+    assert not stale.exists() and live.exists()
