@@ -41,6 +41,7 @@ about N is L = 2 (N.R) N - R, which is what is implemented (it keeps R.V = cos a
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -776,6 +777,9 @@ def plot_efficiency(ds, path):
         a.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7, ncol=2)
     bx.legend(fontsize=7)
-    fig.savefig(path, dpi=90)
+    from .tables import atomic_path
+
+    with atomic_path(path) as tmp:  # (atomically, with the user's permissions)
+        fig.savefig(tmp, dpi=90, format=os.path.splitext(os.fspath(path))[1][1:] or "png")
     plt.close(fig)
     return path

@@ -55,6 +55,7 @@ True
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -794,5 +795,8 @@ def plot(result: Chi2Result, path, index: int | None = None):
         f"level {result.significance:.3g}, {'pass' if result.passed_each[j] else 'FAIL'}"
     )
     fig.tight_layout()
-    fig.savefig(path)
+    from .tables import atomic_path
+
+    with atomic_path(path) as tmp:  # (atomically, with the user's permissions)
+        fig.savefig(tmp, format=os.path.splitext(os.fspath(path))[1][1:] or "png")
     return fig

@@ -1,6 +1,7 @@
 """Importance sampling and Monte Carlo estimators (issue 8; 000 sec. 4)."""
 
 import math
+import os
 
 import helpers
 import numpy as np
@@ -387,3 +388,20 @@ def test_chi2_catches_a_wrong_phong_pdf():
 
     res = chi2_test(sample, lambda wi, wo: pumpup.sampling.pdf(wrong, wi, wo), CHI2_VIEWS, n_samples=1_000_000, seed=11)
     assert not res.passed
+
+
+def test_the_efficiency_figure_is_written_atomically_with_the_users_permissions(tmp_path):
+    import stat
+
+    from pumpup import sampling
+
+    ds = pumpup.open_table(helpers.ROOT / "tables" / "sampling_efficiency.nc")
+    out = tmp_path / "efficiency.png"
+    sampling.plot_efficiency(ds, out)
+    umask = os.umask(0)
+    os.umask(umask)
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert stat.S_IMODE(out.stat().st_mode) == 0o666 & ~umask
+    assert [p.name for p in tmp_path.iterdir()] == ["efficiency.png"]  # no temporary left
+    with pytest.raises(OSError, match="does not exist"):
+        sampling.plot_efficiency(ds, tmp_path / "missing" / "efficiency.png")
