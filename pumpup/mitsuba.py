@@ -514,6 +514,31 @@ class _ProductG:
         return g + self.rows[s * w + d]
 
 
+#: the largest float32, the type Mitsuba's JIT variants evaluate in
+FLOAT32_MAX = float(np.finfo(np.float32).max)
+
+
+def _check_float32(brdf: BRDF) -> None:
+    """A SpecError unless every number of ``brdf``'s spec and its value at normal incidence and at a 45-degree
+    mirror pair fit float32: beyond it, Mitsuba would get inf without a word.
+    """
+    stack = [("", brdf.spec)]
+    while stack:
+        name, v = stack.pop()
+        if isinstance(v, dict):
+            stack.extend((k if not name else f"{name}.{k}", x) for k, x in v.items())
+        elif isinstance(v, list):
+            stack.extend((f"{name}[{i}]", x) for i, x in enumerate(v))
+        elif isinstance(v, (int, float)) and not isinstance(v, bool) and abs(v) > FLOAT32_MAX:
+            raise SpecError(f"pumpup.mitsuba: parameter {name!r} = {v:g} is beyond float32's range (|x| <= 3.4e38), "
+                            "in which Mitsuba evaluates: the BSDF would return inf")
+    s = math.sqrt(0.5)
+    peak = np.asarray(brdf.eval(np.array([[0.0, 0.0, 1.0], [s, 0.0, s]]), np.array([[0.0, 0.0, 1.0], [-s, 0.0, s]])))
+    if not np.all(np.abs(peak) <= FLOAT32_MAX):
+        raise SpecError(f"pumpup.mitsuba: {json.dumps(brdf.spec)} evaluates to {float(np.max(np.abs(peak))):g} at its "
+                        "peak, beyond float32's range (3.4e38) in which Mitsuba evaluates")
+
+
 class _DrModel:
     """A pumpup BRDF translated to Dr.Jit: ``f(wl, v)`` in Float64, and its sampling strategy."""
 
@@ -521,6 +546,7 @@ class _DrModel:
     ROUND_DOWN = 1.0 - 2.0**-23
 
     def __init__(self, brdf: BRDF):
+        _check_float32(brdf)
         self.brdf = brdf
         self.levels: list[_Level] = []
         #: (eta, k) of an outer ``fresnel`` model (base x F(Theta_min), pumpup.models.fresnel), else None

@@ -612,7 +612,8 @@ def albedo(brdf: BRDF, mu: ArrayLike, return_error: bool = False, rtol: float = 
     return_error : bool
         Also return the error estimate.
     rtol, atol : float
-        The cubature refines until its error estimate is below max(rtol * a, atol).
+        The cubature refines until its error estimate is below max(rtol * a, atol): rtol in (0, 1], atol >= 0
+        (0: the relative tolerance alone).
     max_regions : int
         Rectangles that refinement may add per value of mu (beyond the first grid, which
         grows with the lobe's kinks); if the tolerance is not met by then, an

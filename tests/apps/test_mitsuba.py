@@ -409,3 +409,14 @@ def test_from_mitsuba_diffuse_albedo_and_reciprocity():
     assert 0 < r.max_rel_error <= 4 * 2.0**-24
     with pytest.raises(ValueError, match="channel"):
         pm.from_mitsuba({"type": "diffuse"}, channel=3, variant=LLVM)
+
+
+def test_parameters_beyond_float32_are_refused_in_one_line():
+    """Mitsuba evaluates in float32: a parameter or a peak value beyond 3.4e38 would give inf radiance without a word."""
+    from pumpup import mitsuba as M
+
+    with pytest.raises(pumpup.SpecError, match="parameter 'c' = 1e\\+40 is beyond float32"):
+        M._DrModel(pumpup.load({"type": "phong", "n": 20, "c": 1e40}))
+    with pytest.raises(pumpup.SpecError, match="at its peak, beyond float32"):  # (c / cos 45 deg at the mirror)
+        M._DrModel(pumpup.load({"type": "stretched_phong", "n": 2000, "c": 3e38}))
+    M._DrModel(pumpup.load({"type": "phong", "n": 20, "c": 3e38}))  # (c at its peak: within float32)
