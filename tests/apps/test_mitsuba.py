@@ -412,7 +412,7 @@ def test_from_mitsuba_diffuse_albedo_and_reciprocity():
 
 
 def test_parameters_beyond_float32_are_refused_in_one_line():
-    """Mitsuba evaluates in float32: a parameter or a peak value beyond 3.4e38 would give inf radiance without a word."""
+    """Mitsuba evaluates in float32: a parameter or a peak value beyond 3.4e38 would give inf radiance, unsaid."""
     from pumpup import mitsuba as M
 
     with pytest.raises(pumpup.SpecError, match="parameter 'c' = 1e\\+40 is beyond float32"):
