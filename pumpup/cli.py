@@ -675,7 +675,7 @@ def cmd_render(args) -> int:
 
     try:
         size = render.check_size(int(args.size) if args.size.strip().lstrip("+-").isdigit() else args.size)
-        lights = [render.check_light(v) for v in args.light.split(",")] if args.what == "sphere" else []
+        lights = [render.check_light(v, from_text=True) for v in args.light.split(",")] if args.what == "sphere" else []
         exposure = float(args.exposure)
         if not math.isfinite(exposure):
             raise ValueError(f"--exposure must be a finite number of stops, got {args.exposure!r}")

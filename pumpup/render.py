@@ -118,8 +118,12 @@ def check_size(size) -> int:
     return int(size)
 
 
-def check_light(light_deg) -> float:
-    """``light_deg`` (Phi_L, degrees) as a float in [0, 180), or a ValueError naming it."""
+def check_light(light_deg, from_text: bool = False) -> float:
+    """``light_deg`` (Phi_L, degrees) as a float in [0, 180), or a ValueError naming it; a string only
+    ``from_text`` (the command line's).
+    """
+    if not from_text and (isinstance(light_deg, (str, bytes, bool, np.bool_))):
+        raise ValueError(f"light angle Phi_L must be a number of degrees in [0, 180), got {light_deg!r}")
     try:
         v = float(light_deg)
     except (TypeError, ValueError):

@@ -279,3 +279,11 @@ def test_furnace_clipping_allows_the_error_bound():
     assert R.tone_map(im)[1].all()
     im.radiance[:] = 1.0 + 2e-16  # a light scaled so that the peak is 1, to rounding: not clipped
     assert not R.tone_map(im)[1].any()
+
+
+@pytest.mark.parametrize("light", ["30", True, b"30"], ids=str)
+def test_a_light_angle_given_as_text_or_a_bool_is_refused_in_one_line(light):
+    from pumpup import render
+
+    with pytest.raises(ValueError, match="light angle Phi_L must be a number of degrees"):
+        render.sphere({"type": "lambert"}, light_deg=light, size=8)
