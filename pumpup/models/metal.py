@@ -256,6 +256,8 @@ class Plastic(BRDF):
         s_max = _plastic_max_s(n, self.p["eta"])  # the bound fails: compute max S itself (cached)
         if ad + a_s * s_max > 1.0 + 1e-9:
             limit = (1.0 - ad) / s_max
+            scale = 10.0 ** (5 - math.floor(math.log10(limit))) if limit > 0.0 else 1.0
+            limit = math.floor(limit * scale) / scale  # (6 digits, rounded down: the advice must be followable)
             raise SpecError(
                 f"{self.type}: ad + a_s * max S must not exceed 1 (energy conservation; S, the specular lobe's "
                 f"albedo, reaches {s_max:.6f} for n = {n:g}): with ad = {ad:g}, 'a_s' must be at most {limit:.6g}; "

@@ -61,3 +61,15 @@ def test_other_energy_claims(spec):
     # "the largest c that conserves energy" (000 eq. 6)
     lo, _ = _max_albedo_bound(pumpup.load(spec))
     assert lo <= 1.0
+
+
+@pytest.mark.parametrize("n, ad", [(0.0, 0.3), (0.5, 0.1), (0.2, 0.0), (1.0, 0.5), (0.05, 0.7)])
+def test_plastics_advice_on_a_s_can_be_followed(n, ad):
+    """The error names the largest a_s energy conservation allows, rounded down to its 6 digits: a plastic with that
+    a_s loads (rounded to nearest, the advice could be refused)."""
+    import re
+
+    with pytest.raises(pumpup.SpecError, match="must be at most") as exc:
+        pumpup.load({"type": "plastic", "n": n, "ad": ad, "a_s": 1.0 - ad})
+    limit = float(re.search(r"at most ([0-9.e+-]+);", str(exc.value)).group(1))
+    pumpup.load({"type": "plastic", "n": n, "ad": ad, "a_s": limit})
