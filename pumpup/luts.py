@@ -305,6 +305,9 @@ def model_spec(model, preset=None) -> tuple[dict, str]:
         raise SpecError(f"model {kind!r} has no roughness-like parameter pumpup knows; lut supports "
                         f"{', '.join(ROUGH_PARAM)}")
     param = ROUGH_PARAM[kind]
+    if param in spec and not isinstance(model, BRDF):  # (a BRDF always carries it: its value is replaced alike)
+        raise SpecError(f"the table's axis sets {kind}'s {param!r} (alpha = rough^2 at every node); remove "
+                        f"{param}={spec[param]!r} from the model")
     spec.pop(param, None)
     if preset is not None and kind in ("ggx", "beckmann") and "shadowing" not in spec:
         spec["shadowing"] = _preset(preset).shadowing

@@ -391,3 +391,11 @@ def test_damaged_or_oversized_table_files_are_refused_before_reading(tmp_path):
         with pytest.raises(luts.LutError, match=match):
             luts.read_table(path, preset)
     assert time.monotonic() - start < 1.0
+
+
+def test_a_roughness_the_tables_axis_sets_is_refused_in_the_model():
+    """The table's axis sets alpha = rough^2 at every node: an alpha in the model spec was silently ignored."""
+    with pytest.raises(pumpup.SpecError, match="the table's axis sets ggx's 'alpha'"):
+        pumpup.audit(helpers.DATA / "cycles_shader.tables", preset="cycles", model="ggx:alpha=0.3")
+    with pytest.raises(pumpup.SpecError, match="remove alpha=0.3"):
+        pumpup.lut({"type": "ggx", "alpha": 0.3}, preset="bsdl")
