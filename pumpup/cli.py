@@ -511,8 +511,8 @@ def cmd_mc(args) -> int:
 
     f = _load(args.spec)
     mu = np.asarray(args.mu if args.mu else [1.0, 0.5, 0.1, 0.01], dtype=float)
-    if args.n < 1:
-        raise SystemExit(f"pumpup: --n must be >= 1, got {args.n}")
+    if not 1 <= args.n <= pumpup.sampling.MAX_SAMPLES:
+        raise SystemExit(f"pumpup: --n must be an integer in [1, {pumpup.sampling.MAX_SAMPLES:.0e}], got {args.n}")
     rng = np.random.default_rng(args.seed)
     try:
         est, se = pumpup.mc_albedo(f, mu, args.n, rng, kind=args.strategy)

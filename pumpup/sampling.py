@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import math
 import os
+import reprlib
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -412,9 +413,13 @@ def _check_wo(wo) -> np.ndarray:
     return w
 
 
+#: the most samples :func:`sample` and :func:`mc_albedo` draw at once (their arrays: about 24 bytes per sample each)
+MAX_SAMPLES = 10**8
+
+
 def _check_n(n) -> int:
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise ValueError(f"the number of samples n must be an integer >= 1, got {n!r}")
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= MAX_SAMPLES:
+        raise ValueError(f"the number of samples n must be an integer in [1, {MAX_SAMPLES:.0e}], got {reprlib.repr(n)}")
     return int(n)
 
 

@@ -405,3 +405,9 @@ def test_the_efficiency_figure_is_written_atomically_with_the_users_permissions(
     assert [p.name for p in tmp_path.iterdir()] == ["efficiency.png"]  # no temporary left
     with pytest.raises(OSError, match="does not exist"):
         sampling.plot_efficiency(ds, tmp_path / "missing" / "efficiency.png")
+
+
+def test_a_sample_count_beyond_the_bound_is_refused_in_one_line():
+    """n is bounded (its arrays take about 24 bytes per sample): 10**20 was accepted and ran."""
+    with pytest.raises(ValueError, match="must be an integer in \\[1, 1e\\+08\\]"):
+        pumpup.mc_albedo(pumpup.load({"type": "phong", "n": 20}), 0.5, 10**20)

@@ -45,6 +45,7 @@ CASES = [
     (["divergence", "all", "--tables", "nodir"], "--tables nodir: directory does not exist"),
     (["divergence", "ward:m=-0.1"], r"parameter 'm' = -0.1 is outside its allowed range \[1e-06, 1000\]"),
     (["divergence", "ward:m=0.1", "--mu-min", "0"], r"--mu-min must be a number in \(0, 1\)"),
+    (["mc", "phong:n=20", "--n", "99999999999999999999"], r"--n must be an integer in \[1, 1e\+08\]"),
     (["albedo", "phong:n=20", "--theta", "100"], r"theta must be in \[0, 90\) degrees"),
     (["albedo", "phong:n=20", "--theta", "-30"], r"--theta -30: .*\[0, 90\)"),
     (["albedo", "phong:n=20", "--rtol", "0"], r"rtol must be a finite number in \(0, 1\]"),
