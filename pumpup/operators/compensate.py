@@ -963,7 +963,7 @@ def load_compensated(path: str | os.PathLike[str]) -> BRDF:
     """Load a BRDF saved by :func:`save_compensated`, without recomputing its tables."""
     from ..tables import AlbedoTable, open_table
 
-    root = open_table(path)
+    root = open_table(path, _container=True)  # (the saved BRDF's root)
     if root.attrs.get("pumpup_kind") != "pumpup compensated BRDF":
         raise ValueError(f"{os.fspath(path)!r} is a pumpup file but not a saved compensated BRDF "
                          f"(pumpup_kind {root.attrs.get('pumpup_kind')!r})")

@@ -1098,7 +1098,7 @@ def load_pumped(path: str | os.PathLike[str]) -> Pumped:
     from ..tables.validate import TableError, spec_attribute
 
     where = os.fspath(path)
-    root = open_table(path)
+    root = open_table(path, _container=True)  # (the saved BRDF's root)
     registry()  # (the providers: a kind of file below may be theirs)
     other = FILE_KINDS.get(root.attrs.get("pumpup_kind"))
     if other is not None:  # another kind of pumped model's file (pumpup.spectral's, with a wavelength dimension)

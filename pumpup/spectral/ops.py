@@ -186,7 +186,7 @@ def load_spectral_pumped(path, root=None) -> SpectralPumped:
 
     where = os.fspath(path)
     if root is None:
-        root = open_table(path)
+        root = open_table(path, _container=True)  # (the saved BRDF's root)
     if root.attrs.get("pumpup_kind") != SPECTRAL_PUMPED_KIND:
         raise TableError(f"{where!r} is a pumpup file, not a saved spectral pumped BRDF")
     spec = spec_attribute(where, root)

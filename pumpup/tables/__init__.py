@@ -774,8 +774,13 @@ def write_groups(path, root, groups) -> str:
     return os.fspath(path)
 
 
+#: the kinds of file that hold a saved BRDF (its tables in groups), and the function that reads each
+SAVED_BRDF_READERS = {"pumpup pumped BRDF": "pumpup.load_pumped", "pumpup compensated BRDF": "pumpup.load_compensated",
+                      "pumpup spectral pumped BRDF": "pumpup.load_pumped"}
+
+
 def open_table(path: str | os.PathLike[str], group: str | None = None, *,
-               require_digest: bool = True) -> xr.Dataset:
+               require_digest: bool = True, _container: bool = False) -> xr.Dataset:
     """Open a netCDF table written by pumpup, fully loaded into memory, and validate it
     (:func:`pumpup.tables.validate.validate_dataset`: variables, coordinates, shapes, finite values,
     mu in (0, 1] strictly increasing, albedo >= 0, a loadable spec; the checksum, which every file pumpup writes
@@ -809,6 +814,10 @@ def open_table(path: str | os.PathLike[str], group: str | None = None, *,
         raise TableError(f"{where!r} is not a readable netCDF file (damaged or another format): "
                          f"{type(exc).__name__}: {exc}") from None
     validate_dataset(ds, where, require_digest=require_digest)
+    reader = SAVED_BRDF_READERS.get(ds.attrs.get("pumpup_kind")) if group is None and not _container else None
+    if reader is not None:  # (its tables are in groups: the root alone holds none)
+        raise TableError(f"{path!r} is a {ds.attrs['pumpup_kind'][len('pumpup '):]}, not a table: read it with "
+                         f"{reader}, or give group= one of its tables")
     from .validate import DIGEST_ATTR
 
     ds.attrs.pop(DIGEST_ATTR, None)  # verified; the Dataset is what was written

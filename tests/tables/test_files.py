@@ -330,3 +330,18 @@ def test_a_killed_writes_temporary_is_removed_by_the_next_write_in_its_directory
     live.write_bytes(b"half")
     pumpup.write_table(pumpup.tabulate(pumpup.load({"type": "lambert"}), mu=[0.5, 1.0]), tmp_path / "t.nc")
     assert not stale.exists() and live.exists()
+
+
+def test_open_table_on_a_saved_brdf_names_its_reader(tmp_path):
+    """A saved pumped or compensated BRDF keeps its tables in groups: open_table of its root said nothing and returned
+    an empty Dataset; it names the function that reads it (and its groups still open)."""
+    pumped, comp = tmp_path / "p.nc", tmp_path / "c.nc"
+    pumpup.save_pumped(pumpup.pump({"type": "phong", "n": 20}), pumped)
+    pumpup.save_compensated(pumpup.compensate({"type": "ggx", "alpha": 0.3}), comp)
+    with pytest.raises(ValueError, match="is a pumped BRDF, not a table: read it with pumpup.load_pumped"):
+        pumpup.open_table(pumped)
+    with pytest.raises(ValueError, match="is a compensated BRDF, not a table: read it with pumpup.load_compensated"):
+        pumpup.open_table(comp)
+    assert pumpup.open_table(pumped, group="level1")["albedo"].size > 2
+    assert float(pumpup.albedo(pumpup.load_pumped(pumped), 0.5)) == float(pumpup.albedo(pumpup.pump(
+        {"type": "phong", "n": 20}), 0.5))
