@@ -33,7 +33,7 @@ Gaussian's scale; each piece is adaptive 10/21 Gauss-Kronrod (the worst bisected
 share of the albedo's lower bound so far.
 
 J(theta) is analytic and periodic; the rule over theta is globally adaptive 7/15 Gauss-Kronrod over the turn, the rays'
-errors added through the Kronrod weights as frame 4 does (:func:`pumpup.engine.polar._k_numeric`).  Near grazing
+errors added through the Kronrod weights as frame 4 does (:func:`pumpup.engine.half_arc._k_numeric`).  Near grazing
 incidence the disc's edge nearest to h = N, m* = -(cos phi, sin phi)(1 - s) / mu, comes within the Gaussian: in the
 stretched plane it is a line at the distance ``edge`` = mu / ((1 + s) a_x a_y |T|), T = (-sin phi / a_x, cos phi / a_y)
 its direction.  A ray at an angle delta from it meets it at R ~ edge / sin(delta), so J changes from its value near the
@@ -45,7 +45,7 @@ th0 +- pi / 2 left a_x / a_y = 1000 at mu = 1e-4 4e-7 off, and cuts on the near 
 8.4e-13 off with an estimate of 5e-13.  Where wi lies in the plane of a tangent axis (phi = 0 or pi / 2, and isotropic
 models, which take phi = 0) J is even about th0 and half the turn is integrated.  The estimate per interval, of the rays
 and of theta, is QUADPACK's calibration of |K - G| (:func:`pumpup.physics.quadrature.calibrated`), plus the rounding
-term :data:`pumpup.engine.polar.ROUNDING` times the sum of |K|.
+term :data:`pumpup.engine.lobe_frame.ROUNDING` times the sum of |K|.
 
 Checked in ``tests/engine/test_slope.py`` against ``tests/data/independent_ward_aniso.json`` (two nested-quad methods
 written without pumpup, ``tests/reference/independent_ward_aniso.py``), against the nested engine at rtol 1e-13 (the

@@ -360,7 +360,7 @@ class TorranceSparrow(BRDF):
         from ..core.hints import AzimuthHint, Fresnel, VCavityLobe
 
         # 002 eq. 10: F G D / (pi (N.S)(N.V)); the azimuth of h in closed form for F = 1
-        # (pumpup.engine.polar._k_vcavity), by a rule on its arc with F(wi.h)
+        # (pumpup.engine.half_frames._k_vcavity), by a rule on its arc with F(wi.h)
         f_at_h = Fresnel(ior=self.p["ior"]) if self.p["ior"] else None
         if d == "D1":  # D = b cos^e(alpha): the power weight u^e
             return AzimuthHint(VCavityLobe(n=e, fresnel=f_at_h), scale=lambda mu: b / (math.pi * np.asarray(mu, float)))

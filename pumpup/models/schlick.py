@@ -90,7 +90,7 @@ class Schlick(BRDF):
 
         r, c = self.p["r"], self.p["c"]
         # 000 eq. 36: r / (1 - (1 - r) cos^2)^2 = 1 / (r cos^4 (1 + tan^2 / r)^2), the GGX weight with alpha = sqrt(r);
-        # 1 / (r + (1 - r) N.V) about N, the weight's azimuth in closed form (pumpup.engine.polar._integrate_n), the
-        # rest in the scale
+        # 1 / (r + (1 - r) N.V) about N, the weight's azimuth in closed form (pumpup.engine.normal_frame._integrate_n),
+        # the rest in the scale
         return AzimuthHint(SchlickLobe(r=r),
                            scale=lambda mu: c / (4.0 * math.pi * r * (r + (1.0 - r) * np.asarray(mu, float))))

@@ -91,7 +91,8 @@ class Ward(BRDF):
 
         m, c = self.p["m"], self.p["c"]
         # 000 eq. 34: c / (4 pi m^2 sqrt(mu)) times exp(-tan^2(alpha) / m^2) / sqrt(N.wo); the half vector's azimuth
-        # by complete elliptic integrals (pumpup.engine.polar._k_ward), the Beckmann weight in t = tan^2(alpha) / m^2
+        # by complete elliptic integrals (pumpup.engine.half_frames._k_ward), the Beckmann weight in
+        # t = tan^2(alpha) / m^2
         return AzimuthHint(WardLobe(m=m), scale=lambda mu: c / (4.0 * math.pi * m * m * np.sqrt(mu)))
 
 

@@ -131,8 +131,8 @@ def fresnel_levels(eta: float, k: float, y0_max: float | None = None) -> tuple:
     eta = 1 with k = 0 (a dielectric seen from the denser side) F = 1 up to cos = x0 = sqrt(1 - eta^2), total
     reflection, with a square-root kink there; a small k makes it a near-kink, the branch point sqrt(1 -
     (eta + i k)^2) = x0 - i y0 (:func:`fresnel_branch`) y0 off the axis.  The 1-D path declines such a factor
-    (``pumpup.engine.polar.lobe_fresnel_ok``) and the nested engine, blind to the kink, bisected towards it: fresnel
-    over Blinn n = 5, eta = 0.551, k = 0 took 0.25-0.41 s per value at rtol 1e-10 (issue 14's twenty-first session,
+    (``pumpup.engine.lobe_fresnel.lobe_fresnel_ok``) and the nested engine, blind to the kink, bisected towards it:
+    fresnel over Blinn n = 5, eta = 0.551, k = 0 took 0.25-0.41 s per value at rtol 1e-10 (issue 14's twenty-first session,
     ``scripts/studies/fuzz_engines.py --registry``).
     """
     x0, y0 = fresnel_branch(float(eta), float(k))

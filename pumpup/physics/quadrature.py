@@ -56,7 +56,7 @@ every kink marked) references: at most 0.12 calibrated, 0.18 raw, 0.23 with "min
 evaluations change by only -13 % .. +14 % (``--cost``; Cook-Torrance m = 0.3: +14 %), since the
 refinement is spent where rectangles are poorly resolved, and there QUADPACK's estimate is the
 larger one.  The 1-D path's evaluations are set by its first intervals: the gain there is
-``pumpup.engine.polar.N_INIT`` = 1 (one first interval per piece, was 2), which the calibrated
+``pumpup.engine.lobe_frame.N_INIT`` = 1 (one first interval per piece, was 2), which the calibrated
 estimate meets at rtol 1e-10 almost everywhere.
 """
 
