@@ -815,7 +815,7 @@ def open_table(path: str | os.PathLike[str], group: str | None = None, *,
                          f"{type(exc).__name__}: {exc}") from None
     validate_dataset(ds, where, require_digest=require_digest)
     reader = SAVED_BRDF_READERS.get(ds.attrs.get("pumpup_kind")) if group is None and not _container else None
-    if reader is not None:  # (its tables are in groups: the root alone holds none)
+    if reader is not None and not ds.data_vars:  # (its tables are in groups: this root holds none)
         raise TableError(f"{path!r} is a {ds.attrs['pumpup_kind'][len('pumpup '):]}, not a table: read it with "
                          f"{reader}, or give group= one of its tables")
     from .validate import DIGEST_ATTR
