@@ -1,8 +1,11 @@
 """The albedo engine: directional albedo a(mu) of any BRDF with an error estimate that bounds the truth.
 
-Its routes: the 2-D adaptive cubature (:mod:`.cubature`, which also holds the public :func:`albedo`), the nested
-quadrature on smooth arcs (:mod:`.nested`), the 1-D paths with the azimuth in closed form (:mod:`.polar`) and slope
-space for anisotropic Ward (:mod:`.slope`).
+One table chooses the route from what a model declares (:mod:`.routes`, printed by ``routes.describe()``).  The
+routes: the 2-D adaptive cubature (:mod:`.cubature`, which also holds the public :func:`albedo`), the nested quadrature
+on smooth arcs (:mod:`.nested`; the two share :mod:`.lobe_geometry` and :mod:`.arc_breaks`), the 1-D routes with the
+azimuth in closed form or by a rule on known arcs (run by :mod:`.polar`, one module per frame: :mod:`.lobe_frame`,
+:mod:`.half_frames`, :mod:`.half_arc`, :mod:`.lobe_fresnel`, :mod:`.normal_frame`, :mod:`.chain_frame`, with
+:mod:`.outer_rule` and :mod:`.hint_view`) and slope space for anisotropic Ward (:mod:`.slope`).
 """
 
 from .._lazy import submodules
