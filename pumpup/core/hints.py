@@ -223,11 +223,6 @@ class AzimuthHint:
     scale: Callable
     factors: tuple = ()
 
-    @property
-    def family_name(self) -> str:
-        """The family record's class name."""
-        return type(self.family).__name__
-
     def factor(self, kind: type):
         """The factor of type ``kind``, or None."""
         return next((f for f in self.factors if isinstance(f, kind)), None)

@@ -935,7 +935,7 @@ class Pumped(BRDF):
             hit = lk.table_kinks = tuple(sorted(v for v in out if 0.0 < v < 1.0))
         return hit
 
-    def _polar_levels(self, mu: float) -> tuple:
+    def _hint_levels(self, mu: float) -> tuple:
         """The 1-D path's levels of g at incidence mu: the lobe's (:meth:`lobe`) and :meth:`table_kinks` (the nested
         engine, whose estimate was calibrated without them, keeps the lobe's alone).  The lobe's levels are every
         level's :meth:`kink_levels` and the innermost base's lobe levels, gathered here without the Lobe of every level
@@ -964,7 +964,7 @@ class Pumped(BRDF):
         from ..core.hints import DivideByG
 
         hint = self.chain()[0].base.azimuth_hint()
-        return None if hint is None else hint.times(DivideByG(self._chain_args(), self._polar_levels))
+        return None if hint is None else hint.times(DivideByG(self._chain_args(), self._hint_levels))
 
     def azimuth_range(self):
         """The base's (g depends on N.wi and N.wo only)."""

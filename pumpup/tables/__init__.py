@@ -673,10 +673,11 @@ def _fsync_path(path: str, directory: bool = False) -> None:
         os.close(fd)
 
 
-def check_output_path(path) -> str:
+def check_output_path(path, probe: bool = True) -> str:
     """``path`` as a string if a file can be written there, else an OSError naming it, before any work: not empty, not
     a directory (nor ending with a separator), a name the file system allows, and a directory that exists and takes a
-    new file (probed with a hidden temporary: a read-only mount or ``/proc`` pass the permission bits).
+    new file (``probe``: tried with a hidden temporary, since a read-only mount or ``/proc`` pass the permission bits;
+    :func:`atomic_path` creates its own temporary instead).
     """
     path = os.fspath(path)
     if not path:
@@ -695,13 +696,18 @@ def check_output_path(path) -> str:
     if len(os.fsencode(os.path.basename(path))) > name_max - 24:  # (room for the temporary's prefix and suffix)
         raise OSError(f"cannot write {path!r}: its name is {len(os.path.basename(path))} characters long; this file "
                       f"system allows {name_max} (less the {24} a temporary file adds)")
-    try:
-        fd, probe = tempfile.mkstemp(prefix=".pumpup-probe.", dir=directory)
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as exc:
-        raise OSError(f"cannot write {path!r}: directory {directory!r} takes no new file ({exc.strerror})") from None
+    if probe:
+        try:
+            fd, tmp = tempfile.mkstemp(prefix=".pumpup-probe.", dir=directory)
+            os.close(fd)
+            os.unlink(tmp)
+        except OSError as exc:
+            raise _no_new_file(path, directory, exc) from None
     return path
+
+
+def _no_new_file(path: str, directory: str, exc: OSError) -> OSError:
+    return OSError(f"cannot write {path!r}: directory {directory!r} takes no new file ({exc.strerror})")
 
 
 @contextlib.contextmanager
@@ -713,12 +719,16 @@ def atomic_path(path):
     permissions the user's umask gives a new file (0666 & ~umask), also when it replaces one, and
     its data reach the disk (fsync) before the rename.
     """
-    path = check_output_path(path)
+    path = check_output_path(path, probe=False)  # (the temporary below is the probe)
     directory = os.path.dirname(os.path.abspath(path))
     for stale in stale_temporaries(path, any_target=True):  # (a killed write's, of any file here)
         with contextlib.suppress(OSError):
             os.unlink(stale)
-    fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(path)}.{os.getpid()}.", suffix=_TMP_SUFFIX, dir=directory)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(path)}.{os.getpid()}.", suffix=_TMP_SUFFIX,
+                                   dir=directory)
+    except OSError as exc:
+        raise _no_new_file(path, directory, exc) from None
     os.close(fd)
     try:
         yield tmp
