@@ -311,8 +311,7 @@ def cmd_check(args) -> int:
     if hasattr(f, "report"):  # a compensated BRDF (pumpup.compensate): its E table and bounds
         print(f.report())
     m = pumpup.max_albedo(f)
-    print(f"max albedo (constant set to 1): {m.albedo:.12g} +- {m.error:.2g} at theta = {m.theta_deg:.6f} +- "
-          f"{m.theta_error:.2g} deg; maximum constant {m.constant:.12g}")
+    print(f"max albedo (constant set to 1): {m}")
     return 0 if r.reciprocal else 1
 
 

@@ -923,6 +923,46 @@ class AlbedoMaximum:
     #: half-width [deg] of the theta interval the maximum may lie in: where a(mu) is within the
     #: albedo errors of the maximum (a flat maximum is located only to about sqrt(error / curvature))
     theta_error: float = 0.0
+    #: the albedo grows without bound towards grazing incidence (then ``albedo`` is inf, ``constant`` 0, ``mu`` 0)
+    diverges: bool = False
+    #: for a diverging albedo, k of a(mu) ~ mu^-k over the last decade probed, and the change of k from the decade
+    #: before (0 otherwise)
+    exponent: float = 0.0
+    exponent_error: float = 0.0
+    #: for a diverging albedo, the smallest mu probed and the albedo there (nan otherwise)
+    mu_probed: float = math.nan
+    albedo_probed: float = math.nan
+
+    def __str__(self) -> str:
+        if self.diverges:
+            return (f"unbounded: a(mu) ~ mu^-{self.exponent:.3g} (+- {self.exponent_error:.1g}) towards grazing "
+                    f"incidence ({self.albedo_probed:.6g} at mu = {self.mu_probed:.3g}); maximum constant 0")
+        return (f"{self.albedo:.12g} +- {self.error:.2g} at theta = {self.theta_deg:.6f} +- {self.theta_error:.2g} deg; "
+                f"maximum constant {self.constant:.12g}")
+
+
+#: :func:`max_albedo` probes these decades of mu below its ``mu_min`` when the albedo peaks there
+DIVERGENCE_DECADES = 4
+#: an albedo that still grows by at least this exponent per decade over the last decade probed, and by at least half
+#: the previous decade's exponent, diverges: a bounded albedo that rises to its limit (Schlick's model,
+#: a ~ a0 - c mu) has an exponent that falls tenfold per decade, below 1e-5 under mu = 1e-6; Ward's stays 0.5
+DIVERGENCE_EXPONENT_MIN = 1e-3
+
+
+def _grazing_trend(f, mu_min: float, a_min: float, e_min: float, rtol: float):
+    """(diverges, exponent, exponent_error, mu, albedo) of ``f``'s albedo over :data:`DIVERGENCE_DECADES` decades below
+    ``mu_min``, where the albedo is ``a_min`` +- ``e_min``.
+    """
+    mu = mu_min * 10.0 ** -np.arange(1, DIVERGENCE_DECADES + 1)
+    a, e = albedo(f, mu, return_error=True, rtol=rtol)
+    a, e = np.concatenate([[a_min], a]), np.concatenate([[e_min], e])
+    if not (np.isfinite(a).all() and (a > 0).all()):
+        return False, 0.0, 0.0, math.nan, math.nan
+    k = np.log10(a[1:] / a[:-1])  # a ~ mu^-k per decade
+    rising = bool((np.diff(a) > e[1:] + e[:-1]).all())
+    last, before = float(k[-1]), float(k[-2])
+    diverges = rising and last >= DIVERGENCE_EXPONENT_MIN and last >= 0.5 * before
+    return diverges, last, abs(last - before), float(mu[-1]), float(a[-1])
 
 
 def _unit_constant(brdf: BRDF) -> BRDF:
@@ -936,6 +976,18 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
 
     A scan uniform in theta (plus decades of mu down to ``mu_min``) finds the best node;
     a bounded Brent search (scipy ``minimize_scalar``) between its neighbours refines it.
+
+    Where the albedo peaks at ``mu_min``, four more decades below it are probed: an albedo that keeps growing there
+    as a power of mu (Ward's, a ~ mu^-0.5) has no maximum, and the result says so (``diverges``, with the exponent;
+    ``albedo`` inf and ``constant`` 0) instead of giving the value at ``mu_min``.  ``pumpup.divergence`` fits the law
+    over a wider window.
+
+    Examples
+    --------
+    >>> import pumpup
+    >>> m = pumpup.max_albedo(pumpup.load("ward:m=0.1"))
+    >>> m.diverges, m.constant, round(m.exponent, 3)
+    (True, 0.0, 0.5)
     """
     from scipy.optimize import minimize_scalar
 
@@ -970,6 +1022,12 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
     elif scan is not None:
         best_a, best_e = (float(v) for v in albedo(f, best_mu, return_error=True, rtol=rtol))
     at_boundary = i in (0, len(mu) - 1)
+    if i == 0:  # the albedo peaks at the smallest mu scanned: does it go on growing below it?
+        diverges, k, k_error, mu_probed, a_probed = _grazing_trend(f, best_mu, best_a, best_e, rtol)
+        if diverges:
+            return AlbedoMaximum(albedo=math.inf, error=0.0, mu=0.0, theta_deg=90.0, constant=0.0, constant_error=0.0,
+                                 at_boundary=True, diverges=True, exponent=k, exponent_error=k_error,
+                                 mu_probed=mu_probed, albedo_probed=a_probed)
     theta_error = 0.0 if at_boundary else _location_error(f, best_mu, best_a, best_e, rtol, lo, hi)
     return AlbedoMaximum(
         albedo=best_a,
@@ -1016,6 +1074,8 @@ def max_constant(brdf: BRDF, **kw: Any) -> tuple[float, float]:
     Returns
     -------
     (constant, theta_deg)
+        For an albedo that grows without bound towards grazing incidence (:attr:`AlbedoMaximum.diverges`), (0.0, 90.0)
+        with an :class:`~pumpup.engine.AlbedoWarning` that gives the exponent.
 
     Examples
     --------
@@ -1026,6 +1086,12 @@ def max_constant(brdf: BRDF, **kw: Any) -> tuple[float, float]:
     """
     _check_brdf("max_constant", brdf)
     m = max_albedo(brdf, **kw)
+    if m.diverges:
+        import warnings
+
+        from ..engine.cubature import AlbedoWarning
+
+        warnings.warn(f"max_constant: the albedo of {brdf!r} has no maximum: {m}", AlbedoWarning, stacklevel=2)
     return m.constant, m.theta_deg
 
 

@@ -54,3 +54,11 @@ def test_mc_command(capsys):
         main(["mc", "phong:n=20", "--mu", "0"])
     with pytest.raises(SystemExit, match="--n"):
         main(["mc", "phong:n=20", "--n", "0"])
+
+
+def test_check_says_a_diverging_albedo_has_no_maximum(capsys):
+    assert main(["check", "ward:m=0.1"]) == 0
+    out = capsys.readouterr().out
+    assert "max albedo (constant set to 1): unbounded: a(mu) ~ mu^-0.5" in out and "maximum constant 0" in out
+    assert main(["check", "phong:n=20"]) == 0
+    assert "maximum constant 3.5014" in capsys.readouterr().out  # (n + 2) / (2 pi) / a(1), a(1) = 0.2856
