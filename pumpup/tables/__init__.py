@@ -937,8 +937,8 @@ class AlbedoMaximum:
         if self.diverges:
             return (f"unbounded: a(mu) ~ mu^-{self.exponent:.3g} (+- {self.exponent_error:.1g}) towards grazing "
                     f"incidence ({self.albedo_probed:.6g} at mu = {self.mu_probed:.3g}); maximum constant 0")
-        return (f"{self.albedo:.12g} +- {self.error:.2g} at theta = {self.theta_deg:.6f} +- {self.theta_error:.2g} deg; "
-                f"maximum constant {self.constant:.12g}")
+        return (f"{self.albedo:.12g} +- {self.error:.2g} at theta = {self.theta_deg:.6f} +- {self.theta_error:.2g} "
+                f"deg; maximum constant {self.constant:.12g}")
 
 
 #: :func:`max_albedo` probes these decades of mu below its ``mu_min`` when the albedo peaks there
