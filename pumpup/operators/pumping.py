@@ -1094,15 +1094,22 @@ def load_pumped(path: str | os.PathLike[str]) -> Pumped:
     pumpup.tables.validate.TableError (a ValueError)
         If the file is damaged, edited, or not a saved pumped BRDF (the message says what).
     """
+    from ..tables import snapshot
+
+    with snapshot(path) as copy:  # every group from one file, whatever a concurrent save puts at path meanwhile
+        return _load_pumped(copy, os.fspath(path))
+
+
+def _load_pumped(path: str, where: str) -> Pumped:
+    """:func:`load_pumped` of the file at ``path`` (a snapshot), named ``where`` in messages."""
     from ..tables import open_table
     from ..tables.validate import TableError, spec_attribute
 
-    where = os.fspath(path)
-    root = open_table(path, _container=True)  # (the saved BRDF's root)
+    root = open_table(path, _container=True, _name=where)  # (the saved BRDF's root)
     registry()  # (the providers: a kind of file below may be theirs)
     other = FILE_KINDS.get(root.attrs.get("pumpup_kind"))
     if other is not None:  # another kind of pumped model's file (pumpup.spectral's, with a wavelength dimension)
-        return other(path, root)
+        return other(path, root, where)
     if root.attrs.get("pumpup_kind") != "pumpup pumped BRDF":
         raise TableError(f"{where!r} is a pumpup table, not a saved pumped BRDF")
     spec = spec_attribute(where, root)
@@ -1130,7 +1137,7 @@ def attach_level_table(path, where: str, group: str, level: Pumped, what: str) -
     from ..tables.validate import TableError
 
     try:
-        ds = open_table(path, group=group)
+        ds = open_table(path, group=group, _name=where)
     except OSError as exc:  # a missing group
         raise TableError(f"{where!r}: group {group!r} is missing or unreadable: {exc}") from None
     if ds.attrs.get("pumpup_kind") != "pumpup albedo table":

@@ -167,7 +167,7 @@ def save_spectral_pumped(f: Spectral, path) -> str:
     return write_groups(path, root, groups)
 
 
-def load_spectral_pumped(path, root=None) -> SpectralPumped:
+def load_spectral_pumped(path, root=None, where: str | None = None) -> SpectralPumped:
     """Load a spectral pumped BRDF saved by :func:`save_spectral_pumped`, without recomputing its tables.
 
     Every group is validated (:func:`pumpup.open_table`: checksums, digest, values); the root's
@@ -181,12 +181,14 @@ def load_spectral_pumped(path, root=None) -> SpectralPumped:
     """
     from ..core import load
     from ..operators.pumping import attach_level_table
-    from ..tables import open_table
+    from ..tables import open_table, snapshot
     from ..tables.validate import TableError, spec_attribute
 
-    where = os.fspath(path)
-    if root is None:
-        root = open_table(path, _container=True)  # (the saved BRDF's root)
+    if root is None:  # every group from one file, whatever a concurrent save puts at path meanwhile
+        with snapshot(path) as copy:
+            return load_spectral_pumped(copy, open_table(copy, _container=True, _name=os.fspath(path)),
+                                        os.fspath(path))
+    where = os.fspath(path) if where is None else where
     if root.attrs.get("pumpup_kind") != SPECTRAL_PUMPED_KIND:
         raise TableError(f"{where!r} is a pumpup file, not a saved spectral pumped BRDF")
     spec = spec_attribute(where, root)

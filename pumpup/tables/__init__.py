@@ -789,8 +789,39 @@ SAVED_BRDF_READERS = {"pumpup pumped BRDF": "pumpup.load_pumped", "pumpup compen
                       "pumpup spectral pumped BRDF": "pumpup.load_pumped"}
 
 
+@contextlib.contextmanager
+def snapshot(path: str | os.PathLike[str]):
+    """A private copy of the file at ``path``, read through one open: the path of the copy, inside the block.
+
+    A saved BRDF is several groups of one file; reading them with one open each, an atomic save between two opens
+    would give an object built from two files.  The copy is read whole through one open (the file that was at
+    ``path`` then, whatever replaces it later), so every group comes from one writer's file.  Non-regular files (a
+    FIFO would block the reader forever) are refused before anything is read.
+    """
+    import shutil
+
+    from .validate import TableError
+
+    path = os.fspath(path)
+    if not os.path.exists(path):
+        raise FileNotFoundError(f"no such file: {path!r}")
+    try:  # O_NONBLOCK: a FIFO put at the path after the check above still cannot block the open
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError as exc:
+        raise TableError(f"{path!r} cannot be read: {exc.strerror}") from None
+    with os.fdopen(fd, "rb") as src:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise TableError(f"{path!r} is not a regular file (a directory, a FIFO or a device): saved BRDFs are read "
+                             "from files")
+        with tempfile.TemporaryDirectory(prefix="pumpup-snapshot-") as folder:
+            copy = os.path.join(folder, "snapshot.nc")
+            with open(copy, "wb") as dst:
+                shutil.copyfileobj(src, dst)
+            yield copy
+
+
 def open_table(path: str | os.PathLike[str], group: str | None = None, *,
-               require_digest: bool = True, _container: bool = False) -> xr.Dataset:
+               require_digest: bool = True, _container: bool = False, _name: str | None = None) -> xr.Dataset:
     """Open a netCDF table written by pumpup, fully loaded into memory, and validate it
     (:func:`pumpup.tables.validate.validate_dataset`: variables, coordinates, shapes, finite values,
     mu in (0, 1] strictly increasing, albedo >= 0, a loadable spec; the checksum, which every file pumpup writes
@@ -809,12 +840,13 @@ def open_table(path: str | os.PathLike[str], group: str | None = None, *,
     from .validate import TableError, validate_dataset
 
     path = os.fspath(path)
+    name = path if _name is None else _name  # (a snapshot's reader names the user's file)
     if not os.path.exists(path):
-        raise FileNotFoundError(f"no such table: {path!r}")
+        raise FileNotFoundError(f"no such table: {name!r}")
     if not stat.S_ISREG(os.stat(path).st_mode):  # (a FIFO would block the reader forever)
-        raise TableError(f"{path!r} is not a regular file (a directory, a FIFO or a device): tables are read from "
+        raise TableError(f"{name!r} is not a regular file (a directory, a FIFO or a device): tables are read from "
                          "files")
-    where = path if group is None else f"{path}, group {group!r}"
+    where = name if group is None else f"{name}, group {group!r}"
     try:
         with xr.open_dataset(path, engine="netcdf4", group=group) as ds:
             ds = ds.load()
@@ -826,7 +858,7 @@ def open_table(path: str | os.PathLike[str], group: str | None = None, *,
     validate_dataset(ds, where, require_digest=require_digest)
     reader = SAVED_BRDF_READERS.get(ds.attrs.get("pumpup_kind")) if group is None and not _container else None
     if reader is not None and not ds.data_vars:  # (its tables are in groups: this root holds none)
-        raise TableError(f"{path!r} is a {ds.attrs['pumpup_kind'][len('pumpup '):]}, not a table: read it with "
+        raise TableError(f"{name!r} is a {ds.attrs['pumpup_kind'][len('pumpup '):]}, not a table: read it with "
                          f"{reader}, or give group= one of its tables")
     from .validate import DIGEST_ATTR
 
