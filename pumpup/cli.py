@@ -30,18 +30,40 @@ def parse_spec(text: str) -> dict:
 
 
 def _load(text: str, spectral: bool = False):
-    """The model of a SPEC argument; a spectral one (a 'material' or per-wavelength lists, pumpup.spectral)
-    only where the command prints or writes per wavelength (``spectral=True``).
+    """The model of a SPEC argument, or of a saved BRDF file (``pumpup pump --out``, ``pumpup compensate --out``) read
+    without recomputing its tables; a spectral one (a 'material' or per-wavelength lists, pumpup.spectral) only where
+    the command prints or writes per wavelength (``spectral=True``).
     """
+    import os
+
     import pumpup
 
     try:
-        f = pumpup.load(parse_spec(text))
+        f = _load_file(text) if os.path.isfile(text) else pumpup.load(parse_spec(text))
     except pumpup.SpecError as exc:
         raise SystemExit(f"pumpup: {exc}") from None
     if getattr(f, "is_spectral", False) and not spectral:
         raise SystemExit(f"pumpup: {SPECTRAL_REFUSED}")
     return f
+
+
+def _load_file(path: str):
+    """The BRDF saved in the file at ``path`` (its reader by the file's kind), or exit with one line saying what the
+    file is.
+    """
+    import pumpup
+    from pumpup.tables import SAVED_BRDF_READERS, saved_kind
+    from pumpup.tables.validate import TableError
+
+    try:
+        kind = saved_kind(path)
+        reader = SAVED_BRDF_READERS.get(kind)
+        if reader is None:
+            raise SystemExit(f"pumpup: {path!r} is not a saved BRDF ({kind or 'a file of no known kind'}): a SPEC is a "
+                             "model spec or a file written by 'pumpup pump --out' or 'pumpup compensate --out'")
+        return getattr(pumpup, reader.removeprefix("pumpup."))(path)
+    except (TableError, OSError) as exc:
+        raise SystemExit(f"pumpup: {_one_line(exc)}") from None
 
 
 #: the one line of a command that takes single-channel models only, given a spectral spec

@@ -1060,7 +1060,9 @@ def save_pumped(f: Pumped, path: str | os.PathLike[str]) -> str:
     """Write a pumped BRDF and the albedo tables of all its levels to one netCDF file.
 
     Group ``level1`` holds the table of the innermost base, ``level2`` that of the first
-    pumped level, and so on; the root attributes hold the spec.  Written atomically.
+    pumped level, and so on up to the pumped BRDF itself (``level<levels + 1>``: its albedo curve,
+    ``pumpup.open_table(path, group=f"level{levels + 1}")``); the root attributes hold the spec.
+    Written atomically.
     """
     import xarray as xr
 
@@ -1078,7 +1080,9 @@ def save_pumped(f: Pumped, path: str | os.PathLike[str]) -> str:
 
     root = xr.Dataset(attrs={"pumpup_kind": "pumpup pumped BRDF", "spec": json.dumps(f.spec, sort_keys=True),
                              "levels": len(chain), "pumpup_version": __version__})
-    return write_groups(path, root, [(f"level{i}", level.table().dataset) for i, level in enumerate(chain, start=1)])
+    groups = [(f"level{i}", level.table().dataset) for i, level in enumerate(chain, start=1)]
+    groups.append((f"level{len(chain) + 1}", base_table(f).dataset))  # the top level's own albedo
+    return write_groups(path, root, groups)
 
 
 def load_pumped(path: str | os.PathLike[str]) -> Pumped:
@@ -1125,13 +1129,38 @@ def _load_pumped(path: str, where: str) -> Pumped:
         raise TableError(f"{where!r}: attribute 'levels' = {levels} but its spec has {len(chain)} levels")
     for i, level in enumerate(chain, start=1):
         attach_level_table(path, where, f"level{i}", level, f"level {i} of the spec")
+    attach_top_table(path, where, f"level{len(chain) + 1}", f)
     return f
+
+
+def attach_top_table(path, where: str, group: str, f: Pumped) -> None:
+    """Read the albedo table of the pumped BRDF ``f`` itself from ``group`` of a saved pumped file where the file has
+    that group (files saved before it was written have not), and make it the table that pumping ``f`` again uses;
+    checked as :func:`attach_level_table` checks a level's.
+    """
+    import netCDF4
+
+    with netCDF4.Dataset(path) as nc:  # (path: the loader's snapshot, validated by its reader already)
+        node = nc
+        for name in group.split("/"):
+            node = node.groups.get(name) if node is not None else None
+        present = node is not None
+    if present:
+        f._derived_table = read_level_table(path, where, group, f.spec, "the pumped BRDF is")
 
 
 def attach_level_table(path, where: str, group: str, level: Pumped, what: str) -> None:
     """Read the albedo table in ``group`` of a saved pumped file, check that it is the table of
     ``level``'s base (``what`` names the level in the message) and make it that object's own table;
     every problem is one :class:`TableError` naming the file and the group.
+    """
+    level._own_table = read_level_table(path, where, group, level.base.spec, f"{what} pumps")  # never the shared cache
+
+
+def read_level_table(path, where: str, group: str, spec: dict, what: str):
+    """The :class:`~pumpup.tables.AlbedoTable` in ``group`` of a saved pumped file, checked to be the table of the
+    model ``spec`` (``what``, the message's words before the spec); every problem is one :class:`TableError` naming the file and
+    the group.
     """
     from ..tables import AlbedoTable, open_table
     from ..tables.validate import TableError
@@ -1142,12 +1171,12 @@ def attach_level_table(path, where: str, group: str, level: Pumped, what: str) -
         raise TableError(f"{where!r}: group {group!r} is missing or unreadable: {exc}") from None
     if ds.attrs.get("pumpup_kind") != "pumpup albedo table":
         raise TableError(f"{where!r}: group {group!r} is not an albedo table")
-    if json.loads(ds.attrs["spec"]) != level.base.spec:
+    if json.loads(ds.attrs["spec"]) != spec:
         raise TableError(f"{where!r}: group {group!r} holds the table of {ds.attrs['spec']}, but {what} "
-                         f"pumps {json.dumps(level.base.spec, sort_keys=True)}")
+                         f"{json.dumps(spec, sort_keys=True)}")
     try:
         t = AlbedoTable.from_dataset(ds)
     except (ValueError, KeyError, TypeError) as exc:
         raise TableError(f"{where!r}: group {group!r}: {exc}") from None
     t.dataset = ds
-    level._own_table = t  # this object's own table: never the shared cache
+    return t

@@ -789,6 +789,13 @@ SAVED_BRDF_READERS = {"pumpup pumped BRDF": "pumpup.load_pumped", "pumpup compen
                       "pumpup spectral pumped BRDF": "pumpup.load_pumped"}
 
 
+def saved_kind(path: str | os.PathLike[str]) -> str:
+    """The ``pumpup_kind`` of a file pumpup wrote (``"pumpup albedo table"``, a key of :data:`SAVED_BRDF_READERS`,
+    ...), its root validated as :func:`open_table` does.
+    """
+    return str(open_table(path, _container=True).attrs.get("pumpup_kind", ""))
+
+
 @contextlib.contextmanager
 def snapshot(path: str | os.PathLike[str]):
     """A private copy of the file at ``path``, read through one open: the path of the copy, inside the block.
