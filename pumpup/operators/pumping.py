@@ -1159,8 +1159,8 @@ def attach_level_table(path, where: str, group: str, level: Pumped, what: str) -
 
 def read_level_table(path, where: str, group: str, spec: dict, what: str):
     """The :class:`~pumpup.tables.AlbedoTable` in ``group`` of a saved pumped file, checked to be the table of the
-    model ``spec`` (``what``, the message's words before the spec); every problem is one :class:`TableError` naming the file and
-    the group.
+    model ``spec`` (``what``: the message's words before the spec); every problem is one :class:`TableError` naming
+    the file and the group.
     """
     from ..tables import AlbedoTable, open_table
     from ..tables.validate import TableError
