@@ -328,11 +328,14 @@ def definition_digest(definition: dict) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def _check_existing_output(out: str, digest: str, overwrite: bool) -> None:
-    """Refuse to replace a result of a different sweep (or a file that is not one) unless ``overwrite``."""
+def _check_existing_output(out: str, digest: str, overwrite: bool):
+    """Refuse to replace a result of a different sweep (or a file that is not one) unless ``overwrite``; the finished
+    result of this very sweep in a netCDF file (validated by :func:`pumpup.open_table`, checksums and digest), or None.
+    """
     out = os.fspath(out)
     if not os.path.exists(out) or overwrite:
-        return
+        return None
+    ds = None
     try:
         if out.rstrip("/").endswith(".zarr"):
             import xarray as xr
@@ -342,11 +345,12 @@ def _check_existing_output(out: str, digest: str, overwrite: bool) -> None:
         else:
             from .tables import open_table
 
-            attrs = open_table(out).attrs
+            ds = open_table(out)
+            attrs = ds.attrs
     except Exception:  # unreadable: not ours to replace silently
         attrs = {}
     if attrs.get("sweep_definition_sha256") == digest:
-        return
+        return ds  # (a zarr store, which carries no digest, is computed again)
     what = ("the result of a different sweep" if attrs.get("pumpup_kind") == SWEEP_KIND
             else "something that is not a result of this sweep")
     raise SweepError(f"{out!r} exists and holds {what}; pass overwrite=True (--overwrite) to replace it, "
@@ -534,7 +538,9 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu: ArrayLike | None
         Write the result here (netCDF; a zarr store if the name ends in ``.zarr``) and keep
         finished chunks in ``<out>.parts/`` until the end, so that an interrupted sweep run
         again with the same arguments resumes where it stopped.  The parts directory
-        remembers the sweep's definition; a different sweep is refused, not mixed in.
+        remembers the sweep's definition; a different sweep is refused, not mixed in.  A
+        netCDF ``out`` that holds the finished result of the same sweep is read back
+        (validated) instead of computed again.
     rtol, atol : float
         Quadrature tolerances of the albedo values (see :func:`pumpup.albedo`).
     mean : bool
@@ -645,7 +651,9 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu: ArrayLike | None
     parts = None
     todo = list(blocks)
     if out is not None:
-        _check_existing_output(out, digest, overwrite)
+        finished = _check_existing_output(out, digest, overwrite)
+        if finished is not None:  # this sweep ran to the end before: its result, not a second run
+            return finished
         parts = _Parts(out, definition, overwrite)
         todo = []
         for block in blocks:
