@@ -64,6 +64,7 @@ import numpy as np
 from numba import njit
 
 from ..core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register
+from ..core.budget import check_max_seconds, time_budget
 from ..physics.lookups import CELL_SHIFT, float_bits, scale_bound, upper_scalar
 from .pumping import (
     TABLE_DECADES,
@@ -74,6 +75,7 @@ from .pumping import (
     _ProductError,
     file_tables,
     from_file,
+    prepare,
     table_decades,
 )
 
@@ -834,7 +836,7 @@ def furnace(f: BRDF, mu: ArrayLike, return_error: bool = False,
 
 
 def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None = None, f_avg: float | None = None,
-               white: BRDF | dict | None = None, force: bool = False) -> BRDF:
+               white: BRDF | dict | None = None, force: bool = False, max_seconds: float | None = None) -> BRDF:
     """Energy compensation of a BRDF: the Kulla-Conty lobe, the 1/E scaling, or pumping.
 
     Parameters
@@ -857,6 +859,9 @@ def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None 
         The Fresnel-1 BRDF whose albedo is E (default: f without its Fresnel factor, or f).
     force : bool
         Accept a non-reciprocal base for the methods that need a reciprocal one.
+    max_seconds : float, optional
+        A time budget: the tables are computed now (by default, on first use), and past the budget the work stops
+        with :class:`pumpup.core.budget.BudgetExceeded` (a TimeoutError) instead of running on.
 
     Returns
     -------
@@ -879,7 +884,12 @@ def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None 
             raise SpecError(f"compensate: {name} must be a number in [0, 1], got {reprlib.repr(v)}")
     if not isinstance(force, (bool, np.bool_)):
         raise SpecError(f"compensate: force must be true or false, got {force!r}")
-    return compensate_model(load(f), method, f0=f0, f_avg=f_avg, white=white, force=force)
+    check_max_seconds("compensate", max_seconds)
+    with time_budget("compensate", max_seconds):
+        out = compensate_model(load(f), method, f0=f0, f_avg=f_avg, white=white, force=force)
+        if max_seconds is not None:
+            prepare(out)
+    return out
 
 
 @functools.singledispatch

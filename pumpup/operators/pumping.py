@@ -27,6 +27,7 @@ import numpy as np
 from numba import njit
 
 from ..core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register, registry
+from ..core.budget import check_max_seconds, time_budget
 from ..physics.lookups import (
     CELL_SHIFT,
     INDEX_CELLS,
@@ -1006,7 +1007,8 @@ class _Divided(BRDF):
         return _divided_lobe(self.term.lobe(mu), self.pumped, mu)
 
 
-def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False) -> Pumped:
+def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False,
+         max_seconds: float | None = None) -> Pumped:
     """Pump up the albedo of a symmetric BRDF (001 sec. 3), ``levels`` times.
 
     Parameters
@@ -1022,6 +1024,9 @@ def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False)
         Number of nested pumpings; each uses the albedo of the level below.
     force : bool
         Accept a base that :func:`pumpup.check_reciprocity` finds non-reciprocal.
+    max_seconds : float, optional
+        A time budget: the tables of every level are computed now (by default, on first use), and past the budget
+        the work stops with :class:`pumpup.core.budget.BudgetExceeded` (a TimeoutError) instead of running on.
 
     Returns
     -------
@@ -1041,7 +1046,18 @@ def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False)
         raise SpecError(f"pump: levels must be an integer in [1, {MAX_LEVELS}], got {levels!r}")
     if not isinstance(force, (bool, np.bool_)):
         raise SpecError(f"pump: force must be true or false, got {force!r}")
-    return pump_model(load(brdf), g, int(levels), force)
+    check_max_seconds("pump", max_seconds)
+    pumped = pump_model(load(brdf), g, int(levels), force)
+    if max_seconds is not None:
+        with time_budget("pump", max_seconds):
+            prepare(pumped)
+    return pumped
+
+
+def prepare(f) -> None:
+    """Compute the tables ``f`` reads (a pumped or compensated BRDF builds them on first use): one evaluation."""
+    normal = np.array([0.0, 0.0, 1.0])
+    f.eval(normal, normal)
 
 
 @functools.singledispatch

@@ -25,6 +25,9 @@ import numpy as np
 
 from .._version import __version__
 from ..core import BRDF, check_count, check_open_unit, check_tolerance, provide
+from ..core.budget import check as check_budget
+from ..core.budget import current as current_budget
+from ..core.budget import time_budget
 from ..engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
 from . import reuse as _reuse
 
@@ -307,6 +310,7 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
     V, E = (val[:, None], err[:, None]) if one else (val, err)
 
     def column_values(pts):
+        check_budget(f"refining the table's grid ({len(pts)} more values)")
         if bar is not None:
             bar.total += len(pts)
         v, e = values(pts)
@@ -373,7 +377,7 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
 def tabulate(brdf: BRDF, mu: ArrayLike | None = None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
              interp_tol: float = 1e-7, mu_min: float = 1e-8, max_points: int = 2049, progress: bool | None = None,
              threads: int | None = None, phi: ArrayLike | str | None = None,
-             breaks: ArrayLike | None = None) -> xr.Dataset:
+             breaks: ArrayLike | None = None, max_seconds: float | None = None) -> xr.Dataset:
     """Tabulate the directional albedo of ``brdf``.
 
     Parameters
@@ -413,6 +417,9 @@ def tabulate(brdf: BRDF, mu: ArrayLike | None = None, *, rtol: float = DEFAULT_R
         join the grid, and the interpolating spline is split there (:class:`AlbedoTable`; the attribute
         ``interpolation_breaks``).  The pumping operator gives those of a pumped level's albedo.  Default: the
         model's own, :meth:`pumpup.core.BRDF.albedo_breaks` (none for most models).
+    max_seconds : float, optional
+        A time budget: past it, the work stops with :class:`pumpup.core.budget.BudgetExceeded` (a TimeoutError)
+        instead of running on.  None: no bound.
 
     Returns
     -------
@@ -428,6 +435,13 @@ def tabulate(brdf: BRDF, mu: ArrayLike | None = None, *, rtol: float = DEFAULT_R
     >>> ds["albedo"].values.round(12).tolist()
     [0.5, 0.5, 0.5]
     """
+    with time_budget("tabulate", max_seconds):
+        return _tabulate(brdf, mu, rtol=rtol, atol=atol, interp_tol=interp_tol, mu_min=mu_min, max_points=max_points,
+                         progress=progress, threads=threads, phi=phi, breaks=breaks)
+
+
+def _tabulate(brdf, mu, *, rtol, atol, interp_tol, mu_min, max_points, progress, threads, phi, breaks):
+    """:func:`tabulate`, within its time budget."""
     if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer))
                                 or not 1 <= threads <= MAX_THREADS):
         raise ValueError(f"tabulate: threads must be an integer in [1, {MAX_THREADS}], got {reprlib.repr(threads)}")
@@ -521,14 +535,18 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
             threads = 1
     threads = max(1, min(threads or THREADS or _cores(), len(mu)))
 
+    import contextvars
     import threading
 
     stop = threading.Event()  # set when the caller is interrupted (Ctrl-C): the threads end soon
+    deadline = current_budget()
 
     def work(idx):
         for a in range(0, len(idx), chunk):
             if stop.is_set():
                 return
+            if deadline is not None:
+                deadline.check(f"computing {len(mu)} albedo values of {brdf.type}")
             part = idx[a:a + chunk]
             val[part], err[part] = albedo(brdf, mu[part], return_error=True, rtol=rtol, atol=atol, phi=phi)
             bar.update(len(part))
@@ -549,7 +567,8 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
 
     with ThreadPoolExecutor(threads) as pool:
         try:
-            for done in [pool.submit(work, todo[k::threads]) for k in range(threads)]:
+            # (each thread in a copy of this context: the engine's route choice and the time budget hold there too)
+            for done in [pool.submit(contextvars.copy_context().run, work, todo[k::threads]) for k in range(threads)]:
                 done.result()
         except BaseException:
             stop.set()
