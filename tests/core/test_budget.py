@@ -75,3 +75,18 @@ def test_command_line_budget_names_its_option(capsys):
     assert err.startswith("pumpup: pump: stopped after") and "past its --max-seconds 0.2" in err and "\n" not in err
     with pytest.raises(SystemExit, match="--max-seconds must be a number > 0"):
         main(["table", "phong:n=3", "--out", "x.nc", "--max-seconds", "-2"])
+
+
+def test_long_table_announces_its_estimate_and_progress(monkeypatch, capsys):
+    """A table estimated (from its first values) above LONG_WORK_SECONDS says so in one line on stderr, with a
+    progress bar there, though stderr is no terminal; below it, nothing."""
+    from pumpup import tables
+
+    f = pumpup.load("ggx:alpha=0.2")
+    pumpup.tabulate(f, progress=None)
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(tables, "LONG_WORK_SECONDS", 0.0)
+    pumpup.tabulate(pumpup.load("ggx:alpha=0.21"), progress=None)
+    err = capsys.readouterr().err
+    assert err.startswith("pumpup: the albedo table of pumpup.load(") and "will take about" in err
+    assert "albedo ggx:" in err  # the bar
