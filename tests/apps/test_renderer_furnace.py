@@ -52,7 +52,8 @@ def test_scale_with_exact_nodes_is_one_at_the_nodes():
     """A renderer whose table holds exact E (float64) renders 1 wherever it reads a node; between nodes, it renders
     the look-up's error."""
     conv = {"model": "ggx:shadowing=correlated", "quantity": "E", "format": "npy", "storage": "float64",
-            "shape": [9, 7], "axes": [{"axis": "mu", "clamp": [[0, 1e-3]]}, {"axis": "roughness", "clamp": [[0, 0.05]]}]}
+            "shape": [9, 7],
+            "axes": [{"axis": "mu", "clamp": [[0, 1e-3]]}, {"axis": "roughness", "clamp": [[0, 0.05]]}]}
     mu_nodes = np.arange(1, 9) / 8
     r_nodes = np.arange(1, 7) / 6
     ds = pumpup.furnace_prediction(conv, "scale", mu=mu_nodes, roughness=r_nodes, rtol=1e-10)
