@@ -12,6 +12,7 @@ EXTRAS = {
     "colour": ("spectral", "colour-science"),
     "mitsuba": ("render", "mitsuba"),
     "drjit": ("render", "mitsuba"),
+    "bpy": ("blender", "bpy"),
 }
 
 
