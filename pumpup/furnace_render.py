@@ -3,9 +3,10 @@
 A sphere of F = 1 metal (white base colour and edge tint) under a uniform white environment, seen by an
 orthographic camera: every pixel's value is the furnace toward the viewer at the view cosine mu of its normal,
 which :func:`pumpup.furnace_prediction` predicts.  The renders keep what the comparison needs: a box pixel filter
-one pixel wide (each sample lands in one pixel, so pixels are independent Monte Carlo estimates), no adaptive
-sampling, denoising or clamping, a transparent film (alpha is the pixel's coverage; only fully covered pixels are
-used) and the shading-normal pass, from which each pixel's mu is read.
+one pixel wide and, in Cycles, the Sobol-Burley pattern (each pixel scrambled on its own), so that pixels are
+independent Monte Carlo estimates; no adaptive sampling, denoising or clamping; a transparent film (alpha is the
+pixel's coverage; only fully covered pixels are used) and the shading-normal pass, from which each pixel's mu is
+read.
 
 :func:`rings` bins the pixels by mu and gives, per ring, the render's mean, the prediction's mean at the same
 pixels, and the Monte Carlo standard error of their difference (the scatter of the pixel residuals over the square
@@ -79,6 +80,11 @@ def render_cycles(roughness: float, distribution: str = "MULTI_GGX", *, resoluti
     cy.sample_clamp_indirect = 0.0
     cy.max_bounces = 4
     cy.seed = int(seed)
+    # Cycles' default blue-noise pattern correlates the errors of pixels whose integrands are alike (a ring's);
+    # Sobol-Burley scrambles each pixel on its own, so pixels are independent estimates (a debug option)
+    bpy.context.preferences.experimental.use_cycles_debug = True
+    bpy.context.preferences.view.show_developer_ui = True
+    cy.sampling_pattern = "SOBOL_BURLEY"
     cy.pixel_filter_type = "BOX"
     cy.filter_width = 1.0  # each sample lands in one pixel: independent pixels
     sc.render.threads_mode = "FIXED"
