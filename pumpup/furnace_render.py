@@ -3,10 +3,10 @@
 A sphere of F = 1 metal (white base colour and edge tint) under a uniform white environment, seen by an
 orthographic camera: every pixel's value is the furnace toward the viewer at the view cosine mu of its normal,
 which :func:`pumpup.furnace_prediction` predicts.  The renders keep what the comparison needs: a box pixel filter
-one pixel wide and, in Cycles, the Sobol-Burley pattern (each pixel scrambled on its own), so that pixels are
-independent Monte Carlo estimates; no adaptive sampling, denoising or clamping; a transparent film (alpha is the
-pixel's coverage; only fully covered pixels are used) and the shading-normal pass, from which each pixel's mu is
-read.
+one pixel wide; no adaptive sampling, denoising or clamping; a transparent film (alpha is the pixel's coverage;
+only fully covered pixels are used) and the shading-normal pass (a check of the geometry).  Cycles' default
+blue-noise pattern correlates the errors of pixels whose integrands are alike, as a ring's are: the standard error
+of a ring comes from renders with different seeds.
 
 :func:`rings` bins the pixels by mu and gives, per ring, the render's mean, the prediction's mean at the same
 pixels, and the Monte Carlo standard error of their difference (the scatter of the pixel residuals over the square
@@ -38,7 +38,7 @@ def _read_exr_layers(path: str) -> dict:
 
 
 def render_cycles(roughness: float, distribution: str = "MULTI_GGX", *, resolution: int = 128, spp: int = 64,
-                  seed: int = 1, threads: int = 2, keep: str | None = None) -> dict:
+                  seed: int = 1, threads: int = 2, pattern: str = "AUTOMATIC", keep: str | None = None) -> dict:
     """Render the furnace sphere with Cycles on the CPU (``bpy``).
 
     Parameters
@@ -50,6 +50,10 @@ def render_cycles(roughness: float, distribution: str = "MULTI_GGX", *, resoluti
         shipped table (``microfacet_ggx_preserve_energy``); "GGX" is the single-scattering lobe.
     resolution, spp, seed, threads : int
         Square image size in pixels, samples per pixel, Cycles' seed, CPU threads.
+    pattern : str
+        Cycles' sampling pattern: "AUTOMATIC" (Blender's default, blue noise), or the debug options
+        "TABULATED_SOBOL", "SOBOL_BURLEY", ... (Sobol-Burley renders this furnace with an offset that depends on
+        the sample count and not on the seed).
     keep : str, optional
         Keep the rendered multilayer EXR at this path.
 
@@ -80,11 +84,10 @@ def render_cycles(roughness: float, distribution: str = "MULTI_GGX", *, resoluti
     cy.sample_clamp_indirect = 0.0
     cy.max_bounces = 4
     cy.seed = int(seed)
-    # Cycles' default blue-noise pattern correlates the errors of pixels whose integrands are alike (a ring's);
-    # Sobol-Burley scrambles each pixel on its own, so pixels are independent estimates (a debug option)
-    bpy.context.preferences.experimental.use_cycles_debug = True
-    bpy.context.preferences.view.show_developer_ui = True
-    cy.sampling_pattern = "SOBOL_BURLEY"
+    if pattern != "AUTOMATIC":  # the others are debug options
+        bpy.context.preferences.experimental.use_cycles_debug = True
+        bpy.context.preferences.view.show_developer_ui = True
+    cy.sampling_pattern = pattern
     cy.pixel_filter_type = "BOX"
     cy.filter_width = 1.0  # each sample lands in one pixel: independent pixels
     sc.render.threads_mode = "FIXED"
@@ -209,39 +212,46 @@ def render_mitsuba(alpha: float, *, resolution: int = 128, spp: int = 64, seed: 
             "version": mi.__version__}
 
 
-def rings(render: dict, predict, edges=None, *, extent: float | None = 1.025, subpixels: int = 8,
+def rings(renders, predict, edges=None, *, extent: float | None = 1.025, subpixels: int = 8,
           min_alpha: float = 0.9999, min_pixels: int = 20) -> list[dict]:
     """The render against a prediction along rings of constant view cosine.
 
     Parameters
     ----------
-    render : dict
-        ``value``, ``alpha`` and ``mu`` arrays (:func:`render_cycles`, :func:`render_mitsuba`).
+    renders : dict or list of dict
+        ``value``, ``alpha`` and ``mu`` arrays (:func:`render_cycles`, :func:`render_mitsuba`); a list holds
+        renders of the same scene with different seeds.
     predict : callable
         ``predict(mu)`` -> the predicted furnace at each view cosine (a 1-D array in, the same shape out); it is
         evaluated on 4097 view cosines and interpolated.
     edges : array_like, optional
         Ring edges in mu (default 10 rings of width 0.1).
     extent : float or None
-        Half the image's width in sphere radii (both renders frame the unit sphere in [-1.025, 1.025]^2): the
-        prediction of a pixel is then averaged over ``subpixels`` x ``subpixels`` points of its footprint on the
-        exact sphere (near the rim mu varies by 0.1 across a pixel, and the furnace is not linear in mu).  None
-        predicts at the pixel's mean normal.
+        Half the image's width in sphere radii (both renders frame the unit sphere in [-1.025, 1.025]^2): a pixel
+        then belongs to the ring of its footprint's mean mu on the exact sphere, and its prediction is averaged
+        over ``subpixels`` x ``subpixels`` points of that footprint (near the rim mu varies by 0.1 across a pixel,
+        and the furnace is not linear in mu).  None uses the normal pass's mu for both.
     min_alpha : float
-        The coverage from which a pixel counts as inside the sphere.
+        The coverage from which a pixel counts as inside the sphere (in every render).
 
     Returns
     -------
     list of dict
-        Per ring with at least ``min_pixels`` pixels: ``mu_lo``, ``mu_hi``, ``mu`` (mean of the normal pass),
-        ``n``, ``render``, ``predicted`` (means over the same pixels), ``difference`` (render - predicted), ``se``
-        (the Monte Carlo standard error of the difference: the pixels' residual scatter / sqrt(n)), and
-        ``geometry`` (largest |normal pass - footprint mean| of mu in the ring, with ``extent``).
+        Per ring with at least ``min_pixels`` pixels: ``mu_lo``, ``mu_hi``, ``mu`` (mean), ``n`` (pixels),
+        ``render``, ``predicted`` (means over the same pixels and renders), ``difference`` (render - predicted),
+        ``se``, its Monte Carlo standard error, and ``geometry`` (largest |normal pass - footprint mean| of mu in
+        the ring, with ``extent``).  With several renders, ``se`` is the scatter of the renders' ring differences
+        over the square root of their number, which holds whatever the sampler correlates between pixels (Cycles'
+        default blue-noise pattern does); with one, it is the scatter of the pixel residuals over the square root
+        of their number, which assumes independent pixels.
     """
+    renders = [renders] if isinstance(renders, dict) else list(renders)
     edges = np.linspace(0.0, 1.0, 11) if edges is None else np.asarray(edges, dtype=np.float64)
-    full = (render["alpha"] > min_alpha) & np.isfinite(render["mu"]) & np.isfinite(render["value"])
-    mu = np.clip(render["mu"][full], 1e-6, 1.0)
-    val = render["value"][full]
+    full = np.ones(renders[0]["value"].shape, bool)
+    for rd in renders:
+        full &= (rd["alpha"] > min_alpha) & np.isfinite(rd["mu"]) & np.isfinite(rd["value"])
+    mu = np.clip(renders[0]["mu"][full], 1e-6, 1.0)
+    vals = np.stack([rd["value"][full] for rd in renders])
     grid = np.linspace(0.0, 1.0, 4097)
     grid[0] = 1e-6
     table = np.asarray(predict(grid), dtype=np.float64)
@@ -249,7 +259,7 @@ def rings(render: dict, predict, edges=None, *, extent: float | None = 1.025, su
         pred = np.interp(mu, grid, table)
         mu_fp = mu
     else:
-        n_rows, n_cols = render["value"].shape
+        n_rows, n_cols = renders[0]["value"].shape
         rows, cols = np.nonzero(full)
         sub = (np.arange(subpixels) + 0.5) / subpixels
         x = ((cols[:, None, None] + sub[None, None, :]) / n_cols * 2 - 1) * extent
@@ -260,14 +270,21 @@ def rings(render: dict, predict, edges=None, *, extent: float | None = 1.025, su
         mu_fp = np.sum(m, axis=1) / np.maximum(hit.sum(axis=1), 1)
     out = []
     for lo, hi in zip(edges[:-1], edges[1:]):
-        s = (mu > lo) & (mu <= hi)
+        # membership by the footprint's mu: the normal pass is a sample mean over the same sub-pixel positions as
+        # the radiance, so choosing pixels by it would choose their radiance's noise too
+        s = (mu_fp > lo) & (mu_fp <= hi)
         n = int(s.sum())
         if n < min_pixels:
             continue
-        res = val[s] - pred[s]
-        out.append({"mu_lo": float(lo), "mu_hi": float(hi), "mu": float(mu[s].mean()), "n": n,
-                    "render": float(val[s].mean()), "predicted": float(pred[s].mean()),
-                    "difference": float(res.mean()), "se": float(res.std(ddof=1) / np.sqrt(n)),
+        res = vals[:, s] - pred[s][None, :]
+        per_render = res.mean(axis=1)
+        if len(renders) > 1:
+            se = float(per_render.std(ddof=1) / np.sqrt(len(renders)))
+        else:
+            se = float(res[0].std(ddof=1) / np.sqrt(n))
+        out.append({"mu_lo": float(lo), "mu_hi": float(hi), "mu": float(mu_fp[s].mean()), "n": n,
+                    "render": float(vals[:, s].mean()), "predicted": float(pred[s].mean()),
+                    "difference": float(per_render.mean()), "se": se,
                     "geometry": float(np.max(np.abs(mu[s] - mu_fp[s])))})
     return out
 

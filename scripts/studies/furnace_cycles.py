@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """The white furnace of Blender Cycles and Mitsuba 3, rendered and predicted, ring by ring.
 
-    python scripts/studies/furnace_cycles.py [--resolution 256] [--spp 256] [--roughness 0.15 0.5 1.0]
+    python scripts/studies/furnace_cycles.py [--resolution 256] [--spp 32] [--seeds 8] [--roughness 0.15 0.5 1.0]
                                              [--out docs/user-guide/renderer-tables] [--skip-mitsuba]
 
 Renders a sphere of F = 1 metal in a white environment (pumpup.furnace_render): Cycles' Metallic BSDF with the
@@ -47,7 +47,9 @@ def predictor(conventions, method, r, path=None):
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--resolution", type=int, default=256)
-    ap.add_argument("--spp", type=int, default=256)
+    ap.add_argument("--spp", type=int, default=32, help="samples per pixel of each render")
+    ap.add_argument("--seeds", type=int, default=8, help="renders per configuration, with different seeds (the "
+                    "standard errors come from their scatter)")
     ap.add_argument("--roughness", type=float, nargs="+", default=[0.15, 0.5, 1.0])
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "user-guide", "renderer-tables"))
@@ -59,17 +61,21 @@ def main() -> int:
     runs = []
     for r in args.roughness:
         for dist, method in (("MULTI_GGX", "scale"), ("GGX", "none")):
-            img = fr.render_cycles(r, dist, resolution=args.resolution, spp=args.spp, threads=args.threads)
-            table = fr.rings(img, predictor("cycles", method, r, CYCLES_TABLE), edges)
-            runs.append({"renderer": f"Cycles {img['version']}", "bsdf": f"Metallic BSDF, {dist}",
-                         "method": method, "r": r, "rings": table, "seconds": img["seconds"]})
-            print(f"Cycles {dist} r = {r:g}: {img['seconds']:.1f} s", flush=True)
+            imgs = [fr.render_cycles(r, dist, resolution=args.resolution, spp=args.spp, threads=args.threads,
+                                     seed=1 + k) for k in range(args.seeds)]
+            table = fr.rings(imgs, predictor("cycles", method, r, CYCLES_TABLE), edges)
+            sec = sum(i["seconds"] for i in imgs)
+            runs.append({"renderer": f"Cycles {imgs[0]['version']}", "bsdf": f"Metallic BSDF, {dist}",
+                         "method": method, "r": r, "rings": table, "seconds": sec})
+            print(f"Cycles {dist} r = {r:g}: {sec:.1f} s", flush=True)
         if not args.skip_mitsuba:
-            img = fr.render_mitsuba(r * r, resolution=args.resolution, spp=args.spp)
-            table = fr.rings(img, predictor("mitsuba", "none", r), edges, min_alpha=0.999)
-            runs.append({"renderer": f"Mitsuba {img['version']}", "bsdf": "roughconductor (GGX)", "method": "none",
-                         "r": r, "rings": table, "seconds": img["seconds"]})
-            print(f"Mitsuba r = {r:g}: {img['seconds']:.1f} s", flush=True)
+            imgs = [fr.render_mitsuba(r * r, resolution=args.resolution, spp=args.spp, seed=1 + k)
+                    for k in range(args.seeds)]
+            table = fr.rings(imgs, predictor("mitsuba", "none", r), edges, min_alpha=0.999)
+            sec = sum(i["seconds"] for i in imgs)
+            runs.append({"renderer": f"Mitsuba {imgs[0]['version']}", "bsdf": "roughconductor (GGX)",
+                         "method": "none", "r": r, "rings": table, "seconds": sec})
+            print(f"Mitsuba r = {r:g}: {sec:.1f} s", flush=True)
     total = time.perf_counter() - t_start
 
     # the rings, every run
@@ -86,20 +92,26 @@ def main() -> int:
         fh.write(buf.getvalue())
 
     # the summary
-    lines = [f"Sphere of radius {args.resolution / 2 / 1.025:.0f} pixels, {args.spp} samples per pixel, "
-             f"{len(edges) - 1} rings of width {edges[1] - edges[0]:.2f} in mu from {edges[0]:.1f} to 1; "
-             f"{total:.0f} s in all on {args.threads} threads.", "",
+    lines = [f"Sphere of radius {args.resolution / 2 / 1.025:.0f} pixels; {args.seeds} renders of {args.spp} "
+             f"samples per pixel per configuration (seeds 1 to {args.seeds}; the standard errors are the scatter of "
+             f"the renders' ring means over sqrt({args.seeds})); {len(edges) - 1} rings of width "
+             f"{edges[1] - edges[0]:.2f} in mu from {edges[0]:.1f} to 1; {total:.0f} s in all on {args.threads} "
+             f"threads. z = (render - predicted) / standard error; with {args.seeds} renders it follows Student's t "
+             f"with {args.seeds - 1} degrees of freedom"
+             + (f", whose mean square is {(args.seeds - 1) / (args.seeds - 3):.2f}." if args.seeds > 3 else "."),
+             "",
              "| renderer | BSDF | compensation | r | max abs(predicted - 1) | max abs(render - predicted) "
-             "| max abs(render - predicted) / standard error | standard error (median) |",
-             "|---|---|---|---|---|---|---|---|"]
+             "| standard error (median) | max abs(z) | mean z^2 |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for run in runs:
         rg = run["rings"]
         dev = max(abs(x["predicted"] - 1) for x in rg)
         diff = max(abs(x["difference"]) for x in rg)
         ok, z = fr.compare_rings(rg)
         se = float(np.median([x["se"] for x in rg]))
+        z2 = float(np.mean([(x["difference"] / x["se"]) ** 2 for x in rg]))
         lines.append(f"| {run['renderer']} | {run['bsdf']} | {run['method']} | {run['r']:g} | {dev:.2e} | "
-                     f"{diff:.2e} | {z:.2f} | {se:.1e} |")
+                     f"{diff:.2e} | {se:.1e} | {z:.2f} | {z2:.2f} |")
     text = "\n".join(lines) + "\n"
     with atomic_path(os.path.join(args.out, "furnace_summary.md")) as tmp, open(tmp, "w") as fh:
         fh.write(text)

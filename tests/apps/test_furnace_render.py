@@ -53,6 +53,24 @@ def test_rings_recover_a_curved_truth_and_catch_a_bias():
     assert not fr.compare_rings(biased)[0]
 
 
+def test_rings_over_seeds_hold_an_error_shared_by_pixels():
+    """Noise shared by every pixel of a render (what a sampling pattern common to the pixels gives) is invisible in
+    the pixel scatter and visible across renders."""
+    def truth(m):
+        return 0.7 + 0.3 * np.sqrt(m)
+
+    rng = np.random.default_rng(7)
+    renders = []
+    for k in range(12):
+        img = _synthetic(truth, res=64, noise=1e-3, seed=k)
+        img["value"] = img["value"] + 5e-3 * rng.standard_normal()  # one error for the whole render
+        renders.append(img)
+    one = fr.rings(renders[0], truth)
+    many = fr.rings(renders, truth)
+    assert 3 * max(r["se"] for r in one) < min(r["se"] for r in many)
+    assert fr.compare_rings(many)[0]
+
+
 def _scale(r):
     def predict(mu):
         return pumpup.furnace_prediction("cycles", "scale", path=CYCLES_TABLES, mu=mu, roughness=[r])[
@@ -71,25 +89,27 @@ def test_cycles_rings_agree_with_the_prediction():
     if importlib.util.find_spec("bpy") is None:  # an optional extra, not installed by CI
         pytest.skip("bpy is not installed (pip install --no-deps \"bpy>=5,<6\")")
     r = 0.5
-    multi = fr.render_cycles(r, "MULTI_GGX", resolution=96, spp=64)
-    ok, z = fr.compare_rings(fr.rings(multi, _scale(r)))
+    edges = np.linspace(0.1, 1.0, 6)
+    multi = [fr.render_cycles(r, "MULTI_GGX", resolution=64, spp=16, seed=1 + k) for k in range(16)]
+    ok, z = fr.compare_rings(fr.rings(multi, _scale(r), edges))
     assert ok, f"Multiscatter GGX rings off the 1/E_lookup prediction by {z:.2f} standard errors"
-    single = fr.render_cycles(r, "GGX", resolution=96, spp=64)
-    ok, z = fr.compare_rings(fr.rings(single, _none("cycles", r)))
+    single = [fr.render_cycles(r, "GGX", resolution=64, spp=16, seed=1 + k) for k in range(16)]
+    ok, z = fr.compare_rings(fr.rings(single, _none("cycles", r), edges))
     assert ok, f"GGX rings off E by {z:.2f} standard errors"
     # the comparison can fail: the uncompensated lobe is far from the compensated prediction
-    assert not fr.compare_rings(fr.rings(single, _scale(r)))[0]
+    assert not fr.compare_rings(fr.rings(single, _scale(r), edges))[0]
 
 
 @pytest.mark.slow
 def test_mitsuba_roughconductor_rings_are_E():
     pytest.importorskip("mitsuba")
     r = 0.5
-    img = fr.render_mitsuba(r * r, resolution=96, spp=64)
-    table = fr.rings(img, _none("mitsuba", r), min_alpha=0.999)
-    ok, z = fr.compare_rings(table)
+    edges = np.linspace(0.1, 1.0, 6)
+    imgs = [fr.render_mitsuba(r * r, resolution=64, spp=16, seed=1 + k) for k in range(16)]
+    ok, z = fr.compare_rings(fr.rings(imgs, _none("mitsuba", r), edges, min_alpha=0.999))
     assert ok, f"roughconductor rings off E by {z:.2f} standard errors"
-    assert not fr.compare_rings(fr.rings(img, _none("cycles", r), min_alpha=0.999))[0]  # correlated Smith differs
+    # correlated Smith differs
+    assert not fr.compare_rings(fr.rings(imgs, _none("cycles", r), edges, min_alpha=0.999))[0]
 
 
 def test_docs_examples_are_the_shipped_files():
