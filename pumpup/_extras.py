@@ -12,7 +12,6 @@ EXTRAS = {
     "colour": ("spectral", "colour-science"),
     "mitsuba": ("render", "mitsuba"),
     "drjit": ("render", "mitsuba"),
-    "bpy": ("blender", "bpy"),
 }
 
 

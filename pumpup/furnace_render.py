@@ -65,9 +65,15 @@ def render_cycles(roughness: float, distribution: str = "MULTI_GGX", *, resoluti
     """
     import time
 
-    from ._extras import require
+    from ._extras import MissingExtraError
 
-    bpy = require("bpy", "the Cycles furnace render")
+    try:
+        import bpy
+    except ImportError as exc:
+        raise MissingExtraError(
+            "the Cycles furnace render needs bpy, which is not installed: pip install --no-deps \"bpy>=5,<6\" "
+            "(the blender extra; bpy 5.0 declares numpy < 2, which pumpup's other dependencies exclude, and runs "
+            "with numpy 2)") from exc
     if distribution not in ("MULTI_GGX", "GGX", "BECKMANN"):
         raise ValueError(f"distribution must be MULTI_GGX, GGX or BECKMANN; got {distribution!r}")
     if not 0.0 <= roughness <= 1.0:
