@@ -16,7 +16,7 @@ N = (x, y, sqrt(1 - x^2 - y^2)) and the direction towards the viewer is V = (0, 
 for every pixel.  Pixels off the sphere hold radiance 0 and ``mask`` False.
 
 Local shading frame (pumpup's convention: the normal is the local z axis)
------------------------------------------------------------------------
+-------------------------------------------------------------------------
 The tangent T is the direction of the parallels of a globe whose poles are at the top
 and bottom of the image (the world y axis): T = (y_w x N) / |y_w x N| = (N_z, 0, -N_x) /
 sqrt(N_x^2 + N_z^2), and the bitangent is B = N x T (it runs along the meridians,
