@@ -127,13 +127,32 @@ class ModelList(_Generated):
         return "\n".join(["::", "", *_indent(out.getvalue()), ""])
 
 
-#: the modules of the package documented in the reference, lowest layer first (``docs/reference/subpackages.rst``)
-MODULES = ("pumpup.core", "pumpup.physics", "pumpup.models", "pumpup.engine", "pumpup.engine.routes",
-           "pumpup.engine.cubature", "pumpup.engine.nested", "pumpup.engine.polar", "pumpup.engine.slope",
-           "pumpup.tables", "pumpup.operators.pumping", "pumpup.operators.compensate", "pumpup.spectral",
-           "pumpup.spectral.optical", "pumpup.sampling", "pumpup.testing", "pumpup.divergence", "pumpup.sweeps",
-           "pumpup.fitting", "pumpup.luts", "pumpup.render", "pumpup.reproduce", "pumpup.scenes", "pumpup.mitsuba",
-           "pumpup.cli")
+#: modules with public names (an ``__all__``) that get no reference page, with the reason
+EXCLUDED = {
+    "pumpup.warmup": "a command (pumpup warmup), documented in the CLI reference",
+    "pumpup.figures": "the pumping figures' data, shown by the gallery",
+    "pumpup.plots": "the figures of figures/, shown by the gallery",
+    "pumpup.published": "the papers' printed values, shown by pumpup reproduce",
+    "pumpup.costs": "the cost tables of pumpup reproduce --only costs",
+}
+
+
+def documented_modules() -> list[str]:
+    """The modules of the reference (``reference/modules/``): every package of pumpup and every module with an
+    ``__all__``, but private ones and :data:`EXCLUDED`, sorted by name."""
+    import importlib
+    import pkgutil
+
+    import pumpup
+
+    out = []
+    for info in pkgutil.walk_packages(pumpup.__path__, "pumpup."):
+        if any(part.startswith("_") for part in info.name.split(".")) or info.name in EXCLUDED:
+            continue
+        module = importlib.import_module(info.name)
+        if info.ispkg or getattr(module, "__all__", None):
+            out.append(info.name)
+    return sorted(out)
 
 
 def public_names(module_name: str) -> list[str]:
@@ -175,13 +194,13 @@ def module_page_rst(module_name: str) -> str:
 
 
 def write_module_pages(app) -> None:
-    """Write ``reference/modules/<module>.rst`` for every module of :data:`MODULES` (only where the text changes,
+    """Write ``reference/modules/<module>.rst`` for every module of :func:`documented_modules` (only where the text changes,
     so an unchanged page is not rebuilt)."""
     import os
 
     outdir = os.path.join(app.srcdir, "reference", "modules")
     os.makedirs(outdir, exist_ok=True)
-    for name in MODULES:
+    for name in documented_modules():
         path = os.path.join(outdir, f"{name}.rst")
         text = module_page_rst(name)
         if not os.path.exists(path) or open(path).read() != text:
