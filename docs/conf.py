@@ -64,6 +64,8 @@ sphinx_gallery_conf = {
     "show_memory": False,
     "reference_url": {},
     "abort_on_example_error": True,
+    # the computation-times pages load their table script from a CDN: the site must work offline
+    "write_computation_times": False,
 }
 
 html_theme = "pydata_sphinx_theme"

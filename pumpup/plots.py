@@ -155,7 +155,7 @@ def furnace_grid(size, out):
          for m in ("kulla_conty", "scale")],
     ]
     ims = [[render.furnace(s, size) for s in row] for row in rows]
-    print("furnace: a(mu_V) at the rim pixel / centre / maximum, error bound")
+    print("furnace: a(mu_V) minimum over the sphere / centre / maximum, error bound")
     for row in ims:
         for im in row:
             v = im.radiance[im.mask]
@@ -166,11 +166,11 @@ def furnace_grid(size, out):
 
     def text(im):
         v = im.radiance[im.mask]
-        return f"{render.label(im.spec)}\nrim {float(v.min()):.3f}, max {float(v.max()):.4f}"
+        return f"{render.label(im.spec)}\nmin {float(v.min()):.3f}, max {float(v.max()):.4f}"
 
     return render.grid_figure(ims, os.path.join(out, "render_furnace.png"), tile_text=text, tile_inches=1.9,
                          row_labels=["Phong n=20", "Blinn n=20", "others", "compensated"],
-                         title="white furnace (sky radiance 1): pixel = albedo a(mu_V)")
+                         title="white furnace (sky radiance 1): pixel = albedo a(mu_V); min and max over the sphere")
 
 
 MAKERS = {"lewis_fig3": lewis_fig3, "lewis_fig6": lewis_fig6, "lewis_fig10": lewis_fig10,
@@ -180,45 +180,58 @@ MAKERS = {"lewis_fig3": lewis_fig3, "lewis_fig6": lewis_fig6, "lewis_fig10": lew
 def compensation(ds, path):
     """figures/compensation.png from the compensation study's dataset (``tables/compensation.nc``): the white furnace,
     the point-light radiance in the mirror direction against the base's, and the intermediate-metalness furnace.
-    Written atomically; returns ``path``.
+
+    Methods that give the same values (Kulla-Conty and scaling both reach 1 in the furnace; scaling, g1 and g2 all
+    divide by E(mu) in the mirror direction) are drawn as nested lines, the first thickest, each with its own
+    marker, so every series stays visible.  Written atomically; returns ``path``.
     """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(1, 3, figsize=(15, 4.3))
     colors = {"base": "k", "kulla_conty": "C0", "scale": "C1", "g1": "C2", "g2": "C3"}
+    # drawing order, line width and marker: coincident series nest inside each other
+    style = {"base": (5.0, "o", 7), "kulla_conty": (4.0, "s", 6), "scale": (2.8, "^", 5), "g1": (1.7, "v", 4),
+             "g2": (0.9, "x", 4)}
+
+    def kw(method, ls):
+        lw, marker, ms = style[str(method)]
+        return {"ls": ls, "color": colors[str(method)], "lw": lw, "marker": marker, "ms": ms, "alpha": 0.85,
+                "markerfacecolor": "none" if lw > 2 else colors[str(method)]}
+
+    fig, ax = plt.subplots(1, 3, figsize=(16, 5.2))
     theta_o = np.degrees(np.arccos(ds.mu.values))
     for model, ls in (("ggx alpha=0.3", "-"), ("ggx alpha=1", "--")):
         if model not in ds.model.values:
             continue
         for method in ds.method.values:
-            ax[0].plot(theta_o, ds.furnace.sel({"model": model, "method": method}), ls, color=colors[method],
-                       label=f"{method} ({model})" if ls == "-" else None, marker=".")
+            ax[0].plot(theta_o, ds.furnace.sel({"model": model, "method": method}), **kw(method, ls),
+                       label=f"{method} ({model})")
     ax[0].set_xlabel("viewing angle theta_o [deg]")
     ax[0].set_ylabel("white furnace (albedo)")
-    ax[0].set_title("furnace: GGX alpha 0.3 (solid), 1.0 (dashed)")
-    ax[0].legend(fontsize=7)
+    ax[0].set_title("furnace, GGX alpha 0.3 (solid) and 1 (dashed)", fontsize=10)
+    ax[0].set_ylim(0.0, 1.04)  # room below the curves for the legend
+    ax[0].legend(fontsize=6.5, ncol=2, loc="lower right")
     for method in ds.method.values[1:]:
         for model, ls in (("ggx alpha=0.3", "-"), ("phong n=20", ":")):
             if model in ds.model.values:
-                ax[1].plot(ds.theta_i, ds.mirror_ratio.sel({"model": model, "method": method}), ls,
-                           color=colors[method], marker=".", label=f"{method} ({model})")
+                ax[1].plot(ds.theta_i, ds.mirror_ratio.sel({"model": model, "method": method}), **kw(method, ls),
+                           label=f"{method} ({model})")
     ax[1].set_yscale("log")
     ax[1].set_xlabel("theta_i [deg]")
     ax[1].set_ylabel("f_c(wi, R) / f(wi, R)")
-    ax[1].set_title("point light, mirror direction, against the base")
-    ax[1].legend(fontsize=7)
+    ax[1].set_title("point light, mirror direction, against the base\n(scale, g1, g2 coincide where g = E(mu))",
+                    fontsize=10)
+    ax[1].legend(fontsize=6.5)
     for method in ds.method.values:
         for arrangement, ls in (("lobe", "-"), ("mix", "--")):
             r = ds.metal_residual.sel({"alpha": ds.alpha.values[0], "arrangement": arrangement, "method": method})
-            ax[2].semilogy(ds.metalness, np.maximum(r, 1e-17), ls, color=colors[method], marker="o",
-                           label=f"{method} ({arrangement})")
+            ax[2].semilogy(ds.metalness, np.maximum(r, 1e-17), **kw(method, ls), label=f"{method} ({arrangement})")
     ax[2].axhline(1e-6, color="gray", lw=0.8)
     ax[2].set_xlabel("metalness m")
     ax[2].set_ylabel("max |1 - a|")
-    ax[2].set_title(f"(1 - m) Lambert + m GGX {float(ds.alpha.values[0]):g}")
+    ax[2].set_title(f"(1 - m) Lambert + m GGX {float(ds.alpha.values[0]):g}\n(lobe: solid, mix: dashed)", fontsize=10)
     ax[2].legend(fontsize=6, ncol=2)
     fig.tight_layout()
     with atomic_path(path) as tmp:  # no half PNG if interrupted

@@ -19,11 +19,6 @@ import contextlib
 import io
 import re
 
-from docutils import nodes
-from docutils.statemachine import StringList
-from sphinx.util.docutils import SphinxDirective
-from sphinx.util.nodes import nested_parse_with_titles
-
 #: underline characters of the section levels the CLI reference uses, below the page's own title
 _LEVELS = "=-~^"
 
@@ -66,7 +61,7 @@ def _help_text(parser: argparse.ArgumentParser) -> str:
 
 
 def cli_reference_rst(parser: argparse.ArgumentParser | None = None) -> str:
-    """reStructuredText of the command-line reference: one section per subcommand, its ``--help`` verbatim."""
+    """ReStructuredText of the command-line reference: one section per subcommand, its ``--help`` verbatim."""
     if parser is None:
         from pumpup.cli import build_parser
 
@@ -82,49 +77,46 @@ def cli_reference_rst(parser: argparse.ArgumentParser | None = None) -> str:
     return "\n".join(lines)
 
 
-class _Generated(SphinxDirective):
-    has_content = False
+def routing_table_rst() -> str:
+    """ReStructuredText of the albedo engine's routing table, :func:`pumpup.engine.routes.describe`, verbatim."""
+    from pumpup.engine.routes import describe
 
-    def text(self) -> str:
-        raise NotImplementedError
+    return "\n".join(["::", "", *_indent(describe()), ""])
 
-    def run(self):
-        self.env.note_dependency(__file__)
-        node = nodes.section() if self.titles else nodes.container()
-        content = StringList(self.text().splitlines(), source=self.__class__.__name__)
-        if self.titles:
-            nested_parse_with_titles(self.state, content, node)
+
+def model_list_rst() -> str:
+    """ReStructuredText of the registered models and their parameters, as ``pumpup models`` prints them."""
+    from pumpup.cli import main
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        main(["models"])
+    return "\n".join(["::", "", *_indent(out.getvalue()), ""])
+
+
+def _directive(text, titles: bool):
+    """A directive class that parses ``text()`` (reStructuredText) in place; ``titles``: it holds sections.  Sphinx
+    is imported here, so the functions above work without it (the fast tests use them).
+    """
+    from docutils import nodes
+    from docutils.statemachine import StringList
+    from sphinx.util.docutils import SphinxDirective
+    from sphinx.util.nodes import nested_parse_with_titles
+
+    class Generated(SphinxDirective):
+        has_content = False
+
+        def run(self):
+            self.env.note_dependency(__file__)
+            node = nodes.section() if titles else nodes.container()
+            content = StringList(text().splitlines(), source=text.__name__)
+            if titles:
+                nested_parse_with_titles(self.state, content, node)
+            else:
+                self.state.nested_parse(content, self.content_offset, node)
             return node.children
-        self.state.nested_parse(content, self.content_offset, node)
-        return node.children
 
-
-class CLIReference(_Generated):
-    titles = True
-
-    def text(self) -> str:
-        return cli_reference_rst()
-
-
-class RoutingTable(_Generated):
-    titles = False
-
-    def text(self) -> str:
-        from pumpup.engine.routes import describe
-
-        return "\n".join(["::", "", *_indent(describe()), ""])
-
-
-class ModelList(_Generated):
-    titles = False
-
-    def text(self) -> str:
-        from pumpup.cli import main
-
-        out = io.StringIO()
-        with contextlib.redirect_stdout(out):
-            main(["models"])
-        return "\n".join(["::", "", *_indent(out.getvalue()), ""])
+    return Generated
 
 
 #: modules with public names (an ``__all__``) that get no reference page, with the reason
@@ -139,7 +131,8 @@ EXCLUDED = {
 
 def documented_modules() -> list[str]:
     """The modules of the reference (``reference/modules/``): every package of pumpup and every module with an
-    ``__all__``, but private ones and :data:`EXCLUDED`, sorted by name."""
+    ``__all__``, but private ones and :data:`EXCLUDED`, sorted by name.
+    """
     import importlib
     import pkgutil
 
@@ -177,7 +170,7 @@ def _kind(module_name: str, name: str) -> str:
 
 
 def module_page_rst(module_name: str) -> str:
-    """reStructuredText of one module's reference page: its docstring and an autosummary of its ``__all__``."""
+    """ReStructuredText of one module's reference page: its docstring and an autosummary of its ``__all__``."""
     import pumpup
 
     lines = [module_name, "=" * len(module_name), "", f".. automodule:: {module_name}", "   :no-members:"]
@@ -194,8 +187,9 @@ def module_page_rst(module_name: str) -> str:
 
 
 def write_module_pages(app) -> None:
-    """Write ``reference/modules/<module>.rst`` for every module of :func:`documented_modules` (only where the text changes,
-    so an unchanged page is not rebuilt)."""
+    """Write ``reference/modules/<module>.rst`` for every module of :func:`documented_modules` (only where the text
+    changes, so an unchanged page is not rebuilt).
+    """
     import os
 
     outdir = os.path.join(app.srcdir, "reference", "modules")
@@ -214,7 +208,8 @@ _TRAILING_UNDERSCORE = re.compile(r"(?<=\w)_(?=[\s,.;:)\]|+-]|$)")
 
 def plain_text_math(line: str) -> str:
     """``line`` with the plain-text mathematics of pumpup's docstrings kept literal: ``|x|`` is an absolute value, not a
-    substitution, and ``r_`` a subscript, not a link.  Literals and roles are left alone, and so are table rows."""
+    substitution, and ``r_`` a subscript, not a link.  Literals and roles are left alone, and so are table rows.
+    """
     stripped = line.lstrip()
     if stripped.startswith(("+-", "+=")) or (stripped.startswith("|") and stripped.rstrip().endswith("|")):
         return line
@@ -242,9 +237,10 @@ def escape_docstring(app, what, name, obj, options, lines) -> None:
 
 
 def setup(app):
+    """Register the directives and the hooks with Sphinx."""
     app.connect("builder-inited", write_module_pages, priority=100)
     app.connect("autodoc-process-docstring", escape_docstring)
-    app.add_directive("pumpup-cli", CLIReference)
-    app.add_directive("pumpup-routes", RoutingTable)
-    app.add_directive("pumpup-models", ModelList)
+    app.add_directive("pumpup-cli", _directive(cli_reference_rst, titles=True))
+    app.add_directive("pumpup-routes", _directive(routing_table_rst, titles=False))
+    app.add_directive("pumpup-models", _directive(model_list_rst, titles=False))
     return {"parallel_read_safe": True, "parallel_write_safe": True, "version": "1"}
