@@ -31,6 +31,7 @@ DOCS = os.path.join(ROOT, "docs")
 sys.path.insert(0, os.path.join(DOCS, "_ext"))
 import pumpup_docs  # noqa: E402
 
+
 def test_api_reference_lists_every_public_name():
     text = open(os.path.join(DOCS, "reference", "api.rst")).read()
     listed = set(re.findall(r"^ {3}(\w+)\s*$", text, re.M))  # autosummary entries
@@ -114,9 +115,16 @@ def test_user_guide_globs_its_folder():
 def test_routing_table_directive_prints_the_code_table():
     from pumpup.engine.routes import ROUTES, describe
 
-    text = pumpup_docs.RoutingTable.text(None)
+    text = pumpup_docs.routing_table_rst()
     assert describe().splitlines()[0] in text
     assert all(route in text for route in ROUTES)
+
+
+def test_model_list_is_the_registry():
+    from pumpup.core import registry
+
+    text = pumpup_docs.model_list_rst()
+    assert all(re.search(rf"^ {{3}}{name}: ", text, re.M) for name in registry())
 
 
 def test_plain_text_math_is_kept_literal():
