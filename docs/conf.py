@@ -81,3 +81,5 @@ html_last_updated_fmt = None
 html_show_sourcelink = False
 suppress_warnings = ["config.cache", "toc.empty_glob"]
 autosummary_ignore_module_all = False
+# the theme's colour mode on a first visit (empty, the theme logs a console error and falls back to auto)
+html_context = {"default_mode": "auto"}

@@ -154,16 +154,22 @@ class _Links(html.parser.HTMLParser):
             self.links.append(a["href"])
 
 
+def html_pages(outdir: str) -> list[str]:
+    """The built pages: every .html file but the theme's templates and the copies Sphinx keeps (``_static``...)."""
+    out = []
+    for folder, dirs, files in os.walk(outdir):
+        dirs[:] = [d for d in dirs if not d.startswith("_")]
+        out += [os.path.join(folder, name) for name in files if name.endswith(".html")]
+    return sorted(out)
+
+
 def internal_problems(outdir: str) -> list[str]:
     """Every internal link, anchor or image of the built HTML under ``outdir`` that does not resolve."""
     pages = {}
-    for folder, _, files in os.walk(outdir):
-        for name in files:
-            if name.endswith(".html"):
-                path = os.path.join(folder, name)
-                parser = _Links()
-                parser.feed(open(path, encoding="utf-8").read())
-                pages[os.path.normpath(path)] = parser
+    for path in html_pages(outdir):
+        parser = _Links()
+        parser.feed(open(path, encoding="utf-8").read())
+        pages[os.path.normpath(path)] = parser
     problems = []
     for path, parser in pages.items():
         for kind, targets in (("link", parser.links), ("image", parser.images)):
@@ -201,7 +207,10 @@ def test_docs_build_with_every_internal_link_and_image(built_site):
     for must in ("reference/cli.html", "reference/api.html", "engine/index.html", "user-guide/albedo.html"):
         assert os.path.exists(os.path.join(built_site, must)), must
     cli = open(os.path.join(built_site, "reference", "cli.html"), encoding="utf-8").read()
-    assert "pumpup render scene" in cli
+    from pumpup.cli import build_parser
+
+    for path, _ in subcommands(build_parser()):  # a section (and its anchor) per subcommand
+        assert f'id="cli-{"-".join(path)}"' in cli, path
     problems = internal_problems(built_site)
     assert not problems, "\n".join(problems[:50])
 
@@ -222,8 +231,7 @@ def test_every_page_loads_in_chromium_without_errors(built_site):
         from playwright.sync_api import sync_playwright
     else:
         sync_playwright = pytest.importorskip("playwright.sync_api").sync_playwright
-    pages = sorted(os.path.join(folder, name) for folder, _, files in os.walk(built_site) for name in files
-                   if name.endswith(".html"))
+    pages = html_pages(built_site)
     assert len(pages) > 50
     failures = []
     with sync_playwright() as p:
