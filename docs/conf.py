@@ -33,6 +33,8 @@ extensions = [
     "pumpup_docs",
 ]
 
+# literal blocks without a language (the docstrings' formulas, the generated references) are plain text
+highlight_language = "text"
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
 exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "examples/*.md", "examples/README.rst",

@@ -44,12 +44,12 @@ def _indent(text: str) -> list[str]:
 
 
 def _help_text(parser: argparse.ArgumentParser) -> str:
-    """``parser``'s ``--help`` at a fixed width, so the pages do not depend on the terminal."""
+    """``parser``'s ``--help`` at a fixed width (the page's column), so the pages do not depend on the terminal."""
     formatter_class = parser.formatter_class
 
     def fixed(prog, _cls=formatter_class):
         try:
-            return _cls(prog, width=100)
+            return _cls(prog, width=72)
         except TypeError:
             return _cls(prog)
 
@@ -66,14 +66,15 @@ def cli_reference_rst(parser: argparse.ArgumentParser | None = None) -> str:
         from pumpup.cli import build_parser
 
         parser = build_parser()
-    lines = [".. _cli-pumpup:", "", "``pumpup``", _LEVELS[0] * 10, "", "::", "", *_indent(_help_text(parser)), ""]
+    lines = [".. _cli-pumpup:", "", "``pumpup``", _LEVELS[0] * 10, "", ".. code-block:: text", "",
+             *_indent(_help_text(parser)), ""]
     for path, sub, help_ in walk(parser):
         title = "``pumpup " + " ".join(path) + "``"
         anchor = "cli-" + "-".join(path)
         lines += [f".. _{anchor}:", "", title, _LEVELS[min(len(path), len(_LEVELS) - 1)] * len(title), ""]
         if help_:
             lines += [help_.replace("*", r"\*").replace("`", "'") + ".", ""]
-        lines += ["::", "", *_indent(_help_text(sub)), ""]
+        lines += [".. code-block:: text", "", *_indent(_help_text(sub)), ""]
     return "\n".join(lines)
 
 
@@ -81,7 +82,7 @@ def routing_table_rst() -> str:
     """ReStructuredText of the albedo engine's routing table, :func:`pumpup.engine.routes.describe`, verbatim."""
     from pumpup.engine.routes import describe
 
-    return "\n".join(["::", "", *_indent(describe()), ""])
+    return "\n".join([".. code-block:: text", "", *_indent(describe()), ""])
 
 
 def model_list_rst() -> str:
@@ -91,7 +92,7 @@ def model_list_rst() -> str:
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
         main(["models"])
-    return "\n".join(["::", "", *_indent(out.getvalue()), ""])
+    return "\n".join([".. code-block:: text", "", *_indent(out.getvalue()), ""])
 
 
 def _directive(text, titles: bool):
