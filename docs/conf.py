@@ -37,8 +37,10 @@ extensions = [
 highlight_language = "text"
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
+# a page's own folder of data (docs/user-guide/<page>/: figures, CSV, generated Markdown tables it includes) holds
+# no pages of its own
 exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "examples/*.md", "examples/README.rst",
-                    "sg_execution_times.rst"]
+                    "sg_execution_times.rst", "user-guide/*/**"]
 templates_path = ["_templates"]
 
 # myst: ``$...$`` stays literal text (the pages write formulas in plain text); anchors for ## headings

@@ -26,8 +26,15 @@ import pytest
 ROOT = str(helpers.ROOT)
 README = os.path.join(ROOT, "README.md")
 DOCS = os.path.join(ROOT, "docs")
-#: folders of docs/ that hold generated pages, not written ones
+#: folders of docs/ that hold generated pages or a page's data, not pages (docs/conf.py's exclude_patterns)
 GENERATED = ("_build", "gallery", "reference/generated", "reference/modules", "examples")
+
+
+def _not_a_page_folder(rel: str) -> bool:
+    """Whether docs/``rel`` holds no pages: a generated folder, or a user-guide page's own data folder."""
+    parts = rel.split(os.sep)
+    generated = any(rel == g or rel.startswith(g + os.sep) for g in GENERATED)
+    return generated or (len(parts) > 1 and parts[0] == "user-guide")
 
 
 def doc_pages() -> list[str]:
@@ -35,7 +42,7 @@ def doc_pages() -> list[str]:
     out = []
     for folder, dirs, files in os.walk(DOCS):
         rel = os.path.relpath(folder, DOCS)
-        if rel != "." and any(rel == g or rel.startswith(g + os.sep) for g in GENERATED):
+        if rel != "." and _not_a_page_folder(rel):
             dirs[:] = []
             continue
         out += [os.path.join(folder, name) for name in files if name.endswith(".md")]
