@@ -34,6 +34,7 @@ from ..physics.lookups import (
     GChain,
     float_bits_reference,
     g_levels,
+    g_levels_call,
     g_pair,
     g_product,
     horner,
@@ -172,17 +173,6 @@ def _uses_file_tables(brdf: BRDF) -> bool:
 
 
 @njit(cache=True, nogil=True)
-def _g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0, index,
-                   index_lo, index_h_inv):  # pragma: no cover - compiled
-    """:func:`g_levels`, called (not inlined) from :func:`_chain_kernel`, whose fast paths then stay small: inlined
-    there, it made the level table's path 2 x slower than the same look-up in a kernel of its own (21 against 10 ns per
-    pair, measured).
-    """
-    return g_levels(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0, index,
-                    index_lo, index_h_inv)
-
-
-@njit(cache=True, nogil=True)
 def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
                   index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow, qmlo, qshift, qcbase, qcstart,
                   qlo, qrow):  # pragma: no cover - compiled
@@ -210,14 +200,11 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
         mmax, mmin = max(mi, mo), min(mi, mo)
         if mmin > pmlo:  # the fast path: one look-up for all levels (no branch on f = 0: 0 / g = 0)
             f[k] = f[k] / g_product(mmax, pcbase, pcstart, plo, prow)  # 001 eq. 16, all levels
-            continue
-        if mmin > qmlo:  # one piece per direction for all levels (0 / g = 0)
+        elif mmin > qmlo:  # one piece per direction for all levels (0 / g = 0)
             f[k] = f[k] / g_pair(mi, mo, controlled, qshift, qcbase, qcstart, qlo, qrow)  # 001 eq. 16, all levels
-            continue
-        if f[k] == 0.0:
-            continue
-        f[k] = f[k] / _g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
-                                      increasing, mu0, index, index_lo, index_h_inv)  # 001 eq. 16, all levels
+        elif f[k] != 0.0:
+            f[k] = f[k] / g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
+                                        increasing, mu0, index, index_lo, index_h_inv)  # 001 eq. 16, all levels
 
 
 @njit(cache=True, nogil=True)
@@ -906,6 +893,10 @@ class Pumped(BRDF):
     def _eval(self, wi, wo, levelwise: bool = False):
         from ..core import slabs
 
+        if not levelwise:  # the base's fused kernel: its value and the division in one pass (BRDF.eval_divided)
+            out = self.chain()[0].base.eval_divided(wi, wo, self._chain_args())
+            if out is not None:
+                return out
         shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
         n = math.prod(shape)
         if n <= 2 * self.BLOCK:

@@ -279,6 +279,19 @@ def g_pair(mi, mo, controlled, shift, pcbase, pcstart, plo, prow):  # pragma: no
     return g_all
 
 
+@njit(cache=True, nogil=True)
+def g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0, index,
+                  index_lo, index_h_inv):  # pragma: no cover - compiled
+    """:func:`g_levels`, called (not inlined) where it is the rare path of a loop (the pumped chain kernel, the models'
+    fused kernels ``BRDF.eval_divided``), whose fast paths then stay small: inlined there, it made the level table's
+    path 2 x slower (21 against 10 ns per pair, measured).  Those kernels choose the path as
+    ``pumpup.operators.pumping._chain_kernel`` does, written out in each: a helper inlined with the chain's 15 arrays
+    as arguments cost 94 ns per pair, not 8 (numba's reference counting of each array argument, per pair).
+    """
+    return g_levels(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0, index,
+                    index_lo, index_h_inv)
+
+
 def horner(coef, t):
     """sum_r coef[r] t^(d - r) by Horner's rule, in the order the compiled kernel uses."""
     v = coef[0] * t

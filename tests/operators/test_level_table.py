@@ -109,3 +109,25 @@ def test_phong_keeps_its_product_table():
     f = pumpup.pump({"type": "phong", "n": 20}, g="g2", levels=1)
     assert f.product() is not None and f.level_table() is None
     assert f._chain_args().pair_mlo == math.inf
+
+
+@pytest.mark.parametrize("spec", [{"type": "ggx", "alpha": 0.3}, {"type": "beckmann", "alpha": 0.2, "ior": 1.5}])
+def test_fused_kernel_is_the_base_then_the_chain_kernel(spec, ggx2, rng):
+    """A microfacet base's fused kernel (BRDF.eval_divided) gives, bit for bit, its own value divided by the chain
+    kernel: on every path (level table, level by level below its mlo, below the horizon)."""
+    from pumpup.operators.pumping import _chain_kernel
+
+    f = ggx2 if spec["alpha"] == 0.3 else pumpup.pump(spec, g="g1")
+    base = f.chain()[0].base
+    wi, wo = _pairs(rng, 200)
+    wi, wo = np.concatenate([wi, random_directions(rng, 200)]), np.concatenate([wo, random_directions(rng, 200)])
+    wi[:3, 2], wo[3:6, 2] = 1e-9, 3e-10  # below the level table's mlo: level by level
+    wi /= np.linalg.norm(wi, axis=-1, keepdims=True)
+    wo /= np.linalg.norm(wo, axis=-1, keepdims=True)
+    fused = base.eval_divided(wi, wo, f._chain_args())
+    assert fused is not None
+    two = np.array(base._eval(wi, wo))
+    _chain_kernel(two, wi, wo, *f._chain_args())
+    np.testing.assert_array_equal(fused, two)
+    np.testing.assert_array_equal(f._eval(wi, wo), two)
+    assert base.eval_divided(wi[:, None], wo[None, :], f._chain_args()) is None  # broadcast shapes: the two passes
