@@ -111,13 +111,14 @@ def test_phong_keeps_its_product_table():
     assert f._chain_args().pair_mlo == math.inf
 
 
-@pytest.mark.parametrize("spec", [{"type": "ggx", "alpha": 0.3}, {"type": "beckmann", "alpha": 0.2, "ior": 1.5}])
+@pytest.mark.parametrize("spec", [{"type": "ggx", "alpha": 0.3}, {"type": "beckmann", "alpha": 0.2, "ior": 1.5},
+                                  {"type": "phong", "n": 20}])
 def test_fused_kernel_is_the_base_then_the_chain_kernel(spec, ggx2, rng):
-    """A microfacet base's fused kernel (BRDF.eval_divided) gives, bit for bit, its own value divided by the chain
-    kernel: on every path (level table, level by level below its mlo, below the horizon)."""
+    """A base's fused kernel (BRDF.eval_divided: microfacet, Phong) gives, bit for bit, its own value divided by the
+    chain kernel: on every path (product or level table, level by level below its mlo, below the horizon)."""
     from pumpup.operators.pumping import _chain_kernel
 
-    f = ggx2 if spec["alpha"] == 0.3 else pumpup.pump(spec, g="g1")
+    f = ggx2 if spec.get("alpha") == 0.3 else pumpup.pump(spec, g="g1")
     base = f.chain()[0].base
     wi, wo = _pairs(rng, 200)
     wi, wo = np.concatenate([wi, random_directions(rng, 200)]), np.concatenate([wo, random_directions(rng, 200)])
