@@ -288,6 +288,28 @@ class _SchlickWeighted(BRDF):
     def lobe(self, mu):
         return self.base.lobe(mu)
 
+    def azimuth_hint(self):
+        """The base's Smith hint with Schlick's Fc as its Fresnel factor at wi.h (the 1-D half-vector route), where the
+        base is a Smith model with F = 1; else None (the nested quadrature of :meth:`_eval`).
+        """
+        from dataclasses import replace
+
+        from .core.hints import Fresnel, SmithLobe
+
+        hint = self.base.azimuth_hint()
+        if hint is None or hint.factors or not isinstance(hint.family, SmithLobe) or hint.family.fresnel is not None:
+            return None
+        return replace(hint, family=replace(hint.family, fresnel=Fresnel(schlick=0.0)))  # Fc = (1 - wi.h)^5
+
+
+class _NestedSchlickWeighted(_SchlickWeighted):
+    """:class:`_SchlickWeighted` without its hint: B by the nested quadrature of ``eval`` alone (the independent second
+    route of the tests, and the baseline of scripts/bench/bench_lut.py).
+    """
+
+    def azimuth_hint(self):
+        return None
+
 
 def model_spec(model, preset=None) -> tuple[dict, str]:
     """(base spec without the roughness parameter, name of that parameter) for a model argument."""
@@ -356,13 +378,14 @@ def _map_columns(fn, n: int, threads: int | None):
 
 
 def truth_grid(spec: dict, param: str, mu, rough, *, rtol: float = 1e-8, split: bool = False,
-               max_regions: int = 200, threads: int | None = None) -> dict:
+               max_regions: int = 200, threads: int | None = None, _weighted=_SchlickWeighted) -> dict:
     """E (and with ``split`` A, B) on the product grid mu x rough, each with its error estimate.
 
     Returns a dict of arrays of shape (len(mu), len(rough)): ``E``, ``E_error`` (and ``A``,
     ``B``, ``A_error``, ``B_error``), plus ``over_tolerance``: the number of nodes whose
     error estimate exceeds rtol * E (the engine stopped at ``max_regions``; their estimate is
-    still an honest bound, only larger).
+    still an honest bound, only larger).  B of a Smith model with F = 1 takes the engine's 1-D routes, with Schlick's Fc
+    as the Fresnel factor at wi.h (:class:`_SchlickWeighted`); of other models, the nested quadrature.
     """
     mu = np.asarray(mu, dtype=np.float64)
     rough = np.asarray(rough, dtype=np.float64)
@@ -373,7 +396,7 @@ def truth_grid(spec: dict, param: str, mu, rough, *, rtol: float = 1e-8, split: 
         if not split:
             return e, ee
         # B is small where Fc is (near normal incidence): its tolerance is relative to E, not to B
-        b, be = _albedo(_SchlickWeighted(f), mu, rtol, max_regions, atol=rtol * float(np.min(e)))
+        b, be = _albedo(_weighted(f), mu, rtol, max_regions, atol=rtol * float(np.min(e)))
         return e, ee, b, be
 
     cols = _map_columns(column, len(rough), threads)

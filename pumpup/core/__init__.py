@@ -543,6 +543,22 @@ class BRDF:
             return out
         return self.kernel(*split(wi), *split(wo), *self.kernel_args())
 
+    def eval_divided(self, wi: np.ndarray, wo: np.ndarray, chain) -> np.ndarray | None:
+        """f_r divided by a pumped chain's g_1 ... g_k (001 eq. 16) in one compiled pass, or None (the default: the
+        pumped model then evaluates this model and divides in a second pass).  ``chain`` is the chain's look-ups
+        (``pumpup.physics.lookups.GChain``); a model that has a fused kernel returns exactly what the second pass gives
+        (the same operations), for C-contiguous (N, 3)-shaped float64 ``wi`` and ``wo`` of one shape, else None.
+        """
+        return None
+
+    def eval_plus_lobe(self, wi: np.ndarray, wo: np.ndarray, scale: float, bound: tuple) -> np.ndarray | None:
+        """f_r + ``scale`` D(N.wi) D(N.wo) (the Kulla-Conty lobe, D = 1 - U clamped at 0; ``bound`` the look-up's
+        arguments, ``pumpup.operators.compensate``) in one compiled pass, or None (the default: the compensated model
+        then evaluates this model and adds the lobe in a second pass).  A model that has a fused kernel returns exactly
+        what the second pass gives, for C-contiguous (N, 3)-shaped float64 ``wi`` and ``wo`` of one shape, else None.
+        """
+        return None
+
     def kernel_args(self) -> tuple:
         """Scalar parameters passed to the compiled kernel after the 6 direction components."""
         return tuple(self.p[k] for k in self.params)

@@ -44,15 +44,27 @@ def _bad(record: str, what: str) -> None:
 
 @dataclass(frozen=True)
 class Fresnel:
-    """A Fresnel factor at wi.h: a dielectric of real index ``ior`` > 0, or a conductor ``eta`` + i ``k`` (eta > 0)."""
+    """A Fresnel factor at c = wi.h: a dielectric of real index ``ior`` > 0, a conductor ``eta`` + i ``k`` (eta > 0), or
+    Schlick's f0 + (1 - f0) (1 - c)^5 with f0 = ``schlick`` in [0, 1] (Karis 2013; f0 = 0 is the Fc that weights the
+    split sum's second term).  Schlick's record carries ior = -1 - f0 (< 0), the form the kernels read.
+    """
 
     ior: float = 0.0
     eta: float = 0.0
     k: float = 0.0
+    schlick: float | None = None
 
     def __post_init__(self):
-        if (self.ior > 0.0) == (self.eta > 0.0):
-            _bad("Fresnel", f"give ior > 0 (dielectric) or eta > 0 (conductor), got ior={self.ior!r}, eta={self.eta!r}")
+        if self.schlick is not None and self.ior == -1.0 - self.schlick:  # (a copy of a Schlick record)
+            object.__setattr__(self, "ior", 0.0)
+        kinds = (self.ior > 0.0) + (self.eta > 0.0) + (self.schlick is not None)
+        if kinds != 1:
+            _bad("Fresnel", f"give ior > 0 (dielectric), eta > 0 (conductor) or schlick in [0, 1], got "
+                            f"ior={self.ior!r}, eta={self.eta!r}, schlick={self.schlick!r}")
+        if self.schlick is not None and not 0.0 <= self.schlick <= 1.0:
+            _bad("Fresnel", f"schlick (f0) must be in [0, 1], got {self.schlick!r}")
+        if self.schlick is not None:
+            object.__setattr__(self, "ior", -1.0 - float(self.schlick))
 
 
 @dataclass(frozen=True)

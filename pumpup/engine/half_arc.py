@@ -46,10 +46,16 @@ def fresnel_scale(ior: float, eta: float, k: float) -> float:
 
 @njit(cache=True, nogil=True, inline="always")
 def _fresnel_at(mp, c):  # pragma: no cover - compiled
-    """The Fresnel factor at wi.h = c of frames 4 and 6: the conductor's (eta, k = mp[6], mp[7]; metal.py) or the
-    dielectric's (ior = mp[5], 1 when ior <= 0; cook_torrance.py).
+    """The Fresnel factor at wi.h = c of frames 4 and 6: the conductor's (eta, k = mp[6], mp[7]; metal.py), Schlick's
+    f0 + (1 - f0) (1 - c)^5 where mp[5] = -1 - f0 < 0 (Karis 2013), or the dielectric's (ior = mp[5], 1 when ior = 0;
+    cook_torrance.py).
     """
-    return _fresnel_real(c, mp[6], mp[7]) if mp[6] > 0.0 else _fresnel(c, mp[5])
+    if mp[6] > 0.0:
+        return _fresnel_real(c, mp[6], mp[7])
+    if mp[5] < 0.0:
+        q = 1.0 - c
+        return (-1.0 - mp[5]) + (2.0 + mp[5]) * ((q * q) * (q * q) * q)  # Schlick, f0 = -1 - mp[5]
+    return _fresnel(c, mp[5])
 
 
 @njit(cache=True, nogil=True, inline="always")

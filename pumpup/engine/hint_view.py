@@ -34,7 +34,8 @@ class KernelView:
     """An :class:`~pumpup.core.hints.AzimuthHint` as the kernels read it (:func:`kernel_view`): ``kind`` "constant",
     "lobe" (u = R.wo) or "half" (u = N.h); the exponent or width ``n``, the power ``p`` of max(N.wi, N.wo), the radial
     weight, Ward's ``sqrt_cos``, the V-cavity's ``vcavity``, Smith's codes ``smith`` = (distribution, G1, shadowing,
-    alpha), the Fresnel factor ``fresnel`` = (ior, eta, k) at wi.h (or, for a lobe, F(max) of (0, eta, k)),
+    alpha), the Fresnel factor ``fresnel`` = (ior, eta, k) at wi.h (ior = -1 - f0 < 0: Schlick's of f0; or, for a lobe,
+    F(max) of (0, eta, k)),
     Schlick's ``schlick``; and the factors: ``chain`` (pumping's look-ups), ``factor`` (1/E's (f0, *U's arguments)),
     ``fmax`` (F(max) of (eta, k) on a half-vector family), ``levels`` (the kinks of g or U in N.wo).
     """
@@ -63,7 +64,7 @@ def kernel_view(hint: AzimuthHint) -> KernelView:
     out = {"scale": hint.scale}
 
     def fres(fr):
-        """A Fresnel factor's (ior, eta, k) as floats, or zeros without one."""
+        """A Fresnel factor's (ior, eta, k) as floats (Schlick's: ior = -1 - f0), or zeros without one."""
         return (0.0, 0.0, 0.0) if fr is None else (float(fr.ior), float(fr.eta), float(fr.k))
 
     if isinstance(f, ClosedForm):

@@ -736,8 +736,11 @@ def n_fresnel_ok(ior: float, eta: float, k: float) -> bool:
     reflectance's poles, on the physical sheet in the left half-plane, :func:`fresnel_pole`) at least
     :data:`N_FRESNEL_SING_MIN` from the rings' range of c, [:data:`N_FRESNEL_S_MIN`, 1].  A dielectric with ior > 1 has
     w on the imaginary axis; ior <= 1 (a total reflection's kink at c = w real) and a near-kink conductor
-    (w near the real segment) stay with frame 4.
+    (w near the real segment) stay with frame 4.  Schlick's factor (ior = -1 - f0 < 0, :func:`_fresnel_at`) is a
+    polynomial in c: c = 0 is its only singularity.
     """
+    if ior < 0.0:
+        return True
     if eta > 0.0:
         w = complex(1.0 - (eta * eta - k * k), -2.0 * eta * k) ** 0.5
         x = min(max(abs(w.real), N_FRESNEL_S_MIN), 1.0)

@@ -147,7 +147,8 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
             # K's error may be itol |K| or iacc / fac: the second's share of the sum is at most itol times the
             # integral's lower bound so far (iacc, :func:`_integrate`).  Where that exceeds K's bound (0 <= K <= kmax:
             # 8 pi / P(mu) for the Smith models, 16 pi u mu for the V-cavity, 8 pi for Schlick's; F <= 1), K = 0 with
-            # the error kmax (far in the weight's tail: a narrow GGX lobe's nodes beyond the horizon break)
+            # the error kmax (far in the weight's tail: a narrow GGX lobe's nodes beyond the horizon break); kmax holds
+            # for every F(wi.h) <= 1 (the dielectric's, the conductor's, Schlick's)
             kmax = 8.0 * math.pi / mp[8] if mp[0] == SMITH else (16.0 * math.pi * u * mu if mp[0] == VCAVITY_F
                                                                  else 8.0 * math.pi)
             if iacc >= kmax * fac:

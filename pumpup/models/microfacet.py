@@ -42,9 +42,10 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import vectorize
+from numba import njit, vectorize
 
 from ..core import BRDF, MAX_INDEX, MAX_WIDTH, MIN_ALPHA, MIN_INDEX, Lobe, Param, SpecError, register
+from ..physics.lookups import CELL_SHIFT, float_bits, g_levels_call, g_pair, g_product, upper_scalar
 from ..physics.microfacet import projected, projected_reference, walter_level
 from ._half import tan2_half
 from .cook_torrance import _IOR, _fresnel, _fresnel_reference
@@ -64,8 +65,7 @@ _G1 = {"exact": 0, "walter": 1}
 # ----------------------------------------------------------------------------------------
 
 
-@vectorize(cache=True)
-def _mf_kernel(lx, ly, lz, vx, vy, vz, dist, alpha, shadowing, g1, ior, eta, k):  # pragma: no cover - compiled
+def _mf_value(lx, ly, lz, vx, vy, vz, dist, alpha, shadowing, g1, ior, eta, k):  # pragma: no cover - compiled
     if lz <= 0.0 or vz <= 0.0:
         return 0.0
     sx = lx + vx
@@ -93,6 +93,38 @@ def _mf_kernel(lx, ly, lz, vx, vy, vz, dist, alpha, shadowing, g1, ior, eta, k):
     if shadowing == 0:
         return d * f / (4.0 * pl * pv)  # D F G1(wi) G1(wo) / (4 N.wi N.wo), Walter eq. 20
     return d * f / (4.0 * (vz * pl + lz * pv - lz * vz))  # G = 1 / (1 + Lambda_i + Lambda_o), Heitz 2014
+
+
+#: the kernel, over broadcast arrays
+_mf_kernel = vectorize(cache=True)(_mf_value)
+#: the kernel at one pair (the fused pumped kernel's)
+_mf_scalar = njit(cache=True, nogil=True, inline="always")(_mf_value)
+
+
+@njit(cache=True, nogil=True)
+def _mf_divided(wi, wo, out, dist, alpha, shadowing, g1, ior, eta, k, offsets, logx, coef, v0, slope0, margin_lo, cap,
+                controlled, increasing, mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow, qmlo,
+                qshift, qcbase, qcstart, qlo, qrow):  # pragma: no cover - compiled
+    """f_r / (g_1 ... g_k) (001 eq. 16) over the rows of (N, 3) arrays into ``out``: the kernel's value and the pumped
+    chain's division in one pass, the same operations as the kernel followed by the chain kernel
+    (``pumpup.operators.pumping._chain_kernel``; ``BRDF.eval_divided``).
+    """
+    for r in range(out.shape[0]):
+        lz, vz = wi[r, 2], wo[r, 2]
+        if lz <= 0.0 or vz <= 0.0:
+            out[r] = 0.0
+            continue
+        f = _mf_scalar(wi[r, 0], wi[r, 1], lz, wo[r, 0], wo[r, 1], vz, dist, alpha, shadowing, g1, ior, eta, k)
+        mmax, mmin = max(lz, vz), min(lz, vz)
+        if mmin > pmlo:  # as pumpup.operators.pumping._chain_kernel chooses (physics.lookups.g_levels_call says why)
+            out[r] = f / g_product(mmax, pcbase, pcstart, plo, prow)  # 001 eq. 16, all levels
+        elif mmin > qmlo:
+            out[r] = f / g_pair(lz, vz, controlled, qshift, qcbase, qcstart, qlo, qrow)
+        elif f != 0.0:
+            out[r] = f / g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
+                                       increasing, mu0, index, index_lo, index_h_inv)
+        else:
+            out[r] = 0.0
 
 
 # ----------------------------------------------------------------------------------------
@@ -272,6 +304,43 @@ def wih_kinks(brdf, eta, k):
     return hit
 
 
+@njit(cache=True, nogil=True)
+def _mf_kc(wi, wo, out, dist, alpha, shadowing, g1, ior, eta, k, scale, pmlo, pcbase, pcstart, plo, prow, logx, coef,
+           v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
+    """f_r + scale D(mu_i) D(mu_o) (KC eq. 1) over the rows of (N, 3) arrays into ``out`` in one pass: the kernel's
+    value and the Kulla-Conty lobe (``pumpup.operators.compensate._kc_kernel``'s operations; ``BRDF.eval_plus_lobe``).
+    """
+    last = pcstart.shape[0] - 1
+    for r in range(out.shape[0]):
+        lz, vz = wi[r, 2], wo[r, 2]
+        if lz <= 0.0 or vz <= 0.0:
+            out[r] = 0.0
+            continue
+        f = _mf_scalar(wi[r, 0], wi[r, 1], lz, wo[r, 0], wo[r, 1], vz, dist, alpha, shadowing, g1, ior, eta, k)
+        # U(mu_i), U(mu_o): physics.lookups.scale_bound's look-up written out, as _kc_kernel (an inlined helper
+        # taking the look-up's arrays cost 2 x: numba counts references of array arguments per call)
+        if lz > pmlo:
+            s = pcstart[min((float_bits(lz) >> CELL_SHIFT) - pcbase, last)]
+            while lz >= plo[s + 1]:
+                s += 1
+            t = (lz - prow[s, 6]) * prow[s, 7]
+            ui = ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
+        else:
+            ui = upper_scalar(lz, logx, coef, v0, slope0, margin_lo, margin, cap)
+        if vz > pmlo:
+            s = pcstart[min((float_bits(vz) >> CELL_SHIFT) - pcbase, last)]
+            while vz >= plo[s + 1]:
+                s += 1
+            t = (vz - prow[s, 6]) * prow[s, 7]
+            uo = ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
+        else:
+            uo = upper_scalar(vz, logx, coef, v0, slope0, margin_lo, margin, cap)
+        di, do = 1.0 - ui, 1.0 - uo
+        if di > 0.0 and do > 0.0:
+            f += scale * (di * do)  # KC eq. 1
+        out[r] = f
+
+
 class _Microfacet(BRDF):
     """Shared machinery of :class:`Beckmann` and :class:`GGX`."""
 
@@ -301,6 +370,24 @@ class _Microfacet(BRDF):
             0.0 if p["eta"] is None else p["eta"],
             0.0 if p["k"] is None else p["k"],
         )
+
+    def eval_divided(self, wi, wo, chain):
+        """f_r / (g_1 ... g_k) of a pumped chain in one pass (:func:`_mf_divided`; ``BRDF.eval_divided``)."""
+        if not (isinstance(wi, np.ndarray) and isinstance(wo, np.ndarray) and wi.shape == wo.shape and wi.ndim >= 2
+                and wi.dtype == np.float64 == wo.dtype and wi.flags.c_contiguous and wo.flags.c_contiguous):
+            return None
+        out = np.empty(wi.shape[:-1])
+        _mf_divided(wi.reshape(-1, 3), wo.reshape(-1, 3), out.reshape(-1), *self.kernel_args(), *chain)
+        return out
+
+    def eval_plus_lobe(self, wi, wo, scale, bound):
+        """f_r plus a Kulla-Conty lobe in one pass (:func:`_mf_kc`; ``BRDF.eval_plus_lobe``)."""
+        if not (isinstance(wi, np.ndarray) and isinstance(wo, np.ndarray) and wi.shape == wo.shape and wi.ndim >= 2
+                and wi.dtype == np.float64 == wo.dtype and wi.flags.c_contiguous and wo.flags.c_contiguous):
+            return None
+        out = np.empty(wi.shape[:-1])
+        _mf_kc(wi.reshape(-1, 3), wo.reshape(-1, 3), out.reshape(-1), *self.kernel_args(), scale, *bound)
+        return out
 
     def fresnel_one(self):
         """The same distribution and G with F = 1 (no ior, no conductor), or None without a Fresnel factor."""

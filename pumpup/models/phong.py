@@ -15,6 +15,7 @@ from numba import njit, vectorize
 
 from ..core import BRDF, MAX_EXPONENT, Lobe, Param, dot, register
 from ..core.checks import off_unit
+from ..physics.lookups import g_levels_call, g_pair, g_product
 
 
 def _phong_c(p):
@@ -107,6 +108,47 @@ def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compi
     return bad_i, bad_o
 
 
+@njit(cache=True, nogil=True)
+def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
+                   index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow, qmlo, qshift, qcbase, qcstart, qlo,
+                   qrow):  # pragma: no cover - compiled
+    """f_r / (g_1 ... g_k) (001 eq. 16) over the rows of C-contiguous (N, 3) arrays into ``out`` in one pass: each
+    block of _BLOCK rows as :func:`_phong_rows` (without the check), then divided by the pumped chain's g while it is
+    in the cache, the path chosen as ``pumpup.operators.pumping._chain_kernel`` chooses it (``BRDF.eval_divided``):
+    the same operations, the same values.
+    """
+    N = out.shape[0]
+    x = np.empty(_BLOCK)
+    lit = np.empty(_BLOCK, dtype=np.int64)
+    for s in range(0, N, _BLOCK):
+        m = min(N - s, _BLOCK)
+        a = wi[s : s + m]
+        b = wo[s : s + m]
+        f = out[s : s + m]
+        for r in range(m):
+            x[r] = _lit_cos(a[r, 0], a[r, 1], a[r, 2], b[r, 0], b[r, 1], b[r, 2])
+            f[r] = 0.0
+        q = 0
+        for r in range(m):
+            lit[q] = r
+            q += (x[r] > 0.0) | (x[r] != x[r])
+        for j in range(q):
+            r = lit[j]
+            f[r] = c * x[r] ** n  # 000 eq. 5
+        for r in range(m):
+            lz, vz = a[r, 2], b[r, 2]
+            if lz <= 0.0 or vz <= 0.0:
+                continue  # (0 already)
+            mmax, mmin = max(lz, vz), min(lz, vz)
+            if mmin > pmlo:  # (pumpup.physics.lookups.g_levels_call says why this is written out)
+                f[r] = f[r] / g_product(mmax, pcbase, pcstart, plo, prow)  # 001 eq. 16, all levels
+            elif mmin > qmlo:
+                f[r] = f[r] / g_pair(lz, vz, controlled, qshift, qcbase, qcstart, qlo, qrow)
+            elif f[r] != 0.0:
+                f[r] = f[r] / g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
+                                            increasing, mu0, index, index_lo, index_h_inv)
+
+
 def _phong_reference(wi, wo, n, c):
     rv = np.maximum(_cos_alpha(wi, wo), 0.0)
     return np.where(_up(wi, wo) & (rv > 0), c * rv**n, 0.0)  # 000 eq. 5
@@ -138,6 +180,14 @@ class Phong(BRDF):
     }
     examples = [{"n": 0}, {"n": 1}, {"n": 20}, {"n": 5000}, {"n": 10.5, "c": 1.0}]
     kernel = staticmethod(_phong_kernel)
+
+    def eval_divided(self, wi, wo, chain):
+        """f_r / (g_1 ... g_k) of a pumped chain in one pass (:func:`_phong_divided`; ``BRDF.eval_divided``)."""
+        if self._rows(wi, wo) is None:
+            return None
+        out = np.empty(wi.shape[:-1])
+        _phong_divided(wi.reshape(-1, 3), wo.reshape(-1, 3), out.reshape(-1), *self.kernel_args(), *chain)
+        return out
     rows_kernel = staticmethod(_phong_rows)
     reference_fn = staticmethod(_phong_reference)
 

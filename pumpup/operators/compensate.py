@@ -496,6 +496,13 @@ class KullaConty(_Compensated):
         return out
 
     def _eval(self, wi, wo):
+        out = self.base.eval_plus_lobe(wi, wo, self.scale, self.bound.args)  # one pass, where the base has one
+        return out if out is not None else self._run(_kc_kernel, self.scale, wi, wo)
+
+    def _eval_two_passes(self, wi, wo):
+        """:meth:`_eval` as the base's kernel, then :func:`_kc_kernel`: the reference of the fused pass and the
+        baseline of scripts/bench/bench_eval.py.
+        """
         return self._run(_kc_kernel, self.scale, wi, wo)
 
     def reference(self, wi, wo):

@@ -35,6 +35,8 @@ from ..physics.lookups import (
     GChain,
     float_bits_reference,
     g_levels,
+    g_levels_call,
+    g_pair,
     g_product,
     horner,
     kink_roots,
@@ -173,7 +175,8 @@ def _uses_file_tables(brdf: BRDF) -> bool:
 
 @njit(cache=True, nogil=True)
 def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
-                  index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow):  # pragma: no cover - compiled
+                  index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow, qmlo, qshift, qcbase, qcstart,
+                  qlo, qrow):  # pragma: no cover - compiled
     """All levels of a pumped chain in one pass: f / (g_1 g_2 ... g_k) (001 eq. 16), in place.
 
     The tables of the levels are concatenated (level j owns nodes offsets[j]:offsets[j+1]);
@@ -186,7 +189,9 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
 
     Fast path: where every level's bound increases, the product of all levels' g is one function
     of mmax (:class:`_Product`, :func:`g_product`; ``pmlo`` = inf turns it off).  Tested against
-    :meth:`_Product.__call__` and the reference.
+    :meth:`_Product.__call__` and the reference.  Otherwise, where both cosines exceed ``qmlo``, every level's bound
+    from the level table, one piece per direction (:class:`_LevelTable`, :func:`g_pair`; ``qmlo`` = inf turns it
+    off, :meth:`Pumped._eval_levelwise`).
     """
     for k in range(f.shape[0]):
         mi, mo = wi[k, 2], wo[k, 2]
@@ -195,6 +200,28 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
             continue
         mmax, mmin = max(mi, mo), min(mi, mo)
         if mmin > pmlo:  # the fast path: one look-up for all levels (no branch on f = 0: 0 / g = 0)
+            f[k] = f[k] / g_product(mmax, pcbase, pcstart, plo, prow)  # 001 eq. 16, all levels
+        elif mmin > qmlo:  # one piece per direction for all levels (0 / g = 0)
+            f[k] = f[k] / g_pair(mi, mo, controlled, qshift, qcbase, qcstart, qlo, qrow)  # 001 eq. 16, all levels
+        elif f[k] != 0.0:
+            f[k] = f[k] / g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
+                                        increasing, mu0, index, index_lo, index_h_inv)  # 001 eq. 16, all levels
+
+
+@njit(cache=True, nogil=True)
+def _chain_kernel_levelwise(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
+                            index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow):  # pragma: no cover
+    """:func:`_chain_kernel` without the level table, as it was before it (the product table's path, else every level
+    looked up level by level, :func:`g_levels` inlined): the baseline :meth:`Pumped._eval_levelwise` runs, for the
+    tests of the level table and scripts/bench/bench_eval.py.
+    """
+    for k in range(f.shape[0]):
+        mi, mo = wi[k, 2], wo[k, 2]
+        if mi <= 0.0 or mo <= 0.0:
+            f[k] = 0.0
+            continue
+        mmax, mmin = max(mi, mo), min(mi, mo)
+        if mmin > pmlo:
             f[k] = f[k] / g_product(mmax, pcbase, pcstart, plo, prow)  # 001 eq. 16, all levels
             continue
         if f[k] == 0.0:
@@ -379,6 +406,161 @@ class _Product:
         m = np.asarray(m, dtype=np.float64)
         s = self.piece(m)
         return horner(self.coef[:, s], (m - self.center[s]) * self.ihalf[s])
+
+
+def _cap_kinks(looks, br) -> np.ndarray:
+    """Values of m in the range of ``br`` (sorted) where a level's uncapped bound crosses its cap (u_j = cap: a kink of
+    the capped bound), by bisection of the sign changes on ``br`` and its geometric midpoints.
+    """
+    from scipy.optimize import brentq
+
+    grid = np.unique(np.concatenate([br, np.sqrt(br[:-1] * br[1:])]))
+    out = []
+    for lk in looks:
+        if not math.isfinite(lk.cap):
+            continue
+        v = lk.upper(grid, capped=False) - lk.cap
+        for i in np.nonzero(np.sign(v[:-1]) * np.sign(v[1:]) < 0)[0]:
+            out.append(brentq(lambda m, lk=lk: float(lk.upper(np.array([m]), capped=False)[0]) - lk.cap,
+                              grid[i], grid[i + 1], xtol=1e-300, rtol=1e-15))
+    return np.array(out)
+
+
+class _LevelTable:
+    """Every level's bound U_j(m) (the capped upper bound :meth:`_Lookup.upper`) as polynomials in m on one set of
+    pieces: the chain kernel's path where some level's bound is not monotone (GGX's albedo falls, then rises), so that
+    the product of the levels' g is no function of max(N.wi, N.wo) alone (:class:`_Product`).
+
+    One piece per direction then serves every level, found from the bits of m (no logarithm; :func:`g_pair`), where
+    the level-by-level path (:func:`g_levels`) took a logarithm per cosine and a table search per level and cosine.
+    Pieces: at most an eighth of an octave, split at every breakpoint of every level's spline and where a level's bound
+    reaches its cap, so that each U_j is analytic on each; on each a Chebyshev interpolant of degree PRODUCT_DEGREE per
+    level, bisected until every level matches its U_j to ``TOL`` (relative) at 4 (degree + 1) + 1 test points.  The
+    coefficients are then scaled by 1 - ``epsilon`` (twice the largest miss, plus 16 ulp), so every piece is at most
+    U_j and at least U_j (1 - 2 ``epsilon``): g_j = max(U_j(mu_i), U_j(mu_o)[, mu_i, mu_o]) is at most the
+    level-by-level g_j, so the pumped BRDF is at least the level-by-level one (and lower than the ideal operator's while
+    U_j (1 - 2 ``epsilon``) stays above the albedo, which the table's margin, about 1e-7 of it, leaves room for).  The
+    albedo engine divides by the level-by-level g (:func:`g_levels`, so tables are unchanged): what ``eval`` gives
+    exceeds what it integrates by at most 2 ``epsilon`` (about 1e-14) per level, relative.  The layout of
+    ``rows``: per piece its centre, inverse half-width, then each level's coefficients, highest power first; the cells
+    that find a piece are finer than the product table's where the pieces crowd (:meth:`_cells`).
+    :meth:`g` is the plain numpy version of :func:`g_pair`.
+    """
+
+    TOL = 1e-15
+
+    def __init__(self, looks, controlled):
+        self.looks, self.controlled = looks, np.asarray(controlled, dtype=np.bool_)
+        self.mlo = max(max(lk.mu0, math.exp(lk.logx[0])) for lk in looks) * (1.0 + 1e-12)  # (as _Product)
+        knots = np.exp(np.concatenate([lk.logx for lk in looks]))
+        eighths = 2.0 ** np.arange(math.floor(math.log2(self.mlo)), 0, 0.125)  # pieces span at most 1/8 octave
+        br = np.unique(np.concatenate([[self.mlo, 1.0], eighths, knots]))
+        br = br[(br >= self.mlo) & (br <= 1.0)]
+        br = np.unique(np.concatenate([br, _cap_kinks(looks, br)]))
+        lo, hi = br[:-1], br[1:]
+        deg = PRODUCT_DEGREE
+        xk = np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))  # Chebyshev points
+        vand = np.polynomial.chebyshev.chebvander(xk, deg)
+        to_mono = np.array([np.pad(np.polynomial.chebyshev.cheb2poly(np.eye(deg + 1)[k]), (0, deg - k))
+                            for k in range(deg + 1)])  # row k: monomial coefficients of T_k (low first)
+        fit = np.linalg.solve(vand, np.eye(deg + 1)).T @ to_mono  # values at xk -> monomial (low first)
+        tt = np.linspace(-1.0, 1.0, 4 * (deg + 1) + 1)
+        for _ in range(64):
+            center, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+            coefs, worst = [], np.zeros(len(lo))
+            for lk in looks:
+                vals = lk.upper(center[:, None] + half[:, None] * xk[None, :])
+                coef = (vals @ fit)[:, ::-1].T  # (deg + 1, pieces), highest power first
+                miss = np.abs(horner(coef[..., None], tt) / lk.upper(center[:, None] + half[:, None] * tt) - 1.0)
+                coefs.append(coef)
+                worst = np.maximum(worst, miss.max(axis=1))
+            # bisect the pieces that miss, unless already narrower than 1e-9 m (then the miss is the rounding of the
+            # bound itself, and it goes into epsilon)
+            bad = (worst > self.TOL) & (hi - lo > 1e-9 * hi)
+            if not bad.any():
+                break
+            if len(lo) + bad.sum() > 100_000:
+                raise _ProductError(f"the level table needs more than 100000 pieces to reach {self.TOL:g}")
+            mid = 0.5 * (lo[bad] + hi[bad])
+            lo = np.sort(np.concatenate([lo, mid]))
+            hi = np.sort(np.concatenate([hi, mid]))
+        else:
+            raise _ProductError(f"the level table did not reach {self.TOL:g} (worst {worst.max():.3g})")
+        self.epsilon = 2.0 * float(worst.max()) + 16 * np.finfo(float).eps
+        #: (levels, degree + 1, pieces): each level's coefficients, scaled down by 1 - epsilon
+        self.coef = np.stack(coefs) * (1.0 - self.epsilon)
+        self.center, self.ihalf = center, 1.0 / half
+        self.rows = np.ascontiguousarray(np.concatenate(
+            [center[None], self.ihalf[None], self.coef.reshape(-1, len(lo))]).T)
+        self.lo = np.concatenate([lo, [math.inf]])  # a sentinel ends the search
+        self._cells(lo)
+        self._check(tt)
+
+    #: the most cells per octave (2^CELLS_MAX_BITS): 4096 int32 per octave, 16 kB, for the octaves that most
+    #: cosines fall in
+    CELLS_MAX_BITS = 12
+
+    def _cells(self, lo) -> None:
+        """The cell index: 2^bits cells per octave (cell c = (bits(m) >> ``shift``) - ``cbase`` starts at piece
+        ``cstart[c]``), with bits from CELL_BITS up until no cell of the top two octaves, where most cosines lie, holds
+        more than two piece starts (3-level g2 pumped GGX alpha 0.3: 462 pieces in [0.5, 1], up to 41 forward steps
+        with 256 cells per octave), at most CELLS_MAX_BITS.
+        """
+        for bits in range(52 - CELL_SHIFT, self.CELLS_MAX_BITS + 1):
+            shift = 52 - bits
+            top = lo[lo >= 0.25]
+            per = np.bincount((float_bits_reference(top) >> shift) - (int(float_bits_reference(0.25)) >> shift))
+            if per.size == 0 or per.max() <= 2:
+                break
+        self.shift = shift
+        b0 = int(float_bits_reference(self.mlo)) >> shift
+        b1 = int(float_bits_reference(1.0)) >> shift
+        self.cbase = b0
+        bounds = (np.arange(b0, b1 + 1, dtype=np.int64) << shift).view(np.float64)
+        self.cstart = np.clip(np.searchsorted(lo, bounds, side="right") - 1, 0, len(lo) - 1).astype(np.int32)
+
+    def _check(self, tt) -> None:
+        """Refuse the table (:class:`_ProductError`) unless every piece is at most its level's bound at the fit's test
+        points and at 2000 points spread over [mlo, 1] (the bound the level-by-level path divides by).
+        """
+        m = np.concatenate([(self.center[:, None] + tt[None, :] / self.ihalf[:, None]).ravel(),
+                            np.geomspace(self.mlo * (1 + 1e-12), 1.0, 2000)])
+        m = m[(m > self.mlo) & (m <= 1.0)]
+        got = self.levels(m)
+        for j, lk in enumerate(self.looks):
+            if np.any(got[j] > lk.upper(m)):
+                raise _ProductError("the level table exceeds a level's bound")
+
+    def piece(self, m):
+        """The piece that holds m (> mlo), found as the kernel finds it (:meth:`_Product.piece`)."""
+        m = np.asarray(m, dtype=np.float64)
+        c = np.minimum((float_bits_reference(m) >> self.shift) - self.cbase, len(self.cstart) - 1)
+        s = self.cstart[c]
+        while True:
+            step = m >= self.lo[s + 1]
+            if not np.any(step):
+                return s
+            s = s + step
+
+    def levels(self, m) -> np.ndarray:
+        """Every level's U_j(m) (m > mlo) as the kernel computes it: an array (levels,) + m's shape."""
+        m = np.asarray(m, dtype=np.float64)
+        s = self.piece(m)
+        t = (m - self.center[s]) * self.ihalf[s]
+        return np.stack([horner(self.coef[j][:, s], t) for j in range(len(self.looks))])
+
+    def g(self, mu_i, mu_o) -> np.ndarray:
+        """g_1 ... g_k at (mu_i, mu_o), both > mlo: the plain numpy reference of :func:`g_pair` (001 eq. 20, 21)."""
+        mu_i, mu_o = np.broadcast_arrays(np.asarray(mu_i, np.float64), np.asarray(mu_o, np.float64))
+        ui, uo = self.levels(mu_i), self.levels(mu_o)
+        mmax = np.maximum(mu_i, mu_o)
+        out = np.ones(mu_i.shape)
+        for j in range(len(self.looks)):
+            g = np.maximum(ui[j], uo[j])  # 001 eq. 20
+            if self.controlled[j]:
+                g = np.maximum(g, mmax)  # 001 eq. 21
+            out = out * g
+        return out
 
 
 class _Lookup:
@@ -654,7 +836,7 @@ class Pumped(BRDF):
               for name in ("v0", "slope0", "margin_lo", "cap")),
             np.array([lev.controlled for lev in self.chain()]),
             np.array([lk.increasing for lk in looks]), np.array([lk.mu0 for lk in looks]),
-            index, lo, 1.0 / h, *self._product_args(),
+            index, lo, 1.0 / h, *self._product_args(), *self._level_args(),
         )
 
     def product(self) -> _Product | None:
@@ -674,6 +856,30 @@ class Pumped(BRDF):
                     self._product = product
         return self._product
 
+    def level_table(self) -> _LevelTable | None:
+        """The level table of the chain (:class:`_LevelTable`), where it has no product table (None where it has one,
+        or where the level table cannot reach its tolerance: the kernel then looks up level by level).
+        """
+        if not hasattr(self, "_levels_table"):
+            with self._init_lock:
+                if not hasattr(self, "_levels_table"):
+                    table = None
+                    if self.product() is None:
+                        try:
+                            table = _LevelTable([lev.lookup() for lev in self.chain()],
+                                                [lev.controlled for lev in self.chain()])
+                        except _ProductError:
+                            pass
+                    self._levels_table = table
+        return self._levels_table
+
+    def _level_args(self):
+        q = self.level_table()
+        if q is None:  # off: qmlo = inf
+            return (math.inf, CELL_SHIFT, 0, np.zeros(1, np.int32), np.full(2, math.inf),
+                    np.zeros((1, 2 + PRODUCT_DEGREE + 1)))
+        return q.mlo, q.shift, q.cbase, q.cstart, q.lo, q.rows
+
     def _product_args(self):
         p = self.product()
         if p is None:  # off: pmlo = inf
@@ -685,18 +891,22 @@ class Pumped(BRDF):
     #: per pair, measured with scripts/bench/bench_eval.py)
     BLOCK = 8192
 
-    def _eval(self, wi, wo):
+    def _eval(self, wi, wo, levelwise: bool = False):
         from ..core import slabs
 
+        if not levelwise:  # the base's fused kernel: its value and the division in one pass (BRDF.eval_divided)
+            out = self.chain()[0].base.eval_divided(wi, wo, self._chain_args())
+            if out is not None:
+                return out
         shape = np.broadcast_shapes(wi.shape[:-1], wo.shape[:-1])
         n = math.prod(shape)
         if n <= 2 * self.BLOCK:
-            return self._eval_block(wi, wo)
+            return self._eval_block(wi, wo, levelwise)
         if wi.shape == wo.shape and wi.flags.c_contiguous and wo.flags.c_contiguous:
             a, b = wi.reshape(-1, 3), wo.reshape(-1, 3)  # views
             out = np.empty(n)
             for s in range(0, n, self.BLOCK):
-                out[s:s + self.BLOCK] = self._eval_block(a[s:s + self.BLOCK], b[s:s + self.BLOCK])
+                out[s:s + self.BLOCK] = self._eval_block(a[s:s + self.BLOCK], b[s:s + self.BLOCK], levelwise)
             return out.reshape(shape)
         # broadcast (or strided) inputs: read-only views of the full shape, cut into slabs of about
         # BLOCK pairs along the leading axes; only a slab's directions are ever copied (a copy of
@@ -704,10 +914,10 @@ class Pumped(BRDF):
         a, b = np.broadcast_to(wi, shape + (3,)), np.broadcast_to(wo, shape + (3,))
         out = np.empty(shape)
         for idx in slabs(shape, self.BLOCK):
-            out[idx] = self._eval_block(a[idx], b[idx])
+            out[idx] = self._eval_block(a[idx], b[idx], levelwise)
         return out
 
-    def _eval_block(self, wi, wo):
+    def _eval_block(self, wi, wo, levelwise: bool = False):
         base = self.chain()[0].base
         f = base._eval(wi, wo)  # the innermost base, once
         own = (isinstance(f, np.ndarray) and f.dtype == np.float64 and f.flags.owndata and f.flags.c_contiguous
@@ -718,8 +928,18 @@ class Pumped(BRDF):
         if wi.shape[:-1] != shape or wo.shape[:-1] != shape:
             wi, wo = np.broadcast_to(wi, shape + (3,)), np.broadcast_to(wo, shape + (3,))  # read-only views
         # (n, 3) views of the directions when their strides allow it (the engine's do): no copies
-        _chain_kernel(f.reshape(-1), wi.reshape(-1, 3), wo.reshape(-1, 3), *self._chain_args())
+        if levelwise:
+            _chain_kernel_levelwise(f.reshape(-1), wi.reshape(-1, 3), wo.reshape(-1, 3), *self._chain_args()[:-6])
+        else:
+            _chain_kernel(f.reshape(-1), wi.reshape(-1, 3), wo.reshape(-1, 3), *self._chain_args())
         return f
+
+    def _eval_levelwise(self, wi, wo):
+        """f_r as :meth:`_eval` without the level table (:class:`_LevelTable`): where the chain has no product table,
+        every level's bound looked up level by level (:func:`g_levels`).  The baseline of the level table, for its tests
+        (it divides by at least the level table's g) and scripts/bench/bench_eval.py.
+        """
+        return self._eval(np.asarray(wi, dtype=np.float64), np.asarray(wo, dtype=np.float64), levelwise=True)
 
     def reference(self, wi, wo):
         """The plain numpy f_r: the base's reference divided by g (001 eq. 16)."""

@@ -3,8 +3,10 @@
 An albedo table (``pumpup.tables.AlbedoTable``) is flattened into arrays: its spline pieces in log(mu) with the margin
 that makes them an upper bound of the albedo (:func:`upper_scalar`, :func:`upper_array`; below the first node a power
 law), and, for a chain of pumped levels or a 1/E scaling, one product table of polynomial pieces in m = max(N.wi, N.wo)
-found from the bits of m (:func:`g_product`, :func:`scale_bound`).  The pumped BRDF divides by g (001 eq. 16, 20,
-21), the engine integrates it node by node, and the Mitsuba plugin evaluates it: all three read these functions.
+found from the bits of m (:func:`g_product`, :func:`scale_bound`), or, where a level's bound is not monotone, one
+level table of every level's bound as polynomial pieces in m on shared pieces, one piece per direction
+(:func:`g_pair`).  The pumped BRDF divides by g (001 eq. 16, 20, 21), the engine integrates it node by node, and the
+Mitsuba plugin evaluates it: all three read these functions.
 """
 
 from __future__ import annotations
@@ -225,6 +227,71 @@ def g_levels(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, contro
     return g_all
 
 
+@njit(cache=True, nogil=True, inline="always")
+def pair_piece(m, shift, pcbase, pcstart, plo):  # pragma: no cover - compiled
+    """The piece of a table in m (:func:`g_pair`'s) that holds m (> its ``mlo``): the cell from the bits of m (2^(52 -
+    ``shift``) cells per octave), then forward.
+    """
+    s = pcstart[min((float_bits(m) >> shift) - pcbase, pcstart.shape[0] - 1)]
+    s += m >= plo[s + 1]  # most cells hold one or two pieces: a branch-free step,
+    while m >= plo[s + 1]:  # then a loop that is rarely entered
+        s += 1
+    return s
+
+
+@njit(cache=True, nogil=True, inline="always")
+def g_pair(mi, mo, controlled, shift, pcbase, pcstart, plo, prow):  # pragma: no cover - compiled
+    """g_1 g_2 ... g_k at N.wi = ``mi``, N.wo = ``mo`` (both above the table's ``mlo``) from the level table in m: every
+    level's bound U_j as a polynomial piece in m, all levels on one set of pieces, so one piece per direction serves
+    every level (:class:`pumpup.operators.pumping._LevelTable`; no logarithm; its cells are ``shift``'s, finer than
+    :func:`g_product`'s where the pieces crowd).  Row ``prow[s]``: the piece's centre,
+    inverse half-width, then each level's PRODUCT_DEGREE + 1 coefficients, highest power first.
+    g_j = max(U_j(mi), U_j(mo)) (001 eq. 20), and max(., mi, mo) where ``controlled[j]`` (001 eq. 21).  Inlined where
+    it is called.  Its numpy reference is :meth:`pumpup.operators.pumping._LevelTable.g`.
+    """
+    si = pair_piece(mi, shift, pcbase, pcstart, plo)
+    so = pair_piece(mo, shift, pcbase, pcstart, plo)
+    ti = (mi - prow[si, 0]) * prow[si, 1]
+    to = (mo - prow[so, 0]) * prow[so, 1]
+    mmax = max(mi, mo)
+    nlev = controlled.shape[0]
+    width = PRODUCT_DEGREE + 1  # (a constant of the compiled code)
+    g_all = 1.0
+    for j in range(nlev):
+        a = 2 + j * width
+        if width == 6:  # the quintic, written out (Horner, the order of horner)
+            ui = ((((prow[si, a] * ti + prow[si, a + 1]) * ti + prow[si, a + 2]) * ti + prow[si, a + 3]) * ti
+                  + prow[si, a + 4]) * ti + prow[si, a + 5]
+            uo = ((((prow[so, a] * to + prow[so, a + 1]) * to + prow[so, a + 2]) * to + prow[so, a + 3]) * to
+                  + prow[so, a + 4]) * to + prow[so, a + 5]
+        else:
+            ui = prow[si, a] * ti
+            uo = prow[so, a] * to
+            for r in range(1, width - 1):
+                ui = (ui + prow[si, a + r]) * ti
+                uo = (uo + prow[so, a + r]) * to
+            ui += prow[si, a + width - 1]
+            uo += prow[so, a + width - 1]
+        g = max(ui, uo)  # 001 eq. 20
+        if controlled[j]:
+            g = max(g, mmax)  # 001 eq. 21
+        g_all *= g
+    return g_all
+
+
+@njit(cache=True, nogil=True)
+def g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0, index,
+                  index_lo, index_h_inv):  # pragma: no cover - compiled
+    """:func:`g_levels`, called (not inlined) where it is the rare path of a loop (the pumped chain kernel, the models'
+    fused kernels ``BRDF.eval_divided``), whose fast paths then stay small: inlined there, it made the level table's
+    path 2 x slower (21 against 10 ns per pair, measured).  Those kernels choose the path as
+    ``pumpup.operators.pumping._chain_kernel`` does, written out in each: a helper inlined with the chain's 15 arrays
+    as arguments cost 94 ns per pair, not 8 (numba's reference counting of each array argument, per pair).
+    """
+    return g_levels(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0, index,
+                    index_lo, index_h_inv)
+
+
 def horner(coef, t):
     """sum_r coef[r] t^(d - r) by Horner's rule, in the order the compiled kernel uses."""
     v = coef[0] * t
@@ -252,10 +319,13 @@ def scale_bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, mar
 
 
 #: a pumped chain's look-ups, as the compiled kernels read them (:meth:`pumpup.operators.pumping.Pumped._chain_args`):
-#: every level's upper bound (:func:`g_levels`' arguments) and the product table of all levels (:func:`g_product`'s,
-#: with the N.wo above which it applies, ``product_mlo``; inf when there is none)
+#: every level's upper bound (:func:`g_levels`' arguments), the product table of all levels (:func:`g_product`'s,
+#: with the N.wo above which it applies, ``product_mlo``; inf when there is none) and, where there is no product table
+#: (a level's bound falls somewhere), the level table (:func:`g_pair`'s, with the smaller cosine above which it applies,
+#: ``pair_mlo``; inf when there is none)
 GChain = namedtuple("GChain", [
     "offsets", "logx", "coef", "v0", "slope0", "margin_lo", "cap", "controlled", "increasing", "mu0", "index",
     "index_lo", "index_h_inv", "product_mlo", "product_cbase", "product_cstart", "product_lo", "product_rows",
+    "pair_mlo", "pair_shift", "pair_cbase", "pair_cstart", "pair_lo", "pair_rows",
 ])
 

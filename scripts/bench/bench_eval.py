@@ -5,10 +5,16 @@ Phong).  One core, 2e6 random direction pairs in the upper hemisphere, best of 5
 a warm-up call (so numba compilation is not timed).  The baseline (reciprocal Phong) is
 measured in the same run.
 
-    python scripts/bench/bench_eval.py [--pumped] [--spectral]
+    python scripts/bench/bench_eval.py [--pumped] [--spectral] [--issue55]
 
 (These are the kernels, ``_eval``.  The cost of ``BRDF.eval``'s input checks, and eval against a
 fused numpy expression, is ``python scripts/bench/bench_albedo.py --eval``.)
+
+``--issue55`` prints only the eval rows of issue 55's table (pumped and compensated models against their base), each
+with its target and the old and new path measured alternating in one run (old: the chain kernel level by level,
+``Pumped._eval_levelwise``, and the compensated model's two passes, ``KullaConty._eval_two_passes``; new: ``_eval``,
+the level table where the chain has no product table, and the base's fused kernel where it has one); 2^20 pairs, best
+of 9 in this thread's CPU time (``time.thread_time``: on a shared machine the time spent waiting for a core is out).
 
 ``--spectral`` also times the spectral gold of 000 sec. 5 (8 wavelengths, n = 20) against one
 wavelength (the scalar ``metal``), with input checks on both: 000 eq. 27/28 with the Fresnel factor
@@ -110,5 +116,45 @@ def spectral_rows(wi, wo, repeat=5):
           f"  (|F error| <= {gold.fresnel_table()[1]:.1e})")
 
 
+def issue55_rows(repeat=9, n=1 << 20):
+    """Issue 55's eval rows: target, old and new (alternating), as ratios to the base measured in the same rounds."""
+    rng = np.random.default_rng(1)
+    wi, wo = directions(rng, n), directions(rng, n)
+    ggx = pumpup.load({"type": "ggx", "alpha": 0.3})
+    phong = pumpup.load({"type": "phong", "n": 20})
+    rows = []  # (label, base, old callable, new callable, target)
+    for levels in (1, 2, 3):
+        p = pumpup.pump({"type": "ggx", "alpha": 0.3}, g="g2", levels=levels)
+        rows.append((f"pumped GGX alpha 0.3, g2, {levels} level{'s' * (levels > 1)}", ggx, p._eval_levelwise, p._eval,
+                     1.5))
+    pp = pumpup.pump({"type": "phong", "n": 20}, g="g2", levels=3)
+    rows.append(("pumped Phong n 20, g2, 3 levels", phong, pp._eval_levelwise, pp._eval, 1.3))
+    kc = pumpup.compensate({"type": "ggx", "alpha": 0.3}, method="kulla_conty")
+    rows.append(("GGX alpha 0.3 + Kulla-Conty lobe", ggx, kc._eval_two_passes, kc._eval, 1.3))
+    fns = {"ggx": ggx._eval, "phong": phong._eval}
+    for label, _, old, new, _ in rows:
+        fns[label + " old"], fns[label + " new"] = old, new
+    for fn in fns.values():
+        fn(wi[:10], wo[:10])
+        fn(wi, wo)
+    best = dict.fromkeys(fns, np.inf)
+    for _ in range(repeat):
+        for key, fn in fns.items():  # every path once per round: old and new alternate under the same load
+            t = time.thread_time()  # CPU time of this thread: the time it waits for a core on a loaded machine is out
+            fn(wi, wo)
+            best[key] = min(best[key], time.thread_time() - t)
+    import os
+
+    print(f"issue 55, eval against the base, {n} pairs, best of {repeat} (load {os.getloadavg()[0]:.1f}):")
+    print(f"{'':40s} {'target':>7s} {'old':>7s} {'new':>7s} {'base ns':>8s} {'new ns':>7s}")
+    for label, base, _, _, target in rows:
+        b = best["ggx" if base is ggx else "phong"]
+        o, w = best[label + " old"], best[label + " new"]
+        print(f"{label:40s} {target:6.1f}x {o / b:6.2f}x {w / b:6.2f}x {b / n * 1e9:8.1f} {w / n * 1e9:7.1f}")
+
+
 if __name__ == "__main__":
-    main()
+    if "--issue55" in sys.argv:
+        issue55_rows()
+    else:
+        main()

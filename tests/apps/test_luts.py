@@ -179,6 +179,56 @@ def test_split_sum_against_dblquad():
     assert abs(float(b) - ref) < 1e-7
 
 
+def _b_both_routes(alphas, mu, rtol):
+    """B at every (mu, alpha) by the 1-D routes (Schlick's Fc at wi.h) and by the nested quadrature of eval alone."""
+    out = []
+    for alpha in alphas:
+        f = pumpup.load({"type": "ggx", "alpha": alpha, "shadowing": "correlated"})
+        e, _ = luts._albedo(f, mu, rtol, 200)
+        atol = rtol * float(np.min(e))
+        assert luts._SchlickWeighted(f).azimuth_hint() is not None
+        b1, e1 = luts._albedo(luts._SchlickWeighted(f), mu, rtol, 200, atol=atol)
+        b0, e0 = luts._albedo(luts._NestedSchlickWeighted(f), mu, rtol, 200, atol=atol)
+        out.append((b1, e1, b0, e0))
+    return out
+
+
+def test_split_sum_b_routes_agree_within_their_estimates():
+    """The 1-D routes' B (frame 6 above N_FRESNEL_MU_MIN, the half-vector arc below) against the nested quadrature of
+    _eval: they differ by at most the sum of their error estimates, at Filament's rtol and a tighter one.
+    """
+    mu = np.array([1e-4, 0.01, 0.1, 0.2, 0.3, 0.5, 0.8, 0.99, 1.0])
+    for rtol in (1e-6, 1e-9):
+        for b1, e1, b0, e0 in _b_both_routes([1.4e-4, 0.003, 0.06, 0.36, 1.0], mu, rtol):
+            assert np.all(b1 >= 0) and np.all(b1 <= 1)
+            assert np.all(np.abs(b1 - b0) <= e1 + e0 + 1e-15), (b1 - b0, e1 + e0)
+
+
+def test_schlick_hint_is_only_for_a_plain_smith_model():
+    assert luts._SchlickWeighted(pumpup.load({"type": "ggx", "alpha": 0.3, "ior": 1.5})).azimuth_hint() is None
+    assert luts._SchlickWeighted(pumpup.load({"type": "phong", "n": 20})).azimuth_hint() is None
+    from pumpup.core.hints import Fresnel
+
+    with pytest.raises(ValueError, match="schlick"):
+        Fresnel(schlick=1.5)
+    with pytest.raises(ValueError, match="give ior"):
+        Fresnel(ior=1.5, schlick=0.0)
+
+
+@pytest.mark.slow
+def test_filament_table_b_against_the_nested_route():
+    """The whole 128 x 128 Filament table: B by the 1-D routes and by the nested quadrature agree within their
+    estimates, and E (the same route either way) is the same.
+    """
+    spec, param = luts.model_spec("ggx", "filament")
+    mu, rough = luts.nodes("filament")
+    new = luts.truth_grid(spec, param, mu, rough, rtol=1e-6, split=True)
+    old = luts.truth_grid(spec, param, mu, rough, rtol=1e-6, split=True, _weighted=luts._NestedSchlickWeighted)
+    np.testing.assert_array_equal(new["E"], old["E"])
+    assert np.all(np.abs(new["B"] - old["B"]) <= new["B_error"] + old["B_error"])
+    assert new["over_tolerance"] == 0
+
+
 # ------------------------------------------------------------------------------------------
 # the renderer's look-up
 # ------------------------------------------------------------------------------------------

@@ -184,10 +184,12 @@ def test_tabulate_splits_at_the_models_own_kink():
                                                           interp_tol=1e-5).attrs
 
 
-@pytest.mark.parametrize("spec,mu", [({"type": "beckmann", "alpha": 0.003203041150077256, "shadowing": "correlated",
-                                       "g1": "walter", "ior": 1.9173977996887648}, 1.75340447e-06),
-                                     ({"type": "beckmann", "alpha": 0.3, "shadowing": "correlated", "g1": "walter",
-                                       "ior": 1.5}, 0.3)], ids=["grazing", "rough"])
+@pytest.mark.parametrize("spec,mu", [
+    # (the grazing case's 2-D reference takes minutes: -m slow; the rough one checks the same route by default)
+    pytest.param({"type": "beckmann", "alpha": 0.003203041150077256, "shadowing": "correlated", "g1": "walter",
+                  "ior": 1.9173977996887648}, 1.75340447e-06, id="grazing", marks=pytest.mark.slow),
+    pytest.param({"type": "beckmann", "alpha": 0.3, "shadowing": "correlated", "g1": "walter", "ior": 1.5}, 0.3,
+                 id="rough")])
 def test_beckmann_walter_correlated_with_fresnel(spec, mu):
     """Walter's G1 (a jump at its switch level) in the height-correlated G with a Fresnel factor: frame 4 was 7 x its
     estimate at rtol 1e-10 (the first case: 1.27e-11 off, estimate 1.8e-12) and 3.8 x at 1e-12 (the second), against the

@@ -98,7 +98,9 @@ def brute_albedo(spec, mu, n):
 
 @pytest.mark.parametrize(
     "spec,mu",
-    [(FIG5, 1.0), (FIG5, 0.5), (FIG5, 0.2),
+    [(FIG5, 1.0),
+     # (the same model at two more incidences: -m slow)
+     pytest.param(FIG5, 0.5, marks=pytest.mark.slow), pytest.param(FIG5, 0.2, marks=pytest.mark.slow),
      ({"type": "he_torrance", "sigma_0": 0.18, "tau": 1.0, "wavelength": 0.4, "n": 1.5, "k": 0.3, "diffuse": 0.2},
       0.7)],
 )

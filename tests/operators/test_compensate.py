@@ -10,7 +10,7 @@ import sys
 import helpers
 import numpy as np
 import pytest
-from helpers import at_mu, direction_pairs
+from helpers import at_mu, direction_pairs, random_directions
 
 import pumpup
 from pumpup.operators.compensate import KullaConty, Scaled, compensation_table
@@ -525,3 +525,18 @@ def test_an_f0_or_f_avg_beyond_the_float_range_is_refused_in_one_line(name):
     method = "scale" if name == "f0" else "kulla_conty"
     with pytest.raises(pumpup.SpecError, match=f"^compensate: {name} must be a number in \\[0, 1\\], got 1000"):
         pumpup.compensate({"type": "ggx", "alpha": 0.3}, method=method, **{name: 10**400})
+
+
+@pytest.mark.parametrize("spec", [{"type": "ggx", "alpha": 0.3}, {"type": "beckmann", "alpha": 0.5,
+                                                                  "shadowing": "correlated"}])
+def test_kulla_conty_fused_pass_is_the_two_passes(spec, rng):
+    """A microfacet base's fused kernel (BRDF.eval_plus_lobe) gives, bit for bit, the base's value plus the lobe of the
+    second pass (_kc_kernel), at random and grazing pairs and below the horizon; broadcast shapes take the two passes.
+    """
+    kc = pumpup.compensate(spec, method="kulla_conty")
+    wi, wo = random_directions(rng, 3000), random_directions(rng, 3000)
+    fused = kc.base.eval_plus_lobe(wi, wo, kc.scale, kc.bound.args)
+    assert fused is not None
+    np.testing.assert_array_equal(fused, kc._eval_two_passes(wi, wo))
+    np.testing.assert_array_equal(kc._eval(wi, wo), fused)
+    assert kc.base.eval_plus_lobe(wi[:5, None], wo[None, :5], kc.scale, kc.bound.args) is None

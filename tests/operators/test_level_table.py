@@ -1,0 +1,134 @@
+"""The chain kernel's level table (pumpup.operators.pumping._LevelTable, pumpup.physics.lookups.g_pair): every level's
+bound on one set of polynomial pieces in m, for chains whose bounds are not monotone (GGX).
+
+What must hold, pointwise: the pumped BRDF is at least what the level-by-level path gives (the baseline,
+``Pumped._eval_levelwise``) and at most the ideal operator's (the exact albedo of each level, from pumpup.albedo with
+its error), at random, near-mirror and grazing pairs; the compiled kernel matches its numpy reference.
+"""
+
+import math
+
+import numpy as np
+import pytest
+from helpers import random_directions
+
+import pumpup
+from pumpup.operators.pumping import _LevelTable
+
+
+@pytest.fixture(scope="module")
+def ggx2():
+    """2-level g2 pumped GGX alpha 0.3: its bounds fall, then rise (no product table)."""
+    return pumpup.pump({"type": "ggx", "alpha": 0.3}, g="g2", levels=2)
+
+
+@pytest.fixture(scope="module")
+def ggx1_g1():
+    return pumpup.pump({"type": "ggx", "alpha": 0.3, "shadowing": "correlated"}, g="g1", levels=1)
+
+
+def _pairs(rng, n=300):
+    """Random pairs, near-mirror pairs and grazing pairs (cosines down to 1e-7), all above the horizon."""
+    wi, wo = random_directions(rng, n), random_directions(rng, n)
+    mu = 10 ** rng.uniform(-7, 0, n)
+    phi = rng.uniform(0, 2 * math.pi, n)
+    s = np.sqrt(1 - mu * mu)
+    a = np.stack([s * np.cos(phi), s * np.sin(phi), mu], axis=-1)
+    mirror = a * np.array([-1, -1, 1]) + 1e-4 * rng.normal(size=(n, 3))
+    mirror[:, 2] = np.abs(mirror[:, 2]) + 1e-9
+    mirror /= np.linalg.norm(mirror, axis=-1, keepdims=True)
+    mu2 = 10 ** rng.uniform(-7, -2, n)
+    s2 = np.sqrt(1 - mu2 * mu2)
+    graze = np.stack([s2 * np.cos(phi + 1.0), s2 * np.sin(phi + 1.0), mu2], axis=-1)
+    return np.concatenate([wi, a, a, graze]), np.concatenate([wo, mirror, graze, wo])
+
+
+@pytest.mark.parametrize("name", ["ggx2", "ggx1_g1"])
+def test_level_table_between_the_levelwise_and_the_ideal_operator(name, request, rng):
+    f = request.getfixturevalue(name)
+    assert f.product() is None and f.level_table() is not None  # the level table is what this tests
+    wi, wo = _pairs(rng)
+    new = f._eval(wi, wo)
+    old = f._eval_levelwise(wi, wo)
+    assert np.all(new >= old)  # at least what the level-by-level path gives, exactly
+    up = new > 0
+    assert np.count_nonzero(up) > 0.5 * len(up)
+    assert np.max(np.abs(new[up] / old[up] - 1)) < 1e-13  # and no more than the fit's 2 epsilon per level above
+    # at most the ideal operator's: f / prod_j max(a_j(mu_i), a_j(mu_o)[, mu_i, mu_o]) with every a_j raised by its
+    # error estimate (so the check is stricter than the ideal's own value)
+    keep = (wi[:, 2] > 0) & (wo[:, 2] > 0)
+    wi, wo, new = wi[keep], wo[keep], new[keep]
+    mi, mo = wi[:, 2], wo[:, 2]
+    mus = np.concatenate([mi, mo])
+    g = np.ones(len(wi))
+    for lev in f.chain():
+        a, e = pumpup.albedo(lev.base, mus, return_error=True, rtol=1e-10)
+        hi = a + e
+        gj = np.maximum(hi[:len(wi)], hi[len(wi):])
+        if lev.controlled:
+            gj = np.maximum(gj, np.maximum(mi, mo))
+        g = g * gj
+    ideal = f.chain()[0].base._eval(wi, wo) / g
+    assert np.all(new <= ideal)
+
+
+def test_kernel_against_its_numpy_reference(ggx2, rng):
+    q = ggx2.level_table()
+    m = np.concatenate([10 ** rng.uniform(math.log10(q.mlo) + 1e-9, 0, 4000), [1.0], q.lo[1:-1],
+                        q.lo[1:-1] * (1 - 1e-15)])
+    m = m[(m > q.mlo) & (m <= 1.0)]
+    mi, mo = rng.permutation(m), m
+    # the kernel, through the chain kernel (f = 1 / g), at directions with these cosines
+    wi = np.stack([np.sqrt(1 - mi * mi), np.zeros_like(mi), mi], axis=-1)
+    wo = np.stack([np.zeros_like(mo), np.sqrt(1 - mo * mo), mo], axis=-1)
+    from pumpup.operators.pumping import _chain_kernel
+
+    f = np.ones(len(m))
+    _chain_kernel(f, wi, wo, *ggx2._chain_args())
+    ref = 1.0 / q.g(mi, mo)
+    np.testing.assert_allclose(f, ref, rtol=4e-16 * 8, atol=0)
+    # every level's piece is at most the level's bound and within 2 epsilon below it
+    for j, lk in enumerate(q.looks):
+        u, got = lk.upper(m), q.levels(m)[j]
+        assert np.all(got <= u) and np.all(got >= u * (1 - 2 * q.epsilon - 1e-15))
+
+
+def test_level_table_layout(ggx2):
+    """The rows hold centre, inverse half-width and each level's PRODUCT_DEGREE + 1 coefficients; the GChain names."""
+    from pumpup.physics.lookups import PRODUCT_DEGREE
+
+    q = ggx2.level_table()
+    args = ggx2._chain_args()
+    assert q.rows.shape == (len(q.lo) - 1, 2 + 2 * (PRODUCT_DEGREE + 1))
+    assert args.pair_mlo == q.mlo and args.pair_rows is q.rows
+    assert _LevelTable.TOL <= 1e-14
+
+
+def test_phong_keeps_its_product_table():
+    """Where every level's bound increases, the product table serves (one look-up per pair) and no level table."""
+    f = pumpup.pump({"type": "phong", "n": 20}, g="g2", levels=1)
+    assert f.product() is not None and f.level_table() is None
+    assert f._chain_args().pair_mlo == math.inf
+
+
+@pytest.mark.parametrize("spec", [{"type": "ggx", "alpha": 0.3}, {"type": "beckmann", "alpha": 0.2, "ior": 1.5},
+                                  {"type": "phong", "n": 20}])
+def test_fused_kernel_is_the_base_then_the_chain_kernel(spec, ggx2, rng):
+    """A base's fused kernel (BRDF.eval_divided: microfacet, Phong) gives, bit for bit, its own value divided by the
+    chain kernel: on every path (product or level table, level by level below its mlo, below the horizon)."""
+    from pumpup.operators.pumping import _chain_kernel
+
+    f = ggx2 if spec.get("alpha") == 0.3 else pumpup.pump(spec, g="g1")
+    base = f.chain()[0].base
+    wi, wo = _pairs(rng, 200)
+    wi, wo = np.concatenate([wi, random_directions(rng, 200)]), np.concatenate([wo, random_directions(rng, 200)])
+    wi[:3, 2], wo[3:6, 2] = 1e-9, 3e-10  # below the level table's mlo: level by level
+    wi /= np.linalg.norm(wi, axis=-1, keepdims=True)
+    wo /= np.linalg.norm(wo, axis=-1, keepdims=True)
+    fused = base.eval_divided(wi, wo, f._chain_args())
+    assert fused is not None
+    two = np.array(base._eval(wi, wo))
+    _chain_kernel(two, wi, wo, *f._chain_args())
+    np.testing.assert_array_equal(fused, two)
+    np.testing.assert_array_equal(f._eval(wi, wo), two)
+    assert base.eval_divided(wi[:, None], wo[None, :], f._chain_args()) is None  # broadcast shapes: the two passes
