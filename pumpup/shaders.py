@@ -507,6 +507,43 @@ def _poly_error(coef: np.ndarray, w: np.ndarray, delta: np.ndarray) -> np.ndarra
     return err
 
 
+#: cells per octave of the piece index (the float32 bits of the variable, as pumpup's kernel uses the float64 bits)
+_CELL_BITS = 4
+
+
+def _search(bounds32: np.ndarray, nm: str, var: str) -> tuple[str, str]:
+    """GLSL that sets ``int i`` to the largest s with ``{nm}_b[s] <= var`` (``var`` >= the first bound, a float32 >
+    0): the cell of ``var`` from its float32 bits (2^_CELL_BITS cells per octave, as
+    :func:`pumpup.physics.lookups.g_product` finds a piece from the float64 bits), the first candidate piece of the
+    cell, then a binary search of fixed length over the cell's pieces.  (arrays, code).
+    """
+    b = np.asarray(bounds32, dtype=np.float32)
+    n = len(b)
+    shift = 23 - _CELL_BITS
+    bits = b.view(np.uint32).astype(np.int64)
+    cbase = int(bits[0] >> shift)
+    cend = int(np.array([1.0], np.float32).view(np.uint32)[0] >> shift)
+    ncell = max(cend - cbase + 1, 1)
+    starts = ((np.arange(ncell, dtype=np.int64) + cbase) << shift).astype(np.uint32).view(np.float32)
+    ends = ((np.arange(ncell, dtype=np.int64) + cbase + 1) << shift).astype(np.uint32).view(np.float32)
+    first = np.clip(np.searchsorted(b, starts, side="right") - 1, 0, n - 1)
+    last = np.clip(np.searchsorted(b, ends, side="left") - 1, 0, n - 1)
+    count = int(np.max(last - first)) + 1
+    steps = []
+    k = 1
+    while k < count:
+        k *= 2
+    k //= 2
+    while k >= 1:
+        steps.append(f"    j = i + {k}; if (j <= {n - 1} && {nm}_b[j] <= {var}) i = j;")
+        k //= 2
+    vals = ", ".join(str(int(x)) for x in first)
+    arrays = _array(f"{nm}_b", b) + f"const int {nm}_cs[{ncell}] = int[{ncell}]({vals});\n"
+    code = (f"    int i = {nm}_cs[clamp(int(floatBitsToUint({var}) >> {shift}u) - {cbase}, 0, {ncell - 1})];\n"
+            "    int j;\n" + "\n".join(steps) + ("\n" if steps else ""))
+    return arrays, code
+
+
 class _LevelTable:
     """One level's upper bound u(mu) (:func:`pumpup.physics.lookups.upper_scalar`), as the shader reads it."""
 
@@ -537,18 +574,9 @@ class _LevelTable:
         self.margin = float(lk.margin)
 
     def glsl(self) -> str:
-        nm, n = self.name, self.npieces
-        d = self.deg
-        out = [_array(f"{nm}_k", self.knots), _array(f"{nm}_x", self.logx32),
-               _array(f"{nm}_c", self.coef32.T.ravel())]
-        steps = []
-        s = 1
-        while s < n:
-            s *= 2
-        s //= 2
-        while s >= 1:
-            steps.append(f"    c = i + {s}; if (c <= {n - 1} && {nm}_k[c] <= mu) i = c;")
-            s //= 2
+        nm, d = self.name, self.deg
+        arrays, search = _search(self.knots, nm, "mu")
+        out = [arrays, _array(f"{nm}_x", self.logx32), _array(f"{nm}_c", self.coef32.T.ravel())]
         horner = f"{nm}_c[b]"
         for r in range(1, d + 1):
             horner = f"({horner}) * dd + {nm}_c[b + {r}]" if r > 1 else f"{nm}_c[b] * dd + {nm}_c[b + 1]"
@@ -556,21 +584,18 @@ class _LevelTable:
         v0 = _lit(_up32(self.v0))
         mlo = _lit(_up32(self.margin_lo * (1.0 + 4 * U)))
         out.append(f"""\
-// the upper bound of the level's albedo at mu in (0, 1] (pumpup.physics.lookups.upper_scalar): the spline piece in
-// ln(mu) that holds mu, a power law below the first node, at most the cap
-float {nm}_u(float mu) {{
-    float lm = log(mu);
-    if (mu < {nm}_k[0]) {{
+// the upper bound of the level's albedo at mu in (0, 1] (pumpup.physics.lookups.upper_scalar), lm = log(mu): the
+// spline piece in ln(mu) that holds mu, a power law below the first node, at most the cap
+float {nm}_u(float mu, float lm) {{
+    if (mu < {nm}_b[0]) {{
         float x = {_lit(self.slope0)} * (lm - {_lit(self.logx0)});
-        float dx = abs({_lit(self.slope0)}) * (pumpup_log_err(lm) + 2.0 * pumpup_U * (abs(lm) + {_lit(abs(self.logx0))}))
+        float dx = abs({_lit(self.slope0)})
+            * (pumpup_log_err(lm) + 2.0 * pumpup_U * (abs(lm) + {_lit(abs(self.logx0))}))
             + 2.0 * pumpup_U * abs(x);
         float u = {v0} * exp(x) * (1.0 + 2.0 * pumpup_exp_err(x, dx) + 4.0 * pumpup_U) + {mlo};
         return {cap};
     }}
-    int i = 0;
-    int c;
-{chr(10).join(steps)}
-    float dd = lm - {nm}_x[i];
+{search}    float dd = lm - {nm}_x[i];
     int b = {d + 1} * i;
     float u = {horner};
     return {cap};
@@ -622,27 +647,17 @@ class _ProductTable:
         self.epsilon = float(getattr(prod, "epsilon", 0.0))
 
     def glsl(self) -> str:
-        nm, n, d = self.name, self.npieces, self.deg
-        out = [_array(f"{nm}_lo", self.lo32), _array(f"{nm}_cen", self.c32), _array(f"{nm}_ih", self.ih32),
+        nm, d = self.name, self.deg
+        arrays, search = _search(self.lo32, nm, "m")
+        out = [arrays, _array(f"{nm}_cen", self.c32), _array(f"{nm}_ih", self.ih32),
                _array(f"{nm}_c", self.coef32.T.ravel())]
-        steps = []
-        s = 1
-        while s < n:
-            s *= 2
-        s //= 2
-        while s >= 1:
-            steps.append(f"    c = i + {s}; if (c <= {n - 1} && {nm}_lo[c] <= m) i = c;")
-            s //= 2
         horner = f"{nm}_c[b] * t + {nm}_c[b + 1]"
         for r in range(2, d + 1):
             horner = f"({horner}) * t + {nm}_c[b + {r}]"
         out.append(f"""\
 // the product table at m (> its lower end): the polynomial piece that holds m (pumpup.physics.lookups.g_product)
 float {nm}_g(float m) {{
-    int i = 0;
-    int c;
-{chr(10).join(steps)}
-    float t = (m - {nm}_cen[i]) * {nm}_ih[i];
+{search}    float t = (m - {nm}_cen[i]) * {nm}_ih[i];
     int b = {d + 1} * i;
     return {horner};
 }}
@@ -689,9 +704,9 @@ def _pumped_glsl(plan: _Plan) -> tuple[str, list[str], int]:
     for j, (t, controlled) in enumerate(levels):
         nm = t.name
         if t.increasing:
-            look = (f"mmin > {_lit(_down32(t.mu0))} ? {nm}_u(mmax) : max({nm}_u(mi), {nm}_u(mo))")
+            look = (f"mmin > {_lit(_down32(t.mu0))} ? {nm}_u(mmax, lmax) : max({nm}_u(mi, li), {nm}_u(mo, lo))")
         else:
-            look = f"max({nm}_u(mi), {nm}_u(mo))"
+            look = f"max({nm}_u(mi, li), {nm}_u(mo, lo))"
         body.append(f"    float g{j + 1} = {look};  // 001 eq. 20")
         if controlled:
             body.append(f"    g{j + 1} = max(g{j + 1}, mmax);  // 001 eq. 21")
@@ -701,7 +716,10 @@ def _pumped_glsl(plan: _Plan) -> tuple[str, list[str], int]:
 float pumpup_g(float mi, float mo) {{
     float mmax = max(mi, mo);
     float mmin = min(mi, mo);
-{cond}{chr(10).join(body)}
+{cond}    float li = log(mi);
+    float lo = log(mo);
+    float lmax = mi >= mo ? li : lo;
+{chr(10).join(body)}
     return {prod_expr};
 }}
 """)
@@ -721,9 +739,9 @@ def _comp_glsl(plan: _Plan) -> tuple[str, list[str]]:
         out.append(p.glsl())
         notes.append(f"product table of U in m: {p.npieces} pieces (degree {p.deg}) for m > {p.mlo:.6g}, relative fit "
                      f"<= {p.epsilon:.3g} (added), float32 error <= {float(np.max(p.err)):.3g} (added)")
-        look = f"m > {_lit(p.mlo32)} ? pumpup_eprod_g(m) : pumpup_e_u(m)"
+        look = f"m > {_lit(p.mlo32)} ? pumpup_eprod_g(m) : pumpup_e_u(m, log(m))"
     else:
-        look = "pumpup_e_u(m)"
+        look = "pumpup_e_u(m, log(m))"
     out.append(f"""\
 // U(m) >= E(m), at least pumpup's bound (pumpup.physics.lookups.scale_bound)
 float pumpup_upper(float m) {{
@@ -961,7 +979,9 @@ def _translate(lib: str, target: str) -> str:
 
 
 def _brdf_explorer(plan: _Plan, lib: str, header: str) -> str:
-    """A ``.brdf`` file of Disney's BRDF Explorer: the uniforms as its parameters, BRDF(L, V, N, X, Y) in world space."""
+    """A ``.brdf`` file of Disney's BRDF Explorer: the uniforms as its parameters, BRDF(L, V, N, X, Y) in world
+    space.
+    """
     from .core import registry
 
     cls = registry()[plan.base.type]
