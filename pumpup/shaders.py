@@ -378,6 +378,70 @@ vec2 pumpup_base(vec3 l, vec3 v) {{
 """
 
 
+def _power_lines(var: str, err_abs: str, n: str) -> str:
+    """GLSL lines: ``float pw = var^n`` as exp2(n log2 var) and ``float pe``, a bound of its relative error, for
+    ``var`` > 0 with absolute error ``err_abs``.
+    """
+    return f"""\
+    float l2 = log2({var});
+    float z = {n} * l2;
+    float pw = exp2(z);
+    float pe = pumpup_exp_err(z, 0.6931472 * ({n} * ({err_abs} / ({var} * 0.6931472) + pumpup_log_err(l2))
+        + 2.0 * pumpup_U * abs(z)));
+"""
+
+
+def _retro_code(b: BRDF) -> str:
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float lv = dot(l, v);  // L.V (absolute error <= 6 U)
+    if (lv <= 0.0) return vec2(0.0);
+{_power_lines("lv", "6.0 * pumpup_U", "pumpup_n")}    float mx = max(l.z, v.z);
+    float f = pumpup_c * pw;
+    float e = pe + 4.0 * pumpup_U;
+    if (pumpup_p == 1.0) {{
+        f /= mx;
+        e += 5.0 * pumpup_U;
+    }} else {{
+        float lm = log2(mx);
+        float zp = pumpup_p * lm;
+        f /= exp2(zp);
+        e += pumpup_exp_err(-abs(zp), 0.6931472 * (pumpup_p * pumpup_log_err(lm) + 2.0 * pumpup_U * abs(zp)))
+            + 5.0 * pumpup_U;
+    }}
+    return vec2(f, e);  // c (L.V)^n / max(N.L, N.V)^p, 000 eq. 13
+}}
+"""
+
+
+def _metal_code(b: BRDF) -> str:
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float rv = 2.0 * l.z * v.z - dot(l, v);  // R.V, 000 eq. 9 (absolute error <= 8 U)
+    if (rv <= 0.0) return vec2(0.0);
+{_power_lines("rv", "11.6 * pumpup_U", "pumpup_n")}    float mx = max(l.z, v.z);  // cos(Theta_min)
+    vec2 fr = pumpup_fresnel_conductor(mx, pumpup_eta, pumpup_k);
+    return vec2(pumpup_c * pw / mx * fr.x, pe + fr.y + 10.0 * pumpup_U);  // 000 eq. 28
+}}
+"""
+
+
+def _plastic_code(b: BRDF) -> str:
+    fres = ("vec2 fr = pumpup_fresnel_conductor(mx, pumpup_eta, 0.0);  // 000 eq. 30" if b.p["eta"] is not None
+            else "vec2 fr = vec2(1.0, 0.0);")
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float f = pumpup_ad * 0.318309886;
+    float rv = 2.0 * l.z * v.z - dot(l, v);  // R.V, 000 eq. 9 (absolute error <= 8 U)
+    if (rv <= 0.0) return vec2(f, 6.0 * pumpup_U);
+{_power_lines("rv", "11.6 * pumpup_U", "pumpup_n")}    float mx = max(l.z, v.z);  // cos(Theta_min)
+    {fres}
+    float spec = pumpup_a_s * (pumpup_n + 2.0) / (2.0 * pumpup_PI) * pw / mx * fr.x;  // 000 eq. 29
+    return vec2(f + spec, max(6.0 * pumpup_U, pe + fr.y + 14.0 * pumpup_U) + 2.0 * pumpup_U);
+}}
+"""
+
+
 #: type -> (the parameters that become uniforms, code generator)
 _MODELS = {
     "lambert": (("albedo",), _lambert_code),
@@ -391,6 +455,9 @@ _MODELS = {
     "schlick": (("r", "c"), _schlick_code),
     "ggx": (("alpha", "ior", "eta", "k"), _microfacet_code),
     "beckmann": (("alpha", "ior", "eta", "k"), _microfacet_code),
+    "retro": (("n", "p", "c"), _retro_code),
+    "metal": (("n", "eta", "k", "c"), _metal_code),
+    "plastic": (("n", "ad", "a_s", "eta"), _plastic_code),
 }
 
 #: the model types :func:`shader` translates (and the operators over them)
@@ -408,6 +475,9 @@ def error_bound_text() -> dict[str, str]:
         "schlick": "192 U",
         "ggx": "128 U + Fresnel + 2 x 1.5e-6 (Smith) + 24 U",
         "beckmann": "(exp) + 31 U tan^2/alpha^2 + 64 U + Fresnel + 2 x 3.2e-6 (Smith with erf) + 24 U",
+        "retro": "as phong with L.V (absolute error 6 U) and the max(N.L, N.V)^p term",
+        "metal": "as phong + conductor Fresnel + 10 U",
+        "plastic": "max(6 U, phong's + Fresnel + 14 U) + 2 U",
     }
 
 

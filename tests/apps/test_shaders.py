@@ -31,7 +31,9 @@ BASES = [
     {"type": "cook_torrance", "m": 0.1}, "schlick:r=0.1", "lambert:albedo=0.5",
     {"type": "ggx", "alpha": 0.3, "eta": 0.2, "k": 3.0, "shadowing": "correlated"},
     {"type": "ggx", "alpha": 0.05, "ior": 1.5}, {"type": "beckmann", "alpha": 0.3, "ior": 1.5},
-    {"type": "beckmann", "alpha": 0.3, "g1": "walter"},
+    {"type": "beckmann", "alpha": 0.3, "g1": "walter"}, {"type": "retro", "n": 20},
+    {"type": "retro", "n": 50, "p": 0.5}, {"type": "metal", "n": 20, "eta": 0.2, "k": 3.0},
+    {"type": "plastic", "n": 30, "ad": 0.4, "a_s": 0.5, "eta": 1.5}, {"type": "plastic", "n": 30},
 ]
 
 GGX = {"type": "ggx", "alpha": 0.3}
