@@ -442,6 +442,33 @@ vec2 pumpup_base(vec3 l, vec3 v) {{
 """
 
 
+def _minnaert_code(b: BRDF) -> str:
+    return """\
+vec2 pumpup_base(vec3 l, vec3 v) {
+    float k1 = pumpup_k - 1.0;
+    float al = log2(l.z);
+    float av = log2(v.z);
+    float zl = k1 * al;
+    float zv = k1 * av;
+    float f = pumpup_b * exp2(zl) * exp2(zv);  // b ((N.S)(N.V))^(k - 1), 002 sec. 3.4
+    float el = pumpup_exp_err(zl, 0.6931472 * (abs(k1) * pumpup_log_err(al) + 2.0 * pumpup_U * abs(zl)
+        + pumpup_U * pumpup_k * abs(al)));
+    float ev = pumpup_exp_err(zv, 0.6931472 * (abs(k1) * pumpup_log_err(av) + 2.0 * pumpup_U * abs(zv)
+        + pumpup_U * pumpup_k * abs(av)));
+    return vec2(f, el + ev + 4.0 * pumpup_U);
+}
+"""
+
+
+def _lacquer_code(b: BRDF) -> str:
+    return """\
+vec2 pumpup_base(vec3 l, vec3 v) {
+    float x = pumpup_s / l.z + pumpup_s / v.z;
+    return vec2(pumpup_c * exp(-x), pumpup_exp_err(-x, 8.0 * pumpup_U * x) + 4.0 * pumpup_U);  // 002 sec. 3.3
+}
+"""
+
+
 #: type -> (the parameters that become uniforms, code generator)
 _MODELS = {
     "lambert": (("albedo",), _lambert_code),
@@ -458,6 +485,8 @@ _MODELS = {
     "retro": (("n", "p", "c"), _retro_code),
     "metal": (("n", "eta", "k", "c"), _metal_code),
     "plastic": (("n", "ad", "a_s", "eta"), _plastic_code),
+    "minnaert": (("k", "b"), _minnaert_code),
+    "lacquer": (("c", "s"), _lacquer_code),
 }
 
 #: the model types :func:`shader` translates (and the operators over them)
@@ -478,6 +507,8 @@ def error_bound_text() -> dict[str, str]:
         "retro": "as phong with L.V (absolute error 6 U) and the max(N.L, N.V)^p term",
         "metal": "as phong + conductor Fresnel + 10 U",
         "plastic": "max(6 U, phong's + Fresnel + 14 U) + 2 U",
+        "minnaert": "two exp2 terms e(z, |k - 1| (2^-21 + 6 U |log2 mu|) + 2 U |z| + U k |log2 mu|) + 4 U",
+        "lacquer": "e(-x, 8 U x) + 4 U, x = s (1/N.L + 1/N.V)",
     }
 
 
