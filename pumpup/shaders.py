@@ -469,6 +469,30 @@ vec2 pumpup_base(vec3 l, vec3 v) {
 """
 
 
+def _phong_shader_code(b: BRDF) -> str:
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float rv = 2.0 * l.z * v.z - dot(l, v);  // R.V (absolute error <= 8 U)
+    if (rv <= 0.0) return vec2(pumpup_kd, pumpup_U);
+{_power_lines("rv", "11.6 * pumpup_U", "pumpup_n")}    float spec = pumpup_ks * pw / l.z;  // 002 eq. 5, 8
+    return vec2(pumpup_kd + spec, max(pumpup_U, pe + 9.0 * pumpup_U) + 2.0 * pumpup_U);
+}}
+"""
+
+
+def _phong_blinn_code(b: BRDF) -> str:
+    return """\
+vec2 pumpup_base(vec3 l, vec3 v) {
+    float t = pumpup_tan2_half(l, v);
+    vec2 lp = pumpup_log1p(t);  // -ln (N.H)^2
+    float x = -0.5 * pumpup_n * lp.x;
+    float spec = pumpup_ks * exp(x);  // 002 eq. 24, 6
+    float dx = 0.5 * pumpup_n * (lp.y + 22.0 * pumpup_U * t / (1.0 + t)) + 2.0 * pumpup_U * abs(x);
+    return vec2(pumpup_kd + spec, max(pumpup_U, pumpup_exp_err(x, dx) + 4.0 * pumpup_U) + 2.0 * pumpup_U);
+}
+"""
+
+
 #: type -> (the parameters that become uniforms, code generator)
 _MODELS = {
     "lambert": (("albedo",), _lambert_code),
@@ -487,6 +511,8 @@ _MODELS = {
     "plastic": (("n", "ad", "a_s", "eta"), _plastic_code),
     "minnaert": (("k", "b"), _minnaert_code),
     "lacquer": (("c", "s"), _lacquer_code),
+    "phong_shader": (("n", "ks", "kd"), _phong_shader_code),
+    "phong_blinn": (("n", "ks", "kd"), _phong_blinn_code),
 }
 
 #: the model types :func:`shader` translates (and the operators over them)
@@ -509,6 +535,8 @@ def error_bound_text() -> dict[str, str]:
         "plastic": "max(6 U, phong's + Fresnel + 14 U) + 2 U",
         "minnaert": "two exp2 terms e(z, |k - 1| (2^-21 + 6 U |log2 mu|) + 2 U |z| + U k |log2 mu|) + 4 U",
         "lacquer": "e(-x, 8 U x) + 4 U, x = s (1/N.L + 1/N.V)",
+        "phong_shader": "max(U, phong's + 9 U) + 2 U",
+        "phong_blinn": "max(U, blinn's) + 2 U",
     }
 
 

@@ -35,6 +35,7 @@ BASES = [
     {"type": "retro", "n": 50, "p": 0.5}, {"type": "metal", "n": 20, "eta": 0.2, "k": 3.0},
     {"type": "plastic", "n": 30, "ad": 0.4, "a_s": 0.5, "eta": 1.5}, {"type": "plastic", "n": 30},
     {"type": "minnaert", "k": 0.7}, {"type": "minnaert", "k": 3.0}, {"type": "lacquer", "s": 0.1},
+    {"type": "phong_shader", "n": 5, "kd": 0.1, "ks": 0.3}, {"type": "phong_blinn", "n": 300, "kd": 0.2, "ks": 0.5},
 ]
 
 GGX = {"type": "ggx", "alpha": 0.3}
