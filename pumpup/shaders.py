@@ -516,7 +516,7 @@ _MODELS = {
 }
 
 #: the model types :func:`shader` translates (and the operators over them)
-SUPPORTED = tuple(sorted(_MODELS)) + ("pumped", "kulla_conty", "scaled")
+SUPPORTED = tuple(sorted(_MODELS)) + ("pumped", "kulla_conty", "scaled", "fresnel")
 
 
 def error_bound_text() -> dict[str, str]:
@@ -564,6 +564,13 @@ class _Plan:
         self.levels: list = []
         self.comp = None
         b = brdf
+        #: (eta, k) of an outer ``fresnel`` model (base x F(Theta_min), 000 eq. 28), else None
+        self.fresnel = None
+        if b.type == "fresnel" and np.ndim(b.p["eta"]) == 0 and np.ndim(b.p["k"]) == 0:
+            self.fresnel = (float(b.p["eta"]), float(b.p["k"]))
+            b = b.p["base"]
+            if isinstance(b, (KullaConty, Scaled)):
+                raise _unsupported(b, "inside 'fresnel': F(Theta_min) over a compensation")
         if isinstance(b, (KullaConty, Scaled)):
             self.comp = b
             b = b.base
@@ -580,6 +587,8 @@ class _Plan:
         self.baked = bool(self.levels) or self.comp is not None
         names = _MODELS[b.type][0]
         self.params = {k: float(b.p[k]) for k in names if b.p.get(k) is not None}
+        if self.fresnel is not None:
+            self.params["fresnel_eta"], self.params["fresnel_k"] = self.fresnel
         s = math.sqrt(0.5)
         peak = np.asarray(brdf.eval(np.array([[0.0, 0.0, 1.0], [s, 0.0, s]]),
                                     np.array([[0.0, 0.0, 1.0], [-s, 0.0, s]])))
@@ -934,7 +943,20 @@ def _library(plan: _Plan) -> tuple[str, list[str]]:
         parts.append(_ERF)
     parts.append(_param_decls(plan))
     parts.append(f"// the base model {b.type}: (f_r, a bound of its relative float32 error) for N.wi, N.wo > 0\n")
-    parts.append(code)
+    if plan.fresnel is not None:
+        if "pumpup_fresnel_conductor" not in code:
+            parts.append(_FRESNEL_CONDUCTOR)
+        parts.append(code.replace("vec2 pumpup_base(vec3 l, vec3 v)", "vec2 pumpup_base_inner(vec3 l, vec3 v)"))
+        parts.append("""\
+// the fresnel model: the base times F(eta + i k, Theta_min), cos(Theta_min) = max(N.wi, N.wo) (000 eq. 28)
+vec2 pumpup_base(vec3 l, vec3 v) {
+    vec2 f = pumpup_base_inner(l, v);
+    vec2 fr = pumpup_fresnel_conductor(max(l.z, v.z), pumpup_fresnel_eta, pumpup_fresnel_k);
+    return vec2(f.x * fr.x, f.y + fr.y + 2.0 * pumpup_U);
+}
+""")
+    else:
+        parts.append(code)
     notes: list[str] = []
     if plan.levels:
         glsl, notes, nlev = _pumped_glsl(plan)

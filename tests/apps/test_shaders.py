@@ -36,6 +36,7 @@ BASES = [
     {"type": "plastic", "n": 30, "ad": 0.4, "a_s": 0.5, "eta": 1.5}, {"type": "plastic", "n": 30},
     {"type": "minnaert", "k": 0.7}, {"type": "minnaert", "k": 3.0}, {"type": "lacquer", "s": 0.1},
     {"type": "phong_shader", "n": 5, "kd": 0.1, "ks": 0.3}, {"type": "phong_blinn", "n": 300, "kd": 0.2, "ks": 0.5},
+    {"type": "fresnel", "base": {"type": "phong", "n": 20}, "eta": 0.2, "k": 3.0},
 ]
 
 GGX = {"type": "ggx", "alpha": 0.3}
@@ -106,6 +107,8 @@ def test_unsupported_models_name_what_is_missing():
         shader({"type": "he_torrance", "sigma_0": 0.1, "tau": 1.0, "n": 1.5})
     with pytest.raises(SpecError, match="oren_nayar"):
         shader("oren_nayar:sigma=0.3", target="glsl-es")
+    with pytest.raises(SpecError, match="inside 'fresnel'"):
+        shader({"type": "fresnel", "base": {"type": "kulla_conty", "base": GGX}, "eta": 0.2, "k": 3.0})
     with pytest.raises(ValueError, match="target must be one of"):
         shader("phong:n=20", target="vulkan")
 
@@ -165,7 +168,8 @@ def test_pumped_matrix_never_above():
              for n in (1, 3)]
     specs += [{"type": m, "base": b} for m in ("kulla_conty", "scaled")
               for b in (PHONG, {"type": "cook_torrance", "m": 0.3}, {"type": "ggx", "alpha": 0.5, "ior": 1.5})]
-    specs += [{"type": "scaled", "base": GGX, "f0": 0.5}]
+    specs += [{"type": "scaled", "base": GGX, "f0": 0.5},
+              {"type": "fresnel", "base": {"type": "pumped", "base": PHONG, "levels": 3}, "eta": 0.2, "k": 3.0}]
     items = []
     for s in specs:
         f = pumpup.load(s)
