@@ -104,7 +104,7 @@ def run(ctx, libraries: list[str], wi: np.ndarray, wo: np.ndarray, es: bool = Fa
     size = group
     for s in range(0, len(libraries), size):
         group = libraries[s:s + size]
-        head = "#version 300 es\nprecision highp float;\nprecision highp int;\n" if es else "#version 430 core\n"
+        head = "#version 300 es\nprecision highp float;\n" if es else "#version 430 core\n"
         src = [head]
         for k, lib in enumerate(group):
             src.append(renamed(lib, s + k))
@@ -175,7 +175,7 @@ def furnace(ctx, libraries: list[str], mu: np.ndarray, nodes: int = 256, es: boo
     size = group
     for s in range(0, len(libraries), size):
         group = libraries[s:s + size]
-        head = "#version 300 es\nprecision highp float;\nprecision highp int;\n" if es else "#version 430 core\n"
+        head = "#version 300 es\nprecision highp float;\n" if es else "#version 430 core\n"
         src = [head] + [renamed(lib, s + k) for k, lib in enumerate(group)]
         src.append("uniform highp sampler2D pumpup_test_nodes;\nuniform highp sampler2D pumpup_test_mu;\n")
         for k in range(len(group)):
