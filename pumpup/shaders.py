@@ -698,6 +698,9 @@ class _LevelTable:
         x32 = logx[:-1].astype(np.float32)
         delta = (2.0**-21 + 6.0 * U * lmax) + np.abs(x32.astype(np.float64) - logx[:-1]) + U * (w + lmax) * 2.0
         err = _poly_error(coef, w, delta)
+        vals = np.min([np.polyval(coef, w * f) for f in np.linspace(0.0, 1.0, 9)], axis=0) + lk.margin
+        #: the largest relative amount by which a piece was raised (half the piece's smallest sampled value)
+        self.rel = float(np.max(2.0 * err / np.maximum(0.5 * np.minimum(vals, lk.cap), 1e-300)))
         coef[-1] += lk.margin + 2.0 * err  # the bound of upper_scalar, raised by twice the float32 error
         self.err = err
         self.coef32 = coef.astype(np.float32)
@@ -772,6 +775,9 @@ class _ProductTable:
         err = _poly_error(qh, smax, U * smax) + 1e-15 * np.sum(np.abs(qh) * smax ** np.arange(deg, -1, -1)[:, None],
                                                                axis=0)
         qh = qh.copy()
+        vals = np.min([np.polyval(coef, t) for t in np.linspace(-1.0, 1.0, 9)], axis=0)
+        #: the largest relative amount by which a piece was raised (half the piece's smallest sampled value)
+        self.rel = float(np.max(2.0 * err / np.maximum(0.5 * vals, 1e-300)))
         qh[-1] += 2.0 * err
         self.err = err
         self.coef32 = qh.astype(np.float32)
@@ -912,21 +918,22 @@ def table_error(spec: Any) -> dict[str, float]:
         for lev in plan.levels:
             lk = lev.lookup()
             t = _LevelTable(lk, "x")
-            rel += 2.0 * float(np.max(t.err)) / (0.5 * float(np.min(lk.table.value)))
+            rel += t.rel
         prod = plan.levels[-1].product()
         if prod is not None:
             p = _ProductTable(prod, "x")
-            gmin = float(np.min(prod.exact(np.asarray(prod.lo[:-1], dtype=np.float64))))
-            rel += 2.0 * float(np.max(p.err)) / (0.5 * gmin)
+            rel += p.rel
         return {"relative": rel + 4.0 * (len(plan.levels) + 9) * U, "absolute": 0.0}
     if plan.comp is not None:
         bound = plan.comp.bound
         t = _LevelTable(bound.lookup, "x")
         a = 2.0 * float(np.max(t.err)) + 4.0 * U
+        rel = t.rel
         if bound.product is not None:
-            a = max(a, 2.0 * float(np.max(_ProductTable(bound.product, "x").err)) + 4.0 * U)
-        umin = 0.5 * float(np.min(bound.lookup.table.value))
-        return {"relative": a / umin + 32.0 * U, "absolute": a}
+            p = _ProductTable(bound.product, "x")
+            a = max(a, 2.0 * float(np.max(p.err)) + 4.0 * U)
+            rel = max(rel, p.rel)
+        return {"relative": rel + 32.0 * U, "absolute": a}
     return {"relative": 0.0, "absolute": 0.0}
 
 
