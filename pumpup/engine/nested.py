@@ -68,6 +68,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..core import budget
 from .arc_breaks import horizon_breaks, kink_breaks, tau_of_angle
 from .lobe_geometry import (
     AXIS_CODE,
@@ -360,6 +361,7 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
     weights, and the sum of |values| (all including the interval width); and the evaluations per
     problem.
     """
+    budget.check("the nested quadrature refined its intervals")  # (a time budget: pumpup.core.budget)
     lobe = g.lobe
     RO, RI = len(_OUTER[0]), len(_INNER[0])
     onodes, owk, owg = _OUTER
@@ -426,6 +428,8 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
     signs = (1.0,) if lobe.symmetric else (1.0, -1.0)
     axis = AXIS_CODE[lobe.axis]
     for c0 in range(0, B, CHUNK):
+        if c0:
+            budget.check("the nested quadrature refined its intervals")
         sl = slice(c0, min(B, c0 + CHUNK))
         n = (sl.stop - sl.start) * RI
         wi_, wo_, w_, v_ = wi[:n], wo[:n], weight[:n], vals[:n]
