@@ -908,8 +908,8 @@ def table_error(spec: Any) -> dict[str, float]:
     Returns
     -------
     dict
-        ``{"relative": r, "absolute": a}``: a pumped value is at least pumpup's x (1 - 2 B - r); a ``scaled`` one too;
-        a ``kulla_conty`` one at least pumpup's base x (1 - 2 B - r) + its lobe - scale x 2 a (a: the largest amount by
+        ``{"relative": r, "absolute": a}``: a pumped value is at least pumpup's x (1 - 3 B - r); a ``scaled`` one too;
+        a ``kulla_conty`` one at least pumpup's base x (1 - 3 B - r) + its lobe - scale x 2 a (a: the largest amount by
         which the shader's U exceeds pumpup's).  Both 0 for a closed-form model.
     """
     plan = _Plan(spec if isinstance(spec, BRDF) else load(spec))
