@@ -493,6 +493,29 @@ vec2 pumpup_base(vec3 l, vec3 v) {
 """
 
 
+def _lafortune_code(b: BRDF) -> str:
+    err = "8.0 * pumpup_U * (abs(pumpup_cx) + abs(pumpup_cy) + abs(pumpup_cz))"
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float rv = pumpup_cz * (l.z * v.z) - pumpup_cx * (l.x * v.x) - pumpup_cy * (l.y * v.y);  // 000 eq. 14
+    if (rv <= 0.0) return vec2(0.0);
+{_power_lines("rv", err, "pumpup_n")}    float f = pumpup_c * pw;
+    float e = pe + 4.0 * pumpup_U;
+    if (pumpup_p == 1.0) {{
+        f /= max(l.z, v.z);
+        e += 5.0 * pumpup_U;
+    }} else if (pumpup_p != 0.0) {{
+        float lm = log2(max(l.z, v.z));
+        float zp = pumpup_p * lm;
+        f /= exp2(zp);  // max(N.L, N.V)^p, 000 eq. 15
+        e += pumpup_exp_err(-abs(zp), 0.6931472 * (pumpup_p * pumpup_log_err(lm) + 2.0 * pumpup_U * abs(zp)))
+            + 5.0 * pumpup_U;
+    }}
+    return vec2(f, e);
+}}
+"""
+
+
 #: type -> (the parameters that become uniforms, code generator)
 _MODELS = {
     "lambert": (("albedo",), _lambert_code),
@@ -513,6 +536,7 @@ _MODELS = {
     "lacquer": (("c", "s"), _lacquer_code),
     "phong_shader": (("n", "ks", "kd"), _phong_shader_code),
     "phong_blinn": (("n", "ks", "kd"), _phong_blinn_code),
+    "lafortune": (("n", "cx", "cy", "cz", "p", "c"), _lafortune_code),
 }
 
 #: the model types :func:`shader` translates (and the operators over them)
@@ -537,6 +561,7 @@ def error_bound_text() -> dict[str, str]:
         "lacquer": "e(-x, 8 U x) + 4 U, x = s (1/N.L + 1/N.V)",
         "phong_shader": "max(U, phong's + 9 U) + 2 U",
         "phong_blinn": "max(U, blinn's) + 2 U",
+        "lafortune": "as phong with the lobe's absolute error 8 U (|cx| + |cy| + |cz|) and the max(N.L, N.V)^p term",
     }
 
 

@@ -37,6 +37,7 @@ BASES = [
     {"type": "minnaert", "k": 0.7}, {"type": "minnaert", "k": 3.0}, {"type": "lacquer", "s": 0.1},
     {"type": "phong_shader", "n": 5, "kd": 0.1, "ks": 0.3}, {"type": "phong_blinn", "n": 300, "kd": 0.2, "ks": 0.5},
     {"type": "fresnel", "base": {"type": "phong", "n": 20}, "eta": 0.2, "k": 3.0},
+    {"type": "lafortune", "n": 50, "cx": -0.8, "cy": -0.8, "cz": 1.0, "p": 0.5},
 ]
 
 GGX = {"type": "ggx", "alpha": 0.3}
