@@ -53,6 +53,7 @@ _PUBLIC = {
     "conventions": ("conventions", None),
     "load_conventions": ("conventions", "load_conventions"),
     "furnace_prediction": ("renderer_furnace", "furnace_prediction"),
+    "shader": ("shaders", "shader"),
     "FitResult": ("fitting", "FitResult"),
     "fit": ("fitting", "fit"),
     "BRDF": ("core", "BRDF"),
