@@ -1123,8 +1123,8 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
         error=best_e,
         mu=best_mu,
         theta_deg=math.degrees(math.acos(best_mu)),
-        constant=1.0 / best_a,
-        constant_error=best_e / best_a**2,
+        constant=1.0 / best_a if best_a > 0.0 else math.inf,  # (a model that reflects nothing: any constant)
+        constant_error=best_e / best_a**2 if best_a > 0.0 else 0.0,
         at_boundary=at_boundary,
         theta_error=theta_error,
     )

@@ -58,3 +58,11 @@ def test_bounded_albedo_rising_to_grazing_keeps_its_maximum(spec, mu_min):
     assert not m.diverges and math.isfinite(m.albedo) and m.constant > 0
     if mu_min == 1e-12:  # the limit: the rise below mu falls tenfold per decade, 2.5e-12 relative at 1e-12
         assert m.mu == mu_min and abs(float(pumpup.albedo(f, 1e-15)) - m.albedo) <= 1e-10 * m.albedo
+
+
+def test_a_model_that_reflects_nothing_has_no_bound_on_its_constant():
+    """A Fresnel factor of index 1 reflects nothing (metal n = 1, eta = 1, k = 0, plastic's specular lobe at eta = 1):
+    its albedo is 0 everywhere, so every constant conserves energy; and plastic with eta = 1 loads."""
+    m = max_albedo(pumpup.load({"type": "metal", "n": 1.0, "eta": 1.0, "k": 0.0}))
+    assert m.albedo == 0.0 and m.constant == math.inf and not m.diverges
+    pumpup.load({"type": "plastic", "n": 1.0, "eta": 1.0, "a_s": 0.5, "ad": 0.5})
