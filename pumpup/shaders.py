@@ -1,0 +1,1026 @@
+"""Shader code for pumpup's BRDFs: GLSL, GLSL ES, HLSL, Metal and Disney's BRDF Explorer, with the tables baked in.
+
+``pumpup.shader(spec, target="glsl")`` turns a closed-form model, a ``pumped`` chain of it (g1 or g2, any number of
+levels) or a compensated one (``kulla_conty``, ``scaled``) into source code.  The pumped levels' albedo bounds and the
+compensation's bound U >= E go in as constant arrays, piece for piece as pumpup's compiled kernels read them
+(:mod:`pumpup.physics.lookups`): a level's spline pieces in ln(mu) (a power law below its first node, at most its cap)
+and, where pumpup has one, the product table G(m) of polynomial pieces in m = max(N.wi, N.wo).
+
+Conventions of the ``glsl`` and ``glsl-es`` targets (a library snippet: a header comment, no ``#version`` line, no
+``precision`` line, no ``main``; every global name starts with ``pumpup_``)::
+
+    float pumpup_brdf(vec3 wi, vec3 wo)
+
+in the local frame N = (0, 0, 1), ``wi`` towards the light, ``wo`` towards the viewer, f_r in 1/sr *without* the cosine
+factor, 0 below the horizon: :meth:`pumpup.core.BRDF.eval`.  A model's parameters are ``uniform float pumpup_<name>;``
+(:func:`uniforms` gives their values); a pumped or compensated model bakes every parameter, since each one changes the
+tables, and the header says so.
+
+The bound survives the cast
+---------------------------
+The shader evaluates in float32.  Every model's code computes, beside its value, a bound B of its relative float32
+error (first-order propagation of the roundings with the accuracy GLSL specifies for its built-ins: + - * correctly
+rounded, / 2.5 ULP, exp and exp2 (3 + 2|x|) ULP, log and log2 an absolute 2^-21 inside [0.5, 2] and 3 ULP outside,
+inversesqrt 2 ULP; the float32 rounding of the parameters included).  A pumped or compensated model multiplies its base
+value by 1 - 2 B and reads table pieces whose constant terms were raised, in double precision before the rounding to
+float32, by twice the worst float32 error of the piece (Horner's rule, the rounding of the coefficients and of the
+variable), so that every bound it divides by is at least pumpup's, and the result is rounded down once more for the
+final products and quotient: the shader's value is never above pumpup's double-precision value at the same
+(float32) directions, and the exported BRDF keeps its albedo <= 1 (001 eq. 18), as the Mitsuba plugin does
+(:mod:`pumpup.mitsuba`).
+
+The ``hlsl`` and ``msl`` targets are translated by ``glslangValidator`` (GLSL -> SPIR-V) and ``spirv-cross``
+(SPIR-V -> HLSL / MSL) from a standalone compute shader that wraps the GLSL library; ``brdf-explorer`` writes a
+``.brdf`` file for Disney's BRDF Explorer (a parameter block and ``vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)``,
+which works in the frame it is given).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shlex
+import shutil
+import subprocess
+import tempfile
+from typing import Any
+
+import numpy as np
+
+from ._version import __version__
+from .core import BRDF, SpecError, load
+
+__all__ = ["shader", "uniforms", "TARGETS", "SUPPORTED", "write_shader", "error_bound_text"]
+
+#: the targets :func:`shader` writes
+TARGETS = ("glsl", "glsl-es", "hlsl", "msl", "brdf-explorer")
+
+#: float32's unit roundoff
+U = 2.0**-24
+_LN2 = math.log(2.0)
+
+# ----------------------------------------------------------------------------------------
+# float32 helpers: literals and directed rounding
+# ----------------------------------------------------------------------------------------
+
+
+def _f32(x: float) -> np.float32:
+    return np.float32(x)
+
+
+def _up32(x: float) -> np.float32:
+    """The smallest float32 >= x."""
+    y = np.float32(x)
+    if float(y) < x:
+        y = np.nextafter(y, np.float32(np.inf))
+    return y
+
+
+def _down32(x: float) -> np.float32:
+    """The largest float32 <= x."""
+    y = np.float32(x)
+    if float(y) > x:
+        y = np.nextafter(y, np.float32(-np.inf))
+    return y
+
+
+def _up32_array(x: np.ndarray) -> np.ndarray:
+    y = np.asarray(x, dtype=np.float64).astype(np.float32)
+    low = y.astype(np.float64) < x
+    y[low] = np.nextafter(y[low], np.float32(np.inf))
+    return y
+
+
+def _lit(x: Any) -> str:
+    """A GLSL float literal of the float32 value of ``x`` (the shortest decimal that reads back to it)."""
+    v = np.float32(x)
+    if not np.isfinite(v):
+        raise SpecError(f"pumpup.shader: the value {float(x):g} is beyond float32's range (|x| <= 3.4e38), in which "
+                        "the shader evaluates")
+    s = repr(float(v))
+    if "e" not in s and "." not in s:
+        s += ".0"
+    return s
+
+
+def _array(name: str, values, per_line: int = 6) -> str:
+    vals = [_lit(v) for v in np.asarray(values).ravel()]
+    n = len(vals)
+    rows = [", ".join(vals[i:i + per_line]) for i in range(0, n, per_line)]
+    body = ",\n    ".join(rows)
+    return f"const float {name}[{n}] = float[{n}](\n    {body});\n"
+
+
+# ----------------------------------------------------------------------------------------
+# The GLSL of the models: vec2 pumpup_base(l, v) = (f_r, bound of its relative float32 error), for l.z, v.z > 0
+# ----------------------------------------------------------------------------------------
+
+_COMMON = """\
+const float pumpup_U = 5.9604645e-08;  // float32's unit roundoff, 2^-24
+const float pumpup_PI = 3.14159265;
+
+// tan^2 of the angle between N and H = (L + V) / |L + V|, from S = L + V (relative error <= 20 U)
+float pumpup_tan2_half(vec3 l, vec3 v) {
+    float sz = l.z + v.z;
+    float qx = (l.x + v.x) / sz;
+    float qy = (l.y + v.y) / sz;
+    return qx * qx + qy * qy;
+}
+
+// bound of the absolute error of log2(x) or log(x) = y (GLSL: 2^-21 inside [0.5, 2], 3 ULP outside)
+float pumpup_log_err(float y) {
+    return 4.7683716e-07 + 6.0 * pumpup_U * abs(y);
+}
+
+// bound of the relative error of exp(x) (or exp2(x) with dx in units of ln 2) whose argument has absolute error
+// dx: e^dx - 1 plus GLSL's (3 + 2|x|) ULP; 1 where float32 underflows
+float pumpup_exp_err(float x, float dx) {
+    if (x < -87.0) return 1.0;
+    return dx * (1.0 + dx) + (3.0 + 2.0 * abs(x)) * 2.0 * pumpup_U;
+}
+
+// ln(1 + x) for x >= 0 and a bound of its absolute error
+vec2 pumpup_log1p(float x) {
+    if (x < 0.03) {
+        float s = x * (1.0 - x * (0.5 - x * (0.33333333 - x * (0.25 - x * 0.2))));
+        return vec2(s, 12.0 * pumpup_U * s + x * x * x * x * x * x * 0.17);
+    }
+    float s = log(1.0 + x);
+    return vec2(s, pumpup_log_err(s) + 2.0 * pumpup_U * (1.0 + x));
+}
+"""
+
+_FRESNEL_DIELECTRIC = """\
+// Fresnel factor of a dielectric (002 sec. 3.2) and a bound of its relative error
+vec2 pumpup_fresnel_dielectric(float c, float n) {
+    float g2 = n * n + c * c - 1.0;
+    float g = sqrt(max(g2, 0.0));
+    float a = (g - c) / (g + c);
+    float q = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+    float f = 0.5 * a * a * (1.0 + q * q);
+    float eg = 4.0 * pumpup_U * (n * n + c * c) / max(g2, 1e-30) + 12.0 * pumpup_U;
+    float err = 40.0 * pumpup_U + 4.0 * (g + c) / max(abs(g - c), 1e-30) * eg
+        + 8.0 * pumpup_U * (c * (g + c) + 1.0) + 8.0 * pumpup_U * n * n / max(g2, 1e-30);
+    return vec2(f, err);
+}
+"""
+
+_FRESNEL_CONDUCTOR = """\
+// exact Fresnel factor of a conductor (eta + i k) without cancellation, as pumpup.models.metal, and a bound of its
+// relative error
+vec2 pumpup_fresnel_conductor(float c, float eta, float k) {
+    float s2 = (1.0 - c) * (1.0 + c);
+    float t0 = (eta - 1.0) * (eta + 1.0) - k * k + c * c;
+    float big = sqrt(t0 * t0 + (2.0 * eta * k) * (2.0 * eta * k));
+    float ra = sqrt(max(0.5 * (big + t0), 0.0));
+    float rb = sqrt(max(0.5 * (big - t0), 0.0));
+    float a = t0 >= 0.0 ? ra : eta * k / max(rb, 1e-30);
+    float b = t0 >= 0.0 ? eta * k / max(ra, 1e-30) : rb;
+    if (big == 0.0) { a = 0.0; b = 0.0; }
+    float e21 = (eta - 1.0) * (eta + 1.0) - k * k;
+    float plus = (a + c) * (a + c) + b * b;
+    float rs = plus > 0.0 ? (e21 * e21 + 4.0 * eta * eta * k * k) / (plus * plus) : 0.0;
+    float rp = rs * ((a * c - s2) * (a * c - s2) + b * b * c * c) / ((a * c + s2) * (a * c + s2) + b * b * c * c);
+    float err = 256.0 * pumpup_U * (1.0 + (eta * eta + k * k + 1.0) / max(abs(e21) + 2.0 * eta * k, 1e-30));
+    return vec2(0.5 * (rs + rp), err);
+}
+"""
+
+_ERF = """\
+// erf(x) for x >= 0 (Abramowitz and Stegun 7.1.26: absolute error <= 1.5e-7)
+float pumpup_erf(float x) {
+    float t = 1.0 / (1.0 + 0.3275911 * x);
+    float p = t * (0.254829592 + t * (-0.284496736 + t * (1.421413741 + t * (-1.453152027 + t * 1.061405429))));
+    return 1.0 - p * exp(-x * x);
+}
+"""
+
+
+def _phong_code(b: BRDF, stretched: bool) -> str:
+    den = ""
+    if stretched:
+        den = """
+    float mx = max(l.z, v.z);
+    if (pumpup_p == 1.0) {
+        f /= mx;
+        e += 5.0 * pumpup_U;
+    } else {
+        float lm = log2(mx);
+        float zp = pumpup_p * lm;
+        f /= exp2(zp);  // max(N.L, N.V)^p, 000 eq. 12
+        e += pumpup_exp_err(-abs(zp), 0.6931472 * (pumpup_p * pumpup_log_err(lm) + 2.0 * pumpup_U * abs(zp)))
+            + 5.0 * pumpup_U;
+    }"""
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float rv = 2.0 * l.z * v.z - dot(l, v);  // R.V, 000 eq. 9 (absolute error <= 8 U)
+    if (rv <= 0.0) return vec2(0.0);
+    float l2 = log2(rv);
+    float z = pumpup_n * l2;
+    float f = pumpup_c * exp2(z);  // 000 eq. 5
+    float e = pumpup_exp_err(z, 0.6931472 * (pumpup_n * (11.6 * pumpup_U / rv + pumpup_log_err(l2))
+        + 2.0 * pumpup_U * abs(z))) + 4.0 * pumpup_U;{den}
+    return vec2(f, e);
+}}
+"""
+
+
+def _blinn_code(b: BRDF, stretched: bool) -> str:
+    tail = "\n    f /= max(l.z, v.z);  // 000 eq. 32\n    e += 5.0 * pumpup_U;" if stretched else ""
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float t = pumpup_tan2_half(l, v);
+    vec2 lp = pumpup_log1p(t);  // -ln (N.H)^2
+    float x = -0.5 * pumpup_n * lp.x;
+    float f = pumpup_c * exp(x);  // c (N.H)^n, 000 eq. 31
+    float dx = 0.5 * pumpup_n * (lp.y + 22.0 * pumpup_U * t / (1.0 + t)) + 2.0 * pumpup_U * abs(x);
+    float e = pumpup_exp_err(x, dx) + 4.0 * pumpup_U;{tail}
+    return vec2(f, e);
+}}
+"""
+
+
+def _ward_code(b: BRDF, modified: bool) -> str:
+    if modified:
+        den = "4.0 * pumpup_PI * m2 * max(l.z, v.z)"
+        cite = "000 eq. 35"
+    else:
+        den = "4.0 * pumpup_PI * m2 * (sqrt(l.z) * sqrt(v.z))"
+        cite = "000 eq. 34, 001 eq. 8"
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float m2 = pumpup_m * pumpup_m;
+    float x = pumpup_tan2_half(l, v) / m2;
+    float f = pumpup_c * exp(-x) / ({den});  // {cite}
+    return vec2(f, pumpup_exp_err(-x, 31.0 * pumpup_U * x) + 48.0 * pumpup_U);
+}}
+"""
+
+
+def _cook_torrance_code(b: BRDF) -> str:
+    ior = b.p["ior"]
+    fres = ("vec2 fr = pumpup_fresnel_dielectric(c, pumpup_ior);  // 002 sec. 3.2" if ior is not None
+            else "vec2 fr = vec2(1.0, 0.0);")
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    vec3 s = l + v;
+    float t = pumpup_tan2_half(l, v);
+    float m2 = pumpup_m * pumpup_m;
+    float x = t / m2;
+    float d = exp(-x) * ((1.0 + t) * (1.0 + t)) / (4.0 * pumpup_PI * m2);  // 001 eq. 9
+    float g = min(1.0, 4.0 * min(l.z, v.z) / (s.z * (1.0 + t)));  // 001 eq. 10
+    float c = 0.5 * sqrt(dot(s, s));  // V.H
+    {fres}
+    float f = fr.x * d * g / (l.z * v.z);  // 001 eq. 9
+    return vec2(f, pumpup_exp_err(-x, 31.0 * pumpup_U * x) + fr.y + 96.0 * pumpup_U);
+}}
+"""
+
+
+def _schlick_code(b: BRDF) -> str:
+    return """\
+vec2 pumpup_base(vec3 l, vec3 v) {
+    float t = pumpup_tan2_half(l, v);
+    float cos2 = 1.0 / (1.0 + t);
+    float sin2 = t <= 1.0 ? t * cos2 : 1.0 - cos2;
+    float r = pumpup_r;
+    float d = r + (1.0 - r) * sin2;  // 1 - (1 - r)(N.H)^2
+    float gl = r + (1.0 - r) * l.z;
+    float gv = r + (1.0 - r) * v.z;
+    float f = pumpup_c / (4.0 * pumpup_PI) * (r / d / d) / (gl * gv);  // 000 eq. 36
+    return vec2(f, 192.0 * pumpup_U);
+}
+"""
+
+
+def _lambert_code(b: BRDF) -> str:
+    return """\
+vec2 pumpup_base(vec3 l, vec3 v) {
+    return vec2(pumpup_albedo * 0.318309886, 6.0 * pumpup_U);
+}
+"""
+
+
+def _microfacet_code(b: BRDF) -> str:
+    dist, _alpha, shadowing, g1, ior, eta, _k = b.kernel_args()
+    parts = []
+    if dist == 0:  # Beckmann
+        parts.append("""\
+    float x = t / a2;
+    float d = exp(-x) * ((1.0 + t) * (1.0 + t)) / (pumpup_PI * a2);  // Walter eq. 25
+    float e = pumpup_exp_err(-x, 31.0 * pumpup_U * x) + 64.0 * pumpup_U;""")
+        if g1 == 0:
+            proj = """\
+float pumpup_projected(vec3 w) {  // z (1 + Lambda) = z / G1, Walter eq. 27 (exact)
+    float s = sqrt(w.x * w.x + w.y * w.y);
+    if (s == 0.0) return w.z;
+    float a = w.z / (pumpup_alpha * s);
+    return 0.5 * (w.z * (1.0 + pumpup_erf(a)) + pumpup_alpha * s * exp(-a * a) * 0.564189584);
+}
+const float pumpup_projected_err = 3.2e-6;
+"""
+        else:
+            proj = """\
+float pumpup_projected(vec3 w) {  // z / G1 with Walter's rational G1 (Walter eq. 27)
+    float s = sqrt(w.x * w.x + w.y * w.y);
+    if (s == 0.0) return w.z;
+    float a = w.z / (pumpup_alpha * s);
+    if (a >= 1.6) return w.z;
+    return pumpup_alpha * s * (1.0 + 2.276 * a + 2.577 * a * a) / (3.535 + 2.181 * a);
+}
+float pumpup_projected_jump(vec3 w) {  // Walter's G1 jumps by 5.7e-5 at a = 1.6: a bound where a may round across
+    float s = sqrt(w.x * w.x + w.y * w.y);
+    float a = w.z / (pumpup_alpha * s);
+    return abs(a - 1.6) < 1e-5 ? 1.2e-4 : 0.0;
+}
+const float pumpup_projected_err = 1.9e-6;
+"""
+    else:  # GGX
+        parts.append("""\
+    float cos2 = 1.0 / (1.0 + t);
+    float sin2 = t <= 1.0 ? t * cos2 : 1.0 - cos2;
+    float q = a2 * cos2 + sin2;
+    float d = a2 / (pumpup_PI * q * q);  // Walter eq. 33
+    float e = 128.0 * pumpup_U;""")
+        proj = """\
+float pumpup_projected(vec3 w) {  // z (1 + Lambda) = z / G1, Walter eq. 34
+    float s2 = w.x * w.x + w.y * w.y;
+    return 0.5 * (w.z + sqrt(w.z * w.z + pumpup_alpha * pumpup_alpha * s2));
+}
+const float pumpup_projected_err = 1.5e-6;
+"""
+    if eta > 0.0:
+        fres = "vec2 fr = pumpup_fresnel_conductor(c, pumpup_eta, pumpup_k);"
+    elif ior > 0.0:
+        fres = "vec2 fr = pumpup_fresnel_dielectric(c, pumpup_ior);"
+    else:
+        fres = "vec2 fr = vec2(1.0, 0.0);"
+    if shadowing == 0:
+        tail = "float f = d * fr.x / (4.0 * pl * pv);  // Walter eq. 20, separable Smith"
+    else:
+        tail = "float f = d * fr.x / (4.0 * (v.z * pl + l.z * pv - l.z * v.z));  // Heitz 2014, height-correlated"
+    jump = " + pumpup_projected_jump(l) + pumpup_projected_jump(v)" if (dist == 0 and g1 == 1) else ""
+    body = "\n".join(parts)
+    return proj + f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    vec3 s = l + v;
+    float t = pumpup_tan2_half(l, v);
+    float a2 = pumpup_alpha * pumpup_alpha;
+{body}
+    float c = 0.5 * sqrt(dot(s, s));  // wi.h
+    {fres}
+    float pl = pumpup_projected(l);
+    float pv = pumpup_projected(v);
+    {tail}
+    return vec2(f, e + fr.y + 2.0 * pumpup_projected_err + 24.0 * pumpup_U{jump});
+}}
+"""
+
+
+#: type -> (the parameters that become uniforms, code generator)
+_MODELS = {
+    "lambert": (("albedo",), _lambert_code),
+    "phong": (("n", "c"), lambda b: _phong_code(b, False)),
+    "stretched_phong": (("n", "p", "c"), lambda b: _phong_code(b, True)),
+    "blinn": (("n", "c"), lambda b: _blinn_code(b, False)),
+    "stretched_blinn": (("n", "c"), lambda b: _blinn_code(b, True)),
+    "ward": (("m", "c"), lambda b: _ward_code(b, False)),
+    "modified_ward": (("m", "c"), lambda b: _ward_code(b, True)),
+    "cook_torrance": (("m", "ior"), _cook_torrance_code),
+    "schlick": (("r", "c"), _schlick_code),
+    "ggx": (("alpha", "ior", "eta", "k"), _microfacet_code),
+    "beckmann": (("alpha", "ior", "eta", "k"), _microfacet_code),
+}
+
+#: the model types :func:`shader` translates (and the operators over them)
+SUPPORTED = tuple(sorted(_MODELS)) + ("pumped", "kulla_conty", "scaled")
+
+
+def error_bound_text() -> dict[str, str]:
+    """The relative float32 error bound B of each model's shader code, in words (the docs' table)."""
+    return {
+        "lambert": "6 U",
+        "phong": "(exp) + n (11.6 U / R.V + 2^-21 + 6 U |log2 R.V|) ln 2 + 2 U |n log2 R.V| + 4 U",
+        "blinn": "(exp) + n/2 (error of ln(1 + tan^2) + 22 U) + 4 U",
+        "ward": "(exp) + 31 U tan^2/m^2 + 48 U",
+        "cook_torrance": "(exp) + 31 U tan^2/m^2 + Fresnel + 96 U",
+        "schlick": "192 U",
+        "ggx": "128 U + Fresnel + 2 x 1.5e-6 (Smith) + 24 U",
+        "beckmann": "(exp) + 31 U tan^2/alpha^2 + 64 U + Fresnel + 2 x 3.2e-6 (Smith with erf) + 24 U",
+    }
+
+
+# ----------------------------------------------------------------------------------------
+# What a spec becomes: the base, its levels or compensation, and the parameters
+# ----------------------------------------------------------------------------------------
+
+
+def _unsupported(b: BRDF, where: str = "") -> SpecError:
+    what = f"model type {b.type!r}" + (f" ({where})" if where else "")
+    return SpecError(f"pumpup.shader: {what} has no shader translation; supported: {', '.join(SUPPORTED)} "
+                     "(pumped and compensated over the closed-form ones)")
+
+
+class _Plan:
+    """A BRDF taken apart for the shader: ``base`` (a closed-form model), ``levels`` (pumped, innermost first) or
+    ``comp`` (a compensated model), and whether its parameters are baked.
+    """
+
+    def __init__(self, brdf: BRDF):
+        from .operators.compensate import KullaConty, Scaled
+        from .operators.pumping import Pumped
+
+        self.brdf = brdf
+        self.levels: list = []
+        self.comp = None
+        b = brdf
+        if isinstance(b, (KullaConty, Scaled)):
+            self.comp = b
+            b = b.base
+        elif isinstance(b, Pumped):
+            self.levels = b.chain()
+            b = self.levels[0].base
+        if isinstance(b, (Pumped, KullaConty, Scaled)):
+            raise _unsupported(b, f"inside {brdf.type!r}: one operator over a closed-form model is supported")
+        if b.type not in _MODELS or not isinstance(b, BRDF) or getattr(b, "fn", None) is not None:
+            raise _unsupported(b)
+        if np.ndim(b.eval(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0]))) != 0:
+            raise _unsupported(b, "spectral or multi-channel")
+        self.base = b
+        self.baked = bool(self.levels) or self.comp is not None
+        names = _MODELS[b.type][0]
+        self.params = {k: float(b.p[k]) for k in names if b.p.get(k) is not None}
+        s = math.sqrt(0.5)
+        peak = np.asarray(brdf.eval(np.array([[0.0, 0.0, 1.0], [s, 0.0, s]]),
+                                    np.array([[0.0, 0.0, 1.0], [-s, 0.0, s]])))
+        for k, v in self.params.items():
+            if not abs(v) <= float(np.finfo(np.float32).max):
+                raise SpecError(f"pumpup.shader: parameter {k!r} = {v:g} is beyond float32's range (|x| <= 3.4e38), "
+                                "in which the shader evaluates")
+        if not np.all(np.abs(peak) <= float(np.finfo(np.float32).max)):
+            raise SpecError(f"pumpup.shader: {json.dumps(brdf.spec)} evaluates to {float(np.max(np.abs(peak))):g} "
+                            "at its peak, beyond float32's range (3.4e38) in which the shader evaluates")
+
+
+def uniforms(spec: Any) -> dict[str, float]:
+    """The uniforms of :func:`shader`'s GLSL for ``spec``: name -> value (empty when every parameter is baked).
+
+    Parameters
+    ----------
+    spec : dict, str or BRDF
+        As :func:`pumpup.load`.
+
+    Returns
+    -------
+    dict
+        ``{"pumpup_n": 20.0, "pumpup_c": 3.18...}``: set each ``uniform float`` to its value.
+
+    Examples
+    --------
+    >>> uniforms("phong:n=20")["pumpup_n"]
+    20.0
+    """
+    plan = _Plan(spec if isinstance(spec, BRDF) else load(spec))
+    if plan.baked:
+        return {}
+    return {f"pumpup_{k}": v for k, v in plan.params.items()}
+
+
+# ----------------------------------------------------------------------------------------
+# Tables: a level's spline pieces in ln(mu), a product table's polynomial pieces in m
+# ----------------------------------------------------------------------------------------
+
+_GAMMA = 12.0 * U  # Horner's rule of degree 5 in float32 (2 x 5 roundings), with the coefficients' own
+
+
+def _poly_error(coef: np.ndarray, w: np.ndarray, delta: np.ndarray) -> np.ndarray:
+    """Per piece (columns of ``coef``, highest power first): a bound of |P32(x') - P(x)| for |x| <= w, |x' - x| <=
+    ``delta``, P32 Horner's rule in float32 on the coefficients rounded to float32.
+    """
+    deg = coef.shape[0] - 1
+    err = np.zeros(coef.shape[1])
+    for r in range(deg + 1):
+        p = deg - r
+        a = np.abs(coef[r])
+        err += a * (((w + delta) ** p - w ** p) + _GAMMA * (w + delta) ** p)
+    return err
+
+
+class _LevelTable:
+    """One level's upper bound u(mu) (:func:`pumpup.physics.lookups.upper_scalar`), as the shader reads it."""
+
+    def __init__(self, lk, name: str):
+        self.name = name
+        n = len(lk.logx)
+        self.npieces = n - 1
+        logx = np.asarray(lk.logx, dtype=np.float64)
+        coef = np.array(lk.coef, dtype=np.float64)  # (deg + 1, n - 1), highest power first, in d = ln mu - logx[i]
+        self.deg = coef.shape[0] - 1
+        hi = np.concatenate([logx[1:-1], [max(logx[-1], 0.0)]])
+        w = hi - logx[:-1]
+        lmax = np.maximum(np.abs(logx[:-1]), np.abs(hi))
+        x32 = logx[:-1].astype(np.float32)
+        delta = (2.0**-21 + 6.0 * U * lmax) + np.abs(x32.astype(np.float64) - logx[:-1]) + U * (w + lmax) * 2.0
+        err = _poly_error(coef, w, delta)
+        coef[-1] += lk.margin + 2.0 * err  # the bound of upper_scalar, raised by twice the float32 error
+        self.err = err
+        self.coef32 = coef.astype(np.float32)
+        self.coef32[-1] = _up32_array(coef[-1])
+        self.knots = _up32_array(np.exp(logx[:-1]))  # mu >= knots[i]  <=>  ln mu >= logx[i] (in exact arithmetic)
+        self.logx32 = x32
+        self.logx0 = float(logx[0])
+        self.v0, self.slope0, self.margin_lo = float(lk.v0), float(lk.slope0), float(lk.margin_lo)
+        self.cap = float(lk.cap)
+        self.increasing = bool(lk.increasing)
+        self.mu0 = float(lk.mu0)
+        self.margin = float(lk.margin)
+
+    def glsl(self) -> str:
+        nm, n = self.name, self.npieces
+        d = self.deg
+        out = [_array(f"{nm}_k", self.knots), _array(f"{nm}_x", self.logx32),
+               _array(f"{nm}_c", self.coef32.T.ravel())]
+        steps = []
+        s = 1
+        while s < n:
+            s *= 2
+        s //= 2
+        while s >= 1:
+            steps.append(f"    c = i + {s}; if (c <= {n - 1} && {nm}_k[c] <= mu) i = c;")
+            s //= 2
+        horner = f"{nm}_c[b]"
+        for r in range(1, d + 1):
+            horner = f"({horner}) * dd + {nm}_c[b + {r}]" if r > 1 else f"{nm}_c[b] * dd + {nm}_c[b + 1]"
+        cap = f"min(u, {_lit(self.cap)})" if math.isfinite(self.cap) else "u"
+        v0 = _lit(_up32(self.v0))
+        mlo = _lit(_up32(self.margin_lo * (1.0 + 4 * U)))
+        out.append(f"""\
+// the upper bound of the level's albedo at mu in (0, 1] (pumpup.physics.lookups.upper_scalar): the spline piece in
+// ln(mu) that holds mu, a power law below the first node, at most the cap
+float {nm}_u(float mu) {{
+    float lm = log(mu);
+    if (mu < {nm}_k[0]) {{
+        float x = {_lit(self.slope0)} * (lm - {_lit(self.logx0)});
+        float dx = abs({_lit(self.slope0)}) * (pumpup_log_err(lm) + 2.0 * pumpup_U * (abs(lm) + {_lit(abs(self.logx0))}))
+            + 2.0 * pumpup_U * abs(x);
+        float u = {v0} * exp(x) * (1.0 + 2.0 * pumpup_exp_err(x, dx) + 4.0 * pumpup_U) + {mlo};
+        return {cap};
+    }}
+    int i = 0;
+    int c;
+{chr(10).join(steps)}
+    float dd = lm - {nm}_x[i];
+    int b = {d + 1} * i;
+    float u = {horner};
+    return {cap};
+}}
+""")
+        return "".join(out)
+
+
+class _ProductTable:
+    """A product table G(m) (:class:`pumpup.operators.pumping._Product`): the same pieces, each polynomial re-expanded
+    about its float32 centre (so that m - centre is exact in float32) and raised by twice its float32 error.
+    """
+
+    def __init__(self, prod, name: str):
+        self.name = name
+        lo = np.asarray(prod.lo[:-1], dtype=np.float64)
+        hi = np.minimum(np.concatenate([lo[1:], [1.0]]), 1.0)
+        coef = np.asarray(prod.coef, dtype=np.float64)  # (deg + 1, pieces), highest power first, t = (m - c) ih
+        center, ihalf = np.asarray(prod.center, dtype=np.float64), np.asarray(prod.ihalf, dtype=np.float64)
+        c32 = center.astype(np.float32)
+        ih32 = ihalf.astype(np.float32)
+        alpha = ihalf / ih32.astype(np.float64)
+        beta = (c32.astype(np.float64) - center) * ihalf
+        deg = coef.shape[0] - 1
+        # Q(s) = P(alpha s + beta): Horner on the coefficient arrays (low power first), all pieces at once
+        q = np.zeros((deg + 1, coef.shape[1]))
+        q[0] = coef[0]
+        for r in range(1, deg + 1):
+            nq = np.zeros_like(q)
+            nq[1:] += q[:-1] * alpha
+            nq += q * beta
+            nq[0] += coef[r]
+            q = nq
+        qh = q[::-1]  # highest power first
+        smax = np.maximum(np.abs(lo - c32), np.abs(hi - c32)) * ih32.astype(np.float64) * (1.0 + 4 * U)
+        err = _poly_error(qh, smax, U * smax) + 1e-15 * np.sum(np.abs(qh) * smax ** np.arange(deg, -1, -1)[:, None],
+                                                               axis=0)
+        qh = qh.copy()
+        qh[-1] += 2.0 * err
+        self.err = err
+        self.coef32 = qh.astype(np.float32)
+        self.coef32[-1] = _up32_array(qh[-1])
+        self.lo32 = _up32_array(lo)  # m >= lo32[s]  <=>  m >= lo[s], for a float32 m
+        self.c32, self.ih32 = c32, ih32
+        self.deg = deg
+        self.mlo = float(prod.mlo)
+        self.mlo32 = _down32(self.mlo)  # m > mlo32  <=>  m > mlo, for a float32 m
+        self.npieces = len(lo)
+        self.epsilon = float(getattr(prod, "epsilon", 0.0))
+
+    def glsl(self) -> str:
+        nm, n, d = self.name, self.npieces, self.deg
+        out = [_array(f"{nm}_lo", self.lo32), _array(f"{nm}_cen", self.c32), _array(f"{nm}_ih", self.ih32),
+               _array(f"{nm}_c", self.coef32.T.ravel())]
+        steps = []
+        s = 1
+        while s < n:
+            s *= 2
+        s //= 2
+        while s >= 1:
+            steps.append(f"    c = i + {s}; if (c <= {n - 1} && {nm}_lo[c] <= m) i = c;")
+            s //= 2
+        horner = f"{nm}_c[b] * t + {nm}_c[b + 1]"
+        for r in range(2, d + 1):
+            horner = f"({horner}) * t + {nm}_c[b + {r}]"
+        out.append(f"""\
+// the product table at m (> its lower end): the polynomial piece that holds m (pumpup.physics.lookups.g_product)
+float {nm}_g(float m) {{
+    int i = 0;
+    int c;
+{chr(10).join(steps)}
+    float t = (m - {nm}_cen[i]) * {nm}_ih[i];
+    int b = {d + 1} * i;
+    return {horner};
+}}
+""")
+        return "".join(out)
+
+
+# ----------------------------------------------------------------------------------------
+# Assembling the library
+# ----------------------------------------------------------------------------------------
+
+
+def _param_decls(plan: _Plan) -> str:
+    lines = []
+    for k, v in plan.params.items():
+        if plan.baked:
+            lines.append(f"const float pumpup_{k} = {_lit(v)};")
+        else:
+            lines.append(f"uniform float pumpup_{k};")
+    return "\n".join(lines) + ("\n" if lines else "")
+
+
+def _pumped_glsl(plan: _Plan) -> tuple[str, list[str], int]:
+    top = plan.levels[-1]
+    prod = top.product()
+    out, notes = [], []
+    levels = []
+    for j, lev in enumerate(plan.levels):
+        t = _LevelTable(lev.lookup(), f"pumpup_level{j + 1}")
+        levels.append((t, lev.controlled))
+        out.append(t.glsl())
+        notes.append(f"level {j + 1} ({lev.p['g']}): albedo bound of {json.dumps(lev.base.spec)}: {t.npieces} "
+                     f"pieces (degree {t.deg} in ln mu), table margin {t.margin:.3g}, float32 error <= "
+                     f"{float(np.max(t.err)):.3g} (added), cap {t.cap:g}")
+    cond = ""
+    if prod is not None:
+        p = _ProductTable(prod, "pumpup_product")
+        out.append(p.glsl())
+        notes.append(f"product table G(m) of all levels: {p.npieces} pieces (degree {p.deg} in m) for min(N.wi, "
+                     f"N.wo) > {p.mlo:.6g}, relative fit <= {p.epsilon:.3g} (added), float32 error <= "
+                     f"{float(np.max(p.err)):.3g} (added)")
+        cond = f"    if (mmin > {_lit(p.mlo32)}) return pumpup_product_g(mmax);\n"
+    body = []
+    for j, (t, controlled) in enumerate(levels):
+        nm = t.name
+        if t.increasing:
+            look = (f"mmin > {_lit(_down32(t.mu0))} ? {nm}_u(mmax) : max({nm}_u(mi), {nm}_u(mo))")
+        else:
+            look = f"max({nm}_u(mi), {nm}_u(mo))"
+        body.append(f"    float g{j + 1} = {look};  // 001 eq. 20")
+        if controlled:
+            body.append(f"    g{j + 1} = max(g{j + 1}, mmax);  // 001 eq. 21")
+    prod_expr = " * ".join(f"g{j + 1}" for j in range(len(levels)))
+    out.append(f"""\
+// the product of all levels' g at the cosines mi, mo > 0 (001 eq. 16, 20, 21), at least pumpup's
+float pumpup_g(float mi, float mo) {{
+    float mmax = max(mi, mo);
+    float mmin = min(mi, mo);
+{cond}{chr(10).join(body)}
+    return {prod_expr};
+}}
+""")
+    return "".join(out), notes, len(levels)
+
+
+def _comp_glsl(plan: _Plan) -> tuple[str, list[str]]:
+    c = plan.comp
+    bound = c.bound
+    lvl = _LevelTable(bound.lookup, "pumpup_e")
+    out = [lvl.glsl()]
+    notes = [f"compensation bound U >= E of {json.dumps(c.white.spec)}: {lvl.npieces} pieces (degree {lvl.deg} in ln "
+             f"mu), table margin {lvl.margin:.3g}, float32 error <= {float(np.max(lvl.err)):.3g} (added), cap "
+             f"{lvl.cap:g}"]
+    if bound.product is not None:
+        p = _ProductTable(bound.product, "pumpup_eprod")
+        out.append(p.glsl())
+        notes.append(f"product table of U in m: {p.npieces} pieces (degree {p.deg}) for m > {p.mlo:.6g}, relative fit "
+                     f"<= {p.epsilon:.3g} (added), float32 error <= {float(np.max(p.err)):.3g} (added)")
+        look = f"m > {_lit(p.mlo32)} ? pumpup_eprod_g(m) : pumpup_e_u(m)"
+    else:
+        look = "pumpup_e_u(m)"
+    out.append(f"""\
+// U(m) >= E(m), at least pumpup's bound (pumpup.physics.lookups.scale_bound)
+float pumpup_upper(float m) {{
+    return {look};
+}}
+""")
+    return "".join(out), notes
+
+
+def _library(plan: _Plan) -> tuple[str, list[str]]:
+    """(GLSL library body without the header, table notes)."""
+    parts = [_COMMON]
+    b = plan.base
+    code = _MODELS[b.type][1](b)
+    if "pumpup_fresnel_dielectric" in code:
+        parts.append(_FRESNEL_DIELECTRIC)
+    if "pumpup_fresnel_conductor" in code:
+        parts.append(_FRESNEL_CONDUCTOR)
+    if "pumpup_erf" in code:
+        parts.append(_ERF)
+    parts.append(_param_decls(plan))
+    parts.append(f"// the base model {b.type}: (f_r, a bound of its relative float32 error) for N.wi, N.wo > 0\n")
+    parts.append(code)
+    notes: list[str] = []
+    if plan.levels:
+        glsl, notes, nlev = _pumped_glsl(plan)
+        parts.append(glsl)
+        rd = 1.0 - 4.0 * (nlev + 8) * U
+        parts.append(f"""\
+// the pumped BRDF (001 eq. 16): the base's lower bound over the product of the levels' upper bounds, rounded down
+float pumpup_brdf(vec3 wi, vec3 wo) {{
+    if (wi.z <= 0.0 || wo.z <= 0.0) return 0.0;
+    vec2 f = pumpup_base(wi, wo);
+    float lo = max(f.x * (1.0 - 2.0 * f.y), 0.0);
+    return lo / pumpup_g(wi.z, wo.z) * {_lit(_down32(rd))};
+}}
+""")
+    elif plan.comp is not None:
+        glsl, notes = _comp_glsl(plan)
+        parts.append(glsl)
+        c = plan.comp
+        if c.type == "kulla_conty":
+            scale = _lit(_down32(c.scale))
+            parts.append(f"""\
+// the Kulla-Conty compensation f + F_ms D(mu_i) D(mu_o) / (pi I) (KC eq. 1-2), D = max(0, 1 - U), rounded down
+float pumpup_brdf(vec3 wi, vec3 wo) {{
+    if (wi.z <= 0.0 || wo.z <= 0.0) return 0.0;
+    vec2 f = pumpup_base(wi, wo);
+    float lo = max(f.x * (1.0 - 2.0 * f.y), 0.0);
+    float di = max(0.0, 1.0 - pumpup_upper(wi.z));
+    float dd = max(0.0, 1.0 - pumpup_upper(wo.z));
+    return (lo + {scale} * (di * dd) * {_lit(_down32(1.0 - 8.0 * U))}) * {_lit(_down32(1.0 - 8.0 * U))};
+}}
+""")
+        else:
+            f0 = float(c.p["f0"])
+            if f0 == 1.0:
+                expr = f"lo / pumpup_upper(wo.z) * {_lit(_down32(1.0 - 12.0 * U))}"
+            else:
+                expr = (f"lo * max(0.0, s - 8.0 * pumpup_U * (1.0 + {_lit(f0)} * (r + 1.0)))"
+                        f" * {_lit(_down32(1.0 - 8.0 * U))}")
+            parts.append(f"""\
+// the 1/E scaling f (1 + F0 (1 / U(mu_o) - 1)) (Turquin eq. 6), rounded down
+float pumpup_brdf(vec3 wi, vec3 wo) {{
+    if (wi.z <= 0.0 || wo.z <= 0.0) return 0.0;
+    vec2 f = pumpup_base(wi, wo);
+    float lo = max(f.x * (1.0 - 2.0 * f.y), 0.0);
+    float r = 1.0 / pumpup_upper(wo.z) * {_lit(_down32(1.0 - 6.0 * U))};
+    float s = 1.0 + {_lit(f0)} * (r - 1.0);
+    return {expr};
+}}
+""")
+    else:
+        parts.append("""\
+// f_r [1/sr] without the cosine factor, 0 below the horizon (pumpup's BRDF.eval)
+float pumpup_brdf(vec3 wi, vec3 wo) {
+    if (wi.z <= 0.0 || wo.z <= 0.0) return 0.0;
+    return pumpup_base(wi, wo).x;
+}
+
+// a bound of the relative float32 error of pumpup_brdf (the tests compare it with pumpup's double precision)
+float pumpup_brdf_error(vec3 wi, vec3 wo) {
+    if (wi.z <= 0.0 || wo.z <= 0.0) return 0.0;
+    return pumpup_base(wi, wo).y;
+}
+""")
+    return "".join(parts), notes
+
+
+def _header(plan: _Plan, target: str, notes: list[str], command: str | None, comment: str = "//") -> str:
+    spec = json.dumps(plan.brdf.spec, sort_keys=True)
+    cmd = command or f"pumpup.shader({spec!r}, target={target!r})"
+    lines = [
+        f"pumpup shader, target {target}",
+        f"spec: {spec}",
+        f"pumpup version: {__version__}",
+        f"made by: {cmd}",
+        "conventions: local frame N = (0, 0, 1); pumpup_brdf(wi, wo) with wi towards the light (L) and wo towards the",
+        "  viewer (V), unit vectors; returns f_r in 1/sr WITHOUT the cosine factor, 0 below the horizon",
+        "  (pumpup's BRDF.eval); every global name starts with pumpup_.",
+    ]
+    if plan.baked:
+        lines.append("parameters: baked as constants (each one changes the tables): "
+                     + ", ".join(f"{k} = {v:.9g}" for k, v in plan.params.items()))
+        lines.append("float32: the value is at most pumpup's double-precision value at the same directions (the base's")
+        lines.append("  float32 error bound subtracted, every table bound raised by its float32 error, rounded down),")
+        lines.append("  so the albedo stays <= 1")
+    else:
+        lines.append("uniforms: " + (", ".join(f"float pumpup_{k} (= {v:.9g} for this spec)"
+                                                for k, v in plan.params.items()) or "none"))
+        lines.append("float32: pumpup_brdf_error(wi, wo) bounds the relative difference from pumpup's double precision")
+    for n in notes:
+        lines.append("table: " + n)
+    return "".join(f"{comment} {ln}\n" for ln in lines)
+
+
+def _glsl(plan: _Plan, target: str, command: str | None) -> str:
+    body, notes = _library(plan)
+    return _header(plan, target, notes, command) + body
+
+
+# ----------------------------------------------------------------------------------------
+# Standalone shaders, SPIR-V translation, BRDF Explorer
+# ----------------------------------------------------------------------------------------
+
+_COMPUTE_MAIN = """
+// standalone: f[i] = pumpup_brdf(dirs[2 i].xyz, dirs[2 i + 1].xyz), one invocation per pair
+layout(local_size_x = 64) in;
+layout(std430, binding = 0) readonly buffer pumpup_In { vec4 pumpup_dirs[]; };
+layout(std430, binding = 1) writeonly buffer pumpup_Out { float pumpup_values[]; };
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= uint(pumpup_values.length())) return;
+    pumpup_values[i] = pumpup_brdf(pumpup_dirs[2u * i].xyz, pumpup_dirs[2u * i + 1u].xyz);
+}
+"""
+
+_FRAGMENT_MAIN_ES = """
+// standalone: the BRDF at the uniform directions pumpup_wi, pumpup_wo, written to pumpup_value
+uniform vec3 pumpup_wi;
+uniform vec3 pumpup_wo;
+out vec4 pumpup_value;
+void main() {
+    pumpup_value = vec4(pumpup_brdf(pumpup_wi, pumpup_wo));
+}
+"""
+
+
+def _standalone(lib: str, es: bool) -> str:
+    if es:
+        return "#version 300 es\nprecision highp float;\nprecision highp int;\n" + lib + _FRAGMENT_MAIN_ES
+    return "#version 450\n" + lib + _COMPUTE_MAIN
+
+
+def _tool(name: str) -> str:
+    path = shutil.which(name)
+    if path is None:
+        pkg = "glslang-tools" if name == "glslangValidator" else "spirv-cross"
+        raise RuntimeError(f"pumpup.shader: the hlsl and msl targets need {name} on PATH (Debian/Ubuntu: apt-get "
+                           f"install {pkg})")
+    return path
+
+
+def _uniform_block(lib: str) -> str:
+    """SPIR-V for Vulkan needs the loose uniforms in a block: ``uniform float pumpup_x;`` -> one std140 block."""
+    lines = lib.splitlines()
+    names = [ln.split()[2].rstrip(";") for ln in lines if ln.startswith("uniform float ")]
+    if not names:
+        return lib
+    body = "\n".join(ln for ln in lines if not ln.startswith("uniform float "))
+    block = ("layout(std140, binding = 2) uniform pumpup_Params {\n"
+             + "".join(f"    float {n};\n" for n in names) + "};\n")
+    # the block goes before the first use: right after the header comment and the common helpers' first line
+    return block + body + "\n"
+
+
+def _translate(lib: str, target: str) -> str:
+    validator, cross = _tool("glslangValidator"), _tool("spirv-cross")
+    src = _standalone(_uniform_block(lib), es=False)
+    with tempfile.TemporaryDirectory(prefix="pumpup-shader-") as tmp:
+        comp = os.path.join(tmp, "pumpup.comp")
+        spv = os.path.join(tmp, "pumpup.spv")
+        with open(comp, "w") as fh:
+            fh.write(src)
+        r = subprocess.run([validator, "-V", "--target-env", "vulkan1.1", "-o", spv, comp], capture_output=True,
+                           text=True)
+        if r.returncode != 0:
+            raise RuntimeError(f"pumpup.shader: glslangValidator rejected the GLSL: {(r.stdout + r.stderr).strip()}")
+        args = [cross, spv, "--hlsl", "--shader-model", "50"] if target == "hlsl" else [cross, spv, "--msl"]
+        r = subprocess.run(args, capture_output=True, text=True)
+        if r.returncode != 0:
+            raise RuntimeError(f"pumpup.shader: spirv-cross failed: {(r.stdout + r.stderr).strip()}")
+        return r.stdout
+
+
+def _brdf_explorer(plan: _Plan, lib: str, header: str) -> str:
+    """A ``.brdf`` file of Disney's BRDF Explorer: the uniforms as its parameters, BRDF(L, V, N, X, Y) in world space."""
+    from .core import registry
+
+    cls = registry()[plan.base.type]
+    params = []
+    if not plan.baked:
+        for k, v in plan.params.items():
+            decl = cls.params.get(k)
+            lo = decl.lo if decl is not None and math.isfinite(decl.lo) else 0.0
+            hi = decl.hi if decl is not None and math.isfinite(decl.hi) else max(2.0 * abs(v), 1.0)
+            hi = max(hi, v) if math.isfinite(hi) else max(2.0 * abs(v), 1.0)
+            if not math.isfinite(hi) or hi > 1e6:
+                hi = max(2.0 * abs(v), 1.0)
+            params.append(f"float pumpup_{k} {lo:.9g} {hi:.9g} {v:.9g}")
+    body = "\n".join(ln for ln in lib.splitlines() if not ln.startswith("uniform float "))
+    hdr = "".join("# " + ln[3:] + "\n" if ln.startswith("// ") else ln + "\n" for ln in header.splitlines())
+    return (hdr + "# BRDF Explorer passes world-space L, V and the frame N, X, Y; the shader maps them to the local frame\n"
+            "\n::begin parameters\n" + "".join(p + "\n" for p in params) + "::end parameters\n\n"
+            "::begin shader\n" + body + """
+vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)
+{
+    vec3 wi = vec3(dot(L, X), dot(L, Y), dot(L, N));
+    vec3 wo = vec3(dot(V, X), dot(V, Y), dot(V, N));
+    return vec3(pumpup_brdf(wi, wo));
+}
+
+::end shader
+""")
+
+
+# ----------------------------------------------------------------------------------------
+# The public functions
+# ----------------------------------------------------------------------------------------
+
+
+def shader(spec: Any, target: str = "glsl", standalone: bool = False, command: str | None = None) -> str:
+    """Shader source code of a BRDF with its tables baked in.
+
+    Parameters
+    ----------
+    spec : dict, str or BRDF
+        A closed-form model (:data:`SUPPORTED`), a ``pumped`` chain of one (g1 or g2, any levels) or a ``kulla_conty``
+        or ``scaled`` compensation of one.
+    target : {"glsl", "glsl-es", "hlsl", "msl", "brdf-explorer"}
+        ``glsl`` (GLSL 4.x) and ``glsl-es`` (GLSL ES 3.00, WebGL 2): a library snippet defining ``float
+        pumpup_brdf(vec3 wi, vec3 wo)`` (see the module docstring); ``hlsl`` (shader model 5) and ``msl`` (Metal):
+        translated through SPIR-V by glslangValidator and spirv-cross from a compute shader that evaluates
+        ``pumpup_brdf`` on a buffer of direction pairs; ``brdf-explorer``: a ``.brdf`` file for Disney's BRDF
+        Explorer.
+    standalone : bool
+        For ``glsl`` / ``glsl-es``: add the ``#version`` line and a ``main`` (a compute shader over a buffer of pairs
+        for GLSL 4.50, a fragment shader of the uniform directions ``pumpup_wi``, ``pumpup_wo`` for GLSL ES).
+    command : str, optional
+        The command that made the file, for the header (default: the Python call).
+
+    Returns
+    -------
+    str
+        The source.  A header comment gives the spec, pumpup's version, the conventions, the uniforms or baked
+        parameters, the tables' sizes and error bounds and the command.
+
+    Raises
+    ------
+    SpecError
+        For a model without a closed form in the shader (``from_function``, spectral models, ``he_torrance``, ...),
+        naming it; ValueError for an unknown target.
+
+    Examples
+    --------
+    >>> src = shader("phong:n=20", target="glsl-es")
+    >>> "float pumpup_brdf(vec3 wi, vec3 wo)" in src and "uniform float pumpup_n;" in src
+    True
+    """
+    if target not in TARGETS:
+        raise ValueError(f"target must be one of {', '.join(TARGETS)}; got {target!r}")
+    brdf = spec if isinstance(spec, BRDF) else load(spec)
+    plan = _Plan(brdf)
+    if target in ("glsl", "glsl-es"):
+        src = _glsl(plan, target, command)
+        if standalone:
+            src = _standalone(src, es=target == "glsl-es")
+        return src
+    lib, notes = _library(plan)
+    header = _header(plan, target, notes, command)
+    if target == "brdf-explorer":
+        return _brdf_explorer(plan, lib, header)
+    return header + _translate(lib, target)
+
+
+def write_shader(spec: Any, target: str, path: str | os.PathLike[str], command: str | None = None) -> str:
+    """Write :func:`shader`'s source to ``path`` atomically (a temporary file renamed into place); returns the path."""
+    from .tables import atomic_path
+
+    src = shader(spec, target=target, command=command)
+    with atomic_path(path) as tmp:
+        with open(tmp, "w") as fh:
+            fh.write(src)
+    return os.fspath(path)
+
+
+def command_line(spec_text: str, target: str, out: str | None) -> str:
+    """The shell command that makes a file (for the header)."""
+    cmd = f"pumpup shader {shlex.quote(spec_text)} --target {target}"
+    return cmd + (f" --out {shlex.quote(out)}" if out else "")
