@@ -49,7 +49,7 @@ LOG_PARAMS = ("n", "nu", "nv", "m", "alpha", "ax", "ay", "s", "sigma", "sigma_0"
 #: the points follow mu down to 1e-3
 ALBEDO_THETA = np.concatenate([np.linspace(0.0, 85.0, 86), np.degrees(np.arccos(np.geomspace(0.087, 1e-3, 24)))])
 #: sizes of the images (pixels per side)
-FURNACE_SIZE = 96
+FURNACE_SIZE = 64
 SPHERE_SIZE = 128
 SLICE_SIZE = 64
 
@@ -320,9 +320,26 @@ def slice_image(f: BRDF, phi: float = 0.0, n: int = SLICE_SIZE) -> dict:
 
 
 def furnace_image(f: BRDF, size: int = FURNACE_SIZE) -> dict:
-    """The white-furnace sphere (``pumpup.render.furnace``): pixel = a(mu_V) from pumpup's albedo table."""
+    """The white-furnace sphere in ``pumpup.render``'s geometry: pixel = a(mu_V), mu_V = N.V (000 eq. 2).
+
+    For a reciprocal isotropic model every pixel is ``pumpup.albedo(f, mu_V, return_error=True)`` at its own mu_V
+    (one call over the distinct values: 296 at 64 pixels), and ``bound`` is the largest error estimate; otherwise
+    (a non-reciprocal model, whose furnace integrates over the incidence direction, or an anisotropic one, which
+    pumpup refuses) it is ``pumpup.render.furnace``'s image and bound.  ``method`` says which.
+    """
+    import pumpup
+
+    g = render.geometry(size)
+    if f.reciprocal and render._anisotropy(f) <= render.ISOTROPY_TOL:
+        mu, inverse = np.unique(g.view[:, 2], return_inverse=True)
+        a, err = pumpup.albedo(f, mu, return_error=True)
+        rad = np.zeros(g.mask.shape)
+        rad[g.mask] = np.asarray(a, dtype=np.float64)[inverse]
+        return {"size": size, "data": _b64(rad), "bound": float(np.max(err)), "max": float(rad.max()),
+                "method": "pumpup.albedo per pixel"}
     im = render.furnace(f, size=size)
-    return {"size": size, "data": _b64(im.radiance), "bound": float(im.error), "max": float(im.radiance.max())}
+    return {"size": size, "data": _b64(im.radiance), "bound": float(im.error), "max": float(im.radiance.max()),
+            "method": "pumpup.render.furnace"}
 
 
 def sphere_image(f: BRDF, light: float, azimuth: float, size: int = SPHERE_SIZE) -> dict:
@@ -332,18 +349,18 @@ def sphere_image(f: BRDF, light: float, azimuth: float, size: int = SPHERE_SIZE)
 
 
 def shader_source(f: BRDF) -> dict | None:
-    """The GLSL ES library of ``pumpup.shader(spec, target="glsl-es")`` and its uniforms, or None where pumpup has
-    no shader export.
+    """The GLSL ES library of ``pumpup.shader(spec, target="glsl-es")`` and its uniforms
+    (``pumpup.shaders.uniforms``), ``{"error": message}`` for a model the export does not translate, or None where
+    pumpup has no shader export.
     """
     import importlib.util
 
     if importlib.util.find_spec("pumpup.shaders") is None:
         return None
-    import pumpup
-    from pumpup import shaders
+    from .. import shaders
 
     try:
-        return {"glsl": pumpup.shader(f.spec, target="glsl-es"), "uniforms": shaders.uniforms(f.spec)}
+        return {"glsl": shaders.shader(f.spec, target="glsl-es"), "uniforms": shaders.uniforms(f.spec)}
     except (SpecError, ValueError, NotImplementedError) as exc:
         return {"error": str(exc)}
 

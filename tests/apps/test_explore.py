@@ -42,12 +42,25 @@ def test_views_equal_pumpups_api():
     np.testing.assert_array_equal(m["overlays"]["pumped"]["albedo"]["a"], pumpup.albedo(g, mu))
     kc = pumpup.compensate(f, method="kulla_conty")
     assert m["overlays"]["kulla_conty"]["mean_albedo"] == pumpup.mean_albedo(kc)
-    # the furnace image is pumpup.render.furnace's
+    # the furnace image: pumpup.albedo at every pixel's mu_V, within pumpup.render.furnace's bound of its image
+    g = pumpup.render.geometry(C.FURNACE_SIZE)
+    got = np.frombuffer(__import__("base64").b64decode(m["furnace"]["data"]), "<f8").reshape(g.mask.shape)
+    a_px, err_px = pumpup.albedo(f, g.view[:, 2], return_error=True)
+    np.testing.assert_array_equal(got[g.mask], a_px)
+    assert not got[~g.mask].any() and m["furnace"]["bound"] == err_px.max()
     im = pumpup.render.furnace(f, size=C.FURNACE_SIZE)
-    np.testing.assert_array_equal(np.frombuffer(__import__("base64").b64decode(m["furnace"]["data"]), "<f8"),
-                                  im.radiance.ravel())
-    assert m["furnace"]["bound"] == im.error
+    assert np.abs(got - im.radiance).max() <= im.error + err_px.max()
     json.dumps(r, allow_nan=False)  # what the server sends
+
+
+def test_furnace_of_a_non_reciprocal_model_is_pumpups_furnace():
+    f = pumpup.compensate(pumpup.load(PHONG), method="scale")
+    m = C.furnace_image(f)
+    im = pumpup.render.furnace(f, size=C.FURNACE_SIZE)
+    assert m["method"] == "pumpup.render.furnace" and m["bound"] == im.error
+    np.testing.assert_array_equal(np.frombuffer(__import__("base64").b64decode(m["data"]), "<f8"), im.radiance.ravel())
+    with pytest.raises(SpecError, match="anisotropic"):
+        C.furnace_image(pumpup.load("ward_aniso:ax=0.1,ay=0.3"))
 
 
 def test_above_one_is_where_albedo_minus_error_exceeds_one():

@@ -32,7 +32,7 @@ function shortSpec(spec) {
 function defaultState() {
   return {specs: BOOT.initial.slice(0, 4), active: 0, theta_i: 30, phi: 0, log: false,
           pump: {on: false, g: "g2", levels: 1}, kulla_conty: false, scaled: false,
-          light: 30, light_azimuth: 0, exposure: 0};
+          light: 30, light_azimuth: 0, exposure: -2};
 }
 
 function stateFromURL() {
@@ -65,7 +65,7 @@ function writeURL() {
   if (st.kulla_conty) q.set("kc", "1");
   if (st.scaled) q.set("sc", "1");
   q.set("light", st.light); if (st.light_azimuth) q.set("laz", st.light_azimuth);
-  if (st.exposure) q.set("exp", st.exposure);
+  if (st.exposure !== -2) q.set("exp", st.exposure);
   history.replaceState(null, "", "?" + q.toString());
 }
 
@@ -558,9 +558,12 @@ function glProgram(canvas, glsl) {
     c = {gl, source: null, program: null};
     glCache.set(canvas, c);
   }
-  if (c.source !== glsl) {
+  // the header comment names the parameter values: only the code decides whether to compile again (a parameter
+  // that is a uniform changes no code)
+  const code = glsl.split("\n").filter((line) => !line.startsWith("//")).join("\n");
+  if (c.source !== code) {
     const gl = c.gl;
-    const src = "#version 300 es\nprecision highp float;\nprecision highp int;\n" + glsl + "\n" + MAIN;
+    const src = "#version 300 es\nprecision highp float;\nprecision highp int;\n" + code + "\n" + MAIN;
     const prog = gl.createProgram();
     gl.attachShader(prog, compile(gl, gl.VERTEX_SHADER, VERTEX));
     gl.attachShader(prog, compile(gl, gl.FRAGMENT_SHADER, src));
@@ -572,7 +575,8 @@ function glProgram(canvas, glsl) {
     const loc = gl.getAttribLocation(prog, "p_pos");
     gl.enableVertexAttribArray(loc);
     gl.vertexAttribPointer(loc, 2, gl.FLOAT, false, 0, 0);
-    c.program = prog; c.source = glsl;
+    if (c.program) gl.deleteProgram(c.program);
+    c.program = prog; c.source = code;
   }
   return c;
 }
@@ -623,14 +627,13 @@ explore.sphereRadiance = function (index, size) {
 function srgb(v) { v = Math.min(1, Math.max(0, v)); return v <= 0.0031308 ? 12.92 * v : 1.055 * Math.pow(v, 1 / 2.4) - 0.055; }
 
 // pumpup.render.tone_map of an image sent by the server
-function paintImage(canvas, img, error) {
+function paintImage(canvas, img, error, exposure) {
   const size = img.size;
   canvas.width = size; canvas.height = size;
   const ctx = canvas.getContext("2d");
   const data = ctx.createImageData(size, size);
   const rad = decode64(img.data);
-  const k = Math.pow(2, explore.state.exposure);
-  const r0 = size / 2;
+  const k = Math.pow(2, exposure);
   for (let i = 0; i < size; i++) {
     for (let j = 0; j < size; j++) {
       const x = -1 + (2 * j + 1) / size, y = 1 - (2 * i + 1) / size;
@@ -646,7 +649,6 @@ function paintImage(canvas, img, error) {
     }
   }
   ctx.putImageData(data, 0, 0);
-  void r0;
 }
 
 function dragLight(canvas) {
@@ -679,7 +681,7 @@ function drawSpheres(r) {
       pair.className = "sphere-pair";
       pair.innerHTML = `<canvas id="lit-${i}" width="${size}" height="${size}"></canvas>` +
                        `<canvas id="lit2d-${i}" width="${size}" height="${size}" hidden></canvas>` +
-                       `<canvas id="furnace-${i}" width="96" height="96"></canvas><div class="cap"></div><div class="err"></div>`;
+                       `<canvas id="furnace-${i}" width="64" height="64"></canvas><div class="cap"></div><div class="err"></div>`;
       box.appendChild(pair);
       dragLight(pair.querySelector(`#lit-${i}`));
       dragLight(pair.querySelector(`#lit2d-${i}`));
@@ -692,12 +694,13 @@ function drawSpheres(r) {
       catch (e) { errs.push(String(e.message || e)); explore.glErrors.push(String(e.message || e)); }
     } else {
       lit.hidden = true; lit2d.hidden = false; usesServer = true;
-      if (m.sphere && !m.sphere.error) paintImage(lit2d, m.sphere, 0);
+      if (m.sphere && !m.sphere.error) paintImage(lit2d, m.sphere, 0, explore.state.exposure);
       else if (m.sphere) errs.push("sphere: " + m.sphere.error);
       if (m.shader && m.shader.error) errs.push("shader: " + m.shader.error);
     }
     const fc = pair.querySelector(`#furnace-${i}`);
-    if (m.furnace && !m.furnace.error) paintImage(fc, m.furnace, m.furnace.bound);
+    // the furnace at exposure 0: magenta where a(mu_V) > 1 beyond the table's bound (more light out than in)
+    if (m.furnace && !m.furnace.error) paintImage(fc, m.furnace, m.furnace.bound, 0);
     else if (m.furnace) errs.push("furnace: " + m.furnace.error);
     pair.querySelector(".cap").textContent = `${label(m, i)}: lit | furnace`;
     pair.querySelector(".cap").style.color = COLOURS[i];
@@ -708,10 +711,9 @@ function drawSpheres(r) {
 }
 
 function draw(r) {
-  drawLobe(r);
-  drawAlbedo(r);
-  drawSpheres(r);
-  drawSlice(r);
+  const t = [performance.now()];
+  for (const f of [drawLobe, drawAlbedo, drawSpheres, drawSlice]) { f(r); t.push(performance.now()); }
+  explore.drawMs = {lobe: t[1] - t[0], albedo: t[2] - t[1], spheres: t[3] - t[2], slice: t[4] - t[3]};
 }
 
 // ---------------------------------------------------------------------------------------------------------------
