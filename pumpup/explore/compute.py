@@ -45,6 +45,9 @@ MAX_COMPARE = 4
 MAX_LEVELS = 5
 #: parameters shown on a log slider: lobe exponents and widths (roughness)
 LOG_PARAMS = ("n", "nu", "nv", "m", "alpha", "ax", "ay", "s", "sigma", "sigma_0", "k")
+#: the lobe widths among them (slopes and roughness): their sliders span 1e-3 to 2, the exponents' 0.1 to 1e4 (the
+#: field beside a slider takes any value in the registry's range)
+WIDTH_PARAMS = ("m", "alpha", "ax", "ay", "sigma", "sigma_0")
 #: incidence angles of the albedo plot [degrees]: 0 to 89.9 (theta, so that the plot reads in degrees); near grazing
 #: the points follow mu down to 1e-3
 ALBEDO_THETA = np.concatenate([np.linspace(0.0, 85.0, 86), np.degrees(np.arccos(np.geomspace(0.087, 1e-3, 24)))])
@@ -81,6 +84,22 @@ def _walk_types(spec: Any) -> list[str]:
     return out
 
 
+def _refuse(spec: dict) -> None:
+    """A SpecError for a spec dict that names a type outside the registry or in :data:`REFUSED_TYPES`, or that is
+    spectral (nothing is built).
+    """
+    known = registry()
+    for t in _walk_types(spec):
+        if not isinstance(t, str) or t not in known:
+            raise SpecError(f"spec: unknown model type {t!r}; known types: "
+                            f"{', '.join(k for k in known if k not in REFUSED_TYPES)}")
+        if t in REFUSED_TYPES:
+            raise SpecError(f"spec: type {t!r} wraps Python code and is not accepted here; use a registered model")
+    if is_spectral_spec(spec):
+        raise SpecError("spec: spectral specs (a 'material', 'wavelengths' or per-wavelength lists) are not shown "
+                        "here; give one channel (eta, k numbers)")
+
+
 def check_spec(spec: Any) -> BRDF:
     """A registry model from the page's spec (its short form, JSON text or a dict); a SpecError otherwise.
 
@@ -98,16 +117,7 @@ def check_spec(spec: Any) -> BRDF:
         raise SpecError(f"spec: must be a model spec (a dict with a 'type'), got {type(spec).__name__}")
     if len(json.dumps(spec, default=str)) > MAX_SPEC_CHARS:
         raise SpecError(f"spec: at most {MAX_SPEC_CHARS} characters of JSON")
-    known = registry()
-    for t in _walk_types(spec):
-        if not isinstance(t, str) or t not in known:
-            raise SpecError(f"spec: unknown model type {t!r}; known types: "
-                            f"{', '.join(k for k in known if k not in REFUSED_TYPES)}")
-        if t in REFUSED_TYPES:
-            raise SpecError(f"spec: type {t!r} wraps Python code and is not accepted here; use a registered model")
-    if is_spectral_spec(spec):
-        raise SpecError("spec: spectral specs (a 'material', 'wavelengths' or per-wavelength lists) are not shown "
-                        "here; give one channel (eta, k numbers)")
+    _refuse(spec)
     f = load(spec)
     if getattr(f, "is_spectral", False):
         raise SpecError("spec: spectral models are not shown here; give one channel")
@@ -182,9 +192,10 @@ def _slider(name: str, p, default: Any) -> dict:
     """The slider of a numeric parameter: its range (inside the registry's), and whether it is logarithmic."""
     lo, hi = float(p.lo), float(p.hi)
     log = name in LOG_PARAMS and lo >= 0.0
-    if log:
-        s_lo = max(lo, 1e-3)
-        s_hi = min(hi, 1e4)
+    if log and name in WIDTH_PARAMS:  # roughness: 1e-3 (a mirror on screen) to 2 (rougher than any surface)
+        s_lo, s_hi = max(lo, 1e-3), min(hi, 2.0)
+    elif log:  # exponents: 0.1 (nearly diffuse) to 1e4 (a sharp highlight)
+        s_lo, s_hi = max(lo, 0.1), min(hi, 1e4)
     else:
         s_lo = lo if math.isfinite(lo) else -10.0
         ref = abs(default) if isinstance(default, (int, float)) and not isinstance(default, bool) else 1.0
@@ -211,10 +222,13 @@ def model_catalog() -> list[dict]:
                 entry["slider"] = _slider(pname, p, d)
             params.append(entry)
         example = {"type": name, **(cls.examples[0] if cls.examples else {})}
+        for pname, p in cls.params.items():  # an operator without an example (pumped): over Phong
+            if p.kind == "spec" and p.default is REQUIRED and pname not in example:
+                example[pname] = {"type": "phong", "n": 20}
         try:
-            check_spec(example)
-        except (SpecError, ValueError):
-            continue  # a model whose only examples need a spec kind the page refuses
+            _refuse(example)
+        except SpecError:
+            continue  # a model whose example is a spec kind the page refuses
         out.append({"type": name, "params": params, "example": example,
                     "doc": (cls.__doc__ or "").strip().split("\n")[0]})
     return out

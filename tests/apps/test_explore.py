@@ -54,7 +54,8 @@ def test_views_equal_pumpups_api():
 
 
 def test_furnace_of_a_non_reciprocal_model_is_pumpups_furnace():
-    f = pumpup.compensate(pumpup.load(PHONG), method="scale")
+    f = pumpup.compensate(pumpup.load("lambert:albedo=0.5"), method="scale")
+    assert not f.reciprocal
     m = C.furnace_image(f)
     im = pumpup.render.furnace(f, size=C.FURNACE_SIZE)
     assert m["method"] == "pumpup.render.furnace" and m["bound"] == im.error

@@ -138,7 +138,7 @@ function onAnswer(ans) {
   explore.drawnId = ans.id;
   explore.drawn += 1;
   explore.lastMs = ms;
-  explore.ready = true;
+  explore.ready = explore.catalog !== null;  // the views drawn and the controls built
   document.body.dataset.drawn = String(explore.drawn);
   writeURL();
   updateControls();
@@ -722,11 +722,12 @@ function draw(r) {
 
 async function start() {
   explore.state = stateFromURL();
+  connect();
+  request();  // the views are computed while the model list loads
   const res = await fetch("/api/models");
   explore.catalog = await res.json();
   initControls();
-  connect();
-  request();
+  if (explore.result) { updateControls(); explore.ready = true; }
 }
 
 start().catch((e) => showMessage("the page could not start: " + e));
