@@ -30,18 +30,40 @@ def parse_spec(text: str) -> dict:
 
 
 def _load(text: str, spectral: bool = False):
-    """The model of a SPEC argument; a spectral one (a 'material' or per-wavelength lists, pumpup.spectral)
-    only where the command prints or writes per wavelength (``spectral=True``).
+    """The model of a SPEC argument, or of a saved BRDF file (``pumpup pump --out``, ``pumpup compensate --out``) read
+    without recomputing its tables; a spectral one (a 'material' or per-wavelength lists, pumpup.spectral) only where
+    the command prints or writes per wavelength (``spectral=True``).
     """
+    import os
+
     import pumpup
 
     try:
-        f = pumpup.load(parse_spec(text))
+        f = _load_file(text) if os.path.isfile(text) else pumpup.load(parse_spec(text))
     except pumpup.SpecError as exc:
         raise SystemExit(f"pumpup: {exc}") from None
     if getattr(f, "is_spectral", False) and not spectral:
         raise SystemExit(f"pumpup: {SPECTRAL_REFUSED}")
     return f
+
+
+def _load_file(path: str):
+    """The BRDF saved in the file at ``path`` (its reader by the file's kind), or exit with one line saying what the
+    file is.
+    """
+    import pumpup
+    from pumpup.tables import SAVED_BRDF_READERS, saved_kind
+    from pumpup.tables.validate import TableError
+
+    try:
+        kind = saved_kind(path)
+        reader = SAVED_BRDF_READERS.get(kind)
+        if reader is None:
+            raise SystemExit(f"pumpup: {path!r} is not a saved BRDF ({kind or 'a file of no known kind'}): a SPEC is a "
+                             "model spec or a file written by 'pumpup pump --out' or 'pumpup compensate --out'")
+        return getattr(pumpup, reader.removeprefix("pumpup."))(path)
+    except (TableError, OSError) as exc:
+        raise SystemExit(f"pumpup: {_one_line(exc)}") from None
 
 
 #: the one line of a command that takes single-channel models only, given a spectral spec
@@ -311,8 +333,7 @@ def cmd_check(args) -> int:
     if hasattr(f, "report"):  # a compensated BRDF (pumpup.compensate): its E table and bounds
         print(f.report())
     m = pumpup.max_albedo(f)
-    print(f"max albedo (constant set to 1): {m.albedo:.12g} +- {m.error:.2g} at theta = {m.theta_deg:.6f} +- "
-          f"{m.theta_error:.2g} deg; maximum constant {m.constant:.12g}")
+    print(f"max albedo (constant set to 1): {m}")
     return 0 if r.reciprocal else 1
 
 
@@ -867,6 +888,11 @@ def cmd_render_scene(args) -> int:
     return 0
 
 
+def _budget_option(s) -> None:
+    s.add_argument("--max-seconds", type=float, default=None, metavar="S",
+                   help="stop with one line after S seconds instead of running on (default: no bound)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``pumpup`` command, one subcommand per ``cmd_*`` function (its ``func`` default)."""
     p = _Parser(
@@ -889,6 +915,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--quiet", action="store_true", help="no progress lines (default: one per step, on stderr)")
     s.set_defaults(func=cmd_warmup)
     s = sub.add_parser("albedo", help="directional albedo of a model, with error estimates")
+    _budget_option(s)
     s.add_argument("spec", help="a model SPEC: JSON or short, e.g. phong:n=20")
     g = s.add_mutually_exclusive_group()
     g.add_argument("--mu", type=float, nargs="+", help="cos(theta_i) values in (0, 1] (default: 1 0.5 0.1 0.01)")
@@ -899,6 +926,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "anisotropic models depend on it, isotropic ones do not")
     s.set_defaults(func=cmd_albedo)
     s = sub.add_parser("table", help="tabulate the albedo on an adaptive grid into a netCDF file")
+    _budget_option(s)
     s.add_argument("spec", help="a model SPEC: JSON or short, e.g. phong:n=20")
     s.add_argument("--out", required=True, help="the netCDF file to write (required; its directory must exist)")
     s.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of every value (default: 1e-10)")
@@ -907,6 +935,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "mu at phi = 0)")
     s.set_defaults(func=cmd_table)
     s = sub.add_parser("pump", help="pump up a model's albedo (001 sec. 3) and print the albedo of every level")
+    _budget_option(s)
     s.add_argument("spec", help="a model SPEC: JSON or short, e.g. phong:n=20")
     s.add_argument("--g", choices=("g1", "g2"), default="g1",
                    help="g1 = max(a(wi), a(wo)) (001 eq. 20) or the controlled g2 (001 eq. 21) (default: g1)")
@@ -942,6 +971,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_check)
     s = sub.add_parser("sweep", help="albedo tables over a grid of model parameters, in chunks on dask "
                                      "(resumable; a dask.distributed cluster with --scheduler)")
+    _budget_option(s)
     s.add_argument("spec", help="a model SPEC: JSON or short, e.g. phong:n=20")
     s.add_argument("--param", action="append", required=True, metavar="NAME=VALUES",
                    help="a swept parameter: n=1,2,4 or n=geom:1:1000:64 or p=lin:0:1:64 (required; repeat for more)")
@@ -970,6 +1000,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_sweep)
     s = sub.add_parser("compensate", help="energy compensation: Kulla-Conty lobe, 1/E scaling (not reciprocal), or "
                                           "pumping g1/g2; prints the furnace and saves the BRDF with its tables")
+    _budget_option(s)
     s.add_argument("spec", help="a model SPEC: JSON or short, e.g. ggx:alpha=0.3")
     s.add_argument("--method", choices=("kulla_conty", "scale", "g1", "g2"), default="kulla_conty",
                    help="the compensation (default: kulla_conty)")
@@ -1001,6 +1032,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.set_defaults(func=cmd_render)
     s = sub.add_parser("lut", help="a renderer's albedo look-up table, computed exactly, with its node, storage and "
                                    "look-up errors")
+    _budget_option(s)
     s.add_argument("model", nargs="?", default="ggx", help="ggx (default), beckmann, or a spec such as "
                                                            "ggx:shadowing=separable")
     s.add_argument("--preset", required=True, help="cycles, filament, filament-centred, appleseed, bsdl, mitsuba, "
@@ -1137,6 +1169,13 @@ def main(argv: list[str] | None = None, notify: bool = False) -> int:
             from .warmup import notify_compiles
 
             notify_compiles()
+        if getattr(args, "max_seconds", None) is not None:
+            from .core.budget import time_budget
+
+            if not args.max_seconds > 0 or args.max_seconds == float("inf"):
+                raise SystemExit(f"pumpup: --max-seconds must be a number > 0 (seconds), got {args.max_seconds:g}")
+            with time_budget(args.command, args.max_seconds, option="--max-seconds"):
+                return args.func(args)
         return args.func(args)
     except UsageError:
         raise

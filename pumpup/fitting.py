@@ -68,7 +68,7 @@ from .core import BRDF, SpecError, load, registry
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
-__all__ = ["fit", "FitResult", "FitData", "FitError", "lobe_grid", "relative_errors", "plot_fits",
+__all__ = ["fit", "FitResult", "FitData", "FitError", "FitWarning", "lobe_grid", "relative_errors", "plot_fits",
            "DEFAULT_LOBE_FRACTION", "DEFAULT_MU_MIN"]
 
 #: default lobe region: f_t cos(theta_L) at least this fraction of its maximum over L for the view
@@ -85,6 +85,15 @@ METHODS = ("perceptual", "least_squares")
 
 class FitError(SpecError):
     """Bad input to :func:`fit`; the message names the argument and its allowed range."""
+
+
+class FitWarning(UserWarning):
+    """A fit that is hardly better than the zero BRDF (:data:`NEAR_ZERO_FIT`)."""
+
+
+#: a fit whose objective max(w_f e_f, w_a e_a) is at least this fraction of the zero BRDF's (e_f = e_a = 1: f = 0 is
+#: 100 % off everywhere) is reported as no fit, with a :class:`FitWarning` and a note
+NEAR_ZERO_FIT = 0.9
 
 
 # ----------------------------------------------------------------------------------------
@@ -949,6 +958,8 @@ def fit(target: BRDF | dict | str, family: str, params: dict | None = None, fixe
             mu_search = mu_final = np.unique(check_mu(mu).ravel())[::-1]
         except ValueError as exc:
             raise FitError(f"fit: {exc}") from None
+        if mu_search.size == 0:
+            raise FitError("fit: mu must hold at least one value in (0, 1], got an empty array")
     if directions is None:
         for name, g in (("grid", grid), ("eval_grid", eval_grid)):
             if (not isinstance(g, (tuple, list)) or len(g) != 3
@@ -1031,13 +1042,21 @@ def fit(target: BRDF | dict | str, family: str, params: dict | None = None, fixe
         lo, hi = bounds[k]
         if v <= lo * (1 + 1e-9) + 1e-300 or v >= hi * (1 - 1e-9):
             notes.append(f"{k} = {v:g} is at the edge of its range [{lo:g}, {hi:g}]")
+    objective = max(weights[0] * e_f, weights[1] * e_a)
+    if objective >= NEAR_ZERO_FIT * max(weights):  # the zero BRDF scores max(w_f, w_a)
+        import warnings
+
+        why = (f"the fit's error max(w_f e_f, w_a e_a) = {objective:.3g} is within {1 - NEAR_ZERO_FIT:.0%} of the "
+               f"zero BRDF's {max(weights):.3g}: {family} cannot follow this target's lobe on these directions")
+        notes.append(why)
+        warnings.warn(f"fit: {why}", FitWarning, stacklevel=2)
     return FitResult(
         target=tgt.spec, target_brdf=tgt, family=family, method=method, spec=brdf.spec, brdf=brdf, params=fitted,
         bounds=bounds, brdf_error=e_f, albedo_error=e_a, albedo_error_bound=bound, worst_pair=(worst_wi, worst_wo),
         worst_mu=worst_mu, search_objective=search_objective, exchanges=exchanges, plausible=bool(plausible),
         directions_given=directions is not None, view_mu_min=float(np.min(final.wo[:, 2])),
         albedo_evaluations=prob.albedo_evaluations, n_mu_search=len(mu_search),
-        objective=max(weights[0] * e_f, weights[1] * e_a), weights=weights, lsq=math.sqrt(lsq_search),
+        objective=objective, weights=weights, lsq=math.sqrt(lsq_search),
         mu=final.mu, lobe_fraction=lobe_fraction, eval_pairs=int(final.region.sum()),
         eval_views=int(final.view.max()) + 1, max_albedo=float(np.max(a_fit)), evaluations=prob.evaluations,
         seconds=time.perf_counter() - t0, final_rtol=final_rtol, search_rtol=search_rtol, notes=notes,

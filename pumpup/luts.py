@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .core import BRDF, SpecError, load
+from .core.budget import time_budget
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -338,10 +339,18 @@ def _map_columns(fn, n: int, threads: int | None):
         for j in range(1, n):
             out[j] = fn(j)
         return out
+    import contextvars
     from concurrent.futures import ThreadPoolExecutor
 
+    from .core import budget
+
+    def column(j):  # (in a copy of the caller's context: its route choice and time budget hold on the threads)
+        budget.check(f"computing column {j} of {n}")
+        return fn(j)
+
+    context = contextvars.copy_context()
     with ThreadPoolExecutor(threads) as pool:
-        for j, r in zip(range(1, n), pool.map(fn, range(1, n))):
+        for j, r in zip(range(1, n), pool.map(lambda j: context.copy().run(column, j), range(1, n))):
             out[j] = r
     return out
 
@@ -526,7 +535,7 @@ def lookup_error(table, spec: dict, param: str, preset, *, per_cell: int = 1, st
 def lut(model: str | dict | BRDF = "ggx", preset: str = "cycles", *, rtol: float | None = None,
         eavg: bool | None = None, split: bool | None = None, lookup_check: bool = True, per_cell: int | None = None,
         stride: int | None = None, max_lookup_error: float | None = None, threads: int | None = None,
-        max_regions: int = 200) -> xr.Dataset:
+        max_regions: int = 200, max_seconds: float | None = None) -> xr.Dataset:
     """A renderer's albedo table of ``model``, computed exactly, with its errors.
 
     Parameters
@@ -553,6 +562,9 @@ def lut(model: str | dict | BRDF = "ggx", preset: str = "cycles", *, rtol: float
         Raise :class:`LutError`, saying where, if the measured look-up error exceeds this.
     threads : int, optional
         Threads for the columns (default: one per core).
+    max_seconds : float, optional
+        A time budget: past it, the work stops with :class:`pumpup.core.budget.BudgetExceeded` (a TimeoutError)
+        instead of running on.  None: no bound.
 
     Returns
     -------
@@ -570,6 +582,11 @@ def lut(model: str | dict | BRDF = "ggx", preset: str = "cycles", *, rtol: float
     >>> ds["E"].shape
     (16, 16)
     """
+    if max_seconds is not None:  # (a time budget: past it, pumpup.core.budget.BudgetExceeded, a TimeoutError)
+        with time_budget("lut", max_seconds):
+            return lut(model, preset, rtol=rtol, eavg=eavg, split=split, lookup_check=lookup_check,
+                       per_cell=per_cell, stride=stride, max_lookup_error=max_lookup_error, threads=threads,
+                       max_regions=max_regions)
     import xarray as xr
 
     from ._version import __version__

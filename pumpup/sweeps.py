@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ._version import __version__
-from .core import BRDF, SpecError, load
+from .core import BRDF, SpecError, budget, load
 from .engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, check_mu
 
 if TYPE_CHECKING:
@@ -328,11 +328,14 @@ def definition_digest(definition: dict) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def _check_existing_output(out: str, digest: str, overwrite: bool) -> None:
-    """Refuse to replace a result of a different sweep (or a file that is not one) unless ``overwrite``."""
+def _check_existing_output(out: str, digest: str, overwrite: bool):
+    """Refuse to replace a result of a different sweep (or a file that is not one) unless ``overwrite``; the finished
+    result of this very sweep in a netCDF file (validated by :func:`pumpup.open_table`, checksums and digest), or None.
+    """
     out = os.fspath(out)
     if not os.path.exists(out) or overwrite:
-        return
+        return None
+    ds = None
     try:
         if out.rstrip("/").endswith(".zarr"):
             import xarray as xr
@@ -342,11 +345,12 @@ def _check_existing_output(out: str, digest: str, overwrite: bool) -> None:
         else:
             from .tables import open_table
 
-            attrs = open_table(out).attrs
+            ds = open_table(out)
+            attrs = ds.attrs
     except Exception:  # unreadable: not ours to replace silently
         attrs = {}
     if attrs.get("sweep_definition_sha256") == digest:
-        return
+        return ds  # (a zarr store, which carries no digest, is computed again)
     what = ("the result of a different sweep" if attrs.get("pumpup_kind") == SWEEP_KIND
             else "something that is not a result of this sweep")
     raise SweepError(f"{out!r} exists and holds {what}; pass overwrite=True (--overwrite) to replace it, "
@@ -488,7 +492,7 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu: ArrayLike | None
           client: Any = None, scheduler: str | None = None, workers: int | None = None,
           chunks: int | Mapping[str, int] | None = None, out: str | os.PathLike | None = None,
           rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL, mean: bool = True, maximum: bool = True,
-          progress: bool | None = None, overwrite: bool = False) -> xr.Dataset:
+          progress: bool | None = None, overwrite: bool = False, max_seconds: float | None = None) -> xr.Dataset:
     """Albedo tables over a grid of model parameters, computed in chunks through dask.
 
     Cell (v_1, ..., v_k) of the grid is the model ``pumpup.load(spec | {p_1: v_1, ...})``
@@ -534,7 +538,9 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu: ArrayLike | None
         Write the result here (netCDF; a zarr store if the name ends in ``.zarr``) and keep
         finished chunks in ``<out>.parts/`` until the end, so that an interrupted sweep run
         again with the same arguments resumes where it stopped.  The parts directory
-        remembers the sweep's definition; a different sweep is refused, not mixed in.
+        remembers the sweep's definition; a different sweep is refused, not mixed in.  A
+        netCDF ``out`` that holds the finished result of the same sweep is read back
+        (validated) instead of computed again.
     rtol, atol : float
         Quadrature tolerances of the albedo values (see :func:`pumpup.albedo`).
     mean : bool
@@ -547,8 +553,12 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu: ArrayLike | None
         Show a progress bar over cells (default: when stderr is a terminal).
     overwrite : bool
         Replace ``out`` (and discard the parts in ``<out>.parts/``) when they belong to a different
-        sweep; without it such a sweep is refused before it computes.  A result of the same sweep
-        is always replaced (by the same numbers).
+        sweep; without it such a sweep is refused before it computes.  With it, a finished result of
+        the same sweep is computed again and replaced (by the same numbers).
+    max_seconds : float, optional
+        A time budget: past it, the sweep stops with :class:`pumpup.core.budget.BudgetExceeded` (a
+        TimeoutError): at once on the synchronous scheduler, else when the next chunk finishes; with
+        ``out``, the finished chunks are kept and a new run resumes from them.  None: no bound.
 
     Returns
     -------
@@ -607,6 +617,7 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu: ArrayLike | None
                          f"of a dask.distributed scheduler such as 'tcp://host:8786', got {scheduler!r}")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ValueError(f"sweep: workers must be an integer >= 1, got {workers!r}")
+    budget.check_max_seconds("sweep", max_seconds)
     shape = tuple(len(values[n]) for n in names)
     cshape = _chunk_shape(names, shape, chunks)
     base = {k: v for k, v in spec.items() if k not in values}
@@ -645,7 +656,9 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu: ArrayLike | None
     parts = None
     todo = list(blocks)
     if out is not None:
-        _check_existing_output(out, digest, overwrite)
+        finished = _check_existing_output(out, digest, overwrite)
+        if finished is not None:  # this sweep ran to the end before: its result, not a second run
+            return finished
         parts = _Parts(out, definition, overwrite)
         todo = []
         for block in blocks:
@@ -657,12 +670,17 @@ def sweep(spec: dict | str, params: Mapping[str, Sequence], mu: ArrayLike | None
 
     try:
         tasks = [(block, ([cell_spec(i) for i in block_cells(block)], pump, grid, opts)) for block in todo]
-        with _progress_bar(sum(len(block_cells(b)) for b in todo), progress) as bar:
+        total = sum(len(block_cells(b)) for b in todo)
+        done = [0]
+        with _progress_bar(total, progress) as bar, budget.time_budget("sweep", max_seconds):
             def on_done(block, result):
                 if parts is not None:
                     parts.save(block, result)
                 place(block, result)
                 bar.update(len(block_cells(block)))
+                done[0] += len(block_cells(block))
+                budget.check(f"{done[0]} of {total} cells were done"
+                             + (" (the finished chunks are kept: a new run resumes)" if parts is not None else ""))
 
             if tasks:
                 if client is not None or (scheduler is not None and scheduler not in LOCAL_SCHEDULERS):

@@ -53,7 +53,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numba import njit
 
-from ..core import BRDF, Lobe
+from ..core import BRDF, Lobe, budget
 from .arc_breaks import graded, horizon_breaks, kink_breaks
 from .lobe_geometry import (
     AXES,
@@ -323,6 +323,7 @@ def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
     """
     from ..physics.quadrature import calibrated_array, mode_code
 
+    budget.check("the 2-D cubature refined its rectangles")  # (a time budget: pumpup.core.budget)
     mode = mode_code(smooth=False)  # raw |K - G| unless pumpup.physics.quadrature.MODE_2D says otherwise
     R = len(prob)
     out = np.empty((R, 4))
@@ -594,7 +595,8 @@ def _groups(brdf: BRDF, mu: np.ndarray, phi: np.ndarray | None = None):
 
 def albedo(brdf: BRDF, mu: ArrayLike, return_error: bool = False, rtol: float = DEFAULT_RTOL,
            atol: float = DEFAULT_ATOL, max_regions: int = 20000, phi: ArrayLike = 0.0,
-           engine: str | None = None) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+           engine: str | None = None,
+           max_seconds: float | None = None) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """Directional albedo a(mu) of ``brdf`` (000 eq. 2; Lewis's k_rho, 002 eq. 15).
 
     a(mu, phi) = integral over the hemisphere of f_r(wi, wo) cos(theta_o) d omega_o, with
@@ -628,6 +630,9 @@ def albedo(brdf: BRDF, mu: ArrayLike, return_error: bool = False, rtol: float = 
         only ("1d": an error for a model or a value of mu none of them takes); the nested quadrature where it applies,
         else the 2-D cubature ("nested"); the 2-D cubature alone ("2d", the reference the others are tested against).
         None: the choice in force (:func:`pumpup.engine.routes.using`, by default "auto").
+    max_seconds : float, optional
+        A time budget (:mod:`pumpup.core.budget`): past it the work stops with a ``BudgetExceeded`` (a TimeoutError)
+        instead of running on.  None: no bound of its own.
 
     Returns
     -------
@@ -649,6 +654,9 @@ def albedo(brdf: BRDF, mu: ArrayLike, return_error: bool = False, rtol: float = 
     >>> abs(float(a) - 1.0) < 1e-10 and float(err) < 1e-9
     True
     """
+    if max_seconds is not None:
+        with budget.time_budget("albedo", max_seconds):
+            return albedo(brdf, mu, return_error, rtol, atol, max_regions, phi, engine)
     if not isinstance(brdf, BRDF):
         if getattr(brdf, "is_spectral", False):  # pumpup.spectral: one albedo per wavelength, on a trailing axis
             return brdf.albedo(mu, return_error=return_error, rtol=rtol, atol=atol, max_regions=max_regions, phi=phi)

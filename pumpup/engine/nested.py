@@ -68,6 +68,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..core import budget
 from .arc_breaks import horizon_breaks, kink_breaks, tau_of_angle
 from .lobe_geometry import (
     AXIS_CODE,
@@ -360,6 +361,7 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
     weights, and the sum of |values| (all including the interval width); and the evaluations per
     problem.
     """
+    budget.check("the nested quadrature refined its intervals")  # (a time budget: pumpup.core.budget)
     lobe = g.lobe
     RO, RI = len(_OUTER[0]), len(_INNER[0])
     onodes, owk, owg = _OUTER

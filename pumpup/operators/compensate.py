@@ -64,6 +64,7 @@ import numpy as np
 from numba import njit
 
 from ..core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register
+from ..core.budget import check_max_seconds, time_budget
 from ..physics.lookups import CELL_SHIFT, float_bits, scale_bound, upper_scalar
 from .pumping import (
     TABLE_DECADES,
@@ -74,6 +75,7 @@ from .pumping import (
     _ProductError,
     file_tables,
     from_file,
+    prepare,
     table_decades,
 )
 
@@ -834,7 +836,7 @@ def furnace(f: BRDF, mu: ArrayLike, return_error: bool = False,
 
 
 def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None = None, f_avg: float | None = None,
-               white: BRDF | dict | None = None, force: bool = False) -> BRDF:
+               white: BRDF | dict | None = None, force: bool = False, max_seconds: float | None = None) -> BRDF:
     """Energy compensation of a BRDF: the Kulla-Conty lobe, the 1/E scaling, or pumping.
 
     Parameters
@@ -857,6 +859,9 @@ def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None 
         The Fresnel-1 BRDF whose albedo is E (default: f without its Fresnel factor, or f).
     force : bool
         Accept a non-reciprocal base for the methods that need a reciprocal one.
+    max_seconds : float, optional
+        A time budget: the tables are computed now (by default, on first use), and past the budget the work stops
+        with :class:`pumpup.core.budget.BudgetExceeded` (a TimeoutError) instead of running on.
 
     Returns
     -------
@@ -879,7 +884,12 @@ def compensate(f: BRDF | dict, method: str = "kulla_conty", *, f0: float | None 
             raise SpecError(f"compensate: {name} must be a number in [0, 1], got {reprlib.repr(v)}")
     if not isinstance(force, (bool, np.bool_)):
         raise SpecError(f"compensate: force must be true or false, got {force!r}")
-    return compensate_model(load(f), method, f0=f0, f_avg=f_avg, white=white, force=force)
+    check_max_seconds("compensate", max_seconds)
+    with time_budget("compensate", max_seconds):
+        out = compensate_model(load(f), method, f0=f0, f_avg=f_avg, white=white, force=force)
+        if max_seconds is not None:
+            prepare(out)
+    return out
 
 
 @functools.singledispatch
@@ -960,27 +970,39 @@ def save_compensated(f: BRDF, path: str | os.PathLike[str]) -> str:
 
 
 def load_compensated(path: str | os.PathLike[str]) -> BRDF:
-    """Load a BRDF saved by :func:`save_compensated`, without recomputing its tables."""
+    """Load a BRDF saved by :func:`save_compensated`, without recomputing its tables.
+
+    Every group is read from one file (:func:`pumpup.tables.snapshot`), whatever a concurrent save puts at ``path``
+    meanwhile.
+    """
+    from ..tables import snapshot
+
+    with snapshot(path) as copy:
+        return _load_compensated(copy, os.fspath(path))
+
+
+def _load_compensated(path: str, where: str) -> BRDF:
+    """:func:`load_compensated` of the file at ``path`` (a snapshot), named ``where`` in messages."""
     from ..tables import AlbedoTable, open_table
 
-    root = open_table(path, _container=True)  # (the saved BRDF's root)
+    root = open_table(path, _container=True, _name=where)  # (the saved BRDF's root)
     if root.attrs.get("pumpup_kind") != "pumpup compensated BRDF":
-        raise ValueError(f"{os.fspath(path)!r} is a pumpup file but not a saved compensated BRDF "
+        raise ValueError(f"{where!r} is a pumpup file but not a saved compensated BRDF "
                          f"(pumpup_kind {root.attrs.get('pumpup_kind')!r})")
     try:
         n = int(root.attrs["tables"])
         spec = json.loads(root.attrs["spec"])
     except (KeyError, ValueError) as exc:
-        raise ValueError(f"{os.fspath(path)!r}: damaged compensated-BRDF file ({exc})") from None
+        raise ValueError(f"{where!r}: damaged compensated-BRDF file ({exc})") from None
     tables = {}
     # innermost first (the groups were saved outermost first): a group's spec is validated by
     # building it, which needs the tables of the BRDFs nested in it, taken from this file
     with file_tables(tables):
         for i in range(n, 0, -1):
-            ds = open_table(path, group=f"table{i}")
+            ds = open_table(path, group=f"table{i}", _name=where)
             kind = ds.attrs.get("cache")
             if kind not in ("compensate", "pump") or "albedo" not in ds or "albedo_error" not in ds:
-                raise ValueError(f"{os.fspath(path)!r}: group table{i} is not a compensation or pumping table")
+                raise ValueError(f"{where!r}: group table{i} is not a compensation or pumping table")
             t = AlbedoTable.from_dataset(ds)
             ds = ds.copy()
             del ds.attrs["cache"]
@@ -994,7 +1016,7 @@ def load_compensated(path: str | os.PathLike[str]) -> BRDF:
             if isinstance(node, Pumped):
                 t = tables.get(("pump", _key(node.base)))
                 if t is None:
-                    raise ValueError(f"{os.fspath(path)!r}: no table for the pumped level of {node.base.spec}")
+                    raise ValueError(f"{where!r}: no table for the pumped level of {node.base.spec}")
                 node._own_table = t
                 node.lookup()  # built now, from the file's table
     return f

@@ -27,6 +27,7 @@ import numpy as np
 from numba import njit
 
 from ..core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register, registry
+from ..core.budget import check_max_seconds, time_budget
 from ..physics.lookups import (
     CELL_SHIFT,
     INDEX_CELLS,
@@ -1006,7 +1007,8 @@ class _Divided(BRDF):
         return _divided_lobe(self.term.lobe(mu), self.pumped, mu)
 
 
-def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False) -> Pumped:
+def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False,
+         max_seconds: float | None = None) -> Pumped:
     """Pump up the albedo of a symmetric BRDF (001 sec. 3), ``levels`` times.
 
     Parameters
@@ -1022,6 +1024,9 @@ def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False)
         Number of nested pumpings; each uses the albedo of the level below.
     force : bool
         Accept a base that :func:`pumpup.check_reciprocity` finds non-reciprocal.
+    max_seconds : float, optional
+        A time budget: the tables of every level are computed now (by default, on first use), and past the budget
+        the work stops with :class:`pumpup.core.budget.BudgetExceeded` (a TimeoutError) instead of running on.
 
     Returns
     -------
@@ -1041,7 +1046,18 @@ def pump(brdf: BRDF | dict, g: str = "g1", levels: int = 1, force: bool = False)
         raise SpecError(f"pump: levels must be an integer in [1, {MAX_LEVELS}], got {levels!r}")
     if not isinstance(force, (bool, np.bool_)):
         raise SpecError(f"pump: force must be true or false, got {force!r}")
-    return pump_model(load(brdf), g, int(levels), force)
+    check_max_seconds("pump", max_seconds)
+    pumped = pump_model(load(brdf), g, int(levels), force)
+    if max_seconds is not None:
+        with time_budget("pump", max_seconds):
+            prepare(pumped)
+    return pumped
+
+
+def prepare(f) -> None:
+    """Compute the tables ``f`` reads (a pumped or compensated BRDF builds them on first use): one evaluation."""
+    normal = np.array([0.0, 0.0, 1.0])
+    f.eval(normal, normal)
 
 
 @functools.singledispatch
@@ -1060,7 +1076,9 @@ def save_pumped(f: Pumped, path: str | os.PathLike[str]) -> str:
     """Write a pumped BRDF and the albedo tables of all its levels to one netCDF file.
 
     Group ``level1`` holds the table of the innermost base, ``level2`` that of the first
-    pumped level, and so on; the root attributes hold the spec.  Written atomically.
+    pumped level, and so on up to the pumped BRDF itself (``level<levels + 1>``: its albedo curve,
+    ``pumpup.open_table(path, group=f"level{levels + 1}")``); the root attributes hold the spec.
+    Written atomically.
     """
     import xarray as xr
 
@@ -1078,7 +1096,9 @@ def save_pumped(f: Pumped, path: str | os.PathLike[str]) -> str:
 
     root = xr.Dataset(attrs={"pumpup_kind": "pumpup pumped BRDF", "spec": json.dumps(f.spec, sort_keys=True),
                              "levels": len(chain), "pumpup_version": __version__})
-    return write_groups(path, root, [(f"level{i}", level.table().dataset) for i, level in enumerate(chain, start=1)])
+    groups = [(f"level{i}", level.table().dataset) for i, level in enumerate(chain, start=1)]
+    groups.append((f"level{len(chain) + 1}", base_table(f).dataset))  # the top level's own albedo
+    return write_groups(path, root, groups)
 
 
 def load_pumped(path: str | os.PathLike[str]) -> Pumped:
@@ -1094,15 +1114,22 @@ def load_pumped(path: str | os.PathLike[str]) -> Pumped:
     pumpup.tables.validate.TableError (a ValueError)
         If the file is damaged, edited, or not a saved pumped BRDF (the message says what).
     """
+    from ..tables import snapshot
+
+    with snapshot(path) as copy:  # every group from one file, whatever a concurrent save puts at path meanwhile
+        return _load_pumped(copy, os.fspath(path))
+
+
+def _load_pumped(path: str, where: str) -> Pumped:
+    """:func:`load_pumped` of the file at ``path`` (a snapshot), named ``where`` in messages."""
     from ..tables import open_table
     from ..tables.validate import TableError, spec_attribute
 
-    where = os.fspath(path)
-    root = open_table(path, _container=True)  # (the saved BRDF's root)
+    root = open_table(path, _container=True, _name=where)  # (the saved BRDF's root)
     registry()  # (the providers: a kind of file below may be theirs)
     other = FILE_KINDS.get(root.attrs.get("pumpup_kind"))
     if other is not None:  # another kind of pumped model's file (pumpup.spectral's, with a wavelength dimension)
-        return other(path, root)
+        return other(path, root, where)
     if root.attrs.get("pumpup_kind") != "pumpup pumped BRDF":
         raise TableError(f"{where!r} is a pumpup table, not a saved pumped BRDF")
     spec = spec_attribute(where, root)
@@ -1118,7 +1145,24 @@ def load_pumped(path: str | os.PathLike[str]) -> Pumped:
         raise TableError(f"{where!r}: attribute 'levels' = {levels} but its spec has {len(chain)} levels")
     for i, level in enumerate(chain, start=1):
         attach_level_table(path, where, f"level{i}", level, f"level {i} of the spec")
+    attach_top_table(path, where, f"level{len(chain) + 1}", f)
     return f
+
+
+def attach_top_table(path, where: str, group: str, f: Pumped) -> None:
+    """Read the albedo table of the pumped BRDF ``f`` itself from ``group`` of a saved pumped file where the file has
+    that group (files saved before it was written have not), and make it the table that pumping ``f`` again uses;
+    checked as :func:`attach_level_table` checks a level's.
+    """
+    import netCDF4
+
+    with netCDF4.Dataset(path) as nc:  # (path: the loader's snapshot, validated by its reader already)
+        node = nc
+        for name in group.split("/"):
+            node = node.groups.get(name) if node is not None else None
+        present = node is not None
+    if present:
+        f._derived_table = read_level_table(path, where, group, f.spec, "the pumped BRDF is")
 
 
 def attach_level_table(path, where: str, group: str, level: Pumped, what: str) -> None:
@@ -1126,21 +1170,29 @@ def attach_level_table(path, where: str, group: str, level: Pumped, what: str) -
     ``level``'s base (``what`` names the level in the message) and make it that object's own table;
     every problem is one :class:`TableError` naming the file and the group.
     """
+    level._own_table = read_level_table(path, where, group, level.base.spec, f"{what} pumps")  # never the shared cache
+
+
+def read_level_table(path, where: str, group: str, spec: dict, what: str):
+    """The :class:`~pumpup.tables.AlbedoTable` in ``group`` of a saved pumped file, checked to be the table of the
+    model ``spec`` (``what``: the message's words before the spec); every problem is one :class:`TableError` naming
+    the file and the group.
+    """
     from ..tables import AlbedoTable, open_table
     from ..tables.validate import TableError
 
     try:
-        ds = open_table(path, group=group)
+        ds = open_table(path, group=group, _name=where)
     except OSError as exc:  # a missing group
         raise TableError(f"{where!r}: group {group!r} is missing or unreadable: {exc}") from None
     if ds.attrs.get("pumpup_kind") != "pumpup albedo table":
         raise TableError(f"{where!r}: group {group!r} is not an albedo table")
-    if json.loads(ds.attrs["spec"]) != level.base.spec:
+    if json.loads(ds.attrs["spec"]) != spec:
         raise TableError(f"{where!r}: group {group!r} holds the table of {ds.attrs['spec']}, but {what} "
-                         f"pumps {json.dumps(level.base.spec, sort_keys=True)}")
+                         f"{json.dumps(spec, sort_keys=True)}")
     try:
         t = AlbedoTable.from_dataset(ds)
     except (ValueError, KeyError, TypeError) as exc:
         raise TableError(f"{where!r}: group {group!r}: {exc}") from None
     t.dataset = ds
-    level._own_table = t  # this object's own table: never the shared cache
+    return t

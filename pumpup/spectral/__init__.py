@@ -761,10 +761,10 @@ def _save_spectral(f: Spectral, path) -> str:
     return save_spectral_pumped(f, path)  # one file with a wavelength dimension
 
 
-def _load_spectral(path, root):
+def _load_spectral(path, root, where):
     from .ops import load_spectral_pumped
 
-    return load_spectral_pumped(path, root)
+    return load_spectral_pumped(path, root, where)
 
 
 _pumping.FILE_KINDS["pumpup spectral pumped BRDF"] = _load_spectral

@@ -136,12 +136,14 @@ def save_spectral_pumped(f: Spectral, path) -> str:
 
     The root holds the ``wavelength`` coordinate [nm], the per-wavelength parameters of the
     innermost model (``eta``, ``k``, ``ad``, ``a_s``) and the spec; group ``wavelength{j}/level{i}``
-    holds the table of level i (``level1``: the innermost base) of wavelength j.  Written
+    holds the table of level i (``level1``: the innermost base; ``level<levels + 1>``: the pumped model itself) of
+    wavelength j.  Written
     atomically with checksums and digests (:func:`pumpup.tables.write_groups`).
     """
     import xarray as xr
 
     from .._version import __version__
+    from ..operators.pumping import base_table
     from ..tables import write_groups
 
     if not isinstance(f, SpectralPumped):
@@ -164,10 +166,12 @@ def save_spectral_pumped(f: Spectral, path) -> str:
             root.attrs[f"optical_{key}"] = val
     groups = [(_group(j, i), level.table().dataset) for j, chain in enumerate(chains)
               for i, level in enumerate(chain, start=1)]
+    groups += [(_group(j, len(chain) + 1), base_table(chain[-1]).dataset)  # each wavelength's pumped BRDF itself
+               for j, chain in enumerate(chains)]
     return write_groups(path, root, groups)
 
 
-def load_spectral_pumped(path, root=None) -> SpectralPumped:
+def load_spectral_pumped(path, root=None, where: str | None = None) -> SpectralPumped:
     """Load a spectral pumped BRDF saved by :func:`save_spectral_pumped`, without recomputing its tables.
 
     Every group is validated (:func:`pumpup.open_table`: checksums, digest, values); the root's
@@ -180,13 +184,15 @@ def load_spectral_pumped(path, root=None) -> SpectralPumped:
         If the file is damaged, edited, or not a saved spectral pumped BRDF.
     """
     from ..core import load
-    from ..operators.pumping import attach_level_table
-    from ..tables import open_table
+    from ..operators.pumping import attach_level_table, attach_top_table
+    from ..tables import open_table, snapshot
     from ..tables.validate import TableError, spec_attribute
 
-    where = os.fspath(path)
-    if root is None:
-        root = open_table(path, _container=True)  # (the saved BRDF's root)
+    if root is None:  # every group from one file, whatever a concurrent save puts at path meanwhile
+        with snapshot(path) as copy:
+            return load_spectral_pumped(copy, open_table(copy, _container=True, _name=os.fspath(path)),
+                                        os.fspath(path))
+    where = os.fspath(path) if where is None else where
     if root.attrs.get("pumpup_kind") != SPECTRAL_PUMPED_KIND:
         raise TableError(f"{where!r} is a pumpup file, not a saved spectral pumped BRDF")
     spec = spec_attribute(where, root)
@@ -211,4 +217,5 @@ def load_spectral_pumped(path, root=None) -> SpectralPumped:
             raise TableError(f"{where!r}: attribute 'levels' = {levels} but its spec has {len(chain)} levels")
         for i, level in enumerate(chain, start=1):
             attach_level_table(path, where, _group(j, i), level, f"level {i} at {f.wavelengths[j]:g} nm")
+        attach_top_table(path, where, _group(j, len(chain) + 1), chain[-1])
     return f

@@ -17,6 +17,7 @@ import reprlib
 import stat
 import sys
 import tempfile
+import time
 import weakref
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -25,6 +26,9 @@ import numpy as np
 
 from .._version import __version__
 from ..core import BRDF, check_count, check_open_unit, check_tolerance, provide
+from ..core.budget import check as check_budget
+from ..core.budget import current as current_budget
+from ..core.budget import time_budget
 from ..engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
 from . import reuse as _reuse
 
@@ -68,6 +72,32 @@ def default_grid(n_theta: int = 33, mu_min: float = 1e-8) -> np.ndarray:
     lo = math.log10(mu_min)
     decades = np.logspace(math.log10(0.02), lo, max(2, int(round(math.log10(0.02) - lo)) * 2 + 1))
     return np.unique(np.concatenate([mu, decades, [1.0]]))
+
+
+#: a table whose estimated time exceeds this many seconds announces it and shows its progress (:func:`_long_work_bar`)
+LONG_WORK_SECONDS = 30.0
+#: an adaptive table computes about this many times the values of its first grid (measured over the registry's
+#: examples: 1.3 to 2.6 times, the checks near mu = 1 and between nodes included)
+ADAPTIVE_FACTOR = 3.0
+
+
+@contextlib.contextmanager
+def _long_work_bar(bar, brdf, seconds: float, done: int):
+    """``bar`` itself, or, where it is silent and the first ``done`` values took ``seconds`` so that the whole table
+    will take longer than :data:`LONG_WORK_SECONDS` (``ADAPTIVE_FACTOR`` times as many values), one line on stderr
+    with the estimate and a progress bar there with the remaining time.
+    """
+    estimate = seconds * ADAPTIVE_FACTOR
+    if not bar.disable or estimate < LONG_WORK_SECONDS:
+        yield bar
+        return
+    from tqdm.auto import tqdm
+
+    print(f"pumpup: the albedo table of {brdf!r} will take about {estimate:.0f} s (its first {done} values took "
+          f"{seconds:.1f} s); progress follows on stderr", file=sys.stderr, flush=True)
+    with tqdm(total=done, initial=done, desc=f"albedo {brdf.type}", unit="mu", leave=True, file=sys.stderr,
+              mininterval=5.0) as loud:
+        yield loud
 
 
 def _progress(total: int, desc: str, progress: bool | None):
@@ -307,6 +337,7 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
     V, E = (val[:, None], err[:, None]) if one else (val, err)
 
     def column_values(pts):
+        check_budget(f"refining the table's grid ({len(pts)} more values)")
         if bar is not None:
             bar.total += len(pts)
         v, e = values(pts)
@@ -373,7 +404,7 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
 def tabulate(brdf: BRDF, mu: ArrayLike | None = None, *, rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
              interp_tol: float = 1e-7, mu_min: float = 1e-8, max_points: int = 2049, progress: bool | None = None,
              threads: int | None = None, phi: ArrayLike | str | None = None,
-             breaks: ArrayLike | None = None) -> xr.Dataset:
+             breaks: ArrayLike | None = None, max_seconds: float | None = None) -> xr.Dataset:
     """Tabulate the directional albedo of ``brdf``.
 
     Parameters
@@ -413,6 +444,9 @@ def tabulate(brdf: BRDF, mu: ArrayLike | None = None, *, rtol: float = DEFAULT_R
         join the grid, and the interpolating spline is split there (:class:`AlbedoTable`; the attribute
         ``interpolation_breaks``).  The pumping operator gives those of a pumped level's albedo.  Default: the
         model's own, :meth:`pumpup.core.BRDF.albedo_breaks` (none for most models).
+    max_seconds : float, optional
+        A time budget: past it, the work stops with :class:`pumpup.core.budget.BudgetExceeded` (a TimeoutError)
+        instead of running on.  None: no bound.
 
     Returns
     -------
@@ -428,6 +462,13 @@ def tabulate(brdf: BRDF, mu: ArrayLike | None = None, *, rtol: float = DEFAULT_R
     >>> ds["albedo"].values.round(12).tolist()
     [0.5, 0.5, 0.5]
     """
+    with time_budget("tabulate", max_seconds):
+        return _tabulate(brdf, mu, rtol=rtol, atol=atol, interp_tol=interp_tol, mu_min=mu_min, max_points=max_points,
+                         progress=progress, threads=threads, phi=phi, breaks=breaks)
+
+
+def _tabulate(brdf, mu, *, rtol, atol, interp_tol, mu_min, max_points, progress, threads, phi, breaks):
+    """:func:`tabulate`, within its time budget."""
     if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer))
                                 or not 1 <= threads <= MAX_THREADS):
         raise ValueError(f"tabulate: threads must be an integer in [1, {MAX_THREADS}], got {reprlib.repr(threads)}")
@@ -470,8 +511,12 @@ def tabulate(brdf: BRDF, mu: ArrayLike | None = None, *, rtol: float = DEFAULT_R
     grid = default_grid(mu_min=mu_min)
     if breaks is not None:
         grid = np.unique(np.concatenate([grid, breaks]))
-    with _progress(len(grid), f"albedo {brdf.type}", progress) as bar:
+    with contextlib.ExitStack() as stack:
+        bar = stack.enter_context(_progress(len(grid), f"albedo {brdf.type}", progress))
+        start = time.monotonic()
         val, err = values(grid, bar)
+        if progress is None:  # a long table says so, and shows its progress, even where stderr is no terminal
+            bar = stack.enter_context(_long_work_bar(bar, brdf, time.monotonic() - start, len(grid)))
         grid, val, err, interp = adaptive_grid(grid, val, err, lambda m: values(m, bar), interp_tol, max_points,
                                                () if breaks is None else breaks, bar, built_on_tables(brdf.spec))
         interp_error = float(interp.max())
@@ -521,14 +566,18 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
             threads = 1
     threads = max(1, min(threads or THREADS or _cores(), len(mu)))
 
+    import contextvars
     import threading
 
     stop = threading.Event()  # set when the caller is interrupted (Ctrl-C): the threads end soon
+    deadline = current_budget()
 
     def work(idx):
         for a in range(0, len(idx), chunk):
             if stop.is_set():
                 return
+            if deadline is not None:
+                deadline.check(f"computing {len(mu)} albedo values of {brdf.type}")
             part = idx[a:a + chunk]
             val[part], err[part] = albedo(brdf, mu[part], return_error=True, rtol=rtol, atol=atol, phi=phi)
             bar.update(len(part))
@@ -549,7 +598,8 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
 
     with ThreadPoolExecutor(threads) as pool:
         try:
-            for done in [pool.submit(work, todo[k::threads]) for k in range(threads)]:
+            # (each thread in a copy of this context: the engine's route choice and the time budget hold there too)
+            for done in [pool.submit(contextvars.copy_context().run, work, todo[k::threads]) for k in range(threads)]:
                 done.result()
         except BaseException:
             stop.set()
@@ -789,8 +839,46 @@ SAVED_BRDF_READERS = {"pumpup pumped BRDF": "pumpup.load_pumped", "pumpup compen
                       "pumpup spectral pumped BRDF": "pumpup.load_pumped"}
 
 
+def saved_kind(path: str | os.PathLike[str]) -> str:
+    """The ``pumpup_kind`` of a file pumpup wrote (``"pumpup albedo table"``, a key of :data:`SAVED_BRDF_READERS`,
+    ...), its root validated as :func:`open_table` does.
+    """
+    return str(open_table(path, _container=True).attrs.get("pumpup_kind", ""))
+
+
+@contextlib.contextmanager
+def snapshot(path: str | os.PathLike[str]):
+    """A private copy of the file at ``path``, read through one open: the path of the copy, inside the block.
+
+    A saved BRDF is several groups of one file; reading them with one open each, an atomic save between two opens
+    would give an object built from two files.  The copy is read whole through one open (the file that was at
+    ``path`` then, whatever replaces it later), so every group comes from one writer's file.  Non-regular files (a
+    FIFO would block the reader forever) are refused before anything is read.
+    """
+    import shutil
+
+    from .validate import TableError
+
+    path = os.fspath(path)
+    if not os.path.exists(path):
+        raise FileNotFoundError(f"no such file: {path!r}")
+    try:  # O_NONBLOCK: a FIFO put at the path after the check above still cannot block the open
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError as exc:
+        raise TableError(f"{path!r} cannot be read: {exc.strerror}") from None
+    with os.fdopen(fd, "rb") as src:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise TableError(f"{path!r} is not a regular file (a directory, a FIFO or a device): saved BRDFs are read "
+                             "from files")
+        with tempfile.TemporaryDirectory(prefix="pumpup-snapshot-") as folder:
+            copy = os.path.join(folder, "snapshot.nc")
+            with open(copy, "wb") as dst:
+                shutil.copyfileobj(src, dst)
+            yield copy
+
+
 def open_table(path: str | os.PathLike[str], group: str | None = None, *,
-               require_digest: bool = True, _container: bool = False) -> xr.Dataset:
+               require_digest: bool = True, _container: bool = False, _name: str | None = None) -> xr.Dataset:
     """Open a netCDF table written by pumpup, fully loaded into memory, and validate it
     (:func:`pumpup.tables.validate.validate_dataset`: variables, coordinates, shapes, finite values,
     mu in (0, 1] strictly increasing, albedo >= 0, a loadable spec; the checksum, which every file pumpup writes
@@ -809,12 +897,13 @@ def open_table(path: str | os.PathLike[str], group: str | None = None, *,
     from .validate import TableError, validate_dataset
 
     path = os.fspath(path)
+    name = path if _name is None else _name  # (a snapshot's reader names the user's file)
     if not os.path.exists(path):
-        raise FileNotFoundError(f"no such table: {path!r}")
+        raise FileNotFoundError(f"no such table: {name!r}")
     if not stat.S_ISREG(os.stat(path).st_mode):  # (a FIFO would block the reader forever)
-        raise TableError(f"{path!r} is not a regular file (a directory, a FIFO or a device): tables are read from "
+        raise TableError(f"{name!r} is not a regular file (a directory, a FIFO or a device): tables are read from "
                          "files")
-    where = path if group is None else f"{path}, group {group!r}"
+    where = name if group is None else f"{name}, group {group!r}"
     try:
         with xr.open_dataset(path, engine="netcdf4", group=group) as ds:
             ds = ds.load()
@@ -826,7 +915,7 @@ def open_table(path: str | os.PathLike[str], group: str | None = None, *,
     validate_dataset(ds, where, require_digest=require_digest)
     reader = SAVED_BRDF_READERS.get(ds.attrs.get("pumpup_kind")) if group is None and not _container else None
     if reader is not None and not ds.data_vars:  # (its tables are in groups: this root holds none)
-        raise TableError(f"{path!r} is a {ds.attrs['pumpup_kind'][len('pumpup '):]}, not a table: read it with "
+        raise TableError(f"{name!r} is a {ds.attrs['pumpup_kind'][len('pumpup '):]}, not a table: read it with "
                          f"{reader}, or give group= one of its tables")
     from .validate import DIGEST_ATTR
 
@@ -923,6 +1012,46 @@ class AlbedoMaximum:
     #: half-width [deg] of the theta interval the maximum may lie in: where a(mu) is within the
     #: albedo errors of the maximum (a flat maximum is located only to about sqrt(error / curvature))
     theta_error: float = 0.0
+    #: the albedo grows without bound towards grazing incidence (then ``albedo`` is inf, ``constant`` 0, ``mu`` 0)
+    diverges: bool = False
+    #: for a diverging albedo, k of a(mu) ~ mu^-k over the last decade probed, and the change of k from the decade
+    #: before (0 otherwise)
+    exponent: float = 0.0
+    exponent_error: float = 0.0
+    #: for a diverging albedo, the smallest mu probed and the albedo there (nan otherwise)
+    mu_probed: float = math.nan
+    albedo_probed: float = math.nan
+
+    def __str__(self) -> str:
+        if self.diverges:
+            return (f"unbounded: a(mu) ~ mu^-{self.exponent:.3g} (+- {self.exponent_error:.1g}) towards grazing "
+                    f"incidence ({self.albedo_probed:.6g} at mu = {self.mu_probed:.3g}); maximum constant 0")
+        return (f"{self.albedo:.12g} +- {self.error:.2g} at theta = {self.theta_deg:.6f} +- {self.theta_error:.2g} "
+                f"deg; maximum constant {self.constant:.12g}")
+
+
+#: :func:`max_albedo` probes these decades of mu below its ``mu_min`` when the albedo peaks there
+DIVERGENCE_DECADES = 4
+#: an albedo that still grows by at least this exponent per decade over the last decade probed, and by at least half
+#: the previous decade's exponent, diverges: a bounded albedo that rises to its limit (Schlick's model,
+#: a ~ a0 - c mu) has an exponent that falls tenfold per decade, below 1e-5 under mu = 1e-6; Ward's stays 0.5
+DIVERGENCE_EXPONENT_MIN = 1e-3
+
+
+def _grazing_trend(f, mu_min: float, a_min: float, e_min: float, rtol: float):
+    """(diverges, exponent, exponent_error, mu, albedo) of ``f``'s albedo over :data:`DIVERGENCE_DECADES` decades below
+    ``mu_min``, where the albedo is ``a_min`` +- ``e_min``.
+    """
+    mu = mu_min * 10.0 ** -np.arange(1, DIVERGENCE_DECADES + 1)
+    a, e = albedo(f, mu, return_error=True, rtol=rtol)
+    a, e = np.concatenate([[a_min], a]), np.concatenate([[e_min], e])
+    if not (np.isfinite(a).all() and (a > 0).all()):
+        return False, 0.0, 0.0, math.nan, math.nan
+    k = np.log10(a[1:] / a[:-1])  # a ~ mu^-k per decade
+    rising = bool((np.diff(a) > e[1:] + e[:-1]).all())
+    last, before = float(k[-1]), float(k[-2])
+    diverges = rising and last >= DIVERGENCE_EXPONENT_MIN and last >= 0.5 * before
+    return diverges, last, abs(last - before), float(mu[-1]), float(a[-1])
 
 
 def _unit_constant(brdf: BRDF) -> BRDF:
@@ -936,6 +1065,18 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
 
     A scan uniform in theta (plus decades of mu down to ``mu_min``) finds the best node;
     a bounded Brent search (scipy ``minimize_scalar``) between its neighbours refines it.
+
+    Where the albedo peaks at ``mu_min``, four more decades below it are probed: an albedo that keeps growing there
+    as a power of mu (Ward's, a ~ mu^-0.5) has no maximum, and the result says so (``diverges``, with the exponent;
+    ``albedo`` inf and ``constant`` 0) instead of giving the value at ``mu_min``.  ``pumpup.divergence`` fits the law
+    over a wider window.
+
+    Examples
+    --------
+    >>> import pumpup
+    >>> m = pumpup.max_albedo(pumpup.load("ward:m=0.1"))
+    >>> m.diverges, m.constant, round(m.exponent, 3)
+    (True, 0.0, 0.5)
     """
     from scipy.optimize import minimize_scalar
 
@@ -970,6 +1111,12 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
     elif scan is not None:
         best_a, best_e = (float(v) for v in albedo(f, best_mu, return_error=True, rtol=rtol))
     at_boundary = i in (0, len(mu) - 1)
+    if i == 0:  # the albedo peaks at the smallest mu scanned: does it go on growing below it?
+        diverges, k, k_error, mu_probed, a_probed = _grazing_trend(f, best_mu, best_a, best_e, rtol)
+        if diverges:
+            return AlbedoMaximum(albedo=math.inf, error=0.0, mu=0.0, theta_deg=90.0, constant=0.0, constant_error=0.0,
+                                 at_boundary=True, diverges=True, exponent=k, exponent_error=k_error,
+                                 mu_probed=mu_probed, albedo_probed=a_probed)
     theta_error = 0.0 if at_boundary else _location_error(f, best_mu, best_a, best_e, rtol, lo, hi)
     return AlbedoMaximum(
         albedo=best_a,
@@ -1016,6 +1163,8 @@ def max_constant(brdf: BRDF, **kw: Any) -> tuple[float, float]:
     Returns
     -------
     (constant, theta_deg)
+        For an albedo that grows without bound towards grazing incidence (:attr:`AlbedoMaximum.diverges`), (0.0, 90.0)
+        with an :class:`~pumpup.engine.AlbedoWarning` that gives the exponent.
 
     Examples
     --------
@@ -1026,6 +1175,12 @@ def max_constant(brdf: BRDF, **kw: Any) -> tuple[float, float]:
     """
     _check_brdf("max_constant", brdf)
     m = max_albedo(brdf, **kw)
+    if m.diverges:
+        import warnings
+
+        from ..engine.cubature import AlbedoWarning
+
+        warnings.warn(f"max_constant: the albedo of {brdf!r} has no maximum: {m}", AlbedoWarning, stacklevel=2)
     return m.constant, m.theta_deg
 
 

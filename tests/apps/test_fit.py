@@ -163,6 +163,7 @@ BAD = [
     (dict(weights=(0, 0)), "weights"),
     (dict(method="l1"), "method"),
     (dict(mu=[0.5, 1.5]), "mu"),
+    (dict(mu=[]), "mu must hold at least one value"),
     (dict(lobe_fraction=1.5), "lobe_fraction"),
     (dict(ties={"c": "zz"}), "has no parameter 'zz'"),
     (dict(grid=(5, 5)), "grid must be three integers"),
@@ -229,3 +230,11 @@ def test_cli_fit_writes_the_figure(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "max rel. error of f cos(theta_L)" in text and "wrote" in text
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_fit_no_better_than_the_zero_brdf_warns():
+    """Stretched Phong n = 1 to a mirror-like GGX (alpha 0.01) on the default directions: the lobe cannot follow, the
+    objective is near the zero BRDF's (f = 0 scores e_f = e_a = 1), and the result says so."""
+    with pytest.warns(pf.FitWarning, match="zero BRDF"):
+        r = pumpup.fit({"type": "ggx", "alpha": 0.01}, "stretched_phong", params={"n": (1, 2)}, maxiter=20)
+    assert r.objective >= pf.NEAR_ZERO_FIT and any("zero BRDF" in note for note in r.notes)

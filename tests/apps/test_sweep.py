@@ -184,6 +184,23 @@ def test_interrupted_sweep_resumes_and_gives_the_same_file(tmp_path, monkeypatch
     assert filecmp.cmp(out, tmp_path / "whole.nc", shallow=False)
 
 
+def test_finished_sweep_is_read_back_not_recomputed(tmp_path, monkeypatch):
+    out = tmp_path / "sweep.nc"
+    first = pumpup.sweep(**RESUME, out=out)
+    calls = count_cells(monkeypatch)
+    again = pumpup.sweep(**RESUME, out=out)
+    assert calls == []  # no cell computed again
+    xr.testing.assert_identical(again, pumpup.open_table(out))
+    np.testing.assert_array_equal(again["albedo"].values, first["albedo"].values)
+    pumpup.sweep(**RESUME, out=out, overwrite=True)  # overwrite computes afresh
+    assert len(calls) == 8
+    data = bytearray(out.read_bytes())  # a damaged result is not taken as finished: refused with one line
+    data[len(data) // 2] ^= 0xFF
+    out.write_bytes(bytes(data))
+    with pytest.raises(sweep_module.SweepError, match="exists and holds something that is not a result of this sweep"):
+        pumpup.sweep(**RESUME, out=out)
+
+
 def test_damaged_part_is_recomputed(tmp_path, monkeypatch):
     out = tmp_path / "sweep.nc"
     count_cells(monkeypatch, fail_after=2)

@@ -54,3 +54,34 @@ def test_mc_command(capsys):
         main(["mc", "phong:n=20", "--mu", "0"])
     with pytest.raises(SystemExit, match="--n"):
         main(["mc", "phong:n=20", "--n", "0"])
+
+
+def test_check_says_a_diverging_albedo_has_no_maximum(capsys):
+    assert main(["check", "ward:m=0.1"]) == 0
+    out = capsys.readouterr().out
+    assert "max albedo (constant set to 1): unbounded: a(mu) ~ mu^-0.5" in out and "maximum constant 0" in out
+    assert main(["check", "phong:n=20"]) == 0
+    assert "maximum constant 3.5014" in capsys.readouterr().out  # (n + 2) / (2 pi) / a(1), a(1) = 0.2856
+
+
+def test_commands_read_saved_brdf_files(tmp_path, capsys):
+    """A SPEC argument may be a file written by pump --out or compensate --out; another file gets one line."""
+    pumped, comp, table = str(tmp_path / "p.nc"), str(tmp_path / "c.nc"), str(tmp_path / "t.nc")
+    assert main(["pump", "phong:n=20", "--levels", "2", "--out", pumped]) == 0
+    assert main(["compensate", "ggx:alpha=0.3", "--out", comp]) == 0
+    capsys.readouterr()
+    assert main(["albedo", pumped, "--mu", "1", "0.5"]) == 0
+    out = capsys.readouterr().out
+    import pumpup
+
+    expected = pumpup.albedo(pumpup.pump("phong:n=20", levels=2), [1.0, 0.5])
+    row = [line.split() for line in out.splitlines() if line.split()[:1] == ["0.5"]][0]
+    assert abs(float(row[2]) - expected[1]) <= float(row[3]) and '"type": "pumped"' in out
+    assert main(["albedo", comp, "--mu", "0.5"]) == 0
+    assert '"type": "kulla_conty"' in capsys.readouterr().out
+    assert main(["table", pumped, "--out", table]) == 0
+    with pytest.raises(SystemExit, match="not a saved BRDF .pumpup albedo table."):
+        main(["albedo", table])
+    (tmp_path / "junk.nc").write_bytes(b"not netcdf")
+    with pytest.raises(SystemExit, match="not a readable netCDF file"):
+        main(["check", str(tmp_path / "junk.nc")])
