@@ -384,14 +384,16 @@ def reproduce_lines(state: dict, spec: dict) -> dict:
     short = short_spec(spec)
     spec = json.dumps(spec)
     q = "'"
+    theta = state["theta_i"]
     py = [
         "import numpy as np, pumpup, pumpup.render",
         f"f = pumpup.load({spec})",
-        f"mu = np.cos(np.radians([0, 30, 60, 85]))  # theta_i = {state['theta_i']:g} deg on the page",
-        "a, err = pumpup.albedo(f, mu, return_error=True)",
+        f"a, err = pumpup.albedo(f, np.cos(np.radians({theta:g})), return_error=True)  # at the page's theta_i",
+        "theta = np.linspace(0, 89, 90)  # the albedo plot",
+        "a, err = pumpup.albedo(f, np.cos(np.radians(theta)), return_error=True)",
         "pumpup.mean_albedo(f), pumpup.max_constant(f)",
     ]
-    cli = [f"pumpup explore {q}{short}{q}", f"pumpup albedo {q}{short}{q} --theta 0 30 60 85",
+    cli = [f"pumpup explore {q}{short}{q}", f"pumpup albedo {q}{short}{q} --theta {theta:g}",
            f"pumpup check {q}{short}{q}"]
     if state["pump"]["on"]:
         g, lv = state["pump"]["g"], state["pump"]["levels"]
@@ -404,7 +406,8 @@ def reproduce_lines(state: dict, spec: dict) -> dict:
     py.append(f"pumpup.render.sphere(f, light_deg={state['light']:g}, azimuth_deg={state['light_azimuth']:g}, "
               f"size={SPHERE_SIZE})")
     py.append(f"pumpup.render.furnace(f, size={FURNACE_SIZE})")
-    cli.append(f"pumpup render sphere {q}{short}{q} --light {state['light']:g} --out sphere.png")
+    cli.append(f"pumpup render sphere {q}{short}{q} --light {state['light']:g} --size {SPHERE_SIZE} --out spheres")
+    cli.append(f"pumpup render furnace {q}{short}{q} --size {FURNACE_SIZE} --out spheres")
     return {"python": "\n".join(py), "cli": "\n".join(cli)}
 
 
@@ -495,8 +498,22 @@ def compute(state: Any, *, cancel: Callable[[], bool] | None = None, deadline: f
         if cancel is not None and cancel():
             raise Cancelled()
         if deadline is not None and time.monotonic() > deadline:
-            raise TimeLimit()
+            raise TimeLimit("pumpup explore: past the time limit")
 
+    from ..core.budget import BudgetExceeded, time_budget
+
+    seconds = None if deadline is None else max(deadline - time.monotonic(), 1e-9)
+    try:
+        # the budget holds inside pumpup's own work too (the engine checks it between pieces of work)
+        with time_budget("pumpup explore", seconds, option="time limit"):
+            out = _models(st, models, inputs, check)
+    except BudgetExceeded as exc:
+        raise TimeLimit(str(exc)) from None
+    return {"state": st, "models": out, "lines": reproduce_lines(st, inputs[0])}
+
+
+def _models(st: dict, models: list, inputs: list, check: Callable[[], None]) -> list:
+    """The views of every model and of its overlays."""
     import pumpup
 
     out = []
@@ -524,4 +541,4 @@ def compute(state: Any, *, cancel: Callable[[], bool] | None = None, deadline: f
             except (SpecError, ValueError, ArithmeticError) as exc:
                 entry["overlays"][name] = {"error": str(exc)}
         out.append(entry)
-    return {"state": st, "models": out, "lines": reproduce_lines(st, inputs[0])}
+    return out

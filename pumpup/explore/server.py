@@ -140,8 +140,9 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
                 reply = {"id": msg_id, "cancelled": True}
             except (C.TimeLimit, asyncio.TimeoutError):
                 reply = {"id": msg_id, "ok": False,
-                         "error": f"the computation took longer than {time_limit:g} s and was stopped (the first use "
-                                  "of a model compiles its kernels: run 'pumpup warmup' once)"}
+                         "error": f"the computation took longer than the time limit, {time_limit:g} s, and was "
+                                  "stopped (pumpup explore --time-limit raises it; the first use of a model compiles "
+                                  "its kernels: run 'pumpup warmup' once)"}
             except (SpecError, ValueError, TypeError, ArithmeticError) as exc:
                 reply = {"id": msg_id, "ok": False, "error": _one_line(exc)}
             except Exception as exc:  # a bug in a view must not end the tab's connection
@@ -203,7 +204,7 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
             def table() -> bytes:
                 import pumpup
 
-                ds = pumpup.tabulate(f, progress=False)
+                ds = pumpup.tabulate(f, progress=False, max_seconds=time_limit)
                 with tempfile.TemporaryDirectory(prefix="pumpup-explore-") as tmp:
                     path = pumpup.write_table(ds, os.path.join(tmp, "albedo.nc"))
                     with open(path, "rb") as fh:
@@ -211,8 +212,9 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
 
             try:
                 body = await asyncio.wait_for(loop.run_in_executor(pool, table), timeout=time_limit)
-            except asyncio.TimeoutError:
-                return PlainTextResponse(f"the table took longer than {time_limit:g} s", status_code=503)
+            except (asyncio.TimeoutError, TimeoutError):  # pumpup's BudgetExceeded is a TimeoutError
+                return PlainTextResponse(f"the table took longer than the time limit, {time_limit:g} s",
+                                         status_code=503)
             except (SpecError, ValueError) as exc:
                 return PlainTextResponse(_one_line(exc), status_code=400)
             media, name = "application/x-netcdf", f"{stem}-albedo.nc"

@@ -121,6 +121,14 @@ def test_a_newer_request_cancels_and_a_deadline_stops():
         C.compute({"specs": ["phong:n=3"]}, cancel=lambda: True)
     with pytest.raises(C.TimeLimit):
         C.compute({"specs": ["phong:n=3"]}, deadline=0.0)
+    # a heavy request (a 5-level pumping of a new model) stops soon after its time limit
+    import time
+
+    t0 = time.monotonic()
+    with pytest.raises(C.TimeLimit, match="time limit"):
+        C.compute({"specs": ["stretched_phong:n=37.25"], "pump": {"on": True, "g": "g2", "levels": 5}},
+                  deadline=t0 + 0.05)
+    assert time.monotonic() - t0 < 5.0
 
 
 def test_catalog_has_registry_ranges_and_log_sliders():
@@ -176,3 +184,21 @@ def test_default_host_is_local_and_silent(capsys):
     stop = threading.Event()
     explore.serve(None, port=0, open_browser=False, stop=stop, ready=lambda u: stop.set())
     assert capsys.readouterr().err == ""
+
+
+def test_the_lines_shown_reproduce_the_view(tmp_path, monkeypatch, capsys):
+    import shlex
+
+    from pumpup import cli
+
+    r = C.compute({"specs": ["phong:n=20"], "theta_i": 50, "pump": {"on": True, "g": "g2", "levels": 2}})
+    monkeypatch.chdir(tmp_path)
+    scope: dict = {}
+    exec(r["lines"]["python"], scope)  # the Python lines run as shown
+    assert scope["f"] == pumpup.load(PHONG) and scope["p"] == pumpup.pump(PHONG, g="g2", levels=2)
+    for line in r["lines"]["cli"].splitlines():
+        args = shlex.split(line)
+        assert args[0] == "pumpup"
+        if args[1] != "explore":
+            assert cli.main(args[1:]) in (0, None), line
+    assert "50.0" in capsys.readouterr().out  # pumpup albedo ... --theta 50

@@ -366,7 +366,10 @@ function lightMoved() {
 
 const PLOT_CONFIG = {displaylogo: false, responsive: true};
 
-function label(m, i) { return `${i + 1}: ${m.short}`; }
+function label(m, i) {
+  const text = m.short.length > 44 ? m.short.slice(0, 42) + "…" : m.short;
+  return `${i + 1}: ${text}`;
+}
 
 function drawLobe(r) {
   const st = explore.state;
@@ -389,7 +392,9 @@ function drawLobe(r) {
                name: "light", line: {color: "#888", dash: "dot"}, hoverinfo: "skip"});
   const layout = {margin: {l: 30, r: 30, t: 20, b: 20}, showlegend: true, legend: {orientation: "h"},
                   polar: {sector: [0, 180], angularaxis: {rotation: 90, direction: "clockwise", dtick: 15},
-                          radialaxis: {type: st.log ? "log" : "linear", exponentformat: "power"}}};
+                          radialaxis: {type: st.log ? "log" : "linear", exponentformat: "power",
+                                       // log: four decades below the largest value
+                                       range: st.log && rmax > 0 ? [Math.log10(rmax) - 4, Math.log10(rmax) + 0.05] : undefined}}};
   Plotly.react("lobe", traces, layout, PLOT_CONFIG);
 }
 
@@ -483,7 +488,7 @@ function drawSlice(r) {
     coloraxis: {colorscale: "Viridis", cmin: st.log ? Math.log10(Math.max(zmax, 1e-30)) - 4 : 0,
                 cmax: st.log ? Math.log10(Math.max(zmax, 1e-30)) : zmax,
                 colorbar: {title: {text: st.log ? "log10 fr" : "fr"}}},
-    annotations: r.models.map((m, i) => ({text: label(m, i), showarrow: false, xref: `x${i ? i + 1 : ""} domain`,
+    annotations: r.models.map((m, i) => ({text: n > 1 ? String(i + 1) : label(m, i), showarrow: false, xref: `x${i ? i + 1 : ""} domain`,
                                          yref: `y${i ? i + 1 : ""} domain`, x: 0.5, y: 1.08, font: {color: COLOURS[i]}}))};
   for (let i = 0; i < n; i++) {
     const ax = i === 0 ? "" : String(i + 1);
