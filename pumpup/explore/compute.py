@@ -14,6 +14,7 @@ import base64
 import json
 import math
 import time
+import warnings
 from collections.abc import Callable
 from typing import Any
 
@@ -449,16 +450,23 @@ def _one(f: BRDF, st: dict, check: Callable[[], None], with_images: bool) -> dic
         steps += [("slice", lambda: slice_image(f, st["phi"])), ("furnace", lambda: furnace_image(f))]
         if st["server_sphere"]:
             steps.append(("sphere", lambda: sphere_image(f, st["light"], st["light_azimuth"])))
+    notes: list[str] = []
     for key, step in steps:
         check()
-        try:
-            value = step()
-        except (SpecError, ValueError, ArithmeticError) as exc:
-            value = {"error": str(exc)}
+        # pumpup's warnings (an unbounded albedo, a tolerance not met) go to the page, not to the server's terminal;
+        # catch_warnings changes process-wide state, so the server runs one computation at a time
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                value = step()
+            except (SpecError, ValueError, ArithmeticError) as exc:
+                value = {"error": str(exc)}
+        notes.extend(f"{key}: {w.message}" for w in caught if f"{key}: {w.message}" not in notes)
         if key == "scalars" and "error" not in value:
             out.update(value)
         else:
             out[key] = value
+    out["notes"] = notes
     return out
 
 

@@ -94,6 +94,7 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
     catalog: dict[str, Any] = {}
 
     lock = threading.Lock()
+    compute_lock = threading.Lock()
 
     def models() -> list:
         with lock:
@@ -131,7 +132,8 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
             deadline = t0 + time_limit
 
             def work():
-                return C.compute(state, cancel=lambda: session.generation != generation, deadline=deadline)
+                with compute_lock:  # one computation at a time (the GIL and pumpup's warnings capture)
+                    return C.compute(state, cancel=lambda: session.generation != generation, deadline=deadline)
 
             try:
                 result = await asyncio.wait_for(loop.run_in_executor(pool, work), timeout=time_limit + 1.0)

@@ -10,8 +10,9 @@ A move sets a parameter's slider to a new value and fires its ``input`` and ``ch
 time runs until the page has drawn the answer to that value and the browser has painted a frame.  Every move gives a
 new parameter value (no cache hit).  The machine is shared, so every case also prints the baseline measured in the
 same run: ``pumpup.explore.compute.compute`` of the same states called in this process (pumpup's own work); the
-ratio is what the server, the socket and the drawing add.  Needs the ``explore`` extra, playwright and Debian's
-chromium.  The load average is printed first.
+ratio is what the server, the socket and the drawing add.  ``server ms`` is the server's time for the request (its
+queue included) and ``draw ms`` the page's plotting and WebGL time, both medians.  Needs the ``explore`` extra,
+playwright and Debian's chromium.  The load average is printed first.
 """
 
 from __future__ import annotations
@@ -23,7 +24,6 @@ import statistics
 import subprocess
 import sys
 import time
-import urllib.parse
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, ROOT)  # this checkout's pumpup
@@ -55,7 +55,8 @@ MOVE_JS = """async ([id, v]) => {
   if (want === before) return -1;
   while (window.explore.drawnId !== want) await new Promise((r) => setTimeout(r, 1));
   await new Promise((r) => requestAnimationFrame(() => r()));
-  return performance.now() - t0;
+  const d = window.explore.drawMs;
+  return [performance.now() - t0, window.explore.serverMs, d.lobe + d.albedo + d.spheres + d.slice];
 }"""
 
 
@@ -65,7 +66,7 @@ def positions(moves: int) -> list[int]:
 
 
 def baseline(page, query: str, slider: str, moves: int) -> list[float]:
-    """pumpup's own work for the states the page sent: compute() in this process [ms]."""
+    """The time of pumpup's own work for the states the page sent: compute() in this process [ms]."""
     states = page.evaluate("window.__states")
     out = []
     for st in states[-moves:]:
@@ -76,6 +77,7 @@ def baseline(page, query: str, slider: str, moves: int) -> list[float]:
 
 
 def main(argv=None) -> int:
+    """Print the page-ready time and, per case, the slider-to-redrawn times beside pumpup's own."""
     ap = argparse.ArgumentParser()
     ap.add_argument("--moves", type=int, default=20)
     ap.add_argument("--cases", default=",".join(CASES))
@@ -105,7 +107,7 @@ def main(argv=None) -> int:
             print(f"page ready {t_ready:.2f} s after the command (server listening after {t_listen:.2f} s; "
                   "target < 2 s)")
             print(f"{'case':22s} {'median ms':>10s} {'max ms':>8s} {'target':>7s} {'max/med':>8s} "
-                  f"{'pumpup ms':>10s} {'ratio':>6s}")
+                  f"{'pumpup ms':>10s} {'ratio':>6s} {'server ms':>9s} {'draw ms':>8s}")
             for name in args.cases.split(","):
                 query, slider, target = CASES[name]
                 page.goto(url + "?" + query)
@@ -113,17 +115,20 @@ def main(argv=None) -> int:
                 page.evaluate("""() => { window.__states = []; const send = WebSocket.prototype.send;
                     WebSocket.prototype.send = function (m) { try { window.__states.push(JSON.parse(m).state); }
                     catch (e) {} return send.call(this, m); }; }""")
-                times = []
+                times, server, drawing = [], [], []
                 for v in positions(args.moves):
                     ms = page.evaluate(MOVE_JS, [slider, v])
-                    if ms >= 0:
-                        times.append(ms)
+                    if ms != -1:
+                        times.append(ms[0])
+                        server.append(ms[1])
+                        drawing.append(ms[2])
                 err = page.evaluate("document.getElementById('message').hidden")
                 base = baseline(page, query, slider, len(times))
                 med, mx, bmed = statistics.median(times), max(times), statistics.median(base)
                 flag = "" if med < target and mx < 3 * med else "  MISSED"
                 print(f"{name:22s} {med:10.1f} {mx:8.1f} {target:7d} {mx / med:8.2f} {bmed:10.1f} "
-                      f"{med / bmed:6.2f}{flag}{'' if err else '  (error shown)'}")
+                      f"{med / bmed:6.2f} {statistics.median(server):9.1f} {statistics.median(drawing):8.1f}"
+                      f"{flag}{'' if err else '  (error shown)'}")
         finally:
             proc.terminate()
             proc.wait(10)

@@ -35,6 +35,7 @@ SHOTS = {
 
 
 def main(argv=None) -> int:
+    """Save the screenshots (one line per file written)."""
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "_static", "explore"))
     args = ap.parse_args(argv)

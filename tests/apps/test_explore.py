@@ -202,3 +202,9 @@ def test_the_lines_shown_reproduce_the_view(tmp_path, monkeypatch, capsys):
         if args[1] != "explore":
             assert cli.main(args[1:]) in (0, None), line
     assert "50.0" in capsys.readouterr().out  # pumpup albedo ... --theta 50
+
+
+def test_pumpups_warnings_reach_the_page():
+    m = C.compute({"specs": ["ward:m=0.05"]})["models"][0]
+    assert m["max_constant"]["value"] == 0.0
+    assert any("unbounded" in note for note in m["notes"]), m["notes"]

@@ -138,6 +138,7 @@ function onAnswer(ans) {
   explore.drawnId = ans.id;
   explore.drawn += 1;
   explore.lastMs = ms;
+  explore.serverMs = ans.ms;
   explore.ready = explore.catalog !== null;  // the views drawn and the controls built
   document.body.dataset.drawn = String(explore.drawn);
   writeURL();
@@ -450,6 +451,13 @@ function drawAlbedo(r) {
     const spans = m.albedo && m.albedo.above_one ? m.albedo.above_one : [];
     cell("above-one", spans.length ? spans.map(([a, b]) => `${a.toFixed(1)}–${b.toFixed(1)}°`).join(", ") : "nowhere");
     body.appendChild(tr);
+    for (const note of m.notes || []) {
+      const nr = document.createElement("tr");
+      nr.className = "note";
+      const td = document.createElement("td");
+      td.colSpan = 5; td.textContent = "note: " + note;
+      nr.appendChild(td); body.appendChild(nr);
+    }
   });
 }
 
