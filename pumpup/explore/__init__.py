@@ -73,7 +73,8 @@ def serve(specs: list[str] | None = None, *, host: str = "127.0.0.1", port: int 
 
     from . import server
 
-    app = server.create_app(specs, time_limit=server.TIME_LIMIT if time_limit is None else float(time_limit))
+    app = server.create_app(specs, time_limit=server.TIME_LIMIT if time_limit is None else float(time_limit),
+                            allowed_hosts=None if host in LOCAL_HOSTS else ["*"])
     if host not in LOCAL_HOSTS:
         print(f"pumpup explore: warning: listening on {host}, so other machines that reach it can use the explorer",
               file=sys.stderr)

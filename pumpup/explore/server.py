@@ -14,14 +14,16 @@ Routes
     view and answers ``{"id": n, "cancelled": true}``); each computation has a time bound.
 ``GET /download/{kind}?spec=...``
     ``spec.json``, ``albedo.nc`` (``pumpup.tabulate`` written by ``pumpup.write_table`` to a temporary directory
-    that is removed once the bytes are read), ``shader.glsl`` (``pumpup.shader``, target glsl-es) and
-    ``mitsuba.json`` (``pumpup.mitsuba.bsdf_dict``).  The server writes no other file.
+    that is removed once the bytes are read), ``shader.glsl`` and ``shader.brdf`` (``pumpup.shader``, targets
+    glsl-es and brdf-explorer) and ``mitsuba.json`` (``pumpup.mitsuba.bsdf_dict``).  The server writes no other
+    file.  Requests must name this machine in their Host header (or the host given to ``--host``).
 """
 
 from __future__ import annotations
 
 import asyncio
 import contextlib
+import importlib.util
 import json
 import os
 import tempfile
@@ -67,7 +69,8 @@ def _one_line(text: str) -> str:
     return " ".join(str(text).split())
 
 
-def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TIME_LIMIT, workers: int = WORKERS):
+def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TIME_LIMIT, workers: int = WORKERS,
+               allowed_hosts: list[str] | None = None):
     """The Starlette application.
 
     Parameters
@@ -78,6 +81,9 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
         Seconds one computation may take.
     workers : int
         Threads that compute.
+    allowed_hosts : list of str, optional
+        Host names the requests may name (their ``Host`` header, so a web page elsewhere cannot reach a local server
+        through a name that resolves to 127.0.0.1); by default this machine's names.
     """
     from starlette.applications import Starlette
     from starlette.responses import FileResponse, HTMLResponse, JSONResponse, PlainTextResponse, Response
@@ -195,13 +201,17 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
 
             body, media, name = json.dumps(pm.bsdf_dict(f.spec), indent=2) + "\n", "application/json", \
                 f"{stem}-mitsuba.json"
-        elif kind == "shader.glsl":
-            src = C.shader_source(f)
-            if src is None:
+        elif kind in ("shader.glsl", "shader.brdf"):
+            if importlib.util.find_spec("pumpup.shaders") is None:
                 return PlainTextResponse("this pumpup has no shader export (pumpup.shader)", status_code=404)
-            if "error" in src:
-                return PlainTextResponse(_one_line(src["error"]), status_code=400)
-            body, media, name = src["glsl"], "text/plain", f"{stem}.glsl"
+            from .. import shaders
+
+            target = "glsl-es" if kind == "shader.glsl" else "brdf-explorer"
+            try:
+                body = shaders.shader(f.spec, target=target)
+            except (SpecError, ValueError) as exc:
+                return PlainTextResponse(_one_line(exc), status_code=400)
+            media, name = "text/plain", f"{stem}.{kind.split('.')[1]}"
         elif kind == "albedo.nc":
             def table() -> bytes:
                 import pumpup
@@ -222,7 +232,7 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
             media, name = "application/x-netcdf", f"{stem}-albedo.nc"
         else:
             return PlainTextResponse(f"unknown download {kind!r}; one of spec.json, albedo.nc, shader.glsl, "
-                                     "mitsuba.json", status_code=404)
+                                     "shader.brdf, mitsuba.json", status_code=404)
         return Response(body, media_type=media, headers={"Content-Disposition": f'attachment; filename="{name}"'})
 
     async def favicon(request):
@@ -237,4 +247,9 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
         yield
         pool.shutdown(wait=False, cancel_futures=True)
 
-    return Starlette(routes=routes, lifespan=lifespan)
+    from starlette.middleware import Middleware
+    from starlette.middleware.trustedhost import TrustedHostMiddleware
+
+    hosts = allowed_hosts or ["127.0.0.1", "localhost", "[::1]", "::1"]
+    return Starlette(routes=routes, lifespan=lifespan,
+                     middleware=[Middleware(TrustedHostMiddleware, allowed_hosts=hosts)])

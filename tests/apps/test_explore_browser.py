@@ -222,6 +222,17 @@ def test_compare_shares_axes_and_downloads(chromium, server):
         np.testing.assert_array_equal(ds["albedo"].values, ref["albedo"].values)
     bad = p.page.request.get(server + "download/albedo.nc", params={"spec": "function:name=x"})
     assert bad.status == 400 and "wraps Python code" in bad.text()
+    import importlib.util
+
+    if importlib.util.find_spec("pumpup.shaders") is not None:
+        from pumpup import shaders
+
+        for kind, target in (("shader.glsl", "glsl-es"), ("shader.brdf", "brdf-explorer")):
+            got = p.page.request.get(server + "download/" + kind, params={"spec": spec})
+            assert got.ok and got.text() == shaders.shader(pumpup.load(spec).spec, target=target), kind
+    # a request naming another host (a page elsewhere reaching this one through DNS) is refused
+    foreign = p.page.request.get(server + "api/models", headers={"Host": "attacker.example"})
+    assert foreign.status == 400
     assert p.errors == []
 
 

@@ -301,10 +301,11 @@ function updateControls() {
   $("dl-spec").href = `/download/spec.json?spec=${spec}`;
   $("dl-nc").href = `/download/albedo.nc?spec=${spec}`;
   $("dl-glsl").href = `/download/shader.glsl?spec=${spec}`;
+  $("dl-brdf").href = `/download/shader.brdf?spec=${spec}`;
   $("dl-mitsuba").href = `/download/mitsuba.json?spec=${spec}`;
   const r = explore.result;
   const m = r && r.models[st.active];
-  $("dl-glsl").hidden = !(m && m.shader && m.shader.glsl);
+  $("dl-glsl").hidden = $("dl-brdf").hidden = !(m && m.shader && m.shader.glsl);
   if (r) { $("python").textContent = r.lines.python; $("cli").textContent = r.lines.cli; }
 }
 
