@@ -141,7 +141,7 @@ def check_state(state: Any) -> dict:
     Keys: ``specs`` (1 to 4 specs), ``theta_i`` (degrees, [0, 89.9]), ``phi`` (azimuth of the plane of incidence,
     degrees, [-180, 180]), ``pump`` ({"on", "g": g1|g2, "levels": 1-5}), ``kulla_conty`` and ``scaled`` (bool),
     ``light`` (degrees from the view, [0, 179]) and ``light_azimuth`` (degrees), ``server_sphere`` (bool: send the
-    server-rendered sphere image too).
+    server-rendered sphere image too), ``lobe3d`` (bool: the lobe over the whole hemisphere too).
     """
     if not isinstance(state, dict):
         raise SpecError("state: must be a JSON object")
@@ -167,6 +167,7 @@ def check_state(state: Any) -> dict:
         "light": _number(state.get("light", 30.0), "light (degrees from the view)", 0.0, 179.0),
         "light_azimuth": _number(state.get("light_azimuth", 0.0), "light azimuth (degrees)", -360.0, 360.0),
         "server_sphere": bool(state.get("server_sphere", False)),
+        "lobe3d": bool(state.get("lobe3d", False)),
     }
 
 
@@ -279,6 +280,18 @@ def lobe_curve(f: BRDF, theta_i: float, phi: float = 0.0) -> dict:
     wi = incidence(theta_i, phi)
     fr = np.asarray(f.eval(wi, wo), dtype=np.float64)
     return {"theta_o": _floats(t), "value": _floats(fr * np.cos(tr))}  # f_r cos(theta_o), 000 eq. 2's integrand
+
+
+def lobe_surface(f: BRDF, theta_i: float, phi: float = 0.0, n_theta: int = 31, n_phi: int = 61) -> dict:
+    """f_r(wi, wo) cos(theta_o) over the hemisphere of wo, for the 3-D lobe: rows theta_o (0 to 90 degrees, the
+    last row at 89.9), columns phi_o (-180 to 180 degrees), wi at ``theta_i`` and azimuth ``phi``.
+    """
+    t = np.radians(np.linspace(0.0, 89.9, n_theta))[:, None]
+    p = np.radians(np.linspace(-180.0, 180.0, n_phi))[None, :]
+    wo = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t) + 0.0 * p], axis=-1)
+    fr = np.asarray(f.eval(incidence(theta_i, phi), wo), dtype=np.float64)
+    return {"theta": _floats(np.degrees(t)), "phi": _floats(np.degrees(p)),
+            "data": _b64(fr * np.cos(t))}  # f_r cos(theta_o)
 
 
 def albedo_curve(f: BRDF, phi: float = 0.0) -> dict:
@@ -446,6 +459,8 @@ def _one(f: BRDF, st: dict, check: Callable[[], None], with_images: bool) -> dic
         ("albedo", lambda: albedo_curve(f, st["phi"])),
         ("scalars", lambda: _scalar_views(f)),
     ]
+    if st["lobe3d"]:
+        steps.append(("lobe3d", lambda: lobe_surface(f, st["theta_i"], st["phi"])))
     if with_images:
         steps += [("slice", lambda: slice_image(f, st["phi"])), ("furnace", lambda: furnace_image(f))]
         if st["server_sphere"]:

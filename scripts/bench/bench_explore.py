@@ -56,7 +56,7 @@ MOVE_JS = """async ([id, v]) => {
   while (window.explore.drawnId !== want) await new Promise((r) => setTimeout(r, 1));
   await new Promise((r) => requestAnimationFrame(() => r()));
   const d = window.explore.drawMs;
-  return [performance.now() - t0, window.explore.serverMs, d.lobe + d.albedo + d.spheres + d.slice];
+  return [performance.now() - t0, window.explore.serverMs, d.lobe + d.albedo + d.spheres + d.slice + d.lobe3d];
 }"""
 
 

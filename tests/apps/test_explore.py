@@ -208,3 +208,14 @@ def test_pumpups_warnings_reach_the_page():
     m = C.compute({"specs": ["ward:m=0.05"]})["models"][0]
     assert m["max_constant"]["value"] == 0.0
     assert any("unbounded" in note for note in m["notes"]), m["notes"]
+
+
+def test_lobe_surface_is_f_cos_over_the_hemisphere():
+    f = pumpup.load("ward:m=0.2")
+    r = C.compute({"specs": ["ward:m=0.2"], "theta_i": 35.0, "lobe3d": True})["models"][0]["lobe3d"]
+    v = np.frombuffer(__import__("base64").b64decode(r["data"]), "<f8").reshape(len(r["theta"]), len(r["phi"]))
+    t, p = np.radians(r["theta"][7]), np.radians(r["phi"][40])
+    wo = np.array([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)])
+    wi = np.array([np.sin(np.radians(35.0)), 0.0, np.cos(np.radians(35.0))])
+    assert v[7, 40] == float(f.eval(wi, wo)) * np.cos(t)
+    assert "lobe3d" not in C.compute({"specs": ["ward:m=0.2"]})["models"][0]

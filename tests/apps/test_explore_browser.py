@@ -148,7 +148,8 @@ def test_slider_shows_pumpups_numbers(chromium, server):
 
 
 def test_bad_input_shows_one_message_and_the_server_keeps_serving(chromium, server):
-    p = Page(chromium, server + "?s=lambert:albedo=0.5")
+    p = Page(chromium, server + "?s=lambert:albedo=0.5&3d=1")
+    assert p.page.is_visible("#lobe3d-view")  # the 3-D lobe, drawn without a console error
     p.page.fill("#spec-text", "phong:n=-5")
     p.page.press("#spec-text", "Enter")
     p.wait_answer()

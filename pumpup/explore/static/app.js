@@ -32,7 +32,7 @@ function shortSpec(spec) {
 function defaultState() {
   return {specs: BOOT.initial.slice(0, 4), active: 0, theta_i: 30, phi: 0, log: false,
           pump: {on: false, g: "g2", levels: 1}, kulla_conty: false, scaled: false,
-          light: 30, light_azimuth: 0, exposure: -2};
+          light: 30, light_azimuth: 0, exposure: -2, lobe3d: false};
 }
 
 function stateFromURL() {
@@ -51,6 +51,7 @@ function stateFromURL() {
   st.kulla_conty = q.get("kc") === "1"; st.scaled = q.get("sc") === "1";
   st.light = num("light", st.light); st.light_azimuth = num("laz", st.light_azimuth);
   st.exposure = num("exp", st.exposure);
+  st.lobe3d = q.get("3d") === "1";
   return st;
 }
 
@@ -66,6 +67,7 @@ function writeURL() {
   if (st.scaled) q.set("sc", "1");
   q.set("light", st.light); if (st.light_azimuth) q.set("laz", st.light_azimuth);
   if (st.exposure !== -2) q.set("exp", st.exposure);
+  if (st.lobe3d) q.set("3d", "1");
   history.replaceState(null, "", "?" + q.toString());
 }
 
@@ -103,7 +105,7 @@ function request() {
   sentAt[id] = performance.now();
   const msg = JSON.stringify({id, state: {
     specs: st.specs, theta_i: st.theta_i, phi: st.phi, pump: st.pump, kulla_conty: st.kulla_conty,
-    scaled: st.scaled, light: st.light, light_azimuth: st.light_azimuth}});
+    scaled: st.scaled, light: st.light, light_azimuth: st.light_azimuth, lobe3d: st.lobe3d}});
   setStatus("computing…");
   if (socket && socket.readyState === WebSocket.OPEN) socket.send(msg); else pending = msg;
   return id;
@@ -353,6 +355,8 @@ function initControls() {
   $("pump-on").addEventListener("change", () => { st.pump.on = $("pump-on").checked; request(); });
   $("pump-g").addEventListener("change", () => { st.pump.g = $("pump-g").value; if (st.pump.on) request(); else writeURL(); });
   $("kc").addEventListener("change", () => { st.kulla_conty = $("kc").checked; request(); });
+  $("lobe3d-on").checked = st.lobe3d;
+  $("lobe3d-on").addEventListener("change", () => { st.lobe3d = $("lobe3d-on").checked; request(); });
   $("scaled").addEventListener("change", () => { st.scaled = $("scaled").checked; request(); });
 }
 
@@ -724,10 +728,38 @@ function drawSpheres(r) {
     usesServer && !usesGL ? "(rendered by pumpup.render.sphere)" : "(WebGL 2 where a shader exists, else pumpup.render.sphere)";
 }
 
+function drawLobe3d(r) {
+  const view = $("lobe3d-view");
+  const on = r.models.some((m) => m.lobe3d && !m.lobe3d.error);
+  view.hidden = !on;
+  if (!on) { Plotly.purge("lobe3d"); return; }
+  const traces = [];
+  r.models.forEach((m, i) => {
+    if (!m.lobe3d || m.lobe3d.error) return;
+    const v = decode64(m.lobe3d.data), th = m.lobe3d.theta, ph = m.lobe3d.phi;
+    const x = [], y = [], z = [];
+    th.forEach((t, a) => {
+      const xr = [], yr = [], zr = [];
+      ph.forEach((p, b) => {
+        const rr = v[a * ph.length + b], tr = t * Math.PI / 180, pr = p * Math.PI / 180;
+        xr.push(rr * Math.sin(tr) * Math.cos(pr)); yr.push(rr * Math.sin(tr) * Math.sin(pr)); zr.push(rr * Math.cos(tr));
+      });
+      x.push(xr); y.push(yr); z.push(zr);
+    });
+    traces.push({type: "surface", x, y, z, name: label(m, i), showscale: false, opacity: 0.85,
+                 colorscale: [[0, COLOURS[i]], [1, COLOURS[i]]], surfacecolor: z.map((row) => row.map(() => 0)),
+                 cmin: 0, cmax: 1, hoverinfo: "name"});
+  });
+  Plotly.react("lobe3d", traces, {margin: {l: 0, r: 0, t: 0, b: 0},
+    scene: {aspectmode: "data", xaxis: {title: {text: "x"}}, yaxis: {title: {text: "y"}}, zaxis: {title: {text: "N"}}}},
+    PLOT_CONFIG);
+}
+
 function draw(r) {
   const t = [performance.now()];
-  for (const f of [drawLobe, drawAlbedo, drawSpheres, drawSlice]) { f(r); t.push(performance.now()); }
-  explore.drawMs = {lobe: t[1] - t[0], albedo: t[2] - t[1], spheres: t[3] - t[2], slice: t[4] - t[3]};
+  for (const f of [drawLobe, drawAlbedo, drawSpheres, drawSlice, drawLobe3d]) { f(r); t.push(performance.now()); }
+  explore.drawMs = {lobe: t[1] - t[0], albedo: t[2] - t[1], spheres: t[3] - t[2], slice: t[4] - t[3],
+                    lobe3d: t[5] - t[4]};
 }
 
 // ---------------------------------------------------------------------------------------------------------------
