@@ -125,6 +125,11 @@ def check_spec(spec: Any) -> BRDF:
     return f
 
 
+def parse_spec_any(spec: Any) -> dict:
+    """The spec as the user gave it, as a dict (its text parsed); call :func:`check_spec` first."""
+    return parse_spec(spec) if isinstance(spec, str) else dict(spec)
+
+
 def _number(value: Any, name: str, lo: float, hi: float) -> float:
     """``value`` as a float in [lo, hi]; a SpecError naming ``name`` otherwise."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):

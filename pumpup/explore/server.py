@@ -15,8 +15,10 @@ Routes
 ``GET /download/{kind}?spec=...``
     ``spec.json``, ``albedo.nc`` (``pumpup.tabulate`` written by ``pumpup.write_table`` to a temporary directory
     that is removed once the bytes are read), ``shader.glsl`` and ``shader.brdf`` (``pumpup.shader``, targets
-    glsl-es and brdf-explorer) and ``mitsuba.json`` (``pumpup.mitsuba.bsdf_dict``).  The server writes no other
-    file.  Requests must name this machine in their Host header (or the host given to ``--host``).
+    glsl-es and brdf-explorer), ``mitsuba.json`` (``pumpup.mitsuba.bsdf_dict``) and ``lut?preset=...`` (a
+    renderer's table, ``pumpup.lut`` written by ``pumpup.luts.write_lut``, for the models with a roughness).  The
+    server writes no other file.  Requests must name this machine in their Host header (or the host given to
+    ``--host``).
 """
 
 from __future__ import annotations
@@ -230,8 +232,39 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
             except (SpecError, ValueError) as exc:
                 return PlainTextResponse(_one_line(exc), status_code=400)
             media, name = "application/x-netcdf", f"{stem}-albedo.nc"
+        elif kind == "lut":
+            from .. import luts
+
+            preset = request.query_params.get("preset", "cycles")
+            ext = {"c": "h", "netcdf": "nc", "npy": "npy", "exr": "exr", "filament": "inc"}
+            if preset not in luts.PRESETS:
+                return PlainTextResponse(f"preset must be one of {', '.join(luts.PRESETS)}, got {preset!r}",
+                                         status_code=400)
+            if f.type not in luts.ROUGH_PARAM:
+                return PlainTextResponse(f"a renderer's table is made over the roughness of "
+                                         f"{', '.join(luts.ROUGH_PARAM)}; {f.type} has none", status_code=400)
+            name = f"{stem}-{preset}.{ext.get(luts.PRESETS[preset].fmt, 'dat')}"
+
+            # the table's axis sets the roughness; the preset sets the shadowing unless the spec gives one
+            given = {k: v for k, v in C.parse_spec_any(text).items() if k != luts.ROUGH_PARAM[f.type]}
+
+            def table() -> bytes:
+                ds = luts.lut(given, preset=preset, max_seconds=time_limit)
+                with tempfile.TemporaryDirectory(prefix="pumpup-explore-") as tmp:
+                    path = luts.write_lut(ds, os.path.join(tmp, name))
+                    with open(path, "rb") as fh:
+                        return fh.read()
+
+            try:
+                body = await asyncio.wait_for(loop.run_in_executor(pool, table), timeout=time_limit + 1.0)
+            except (asyncio.TimeoutError, TimeoutError):
+                return PlainTextResponse(f"the table took longer than the time limit, {time_limit:g} s",
+                                         status_code=503)
+            except (SpecError, ValueError) as exc:
+                return PlainTextResponse(_one_line(exc), status_code=400)
+            media = "application/octet-stream"
         else:
-            return PlainTextResponse(f"unknown download {kind!r}; one of spec.json, albedo.nc, shader.glsl, "
+            return PlainTextResponse(f"unknown download {kind!r}; one of spec.json, albedo.nc, lut, shader.glsl, "
                                      "shader.brdf, mitsuba.json", status_code=404)
         return Response(body, media_type=media, headers={"Content-Disposition": f'attachment; filename="{name}"'})
 

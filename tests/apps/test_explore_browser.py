@@ -231,6 +231,15 @@ def test_compare_shares_axes_and_downloads(chromium, server):
         for kind, target in (("shader.glsl", "glsl-es"), ("shader.brdf", "brdf-explorer")):
             got = p.page.request.get(server + "download/" + kind, params={"spec": spec})
             assert got.ok and got.text() == shaders.shader(pumpup.load(spec).spec, target=target), kind
+    got = p.page.request.get(server + "download/lut", params={"spec": spec, "preset": "cycles"}, timeout=120_000)
+    assert got.ok and "table_ggx_E" in got.text()
+    from pumpup import luts
+
+    with tempfile.TemporaryDirectory() as tmp:  # the same file as pumpup.lut("ggx", preset="cycles") writes
+        with open(luts.write_lut(pumpup.lut("ggx", preset="cycles"), os.path.join(tmp, "t.h"))) as fh:
+            assert got.text() == fh.read()
+    bad = p.page.request.get(server + "download/lut", params={"spec": "phong:n=2", "preset": "cycles"})
+    assert bad.status == 400 and "roughness" in bad.text()
     # a request naming another host (a page elsewhere reaching this one through DNS) is refused
     foreign = p.page.request.get(server + "api/models", headers={"Host": "attacker.example"})
     assert foreign.status == 400

@@ -299,12 +299,16 @@ function updateControls() {
       if (f && f !== focused && typeof v === "number") f.value = String(v);
     }
   }
-  const spec = encodeURIComponent(JSON.stringify(canon || {}));
+  // the downloads take the spec as the user gave it (the canonical one also names computed defaults)
+  const spec = encodeURIComponent(JSON.stringify(activeSpec() || canon || {}));
   $("dl-spec").href = `/download/spec.json?spec=${spec}`;
   $("dl-nc").href = `/download/albedo.nc?spec=${spec}`;
   $("dl-glsl").href = `/download/shader.glsl?spec=${spec}`;
   $("dl-brdf").href = `/download/shader.brdf?spec=${spec}`;
   $("dl-mitsuba").href = `/download/mitsuba.json?spec=${spec}`;
+  $("dl-lut-cycles").href = `/download/lut?preset=cycles&spec=${spec}`;
+  $("dl-lut-nc").href = `/download/lut?preset=netcdf&spec=${spec}`;
+  $("dl-lut-row").hidden = !(canon && ["ggx", "beckmann", "ward", "modified_ward", "cook_torrance"].includes(canon.type));
   const r = explore.result;
   const m = r && r.models[st.active];
   $("dl-glsl").hidden = $("dl-brdf").hidden = !(m && m.shader && m.shader.glsl);
