@@ -50,6 +50,7 @@ _PUBLIC = {
     "lut_module": ("luts", None),
     "audit": ("luts", "audit"),
     "lut": ("luts", "lut"),
+    "shader": ("shaders", "shader"),
     "FitResult": ("fitting", "FitResult"),
     "fit": ("fitting", "fit"),
     "BRDF": ("core", "BRDF"),

@@ -836,6 +836,26 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {_one_line(message)} (see {self.prog} --help)\n")
 
 
+def cmd_shader(args) -> int:
+    """``pumpup shader SPEC --target T [--out FILE]``: shader source with the tables baked in (:func:`pumpup.shader`),
+    written atomically to ``--out`` or printed; status 2 and one line for a bad argument or an unsupported model.
+    """
+    from . import shaders
+
+    if args.target not in shaders.TARGETS:
+        raise SystemExit(f"pumpup: --target must be one of {', '.join(shaders.TARGETS)}; got {args.target!r}")
+    if args.out:
+        check_out(args.out)
+    f = _load(args.model, spectral=True)
+    command = shaders.command_line(args.model, args.target, args.out)
+    if args.out:
+        shaders.write_shader(f, args.target, args.out, command=command)
+        print(f"wrote {args.out}: {args.target} shader of {json.dumps(f.spec)}")
+    else:
+        sys.stdout.write(shaders.shader(f, target=args.target, command=command))
+    return 0
+
+
 def cmd_render_scene(args) -> int:
     """``pumpup render scene NAME``: the papers' scenes path-traced by Mitsuba 3 (pumpup.scenes); every
     argument is checked (one line, status 2) before rendering; without mitsuba, the ``render`` extra is named.
@@ -1045,6 +1065,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="skip the look-up error between the nodes (default: measured)")
     s.add_argument("--no-eavg", action="store_true", help="skip E_avg (default: computed)")
     s.set_defaults(func=cmd_lut)
+    s = sub.add_parser("shader", help="shader code of a model with its tables baked in: GLSL, GLSL ES, HLSL, Metal "
+                                      "or a BRDF Explorer file")
+    s.add_argument("model", help="a spec: a closed-form model, pumped or compensated (e.g. ggx:alpha=0.3)")
+    s.add_argument("--target", default="glsl", help="glsl (default), glsl-es, hlsl, msl or brdf-explorer")
+    s.add_argument("--out", help="the file to write (atomically); default: standard output")
+    s.set_defaults(func=cmd_shader)
     s = sub.add_parser("audit", help="grade a shipped albedo table against pumpup's truth (status 1 beyond --tol)")
     s.add_argument("file", help="the shipped table to audit")
     s.add_argument("--preset", required=True, help="cycles, filament, filament-centred, appleseed, bsdl, mitsuba, "

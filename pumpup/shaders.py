@@ -51,7 +51,7 @@ import numpy as np
 from ._version import __version__
 from .core import BRDF, SpecError, load
 
-__all__ = ["shader", "uniforms", "TARGETS", "SUPPORTED", "write_shader", "error_bound_text"]
+__all__ = ["shader", "uniforms", "table_error", "TARGETS", "SUPPORTED", "write_shader", "error_bound_text"]
 
 #: the targets :func:`shader` writes
 TARGETS = ("glsl", "glsl-es", "hlsl", "msl", "brdf-explorer")
@@ -733,6 +733,47 @@ float pumpup_upper(float m) {{
     return "".join(out), notes
 
 
+def table_error(spec: Any) -> dict[str, float]:
+    """How far below pumpup's value the shader's tables may take a pumped or compensated BRDF (its base's own float32
+    error bound B aside): the float32 error added to the table pieces (twice, in :func:`shader`) and the final rounding
+    down.
+
+    Parameters
+    ----------
+    spec : dict, str or BRDF
+        As :func:`shader`.
+
+    Returns
+    -------
+    dict
+        ``{"relative": r, "absolute": a}``: a pumped value is at least pumpup's x (1 - 2 B - r); a ``scaled`` one too;
+        a ``kulla_conty`` one at least pumpup's base x (1 - 2 B - r) + its lobe - scale x 2 a (a: the largest amount by
+        which the shader's U exceeds pumpup's).  Both 0 for a closed-form model.
+    """
+    plan = _Plan(spec if isinstance(spec, BRDF) else load(spec))
+    if plan.levels:
+        rel = 0.0
+        for lev in plan.levels:
+            lk = lev.lookup()
+            t = _LevelTable(lk, "x")
+            rel += 2.0 * float(np.max(t.err)) / (0.5 * float(np.min(lk.table.value)))
+        prod = plan.levels[-1].product()
+        if prod is not None:
+            p = _ProductTable(prod, "x")
+            gmin = float(np.min(prod.exact(np.asarray(prod.lo[:-1], dtype=np.float64))))
+            rel += 2.0 * float(np.max(p.err)) / (0.5 * gmin)
+        return {"relative": rel + 4.0 * (len(plan.levels) + 9) * U, "absolute": 0.0}
+    if plan.comp is not None:
+        bound = plan.comp.bound
+        t = _LevelTable(bound.lookup, "x")
+        a = 2.0 * float(np.max(t.err)) + 4.0 * U
+        if bound.product is not None:
+            a = max(a, 2.0 * float(np.max(_ProductTable(bound.product, "x").err)) + 4.0 * U)
+        umin = 0.5 * float(np.min(bound.lookup.table.value))
+        return {"relative": a / umin + 32.0 * U, "absolute": a}
+    return {"relative": 0.0, "absolute": 0.0}
+
+
 def _library(plan: _Plan) -> tuple[str, list[str]]:
     """(GLSL library body without the header, table notes)."""
     parts = [_COMMON]
@@ -882,7 +923,7 @@ def _tool(name: str) -> str:
     path = shutil.which(name)
     if path is None:
         pkg = "glslang-tools" if name == "glslangValidator" else "spirv-cross"
-        raise RuntimeError(f"pumpup.shader: the hlsl and msl targets need {name} on PATH (Debian/Ubuntu: apt-get "
+        raise FileNotFoundError(f"pumpup.shader: the hlsl and msl targets need {name} on PATH (Debian/Ubuntu: apt-get "
                            f"install {pkg})")
     return path
 
@@ -936,7 +977,8 @@ def _brdf_explorer(plan: _Plan, lib: str, header: str) -> str:
             params.append(f"float pumpup_{k} {lo:.9g} {hi:.9g} {v:.9g}")
     body = "\n".join(ln for ln in lib.splitlines() if not ln.startswith("uniform float "))
     hdr = "".join("# " + ln[3:] + "\n" if ln.startswith("// ") else ln + "\n" for ln in header.splitlines())
-    return (hdr + "# BRDF Explorer passes world-space L, V and the frame N, X, Y; the shader maps them to the local frame\n"
+    return ("analytic\n\n" + hdr
+            + "# BRDF Explorer passes world-space L, V and the frame N, X, Y; the shader maps them to the local frame\n"
             "\n::begin parameters\n" + "".join(p + "\n" for p in params) + "::end parameters\n\n"
             "::begin shader\n" + body + """
 vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)
