@@ -390,12 +390,28 @@ def shader_source(f: BRDF) -> dict | None:
 
     if importlib.util.find_spec("pumpup.shaders") is None:
         return None
-    from .. import shaders
+    import pumpup
+    from pumpup import shaders
 
     try:
-        return {"glsl": shaders.shader(f.spec, target="glsl-es"), "uniforms": shaders.uniforms(f.spec)}
+        return {"glsl": pumpup.shader(f.spec, target="glsl-es"), "uniforms": shaders.uniforms(f.spec)}
     except (SpecError, ValueError, NotImplementedError) as exc:
         return {"error": str(exc)}
+
+
+def _has_shader(spec: dict) -> bool:
+    """Whether ``pumpup shader`` translates the model."""
+    import importlib.util
+
+    if importlib.util.find_spec("pumpup.shaders") is None:
+        return False
+    from pumpup import shaders
+
+    try:
+        shaders.uniforms(spec)
+    except (SpecError, ValueError):
+        return False
+    return True
 
 
 def reproduce_lines(state: dict, spec: dict) -> dict:
@@ -427,6 +443,9 @@ def reproduce_lines(state: dict, spec: dict) -> dict:
     py.append(f"pumpup.render.furnace(f, size={FURNACE_SIZE})")
     cli.append(f"pumpup render sphere {q}{short}{q} --light {state['light']:g} --size {SPHERE_SIZE} --out spheres")
     cli.append(f"pumpup render furnace {q}{short}{q} --size {FURNACE_SIZE} --out spheres")
+    if _has_shader(json.loads(spec)):
+        py.append("glsl = pumpup.shader(f, target='glsl-es')")
+        cli.append(f"pumpup shader {q}{short}{q} --target glsl-es --out {json.loads(spec)['type']}.glsl")
     return {"python": "\n".join(py), "cli": "\n".join(cli)}
 
 
