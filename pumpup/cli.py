@@ -1101,7 +1101,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("spec", nargs="*", help="one to four model SPECs to open (default: phong:n=20)")
     s.add_argument("--port", type=int, default=8765, help="the port, 0 for a free one (default: 8765)")
     s.add_argument("--host", default="127.0.0.1",
-                   help="the address to listen on (default: 127.0.0.1, this machine only; another host warns)")
+                   help="the address to listen on; any host but this machine's prints a warning (default: 127.0.0.1)")
     s.add_argument("--no-browser", action="store_true", help="do not open the page in a browser (default: open it)")
     s.add_argument("--time-limit", type=float, default=60.0,
                    help="seconds one computation may take, in (0, 3600] (default: 60)")
