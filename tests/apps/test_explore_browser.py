@@ -156,6 +156,10 @@ def test_bad_input_shows_one_message_and_the_server_keeps_serving(chromium, serv
     msg = p.page.text_content("#message")
     assert p.page.is_visible("#message") and "'n' = -5 is outside its allowed range [0, 1e+06]" in msg
     assert "\n" not in msg.strip()
+    # the views keep the last good state: a slider move after the error computes lambert again
+    p.slide("#theta-i", 40)
+    p.wait_answer()
+    assert not p.page.is_visible("#message") and p.result()["models"][0]["input"] == {"type": "lambert", "albedo": 0.5}
     for bad in ("function:name=x", "/etc/passwd", '{"type": "ggx", "alpha": "x"}'):
         p.page.fill("#spec-text", bad)
         p.page.press("#spec-text", "Enter")

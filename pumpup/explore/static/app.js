@@ -117,7 +117,14 @@ function onAnswer(ans) {
   if (!ans.ok) {
     explore.errors += 1;
     showMessage(ans.error);
-    setStatus("error");
+    setStatus("error: the views show the last good state");
+    // back to the last good models, so that the next slider move does not send the bad spec again (the spec box
+    // keeps the text to correct)
+    if (explore.result) {
+      explore.state.specs = explore.result.models.map((m) => m.input);
+      explore.state.active = Math.min(explore.state.active, explore.state.specs.length - 1);
+      writeURL();
+    }
     explore.drawnId = ans.id;
     explore.drawn += 1;
     document.body.dataset.drawn = String(explore.drawn);
