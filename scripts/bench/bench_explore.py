@@ -46,6 +46,7 @@ CASES = {
 
 MOVE_JS = """async ([id, v]) => {
   const e = document.getElementById(id);
+  e.focus();  // as under the user's pointer: the page does not rebuild the control being dragged
   const before = window.explore.sent;
   const t0 = performance.now();
   e.value = v;
