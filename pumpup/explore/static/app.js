@@ -111,7 +111,16 @@ function request() {
   return id;
 }
 
+// plotly.js (4.6 MB) loads while the first views are computed; drawing waits for it
+const plotlyReady = new Promise((resolve) => {
+  if (window.Plotly) { resolve(); return; }
+  const tag = document.getElementById("plotly-js");
+  tag.addEventListener("load", () => resolve());
+  tag.addEventListener("error", () => showMessage("plotly.js did not load from the server"));
+});
+
 function onAnswer(ans) {
+  if (!window.Plotly) { plotlyReady.then(() => onAnswer(ans)); return; }
   if (ans.cancelled) return;
   if (ans.id !== null && ans.id !== explore.sent) return;  // an older answer: a newer request is on its way
   if (!ans.ok) {
