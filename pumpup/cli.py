@@ -793,14 +793,26 @@ def cmd_lut(args) -> int:
 
 
 def cmd_audit(args) -> int:
-    """``pumpup audit FILE --preset NAME``: a shipped albedo table graded against pumpup's values
-    (:func:`pumpup.audit`); status 1 beyond ``--tol`` or ``--max-lookup-error``, 2 for a bad argument, else 0.
+    """``pumpup audit FILE --preset NAME`` or ``--conventions FILE.toml``: a shipped albedo table graded against
+    pumpup's values (:func:`pumpup.audit`), read as a preset or a description says; status 1 beyond ``--tol`` or
+    ``--max-lookup-error``, 2 for a bad argument, a wrong description or a file that does not match it, else 0.
     """
     import pumpup
     from pumpup import luts
 
-    if args.preset not in luts.PRESETS:
+    if (args.preset is None) == (args.conventions is None):
+        return _lut_fail("give --preset NAME or --conventions FILE.toml (one of them)")
+    if args.preset is not None and args.preset not in luts.PRESETS:
         return _lut_fail(f"--preset must be one of {', '.join(luts.PRESETS)}; got {args.preset!r}")
+    if args.conventions is not None:
+        from pumpup.conventions import ConventionsError, load_conventions
+
+        try:  # the description is checked before the file is read
+            conventions = load_conventions(args.conventions)
+        except ConventionsError as exc:
+            return _lut_fail(str(exc))
+    else:
+        conventions = None
     for name in ("tol", "max_lookup_error"):
         v = getattr(args, name)
         if v is not None and not v > 0:
@@ -808,7 +820,7 @@ def cmd_audit(args) -> int:
     if args.png:
         check_out(args.png, "--png")
     try:
-        res = pumpup.audit(args.file, preset=args.preset, model=args.model, rtol=args.rtol,
+        res = pumpup.audit(args.file, preset=args.preset, model=args.model, conventions=conventions, rtol=args.rtol,
                            lookup_check=not args.no_lookup_check, png=args.png, eavg=not args.no_eavg)
     except (luts.LutError, pumpup.SpecError, ValueError, TypeError, OSError) as exc:
         return _lut_fail(str(exc))
@@ -818,12 +830,12 @@ def cmd_audit(args) -> int:
     if not res.ok(args.tol, args.max_lookup_error):
         what = []
         if args.tol is not None and res.max_abs > args.tol:
-            what.append(f"node error {res.max_abs:.3g} > --tol {args.tol:g} at mu = {res.where_abs[0]:.6g}, "
-                        f"rough = {res.where_abs[1]:.6g}")
+            what.append(f"node error {res.max_abs:.3g} > --tol {args.tol:g} at {res.labels[0]} = "
+                        f"{res.where_abs[0]:.6g}, {res.labels[1]} = {res.where_abs[1]:.6g}")
         if args.max_lookup_error is not None and res.lookup and res.lookup["max_abs"] > args.max_lookup_error:
             lk = res.lookup
             what.append(f"look-up error {lk['max_abs']:.3g} > --max-lookup-error {args.max_lookup_error:g} at "
-                        f"mu = {lk['where'][0]:.6g}, rough = {lk['where'][1]:.6g}")
+                        f"{res.labels[0]} = {lk['where'][0]:.6g}, {res.labels[1]} = {lk['where'][1]:.6g}")
         print("pumpup: table fails: " + "; ".join(what), file=sys.stderr)
         return 1
     return 0
@@ -1073,9 +1085,12 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_shader)
     s = sub.add_parser("audit", help="grade a shipped albedo table against pumpup's truth (status 1 beyond --tol)")
     s.add_argument("file", help="the shipped table to audit")
-    s.add_argument("--preset", required=True, help="cycles, filament, filament-centred, appleseed, bsdl, mitsuba, "
-                                                  "netcdf, exr (required)")
-    s.add_argument("--model", default="ggx", help="the model the table claims (default ggx with the preset's Smith)")
+    s.add_argument("--preset", help="cycles, filament, filament-centred, appleseed, bsdl, mitsuba, netcdf, exr (this "
+                                    "or --conventions)")
+    s.add_argument("--conventions", help="a TOML or JSON file describing the table (model, quantity, format, "
+                                         "storage, shape, axes, look-up; see docs/user-guide/renderer-tables.md)")
+    s.add_argument("--model", help="the model the table claims (default: ggx with the preset's Smith, or the "
+                                   "conventions' model)")
     s.add_argument("--tol", type=float, help="fail (status 1) if a node is off by more than this (default: no limit)")
     s.add_argument("--max-lookup-error", type=float,
                    help="fail (status 1) if the look-up error exceeds this (default: no limit)")

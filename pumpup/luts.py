@@ -39,7 +39,7 @@ from .core.budget import time_budget
 if TYPE_CHECKING:
     import xarray as xr
 
-__all__ = ["PRESETS", "Preset", "LutError", "lut", "audit", "read_table", "write_lut", "lookup", "AuditResult"]
+__all__ = ["PRESETS", "Preset", "LutError", "lut", "audit", "read_table", "write_lut", "lookup", "AuditResult", "grade"]
 
 
 class LutError(ValueError):
@@ -493,8 +493,17 @@ def lookup_error(table, spec: dict, param: str, preset, *, per_cell: int = 1, st
     n_mu, n_r = table.shape
     mu = _dense_axis(p.mu_lookup, n_mu, p.lookup_mu_min, per_cell, stride)
     rough = _dense_axis(p.rough_lookup, n_r, p.lookup_rough_min, per_cell, stride)
+    return lookup_error_on(lambda m, r: lookup(table, m, r, p), spec, param, mu, rough, rtol=rtol, refine=refine,
+                           threads=threads, max_regions=max_regions)
+
+
+def lookup_error_on(look, spec: dict, param: str, mu: np.ndarray, rough: np.ndarray, *, rtol: float = 1e-7,
+                    refine: int = 3, threads: int | None = None, max_regions: int = 200) -> dict:
+    """:func:`lookup_error` for any look-up ``look(mu, rough)`` (broadcasting) on the dense axes ``mu`` x ``rough``
+    (the model parameter is rough^2), refined around the ``refine`` worst points.
+    """
     tr = truth_grid(spec, param, mu, rough, rtol=rtol, threads=threads, max_regions=max_regions)
-    err = lookup(table, mu[:, None], rough[None, :], p) - tr["E"]
+    err = look(mu[:, None], rough[None, :]) - tr["E"]
     i, j = np.unravel_index(np.argmax(np.abs(err)), err.shape)
     out = {"grid_max_abs": float(abs(err[i, j])), "grid_where": (float(mu[i]), float(rough[j])),
            "rms": float(np.sqrt(np.mean(err ** 2))), "points": int(err.size),
@@ -514,7 +523,7 @@ def lookup_error(table, spec: dict, param: str, preset, *, per_cell: int = 1, st
                 m, r = np.clip(x, lo, hi)
                 v, e = _albedo(_brdf(spec, param, r), m, rtol, max_regions)
                 truth_err[0] = max(truth_err[0], float(e))
-                return -abs(float(lookup(table, m, r, p)) - float(v))
+                return -abs(float(look(m, r)) - float(v))
 
             res = minimize(neg, np.array([mu[a], rough[b]]), method="Nelder-Mead", bounds=list(zip(lo, hi)),
                            options={"maxfev": 60, "xatol": 1e-6, "fatol": 1e-10})
@@ -924,6 +933,18 @@ class AuditResult:
     monotonicity: list = field(default_factory=list)
     lookup: dict | None = None
     eavg: dict | None = None
+    #: adjacent pairs stepping the other way than E within two rounding bounds of the storage (rounding, not errors)
+    monotonicity_rounding: int = 0
+    #: the quantity the file stores ("E" or "1-E"), and the largest error relative to it (over the nodes where it
+    #: exceeds ten rounding bounds; ``small_stored`` nodes are smaller) and where
+    stores: str = "E"
+    max_rel_stored: float = float("nan")
+    where_rel_stored: tuple = ()
+    small_stored: int = 0
+    #: the worst nodes, one line each, indexed and located in the renderer's own axes
+    worst: list = field(default_factory=list)
+    #: the names of the coordinates in ``where_*``, ``mu`` and ``rough`` (the renderer's axes)
+    labels: tuple = ("mu", "rough")
     error_map: np.ndarray | None = None
     truth: np.ndarray | None = None
     table: np.ndarray | None = None
@@ -941,25 +962,37 @@ class AuditResult:
         """The audit for people, a few lines: the worst errors at the nodes, the truth's quadrature error and the
         format's rounding, E > 1 and monotonicity violations, and the look-up and E_avg checks where they ran.
         """
+        a, b = self.labels
+
+        def at(w):
+            return f"{a} = {w[0]:.6g}, {b} = {w[1]:.6g}"
+
         lines = [f"audit of a {self.preset} table ({self.n_nodes} nodes) against pumpup's {json.dumps(self.spec)}",
-                 f"  nodes: max |table - E| = {self.max_abs:.3g} at mu = {self.where_abs[0]:.6g}, rough = "
-                 f"{self.where_abs[1]:.6g}; max relative {self.max_rel:.3g} at mu = {self.where_rel[0]:.6g}, rough = "
-                 f"{self.where_rel[1]:.6g}",
-                 f"  truth: quadrature error <= {self.truth_error:.2g}; the format rounds by <= "
-                 f"{self.quantisation_bound:.2g}",
-                 f"  E > 1 at {self.above_one} node(s); {len(self.monotonicity)} monotonicity violation(s)"]
+                 f"  nodes: max |table - E| = {self.max_abs:.3g} at {at(self.where_abs)}; max relative to E "
+                 f"{self.max_rel:.3g} at {at(self.where_rel)}"]
+        if self.stores != "E":
+            rel = (f"max {self.max_rel_stored:.3g} at {at(self.where_rel_stored)}" if self.where_rel_stored
+                   else "no node above ten rounding bounds")
+            lines.append(f"  relative to the stored {self.stores}: {rel} (over the nodes where {self.stores} exceeds "
+                         f"ten rounding bounds; {self.small_stored} smaller)")
+        if self.worst:
+            lines.append("  worst nodes (the file's own indices and axes):")
+            lines.extend(f"    {w}" for w in self.worst[:5])
+        lines += [f"  truth: quadrature error <= {self.truth_error:.2g}; the format rounds by <= "
+                  f"{self.quantisation_bound:.2g}",
+                  f"  E > 1 at {self.above_one} node(s); {len(self.monotonicity)} monotonicity violation(s) beyond two "
+                  f"rounding bounds ({self.monotonicity_rounding} within rounding)"]
         for m in self.monotonicity[:5]:
             lines.append(f"    {m}")
         if self.lookup is not None:
             lk = self.lookup
-            lines.append(f"  look-up (the renderer's bilinear interpolation) against E: max {lk['max_abs']:.3g} at "
-                         f"mu = {lk['where'][0]:.6g}, rough = {lk['where'][1]:.6g} (rms {lk['rms']:.2g} over "
-                         f"{lk['points']} points)")
+            lines.append(f"  look-up (the renderer's interpolation) against E: max {lk['max_abs']:.3g} at "
+                         f"{at(lk['where'])} (rms {lk['rms']:.2g} over {lk['points']} points)")
         if self.eavg is not None:
             e = self.eavg
             lines.append(f"  E_avg: max |stored - 2 int E mu dmu of the table's own E| = {e['vs_own']:.3g} "
-                         f"(rough = {e['vs_own_where']:.6g}); max |stored - true E_avg| = {e['vs_truth']:.3g} "
-                         f"(rough = {e['vs_truth_where']:.6g})")
+                         f"({b} = {e['vs_own_where']:.6g}); max |stored - true E_avg| = {e['vs_truth']:.3g} "
+                         f"({b} = {e['vs_truth_where']:.6g})")
         return "\n".join(lines)
 
 
@@ -989,26 +1022,75 @@ def _own_eavg(E: np.ndarray, p: Preset) -> np.ndarray:
     return out
 
 
-def _monotonicity(table: np.ndarray, truth: np.ndarray, slack: float, mu, rough) -> list[str]:
-    """Adjacent pairs where the table steps the other way than the truth does by more than ``slack``."""
+def _monotonicity(table: np.ndarray, truth: np.ndarray, bound: float, truth_error: float, mu, rough,
+                  labels: tuple = ("mu", "rough")) -> tuple[list[str], int]:
+    """Adjacent pairs where the table steps the other way than the truth does.
+
+    A step of the table is the difference of two rounded values, each off by up to the storage's rounding
+    ``bound``: a pair is a violation only where the table's step differs from the truth's by more than two
+    bounds (plus twice the truth's error); the others are rounding, counted apart.  Steps of the truth below
+    twice its error are no direction.  Returns (one line per violation, the number within rounding).
+    """
     found = []
-    for axis, name in ((0, "mu"), (1, "rough")):
+    within = 0
+    slack = 2 * bound + 2 * truth_error
+    for axis, name in ((0, labels[0]), (1, labels[1])):
         dt = np.diff(table, axis=axis)
         de = np.diff(truth, axis=axis)
-        bad = (np.sign(dt) != np.sign(de)) & (np.abs(de) > slack) & (np.abs(dt - de) > slack)
+        other = (np.sign(dt) != np.sign(de)) & (np.abs(de) > 2 * truth_error)
+        bad = other & (np.abs(dt - de) > slack)
+        within += int(np.count_nonzero(other & ~bad))
         for i, j in np.argwhere(bad):
             m0, r0 = mu[i], rough[j]
             m1, r1 = (mu[i + 1], r0) if axis == 0 else (m0, rough[j + 1])
             found.append(f"along {name}: table steps {dt[i, j]:+.3g} where E steps {de[i, j]:+.3g} between "
-                         f"(mu, rough) = ({m0:.4g}, {r0:.4g}) and ({m1:.4g}, {r1:.4g})")
-    return found
+                         f"({labels[0]}, {labels[1]}) = ({m0:.4g}, {r0:.4g}) and ({m1:.4g}, {r1:.4g})")
+    return found, within
 
 
-def audit(path: str | os.PathLike[str], preset: str = "cycles", model: str | dict | BRDF = "ggx", *,
-          rtol: float = 1e-7, lookup_check: bool = True, eavg: bool = True, per_cell: int = 1,
+def grade(E: np.ndarray, truth: np.ndarray, truth_error: np.ndarray, bound: float, stores: str, mu, rough, *,
+          name: str, spec: dict, labels: tuple = ("mu", "rough"), cell=None, n_worst: int = 5) -> AuditResult:
+    """The node part of an audit: ``E`` (the table, as E) against ``truth`` on the grid ``mu`` x ``rough`` (the
+    coordinates reported, named ``labels``), for a storage that rounds by ``bound`` and holds ``stores``
+    ("E" or "1-E").  ``cell(i, j)`` names a node in the renderer's own indexing (default "[i, j]").
+    """
+    diff = E - truth
+    i, j = np.unravel_index(np.argmax(np.abs(diff)), diff.shape)
+    rel = np.abs(diff) / np.maximum(np.abs(truth), 1e-300)
+    k, m = np.unravel_index(np.argmax(rel), rel.shape)
+    stored_truth = truth if stores == "E" else 1.0 - truth
+    # relative to the stored quantity where it is more than ten rounding bounds (below, rounding alone is 10 %)
+    big = np.abs(stored_truth) > 10 * bound
+    rel_s = np.where(big, np.abs(diff) / np.maximum(np.abs(stored_truth), 1e-300), -1.0)
+    ks, ms = np.unravel_index(np.argmax(rel_s), rel_s.shape)
+    terr = float(np.max(truth_error))
+    mono, within = _monotonicity(E, truth, bound, terr, mu, rough, labels)
+    cell = cell or (lambda a, b: f"[{a}, {b}]")
+    worst = []
+    for flat in np.argsort(np.abs(diff), axis=None)[::-1][:n_worst]:
+        a, b = np.unravel_index(flat, diff.shape)
+        worst.append(f"{cell(a, b)} {labels[0]} = {mu[a]:.6g}, {labels[1]} = {rough[b]:.6g}: table {E[a, b]:.7g}, "
+                     f"E {truth[a, b]:.7g} ({diff[a, b]:+.3g})")
+    return AuditResult(
+        preset=name, spec=spec, n_nodes=int(E.size), max_abs=float(abs(diff[i, j])),
+        where_abs=(float(mu[i]), float(rough[j])), max_rel=float(rel[k, m]), where_rel=(float(mu[k]), float(rough[m])),
+        truth_error=terr, quantisation_bound=float(bound),
+        above_one=int(np.count_nonzero(E - 1.0 > bound + terr)), monotonicity=mono, monotonicity_rounding=within,
+        stores=stores, max_rel_stored=float(max(rel_s[ks, ms], 0.0)) if big.any() else float("nan"),
+        where_rel_stored=(float(mu[ks]), float(rough[ms])), small_stored=int(np.count_nonzero(~big)), worst=worst,
+        labels=tuple(labels), error_map=diff, truth=truth, table=E, mu=np.asarray(mu), rough=np.asarray(rough))
+
+
+def audit(path: str | os.PathLike[str], preset: str | None = None, model: str | dict | BRDF | None = None, *,
+          conventions=None, rtol: float = 1e-7, lookup_check: bool = True, eavg: bool = True, per_cell: int = 1,
           stride: int | None = None, png: str | None = None, threads: int | None = None,
           max_regions: int = 200) -> AuditResult:
-    """Grade a shipped table against pumpup's truth, in the preset's conventions.
+    """Grade a shipped table against pumpup's truth, in a preset's conventions or any described ones.
+
+    With ``conventions`` (a path to a TOML or JSON file, a dict, or a
+    :class:`pumpup.conventions.Conventions`), the table is read and graded as that description says
+    (:func:`pumpup.conventions.audit_conventions`; ``model`` then overrides its model).  Otherwise
+    ``preset`` names one of :data:`PRESETS` (default ``"cycles"``) and ``model`` defaults to GGX.
 
     Reads ``path`` (:func:`read_table`), recomputes every node with ``model`` (default GGX with
     the preset's Smith term, F = 1) and reports: max absolute and relative node error and where,
@@ -1025,23 +1107,21 @@ def audit(path: str | os.PathLike[str], preset: str = "cycles", model: str | dic
     >>> r.max_abs < 1e-7
     True
     """
-    p = _preset(preset)
+    if conventions is not None:
+        from .conventions import audit_conventions
+
+        if preset is not None:
+            raise SpecError("give either preset or conventions, not both")
+        return audit_conventions(path, conventions, model=model, rtol=rtol, lookup_check=lookup_check, eavg=eavg,
+                                 per_cell=per_cell, stride=stride, png=png, threads=threads, max_regions=max_regions)
+    p = _preset("cycles" if preset is None else preset)
     tab = read_table(path, p)
-    spec, param = model_spec(model, p)
+    spec, param = model_spec("ggx" if model is None else model, p)
     mu, rough = nodes(p)
     tr = _edge_rule(truth_grid(spec, param, mu, rough, rtol=rtol, threads=threads, max_regions=max_regions), p)
     E = tab["E"]
-    diff = E - tr["E"]
-    i, j = np.unravel_index(np.argmax(np.abs(diff)), diff.shape)
-    rel = np.abs(diff) / np.maximum(np.abs(tr["E"]), 1e-300)
-    k, m = np.unravel_index(np.argmax(rel), rel.shape)
-    slack = STORAGE_BOUND[p.storage] + float(tr["E_error"].max())
-    res = AuditResult(
-        preset=p.name, spec={**spec, param: "rough^2"}, n_nodes=int(E.size), max_abs=float(abs(diff[i, j])),
-        where_abs=(float(mu[i]), float(rough[j])), max_rel=float(rel[k, m]), where_rel=(float(mu[k]), float(rough[m])),
-        truth_error=float(tr["E_error"].max()), quantisation_bound=STORAGE_BOUND[p.storage],
-        above_one=int(np.count_nonzero(E - 1.0 > slack)), monotonicity=_monotonicity(E, tr["E"], slack, mu, rough),
-        error_map=diff, truth=tr["E"], table=E, mu=mu, rough=rough)
+    res = grade(E, tr["E"], tr["E_error"], STORAGE_BOUND[p.storage], p.stores, mu, rough, name=p.name,
+                spec={**spec, param: "rough^2"})
     if eavg and "E_avg" in tab:
         own = _own_eavg(E, p)
         true_avg, true_err = mean_albedo_grid(spec, param, rough, rtol=rtol, threads=threads, max_regions=max_regions)
@@ -1076,8 +1156,8 @@ def error_map_png(res: AuditResult, path) -> str:
     for ax, (title, mu, rough, err) in zip(axes[0], panels):
         lim = float(np.max(np.abs(err))) or 1.0
         im = ax.pcolormesh(rough, mu, err, cmap="RdBu_r", vmin=-lim, vmax=lim, shading="nearest")
-        ax.set_xlabel("roughness r (alpha = r^2)")
-        ax.set_ylabel("mu = cos theta")
+        ax.set_xlabel("roughness r (alpha = r^2)" if res.labels[1] == "rough" else res.labels[1])
+        ax.set_ylabel("mu = cos theta" if res.labels[0] == "mu" else res.labels[0])
         ax.set_title(f"{res.preset}: {title}", fontsize=9)
         fig.colorbar(im, ax=ax)
     fig.tight_layout()

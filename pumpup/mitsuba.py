@@ -57,7 +57,7 @@ The BSDF
     A Mitsuba BSDF as a pumpup BRDF: f_r(wi, wo) = eval(si.wi = wo, wo = wi)[channel] / N.wi,
     front side, so that ``albedo``, ``tabulate``, ``check_reciprocity``, ``pump`` and
     ``compensate`` work on it.  Evaluated by Mitsuba in float32: its relative accuracy is about
-    1e-7 per value (see docs/user-guide.md for what this limits).
+    1e-7 per value (see docs/user-guide/mitsuba.md for what this limits).
 
 Supported pumpup types: lambert, phong, stretched_phong, retro, phong_shader, blinn,
 stretched_blinn, phong_blinn, ward, modified_ward, ward_aniso, schlick, cook_torrance,

@@ -16,7 +16,7 @@ N = (x, y, sqrt(1 - x^2 - y^2)) and the direction towards the viewer is V = (0, 
 for every pixel.  Pixels off the sphere hold radiance 0 and ``mask`` False.
 
 Local shading frame (pumpup's convention: the normal is the local z axis)
------------------------------------------------------------------------
+-------------------------------------------------------------------------
 The tangent T is the direction of the parallels of a globe whose poles are at the top
 and bottom of the image (the world y axis): T = (y_w x N) / |y_w x N| = (N_z, 0, -N_x) /
 sqrt(N_x^2 + N_z^2), and the bitangent is B = N x T (it runs along the meridians,
@@ -68,6 +68,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import textwrap
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -650,7 +651,9 @@ def grid_figure(images, path, *, row_labels=None, col_labels=None, exposure: flo
             rgb, clipped = tone_map(im, exposure)
             ax.imshow(rgb, interpolation="nearest")
             text = tile_text(im) if tile_text else _default_tile_text(im, clipped)
-            if text:
+            if text:  # wrapped to the tile's width (6.5 pt characters), so it never runs into the next tile
+                width = max(12, int(tile_inches * 72 / (6.5 * 0.62)))
+                text = "\n".join(textwrap.fill(line, width) for line in text.splitlines())
                 ax.text(0.02, 0.98, text, transform=ax.transAxes, va="top", ha="left", fontsize=6.5, color="white",
                         bbox={"facecolor": "black", "alpha": 0.55, "pad": 1.5, "linewidth": 0})
             if i == 0 and col_labels:
@@ -671,7 +674,7 @@ def _default_tile_text(im: Image, clipped) -> str:
     vals = im.radiance[im.mask]
     peak = float(vals.max()) if vals.size else 0.0
     if im.kind == "furnace":
-        return f"max {peak:.4f}\nrim {float(vals.min()):.3f}"
+        return f"max {peak:.4f}\nmin {float(vals.min()):.3f}"
     return f"max {peak:.3g}" + (f"\n{int(clipped.sum())} clipped" if clipped.any() else "")
 
 

@@ -249,7 +249,7 @@ def _divergence_report(ds) -> str:
         lines.append(f"| {name} | {ds.verdict.values[i]} | {float(ds.k[i]):.5f} ± {float(ds.k_error[i]):.1g} | "
                      f"{float(ds.albedo[i, -1]):.6g} |")
     lines += ["", ("001 claims that Ward and Cook-Torrance diverge; "
-                   "see docs/user-guide.md for why Cook-Torrance does not."), ""]
+                   "see docs/studies/papers.md for why Cook-Torrance does not."), ""]
     return "\n".join(lines)
 
 

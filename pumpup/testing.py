@@ -3,7 +3,7 @@
 A sampler that draws incidence directions ``wi`` for a viewing direction ``wo`` and
 reports their density is correct only if the directions really follow that density.
 :func:`chi2_test` checks this the way renderers check their BSDF samplers (pbrt-v4's
-``bsdfs_test.cpp``, Mitsuba 3's ``chi2`` module):
+``bsdfs_test.cpp`` [1]_, Mitsuba 3's ``chi2`` module [2]_):
 
 1. draw ``n_samples`` directions and bin them on the whole sphere in (cos theta, phi),
    equal-area bins (Mitsuba's ``SphericalDomain``); samples the sampler rejected (it
@@ -14,9 +14,9 @@ reports their density is correct only if the directions really follow that densi
    expected count of the rejected cell is ``n_samples`` times (1 - the integral over the
    sphere), so rejected samples are never renormalised away;
 3. pool cells with an expected count below ``min_expected`` (sorted by expected count, as
-   both references do), compute Pearson's statistic and its p-value;
+   both references do), compute Pearson's statistic [4]_ and its p-value;
 4. reject the sampler if the p-value is below the significance level, which for ``k``
-   viewing directions is Sidak's ``1 - (1 - alpha)^(1/k)`` per direction (Sidak 1967).
+   viewing directions is Sidak's ``1 - (1 - alpha)^(1/k)`` per direction (Sidak 1967 [3]_).
 
 It also checks, as Mitsuba does, that the pdf integrates to at most 1 and that no sample
 lands where the pdf says none can, and that every sample's reported pdf equals

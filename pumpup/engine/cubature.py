@@ -323,12 +323,12 @@ def _rule(brdf, g, prob, piece, x0, x1, t0, t1, chunk=1_500_000):
     """
     from ..physics.quadrature import calibrated_array, mode_code
 
-    budget.check("the 2-D cubature refined its rectangles")  # (a time budget: pumpup.core.budget)
     mode = mode_code(smooth=False)  # raw |K - G| unless pumpup.physics.quadrature.MODE_2D says otherwise
     R = len(prob)
     out = np.empty((R, 4))
     per = max(1, chunk // 225)
     for a in range(0, R, per):
+        budget.check("the 2-D cubature refined its rectangles")  # (a time budget: pumpup.core.budget)
         sl = slice(a, min(R, a + per))
         n = sl.stop - sl.start
         hx = (x1[sl] - x0[sl])[:, None, None]

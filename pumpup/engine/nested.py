@@ -428,6 +428,8 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
     signs = (1.0,) if lobe.symmetric else (1.0, -1.0)
     axis = AXIS_CODE[lobe.axis]
     for c0 in range(0, B, CHUNK):
+        if c0:
+            budget.check("the nested quadrature refined its intervals")
         sl = slice(c0, min(B, c0 + CHUNK))
         n = (sl.stop - sl.start) * RI
         wi_, wo_, w_, v_ = wi[:n], wo[:n], weight[:n], vals[:n]

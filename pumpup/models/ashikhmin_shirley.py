@@ -186,9 +186,30 @@ class _Diffuse(BRDF):
         return AzimuthHint(ClosedForm(ulps=8.0), scale=diffuse_albedo)
 
 
-def _y_axis(mu, s, cos_a, sin_a):
-    """The half-vector azimuth beta = pi/2 (the tangent y axis) as a breakpoint: 0 + 1 cos(beta) = 0."""
-    return [(0.0, 1.0)]
+def _ridge_cuts(nu: float, nv: float):
+    """The kinks of an anisotropic lobe's hint: the y axis (beta = pi / 2: 0 + 1 cos(beta) = 0), and cuts of beta graded
+    geometrically towards the axis the lobe is a ridge along (the x axis, beta = 0 and pi, where nv > nu; the y axis
+    where nu > nv),
+    from pi / 4 down to a tenth of the ridge's width sqrt(min / max) (the lobe (N.h)^(nu cos^2 + nv sin^2) at the wide
+    exponent's polar angle 1 / sqrt(min) falls as exp(-max beta^2 / (2 min)) across the ridge).  Without the grading
+    the 2-D cubature met nu = 10, nv = 1000 at mu = 0.5 with 0.34106804 +- 3.3e-12 against 0.341068116566 of two
+    independent quadratures (tests/reference/ashikhmin_shirley.py).
+    """
+    lo, hi = min(nu, nv), max(nu, nv)
+    offsets = []
+    w = math.pi / 4
+    while w > 0.1 * math.sqrt(lo / hi):
+        w *= 0.5
+        offsets.append(w)
+    if nv > nu:  # ridge along x: cos(beta) = +-cos(w)
+        cuts = [(0.0, 1.0)] + [(-math.cos(w), 1.0) for w in offsets] + [(math.cos(w), 1.0) for w in offsets]
+    else:  # ridge along y: cos(beta) = +-sin(w)
+        cuts = [(0.0, 1.0)] + [(-math.sin(w), 1.0) for w in offsets] + [(math.sin(w), 1.0) for w in offsets]
+
+    def kinks(mu, s, cos_a, sin_a):
+        return cuts
+
+    return kinks
 
 
 @register("ashikhmin_shirley")
@@ -302,7 +323,7 @@ class AshikhminShirley(BRDF):
         # a lobe narrow across one axis is a ridge along the other
         nu, nv = self.p["nu"], self.p["nv"]
         return Lobe(axis="half", radial="power", sharpness=min(nu, nv), levels=(mu,), symmetric=True,
-                    kinks=None if nu == nv else _y_axis)
+                    kinks=None if nu == nv else _ridge_cuts(nu, nv))
 
     def azimuth_range(self):
         """None when isotropic (nu = nv), else pi / 2 (the albedo is even in x and in y)."""

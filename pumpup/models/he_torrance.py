@@ -61,7 +61,7 @@ the known geometric-optics limit of the Kirchhoff theory.
 
 Where 000 and the original differ: 000 cites the model (ref. 7) and shows its albedo for
 sigma_0 = 0.1, tau = 1.7 with F = 1 (Fig. 5) without a wavelength; HTSG give sigma_0 and
-tau in micrometres.  000 Table 1 calls it physically plausible; measured here (docs/user-guide.md, "He-Torrance"), it is
+tau in micrometres.  000 Table 1 calls it physically plausible; measured here (docs/studies/he-torrance.md), it is
 reciprocal to the last bit but its albedo with F = 1 exceeds 1 by up to 4 % near 80 degrees
 (1e-4 at normal incidence), so it is not energy-conserving in this unpolarised form.  The
 specular part makes it a BRDF with a delta, which 000 does not discuss.

@@ -61,7 +61,7 @@ def phong_hs(mu, n: float) -> np.ndarray:
     N.V = mu u + s sqrt(1 - u^2) cos(beta).  For u >= s the whole circle is visible; for
     u < s the visible arc is |beta| < beta0 with sin(beta0) sqrt(1 - u^2) s = sqrt(s^2 - u^2)
     and beta0 = pi/2 + atan(mu u / sqrt(s^2 - u^2)).  Integrating beta in closed form and
-    substituting u = s sin(phi) gives
+    substituting u = s sin(phi) gives::
 
         H_s = pi mu (2 - s^(n+2)) / (n + 2)
               + s^(n+2) [B((n+1)/2, 3/2) + 2 mu K],

@@ -50,7 +50,7 @@ FILE_KINDS: dict = {}
 #: accuracy of the albedo tables that pumped BRDFs divide by: g is an upper bound that exceeds
 #: the albedo by about 2 x TABLE_INTERP_TOL, so the pumped albedo is lower than the ideal by
 #: that much (relative); tighter tolerances cost 3 x more time per table, looser ones save 2-4 x
-#: (docs/user-guide.md); keep TABLE_RTOL <= TABLE_INTERP_TOL / 100, or quadrature noise makes the grid refine
+#: (docs/user-guide/pumping.md); keep TABLE_RTOL <= TABLE_INTERP_TOL / 100, or quadrature noise makes the grid refine
 #: (1e-8 with 1e-7: 6 x slower, measured)
 TABLE_RTOL = 1e-9
 TABLE_INTERP_TOL = 1e-7

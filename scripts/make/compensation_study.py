@@ -34,7 +34,6 @@ import time
 import numpy as np
 
 import pumpup
-from pumpup.tables import atomic_path
 
 METHODS = ("base", "kulla_conty", "scale", "g1", "g2")
 MU = np.array([1.0, 0.9, 0.7, 0.5, 0.3, 0.1, 0.03, 1e-2, 1e-3, 1e-4, 1e-6])
@@ -235,49 +234,10 @@ def study(quick: bool = False, progress=print):
 
 
 def plot(ds, path):
-    import matplotlib
+    """figures/compensation.png: :func:`pumpup.plots.compensation` (the gallery draws it with the same function)."""
+    from pumpup.plots import compensation
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(1, 3, figsize=(15, 4.3))
-    colors = {"base": "k", "kulla_conty": "C0", "scale": "C1", "g1": "C2", "g2": "C3"}
-    theta_o = np.degrees(np.arccos(ds.mu.values))
-    for model, ls in (("ggx alpha=0.3", "-"), ("ggx alpha=1", "--")):
-        if model not in ds.model.values:
-            continue
-        for method in ds.method.values:
-            ax[0].plot(theta_o, ds.furnace.sel({"model": model, "method": method}), ls, color=colors[method],
-                       label=f"{method} ({model})" if ls == "-" else None, marker=".")
-    ax[0].set_xlabel("viewing angle theta_o [deg]")
-    ax[0].set_ylabel("white furnace (albedo)")
-    ax[0].set_title("furnace: GGX alpha 0.3 (solid), 1.0 (dashed)")
-    ax[0].legend(fontsize=7)
-    for method in ds.method.values[1:]:
-        for model, ls in (("ggx alpha=0.3", "-"), ("phong n=20", ":")):
-            if model in ds.model.values:
-                ax[1].plot(ds.theta_i, ds.mirror_ratio.sel({"model": model, "method": method}), ls, color=colors[method],
-                           marker=".", label=f"{method} ({model})")
-    ax[1].set_yscale("log")
-    ax[1].set_xlabel("theta_i [deg]")
-    ax[1].set_ylabel("f_c(wi, R) / f(wi, R)")
-    ax[1].set_title("point light, mirror direction, against the base")
-    ax[1].legend(fontsize=7)
-    for method in ds.method.values:
-        for arrangement, ls in (("lobe", "-"), ("mix", "--")):
-            r = ds.metal_residual.sel({"alpha": ds.alpha.values[0], "arrangement": arrangement, "method": method})
-            ax[2].semilogy(ds.metalness, np.maximum(r, 1e-17), ls, color=colors[method], marker="o",
-                           label=f"{method} ({arrangement})")
-    ax[2].axhline(1e-6, color="gray", lw=0.8)
-    ax[2].set_xlabel("metalness m")
-    ax[2].set_ylabel("max |1 - a|")
-    ax[2].set_title(f"(1 - m) Lambert + m GGX {float(ds.alpha.values[0]):g}")
-    ax[2].legend(fontsize=6, ncol=2)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:  # no half PNG if interrupted
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
-    return path
+    return compensation(ds, path)
 
 
 def markdown(ds) -> str:

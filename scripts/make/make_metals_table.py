@@ -70,43 +70,10 @@ def build(path="tables/metals.nc"):
 
 
 def figure(ds, path="figures/metals.png"):
-    import matplotlib
+    """figures/metals.png: :func:`pumpup.plots.metals` (the gallery draws it with the same function)."""
+    from pumpup.plots import metals
 
-    matplotlib.use("Agg")
-    import colour
-    import matplotlib.pyplot as plt
-
-    from pumpup import spectral
-    from pumpup.tables import atomic_path
-
-    fig, axes = plt.subplots(2, 4, figsize=(14, 6.5), sharex=True, sharey=True)
-    w = ds["wavelength"].values
-    line_rgb = np.clip(colour.XYZ_to_sRGB(colour.wavelength_to_XYZ(w)), 0, None)
-    line_rgb = line_rgb / line_rgb.max(axis=1, keepdims=True)
-    theta = ds["theta"].values
-    for j, n in enumerate(ds["exponent"].values):
-        for i, m in enumerate(ds["metal"].values):
-            ax = axes[j, i]
-            for v, style in zip(ds["variant"].values, ["-", "--", ":"]):
-                a = ds["albedo"].sel(metal=m, exponent=n, variant=v).values
-                for q in range(w.size):
-                    ax.plot(theta, a[:, q], style, color=line_rgb[q], lw=1.2)
-                rgb = np.clip(spectral.to_srgb(a, w, encoded=True), 0, 1)
-                y0 = {"stretched": 0.02, "pumped": 0.08, "colour_keeping": 0.14}[str(v)]
-                ax.scatter(theta, np.full(theta.size, y0), c=rgb, s=60, marker="s", edgecolors="k", linewidths=0.3)
-            ax.set_title(f"{m}, n = {n:g}")
-            ax.set_ylim(0, 1.05)
-            ax.grid(alpha=0.3)
-    for ax in axes[-1]:
-        ax.set_xlabel("theta_i [deg]")
-    for ax in axes[:, 0]:
-        ax.set_ylabel("albedo")
-    fig.suptitle("Albedo per wavelength (line colour = wavelength, 400-680 nm): eq. 28 solid, pumped per wavelength "
-                 "dashed, colour-keeping pumped dotted;\nsquares: sRGB of the albedo spectrum (bottom to top: eq. 28, "
-                 "pumped, colour-keeping)", fontsize=9)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:  # no half PNG if interrupted
-        fig.savefig(tmp, dpi=110, format="png")
+    return metals(ds, path)
 
 
 if __name__ == "__main__":

@@ -437,3 +437,15 @@ def test_isotropic_lobe_takes_a_1d_route(spec):
     assert np.all(np.abs(a - b) <= e + eb), (np.abs(a - b) / (e + eb)).max()
     assert np.all(e <= 1e-10 * a)
     assert {r for _, t in load(nu=10, nv=1000, rs=0.5).albedo_terms() for r, _, _ in plan(t, mu)} == {"nested"}
+
+
+@pytest.mark.parametrize("nu, nv, mu, phi", [(10, 1000, 0.5, 0.0), (1000, 10, 0.5, 0.0), (10, 1000, 0.05, 0.0),
+                                             (10, 1000, 0.5, 0.7), (100, 10000, 0.5, 0.0)])
+@pytest.mark.parametrize("engine", ["nested", "2d"])
+def test_strongly_anisotropic_albedo_within_its_error_on_every_engine(nu, nv, mu, phi, engine):
+    """A lobe narrow across one axis is a ridge along the other: both engines resolve it (the hint's cuts graded
+    towards the ridge) and their estimates bound the error against the independent cylindrical quadrature."""
+    f = pumpup.load({"type": "ashikhmin_shirley", "nu": nu, "nv": nv, "rs": 0.5})
+    a, e = pumpup.albedo(f, mu, phi=phi, return_error=True, rtol=1e-10, engine=engine)
+    r, r_err = ref.albedo_cylinder(mu, nu, nv, 0.5, phi=phi, n=30)
+    assert abs(float(a) - r) <= float(e) + r_err

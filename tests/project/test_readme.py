@@ -1,7 +1,8 @@
-"""Every ```python and ```bash block of README.md and docs/user-guide.md runs.
+"""Every ```python and ```bash block of README.md and of the documentation's Markdown pages (docs/) runs.
 
-The python blocks run in order as ONE script (a file, as a user would save them; the processes
-scheduler of the sweep example then needs its main guard) in a fresh process.  The bash blocks
+The python blocks of one document run in order as ONE script (a file, as a user would save them; the
+processes scheduler of the sweep example then needs its main guard) in a fresh process: every page
+stands on its own, as a reader who opens it sees it.  The bash blocks
 run line by line with ``pumpup`` meaning this checkout's command line.  Both run in a scratch
 directory that mirrors the repository root (a symlink to every top-level entry but .git), so
 the examples read what they would read from the root while the files they write (tables,
@@ -24,8 +25,32 @@ import pytest
 
 ROOT = str(helpers.ROOT)
 README = os.path.join(ROOT, "README.md")
-#: the documents whose examples run, in this order (the user guide's python blocks continue the README's script)
-DOCUMENTS = [README, os.path.join(ROOT, "docs", "user-guide.md")]
+DOCS = os.path.join(ROOT, "docs")
+#: folders of docs/ that hold generated pages or a page's data, not pages (docs/conf.py's exclude_patterns)
+GENERATED = ("_build", "gallery", "reference/generated", "reference/modules", "examples")
+
+
+def _not_a_page_folder(rel: str) -> bool:
+    """Whether docs/``rel`` holds no pages: a generated folder, or a user-guide page's own data folder."""
+    parts = rel.split(os.sep)
+    generated = any(rel == g or rel.startswith(g + os.sep) for g in GENERATED)
+    return generated or (len(parts) > 1 and parts[0] == "user-guide")
+
+
+def doc_pages() -> list[str]:
+    """Every Markdown page of the documentation site (docs/), sorted; a page added later is run unchanged."""
+    out = []
+    for folder, dirs, files in os.walk(DOCS):
+        rel = os.path.relpath(folder, DOCS)
+        if rel != "." and _not_a_page_folder(rel):
+            dirs[:] = []
+            continue
+        out += [os.path.join(folder, name) for name in files if name.endswith(".md")]
+    return sorted(out)
+
+
+#: the documents whose examples run: the README, then every page of the site
+DOCUMENTS = [README, *doc_pages()]
 
 #: commands of the README's bash blocks that the default suite does not run, with the reason
 EXPENSIVE = {
@@ -34,8 +59,13 @@ EXPENSIVE = {
     "pumpup render scene 000-fig8 --spp 64 --size 256 --variant auto --out scenes":
         "a path-traced scene, minutes: run by test_expensive_bash_commands (-m slow)",
 }
+EXPENSIVE.update({
+    "python -m pytest -q -m slow": "the slow test suite itself: a test cannot run it inside itself",
+    "python -m sphinx -W -b html docs docs/_build/html":
+        "the documentation build, minutes: tests/project/test_docs.py builds it (-m slow) and .ci/run",
+})
 #: commands that are never run by a test, even with -m slow
-NEVER = {"python -m pytest -q"}
+NEVER = {"python -m pytest -q", "python -m pytest -q -m slow", "python -m sphinx -W -b html docs docs/_build/html"}
 
 
 def blocks(text=None):
@@ -118,14 +148,24 @@ def workspace(tmp_path):
     return work, env
 
 
-def test_python_blocks_run_as_one_script(workspace):
+def python_script(path) -> str:
+    """The python blocks of one document as one script, each block headed by its line number."""
+    rel = os.path.relpath(path, ROOT)
+    return "\n".join(f"# --- {rel} line {line}\n{code}" for lang, code, line in blocks(open(path).read())
+                     if lang == "python")
+
+
+def test_every_page_is_found():
+    names = {os.path.relpath(p, ROOT) for p in DOCUMENTS}
+    assert {"README.md", "docs/getting-started.md", "docs/user-guide/albedo.md"} <= names
+    assert not any("_build" in n or n.startswith("docs/gallery") for n in names)
+
+
+@pytest.mark.parametrize("path", [p for p in DOCUMENTS if python_script(p)], ids=lambda p: os.path.relpath(p, ROOT))
+def test_python_blocks_run_as_one_script(workspace, path):
     work, env = workspace
-    code = []
-    for lang, block, line in blocks():
-        if lang == "python":
-            code.append(f"# --- {line}\n{block}")
-    script = work / "readme_examples.py"
-    script.write_text("\n".join(code))
+    script = work / "doc_examples.py"
+    script.write_text(python_script(path))
     r = subprocess.run([sys.executable, str(script)], cwd=work, env=env, capture_output=True, text=True,
                        timeout=900)
     assert r.returncode == 0, r.stderr[-3000:]
