@@ -378,6 +378,144 @@ vec2 pumpup_base(vec3 l, vec3 v) {{
 """
 
 
+def _power_lines(var: str, err_abs: str, n: str) -> str:
+    """GLSL lines: ``float pw = var^n`` as exp2(n log2 var) and ``float pe``, a bound of its relative error, for
+    ``var`` > 0 with absolute error ``err_abs``.
+    """
+    return f"""\
+    float l2 = log2({var});
+    float z = {n} * l2;
+    float pw = exp2(z);
+    float pe = pumpup_exp_err(z, 0.6931472 * ({n} * ({err_abs} / ({var} * 0.6931472) + pumpup_log_err(l2))
+        + 2.0 * pumpup_U * abs(z)));
+"""
+
+
+def _retro_code(b: BRDF) -> str:
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float lv = dot(l, v);  // L.V (absolute error <= 6 U)
+    if (lv <= 0.0) return vec2(0.0);
+{_power_lines("lv", "6.0 * pumpup_U", "pumpup_n")}    float mx = max(l.z, v.z);
+    float f = pumpup_c * pw;
+    float e = pe + 4.0 * pumpup_U;
+    if (pumpup_p == 1.0) {{
+        f /= mx;
+        e += 5.0 * pumpup_U;
+    }} else {{
+        float lm = log2(mx);
+        float zp = pumpup_p * lm;
+        f /= exp2(zp);
+        e += pumpup_exp_err(-abs(zp), 0.6931472 * (pumpup_p * pumpup_log_err(lm) + 2.0 * pumpup_U * abs(zp)))
+            + 5.0 * pumpup_U;
+    }}
+    return vec2(f, e);  // c (L.V)^n / max(N.L, N.V)^p, 000 eq. 13
+}}
+"""
+
+
+def _metal_code(b: BRDF) -> str:
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float rv = 2.0 * l.z * v.z - dot(l, v);  // R.V, 000 eq. 9 (absolute error <= 8 U)
+    if (rv <= 0.0) return vec2(0.0);
+{_power_lines("rv", "11.6 * pumpup_U", "pumpup_n")}    float mx = max(l.z, v.z);  // cos(Theta_min)
+    vec2 fr = pumpup_fresnel_conductor(mx, pumpup_eta, pumpup_k);
+    return vec2(pumpup_c * pw / mx * fr.x, pe + fr.y + 10.0 * pumpup_U);  // 000 eq. 28
+}}
+"""
+
+
+def _plastic_code(b: BRDF) -> str:
+    fres = ("vec2 fr = pumpup_fresnel_conductor(mx, pumpup_eta, 0.0);  // 000 eq. 30" if b.p["eta"] is not None
+            else "vec2 fr = vec2(1.0, 0.0);")
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float f = pumpup_ad * 0.318309886;
+    float rv = 2.0 * l.z * v.z - dot(l, v);  // R.V, 000 eq. 9 (absolute error <= 8 U)
+    if (rv <= 0.0) return vec2(f, 6.0 * pumpup_U);
+{_power_lines("rv", "11.6 * pumpup_U", "pumpup_n")}    float mx = max(l.z, v.z);  // cos(Theta_min)
+    {fres}
+    float spec = pumpup_a_s * (pumpup_n + 2.0) / (2.0 * pumpup_PI) * pw / mx * fr.x;  // 000 eq. 29
+    return vec2(f + spec, max(6.0 * pumpup_U, pe + fr.y + 14.0 * pumpup_U) + 2.0 * pumpup_U);
+}}
+"""
+
+
+def _minnaert_code(b: BRDF) -> str:
+    return """\
+vec2 pumpup_base(vec3 l, vec3 v) {
+    float k1 = pumpup_k - 1.0;
+    float al = log2(l.z);
+    float av = log2(v.z);
+    float zl = k1 * al;
+    float zv = k1 * av;
+    float f = pumpup_b * exp2(zl) * exp2(zv);  // b ((N.S)(N.V))^(k - 1), 002 sec. 3.4
+    float el = pumpup_exp_err(zl, 0.6931472 * (abs(k1) * pumpup_log_err(al) + 2.0 * pumpup_U * abs(zl)
+        + pumpup_U * pumpup_k * abs(al)));
+    float ev = pumpup_exp_err(zv, 0.6931472 * (abs(k1) * pumpup_log_err(av) + 2.0 * pumpup_U * abs(zv)
+        + pumpup_U * pumpup_k * abs(av)));
+    return vec2(f, el + ev + 4.0 * pumpup_U);
+}
+"""
+
+
+def _lacquer_code(b: BRDF) -> str:
+    return """\
+vec2 pumpup_base(vec3 l, vec3 v) {
+    float x = pumpup_s / l.z + pumpup_s / v.z;
+    return vec2(pumpup_c * exp(-x), pumpup_exp_err(-x, 8.0 * pumpup_U * x) + 4.0 * pumpup_U);  // 002 sec. 3.3
+}
+"""
+
+
+def _phong_shader_code(b: BRDF) -> str:
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float rv = 2.0 * l.z * v.z - dot(l, v);  // R.V (absolute error <= 8 U)
+    if (rv <= 0.0) return vec2(pumpup_kd, pumpup_U);
+{_power_lines("rv", "11.6 * pumpup_U", "pumpup_n")}    float spec = pumpup_ks * pw / l.z;  // 002 eq. 5, 8
+    return vec2(pumpup_kd + spec, max(pumpup_U, pe + 9.0 * pumpup_U) + 2.0 * pumpup_U);
+}}
+"""
+
+
+def _phong_blinn_code(b: BRDF) -> str:
+    return """\
+vec2 pumpup_base(vec3 l, vec3 v) {
+    float t = pumpup_tan2_half(l, v);
+    vec2 lp = pumpup_log1p(t);  // -ln (N.H)^2
+    float x = -0.5 * pumpup_n * lp.x;
+    float spec = pumpup_ks * exp(x);  // 002 eq. 24, 6
+    float dx = 0.5 * pumpup_n * (lp.y + 22.0 * pumpup_U * t / (1.0 + t)) + 2.0 * pumpup_U * abs(x);
+    return vec2(pumpup_kd + spec, max(pumpup_U, pumpup_exp_err(x, dx) + 4.0 * pumpup_U) + 2.0 * pumpup_U);
+}
+"""
+
+
+def _lafortune_code(b: BRDF) -> str:
+    err = "8.0 * pumpup_U * (abs(pumpup_cx) + abs(pumpup_cy) + abs(pumpup_cz))"
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float rv = pumpup_cz * (l.z * v.z) - pumpup_cx * (l.x * v.x) - pumpup_cy * (l.y * v.y);  // 000 eq. 14
+    if (rv <= 0.0) return vec2(0.0);
+{_power_lines("rv", err, "pumpup_n")}    float f = pumpup_c * pw;
+    float e = pe + 4.0 * pumpup_U;
+    if (pumpup_p == 1.0) {{
+        f /= max(l.z, v.z);
+        e += 5.0 * pumpup_U;
+    }} else if (pumpup_p != 0.0) {{
+        float lm = log2(max(l.z, v.z));
+        float zp = pumpup_p * lm;
+        f /= exp2(zp);  // max(N.L, N.V)^p, 000 eq. 15
+        e += pumpup_exp_err(-abs(zp), 0.6931472 * (pumpup_p * pumpup_log_err(lm) + 2.0 * pumpup_U * abs(zp)))
+            + 5.0 * pumpup_U;
+    }}
+    return vec2(f, e);
+}}
+"""
+
+
 #: type -> (the parameters that become uniforms, code generator)
 _MODELS = {
     "lambert": (("albedo",), _lambert_code),
@@ -391,10 +529,18 @@ _MODELS = {
     "schlick": (("r", "c"), _schlick_code),
     "ggx": (("alpha", "ior", "eta", "k"), _microfacet_code),
     "beckmann": (("alpha", "ior", "eta", "k"), _microfacet_code),
+    "retro": (("n", "p", "c"), _retro_code),
+    "metal": (("n", "eta", "k", "c"), _metal_code),
+    "plastic": (("n", "ad", "a_s", "eta"), _plastic_code),
+    "minnaert": (("k", "b"), _minnaert_code),
+    "lacquer": (("c", "s"), _lacquer_code),
+    "phong_shader": (("n", "ks", "kd"), _phong_shader_code),
+    "phong_blinn": (("n", "ks", "kd"), _phong_blinn_code),
+    "lafortune": (("n", "cx", "cy", "cz", "p", "c"), _lafortune_code),
 }
 
 #: the model types :func:`shader` translates (and the operators over them)
-SUPPORTED = tuple(sorted(_MODELS)) + ("pumped", "kulla_conty", "scaled")
+SUPPORTED = tuple(sorted(_MODELS)) + ("pumped", "kulla_conty", "scaled", "fresnel")
 
 
 def error_bound_text() -> dict[str, str]:
@@ -408,6 +554,14 @@ def error_bound_text() -> dict[str, str]:
         "schlick": "192 U",
         "ggx": "128 U + Fresnel + 2 x 1.5e-6 (Smith) + 24 U",
         "beckmann": "(exp) + 31 U tan^2/alpha^2 + 64 U + Fresnel + 2 x 3.2e-6 (Smith with erf) + 24 U",
+        "retro": "as phong with L.V (absolute error 6 U) and the max(N.L, N.V)^p term",
+        "metal": "as phong + conductor Fresnel + 10 U",
+        "plastic": "max(6 U, phong's + Fresnel + 14 U) + 2 U",
+        "minnaert": "two exp2 terms e(z, |k - 1| (2^-21 + 6 U |log2 mu|) + 2 U |z| + U k |log2 mu|) + 4 U",
+        "lacquer": "e(-x, 8 U x) + 4 U, x = s (1/N.L + 1/N.V)",
+        "phong_shader": "max(U, phong's + 9 U) + 2 U",
+        "phong_blinn": "max(U, blinn's) + 2 U",
+        "lafortune": "as phong with the lobe's absolute error 8 U (|cx| + |cy| + |cz|) and the max(N.L, N.V)^p term",
     }
 
 
@@ -435,6 +589,13 @@ class _Plan:
         self.levels: list = []
         self.comp = None
         b = brdf
+        #: (eta, k) of an outer ``fresnel`` model (base x F(Theta_min), 000 eq. 28), else None
+        self.fresnel = None
+        if b.type == "fresnel" and np.ndim(b.p["eta"]) == 0 and np.ndim(b.p["k"]) == 0:
+            self.fresnel = (float(b.p["eta"]), float(b.p["k"]))
+            b = b.p["base"]
+            if isinstance(b, (KullaConty, Scaled)):
+                raise _unsupported(b, "inside 'fresnel': F(Theta_min) over a compensation")
         if isinstance(b, (KullaConty, Scaled)):
             self.comp = b
             b = b.base
@@ -451,6 +612,8 @@ class _Plan:
         self.baked = bool(self.levels) or self.comp is not None
         names = _MODELS[b.type][0]
         self.params = {k: float(b.p[k]) for k in names if b.p.get(k) is not None}
+        if self.fresnel is not None:
+            self.params["fresnel_eta"], self.params["fresnel_k"] = self.fresnel
         s = math.sqrt(0.5)
         peak = np.asarray(brdf.eval(np.array([[0.0, 0.0, 1.0], [s, 0.0, s]]),
                                     np.array([[0.0, 0.0, 1.0], [-s, 0.0, s]])))
@@ -507,6 +670,43 @@ def _poly_error(coef: np.ndarray, w: np.ndarray, delta: np.ndarray) -> np.ndarra
     return err
 
 
+#: cells per octave of the piece index (the float32 bits of the variable, as pumpup's kernel uses the float64 bits)
+_CELL_BITS = 4
+
+
+def _search(bounds32: np.ndarray, nm: str, var: str) -> tuple[str, str]:
+    """GLSL that sets ``int i`` to the largest s with ``{nm}_b[s] <= var`` (``var`` >= the first bound, a float32 >
+    0): the cell of ``var`` from its float32 bits (2^_CELL_BITS cells per octave, as
+    :func:`pumpup.physics.lookups.g_product` finds a piece from the float64 bits), the first candidate piece of the
+    cell, then a binary search of fixed length over the cell's pieces.  (arrays, code).
+    """
+    b = np.asarray(bounds32, dtype=np.float32)
+    n = len(b)
+    shift = 23 - _CELL_BITS
+    bits = b.view(np.uint32).astype(np.int64)
+    cbase = int(bits[0] >> shift)
+    cend = int(np.array([1.0], np.float32).view(np.uint32)[0] >> shift)
+    ncell = max(cend - cbase + 1, 1)
+    starts = ((np.arange(ncell, dtype=np.int64) + cbase) << shift).astype(np.uint32).view(np.float32)
+    ends = ((np.arange(ncell, dtype=np.int64) + cbase + 1) << shift).astype(np.uint32).view(np.float32)
+    first = np.clip(np.searchsorted(b, starts, side="right") - 1, 0, n - 1)
+    last = np.clip(np.searchsorted(b, ends, side="left") - 1, 0, n - 1)
+    count = int(np.max(last - first)) + 1
+    steps = []
+    k = 1
+    while k < count:
+        k *= 2
+    k //= 2
+    while k >= 1:
+        steps.append(f"    j = i + {k}; if (j <= {n - 1} && {nm}_b[j] <= {var}) i = j;")
+        k //= 2
+    vals = ", ".join(str(int(x)) for x in first)
+    arrays = _array(f"{nm}_b", b) + f"const int {nm}_cs[{ncell}] = int[{ncell}]({vals});\n"
+    code = (f"    int i = {nm}_cs[clamp(int(floatBitsToUint({var}) >> {shift}u) - {cbase}, 0, {ncell - 1})];\n"
+            "    int j;\n" + "\n".join(steps) + ("\n" if steps else ""))
+    return arrays, code
+
+
 class _LevelTable:
     """One level's upper bound u(mu) (:func:`pumpup.physics.lookups.upper_scalar`), as the shader reads it."""
 
@@ -523,6 +723,9 @@ class _LevelTable:
         x32 = logx[:-1].astype(np.float32)
         delta = (2.0**-21 + 6.0 * U * lmax) + np.abs(x32.astype(np.float64) - logx[:-1]) + U * (w + lmax) * 2.0
         err = _poly_error(coef, w, delta)
+        vals = np.min([np.polyval(coef, w * f) for f in np.linspace(0.0, 1.0, 9)], axis=0) + lk.margin
+        #: the largest relative amount by which a piece was raised (half the piece's smallest sampled value)
+        self.rel = float(np.max(2.0 * err / np.maximum(0.5 * np.minimum(vals, lk.cap), 1e-300)))
         coef[-1] += lk.margin + 2.0 * err  # the bound of upper_scalar, raised by twice the float32 error
         self.err = err
         self.coef32 = coef.astype(np.float32)
@@ -537,18 +740,9 @@ class _LevelTable:
         self.margin = float(lk.margin)
 
     def glsl(self) -> str:
-        nm, n = self.name, self.npieces
-        d = self.deg
-        out = [_array(f"{nm}_k", self.knots), _array(f"{nm}_x", self.logx32),
-               _array(f"{nm}_c", self.coef32.T.ravel())]
-        steps = []
-        s = 1
-        while s < n:
-            s *= 2
-        s //= 2
-        while s >= 1:
-            steps.append(f"    c = i + {s}; if (c <= {n - 1} && {nm}_k[c] <= mu) i = c;")
-            s //= 2
+        nm, d = self.name, self.deg
+        arrays, search = _search(self.knots, nm, "mu")
+        out = [arrays, _array(f"{nm}_x", self.logx32), _array(f"{nm}_c", self.coef32.T.ravel())]
         horner = f"{nm}_c[b]"
         for r in range(1, d + 1):
             horner = f"({horner}) * dd + {nm}_c[b + {r}]" if r > 1 else f"{nm}_c[b] * dd + {nm}_c[b + 1]"
@@ -556,21 +750,18 @@ class _LevelTable:
         v0 = _lit(_up32(self.v0))
         mlo = _lit(_up32(self.margin_lo * (1.0 + 4 * U)))
         out.append(f"""\
-// the upper bound of the level's albedo at mu in (0, 1] (pumpup.physics.lookups.upper_scalar): the spline piece in
-// ln(mu) that holds mu, a power law below the first node, at most the cap
-float {nm}_u(float mu) {{
-    float lm = log(mu);
-    if (mu < {nm}_k[0]) {{
+// the upper bound of the level's albedo at mu in (0, 1] (pumpup.physics.lookups.upper_scalar), lm = log(mu): the
+// spline piece in ln(mu) that holds mu, a power law below the first node, at most the cap
+float {nm}_u(float mu, float lm) {{
+    if (mu < {nm}_b[0]) {{
         float x = {_lit(self.slope0)} * (lm - {_lit(self.logx0)});
-        float dx = abs({_lit(self.slope0)}) * (pumpup_log_err(lm) + 2.0 * pumpup_U * (abs(lm) + {_lit(abs(self.logx0))}))
+        float dx = abs({_lit(self.slope0)})
+            * (pumpup_log_err(lm) + 2.0 * pumpup_U * (abs(lm) + {_lit(abs(self.logx0))}))
             + 2.0 * pumpup_U * abs(x);
         float u = {v0} * exp(x) * (1.0 + 2.0 * pumpup_exp_err(x, dx) + 4.0 * pumpup_U) + {mlo};
         return {cap};
     }}
-    int i = 0;
-    int c;
-{chr(10).join(steps)}
-    float dd = lm - {nm}_x[i];
+{search}    float dd = lm - {nm}_x[i];
     int b = {d + 1} * i;
     float u = {horner};
     return {cap};
@@ -609,6 +800,9 @@ class _ProductTable:
         err = _poly_error(qh, smax, U * smax) + 1e-15 * np.sum(np.abs(qh) * smax ** np.arange(deg, -1, -1)[:, None],
                                                                axis=0)
         qh = qh.copy()
+        vals = np.min([np.polyval(coef, t) for t in np.linspace(-1.0, 1.0, 9)], axis=0)
+        #: the largest relative amount by which a piece was raised (half the piece's smallest sampled value)
+        self.rel = float(np.max(2.0 * err / np.maximum(0.5 * vals, 1e-300)))
         qh[-1] += 2.0 * err
         self.err = err
         self.coef32 = qh.astype(np.float32)
@@ -622,27 +816,17 @@ class _ProductTable:
         self.epsilon = float(getattr(prod, "epsilon", 0.0))
 
     def glsl(self) -> str:
-        nm, n, d = self.name, self.npieces, self.deg
-        out = [_array(f"{nm}_lo", self.lo32), _array(f"{nm}_cen", self.c32), _array(f"{nm}_ih", self.ih32),
+        nm, d = self.name, self.deg
+        arrays, search = _search(self.lo32, nm, "m")
+        out = [arrays, _array(f"{nm}_cen", self.c32), _array(f"{nm}_ih", self.ih32),
                _array(f"{nm}_c", self.coef32.T.ravel())]
-        steps = []
-        s = 1
-        while s < n:
-            s *= 2
-        s //= 2
-        while s >= 1:
-            steps.append(f"    c = i + {s}; if (c <= {n - 1} && {nm}_lo[c] <= m) i = c;")
-            s //= 2
         horner = f"{nm}_c[b] * t + {nm}_c[b + 1]"
         for r in range(2, d + 1):
             horner = f"({horner}) * t + {nm}_c[b + {r}]"
         out.append(f"""\
 // the product table at m (> its lower end): the polynomial piece that holds m (pumpup.physics.lookups.g_product)
 float {nm}_g(float m) {{
-    int i = 0;
-    int c;
-{chr(10).join(steps)}
-    float t = (m - {nm}_cen[i]) * {nm}_ih[i];
+{search}    float t = (m - {nm}_cen[i]) * {nm}_ih[i];
     int b = {d + 1} * i;
     return {horner};
 }}
@@ -689,9 +873,9 @@ def _pumped_glsl(plan: _Plan) -> tuple[str, list[str], int]:
     for j, (t, controlled) in enumerate(levels):
         nm = t.name
         if t.increasing:
-            look = (f"mmin > {_lit(_down32(t.mu0))} ? {nm}_u(mmax) : max({nm}_u(mi), {nm}_u(mo))")
+            look = (f"mmin > {_lit(_down32(t.mu0))} ? {nm}_u(mmax, lmax) : max({nm}_u(mi, li), {nm}_u(mo, lo))")
         else:
-            look = f"max({nm}_u(mi), {nm}_u(mo))"
+            look = f"max({nm}_u(mi, li), {nm}_u(mo, lo))"
         body.append(f"    float g{j + 1} = {look};  // 001 eq. 20")
         if controlled:
             body.append(f"    g{j + 1} = max(g{j + 1}, mmax);  // 001 eq. 21")
@@ -701,7 +885,10 @@ def _pumped_glsl(plan: _Plan) -> tuple[str, list[str], int]:
 float pumpup_g(float mi, float mo) {{
     float mmax = max(mi, mo);
     float mmin = min(mi, mo);
-{cond}{chr(10).join(body)}
+{cond}    float li = log(mi);
+    float lo = log(mo);
+    float lmax = mi >= mo ? li : lo;
+{chr(10).join(body)}
     return {prod_expr};
 }}
 """)
@@ -721,9 +908,9 @@ def _comp_glsl(plan: _Plan) -> tuple[str, list[str]]:
         out.append(p.glsl())
         notes.append(f"product table of U in m: {p.npieces} pieces (degree {p.deg}) for m > {p.mlo:.6g}, relative fit "
                      f"<= {p.epsilon:.3g} (added), float32 error <= {float(np.max(p.err)):.3g} (added)")
-        look = f"m > {_lit(p.mlo32)} ? pumpup_eprod_g(m) : pumpup_e_u(m)"
+        look = f"m > {_lit(p.mlo32)} ? pumpup_eprod_g(m) : pumpup_e_u(m, log(m))"
     else:
-        look = "pumpup_e_u(m)"
+        look = "pumpup_e_u(m, log(m))"
     out.append(f"""\
 // U(m) >= E(m), at least pumpup's bound (pumpup.physics.lookups.scale_bound)
 float pumpup_upper(float m) {{
@@ -746,8 +933,8 @@ def table_error(spec: Any) -> dict[str, float]:
     Returns
     -------
     dict
-        ``{"relative": r, "absolute": a}``: a pumped value is at least pumpup's x (1 - 2 B - r); a ``scaled`` one too;
-        a ``kulla_conty`` one at least pumpup's base x (1 - 2 B - r) + its lobe - scale x 2 a (a: the largest amount by
+        ``{"relative": r, "absolute": a}``: a pumped value is at least pumpup's x (1 - 3 B - r); a ``scaled`` one too;
+        a ``kulla_conty`` one at least pumpup's base x (1 - 3 B - r) + its lobe - scale x 2 a (a: the largest amount by
         which the shader's U exceeds pumpup's).  Both 0 for a closed-form model.
     """
     plan = _Plan(spec if isinstance(spec, BRDF) else load(spec))
@@ -756,21 +943,22 @@ def table_error(spec: Any) -> dict[str, float]:
         for lev in plan.levels:
             lk = lev.lookup()
             t = _LevelTable(lk, "x")
-            rel += 2.0 * float(np.max(t.err)) / (0.5 * float(np.min(lk.table.value)))
+            rel += t.rel
         prod = plan.levels[-1].product()
         if prod is not None:
             p = _ProductTable(prod, "x")
-            gmin = float(np.min(prod.exact(np.asarray(prod.lo[:-1], dtype=np.float64))))
-            rel += 2.0 * float(np.max(p.err)) / (0.5 * gmin)
+            rel += p.rel
         return {"relative": rel + 4.0 * (len(plan.levels) + 9) * U, "absolute": 0.0}
     if plan.comp is not None:
         bound = plan.comp.bound
         t = _LevelTable(bound.lookup, "x")
         a = 2.0 * float(np.max(t.err)) + 4.0 * U
+        rel = t.rel
         if bound.product is not None:
-            a = max(a, 2.0 * float(np.max(_ProductTable(bound.product, "x").err)) + 4.0 * U)
-        umin = 0.5 * float(np.min(bound.lookup.table.value))
-        return {"relative": a / umin + 32.0 * U, "absolute": a}
+            p = _ProductTable(bound.product, "x")
+            a = max(a, 2.0 * float(np.max(p.err)) + 4.0 * U)
+            rel = max(rel, p.rel)
+        return {"relative": rel + 32.0 * U, "absolute": a}
     return {"relative": 0.0, "absolute": 0.0}
 
 
@@ -787,7 +975,20 @@ def _library(plan: _Plan) -> tuple[str, list[str]]:
         parts.append(_ERF)
     parts.append(_param_decls(plan))
     parts.append(f"// the base model {b.type}: (f_r, a bound of its relative float32 error) for N.wi, N.wo > 0\n")
-    parts.append(code)
+    if plan.fresnel is not None:
+        if "pumpup_fresnel_conductor" not in code:
+            parts.append(_FRESNEL_CONDUCTOR)
+        parts.append(code.replace("vec2 pumpup_base(vec3 l, vec3 v)", "vec2 pumpup_base_inner(vec3 l, vec3 v)"))
+        parts.append("""\
+// the fresnel model: the base times F(eta + i k, Theta_min), cos(Theta_min) = max(N.wi, N.wo) (000 eq. 28)
+vec2 pumpup_base(vec3 l, vec3 v) {
+    vec2 f = pumpup_base_inner(l, v);
+    vec2 fr = pumpup_fresnel_conductor(max(l.z, v.z), pumpup_fresnel_eta, pumpup_fresnel_k);
+    return vec2(f.x * fr.x, f.y + fr.y + 2.0 * pumpup_U);
+}
+""")
+    else:
+        parts.append(code)
     notes: list[str] = []
     if plan.levels:
         glsl, notes, nlev = _pumped_glsl(plan)
@@ -961,7 +1162,9 @@ def _translate(lib: str, target: str) -> str:
 
 
 def _brdf_explorer(plan: _Plan, lib: str, header: str) -> str:
-    """A ``.brdf`` file of Disney's BRDF Explorer: the uniforms as its parameters, BRDF(L, V, N, X, Y) in world space."""
+    """A ``.brdf`` file of Disney's BRDF Explorer: the uniforms as its parameters, BRDF(L, V, N, X, Y) in world
+    space.
+    """
     from .core import registry
 
     cls = registry()[plan.base.type]

@@ -42,6 +42,7 @@ void main() {
 
 
 def generation_times() -> None:
+    """Print the time to build a 3-level pumped GGX's tables and to generate its shader."""
     print("generation (pumpup.shader, target glsl-es):")
     for g in ("g1", "g2"):
         spec = {"type": "pumped", "base": GGX, "g": g, "levels": 3}
@@ -60,6 +61,7 @@ def generation_times() -> None:
 
 
 def evaluation_times(pairs: int, repeat: int) -> None:
+    """Print the cost per pair of each case's GLSL on llvmpipe, and its ratio to its base's."""
     import moderngl
 
     ctx = moderngl.create_standalone_context(backend="egl", require=430)
@@ -115,6 +117,7 @@ def evaluation_times(pairs: int, repeat: int) -> None:
 
 
 def main() -> None:
+    """Run both measurements."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--pairs", type=int, default=1 << 20)
     ap.add_argument("--repeat", type=int, default=5)

@@ -104,7 +104,7 @@ def run(ctx, libraries: list[str], wi: np.ndarray, wo: np.ndarray, es: bool = Fa
     size = group
     for s in range(0, len(libraries), size):
         group = libraries[s:s + size]
-        head = "#version 300 es\nprecision highp float;\nprecision highp int;\n" if es else "#version 430 core\n"
+        head = "#version 300 es\nprecision highp float;\n" if es else "#version 430 core\n"
         src = [head]
         for k, lib in enumerate(group):
             src.append(renamed(lib, s + k))
@@ -112,7 +112,8 @@ def run(ctx, libraries: list[str], wi: np.ndarray, wo: np.ndarray, es: bool = Fa
         for k in range(len(group)):
             src.append(f"layout(location = {k}) out vec4 pumpup_test_out{k};\n")
         src.append("void main() {\n    ivec2 p = ivec2(gl_FragCoord.xy);\n"
-                   "    vec3 a = texelFetch(pumpup_test_wi, p, 0).xyz;\n    vec3 b = texelFetch(pumpup_test_wo, p, 0).xyz;\n"
+                   "    vec3 a = texelFetch(pumpup_test_wi, p, 0).xyz;\n"
+                   "    vec3 b = texelFetch(pumpup_test_wo, p, 0).xyz;\n"
                    "    bool up = a.z > 0.0 && b.z > 0.0;\n")
         for k in range(len(group)):
             j = s + k
@@ -174,12 +175,12 @@ def furnace(ctx, libraries: list[str], mu: np.ndarray, nodes: int = 256, es: boo
     size = group
     for s in range(0, len(libraries), size):
         group = libraries[s:s + size]
-        head = "#version 300 es\nprecision highp float;\nprecision highp int;\n" if es else "#version 430 core\n"
+        head = "#version 300 es\nprecision highp float;\n" if es else "#version 430 core\n"
         src = [head] + [renamed(lib, s + k) for k, lib in enumerate(group)]
         src.append("uniform highp sampler2D pumpup_test_nodes;\nuniform highp sampler2D pumpup_test_mu;\n")
         for k in range(len(group)):
             src.append(f"layout(location = {k}) out vec4 pumpup_test_out{k};\n")
-        src.append(f"""void main() {{
+        src.append("""void main() {
     int p = int(gl_FragCoord.x);
     float mu = texelFetch(pumpup_test_mu, ivec2(p, 0), 0).x;
     vec3 wi = vec3(sqrt(max(0.0, (1.0 - mu) * (1.0 + mu))), 0.0, mu);

@@ -154,6 +154,7 @@ WRITERS = {
     "fit": ["fit", "ggx:alpha=0.1", "--family", "phong", "--param", "n=2:300", "--out", "{p}/f.png"],
     "render": ["render", "sphere", "phong:n=2", "--out", "{p}/img"],
     "sweep": ["sweep", "phong", "--param", "n=1,2", "--out", "{p}/s.nc"],
+    "shader": ["shader", "phong:n=2", "--target", "glsl", "--out", "{p}/s.glsl"],
 }
 
 
