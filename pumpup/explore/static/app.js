@@ -601,7 +601,8 @@ function glProgram(canvas, glsl) {
   const code = glsl.split("\n").filter((line) => !line.startsWith("//")).join("\n");
   if (c.source !== code) {
     const gl = c.gl;
-    const src = "#version 300 es\nprecision highp float;\nprecision highp int;\n" + code + "\n" + MAIN;
+    // what the shader contract says the explorer prepends, and nothing else
+    const src = "#version 300 es\nprecision highp float;\n" + code + "\n" + MAIN;
     const prog = gl.createProgram();
     gl.attachShader(prog, compile(gl, gl.VERTEX_SHADER, VERTEX));
     gl.attachShader(prog, compile(gl, gl.FRAGMENT_SHADER, src));
