@@ -1111,6 +1111,16 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--out", default="scenes", help="directory for NAME.png and the panels' EXR (default scenes)")
     r.add_argument("--quiet", action="store_true", help="no progress lines (default: progress shown)")
     r.set_defaults(func=cmd_render_scene)
+    s = sub.add_parser("explore", help="look at BRDFs live in the browser: lobe, albedo, pumped and compensated, "
+                                       "lit and furnace spheres (needs the 'explore' extra)")
+    s.add_argument("spec", nargs="*", help="one to four model SPECs to open (default: phong:n=20)")
+    s.add_argument("--port", type=int, default=8765, help="the port, 0 for a free one (default: 8765)")
+    s.add_argument("--host", default="127.0.0.1",
+                   help="the address to listen on; any host but this machine's prints a warning (default: 127.0.0.1)")
+    s.add_argument("--no-browser", action="store_true", help="do not open the page in a browser (default: open it)")
+    s.add_argument("--time-limit", type=float, default=60.0,
+                   help="seconds one computation may take, in (0, 3600] (default: 60)")
+    s.set_defaults(func=cmd_explore)
     s = sub.add_parser("fit", help="fit a model family to a target: max relative error of f cos(theta_L) and of "
                                    "the albedo (perceptual, 001 sec. 1.1) or least squares")
     s.add_argument("target", help="the target's SPEC, e.g. ggx:alpha=0.1")
@@ -1132,6 +1142,21 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", help="write the comparison figure (PNG) here (default: none)")
     s.set_defaults(func=cmd_fit)
     return p
+
+
+def cmd_explore(args) -> int:
+    """``pumpup explore``: serve the explorer until Ctrl-C (bad specs, a taken port or a missing extra: status 2)."""
+    if len(args.spec) > 4:
+        raise SystemExit(f"pumpup: explore takes at most 4 specs, got {len(args.spec)}")
+    if not (0 <= args.port <= 65535):
+        raise SystemExit(f"pumpup: --port must be in [0, 65535], got {args.port}")
+    if not (math.isfinite(args.time_limit) and 0 < args.time_limit <= 3600):
+        raise SystemExit(f"pumpup: --time-limit must be in (0, 3600] seconds, got {args.time_limit:g}")
+    from . import explore
+
+    explore.serve(args.spec or None, host=args.host, port=args.port, open_browser=not args.no_browser,
+                  time_limit=args.time_limit)
+    return 0
 
 
 #: commands that compute nothing, so they never compile a kernel (no compile notice)
