@@ -1080,15 +1080,16 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("shader", help="shader code of a model with its tables baked in: GLSL, GLSL ES, HLSL, Metal "
                                       "or a BRDF Explorer file")
     s.add_argument("model", help="a spec: a closed-form model, pumped or compensated (e.g. ggx:alpha=0.3)")
-    s.add_argument("--target", default="glsl", help="glsl (default), glsl-es, hlsl, msl or brdf-explorer")
+    s.add_argument("--target", default="glsl", help="glsl, glsl-es, hlsl, msl or brdf-explorer (default: glsl)")
     s.add_argument("--out", help="the file to write (atomically); default: standard output")
     s.set_defaults(func=cmd_shader)
     s = sub.add_parser("audit", help="grade a shipped albedo table against pumpup's truth (status 1 beyond --tol)")
     s.add_argument("file", help="the shipped table to audit")
-    s.add_argument("--preset", help="cycles, filament, filament-centred, appleseed, bsdl, mitsuba, netcdf, exr (this "
-                                    "or --conventions)")
+    s.add_argument("--preset", help="cycles, filament, filament-centred, appleseed, bsdl, mitsuba, netcdf, exr "
+                                    "(this or --conventions is required)")
     s.add_argument("--conventions", help="a TOML or JSON file describing the table (model, quantity, format, "
-                                         "storage, shape, axes, look-up; see docs/user-guide/renderer-tables.md)")
+                                         "storage, shape, axes, look-up; see docs/user-guide/renderer-tables.md; "
+                                         "this or --preset is required)")
     s.add_argument("--model", help="the model the table claims (default: ggx with the preset's Smith, or the "
                                    "conventions' model)")
     s.add_argument("--tol", type=float, help="fail (status 1) if a node is off by more than this (default: no limit)")
