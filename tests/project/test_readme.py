@@ -64,8 +64,13 @@ EXPENSIVE.update({
     "python -m sphinx -W -b html docs docs/_build/html":
         "the documentation build, minutes: tests/project/test_docs.py builds it (-m slow) and .ci/run",
 })
+EXPENSIVE.update({
+    "pumpup explore phong:n=20 ggx:alpha=0.3":
+        "a server that runs until Ctrl-C: tests/apps/test_explore_browser.py starts it and drives it in chromium",
+})
 #: commands that are never run by a test, even with -m slow
-NEVER = {"python -m pytest -q", "python -m pytest -q -m slow", "python -m sphinx -W -b html docs docs/_build/html"}
+NEVER = {"python -m pytest -q", "python -m pytest -q -m slow", "python -m sphinx -W -b html docs docs/_build/html",
+         "pumpup explore phong:n=20 ggx:alpha=0.3"}
 
 
 def blocks(text=None):
