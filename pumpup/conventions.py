@@ -33,6 +33,9 @@ are the bits of a ``float16``; other numbers are values.
 
 The presets of :mod:`pumpup.luts` ship as such files (:func:`preset_conventions`), and
 :func:`audit_conventions` grades any described table as :func:`pumpup.luts.audit` grades a preset's.
+
+This module is over 1,000 lines because the description's checks, the reader and writer of each format and
+storage, and the renderer's look-up all follow the one description, field by field, and are tested as one.
 """
 
 from __future__ import annotations
