@@ -284,6 +284,44 @@ def _monotone_envelope(spline, margin: float):
     return nx, nc, flats
 
 
+#: where :func:`fit_pieces` checks a piece: 4 (degree + 1) + 1 points evenly over its [-1, 1]
+FIT_TEST_POINTS = np.linspace(-1.0, 1.0, 4 * (PRODUCT_DEGREE + 1) + 1)
+
+
+def fit_pieces(functions, lo: np.ndarray, hi: np.ndarray, tol: float, what: str):
+    """Polynomial pieces of degree :data:`PRODUCT_DEGREE` on the intervals [lo, hi) for each of ``functions``
+    (positive, of an array of m): each interpolated at the Chebyshev points of every piece, the pieces bisected until
+    every function's relative miss at :data:`FIT_TEST_POINTS` is at most ``tol``, unless a piece is already
+    narrower than 1e-9 m (then the miss is the rounding of the function itself).  Returns (coefficients, one
+    (degree + 1, pieces) array per function with the highest power first, lo, hi, centres, half-widths, the largest
+    miss of each piece); :class:`_ProductError` (naming ``what``) beyond 100000 pieces or 64 rounds.
+    """
+    deg = PRODUCT_DEGREE
+    xk = np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))  # Chebyshev points
+    vand = np.polynomial.chebyshev.chebvander(xk, deg)
+    to_mono = np.array([np.pad(np.polynomial.chebyshev.cheb2poly(np.eye(deg + 1)[k]), (0, deg - k))
+                        for k in range(deg + 1)])  # row k: monomial coefficients of T_k (low first)
+    fit = np.linalg.solve(vand, np.eye(deg + 1)).T @ to_mono  # values at xk -> monomial (low first)
+    tt = FIT_TEST_POINTS
+    for _ in range(64):
+        center, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+        coefs, worst = [], np.zeros(len(lo))
+        for fn in functions:
+            coef = (fn(center[:, None] + half[:, None] * xk[None, :]) @ fit)[:, ::-1].T
+            miss = np.abs(horner(coef[..., None], tt) / fn(center[:, None] + half[:, None] * tt) - 1.0)
+            coefs.append(coef)
+            worst = np.maximum(worst, miss.max(axis=1))
+        bad = (worst > tol) & (hi - lo > 1e-9 * hi)
+        if not bad.any():
+            return coefs, lo, hi, center, half, worst
+        if len(lo) + bad.sum() > 100_000:
+            raise _ProductError(f"the {what} needs more than 100000 pieces to reach {tol:g}")
+        mid = 0.5 * (lo[bad] + hi[bad])
+        lo = np.sort(np.concatenate([lo, mid]))
+        hi = np.sort(np.concatenate([hi, mid]))
+    raise _ProductError(f"the {what} did not reach {tol:g} (worst {worst.max():.3g})")
+
+
 class _ProductError(RuntimeError):
     """The product table cannot reach its tolerance (the kernel then looks up level by level)."""
 
@@ -325,31 +363,7 @@ class _Product:
         br = br[(br >= self.mlo) & (br <= 1.0)]
         br = np.unique(np.concatenate([br, self._kinks(br)]))
         lo, hi = br[:-1], br[1:]
-        deg = PRODUCT_DEGREE
-        xk = np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))  # Chebyshev points
-        vand = np.polynomial.chebyshev.chebvander(xk, deg)
-        to_mono = np.array([np.pad(np.polynomial.chebyshev.cheb2poly(np.eye(deg + 1)[k]), (0, deg - k))
-                            for k in range(deg + 1)])  # row k: monomial coefficients of T_k (low first)
-        fit = np.linalg.solve(vand, np.eye(deg + 1)).T @ to_mono  # values at xk -> monomial (low first)
-        tt = np.linspace(-1.0, 1.0, 4 * (deg + 1) + 1)
-        for _ in range(64):
-            center, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
-            vals = self.exact(center[:, None] + half[:, None] * xk[None, :])
-            coef = (vals @ fit)[:, ::-1].T  # (deg + 1, pieces), highest power first
-            miss = np.abs(horner(coef[..., None], tt) / self.exact(center[:, None] + half[:, None] * tt) - 1.0)
-            worst = miss.max(axis=1)
-            # bisect the pieces that miss, unless already narrower than 1e-9 m (then the miss is
-            # the rounding of G itself, and it goes into epsilon)
-            bad = (worst > self.TOL) & (hi - lo > 1e-9 * hi)
-            if not bad.any():
-                break
-            if len(lo) + bad.sum() > 100_000:
-                raise _ProductError(f"the product table needs more than 100000 pieces to reach {self.TOL:g}")
-            mid = 0.5 * (lo[bad] + hi[bad])
-            lo = np.sort(np.concatenate([lo, mid]))
-            hi = np.sort(np.concatenate([hi, mid]))
-        else:
-            raise _ProductError(f"the product table did not reach {self.TOL:g} (worst {worst.max():.3g})")
+        (coef,), lo, hi, center, half, worst = fit_pieces([self.exact], lo, hi, self.TOL, "product table")
         self.epsilon = 2.0 * float(worst.max()) + 4 * np.finfo(float).eps
         self.coef = np.ascontiguousarray(coef * (1.0 + self.epsilon))
         self.center, self.ihalf = center, 1.0 / half
@@ -458,34 +472,7 @@ class _LevelTable:
         br = br[(br >= self.mlo) & (br <= 1.0)]
         br = np.unique(np.concatenate([br, _cap_kinks(looks, br)]))
         lo, hi = br[:-1], br[1:]
-        deg = PRODUCT_DEGREE
-        xk = np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))  # Chebyshev points
-        vand = np.polynomial.chebyshev.chebvander(xk, deg)
-        to_mono = np.array([np.pad(np.polynomial.chebyshev.cheb2poly(np.eye(deg + 1)[k]), (0, deg - k))
-                            for k in range(deg + 1)])  # row k: monomial coefficients of T_k (low first)
-        fit = np.linalg.solve(vand, np.eye(deg + 1)).T @ to_mono  # values at xk -> monomial (low first)
-        tt = np.linspace(-1.0, 1.0, 4 * (deg + 1) + 1)
-        for _ in range(64):
-            center, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
-            coefs, worst = [], np.zeros(len(lo))
-            for lk in looks:
-                vals = lk.upper(center[:, None] + half[:, None] * xk[None, :])
-                coef = (vals @ fit)[:, ::-1].T  # (deg + 1, pieces), highest power first
-                miss = np.abs(horner(coef[..., None], tt) / lk.upper(center[:, None] + half[:, None] * tt) - 1.0)
-                coefs.append(coef)
-                worst = np.maximum(worst, miss.max(axis=1))
-            # bisect the pieces that miss, unless already narrower than 1e-9 m (then the miss is the rounding of the
-            # bound itself, and it goes into epsilon)
-            bad = (worst > self.TOL) & (hi - lo > 1e-9 * hi)
-            if not bad.any():
-                break
-            if len(lo) + bad.sum() > 100_000:
-                raise _ProductError(f"the level table needs more than 100000 pieces to reach {self.TOL:g}")
-            mid = 0.5 * (lo[bad] + hi[bad])
-            lo = np.sort(np.concatenate([lo, mid]))
-            hi = np.sort(np.concatenate([hi, mid]))
-        else:
-            raise _ProductError(f"the level table did not reach {self.TOL:g} (worst {worst.max():.3g})")
+        coefs, lo, hi, center, half, worst = fit_pieces([lk.upper for lk in looks], lo, hi, self.TOL, "level table")
         self.epsilon = 2.0 * float(worst.max()) + 16 * np.finfo(float).eps
         #: (levels, degree + 1, pieces): each level's coefficients, scaled down by 1 - epsilon
         self.coef = np.stack(coefs) * (1.0 - self.epsilon)
@@ -494,7 +481,7 @@ class _LevelTable:
             [center[None], self.ihalf[None], self.coef.reshape(-1, len(lo))]).T)
         self.lo = np.concatenate([lo, [math.inf]])  # a sentinel ends the search
         self._cells(lo)
-        self._check(tt)
+        self._check(FIT_TEST_POINTS)
 
     #: the most cells per octave (2^CELLS_MAX_BITS): 4096 int32 per octave, 16 kB, for the octaves that most
     #: cosines fall in
