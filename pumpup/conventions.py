@@ -50,7 +50,17 @@ from typing import Any
 import numpy as np
 
 from .core import SpecError
-from .luts import AuditResult, LutError, grade, lookup_error_on, mean_albedo_grid, model_spec, truth_grid
+from .luts import (
+    AuditResult,
+    LutError,
+    check_npy_size,
+    grade,
+    lookup_error_on,
+    mean_albedo_grid,
+    model_spec,
+    npy_header,
+    truth_grid,
+)
 
 __all__ = ["Axis", "Conventions", "ConventionsError", "load_conventions", "preset_conventions", "audit_conventions",
            "quantise", "storage_bound", "PRESET_FILES"]
@@ -694,24 +704,13 @@ def _split_channels(vals: np.ndarray, c: Conventions) -> dict:
 
 
 def _npy(path: str, c: Conventions) -> np.ndarray:
-    try:
-        with open(path, "rb") as fh:
-            version = np.lib.format.read_magic(fh)
-            fmt = np.lib.format
-            read_header = fmt.read_array_header_1_0 if version == (1, 0) else fmt.read_array_header_2_0
-            shape, _, dtype = read_header(fh)
-            offset = fh.tell()
-    except (ValueError, OSError, EOFError, SyntaxError) as exc:
-        raise LutError(f"{path!r} is not a readable .npy file: {exc}") from None
+    shape, dtype, offset = npy_header(path)
     want = tuple(c.shape) + ((len(c.channels),) if c.channels else ())
-    if tuple(shape) != want:
-        raise LutError(f"{path!r}: array of shape {tuple(shape)}; the conventions need {want}")
+    if shape != want:
+        raise LutError(f"{path!r}: array of shape {shape}; the conventions need {want}")
     if dtype.kind not in "fu":
         raise LutError(f"{path!r}: array of dtype {dtype}; tables are floats or unsigned integer codes")
-    need = offset + int(np.prod(shape)) * dtype.itemsize
-    if os.path.getsize(path) < need:
-        raise LutError(f"{path!r} is truncated: its header declares {need} bytes, the file holds "
-                       f"{os.path.getsize(path)}")
+    check_npy_size(path, shape, dtype, offset)
     arr = np.load(path, allow_pickle=False)
     if dtype.kind == "u":
         if not c.storage.startswith("unorm"):

@@ -838,9 +838,9 @@ def _read_filament(path: str, p: Preset) -> dict:
 MAX_TEXT_BYTES = 8 * 2**20
 
 
-def _check_npy_header(path: str, p: Preset) -> None:
-    """A LutError unless the .npy file's header declares a (n_rough, n_mu, 1 or 2) array whose bytes the file holds:
-    checked before any array is allocated (a damaged header may declare terabytes).
+def npy_header(path: str):
+    """(shape, dtype, offset of the data) from a .npy file's header, the array not read; a LutError if the file is no
+    readable .npy file.
     """
     try:
         with open(path, "rb") as fh:
@@ -851,12 +851,25 @@ def _check_npy_header(path: str, p: Preset) -> None:
             offset = fh.tell()
     except (ValueError, OSError, EOFError, SyntaxError) as exc:
         raise LutError(f"{path!r} is not a readable .npy file: {exc}") from None
-    if len(shape) != 3 or tuple(shape[:2]) != (p.n_rough, p.n_mu) or shape[2] not in (1, 2):
-        raise LutError(f"{path!r}: array of shape {shape}; preset {p.name} needs ({p.n_rough}, {p.n_mu}, 1 or 2)")
+    return tuple(shape), dtype, offset
+
+
+def check_npy_size(path: str, shape: tuple, dtype, offset: int) -> None:
+    """A LutError unless the file holds the bytes its .npy header declares: checked before any array is allocated (a
+    damaged header may declare terabytes).
+    """
     need = offset + int(np.prod(shape)) * dtype.itemsize
     if os.path.getsize(path) < need:
         raise LutError(f"{path!r} is truncated: its header declares {need} bytes, the file holds "
                        f"{os.path.getsize(path)}")
+
+
+def _check_npy_header(path: str, p: Preset) -> None:
+    """A LutError unless the .npy file's header declares a (n_rough, n_mu, 1 or 2) array whose bytes the file holds."""
+    shape, dtype, offset = npy_header(path)
+    if len(shape) != 3 or tuple(shape[:2]) != (p.n_rough, p.n_mu) or shape[2] not in (1, 2):
+        raise LutError(f"{path!r}: array of shape {shape}; preset {p.name} needs ({p.n_rough}, {p.n_mu}, 1 or 2)")
+    check_npy_size(path, shape, dtype, offset)
 
 
 def read_table(path, preset) -> dict:
