@@ -54,6 +54,7 @@ from .luts import (
     AuditResult,
     LutError,
     check_npy_size,
+    exr_channels,
     grade,
     lookup_error_on,
     mean_albedo_grid,
@@ -765,13 +766,7 @@ def _read(c: Conventions, path: str) -> dict:
         else:
             chans, main = {}, arr
     elif c.format == "exr":
-        import OpenEXR
-
-        try:
-            with OpenEXR.File(path) as f:
-                chans = {nm: np.asarray(v.pixels, dtype=np.float64) for nm, v in f.channels().items()}
-        except Exception as exc:  # the binding raises several types for damaged files
-            raise LutError(f"{path!r} is not a readable OpenEXR file: {exc}") from None
+        chans = exr_channels(path)
         if c.channel not in chans:
             raise LutError(f"{path!r}: no channel {c.channel!r} (channels: {', '.join(chans) or 'none'})")
         main = chans[c.channel]

@@ -854,6 +854,17 @@ def npy_header(path: str):
     return tuple(shape), dtype, offset
 
 
+def exr_channels(path: str) -> dict:
+    """The channels of an OpenEXR file as float64 arrays (name -> array); a LutError if the file is no readable EXR."""
+    import OpenEXR
+
+    try:
+        with OpenEXR.File(path) as f:
+            return {name: np.asarray(v.pixels, dtype=np.float64) for name, v in f.channels().items()}
+    except Exception as exc:  # the binding raises several types for damaged files
+        raise LutError(f"{path!r} is not a readable OpenEXR file: {exc}") from None
+
+
 def check_npy_size(path: str, shape: tuple, dtype, offset: int) -> None:
     """A LutError unless the file holds the bytes its .npy header declares: checked before any array is allocated (a
     damaged header may declare terabytes).
@@ -924,13 +935,7 @@ def read_table(path, preset) -> dict:
                 out["B"] = ds["B"].values
             return out
         if p.fmt == "exr":
-            import OpenEXR
-
-            try:
-                with OpenEXR.File(path) as f:
-                    ch = {k: np.asarray(v.pixels, dtype=np.float64) for k, v in f.channels().items()}
-            except Exception as exc:  # the binding raises several types for damaged files
-                raise LutError(f"{path!r} is not a readable OpenEXR file: {exc}") from None
+            ch = exr_channels(path)
             if "E" not in ch or ch["E"].shape != (p.n_rough, p.n_mu):
                 shape = ch["E"].shape if "E" in ch else None
                 raise LutError(f"{path!r}: channel E of shape {shape}; preset {p.name} needs ({p.n_rough}, {p.n_mu})")

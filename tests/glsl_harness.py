@@ -79,6 +79,37 @@ _VS_430 = "#version 430 core\nin vec2 pumpup_pos;\nvoid main() { gl_Position = v
 _VS_ES = "#version 300 es\nin vec2 pumpup_pos;\nvoid main() { gl_Position = vec4(pumpup_pos, 0.0, 1.0); }\n"
 
 
+def _draw(ctx, fragment: str, es: bool, outputs: int, uniforms, first: int, samplers: dict, size: tuple, vbo):
+    """Compile ``fragment`` (with ``outputs`` float outputs), set each library's uniforms (``uniforms[k]`` for library
+    ``first + k``, renamed as :func:`renamed` renames them) and the samplers (name -> texture, units in order), draw the
+    full-screen triangle into ``size`` float textures and read them back: one (pixels, 4) array per output.
+    """
+    import moderngl
+
+    prog = ctx.program(vertex_shader=_VS_ES if es else _VS_430, fragment_shader=fragment)
+    for k, values in enumerate(uniforms):
+        for name, val in values.items():
+            key = name.replace("pumpup_", f"pumpup{first + k}_", 1)
+            if key in prog:
+                prog[key].value = float(np.float32(val))
+    for unit, (name, texture) in enumerate(samplers.items()):
+        prog[name].value = unit
+        texture.use(unit)
+    outs = [ctx.texture(size, 4, dtype="f4") for _ in range(outputs)]
+    fbo = ctx.framebuffer(outs)
+    fbo.use()
+    vao = ctx.vertex_array(prog, [(vbo, "2f", "pumpup_pos")])
+    vao.render(moderngl.TRIANGLES)
+    got = [np.frombuffer(fbo.read(components=4, dtype="f4", attachment=k), "f4").reshape(-1, 4)
+           for k in range(outputs)]
+    for o in outs:
+        o.release()
+    fbo.release()
+    vao.release()
+    prog.release()
+    return got
+
+
 def run(ctx, libraries: list[str], wi: np.ndarray, wo: np.ndarray, es: bool = False, uniforms=None,
         with_error: bool = True, group: int = 8) -> tuple[np.ndarray, np.ndarray]:
     """Evaluate ``pumpup_brdf`` of every library at the pairs (one draw for up to ``group`` <= 8 libraries): (values,
@@ -120,30 +151,10 @@ def run(ctx, libraries: list[str], wi: np.ndarray, wo: np.ndarray, es: bool = Fa
             err = f"up ? pumpup{j}_base(a, b).y : 0.0" if with_error else "0.0"
             src.append(f"    pumpup_test_out{k} = vec4(pumpup{j}_brdf(a, b), {err}, 0.0, 1.0);\n")
         src.append("}\n")
-        prog = ctx.program(vertex_shader=_VS_ES if es else _VS_430, fragment_shader="".join(src))
-        for k in range(len(group)):
-            for name, val in (uniforms[s + k] if uniforms else {}).items():
-                key = name.replace("pumpup_", f"pumpup{s + k}_", 1)
-                if key in prog:
-                    prog[key].value = float(np.float32(val))
-        prog["pumpup_test_wi"].value = 0
-        prog["pumpup_test_wo"].value = 1
-        outs = [ctx.texture((WIDTH, h), 4, dtype="f4") for _ in group]
-        fbo = ctx.framebuffer(outs)
-        fbo.use()
-        twi.use(0)
-        two.use(1)
-        vao = ctx.vertex_array(prog, [(vbo, "2f", "pumpup_pos")])
-        vao.render(moderngl.TRIANGLES)
-        for k in range(len(group)):
-            r = np.frombuffer(fbo.read(components=4, dtype="f4", attachment=k), "f4").reshape(-1, 4)[:n]
-            values.append(r[:, 0].astype(np.float64))
-            errors.append(r[:, 1].astype(np.float64))
-        for o in outs:
-            o.release()
-        fbo.release()
-        vao.release()
-        prog.release()
+        for r in _draw(ctx, "".join(src), es, len(group), (uniforms or [])[s:s + size], s,
+                       {"pumpup_test_wi": twi, "pumpup_test_wo": two}, (WIDTH, h), vbo):
+            values.append(r[:n, 0].astype(np.float64))
+            errors.append(r[:n, 1].astype(np.float64))
     twi.release()
     two.release()
     vbo.release()
@@ -207,29 +218,9 @@ def furnace(ctx, libraries: list[str], mu: np.ndarray, nodes: int = 256, es: boo
         for k in range(len(group)):
             src.append(f"    pumpup_test_out{k} = vec4(sum{k} * 6.28318531 / {float(nodes)}, 0.0, 0.0, 1.0);\n")
         src.append("}\n")
-        prog = ctx.program(vertex_shader=_VS_ES if es else _VS_430, fragment_shader="".join(src))
-        for k in range(len(group)):
-            for name, val in (uniforms[s + k] if uniforms else {}).items():
-                key = name.replace("pumpup_", f"pumpup{s + k}_", 1)
-                if key in prog:
-                    prog[key].value = float(np.float32(val))
-        prog["pumpup_test_nodes"].value = 0
-        prog["pumpup_test_mu"].value = 1
-        outs = [ctx.texture((m, 1), 4, dtype="f4") for _ in group]
-        fbo = ctx.framebuffer(outs)
-        fbo.use()
-        tnodes.use(0)
-        tmu.use(1)
-        vao = ctx.vertex_array(prog, [(vbo, "2f", "pumpup_pos")])
-        vao.render(moderngl.TRIANGLES)
-        for k in range(len(group)):
-            r = np.frombuffer(fbo.read(components=4, dtype="f4", attachment=k), "f4").reshape(-1, 4)[:m]
-            out.append(r[:, 0].astype(np.float64))
-        for o in outs:
-            o.release()
-        fbo.release()
-        vao.release()
-        prog.release()
+        for r in _draw(ctx, "".join(src), es, len(group), (uniforms or [])[s:s + size], s,
+                       {"pumpup_test_nodes": tnodes, "pumpup_test_mu": tmu}, (m, 1), vbo):
+            out.append(r[:m, 0].astype(np.float64))
     tnodes.release()
     tmu.release()
     vbo.release()
