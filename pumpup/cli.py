@@ -1279,12 +1279,22 @@ def _redeliver_interrupts(hook):
     return unraisable
 
 
+def _record_interrupt(signum, frame) -> None:
+    """Python's own SIGINT handler, raising KeyboardInterrupt, that also records the interrupt: a C extension whose
+    import the KeyboardInterrupt lands in (numpy's ``PyCapsule_Import`` of datetime) may replace it by an ImportError
+    that does not chain it, and the command must still end as interrupted.
+    """
+    _PENDING_INTERRUPT.append(True)
+    raise KeyboardInterrupt
+
+
 def console_main() -> None:
     """The ``pumpup`` console script: :func:`main`, then an exit in which a late Ctrl-C or a closed pipe
     prints nothing more (Ctrl-C is ignored once the command has finished and flushed its output).
     """
     try:
         sys.unraisablehook = _redeliver_interrupts(sys.unraisablehook)
+        signal.signal(signal.SIGINT, _record_interrupt)
         code = main(notify=True)
         sys.stdout.flush()
         if _PENDING_INTERRUPT:

@@ -256,3 +256,23 @@ def test_warmup_fills_the_cache(tmp_path):
              "print(seen)\n")
     r = _python(probe, NUMBA_CACHE_DIR=str(tmp_path))
     assert r.returncode == 0 and r.stdout.strip() == "[]", (r.stdout, r.stderr)
+
+
+def test_ctrl_c_that_a_c_extension_turns_into_an_unchained_import_error_is_still_130():
+    """A SIGINT whose KeyboardInterrupt a C extension replaces by an ImportError with no trace of it (numpy's
+    ``PyCapsule_Import`` of datetime does): the command still ends as interrupted."""
+    code = ("import os, signal, time, pumpup.cli as cli\n"
+            "def main(*a, **k):\n"
+            "    lost = False\n"
+            "    try:\n"
+            "        os.kill(os.getpid(), signal.SIGINT)\n"
+            "        time.sleep(5)\n"
+            "    except KeyboardInterrupt:\n"
+            "        lost = True\n"
+            "    if lost:\n"
+            "        raise ImportError('PyCapsule_Import could not import module \"datetime\"')\n"
+            "cli.main = main\ncli.console_main()\n")
+    p = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=_env(), capture_output=True, text=True,
+                       preexec_fn=default_sigint, timeout=60)
+    assert p.returncode == 130, (p.returncode, p.stderr)
+    assert p.stderr.strip() == "pumpup: interrupted", p.stderr
