@@ -2,8 +2,8 @@
 
 The python blocks of one document run in order as ONE script (a file, as a user would save them; the
 processes scheduler of the sweep example then needs its main guard) in a fresh process: every page
-stands on its own, as a reader who opens it sees it.  The bash blocks
-run line by line with ``pumpup`` meaning this checkout's command line.  Both run in a scratch
+stands on its own, as a reader who opens it sees it.  The bash blocks of one document
+run line by line, in order, with ``pumpup`` meaning this checkout's command line.  Both run in a scratch
 directory that mirrors the repository root (a symlink to every top-level entry but .git), so
 the examples read what they would read from the root while the files they write (tables,
 sweeps) do not land in the checkout.
@@ -135,15 +135,14 @@ def clone_entries() -> list[str]:
     return sorted({line.split("/", 1)[0] for line in r.stdout.splitlines()})
 
 
-@pytest.fixture
-def workspace(tmp_path):
-    """A scratch directory that mirrors the repository root, and a PATH on which ``pumpup`` is
+def make_workspace(base) -> tuple:
+    """A scratch directory under ``base`` that mirrors the repository root, and a PATH on which ``pumpup`` is
     this checkout's command line."""
-    work = tmp_path / "root"
-    work.mkdir()
+    work = base / "root"
+    work.mkdir(parents=True)
     for name in clone_entries():
         os.symlink(os.path.join(ROOT, name), work / name)
-    bindir = tmp_path / "bin"
+    bindir = base / "bin"
     bindir.mkdir()
     shim = bindir / "pumpup"
     shim.write_text(f"#!/bin/sh\nexec {shlex.quote(sys.executable)} -m pumpup.cli \"$@\"\n")
@@ -151,6 +150,12 @@ def workspace(tmp_path):
     env = dict(os.environ, PYTHONPATH=ROOT, PATH=f"{bindir}{os.pathsep}{os.environ['PATH']}", MPLBACKEND="Agg")
     env.pop("PYTHONSTARTUP", None)
     return work, env
+
+
+@pytest.fixture
+def workspace(tmp_path):
+    """A scratch directory that mirrors the repository root, with ``pumpup`` on its PATH."""
+    return make_workspace(tmp_path)
 
 
 def python_script(path) -> str:
@@ -177,16 +182,48 @@ def test_python_blocks_run_as_one_script(workspace, path):
     assert "Traceback" not in r.stderr
 
 
-def test_bash_blocks_run(workspace):
-    work, env = workspace
-    ran = 0
+def commands_by_document() -> dict[str, list[tuple[str, str]]]:
+    """The bash commands the default suite runs, grouped by document in order; a command repeated within one
+    document runs once there (the second run would see the same files and print the same)."""
+    out: dict[str, list[tuple[str, str]]] = {}
     for cmd, line in bash_commands():
         if cmd in EXPENSIVE:
             continue
-        r = subprocess.run(["bash", "-c", cmd], cwd=work, env=env, capture_output=True, text=True, timeout=900)
-        assert r.returncode == 0, f"{line}: {cmd}\n{r.stderr[-2000:]}"
-        ran += 1
-    assert ran >= 1
+        doc = line.rsplit(" line ", 1)[0]
+        if cmd not in (c for c, _ in out.get(doc, [])):
+            out.setdefault(doc, []).append((cmd, line))
+    return out
+
+
+def test_commands_by_document_keeps_every_command():
+    by_doc = commands_by_document()
+    assert {cmd for cmd, _ in bash_commands() if cmd not in EXPENSIVE} == {c for cmds in by_doc.values()
+                                                                            for c, _ in cmds}
+    assert "README.md" in by_doc and "docs/user-guide/files.md" in by_doc
+
+
+def test_bash_blocks_run(tmp_path):
+    """Each document's commands run in order in a workspace of the document's own (a command may read what an
+    earlier one of its page wrote); the documents run side by side, one per core."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    by_doc = commands_by_document()
+
+    def run_document(index_and_doc):
+        index, doc = index_and_doc
+        work, env = make_workspace(tmp_path / f"doc{index}")
+        failures = []
+        for cmd, line in by_doc[doc]:
+            r = subprocess.run(["bash", "-c", cmd], cwd=work, env=env, capture_output=True, text=True, timeout=900)
+            if r.returncode != 0:
+                failures.append(f"{line}: {cmd}\n{r.stderr[-2000:]}")
+                break
+        return failures
+
+    with ThreadPoolExecutor(max(1, min(2, os.cpu_count() or 1))) as pool:
+        failures = [f for fs in pool.map(run_document, enumerate(by_doc)) for f in fs]
+    assert not failures, "\n".join(failures)
+    assert sum(map(len, by_doc.values())) >= 1
 
 
 @pytest.mark.slow
