@@ -471,47 +471,170 @@ class _Level:
         return g
 
 
-class _ProductG:
-    """The chain kernel's fast path in Dr.Jit: G(m) = g_1 ... g_k as one piecewise quintic in
-    m = max(N.wi, N.wo) (:class:`pumpup.operators.pumping._Product`, the same pieces and coefficients, already scaled
-    up by 1 + epsilon), the piece found from the float64 bits of m, for min(N.wi, N.wo) > ``mlo``.
+class _Rows:
+    """Rows of float64 numbers, one per piece, for one gather per piece: in JIT variants padded to a multiple of 8
+    and read as packets of 8 consecutive values (a 64-byte line each, ``dr.gather`` of an ``ArrayXf64``), in scalar
+    variants a numpy array.
     """
 
-    def __init__(self, prod):
-        from .physics.lookups import CELL_SHIFT, float_bits_reference
+    PACKET = 8
 
-        self.mlo, self.cbase, self.shift = float(prod.mlo), int(prod.cbase), CELL_SHIFT
-        self.ncell = len(prod.cstart)
-        self.deg = prod.rows.shape[1] - 3
-        self.width = prod.rows.shape[1]
-        self.rows = _Table(prod.rows)  # piece s: coefficients (highest power first), centre, 1 / half-width
-        self.lo = _Table(prod.lo)  # piece starts, with an inf sentinel
-        self.cstart_np = np.asarray(prod.cstart, dtype=np.int64)
-        self.cstart = mi.UInt32(self.cstart_np.astype(np.uint32)) if _jit() else None
-        # the most pieces that start inside one cell: the kernel's forward steps, unrolled here
-        bounds = (np.arange(self.cbase, self.cbase + self.ncell + 1, dtype=np.int64) << self.shift).view(np.float64)
-        ends = np.searchsorted(prod.lo[:-1], bounds[1:], side="left") - 1
-        self.steps = int(max(0, np.max(ends - self.cstart_np))) + 1
+    def __init__(self, rows):
+        rows = np.asarray(rows, dtype=np.float64)
+        self.width = rows.shape[1]
+        self.packets = -(-self.width // self.PACKET)
+        padded = np.zeros((rows.shape[0], self.packets * self.PACKET))
+        padded[:, :self.width] = rows
+        self.np = padded
+        self.dr, self._host = _aligned_f64(padded) if _jit() else (None, None)
+
+    def __call__(self, s) -> list:
+        """Row ``s`` (a UInt32 array, or an int in scalar variants) as a list of its ``width`` values."""
+        if self.dr is None:
+            return [float(x) for x in self.np[int(s)][:self.width]]
+        packet = _array_xf64()
+        out = []
+        for j in range(self.packets):
+            idx = s * self.packets + j if self.packets > 1 else s
+            p = dr.gather(packet, self.dr, idx, shape=(self.PACKET, dr.width(s)))
+            out.extend(p[i] for i in range(self.PACKET))
+        return out[:self.width]
+
+
+def _aligned_f64(values, align: int = 64):
+    """A Float64 array of ``values`` whose storage starts on an ``align``-byte boundary: Dr.Jit maps a numpy array's
+    memory (no copy) and reads packets from it only when it is so aligned, else it gathers each value alone (the same
+    numbers, slower).  Returns (the Float64 array, the numpy buffer it maps, which must outlive it).
+    """
+    values = np.ascontiguousarray(values, dtype=np.float64).ravel()
+    buf = np.empty(values.size + align // 8)
+    off = (-buf.ctypes.data % align) // 8
+    host = buf[off:off + values.size]
+    host[:] = values
+    return mi.Float64(host), host
+
+
+def _array_xf64():
+    """The dynamic array of Float64 arrays of the current JIT variant (what ``dr.gather`` reads packets into)."""
+    import importlib
+
+    return importlib.import_module(mi.Float64.__module__).ArrayXf64
+
+
+class _Cells:
+    """The piece of a table in m (pieces [lo[s], lo[s + 1]), ``lo`` ending with an inf sentinel) that holds m > mlo,
+    found from the float64 bits of m as :meth:`pumpup.operators.pumping._LevelTable.piece` finds it, with one gather:
+    cell c = (bits(m) >> ``shift``) - ``cbase`` holds (s0, b), s0 the piece where the cell starts and b = lo[s0 + 1]
+    when at most one piece starts inside the cell (then the piece is s0 + (m >= b)), else NaN (a crowded cell: the
+    piece is found by stepping forward, in a loop that runs only where a crowded cell is hit).  2^bits cells per
+    octave, bits the smallest from CELL_BITS up to ``MAX_BITS`` with no crowded cell in [1/4, 1], where most cosines
+    lie.
+    """
+
+    MAX_BITS = 12
+
+    def __init__(self, lo, mlo: float):
+        from .physics.lookups import CELL_BITS, float_bits_reference
+
+        self.lo_np = np.asarray(lo, dtype=np.float64)
+        starts = self.lo_np[:-1]
+        for bits in range(CELL_BITS, self.MAX_BITS + 1):
+            shift = 52 - bits
+            top = starts[starts > 0.25]
+            per = np.bincount((float_bits_reference(top) >> shift) - (int(float_bits_reference(0.25)) >> shift))
+            if per.size == 0 or per.max() <= 1:
+                break
+        self.shift = shift
+        self.cbase = int(float_bits_reference(mlo)) >> shift
+        top = int(float_bits_reference(1.0)) >> shift
+        bounds = (np.arange(self.cbase, top + 2, dtype=np.int64) << shift).view(np.float64)
+        s0 = np.clip(np.searchsorted(starts, bounds[:-1], side="right") - 1, 0, len(starts) - 1)
+        inside = np.searchsorted(starts, bounds[1:], side="left") - np.searchsorted(starts, bounds[:-1], side="right")
+        nxt = self.lo_np[s0 + 1]
+        self.crowded = bool(np.any(inside > 1))
+        self.np = np.stack([s0.astype(np.float64), np.where(inside > 1, math.nan, nxt)], axis=1)
+        self.ncell = len(s0)
+        if _jit():
+            self.dr, self._host = _aligned_f64(self.np)
+            self.lo = mi.Float64(self.lo_np)
         self._bits = float_bits_reference
 
     def __call__(self, m):
-        if _jit():
-            bits = dr.reinterpret_array(mi.UInt64, m) >> self.shift
-            c = mi.UInt32(dr.minimum(dr.maximum(bits, self.cbase) - self.cbase, self.ncell - 1))
-            s = dr.gather(mi.UInt32, self.cstart, c)
-            for _ in range(self.steps):  # forward to the piece that holds m (pumpup.operators.pumping._Product.piece)
-                s = dr.select(m >= self.lo[s + 1], s + 1, s)
-        else:
+        """The piece that holds m (m > mlo; other m give some valid piece index)."""
+        if not _jit():
             c = min(max((int(self._bits(m)) >> self.shift) - self.cbase, 0), self.ncell - 1)
-            s = int(self.cstart_np[c])
-            while m >= self.lo[s + 1]:
+            s = int(self.np[c, 0])
+            while m >= self.lo_np[s + 1]:
                 s += 1
-        w, d = self.width, self.deg
-        t = (m - self.rows[s * w + d + 1]) * self.rows[s * w + d + 2]
-        g = self.rows[s * w] * t
-        for r in range(1, d):  # Horner, in the order of pumpup.physics.lookups.horner
-            g = (g + self.rows[s * w + r]) * t
-        return g + self.rows[s * w + d]
+            return s
+        bits = dr.reinterpret_array(mi.UInt64, m) >> self.shift
+        c = mi.UInt32(dr.minimum(dr.maximum(bits, self.cbase) - self.cbase, self.ncell - 1))
+        cell = dr.gather(_array_xf64(), self.dr, c, shape=(2, dr.width(c)))
+        s = mi.UInt32(cell[0]) + dr.select(m >= cell[1], mi.UInt32(1), mi.UInt32(0))
+        if not self.crowded:
+            return s
+
+        def forward(s, m):  # a crowded cell: step forward while the next piece starts at or below m
+            def body(s, m):
+                return s + 1, m
+            return dr.while_loop((s, m), lambda s, m: m >= dr.gather(mi.Float64, self.lo, s + 1), body)[0]
+
+        return dr.if_stmt((s, m), dr.isnan(cell[1]), forward, lambda s, m: s)
+
+
+def _horner(row, a: int, deg: int, t):
+    """sum_r row[a + r] t^(deg - r), in the order of :func:`pumpup.physics.lookups.horner` (and the compiled
+    kernels)."""
+    v = row[a] * t
+    for r in range(1, deg):
+        v = (v + row[a + r]) * t
+    return v + row[a + deg]
+
+
+class _ProductG:
+    """The product table's G(m) = g_1 ... g_k in Dr.Jit (:class:`pumpup.operators.pumping._Product`, the same pieces
+    and coefficients, already scaled up by 1 + epsilon; its numpy reference is ``_Product.__call__``): m = max(N.wi,
+    N.wo), one cell gather and one gather of the piece's row (6 coefficients, centre, inverse half-width: 64 bytes).
+    """
+
+    def __init__(self, prod):
+        self.mlo = float(prod.mlo)
+        self.deg = prod.coef.shape[0] - 1
+        self.cells = _Cells(prod.lo, self.mlo)
+        self.rows = _Rows(np.concatenate([prod.coef, prod.center[None], prod.ihalf[None]]).T)
+
+    def __call__(self, mi_, mo):
+        m = dr.maximum(mi_, mo)
+        row = self.rows(self.cells(m))
+        d = self.deg
+        return _horner(row, 0, d, (m - row[d + 1]) * row[d + 2])
+
+
+class _PairG:
+    """The level table's g_1 ... g_k at (N.wi, N.wo) in Dr.Jit (:class:`pumpup.operators.pumping._LevelTable`, the
+    compiled :func:`pumpup.physics.lookups.g_pair`; its numpy reference is ``_LevelTable.g``): one piece per cosine
+    serves every level, its row (centre, inverse half-width, each level's coefficients) read in packets of 8.
+    """
+
+    def __init__(self, table):
+        self.mlo = float(table.mlo)
+        self.deg = table.coef.shape[1] - 1
+        self.controlled = [bool(c) for c in table.controlled]
+        self.cells = _Cells(table.lo, self.mlo)
+        self.rows = _Rows(table.rows)
+
+    def __call__(self, mi_, mo):
+        ri, ro = self.rows(self.cells(mi_)), self.rows(self.cells(mo))
+        ti, to = (mi_ - ri[0]) * ri[1], (mo - ro[0]) * ro[1]
+        mmax = dr.maximum(mi_, mo)
+        g_all = None
+        for j, controlled in enumerate(self.controlled):
+            a = 2 + j * (self.deg + 1)
+            g = dr.maximum(_horner(ri, a, self.deg, ti), _horner(ro, a, self.deg, to))  # 001 eq. 20
+            if controlled:
+                g = dr.maximum(g, mmax)  # 001 eq. 21
+            g_all = g if g_all is None else g_all * g
+        return g_all
 
 
 #: the largest float32, the type Mitsuba's JIT variants evaluate in
@@ -554,8 +677,13 @@ class _DrModel:
         base = brdf.p["base"] if self.fresnel is not None else brdf
         from .operators.pumping import Pumped
 
-        prod = base.product() if isinstance(base, Pumped) else None
-        self.product = _ProductG(prod) if prod is not None else None
+        #: one table for all levels where the chain has one: the product table G(max(N.wi, N.wo)) where every level's
+        #: bound increases, else the level table (as pumpup's chain kernel chooses); None: level by level
+        self.fast: _ProductG | _PairG | None = None
+        if isinstance(base, Pumped):
+            prod = base.product()
+            table = base.level_table() if prod is None else None
+            self.fast = _ProductG(prod) if prod is not None else (_PairG(table) if table is not None else None)
         while isinstance(base, Pumped):
             self.levels.append(_Level(base.lookup(), base.controlled))
             base = base.base
@@ -574,27 +702,31 @@ class _DrModel:
         self.components = strat.components
 
     def g(self, mi_, mo):
-        """The product of all levels' g at cosines (mi_, mo) > 0, as pumpup's chain kernel computes it."""
+        """The product of all levels' g at cosines (mi_, mo), as pumpup's chain kernel computes it where both are > 0
+        (elsewhere a value that the caller masks)."""
         def by_levels(mi_, mo):
+            mi_, mo = dr.maximum(mi_, 1e-300), dr.maximum(mo, 1e-300)
             g = 1.0
             for lev in self.levels:
                 g = g * lev.g(mi_, mo)
             return g
 
-        if self.product is None:
+        if self.fast is None:
             return by_levels(mi_, mo)
-        fast = dr.minimum(mi_, mo) > self.product.mlo  # both cosines where the product table holds
+        # the table where both cosines exceed its mlo; level by level where the smaller lies in (0, mlo] (a pair
+        # with a cosine <= 0 gives 0 whatever g is: it stays on the table's path, whose lookups stay in range)
+        mmin = dr.minimum(mi_, mo)
+        slow = (mmin <= self.fast.mlo) & (mmin > 0.0)
         if not _jit():
-            return self.product(dr.maximum(mi_, mo)) if fast else by_levels(mi_, mo)
-        return dr.if_stmt((mi_, mo), fast, lambda a, b: self.product(dr.maximum(a, b)), by_levels)
+            return by_levels(mi_, mo) if (slow or mmin <= 0.0) else self.fast(mi_, mo)
+        return dr.if_stmt((mi_, mo), slow, by_levels, self.fast)
 
     def f(self, wl, v):
         val = self.kernel(wl, v, *self.args)
         if self.fresnel is not None:  # 000 eq. 28's factor F(Theta_min), before the rounding down below
             val = val * _fresnel_conductor(dr.maximum(wl[2], v[2]), *self.fresnel)
         if self.levels:
-            g = self.g(dr.maximum(wl[2], 1e-300), dr.maximum(v[2], 1e-300))
-            val = _div(val, g) * self.ROUND_DOWN  # 001 eq. 16, all levels
+            val = _div(val, self.g(wl[2], v[2])) * self.ROUND_DOWN  # 001 eq. 16, all levels
         return dr.select((wl[2] > 0) & (v[2] > 0), val, 0.0)
 
 
