@@ -719,7 +719,10 @@ class _DrModel:
         slow = (mmin <= self.fast.mlo) & (mmin > 0.0)
         if not _jit():
             return by_levels(mi_, mo) if (slow or mmin <= 0.0) else self.fast(mi_, mo)
-        return dr.if_stmt((mi_, mo), slow, by_levels, self.fast)
+        # the table's value outside the conditional, so that Dr.Jit shares it between sample() and eval() at the same
+        # pair; the conditional runs the level-by-level path only where some lane of a packet needs it
+        g = self.fast(mi_, mo)
+        return dr.if_stmt((mi_, mo, g), slow, lambda a, b, g: by_levels(a, b), lambda a, b, g: g)
 
     def f(self, wl, v):
         val = self.kernel(wl, v, *self.args)
