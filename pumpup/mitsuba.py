@@ -104,6 +104,7 @@ FALLBACK_VARIANT = "scalar_rgb"
 _INV_PI = 1.0 / math.pi
 _INV_2PI = 0.5 / math.pi
 _SQRT_PI = math.sqrt(math.pi)
+_TWO_PI_F32 = float(np.float32(2.0 * math.pi))
 
 # ----------------------------------------------------------------------------------------
 # The subprocess probe of a JIT variant
@@ -272,12 +273,17 @@ def _fresnel_conductor(c, eta, k):
     return 0.5 * (rs + rp)
 
 
+def _mirror_cos(wl, v):
+    """R.V with R the mirror of wl about the normal, 2 (N.wl)(N.v) - wl.v (000 eq. 9)."""
+    return 2.0 * wl[2] * v[2] - _dot(wl, v)
+
+
 def _dr_lambert(wl, v, albedo):
     return albedo * _INV_PI + 0.0 * wl[2]
 
 
 def _dr_phong(wl, v, n, c):
-    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)  # 000 eq. 9
+    rv = _mirror_cos(wl, v)  # 000 eq. 9
     return dr.select(rv > 0, c * _pow_pos(rv, n), 0.0)  # 000 eq. 5
 
 
@@ -286,7 +292,7 @@ def _den_p(mx, p):
 
 
 def _dr_stretched_phong(wl, v, n, p, c):
-    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)  # 000 eq. 9
+    rv = _mirror_cos(wl, v)  # 000 eq. 9
     mx = dr.maximum(wl[2], v[2])
     return dr.select(rv > 0, _div(c * _pow_pos(rv, n), _den_p(mx, p)), 0.0)  # 000 eq. 10, 12
 
@@ -298,7 +304,7 @@ def _dr_retro(wl, v, n, p, c):
 
 
 def _dr_phong_shader(wl, v, n, ks, kd):
-    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)
+    rv = _mirror_cos(wl, v)
     return kd + dr.select(rv > 0, _div(ks * _pow_pos(rv, n), wl[2]), 0.0)  # 002 eq. 5, 8
 
 
@@ -361,9 +367,9 @@ def _dr_cook_torrance(wl, v, m, ior):
 def _projected(w, dist, g1, alpha):
     """pumpup.physics.microfacet.projected: P = z (1 + Lambda) = z / G1 (Walter et al. 2007)."""
     x, y, z = w
-    s = dr.sqrt(x * x + y * y)
     if dist == 1:
-        return 0.5 * (z + dr.sqrt(z * z + (alpha * s) ** 2))  # Walter eq. 34
+        return 0.5 * (z + dr.sqrt(z * z + alpha * alpha * (x * x + y * y)))  # Walter eq. 34
+    s = dr.sqrt(x * x + y * y)
     a = _div(z, alpha * s)
     if g1 == 0:
         p = 0.5 * (z * (1.0 + dr.erf(a)) + alpha * s * dr.exp(-a * a) / _SQRT_PI)  # Walter eq. 27 (exact)
@@ -373,38 +379,38 @@ def _projected(w, dist, g1, alpha):
 
 
 def _dr_microfacet(wl, v, dist, alpha, shadowing, g1, ior, eta, k):
-    s = (wl[0] + v[0], wl[1] + v[1], wl[2] + v[2])
-    t = _tan2_half(wl, v)
+    """D F G / (4 N.wi N.wo) with the half-vector terms written in S = wi + wo (|S|^2 = n2, S_z^2 = sz2, S_x^2 + S_y^2
+    = sxy2: cos^2 theta_h = sz2 / n2, tan^2 theta_h = sxy2 / sz2), one division for the whole quotient."""
+    sx, sy, sz = wl[0] + v[0], wl[1] + v[1], wl[2] + v[2]
+    sxy2, sz2 = sx * sx + sy * sy, sz * sz
+    n2 = sxy2 + sz2
     a2 = alpha * alpha
     if dist == 0:
-        d = dr.exp(-t / a2) * ((1.0 + t) * (1.0 + t)) / (math.pi * a2)  # Walter eq. 25
+        r = dr.rcp(sz2)
+        num = dr.exp(-(sxy2 * r) / a2) * ((n2 * r) * (n2 * r))  # Walter eq. 25: exp(-tan^2 / a2) / cos^4 ...
+        den = math.pi * a2  # ... / (pi a2)
     else:
-        cos2 = dr.rcp(1.0 + t)
-        sin2 = dr.select(t <= 1.0, t * cos2, 1.0 - cos2)
-        q = a2 * cos2 + sin2
-        d = _div(a2, math.pi * q * q)  # Walter eq. 33
-    c = 0.5 * dr.sqrt(_dot(s, s))  # wi.h
+        q = a2 * sz2 + sxy2
+        num, den = a2 * (n2 * n2), math.pi * (q * q)  # Walter eq. 33: a2 / (pi cos^4 (a2 + tan^2)^2)
     if eta > 0.0:
-        f = _fresnel_conductor(c, eta, k)
+        num = num * _fresnel_conductor(0.5 * dr.sqrt(n2), eta, k)  # at wi.h = |S| / 2
     elif ior > 0.0:
-        f = _fresnel_dielectric(c, ior)
-    else:
-        f = 1.0
+        num = num * _fresnel_dielectric(0.5 * dr.sqrt(n2), ior)
     pl = _projected(wl, dist, g1, alpha)
     pv = _projected(v, dist, g1, alpha)
     if shadowing == 0:
-        return _div(d * f, 4.0 * pl * pv)  # Walter eq. 20, separable Smith
-    return _div(d * f, 4.0 * (v[2] * pl + wl[2] * pv - wl[2] * v[2]))  # Heitz 2014, height-correlated
+        return _div(num, den * (4.0 * pl * pv))  # Walter eq. 20, separable Smith
+    return _div(num, den * (4.0 * (v[2] * pl + wl[2] * pv - wl[2] * v[2])))  # Heitz 2014, height-correlated
 
 
 def _dr_metal(wl, v, n, eta, k, c):
-    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)  # 000 eq. 9
+    rv = _mirror_cos(wl, v)  # 000 eq. 9
     mx = dr.maximum(wl[2], v[2])
     return dr.select(rv > 0, _div(c * _pow_pos(rv, n), mx) * _fresnel_conductor(mx, eta, k), 0.0)  # 000 eq. 28
 
 
 def _dr_plastic(wl, v, n, ad, a_s, eta):
-    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)
+    rv = _mirror_cos(wl, v)
     mx = dr.maximum(wl[2], v[2])
     fr = _fresnel_conductor(mx, eta, 0.0) if eta > 0.0 else 1.0  # 000 eq. 30
     spec = _div(a_s * (n + 2.0) / (2.0 * math.pi) * _pow_pos(rv, n), mx) * fr  # 000 eq. 29
@@ -750,8 +756,8 @@ def _frame(a):
 def _comp_sample(kind, k, v, u1, u2):
     """One component of pumpup.sampling._sample_kernel: (wi (x, y, z), ok)."""
     C = _sampling
-    phi = 2.0 * math.pi * u2
-    sp, cp = dr.sincos(phi)
+    sp, cp = dr.sincos(mi.Float(u2) * _TWO_PI_F32)  # in float32 (u2 is one): a direction's last bits are float32's
+    sp, cp = _f64(sp), _f64(cp)
     if kind == C.COSINE:
         r = dr.sqrt(u1)
         z = dr.sqrt(dr.maximum(1.0 - u1, 0.0))
@@ -791,21 +797,24 @@ def _comp_pdf(kind, k, wl, v):
     elif kind in (C.MIRROR, C.RETRO):
         rx, ry = (-wl[0], -wl[1]) if kind == C.MIRROR else (wl[0], wl[1])
         dx, dy, dz = rx - v[0], ry - v[1], wl[2] - v[2]
-        h = 0.5 * (dx * dx + dy * dy + dz * dz)  # 1 - R.V without cancellation
+        h = 0.5 * (dx * dx + dy * dy + dz * dz)  # 1 - R.V without cancellation (and as pumpup.sampling for float32
+        # directions a few 1e-8 off unit length, where R.V itself differs from it by that much)
         p = dr.select(h < 1.0, (k + 1.0) * _INV_2PI * dr.exp(k * dr.log(dr.maximum(1.0 - h, 1e-300))), 0.0)
-    else:
-        s = (wl[0] + v[0], wl[1] + v[1], wl[2] + v[2])
-        n = dr.sqrt(_dot(s, s))
-        t2 = _div(s[0] * s[0] + s[1] * s[1], s[2] * s[2])
-        ch = _div(s[2], n)
+    else:  # p(h) / (4 wo.h) in S = wi + wo, as in _dr_microfacet (|S| = 2 wo.h, cos theta_h = S_z / |S|)
+        sx, sy, sz = wl[0] + v[0], wl[1] + v[1], wl[2] + v[2]
+        sxy2, sz2 = sx * sx + sy * sy, sz * sz
+        n2 = sxy2 + sz2
         if kind == C.HALF_POWER:
-            ph = (k + 1.0) * _INV_2PI * _pow_pos(ch, k) if k > 0 else _INV_2PI + 0.0 * ch
+            n = dr.sqrt(n2)
+            ph = (k + 1.0) * _INV_2PI * _pow_pos(_div(sz, n), k) if k > 0 else _INV_2PI + 0.0 * n
+            p = _div(ph, 2.0 * n)
         elif kind == C.HALF_BECKMANN:
-            ph = _div(dr.exp(-t2 / (k * k)), math.pi * k * k * ch * ch * ch)
+            r = dr.rcp(sz2)
+            p = _div(dr.exp(-(sxy2 * r) / (k * k)) * n2 * r, (2.0 * math.pi * k * k) * sz)  # e^(-tan^2/k^2) / (pi k^2 ch^3) / (2|S|)
         else:
-            q = k + t2
-            ph = _div(k, math.pi * ch * ch * ch * q * q)
-        p = dr.select(n > 0.0, _div(ph, 2.0 * n), 0.0)
+            q = k * sz2 + sxy2
+            p = _div(k * n2 * sz, (2.0 * math.pi) * (q * q))  # k / (pi ch^3 (k + tan^2)^2) / (2|S|)
+        p = dr.select(n2 > 0.0, p, 0.0)
     return dr.select((wl[2] > 0.0) & (v[2] > 0.0), p, 0.0)
 
 
