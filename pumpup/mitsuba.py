@@ -242,7 +242,17 @@ def _tan2_half(wl, v):
 
 
 def _pow_pos(x, n):
-    """x^n for x > 0 (0 elsewhere: every caller masks x <= 0)."""
+    """x^n for x > 0 (0 elsewhere: every caller masks x <= 0); an integer n up to 2^16 by repeated squaring (at most
+    32 products, each rounded once: a few 1e-16 relative, no logarithm and exponential)."""
+    if float(n) == int(n) and 0 < n <= 2**16:
+        k, sq, out = int(n), x, None
+        while k:
+            if k & 1:
+                out = sq if out is None else out * sq
+            k >>= 1
+            if k:
+                sq = sq * sq
+        return dr.select(x > 0, out, 0.0)
     return dr.select(x > 0, dr.power(dr.maximum(x, 1e-300), n), 0.0)
 
 
@@ -529,12 +539,13 @@ def _array_xf64():
 
 class _Cells:
     """The piece of a table in m (pieces [lo[s], lo[s + 1]), ``lo`` ending with an inf sentinel) that holds m > mlo,
-    found from the float64 bits of m as :meth:`pumpup.operators.pumping._LevelTable.piece` finds it, with one gather:
-    cell c = (bits(m) >> ``shift``) - ``cbase`` holds (s0, b), s0 the piece where the cell starts and b = lo[s0 + 1]
-    when at most one piece starts inside the cell (then the piece is s0 + (m >= b)), else NaN (a crowded cell: the
-    piece is found by stepping forward, in a loop that runs only where a crowded cell is hit).  2^bits cells per
-    octave, bits the smallest from CELL_BITS up to ``MAX_BITS`` with no crowded cell in [1/4, 1], where most cosines
-    lie.
+    found from the float64 bits of m as :meth:`pumpup.operators.pumping._LevelTable.piece` finds it, without a branch:
+    cell c = (bits(m) >> ``shift``) - ``cbase`` holds a packet (s0, b_1, ..., b_(w-1)), s0 the piece where the cell
+    starts and b_i the start of piece s0 + i where it lies inside the cell (else inf); the piece is s0 + the number of
+    b_i <= m, read with one gather.  2^bits cells per octave and w in {2, 4, 8}: the fewest bits from CELL_BITS to
+    ``MAX_BITS`` at which no cell holds more than 3 piece starts (w = 2 or 4), else than 7 (w = 8); where even
+    ``MAX_BITS`` leaves K > 7 starts in a cell, the starts of pieces s0 + 8 ... s0 + K are read too, for every m
+    (``extra``).
     """
 
     MAX_BITS = 12
@@ -544,24 +555,37 @@ class _Cells:
 
         self.lo_np = np.asarray(lo, dtype=np.float64)
         starts = self.lo_np[:-1]
-        for bits in range(CELL_BITS, self.MAX_BITS + 1):
+
+        def most(bits):  # the most piece starts inside one cell (after its first piece's)
             shift = 52 - bits
-            top = starts[starts > 0.25]
-            per = np.bincount((float_bits_reference(top) >> shift) - (int(float_bits_reference(0.25)) >> shift))
-            if per.size == 0 or per.max() <= 1:
-                break
-        self.shift = shift
+            b0 = int(float_bits_reference(mlo)) >> shift
+            top = int(float_bits_reference(1.0)) >> shift
+            bounds = (np.arange(b0, top + 2, dtype=np.int64) << shift).view(np.float64)
+            inside = (np.searchsorted(starts, bounds[1:], side="left")
+                      - np.searchsorted(starts, bounds[:-1], side="right"))
+            return int(inside.max())
+
+        counts = {bits: most(bits) for bits in range(CELL_BITS, self.MAX_BITS + 1)}
+        few = [b for b in counts if counts[b] <= 3]
+        some = [b for b in counts if counts[b] <= 7]
+        bits = few[0] if few else (some[0] if some else self.MAX_BITS)
+        k = counts[bits]
+        self.width = 2 if k <= 1 else (4 if k <= 3 else 8)
+        self.extra = max(0, k - 7)
+        self.shift = shift = 52 - bits
         self.cbase = int(float_bits_reference(mlo)) >> shift
         top = int(float_bits_reference(1.0)) >> shift
         bounds = (np.arange(self.cbase, top + 2, dtype=np.int64) << shift).view(np.float64)
         s0 = np.clip(np.searchsorted(starts, bounds[:-1], side="right") - 1, 0, len(starts) - 1)
-        inside = np.searchsorted(starts, bounds[1:], side="left") - np.searchsorted(starts, bounds[:-1], side="right")
-        nxt = self.lo_np[s0 + 1]
-        self.crowded = bool(np.any(inside > 1))
-        self.np = np.stack([s0.astype(np.float64), np.where(inside > 1, math.nan, nxt)], axis=1)
+        table = np.full((len(s0), self.width), math.inf)
+        table[:, 0] = s0
+        for i in range(1, self.width):
+            nxt = self.lo_np[np.minimum(s0 + i, len(self.lo_np) - 1)]
+            table[:, i] = np.where(nxt < bounds[1:], nxt, math.inf)  # a start inside the cell, else never reached
+        self.np = table
         self.ncell = len(s0)
         if _jit():
-            self.dr, self._host = _aligned_f64(self.np)
+            self.dr, self._host = _aligned_f64(table)
             self.lo = mi.Float64(self.lo_np)
         self._bits = float_bits_reference
 
@@ -575,17 +599,17 @@ class _Cells:
             return s
         bits = dr.reinterpret_array(mi.UInt64, m) >> self.shift
         c = mi.UInt32(dr.minimum(dr.maximum(bits, self.cbase) - self.cbase, self.ncell - 1))
-        cell = dr.gather(_array_xf64(), self.dr, c, shape=(2, dr.width(c)))
-        s = mi.UInt32(cell[0]) + dr.select(m >= cell[1], mi.UInt32(1), mi.UInt32(0))
-        if not self.crowded:
-            return s
-
-        def forward(s, m):  # a crowded cell: step forward while the next piece starts at or below m
-            def body(s, m):
-                return s + 1, m
-            return dr.while_loop((s, m), lambda s, m: m >= dr.gather(mi.Float64, self.lo, s + 1), body)[0]
-
-        return dr.if_stmt((s, m), dr.isnan(cell[1]), forward, lambda s, m: s)
+        cell = dr.gather(_array_xf64(), self.dr, c, shape=(self.width, dr.width(c)))
+        one, zero = mi.UInt32(1), mi.UInt32(0)
+        s0 = mi.UInt32(cell[0])
+        s = s0
+        for i in range(1, self.width):
+            s = s + dr.select(m >= cell[i], one, zero)
+        end = len(self.lo_np) - 1  # the sentinel
+        for i in range(self.width, self.width + self.extra):  # a cell with more starts than its packet: the starts
+            # after them, each read from s0 (independent reads; lo increases, so those beyond m count nothing)
+            s = s + dr.select(m >= dr.gather(mi.Float64, self.lo, dr.minimum(s0 + i, end)), one, zero)
+        return s
 
 
 def _horner(row, a: int, deg: int, t):
@@ -799,7 +823,7 @@ def _comp_pdf(kind, k, wl, v):
         dx, dy, dz = rx - v[0], ry - v[1], wl[2] - v[2]
         h = 0.5 * (dx * dx + dy * dy + dz * dz)  # 1 - R.V without cancellation (and as pumpup.sampling for float32
         # directions a few 1e-8 off unit length, where R.V itself differs from it by that much)
-        p = dr.select(h < 1.0, (k + 1.0) * _INV_2PI * dr.exp(k * dr.log(dr.maximum(1.0 - h, 1e-300))), 0.0)
+        p = dr.select(h < 1.0, (k + 1.0) * _INV_2PI * _pow_pos(1.0 - h, k), 0.0)
     else:  # p(h) / (4 wo.h) in S = wi + wo, as in _dr_microfacet (|S| = 2 wo.h, cos theta_h = S_z / |S|)
         sx, sy, sz = wl[0] + v[0], wl[1] + v[1], wl[2] + v[2]
         sxy2, sz2 = sx * sx + sy * sy, sz * sz

@@ -201,7 +201,7 @@ def test_table_kernels_equal_their_numpy_references(spec, rng):
     assert np.array_equal(got, ref)
     assert np.array_equal(np.array(fast.cells(mi.Float64(x))), t.piece(x))
     if spec["levels"] == 3:
-        assert fast.cells.crowded  # the forward loop of crowded cells ran
+        assert fast.cells.width > 2  # cells that hold several piece starts
 
 
 def test_table_kernels_scalar_equal_their_numpy_references(rng):
