@@ -644,6 +644,12 @@ class _PairG:
     """The level table's g_1 ... g_k at (N.wi, N.wo) in Dr.Jit (:class:`pumpup.operators.pumping._LevelTable`, the
     compiled :func:`pumpup.physics.lookups.g_pair`; its numpy reference is ``_LevelTable.g``): one piece per cosine
     serves every level, its row (centre, inverse half-width, each level's coefficients) read in packets of 8.
+
+    ``below``: where no float32 lies between the table's mlo and a level's first node (nor above its mu0), a float32
+    cosine m <= mlo lies below every level's spline, where pumpup's level-by-level path (:func:`g_levels`) takes the
+    power law v0 exp(slope0 (log m - log x0)) + margin_lo (at most the cap): this class then computes it too, without a
+    branch (the exponential as a Taylor polynomial where |slope0 (log m - log x0)| <= 1e-3, 7 terms: exact to 1e-24),
+    and the pair needs no level-by-level path at all.
     """
 
     def __init__(self, table):
@@ -652,15 +658,45 @@ class _PairG:
         self.controlled = [bool(c) for c in table.controlled]
         self.cells = _Cells(table.lo, self.mlo)
         self.rows = _Rows(table.rows)
+        f32 = np.float32(self.mlo)
+        if float(f32) > self.mlo:
+            f32 = np.nextafter(f32, np.float32(0.0))
+        top = float(f32)  # the largest float32 <= mlo
+        looks = table.looks
+        span = math.log(self.mlo) - math.log(float(np.finfo(np.float32).smallest_subnormal)) + 1.0
+        self.below = None
+        if all(top < math.exp(lk.logx[0]) * (1.0 - 1e-12) and top <= lk.mu0 for lk in looks):
+            self.below = [(float(lk.v0), float(lk.slope0), float(lk.logx[0]), float(lk.margin_lo), float(lk.cap),
+                           abs(float(lk.slope0)) * span <= 1e-3) for lk in looks]
+
+    @staticmethod
+    def _power_law(lm, v0, slope0, logx0, margin_lo, cap, taylor):
+        """A level's bound below its first node (pumpup.physics.lookups.upper_log), at log(m) = ``lm``."""
+        y = slope0 * (lm - logx0)
+        if taylor:
+            e = 1.0 + y / 6.0
+            for r in (5.0, 4.0, 3.0, 2.0, 1.0):
+                e = 1.0 + (y / r) * e  # exp(y) to 7 terms (|y| <= 1e-3: error below 1e-24)
+        else:
+            e = dr.exp(y)
+        u = v0 * e + margin_lo
+        return dr.minimum(u, cap) if math.isfinite(cap) else u
 
     def __call__(self, mi_, mo):
         ri, ro = self.rows(self.cells(mi_)), self.rows(self.cells(mo))
         ti, to = (mi_ - ri[0]) * ri[1], (mo - ro[0]) * ro[1]
         mmax = dr.maximum(mi_, mo)
+        if self.below is not None:
+            lmi, lmo = dr.log(dr.maximum(mi_, 1e-300)), dr.log(dr.maximum(mo, 1e-300))
+            low_i, low_o = mi_ <= self.mlo, mo <= self.mlo
         g_all = None
         for j, controlled in enumerate(self.controlled):
             a = 2 + j * (self.deg + 1)
-            g = dr.maximum(_horner(ri, a, self.deg, ti), _horner(ro, a, self.deg, to))  # 001 eq. 20
+            ui, uo = _horner(ri, a, self.deg, ti), _horner(ro, a, self.deg, to)
+            if self.below is not None:  # (power laws below the tables, as g_levels)
+                ui = dr.select(low_i, self._power_law(lmi, *self.below[j]), ui)
+                uo = dr.select(low_o, self._power_law(lmo, *self.below[j]), uo)
+            g = dr.maximum(ui, uo)  # 001 eq. 20
             if controlled:
                 g = dr.maximum(g, mmax)  # 001 eq. 21
             g_all = g if g_all is None else g_all * g
@@ -745,6 +781,8 @@ class _DrModel:
             return by_levels(mi_, mo)
         # the table where both cosines exceed its mlo; level by level where the smaller lies in (0, mlo] (a pair
         # with a cosine <= 0 gives 0 whatever g is: it stays on the table's path, whose lookups stay in range)
+        if getattr(self.fast, "below", None) is not None:  # the table holds every float32 cosine > 0
+            return self.fast(mi_, mo) if _jit() or dr.minimum(mi_, mo) > 0.0 else 1.0
         mmin = dr.minimum(mi_, mo)
         slow = (mmin <= self.fast.mlo) & (mmin > 0.0)
         if not _jit():
