@@ -648,8 +648,8 @@ class _PairG:
     ``below``: where no float32 lies between the table's mlo and a level's first node (nor above its mu0), a float32
     cosine m <= mlo lies below every level's spline, where pumpup's level-by-level path (:func:`g_levels`) takes the
     power law v0 exp(slope0 (log m - log x0)) + margin_lo (at most the cap): this class then computes it too, without a
-    branch (the exponential as a Taylor polynomial where |slope0 (log m - log x0)| <= 1e-3, 7 terms: exact to 1e-24),
-    and the pair needs no level-by-level path at all.
+    branch (the exponential as a Taylor polynomial where |slope0 (log m - log x0)| <= 1e-3, to 1e-18), and the pair
+    needs no level-by-level path at all.
     """
 
     def __init__(self, table):
@@ -666,28 +666,44 @@ class _PairG:
         span = math.log(self.mlo) - math.log(float(np.finfo(np.float32).smallest_subnormal)) + 1.0
         self.below = None
         if all(top < math.exp(lk.logx[0]) * (1.0 - 1e-12) and top <= lk.mu0 for lk in looks):
-            self.below = [(float(lk.v0), float(lk.slope0), float(lk.logx[0]), float(lk.margin_lo), float(lk.cap),
-                           abs(float(lk.slope0)) * span <= 1e-3) for lk in looks]
+            self.below = []
+            for lk in looks:
+                ymax = abs(float(lk.slope0)) * span  # |slope0 (log m - log x0)| for every float32 m in (0, mlo]
+                terms = next((d for d in range(1, 8) if ymax ** (d + 1) / math.factorial(d + 1) <= 1e-18), None)
+                self.below.append((float(lk.v0), float(lk.slope0), float(lk.logx[0]), float(lk.margin_lo),
+                                   float(lk.cap), terms if ymax <= 1e-3 else None))
+            #: log(m) from the exponent and a float32 logarithm of the mantissa (m is a float32: its mantissa is
+            #: exact in float32; the logarithm is off by at most 3e-7) where that moves every slope0 log(m) by at most
+            #: 1e-13, else in float64
+            self.cheap_log = all(abs(b[1]) * 3e-7 <= 1e-13 for b in self.below)
 
     @staticmethod
-    def _power_law(lm, v0, slope0, logx0, margin_lo, cap, taylor):
+    def _power_law(lm, v0, slope0, logx0, margin_lo, cap, terms):
         """A level's bound below its first node (pumpup.physics.lookups.upper_log), at log(m) = ``lm``."""
         y = slope0 * (lm - logx0)
-        if taylor:
-            e = 1.0 + y / 6.0
-            for r in (5.0, 4.0, 3.0, 2.0, 1.0):
-                e = 1.0 + (y / r) * e  # exp(y) to 7 terms (|y| <= 1e-3: error below 1e-24)
+        if terms is not None:  # exp(y) to ``terms`` + 1 terms of its Taylor series (Horner), error below 1e-18
+            e = 1.0 / math.factorial(terms)
+            for r in range(terms - 1, -1, -1):
+                e = e * y + 1.0 / math.factorial(r)
         else:
             e = dr.exp(y)
         u = v0 * e + margin_lo
         return dr.minimum(u, cap) if math.isfinite(cap) else u
+
+    def _log(self, m):
+        if not (self.cheap_log and _jit()):
+            return dr.log(dr.maximum(m, 1e-300))
+        bits = dr.reinterpret_array(mi.UInt64, m)
+        e = mi.Float64(mi.Int32(mi.UInt32(bits >> 52))) - 1023.0  # the exponent (m > 0; others are masked)
+        mant = dr.reinterpret_array(mi.Float64, (bits & ((1 << 52) - 1)) | (1023 << 52))  # in [1, 2)
+        return e * math.log(2.0) + mi.Float64(dr.log(mi.Float(mant)))
 
     def __call__(self, mi_, mo):
         ri, ro = self.rows(self.cells(mi_)), self.rows(self.cells(mo))
         ti, to = (mi_ - ri[0]) * ri[1], (mo - ro[0]) * ro[1]
         mmax = dr.maximum(mi_, mo)
         if self.below is not None:
-            lmi, lmo = dr.log(dr.maximum(mi_, 1e-300)), dr.log(dr.maximum(mo, 1e-300))
+            lmi, lmo = self._log(mi_), self._log(mo)
             low_i, low_o = mi_ <= self.mlo, mo <= self.mlo
         g_all = None
         for j, controlled in enumerate(self.controlled):

@@ -204,6 +204,27 @@ def test_table_kernels_equal_their_numpy_references(spec, rng):
         assert fast.cells.width > 2  # cells that hold several piece starts
 
 
+@needs_llvm
+def test_level_table_below_mlo_is_the_level_by_level_power_law(rng):
+    """Float32 cosines at or below the level table's mlo (down to the smallest float32), paired with any cosine: the
+    plugin's branch-free power law against the level-by-level numpy reference (each level's Pumped.g), within the
+    error it allows itself (1e-13 per level from the float32 logarithm of the mantissa)."""
+    pm.register(LLVM)
+    f = pumpup.load(LEVEL_TABLE[1])
+    fast = pm._DrModel(f).fast
+    assert fast.below is not None and fast.cheap_log
+    low = np.exp(rng.uniform(math.log(1.5e-45), math.log(fast.mlo), 3000)).astype(np.float32).astype(np.float64)
+    low = np.concatenate([low[low > 0], [float(np.float32(1e-8)), float(np.finfo(np.float32).smallest_subnormal)]])
+    other = np.concatenate([rng.uniform(0.0, 1.0, len(low) // 2), low[: len(low) - len(low) // 2][::-1]])
+    other = other.astype(np.float32).astype(np.float64)
+    other[other <= 0] = 1e-30
+    ref = np.ones(len(low))
+    for lev in f.chain():
+        ref = ref * lev.g(low, other)
+    got = np.array(fast(mi.Float64(low), mi.Float64(other)), dtype=np.float64)
+    assert np.all(np.abs(got / ref - 1.0) <= 3 * 1e-13)
+
+
 def test_table_kernels_scalar_equal_their_numpy_references(rng):
     pm.register("scalar_rgb")
     for spec in (PUMPED[0], LEVEL_TABLE[0]):
