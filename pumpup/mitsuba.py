@@ -45,14 +45,19 @@ The BSDF
     * ``eval_pdf`` returns (eval, pdf).
 
     Everything is computed in Dr.Jit operations on Float64 (the float32 inputs converted exactly,
-    the result rounded once to Mitsuba's float32), so in ``llvm_*`` variants it is traced into
-    Mitsuba's kernels; in ``scalar_*`` variants the same code runs on Python floats.  A pumped
-    model divides by the same upper bounds of the albedo tables as pumpup's compiled kernel
-    (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`): through pumpup's product table G(m)
-    of all levels where it has one (:class:`pumpup.operators.pumping._Product`, piece found from the float64 bits
-    of m = max(N.wi, N.wo)), else level by level, with ``dr.gather`` on the tables; its value is rounded down before the
-    cast to float32 (x (1 - 2^-23)), so the exported BSDF is pointwise at most the double-precision one and
-    keeps its proof of energy conservation (001 eq. 18).
+    the result rounded once to Mitsuba's float32; only the sampler's azimuth sine and cosine are float32, of the
+    float32 sample), so in ``llvm_*`` variants it is traced into Mitsuba's kernels; in ``scalar_*`` variants the
+    same code runs on Python floats.  A pumped model divides by the same upper bounds of the albedo tables as
+    pumpup's compiled kernel (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`), through the
+    same table of all levels: the product table G(m) where every level's bound increases
+    (:class:`pumpup.operators.pumping._Product`, m = max(N.wi, N.wo)), else the level table
+    (:class:`pumpup.operators.pumping._LevelTable`: every level's bound on one set of pieces, one piece per cosine
+    for all levels), else level by level.  A piece is found from the float64 bits of the cosine with one read of a
+    cell (its first piece and the next starts) and its row is read in 64-byte packets (:class:`_Cells`,
+    :class:`_Rows`); below a level table's start the levels' power laws are computed without a branch, below a product
+    table's the level-by-level path runs in a conditional.  The value is rounded down before the cast to float32
+    (x (1 - 2^-23)), so the exported BSDF is pointwise at most the double-precision one and keeps its proof of energy
+    conservation (001 eq. 18).
 ``from_mitsuba(bsdf_dict, channel=0, variant=None) -> pumpup BRDF``
     A Mitsuba BSDF as a pumpup BRDF: f_r(wi, wo) = eval(si.wi = wo, wo = wi)[channel] / N.wi,
     front side, so that ``albedo``, ``tabulate``, ``check_reciprocity``, ``pump`` and
@@ -243,7 +248,8 @@ def _tan2_half(wl, v):
 
 def _pow_pos(x, n):
     """x^n for x > 0 (0 elsewhere: every caller masks x <= 0); an integer n up to 2^16 by repeated squaring (at most
-    32 products, each rounded once: a few 1e-16 relative, no logarithm and exponential)."""
+    32 products, each rounded once: a few 1e-16 relative, no logarithm and exponential).
+    """
     if float(n) == int(n) and 0 < n <= 2**16:
         k, sq, out = int(n), x, None
         while k:
@@ -390,7 +396,8 @@ def _projected(w, dist, g1, alpha):
 
 def _dr_microfacet(wl, v, dist, alpha, shadowing, g1, ior, eta, k):
     """D F G / (4 N.wi N.wo) with the half-vector terms written in S = wi + wo (|S|^2 = n2, S_z^2 = sz2, S_x^2 + S_y^2
-    = sxy2: cos^2 theta_h = sz2 / n2, tan^2 theta_h = sxy2 / sz2), one division for the whole quotient."""
+    = sxy2: cos^2 theta_h = sz2 / n2, tan^2 theta_h = sxy2 / sz2), one division for the whole quotient.
+    """
     sx, sy, sz = wl[0] + v[0], wl[1] + v[1], wl[2] + v[2]
     sxy2, sz2 = sx * sx + sy * sy, sz * sz
     n2 = sxy2 + sz2
@@ -614,7 +621,8 @@ class _Cells:
 
 def _horner(row, a: int, deg: int, t):
     """sum_r row[a + r] t^(deg - r), in the order of :func:`pumpup.physics.lookups.horner` (and the compiled
-    kernels)."""
+    kernels).
+    """
     v = row[a] * t
     for r in range(1, deg):
         v = (v + row[a + r]) * t
@@ -785,7 +793,8 @@ class _DrModel:
 
     def g(self, mi_, mo):
         """The product of all levels' g at cosines (mi_, mo), as pumpup's chain kernel computes it where both are > 0
-        (elsewhere a value that the caller masks)."""
+        (elsewhere a value that the caller masks).
+        """
         def by_levels(mi_, mo):
             mi_, mo = dr.maximum(mi_, 1e-300), dr.maximum(mo, 1e-300)
             g = 1.0
@@ -888,7 +897,8 @@ def _comp_pdf(kind, k, wl, v):
             p = _div(ph, 2.0 * n)
         elif kind == C.HALF_BECKMANN:
             r = dr.rcp(sz2)
-            p = _div(dr.exp(-(sxy2 * r) / (k * k)) * n2 * r, (2.0 * math.pi * k * k) * sz)  # e^(-tan^2/k^2) / (pi k^2 ch^3) / (2|S|)
+            # exp(-tan^2 / k^2) / (pi k^2 ch^3) / (2 |S|)
+            p = _div(dr.exp(-(sxy2 * r) / (k * k)) * n2 * r, (2.0 * math.pi * k * k) * sz)
         else:
             q = k * sz2 + sxy2
             p = _div(k * n2 * sz, (2.0 * math.pi) * (q * q))  # k / (pi ch^3 (k + tan^2)^2) / (2|S|)

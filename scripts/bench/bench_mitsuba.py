@@ -44,7 +44,8 @@ MODELS = [
 
 def _load_baseline(path):
     """Another copy of pumpup/mitsuba.py as a module of the pumpup package, its plugin registered as
-    ``pumpup_baseline`` (for the current variant)."""
+    ``pumpup_baseline`` (for the current variant).
+    """
     import mitsuba as mi
 
     spec = importlib.util.spec_from_file_location("pumpup._bench_baseline_mitsuba", path)
@@ -66,6 +67,7 @@ def _bsdf(pm, spec, plugin="pumpup"):
 
 
 def bench_llvm(pm, models, n, rounds, baseline):
+    """CPU and wall seconds of sample() + eval() per round for roughconductor and every model (and its baseline)."""
     import drjit as dr
     import mitsuba as mi
 
@@ -116,6 +118,7 @@ def _report_llvm(models, cpu, wall, n, baseline):
 
 
 def bench_scalar(pm, models, n):
+    """Samples per CPU second of a Python loop of single sample() + eval() calls, printed as a table."""
     import mitsuba as mi
 
     rng = np.random.default_rng(1)
@@ -139,6 +142,7 @@ def bench_scalar(pm, models, n):
 
 
 def main(argv=None):
+    """Run the llvm rounds (and the scalar loop) and print the tables with the load average."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=1 << 20, help="samples per llvm call")
     ap.add_argument("--rounds", type=int, default=9, help="timed llvm rounds (all models in each)")
