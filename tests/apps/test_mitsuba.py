@@ -265,8 +265,13 @@ def _sample(b, wo, n, seed):
     return d, np.array(bs.pdf, dtype=np.float64), np.array(w, dtype=np.float64), si, bs
 
 
+#: a level-table chain in the Monte Carlo and chi-square checks (slow: its tables take a minute on a loaded machine)
+LEVEL_TABLE_SLOW = [pytest.param(s, id=json.dumps(s, separators=(",", ":"))[:60], marks=pytest.mark.slow)
+                    for s in LEVEL_TABLE[:1]]
+
+
 @needs_llvm
-@pytest.mark.parametrize("spec", _split(SPECS))
+@pytest.mark.parametrize("spec", _split(SPECS) + LEVEL_TABLE_SLOW)
 def test_mc_albedo_within_4_standard_errors(spec):
     """Mitsuba Monte Carlo with the plugin's own sample() against pumpup.albedo (reciprocal models:
     the albedo at wo is the albedo at wi)."""
@@ -334,7 +339,7 @@ def _chi2(sample_spec, wi, test_count, pdf_spec=None, ires=CHI2_IRES):
 
 
 @needs_llvm
-@pytest.mark.parametrize("spec", _split(CHI2_SPECS))
+@pytest.mark.parametrize("spec", _split(CHI2_SPECS) + LEVEL_TABLE_SLOW)
 def test_mitsuba_chi2(spec):
     pm.register(LLVM)
     for theta in CHI2_ANGLES:
