@@ -509,7 +509,7 @@ class _Rows:
         padded = np.zeros((rows.shape[0], self.packets * self.PACKET))
         padded[:, :self.width] = rows
         self.np = padded
-        self.dr, self._host = _aligned_f64(padded) if _jit() else (None, None)
+        self.dr = _aligned_f64(padded) if _jit() else None
 
     def __call__(self, s) -> list:
         """Row ``s`` (a UInt32 array, or an int in scalar variants) as a list of its ``width`` values."""
@@ -526,15 +526,15 @@ class _Rows:
 
 def _aligned_f64(values, align: int = 64):
     """A Float64 array of ``values`` whose storage starts on an ``align``-byte boundary: Dr.Jit maps a numpy array's
-    memory (no copy) and reads packets from it only when it is so aligned, else it gathers each value alone (the same
-    numbers, slower).  Returns (the Float64 array, the numpy buffer it maps, which must outlive it).
+    memory (no copy; it holds a reference to the array) and reads packets from it only when it is so aligned, else it
+    gathers each value alone (the same numbers, slower).
     """
     values = np.ascontiguousarray(values, dtype=np.float64).ravel()
     buf = np.empty(values.size + align // 8)
     off = (-buf.ctypes.data % align) // 8
     host = buf[off:off + values.size]
     host[:] = values
-    return mi.Float64(host), host
+    return mi.Float64(host)
 
 
 def _array_xf64():
@@ -592,7 +592,7 @@ class _Cells:
         self.np = table
         self.ncell = len(s0)
         if _jit():
-            self.dr, self._host = _aligned_f64(table)
+            self.dr = _aligned_f64(table)
             self.lo = mi.Float64(self.lo_np)
         self._bits = float_bits_reference
 

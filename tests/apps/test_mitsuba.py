@@ -202,6 +202,8 @@ def test_table_kernels_equal_their_numpy_references(spec, rng):
     assert np.array_equal(np.array(fast.cells(mi.Float64(x))), t.piece(x))
     if spec["levels"] == 3:
         assert fast.cells.width > 2  # cells that hold several piece starts
+    for table in (fast.rows.dr, fast.cells.dr):  # 64-byte aligned: Dr.Jit reads them in packets
+        assert np.asarray(table).__array_interface__["data"][0] % 64 == 0
 
 
 @needs_llvm
