@@ -45,14 +45,19 @@ The BSDF
     * ``eval_pdf`` returns (eval, pdf).
 
     Everything is computed in Dr.Jit operations on Float64 (the float32 inputs converted exactly,
-    the result rounded once to Mitsuba's float32), so in ``llvm_*`` variants it is traced into
-    Mitsuba's kernels; in ``scalar_*`` variants the same code runs on Python floats.  A pumped
-    model divides by the same upper bounds of the albedo tables as pumpup's compiled kernel
-    (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`): through pumpup's product table G(m)
-    of all levels where it has one (:class:`pumpup.operators.pumping._Product`, piece found from the float64 bits
-    of m = max(N.wi, N.wo)), else level by level, with ``dr.gather`` on the tables; its value is rounded down before the
-    cast to float32 (x (1 - 2^-23)), so the exported BSDF is pointwise at most the double-precision one and
-    keeps its proof of energy conservation (001 eq. 18).
+    the result rounded once to Mitsuba's float32; only the sampler's azimuth sine and cosine are float32, of the
+    float32 sample), so in ``llvm_*`` variants it is traced into Mitsuba's kernels; in ``scalar_*`` variants the
+    same code runs on Python floats.  A pumped model divides by the same upper bounds of the albedo tables as
+    pumpup's compiled kernel (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`), through the
+    same table of all levels: the product table G(m) where every level's bound increases
+    (:class:`pumpup.operators.pumping._Product`, m = max(N.wi, N.wo)), else the level table
+    (:class:`pumpup.operators.pumping._LevelTable`: every level's bound on one set of pieces, one piece per cosine
+    for all levels), else level by level.  A piece is found from the float64 bits of the cosine with one read of a
+    cell (its first piece and the next starts) and its row is read in 64-byte packets (:class:`_Cells`,
+    :class:`_Rows`); below a level table's start the levels' power laws are computed without a branch, below a product
+    table's the level-by-level path runs in a conditional.  The value is rounded down before the cast to float32
+    (x (1 - 2^-23)), so the exported BSDF is pointwise at most the double-precision one and keeps its proof of energy
+    conservation (001 eq. 18).
 ``from_mitsuba(bsdf_dict, channel=0, variant=None) -> pumpup BRDF``
     A Mitsuba BSDF as a pumpup BRDF: f_r(wi, wo) = eval(si.wi = wo, wo = wi)[channel] / N.wi,
     front side, so that ``albedo``, ``tabulate``, ``check_reciprocity``, ``pump`` and
@@ -104,6 +109,7 @@ FALLBACK_VARIANT = "scalar_rgb"
 _INV_PI = 1.0 / math.pi
 _INV_2PI = 0.5 / math.pi
 _SQRT_PI = math.sqrt(math.pi)
+_TWO_PI_F32 = float(np.float32(2.0 * math.pi))
 
 # ----------------------------------------------------------------------------------------
 # The subprocess probe of a JIT variant
@@ -241,7 +247,18 @@ def _tan2_half(wl, v):
 
 
 def _pow_pos(x, n):
-    """x^n for x > 0 (0 elsewhere: every caller masks x <= 0)."""
+    """x^n for x > 0 (0 elsewhere: every caller masks x <= 0); an integer n up to 2^16 by repeated squaring (at most
+    32 products, each rounded once: a few 1e-16 relative, no logarithm and exponential).
+    """
+    if float(n) == int(n) and 0 < n <= 2**16:
+        k, sq, out = int(n), x, None
+        while k:
+            if k & 1:
+                out = sq if out is None else out * sq
+            k >>= 1
+            if k:
+                sq = sq * sq
+        return dr.select(x > 0, out, 0.0)
     return dr.select(x > 0, dr.power(dr.maximum(x, 1e-300), n), 0.0)
 
 
@@ -272,12 +289,17 @@ def _fresnel_conductor(c, eta, k):
     return 0.5 * (rs + rp)
 
 
+def _mirror_cos(wl, v):
+    """R.V with R the mirror of wl about the normal, 2 (N.wl)(N.v) - wl.v (000 eq. 9)."""
+    return 2.0 * wl[2] * v[2] - _dot(wl, v)
+
+
 def _dr_lambert(wl, v, albedo):
     return albedo * _INV_PI + 0.0 * wl[2]
 
 
 def _dr_phong(wl, v, n, c):
-    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)  # 000 eq. 9
+    rv = _mirror_cos(wl, v)  # 000 eq. 9
     return dr.select(rv > 0, c * _pow_pos(rv, n), 0.0)  # 000 eq. 5
 
 
@@ -286,7 +308,7 @@ def _den_p(mx, p):
 
 
 def _dr_stretched_phong(wl, v, n, p, c):
-    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)  # 000 eq. 9
+    rv = _mirror_cos(wl, v)  # 000 eq. 9
     mx = dr.maximum(wl[2], v[2])
     return dr.select(rv > 0, _div(c * _pow_pos(rv, n), _den_p(mx, p)), 0.0)  # 000 eq. 10, 12
 
@@ -298,7 +320,7 @@ def _dr_retro(wl, v, n, p, c):
 
 
 def _dr_phong_shader(wl, v, n, ks, kd):
-    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)
+    rv = _mirror_cos(wl, v)
     return kd + dr.select(rv > 0, _div(ks * _pow_pos(rv, n), wl[2]), 0.0)  # 002 eq. 5, 8
 
 
@@ -361,9 +383,9 @@ def _dr_cook_torrance(wl, v, m, ior):
 def _projected(w, dist, g1, alpha):
     """pumpup.physics.microfacet.projected: P = z (1 + Lambda) = z / G1 (Walter et al. 2007)."""
     x, y, z = w
-    s = dr.sqrt(x * x + y * y)
     if dist == 1:
-        return 0.5 * (z + dr.sqrt(z * z + (alpha * s) ** 2))  # Walter eq. 34
+        return 0.5 * (z + dr.sqrt(z * z + alpha * alpha * (x * x + y * y)))  # Walter eq. 34
+    s = dr.sqrt(x * x + y * y)
     a = _div(z, alpha * s)
     if g1 == 0:
         p = 0.5 * (z * (1.0 + dr.erf(a)) + alpha * s * dr.exp(-a * a) / _SQRT_PI)  # Walter eq. 27 (exact)
@@ -373,38 +395,39 @@ def _projected(w, dist, g1, alpha):
 
 
 def _dr_microfacet(wl, v, dist, alpha, shadowing, g1, ior, eta, k):
-    s = (wl[0] + v[0], wl[1] + v[1], wl[2] + v[2])
-    t = _tan2_half(wl, v)
+    """D F G / (4 N.wi N.wo) with the half-vector terms written in S = wi + wo (|S|^2 = n2, S_z^2 = sz2, S_x^2 + S_y^2
+    = sxy2: cos^2 theta_h = sz2 / n2, tan^2 theta_h = sxy2 / sz2), one division for the whole quotient.
+    """
+    sx, sy, sz = wl[0] + v[0], wl[1] + v[1], wl[2] + v[2]
+    sxy2, sz2 = sx * sx + sy * sy, sz * sz
+    n2 = sxy2 + sz2
     a2 = alpha * alpha
     if dist == 0:
-        d = dr.exp(-t / a2) * ((1.0 + t) * (1.0 + t)) / (math.pi * a2)  # Walter eq. 25
+        r = dr.rcp(sz2)
+        num = dr.exp(-(sxy2 * r) / a2) * ((n2 * r) * (n2 * r))  # Walter eq. 25: exp(-tan^2 / a2) / cos^4 ...
+        den = math.pi * a2  # ... / (pi a2)
     else:
-        cos2 = dr.rcp(1.0 + t)
-        sin2 = dr.select(t <= 1.0, t * cos2, 1.0 - cos2)
-        q = a2 * cos2 + sin2
-        d = _div(a2, math.pi * q * q)  # Walter eq. 33
-    c = 0.5 * dr.sqrt(_dot(s, s))  # wi.h
+        q = a2 * sz2 + sxy2
+        num, den = a2 * (n2 * n2), math.pi * (q * q)  # Walter eq. 33: a2 / (pi cos^4 (a2 + tan^2)^2)
     if eta > 0.0:
-        f = _fresnel_conductor(c, eta, k)
+        num = num * _fresnel_conductor(0.5 * dr.sqrt(n2), eta, k)  # at wi.h = |S| / 2
     elif ior > 0.0:
-        f = _fresnel_dielectric(c, ior)
-    else:
-        f = 1.0
+        num = num * _fresnel_dielectric(0.5 * dr.sqrt(n2), ior)
     pl = _projected(wl, dist, g1, alpha)
     pv = _projected(v, dist, g1, alpha)
     if shadowing == 0:
-        return _div(d * f, 4.0 * pl * pv)  # Walter eq. 20, separable Smith
-    return _div(d * f, 4.0 * (v[2] * pl + wl[2] * pv - wl[2] * v[2]))  # Heitz 2014, height-correlated
+        return _div(num, den * (4.0 * pl * pv))  # Walter eq. 20, separable Smith
+    return _div(num, den * (4.0 * (v[2] * pl + wl[2] * pv - wl[2] * v[2])))  # Heitz 2014, height-correlated
 
 
 def _dr_metal(wl, v, n, eta, k, c):
-    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)  # 000 eq. 9
+    rv = _mirror_cos(wl, v)  # 000 eq. 9
     mx = dr.maximum(wl[2], v[2])
     return dr.select(rv > 0, _div(c * _pow_pos(rv, n), mx) * _fresnel_conductor(mx, eta, k), 0.0)  # 000 eq. 28
 
 
 def _dr_plastic(wl, v, n, ad, a_s, eta):
-    rv = 2.0 * wl[2] * v[2] - _dot(wl, v)
+    rv = _mirror_cos(wl, v)
     mx = dr.maximum(wl[2], v[2])
     fr = _fresnel_conductor(mx, eta, 0.0) if eta > 0.0 else 1.0  # 000 eq. 30
     spec = _div(a_s * (n + 2.0) / (2.0 * math.pi) * _pow_pos(rv, n), mx) * fr  # 000 eq. 29
@@ -471,47 +494,237 @@ class _Level:
         return g
 
 
-class _ProductG:
-    """The chain kernel's fast path in Dr.Jit: G(m) = g_1 ... g_k as one piecewise quintic in
-    m = max(N.wi, N.wo) (:class:`pumpup.operators.pumping._Product`, the same pieces and coefficients, already scaled
-    up by 1 + epsilon), the piece found from the float64 bits of m, for min(N.wi, N.wo) > ``mlo``.
+class _Rows:
+    """Rows of float64 numbers, one per piece, for one gather per piece: in JIT variants padded to a multiple of 8
+    and read as packets of 8 consecutive values (a 64-byte line each, ``dr.gather`` of an ``ArrayXf64``), in scalar
+    variants a numpy array.
     """
 
-    def __init__(self, prod):
-        from .physics.lookups import CELL_SHIFT, float_bits_reference
+    PACKET = 8
 
-        self.mlo, self.cbase, self.shift = float(prod.mlo), int(prod.cbase), CELL_SHIFT
-        self.ncell = len(prod.cstart)
-        self.deg = prod.rows.shape[1] - 3
-        self.width = prod.rows.shape[1]
-        self.rows = _Table(prod.rows)  # piece s: coefficients (highest power first), centre, 1 / half-width
-        self.lo = _Table(prod.lo)  # piece starts, with an inf sentinel
-        self.cstart_np = np.asarray(prod.cstart, dtype=np.int64)
-        self.cstart = mi.UInt32(self.cstart_np.astype(np.uint32)) if _jit() else None
-        # the most pieces that start inside one cell: the kernel's forward steps, unrolled here
-        bounds = (np.arange(self.cbase, self.cbase + self.ncell + 1, dtype=np.int64) << self.shift).view(np.float64)
-        ends = np.searchsorted(prod.lo[:-1], bounds[1:], side="left") - 1
-        self.steps = int(max(0, np.max(ends - self.cstart_np))) + 1
+    def __init__(self, rows):
+        rows = np.asarray(rows, dtype=np.float64)
+        self.width = rows.shape[1]
+        self.packets = -(-self.width // self.PACKET)
+        padded = np.zeros((rows.shape[0], self.packets * self.PACKET))
+        padded[:, :self.width] = rows
+        self.np = padded
+        self.dr = _aligned_f64(padded) if _jit() else None
+
+    def __call__(self, s) -> list:
+        """Row ``s`` (a UInt32 array, or an int in scalar variants) as a list of its ``width`` values."""
+        if self.dr is None:
+            return [float(x) for x in self.np[int(s)][:self.width]]
+        packet = _array_xf64()
+        out = []
+        for j in range(self.packets):
+            idx = s * self.packets + j if self.packets > 1 else s
+            p = dr.gather(packet, self.dr, idx, shape=(self.PACKET, dr.width(s)))
+            out.extend(p[i] for i in range(self.PACKET))
+        return out[:self.width]
+
+
+def _aligned_f64(values, align: int = 64):
+    """A Float64 array of ``values`` whose storage starts on an ``align``-byte boundary: Dr.Jit maps a numpy array's
+    memory (no copy; it holds a reference to the array) and reads packets from it only when it is so aligned, else it
+    gathers each value alone (the same numbers, slower).
+    """
+    values = np.ascontiguousarray(values, dtype=np.float64).ravel()
+    buf = np.empty(values.size + align // 8)
+    off = (-buf.ctypes.data % align) // 8
+    host = buf[off:off + values.size]
+    host[:] = values
+    return mi.Float64(host)
+
+
+def _array_xf64():
+    """The dynamic array of Float64 arrays of the current JIT variant (what ``dr.gather`` reads packets into)."""
+    import importlib
+
+    return importlib.import_module(mi.Float64.__module__).ArrayXf64
+
+
+class _Cells:
+    """The piece of a table in m (pieces [lo[s], lo[s + 1]), ``lo`` ending with an inf sentinel) that holds m > mlo,
+    found from the float64 bits of m as :meth:`pumpup.operators.pumping._LevelTable.piece` finds it, without a branch:
+    cell c = (bits(m) >> ``shift``) - ``cbase`` holds a packet (s0, b_1, ..., b_(w-1)), s0 the piece where the cell
+    starts and b_i the start of piece s0 + i where it lies inside the cell (else inf); the piece is s0 + the number of
+    b_i <= m, read with one gather.  2^bits cells per octave and w in {2, 4, 8}: the fewest bits from CELL_BITS to
+    ``MAX_BITS`` at which no cell holds more than 3 piece starts (w = 2 or 4), else than 7 (w = 8); where even
+    ``MAX_BITS`` leaves K > 7 starts in a cell, the starts of pieces s0 + 8 ... s0 + K are read too, for every m
+    (``extra``).
+    """
+
+    MAX_BITS = 12
+
+    def __init__(self, lo, mlo: float):
+        from .physics.lookups import CELL_BITS, float_bits_reference
+
+        self.lo_np = np.asarray(lo, dtype=np.float64)
+        starts = self.lo_np[:-1]
+
+        def most(bits):  # the most piece starts inside one cell (after its first piece's)
+            shift = 52 - bits
+            b0 = int(float_bits_reference(mlo)) >> shift
+            top = int(float_bits_reference(1.0)) >> shift
+            bounds = (np.arange(b0, top + 2, dtype=np.int64) << shift).view(np.float64)
+            inside = (np.searchsorted(starts, bounds[1:], side="left")
+                      - np.searchsorted(starts, bounds[:-1], side="right"))
+            return int(inside.max())
+
+        counts = {bits: most(bits) for bits in range(CELL_BITS, self.MAX_BITS + 1)}
+        few = [b for b in counts if counts[b] <= 3]
+        some = [b for b in counts if counts[b] <= 7]
+        bits = few[0] if few else (some[0] if some else self.MAX_BITS)
+        k = counts[bits]
+        self.width = 2 if k <= 1 else (4 if k <= 3 else 8)
+        self.extra = max(0, k - 7)
+        self.shift = shift = 52 - bits
+        self.cbase = int(float_bits_reference(mlo)) >> shift
+        top = int(float_bits_reference(1.0)) >> shift
+        bounds = (np.arange(self.cbase, top + 2, dtype=np.int64) << shift).view(np.float64)
+        s0 = np.clip(np.searchsorted(starts, bounds[:-1], side="right") - 1, 0, len(starts) - 1)
+        table = np.full((len(s0), self.width), math.inf)
+        table[:, 0] = s0
+        for i in range(1, self.width):
+            nxt = self.lo_np[np.minimum(s0 + i, len(self.lo_np) - 1)]
+            table[:, i] = np.where(nxt < bounds[1:], nxt, math.inf)  # a start inside the cell, else never reached
+        self.np = table
+        self.ncell = len(s0)
+        if _jit():
+            self.dr = _aligned_f64(table)
+            self.lo = mi.Float64(self.lo_np)
         self._bits = float_bits_reference
 
     def __call__(self, m):
-        if _jit():
-            bits = dr.reinterpret_array(mi.UInt64, m) >> self.shift
-            c = mi.UInt32(dr.minimum(dr.maximum(bits, self.cbase) - self.cbase, self.ncell - 1))
-            s = dr.gather(mi.UInt32, self.cstart, c)
-            for _ in range(self.steps):  # forward to the piece that holds m (pumpup.operators.pumping._Product.piece)
-                s = dr.select(m >= self.lo[s + 1], s + 1, s)
-        else:
+        """The piece that holds m (m > mlo; other m give some valid piece index)."""
+        if not _jit():
             c = min(max((int(self._bits(m)) >> self.shift) - self.cbase, 0), self.ncell - 1)
-            s = int(self.cstart_np[c])
-            while m >= self.lo[s + 1]:
+            s = int(self.np[c, 0])
+            while m >= self.lo_np[s + 1]:
                 s += 1
-        w, d = self.width, self.deg
-        t = (m - self.rows[s * w + d + 1]) * self.rows[s * w + d + 2]
-        g = self.rows[s * w] * t
-        for r in range(1, d):  # Horner, in the order of pumpup.physics.lookups.horner
-            g = (g + self.rows[s * w + r]) * t
-        return g + self.rows[s * w + d]
+            return s
+        bits = dr.reinterpret_array(mi.UInt64, m) >> self.shift
+        c = mi.UInt32(dr.minimum(dr.maximum(bits, self.cbase) - self.cbase, self.ncell - 1))
+        cell = dr.gather(_array_xf64(), self.dr, c, shape=(self.width, dr.width(c)))
+        one, zero = mi.UInt32(1), mi.UInt32(0)
+        s0 = mi.UInt32(cell[0])
+        s = s0
+        for i in range(1, self.width):
+            s = s + dr.select(m >= cell[i], one, zero)
+        end = len(self.lo_np) - 1  # the sentinel
+        for i in range(self.width, self.width + self.extra):  # a cell with more starts than its packet: the starts
+            # after them, each read from s0 (independent reads; lo increases, so those beyond m count nothing)
+            s = s + dr.select(m >= dr.gather(mi.Float64, self.lo, dr.minimum(s0 + i, end)), one, zero)
+        return s
+
+
+def _horner(row, a: int, deg: int, t):
+    """sum_r row[a + r] t^(deg - r), in the order of :func:`pumpup.physics.lookups.horner` (and the compiled
+    kernels).
+    """
+    v = row[a] * t
+    for r in range(1, deg):
+        v = (v + row[a + r]) * t
+    return v + row[a + deg]
+
+
+class _ProductG:
+    """The product table's G(m) = g_1 ... g_k in Dr.Jit (:class:`pumpup.operators.pumping._Product`, the same pieces
+    and coefficients, already scaled up by 1 + epsilon; its numpy reference is ``_Product.__call__``): m = max(N.wi,
+    N.wo), one cell gather and one gather of the piece's row (6 coefficients, centre, inverse half-width: 64 bytes).
+    """
+
+    def __init__(self, prod):
+        self.mlo = float(prod.mlo)
+        self.deg = prod.coef.shape[0] - 1
+        self.cells = _Cells(prod.lo, self.mlo)
+        self.rows = _Rows(np.concatenate([prod.coef, prod.center[None], prod.ihalf[None]]).T)
+
+    def __call__(self, mi_, mo):
+        m = dr.maximum(mi_, mo)
+        row = self.rows(self.cells(m))
+        d = self.deg
+        return _horner(row, 0, d, (m - row[d + 1]) * row[d + 2])
+
+
+class _PairG:
+    """The level table's g_1 ... g_k at (N.wi, N.wo) in Dr.Jit (:class:`pumpup.operators.pumping._LevelTable`, the
+    compiled :func:`pumpup.physics.lookups.g_pair`; its numpy reference is ``_LevelTable.g``): one piece per cosine
+    serves every level, its row (centre, inverse half-width, each level's coefficients) read in packets of 8.
+
+    ``below``: where no float32 lies between the table's mlo and a level's first node (nor above its mu0), a float32
+    cosine m <= mlo lies below every level's spline, where pumpup's level-by-level path (:func:`g_levels`) takes the
+    power law v0 exp(slope0 (log m - log x0)) + margin_lo (at most the cap): this class then computes it too, without a
+    branch (the exponential as a Taylor polynomial where |slope0 (log m - log x0)| <= 1e-3, to 1e-18), and the pair
+    needs no level-by-level path at all.
+    """
+
+    def __init__(self, table):
+        self.mlo = float(table.mlo)
+        self.deg = table.coef.shape[1] - 1
+        self.controlled = [bool(c) for c in table.controlled]
+        self.cells = _Cells(table.lo, self.mlo)
+        self.rows = _Rows(table.rows)
+        f32 = np.float32(self.mlo)
+        if float(f32) > self.mlo:
+            f32 = np.nextafter(f32, np.float32(0.0))
+        top = float(f32)  # the largest float32 <= mlo
+        looks = table.looks
+        span = math.log(self.mlo) - math.log(float(np.finfo(np.float32).smallest_subnormal)) + 1.0
+        self.below = None
+        if all(top < math.exp(lk.logx[0]) * (1.0 - 1e-12) and top <= lk.mu0 for lk in looks):
+            self.below = []
+            for lk in looks:
+                ymax = abs(float(lk.slope0)) * span  # |slope0 (log m - log x0)| for every float32 m in (0, mlo]
+                terms = next((d for d in range(1, 8) if ymax ** (d + 1) / math.factorial(d + 1) <= 1e-18), None)
+                self.below.append((float(lk.v0), float(lk.slope0), float(lk.logx[0]), float(lk.margin_lo),
+                                   float(lk.cap), terms if ymax <= 1e-3 else None))
+            #: log(m) from the exponent and a float32 logarithm of the mantissa (m is a float32: its mantissa is
+            #: exact in float32; the logarithm is off by at most 3e-7) where that moves every slope0 log(m) by at most
+            #: 1e-13, else in float64
+            self.cheap_log = all(abs(b[1]) * 3e-7 <= 1e-13 for b in self.below)
+
+    @staticmethod
+    def _power_law(lm, v0, slope0, logx0, margin_lo, cap, terms):
+        """A level's bound below its first node (pumpup.physics.lookups.upper_log), at log(m) = ``lm``."""
+        y = slope0 * (lm - logx0)
+        if terms is not None:  # exp(y) to ``terms`` + 1 terms of its Taylor series (Horner), error below 1e-18
+            e = 1.0 / math.factorial(terms)
+            for r in range(terms - 1, -1, -1):
+                e = e * y + 1.0 / math.factorial(r)
+        else:
+            e = dr.exp(y)
+        u = v0 * e + margin_lo
+        return dr.minimum(u, cap) if math.isfinite(cap) else u
+
+    def _log(self, m):
+        if not (self.cheap_log and _jit()):
+            return dr.log(dr.maximum(m, 1e-300))
+        bits = dr.reinterpret_array(mi.UInt64, m)
+        e = mi.Float64(mi.Int32(mi.UInt32(bits >> 52))) - 1023.0  # the exponent (m > 0; others are masked)
+        mant = dr.reinterpret_array(mi.Float64, (bits & ((1 << 52) - 1)) | (1023 << 52))  # in [1, 2)
+        return e * math.log(2.0) + mi.Float64(dr.log(mi.Float(mant)))
+
+    def __call__(self, mi_, mo):
+        ri, ro = self.rows(self.cells(mi_)), self.rows(self.cells(mo))
+        ti, to = (mi_ - ri[0]) * ri[1], (mo - ro[0]) * ro[1]
+        mmax = dr.maximum(mi_, mo)
+        if self.below is not None:
+            lmi, lmo = self._log(mi_), self._log(mo)
+            low_i, low_o = mi_ <= self.mlo, mo <= self.mlo
+        g_all = None
+        for j, controlled in enumerate(self.controlled):
+            a = 2 + j * (self.deg + 1)
+            ui, uo = _horner(ri, a, self.deg, ti), _horner(ro, a, self.deg, to)
+            if self.below is not None:  # (power laws below the tables, as g_levels)
+                ui = dr.select(low_i, self._power_law(lmi, *self.below[j]), ui)
+                uo = dr.select(low_o, self._power_law(lmo, *self.below[j]), uo)
+            g = dr.maximum(ui, uo)  # 001 eq. 20
+            if controlled:
+                g = dr.maximum(g, mmax)  # 001 eq. 21
+            g_all = g if g_all is None else g_all * g
+        return g_all
 
 
 #: the largest float32, the type Mitsuba's JIT variants evaluate in
@@ -554,8 +767,13 @@ class _DrModel:
         base = brdf.p["base"] if self.fresnel is not None else brdf
         from .operators.pumping import Pumped
 
-        prod = base.product() if isinstance(base, Pumped) else None
-        self.product = _ProductG(prod) if prod is not None else None
+        #: one table for all levels where the chain has one: the product table G(max(N.wi, N.wo)) where every level's
+        #: bound increases, else the level table (as pumpup's chain kernel chooses); None: level by level
+        self.fast: _ProductG | _PairG | None = None
+        if isinstance(base, Pumped):
+            prod = base.product()
+            table = base.level_table() if prod is None else None
+            self.fast = _ProductG(prod) if prod is not None else (_PairG(table) if table is not None else None)
         while isinstance(base, Pumped):
             self.levels.append(_Level(base.lookup(), base.controlled))
             base = base.base
@@ -574,27 +792,37 @@ class _DrModel:
         self.components = strat.components
 
     def g(self, mi_, mo):
-        """The product of all levels' g at cosines (mi_, mo) > 0, as pumpup's chain kernel computes it."""
+        """The product of all levels' g at cosines (mi_, mo), as pumpup's chain kernel computes it where both are > 0
+        (elsewhere a value that the caller masks).
+        """
         def by_levels(mi_, mo):
+            mi_, mo = dr.maximum(mi_, 1e-300), dr.maximum(mo, 1e-300)
             g = 1.0
             for lev in self.levels:
                 g = g * lev.g(mi_, mo)
             return g
 
-        if self.product is None:
+        if self.fast is None:
             return by_levels(mi_, mo)
-        fast = dr.minimum(mi_, mo) > self.product.mlo  # both cosines where the product table holds
+        # the table where both cosines exceed its mlo; level by level where the smaller lies in (0, mlo] (a pair
+        # with a cosine <= 0 gives 0 whatever g is: it stays on the table's path, whose lookups stay in range)
+        if getattr(self.fast, "below", None) is not None:  # the table holds every float32 cosine > 0
+            return self.fast(mi_, mo) if _jit() or dr.minimum(mi_, mo) > 0.0 else 1.0
+        mmin = dr.minimum(mi_, mo)
+        slow = (mmin <= self.fast.mlo) & (mmin > 0.0)
         if not _jit():
-            return self.product(dr.maximum(mi_, mo)) if fast else by_levels(mi_, mo)
-        return dr.if_stmt((mi_, mo), fast, lambda a, b: self.product(dr.maximum(a, b)), by_levels)
+            return by_levels(mi_, mo) if (slow or mmin <= 0.0) else self.fast(mi_, mo)
+        # the table's value outside the conditional, so that Dr.Jit shares it between sample() and eval() at the same
+        # pair; the conditional runs the level-by-level path only where some lane of a packet needs it
+        g = self.fast(mi_, mo)
+        return dr.if_stmt((mi_, mo, g), slow, lambda a, b, g: by_levels(a, b), lambda a, b, g: g)
 
     def f(self, wl, v):
         val = self.kernel(wl, v, *self.args)
         if self.fresnel is not None:  # 000 eq. 28's factor F(Theta_min), before the rounding down below
             val = val * _fresnel_conductor(dr.maximum(wl[2], v[2]), *self.fresnel)
         if self.levels:
-            g = self.g(dr.maximum(wl[2], 1e-300), dr.maximum(v[2], 1e-300))
-            val = _div(val, g) * self.ROUND_DOWN  # 001 eq. 16, all levels
+            val = _div(val, self.g(wl[2], v[2])) * self.ROUND_DOWN  # 001 eq. 16, all levels
         return dr.select((wl[2] > 0) & (v[2] > 0), val, 0.0)
 
 
@@ -615,8 +843,8 @@ def _frame(a):
 def _comp_sample(kind, k, v, u1, u2):
     """One component of pumpup.sampling._sample_kernel: (wi (x, y, z), ok)."""
     C = _sampling
-    phi = 2.0 * math.pi * u2
-    sp, cp = dr.sincos(phi)
+    sp, cp = dr.sincos(mi.Float(u2) * _TWO_PI_F32)  # in float32 (u2 is one): a direction's last bits are float32's
+    sp, cp = _f64(sp), _f64(cp)
     if kind == C.COSINE:
         r = dr.sqrt(u1)
         z = dr.sqrt(dr.maximum(1.0 - u1, 0.0))
@@ -656,21 +884,25 @@ def _comp_pdf(kind, k, wl, v):
     elif kind in (C.MIRROR, C.RETRO):
         rx, ry = (-wl[0], -wl[1]) if kind == C.MIRROR else (wl[0], wl[1])
         dx, dy, dz = rx - v[0], ry - v[1], wl[2] - v[2]
-        h = 0.5 * (dx * dx + dy * dy + dz * dz)  # 1 - R.V without cancellation
-        p = dr.select(h < 1.0, (k + 1.0) * _INV_2PI * dr.exp(k * dr.log(dr.maximum(1.0 - h, 1e-300))), 0.0)
-    else:
-        s = (wl[0] + v[0], wl[1] + v[1], wl[2] + v[2])
-        n = dr.sqrt(_dot(s, s))
-        t2 = _div(s[0] * s[0] + s[1] * s[1], s[2] * s[2])
-        ch = _div(s[2], n)
+        h = 0.5 * (dx * dx + dy * dy + dz * dz)  # 1 - R.V without cancellation (and as pumpup.sampling for float32
+        # directions a few 1e-8 off unit length, where R.V itself differs from it by that much)
+        p = dr.select(h < 1.0, (k + 1.0) * _INV_2PI * _pow_pos(1.0 - h, k), 0.0)
+    else:  # p(h) / (4 wo.h) in S = wi + wo, as in _dr_microfacet (|S| = 2 wo.h, cos theta_h = S_z / |S|)
+        sx, sy, sz = wl[0] + v[0], wl[1] + v[1], wl[2] + v[2]
+        sxy2, sz2 = sx * sx + sy * sy, sz * sz
+        n2 = sxy2 + sz2
         if kind == C.HALF_POWER:
-            ph = (k + 1.0) * _INV_2PI * _pow_pos(ch, k) if k > 0 else _INV_2PI + 0.0 * ch
+            n = dr.sqrt(n2)
+            ph = (k + 1.0) * _INV_2PI * _pow_pos(_div(sz, n), k) if k > 0 else _INV_2PI + 0.0 * n
+            p = _div(ph, 2.0 * n)
         elif kind == C.HALF_BECKMANN:
-            ph = _div(dr.exp(-t2 / (k * k)), math.pi * k * k * ch * ch * ch)
+            r = dr.rcp(sz2)
+            # exp(-tan^2 / k^2) / (pi k^2 ch^3) / (2 |S|)
+            p = _div(dr.exp(-(sxy2 * r) / (k * k)) * n2 * r, (2.0 * math.pi * k * k) * sz)
         else:
-            q = k + t2
-            ph = _div(k, math.pi * ch * ch * ch * q * q)
-        p = dr.select(n > 0.0, _div(ph, 2.0 * n), 0.0)
+            q = k * sz2 + sxy2
+            p = _div(k * n2 * sz, (2.0 * math.pi) * (q * q))  # k / (pi ch^3 (k + tan^2)^2) / (2|S|)
+        p = dr.select(n2 > 0.0, p, 0.0)
     return dr.select((wl[2] > 0.0) & (v[2] > 0.0), p, 0.0)
 
 

@@ -155,9 +155,88 @@ def test_eval_agrees_with_pumpup_llvm(spec, rng):
     _check_agreement(spec, LLVM, 2000, rng)
 
 
-@pytest.mark.parametrize("spec", SPECS[:: 3] + PUMPED[:1], ids=_ids(SPECS[:: 3] + PUMPED[:1]))
+#: pumped chains whose levels' bounds are not all monotone (GGX's albedo falls, then rises): the plugin divides by
+#: the level table (one piece per cosine for every level), as pumpup's chain kernel does
+LEVEL_TABLE = [{"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 2},
+               {"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 3}]
+
+
+@needs_llvm
+@pytest.mark.parametrize("spec", LEVEL_TABLE, ids=_ids(LEVEL_TABLE))
+def test_level_table_chains_agree_with_pumpup_llvm(spec, rng):
+    pm.register(LLVM)
+    assert pm._DrModel(pumpup.load(spec)).fast.__class__.__name__ == "_PairG"
+    _check_agreement(spec, LLVM, 2000, rng)
+
+
+@pytest.mark.parametrize("spec", SPECS[:: 3] + PUMPED[:1] + LEVEL_TABLE[:1],
+                         ids=_ids(SPECS[:: 3] + PUMPED[:1] + LEVEL_TABLE[:1]))
 def test_eval_agrees_with_pumpup_scalar(spec, rng):
     _check_agreement(spec, "scalar_rgb", 24, rng)
+
+
+def _table_points(t, rng):
+    """Cosines above a table's mlo: uniform, log-uniform, every piece start and the float below it, and 1."""
+    lo = t.lo[1:-1]
+    x = np.concatenate([rng.uniform(t.mlo, 1.0, 4000), np.exp(rng.uniform(math.log(t.mlo), 0.0, 4000)), lo,
+                        np.nextafter(lo, 0.0), [1.0]])
+    return x[x > t.mlo]
+
+
+@needs_llvm
+@pytest.mark.parametrize("spec", [PUMPED[0], LEVEL_TABLE[1], {**PUMPED[0], "levels": 3}],
+                         ids=["product-2", "level-table-3", "product-3"])
+def test_table_kernels_equal_their_numpy_references(spec, rng):
+    """The Dr.Jit look-ups of the product table and the level table (a cell gather, one row per piece in 64-byte
+    packets, Horner) against their plain numpy references, _Product.__call__ and _LevelTable.g: the same pieces, the
+    same value to the last bit, at random cosines and at both sides of every piece start (crowded cells included)."""
+    pm.register(LLVM)
+    f = pumpup.load(spec)
+    fast = pm._DrModel(f).fast
+    t = f.product() if f.product() is not None else f.level_table()
+    x = _table_points(t, rng)
+    y = rng.permutation(x)
+    got = np.array(fast(mi.Float64(x), mi.Float64(y)), dtype=np.float64)
+    ref = t(np.maximum(x, y)) if f.product() is not None else t.g(x, y)
+    assert np.array_equal(got, ref)
+    assert np.array_equal(np.array(fast.cells(mi.Float64(x))), t.piece(x))
+    if spec["levels"] == 3:
+        assert fast.cells.width > 2  # cells that hold several piece starts
+    for table in (fast.rows.dr, fast.cells.dr):  # 64-byte aligned: Dr.Jit reads them in packets
+        assert np.asarray(table).__array_interface__["data"][0] % 64 == 0
+
+
+@needs_llvm
+def test_level_table_below_mlo_is_the_level_by_level_power_law(rng):
+    """Float32 cosines at or below the level table's mlo (down to the smallest float32), paired with any cosine: the
+    plugin's branch-free power law against the level-by-level numpy reference (each level's Pumped.g), within the
+    error it allows itself (1e-13 per level from the float32 logarithm of the mantissa)."""
+    pm.register(LLVM)
+    f = pumpup.load(LEVEL_TABLE[1])
+    fast = pm._DrModel(f).fast
+    assert fast.below is not None and fast.cheap_log
+    low = np.exp(rng.uniform(math.log(1.5e-45), math.log(fast.mlo), 3000)).astype(np.float32).astype(np.float64)
+    low = np.concatenate([low[low > 0], [float(np.float32(1e-8)), float(np.finfo(np.float32).smallest_subnormal)]])
+    other = np.concatenate([rng.uniform(0.0, 1.0, len(low) // 2), low[: len(low) - len(low) // 2][::-1]])
+    other = other.astype(np.float32).astype(np.float64)
+    other[other <= 0] = 1e-30
+    ref = np.ones(len(low))
+    for lev in f.chain():
+        ref = ref * lev.g(low, other)
+    got = np.array(fast(mi.Float64(low), mi.Float64(other)), dtype=np.float64)
+    assert np.all(np.abs(got / ref - 1.0) <= 3 * 1e-13)
+
+
+def test_table_kernels_scalar_equal_their_numpy_references(rng):
+    pm.register("scalar_rgb")
+    for spec in (PUMPED[0], LEVEL_TABLE[0]):
+        f = pumpup.load(spec)
+        fast = pm._DrModel(f).fast
+        t = f.product() if f.product() is not None else f.level_table()
+        x = _table_points(t, rng)[::40]
+        y = rng.permutation(x)
+        ref = t(np.maximum(x, y)) if f.product() is not None else t.g(x, y)
+        assert [fast(float(a), float(b)) for a, b in zip(x, y)] == list(ref)
 
 
 @needs_llvm
@@ -188,8 +267,13 @@ def _sample(b, wo, n, seed):
     return d, np.array(bs.pdf, dtype=np.float64), np.array(w, dtype=np.float64), si, bs
 
 
+#: a level-table chain in the Monte Carlo and chi-square checks (slow: its tables take a minute on a loaded machine)
+LEVEL_TABLE_SLOW = [pytest.param(s, id=json.dumps(s, separators=(",", ":"))[:60], marks=pytest.mark.slow)
+                    for s in LEVEL_TABLE[:1]]
+
+
 @needs_llvm
-@pytest.mark.parametrize("spec", _split(SPECS))
+@pytest.mark.parametrize("spec", _split(SPECS) + LEVEL_TABLE_SLOW)
 def test_mc_albedo_within_4_standard_errors(spec):
     """Mitsuba Monte Carlo with the plugin's own sample() against pumpup.albedo (reciprocal models:
     the albedo at wo is the albedo at wi)."""
@@ -257,7 +341,7 @@ def _chi2(sample_spec, wi, test_count, pdf_spec=None, ires=CHI2_IRES):
 
 
 @needs_llvm
-@pytest.mark.parametrize("spec", _split(CHI2_SPECS))
+@pytest.mark.parametrize("spec", _split(CHI2_SPECS) + LEVEL_TABLE_SLOW)
 def test_mitsuba_chi2(spec):
     pm.register(LLVM)
     for theta in CHI2_ANGLES:
