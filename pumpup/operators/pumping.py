@@ -177,7 +177,8 @@ def _uses_file_tables(brdf: BRDF) -> bool:
 @njit(cache=True, nogil=True)
 def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
                   index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow, qmlo, qshift, qcbase, qcstart,
-                  qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcstart, rlo, rcoef):  # pragma: no cover
+                  qlo, qrow, rcells, rpattern, rfid, rhid, rpower, rshift, rcbase, rcstart, rlo,
+                  rcoef):  # pragma: no cover - compiled
     """All levels of a pumped chain in one pass: f / (g_1 g_2 ... g_k) (001 eq. 16), in place.
 
     The tables of the levels are concatenated (level j owns nodes offsets[j]:offsets[j+1]);
@@ -207,7 +208,7 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
         elif mmin > qmlo:  # one piece per direction for all levels (0 / g = 0)
             g = 0.0
             if rcells > 0:  # one product F(mmin) H(mmax), 0 where the cell has no pattern
-                g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcstart, rlo, rcoef)
+                g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rpower, rshift, rcbase, rcstart, rlo, rcoef)
             if g == 0.0:
                 g = g_pair(mi, mo, controlled, qshift, qcbase, qcstart, qlo, qrow)
             f[k] = f[k] / g  # 001 eq. 16, all levels
@@ -584,20 +585,23 @@ class _SplitTable:
     its smallest value over the cell exceeds the other terms' largest by the relative SAFETY, each U_j's range over a
     cell's interval taken from its values at the ends and at the zeros of its spline's derivative inside.  A cell whose
     levels all have a certified term holds a pattern (the term of every level); then
-    g_1 ... g_k = F_A(l) H_B(m) with F_A the product of the U_j of the levels A that take U_j(l), and H_B the product
-    of the U_j of the levels that take U_j(m) times m for each level that takes m (001 eq. 21).  The other cells
+    g_1 ... g_k = F_A(l) H_B(m) m^c with F_A the product of the U_j of the levels A that take U_j(l), H_B the product
+    of the U_j of the levels B that take U_j(m), and c the number of levels that take m (001 eq. 21).  The other cells
     (the diagonal ones, and those a kink crosses: U_j(l) = U_j(m), U_j = m, U_j = cap) hold -1, and the kernel takes
     the level table there.
 
-    Every F_A and H_B used is tabulated on one set of pieces in m, as the level table tabulates the U_j (pieces split
+    Every product of bounds used (:attr:`functions`; row 0, the empty product, is exactly 1) is tabulated on one set of
+    pieces in m, as the level table tabulates the U_j (pieces split
     at every breakpoint of every level's spline and where a level's bound reaches its cap; a Chebyshev interpolant of
     degree PRODUCT_DEGREE on each, bisected until it matches its function to ``TOL``, relative, at 4 (degree + 1) + 1
     test points), scaled by 1 - ``epsilon`` (twice the largest miss plus 16 ulp) and checked never to exceed its
     function: the product the kernel divides by is at most the level-by-level product of g (the pumped BRDF at least
-    the level-by-level one) and at least that product times (1 - 2 ``epsilon``), as the level table's.
+    the level-by-level one) and at least that product times (1 - 2 ``epsilon``), as the level table's; m is
+    multiplied in exactly (where every level takes m, the ideal operator's g is m^k itself, with no room below it).
     ``coef[f, s]`` holds function f's coefficients on piece s (highest power first), the piece's centre and inverse
     half-width: one cache line per look-up.  ``pattern[i, k]`` (int8) is the pattern of the cell i = floor(l CELLS),
-    k = floor(m CELLS) (-1: none), ``fid[p]`` and ``hid[p]`` the rows of ``coef`` that hold its F_A and H_B.
+    k = floor(m CELLS) (-1: none), ``fid[p]`` and ``hid[p]`` the rows of ``coef`` that hold its F_A and H_B,
+    ``power[p]`` one flag per level, the c levels that take m first.
     :meth:`g` is the plain numpy version of the kernel.
     """
 
@@ -626,40 +630,42 @@ class _SplitTable:
         self.pattern[ok] = inverse.ravel().astype(np.int8)
         #: the term of every level in each pattern (0: U_j(l), 1: U_j(m), 2: m)
         self.patterns = keys.astype(np.int8)
-        fkeys = sorted({tuple(np.nonzero(k == 0)[0]) for k in keys})
-        hkeys = sorted({(tuple(np.nonzero(k == 1)[0]), int(np.count_nonzero(k == 2))) for k in keys})
-        #: the functions tabulated: ("F", levels) or ("H", levels, power of m), F's first
-        self.functions = [("F", a) for a in fkeys] + [("H", b, c) for b, c in hkeys]
-        self.fid = np.array([fkeys.index(tuple(np.nonzero(k == 0)[0])) for k in keys], dtype=np.int64)
-        self.hid = np.array([len(fkeys) + hkeys.index((tuple(np.nonzero(k == 1)[0]), int(np.count_nonzero(k == 2))))
-                             for k in keys], dtype=np.int64)
         if len(keys) == 0:  # (no cell certified: a table of nothing; the chain keeps the level table alone)
             raise _ProductError("no cell of the split table has one term per level")
+        sets = sorted({tuple(np.nonzero(k == 0)[0]) for k in keys} | {tuple(np.nonzero(k == 1)[0]) for k in keys},
+                      key=lambda a: (len(a), a))
+        #: the products of levels' bounds tabulated, as tuples of levels: row 0 the empty product (exactly 1)
+        self.functions = sets if sets[0] == () else [(), *sets]
+        self.fid = np.array([self.functions.index(tuple(np.nonzero(k == 0)[0])) for k in keys], dtype=np.int64)
+        self.hid = np.array([self.functions.index(tuple(np.nonzero(k == 1)[0])) for k in keys], dtype=np.int64)
+        #: per pattern, one flag per level: 1 for each level that takes m (001 eq. 21), first; the kernel multiplies
+        #: m in exactly, once per flag
+        self.power = np.array([np.sort(k == 2)[::-1] for k in keys], dtype=np.int8)
         br = _level_breaks(self.looks, self.mlo)
-        fns = [self._function(fn) for fn in self.functions]
+        fns = [self._function(fn) for fn in self.functions[1:]]
         coefs, lo, hi, center, half, worst = fit_pieces(fns, br[:-1], br[1:], self.TOL, "split table")
         self.epsilon = 2.0 * float(worst.max()) + 16 * np.finfo(float).eps
-        coef = np.stack(coefs) * (1.0 - self.epsilon)  # (functions, degree + 1, pieces)
+        one = np.zeros((1, PRODUCT_DEGREE + 1, len(lo)))
+        one[0, -1] = 1.0  # the empty product: Horner's rule gives exactly 1, so a cell whose every level takes m
+        # divides by exactly m^k, as the level-by-level path (the ideal operator's value there too: no room below it)
+        coef = np.concatenate([one, np.stack(coefs) * (1.0 - self.epsilon)])  # (functions, degree + 1, pieces)
         self.coef = _aligned(np.concatenate(
-            [coef.transpose(0, 2, 1), np.broadcast_to(center[None, :, None], (len(fns), len(lo), 1)),
-             np.broadcast_to(1.0 / half[None, :, None], (len(fns), len(lo), 1))], axis=2))
+            [coef.transpose(0, 2, 1), np.broadcast_to(center[None, :, None], (len(coef), len(lo), 1)),
+             np.broadcast_to(1.0 / half[None, :, None], (len(coef), len(lo), 1))], axis=2))
         self.center, self.ihalf = center, 1.0 / half
         self.lo = np.concatenate([lo, [math.inf]])  # a sentinel ends the search
         self.shift, self.cbase, self.cstart = _piece_cells(lo, self.mlo, self.CELLS_MAX_BITS)
-        self._check(fns)
+        self._check([self._function(fn) for fn in self.functions])
 
     def _function(self, fn):
-        """The exact function of one of :attr:`functions`, of an array of m: a product of levels' bounds (and m^c)."""
+        """The exact function of one of :attr:`functions`, of an array of m: a product of levels' bounds."""
         looks = self.looks
 
         def f(m):
             m = np.asarray(m, dtype=np.float64)
             out = np.ones_like(m)
-            for j in fn[1]:
+            for j in fn:
                 out = out * looks[j].upper(m)
-            if fn[0] == "H":
-                for _ in range(fn[2]):
-                    out = out * m  # 001 eq. 21: g_j = m
             return out
 
         return f
@@ -756,7 +762,11 @@ class _SplitTable:
                 w = pp == q
                 f[w] = self.function(self.fid[q], lo[on][w])
                 h[w] = self.function(self.hid[q], hi[on][w])
-            out[on] = f * h  # F_A(l) H_B(m)
+            g = f * h  # F_A(l) H_B(m)
+            m = hi[on]
+            for c in range(self.power.shape[1]):
+                g = np.where(self.power[pp, c] == 1, g * m, g)  # 001 eq. 21: m for each level that takes it
+            out[on] = g
         return out
 
     def share(self) -> float:
@@ -777,7 +787,8 @@ def _aligned(a: np.ndarray, line: int = 64) -> np.ndarray:
 
 
 #: the split table's arguments of the kernels when there is none (:meth:`Pumped._split_args`)
-_SPLIT_OFF = (0, np.full((1, 1), -1, dtype=np.int8), np.zeros(1, np.int64), np.zeros(1, np.int64), CELL_SHIFT, 0,
+_SPLIT_OFF = (0, np.full((1, 1), -1, dtype=np.int8), np.zeros(1, np.int64), np.zeros(1, np.int64),
+              np.zeros((1, 1), np.int8), CELL_SHIFT, 0,
               np.zeros(1, np.int32), np.full(2, math.inf), np.zeros((1, 1, PRODUCT_DEGREE + 3)))
 
 
@@ -1113,7 +1124,7 @@ class Pumped(BRDF):
         r = self.split_table()
         if r is None:  # off: split_cells = 0
             return _SPLIT_OFF
-        return r.ncell, r.pattern, r.fid, r.hid, r.shift, r.cbase, r.cstart, r.lo, r.coef
+        return r.ncell, r.pattern, r.fid, r.hid, r.power, r.shift, r.cbase, r.cstart, r.lo, r.coef
 
     def _level_args(self):
         q = self.level_table()

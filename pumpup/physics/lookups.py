@@ -281,13 +281,14 @@ def g_pair(mi, mo, controlled, shift, pcbase, pcstart, plo, prow):  # pragma: no
 
 
 @njit(cache=True, nogil=True, inline="always")
-def g_split(mmin, mmax, ncell, pattern, fid, hid, shift, pcbase, pcstart, plo, pcoef):  # pragma: no cover - compiled
+def g_split(mmin, mmax, ncell, pattern, fid, hid, power, shift, pcbase, pcstart, plo, pcoef):  # pragma: no cover
     """g_1 g_2 ... g_k at min(N.wi, N.wo) = ``mmin`` and max = ``mmax`` (both above the table's ``mlo``) as ONE
-    product F(mmin) H(mmax) of two tabulated functions, whatever the number of levels, or 0.0 where the cell of
+    product F(mmin) H(mmax) mmax^c of two tabulated functions, whatever the number of levels, or 0.0 where the cell of
     (mmin, mmax) has no pattern (the caller then takes :func:`g_pair`): the cell i = floor(mmin ``ncell``),
     k = floor(mmax ``ncell``) gives the pattern p = ``pattern[i, k]``, whose functions are rows ``fid[p]`` and
-    ``hid[p]`` of ``pcoef`` (:class:`pumpup.operators.pumping._SplitTable`; 001 eq. 20, 21 with every level's term
-    fixed in the cell).  ``pcoef[f, s]``: piece s's PRODUCT_DEGREE + 1 coefficients, highest power first, its centre
+    ``hid[p]`` of ``pcoef``, and ``power[p]`` flags the c levels that take mmax (:class:`pumpup.operators.pumping.
+    _SplitTable`; 001 eq. 20, 21 with every level's term fixed in the cell; mmax multiplied in exactly, no branch).
+    ``pcoef[f, s]``: piece s's PRODUCT_DEGREE + 1 coefficients, highest power first, its centre
     and inverse half-width.  Inlined where it is called.  Its numpy reference is
     :meth:`pumpup.operators.pumping._SplitTable.g`.
     """
@@ -306,7 +307,10 @@ def g_split(mmin, mmax, ncell, pattern, fid, hid, shift, pcbase, pcstart, plo, p
           + pcoef[a, si, 4]) * ti + pcoef[a, si, 5]
     go = ((((pcoef[b, so, 0] * to + pcoef[b, so, 1]) * to + pcoef[b, so, 2]) * to + pcoef[b, so, 3]) * to
           + pcoef[b, so, 4]) * to + pcoef[b, so, 5]
-    return gi * go
+    g = gi * go
+    for j in range(power.shape[1]):  # one pass per level, a select each (a loop of c passes would mispredict)
+        g *= mmax if power[p, j] else 1.0  # 001 eq. 21
+    return g
 
 
 @njit(cache=True, nogil=True)
@@ -358,7 +362,7 @@ GChain = namedtuple("GChain", [
     "offsets", "logx", "coef", "v0", "slope0", "margin_lo", "cap", "controlled", "increasing", "mu0", "index",
     "index_lo", "index_h_inv", "product_mlo", "product_cbase", "product_cstart", "product_lo", "product_rows",
     "pair_mlo", "pair_shift", "pair_cbase", "pair_cstart", "pair_lo", "pair_rows",
-    "split_cells", "split_pattern", "split_fid", "split_hid", "split_shift", "split_cbase", "split_cstart", "split_lo",
-    "split_coef",
+    "split_cells", "split_pattern", "split_fid", "split_hid", "split_power", "split_shift", "split_cbase",
+    "split_cstart", "split_lo", "split_coef",
 ])
 
