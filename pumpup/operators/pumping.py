@@ -177,7 +177,7 @@ def _uses_file_tables(brdf: BRDF) -> bool:
 @njit(cache=True, nogil=True)
 def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
                   index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow, qmlo, qshift, qcbase, qcstart,
-                  qlo, qrow, rcells, rpattern, rfid, rhid, rpower, rshift, rcbase, rcstart, rlo,
+                  qlo, qrow, rcells, rpattern, rsub, rfid, rhid, rshift, rcbase, rcstart, rlo,
                   rcoef):  # pragma: no cover - compiled
     """All levels of a pumped chain in one pass: f / (g_1 g_2 ... g_k) (001 eq. 16), in place.
 
@@ -208,7 +208,8 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
         elif mmin > qmlo:  # one piece per direction for all levels (0 / g = 0)
             g = 0.0
             if rcells > 0:  # one product F(mmin) H(mmax), 0 where the cell has no pattern
-                g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rpower, rshift, rcbase, rcstart, rlo, rcoef)
+                g = g_split(mmin, mmax, rcells, rpattern, rsub, rfid, rhid, rshift, rcbase, rcstart, rlo,
+                            rcoef)
             if g == 0.0:
                 g = g_pair(mi, mo, controlled, qshift, qcbase, qcstart, qlo, qrow)
             f[k] = f[k] / g  # 001 eq. 16, all levels
@@ -585,10 +586,10 @@ class _SplitTable:
     its smallest value over the cell exceeds the other terms' largest by the relative SAFETY, each U_j's range over a
     cell's interval taken from its values at the ends and at the zeros of its spline's derivative inside.  A cell whose
     levels all have a certified term holds a pattern (the term of every level); then
-    g_1 ... g_k = F_A(l) H_B(m) m^c with F_A the product of the U_j of the levels A that take U_j(l), H_B the product
-    of the U_j of the levels B that take U_j(m), and c the number of levels that take m (001 eq. 21).  The other cells
-    (the diagonal ones, and those a kink crosses: U_j(l) = U_j(m), U_j = m, U_j = cap) hold -1, and the kernel takes
-    the level table there.
+    g_1 ... g_k = F_A(l) H_B(m) with F_A the product of the U_j of the levels A that take U_j(l), and H_B the product
+    of the U_j of the levels B that take U_j(m) times m^c, c the number of levels that take m (001 eq. 21).  The
+    other cells (the diagonal ones, and those a kink crosses: U_j(l) = U_j(m), U_j = m, U_j = cap) hold -1, and the
+    kernel takes the level table there.
 
     Every product of bounds used (:attr:`functions`; row 0, the empty product, is exactly 1) is tabulated on one set of
     pieces in m, as the level table tabulates the U_j (pieces split
@@ -596,12 +597,11 @@ class _SplitTable:
     degree PRODUCT_DEGREE on each, bisected until it matches its function to ``TOL``, relative, at 4 (degree + 1) + 1
     test points), scaled by 1 - ``epsilon`` (twice the largest miss plus 16 ulp) and checked never to exceed its
     function: the product the kernel divides by is at most the level-by-level product of g (the pumped BRDF at least
-    the level-by-level one) and at least that product times (1 - 2 ``epsilon``), as the level table's; m is
-    multiplied in exactly (where every level takes m, the ideal operator's g is m^k itself, with no room below it).
+    the level-by-level one) and at least that product times (1 - 2 ``epsilon``), as the level table's.  The cells where
+    every level takes m hold -1: there the ideal operator's g is m^k itself, with no room below it for a scaled table.
     ``coef[f, s]`` holds function f's coefficients on piece s (highest power first), the piece's centre and inverse
     half-width: one cache line per look-up.  ``pattern[i, k]`` (int8) is the pattern of the cell i = floor(l CELLS),
-    k = floor(m CELLS) (-1: none), ``fid[p]`` and ``hid[p]`` the rows of ``coef`` that hold its F_A and H_B,
-    ``power[p]`` one flag per level, the c levels that take m first.
+    k = floor(m CELLS) (-1: none), ``fid[p]`` and ``hid[p]`` the rows of ``coef`` that hold its F_A and H_B.
     :meth:`g` is the plain numpy version of the kernel.
     """
 
@@ -609,7 +609,9 @@ class _SplitTable:
     #: pieces of 5-level GGX's products were bisected beyond 100000 chasing that rounding)
     TOL = 1e-14
     #: cells per axis of the grid in (l, m)
-    CELLS = 256
+    CELLS = 128
+    #: sub-cells per axis of a cell that has no pattern
+    SUB = 8
     #: how far (relative) a level's certified term stays above its others throughout a cell
     SAFETY = 1e-12
     #: the most cells per octave of the piece index (2^CELLS_MAX_BITS, :func:`_piece_cells`)
@@ -619,35 +621,56 @@ class _SplitTable:
         self.levels_table = levels
         self.looks, self.controlled, self.mlo = levels.looks, levels.controlled, levels.mlo
         n = self.ncell = self.CELLS
-        edges = np.arange(n + 1, dtype=np.float64) / n
-        lo_e, hi_e = np.maximum(edges[:-1], self.mlo), edges[1:]
-        codes = self._codes(lo_e, hi_e)  # (levels, n, n)
-        ok = np.all(codes >= 0, axis=0) & np.triu(np.ones((n, n), dtype=bool), 1) & (hi_e > self.mlo)[:, None]
-        keys, inverse = np.unique(codes[:, ok].T, axis=0, return_inverse=True)
+        ns = self.SUB
+        edges = np.arange(n * ns + 1, dtype=np.float64) / (n * ns)  # the sub-cells' edges (exact: n ns = 2^k)
+        lo_f, hi_f = np.maximum(edges[:-1], self.mlo), edges[1:]
+        rlo_f, rhi_f = self._ranges(lo_f, hi_f)  # (levels, n ns)
+        rlo, rhi = rlo_f.reshape(-1, n, ns).min(axis=2), rhi_f.reshape(-1, n, ns).max(axis=2)  # the cells'
+        lo_e, hi_e = lo_f[::ns], hi_f[ns - 1::ns]
+        codes = self._codes(rlo[:, :, None], rhi[:, :, None], rlo[:, None, :], rhi[:, None, :],
+                            lo_e[None, :], hi_e[None, :])  # (levels, n, n)
+        above = np.triu(np.ones((n, n), dtype=bool), 1) & (hi_e > self.mlo)[:, None]
+        ok = self._certified(codes) & above
+        # cells without one pattern (kinks cross them, or on the diagonal): the same for their SUB x SUB sub-cells
+        ii, kk = np.nonzero(~ok & np.triu(np.ones((n, n), dtype=bool)) & (hi_e > self.mlo)[:, None])
+        fi = ii[:, None, None] * ns + np.arange(ns)[None, :, None]  # (refined, ns, 1): the sub-cells' rows
+        fk = kk[:, None, None] * ns + np.arange(ns)[None, None, :]  # (refined, 1, ns): their columns
+        sub_codes = self._codes(rlo_f[:, fi], rhi_f[:, fi], rlo_f[:, fk], rhi_f[:, fk], lo_f[fk], hi_f[fk])
+        sub_ok = self._certified(sub_codes) & (fi < fk) & (hi_f[fi] > self.mlo)
+        keys, inverse = np.unique(np.concatenate([codes[:, ok].T, sub_codes[:, sub_ok].T]), axis=0,
+                                  return_inverse=True)
+        inverse = inverse.ravel()
         if len(keys) > 127:
             raise _ProductError("the split table needs more than 127 patterns")
         self.pattern = np.full((n, n), -1, dtype=np.int8)
-        self.pattern[ok] = inverse.ravel().astype(np.int8)
+        self.pattern[ok] = inverse[:np.count_nonzero(ok)].astype(np.int8)
+        #: the sub-cells of the cells without one pattern: ``sub[q, a, b]`` is the pattern of sub-cell (a, b) of the
+        #: cell (i, k) with ``pattern[i, k]`` = -2 - q, l in [(i SUB + a) / (CELLS SUB), ...), m likewise (-1: none)
+        sub = np.full(sub_ok.shape, -1, dtype=np.int8)
+        sub[sub_ok] = inverse[np.count_nonzero(ok):].astype(np.int8)
+        keep = np.any(sub >= 0, axis=(1, 2))  # refined cells where some sub-cell has a pattern
+        self.sub = np.ascontiguousarray(sub[keep]) if keep.any() else np.full((1, ns, ns), -1, dtype=np.int8)
+        #: (int16) the pattern of each cell, -1 for none, and -2 - q for the cells whose sub-cells ``sub[q]`` hold them
+        self.pattern = self.pattern.astype(np.int16)
+        self.pattern[ii[keep], kk[keep]] = -2 - np.arange(np.count_nonzero(keep))
         #: the term of every level in each pattern (0: U_j(l), 1: U_j(m), 2: m)
         self.patterns = keys.astype(np.int8)
         if len(keys) == 0:  # (no cell certified: a table of nothing; the chain keeps the level table alone)
             raise _ProductError("no cell of the split table has one term per level")
-        sets = sorted({tuple(np.nonzero(k == 0)[0]) for k in keys} | {tuple(np.nonzero(k == 1)[0]) for k in keys},
-                      key=lambda a: (len(a), a))
-        #: the products of levels' bounds tabulated, as tuples of levels: row 0 the empty product (exactly 1)
-        self.functions = sets if sets[0] == () else [(), *sets]
-        self.fid = np.array([self.functions.index(tuple(np.nonzero(k == 0)[0])) for k in keys], dtype=np.int64)
-        self.hid = np.array([self.functions.index(tuple(np.nonzero(k == 1)[0])) for k in keys], dtype=np.int64)
-        #: per pattern, one flag per level: 1 for each level that takes m (001 eq. 21), first; the kernel multiplies
-        #: m in exactly, once per flag
-        self.power = np.array([np.sort(k == 2)[::-1] for k in keys], dtype=np.int8)
+        fkeys = {(tuple(np.nonzero(k == 0)[0]), 0) for k in keys}
+        hkeys = {(tuple(np.nonzero(k == 1)[0]), int(np.count_nonzero(k == 2))) for k in keys}
+        #: the functions tabulated, each (levels, c): the product of those levels' bounds times m^c; row 0 the empty
+        #: product, exactly 1
+        self.functions = [((), 0)] + sorted((fkeys | hkeys) - {((), 0)}, key=lambda a: (len(a[0]), a))
+        self.fid = np.array([self.functions.index((tuple(np.nonzero(k == 0)[0]), 0)) for k in keys], dtype=np.int64)
+        self.hid = np.array([self.functions.index((tuple(np.nonzero(k == 1)[0]), int(np.count_nonzero(k == 2))))
+                             for k in keys], dtype=np.int64)
         br = _level_breaks(self.looks, self.mlo)
         fns = [self._function(fn) for fn in self.functions[1:]]
         coefs, lo, hi, center, half, worst = fit_pieces(fns, br[:-1], br[1:], self.TOL, "split table")
         self.epsilon = 2.0 * float(worst.max()) + 16 * np.finfo(float).eps
         one = np.zeros((1, PRODUCT_DEGREE + 1, len(lo)))
-        one[0, -1] = 1.0  # the empty product: Horner's rule gives exactly 1, so a cell whose every level takes m
-        # divides by exactly m^k, as the level-by-level path (the ideal operator's value there too: no room below it)
+        one[0, -1] = 1.0  # the empty product: Horner's rule gives exactly 1
         coef = np.concatenate([one, np.stack(coefs) * (1.0 - self.epsilon)])  # (functions, degree + 1, pieces)
         self.coef = _aligned(np.concatenate(
             [coef.transpose(0, 2, 1), np.broadcast_to(center[None, :, None], (len(coef), len(lo), 1)),
@@ -658,14 +681,16 @@ class _SplitTable:
         self._check([self._function(fn) for fn in self.functions])
 
     def _function(self, fn):
-        """The exact function of one of :attr:`functions`, of an array of m: a product of levels' bounds."""
+        """The exact function of one of :attr:`functions`, of an array of m: a product of levels' bounds times m^c."""
         looks = self.looks
 
         def f(m):
             m = np.asarray(m, dtype=np.float64)
             out = np.ones_like(m)
-            for j in fn:
+            for j in fn[0]:
                 out = out * looks[j].upper(m)
+            for _ in range(fn[1]):
+                out = out * m  # 001 eq. 21: g_j = m
             return out
 
         return f
@@ -684,30 +709,36 @@ class _SplitTable:
             crit = np.exp(np.sort(crit[np.isfinite(crit)]))
             pts = np.unique(np.concatenate([lo_e, hi_e, crit[(crit > self.mlo) & (crit < 1.0)]]))
             u = lk.upper(pts)
-            a = np.searchsorted(pts, lo_e, side="left")
-            b = np.searchsorted(pts, hi_e, side="right")
-            for i in range(len(lo_e)):
-                rlo[j, i], rhi[j, i] = u[a[i]:b[i]].min(), u[a[i]:b[i]].max()
+            a = np.searchsorted(pts, lo_e, side="left")  # (increasing: the intervals follow each other)
+            b = np.searchsorted(pts, hi_e, side="right") - 1  # each interval's last point, its hi_e
+            rlo[j] = np.minimum(np.minimum.reduceat(u, a), u[b])  # (reduceat: from a[i] to a[i + 1] - 1)
+            rhi[j] = np.maximum(np.maximum.reduceat(u, a), u[b])
         return rlo, rhi
 
-    def _codes(self, lo_e, hi_e) -> np.ndarray:
-        """The certified term of each level in each cell (l in interval i, m in interval k): 0 U_j(l), 1 U_j(m),
-        2 m (g2 only), -1 none; an array (levels, cells, cells).
+    def _codes(self, ll, lh, ml, mh, m0, m1) -> np.ndarray:
+        """The certified term of each level in each cell: 0 U_j(l), 1 U_j(m), 2 m (g2 only), -1 none; an array
+        (levels,) + the cells' shape.  ``ll``, ``lh`` (levels,) + cells: U_j's range over the cell's interval of l;
+        ``ml``, ``mh`` over its interval of m, [``m0``, ``m1``] (broadcast).
         """
-        rlo, rhi = self._ranges(lo_e, hi_e)
         s = 1.0 + self.SAFETY
-        m0, m1 = lo_e[None, :], hi_e[None, :]
-        out = np.empty((len(self.looks), len(lo_e), len(lo_e)), dtype=np.int8)
+        shape = np.broadcast_shapes(ll.shape, ml.shape, (1,) + np.shape(m1))
+        out = np.empty(shape, dtype=np.int8)
         for j in range(len(self.looks)):
-            ll, lh = rlo[j][:, None], rhi[j][:, None]  # U_j(l) over the row's interval
-            ml, mh = rlo[j][None, :], rhi[j][None, :]  # U_j(m) over the column's
             ctl = bool(self.controlled[j])
-            top = np.maximum(mh, m1) if ctl else np.broadcast_to(mh, (1, len(lo_e)))
-            c0 = ll >= top * s
-            c1 = (ml >= lh * s) & ((ml >= m1 * s) if ctl else True)
-            c2 = (m0 >= np.maximum(lh, mh) * s) if ctl else np.zeros((len(lo_e), len(lo_e)), dtype=bool)
+            top = np.maximum(mh[j], m1) if ctl else mh[j]
+            c0 = ll[j] >= top * s  # U_j(l) above U_j(m) and m throughout
+            c1 = (ml[j] >= lh[j] * s) & ((ml[j] >= m1 * s) if ctl else True)
+            c2 = (m0 >= np.maximum(lh[j], mh[j]) * s) if ctl else False
             out[j] = np.where(c0, 0, np.where(c1, 1, np.where(c2, 2, -1)))
         return out
+
+    @staticmethod
+    def _certified(codes) -> np.ndarray:
+        """Cells where every level has a certified term, but not m for every level: there (001 eq. 21) the ideal
+        operator's g is m^k itself, with no room below it for a table scaled down, and the level table, which
+        multiplies m in exactly as the level-by-level path, serves.
+        """
+        return np.all(codes >= 0, axis=0) & ~np.all(codes == 2, axis=0)
 
     def _check(self, fns) -> None:
         """Refuse the table (:class:`_ProductError`) unless every function's pieces are at most the function at the
@@ -740,10 +771,16 @@ class _SplitTable:
         return horner(np.moveaxis(row[..., :PRODUCT_DEGREE + 1], -1, 0), (m - row[..., -2]) * row[..., -1])
 
     def cell(self, mu_i, mu_o) -> np.ndarray:
-        """The pattern of the cell of each pair (-1 where the level table serves)."""
+        """The pattern of the cell (or sub-cell) of each pair (-1 where the level table serves), as the kernel finds
+        it.
+        """
         lo, hi = np.minimum(mu_i, mu_o), np.maximum(mu_i, mu_o)
-        n = self.ncell
-        return self.pattern[np.minimum((lo * n).astype(np.int64), n - 1), np.minimum((hi * n).astype(np.int64), n - 1)]
+        n, ns = self.ncell, self.SUB
+        i, k = np.minimum((lo * n).astype(np.int64), n - 1), np.minimum((hi * n).astype(np.int64), n - 1)
+        p = self.pattern[i, k]
+        a = np.minimum((lo * (n * ns)).astype(np.int64) - i * ns, ns - 1)
+        b = np.minimum((hi * (n * ns)).astype(np.int64) - k * ns, ns - 1)
+        return np.where(p < -1, self.sub[np.maximum(-2 - p, 0), a, b], p)
 
     def g(self, mu_i, mu_o) -> np.ndarray:
         """g_1 ... g_k at (mu_i, mu_o), both > mlo: the plain numpy reference of :func:`g_split` followed, in the cells
@@ -762,17 +799,16 @@ class _SplitTable:
                 w = pp == q
                 f[w] = self.function(self.fid[q], lo[on][w])
                 h[w] = self.function(self.hid[q], hi[on][w])
-            g = f * h  # F_A(l) H_B(m)
-            m = hi[on]
-            for c in range(self.power.shape[1]):
-                g = np.where(self.power[pp, c] == 1, g * m, g)  # 001 eq. 21: m for each level that takes it
-            out[on] = g
+            out[on] = f * h  # F_A(l) H_B(m)
         return out
 
     def share(self) -> float:
-        """The share of pairs with both cosines uniform on [0, 1] (the cells' area) that the split table serves."""
-        n = self.ncell
-        return 2.0 * np.count_nonzero(self.pattern >= 0) / (n * n)
+        """The share of pairs with both cosines uniform on [0, 1] (the cells' area) that the split table serves, and
+        the share that it finds in a sub-cell.
+        """
+        n, ns = self.ncell, self.SUB
+        refined = 2.0 * np.count_nonzero(self.sub[-2 - self.pattern[self.pattern < -1]] >= 0) / (n * n * ns * ns)
+        return 2.0 * np.count_nonzero(self.pattern >= 0) / (n * n) + refined, refined
 
 
 def _aligned(a: np.ndarray, line: int = 64) -> np.ndarray:
@@ -787,8 +823,8 @@ def _aligned(a: np.ndarray, line: int = 64) -> np.ndarray:
 
 
 #: the split table's arguments of the kernels when there is none (:meth:`Pumped._split_args`)
-_SPLIT_OFF = (0, np.full((1, 1), -1, dtype=np.int8), np.zeros(1, np.int64), np.zeros(1, np.int64),
-              np.zeros((1, 1), np.int8), CELL_SHIFT, 0,
+_SPLIT_OFF = (0, np.full((1, 1), -1, dtype=np.int16), np.full((1, 1, 1), -1, dtype=np.int8), np.zeros(1, np.int64),
+              np.zeros(1, np.int64), CELL_SHIFT, 0,
               np.zeros(1, np.int32), np.full(2, math.inf), np.zeros((1, 1, PRODUCT_DEGREE + 3)))
 
 
@@ -1124,7 +1160,7 @@ class Pumped(BRDF):
         r = self.split_table()
         if r is None:  # off: split_cells = 0
             return _SPLIT_OFF
-        return r.ncell, r.pattern, r.fid, r.hid, r.power, r.shift, r.cbase, r.cstart, r.lo, r.coef
+        return r.ncell, r.pattern, r.sub, r.fid, r.hid, r.shift, r.cbase, r.cstart, r.lo, r.coef
 
     def _level_args(self):
         q = self.level_table()

@@ -232,8 +232,8 @@ def test_split_table_layout_and_switch(ggx3, ggx2):
     args = ggx3._chain_args()
     assert args.split_cells == r.ncell == _SplitTable.CELLS and args.split_coef is r.coef
     assert r.coef.shape == (len(r.functions), len(r.lo) - 1, PRODUCT_DEGREE + 3)
-    assert r.functions[0] == () and np.all(r.coef[0, :, :PRODUCT_DEGREE + 1] == np.eye(PRODUCT_DEGREE + 1)[-1])
-    assert r.power.shape == (len(r.patterns), len(r.looks))
+    assert r.functions[0] == ((), 0) and np.all(r.coef[0, :, :PRODUCT_DEGREE + 1] == np.eye(PRODUCT_DEGREE + 1)[-1])
+    assert not np.any(np.all(r.patterns == 2, axis=1))  # where every level takes m, the level table serves
     assert r.pattern.shape == (r.ncell, r.ncell) and r.pattern.dtype == np.int8
     assert np.all(np.tril(r.pattern + 1) == 0)  # only cells with min < max hold a pattern
     assert r.share() > 0.85  # most uniform pairs take one product
