@@ -281,26 +281,20 @@ def g_pair(mi, mo, controlled, shift, pcbase, pcstart, plo, prow):  # pragma: no
 
 
 @njit(cache=True, nogil=True, inline="always")
-def g_split(mmin, mmax, ncell, pattern, sub, fid, hid, shift, pcbase, pcstart, plo,  # pragma: no cover
+def g_split(mmin, mmax, ncell, pattern, fid, hid, shift, pcbase, pcstart, plo,  # pragma: no cover
             pcoef):
     """g_1 g_2 ... g_k at min(N.wi, N.wo) = ``mmin`` and max = ``mmax`` (both above the table's ``mlo``) as ONE
     product F(mmin) H(mmax) of two tabulated functions, whatever the number of levels, or 0.0 where the cell of
     (mmin, mmax) has no pattern (the caller then takes :func:`g_pair`): the cell i = floor(mmin ``ncell``),
-    k = floor(mmax ``ncell``) gives the pattern p = ``pattern[i, k]`` (-2 - q: the sub-cell's, ``sub[q, a, b]``
-    with a = floor(mmin ``ncell`` SUB) - i SUB, b likewise, SUB = ``sub.shape[1]``), whose functions are rows
-    ``fid[p]`` and ``hid[p]`` of ``pcoef`` (:class:`pumpup.operators.pumping._SplitTable`; 001 eq. 20, 21 with
-    every level's term fixed in the cell).  ``pcoef[f, s]``: piece s's PRODUCT_DEGREE + 1 coefficients, highest
-    power first, its centre and inverse half-width.  Inlined where it is called.  Its numpy reference is
+    k = floor(mmax ``ncell``) gives the pattern p = ``pattern[i, k]``, whose functions are rows ``fid[p]`` and
+    ``hid[p]`` of ``pcoef`` (:class:`pumpup.operators.pumping._SplitTable`; 001 eq. 20, 21 with every level's term
+    fixed in the cell).  ``pcoef[f, s]``: piece s's PRODUCT_DEGREE + 1 coefficients, highest power first, its centre
+    and inverse half-width.  Inlined where it is called.  Its numpy reference is
     :meth:`pumpup.operators.pumping._SplitTable.g`.
     """
     i = min(int(mmin * ncell), ncell - 1)
     k = min(int(mmax * ncell), ncell - 1)
-    c = pattern[i, k]
-    ns = sub.shape[1]
-    a = min(int(mmin * (ncell * ns)) - i * ns, ns - 1)
-    b = min(int(mmax * (ncell * ns)) - k * ns, ns - 1)
-    ps = sub[max(-2 - c, 0), a, b]  # (branch-free: a cell with a pattern reads sub-cell table 0, unused)
-    p = ps if c < -1 else c
+    p = pattern[i, k]
     if p < 0:
         return 0.0
     a, b = fid[p], hid[p]
@@ -365,7 +359,7 @@ GChain = namedtuple("GChain", [
     "offsets", "logx", "coef", "v0", "slope0", "margin_lo", "cap", "controlled", "increasing", "mu0", "index",
     "index_lo", "index_h_inv", "product_mlo", "product_cbase", "product_cstart", "product_lo", "product_rows",
     "pair_mlo", "pair_shift", "pair_cbase", "pair_cstart", "pair_lo", "pair_rows",
-    "split_cells", "split_pattern", "split_sub", "split_fid", "split_hid", "split_shift", "split_cbase",
+    "split_cells", "split_pattern", "split_fid", "split_hid", "split_shift", "split_cbase",
     "split_cstart", "split_lo", "split_coef",
 ])
 
