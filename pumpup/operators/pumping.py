@@ -625,7 +625,7 @@ class _SplitTable:
         codes = self._codes(rlo[:, :, None], rhi[:, :, None], rlo[:, None, :], rhi[:, None, :],
                             lo_e[None, :], hi_e[None, :])  # (levels, n, n)
         ok = self._certified(codes) & np.triu(np.ones((n, n), dtype=bool), 1) & (hi_e > self.mlo)[:, None]
-        keys, inverse = np.unique(codes[:, ok].T, axis=0, return_inverse=True)
+        keys, inverse = _unique_rows(codes[:, ok].T)
         if len(keys) > 127:
             raise _ProductError("the split table needs more than 127 patterns")
         self.pattern = np.full((n, n), -1, dtype=np.int8)
@@ -788,6 +788,19 @@ def _aligned(a: np.ndarray, line: int = 64) -> np.ndarray:
     out = buf[off:off + a.nbytes].view(a.dtype).reshape(a.shape)
     out[...] = a
     return out
+
+
+def _unique_rows(rows: np.ndarray):
+    """np.unique(rows, axis=0, return_inverse=True) for rows of digits 0-2 (each row read as a number in base 3: the
+    sort of rows as records took 0.14 s of a 3-level split table's 0.4 s).
+    """
+    if rows.shape[1] > 39:  # (beyond int64)
+        keys, inverse = np.unique(rows, axis=0, return_inverse=True)
+        return keys, inverse.ravel()
+    weight = 3 ** np.arange(rows.shape[1] - 1, -1, -1, dtype=np.int64)  # (the first digit the most significant)
+    u, inverse = np.unique(rows.astype(np.int64) @ weight, return_inverse=True)
+    keys = (u[:, None] // weight[None, :]) % 3
+    return keys.astype(rows.dtype), inverse.ravel()
 
 
 #: the split table's arguments of the kernels when there is none (:meth:`Pumped._split_args`)
