@@ -592,23 +592,23 @@ class _SplitTable:
     kernel takes the level table there.
 
     Every product of bounds used (:attr:`functions`; row 0, the empty product, is exactly 1) is tabulated on one set of
-    pieces in m, as the level table tabulates the U_j (pieces split
-    at every breakpoint of every level's spline and where a level's bound reaches its cap; a Chebyshev interpolant of
-    degree PRODUCT_DEGREE on each, bisected until it matches its function to ``TOL``, relative, at 4 (degree + 1) + 1
-    test points), scaled by 1 - ``epsilon`` (twice the largest miss plus 16 ulp) and checked never to exceed its
-    function: the product the kernel divides by is at most the level-by-level product of g (the pumped BRDF at least
-    the level-by-level one) and at least that product times (1 - 2 ``epsilon``), as the level table's.  The cells where
-    every level takes m hold -1: there the ideal operator's g is m^k itself, with no room below it for a scaled table.
-    ``coef[f, s]`` holds function f's coefficients on piece s (highest power first), the piece's centre and inverse
-    half-width: one cache line per look-up.  ``pattern[i, k]`` (int8) is the pattern of the cell i = floor(l CELLS),
-    k = floor(m CELLS) (-1: none), ``fid[p]`` and ``hid[p]`` the rows of ``coef`` that hold its F_A and H_B.
-    :meth:`g` is the plain numpy version of the kernel.
+    pieces in m, as the level table tabulates the U_j (pieces split at every breakpoint of every level's spline and
+    where a level's bound reaches its cap; a Chebyshev interpolant of degree PRODUCT_DEGREE on each, bisected until it
+    matches its function to ``TOL``, relative, at 4 (degree + 1) + 1 test points), scaled by 1 - ``epsilon`` (twice the
+    largest miss plus 16 ulp) and checked never to exceed its function: the product the kernel divides by is at most the
+    level-by-level product of g (the pumped BRDF at least the level-by-level one) and at least that product times (1 - 2
+    ``epsilon``), as the level table's.  The cells where every level takes m hold -1: there the ideal operator's g is
+    m^k itself, with no room below it for a scaled table. ``coef[f, s]`` holds function f's coefficients on piece s
+    (highest power first), the piece's centre and inverse half-width: one cache line per look-up.  ``pattern[i, k]``
+    (int8) is the pattern of the cell i = floor(l CELLS), k = floor(m CELLS) (-1: none; the kernel reads ``packed``, its
+    cells with i <= k, 32 kB), ``fid[p]`` and ``hid[p]`` the rows of ``coef`` that hold its F_A and H_B. :meth:`g` is
+    the plain numpy version of the kernel.
     """
 
     #: the fit's relative tolerance (a product of k bounds is itself only good to a few k ulp: at 1e-15 the
     #: pieces of 5-level GGX's products were bisected beyond 100000 chasing that rounding)
     TOL = 1e-14
-    #: cells per axis of the grid in (l, m) (512: 3 % more pairs served, 256 kB, slower)
+    #: cells per axis of the grid in (l, m) (512: 3 % more pairs served, 128 kB packed, no faster, measured)
     CELLS = 256
     #: how far (relative) a level's certified term stays above its others throughout a cell
     SAFETY = 1e-12
@@ -630,6 +630,9 @@ class _SplitTable:
             raise _ProductError("the split table needs more than 127 patterns")
         self.pattern = np.full((n, n), -1, dtype=np.int8)
         self.pattern[ok] = inverse.ravel().astype(np.int8)
+        k_, i_ = np.tril_indices(n)  # (k >= i: the cells with l <= m, row by row of k)
+        #: ``pattern``'s cells with i <= k packed as the kernel reads them: cell (i, k) at k (k + 1) / 2 + i
+        self.packed = np.ascontiguousarray(self.pattern[i_, k_])
         #: the term of every level in each pattern (0: U_j(l), 1: U_j(m), 2: m)
         self.patterns = keys.astype(np.int8)
         if len(keys) == 0:  # (no cell certified: a table of nothing; the chain keeps the level table alone)
@@ -751,7 +754,8 @@ class _SplitTable:
         """The pattern of the cell of each pair (-1 where the level table serves), as the kernel finds it."""
         lo, hi = np.minimum(mu_i, mu_o), np.maximum(mu_i, mu_o)
         n = self.ncell
-        return self.pattern[np.minimum((lo * n).astype(np.int64), n - 1), np.minimum((hi * n).astype(np.int64), n - 1)]
+        i, k = np.minimum((lo * n).astype(np.int64), n - 1), np.minimum((hi * n).astype(np.int64), n - 1)
+        return self.packed[k * (k + 1) // 2 + i]
 
     def g(self, mu_i, mu_o) -> np.ndarray:
         """g_1 ... g_k at (mu_i, mu_o), both > mlo: the plain numpy reference of :func:`g_split` followed, in the cells
@@ -804,7 +808,7 @@ def _unique_rows(rows: np.ndarray):
 
 
 #: the split table's arguments of the kernels when there is none (:meth:`Pumped._split_args`)
-_SPLIT_OFF = (0, np.full((1, 1), -1, dtype=np.int8), np.zeros(1, np.int64), np.zeros(1, np.int64), CELL_SHIFT, 0,
+_SPLIT_OFF = (0, np.full(1, -1, dtype=np.int8), np.zeros(1, np.int64), np.zeros(1, np.int64), CELL_SHIFT, 0,
               np.zeros(1, np.int32), np.full(2, math.inf), np.zeros((1, 1, PRODUCT_DEGREE + 3)))
 
 
@@ -1140,7 +1144,7 @@ class Pumped(BRDF):
         r = self.split_table()
         if r is None:  # off: split_cells = 0
             return _SPLIT_OFF
-        return r.ncell, r.pattern, r.fid, r.hid, r.shift, r.cbase, r.cstart, r.lo, r.coef
+        return r.ncell, r.packed, r.fid, r.hid, r.shift, r.cbase, r.cstart, r.lo, r.coef
 
     def _level_args(self):
         q = self.level_table()

@@ -283,18 +283,18 @@ def g_pair(mi, mo, controlled, shift, pcbase, pcstart, plo, prow):  # pragma: no
 @njit(cache=True, nogil=True, inline="always")
 def g_split(mmin, mmax, ncell, pattern, fid, hid, shift, pcbase, pcstart, plo,  # pragma: no cover
             pcoef):
-    """g_1 g_2 ... g_k at min(N.wi, N.wo) = ``mmin`` and max = ``mmax`` (both above the table's ``mlo``) as ONE
-    product F(mmin) H(mmax) of two tabulated functions, whatever the number of levels, or 0.0 where the cell of
-    (mmin, mmax) has no pattern (the caller then takes :func:`g_pair`): the cell i = floor(mmin ``ncell``),
-    k = floor(mmax ``ncell``) gives the pattern p = ``pattern[i, k]``, whose functions are rows ``fid[p]`` and
-    ``hid[p]`` of ``pcoef`` (:class:`pumpup.operators.pumping._SplitTable`; 001 eq. 20, 21 with every level's term
-    fixed in the cell).  ``pcoef[f, s]``: piece s's PRODUCT_DEGREE + 1 coefficients, highest power first, its centre
-    and inverse half-width.  Inlined where it is called.  Its numpy reference is
+    """g_1 g_2 ... g_k at min(N.wi, N.wo) = ``mmin`` and max = ``mmax`` (both above the table's ``mlo``) as ONE product
+    F(mmin) H(mmax) of two tabulated functions, whatever the number of levels, or 0.0 where the cell of (mmin, mmax)
+    has no pattern (the caller then takes :func:`g_pair`): the cell i = floor(mmin ``ncell``), k = floor(mmax
+    ``ncell``) gives the pattern p = ``pattern[k (k + 1) / 2 + i]`` (the cells with i <= k, packed), whose functions
+    are rows ``fid[p]`` and ``hid[p]`` of ``pcoef`` (:class:`pumpup.operators.pumping._SplitTable`; 001 eq. 20, 21
+    with every level's term fixed in the cell).  ``pcoef[f, s]``: piece s's PRODUCT_DEGREE + 1 coefficients, highest
+    power first, its centre and inverse half-width.  Inlined where it is called.  Its numpy reference is
     :meth:`pumpup.operators.pumping._SplitTable.g`.
     """
     i = min(int(mmin * ncell), ncell - 1)
     k = min(int(mmax * ncell), ncell - 1)
-    p = pattern[i, k]
+    p = pattern[((k * (k + 1)) >> 1) + i]  # (the cells with i <= k, packed)
     if p < 0:
         return 0.0
     a, b = fid[p], hid[p]

@@ -238,6 +238,8 @@ def test_split_table_layout_and_switch(ggx3, ggx2):
     assert not np.any(np.all(r.patterns == 2, axis=1))  # where every level takes m, the level table serves
     assert r.pattern.shape == (r.ncell, r.ncell) and r.pattern.dtype == np.int8
     assert np.all(np.tril(r.pattern + 1) == 0)  # only cells with min < max hold a pattern
+    i, k = np.triu_indices(r.ncell)
+    assert args.split_pattern is r.packed and np.array_equal(r.packed[k * (k + 1) // 2 + i], r.pattern[i, k])
     assert r.share() > 0.85  # most uniform pairs take one product
     off = ggx3._level_table_args()
     assert off.split_cells == 0 and off.pair_rows is args.pair_rows
