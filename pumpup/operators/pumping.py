@@ -38,6 +38,7 @@ from ..physics.lookups import (
     g_levels_call,
     g_pair,
     g_product,
+    g_split,
     horner,
     kink_roots,
     upper_array,
@@ -176,7 +177,8 @@ def _uses_file_tables(brdf: BRDF) -> bool:
 @njit(cache=True, nogil=True)
 def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
                   index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow, qmlo, qshift, qcbase, qcstart,
-                  qlo, qrow):  # pragma: no cover - compiled
+                  qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcstart, rlo,
+                  rcoef):  # pragma: no cover - compiled
     """All levels of a pumped chain in one pass: f / (g_1 g_2 ... g_k) (001 eq. 16), in place.
 
     The tables of the levels are concatenated (level j owns nodes offsets[j]:offsets[j+1]);
@@ -191,7 +193,9 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
     of mmax (:class:`_Product`, :func:`g_product`; ``pmlo`` = inf turns it off).  Tested against
     :meth:`_Product.__call__` and the reference.  Otherwise, where both cosines exceed ``qmlo``, every level's bound
     from the level table, one piece per direction (:class:`_LevelTable`, :func:`g_pair`; ``qmlo`` = inf turns it
-    off, :meth:`Pumped._eval_levelwise`).
+    off, :meth:`Pumped._eval_levelwise`); there, first, the split table (:class:`_SplitTable`, :func:`g_split`: one
+    product of two look-ups whatever the number of levels, in the cells where every level's term is fixed;
+    ``rcells`` = 0 turns it off, :meth:`Pumped._eval_level_table`).
     """
     for k in range(f.shape[0]):
         mi, mo = wi[k, 2], wo[k, 2]
@@ -202,7 +206,13 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
         if mmin > pmlo:  # the fast path: one look-up for all levels (no branch on f = 0: 0 / g = 0)
             f[k] = f[k] / g_product(mmax, pcbase, pcstart, plo, prow)  # 001 eq. 16, all levels
         elif mmin > qmlo:  # one piece per direction for all levels (0 / g = 0)
-            f[k] = f[k] / g_pair(mi, mo, controlled, qshift, qcbase, qcstart, qlo, qrow)  # 001 eq. 16, all levels
+            g = 0.0
+            if rcells > 0:  # one product F(mmin) H(mmax), 0 where the cell has no pattern
+                g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcstart, rlo,
+                            rcoef)
+            if g == 0.0:
+                g = g_pair(mi, mo, controlled, qshift, qcbase, qcstart, qlo, qrow)
+            f[k] = f[k] / g  # 001 eq. 16, all levels
         elif f[k] != 0.0:
             f[k] = f[k] / g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
                                         increasing, mu0, index, index_lo, index_h_inv)  # 001 eq. 16, all levels
@@ -440,6 +450,37 @@ def _cap_kinks(looks, br) -> np.ndarray:
     return np.array(out)
 
 
+def _level_breaks(looks, mlo: float) -> np.ndarray:
+    """The first breakpoints in m of a table of the levels' bounds on [mlo, 1] (:class:`_LevelTable`,
+    :class:`_PairTable`): at most an eighth of an octave apart, at every breakpoint of every level's spline and where a
+    level's bound reaches its cap, so that each bound is analytic between two of them.
+    """
+    knots = np.exp(np.concatenate([lk.logx for lk in looks]))
+    eighths = 2.0 ** np.arange(math.floor(math.log2(mlo)), 0, 0.125)  # pieces span at most 1/8 octave
+    br = np.unique(np.concatenate([[mlo, 1.0], eighths, knots]))
+    br = br[(br >= mlo) & (br <= 1.0)]
+    return np.unique(np.concatenate([br, _cap_kinks(looks, br)]))
+
+
+def _piece_cells(lo: np.ndarray, mlo: float, max_bits: int) -> tuple[int, int, np.ndarray]:
+    """The cell index of pieces that start at ``lo`` (sorted, the first at ``mlo``): 2^bits cells per octave, cell
+    c = (bits(m) >> shift) - cbase starting at piece cstart[c], with bits from CELL_BITS up until no cell of the top
+    two octaves, where most cosines lie, holds more than two piece starts, at most ``max_bits``.  Returns (shift,
+    cbase, cstart).
+    """
+    for bits in range(52 - CELL_SHIFT, max_bits + 1):
+        shift = 52 - bits
+        top = lo[lo >= 0.25]
+        per = np.bincount((float_bits_reference(top) >> shift) - (int(float_bits_reference(0.25)) >> shift))
+        if per.size == 0 or per.max() <= 2:
+            break
+    b0 = int(float_bits_reference(mlo)) >> shift
+    b1 = int(float_bits_reference(1.0)) >> shift
+    bounds = (np.arange(b0, b1 + 1, dtype=np.int64) << shift).view(np.float64)
+    cstart = np.clip(np.searchsorted(lo, bounds, side="right") - 1, 0, len(lo) - 1).astype(np.int32)
+    return shift, b0, cstart
+
+
 class _LevelTable:
     """Every level's bound U_j(m) (the capped upper bound :meth:`_Lookup.upper`) as polynomials in m on one set of
     pieces: the chain kernel's path where some level's bound is not monotone (GGX's albedo falls, then rises), so that
@@ -466,11 +507,7 @@ class _LevelTable:
     def __init__(self, looks, controlled):
         self.looks, self.controlled = looks, np.asarray(controlled, dtype=np.bool_)
         self.mlo = max(max(lk.mu0, math.exp(lk.logx[0])) for lk in looks) * (1.0 + 1e-12)  # (as _Product)
-        knots = np.exp(np.concatenate([lk.logx for lk in looks]))
-        eighths = 2.0 ** np.arange(math.floor(math.log2(self.mlo)), 0, 0.125)  # pieces span at most 1/8 octave
-        br = np.unique(np.concatenate([[self.mlo, 1.0], eighths, knots]))
-        br = br[(br >= self.mlo) & (br <= 1.0)]
-        br = np.unique(np.concatenate([br, _cap_kinks(looks, br)]))
+        br = _level_breaks(looks, self.mlo)
         lo, hi = br[:-1], br[1:]
         coefs, lo, hi, center, half, worst = fit_pieces([lk.upper for lk in looks], lo, hi, self.TOL, "level table")
         self.epsilon = 2.0 * float(worst.max()) + 16 * np.finfo(float).eps
@@ -491,20 +528,9 @@ class _LevelTable:
         """The cell index: 2^bits cells per octave (cell c = (bits(m) >> ``shift``) - ``cbase`` starts at piece
         ``cstart[c]``), with bits from CELL_BITS up until no cell of the top two octaves, where most cosines lie, holds
         more than two piece starts (3-level g2 pumped GGX alpha 0.3: 462 pieces in [0.5, 1], up to 41 forward steps
-        with 256 cells per octave), at most CELLS_MAX_BITS.
+        with 256 cells per octave), at most CELLS_MAX_BITS (:func:`_piece_cells`).
         """
-        for bits in range(52 - CELL_SHIFT, self.CELLS_MAX_BITS + 1):
-            shift = 52 - bits
-            top = lo[lo >= 0.25]
-            per = np.bincount((float_bits_reference(top) >> shift) - (int(float_bits_reference(0.25)) >> shift))
-            if per.size == 0 or per.max() <= 2:
-                break
-        self.shift = shift
-        b0 = int(float_bits_reference(self.mlo)) >> shift
-        b1 = int(float_bits_reference(1.0)) >> shift
-        self.cbase = b0
-        bounds = (np.arange(b0, b1 + 1, dtype=np.int64) << shift).view(np.float64)
-        self.cstart = np.clip(np.searchsorted(lo, bounds, side="right") - 1, 0, len(lo) - 1).astype(np.int32)
+        self.shift, self.cbase, self.cstart = _piece_cells(lo, self.mlo, self.CELLS_MAX_BITS)
 
     def _check(self, tt) -> None:
         """Refuse the table (:class:`_ProductError`) unless every piece is at most its level's bound at the fit's test
@@ -548,6 +574,242 @@ class _LevelTable:
                 g = np.maximum(g, mmax)  # 001 eq. 21
             out = out * g
         return out
+
+
+class _SplitTable:
+    """g_1 g_2 ... g_k of a chain with a level table (:class:`_LevelTable`) as one product of two functions of one
+    variable, F(l) H(m) with l = min(N.wi, N.wo) and m = max(N.wi, N.wo), chosen by the cell of (l, m): the chain
+    kernel's path that costs the same for any number of levels (:func:`pumpup.physics.lookups.g_split`).
+
+    Each level's g_j = max(U_j(l), U_j(m)[, m]) (001 eq. 20, 21) takes one of its two or three terms throughout most
+    cells of a grid of CELLS x CELLS cells in (l, m) (l < m: the cells above the diagonal): the term is certified when
+    its smallest value over the cell exceeds the other terms' largest by the relative SAFETY, each U_j's range over a
+    cell's interval taken from its values at the ends and at the zeros of its spline's derivative inside.  A cell whose
+    levels all have a certified term holds a pattern (the term of every level); then
+    g_1 ... g_k = F_A(l) H_B(m) with F_A the product of the U_j of the levels A that take U_j(l), and H_B the product
+    of the U_j of the levels B that take U_j(m) times m^c, c the number of levels that take m (001 eq. 21).  The
+    other cells (the diagonal ones, and those a kink crosses: U_j(l) = U_j(m), U_j = m, U_j = cap) hold -1, and the
+    kernel takes the level table there.
+
+    Every product of bounds used (:attr:`functions`; row 0, the empty product, is exactly 1) is tabulated on one set of
+    pieces in m, as the level table tabulates the U_j (pieces split at every breakpoint of every level's spline and
+    where a level's bound reaches its cap; a Chebyshev interpolant of degree PRODUCT_DEGREE on each, bisected until it
+    matches its function to ``TOL``, relative, at 4 (degree + 1) + 1 test points), scaled by 1 - ``epsilon`` (twice the
+    largest miss plus 16 ulp) and checked never to exceed its function: the product the kernel divides by is at most the
+    level-by-level product of g (the pumped BRDF at least the level-by-level one) and at least that product times (1 - 2
+    ``epsilon``), as the level table's.  The cells where every level takes m hold -1: there the ideal operator's g is
+    m^k itself, with no room below it for a scaled table. ``coef[f, s]`` holds function f's coefficients on piece s
+    (highest power first), the piece's centre and inverse half-width: one cache line per look-up.  ``pattern[i, k]``
+    (int8) is the pattern of the cell i = floor(l CELLS), k = floor(m CELLS) (-1: none; the kernel reads ``packed``, its
+    cells with i <= k, 32 kB), ``fid[p]`` and ``hid[p]`` the rows of ``coef`` that hold its F_A and H_B. :meth:`g` is
+    the plain numpy version of the kernel.
+    """
+
+    #: the fit's relative tolerance (a product of k bounds is itself only good to a few k ulp: at 1e-15 the
+    #: pieces of 5-level GGX's products were bisected beyond 100000 chasing that rounding)
+    TOL = 1e-14
+    #: cells per axis of the grid in (l, m) (512: 3 % more pairs served, 128 kB packed, no faster, measured)
+    CELLS = 256
+    #: how far (relative) a level's certified term stays above its others throughout a cell
+    SAFETY = 1e-12
+    #: the most cells per octave of the piece index (2^CELLS_MAX_BITS, :func:`_piece_cells`)
+    CELLS_MAX_BITS = 12
+
+    def __init__(self, levels: _LevelTable):
+        self.levels_table = levels
+        self.looks, self.controlled, self.mlo = levels.looks, levels.controlled, levels.mlo
+        n = self.ncell = self.CELLS
+        edges = np.arange(n + 1, dtype=np.float64) / n
+        lo_e, hi_e = np.maximum(edges[:-1], self.mlo), edges[1:]
+        rlo, rhi = self._ranges(lo_e, hi_e)  # (levels, n)
+        codes = self._codes(rlo[:, :, None], rhi[:, :, None], rlo[:, None, :], rhi[:, None, :],
+                            lo_e[None, :], hi_e[None, :])  # (levels, n, n)
+        ok = self._certified(codes) & np.triu(np.ones((n, n), dtype=bool), 1) & (hi_e > self.mlo)[:, None]
+        keys, inverse = _unique_rows(codes[:, ok].T)
+        if len(keys) > 127:
+            raise _ProductError("the split table needs more than 127 patterns")
+        self.pattern = np.full((n, n), -1, dtype=np.int8)
+        self.pattern[ok] = inverse.ravel().astype(np.int8)
+        k_, i_ = np.tril_indices(n)  # (k >= i: the cells with l <= m, row by row of k)
+        #: ``pattern``'s cells with i <= k packed as the kernel reads them: cell (i, k) at k (k + 1) / 2 + i
+        self.packed = np.ascontiguousarray(self.pattern[i_, k_])
+        #: the term of every level in each pattern (0: U_j(l), 1: U_j(m), 2: m)
+        self.patterns = keys.astype(np.int8)
+        if len(keys) == 0:  # (no cell certified: a table of nothing; the chain keeps the level table alone)
+            raise _ProductError("no cell of the split table has one term per level")
+        fkeys = {(tuple(np.nonzero(k == 0)[0]), 0) for k in keys}
+        hkeys = {(tuple(np.nonzero(k == 1)[0]), int(np.count_nonzero(k == 2))) for k in keys}
+        #: the functions tabulated, each (levels, c): the product of those levels' bounds times m^c; row 0 the empty
+        #: product, exactly 1
+        self.functions = [((), 0)] + sorted((fkeys | hkeys) - {((), 0)}, key=lambda a: (len(a[0]), a))
+        self.fid = np.array([self.functions.index((tuple(np.nonzero(k == 0)[0]), 0)) for k in keys], dtype=np.int64)
+        self.hid = np.array([self.functions.index((tuple(np.nonzero(k == 1)[0]), int(np.count_nonzero(k == 2))))
+                             for k in keys], dtype=np.int64)
+        br = _level_breaks(self.looks, self.mlo)
+        fns = [self._function(fn) for fn in self.functions[1:]]
+        coefs, lo, hi, center, half, worst = fit_pieces(fns, br[:-1], br[1:], self.TOL, "split table")
+        self.epsilon = 2.0 * float(worst.max()) + 16 * np.finfo(float).eps
+        one = np.zeros((1, PRODUCT_DEGREE + 1, len(lo)))
+        one[0, -1] = 1.0  # the empty product: Horner's rule gives exactly 1
+        coef = np.concatenate([one, np.stack(coefs) * (1.0 - self.epsilon)])  # (functions, degree + 1, pieces)
+        self.coef = _aligned(np.concatenate(
+            [coef.transpose(0, 2, 1), np.broadcast_to(center[None, :, None], (len(coef), len(lo), 1)),
+             np.broadcast_to(1.0 / half[None, :, None], (len(coef), len(lo), 1))], axis=2))
+        self.center, self.ihalf = center, 1.0 / half
+        self.lo = np.concatenate([lo, [math.inf]])  # a sentinel ends the search
+        self.shift, self.cbase, self.cstart = _piece_cells(lo, self.mlo, self.CELLS_MAX_BITS)
+        self._check([self._function(fn) for fn in self.functions])
+
+    def _function(self, fn):
+        """The exact function of one of :attr:`functions`, of an array of m: a product of levels' bounds times m^c."""
+        looks = self.looks
+
+        def f(m):
+            m = np.asarray(m, dtype=np.float64)
+            out = np.ones_like(m)
+            for j in fn[0]:
+                out = out * looks[j].upper(m)
+            for _ in range(fn[1]):
+                out = out * m  # 001 eq. 21: g_j = m
+            return out
+
+        return f
+
+    def _ranges(self, lo_e, hi_e):
+        """Each level's smallest and largest bound over each interval [lo_e[i], hi_e[i]]: (levels, intervals) twice.
+        The bound is the level's spline in log(m) plus its margin, at most its cap: its extremes lie at the ends or
+        at zeros of the spline's derivative.
+        """
+        from scipy.interpolate import PPoly
+
+        rlo = np.empty((len(self.looks), len(lo_e)))
+        rhi = np.empty_like(rlo)
+        for j, lk in enumerate(self.looks):
+            crit = PPoly(lk.coef, lk.logx).derivative().roots(extrapolate=False)
+            crit = np.exp(np.sort(crit[np.isfinite(crit)]))
+            pts = np.unique(np.concatenate([lo_e, hi_e, crit[(crit > self.mlo) & (crit < 1.0)]]))
+            u = lk.upper(pts)
+            a = np.searchsorted(pts, lo_e, side="left")  # (increasing: the intervals follow each other)
+            b = np.searchsorted(pts, hi_e, side="right") - 1  # each interval's last point, its hi_e
+            rlo[j] = np.minimum(np.minimum.reduceat(u, a), u[b])  # (reduceat: from a[i] to a[i + 1] - 1)
+            rhi[j] = np.maximum(np.maximum.reduceat(u, a), u[b])
+        return rlo, rhi
+
+    def _codes(self, ll, lh, ml, mh, m0, m1) -> np.ndarray:
+        """The certified term of each level in each cell: 0 U_j(l), 1 U_j(m), 2 m (g2 only), -1 none; an array
+        (levels,) + the cells' shape.  ``ll``, ``lh`` (levels,) + cells: U_j's range over the cell's interval of l;
+        ``ml``, ``mh`` over its interval of m, [``m0``, ``m1``] (broadcast).
+        """
+        s = 1.0 + self.SAFETY
+        shape = np.broadcast_shapes(ll.shape, ml.shape, (1,) + np.shape(m1))
+        out = np.empty(shape, dtype=np.int8)
+        for j in range(len(self.looks)):
+            ctl = bool(self.controlled[j])
+            top = np.maximum(mh[j], m1) if ctl else mh[j]
+            c0 = ll[j] >= top * s  # U_j(l) above U_j(m) and m throughout
+            c1 = (ml[j] >= lh[j] * s) & ((ml[j] >= m1 * s) if ctl else True)
+            c2 = (m0 >= np.maximum(lh[j], mh[j]) * s) if ctl else False
+            out[j] = np.where(c0, 0, np.where(c1, 1, np.where(c2, 2, -1)))
+        return out
+
+    @staticmethod
+    def _certified(codes) -> np.ndarray:
+        """Cells where every level has a certified term, but not m for every level: there (001 eq. 21) the ideal
+        operator's g is m^k itself, with no room below it for a table scaled down, and the level table, which
+        multiplies m in exactly as the level-by-level path, serves.
+        """
+        return np.all(codes >= 0, axis=0) & ~np.all(codes == 2, axis=0)
+
+    def _check(self, fns) -> None:
+        """Refuse the table (:class:`_ProductError`) unless every function's pieces are at most the function at the
+        fit's test points and at 2000 points spread over [mlo, 1].
+        """
+        tt = FIT_TEST_POINTS
+        m = np.concatenate([(self.center[:, None] + tt[None, :] / self.ihalf[:, None]).ravel(),
+                            np.geomspace(self.mlo * (1 + 1e-12), 1.0, 2000)])
+        m = m[(m > self.mlo) & (m <= 1.0)]
+        for f, fn in enumerate(fns):
+            if np.any(self.function(f, m) > fn(m)):
+                raise _ProductError("the split table exceeds a product of the levels' bounds")
+
+    def piece(self, m):
+        """The piece that holds m (> mlo), found as the kernel finds it (:meth:`_Product.piece`)."""
+        m = np.asarray(m, dtype=np.float64)
+        c = np.minimum((float_bits_reference(m) >> self.shift) - self.cbase, len(self.cstart) - 1)
+        s = self.cstart[c]
+        while True:
+            step = m >= self.lo[s + 1]
+            if not np.any(step):
+                return s
+            s = s + step
+
+    def function(self, f, m) -> np.ndarray:
+        """Tabulated function ``f`` (a row of ``coef``) at m (> mlo), as the kernel computes it."""
+        m = np.asarray(m, dtype=np.float64)
+        s = self.piece(m)
+        row = self.coef[f, s]
+        return horner(np.moveaxis(row[..., :PRODUCT_DEGREE + 1], -1, 0), (m - row[..., -2]) * row[..., -1])
+
+    def cell(self, mu_i, mu_o) -> np.ndarray:
+        """The pattern of the cell of each pair (-1 where the level table serves), as the kernel finds it."""
+        lo, hi = np.minimum(mu_i, mu_o), np.maximum(mu_i, mu_o)
+        n = self.ncell
+        i, k = np.minimum((lo * n).astype(np.int64), n - 1), np.minimum((hi * n).astype(np.int64), n - 1)
+        return self.packed[k * (k + 1) // 2 + i]
+
+    def g(self, mu_i, mu_o) -> np.ndarray:
+        """g_1 ... g_k at (mu_i, mu_o), both > mlo: the plain numpy reference of :func:`g_split` followed, in the cells
+        without a pattern, by the level table's (:meth:`_LevelTable.g`).
+        """
+        mu_i, mu_o = np.broadcast_arrays(np.asarray(mu_i, np.float64), np.asarray(mu_o, np.float64))
+        lo, hi = np.minimum(mu_i, mu_o), np.maximum(mu_i, mu_o)
+        p = self.cell(mu_i, mu_o)
+        out = self.levels_table.g(mu_i, mu_o)
+        on = p >= 0
+        if np.any(on):
+            pp = p[on]
+            f = np.empty(pp.shape)
+            h = np.empty(pp.shape)
+            for q in np.unique(pp):
+                w = pp == q
+                f[w] = self.function(self.fid[q], lo[on][w])
+                h[w] = self.function(self.hid[q], hi[on][w])
+            out[on] = f * h  # F_A(l) H_B(m)
+        return out
+
+    def share(self) -> float:
+        """The share of pairs with both cosines uniform on [0, 1] (the cells' area) that the split table serves."""
+        n = self.ncell
+        return 2.0 * np.count_nonzero(self.pattern >= 0) / (n * n)
+
+
+def _aligned(a: np.ndarray, line: int = 64) -> np.ndarray:
+    """A C-contiguous copy of ``a`` whose data starts on a ``line``-byte boundary (a row of 8 float64 is then one cache
+    line, not two).
+    """
+    buf = np.empty(a.nbytes + line, dtype=np.uint8)
+    off = (-buf.ctypes.data) % line
+    out = buf[off:off + a.nbytes].view(a.dtype).reshape(a.shape)
+    out[...] = a
+    return out
+
+
+def _unique_rows(rows: np.ndarray):
+    """np.unique(rows, axis=0, return_inverse=True) for rows of digits 0-2 (each row read as a number in base 3: the
+    sort of rows as records took 0.14 s of a 3-level split table's 0.4 s).
+    """
+    if rows.shape[1] > 39:  # (beyond int64)
+        keys, inverse = np.unique(rows, axis=0, return_inverse=True)
+        return keys, inverse.ravel()
+    weight = 3 ** np.arange(rows.shape[1] - 1, -1, -1, dtype=np.int64)  # (the first digit the most significant)
+    u, inverse = np.unique(rows.astype(np.int64) @ weight, return_inverse=True)
+    keys = (u[:, None] // weight[None, :]) % 3
+    return keys.astype(rows.dtype), inverse.ravel()
+
+
+#: the split table's arguments of the kernels when there is none (:meth:`Pumped._split_args`)
+_SPLIT_OFF = (0, np.full(1, -1, dtype=np.int8), np.zeros(1, np.int64), np.zeros(1, np.int64), CELL_SHIFT, 0,
+              np.zeros(1, np.int32), np.full(2, math.inf), np.zeros((1, 1, PRODUCT_DEGREE + 3)))
 
 
 class _Lookup:
@@ -823,7 +1085,7 @@ class Pumped(BRDF):
               for name in ("v0", "slope0", "margin_lo", "cap")),
             np.array([lev.controlled for lev in self.chain()]),
             np.array([lk.increasing for lk in looks]), np.array([lk.mu0 for lk in looks]),
-            index, lo, 1.0 / h, *self._product_args(), *self._level_args(),
+            index, lo, 1.0 / h, *self._product_args(), *self._level_args(), *self._split_args(),
         )
 
     def product(self) -> _Product | None:
@@ -859,6 +1121,30 @@ class Pumped(BRDF):
                             pass
                     self._levels_table = table
         return self._levels_table
+
+    def split_table(self) -> _SplitTable | None:
+        """The split table of the chain (:class:`_SplitTable`) where it has a level table of at least two levels (None
+        otherwise, or where the split table cannot reach its tolerance: the kernel then takes the level table).  With
+        one level the level table already takes one polynomial per direction.
+        """
+        if not hasattr(self, "_split_table"):
+            with self._init_lock:
+                if not hasattr(self, "_split_table"):
+                    table = None
+                    q = self.level_table()
+                    if q is not None and len(q.looks) >= 2:
+                        try:
+                            table = _SplitTable(q)
+                        except _ProductError:
+                            pass
+                    self._split_table = table
+        return self._split_table
+
+    def _split_args(self):
+        r = self.split_table()
+        if r is None:  # off: split_cells = 0
+            return _SPLIT_OFF
+        return r.ncell, r.packed, r.fid, r.hid, r.shift, r.cbase, r.cstart, r.lo, r.coef
 
     def _level_args(self):
         q = self.level_table()
@@ -916,9 +1202,34 @@ class Pumped(BRDF):
             wi, wo = np.broadcast_to(wi, shape + (3,)), np.broadcast_to(wo, shape + (3,))  # read-only views
         # (n, 3) views of the directions when their strides allow it (the engine's do): no copies
         if levelwise:
-            _chain_kernel_levelwise(f.reshape(-1), wi.reshape(-1, 3), wo.reshape(-1, 3), *self._chain_args()[:-6])
+            _chain_kernel_levelwise(f.reshape(-1), wi.reshape(-1, 3), wo.reshape(-1, 3),
+                                    *self._chain_args()[:GChain._fields.index("pair_mlo")])
         else:
             _chain_kernel(f.reshape(-1), wi.reshape(-1, 3), wo.reshape(-1, 3), *self._chain_args())
+        return f
+
+    def _level_table_args(self):
+        """:meth:`_chain_args` with the split table off (``split_cells`` = 0): the kernels take the level table where
+        the split table would serve.
+        """
+        return self._chain_args()._replace(**dict(zip(GChain._fields[GChain._fields.index("split_cells"):],
+                                                      _SPLIT_OFF)))
+
+    def _eval_level_table(self, wi, wo):
+        """f_r as :meth:`_eval` without the split table (:class:`_SplitTable`): every level's bound from the level
+        table.  The baseline of the split table, for its tests (it divides by at least the split table's g) and
+        scripts/bench/bench_eval.py.
+        """
+        wi, wo = np.asarray(wi, dtype=np.float64), np.asarray(wo, dtype=np.float64)
+        args = self._level_table_args()
+        out = self.chain()[0].base.eval_divided(wi, wo, args)
+        if out is not None:
+            return out
+        f = np.array(np.broadcast_to(self.chain()[0].base._eval(wi, wo), np.broadcast_shapes(wi.shape[:-1],
+                                                                                            wo.shape[:-1])))
+        shape = f.shape
+        _chain_kernel(f.reshape(-1), np.broadcast_to(wi, shape + (3,)).reshape(-1, 3),
+                      np.broadcast_to(wo, shape + (3,)).reshape(-1, 3), *args)
         return f
 
     def _eval_levelwise(self, wi, wo):

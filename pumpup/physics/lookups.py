@@ -5,8 +5,9 @@ that makes them an upper bound of the albedo (:func:`upper_scalar`, :func:`upper
 law), and, for a chain of pumped levels or a 1/E scaling, one product table of polynomial pieces in m = max(N.wi, N.wo)
 found from the bits of m (:func:`g_product`, :func:`scale_bound`), or, where a level's bound is not monotone, one
 level table of every level's bound as polynomial pieces in m on shared pieces, one piece per direction
-(:func:`g_pair`).  The pumped BRDF divides by g (001 eq. 16, 20, 21), the engine integrates it node by node, and the
-Mitsuba plugin evaluates it: all three read these functions.
+(:func:`g_pair`), and the split table that gives the product of all levels as F(min) H(max), one look-up per
+direction, wherever every level's term is fixed (:func:`g_split`).  The pumped BRDF divides by g (001 eq. 16, 20,
+21), the engine integrates it node by node, and the Mitsuba plugin evaluates it: all three read these functions.
 """
 
 from __future__ import annotations
@@ -279,6 +280,36 @@ def g_pair(mi, mo, controlled, shift, pcbase, pcstart, plo, prow):  # pragma: no
     return g_all
 
 
+@njit(cache=True, nogil=True, inline="always")
+def g_split(mmin, mmax, ncell, pattern, fid, hid, shift, pcbase, pcstart, plo,  # pragma: no cover
+            pcoef):
+    """g_1 g_2 ... g_k at min(N.wi, N.wo) = ``mmin`` and max = ``mmax`` (both above the table's ``mlo``) as ONE product
+    F(mmin) H(mmax) of two tabulated functions, whatever the number of levels, or 0.0 where the cell of (mmin, mmax)
+    has no pattern (the caller then takes :func:`g_pair`): the cell i = floor(mmin ``ncell``), k = floor(mmax
+    ``ncell``) gives the pattern p = ``pattern[k (k + 1) / 2 + i]`` (the cells with i <= k, packed), whose functions
+    are rows ``fid[p]`` and ``hid[p]`` of ``pcoef`` (:class:`pumpup.operators.pumping._SplitTable`; 001 eq. 20, 21
+    with every level's term fixed in the cell).  ``pcoef[f, s]``: piece s's PRODUCT_DEGREE + 1 coefficients, highest
+    power first, its centre and inverse half-width.  Inlined where it is called.  Its numpy reference is
+    :meth:`pumpup.operators.pumping._SplitTable.g`.
+    """
+    i = min(int(mmin * ncell), ncell - 1)
+    k = min(int(mmax * ncell), ncell - 1)
+    p = pattern[((k * (k + 1)) >> 1) + i]  # (the cells with i <= k, packed)
+    if p < 0:
+        return 0.0
+    a, b = fid[p], hid[p]
+    si = pair_piece(mmin, shift, pcbase, pcstart, plo)
+    so = pair_piece(mmax, shift, pcbase, pcstart, plo)
+    ti = (mmin - pcoef[a, si, 6]) * pcoef[a, si, 7]
+    to = (mmax - pcoef[b, so, 6]) * pcoef[b, so, 7]
+    # the quintics, written out (Horner, the order of horner; PRODUCT_DEGREE = 5)
+    gi = ((((pcoef[a, si, 0] * ti + pcoef[a, si, 1]) * ti + pcoef[a, si, 2]) * ti + pcoef[a, si, 3]) * ti
+          + pcoef[a, si, 4]) * ti + pcoef[a, si, 5]
+    go = ((((pcoef[b, so, 0] * to + pcoef[b, so, 1]) * to + pcoef[b, so, 2]) * to + pcoef[b, so, 3]) * to
+          + pcoef[b, so, 4]) * to + pcoef[b, so, 5]
+    return gi * go
+
+
 @njit(cache=True, nogil=True)
 def g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0, index,
                   index_lo, index_h_inv):  # pragma: no cover - compiled
@@ -322,10 +353,13 @@ def scale_bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, mar
 #: every level's upper bound (:func:`g_levels`' arguments), the product table of all levels (:func:`g_product`'s,
 #: with the N.wo above which it applies, ``product_mlo``; inf when there is none) and, where there is no product table
 #: (a level's bound falls somewhere), the level table (:func:`g_pair`'s, with the smaller cosine above which it applies,
-#: ``pair_mlo``; inf when there is none)
+#: ``pair_mlo``; inf when there is none) and, above the same ``pair_mlo``, the split table that serves most pairs
+#: with one product of two look-ups (:func:`g_split`'s; ``split_cells`` 0 when there is none)
 GChain = namedtuple("GChain", [
     "offsets", "logx", "coef", "v0", "slope0", "margin_lo", "cap", "controlled", "increasing", "mu0", "index",
     "index_lo", "index_h_inv", "product_mlo", "product_cbase", "product_cstart", "product_lo", "product_rows",
     "pair_mlo", "pair_shift", "pair_cbase", "pair_cstart", "pair_lo", "pair_rows",
+    "split_cells", "split_pattern", "split_fid", "split_hid", "split_shift", "split_cbase",
+    "split_cstart", "split_lo", "split_coef",
 ])
 

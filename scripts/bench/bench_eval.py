@@ -117,23 +117,34 @@ def spectral_rows(wi, wo, repeat=5):
 
 
 def issue55_rows(repeat=9, n=1 << 20):
-    """Issue 55's eval rows: target, old and new (alternating), as ratios to the base measured in the same rounds."""
+    """Issue 55's eval rows: target, the old paths and the new (alternating), as ratios to the base measured in the
+    same rounds, and the time and memory of the tables the new path reads.
+    """
+    import os
+
     rng = np.random.default_rng(1)
     wi, wo = directions(rng, n), directions(rng, n)
     ggx = pumpup.load({"type": "ggx", "alpha": 0.3})
     phong = pumpup.load({"type": "phong", "n": 20})
-    rows = []  # (label, base, old callable, new callable, target)
-    for levels in (1, 2, 3):
+    rows = []  # (label, base, {path: callable}, target)
+    built = []
+    for levels in (1, 2, 3, 5):
         p = pumpup.pump({"type": "ggx", "alpha": 0.3}, g="g2", levels=levels)
-        rows.append((f"pumped GGX alpha 0.3, g2, {levels} level{'s' * (levels > 1)}", ggx, p._eval_levelwise, p._eval,
-                     1.5))
-    pp = pumpup.pump({"type": "phong", "n": 20}, g="g2", levels=3)
-    rows.append(("pumped Phong n 20, g2, 3 levels", phong, pp._eval_levelwise, pp._eval, 1.3))
+        built.append((levels, *table_cost(p)))
+        rows.append((f"pumped GGX alpha 0.3, g2, {levels} level{'s' * (levels > 1)}", ggx,
+                     {"levelwise": p._eval_levelwise, "level table": p._eval_level_table, "new": p._eval}, 1.5))
+    for levels in (1, 3, 5):
+        pp = pumpup.pump({"type": "phong", "n": 20}, g="g2", levels=levels)
+        rows.append((f"pumped Phong n 20, g2, {levels} level{'s' * (levels > 1)}", phong,
+                     {"levelwise": pp._eval_levelwise, "level table": _every_row(pp), "new": pp._eval}, 1.3))
     kc = pumpup.compensate({"type": "ggx", "alpha": 0.3}, method="kulla_conty")
-    rows.append(("GGX alpha 0.3 + Kulla-Conty lobe", ggx, kc._eval_two_passes, kc._eval, 1.3))
+    rows.append(("GGX alpha 0.3 + Kulla-Conty lobe", ggx, {"levelwise": kc._eval_two_passes,
+                                                          "level table": kc._eval_two_passes, "new": kc._eval}, 1.3))
+    paths = ("levelwise", "level table", "new")
     fns = {"ggx": ggx._eval, "phong": phong._eval}
-    for label, _, old, new, _ in rows:
-        fns[label + " old"], fns[label + " new"] = old, new
+    for label, _, fn, _ in rows:
+        for path in paths:
+            fns[label + " " + path] = fn[path]
     for fn in fns.values():
         fn(wi[:10], wo[:10])
         fn(wi, wo)
@@ -143,14 +154,52 @@ def issue55_rows(repeat=9, n=1 << 20):
             t = time.thread_time()  # CPU time of this thread: the time it waits for a core on a loaded machine is out
             fn(wi, wo)
             best[key] = min(best[key], time.thread_time() - t)
-    import os
 
     print(f"issue 55, eval against the base, {n} pairs, best of {repeat} (load {os.getloadavg()[0]:.1f}):")
-    print(f"{'':40s} {'target':>7s} {'old':>7s} {'new':>7s} {'base ns':>8s} {'new ns':>7s}")
-    for label, base, _, _, target in rows:
+    print("  levelwise: every level's bound looked up level by level (Pumped._eval_levelwise; Kulla-Conty: two "
+          "passes)\n  level table: every level's bound from one polynomial piece per direction "
+          "(Pumped._eval_level_table; Phong: its previous fused kernel, which divided every row)\n"
+          "  new: Pumped._eval (the split table, one product of two look-ups; Phong: only the lit rows divided)")
+    print(f"{'':40s} {'target':>7s} {'levelwise':>10s} {'lvl table':>10s} {'new':>7s} {'base ns':>8s} {'new ns':>7s}")
+    for label, base, _, target in rows:
         b = best["ggx" if base is ggx else "phong"]
-        o, w = best[label + " old"], best[label + " new"]
-        print(f"{label:40s} {target:6.1f}x {o / b:6.2f}x {w / b:6.2f}x {b / n * 1e9:8.1f} {w / n * 1e9:7.1f}")
+        r = [best[label + " " + path] / b for path in paths]
+        met = "met" if r[2] <= target else "missed"
+        print(f"{label:40s} {target:6.1f}x {r[0]:9.2f}x {r[1]:9.2f}x {r[2]:6.2f}x {b / n * 1e9:8.1f} "
+              f"{best[label + ' new'] / n * 1e9:7.1f}  {met}")
+    print("\ntables of the pumped GGX chains (built again from the levels' albedo tables, which are cached):")
+    for levels, secs, kb, share in built:
+        print(f"  {levels} level{'s' * (levels > 1)}: product/level/split tables {secs * 1e3:7.1f} ms, {kb:8.1f} kB; "
+              f"the split table serves {share:.1%} of uniform (N.wi, N.wo)")
+
+
+def _every_row(p):
+    """The previous fused Phong kernel of pumped chain ``p`` (every row of a block divided by g, the dark ones too,
+    ``Phong._eval_divided_every_row``) with the split table off: the baseline of the "level table" column.
+    """
+    def run(wi, wo):
+        return p.chain()[0].base._eval_divided_every_row(wi, wo, p._level_table_args())
+
+    return run
+
+
+def table_cost(p):
+    """Build time (s) and size (kB) of the look-up tables of pumped chain ``p`` (its levels' albedo tables already
+    built), and the share of pairs the split table serves.
+    """
+    from pumpup.operators.pumping import Pumped
+
+    for lev in p.chain():
+        lev.lookup()
+    fresh = Pumped(base=p.base, g=p.p["g"])  # the same chain, its tables not yet built
+    for lev in fresh.chain():
+        lev.lookup()
+    t = time.perf_counter()
+    args = fresh._chain_args()
+    secs = time.perf_counter() - t
+    kb = sum(a.nbytes for a in args if isinstance(a, np.ndarray)) / 1e3
+    r = fresh.split_table()
+    return secs, kb, (r.share() if r is not None else 0.0)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,7 @@
 """The chain kernel's level table (pumpup.operators.pumping._LevelTable, pumpup.physics.lookups.g_pair): every level's
-bound on one set of polynomial pieces in m, for chains whose bounds are not monotone (GGX).
+bound on one set of polynomial pieces in m, for chains whose bounds are not monotone (GGX); and its split table
+(pumpup.operators.pumping._SplitTable, pumpup.physics.lookups.g_split): the product of all levels as F(min) H(max) in
+the cells of (min, max) where every level's term is fixed.
 
 What must hold, pointwise: the pumped BRDF is at least what the level-by-level path gives (the baseline,
 ``Pumped._eval_levelwise``) and at most the ideal operator's (the exact albedo of each level, from pumpup.albedo with
@@ -13,13 +15,25 @@ import pytest
 from helpers import random_directions
 
 import pumpup
-from pumpup.operators.pumping import _LevelTable
+from pumpup.operators.pumping import _LevelTable, _SplitTable
 
 
 @pytest.fixture(scope="module")
 def ggx2():
     """2-level g2 pumped GGX alpha 0.3: its bounds fall, then rise (no product table)."""
     return pumpup.pump({"type": "ggx", "alpha": 0.3}, g="g2", levels=2)
+
+
+@pytest.fixture(scope="module")
+def ggx3():
+    """3-level g2 pumped GGX alpha 0.3: the split table serves most pairs."""
+    return pumpup.pump({"type": "ggx", "alpha": 0.3}, g="g2", levels=3)
+
+
+@pytest.fixture(scope="module")
+def ggx2_g1():
+    """2-level g1 pumped GGX alpha 0.3 (height-correlated): a split table without the terms m."""
+    return pumpup.pump({"type": "ggx", "alpha": 0.3, "shadowing": "correlated"}, g="g1", levels=2)
 
 
 @pytest.fixture(scope="module")
@@ -43,17 +57,25 @@ def _pairs(rng, n=300):
     return np.concatenate([wi, a, a, graze]), np.concatenate([wo, mirror, graze, wo])
 
 
-@pytest.mark.parametrize("name", ["ggx2", "ggx1_g1"])
-def test_level_table_between_the_levelwise_and_the_ideal_operator(name, request, rng):
+@pytest.mark.parametrize("name", ["ggx2", "ggx3", "ggx2_g1", "ggx1_g1"])
+@pytest.mark.parametrize("path", ["new", "level table"])
+def test_level_table_between_the_levelwise_and_the_ideal_operator(name, path, request, rng):
+    """Both the level table alone and with the split table (``_eval``) are pointwise between the level-by-level path
+    and the ideal operator."""
     f = request.getfixturevalue(name)
     assert f.product() is None and f.level_table() is not None  # the level table is what this tests
+    assert (f.split_table() is not None) == (f.depth >= 2)  # and the split table with two levels or more
     wi, wo = _pairs(rng)
-    new = f._eval(wi, wo)
+    if f.depth >= 2:  # pairs in cells of every pattern, and in cells without one
+        mi, mo = _cell_pairs(f.split_table(), rng)
+        wi = np.concatenate([wi, _at_cosine(mi, rng)])
+        wo = np.concatenate([wo, _at_cosine(mo, rng)])
+    new = f._eval(wi, wo) if path == "new" else f._eval_level_table(wi, wo)
     old = f._eval_levelwise(wi, wo)
     assert np.all(new >= old)  # at least what the level-by-level path gives, exactly
     up = new > 0
     assert np.count_nonzero(up) > 0.5 * len(up)
-    assert np.max(np.abs(new[up] / old[up] - 1)) < 1e-13  # and no more than the fit's 2 epsilon per level above
+    assert np.max(np.abs(new[up] / old[up] - 1)) < 1e-13  # and no more than the fits' 2 epsilon each above
     # at most the ideal operator's: f / prod_j max(a_j(mu_i), a_j(mu_o)[, mu_i, mu_o]) with every a_j raised by its
     # error estimate (so the check is stricter than the ideal's own value)
     keep = (wi[:, 2] > 0) & (wo[:, 2] > 0)
@@ -84,7 +106,7 @@ def test_kernel_against_its_numpy_reference(ggx2, rng):
     from pumpup.operators.pumping import _chain_kernel
 
     f = np.ones(len(m))
-    _chain_kernel(f, wi, wo, *ggx2._chain_args())
+    _chain_kernel(f, wi, wo, *ggx2._level_table_args())  # (the split table off: the level table everywhere)
     ref = 1.0 / q.g(mi, mo)
     np.testing.assert_allclose(f, ref, rtol=4e-16 * 8, atol=0)
     # every level's piece is at most the level's bound and within 2 epsilon below it
@@ -131,4 +153,95 @@ def test_fused_kernel_is_the_base_then_the_chain_kernel(spec, ggx2, rng):
     _chain_kernel(two, wi, wo, *f._chain_args())
     np.testing.assert_array_equal(fused, two)
     np.testing.assert_array_equal(f._eval(wi, wo), two)
+    if spec["type"] == "phong":  # its previous kernel, which divided the dark rows too (the benchmark's baseline)
+        np.testing.assert_array_equal(base._eval_divided_every_row(wi, wo, f._chain_args()), two)
     assert base.eval_divided(wi[:, None], wo[None, :], f._chain_args()) is None  # broadcast shapes: the two passes
+
+
+def _at_cosine(mu, rng):
+    """Unit directions with N.w = ``mu`` at random azimuths."""
+    phi = rng.uniform(0, 2 * math.pi, len(mu))
+    s = np.sqrt(1 - mu * mu)
+    return np.stack([s * np.cos(phi), s * np.sin(phi), mu], axis=-1)
+
+
+def _cell_pairs(r, rng, per=3):
+    """Cosine pairs (N.wi, N.wo) in cells of every pattern of the split table ``r`` (``per`` random pairs in up to 40
+    cells of each), in 200 cells without a pattern, and on the cells' edges (k / CELLS exactly, and one ulp below)."""
+    n = r.ncell
+    cells = []
+    for p in range(-1, len(r.patterns)):
+        ik = np.argwhere(r.pattern == p)
+        if p < 0:
+            ik = ik[ik[:, 0] < ik[:, 1]]  # (the upper triangle: min <= max)
+        cells.append(ik[rng.permutation(len(ik))[:200 if p < 0 else 40]])
+    ik = np.repeat(np.concatenate(cells), per, axis=0)
+    lo = np.maximum((ik[:, 0] + rng.random(len(ik))) / n, r.mlo * 2)
+    hi = np.minimum((ik[:, 1] + rng.random(len(ik))) / n, 1.0)
+    edge = np.arange(1, n) / n
+    lo = np.concatenate([lo, edge[:-1], np.nextafter(edge[:-1], 0), edge[:-1]])
+    hi = np.concatenate([hi, edge[1:], np.nextafter(edge[1:], 0), np.nextafter(edge[1:], 0)])
+    keep = (lo > r.mlo) & (lo <= hi)
+    lo, hi = lo[keep], hi[keep]
+    swap = rng.random(len(lo)) < 0.5  # either direction may hold the smaller cosine
+    return np.where(swap, hi, lo), np.where(swap, lo, hi)
+
+
+@pytest.mark.parametrize("name", ["ggx2", "ggx3", "ggx2_g1"])
+def test_split_table_patterns_hold_in_their_cells(name, request, rng):
+    """In a cell with a pattern, every level's g takes the pattern's term: that term is the largest of U_j(l), U_j(m)
+    and (g2) m at every pair tried there, so F(l) H(m) is the product of the levels' g."""
+    f = request.getfixturevalue(name)
+    r = f.split_table()
+    mi, mo = _cell_pairs(r, rng, per=20)
+    p = r.cell(mi, mo)
+    on = p >= 0
+    assert set(np.unique(p[on])) == set(range(len(r.patterns)))  # every pattern tried
+    lo, hi, codes = np.minimum(mi, mo)[on], np.maximum(mi, mo)[on], r.patterns[p[on]]
+    for j, lk in enumerate(r.looks):
+        terms = np.stack([lk.upper(lo), lk.upper(hi), hi if r.controlled[j] else np.zeros_like(hi)])
+        chosen = terms[codes[:, j], np.arange(len(lo))]
+        assert np.all(chosen >= terms.max(axis=0))  # 001 eq. 20, 21: the max is the pattern's term
+    # and the tabulated functions are at most their products of bounds, within 2 epsilon below them
+    for k, fn in enumerate(r.functions):
+        m = np.geomspace(r.mlo * 1.001, 1.0, 3000)
+        exact = r._function(fn)(m)
+        got = r.function(k, m)
+        assert np.all(got <= exact) and np.all(got >= exact * (1 - 2 * r.epsilon - 1e-15))
+
+
+@pytest.mark.parametrize("name", ["ggx2", "ggx3", "ggx2_g1"])
+def test_split_kernel_against_its_numpy_reference(name, request, rng):
+    """The compiled chain kernel (f = 1, so it returns 1 / g) against :meth:`_SplitTable.g`, on both of its paths."""
+    from pumpup.operators.pumping import _chain_kernel
+
+    f = request.getfixturevalue(name)
+    r = f.split_table()
+    mi, mo = _cell_pairs(r, rng)
+    m = 10 ** rng.uniform(math.log10(r.mlo) + 1e-9, 0, 2000)
+    mi, mo = np.concatenate([mi, m, r.lo[1:-1]]), np.concatenate([mo, rng.permutation(m), rng.permutation(r.lo[1:-1])])
+    assert np.any(r.cell(mi, mo) >= 0) and np.any(r.cell(mi, mo) < 0)  # both paths
+    out = np.ones(len(mi))
+    _chain_kernel(out, _at_cosine(mi, rng), _at_cosine(mo, rng), *f._chain_args())
+    np.testing.assert_allclose(out, 1.0 / r.g(mi, mo), rtol=4e-16 * 8, atol=0)
+
+
+def test_split_table_layout_and_switch(ggx3, ggx2):
+    """The GChain's split fields hold the table; ``_level_table_args`` turns it off; one level has none."""
+    from pumpup.physics.lookups import PRODUCT_DEGREE
+
+    r = ggx3.split_table()
+    args = ggx3._chain_args()
+    assert args.split_cells == r.ncell == _SplitTable.CELLS and args.split_coef is r.coef
+    assert r.coef.shape == (len(r.functions), len(r.lo) - 1, PRODUCT_DEGREE + 3)
+    assert r.functions[0] == ((), 0) and np.all(r.coef[0, :, :PRODUCT_DEGREE + 1] == np.eye(PRODUCT_DEGREE + 1)[-1])
+    assert not np.any(np.all(r.patterns == 2, axis=1))  # where every level takes m, the level table serves
+    assert r.pattern.shape == (r.ncell, r.ncell) and r.pattern.dtype == np.int8
+    assert np.all(np.tril(r.pattern + 1) == 0)  # only cells with min < max hold a pattern
+    i, k = np.triu_indices(r.ncell)
+    assert args.split_pattern is r.packed and np.array_equal(r.packed[k * (k + 1) // 2 + i], r.pattern[i, k])
+    assert r.share() > 0.85  # most uniform pairs take one product
+    off = ggx3._level_table_args()
+    assert off.split_cells == 0 and off.pair_rows is args.pair_rows
+    assert pumpup.pump({"type": "ggx", "alpha": 0.3}, g="g2", levels=1).split_table() is None
+    assert ggx2.split_table().looks is ggx2.level_table().looks
