@@ -1,0 +1,304 @@
+"""Where the numbers the documentation quotes come from.
+
+A page quotes a result in one of three ways, and this module lists all three:
+
+:data:`VALUES`
+    computed when the site is built and written into the text by the role ``{pumpup-value}`key```
+    (``docs/_ext/pumpup_docs.py``).  Each is a :class:`Value`: the function, how it is printed, and whether it
+    takes more than a few seconds (``slow``: then the default test suite does not compute it).
+:data:`TABLES`
+    Markdown tables generated from a file the repository generates (``tables/*.nc``, ``tables/*.json``), inserted
+    by the directive ``{pumpup-table} NAME``.  The script that writes the file is named with each.
+:data:`QUOTES`
+    numbers typed in a page or in the README (in a code comment, or in prose that reads better with the number
+    in it): the exact text, the function that recomputes them, and the tolerance.  ``tests/project/
+    test_docs_numbers.py`` asserts that the text is still in the page and that each typed number is the fresh
+    result rounded to the digits it shows (``slow`` ones under ``-m slow``).
+
+Timings are not quoted as results: they depend on the machine and its load; the pages give the command that
+measures them (``scripts/bench/``).
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.util
+import json
+import math
+import os
+from dataclasses import dataclass
+from typing import Callable
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+TABLES_DIR = os.path.join(ROOT, "tables")
+
+
+@dataclass(frozen=True)
+class Value:
+    """A number (or a tuple of numbers) quoted in a page: ``compute()`` and the format of each number."""
+
+    compute: Callable
+    fmt: str = ".4g"
+    slow: bool = False
+    sep: str = ", "
+
+    def text(self) -> str:
+        v = self.compute()
+        if isinstance(v, str):
+            return v
+        if isinstance(v, (tuple, list)):
+            return self.sep.join(format(float(x), self.fmt) for x in v)
+        return format(float(v), self.fmt)
+
+
+@dataclass(frozen=True)
+class Quote:
+    """Numbers typed in ``page`` (a path from the repository root) inside the exact text ``text``; ``compute()``
+    returns them in the order they appear (one float or a sequence).  Each must equal the fresh value rounded to
+    its printed digits, within ``rtol`` more when given (for values that depend on a tolerance of the code)."""
+
+    page: str
+    text: str
+    compute: Callable
+    rtol: float = 0.0
+    slow: bool = False
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# stored files
+# ---------------------------------------------------------------------------------------------------------------
+
+
+@functools.lru_cache(maxsize=None)
+def _open(name: str):
+    import xarray as xr
+
+    with xr.open_dataset(os.path.join(TABLES_DIR, name)) as ds:
+        return ds.load()
+
+
+def stored(table: str, row: str, column: str) -> float:
+    """The ``computed`` value of one entry of a ``pumpup reproduce`` table (``tables/<table>.nc``)."""
+    ds = _open(f"{table}.nc")
+    for i in range(ds.sizes["entry"]):
+        e = ds.isel(entry=i)
+        if str(e.row.values) == row and str(e.column.values) == column:
+            return float(e.computed)
+    raise KeyError(f"tables/{table}.nc has no entry row={row!r} column={column!r}")
+
+
+def reproduce_agreement() -> str:
+    """How many printed values of 000 and 001 that ``pumpup reproduce`` regenerates agree to their digits."""
+    agree = total = 0
+    for t in ("table2", "table3", "table4", "text"):
+        ds = _open(f"{t}.nc")
+        agree += int(ds.agrees.sum())
+        total += int(ds.sizes["entry"])
+    return f"{agree} of {total}"
+
+
+def divergence_k(family: str) -> float:
+    """The exponent k of a ~ K mu^-k of every m of ``family`` in ``tables/divergence.nc``, if they agree to 4
+    decimals (else an error: the page quotes one number for all)."""
+    ds = _open("divergence.nc")
+    ks = [float(ds.k.sel(model=m)) for m in ds.model.values if str(m).startswith(family + " ")]
+    if len({round(k, 4) for k in ks}) != 1:
+        raise ValueError(f"{family}: k differs between the m of tables/divergence.nc: {ks}")
+    return ks[0]
+
+
+def divergence_albedo(model: str, mu: float) -> float:
+    ds = _open("divergence.nc")
+    i = int(abs(ds.mu.values - mu).argmin())
+    if abs(ds.mu.values[i] / mu - 1) > 1e-9:
+        raise KeyError(f"tables/divergence.nc has no mu = {mu:g}")
+    return float(ds.albedo.sel(model=model).isel(mu=i))
+
+
+def pumping_figures(var: str, **sel) -> float:
+    return float(_open("pumping_figures.nc")[var].sel(**sel).max())
+
+
+def _script(name: str):
+    """A module of ``scripts/make/`` (not a package), imported by path."""
+    path = os.path.join(ROOT, "scripts", "make", f"{name}.py")
+    spec = importlib.util.spec_from_file_location(f"_pumpup_docs_{name}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# generated tables
+# ---------------------------------------------------------------------------------------------------------------
+
+FITTING_FILES = ("fitting_study.json", "fitting_study_pumped.json", "fitting_study_plausible.json",
+                 "fitting_study_mu026.json")
+
+
+@functools.lru_cache(maxsize=None)
+def fitting_records() -> tuple:
+    """Every record of the fitting study (``scripts/make/fitting_study.py`` writes them), as dicts."""
+    out = []
+    for name in FITTING_FILES:
+        with open(os.path.join(TABLES_DIR, name)) as fh:
+            data = json.load(fh)
+        out += data["records"] if isinstance(data, dict) else data
+    return tuple(out)
+
+
+def fitting_tables() -> str:
+    """The tables of the fitting study, as ``python scripts/make/fitting_study.py --table --read ...`` prints them."""
+    fs = _script("fitting_study")
+    recs = list(fitting_records())
+    parts = []
+    for mu_min, pl in sorted({(round(r["mu_min"], 9), r.get("plausible", False)) for r in recs}):
+        sub = [r for r in recs if round(r["mu_min"], 9) == mu_min and r.get("plausible", False) == pl]
+        parts.append(f"**mu_min = {mu_min:g} (views and albedo down to theta = "
+                     f"{math.degrees(math.acos(mu_min)):.1f} deg)" + (", albedo <= 1 imposed" if pl else ", scale free")
+                     + "**")
+        parts.append(fs.table(sub))
+        parts.append(fs.best(sub))
+    return "\n\n".join(parts)
+
+
+def compensation_table() -> str:
+    """The compensation study's table (``scripts/make/compensation_study.py``, ``tables/compensation.nc``)."""
+    return _script("compensation_study").markdown(_open("compensation.nc"))
+
+
+def compensation_metalness() -> str:
+    """The intermediate-metalness furnace of the compensation study (``tables/compensation.nc``)."""
+    return _script("compensation_study").metal_markdown(_open("compensation.nc"))
+
+
+#: generated tables: name -> function returning Markdown
+TABLES: dict[str, Callable[[], str]] = {
+    "fitting-study": fitting_tables,
+    "compensation-study": compensation_table,
+    "compensation-metalness": compensation_metalness,
+}
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# values computed in the build
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def _albedo(spec, mu, **kw):
+    import numpy as np
+
+    import pumpup
+
+    return tuple(float(x) for x in np.atleast_1d(pumpup.albedo(pumpup.load(spec), mu, **kw)))
+
+
+VALUES: dict[str, Value] = {
+    "reproduce-agreement": Value(reproduce_agreement),
+    "schlick-r0.001": Value(lambda: stored("text", "r = 0.001", "schlick C_max"), ".4f"),
+    "ward-k": Value(lambda: divergence_k("ward"), ".4f"),
+    "ward-grazing": Value(lambda: tuple(stored("text", t, "ward m=0.1 a(theta)")
+                                        for t in ("89.995", "89.999", "89.9995")), ".4f"),
+    "ward-89.9995": Value(lambda: stored("text", "89.9995", "ward m=0.1 a(theta)"), ".2f"),
+    "ct-grazing-1e-3": Value(lambda: divergence_albedo("cook_torrance m=0.1", 1e-3), ".5f"),
+    "ct-grazing-1e-5": Value(lambda: divergence_albedo("cook_torrance m=0.1", 1e-5), ".5f"),
+    "ct-grazing-1e-8": Value(lambda: divergence_albedo("cook_torrance m=0.1", 1e-8), ".9f"),
+    "phong-g2-3-mirror": Value(lambda: pumping_figures("mirror_radiance", model="phong", g="g2", level=3), ".2f"),
+    "phong-g2-3-over-c": Value(lambda: pumping_figures("mirror_radiance", model="phong", g="g2", level=3)
+                               / _open("pumping_figures.nc").attrs["phong_c"], ".2g"),
+    "blinn-g2-3-over-c": Value(lambda: pumping_figures("mirror_radiance", model="blinn", g="g2", level=3)
+                               / _open("pumping_figures.nc").attrs["blinn_c"], ".0f"),
+    "phong-c": Value(lambda: _open("pumping_figures.nc").attrs["phong_c"], ".2f"),
+    "g1-g2-phong": Value(lambda: float(abs(_open("pumping_figures.nc").albedo.sel(model="phong", g="g1")
+                                           - _open("pumping_figures.nc").albedo.sel(model="phong", g="g2")).max()),
+                         ".2g"),
+    "g1-g2-blinn": Value(lambda: float(abs(_open("pumping_figures.nc").albedo.sel(model="blinn", g="g1")
+                                           - _open("pumping_figures.nc").albedo.sel(model="blinn", g="g2")).max()),
+                         ".2f"),
+}
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# numbers typed in the pages and the README, checked by tests/project/test_docs_numbers.py
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def _fit(target, model, method="perceptual", mu_min=0.05, plausible=False):
+    for r in fitting_records():
+        if (r["target_name"] == target and r["model"] == model and r["method"] == method
+                and abs(r["mu_min"] - mu_min) < 1e-9 and r.get("plausible", False) == plausible):
+            return r
+    raise KeyError((target, model, method, mu_min, plausible))
+
+
+def _comp(model, method, var, theta_i=None):
+    ds = _open("compensation.nc").sel({"model": model, "method": method})
+    v = ds[var]
+    return float(v.sel(theta_i=theta_i) if theta_i is not None else v)
+
+
+QUOTES: list[Quote] = [
+    # README: what pumpup measured that the papers and renderers got wrong
+    Quote("README.md", "| 5.34 | 5.334 (closed form", lambda: stored("table2", "128", "blinn")),
+    Quote("README.md", "| 0.368 | 0.3638: the maximum is at 41.41 deg",
+          lambda: (0.368, stored("table2", "2", "stretched_blinn"),
+                   float(_open("table2.nc").theta_deg.isel(entry=11)))),
+    Quote("README.md", "| 1.005, 1.002, 1.002 | 1.0016, 1.0004, 1.0001",
+          lambda: (1.005, 1.002, 1.002, *(stored("table4", m, "modified_ward") for m in ("0.02", "0.01", "0.005")))),
+    Quote("README.md", "| 0.042 | 0.0642", lambda: (0.042, stored("text", "r = 0.001", "schlick C_max"))),
+    Quote("README.md", "| 3.8 | 3.7098", lambda: (3.8, stored("text", "89.9995", "ward m=0.1 a(theta)"))),
+    Quote("README.md", "(m = 0.1: 0.999999990 at mu = 1e-8)",
+          lambda: (0.1, divergence_albedo("cook_torrance m=0.1", 1e-8), 1e-8)),
+    Quote("README.md", "pumpup.max_constant(pumpup.load(\"blinn:n=16\"))          # (0.895",
+          lambda: (16, stored("table2", "16", "blinn"))),
+    Quote("docs/user-guide/albedo.md", "# 0.1865 and 0.2782",
+          lambda: _albedo({"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, 0.2, phi=[0.0, math.pi / 2]), slow=True),
+    # the user guide
+    Quote("docs/user-guide/albedo.md", "max S = 1.0858 at n = 0",
+          lambda: (_plastic_max_s(), 0)),
+    # the fitting study: prose read from tables/fitting_study*.json
+    Quote("docs/user-guide/fitting.md", "(n = 48, c = 5.2)",
+          lambda: (_fit("ggx a=0.1 F=1", "stretched_phong")["params"]["n"],
+                   _fit("ggx a=0.1 F=1", "stretched_phong")["params"]["c"])),
+    Quote("docs/user-guide/fitting.md", "metal (alpha = 0.1) to 7.5-21 % with Fresnel 1 and 12-19 % for aluminium",
+          lambda: (0.1, 100 * _fit("ggx a=0.1 F=1", "pumped_phong_g2_3")["albedo_error"],
+                   100 * _fit("ggx a=0.1 F=1", "pumped_phong_g2_2")["albedo_error"],
+                   100 * _fit("ggx a=0.1 Al", "pumped_phong_g2_2")["albedo_error"],
+                   100 * _fit("ggx a=0.1 Al", "pumped_phong_g2_3")["albedo_error"]), rtol=0.02),
+    Quote("docs/user-guide/fitting.md", "against 57 % for the\nbest unpumped model",
+          lambda: 100 * _fit("ggx a=0.1 F=1", "stretched_phong")["albedo_error"]),
+    Quote("docs/user-guide/fitting.md", "(0.958-0.974 against 0.948-0.949 at alpha = 0.1)",
+          lambda: (_fit("ggx a=0.1 F=1", "pumped_phong_g2_3")["brdf_error"],
+                   _fit("ggx a=0.1 Al", "pumped_phong_g2_2")["brdf_error"],
+                   _fit("ggx a=0.1 Al", "stretched_phong")["brdf_error"],
+                   _fit("ggx a=0.1 F=1", "stretched_phong")["brdf_error"], 0.1)),
+    Quote("docs/user-guide/fitting.md", "(2 levels: 24 % against 58 %, e_f 0.986 against 0.978)",
+          lambda: (2, 100 * _fit("beckmann a=0.1 F=1", "pumped_phong_g2_2")["albedo_error"],
+                   100 * _fit("beckmann a=0.1 F=1", "stretched_phong")["albedo_error"],
+                   _fit("beckmann a=0.1 F=1", "pumped_phong_g2_2")["brdf_error"],
+                   _fit("beckmann a=0.1 F=1", "stretched_phong")["brdf_error"])),
+    # the compensation study: prose read from tables/compensation.nc
+    Quote("docs/user-guide/compensation.md", "1.5e-5 for Blinn n = 100",
+          lambda: (_comp("blinn n=100", "scale", "furnace_residual"), 100)),
+    # the papers
+    Quote("docs/studies/papers.md", "| 1 | 0.67 | 3.2e-7 | 0.11 |",
+          lambda: (1, *_eq22_row(1)), slow=True),
+]
+
+
+def _plastic_max_s() -> float:
+    """The largest albedo of plastic's specular lobe (a_s = 1, F = 1) at n = 0, over mu, as the model computes it
+    (the upper end of its error estimate)."""
+    from pumpup.models.metal import _plastic_max_s as max_s
+
+    return max_s(0.0, None)
+
+
+def _eq22_row(level: int):
+    """One row of the 001 eq. 22 comparison (``pumpup.figures.eq22_convergence``, which
+    ``scripts/make/pumping_figures.py`` prints): max and median relative BRDF difference and max albedo difference
+    of g2-pumped Phong n = 20 at ``level`` against stretched Phong."""
+    from pumpup.figures import eq22_convergence
+
+    r = eq22_convergence(levels=level)[level]
+    return r["max_rel_brdf_diff"], r["median_rel_brdf_diff"], r["max_albedo_diff"]
