@@ -143,6 +143,20 @@ def scene(name: str, panel: str | None = None, key: str = "mean"):
     return entry[key] if panel is None else entry["panels"][panel][key]
 
 
+@functools.lru_cache(maxsize=None)
+def _noise() -> dict:
+    with open(os.path.join(ROOT, "figures", "scene_noise.json")) as fh:
+        return json.load(fh)
+
+
+def noise(*keys):
+    """A number that ``scripts/make/scene_noise.py`` wrote to ``figures/scene_noise.json``."""
+    v = _noise()
+    for k in keys:
+        v = v[k]
+    return v
+
+
 def _script(name: str):
     """A module of ``scripts/make/`` (not a package), imported by path."""
     path = os.path.join(ROOT, "scripts", "make", f"{name}.py")
@@ -264,6 +278,18 @@ VALUES: dict[str, Value] = {
                                              for n in _scenes()), ""),
     "scene-fireflies": Value(lambda: ", ".join(
         f"{n} {sum(p['fireflies'] for p in _scenes()[n]['panels'].values())}" for n in _scenes()), ""),
+    # the fireflies of 000 Fig. 8 (figures/scene_noise.json)
+    "noise-setup": Value(lambda: f"{noise('size')} x {noise('size')} and {noise('passes') * noise('spp')} spp "
+                                 f"({noise('passes')} passes of {noise('spp')})", ""),
+    "noise-sd-p99": Value(lambda: noise("sample_sd_percentiles", "99"), ".2g"),
+    "noise-sd-p999": Value(lambda: noise("sample_sd_percentiles", "99.9"), ".3g"),
+    "noise-spp-needed": Value(lambda: noise("spp_for_0.01_at_p99"), ",.2g"),
+    "noise-hours-per-panel": Value(lambda: noise("spp_for_0.01_at_p99") * 256 ** 2 / noise("samples_per_second")
+                                   / 3600, ".2g"),
+    "noise-rate": Value(lambda: noise("samples_per_second") / 1e6, ".2g"),
+    "noise-run": Value(lambda: f"{noise('seconds'):.0f} s at load {noise('load'):.1f}", ""),
+    "noise-by-spp": Value(lambda: ", ".join(f"{c} at {n} spp" for n, c in noise("fireflies_by_spp").items()), ""),
+    "noise-variants": Value(lambda: ", ".join(f"{c} {how}" for how, c in noise("fireflies_128_64spp").items()), ""),
     "phong-c": Value(lambda: _open("pumping_figures.nc").attrs["phong_c"], ".2f"),
     "g1-g2-phong": Value(lambda: float(abs(_open("pumping_figures.nc").albedo.sel(model="phong", g="g1")
                                            - _open("pumping_figures.nc").albedo.sel(model="phong", g="g2")).max()),
@@ -313,6 +339,29 @@ QUOTES: list[Quote] = [
           lambda: (16, stored("table2", "16", "blinn"))),
     Quote("docs/user-guide/albedo.md", "# 0.1865 and 0.2782",
           lambda: _albedo({"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, 0.2, phi=[0.0, math.pi / 2]), slow=True),
+    # the notes on the published tables (tables/table2-4.nc and text.nc, written by pumpup reproduce)
+    *[Quote("docs/notes_on_published_tables.md", f"| {m} | {pub} | {val}",
+            lambda m=m: (float(m), published("table4", m, "modified_ward"), stored("table4", m, "modified_ward")))
+      for m, pub, val in (("0.4", "1.63", "1.6205"), ("0.2", "1.16", "1.1576"), ("0.1", "1.04", "1.0398"),
+                          ("0.05", "1.011", "1.00999"), ("0.02", "1.005", "1.0016"), ("0.01", "1.002", "1.0004"),
+                          ("0.005", "1.002", "1.0001"))],
+    Quote("docs/notes_on_published_tables.md", "n = 256 and 512 (10.426, 20.611) agree with the printed 10.4, 20.6",
+          lambda: (256, 512, stored("table2", "256", "blinn"), stored("table2", "512", "blinn"),
+                   published("table2", "256", "blinn"), published("table2", "512", "blinn"))),
+    Quote("docs/notes_on_published_tables.md", "**Stretched Phong n = 128, 256, 512: 0.9523, 0.9647, 0.9742** "
+          "(printed 0.953, 0.966,\n  0.975)",
+          lambda: (128, 256, 512, *(stored("table3", n, "stretched_phong") for n in ("128", "256", "512")),
+                   *(published("table3", n, "stretched_phong") for n in ("128", "256", "512")))),
+    Quote("docs/notes_on_published_tables.md", "2.1485 (r = 0.5), 0.72597 (0.1), 0.20836 (0.01),\n  0.064155 (0.001)",
+          lambda: (stored("text", "r = 0.5", "schlick C_max"), 0.5, stored("text", "r = 0.1", "schlick C_max"), 0.1,
+                   stored("text", "r = 0.01", "schlick C_max"), 0.01,
+                   stored("text", "r = 0.001", "schlick C_max"), 0.001)),
+    Quote("docs/notes_on_published_tables.md", "1.1747 at 89.995 deg and 2.6236 at 89.999 deg",
+          lambda: (stored("text", "89.995", "ward m=0.1 a(theta)"), 89.995,
+                   stored("text", "89.999", "ward m=0.1 a(theta)"), 89.999)),
+    Quote("docs/notes_on_published_tables.md", "**The overshoot of stretched Phong n = 1 (000 sec. 2.2)**: 0.00029 "
+          "at 12.9 deg", lambda: (1, 0, 2.2, stored("text", "n = 1", "stretched_phong overshoot"),
+                                  stored("text", "n = 1", "stretched_phong overshoot angle [deg]"))),
     # the user guide
     Quote("docs/user-guide/albedo.md", "max S = 1.0858 at n = 0",
           lambda: (_plastic_max_s(), 0)),
