@@ -157,6 +157,18 @@ def noise(*keys):
     return v
 
 
+def _scene_names() -> list[str]:
+    from pumpup.scenes import SCENES
+
+    return [n for n in SCENES if n in _scenes()]
+
+
+def _fig8_rate() -> float:
+    """Samples per second of the last 000-fig8 render of ``make_scenes.py`` (both panels, 256 x 256 or as run)."""
+    e = _scenes()["000-fig8"]
+    return e["size"] ** 2 * e["spp"] * len(e["panels"]) / sum(e["seconds"])
+
+
 def _script(name: str):
     """A module of ``scripts/make/`` (not a package), imported by path."""
     path = os.path.join(ROOT, "scripts", "make", f"{name}.py")
@@ -257,7 +269,7 @@ VALUES: dict[str, Value] = {
     "blinn-g2-3-over-c": Value(lambda: pumping_figures("mirror_radiance", model="blinn", g="g2", level=3)
                                / _open("pumping_figures.nc").attrs["blinn_c"], ".0f"),
     # the path-traced scenes (figures/scenes.json)
-    "fig8-plate": Value(lambda: tuple(scene("000-fig8", p, "plate") for p in _FIG8), ".3f", sep=" against "),
+    "fig8-plate": Value(lambda: tuple(scene("000-fig8", p, "plate") for p in _FIG8[::-1]), ".3f", sep=" against "),
     "fig8-mean": Value(lambda: tuple(scene("000-fig8", p, "mean") for p in _FIG8[::-1]), ".3f", sep=" against "),
     "fig9-mean": Value(lambda: tuple(scene("000-fig9", p, "mean") for p in _PLASTIC[::-1]), ".3f", sep=" against "),
     "fig9-p99": Value(lambda: tuple(scene("000-fig9", p, "p99") for p in _PLASTIC[::-1]), ".3f", sep=" against "),
@@ -273,23 +285,24 @@ VALUES: dict[str, Value] = {
                                                 [1.0, 0.5, 0.1, 0.01])[i]
                                         for (a_s, n), _ in _teapots()
                                         for i in range(4)), ".3f"),
-    "scene-spp": Value(lambda: ", ".join(f"{n} {scene(n, key='spp')}" for n in _scenes()), ""),
+    "scene-spp": Value(lambda: ", ".join(f"{n} {scene(n, key='spp')}" for n in _scene_names()), ""),
     "scene-seconds": Value(lambda: ", ".join(f"{n} {sum(scene(n, key='seconds')):.0f} s (load {scene(n, key='load'):g})"
-                                             for n in _scenes()), ""),
+                                             for n in _scene_names()), ""),
     "scene-fireflies": Value(lambda: ", ".join(
-        f"{n} {sum(p['fireflies'] for p in _scenes()[n]['panels'].values())}" for n in _scenes()), ""),
+        f"{n} {sum(p['fireflies'] for p in _scenes()[n]['panels'].values())}" for n in _scene_names()), ""),
     # the fireflies of 000 Fig. 8 (figures/scene_noise.json)
     "noise-setup": Value(lambda: f"{noise('size')} x {noise('size')} and {noise('passes') * noise('spp')} spp "
                                  f"({noise('passes')} passes of {noise('spp')})", ""),
     "noise-sd-p99": Value(lambda: noise("sample_sd_percentiles", "99"), ".2g"),
     "noise-sd-p999": Value(lambda: noise("sample_sd_percentiles", "99.9"), ".3g"),
-    "noise-spp-needed": Value(lambda: noise("spp_for_0.01_at_p99"), ",.2g"),
-    "noise-hours-per-panel": Value(lambda: noise("spp_for_0.01_at_p99") * 256 ** 2 / noise("samples_per_second")
-                                   / 3600, ".2g"),
-    "noise-rate": Value(lambda: noise("samples_per_second") / 1e6, ".2g"),
+    "noise-spp-needed": Value(lambda: f"{round(noise('spp_for_0.01_at_p99'), -4):,.0f}", ""),
+    "noise-hours-per-panel": Value(lambda: noise("spp_for_0.01_at_p99") * 256 ** 2 / _fig8_rate() / 3600, ".2g"),
+    "noise-rate": Value(lambda: _fig8_rate() / 1e6, ".2g"),
     "noise-run": Value(lambda: f"{noise('seconds'):.0f} s at load {noise('load'):.1f}", ""),
-    "noise-by-spp": Value(lambda: ", ".join(f"{c} at {n} spp" for n, c in noise("fireflies_by_spp").items()), ""),
-    "noise-variants": Value(lambda: ", ".join(f"{c} {how}" for how, c in noise("fireflies_128_64spp").items()), ""),
+    "noise-by-spp": Value(lambda: ", ".join(f"{c} at {n} spp" for n, c in sorted(
+        noise("fireflies_by_spp").items(), key=lambda item: int(item[0]))), ""),
+    "noise-variants": Value(lambda: ", ".join(f"{noise('fireflies_128_64spp', how)} {how}"
+                                              for how in ("as it is", "without point lights", "Lambert plate")), ""),
     "phong-c": Value(lambda: _open("pumping_figures.nc").attrs["phong_c"], ".2f"),
     "g1-g2-phong": Value(lambda: float(abs(_open("pumping_figures.nc").albedo.sel(model="phong", g="g1")
                                            - _open("pumping_figures.nc").albedo.sel(model="phong", g="g2")).max()),
