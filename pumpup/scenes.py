@@ -353,7 +353,8 @@ def _scene_dict(name, mats, size, spp):
 
 def _revolve(r, y, n_phi):
     """A surface of revolution about +y of the profile (r[k], y[k]), r[0] = r[-1] = 0 (the poles, bottom first):
-    vertices and faces, counter-clockwise seen from outside."""
+    vertices and faces, counter-clockwise seen from outside.
+    """
     phi = np.linspace(0.0, 2.0 * np.pi, n_phi, endpoint=False)
     m = len(r) - 2
     rings = [np.stack([r[k] * np.cos(phi), np.full(n_phi, y[k]), -r[k] * np.sin(phi)], axis=1) for k in range(1, m + 1)]
@@ -371,7 +372,8 @@ def _revolve(r, y, n_phi):
 
 def _tube(path, radius, n_phi):
     """A tube of radius ``radius[k]`` along a curve ``path`` (k, 3) in the x-y plane, open at both ends: vertices and
-    faces, counter-clockwise seen from outside."""
+    faces, counter-clockwise seen from outside.
+    """
     t = np.gradient(path, axis=0)
     t /= np.linalg.norm(t, axis=1, keepdims=True)
     z = np.array([0.0, 0.0, 1.0])

@@ -126,10 +126,9 @@ def _directive(text, titles: bool):
 
 def _table_directive():
     """``pumpup-table NAME``: the Markdown of ``pumpup_numbers.TABLES[NAME]()``, parsed in place."""
+    import pumpup_numbers
     from docutils.statemachine import StringList
     from sphinx.util.docutils import SphinxDirective
-
-    import pumpup_numbers
 
     class Table(SphinxDirective):
         required_arguments = 1
@@ -153,9 +152,8 @@ def _table_directive():
 
 def value_role(name, rawtext, text, lineno, inliner, options=None, content=None):
     """``:pumpup-value:`KEY```: the number ``pumpup_numbers.VALUES[KEY]`` computes, as text."""
-    from docutils import nodes
-
     import pumpup_numbers
+    from docutils import nodes
 
     key = text.strip()
     if key not in pumpup_numbers.VALUES:

@@ -26,8 +26,8 @@ import importlib.util
 import json
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 TABLES_DIR = os.path.join(ROOT, "tables")
@@ -43,6 +43,7 @@ class Value:
     sep: str = ", "
 
     def text(self) -> str:
+        """The value as the page prints it."""
         v = self.compute()
         if isinstance(v, str):
             return v
@@ -55,7 +56,8 @@ class Value:
 class Quote:
     """Numbers typed in ``page`` (a path from the repository root) inside the exact text ``text``; ``compute()``
     returns them in the order they appear (one float or a sequence).  Each must equal the fresh value rounded to
-    its printed digits, within ``rtol`` more when given (for values that depend on a tolerance of the code)."""
+    its printed digits, within ``rtol`` more when given (for values that depend on a tolerance of the code).
+    """
 
     page: str
     text: str
@@ -69,7 +71,7 @@ class Quote:
 # ---------------------------------------------------------------------------------------------------------------
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _open(name: str):
     import xarray as xr
 
@@ -109,7 +111,8 @@ def reproduce_agreement() -> str:
 
 def divergence_k(family: str) -> float:
     """The exponent k of a ~ K mu^-k of every m of ``family`` in ``tables/divergence.nc``, if they agree to 4
-    decimals (else an error: the page quotes one number for all)."""
+    decimals (else an error: the page quotes one number for all).
+    """
     ds = _open("divergence.nc")
     ks = [float(ds.k.sel(model=m)) for m in ds.model.values if str(m).startswith(family + " ")]
     if len({round(k, 4) for k in ks}) != 1:
@@ -118,6 +121,7 @@ def divergence_k(family: str) -> float:
 
 
 def divergence_albedo(model: str, mu: float) -> float:
+    """The albedo of ``model`` at one of the mu of ``tables/divergence.nc`` (written by ``pumpup reproduce``)."""
     ds = _open("divergence.nc")
     i = int(abs(ds.mu.values - mu).argmin())
     if abs(ds.mu.values[i] / mu - 1) > 1e-9:
@@ -126,10 +130,11 @@ def divergence_albedo(model: str, mu: float) -> float:
 
 
 def pumping_figures(var: str, **sel) -> float:
+    """The largest value of ``var`` in ``tables/pumping_figures.nc`` (``scripts/make/pumping_figures.py``) at sel."""
     return float(_open("pumping_figures.nc")[var].sel(**sel).max())
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _scenes() -> dict:
     with open(os.path.join(ROOT, "figures", "scenes.json")) as fh:
         return json.load(fh)
@@ -138,12 +143,13 @@ def _scenes() -> dict:
 def scene(name: str, panel: str | None = None, key: str = "mean"):
     """A statistic of a path-traced scene that ``scripts/make/make_scenes.py`` wrote to ``figures/scenes.json``:
     ``key`` of ``panel`` (mean, p99, plate: linear sRGB luminance; fireflies: a count), or of the scene (spp,
-    seconds, load) when ``panel`` is None."""
+    seconds, load) when ``panel`` is None.
+    """
     entry = _scenes()[name]
     return entry[key] if panel is None else entry["panels"][panel][key]
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _noise() -> dict:
     with open(os.path.join(ROOT, "figures", "scene_noise.json")) as fh:
         return json.load(fh)
@@ -186,7 +192,7 @@ FITTING_FILES = ("fitting_study.json", "fitting_study_pumped.json", "fitting_stu
                  "fitting_study_mu026.json")
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def fitting_records() -> tuple:
     """Every record of the fitting study (``scripts/make/fitting_study.py`` writes them), as dicts."""
     out = []
@@ -352,6 +358,8 @@ QUOTES: list[Quote] = [
           lambda: (16, stored("table2", "16", "blinn"))),
     Quote("docs/user-guide/albedo.md", "# 0.1865 and 0.2782",
           lambda: _albedo({"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, 0.2, phi=[0.0, math.pi / 2]), slow=True),
+    Quote("README.md", "| nodes right to 9.7e-7; the look-up errs by up to 0.102 near grazing |",
+          lambda: (_cycles_audit().max_abs, _cycles_audit().lookup["max_abs"]), slow=True),
     # the notes on the published tables (tables/table2-4.nc and text.nc, written by pumpup reproduce)
     *[Quote("docs/notes_on_published_tables.md", f"| {m} | {pub} | {val}",
             lambda m=m: (float(m), published("table4", m, "modified_ward"), stored("table4", m, "modified_ward")))
@@ -408,9 +416,18 @@ QUOTES: list[Quote] = [
 ]
 
 
+@functools.cache
+def _cycles_audit():
+    """``pumpup audit tests/data/cycles_shader.tables --preset cycles`` (the README's row on Blender Cycles)."""
+    import pumpup
+
+    return pumpup.audit(os.path.join(ROOT, "tests", "data", "cycles_shader.tables"), preset="cycles")
+
+
 def _plastic_max_s() -> float:
     """The largest albedo of plastic's specular lobe (a_s = 1, F = 1) at n = 0, over mu, as the model computes it
-    (the upper end of its error estimate)."""
+    (the upper end of its error estimate).
+    """
     from pumpup.models.metal import _plastic_max_s as max_s
 
     return max_s(0.0, None)
@@ -419,7 +436,8 @@ def _plastic_max_s() -> float:
 def _eq22_row(level: int):
     """One row of the 001 eq. 22 comparison (``pumpup.figures.eq22_convergence``, which
     ``scripts/make/pumping_figures.py`` prints): max and median relative BRDF difference and max albedo difference
-    of g2-pumped Phong n = 20 at ``level`` against stretched Phong."""
+    of g2-pumped Phong n = 20 at ``level`` against stretched Phong.
+    """
     from pumpup.figures import eq22_convergence
 
     r = eq22_convergence(levels=level)[level]

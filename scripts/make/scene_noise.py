@@ -24,9 +24,9 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspa
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import numpy as np  # noqa: E402
+from make_scenes import LUMINANCE, fireflies  # noqa: E402
 
 import pumpup.scenes as S  # noqa: E402
-from make_scenes import LUMINANCE, fireflies  # noqa: E402
 from pumpup.tables import atomic_path  # noqa: E402
 
 
@@ -37,6 +37,7 @@ def _render(d, seed=0):
 
 
 def main(argv=None) -> int:
+    """Measure, print and write ``scene_noise.json``; returns the exit status."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scene", default="000-fig8", choices=sorted(S.SCENES))
     ap.add_argument("--size", type=int, default=64)
