@@ -228,11 +228,36 @@ def compensation_metalness() -> str:
     return _script("compensation_study").metal_markdown(_open("compensation.nc"))
 
 
+def sampling_table() -> str:
+    """Variance / albedo^2 of the Phong-lobe estimator, Phong / stretched Phong (``tables/sampling_efficiency.nc``,
+    ``scripts/make/sampling_efficiency.py``), at n = 1, 20, 1000 and six incidence angles."""
+    import numpy as np
+
+    ds = _open("sampling_efficiency.nc")
+    cols = [(f"{t:g} deg", float(np.cos(np.radians(t)))) for t in (0, 30, 60, 80, 89)] + [("mu = 1e-8", 1e-8)]
+    idx = [int(abs(ds.mu.values - mu).argmin()) for _, mu in cols]
+    for (name, mu), i in zip(cols, idx):
+        if abs(ds.mu.values[i] - mu) > 1e-9 * max(mu, 1e-8) + 1e-12:
+            raise KeyError(f"tables/sampling_efficiency.nc has no {name}")
+
+    def cell(x: float) -> str:
+        return f"{x:.1e}".replace("e-0", "e-") if x < 1e-2 else f"{x:.3g}"
+
+    rv = ds.relative_variance
+    lines = ["| n | " + " | ".join(c for c, _ in cols) + " |", "|---|" + "---|" * len(cols)]
+    for n in (1.0, 20.0, 1000.0):
+        cells = [cell(float(rv.sel(model="phong", n=n).isel(mu=i))) + " / "
+                 + cell(float(rv.sel(model="stretched_phong", n=n).isel(mu=i))) for i in idx]
+        lines.append(f"| {n:g} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 #: generated tables: name -> function returning Markdown
 TABLES: dict[str, Callable[[], str]] = {
     "fitting-study": fitting_tables,
     "compensation-study": compensation_table,
     "compensation-metalness": compensation_metalness,
+    "sampling-efficiency": sampling_table,
 }
 
 
@@ -386,6 +411,28 @@ QUOTES: list[Quote] = [
     # the user guide
     Quote("docs/user-guide/albedo.md", "max S = 1.0858 at n = 0",
           lambda: (_plastic_max_s(), 0)),
+    # the exact images (docs/user-guide/images.md): the white furnace at 160 x 160, as scripts/make/make_images.py
+    # draws it (pumpup.plots.furnace_grid's models)
+    Quote("docs/user-guide/images.md", "the disc (0.806, near theta = 72 deg)",
+          lambda: (_furnace_min({"type": "ggx", "alpha": 0.3}), _ggx_darkest_theta()), slow=True),
+    Quote("docs/user-guide/images.md", "bright in the middle (1.0000 and 0.9999) and dark\nat the rim (0.10 and 0.06 at "
+          "the outermost pixel, mu_V = 0.029 at 160 x 160)",
+          lambda: (_furnace_centre({"type": "phong", "n": 20}), _furnace_centre(_blinn()),
+                   _furnace_min({"type": "phong", "n": 20}), _furnace_min(_blinn()), _rim_mu(160), 160, 160),
+          slow=True),
+    Quote("docs/user-guide/images.md", "(Phong 0.42, 0.66, 0.79 after one to three levels, Blinn\n0.18 and 0.48 after "
+          "one and three g1 levels)",
+          lambda: (*(_furnace_min(_pumped({"type": "phong", "n": 20}, "g1", k)) for k in (1, 2, 3)),
+                   *(_furnace_min(_pumped(_blinn(), "g1", k)) for k in (1, 3)), 1), slow=True),
+    Quote("docs/user-guide/images.md", "rim less (0.12: the price of control, 001 sec. 3.2), but three reach 0.51",
+          lambda: (_furnace_min(_pumped(_blinn(), "g2", 1)), 1, 3.2, _furnace_min(_pumped(_blinn(), "g2", 3))),
+          slow=True),
+    Quote("docs/user-guide/images.md", "stretched Phong reaches 0.55 at n = 20 and 0.81 at\nn = 5000",
+          lambda: (_furnace_min({"type": "stretched_phong", "n": 20}), 20,
+                   _furnace_min({"type": "stretched_phong", "n": 5000}), 5000), slow=True),
+    Quote("docs/user-guide/images.md", "(alpha = 0.3) and Cook-Torrance (m = 0.3) lose energy to shadowing (0.88 and "
+          "0.996 at the\ncentre)", lambda: (0.3, 0.3, _furnace_centre({"type": "ggx", "alpha": 0.3}),
+                                            _furnace_centre({"type": "cook_torrance", "m": 0.3})), slow=True),
     # the fitting study: prose read from tables/fitting_study*.json
     Quote("docs/user-guide/fitting.md", "(n = 48, c = 5.2)",
           lambda: (_fit("ggx a=0.1 F=1", "stretched_phong")["params"]["n"],
@@ -411,8 +458,12 @@ QUOTES: list[Quote] = [
     Quote("docs/user-guide/compensation.md", "1.6e-5 for Blinn n = 100",
           lambda: (_comp("blinn n=100", "scale", "furnace_residual"), 100)),
     # the papers
-    Quote("docs/studies/papers.md", "| 1 | 0.67 | 3.2e-7 | 0.11 |",
-          lambda: (1, *_eq22_row(1)), slow=True),
+    *[Quote("docs/studies/papers.md", row, lambda level=level: (level, *_eq22_row(level)), slow=True)
+      for level, row in enumerate(("| 0 (Phong) | 0.97 | 0.21 | 0.48 |", "| 1 | 0.67 | 3.1e-7 | 0.11 |",
+                                   "| 2 | 0.36 | 0.048 | 0.19 |", "| 3 | 0.61 | 0.057 | 0.28 |",
+                                   "| 4 | 0.78 | 0.058 | 0.33 |", "| 5 | 0.91 | 0.058 | 0.36 |"))],
+    Quote("docs/studies/he-torrance.md", "# its share: 0.0054, 0.27, 0.82",
+          lambda: _he_torrance().specular_weight([1.0, 0.5, 0.17])),
 ]
 
 
@@ -433,12 +484,66 @@ def _plastic_max_s() -> float:
     return max_s(0.0, None)
 
 
+@functools.cache
+def _furnace(spec_json: str):
+    from pumpup import render
+
+    return render.furnace(json.loads(spec_json), 160)
+
+
+def _furnace_min(spec) -> float:
+    im = _furnace(json.dumps(spec, sort_keys=True))
+    return float(im.radiance[im.mask].min())
+
+
+def _furnace_centre(spec) -> float:
+    return float(_furnace(json.dumps(spec, sort_keys=True)).radiance[80, 80])
+
+
+def _rim_mu(size: int) -> float:
+    """mu_V of the outermost pixel centre inside the unit disc of a size x size image of [-1, 1]^2."""
+    import numpy as np
+
+    x = (np.arange(size) + 0.5) / size * 2 - 1
+    r2 = x[:, None] ** 2 + x[None, :] ** 2
+    return float(np.sqrt(1 - r2[r2 < 1].max()))
+
+
+def _ggx_darkest_theta() -> float:
+    """The angle of the smallest albedo of GGX alpha = 0.3 (a grid of 0.1 degrees)."""
+    import numpy as np
+
+    theta = np.arange(0.0, 90.0, 0.1)
+    return float(theta[int(np.argmin(_albedo({"type": "ggx", "alpha": 0.3}, np.cos(np.radians(theta)))))])
+
+
+def _blinn() -> dict:
+    from pumpup.plots import _blinn_spec
+
+    return _blinn_spec()
+
+
+def _pumped(base, g, levels) -> dict:
+    return {"type": "pumped", "base": base, "g": g, "levels": levels}
+
+
+def _he_torrance():
+    import pumpup
+
+    return pumpup.load({"type": "he_torrance", "sigma_0": 0.1, "tau": 1.7, "wavelength": 0.55})
+
+
+@functools.cache
+def _eq22():
+    from pumpup.figures import eq22_convergence
+
+    return eq22_convergence(levels=5)
+
+
 def _eq22_row(level: int):
     """One row of the 001 eq. 22 comparison (``pumpup.figures.eq22_convergence``, which
     ``scripts/make/pumping_figures.py`` prints): max and median relative BRDF difference and max albedo difference
     of g2-pumped Phong n = 20 at ``level`` against stretched Phong.
     """
-    from pumpup.figures import eq22_convergence
-
-    r = eq22_convergence(levels=level)[level]
+    r = _eq22()[level]
     return r["max_rel_brdf_diff"], r["median_rel_brdf_diff"], r["max_albedo_diff"]
