@@ -230,7 +230,8 @@ def compensation_metalness() -> str:
 
 def sampling_table() -> str:
     """Variance / albedo^2 of the Phong-lobe estimator, Phong / stretched Phong (``tables/sampling_efficiency.nc``,
-    ``scripts/make/sampling_efficiency.py``), at n = 1, 20, 1000 and six incidence angles."""
+    ``scripts/make/sampling_efficiency.py``), at n = 1, 20, 1000 and six incidence angles.
+    """
     import numpy as np
 
     ds = _open("sampling_efficiency.nc")
@@ -415,8 +416,8 @@ QUOTES: list[Quote] = [
     # draws it (pumpup.plots.furnace_grid's models)
     Quote("docs/user-guide/images.md", "the disc (0.806, near theta = 72 deg)",
           lambda: (_furnace_min({"type": "ggx", "alpha": 0.3}), _ggx_darkest_theta()), slow=True),
-    Quote("docs/user-guide/images.md", "bright in the middle (1.0000 and 0.9999) and dark\nat the rim (0.10 and 0.06 at "
-          "the outermost pixel, mu_V = 0.029 at 160 x 160)",
+    Quote("docs/user-guide/images.md", "bright in the middle (1.0000 and 0.9999) and dark\n"
+          "at the rim (0.10 and 0.06 at the outermost pixel, mu_V = 0.029 at 160 x 160)",
           lambda: (_furnace_centre({"type": "phong", "n": 20}), _furnace_centre(_blinn()),
                    _furnace_min({"type": "phong", "n": 20}), _furnace_min(_blinn()), _rim_mu(160), 160, 160),
           slow=True),
