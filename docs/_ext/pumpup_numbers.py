@@ -414,7 +414,7 @@ QUOTES: list[Quote] = [
           lambda: (_plastic_max_s(), 0)),
     # the exact images (docs/user-guide/images.md): the white furnace at 160 x 160, as scripts/make/make_images.py
     # draws it (pumpup.plots.furnace_grid's models)
-    Quote("docs/user-guide/images.md", "the disc (0.806, near theta = 72 deg)",
+    Quote("docs/user-guide/images.md", "the disc (0.806, near theta = 71 deg)",
           lambda: (_furnace_min({"type": "ggx", "alpha": 0.3}), _ggx_darkest_theta()), slow=True),
     Quote("docs/user-guide/images.md", "bright in the middle (1.0000 and 0.9999) and dark\n"
           "at the rim (0.10 and 0.06 at the outermost pixel, mu_V = 0.029 at 160 x 160)",
@@ -424,7 +424,7 @@ QUOTES: list[Quote] = [
     Quote("docs/user-guide/images.md", "(Phong 0.42, 0.66, 0.79 after one to three levels, Blinn\n0.18 and 0.48 after "
           "one and three g1 levels)",
           lambda: (*(_furnace_min(_pumped({"type": "phong", "n": 20}, "g1", k)) for k in (1, 2, 3)),
-                   *(_furnace_min(_pumped(_blinn(), "g1", k)) for k in (1, 3)), 1), slow=True),
+                   *(_furnace_min(_pumped(_blinn(), "g1", k)) for k in (1, 3))), slow=True),
     Quote("docs/user-guide/images.md", "rim less (0.12: the price of control, 001 sec. 3.2), but three reach 0.51",
           lambda: (_furnace_min(_pumped(_blinn(), "g2", 1)), 1, 3.2, _furnace_min(_pumped(_blinn(), "g2", 3))),
           slow=True),
