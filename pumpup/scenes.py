@@ -535,8 +535,11 @@ def write_scene(name, rows, out_dir, *, exposure=0.0, variant="", spp=0, exr=Tru
                     f.write(tmp)
             paths.append(p)
     n_rows, n_cols = len(rows), max(len(r) for r in rows)
-    fig = Figure(figsize=(3.2 * n_cols, 3.2 * n_rows + 0.5))
-    axes = fig.subplots(n_rows, n_cols, squeeze=False)
+    height = 3.5 * n_rows + 0.75  # inches: each panel 3.2 and its title 0.3, the suptitle and the footer
+    fig = Figure(figsize=(3.2 * n_cols, height))
+    axes = fig.subplots(n_rows, n_cols, squeeze=False, gridspec_kw={
+        "left": 0.02, "right": 0.98, "bottom": 0.3 / height, "top": 1 - 0.75 / height, "wspace": 0.06,
+        "hspace": 0.3 / 3.2})  # hspace: a fraction of a panel's height, room for the title of the row below
     for i, row in enumerate(rows):
         for j, (label, img) in enumerate(row):
             ax = axes[i][j]
@@ -547,7 +550,6 @@ def write_scene(name, rows, out_dir, *, exposure=0.0, variant="", spp=0, exr=Tru
     fig.suptitle(SCENES[name], fontsize=7.5)
     fig.text(0.5, 0.005, f"Mitsuba 3 {variant}, {spp} spp; tone map: radiance x 2^{exposure:g}, sRGB transfer, "
              "clipped at 1", ha="center", va="bottom", fontsize=6.5)
-    fig.tight_layout(rect=(0, 0.03, 1, 0.95))
     p = os.path.join(out_dir, f"{name}.png")
     with _atomic(p) as tmp:
         fig.savefig(tmp, dpi=100, format="png")
