@@ -448,6 +448,22 @@ QUOTES: list[Quote] = [
     Quote("docs/user-guide/images.md", "(alpha = 0.3) and Cook-Torrance (m = 0.3) lose energy to shadowing (0.88 and "
           "0.996 at the\ncentre)", lambda: (0.3, 0.3, _furnace_centre({"type": "ggx", "alpha": 0.3}),
                                             _furnace_centre({"type": "cook_torrance", "m": 0.3})), slow=True),
+    # the pumped spheres of docs/user-guide/images.md: peak radiance at 160 x 160, as pumpup.plots draws them
+    Quote("docs/user-guide/images.md", "Phong's highlight fades from 3.49 to 0.95 at Phi_L = 150",
+          lambda: (_peak(_PHONG, 0), _peak(_PHONG, 150), 150), slow=True),
+    Quote("docs/user-guide/images.md", "stretched Phong keeps it between 3.48 and 3.50 at every angle",
+          lambda: (min(_peak(_STRETCHED, a) for a in _LIGHTS), max(_peak(_STRETCHED, a) for a in _LIGHTS)),
+          slow=True),
+    Quote("docs/user-guide/images.md", "one pumping nearly so (3.35), and further levels overshoot (4.92 after three",
+          lambda: (_peak(_pumped(_PHONG, "g1", 1), 150), _peak(_pumped(_PHONG, "g1", 3), 150)), slow=True),
+    Quote("docs/user-guide/images.md", "Blinn n = 20 at its maximum constant c = 1.0504: its highlight fades to 0.34 at "
+          "Phi_L = 150", lambda: (20, _blinn()["c"], _peak(_blinn(), 150), 150), slow=True),
+    Quote("docs/user-guide/images.md", "(1.77, 4.18, 5.99 after one, two, three",
+          lambda: tuple(_peak(_pumped(_blinn(), "g1", k), 150) for k in (1, 2, 3)), slow=True),
+    Quote("docs/user-guide/images.md", "highlight at 1.05 = c, as 001 eq. 21",
+          lambda: (max(_peak(_pumped(_blinn(), "g2", 1), a) for a in _LIGHTS), 1, 21), slow=True),
+    Quote("docs/user-guide/images.md", "(3.59 and 5.90 after two and three",
+          lambda: tuple(_peak(_pumped(_blinn(), "g2", k), 150) for k in (2, 3)), slow=True),
     # the fitting study: prose read from tables/fitting_study*.json
     Quote("docs/user-guide/fitting.md", "(n = 48, c = 5.2)",
           lambda: (_fit("ggx a=0.1 F=1", "stretched_phong")["params"]["n"],
@@ -515,6 +531,18 @@ def _furnace_centre(spec) -> float:
     return float(_furnace(json.dumps(spec, sort_keys=True)).radiance[80, 80])
 
 
+_PHONG = {"type": "phong", "n": 20}
+_STRETCHED = {"type": "stretched_phong", "n": 20}
+_LIGHTS = (0.0, 60.0, 110.0, 130.0, 150.0)  # pumpup.plots.GRAZING
+
+
+def _peak(spec, phi) -> float:
+    """The brightest pixel of a 160 x 160 sphere under a light of irradiance 1 at Phi_L = ``phi`` degrees."""
+    from pumpup import render
+
+    return float(render.sphere(spec, phi, 160, irradiance=1.0).radiance.max())
+
+
 def _rim_mu(size: int) -> float:
     """mu_V of the outermost pixel centre inside the unit disc of a size x size image of [-1, 1]^2."""
     import numpy as np
@@ -532,10 +560,16 @@ def _ggx_darkest_theta() -> float:
     return float(theta[int(np.argmin(_albedo({"type": "ggx", "alpha": 0.3}, np.cos(np.radians(theta)))))])
 
 
-def _blinn() -> dict:
+@functools.cache
+def _blinn_c() -> float:
     from pumpup.plots import _blinn_spec
 
-    return _blinn_spec()
+    return _blinn_spec()["c"]
+
+
+def _blinn() -> dict:
+    """Blinn n = 20 at its maximum constant, as ``pumpup.plots`` draws it."""
+    return {"type": "blinn", "n": 20, "c": _blinn_c()}
 
 
 def _pumped(base, g, levels) -> dict:
