@@ -456,8 +456,8 @@ QUOTES: list[Quote] = [
           slow=True),
     Quote("docs/user-guide/images.md", "one pumping nearly so (3.35), and further levels overshoot (4.92 after three",
           lambda: (_peak(_pumped(_PHONG, "g1", 1), 150), _peak(_pumped(_PHONG, "g1", 3), 150)), slow=True),
-    Quote("docs/user-guide/images.md", "Blinn n = 20 at its maximum constant c = 1.0504: its highlight fades to 0.34 at "
-          "Phi_L = 150", lambda: (20, _blinn()["c"], _peak(_blinn(), 150), 150), slow=True),
+    Quote("docs/user-guide/images.md", "Blinn n = 20 at its maximum constant c = 1.0504: its highlight fades to "
+          "0.34 at Phi_L = 150", lambda: (20, _blinn()["c"], _peak(_blinn(), 150), 150), slow=True),
     Quote("docs/user-guide/images.md", "(1.77, 4.18, 5.99 after one, two, three",
           lambda: tuple(_peak(_pumped(_blinn(), "g1", k), 150) for k in (1, 2, 3)), slow=True),
     Quote("docs/user-guide/images.md", "highlight at 1.05 = c, as 001 eq. 21",
