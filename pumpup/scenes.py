@@ -18,6 +18,12 @@ model and with its stretched or pumped version, side by side:
     Phong (top) against Phong pumped up once (bottom), n = 20 (left) and n = 5000 (right), both times the
     measured metal's F(Theta_min) per RGB channel (the pumped one keeps the colour).  Here
     a gold cube with four small cubes (turned 45 degrees) on a grey Lambert plate.
+``000-fig10``
+    000 Fig. 10: "two ceramic teapots. Again, the diffuse component is dominant, the n exponents are 100
+    and 20" (000 eq. 30, as Fig. 9).  The paper prints no a_s: here a_s = 0.04, the normal-incidence
+    reflectance of a glaze of refractive index 1.5.  The teapots are built here (:func:`teapot_mesh`: a
+    body of revolution, a knob, a spout and a handle), not Newell's patches.  Original: Lambert + a_s x
+    reciprocal Phong; new: 000 eq. 30, on Fig. 9's plastic plate.
 
 Metals: measured gold, silver, copper and aluminium (:mod:`pumpup.spectral.optical`: Johnson & Christy 1972
 for Au, Ag, Cu; Rakic 1995 for Al), one complex index n + i k per RGB channel, the measured one at
@@ -60,7 +66,7 @@ import time
 import numpy as np
 
 __all__ = ["SCENES", "F0", "METALS", "metal_index", "check_scene", "panels", "render_scene", "render_panel",
-           "write_scene"]
+           "write_scene", "teapot_mesh", "TEAPOTS"]
 
 #: normal-incidence reflectance of metals, linear RGB (Hoffman 2010 / Real-Time Rendering 3rd ed., Table 7.3);
 #: the scenes used it before the measured metals (:data:`METALS`); kept for comparison only
@@ -78,6 +84,8 @@ SCENES = {
                 "Lambert + Phong lobe | 000 eq. 30",
     "001-fig8": "001 Fig. 8: gold cube with aluminium, silver, copper, gold cubes; reciprocal Phong | pumped once, "
                 "n = 20 and 5000",
+    "000-fig10": "000 Fig. 10: ceramic teapots, n = 100 (left) and 20 (right), a_s = 0.04; "
+                 "Lambert + a_s Phong | 000 eq. 30",
 }
 
 #: the plastic spheres of 000 Fig. 9: (a_s, n) and a diffuse colour of one hue (orange), different lightness
@@ -87,6 +95,14 @@ PLASTICS = [
     ((0.065, 64.0), (0.60, 0.40, 0.25)),
     ((0.09, 9.0), (0.45, 0.22, 0.05)),
     ((0.13, 3.0), (0.75, 0.55, 0.38)),
+]
+
+
+#: the ceramic teapots of 000 Fig. 10: (a_s, n) and a diffuse glaze colour, max(r, g, b) <= 1 - a_s (000 after
+#: eq. 30); the paper gives n = 100 and 20 and no a_s (0.04: the Fresnel reflectance of index 1.5 at normal incidence)
+TEAPOTS = [
+    ((0.04, 100.0), (0.82, 0.78, 0.68)),
+    ((0.04, 20.0), (0.18, 0.32, 0.66)),
 ]
 
 
@@ -163,6 +179,13 @@ def panels(name) -> list:
         out = []
         for kind, lab in (("phong", "Lambert + a_s Phong (000 eq. 5)"), ("stretched", "plastic, 000 eq. 30")):
             mats = {f"s{i}": plastic(rgb, a_s, n, kind) for i, ((a_s, n), rgb) in enumerate(PLASTICS)}
+            mats["plate"] = plastic((0.45, 0.45, 0.50), 0.04, 20.0, kind)
+            out.append((lab, mats))
+        return [out]
+    if name == "000-fig10":
+        out = []
+        for kind, lab in (("phong", "Lambert + a_s Phong (000 eq. 5)"), ("stretched", "plastic, 000 eq. 30")):
+            mats = {f"t{i}": plastic(rgb, a_s, n, kind) for i, ((a_s, n), rgb) in enumerate(TEAPOTS)}
             mats["plate"] = plastic((0.45, 0.45, 0.50), 0.04, 20.0, kind)
             out.append((lab, mats))
         return [out]
@@ -313,6 +336,11 @@ def _scene_dict(name, mats, size, spp):
         d["head"] = sphere(mats["head"], -0.9, -0.3, 0.75)
         d["sphere"] = sphere(mats["sphere"], 1.3, 0.9, 0.45)
         d["cube"] = cube(mats["cube"], 0.5, -1.3, 0.42, 30)
+    elif name == "000-fig10":
+        path = _teapot_ply()
+        for i, (x, z, turn) in enumerate(((-1.05, -0.7, -25.0), (0.95, 0.75, -150.0))):
+            d[f"t{i}"] = {"type": "ply", "filename": path, "bsdf": _bsdf(mats[f"t{i}"]),
+                          "to_world": T().translate([x, 0.0, z]) @ T().rotate([0, 1, 0], turn) @ T().scale(0.68)}
     elif name == "000-fig9":
         for i in range(4):
             d[f"s{i}"] = sphere(mats[f"s{i}"], -1.5 + 1.0 * i, 0.4 * (i % 2), 0.45)
@@ -321,6 +349,97 @@ def _scene_dict(name, mats, size, spp):
         for i, (x, z) in enumerate(((-1.45, 0.9), (-0.5, 1.5), (0.5, 1.5), (1.45, 0.9))):
             d[f"p{i}"] = cube(mats[f"p{i}"], x, z, 0.3, 45)
     return d
+
+
+def _revolve(r, y, n_phi):
+    """A surface of revolution about +y of the profile (r[k], y[k]), r[0] = r[-1] = 0 (the poles, bottom first):
+    vertices and faces, counter-clockwise seen from outside.
+    """
+    phi = np.linspace(0.0, 2.0 * np.pi, n_phi, endpoint=False)
+    m = len(r) - 2
+    rings = [np.stack([r[k] * np.cos(phi), np.full(n_phi, y[k]), -r[k] * np.sin(phi)], axis=1) for k in range(1, m + 1)]
+    v = np.concatenate([[[0.0, y[0], 0.0]], *rings, [[0.0, y[-1], 0.0]]])
+    i = np.arange(n_phi)
+    j = (i + 1) % n_phi
+    f = [np.stack([np.zeros(n_phi, int), 1 + j, 1 + i], axis=1)]
+    for k in range(m - 1):
+        a, b = 1 + k * n_phi + i, 1 + k * n_phi + j
+        f += [np.stack([a, b, b + n_phi], axis=1), np.stack([a, b + n_phi, a + n_phi], axis=1)]
+    a, b = 1 + (m - 1) * n_phi + i, 1 + (m - 1) * n_phi + j
+    f.append(np.stack([a, b, np.full(n_phi, 1 + m * n_phi)], axis=1))
+    return v, np.concatenate(f)
+
+
+def _tube(path, radius, n_phi):
+    """A tube of radius ``radius[k]`` along a curve ``path`` (k, 3) in the x-y plane, open at both ends: vertices and
+    faces, counter-clockwise seen from outside.
+    """
+    t = np.gradient(path, axis=0)
+    t /= np.linalg.norm(t, axis=1, keepdims=True)
+    z = np.array([0.0, 0.0, 1.0])
+    nrm = np.cross(t, z)
+    phi = np.linspace(0.0, 2.0 * np.pi, n_phi, endpoint=False)
+    v = path[:, None, :] + radius[:, None, None] * (np.cos(phi)[None, :, None] * nrm[:, None, :]
+                                                    + np.sin(phi)[None, :, None] * z)
+    i = np.arange(n_phi)
+    j = (i + 1) % n_phi
+    f = []
+    for k in range(len(path) - 1):
+        a, b = k * n_phi + i, k * n_phi + j
+        f += [np.stack([a, b + n_phi, b], axis=1), np.stack([a, a + n_phi, b + n_phi], axis=1)]
+    return v.reshape(-1, 3), np.concatenate(f)
+
+
+def teapot_mesh(n=48) -> tuple[np.ndarray, np.ndarray]:
+    """A teapot as a triangle mesh: (vertices (V, 3), faces (F, 3) counter-clockwise seen from outside).
+
+    Standing on y = 0, 1.48 high, the spout towards +x: a body of revolution (a superellipse profile, radius 1), a
+    knob, a spout (a tapering tube along a quadratic Bezier curve) and a handle (a tube along an arc).  The parts
+    interpenetrate; a path tracer needs no more.  ``n`` sets the tessellation.
+    """
+    s = np.linspace(0.0, np.pi, n)
+    e = 2.6  # superellipse exponent: a round pot with a broad base
+    r_body = np.abs(np.sin(s)) ** (2 / e)
+    cs = np.cos(s)
+    y_body = 0.62 * (1.0 + np.sign(cs) * np.abs(cs) ** (2 / e))[::-1]  # bottom pole first
+    u = np.linspace(0.0, np.pi, max(n // 2, 4))
+    t = np.linspace(0.0, 1.0, n)
+    p0, p1, p2 = np.array([0.75, 0.45, 0.0]), np.array([1.35, 0.55, 0.0]), np.array([1.55, 1.15, 0.0])
+    spout = ((1 - t) ** 2)[:, None] * p0 + (2 * t * (1 - t))[:, None] * p1 + (t ** 2)[:, None] * p2
+    a = np.linspace(-0.55 * np.pi, 0.55 * np.pi, n)
+    handle = np.stack([-0.92 - 0.42 * np.cos(a), 0.68 + 0.36 * np.sin(a), np.zeros_like(a)], axis=1)
+    parts = [_revolve(r_body, y_body, 2 * n),
+             _revolve(0.13 * np.sin(u), 1.22 + 0.13 * (1.0 - np.cos(u)), n),  # the knob
+             _tube(spout, 0.20 - 0.11 * t, max(n // 2, 4)),
+             _tube(handle, np.full(n, 0.075), max(n // 3, 4))]
+    vs, fs, off = [], [], 0
+    for v, f in parts:
+        vs.append(v)
+        fs.append(f + off)
+        off += len(v)
+    return np.concatenate(vs), np.concatenate(fs).astype(np.int64)
+
+
+_PLY: dict = {}
+
+
+def _teapot_ply() -> str:
+    """:func:`teapot_mesh` as a binary PLY file in a temporary folder (written once per process)."""
+    if "path" not in _PLY or not os.path.exists(_PLY["path"]):
+        import tempfile
+
+        v, f = teapot_mesh()
+        head = (f"ply\nformat binary_little_endian 1.0\nelement vertex {len(v)}\nproperty float x\n"
+                f"property float y\nproperty float z\nelement face {len(f)}\n"
+                "property list uchar int vertex_indices\nend_header\n").encode()
+        faces = np.zeros(len(f), dtype=[("n", "u1"), ("i", "<i4", (3,))])
+        faces["n"] = 3
+        faces["i"] = f
+        path = os.path.join(tempfile.mkdtemp(prefix="pumpup-teapot-"), "teapot.ply")
+        with open(path, "wb") as fh:
+            fh.write(head + v.astype("<f4").tobytes() + faces.tobytes())
+        _PLY["path"] = path
+    return _PLY["path"]
 
 
 def check_args(name, spp, size, variant):
@@ -416,8 +535,11 @@ def write_scene(name, rows, out_dir, *, exposure=0.0, variant="", spp=0, exr=Tru
                     f.write(tmp)
             paths.append(p)
     n_rows, n_cols = len(rows), max(len(r) for r in rows)
-    fig = Figure(figsize=(3.2 * n_cols, 3.2 * n_rows + 0.5))
-    axes = fig.subplots(n_rows, n_cols, squeeze=False)
+    height = 3.5 * n_rows + 0.75  # inches: each panel 3.2 and its title 0.3, the suptitle and the footer
+    fig = Figure(figsize=(3.2 * n_cols, height))
+    axes = fig.subplots(n_rows, n_cols, squeeze=False, gridspec_kw={
+        "left": 0.02, "right": 0.98, "bottom": 0.3 / height, "top": 1 - 0.75 / height, "wspace": 0.06,
+        "hspace": 0.3 / 3.2})  # hspace: a fraction of a panel's height, room for the title of the row below
     for i, row in enumerate(rows):
         for j, (label, img) in enumerate(row):
             ax = axes[i][j]
@@ -428,7 +550,6 @@ def write_scene(name, rows, out_dir, *, exposure=0.0, variant="", spp=0, exr=Tru
     fig.suptitle(SCENES[name], fontsize=7.5)
     fig.text(0.5, 0.005, f"Mitsuba 3 {variant}, {spp} spp; tone map: radiance x 2^{exposure:g}, sRGB transfer, "
              "clipped at 1", ha="center", va="bottom", fontsize=6.5)
-    fig.tight_layout(rect=(0, 0.03, 1, 0.95))
     p = os.path.join(out_dir, f"{name}.png")
     with _atomic(p) as tmp:
         fig.savefig(tmp, dpi=100, format="png")

@@ -7,6 +7,10 @@
     the albedo engine's routing table, :func:`pumpup.engine.routes.describe`.
 ``.. pumpup-models::``
     the registered model types and their parameters (what ``pumpup models`` prints).
+``.. pumpup-table:: NAME``
+    a Markdown table generated from a file the repository generates (``pumpup_numbers.TABLES``).
+``:pumpup-value:`KEY```
+    a number computed when the site is built (``pumpup_numbers.VALUES``); in Markdown ``{pumpup-value}`KEY```.
 
 :func:`cli_reference_rst` is the text the first directive parses; ``tests/project/test_docs.py`` checks that every
 subcommand of the parser appears in it.
@@ -118,6 +122,55 @@ def _directive(text, titles: bool):
             return node.children
 
     return Generated
+
+
+def _table_directive():
+    """``pumpup-table NAME``: the Markdown of ``pumpup_numbers.TABLES[NAME]()``, parsed in place."""
+    import pumpup_numbers
+    from docutils.statemachine import StringList
+    from sphinx.util.docutils import SphinxDirective
+
+    class Table(SphinxDirective):
+        required_arguments = 1
+        has_content = False
+
+        def run(self):
+            from docutils import nodes
+
+            name = self.arguments[0]
+            if name not in pumpup_numbers.TABLES:
+                raise self.error(f"pumpup-table: unknown table {name!r}; known: {', '.join(pumpup_numbers.TABLES)}")
+            self.env.note_dependency(pumpup_numbers.__file__)
+            node = nodes.container()
+            text = pumpup_numbers.TABLES[name]()
+            self.state.nested_parse(StringList(text.splitlines(), source=f"pumpup-table {name}"), self.content_offset,
+                                    node)
+            return node.children
+
+    return Table
+
+
+def value_role(name, rawtext, text, lineno, inliner, options=None, content=None):
+    """``:pumpup-value:`KEY```: the number ``pumpup_numbers.VALUES[KEY]`` computes, as text."""
+    import pumpup_numbers
+    from docutils import nodes
+
+    key = text.strip()
+    if key not in pumpup_numbers.VALUES:
+        msg = inliner.reporter.error(f"pumpup-value: unknown key {key!r}", line=lineno)
+        return [inliner.problematic(rawtext, rawtext, msg)], [msg]
+    return [nodes.Text(_value_text(key))], []
+
+
+_VALUE_CACHE: dict = {}
+
+
+def _value_text(key: str) -> str:
+    import pumpup_numbers
+
+    if key not in _VALUE_CACHE:
+        _VALUE_CACHE[key] = pumpup_numbers.VALUES[key].text()
+    return _VALUE_CACHE[key]
 
 
 #: modules with public names (an ``__all__``) that get no reference page, with the reason
@@ -244,4 +297,6 @@ def setup(app):
     app.add_directive("pumpup-cli", _directive(cli_reference_rst, titles=True))
     app.add_directive("pumpup-routes", _directive(routing_table_rst, titles=False))
     app.add_directive("pumpup-models", _directive(model_list_rst, titles=False))
+    app.add_directive("pumpup-table", _table_directive())
+    app.add_role("pumpup-value", value_role)
     return {"parallel_read_safe": True, "parallel_write_safe": True, "version": "1"}

@@ -1,10 +1,12 @@
 """Regenerate the path-traced scene images under figures/ (Mitsuba 3 with the pumpup plugin; pumpup.scenes).
 
-    python scripts/make/make_scenes.py [--size 256] [--spp 64] [--out figures] [--only 000-fig8 ...]
+    python scripts/make/make_scenes.py [--size 256] [--spp N] [--out figures] [--only 000-fig8 ...]
 
-Needs the render extra (mitsuba).  Prints the variant, the time per panel (the first pass of a panel
-includes Dr.Jit's kernel compilation) and the load average, and, per panel, the mean radiance of the
-image and of the objects' rows (what the README quotes).
+Needs the render extra (mitsuba).  Each scene renders at its own sample count (:data:`SPP`) unless ``--spp`` is
+given.  Prints the variant, the time per panel (the first pass of a panel includes Dr.Jit's kernel compilation)
+and the load average, and, per panel, the mean luminance of the image, its 99th percentile, the mean of the
+bottom rows (the plate) and the number of fireflies (:func:`fireflies`); writes them to ``OUT/scenes.json``
+(one entry per scene, the others kept), which the documentation quotes.
 """
 
 from __future__ import annotations
@@ -16,34 +18,69 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))  # this checkout's pumpup
 
+import json  # noqa: E402
+
 import numpy as np  # noqa: E402
 
 import pumpup.scenes as S  # noqa: E402
+from pumpup.tables import atomic_path  # noqa: E402
+
+#: samples per pixel of each scene.  000 Fig. 9 and Fig. 10 (plastic plate, n <= 169) converge: at 2048 spp no
+#: pixel is a firefly.  000 Fig. 8 and 001 Fig. 8 keep 64: their fireflies are caustics, point light -> near mirror
+#: (n = 5000) -> a rougher surface, which a path tracer finds by chance; more samples make them dimmer and more
+#: numerous, not gone (docs/user-guide/mitsuba.md says what removing them would take).
+SPP = {"000-fig8": 64, "000-fig9": 2048, "001-fig8": 64, "000-fig10": 2048}
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])  # linear sRGB
+
+
+def fireflies(y: np.ndarray) -> int:
+    """Pixels brighter than 1.5 x the median of their 3 x 3 neighbourhood plus 0.1 (linear luminance ``y``): the
+    isolated bright pixels of a Monte Carlo image; 0 for a converged one (edges of highlights are not that abrupt
+    at 256 x 256).
+    """
+    from scipy.ndimage import median_filter
+
+    return int((y > 1.5 * median_filter(y, 3) + 0.1).sum())
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", type=int, default=256)
-    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--spp", type=int, help="samples per pixel of every scene (default: SPP)")
     ap.add_argument("--out", default="figures")
     ap.add_argument("--variant", default="auto")
     ap.add_argument("--only", nargs="+", choices=sorted(S.SCENES))
     args = ap.parse_args(argv)
     for name in args.only or S.SCENES:
-        S.check_args(name, args.spp, args.size, args.variant)
+        S.check_args(name, args.spp or SPP[name], args.size, args.variant)
+    stats_path = os.path.join(args.out, "scenes.json")
     for name in args.only or S.SCENES:
+        spp = args.spp or SPP[name]
         t = time.perf_counter()
-        v, rows, times = S.render_scene(name, args.spp, args.size, args.variant)
-        print(f"{name}: {v}, {args.size} x {args.size}, {args.spp} spp, panels "
-              + ", ".join(f"{x:.1f}" for x in times) + f" s; load {os.getloadavg()[0]:.1f}")
+        v, rows, times = S.render_scene(name, spp, args.size, args.variant)
+        load = os.getloadavg()[0]
+        print(f"{name}: {v}, {args.size} x {args.size}, {spp} spp, panels "
+              + ", ".join(f"{x:.1f}" for x in times) + f" s; load {load:.1f}")
+        panels = {}
         for r in rows:
             for label, im in r:
-                y = im @ np.array([0.2126, 0.7152, 0.0722])  # linear sRGB luminance
+                y = im @ LUMINANCE
                 lo = y[int(0.85 * y.shape[0]):]  # the bottom 15 % of the rows: the plate only
+                panels[label] = {"mean": float(y.mean()), "p99": float(np.percentile(y, 99)),
+                                 "plate": float(lo.mean()), "fireflies": fireflies(y)}
                 print(f"  {label:36s} mean {y.mean():.4f}, 99th percentile {np.percentile(y, 99):.3f}, "
-                      f"plate (bottom 15 % of rows) {lo.mean():.4f}")
-        paths = S.write_scene(name, rows, args.out, variant=v, spp=args.spp, exr=False)
-        print(f"wrote {paths[-1]} in {time.perf_counter() - t:.1f} s", flush=True)
+                      f"plate (bottom 15 % of rows) {lo.mean():.4f}, fireflies {panels[label]['fireflies']}")
+        paths = S.write_scene(name, rows, args.out, variant=v, spp=spp, exr=False)
+        stats = {}
+        if os.path.exists(stats_path):
+            with open(stats_path) as fh:
+                stats = json.load(fh)
+        stats[name] = {"spp": spp, "size": args.size, "variant": v, "seconds": [round(x, 1) for x in times],
+                       "load": round(load, 1), "panels": panels}
+        with atomic_path(stats_path) as tmp:
+            with open(tmp, "w") as fh:
+                json.dump(stats, fh, indent=1, sort_keys=True)
+        print(f"wrote {paths[-1]} and {stats_path} in {time.perf_counter() - t:.1f} s", flush=True)
     return 0
 
 

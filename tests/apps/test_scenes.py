@@ -65,6 +65,50 @@ def test_panels_are_the_papers_parameters():
     assert [s["base"] for s in rows[1][1][1]["tank"][0][1]] == [pumped] * 3
 
 
+def test_fig10_panels_are_the_papers_parameters():
+    """000 Fig. 10: two teapots of 000 eq. 30 with n = 100 and 20, diffuse dominant, energy-conserving."""
+    (orig, new), = S.panels("000-fig10")
+    assert [new[1][f"t{i}"][0][1][0]["n"] for i in range(2)] == [100.0, 20.0]
+    for (a_s, n), rgb in S.TEAPOTS:
+        assert max(rgb) + a_s <= 1 and min(rgb) > a_s  # 000 after eq. 30; the diffuse part dominates
+    assert [s["type"] for s in new[1]["t0"][0][1]] == ["plastic"] * 3
+    assert orig[1]["t1"][1][1] == {"type": "phong", "n": 20.0, "c": pytest.approx(0.04 * 22 / (2 * math.pi))}
+
+
+def _signed_volume(v, f):
+    return float(np.einsum("ij,ij->i", v[f[:, 0]], np.cross(v[f[:, 1]], v[f[:, 2]])).sum() / 6.0)
+
+
+def test_teapot_mesh_faces_point_outwards():
+    """The body of revolution of a unit sphere's profile encloses 4 pi / 3 with outward faces (positive signed
+    volume); every face of a tube faces away from its axis; the teapot's indices are valid and its faces not
+    degenerate."""
+    s = np.linspace(0.0, math.pi, 64)
+    v, f = S._revolve(np.sin(s), -np.cos(s), 128)
+    assert _signed_volume(v, f) == pytest.approx(4 * math.pi / 3, rel=2e-3)
+    t = np.linspace(0.0, 1.0, 20)
+    path = np.stack([t, t ** 2, 0 * t], axis=1)
+    v, f = S._tube(path, np.full(20, 0.1), 12)
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    out = np.einsum("ij,ij->i", np.cross(b - a, c - a), (a + b + c) / 3 - path[f[:, 0] // 12])
+    assert np.all(out > 0)
+    v, f = S.teapot_mesh()
+    assert f.min() == 0 and f.max() == len(v) - 1 and np.all(np.isfinite(v))
+    area = np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
+    assert np.all(area > 0)
+    assert v[:, 1].min() == 0.0 and 1.4 < v[:, 1].max() < 1.5  # stands on y = 0
+
+
+def test_fireflies_counts_isolated_bright_pixels():
+    sys.path.insert(0, os.path.join(ROOT, "scripts", "make"))
+    from make_scenes import fireflies
+
+    y = np.tile(np.linspace(0.2, 0.8, 64), (64, 1))  # a smooth ramp: none
+    assert fireflies(y) == 0
+    y[10, 10] = y[40, 50] = 5.0
+    assert fireflies(y) == 2
+
+
 mi = pytest.importorskip("mitsuba")
 pm = pytest.importorskip("pumpup.mitsuba")
 LLVM_OK, LLVM_WHY = pm.probe("llvm_ad_rgb")
@@ -104,7 +148,8 @@ def test_mix_bsdf_albedo_matches_pumpup():
 
 
 @needs_llvm
-@pytest.mark.parametrize("name", ["000-fig8", "000-fig9", pytest.param("001-fig8", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("name", ["000-fig8", "000-fig9", "000-fig10",
+                                  pytest.param("001-fig8", marks=pytest.mark.slow)])
 def test_tiny_render(name, tmp_path):
     """Each scene renders at 16 x 16, 4 spp: finite, non-negative, the two versions differ; files written."""
     import io

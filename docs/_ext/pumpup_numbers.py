@@ -1,0 +1,598 @@
+"""Where the numbers the documentation quotes come from.
+
+A page quotes a result in one of three ways, and this module lists all three:
+
+:data:`VALUES`
+    computed when the site is built and written into the text by the role ``{pumpup-value}`key```
+    (``docs/_ext/pumpup_docs.py``).  Each is a :class:`Value`: the function, how it is printed, and whether it
+    takes more than a few seconds (``slow``: then the default test suite does not compute it).
+:data:`TABLES`
+    Markdown tables generated from a file the repository generates (``tables/*.nc``, ``tables/*.json``), inserted
+    by the directive ``{pumpup-table} NAME``.  The script that writes the file is named with each.
+:data:`QUOTES`
+    numbers typed in a page or in the README (in a code comment, or in prose that reads better with the number
+    in it): the exact text, the function that recomputes them, and the tolerance.  ``tests/project/
+    test_docs_numbers.py`` asserts that the text is still in the page and that each typed number is the fresh
+    result rounded to the digits it shows (``slow`` ones under ``-m slow``).
+
+Timings are not quoted as results: they depend on the machine and its load; the pages give the command that
+measures them (``scripts/bench/``).
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.util
+import json
+import math
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+TABLES_DIR = os.path.join(ROOT, "tables")
+
+
+@dataclass(frozen=True)
+class Value:
+    """A number (or a tuple of numbers) quoted in a page: ``compute()`` and the format of each number."""
+
+    compute: Callable
+    fmt: str = ".4g"
+    slow: bool = False
+    sep: str = ", "
+
+    def text(self) -> str:
+        """The value as the page prints it."""
+        v = self.compute()
+        if isinstance(v, str):
+            return v
+        if isinstance(v, (tuple, list)):
+            return self.sep.join(format(float(x), self.fmt) for x in v)
+        return format(float(v), self.fmt)
+
+
+@dataclass(frozen=True)
+class Quote:
+    """Numbers typed in ``page`` (a path from the repository root) inside the exact text ``text``; ``compute()``
+    returns them in the order they appear (one float or a sequence).  Each must equal the fresh value rounded to
+    its printed digits, within ``rtol`` more when given (for values that depend on a tolerance of the code).
+    """
+
+    page: str
+    text: str
+    compute: Callable
+    rtol: float = 0.0
+    slow: bool = False
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# stored files
+# ---------------------------------------------------------------------------------------------------------------
+
+
+@functools.cache
+def _open(name: str):
+    import xarray as xr
+
+    with xr.open_dataset(os.path.join(TABLES_DIR, name)) as ds:
+        return ds.load()
+
+
+def stored(table: str, row: str, column: str) -> float:
+    """The ``computed`` value of one entry of a ``pumpup reproduce`` table (``tables/<table>.nc``)."""
+    ds = _open(f"{table}.nc")
+    for i in range(ds.sizes["entry"]):
+        e = ds.isel(entry=i)
+        if str(e.row.values) == row and str(e.column.values) == column:
+            return float(e.computed)
+    raise KeyError(f"tables/{table}.nc has no entry row={row!r} column={column!r}")
+
+
+def published(table: str, row: str, column: str) -> float:
+    """The paper's printed value of one entry of a ``pumpup reproduce`` table (``tables/<table>.nc``)."""
+    ds = _open(f"{table}.nc")
+    for i in range(ds.sizes["entry"]):
+        e = ds.isel(entry=i)
+        if str(e.row.values) == row and str(e.column.values) == column:
+            return float(e.published_value)
+    raise KeyError(f"tables/{table}.nc has no entry row={row!r} column={column!r}")
+
+
+def reproduce_agreement() -> str:
+    """How many printed values of 000 and 001 that ``pumpup reproduce`` regenerates agree to their digits."""
+    agree = total = 0
+    for t in ("table2", "table3", "table4", "text"):
+        ds = _open(f"{t}.nc")
+        agree += int(ds.agrees.sum())
+        total += int(ds.sizes["entry"])
+    return f"{agree} of {total}"
+
+
+def divergence_k(family: str) -> float:
+    """The exponent k of a ~ K mu^-k of every m of ``family`` in ``tables/divergence.nc``, if they agree to 4
+    decimals (else an error: the page quotes one number for all).
+    """
+    ds = _open("divergence.nc")
+    ks = [float(ds.k.sel(model=m)) for m in ds.model.values if str(m).startswith(family + " ")]
+    if len({round(k, 4) for k in ks}) != 1:
+        raise ValueError(f"{family}: k differs between the m of tables/divergence.nc: {ks}")
+    return ks[0]
+
+
+def divergence_albedo(model: str, mu: float) -> float:
+    """The albedo of ``model`` at one of the mu of ``tables/divergence.nc`` (written by ``pumpup reproduce``)."""
+    ds = _open("divergence.nc")
+    i = int(abs(ds.mu.values - mu).argmin())
+    if abs(ds.mu.values[i] / mu - 1) > 1e-9:
+        raise KeyError(f"tables/divergence.nc has no mu = {mu:g}")
+    return float(ds.albedo.sel(model=model).isel(mu=i))
+
+
+def pumping_figures(var: str, **sel) -> float:
+    """The largest value of ``var`` in ``tables/pumping_figures.nc`` (``scripts/make/pumping_figures.py``) at sel."""
+    return float(_open("pumping_figures.nc")[var].sel(**sel).max())
+
+
+@functools.cache
+def _scenes() -> dict:
+    with open(os.path.join(ROOT, "figures", "scenes.json")) as fh:
+        return json.load(fh)
+
+
+def scene(name: str, panel: str | None = None, key: str = "mean"):
+    """A statistic of a path-traced scene that ``scripts/make/make_scenes.py`` wrote to ``figures/scenes.json``:
+    ``key`` of ``panel`` (mean, p99, plate: linear sRGB luminance; fireflies: a count), or of the scene (spp,
+    seconds, load) when ``panel`` is None.
+    """
+    entry = _scenes()[name]
+    return entry[key] if panel is None else entry["panels"][panel][key]
+
+
+@functools.cache
+def _noise() -> dict:
+    with open(os.path.join(ROOT, "figures", "scene_noise.json")) as fh:
+        return json.load(fh)
+
+
+def noise(*keys):
+    """A number that ``scripts/make/scene_noise.py`` wrote to ``figures/scene_noise.json``."""
+    v = _noise()
+    for k in keys:
+        v = v[k]
+    return v
+
+
+def _scene_names() -> list[str]:
+    from pumpup.scenes import SCENES
+
+    return [n for n in SCENES if n in _scenes()]
+
+
+def _fig8_rate() -> float:
+    """Samples per second of the last 000-fig8 render of ``make_scenes.py`` (both panels, 256 x 256 or as run)."""
+    e = _scenes()["000-fig8"]
+    return e["size"] ** 2 * e["spp"] * len(e["panels"]) / sum(e["seconds"])
+
+
+def _script(name: str):
+    """A module of ``scripts/make/`` (not a package), imported by path."""
+    path = os.path.join(ROOT, "scripts", "make", f"{name}.py")
+    spec = importlib.util.spec_from_file_location(f"_pumpup_docs_{name}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# generated tables
+# ---------------------------------------------------------------------------------------------------------------
+
+FITTING_FILES = ("fitting_study.json", "fitting_study_pumped.json", "fitting_study_plausible.json",
+                 "fitting_study_mu026.json")
+
+
+@functools.cache
+def fitting_records() -> tuple:
+    """Every record of the fitting study (``scripts/make/fitting_study.py`` writes them), as dicts."""
+    out = []
+    for name in FITTING_FILES:
+        with open(os.path.join(TABLES_DIR, name)) as fh:
+            data = json.load(fh)
+        out += data["records"] if isinstance(data, dict) else data
+    return tuple(out)
+
+
+def fitting_tables() -> str:
+    """The tables of the fitting study, as ``python scripts/make/fitting_study.py --table --read ...`` prints them."""
+    fs = _script("fitting_study")
+    recs = list(fitting_records())
+    parts = []
+    for mu_min, pl in sorted({(round(r["mu_min"], 9), r.get("plausible", False)) for r in recs}):
+        sub = [r for r in recs if round(r["mu_min"], 9) == mu_min and r.get("plausible", False) == pl]
+        parts.append(f"**mu_min = {mu_min:g} (views and albedo down to theta = "
+                     f"{math.degrees(math.acos(mu_min)):.1f} deg)" + (", albedo <= 1 imposed" if pl else ", scale free")
+                     + "**")
+        parts.append(fs.table(sub))
+        parts.append(fs.best(sub))
+    return "\n\n".join(parts)
+
+
+def compensation_table() -> str:
+    """The compensation study's table (``scripts/make/compensation_study.py``, ``tables/compensation.nc``)."""
+    return _script("compensation_study").markdown(_open("compensation.nc"))
+
+
+def compensation_metalness() -> str:
+    """The intermediate-metalness furnace of the compensation study (``tables/compensation.nc``)."""
+    return _script("compensation_study").metal_markdown(_open("compensation.nc"))
+
+
+def sampling_table() -> str:
+    """Variance / albedo^2 of the Phong-lobe estimator, Phong / stretched Phong (``tables/sampling_efficiency.nc``,
+    ``scripts/make/sampling_efficiency.py``), at n = 1, 20, 1000 and six incidence angles.
+    """
+    import numpy as np
+
+    ds = _open("sampling_efficiency.nc")
+    cols = [(f"{t:g} deg", float(np.cos(np.radians(t)))) for t in (0, 30, 60, 80, 89)] + [("mu = 1e-8", 1e-8)]
+    idx = [int(abs(ds.mu.values - mu).argmin()) for _, mu in cols]
+    for (name, mu), i in zip(cols, idx):
+        if abs(ds.mu.values[i] - mu) > 1e-9 * max(mu, 1e-8) + 1e-12:
+            raise KeyError(f"tables/sampling_efficiency.nc has no {name}")
+
+    def cell(x: float) -> str:
+        return f"{x:.1e}".replace("e-0", "e-") if x < 1e-2 else f"{x:.3g}"
+
+    rv = ds.relative_variance
+    lines = ["| n | " + " | ".join(c for c, _ in cols) + " |", "|---|" + "---|" * len(cols)]
+    for n in (1.0, 20.0, 1000.0):
+        cells = [cell(float(rv.sel(model="phong", n=n).isel(mu=i))) + " / "
+                 + cell(float(rv.sel(model="stretched_phong", n=n).isel(mu=i))) for i in idx]
+        lines.append(f"| {n:g} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+#: generated tables: name -> function returning Markdown
+TABLES: dict[str, Callable[[], str]] = {
+    "fitting-study": fitting_tables,
+    "compensation-study": compensation_table,
+    "compensation-metalness": compensation_metalness,
+    "sampling-efficiency": sampling_table,
+}
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# values computed in the build
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def _albedo(spec, mu, **kw):
+    import numpy as np
+
+    import pumpup
+
+    return tuple(float(x) for x in np.atleast_1d(pumpup.albedo(pumpup.load(spec), mu, **kw)))
+
+
+def _teapots():
+    from pumpup.scenes import TEAPOTS
+
+    return TEAPOTS
+
+
+_FIG8 = ("reciprocal Phong (000 eq. 5)", "stretched Phong (000 eq. 7)")
+_PLASTIC = ("Lambert + a_s Phong (000 eq. 5)", "plastic, 000 eq. 30")
+_PUMPED = {n: (f"reciprocal Phong, n = {n}", f"pumped once (g1), n = {n}") for n in (20, 5000)}
+
+VALUES: dict[str, Value] = {
+    "reproduce-agreement": Value(reproduce_agreement),
+    "schlick-r0.001": Value(lambda: stored("text", "r = 0.001", "schlick C_max"), ".4f"),
+    "ward-k": Value(lambda: divergence_k("ward"), ".4f"),
+    "ward-grazing": Value(lambda: tuple(stored("text", t, "ward m=0.1 a(theta)")
+                                        for t in ("89.995", "89.999", "89.9995")), ".4f"),
+    "ward-89.9995": Value(lambda: stored("text", "89.9995", "ward m=0.1 a(theta)"), ".2f"),
+    "ct-grazing-1e-3": Value(lambda: divergence_albedo("cook_torrance m=0.1", 1e-3), ".5f"),
+    "ct-grazing-1e-5": Value(lambda: divergence_albedo("cook_torrance m=0.1", 1e-5), ".5f"),
+    "ct-grazing-1e-8": Value(lambda: divergence_albedo("cook_torrance m=0.1", 1e-8), ".9f"),
+    "phong-g2-3-mirror": Value(lambda: pumping_figures("mirror_radiance", model="phong", g="g2", level=3), ".2f"),
+    "phong-g2-3-over-c": Value(lambda: pumping_figures("mirror_radiance", model="phong", g="g2", level=3)
+                               / _open("pumping_figures.nc").attrs["phong_c"], ".2g"),
+    "blinn-g2-3-over-c": Value(lambda: pumping_figures("mirror_radiance", model="blinn", g="g2", level=3)
+                               / _open("pumping_figures.nc").attrs["blinn_c"], ".0f"),
+    # the path-traced scenes (figures/scenes.json)
+    "fig8-plate": Value(lambda: tuple(scene("000-fig8", p, "plate") for p in _FIG8[::-1]), ".3f", sep=" against "),
+    "fig8-mean": Value(lambda: tuple(scene("000-fig8", p, "mean") for p in _FIG8[::-1]), ".3f", sep=" against "),
+    "fig9-mean": Value(lambda: tuple(scene("000-fig9", p, "mean") for p in _PLASTIC[::-1]), ".3f", sep=" against "),
+    "fig9-p99": Value(lambda: tuple(scene("000-fig9", p, "p99") for p in _PLASTIC[::-1]), ".3f", sep=" against "),
+    "fig10-mean": Value(lambda: tuple(scene("000-fig10", p, "mean") for p in _PLASTIC[::-1]), ".3f",
+                        sep=" against "),
+    "fig10-p99": Value(lambda: tuple(scene("000-fig10", p, "p99") for p in _PLASTIC[::-1]), ".3f", sep=" against "),
+    "001fig8-n20": Value(lambda: tuple(scene("001-fig8", p, "mean") for p in _PUMPED[20]), ".3f", sep=" to "),
+    "001fig8-n5000": Value(lambda: tuple(scene("001-fig8", p, "mean") for p in _PUMPED[5000]), ".3f", sep=" to "),
+    "fig10-diffuse": Value(lambda: tuple(sorted(0.2126 * r + 0.7152 * g + 0.0722 * b
+                                               for _, (r, g, b) in _teapots())),
+                           ".2f", sep="-"),
+    "fig10-specular": Value(lambda: max(_albedo({"type": "plastic", "n": n, "ad": 0.0, "a_s": a_s},
+                                                [1.0, 0.5, 0.1, 0.01])[i]
+                                        for (a_s, n), _ in _teapots()
+                                        for i in range(4)), ".3f"),
+    "scene-spp": Value(lambda: ", ".join(f"{n} {scene(n, key='spp')}" for n in _scene_names()), ""),
+    "scene-seconds": Value(lambda: ", ".join(f"{n} {sum(scene(n, key='seconds')):.0f} s (load {scene(n, key='load'):g})"
+                                             for n in _scene_names()), ""),
+    "scene-fireflies": Value(lambda: ", ".join(
+        f"{n} {sum(p['fireflies'] for p in _scenes()[n]['panels'].values())}" for n in _scene_names()), ""),
+    # the fireflies of 000 Fig. 8 (figures/scene_noise.json)
+    "noise-setup": Value(lambda: f"{noise('size')} x {noise('size')} and {noise('passes') * noise('spp')} spp "
+                                 f"({noise('passes')} passes of {noise('spp')})", ""),
+    "noise-sd-p99": Value(lambda: noise("sample_sd_percentiles", "99"), ".2g"),
+    "noise-sd-p999": Value(lambda: noise("sample_sd_percentiles", "99.9"), ".3g"),
+    "noise-spp-needed": Value(lambda: f"{round(noise('spp_for_0.01_at_p99'), -4):,.0f}", ""),
+    "noise-hours-per-panel": Value(lambda: noise("spp_for_0.01_at_p99") * 256 ** 2 / _fig8_rate() / 3600, ".2g"),
+    "noise-rate": Value(lambda: _fig8_rate() / 1e6, ".2g"),
+    "noise-run": Value(lambda: f"{noise('seconds'):.0f} s at load {noise('load'):.1f}", ""),
+    "noise-by-spp": Value(lambda: ", ".join(f"{c} at {n} spp" for n, c in sorted(
+        noise("fireflies_by_spp").items(), key=lambda item: int(item[0]))), ""),
+    "noise-variants": Value(lambda: ", ".join(f"{noise('fireflies_128_64spp', how)} {how}"
+                                              for how in ("as it is", "without point lights", "Lambert plate")), ""),
+    "phong-c": Value(lambda: _open("pumping_figures.nc").attrs["phong_c"], ".2f"),
+    "g1-g2-phong": Value(lambda: float(abs(_open("pumping_figures.nc").albedo.sel(model="phong", g="g1")
+                                           - _open("pumping_figures.nc").albedo.sel(model="phong", g="g2")).max()),
+                         ".2g"),
+    "g1-g2-blinn": Value(lambda: float(abs(_open("pumping_figures.nc").albedo.sel(model="blinn", g="g1")
+                                           - _open("pumping_figures.nc").albedo.sel(model="blinn", g="g2")).max()),
+                         ".2f"),
+}
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# numbers typed in the pages and the README, checked by tests/project/test_docs_numbers.py
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def _fit(target, model, method="perceptual", mu_min=0.05, plausible=False):
+    for r in fitting_records():
+        if (r["target_name"] == target and r["model"] == model and r["method"] == method
+                and abs(r["mu_min"] - mu_min) < 1e-9 and r.get("plausible", False) == plausible):
+            return r
+    raise KeyError((target, model, method, mu_min, plausible))
+
+
+def _comp(model, method, var, theta_i=None):
+    ds = _open("compensation.nc").sel({"model": model, "method": method})
+    v = ds[var]
+    return float(v.sel(theta_i=theta_i) if theta_i is not None else v)
+
+
+QUOTES: list[Quote] = [
+    # README: what pumpup measured that the papers and renderers got wrong
+    Quote("README.md", "| 5.34 | 5.334 (closed form", lambda: (published("table2", "128", "blinn"),
+                                                              stored("table2", "128", "blinn"))),
+    Quote("README.md", "| 0.368 | 0.3638: the maximum is at 41.41 deg",
+          lambda: (published("table2", "2", "stretched_blinn"), stored("table2", "2", "stretched_blinn"),
+                   float(_open("table2.nc").theta_deg.isel(entry=11)))),
+    Quote("README.md", "| 1.005, 1.002, 1.002 | 1.0016, 1.0004, 1.0001",
+          lambda: (*(published("table4", m, "modified_ward") for m in ("0.02", "0.01", "0.005")),
+                   *(stored("table4", m, "modified_ward") for m in ("0.02", "0.01", "0.005")))),
+    Quote("README.md", "| 0.042 | 0.0642", lambda: (published("text", "r = 0.001", "schlick C_max"),
+                                               stored("text", "r = 0.001", "schlick C_max"))),
+    Quote("README.md", "| 3.8 | 3.7098", lambda: (published("text", "89.9995", "ward m=0.1 a(theta)"),
+                                             stored("text", "89.9995", "ward m=0.1 a(theta)"))),
+    Quote("README.md", "(m = 0.1: 0.999999990 at mu = 1e-8)",
+          lambda: (0.1, divergence_albedo("cook_torrance m=0.1", 1e-8), 1e-8)),
+    Quote("README.md", "pumpup.max_constant(pumpup.load(\"blinn:n=16\"))          # (0.895",
+          lambda: (16, stored("table2", "16", "blinn"))),
+    Quote("docs/user-guide/albedo.md", "# 0.1865 and 0.2782",
+          lambda: _albedo({"type": "ward_aniso", "ax": 0.1, "ay": 0.3}, 0.2, phi=[0.0, math.pi / 2]), slow=True),
+    Quote("README.md", "| nodes right to 9.7e-7; the look-up errs by up to 0.102 near grazing |",
+          lambda: (_cycles_audit().max_abs, _cycles_audit().lookup["max_abs"]), slow=True),
+    # the Cycles audit table of docs/user-guide/luts.md
+    Quote("docs/user-guide/luts.md", "| max \\|table - E\\| at the 1024 nodes | 9.7e-7 | mu = 20/31, rough = 5/31",
+          lambda: (1024, _cycles_audit().max_abs, 31 * _cycles_audit().where_abs[0], 31,
+                   31 * _cycles_audit().where_abs[1], 31), slow=True),
+    Quote("docs/user-guide/luts.md", "| max relative error | 1.7e-6 | mu = 27/31, rough = 30/31",
+          lambda: (_cycles_audit().max_rel, 31 * _cycles_audit().where_rel[0], 31, 31 * _cycles_audit().where_rel[1],
+                   31), slow=True),
+    Quote("docs/user-guide/luts.md", "| `table_ggx_Eavg` against the true E_avg | 6.2e-7 | rough = 20/31 |",
+          lambda: (_cycles_audit().eavg["vs_truth"], 31 * _cycles_audit().eavg["vs_truth_where"], 31), slow=True),
+    Quote("docs/user-guide/luts.md", "against 2 int E mu dmu of the table's own (linearly interpolated) E | 8.9e-5 | "
+          "rough = 1 |", lambda: (2, _cycles_audit().eavg["vs_own"], _cycles_audit().eavg["vs_own_where"]), slow=True),
+    Quote("docs/user-guide/luts.md", "| 0.102 (rms 0.005) | mu = 1.1e-4, rough = 0.01:",
+          lambda: (_cycles_audit().lookup["max_abs"], _cycles_audit().lookup["rms"], *_cycles_audit().lookup["where"]),
+          slow=True),
+    # the notes on the published tables (tables/table2-4.nc and text.nc, written by pumpup reproduce)
+    *[Quote("docs/notes_on_published_tables.md", f"| {m} | {pub} | {val}",
+            lambda m=m: (float(m), published("table4", m, "modified_ward"), stored("table4", m, "modified_ward")))
+      for m, pub, val in (("0.4", "1.63", "1.6205"), ("0.2", "1.16", "1.1576"), ("0.1", "1.04", "1.0398"),
+                          ("0.05", "1.011", "1.00999"), ("0.02", "1.005", "1.0016"), ("0.01", "1.002", "1.0004"),
+                          ("0.005", "1.002", "1.0001"))],
+    Quote("docs/notes_on_published_tables.md", "n = 256 and 512 (10.426, 20.611) agree with the printed 10.4, 20.6",
+          lambda: (256, 512, stored("table2", "256", "blinn"), stored("table2", "512", "blinn"),
+                   published("table2", "256", "blinn"), published("table2", "512", "blinn"))),
+    Quote("docs/notes_on_published_tables.md", "**Stretched Phong n = 128, 256, 512: 0.9523, 0.9647, 0.9742** "
+          "(printed 0.953, 0.966,\n  0.975)",
+          lambda: (128, 256, 512, *(stored("table3", n, "stretched_phong") for n in ("128", "256", "512")),
+                   *(published("table3", n, "stretched_phong") for n in ("128", "256", "512")))),
+    Quote("docs/notes_on_published_tables.md", "2.1485 (r = 0.5), 0.72597 (0.1), 0.20836 (0.01),\n  0.064155 (0.001)",
+          lambda: (stored("text", "r = 0.5", "schlick C_max"), 0.5, stored("text", "r = 0.1", "schlick C_max"), 0.1,
+                   stored("text", "r = 0.01", "schlick C_max"), 0.01,
+                   stored("text", "r = 0.001", "schlick C_max"), 0.001)),
+    Quote("docs/notes_on_published_tables.md", "1.1747 at 89.995 deg and 2.6236 at 89.999 deg",
+          lambda: (stored("text", "89.995", "ward m=0.1 a(theta)"), 89.995,
+                   stored("text", "89.999", "ward m=0.1 a(theta)"), 89.999)),
+    Quote("docs/notes_on_published_tables.md", "**The overshoot of stretched Phong n = 1 (000 sec. 2.2)**: 0.00029 "
+          "at 12.9 deg", lambda: (1, 0, 2.2, stored("text", "n = 1", "stretched_phong overshoot"),
+                                  stored("text", "n = 1", "stretched_phong overshoot angle [deg]"))),
+    # the user guide
+    Quote("docs/user-guide/albedo.md", "max S = 1.0858 at n = 0",
+          lambda: (_plastic_max_s(), 0)),
+    # the exact images (docs/user-guide/images.md): the white furnace at 160 x 160, as scripts/make/make_images.py
+    # draws it (pumpup.plots.furnace_grid's models)
+    Quote("docs/user-guide/images.md", "the disc (0.806, near theta = 71 deg)",
+          lambda: (_furnace_min({"type": "ggx", "alpha": 0.3}), _ggx_darkest_theta()), slow=True),
+    Quote("docs/user-guide/images.md", "bright in the middle (1.0000 and 0.9999) and dark\n"
+          "at the rim (0.10 and 0.06 at the outermost pixel, mu_V = 0.029 at 160 x 160)",
+          lambda: (_furnace_centre({"type": "phong", "n": 20}), _furnace_centre(_blinn()),
+                   _furnace_min({"type": "phong", "n": 20}), _furnace_min(_blinn()), _rim_mu(160), 160, 160),
+          slow=True),
+    Quote("docs/user-guide/images.md", "(Phong 0.42, 0.66, 0.79 after one to three levels, Blinn\n0.18 and 0.48 after "
+          "one and three g1 levels)",
+          lambda: (*(_furnace_min(_pumped({"type": "phong", "n": 20}, "g1", k)) for k in (1, 2, 3)),
+                   *(_furnace_min(_pumped(_blinn(), "g1", k)) for k in (1, 3))), slow=True),
+    Quote("docs/user-guide/images.md", "rim less (0.12: the price of control, 001 sec. 3.2), but three reach 0.51",
+          lambda: (_furnace_min(_pumped(_blinn(), "g2", 1)), 1, 3.2, _furnace_min(_pumped(_blinn(), "g2", 3))),
+          slow=True),
+    Quote("docs/user-guide/images.md", "stretched Phong reaches 0.55 at n = 20 and 0.81 at\nn = 5000",
+          lambda: (_furnace_min({"type": "stretched_phong", "n": 20}), 20,
+                   _furnace_min({"type": "stretched_phong", "n": 5000}), 5000), slow=True),
+    Quote("docs/user-guide/images.md", "(alpha = 0.3) and Cook-Torrance (m = 0.3) lose energy to shadowing (0.88 and "
+          "0.996 at the\ncentre)", lambda: (0.3, 0.3, _furnace_centre({"type": "ggx", "alpha": 0.3}),
+                                            _furnace_centre({"type": "cook_torrance", "m": 0.3})), slow=True),
+    # the pumped spheres of docs/user-guide/images.md: peak radiance at 160 x 160, as pumpup.plots draws them
+    Quote("docs/user-guide/images.md", "Phong's highlight fades from 3.49 to 0.95 at Phi_L = 150",
+          lambda: (_peak(_PHONG, 0), _peak(_PHONG, 150), 150), slow=True),
+    Quote("docs/user-guide/images.md", "stretched Phong keeps it between 3.48 and 3.50 at every angle",
+          lambda: (min(_peak(_STRETCHED, a) for a in _LIGHTS), max(_peak(_STRETCHED, a) for a in _LIGHTS)),
+          slow=True),
+    Quote("docs/user-guide/images.md", "one pumping nearly so (3.35), and further levels overshoot (4.92 after three",
+          lambda: (_peak(_pumped(_PHONG, "g1", 1), 150), _peak(_pumped(_PHONG, "g1", 3), 150)), slow=True),
+    Quote("docs/user-guide/images.md", "Blinn n = 20 at its maximum constant c = 1.0504: its highlight fades to "
+          "0.34 at Phi_L = 150", lambda: (20, _blinn()["c"], _peak(_blinn(), 150), 150), slow=True),
+    Quote("docs/user-guide/images.md", "(1.77, 4.18, 5.99 after one, two, three",
+          lambda: tuple(_peak(_pumped(_blinn(), "g1", k), 150) for k in (1, 2, 3)), slow=True),
+    Quote("docs/user-guide/images.md", "highlight at 1.05 = c, as 001 eq. 21",
+          lambda: (max(_peak(_pumped(_blinn(), "g2", 1), a) for a in _LIGHTS), 1, 21), slow=True),
+    Quote("docs/user-guide/images.md", "(3.59 and 5.90 after two and three",
+          lambda: tuple(_peak(_pumped(_blinn(), "g2", k), 150) for k in (2, 3)), slow=True),
+    # the fitting study: prose read from tables/fitting_study*.json
+    Quote("docs/user-guide/fitting.md", "(n = 48, c = 5.2)",
+          lambda: (_fit("ggx a=0.1 F=1", "stretched_phong")["params"]["n"],
+                   _fit("ggx a=0.1 F=1", "stretched_phong")["params"]["c"])),
+    Quote("docs/user-guide/fitting.md", "metal (alpha = 0.1) to 7.5-21 % with Fresnel 1 and 12-19 % for aluminium",
+          lambda: (0.1, 100 * _fit("ggx a=0.1 F=1", "pumped_phong_g2_3")["albedo_error"],
+                   100 * _fit("ggx a=0.1 F=1", "pumped_phong_g2_2")["albedo_error"], 1,
+                   100 * _fit("ggx a=0.1 Al", "pumped_phong_g2_2")["albedo_error"],
+                   100 * _fit("ggx a=0.1 Al", "pumped_phong_g2_3")["albedo_error"])),
+    Quote("docs/user-guide/fitting.md", "against 57 % for the\nbest unpumped model",
+          lambda: 100 * _fit("ggx a=0.1 F=1", "stretched_phong")["albedo_error"]),
+    Quote("docs/user-guide/fitting.md", "(0.958-0.974 against 0.948-0.949 at alpha = 0.1)",
+          lambda: (_fit("ggx a=0.1 F=1", "pumped_phong_g2_3")["brdf_error"],
+                   _fit("ggx a=0.1 Al", "pumped_phong_g2_2")["brdf_error"],
+                   _fit("ggx a=0.1 Al", "stretched_phong")["brdf_error"],
+                   _fit("ggx a=0.1 F=1", "stretched_phong")["brdf_error"], 0.1)),
+    Quote("docs/user-guide/fitting.md", "(2 levels: 24 % against 58 %, e_f 0.986 against 0.978)",
+          lambda: (2, 100 * _fit("beckmann a=0.1 F=1", "pumped_phong_g2_2")["albedo_error"],
+                   100 * _fit("beckmann a=0.1 F=1", "stretched_phong")["albedo_error"],
+                   _fit("beckmann a=0.1 F=1", "pumped_phong_g2_2")["brdf_error"],
+                   _fit("beckmann a=0.1 F=1", "stretched_phong")["brdf_error"])),
+    # the compensation study: prose read from tables/compensation.nc
+    Quote("docs/user-guide/compensation.md", "1.6e-5 for Blinn n = 100",
+          lambda: (_comp("blinn n=100", "scale", "furnace_residual"), 100)),
+    # the papers
+    *[Quote("docs/studies/papers.md", row, lambda level=level: (level, *_eq22_row(level)), slow=True)
+      for level, row in enumerate(("| 0 (Phong) | 0.97 | 0.21 | 0.48 |", "| 1 | 0.67 | 3.1e-7 | 0.11 |",
+                                   "| 2 | 0.36 | 0.048 | 0.19 |", "| 3 | 0.61 | 0.057 | 0.28 |",
+                                   "| 4 | 0.78 | 0.058 | 0.33 |", "| 5 | 0.91 | 0.058 | 0.36 |"))],
+    Quote("docs/studies/he-torrance.md", "# its share: 0.0054, 0.27, 0.82",
+          lambda: _he_torrance().specular_weight([1.0, 0.5, 0.17])),
+]
+
+
+@functools.cache
+def _cycles_audit():
+    """``pumpup audit tests/data/cycles_shader.tables --preset cycles`` (the README's row on Blender Cycles)."""
+    import pumpup
+
+    return pumpup.audit(os.path.join(ROOT, "tests", "data", "cycles_shader.tables"), preset="cycles")
+
+
+def _plastic_max_s() -> float:
+    """The largest albedo of plastic's specular lobe (a_s = 1, F = 1) at n = 0, over mu, as the model computes it
+    (the upper end of its error estimate).
+    """
+    from pumpup.models.metal import _plastic_max_s as max_s
+
+    return max_s(0.0, None)
+
+
+@functools.cache
+def _furnace(spec_json: str):
+    from pumpup import render
+
+    return render.furnace(json.loads(spec_json), 160)
+
+
+def _furnace_min(spec) -> float:
+    im = _furnace(json.dumps(spec, sort_keys=True))
+    return float(im.radiance[im.mask].min())
+
+
+def _furnace_centre(spec) -> float:
+    return float(_furnace(json.dumps(spec, sort_keys=True)).radiance[80, 80])
+
+
+_PHONG = {"type": "phong", "n": 20}
+_STRETCHED = {"type": "stretched_phong", "n": 20}
+_LIGHTS = (0.0, 60.0, 110.0, 130.0, 150.0)  # pumpup.plots.GRAZING
+
+
+def _peak(spec, phi) -> float:
+    """The brightest pixel of a 160 x 160 sphere under a light of irradiance 1 at Phi_L = ``phi`` degrees."""
+    from pumpup import render
+
+    return float(render.sphere(spec, phi, 160, irradiance=1.0).radiance.max())
+
+
+def _rim_mu(size: int) -> float:
+    """mu_V of the outermost pixel centre inside the unit disc of a size x size image of [-1, 1]^2."""
+    import numpy as np
+
+    x = (np.arange(size) + 0.5) / size * 2 - 1
+    r2 = x[:, None] ** 2 + x[None, :] ** 2
+    return float(np.sqrt(1 - r2[r2 < 1].max()))
+
+
+def _ggx_darkest_theta() -> float:
+    """The angle of the smallest albedo of GGX alpha = 0.3 (a grid of 0.1 degrees)."""
+    import numpy as np
+
+    theta = np.arange(0.0, 90.0, 0.1)
+    return float(theta[int(np.argmin(_albedo({"type": "ggx", "alpha": 0.3}, np.cos(np.radians(theta)))))])
+
+
+@functools.cache
+def _blinn_c() -> float:
+    from pumpup.plots import _blinn_spec
+
+    return _blinn_spec()["c"]
+
+
+def _blinn() -> dict:
+    """Blinn n = 20 at its maximum constant, as ``pumpup.plots`` draws it."""
+    return {"type": "blinn", "n": 20, "c": _blinn_c()}
+
+
+def _pumped(base, g, levels) -> dict:
+    return {"type": "pumped", "base": base, "g": g, "levels": levels}
+
+
+def _he_torrance():
+    import pumpup
+
+    return pumpup.load({"type": "he_torrance", "sigma_0": 0.1, "tau": 1.7, "wavelength": 0.55})
+
+
+@functools.cache
+def _eq22():
+    from pumpup.figures import eq22_convergence
+
+    return eq22_convergence(levels=5)
+
+
+def _eq22_row(level: int):
+    """One row of the 001 eq. 22 comparison (``pumpup.figures.eq22_convergence``, which
+    ``scripts/make/pumping_figures.py`` prints): max and median relative BRDF difference and max albedo difference
+    of g2-pumped Phong n = 20 at ``level`` against stretched Phong.
+    """
+    r = _eq22()[level]
+    return r["max_rel_brdf_diff"], r["median_rel_brdf_diff"], r["max_albedo_diff"]
