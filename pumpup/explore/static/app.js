@@ -57,6 +57,7 @@ function stateFromURL() {
 
 function writeURL() {
   const st = explore.state;
+  if (!st) return;
   const q = new URLSearchParams();
   for (const s of st.specs) q.append("s", shortSpec(s));
   if (st.active) q.set("active", st.active);
@@ -68,7 +69,8 @@ function writeURL() {
   q.set("light", st.light); if (st.light_azimuth) q.set("laz", st.light_azimuth);
   if (st.exposure !== -2) q.set("exp", st.exposure);
   if (st.lobe3d) q.set("3d", "1");
-  history.replaceState(null, "", "?" + q.toString());
+  const search = "?" + q.toString();
+  if (search !== location.search) history.replaceState(null, "", search);
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -100,14 +102,15 @@ function connect() {
 
 function request() {
   const st = explore.state;
-  writeURL();
   const id = ++explore.sent;
   sentAt[id] = performance.now();
   const msg = JSON.stringify({id, state: {
     specs: st.specs, theta_i: st.theta_i, phi: st.phi, pump: st.pump, kulla_conty: st.kulla_conty,
     scaled: st.scaled, light: st.light, light_azimuth: st.light_azimuth, lobe3d: st.lobe3d}});
-  setStatus("computing…");
   if (socket && socket.readyState === WebSocket.OPEN) socket.send(msg); else pending = msg;
+  // the page's own bookkeeping runs while the server computes
+  writeURL();
+  setStatus("computing…");
   return id;
 }
 
@@ -151,16 +154,24 @@ function onAnswer(ans) {
     throw e;
   }
   const ms = performance.now() - sentAt[ans.id];
-  setStatus(`${r.models.length} model${r.models.length > 1 ? "s" : ""}: server ${ans.ms.toFixed(0)} ms, ` +
-            `drawn ${ms.toFixed(0)} ms after the request`);
+  const status = `${r.models.length} model${r.models.length > 1 ? "s" : ""}: server ${ans.ms.toFixed(0)} ms, ` +
+                 `drawn ${ms.toFixed(0)} ms after the request`;
   explore.drawnId = ans.id;
   explore.drawn += 1;
   explore.lastMs = ms;
   explore.serverMs = ans.ms;
-  explore.ready = explore.catalog !== null;  // the views drawn and the controls built
   document.body.dataset.drawn = String(explore.drawn);
-  writeURL();
-  updateControls();
+  const chrome = () => { if (explore.sent === ans.id) setStatus(status); writeURL(); updateControls(); };
+  if (explore.ready) afterFrame(chrome);  // the views first; the controls, links and URL in the next task
+  else { chrome(); explore.ready = explore.catalog !== null; }  // the views drawn and the controls built
+}
+
+// run fn once after the next frame is painted (calls before then are merged: the newest fn runs)
+let afterFrameFn = null;
+function afterFrame(fn) {
+  const first = afterFrameFn === null;
+  afterFrameFn = fn;
+  if (first) requestAnimationFrame(() => setTimeout(() => { const f = afterFrameFn; afterFrameFn = null; f(); }, 0));
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -493,8 +504,19 @@ function decode64(text) {
   return new Float64Array(bytes.buffer);
 }
 
+// what a view drew last: a view whose inputs did not change is not drawn again (the slice and the furnace do not
+// depend on the incidence angle)
+const lastDrawn = {};
+
+function sameInputs(view, key) {
+  const old = lastDrawn[view];
+  lastDrawn[view] = key;
+  return old !== undefined && old.length === key.length && old.every((v, k) => v === key[k]);
+}
+
 function drawSlice(r) {
   const st = explore.state;
+  if (sameInputs("slice", [st.log, ...r.models.map((m) => (m.slice ? m.slice.data || m.slice.error : null))])) return;
   const traces = [];
   const n = r.models.length;
   let zmax = 0;
@@ -505,15 +527,13 @@ function drawSlice(r) {
     if (!im) return;
     const k = m.slice.n, z = [];
     for (let row = 0; row < k; row++) {
-      const line = [];
-      for (let col = 0; col < k; col++) {
-        const v = im[row * k + col];
-        line.push(st.log ? (v > 0 ? Math.log10(v) : null) : v);
-      }
-      z.push(line);
+      const line = im.subarray(row * k, row * k + k);
+      z.push(st.log ? Array.from(line, (v) => (v > 0 ? Math.log10(v) : null)) : line);
     }
     const ax = i === 0 ? "" : String(i + 1);
-    traces.push({type: "heatmap", x: m.slice.axis, y: m.slice.axis, z, coloraxis: "coloraxis",
+    // pixel centres on a uniform grid (x0, dx): plotly draws the bricks as one image
+    const a = m.slice.axis, d = a.length > 1 ? a[1] - a[0] : 90;
+    traces.push({type: "heatmap", x0: a[0], dx: d, y0: a[0], dy: d, z, coloraxis: "coloraxis",
                  xaxis: "x" + ax, yaxis: "y" + ax, name: label(m, i),
                  hovertemplate: "θh %{x:.1f}°, θd %{y:.1f}°: %{z:.4g}<extra>" + label(m, i) + "</extra>"});
   });
@@ -724,6 +744,7 @@ function drawSpheres(r) {
       box.appendChild(pair);
       dragLight(pair.querySelector(`#lit-${i}`));
       dragLight(pair.querySelector(`#lit2d-${i}`));
+      lastDrawn[`furnace-${i}`] = undefined;  // a new, blank canvas
     }
     const lit = pair.querySelector(`#lit-${i}`), lit2d = pair.querySelector(`#lit2d-${i}`);
     const errs = [];
@@ -739,8 +760,12 @@ function drawSpheres(r) {
     }
     const fc = pair.querySelector(`#furnace-${i}`);
     // the furnace at exposure 0: magenta where a(mu_V) > 1 beyond the table's bound (more light out than in)
-    if (m.furnace && !m.furnace.error) paintImage(fc, m.furnace, m.furnace.bound, 0);
-    else if (m.furnace) errs.push("furnace: " + m.furnace.error);
+    if (m.furnace && !m.furnace.error) {
+      if (!sameInputs(`furnace-${i}`, [m.furnace.data, m.furnace.bound])) paintImage(fc, m.furnace, m.furnace.bound, 0);
+    } else {
+      lastDrawn[`furnace-${i}`] = undefined;
+      if (m.furnace) errs.push("furnace: " + m.furnace.error);
+    }
     pair.querySelector(".cap").textContent = `${label(m, i)}: lit | furnace`;
     pair.querySelector(".cap").style.color = COLOURS[i];
     pair.querySelector(".err").textContent = errs.join("; ");
@@ -753,7 +778,7 @@ function drawLobe3d(r) {
   const view = $("lobe3d-view");
   const on = r.models.some((m) => m.lobe3d && !m.lobe3d.error);
   view.hidden = !on;
-  if (!on) { Plotly.purge("lobe3d"); return; }
+  if (!on) { if ($("lobe3d").data) Plotly.purge("lobe3d"); return; }
   const traces = [];
   r.models.forEach((m, i) => {
     if (!m.lobe3d || m.lobe3d.error) return;
