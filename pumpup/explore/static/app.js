@@ -531,9 +531,9 @@ function drawSlice(r) {
       z.push(st.log ? Array.from(line, (v) => (v > 0 ? Math.log10(v) : null)) : line);
     }
     const ax = i === 0 ? "" : String(i + 1);
-    // pixel centres on a uniform grid (x0, dx): plotly draws the bricks as one image
+    // pixel centres on a uniform grid (x0, dx): plotly draws one image of n x n pixels, scaled without smoothing
     const a = m.slice.axis, d = a.length > 1 ? a[1] - a[0] : 90;
-    traces.push({type: "heatmap", x0: a[0], dx: d, y0: a[0], dy: d, z, coloraxis: "coloraxis",
+    traces.push({type: "heatmap", x0: a[0], dx: d, y0: a[0], dy: d, z, zsmooth: "fast", coloraxis: "coloraxis",
                  xaxis: "x" + ax, yaxis: "y" + ax, name: label(m, i),
                  hovertemplate: "θh %{x:.1f}°, θd %{y:.1f}°: %{z:.4g}<extra>" + label(m, i) + "</extra>"});
   });
