@@ -537,10 +537,12 @@ function drawSlice(r) {
                  xaxis: "x" + ax, yaxis: "y" + ax, name: label(m, i),
                  hovertemplate: "θh %{x:.1f}°, θd %{y:.1f}°: %{z:.4g}<extra>" + label(m, i) + "</extra>"});
   });
+  const cmin = st.log ? Math.log10(Math.max(zmax, 1e-30)) - 4 : 0;
+  const cmax = st.log ? Math.log10(Math.max(zmax, 1e-30)) : zmax;
+  // the colour bar is drawn beside the plot (drawColourBar): plotly's own redraws its ticks and margins at every
+  // move, which costs more than the image
   const layout = {margin: {l: 45, r: 10, t: 25, b: 40}, grid: {rows: 1, columns: n, pattern: "independent"},
-    coloraxis: {colorscale: "Viridis", cmin: st.log ? Math.log10(Math.max(zmax, 1e-30)) - 4 : 0,
-                cmax: st.log ? Math.log10(Math.max(zmax, 1e-30)) : zmax,
-                colorbar: {title: {text: st.log ? "log10 fr" : "fr"}}},
+    coloraxis: {colorscale: VIRIDIS, cmin, cmax, showscale: false},
     annotations: r.models.map((m, i) => ({text: n > 1 ? String(i + 1) : label(m, i), showarrow: false, xref: `x${i ? i + 1 : ""} domain`,
                                          yref: `y${i ? i + 1 : ""} domain`, x: 0.5, y: 1.08, font: {color: COLOURS[i]}}))};
   for (let i = 0; i < n; i++) {
@@ -549,6 +551,37 @@ function drawSlice(r) {
     layout["yaxis" + ax] = {title: {text: i === 0 ? "θd (°)" : ""}, range: [0, 90], matches: i ? "y" : undefined};
   }
   Plotly.react("slice", traces, layout, PLOT_CONFIG);
+  drawColourBar($("slice-scale"), cmin, cmax, st.log ? "log10 fr" : "fr");
+}
+
+// plotly's Viridis
+const VIRIDIS = [[0, "#440154"], [0.06274509803921569, "#48186a"], [0.12549019607843137, "#472d7b"],
+  [0.18823529411764706, "#424086"], [0.25098039215686274, "#3b528b"], [0.3137254901960784, "#33638d"],
+  [0.3764705882352941, "#2c728e"], [0.4392156862745098, "#26828e"], [0.5019607843137255, "#21918c"],
+  [0.5647058823529412, "#1fa088"], [0.6274509803921569, "#28ae80"], [0.6901960784313725, "#3fbc73"],
+  [0.7529411764705882, "#5ec962"], [0.8156862745098039, "#84d44b"], [0.8784313725490196, "#addc30"],
+  [0.9411764705882353, "#d8e219"], [1, "#fde725"]];
+
+// a vertical colour bar: the colour scale from cmin (bottom) to cmax (top), five labelled ticks and a title
+function drawColourBar(box, cmin, cmax, title) {
+  if (!box.firstChild) {
+    box.innerHTML = '<div class="cb-title"></div><div class="cb-body"><div class="cb-ramp"></div><div class="cb-ticks"></div></div>';
+    box.querySelector(".cb-ramp").style.background =
+      `linear-gradient(to top, ${VIRIDIS.map(([t, c]) => `${c} ${(100 * t).toFixed(2)}%`).join(", ")})`;
+    const ticks = box.querySelector(".cb-ticks");
+    for (let k = 0; k < 5; k++) {
+      const t = document.createElement("span");
+      t.style.bottom = `${25 * k}%`;
+      ticks.appendChild(t);
+    }
+  }
+  box.querySelector(".cb-title").textContent = title;
+  box.dataset.cmin = String(cmin);
+  box.dataset.cmax = String(cmax);
+  box.querySelectorAll(".cb-ticks span").forEach((t, k) => {
+    const v = cmin + (k / 4) * (cmax - cmin);
+    t.textContent = Math.abs(v) >= 1e4 || (v !== 0 && Math.abs(v) < 1e-2) ? v.toExponential(1) : String(parseFloat(v.toPrecision(3)));
+  });
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -814,6 +847,9 @@ function draw(r) {
 
 async function start() {
   explore.state = stateFromURL();
+  // while the server computes the first answer, plotly draws the empty lobe and albedo axes (its first drawing of
+  // each kind of plot is the slow one)
+  plotlyReady.then(() => { if (!explore.result) { drawLobe({models: []}); drawAlbedo({models: []}); } });
   connect();
   request();  // the views are computed while the model list loads
   const res = await fetch("/api/models");
