@@ -15,8 +15,8 @@ queue included) and ``draw ms`` the page's plotting and WebGL time, both medians
 playwright and Debian's chromium.  The load average is printed first.
 
 The views are the lobe, the albedo plot with its table of numbers, the spheres and the image slice (and the 3-D lobe
-when it is on); the page updates its status line, URL, download links and code lines in the task after the frame
-that shows the views, so they are not in the time.
+when it is on); the page updates its status line, URL, download links and code lines in the same task, so the same
+frame shows them.
 
 ``--baseline DIR`` runs a second explorer from another checkout (``git archive main | tar -x -C DIR``) in the same
 browser and alternates the two move by move and start by start, so that both see the same load; the last columns are

@@ -82,7 +82,7 @@ function showMessage(text) {
   if (text) { m.textContent = text; m.hidden = false; } else { m.textContent = ""; m.hidden = true; }
 }
 
-function setStatus(text) { $("status").textContent = text; }
+function setStatus(text) { setIf($("status"), "textContent", text); }
 
 // ---------------------------------------------------------------------------------------------------------------
 // Connection: one WebSocket per tab; a newer request supersedes the one still running on the server
@@ -161,17 +161,12 @@ function onAnswer(ans) {
   explore.lastMs = ms;
   explore.serverMs = ans.ms;
   document.body.dataset.drawn = String(explore.drawn);
-  const chrome = () => { if (explore.sent === ans.id) setStatus(status); writeURL(); updateControls(); };
-  if (explore.ready) afterFrame(chrome);  // the views first; the controls, links and URL in the next task
-  else { chrome(); explore.ready = explore.catalog !== null; }  // the views drawn and the controls built
-}
-
-// run fn once after the next frame is painted (calls before then are merged: the newest fn runs)
-let afterFrameFn = null;
-function afterFrame(fn) {
-  const first = afterFrameFn === null;
-  afterFrameFn = fn;
-  if (first) requestAnimationFrame(() => setTimeout(() => { const f = afterFrameFn; afterFrameFn = null; f(); }, 0));
+  // the controls, links and URL in the same task as the views, so that one frame shows them all (only what
+  // changed is touched)
+  setStatus(status);
+  writeURL();
+  updateControls();
+  explore.ready = explore.catalog !== null;  // the views drawn and the controls built
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -289,16 +284,60 @@ function buildParams() {
   }
 }
 
+// set an element's property only when its value changes (an unchanged page is not laid out or painted again)
+function setIf(el, prop, value) { if (el[prop] !== value) el[prop] = value; }
+
 function updateControls() {
   const st = explore.state;
   const tabs = $("model-tabs");
+  const names = st.specs.map((s) => (typeof s === "string" ? s : s.type));
+  const signature = JSON.stringify([names, st.active]);
+  if (tabs.dataset.signature !== signature) buildTabs(tabs, names, signature);
+  setIf($("add-model"), "disabled", st.specs.length >= 4);
+  const canon = activeCanonical();
+  if (canon) {
+    setIf($("model-type"), "value", canon.type);
+    if (document.activeElement !== $("spec-text")) setIf($("spec-text"), "value", shortSpec(activeSpec() || canon));
+  }
+  // rebuild the parameter rows unless the user is dragging one of them
+  const focused = document.activeElement;
+  if (!(focused && focused.closest && focused.closest("#params"))) buildParams();
+  else if (canon) {
+    for (const row of document.querySelectorAll("#params .param")) {
+      const f = row.querySelector("input[type=text]");
+      const v = canon[row.dataset.param];
+      if (f && f !== focused && typeof v === "number") setIf(f, "value", String(v));
+    }
+  }
+  // the downloads take the spec as the user gave it (the canonical one also names computed defaults)
+  const spec = encodeURIComponent(JSON.stringify(activeSpec() || canon || {}));
+  setIf($("dl-spec"), "href", new URL(`/download/spec.json?spec=${spec}`, location.href).href);
+  setIf($("dl-nc"), "href", new URL(`/download/albedo.nc?spec=${spec}`, location.href).href);
+  setIf($("dl-glsl"), "href", new URL(`/download/shader.glsl?spec=${spec}`, location.href).href);
+  setIf($("dl-brdf"), "href", new URL(`/download/shader.brdf?spec=${spec}`, location.href).href);
+  setIf($("dl-mitsuba"), "href", new URL(`/download/mitsuba.json?spec=${spec}`, location.href).href);
+  setIf($("dl-lut-cycles"), "href", new URL(`/download/lut?preset=cycles&spec=${spec}`, location.href).href);
+  setIf($("dl-lut-nc"), "href", new URL(`/download/lut?preset=netcdf&spec=${spec}`, location.href).href);
+  setIf($("dl-lut-row"), "hidden",
+        !(canon && ["ggx", "beckmann", "ward", "modified_ward", "cook_torrance"].includes(canon.type)));
+  const r = explore.result;
+  const m = r && r.models[st.active];
+  const noShader = !(m && m.shader && m.shader.glsl);
+  setIf($("dl-glsl"), "hidden", noShader);
+  setIf($("dl-brdf"), "hidden", noShader);
+  if (r) { setIf($("python"), "textContent", r.lines.python); setIf($("cli"), "textContent", r.lines.cli); }
+}
+
+function buildTabs(tabs, names, signature) {
+  const st = explore.state;
+  tabs.dataset.signature = signature;
   tabs.innerHTML = "";
-  st.specs.forEach((s, i) => {
+  names.forEach((name, i) => {
     const b = document.createElement("button");
     b.type = "button";
     b.className = i === st.active ? "active" : "";
     b.style.color = COLOURS[i];
-    b.textContent = `${i + 1}: ${typeof s === "string" ? s : s.type}`;
+    b.textContent = `${i + 1}: ${name}`;
     b.addEventListener("click", () => { st.active = i; writeURL(); updateControls(); });
     tabs.appendChild(b);
     if (st.specs.length > 1) {
@@ -310,36 +349,6 @@ function updateControls() {
       tabs.appendChild(x);
     }
   });
-  $("add-model").disabled = st.specs.length >= 4;
-  const canon = activeCanonical();
-  if (canon) {
-    $("model-type").value = canon.type;
-    if (document.activeElement !== $("spec-text")) $("spec-text").value = shortSpec(activeSpec() || canon);
-  }
-  // rebuild the parameter rows unless the user is dragging one of them
-  const focused = document.activeElement;
-  if (!(focused && focused.closest && focused.closest("#params"))) buildParams();
-  else if (canon) {
-    for (const row of document.querySelectorAll("#params .param")) {
-      const f = row.querySelector("input[type=text]");
-      const v = canon[row.dataset.param];
-      if (f && f !== focused && typeof v === "number") f.value = String(v);
-    }
-  }
-  // the downloads take the spec as the user gave it (the canonical one also names computed defaults)
-  const spec = encodeURIComponent(JSON.stringify(activeSpec() || canon || {}));
-  $("dl-spec").href = `/download/spec.json?spec=${spec}`;
-  $("dl-nc").href = `/download/albedo.nc?spec=${spec}`;
-  $("dl-glsl").href = `/download/shader.glsl?spec=${spec}`;
-  $("dl-brdf").href = `/download/shader.brdf?spec=${spec}`;
-  $("dl-mitsuba").href = `/download/mitsuba.json?spec=${spec}`;
-  $("dl-lut-cycles").href = `/download/lut?preset=cycles&spec=${spec}`;
-  $("dl-lut-nc").href = `/download/lut?preset=netcdf&spec=${spec}`;
-  $("dl-lut-row").hidden = !(canon && ["ggx", "beckmann", "ward", "modified_ward", "cook_torrance"].includes(canon.type));
-  const r = explore.result;
-  const m = r && r.models[st.active];
-  $("dl-glsl").hidden = $("dl-brdf").hidden = !(m && m.shader && m.shader.glsl);
-  if (r) { $("python").textContent = r.lines.python; $("cli").textContent = r.lines.cli; }
 }
 
 function bindRange(id, apply, fmt) {
