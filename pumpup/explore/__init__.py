@@ -72,8 +72,8 @@ def serve(specs: list[str] | None = None, *, host: str = "127.0.0.1", port: int 
     from . import server
 
     sock = bind(host, port)
-    # the specs are checked before anything is served (a bad one: an error and no URL); the page's first answer
-    # then computes in the server's threads while uvicorn starts and the page loads
+    # the specs are checked before anything is served (a bad one: an error and no URL); once uvicorn runs, the page's
+    # first answer computes in the server's threads while the page loads
     try:
         app = server.create_app(specs, time_limit=server.TIME_LIMIT if time_limit is None else float(time_limit),
                                 allowed_hosts=None if host in LOCAL_HOSTS else ["*"])

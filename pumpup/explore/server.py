@@ -105,8 +105,8 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
 
     lock = threading.Lock()
     compute_lock = threading.Lock()
-    # the page's first request, computed while the server starts and the page loads plotly.js (numba's kernels
-    # load from its cache on first use): the answer waits here for the page's identical first request
+    # the page's first request, computed while the page loads plotly.js (numba's kernels load from its cache on
+    # first use): the answer waits here for the page's identical first request
     first_state = {"specs": initial or [DEFAULT_SPEC]}
     prefetched: dict[str, Any] = {}
 
@@ -123,7 +123,6 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
             except Exception:  # noqa: BLE001 - the page's own request reports any error
                 pass
 
-    pool.submit(prefetch)
 
     def models() -> list:
         with lock:
@@ -302,7 +301,10 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
 
     @contextlib.asynccontextmanager
     async def lifespan(app):
-        pool.submit(models)  # the model list is ready before the first page asks for it
+        # once uvicorn runs (not before: the imports would slow its start), the first answer and the model list are
+        # computed while the page loads
+        pool.submit(prefetch)
+        pool.submit(models)
         yield
         pool.shutdown(wait=False, cancel_futures=True)
 
