@@ -20,7 +20,7 @@ frame shows them.
 
 ``--baseline DIR`` runs a second explorer from another checkout (``git archive main | tar -x -C DIR``) in the same
 browser and alternates the two move by move and start by start, so that both see the same load; the last columns are
-its median and max and the ratio new/old.
+its median and max, the ratio new/old, and its server and drawing medians.
 """
 
 from __future__ import annotations
@@ -165,7 +165,8 @@ def main(argv=None) -> int:
                       f"{len(ready[key])}: {', '.join(f'{t:.2f}' for t in ready[key])})")
             print(f"{'case':22s} {'median ms':>10s} {'max ms':>8s} {'target':>7s} {'max/med':>8s} "
                   f"{'pumpup ms':>10s} {'ratio':>6s} {'server ms':>9s} {'draw ms':>8s}"
-                  + (f" {'old med':>8s} {'old max':>8s} {'new/old':>8s}" if args.baseline else ""))
+                  + (f" {'old med':>8s} {'old max':>8s} {'new/old':>8s} {'old srv':>8s} {'old draw':>8s}"
+                     if args.baseline else ""))
             for name in args.cases.split(","):
                 query, slider, target = CASES[name]
                 for key in roots:
@@ -187,7 +188,9 @@ def main(argv=None) -> int:
                         f"{statistics.median(m[2] for m in got['new']):8.1f}")
                 if args.baseline:
                     old = [m[0] for m in got["old"]]
-                    line += f" {statistics.median(old):8.1f} {max(old):8.1f} {med / statistics.median(old):8.2f}"
+                    line += (f" {statistics.median(old):8.1f} {max(old):8.1f} {med / statistics.median(old):8.2f}"
+                             f" {statistics.median(m[1] for m in got['old']):8.1f}"
+                             f" {statistics.median(m[2] for m in got['old']):8.1f}")
                 print(line + flag + ("" if err else "  (error shown)"), flush=True)
         finally:
             for proc, *_ in running.values():
