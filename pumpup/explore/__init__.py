@@ -69,16 +69,22 @@ def serve(specs: list[str] | None = None, *, host: str = "127.0.0.1", port: int 
     """
     import asyncio
 
-    import uvicorn
-
     from . import server
 
-    app = server.create_app(specs, time_limit=server.TIME_LIMIT if time_limit is None else float(time_limit),
-                            allowed_hosts=None if host in LOCAL_HOSTS else ["*"])
+    sock = bind(host, port)
+    # the specs are checked before anything is served (a bad one: an error and no URL); once uvicorn runs, the page's
+    # first answer computes in the server's threads while the page loads
+    try:
+        app = server.create_app(specs, time_limit=server.TIME_LIMIT if time_limit is None else float(time_limit),
+                                allowed_hosts=None if host in LOCAL_HOSTS else ["*"])
+    except BaseException:
+        sock.close()
+        raise
     if host not in LOCAL_HOSTS:
         print(f"pumpup explore: warning: listening on {host}, so other machines that reach it can use the explorer",
               file=sys.stderr)
-    sock = bind(host, port)
+    import uvicorn
+
     actual = sock.getsockname()[1]
     shown = f"[{host}]" if ":" in host else host
     url = f"http://{shown}:{actual}/"

@@ -42,19 +42,20 @@ from . import compute as C
 TIME_LIMIT = 60.0
 #: threads that compute (the numba kernels hold the GIL for short calls; two keep one tab from blocking the rest)
 WORKERS = 2
+#: the model the page opens with when the command names none
+DEFAULT_SPEC = "phong:n=20"
 
 _STATIC = resources.files(__package__) / "static"
 
 
 def plotly_js_path() -> str:
-    """The path of plotly.min.js inside the installed ``plotly`` package (an ImportError naming the extra if it is
-    not installed).
+    """The path of plotly.min.js inside the installed ``plotly`` package, found without importing the package (an
+    ImportError naming the extra if it is not installed).
     """
-    try:
-        import plotly
-    except ImportError:
-        raise ImportError("pumpup explore needs the 'explore' extra: pip install 'pumpup[explore]'") from None
-    path = os.path.join(os.path.dirname(plotly.__file__), "package_data", "plotly.min.js")
+    spec = importlib.util.find_spec("plotly")
+    if spec is None or not spec.origin:
+        raise ImportError("pumpup explore needs the 'explore' extra: pip install 'pumpup[explore]'")
+    path = os.path.join(os.path.dirname(spec.origin), "package_data", "plotly.min.js")
     if not os.path.exists(path):
         raise ImportError(f"the installed plotly package has no bundled plotly.min.js at {path}")
     return path
@@ -88,7 +89,7 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
         through a name that resolves to 127.0.0.1); by default this machine's names.
     """
     from starlette.applications import Starlette
-    from starlette.responses import FileResponse, HTMLResponse, JSONResponse, PlainTextResponse, Response
+    from starlette.responses import HTMLResponse, JSONResponse, PlainTextResponse, Response
     from starlette.routing import Route, WebSocketRoute
     from starlette.websockets import WebSocket, WebSocketDisconnect
 
@@ -97,12 +98,31 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
         initial.append(C.short_spec(C.check_spec(s).spec))
     if len(initial) > C.MAX_COMPARE:
         raise SpecError(f"pumpup explore: at most {C.MAX_COMPARE} specs, got {len(initial)}")
-    plotly_js = plotly_js_path()
+    with open(plotly_js_path(), "rb") as fh:  # sent in one piece: no file reads that wait for the GIL
+        plotly_js = fh.read()
     pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="pumpup-explore")
     catalog: dict[str, Any] = {}
 
     lock = threading.Lock()
     compute_lock = threading.Lock()
+    # the page's first request, computed while the page loads plotly.js (numba's kernels load from its cache on
+    # first use): the answer waits here for the page's identical first request
+    first_state = {"specs": initial or [DEFAULT_SPEC]}
+    prefetched: dict[str, Any] = {}
+
+    def state_key(state: Any) -> str | None:
+        try:
+            return json.dumps(C.check_state(state), sort_keys=True, default=str)
+        except (SpecError, ValueError, TypeError):
+            return None
+
+    def prefetch() -> None:
+        with compute_lock:
+            try:
+                prefetched[state_key(first_state)] = C.compute(first_state, deadline=time.monotonic() + time_limit)
+            except Exception:  # noqa: BLE001 - the page's own request reports any error
+                pass
+
 
     def models() -> list:
         with lock:
@@ -112,14 +132,14 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
 
     async def index(request):
         html = (_STATIC / "index.html").read_text(encoding="utf-8")
-        boot = json.dumps({"initial": initial or ["phong:n=20"], "time_limit": time_limit})
+        boot = json.dumps({"initial": initial or [DEFAULT_SPEC], "time_limit": time_limit})
         return HTMLResponse(html.replace("/*BOOT*/{}", boot))
 
     async def static(request):
         name = request.path_params["name"]
-        if name == "plotly.min.js":  # 4.6 MB that never changes while the server runs: the browser keeps it
-            return FileResponse(plotly_js, media_type="text/javascript",
-                                headers={"Cache-Control": "max-age=86400, immutable"})
+        if name == "plotly.min.js":  # 4.8 MB that never changes while the server runs: the browser keeps it
+            return Response(plotly_js, media_type="text/javascript",
+                            headers={"Cache-Control": "max-age=86400, immutable"})
         if name not in ("app.js", "app.css"):
             return PlainTextResponse("not found", status_code=404)
         media = "text/javascript" if name.endswith(".js") else "text/css"
@@ -141,6 +161,11 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
 
             def work():
                 with compute_lock:  # one computation at a time (the GIL and pumpup's warnings capture)
+                    if prefetched:
+                        done = prefetched.pop(state_key(state), None)
+                        prefetched.clear()  # used once, by the first request only
+                        if done is not None:
+                            return done
                     return C.compute(state, cancel=lambda: session.generation != generation, deadline=deadline)
 
             try:
@@ -276,7 +301,10 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
 
     @contextlib.asynccontextmanager
     async def lifespan(app):
-        pool.submit(models)  # the model list is ready before the first page asks for it
+        # once uvicorn runs (not before: the imports would slow its start), the first answer and the model list are
+        # computed while the page loads
+        pool.submit(prefetch)
+        pool.submit(models)
         yield
         pool.shutdown(wait=False, cancel_futures=True)
 

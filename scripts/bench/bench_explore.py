@@ -1,6 +1,6 @@
 """Benchmark of ``pumpup explore`` in headless chromium: slider release to every view redrawn, and page-ready time.
 
-    python scripts/bench/bench_explore.py [--moves 20] [--cases phong,ggx,...]
+    python scripts/bench/bench_explore.py [--moves 20] [--cases phong,ggx,...] [--baseline DIR] [--ready-runs N]
 
 Targets (issue 54): from a slider release to every view redrawn (lobe, albedo with its table, spheres, slice), over
 20 moves: the Phong family under 100 ms, every other built-in model under 300 ms, a 3-level pumped model under
@@ -13,6 +13,14 @@ same run: ``pumpup.explore.compute.compute`` of the same states called in this p
 ratio is what the server, the socket and the drawing add.  ``server ms`` is the server's time for the request (its
 queue included) and ``draw ms`` the page's plotting and WebGL time, both medians.  Needs the ``explore`` extra,
 playwright and Debian's chromium.  The load average is printed first.
+
+The views are the lobe, the albedo plot with its table of numbers, the spheres and the image slice (and the 3-D lobe
+when it is on); the page updates its status line, URL, download links and code lines in the same task, so the same
+frame shows them.
+
+``--baseline DIR`` runs a second explorer from another checkout (``git archive main | tar -x -C DIR``) in the same
+browser and alternates the two move by move and start by start, so that both see the same load; the last columns are
+its median and max, the ratio new/old, and its server and drawing medians.
 """
 
 from __future__ import annotations
@@ -77,63 +85,118 @@ def baseline(page, query: str, slider: str, moves: int) -> list[float]:
     return out
 
 
+def start(root: str, browser, env: dict) -> tuple:
+    """Start ``pumpup explore`` from the checkout ``root`` and load its page in a new browser context; the page-ready
+    time is from the command's start to the first answer drawn (``window.explore.ready``).
+
+    Returns (process, url, page, seconds until the server printed its URL, seconds until the page was ready).
+    """
+    env = dict(env, PYTHONPATH=root + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    context = browser.new_context(viewport={"width": 1400, "height": 1000})
+    page = context.new_page()
+    t0 = time.perf_counter()
+    proc = subprocess.Popen([sys.executable, "-m", "pumpup.cli", "explore", "phong:n=20", "--port", "0",
+                             "--no-browser"], stdout=subprocess.PIPE, text=True, env=env)
+    line = proc.stdout.readline()
+    url = line.split()[2]
+    t_listen = time.perf_counter() - t0
+    page.goto(url)
+    page.wait_for_function("window.explore && window.explore.ready", timeout=120_000)
+    return proc, url, page, t_listen, time.perf_counter() - t0
+
+
+def open_case(page, url: str, query: str) -> None:
+    """Load a case's page and record the states it sends (for the baseline of pumpup's own work)."""
+    page.goto(url + "?" + query)
+    page.wait_for_function("window.explore && window.explore.ready", timeout=120_000)
+    page.evaluate("""() => { window.__states = []; const send = WebSocket.prototype.send;
+        WebSocket.prototype.send = function (m) { try { window.__states.push(JSON.parse(m).state); }
+        catch (e) {} return send.call(this, m); }; }""")
+
+
+def move(page, slider: str, v: int) -> list | None:
+    """One slider move: [ms to every view redrawn, server ms, draw ms], or None if the page sent nothing."""
+    ms = page.evaluate(MOVE_JS, [slider, v])
+    return None if ms == -1 else ms
+
+
 def main(argv=None) -> int:
-    """Print the page-ready time and, per case, the slider-to-redrawn times beside pumpup's own."""
+    """Print the page-ready time and, per case, the slider-to-redrawn times beside pumpup's own (and beside another
+    checkout's, with ``--baseline``).
+    """
     ap = argparse.ArgumentParser()
     ap.add_argument("--moves", type=int, default=20)
     ap.add_argument("--cases", default=",".join(CASES))
+    ap.add_argument("--baseline", metavar="DIR",
+                    help="another checkout of pumpup (e.g. git worktree add DIR main, or git archive REV | tar -x "
+                         "-C DIR): its explorer is measured too, alternating with this one's, move by move")
+    ap.add_argument("--ready-runs", type=int, default=1,
+                    help="page-ready measurements per checkout (alternating with --baseline); the median is printed")
     args = ap.parse_args(argv)
     from playwright.sync_api import sync_playwright
 
     print(f"load average: {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} cores")
-    env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    roots = {"new": ROOT}
+    if args.baseline:
+        roots["old"] = os.path.abspath(args.baseline)
     # warm numba's cache for the cases (the target is for a warm kernel cache)
-    subprocess.run([sys.executable, "-m", "pumpup.cli", "warmup", "--quiet"], env=env, check=True)
+    for root in roots.values():
+        subprocess.run([sys.executable, "-m", "pumpup.cli", "warmup", "--quiet"], check=True,
+                       env=dict(os.environ, PYTHONPATH=root + os.pathsep + os.environ.get("PYTHONPATH", "")))
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=shutil.which("chromium"),
                                     args=["--use-angle=swiftshader", "--enable-unsafe-swiftshader"])
-        context = browser.new_context(viewport={"width": 1400, "height": 1000})
-        page = context.new_page()
-        # page ready: from the command's start to the first answer drawn
-        t0 = time.perf_counter()
-        proc = subprocess.Popen([sys.executable, "-m", "pumpup.cli", "explore", "phong:n=20", "--port", "0",
-                                 "--no-browser"], stdout=subprocess.PIPE, text=True, env=env)
+        running: dict[str, tuple] = {}
         try:
-            line = proc.stdout.readline()
-            url = line.split()[2]
-            t_listen = time.perf_counter() - t0
-            page.goto(url)
-            page.wait_for_function("window.explore && window.explore.ready", timeout=120_000)
-            t_ready = time.perf_counter() - t0
-            print(f"page ready {t_ready:.2f} s after the command (server listening after {t_listen:.2f} s; "
-                  "target < 2 s)")
+            ready: dict[str, list] = {k: [] for k in roots}
+            listen: dict[str, list] = {k: [] for k in roots}
+            for run in range(args.ready_runs):
+                for key, root in roots.items():
+                    if key in running:
+                        running[key][0].terminate()
+                        running[key][0].wait(10)
+                        running[key][2].context.close()
+                    running[key] = start(root, browser, os.environ)
+                    listen[key].append(running[key][3])
+                    ready[key].append(running[key][4])
+            for key in roots:
+                print(f"{key}: page ready {statistics.median(ready[key]):.2f} s after the command (server listening "
+                      f"after {statistics.median(listen[key]):.2f} s; target < 2 s; median of "
+                      f"{len(ready[key])}: {', '.join(f'{t:.2f}' for t in ready[key])})")
             print(f"{'case':22s} {'median ms':>10s} {'max ms':>8s} {'target':>7s} {'max/med':>8s} "
-                  f"{'pumpup ms':>10s} {'ratio':>6s} {'server ms':>9s} {'draw ms':>8s}")
+                  f"{'pumpup ms':>10s} {'ratio':>6s} {'server ms':>9s} {'draw ms':>8s}"
+                  + (f" {'old med':>8s} {'old max':>8s} {'new/old':>8s} {'old srv':>8s} {'old draw':>8s}"
+                     if args.baseline else ""))
             for name in args.cases.split(","):
                 query, slider, target = CASES[name]
-                page.goto(url + "?" + query)
-                page.wait_for_function("window.explore && window.explore.ready", timeout=120_000)
-                page.evaluate("""() => { window.__states = []; const send = WebSocket.prototype.send;
-                    WebSocket.prototype.send = function (m) { try { window.__states.push(JSON.parse(m).state); }
-                    catch (e) {} return send.call(this, m); }; }""")
-                times, server, drawing = [], [], []
+                for key in roots:
+                    open_case(running[key][2], running[key][1], query)
+                got: dict[str, list] = {k: [] for k in roots}
                 for v in positions(args.moves):
-                    ms = page.evaluate(MOVE_JS, [slider, v])
-                    if ms != -1:
-                        times.append(ms[0])
-                        server.append(ms[1])
-                        drawing.append(ms[2])
+                    for key in roots:  # alternating: both see the same load
+                        ms = move(running[key][2], slider, v)
+                        if ms is not None:
+                            got[key].append(ms)
+                page = running["new"][2]
+                times = [m[0] for m in got["new"]]
                 err = page.evaluate("document.getElementById('message').hidden")
                 base = baseline(page, query, slider, len(times))
                 med, mx, bmed = statistics.median(times), max(times), statistics.median(base)
                 flag = "" if med < target and mx < 3 * med else "  MISSED"
-                print(f"{name:22s} {med:10.1f} {mx:8.1f} {target:7d} {mx / med:8.2f} {bmed:10.1f} "
-                      f"{med / bmed:6.2f} {statistics.median(server):9.1f} {statistics.median(drawing):8.1f}"
-                      f"{flag}{'' if err else '  (error shown)'}")
+                line = (f"{name:22s} {med:10.1f} {mx:8.1f} {target:7d} {mx / med:8.2f} {bmed:10.1f} "
+                        f"{med / bmed:6.2f} {statistics.median(m[1] for m in got['new']):9.1f} "
+                        f"{statistics.median(m[2] for m in got['new']):8.1f}")
+                if args.baseline:
+                    old = [m[0] for m in got["old"]]
+                    line += (f" {statistics.median(old):8.1f} {max(old):8.1f} {med / statistics.median(old):8.2f}"
+                             f" {statistics.median(m[1] for m in got['old']):8.1f}"
+                             f" {statistics.median(m[2] for m in got['old']):8.1f}")
+                print(line + flag + ("" if err else "  (error shown)"), flush=True)
         finally:
-            proc.terminate()
-            proc.wait(10)
-        browser.close()
+            for proc, *_ in running.values():
+                proc.terminate()
+                proc.wait(10)
+            browser.close()
     return 0
 
 

@@ -57,6 +57,7 @@ function stateFromURL() {
 
 function writeURL() {
   const st = explore.state;
+  if (!st) return;
   const q = new URLSearchParams();
   for (const s of st.specs) q.append("s", shortSpec(s));
   if (st.active) q.set("active", st.active);
@@ -68,7 +69,8 @@ function writeURL() {
   q.set("light", st.light); if (st.light_azimuth) q.set("laz", st.light_azimuth);
   if (st.exposure !== -2) q.set("exp", st.exposure);
   if (st.lobe3d) q.set("3d", "1");
-  history.replaceState(null, "", "?" + q.toString());
+  const search = "?" + q.toString();
+  if (search !== location.search) history.replaceState(null, "", search);
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -80,7 +82,7 @@ function showMessage(text) {
   if (text) { m.textContent = text; m.hidden = false; } else { m.textContent = ""; m.hidden = true; }
 }
 
-function setStatus(text) { $("status").textContent = text; }
+function setStatus(text) { setIf($("status"), "textContent", text); }
 
 // ---------------------------------------------------------------------------------------------------------------
 // Connection: one WebSocket per tab; a newer request supersedes the one still running on the server
@@ -100,14 +102,15 @@ function connect() {
 
 function request() {
   const st = explore.state;
-  writeURL();
   const id = ++explore.sent;
   sentAt[id] = performance.now();
   const msg = JSON.stringify({id, state: {
     specs: st.specs, theta_i: st.theta_i, phi: st.phi, pump: st.pump, kulla_conty: st.kulla_conty,
     scaled: st.scaled, light: st.light, light_azimuth: st.light_azimuth, lobe3d: st.lobe3d}});
-  setStatus("computing…");
   if (socket && socket.readyState === WebSocket.OPEN) socket.send(msg); else pending = msg;
+  // the page's own bookkeeping runs while the server computes
+  writeURL();
+  setStatus("computing…");
   return id;
 }
 
@@ -151,16 +154,19 @@ function onAnswer(ans) {
     throw e;
   }
   const ms = performance.now() - sentAt[ans.id];
-  setStatus(`${r.models.length} model${r.models.length > 1 ? "s" : ""}: server ${ans.ms.toFixed(0)} ms, ` +
-            `drawn ${ms.toFixed(0)} ms after the request`);
+  const status = `${r.models.length} model${r.models.length > 1 ? "s" : ""}: server ${ans.ms.toFixed(0)} ms, ` +
+                 `drawn ${ms.toFixed(0)} ms after the request`;
   explore.drawnId = ans.id;
   explore.drawn += 1;
   explore.lastMs = ms;
   explore.serverMs = ans.ms;
-  explore.ready = explore.catalog !== null;  // the views drawn and the controls built
   document.body.dataset.drawn = String(explore.drawn);
+  // the controls, links and URL in the same task as the views, so that one frame shows them all (only what
+  // changed is touched)
+  setStatus(status);
   writeURL();
   updateControls();
+  explore.ready = explore.catalog !== null;  // the views drawn and the controls built
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -278,16 +284,60 @@ function buildParams() {
   }
 }
 
+// set an element's property only when its value changes (an unchanged page is not laid out or painted again)
+function setIf(el, prop, value) { if (el[prop] !== value) el[prop] = value; }
+
 function updateControls() {
   const st = explore.state;
   const tabs = $("model-tabs");
+  const names = st.specs.map((s) => (typeof s === "string" ? s : s.type));
+  const signature = JSON.stringify([names, st.active]);
+  if (tabs.dataset.signature !== signature) buildTabs(tabs, names, signature);
+  setIf($("add-model"), "disabled", st.specs.length >= 4);
+  const canon = activeCanonical();
+  if (canon) {
+    setIf($("model-type"), "value", canon.type);
+    if (document.activeElement !== $("spec-text")) setIf($("spec-text"), "value", shortSpec(activeSpec() || canon));
+  }
+  // rebuild the parameter rows unless the user is dragging one of them
+  const focused = document.activeElement;
+  if (!(focused && focused.closest && focused.closest("#params"))) buildParams();
+  else if (canon) {
+    for (const row of document.querySelectorAll("#params .param")) {
+      const f = row.querySelector("input[type=text]");
+      const v = canon[row.dataset.param];
+      if (f && f !== focused && typeof v === "number") setIf(f, "value", String(v));
+    }
+  }
+  // the downloads take the spec as the user gave it (the canonical one also names computed defaults)
+  const spec = encodeURIComponent(JSON.stringify(activeSpec() || canon || {}));
+  setIf($("dl-spec"), "href", new URL(`/download/spec.json?spec=${spec}`, location.href).href);
+  setIf($("dl-nc"), "href", new URL(`/download/albedo.nc?spec=${spec}`, location.href).href);
+  setIf($("dl-glsl"), "href", new URL(`/download/shader.glsl?spec=${spec}`, location.href).href);
+  setIf($("dl-brdf"), "href", new URL(`/download/shader.brdf?spec=${spec}`, location.href).href);
+  setIf($("dl-mitsuba"), "href", new URL(`/download/mitsuba.json?spec=${spec}`, location.href).href);
+  setIf($("dl-lut-cycles"), "href", new URL(`/download/lut?preset=cycles&spec=${spec}`, location.href).href);
+  setIf($("dl-lut-nc"), "href", new URL(`/download/lut?preset=netcdf&spec=${spec}`, location.href).href);
+  setIf($("dl-lut-row"), "hidden",
+        !(canon && ["ggx", "beckmann", "ward", "modified_ward", "cook_torrance"].includes(canon.type)));
+  const r = explore.result;
+  const m = r && r.models[st.active];
+  const noShader = !(m && m.shader && m.shader.glsl);
+  setIf($("dl-glsl"), "hidden", noShader);
+  setIf($("dl-brdf"), "hidden", noShader);
+  if (r) { setIf($("python"), "textContent", r.lines.python); setIf($("cli"), "textContent", r.lines.cli); }
+}
+
+function buildTabs(tabs, names, signature) {
+  const st = explore.state;
+  tabs.dataset.signature = signature;
   tabs.innerHTML = "";
-  st.specs.forEach((s, i) => {
+  names.forEach((name, i) => {
     const b = document.createElement("button");
     b.type = "button";
     b.className = i === st.active ? "active" : "";
     b.style.color = COLOURS[i];
-    b.textContent = `${i + 1}: ${typeof s === "string" ? s : s.type}`;
+    b.textContent = `${i + 1}: ${name}`;
     b.addEventListener("click", () => { st.active = i; writeURL(); updateControls(); });
     tabs.appendChild(b);
     if (st.specs.length > 1) {
@@ -299,36 +349,6 @@ function updateControls() {
       tabs.appendChild(x);
     }
   });
-  $("add-model").disabled = st.specs.length >= 4;
-  const canon = activeCanonical();
-  if (canon) {
-    $("model-type").value = canon.type;
-    if (document.activeElement !== $("spec-text")) $("spec-text").value = shortSpec(activeSpec() || canon);
-  }
-  // rebuild the parameter rows unless the user is dragging one of them
-  const focused = document.activeElement;
-  if (!(focused && focused.closest && focused.closest("#params"))) buildParams();
-  else if (canon) {
-    for (const row of document.querySelectorAll("#params .param")) {
-      const f = row.querySelector("input[type=text]");
-      const v = canon[row.dataset.param];
-      if (f && f !== focused && typeof v === "number") f.value = String(v);
-    }
-  }
-  // the downloads take the spec as the user gave it (the canonical one also names computed defaults)
-  const spec = encodeURIComponent(JSON.stringify(activeSpec() || canon || {}));
-  $("dl-spec").href = `/download/spec.json?spec=${spec}`;
-  $("dl-nc").href = `/download/albedo.nc?spec=${spec}`;
-  $("dl-glsl").href = `/download/shader.glsl?spec=${spec}`;
-  $("dl-brdf").href = `/download/shader.brdf?spec=${spec}`;
-  $("dl-mitsuba").href = `/download/mitsuba.json?spec=${spec}`;
-  $("dl-lut-cycles").href = `/download/lut?preset=cycles&spec=${spec}`;
-  $("dl-lut-nc").href = `/download/lut?preset=netcdf&spec=${spec}`;
-  $("dl-lut-row").hidden = !(canon && ["ggx", "beckmann", "ward", "modified_ward", "cook_torrance"].includes(canon.type));
-  const r = explore.result;
-  const m = r && r.models[st.active];
-  $("dl-glsl").hidden = $("dl-brdf").hidden = !(m && m.shader && m.shader.glsl);
-  if (r) { $("python").textContent = r.lines.python; $("cli").textContent = r.lines.cli; }
 }
 
 function bindRange(id, apply, fmt) {
@@ -493,8 +513,19 @@ function decode64(text) {
   return new Float64Array(bytes.buffer);
 }
 
+// what a view drew last: a view whose inputs did not change is not drawn again (the slice and the furnace do not
+// depend on the incidence angle)
+const lastDrawn = {};
+
+function sameInputs(view, key) {
+  const old = lastDrawn[view];
+  lastDrawn[view] = key;
+  return old !== undefined && old.length === key.length && old.every((v, k) => v === key[k]);
+}
+
 function drawSlice(r) {
   const st = explore.state;
+  if (sameInputs("slice", [st.log, ...r.models.map((m) => (m.slice ? m.slice.data || m.slice.error : null))])) return;
   const traces = [];
   const n = r.models.length;
   let zmax = 0;
@@ -505,22 +536,22 @@ function drawSlice(r) {
     if (!im) return;
     const k = m.slice.n, z = [];
     for (let row = 0; row < k; row++) {
-      const line = [];
-      for (let col = 0; col < k; col++) {
-        const v = im[row * k + col];
-        line.push(st.log ? (v > 0 ? Math.log10(v) : null) : v);
-      }
-      z.push(line);
+      const line = im.subarray(row * k, row * k + k);
+      z.push(st.log ? Array.from(line, (v) => (v > 0 ? Math.log10(v) : null)) : line);
     }
     const ax = i === 0 ? "" : String(i + 1);
-    traces.push({type: "heatmap", x: m.slice.axis, y: m.slice.axis, z, coloraxis: "coloraxis",
+    // pixel centres on a uniform grid (x0, dx): plotly draws one image of n x n pixels, scaled without smoothing
+    const a = m.slice.axis, d = a.length > 1 ? a[1] - a[0] : 90;
+    traces.push({type: "heatmap", x0: a[0], dx: d, y0: a[0], dy: d, z, zsmooth: "fast", coloraxis: "coloraxis",
                  xaxis: "x" + ax, yaxis: "y" + ax, name: label(m, i),
                  hovertemplate: "θh %{x:.1f}°, θd %{y:.1f}°: %{z:.4g}<extra>" + label(m, i) + "</extra>"});
   });
+  const cmin = st.log ? Math.log10(Math.max(zmax, 1e-30)) - 4 : 0;
+  const cmax = st.log ? Math.log10(Math.max(zmax, 1e-30)) : zmax;
+  // the colour bar is drawn beside the plot (drawColourBar): plotly's own redraws its ticks and margins at every
+  // move, which costs more than the image
   const layout = {margin: {l: 45, r: 10, t: 25, b: 40}, grid: {rows: 1, columns: n, pattern: "independent"},
-    coloraxis: {colorscale: "Viridis", cmin: st.log ? Math.log10(Math.max(zmax, 1e-30)) - 4 : 0,
-                cmax: st.log ? Math.log10(Math.max(zmax, 1e-30)) : zmax,
-                colorbar: {title: {text: st.log ? "log10 fr" : "fr"}}},
+    coloraxis: {colorscale: VIRIDIS, cmin, cmax, showscale: false},
     annotations: r.models.map((m, i) => ({text: n > 1 ? String(i + 1) : label(m, i), showarrow: false, xref: `x${i ? i + 1 : ""} domain`,
                                          yref: `y${i ? i + 1 : ""} domain`, x: 0.5, y: 1.08, font: {color: COLOURS[i]}}))};
   for (let i = 0; i < n; i++) {
@@ -529,6 +560,37 @@ function drawSlice(r) {
     layout["yaxis" + ax] = {title: {text: i === 0 ? "θd (°)" : ""}, range: [0, 90], matches: i ? "y" : undefined};
   }
   Plotly.react("slice", traces, layout, PLOT_CONFIG);
+  drawColourBar($("slice-scale"), cmin, cmax, st.log ? "log10 fr" : "fr");
+}
+
+// plotly's Viridis
+const VIRIDIS = [[0, "#440154"], [0.06274509803921569, "#48186a"], [0.12549019607843137, "#472d7b"],
+  [0.18823529411764706, "#424086"], [0.25098039215686274, "#3b528b"], [0.3137254901960784, "#33638d"],
+  [0.3764705882352941, "#2c728e"], [0.4392156862745098, "#26828e"], [0.5019607843137255, "#21918c"],
+  [0.5647058823529412, "#1fa088"], [0.6274509803921569, "#28ae80"], [0.6901960784313725, "#3fbc73"],
+  [0.7529411764705882, "#5ec962"], [0.8156862745098039, "#84d44b"], [0.8784313725490196, "#addc30"],
+  [0.9411764705882353, "#d8e219"], [1, "#fde725"]];
+
+// a vertical colour bar: the colour scale from cmin (bottom) to cmax (top), five labelled ticks and a title
+function drawColourBar(box, cmin, cmax, title) {
+  if (!box.firstChild) {
+    box.innerHTML = '<div class="cb-title"></div><div class="cb-body"><div class="cb-ramp"></div><div class="cb-ticks"></div></div>';
+    box.querySelector(".cb-ramp").style.background =
+      `linear-gradient(to top, ${VIRIDIS.map(([t, c]) => `${c} ${(100 * t).toFixed(2)}%`).join(", ")})`;
+    const ticks = box.querySelector(".cb-ticks");
+    for (let k = 0; k < 5; k++) {
+      const t = document.createElement("span");
+      t.style.bottom = `${25 * k}%`;
+      ticks.appendChild(t);
+    }
+  }
+  box.querySelector(".cb-title").textContent = title;
+  box.dataset.cmin = String(cmin);
+  box.dataset.cmax = String(cmax);
+  box.querySelectorAll(".cb-ticks span").forEach((t, k) => {
+    const v = cmin + (k / 4) * (cmax - cmin);
+    t.textContent = Math.abs(v) >= 1e4 || (v !== 0 && Math.abs(v) < 1e-2) ? v.toExponential(1) : String(parseFloat(v.toPrecision(3)));
+  });
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -724,6 +786,7 @@ function drawSpheres(r) {
       box.appendChild(pair);
       dragLight(pair.querySelector(`#lit-${i}`));
       dragLight(pair.querySelector(`#lit2d-${i}`));
+      lastDrawn[`furnace-${i}`] = undefined;  // a new, blank canvas
     }
     const lit = pair.querySelector(`#lit-${i}`), lit2d = pair.querySelector(`#lit2d-${i}`);
     const errs = [];
@@ -739,8 +802,12 @@ function drawSpheres(r) {
     }
     const fc = pair.querySelector(`#furnace-${i}`);
     // the furnace at exposure 0: magenta where a(mu_V) > 1 beyond the table's bound (more light out than in)
-    if (m.furnace && !m.furnace.error) paintImage(fc, m.furnace, m.furnace.bound, 0);
-    else if (m.furnace) errs.push("furnace: " + m.furnace.error);
+    if (m.furnace && !m.furnace.error) {
+      if (!sameInputs(`furnace-${i}`, [m.furnace.data, m.furnace.bound])) paintImage(fc, m.furnace, m.furnace.bound, 0);
+    } else {
+      lastDrawn[`furnace-${i}`] = undefined;
+      if (m.furnace) errs.push("furnace: " + m.furnace.error);
+    }
     pair.querySelector(".cap").textContent = `${label(m, i)}: lit | furnace`;
     pair.querySelector(".cap").style.color = COLOURS[i];
     pair.querySelector(".err").textContent = errs.join("; ");
@@ -753,7 +820,7 @@ function drawLobe3d(r) {
   const view = $("lobe3d-view");
   const on = r.models.some((m) => m.lobe3d && !m.lobe3d.error);
   view.hidden = !on;
-  if (!on) { Plotly.purge("lobe3d"); return; }
+  if (!on) { if ($("lobe3d").data) Plotly.purge("lobe3d"); return; }
   const traces = [];
   r.models.forEach((m, i) => {
     if (!m.lobe3d || m.lobe3d.error) return;
@@ -789,6 +856,9 @@ function draw(r) {
 
 async function start() {
   explore.state = stateFromURL();
+  // while the server computes the first answer, plotly draws the empty lobe and albedo axes (its first drawing of
+  // each kind of plot is the slow one)
+  plotlyReady.then(() => { if (!explore.result) { drawLobe({models: []}); drawAlbedo({models: []}); } });
   connect();
   request();  // the views are computed while the model list loads
   const res = await fetch("/api/models");
