@@ -226,9 +226,11 @@ __all__ = ["albedo_1d", "axis_albedo", "run"]
 
 
 def run(route: str, hint: AzimuthHint, mu: np.ndarray, rtol: float, atol: float, max_regions: int,
-        lobe_fresnel_gauss: bool = True):
+        lobe_fresnel_gauss: bool = True, seed: bool = True):
     """(value, error, converged, evaluations) of the albedo of ``hint`` at every mu (a 1-D float array) by the 1-D
-    ``route`` the routing table chose for it (:mod:`pumpup.engine.routes`).
+    ``route`` the routing table chose for it (:mod:`pumpup.engine.routes`).  ``seed`` False starts frames 0-5 from one
+    interval per piece at every mu instead of the previous mu's final intervals (the baseline of
+    ``scripts/bench/bench_polar.py``).
     """
     hint = kernel_view(hint)
     mu = np.ascontiguousarray(mu, dtype=np.float64)
@@ -281,7 +283,7 @@ def run(route: str, hint: AzimuthHint, mu: np.ndarray, rtol: float, atol: float,
         mp = numeric_params(hint, lobe_fresnel_gauss)
         mp[12] = rtol
         _integrate(frame, _RADIAL[hint.radial], float(hint.n), float(hint.p), mu, float(rtol), atol_q, budget,
-                   ROUNDING, *(_RULES[RULE]), mode, N_INIT, *_RULES["gk15"], jac, mp, val, err, conv, evals)
+                   ROUNDING, *(_RULES[RULE]), mode, N_INIT, *_RULES["gk15"], jac, mp, val, err, conv, evals, seed)
     return scale * val, np.abs(scale) * err, conv, evals
 
 
