@@ -45,8 +45,13 @@ the arc shrinks on the scale of z_s itself (tiny near grazing), so that piece is
 z_s (1 + 4^i).  Every piece is integrated by globally adaptive 10/21 Gauss-Kronrod quadrature
 (QUADPACK's qk21; ``RULE = "gk15"`` selects the engine's 7/15 rule) with a one-sided smoothing
 substitution (x = tau^2 at a square-root end, tau^2 (3 - 2 tau) at two), which turns the
-square-root behaviour at the breakpoints into smooth functions.  Every piece starts as one
-interval (``N_INIT``).
+square-root behaviour at the breakpoints into smooth functions.  The first mu of a table starts every piece as one
+interval (``N_INIT``); each later mu whose pieces match the previous mu's (their number and kinds) starts from the
+previous mu's final intervals, so that the bisections neighbouring mu share are not paid again from one interval
+(every interval keeps its own estimate, and refinement goes on until the tolerance is met: the result is one the
+adaptive rule could have reached, and it may differ from a single mu's in the last digits).  On a 257-point table at
+rtol 1e-10 this took Ward m = 0.2 from 270 to 189 evaluations per mu, stretched Phong n = 5000 from 106 to 69, and
+Phong n = 20 from 99 to 97 (``scripts/bench/bench_polar.py``).
 
 Error estimate (issue 14 item 4): per interval QUADPACK's calibration of |K - G|,
 resasc min(1, (200 |K - G| / resasc)^1.5) with its floor 50 eps resabs
@@ -119,6 +124,12 @@ the arc is integrated by a rule: the Smith microfacet models (GGX, Beckmann, alp
 G = G1(mu) G1(N.wo) or the height-correlated form, Walter et al. 2007 eq. 20; ``SmithLobe``), the V-cavity
 models with a Fresnel factor (4 F(c) min(c, 2 u mu, 2 u N.wo); ``VCavityLobe(fresnel=...)``) and Schlick's
 model (4 c N.wo / (r + (1 - r) N.wo), 000 eq. 36, under the GGX weight with alpha = sqrt(r); ``SchlickLobe(r)``).
+Ashikhmin and Shirley's lobe (4 F(c) min(N.wo, mu) / mu with Schlick's F, ``AshikhminShirleyLobe``) takes this frame
+too, but its arc is a polynomial in 1 - c = g + 2 b sin^2(beta / 2) (g = 1 - cos(theta_i - alpha) >= 0), which
+:func:`~pumpup.engine.half_arc._k_ashikhmin` integrates in closed form from the moments W_k of sin^(2k)(beta / 2),
+sums of terms >= 0; the band below the kink N.wo = mu is a difference of two arcs' moments, whose rounding bound
+(64 eps times every term) is the node's error, and where that exceeds half the node's tolerance (near grazing
+incidence) the rule below takes the node instead.  A 257-point table at rtol 1e-10 takes about 9 ms instead of 30.
 The rule is globally adaptive 7/15 Gauss-Kronrod in delta = beta0 - beta from the arc's end (where d = c - c0 =
 2 e0 sin^2(delta / 2) + b sin(beta0) sin(delta), no cancellation), cut at the kinks and jumps (the V-cavity's
 crossings, Walter's G1 switch) and, where a factor has a singularity near the arc's small end (P(N.wo) at N.wo ~ +-i

@@ -11,6 +11,7 @@ import helpers
 import numpy as np
 import pytest
 from helpers import one_d_against_the_other_engines
+from reference import ashikhmin_shirley as as_ref
 
 import pumpup
 from pumpup.core.hints import AzimuthHint, Fresnel, SchlickLobe, SmithLobe, VCavityLobe
@@ -304,3 +305,16 @@ def test_ashikhmin_closed_form_against_the_rule_and_the_geometry(rng, spec):
             kt, et = _half_arc._k_numeric(mp, *node, 1e-10, 0.0, nodes, wk, wg, 1, ibuf, iwork)
             if e <= 0.5e-10 * abs(k):
                 assert (kt, et) == (k, e)
+
+
+@pytest.mark.parametrize("spec", [{"nu": 10, "nv": 10, "rs": 0.5}, {"nu": 1, "nv": 1, "rs": 1.0}], ids=str)
+def test_ashikhmin_table_against_the_independent_quadrature(spec):
+    """A table of Ashikhmin-Shirley's albedo (the closed form on most nodes, the rule near grazing incidence, each mu
+    seeded with the previous mu's intervals) against tests/reference/ashikhmin_shirley.py's product rule, within the
+    sum of both estimates."""
+    mus = np.array([0.97, 0.2, 0.01, 1e-3])
+    a, e = pumpup.albedo(pumpup.load({"type": "ashikhmin_shirley", **spec}), mus, rtol=1e-10, return_error=True)
+    for mu, ai, ei in zip(mus, a, e):
+        r, r_err = as_ref.albedo(float(mu), **spec)
+        assert r_err < 1e-10
+        assert abs(ai - r) <= ei + r_err, (mu, ai, ei, r, r_err)
