@@ -651,17 +651,12 @@ def _bisect(pk, t0, t1, worst, m):  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True)
 def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, rounding, nodes, wk, wg,  # pragma: no cover
-               mode, n_init, inodes, iwk, iwg, jac, mp, val, err, conv, evals, seed):
+               mode, n_init, inodes, iwk, iwg, jac, mp, val, err, conv, evals):
     """Adaptive Gauss-Kronrod (the rule ``nodes``, ``wk``, ``wg``) of integral u^n K(u) du for
     every mu (without the scale); ``frame`` 0 the lobe frame (:func:`_k_closed`, :func:`_k_of_u`), 1-3 the
     half vector's (:func:`_k_half`, :func:`_k_ward`, :func:`_k_vcavity`; 4 :func:`_k_numeric` with the parameters
     ``mp``, its P(mu) set here per mu), ``radial`` 1 the Beckmann weight, 2 the GGX weight, in place of u^n
     (:func:`_pieces`).
-
-    With ``seed``, a mu whose pieces match the previous mu's (their number, kinds and which are empty) starts from the
-    previous mu's final intervals (in each piece's tau) instead of one interval per piece: neighbouring mu of a table
-    need the same bisections, and their coarse first passes are not evaluated again.  Every interval still carries its
-    own estimate, and the loop refines on until the tolerance is met, as from one interval per piece.
     """
     # (room for every piece's first intervals besides max_intervals bisections: up to PIECES_CAP pieces)
     cap, pk, t0, t1, kv, ke, buf, ibuf, iwork, itol = _buffers(max_intervals + PIECES_CAP * n_init, nodes, inodes, rtol)
@@ -670,9 +665,6 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
     v0 = np.empty(PIECES_CAP)
     w = np.empty(PIECES_CAP)
     cv1 = np.empty(PIECES_CAP)
-    prev_kinds = np.empty(PIECES_CAP, np.int64)  # the previous mu's pieces (kind, or -1 where empty)
-    prev_np = -1  # their number (-1: no partition to seed from)
-    m = 0
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -688,21 +680,8 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
         for i in range(npieces):
             live += n_init if w[i] > 0.0 else 0
         acc = 0.0
-        same = seed and npieces == prev_np
-        for i in range(npieces if same else 0):
-            if prev_kinds[i] != (kinds[i] if w[i] > 0.0 else -1):
-                same = False
-                break
-        if same:  # the previous mu's final intervals (pk, t0, t1 as it left them), evaluated for this mu
-            for j in range(m):
-                i = pk[j]
-                iacc = itol * acc / live
-                kv[j], ke[j] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[j], t1[j], nodes, wk,
-                                   wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
-                acc += max(kv[j] - ke[j], 0.0)
-        else:
-            m = 0
-        for i in range(0 if same else npieces):
+        m = 0
+        for i in range(npieces):
             if w[i] <= 0.0:
                 continue
             for j in range(n_init):
@@ -729,9 +708,6 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
         val[q] = tot
         err[q] = e + r
         conv[q] = ok
-        prev_np = npieces if ok else -1  # (a partition that did not converge is not reused)
-        for i in range(npieces):
-            prev_kinds[i] = kinds[i] if w[i] > 0.0 else -1
         evals[q] = nodes.shape[0] * (m + (m - start))  # every split evaluates two halves
 
 _RULES = {"gk15": (_NODES, _WK, _WG), "gk21": (NODES21, WK21, WG21)}

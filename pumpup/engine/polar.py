@@ -45,13 +45,8 @@ the arc shrinks on the scale of z_s itself (tiny near grazing), so that piece is
 z_s (1 + 4^i).  Every piece is integrated by globally adaptive 10/21 Gauss-Kronrod quadrature
 (QUADPACK's qk21; ``RULE = "gk15"`` selects the engine's 7/15 rule) with a one-sided smoothing
 substitution (x = tau^2 at a square-root end, tau^2 (3 - 2 tau) at two), which turns the
-square-root behaviour at the breakpoints into smooth functions.  The first mu of a table starts every piece as one
-interval (``N_INIT``); each later mu whose pieces match the previous mu's (their number and kinds) starts from the
-previous mu's final intervals, so that the bisections neighbouring mu share are not paid again from one interval
-(every interval keeps its own estimate, and refinement goes on until the tolerance is met: the result is one the
-adaptive rule could have reached, and it may differ from a single mu's in the last digits).  On a 257-point table at
-rtol 1e-10 this took Ward m = 0.2 from 270 to 189 evaluations per mu, stretched Phong n = 5000 from 106 to 69, and
-Phong n = 20 from 99 to 97 (``scripts/bench/bench_polar.py``).
+square-root behaviour at the breakpoints into smooth functions.  Every piece starts as one
+interval (``N_INIT``).
 
 Error estimate (issue 14 item 4): per interval QUADPACK's calibration of |K - G|,
 resasc min(1, (200 |K - G| / resasc)^1.5) with its floor 50 eps resabs
@@ -237,11 +232,9 @@ __all__ = ["albedo_1d", "axis_albedo", "run"]
 
 
 def run(route: str, hint: AzimuthHint, mu: np.ndarray, rtol: float, atol: float, max_regions: int,
-        lobe_fresnel_gauss: bool = True, seed: bool = True):
+        lobe_fresnel_gauss: bool = True):
     """(value, error, converged, evaluations) of the albedo of ``hint`` at every mu (a 1-D float array) by the 1-D
-    ``route`` the routing table chose for it (:mod:`pumpup.engine.routes`).  ``seed`` False starts frames 0-5 from one
-    interval per piece at every mu instead of the previous mu's final intervals (the baseline of
-    ``scripts/bench/bench_polar.py``).
+    ``route`` the routing table chose for it (:mod:`pumpup.engine.routes`).
     """
     hint = kernel_view(hint)
     mu = np.ascontiguousarray(mu, dtype=np.float64)
@@ -294,7 +287,7 @@ def run(route: str, hint: AzimuthHint, mu: np.ndarray, rtol: float, atol: float,
         mp = numeric_params(hint, lobe_fresnel_gauss)
         mp[12] = rtol
         _integrate(frame, _RADIAL[hint.radial], float(hint.n), float(hint.p), mu, float(rtol), atol_q, budget,
-                   ROUNDING, *(_RULES[RULE]), mode, N_INIT, *_RULES["gk15"], jac, mp, val, err, conv, evals, seed)
+                   ROUNDING, *(_RULES[RULE]), mode, N_INIT, *_RULES["gk15"], jac, mp, val, err, conv, evals)
     return scale * val, np.abs(scale) * err, conv, evals
 
 

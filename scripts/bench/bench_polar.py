@@ -10,10 +10,10 @@ rounds in which every path runs once, alternating, so that they share the machin
 * issue 49's row: Ashikhmin-Shirley nu = nv = 10, rs = 0.5 (``half_arc``), target under 20 ms;
 * the other models of frames 0-5 in ``scripts/bench/bench_revisions.py``.
 
-"old" is the same code with ``seed=False`` (every mu starts from one interval per piece instead of the previous mu's
-final intervals) and ``lobe_fresnel_gauss=False`` (Ashikhmin-Shirley's arcs by the adaptive 7/15 rule instead of their
-closed form), the path before issue 49's and 55's speed items.  The values of old and new must agree within their
-summed estimates.
+"old" is the same code with ``lobe_fresnel_gauss=False`` (Ashikhmin-Shirley's arcs by the adaptive 7/15 rule instead
+of their closed form, frame 5's arcs by that rule instead of Gauss-Legendre pieces), the path before issue 49's speed
+item; the other rows show that nothing else moved.  The values of old and new must agree within their summed
+estimates.
 
     PYTHONPATH=. python scripts/bench/bench_polar.py [--rounds 15]
 """
@@ -113,7 +113,7 @@ def main():
             continue
         route = parts[0][0]
         paths = {
-            "old": lambda: _polar.run(route, hint, MU, RTOL, 0.0, 10000, lobe_fresnel_gauss=False, seed=False),
+            "old": lambda: _polar.run(route, hint, MU, RTOL, 0.0, 10000, lobe_fresnel_gauss=False),
             "new": lambda: _polar.run(route, hint, MU, RTOL, 0.0, 10000),
         }
         floor_order = None

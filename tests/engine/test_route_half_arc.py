@@ -309,9 +309,8 @@ def test_ashikhmin_closed_form_against_the_rule_and_the_geometry(rng, spec):
 
 @pytest.mark.parametrize("spec", [{"nu": 10, "nv": 10, "rs": 0.5}, {"nu": 1, "nv": 1, "rs": 1.0}], ids=str)
 def test_ashikhmin_table_against_the_independent_quadrature(spec):
-    """A table of Ashikhmin-Shirley's albedo (the closed form on most nodes, the rule near grazing incidence, each mu
-    seeded with the previous mu's intervals) against tests/reference/ashikhmin_shirley.py's product rule, within the
-    sum of both estimates."""
+    """A table of Ashikhmin-Shirley's albedo (the closed form on most nodes, the rule near grazing incidence) against
+    tests/reference/ashikhmin_shirley.py's product rule, within the sum of both estimates."""
     mus = np.array([0.97, 0.2, 0.01, 1e-3])
     a, e = pumpup.albedo(pumpup.load({"type": "ashikhmin_shirley", **spec}), mus, rtol=1e-10, return_error=True)
     for mu, ai, ei in zip(mus, a, e):
