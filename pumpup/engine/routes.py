@@ -65,7 +65,8 @@ ROUTES = (*ONE_D_ROUTES, "nested", "cubature")
 class Choice:
     """Which routes the engine may take: ``engine`` one of :data:`ENGINES`; ``without``, route names left out (the
     tests' and calibrations' second route for a model); ``lobe_fresnel_gauss``: the ``lobe_fresnel`` route's arcs by
-    Gauss-Legendre pieces with an a-priori bound (else the adaptive 7/15 rule); ``generic_check``: the 2-D cubature
+    Gauss-Legendre pieces with an a-priori bound, and Ashikhmin-Shirley's arcs on the ``half_arc`` route in closed form
+    (else both by the adaptive 7/15 rule); ``generic_check``: the 2-D cubature
     checks a user function's kinks on a grid first.
     """
 

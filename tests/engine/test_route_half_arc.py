@@ -11,6 +11,7 @@ import helpers
 import numpy as np
 import pytest
 from helpers import one_d_against_the_other_engines
+from reference import ashikhmin_shirley as as_ref
 
 import pumpup
 from pumpup.core.hints import AzimuthHint, Fresnel, SchlickLobe, SmithLobe, VCavityLobe
@@ -19,6 +20,7 @@ from pumpup.engine import half_frames as _half_frames
 from pumpup.engine import hint_view as _hint_view
 from pumpup.engine import lobe_fresnel as _lobe_fresnel
 from pumpup.engine import outer_rule as _outer_rule
+from pumpup.engine.lobe_frame import INNER_MAX
 
 MU = [1.0, 0.99, 0.9, math.sqrt(3) / 2, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8]
 
@@ -223,3 +225,95 @@ def test_a_renderers_table_at_its_tolerance(shadowing):
                 warnings.simplefilter("ignore")
                 c, ec = pumpup.albedo(f, mu[2:], return_error=True, rtol=1e-12)
             assert np.all(np.abs(b[2:] - c) <= eb[2:] + ec), (alpha, (np.abs(b[2:] - c) / (eb[2:] + ec)).max())
+
+
+_EPS = float(np.finfo(float).eps)
+
+
+def _as_node(mu, u):
+    """(mu, s, psi, u, sa) of a node of frame 4."""
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    return mu, s, math.atan2(mu, s), u, math.sqrt((1.0 - u) * (1.0 + u))
+
+
+def _as_samples(rng, n):
+    """Random (mu, rs, u) from normal to grazing incidence, rs at 0, 1 and between."""
+    mus = np.concatenate([[1.0, 0.999999], rng.uniform(0, 1, n), 10 ** rng.uniform(-5, 0, n)])
+    for mu in mus:
+        for rs in (0.0, 1.0, float(rng.uniform())):
+            yield float(mu), rs, float(rng.uniform(1e-3, 1.0))
+
+
+def test_w_moments_against_mpmath():
+    """W_k(x) = integral_0^x sin^(2k)(t / 2) dt (the series, the Fourier form and the downward recurrence of
+    _w_moments) against 150-digit mpmath's Fourier form (which cancels by x^-12 at small x), from x = 1e-6 to pi and
+    on both sides of W_SERIES_MAX."""
+    mpmath = pytest.importorskip("mpmath")
+    out = np.empty(13)
+    for x in (1e-6, 1e-3, 0.1, 0.7, 1.5, 2.0, _half_arc.W_SERIES_MAX * (1 - 1e-12), _half_arc.W_SERIES_MAX, 2.9,
+              math.pi):
+        _half_arc._w_moments(x, out)
+        for k in range(7):
+            with mpmath.workdps(150):
+                xm = mpmath.mpf(x)
+                ref = (mpmath.binomial(2 * k, k) * xm + 2 * sum(
+                    (-1) ** j * mpmath.binomial(2 * k, k - j) * mpmath.sin(j * xm) / j for j in range(1, k + 1))) / 4**k
+            assert abs(out[k] - float(ref)) <= 8 * _EPS * float(ref), (x, k, out[k], ref)
+
+
+def test_ashikhmin_closed_form_matches_its_numpy_twin(rng):
+    """_k_ashikhmin (series, recurrences, exact angle forms) against as_arc_reference (plain arc ends, W_k by a
+    48-point Gauss-Legendre rule) within the kernel's rounding bound."""
+    mp = np.zeros(_half_arc.MP_SIZE)
+    mp[0] = _half_arc.ASHIKHMIN
+    ws = np.empty(15)
+    for mu, rs, u in _as_samples(rng, 40):
+        mp[4] = rs
+        k, e = _half_arc._k_ashikhmin(mp, *_as_node(mu, u), ws)
+        ref = _half_arc.as_arc_reference(rs, mu, u)[0]
+        assert abs(k - ref) <= e, (mu, rs, u, k, ref, e)
+
+
+@pytest.mark.parametrize("spec", [{"type": "ashikhmin_shirley", "nu": 10, "nv": 10, "rs": 0.5},
+                                  {"type": "ashikhmin_shirley", "nu": 200, "nv": 200, "rs": 0.02},
+                                  {"type": "ashikhmin_shirley", "nu": 1, "nv": 1, "rs": 1.0}])
+def test_ashikhmin_closed_form_against_the_rule_and_the_geometry(rng, spec):
+    """Ashikhmin-Shirley's K(u) in closed form against the adaptive rule on h's arc (which _k_numeric takes where the
+    closed form's rounding bound exceeds the tolerance) within the sum of their errors, and against the integral of
+    the model's own numpy formula (numeric_integrand_reference, scipy's QUADPACK) within its bound and 1e-12; and
+    _k_numeric returns the closed form where its bound meets the tolerance."""
+    f = pumpup.load(spec)
+    hint = _hint_view.kernel_view(f.azimuth_hint())
+    mp = _half_arc.numeric_params(hint)
+    assert mp[0] == _half_arc.ASHIKHMIN
+    nodes, wk, wg = _outer_rule._RULES["gk15"]
+    ws, ibuf, iwork = np.empty(15), np.empty(15), np.empty((4, INNER_MAX))
+    n = float(hint.n)
+    for mu in (1.0, 0.9, 0.6, 0.3, 0.05, 1e-3):
+        th = math.acos(mu)
+        a_f, a_lo = math.pi / 4 - th / 2, math.pi / 4 + th / 2
+        angles = np.concatenate([rng.uniform(0, a_lo, 4), [a_f * (1 - 1e-9), a_f * (1 + 1e-9), th / 2, th, 0.0]])
+        us = np.cos(angles[(angles >= 0) & (angles < a_lo)])
+        geometry = _half_arc.numeric_integrand_reference(f, mu, us)
+        for u, q in zip(us, geometry):
+            node = _as_node(mu, float(u))
+            k, e = _half_arc._k_ashikhmin(mp, *node, ws)
+            ka, ea = _half_arc._k_numeric(mp, *node, 1e-14, 0.0, nodes, wk, wg, 1, ibuf, iwork)  # the rule
+            assert abs(k - ka) <= e + ea, (mu, u, k, ka, e, ea)
+            if np.isfinite(q) and u**n > 1e-200:
+                assert abs(k - q) <= e + 1e-12 * abs(q), (mu, u, k, q, e)
+            kt, et = _half_arc._k_numeric(mp, *node, 1e-10, 0.0, nodes, wk, wg, 1, ibuf, iwork)
+            if e <= 0.5e-10 * abs(k):
+                assert (kt, et) == (k, e)
+
+
+@pytest.mark.parametrize("spec", [{"nu": 10, "nv": 10, "rs": 0.5}, {"nu": 1, "nv": 1, "rs": 1.0}], ids=str)
+def test_ashikhmin_table_against_the_independent_quadrature(spec):
+    """A table of Ashikhmin-Shirley's albedo (the closed form on most nodes, the rule near grazing incidence) against
+    tests/reference/ashikhmin_shirley.py's product rule, within the sum of both estimates."""
+    mus = np.array([0.97, 0.2, 0.01, 1e-3])
+    a, e = pumpup.albedo(pumpup.load({"type": "ashikhmin_shirley", **spec}), mus, rtol=1e-10, return_error=True)
+    for mu, ai, ei in zip(mus, a, e):
+        r, r_err = as_ref.albedo(float(mu), **spec)
+        assert r_err < 1e-10
+        assert abs(ai - r) <= ei + r_err, (mu, ai, ei, r, r_err)
