@@ -672,6 +672,7 @@ class _HsTable:
 def _lewis_code(b: BRDF) -> str:
     tab = _HsTable(float(b.p["n"]))
     p = tab.pieces
+    hs = p.value(0, "b", "t")
     return p.glsl() + f"""\
 const float pumpup_n = {_lit(b.p["n"])};  // baked: H_s's table is made for it
 vec2 pumpup_base(vec3 l, vec3 v) {{
@@ -679,7 +680,7 @@ vec2 pumpup_base(vec3 l, vec3 v) {{
     float ekd = pumpup_k_rho * 0.318309886 * (2.0 * pumpup_U + 5.0 * pumpup_U * (1.0 - pumpup_k_sigma));
     float rv = 2.0 * l.z * v.z - dot(l, v);  // (R_l.V), 000 eq. 9 (absolute error <= 8 U)
     if (rv <= 0.0) return vec2(kd, ekd / max(kd, 1e-37) + pumpup_U);
-{_power_lines("rv", "11.6 * pumpup_U", "pumpup_n")}{p.locate("", "l.z")}    float hs = {p.value(0, "b", "t")};  // H_s(N.S), 002 sec. 4.1
+{_power_lines("rv", "11.6 * pumpup_U", "pumpup_n")}{p.locate("", "l.z")}    float hs = {hs};  // H_s(N.S), 002 sec. 4.1
     float spec = pumpup_k_rho * pumpup_k_sigma * pw / hs;  // 002 eq. 22 with F_s = (R_l.V)^n, 002 eq. 5
     float f = kd + spec;
     return vec2(f, (ekd + spec * (pe + {_lit(_up32(tab.rel))} + 6.0 * pumpup_U)) / max(f, 1e-37) + pumpup_U);
@@ -740,9 +741,9 @@ def error_bound_text() -> dict[str, str]:
         "phong_shader": "max(U, phong's + 9 U) + 2 U",
         "phong_blinn": "max(U, blinn's) + 2 U",
         "lafortune": "as phong with the lobe's absolute error 8 U (|cx| + |cy| + |cz|) and the max(N.L, N.V)^p term",
-        "torrance_sparrow": "D's + Fresnel + 96 U; D1 e(x, s/2 (error of ln(1 + tan^2) + 22 U tan^2/(1 + tan^2)) + 2 U |x|) "
-                            "+ 2 U, D2 e(-x, x (4e-8 + 110 U)) + 2 U (an atan of relative error 2e-8), D3 128 U, D4 "
-                            "e(-x, 31 U x) + 64 U",
+        "torrance_sparrow": "D's + Fresnel + 96 U; D1 e(x, s/2 (error of ln(1 + tan^2) + 22 U tan^2/(1 + tan^2)) "
+                            "+ 2 U |x|) + 2 U, D2 e(-x, x (4e-8 + 110 U)) + 2 U (an atan of relative error 2e-8), "
+                            "D3 128 U, D4 e(-x, 31 U x) + 64 U",
         "oren_nayar": "(16 U A + 24 U r + 3 U B (|Lx Vx| + |Ly Vy|) / max(N.L, N.V)) / (A + r) + 8 U, "
                       "r = B max(0, Lx Vx + Ly Vy) / max(N.L, N.V)",
         "ashikhmin_shirley": "(the lobe x (e(x, e/2 (error of ln(1 + tan^2) + 22 U tan^2/(1 + tan^2)) + 48 U |x|) + "
@@ -861,42 +862,67 @@ def _poly_error(coef: np.ndarray, w: np.ndarray, delta: np.ndarray) -> np.ndarra
 #: cells per octave of the piece index (the float32 bits of the variable, as pumpup's kernel uses the float64 bits):
 #: at least 2^_CELL_BITS, more (up to 2^_CELL_BITS_MAX) until no cell holds more than two piece starts
 _CELL_BITS = 4
-_CELL_BITS_MAX = 6
+_CELL_BITS_MAX = 10
 #: the most cells of one index (4-byte ints in the source)
 _CELLS_MAX = 2048
 
 
-def _cells(b: np.ndarray, bits: int) -> tuple[int, int, int, np.ndarray, int]:
-    """(shift, cbase, ncell, first piece of each cell, most piece starts in a cell) of 2^bits cells per octave."""
+#: the cosine above which the piece index has its finer cells (most cosines, and most pieces, lie above it)
+_FINE_FROM = 0.25
+
+
+def _cells(b: np.ndarray, bits: int, start: float, end: float) -> tuple[int, int, int, np.ndarray, int]:
+    """(shift, cbase, ncell, first piece of each cell, most piece starts in a cell) of 2^bits cells per octave from the
+    cell of ``start`` up to the cell of ``end``.
+    """
     n = len(b)
     shift = 23 - bits
-    cbase = int(int(b.view(np.uint32)[0]) >> shift)
-    cend = int(np.array([1.0], np.float32).view(np.uint32)[0] >> shift)
+    cbase = int(int(np.array([start], np.float32).view(np.uint32)[0]) >> shift)
+    cend = int(int(np.array([end], np.float32).view(np.uint32)[0]) >> shift)
     ncell = max(cend - cbase + 1, 1)
     starts = ((np.arange(ncell, dtype=np.int64) + cbase) << shift).astype(np.uint32).view(np.float32)
     ends = ((np.arange(ncell, dtype=np.int64) + cbase + 1) << shift).astype(np.uint32).view(np.float32)
+    starts = np.maximum(starts, np.float32(start))
+    ends = np.minimum(ends, np.float32(np.nextafter(np.float32(end), np.float32(np.inf))))
     first = np.clip(np.searchsorted(b, starts, side="right") - 1, 0, n - 1)
     last = np.clip(np.searchsorted(b, ends, side="left") - 1, 0, n - 1)
     return shift, cbase, ncell, first, int(np.max(last - first)) + 1
 
 
+def _choose_cells(b: np.ndarray, start: float, end: float, most: int):
+    """:func:`_cells` with bits from _CELL_BITS up until no cell holds more than two piece starts, within ``most``
+    cells.
+    """
+    bits = _CELL_BITS
+    got = _cells(b, bits, start, end)
+    while got[4] > 2 and bits < _CELL_BITS_MAX:
+        nxt = _cells(b, bits + 1, start, end)
+        if nxt[2] > most:
+            break
+        bits += 1
+        got = nxt
+    return got
+
+
 def _search(bounds32: np.ndarray, nm: str, var: str = "m") -> tuple[str, str]:
     """GLSL of ``int {nm}_piece(float var)``: the largest s with ``{nm}_b[s] <= var`` (``var`` >= the first bound, a
     float32 > 0): the cell of ``var`` from its float32 bits (2^bits cells per octave, as
-    :func:`pumpup.physics.lookups.g_product` finds a piece from the float64 bits; bits from _CELL_BITS up until a cell
-    holds at most two piece starts, within _CELLS_MAX cells), the first candidate piece of the cell, then a binary
-    search of fixed length over the cell's pieces, without branches (the bounds array is padded with float32's
-    largest value, so the steps need no range check).  (arrays, code).
+    :func:`pumpup.physics.lookups.g_product` finds a piece from the float64 bits; below _FINE_FROM and above it bits
+    each from _CELL_BITS up until a cell holds at most two piece starts, within _CELLS_MAX cells in all), the first
+    candidate piece of the cell, then a binary search of fixed length over the cell's pieces, without branches (the
+    bounds array is padded with float32's largest value, so the steps need no range check).  (arrays, code).
     """
     b = np.asarray(bounds32, dtype=np.float32)
-    bits = _CELL_BITS
-    shift, cbase, ncell, first, count = _cells(b, bits)
-    while count > 2 and bits < _CELL_BITS_MAX:
-        nxt = _cells(b, bits + 1)
-        if nxt[2] > _CELLS_MAX:
-            break
-        bits += 1
-        shift, cbase, ncell, first, count = nxt
+    lo = float(b[0])
+    split = max(_FINE_FROM, lo)
+    fine = _choose_cells(b, split, 1.0, _CELLS_MAX // 2)
+    fs, fbase, nfine, ffirst, fcount = fine
+    if lo < split:
+        coarse = _choose_cells(b, lo, split, _CELLS_MAX // 2)
+        cs, cbase, ncoarse, cfirst, ccount = coarse
+    else:
+        cs, cbase, ncoarse, cfirst, ccount = 19, 0, 0, np.zeros(0, np.int64), 1
+    count = max(fcount, ccount)
     k = 1
     while k < count:
         k *= 2
@@ -906,10 +932,18 @@ def _search(bounds32: np.ndarray, nm: str, var: str = "m") -> tuple[str, str]:
     while k >= 1:
         steps.append(f"    i += {nm}_b[i + {k}] <= {var} ? {k} : 0;")
         k //= 2
+    first = np.concatenate([cfirst, ffirst])
+    ncell = len(first)
     vals = ", ".join(str(int(x)) for x in first)
     arrays = _array(f"{nm}_b", np.concatenate([b, pad])) + f"const int {nm}_cs[{ncell}] = int[{ncell}]({vals});\n"
+    fine_c = f"clamp(int(u >> {fs}u) - {fbase - ncoarse}, {ncoarse}, {ncell - 1})"
+    if ncoarse:
+        cell = (f"{var} >= {_lit(split)} ? {fine_c} : clamp(int(u >> {cs}u) - {cbase}, 0, {ncoarse - 1})")
+    else:
+        cell = fine_c
     code = (f"int {nm}_piece(float {var}) {{\n"
-            f"    int i = {nm}_cs[clamp(int(floatBitsToUint({var}) >> {shift}u) - {cbase}, 0, {ncell - 1})];\n"
+            f"    uint u = floatBitsToUint({var});\n"
+            f"    int i = {nm}_cs[{cell}];\n"
             + "".join(st + "\n" for st in steps) + "    return i;\n}\n")
     return arrays, code
 
@@ -1054,6 +1088,21 @@ class _Pieces:
         self.c32, self.ih32 = center.astype(np.float32), ih32
         self.npieces = len(lo)
 
+    def values(self, m) -> np.ndarray:
+        """The plain numpy reference of the shader's look-up at float32 cosines ``m`` (>= the first lower end): every
+        function's value, (functions,) + m's shape, from the float32 coefficients in double precision.
+        """
+        m = np.asarray(m, dtype=np.float32)
+        s = np.clip(np.searchsorted(self.lo32, m, side="right") - 1, 0, self.npieces - 1)
+        t = (m.astype(np.float64) - self.c32[s].astype(np.float64)) * self.ih32[s].astype(np.float64)
+        out = []
+        for j in range(self.nfun):
+            v = np.zeros(m.shape)
+            for r in range(self.deg + 1):
+                v = v * t + self.coef32[s, j, r].astype(np.float64)
+            out.append(v)
+        return np.stack(out)
+
     def glsl(self) -> str:
         """The arrays and ``int {name}_piece(float m)``; :meth:`value` writes a function's value from the piece."""
         nm = self.name
@@ -1069,7 +1118,8 @@ class _Pieces:
         o = j * (d + 1)
         expr = f"{nm}_c[{base} + {o}]"
         for r in range(1, d + 1):
-            expr = f"{expr} * {t} + {nm}_c[{base} + {o + r}]" if r == 1 else f"({expr}) * {t} + {nm}_c[{base} + {o + r}]"
+            head = expr if r == 1 else f"({expr})"
+            expr = f"{head} * {t} + {nm}_c[{base} + {o + r}]"
         return expr
 
     def locate(self, var: str, m: str) -> str:
@@ -1088,7 +1138,8 @@ FIT_TOL = 1e-8
 
 def _kinks(looks, controlled, br: np.ndarray) -> np.ndarray:
     """Values of m in the range of ``br`` where a level's g switches term (its uncapped bound crosses its cap, or, g2,
-    its bound crosses m: 001 eq. 21), from the sign changes on ``br`` and its geometric midpoints (brentq)."""
+    its bound crosses m: 001 eq. 21), from the sign changes on ``br`` and its geometric midpoints (brentq).
+    """
     from scipy.optimize import brentq
 
     grid = np.unique(np.concatenate([br, np.sqrt(br[:-1] * br[1:])]))
@@ -1144,7 +1195,8 @@ def _param_decls(plan: _Plan) -> str:
 
 def _inf_below(lk, t32: float) -> float:
     """The smallest value of a level's bound at float32 cosines in (0, ``t32``) (as :func:`_sup_below`, lowered by
-    1e-9 of itself)."""
+    1e-9 of itself).
+    """
     x0 = math.exp(lk.logx[0])
     lo = math.log(2.0**-149)
     ends = [lk.v0 * math.exp(lk.slope0 * (z - lk.logx[0])) for z in (lo, min(math.log(t32), lk.logx[0]))]
@@ -1157,7 +1209,8 @@ def _inf_below(lk, t32: float) -> float:
 class _PumpedTables:
     """What a pumped chain's shader reads: the product table (every level's bound increases: G(m), m = max(N.wi,
     N.wo)), else the level table (every level's bound on one set of pieces in m), else each level's spline in ln mu;
-    below the tables' lower end ``t32`` (1e-8 for pumpup's tables), each level's largest bound there (``sup``)."""
+    below the tables' lower end ``t32`` (1e-8 for pumpup's tables), each level's largest bound there (``sup``).
+    """
 
     def __init__(self, plan: _Plan):
         from .operators.pumping import _ProductError
@@ -1260,8 +1313,8 @@ float pumpup_g(float mi, float mo) {{
         return "".join(out), notes, nlev
     q = tabs.table
     out.append(q.glsl())
-    notes.append(f"level table: every level's bound U_j(m) on one set of {q.npieces} pieces (degree {q.deg} in m) for m "
-                 f">= {tabs.t32:.9g}, fitted to {FIT_TOL:g}, raised by twice its fit and float32 errors (<= "
+    notes.append(f"level table: every level's bound U_j(m) on one set of {q.npieces} pieces (degree {q.deg} in m) for "
+                 f"m >= {tabs.t32:.9g}, fitted to {FIT_TOL:g}, raised by twice its fit and float32 errors (<= "
                  f"{q.rel:.3g} relative); below it each level's largest bound there: "
                  + ", ".join(f"{c:.9g}" for c in tabs.sup))
     body = []
@@ -1286,7 +1339,8 @@ float pumpup_g(float mi, float mo) {{
 
 class _CompTables:
     """What a compensation's shader reads for U >= E: the product table of U in m (:class:`_Pieces`) above its lower
-    end ``t32``, U's largest value below it (``sup``); or, without a product table, the spline in ln mu."""
+    end ``t32``, U's largest value below it (``sup``); or, without a product table, the spline in ln mu.
+    """
 
     def __init__(self, plan: _Plan):
         bound = plan.comp.bound

@@ -84,7 +84,8 @@ def load_other(path: str):
 
 def evaluation_times(pairs: int, repeat: int, other=None) -> None:
     """Print the cost per pair of each case's GLSL on llvmpipe, and its ratio to its base's (and, with ``other``, the
-    same for that module's shaders, the draws alternating)."""
+    same for that module's shaders, the draws alternating).
+    """
     import moderngl
 
     ctx = moderngl.create_standalone_context(backend="egl", require=430)

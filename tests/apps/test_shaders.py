@@ -372,3 +372,33 @@ def test_cli_shader(tmp_path):
     r = subprocess.run([sys.executable, "-m", "pumpup.cli", "shader", "phong:n=20", "--target", "cuda"],
                        capture_output=True, text=True, env=env)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+
+
+# --- the tables in m: at least the bounds pumpup divides by (no GL needed) --------------------------------------------
+
+
+def test_shader_tables_are_at_least_pumpups_bounds():
+    from pumpup.shaders import _Plan, _PumpedTables
+
+    rng = np.random.default_rng(2)
+    for spec in ({"type": "pumped", "base": GGX, "g": "g2", "levels": 3},
+                 {"type": "pumped", "base": PHONG, "g": "g1", "levels": 3}):
+        f = pumpup.load(spec)
+        tabs = _PumpedTables(_Plan(f))
+        m = np.unique(np.concatenate([10.0 ** rng.uniform(np.log10(tabs.t32), 0.0, 20000),
+                                      rng.uniform(0.9, 1.0, 20000), [tabs.t32, 1.0]]).astype(np.float32))
+        m64 = m.astype(np.float64)
+        if tabs.table is not None:  # every level's U_j, which pumpup's level-by-level path divides by
+            got, want = tabs.table.values(m), np.stack([lk.upper(m64) for lk in tabs.looks])
+            rel = tabs.table.rel
+        else:  # pumpup's product table G(m) (scaled up by its epsilon)
+            got, want = tabs.product.values(m), f.product()(m64)[None]
+            rel = tabs.product.rel
+        assert np.all(got >= want), spec
+        # (the float32 evaluation may fall below the double-precision polynomial by half the raise)
+        assert np.all(got <= want * (1.0 + rel)), (spec, float(np.max(got / want - 1.0)), rel)
+        # below the lower end: the constants are at least every bound there
+        below = np.float32(tabs.t32) * np.float32(0.5) ** np.arange(1, 120, 7, dtype=np.float32)
+        below = below[below > 0]
+        for lk, sup in zip(tabs.looks, tabs.sup):
+            assert np.all(lk.upper(below.astype(np.float64)) <= sup)
