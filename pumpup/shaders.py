@@ -2,9 +2,12 @@
 
 ``pumpup.shader(spec, target="glsl")`` turns a closed-form model, a ``pumped`` chain of it (g1 or g2, any number of
 levels) or a compensated one (``kulla_conty``, ``scaled``) into source code.  The pumped levels' albedo bounds and the
-compensation's bound U >= E go in as constant arrays, piece for piece as pumpup's compiled kernels read them
-(:mod:`pumpup.physics.lookups`): a level's spline pieces in ln(mu) (a power law below its first node, at most its cap)
-and, where pumpup has one, the product table G(m) of polynomial pieces in m = max(N.wi, N.wo).
+compensation's bound U >= E go in as constant arrays of polynomial pieces in the cosine m, fitted for float32
+(:data:`FIT_TOL`): where every level's bound increases, the product G(m) of all levels' g at m = max(N.wi, N.wo) (as
+pumpup's product table, :class:`pumpup.operators.pumping._Product`); otherwise every level's bound on one shared set of
+pieces (as pumpup's level table, :class:`pumpup.operators.pumping._LevelTable`), so that one piece search per cosine
+serves every level (:class:`_Pieces`); below the tables' lower end (1e-8) the bounds' largest values there.  The code
+has no branches on the cosines: a software rasteriser runs every branch of a group of pixels.
 
 Conventions of the ``glsl`` and ``glsl-es`` targets (a library snippet: a header comment, no ``#version`` line, no
 ``precision`` line, no ``main``; every global name starts with ``pumpup_``)::
@@ -23,8 +26,9 @@ error (first-order propagation of the roundings with the accuracy GLSL specifies
 rounded, / 2.5 ULP, exp and exp2 (3 + 2|x|) ULP, log and log2 an absolute 2^-21 inside [0.5, 2] and 3 ULP outside,
 inversesqrt 2 ULP; the float32 rounding of the parameters included).  A pumped or compensated model multiplies its base
 value by 1 - 2 B and reads table pieces whose constant terms were raised, in double precision before the rounding to
-float32, by twice the worst float32 error of the piece (Horner's rule, the rounding of the coefficients and of the
-variable), so that every bound it divides by is at least pumpup's, and the result is rounded down once more for the
+float32, by twice the fit's largest miss, pumpup's own table's epsilon and twice the worst float32 error of the piece
+(Horner's rule, the rounding of the coefficients and of the variable), so that every bound it divides by is at least
+pumpup's, and the result is rounded down once more for the
 final products and quotient: the shader's value is never above pumpup's double-precision value at the same
 (float32) directions, and the exported BRDF keeps its albedo <= 1 (001 eq. 18), as the Mitsuba plugin does
 (:mod:`pumpup.mitsuba`).
@@ -1226,9 +1230,9 @@ class _PumpedTables:
         # above it every level is on its spline (as pumpup's tables: pumping._Product, pumping._LevelTable)
         mlo = max(max(lk.mu0, math.exp(lk.logx[0])) for lk in self.looks) * (1.0 + 1e-12)
         try:
-            if prod is not None:  # pumpup divides by its product table, at least G by its epsilon
+            if prod is not None:  # pumpup divides by its product table: G (1 + epsilon), its miss <= epsilon / 2
                 self.product = _fit_table([prod.exact], self.looks, self.controlled, prod.mlo,
-                                          prod.epsilon + 4 * np.finfo(float).eps, "pumpup_product")
+                                          2.0 * prod.epsilon + 4 * np.finfo(float).eps, "pumpup_product")
                 mlo = prod.mlo
             else:  # pumpup divides by its level table (at most each U_j) or level by level (U_j)
                 self.table = _fit_table([lk.upper for lk in self.looks], self.looks, self.controlled, mlo, 0.0,
@@ -1355,7 +1359,7 @@ class _CompTables:
 
             try:
                 table = _fit_table([bound.product.exact], [self.lookup], [False], bound.product.mlo,
-                                   bound.product.epsilon + 4 * np.finfo(float).eps, "pumpup_eprod")
+                                   2.0 * bound.product.epsilon + 4 * np.finfo(float).eps, "pumpup_eprod")
             except _ProductError:
                 table = None
         if table is not None:
