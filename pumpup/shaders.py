@@ -663,6 +663,9 @@ class _HsTable:
         (coef,), lo, hi, center, half, worst = fit_pieces([hs], br[:-1], br[1:], self.TOL, "H_s table")
         self.lo, self.center, self.ihalf = lo, center, 1.0 / half
         pieces = _Pieces(lo, center, 1.0 / half, [coef], 0.0, "pumpup_hs", raise_=False)
+        # the first piece, [0, lo[1]), is found from max(mu, lo[1] / 2): the index then starts there, not at 0
+        self.floor = float(np.float32(0.5 * lo[1]))
+        pieces.lo32[0] = np.float32(self.floor)
         self.pieces = pieces
         vals = np.min([np.polyval(coef, t) for t in np.linspace(-1.0, 1.0, 9)], axis=0)
         m = np.concatenate([np.geomspace(1e-7, 1.0, 1000), np.linspace(0.0, 1.0, 1000)])
@@ -684,7 +687,7 @@ vec2 pumpup_base(vec3 l, vec3 v) {{
     float ekd = pumpup_k_rho * 0.318309886 * (2.0 * pumpup_U + 5.0 * pumpup_U * (1.0 - pumpup_k_sigma));
     float rv = 2.0 * l.z * v.z - dot(l, v);  // (R_l.V), 000 eq. 9 (absolute error <= 8 U)
     if (rv <= 0.0) return vec2(kd, ekd / max(kd, 1e-37) + pumpup_U);
-{_power_lines("rv", "11.6 * pumpup_U", "pumpup_n")}{p.locate("", "l.z")}    float hs = {hs};  // H_s(N.S), 002 sec. 4.1
+{_power_lines("rv", "11.6 * pumpup_U", "pumpup_n")}{p.locate("", "l.z", f"max(l.z, {_lit(tab.floor)})")}    float hs = {hs};  // H_s(N.S), 002 sec. 4.1
     float spec = pumpup_k_rho * pumpup_k_sigma * pw / hs;  // 002 eq. 22 with F_s = (R_l.V)^n, 002 eq. 5
     float f = kd + spec;
     return vec2(f, (ekd + spec * (pe + {_lit(_up32(tab.rel))} + 6.0 * pumpup_U)) / max(f, 1e-37) + pumpup_U);
@@ -893,11 +896,8 @@ def _cells(b: np.ndarray, bits: int, start: float, end: float) -> tuple[int, int
     return shift, cbase, ncell, first, int(np.max(last - first)) + 1
 
 
-def _choose_cells(b: np.ndarray, start: float, end: float, most: int):
-    """:func:`_cells` with bits from _CELL_BITS up until no cell holds more than two piece starts, within ``most``
-    cells.
-    """
-    bits = _CELL_BITS
+def _choose_cells(b: np.ndarray, start: float, end: float, most: int, bits: int = _CELL_BITS):
+    """:func:`_cells` with ``bits`` and up until no cell holds more than two piece starts, within ``most`` cells."""
     got = _cells(b, bits, start, end)
     while got[4] > 2 and bits < _CELL_BITS_MAX:
         nxt = _cells(b, bits + 1, start, end)
@@ -922,7 +922,7 @@ def _search(bounds32: np.ndarray, nm: str, var: str = "m") -> tuple[str, str]:
     fine = _choose_cells(b, split, 1.0, _CELLS_MAX // 2)
     fs, fbase, nfine, ffirst, fcount = fine
     if lo < split:
-        coarse = _choose_cells(b, lo, split, _CELLS_MAX // 2)
+        coarse = _choose_cells(b, lo, split, _CELLS_MAX // 2, bits=1)  # (few pieces per octave down there)
         cs, cbase, ncoarse, cfirst, ccount = coarse
     else:
         cs, cbase, ncoarse, cfirst, ccount = 19, 0, 0, np.zeros(0, np.int64), 1
@@ -939,15 +939,15 @@ def _search(bounds32: np.ndarray, nm: str, var: str = "m") -> tuple[str, str]:
     first = np.concatenate([cfirst, ffirst])
     ncell = len(first)
     vals = ", ".join(str(int(x)) for x in first)
-    arrays = _array(f"{nm}_b", np.concatenate([b, pad])) + f"const int {nm}_cs[{ncell}] = int[{ncell}]({vals});\n"
+    arrays = _array(f"{nm}_b", np.concatenate([b, pad])) + f"const highp int {nm}_cs[{ncell}] = int[{ncell}]({vals});\n"
     fine_c = f"clamp(int(u >> {fs}u) - {fbase - ncoarse}, {ncoarse}, {ncell - 1})"
     if ncoarse:
         cell = (f"{var} >= {_lit(split)} ? {fine_c} : clamp(int(u >> {cs}u) - {cbase}, 0, {ncoarse - 1})")
     else:
         cell = fine_c
-    code = (f"int {nm}_piece(float {var}) {{\n"
-            f"    uint u = floatBitsToUint({var});\n"
-            f"    int i = {nm}_cs[{cell}];\n"
+    code = (f"highp int {nm}_piece(highp float {var}) {{\n"
+            f"    highp uint u = floatBitsToUint({var});\n"
+            f"    highp int i = {nm}_cs[{cell}];\n"
             + "".join(st + "\n" for st in steps) + "    return i;\n}\n")
     return arrays, code
 
@@ -1021,9 +1021,9 @@ float {nm}_u(float mu, float lm) {{
         float u = {v0} * exp(x) * (1.0 + 2.0 * pumpup_exp_err(x, dx) + 4.0 * pumpup_U) + {mlo};
         return {cap};
     }}
-    int i = {nm}_piece(mu);
+    highp int i = {nm}_piece(mu);
     float dd = lm - {nm}_x[i];
-    int b = {d + 1} * i;
+    highp int b = {d + 1} * i;
     float u = {horner};
     return {cap};
 }}
@@ -1126,12 +1126,14 @@ class _Pieces:
             expr = f"{head} * {t} + {nm}_c[{base} + {o + r}]"
         return expr
 
-    def locate(self, var: str, m: str) -> str:
-        """GLSL lines: the piece of ``m`` (>= the first lower end), ``t{var}`` and ``b{var}`` for :meth:`value`."""
+    def locate(self, var: str, m: str, search: str | None = None) -> str:
+        """GLSL lines: the piece of ``m`` (>= the first lower end; found from ``search`` if given), ``t{var}`` and
+        ``b{var}`` for :meth:`value`.
+        """
         nm = self.name
-        return (f"    int s{var} = {nm}_piece({m});\n"
+        return (f"    highp int s{var} = {nm}_piece({search or m});\n"
                 f"    float t{var} = ({m} - {nm}_cen[s{var}]) * {nm}_ih[s{var}];\n"
-                f"    int b{var} = {self.nfun * (self.deg + 1)} * s{var};\n")
+                f"    highp int b{var} = {self.nfun * (self.deg + 1)} * s{var};\n")
 
 
 #: the relative tolerance of the shader's own tables (:func:`_fit_table`): float32's resolution is 6e-8, so pumpup's
