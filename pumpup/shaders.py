@@ -680,6 +680,7 @@ def _lewis_code(b: BRDF) -> str:
     tab = _HsTable(float(b.p["n"]))
     p = tab.pieces
     hs = p.value(0, "b", "t")
+    where = p.locate("", "l.z", f"max(l.z, {_lit(tab.floor)})")
     return p.glsl() + f"""\
 const float pumpup_n = {_lit(b.p["n"])};  // baked: H_s's table is made for it
 vec2 pumpup_base(vec3 l, vec3 v) {{
@@ -687,7 +688,7 @@ vec2 pumpup_base(vec3 l, vec3 v) {{
     float ekd = pumpup_k_rho * 0.318309886 * (2.0 * pumpup_U + 5.0 * pumpup_U * (1.0 - pumpup_k_sigma));
     float rv = 2.0 * l.z * v.z - dot(l, v);  // (R_l.V), 000 eq. 9 (absolute error <= 8 U)
     if (rv <= 0.0) return vec2(kd, ekd / max(kd, 1e-37) + pumpup_U);
-{_power_lines("rv", "11.6 * pumpup_U", "pumpup_n")}{p.locate("", "l.z", f"max(l.z, {_lit(tab.floor)})")}    float hs = {hs};  // H_s(N.S), 002 sec. 4.1
+{_power_lines("rv", "11.6 * pumpup_U", "pumpup_n")}{where}    float hs = {hs};  // H_s(N.S), 002 sec. 4.1
     float spec = pumpup_k_rho * pumpup_k_sigma * pw / hs;  // 002 eq. 22 with F_s = (R_l.V)^n, 002 eq. 5
     float f = kd + spec;
     return vec2(f, (ekd + spec * (pe + {_lit(_up32(tab.rel))} + 6.0 * pumpup_U)) / max(f, 1e-37) + pumpup_U);
