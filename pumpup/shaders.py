@@ -2,9 +2,12 @@
 
 ``pumpup.shader(spec, target="glsl")`` turns a closed-form model, a ``pumped`` chain of it (g1 or g2, any number of
 levels) or a compensated one (``kulla_conty``, ``scaled``) into source code.  The pumped levels' albedo bounds and the
-compensation's bound U >= E go in as constant arrays, piece for piece as pumpup's compiled kernels read them
-(:mod:`pumpup.physics.lookups`): a level's spline pieces in ln(mu) (a power law below its first node, at most its cap)
-and, where pumpup has one, the product table G(m) of polynomial pieces in m = max(N.wi, N.wo).
+compensation's bound U >= E go in as constant arrays of polynomial pieces in the cosine m, fitted for float32
+(:data:`FIT_TOL`): where every level's bound increases, the product G(m) of all levels' g at m = max(N.wi, N.wo) (as
+pumpup's product table, :class:`pumpup.operators.pumping._Product`); otherwise every level's bound on one shared set of
+pieces (as pumpup's level table, :class:`pumpup.operators.pumping._LevelTable`), so that one piece search per cosine
+serves every level (:class:`_Pieces`); below the tables' lower end (1e-8) the bounds' largest values there.  The code
+has no branches on the cosines: a software rasteriser runs every branch of a group of pixels.
 
 Conventions of the ``glsl`` and ``glsl-es`` targets (a library snippet: a header comment, no ``#version`` line, no
 ``precision`` line, no ``main``; every global name starts with ``pumpup_``)::
@@ -23,8 +26,9 @@ error (first-order propagation of the roundings with the accuracy GLSL specifies
 rounded, / 2.5 ULP, exp and exp2 (3 + 2|x|) ULP, log and log2 an absolute 2^-21 inside [0.5, 2] and 3 ULP outside,
 inversesqrt 2 ULP; the float32 rounding of the parameters included).  A pumped or compensated model multiplies its base
 value by 1 - 2 B and reads table pieces whose constant terms were raised, in double precision before the rounding to
-float32, by twice the worst float32 error of the piece (Horner's rule, the rounding of the coefficients and of the
-variable), so that every bound it divides by is at least pumpup's, and the result is rounded down once more for the
+float32, by twice the fit's largest miss, pumpup's own table's epsilon and twice the worst float32 error of the piece
+(Horner's rule, the rounding of the coefficients and of the variable), so that every bound it divides by is at least
+pumpup's, and the result is rounded down once more for the
 final products and quotient: the shader's value is never above pumpup's double-precision value at the same
 (float32) directions, and the exported BRDF keeps its albedo <= 1 (001 eq. 18), as the Mitsuba plugin does
 (:mod:`pumpup.mitsuba`).
@@ -520,6 +524,178 @@ vec2 pumpup_base(vec3 l, vec3 v) {{
 """
 
 
+_ATAN = """\
+// atan(x) for x >= 0 (Abramowitz and Stegun 4.4.49 on [0, 1]: relative error <= 2e-8; pi/2 - atan(1/x) above)
+float pumpup_atan(float x) {
+    float y = x <= 1.0 ? x : 1.0 / x;
+    float y2 = y * y;
+    float p = 1.0 + y2 * (-0.3333314528 + y2 * (0.1999355085 + y2 * (-0.1420889944 + y2 * (0.1065626393
+        + y2 * (-0.0752896400 + y2 * (0.0429096138 + y2 * (-0.0161657367 + y2 * 0.0028662257)))))));
+    float a = y * p;
+    return x <= 1.0 ? a : 1.57079633 - a;
+}
+"""
+
+
+def _torrance_sparrow_code(b: BRDF) -> str:
+    d = b.p["d"]
+    fres = ("vec2 fr = pumpup_fresnel_dielectric(c, pumpup_ior);  // 002 sec. 3.2" if b.p["ior"] is not None
+            else "vec2 fr = vec2(1.0, 0.0);")
+    if d == "D1":
+        dist = """\
+    vec2 lp = pumpup_log1p(t);  // -ln cos^2 alpha
+    float x = -0.5 * pumpup_s * lp.x;
+    float dist = pumpup_b * exp(x);  // D1 = b cos^e alpha, 002 sec. 3.2
+    float ed = pumpup_exp_err(x, 0.5 * pumpup_s * (lp.y + 22.0 * pumpup_U * t / (1.0 + t)) + 2.0 * pumpup_U * abs(x))
+        + 2.0 * pumpup_U;"""
+    elif d == "D2":
+        dist = """\
+    float al = pumpup_atan(sqrt(t));  // alpha (relative error <= 2e-8 + 48 U)
+    float y = pumpup_s * al;
+    float x = y * y;
+    float dist = pumpup_b * exp(-x);  // D2 = b exp(-(c2 alpha)^2), 002 sec. 3.2
+    float ed = pumpup_exp_err(-x, x * (4.0e-8 + 110.0 * pumpup_U)) + 2.0 * pumpup_U;"""
+    elif d == "D3":
+        dist = """\
+    float cos2 = 1.0 / (1.0 + t);
+    float sin2 = t <= 1.0 ? t * cos2 : 1.0 - cos2;
+    float s2 = pumpup_s * pumpup_s;
+    float q = s2 / (s2 * cos2 + sin2);
+    float dist = pumpup_b * q * q;  // D3, 002 sec. 3.2
+    float ed = 128.0 * pumpup_U;"""
+    else:
+        dist = """\
+    float s2 = pumpup_s * pumpup_s;
+    float x = t / s2;
+    float dist = exp(-x) * ((1.0 + t) * (1.0 + t)) / (4.0 * s2);  // D4 (Beckmann), 002 sec. 3.2
+    float ed = pumpup_exp_err(-x, 31.0 * pumpup_U * x) + 64.0 * pumpup_U;"""
+    return f"""\
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    vec3 s = l + v;
+    float t = pumpup_tan2_half(l, v);  // tan^2 alpha
+{dist}
+    float g = min(1.0, 4.0 * min(l.z, v.z) / (s.z * (1.0 + t)));  // G, 002 sec. 3.2 (001 eq. 10)
+    float c = 0.5 * sqrt(dot(s, s));  // V.H
+    {fres}
+    float f = fr.x * g * dist / (pumpup_PI * (l.z * v.z));  // 002 eq. 10
+    return vec2(f, ed + fr.y + 96.0 * pumpup_U);
+}}
+"""
+
+
+def _oren_nayar_code(b: BRDF) -> str:
+    return """\
+vec2 pumpup_base(vec3 l, vec3 v) {
+    float s2 = pumpup_sigma * pumpup_sigma;
+    float a = 1.0 - 0.5 * s2 / (s2 + 0.33);  // Oren & Nayar 1994, qualitative model
+    float bb = 0.45 * s2 / (s2 + 0.09);
+    // max(0, cos(phi_i - phi_o)) sin(alpha) tan(beta) = max(0, Lx Vx + Ly Vy) / max(N.L, N.V)
+    float t = max(l.x * v.x + l.y * v.y, 0.0);
+    float mx = max(l.z, v.z);
+    float r = bb * t / mx;
+    float f = pumpup_albedo * 0.318309886 * (a + r);  // Oren & Nayar 1994, qualitative model
+    float e = (16.0 * pumpup_U * a + 24.0 * pumpup_U * r + 3.0 * pumpup_U * bb * (abs(l.x * v.x) + abs(l.y * v.y)) / mx)
+        / (a + r) + 8.0 * pumpup_U;
+    return vec2(f, e);
+}
+"""
+
+
+def _ashikhmin_shirley_code(b: BRDF) -> str:
+    return """\
+vec2 pumpup_base(vec3 l, vec3 v) {
+    vec3 s = l + v;
+    float hk = 0.5 * sqrt(dot(s, s));  // h.k = |k1 + k2| / 2
+    vec3 dd = l - v;
+    float q = dot(dd, dd) / (4.0 * (1.0 + hk));  // 1 - h.k
+    float q2 = q * q;
+    float q5 = q2 * q2 * q;
+    float rs = pumpup_rs;
+    float fres = rs + (1.0 - rs) * q5;  // AS 2000 eq. 5 (Schlick's F(h.k))
+    float ef = (2.0 * pumpup_U * rs + 2.0 * pumpup_U * q5 + 140.0 * pumpup_U * (1.0 - rs) * q5) / max(fres, 1e-30)
+        + pumpup_U;
+    float t = pumpup_tan2_half(l, v);  // tan^2 theta_h = (S_x^2 + S_y^2) / S_z^2
+    float d = 1.0;
+    float ed = 0.0;
+    if (t > 0.0) {
+        float qx = s.x / s.z;
+        float qy = s.y / s.z;
+        float e = (pumpup_nu * (qx * qx) + pumpup_nv * (qy * qy)) / t;  // nu cos^2 phi_h + nv sin^2 phi_h
+        vec2 lp = pumpup_log1p(t);  // -2 ln(N.h)
+        float x = -0.5 * e * lp.x;
+        d = exp(x);  // (N.h)^e, AS 2000 eq. 4
+        ed = pumpup_exp_err(x, 0.5 * e * (lp.y + 22.0 * pumpup_U * t / (1.0 + t)) + 48.0 * pumpup_U * abs(x));
+    }
+    float norm = sqrt((pumpup_nu + 1.0) * (pumpup_nv + 1.0)) * 0.0397887358;  // / (8 pi)
+    float spec = norm * d * fres / hk / max(l.z, v.z);  // AS 2000 eq. 4
+    float kd = 0.387507297 * pumpup_rd * (1.0 - rs);  // 28 rd / (23 pi) (1 - rs), AS 2000 eq. 5
+    float xi = 0.5 * l.z;
+    float xo = 0.5 * v.z;
+    // 1 - (1 - x)^5 = x (5 - 10 x + 10 x^2 - 5 x^3 + x^4), x = N.k / 2 (relative error <= 64 U)
+    float gi = xi * (5.0 + xi * (-10.0 + xi * (10.0 + xi * (-5.0 + xi))));
+    float go = xo * (5.0 + xo * (-10.0 + xo * (10.0 + xo * (-5.0 + xo))));
+    float diff = kd * (gi * go);  // AS 2000 eq. 5
+    float f = spec + diff;
+    float abs_err = spec * (ed + ef + 48.0 * pumpup_U) + diff * 136.0 * pumpup_U
+        + 0.387507297 * pumpup_rd * (8.0 * pumpup_U * (1.0 - rs) + 2.0 * pumpup_U) * (gi * go);
+    return vec2(f, abs_err / max(f, 1e-37) + pumpup_U);
+}
+"""
+
+
+class _HsTable:
+    """Lewis's normalisation H_s(mu) (:func:`pumpup.models.lewis.phong_hs`) for one exponent, as polynomial pieces of
+    degree 5 in mu (:func:`pumpup.operators.pumping.fit_pieces`, to 1e-10 relative at its test points, checked at 2000
+    more) and a bound of the relative error of its float32 evaluation, ``rel`` (fit, Horner's rule, the rounding of
+    the coefficients and of mu).
+    """
+
+    TOL = 1e-10
+
+    def __init__(self, n: float):
+        from .models.lewis import phong_hs
+        from .operators.pumping import fit_pieces
+
+        def hs(m):
+            return phong_hs(m, n)
+
+        br = np.concatenate([[0.0], 2.0 ** np.arange(-24.0, 0.0, 0.5), [1.0]])
+        (coef,), lo, hi, center, half, worst = fit_pieces([hs], br[:-1], br[1:], self.TOL, "H_s table")
+        self.lo, self.center, self.ihalf = lo, center, 1.0 / half
+        pieces = _Pieces(lo, center, 1.0 / half, [coef], 0.0, "pumpup_hs", raise_=False)
+        # the first piece, [0, lo[1]), is found from max(mu, lo[1] / 2): the index then starts there, not at 0
+        self.floor = float(np.float32(0.5 * lo[1]))
+        pieces.lo32[0] = np.float32(self.floor)
+        self.pieces = pieces
+        vals = np.min([np.polyval(coef, t) for t in np.linspace(-1.0, 1.0, 9)], axis=0)
+        m = np.concatenate([np.geomspace(1e-7, 1.0, 1000), np.linspace(0.0, 1.0, 1000)])
+        s = np.clip(np.searchsorted(lo, m, side="right") - 1, 0, len(lo) - 1)
+        miss = float(np.max(np.abs(np.polyval(coef[:, s], (m - center[s]) / half[s]) / hs(m) - 1.0)))
+        fit = 2.0 * max(float(np.max(worst)), miss)
+        #: a bound of the relative error of the shader's H_s
+        self.rel = fit + float(np.max(pieces.err / (0.999 * vals))) + 4.0 * U
+
+
+def _lewis_code(b: BRDF) -> str:
+    tab = _HsTable(float(b.p["n"]))
+    p = tab.pieces
+    hs = p.value(0, "b", "t")
+    where = p.locate("", "l.z", f"max(l.z, {_lit(tab.floor)})")
+    return p.glsl() + f"""\
+const float pumpup_n = {_lit(b.p["n"])};  // baked: H_s's table is made for it
+vec2 pumpup_base(vec3 l, vec3 v) {{
+    float kd = pumpup_k_rho * (1.0 - pumpup_k_sigma) * 0.318309886;  // 002 eq. 22, the diffuse part
+    float ekd = pumpup_k_rho * 0.318309886 * (2.0 * pumpup_U + 5.0 * pumpup_U * (1.0 - pumpup_k_sigma));
+    float rv = 2.0 * l.z * v.z - dot(l, v);  // (R_l.V), 000 eq. 9 (absolute error <= 8 U)
+    if (rv <= 0.0) return vec2(kd, ekd / max(kd, 1e-37) + pumpup_U);
+{_power_lines("rv", "11.6 * pumpup_U", "pumpup_n")}{where}    float hs = {hs};  // H_s(N.S), 002 sec. 4.1
+    float spec = pumpup_k_rho * pumpup_k_sigma * pw / hs;  // 002 eq. 22 with F_s = (R_l.V)^n, 002 eq. 5
+    float f = kd + spec;
+    return vec2(f, (ekd + spec * (pe + {_lit(_up32(tab.rel))} + 6.0 * pumpup_U)) / max(f, 1e-37) + pumpup_U);
+}}
+"""
+
+
 #: type -> (the parameters that become uniforms, code generator)
 _MODELS = {
     "lambert": (("albedo",), _lambert_code),
@@ -541,7 +717,14 @@ _MODELS = {
     "phong_shader": (("n", "ks", "kd"), _phong_shader_code),
     "phong_blinn": (("n", "ks", "kd"), _phong_blinn_code),
     "lafortune": (("n", "cx", "cy", "cz", "p", "c"), _lafortune_code),
+    "torrance_sparrow": (("s", "b", "ior"), _torrance_sparrow_code),
+    "oren_nayar": (("albedo", "sigma"), _oren_nayar_code),
+    "ashikhmin_shirley": (("nu", "nv", "rs", "rd"), _ashikhmin_shirley_code),
+    "lewis_phong": (("k_rho", "k_sigma"), _lewis_code),
 }
+
+#: parameters that are baked into a model's code whatever the spec (they choose the code or change a table in it)
+_BAKED = {"torrance_sparrow": ("d",), "lewis_phong": ("n",)}
 
 #: the model types :func:`shader` translates (and the operators over them)
 SUPPORTED = tuple(sorted(_MODELS)) + ("pumped", "kulla_conty", "scaled", "fresnel")
@@ -566,6 +749,16 @@ def error_bound_text() -> dict[str, str]:
         "phong_shader": "max(U, phong's + 9 U) + 2 U",
         "phong_blinn": "max(U, blinn's) + 2 U",
         "lafortune": "as phong with the lobe's absolute error 8 U (|cx| + |cy| + |cz|) and the max(N.L, N.V)^p term",
+        "torrance_sparrow": "D's + Fresnel + 96 U; D1 e(x, s/2 (error of ln(1 + tan^2) + 22 U tan^2/(1 + tan^2)) "
+                            "+ 2 U |x|) + 2 U, D2 e(-x, x (4e-8 + 110 U)) + 2 U (an atan of relative error 2e-8), "
+                            "D3 128 U, D4 e(-x, 31 U x) + 64 U",
+        "oren_nayar": "(16 U A + 24 U r + 3 U B (|Lx Vx| + |Ly Vy|) / max(N.L, N.V)) / (A + r) + 8 U, "
+                      "r = B max(0, Lx Vx + Ly Vy) / max(N.L, N.V)",
+        "ashikhmin_shirley": "(the lobe x (e(x, e/2 (error of ln(1 + tan^2) + 22 U tan^2/(1 + tan^2)) + 48 U |x|) + "
+                             "Schlick's (2 U rs + 2 U q^5 + 140 U (1 - rs) q^5) / F + U + 48 U) + the diffuse term x "
+                             "136 U + its factor's rounding) / f + U",
+        "lewis_phong": "(the diffuse part's 0.32 k_rho (2 U + 5 U (1 - k_sigma)) + the lobe x (phong's power + H_s's "
+                       "table error + 6 U)) / f + U",
     }
 
 
@@ -674,41 +867,105 @@ def _poly_error(coef: np.ndarray, w: np.ndarray, delta: np.ndarray) -> np.ndarra
     return err
 
 
-#: cells per octave of the piece index (the float32 bits of the variable, as pumpup's kernel uses the float64 bits)
+#: cells per octave of the piece index (the float32 bits of the variable, as pumpup's kernel uses the float64 bits):
+#: at least 2^_CELL_BITS, more (up to 2^_CELL_BITS_MAX) until no cell holds more than two piece starts
 _CELL_BITS = 4
+_CELL_BITS_MAX = 10
+#: the most cells of one index (4-byte ints in the source)
+_CELLS_MAX = 2048
 
 
-def _search(bounds32: np.ndarray, nm: str, var: str) -> tuple[str, str]:
-    """GLSL that sets ``int i`` to the largest s with ``{nm}_b[s] <= var`` (``var`` >= the first bound, a float32 >
-    0): the cell of ``var`` from its float32 bits (2^_CELL_BITS cells per octave, as
-    :func:`pumpup.physics.lookups.g_product` finds a piece from the float64 bits), the first candidate piece of the
-    cell, then a binary search of fixed length over the cell's pieces.  (arrays, code).
+#: the cosine above which the piece index has its finer cells (most cosines, and most pieces, lie above it)
+_FINE_FROM = 0.25
+
+
+def _cells(b: np.ndarray, bits: int, start: float, end: float) -> tuple[int, int, int, np.ndarray, int]:
+    """(shift, cbase, ncell, first piece of each cell, most piece starts in a cell) of 2^bits cells per octave from the
+    cell of ``start`` up to the cell of ``end``.
     """
-    b = np.asarray(bounds32, dtype=np.float32)
     n = len(b)
-    shift = 23 - _CELL_BITS
-    bits = b.view(np.uint32).astype(np.int64)
-    cbase = int(bits[0] >> shift)
-    cend = int(np.array([1.0], np.float32).view(np.uint32)[0] >> shift)
+    shift = 23 - bits
+    cbase = int(int(np.array([start], np.float32).view(np.uint32)[0]) >> shift)
+    cend = int(int(np.array([end], np.float32).view(np.uint32)[0]) >> shift)
     ncell = max(cend - cbase + 1, 1)
     starts = ((np.arange(ncell, dtype=np.int64) + cbase) << shift).astype(np.uint32).view(np.float32)
     ends = ((np.arange(ncell, dtype=np.int64) + cbase + 1) << shift).astype(np.uint32).view(np.float32)
+    starts = np.maximum(starts, np.float32(start))
+    ends = np.minimum(ends, np.float32(np.nextafter(np.float32(end), np.float32(np.inf))))
     first = np.clip(np.searchsorted(b, starts, side="right") - 1, 0, n - 1)
     last = np.clip(np.searchsorted(b, ends, side="left") - 1, 0, n - 1)
-    count = int(np.max(last - first)) + 1
-    steps = []
+    return shift, cbase, ncell, first, int(np.max(last - first)) + 1
+
+
+def _choose_cells(b: np.ndarray, start: float, end: float, most: int, bits: int = _CELL_BITS):
+    """:func:`_cells` with ``bits`` and up until no cell holds more than two piece starts, within ``most`` cells."""
+    got = _cells(b, bits, start, end)
+    while got[4] > 2 and bits < _CELL_BITS_MAX:
+        nxt = _cells(b, bits + 1, start, end)
+        if nxt[2] > most:
+            break
+        bits += 1
+        got = nxt
+    return got
+
+
+def _search(bounds32: np.ndarray, nm: str, var: str = "m") -> tuple[str, str]:
+    """GLSL of ``int {nm}_piece(float var)``: the largest s with ``{nm}_b[s] <= var`` (``var`` >= the first bound, a
+    float32 > 0): the cell of ``var`` from its float32 bits (2^bits cells per octave, as
+    :func:`pumpup.physics.lookups.g_product` finds a piece from the float64 bits; below _FINE_FROM and above it bits
+    each from _CELL_BITS up until a cell holds at most two piece starts, within _CELLS_MAX cells in all), the first
+    candidate piece of the cell, then a binary search of fixed length over the cell's pieces, without branches (the
+    bounds array is padded with float32's largest value, so the steps need no range check).  (arrays, code).
+    """
+    b = np.asarray(bounds32, dtype=np.float32)
+    lo = float(b[0])
+    split = max(_FINE_FROM, lo)
+    fine = _choose_cells(b, split, 1.0, _CELLS_MAX // 2)
+    fs, fbase, nfine, ffirst, fcount = fine
+    if lo < split:
+        coarse = _choose_cells(b, lo, split, _CELLS_MAX // 2, bits=1)  # (few pieces per octave down there)
+        cs, cbase, ncoarse, cfirst, ccount = coarse
+    else:
+        cs, cbase, ncoarse, cfirst, ccount = 19, 0, 0, np.zeros(0, np.int64), 1
+    count = max(fcount, ccount)
     k = 1
     while k < count:
         k *= 2
+    pad = np.full(k, np.finfo(np.float32).max, dtype=np.float32)
+    steps = []
     k //= 2
     while k >= 1:
-        steps.append(f"    j = i + {k}; if (j <= {n - 1} && {nm}_b[j] <= {var}) i = j;")
+        steps.append(f"    i += {nm}_b[i + {k}] <= {var} ? {k} : 0;")
         k //= 2
+    first = np.concatenate([cfirst, ffirst])
+    ncell = len(first)
     vals = ", ".join(str(int(x)) for x in first)
-    arrays = _array(f"{nm}_b", b) + f"const int {nm}_cs[{ncell}] = int[{ncell}]({vals});\n"
-    code = (f"    int i = {nm}_cs[clamp(int(floatBitsToUint({var}) >> {shift}u) - {cbase}, 0, {ncell - 1})];\n"
-            "    int j;\n" + "\n".join(steps) + ("\n" if steps else ""))
+    arrays = _array(f"{nm}_b", np.concatenate([b, pad])) + f"const highp int {nm}_cs[{ncell}] = int[{ncell}]({vals});\n"
+    fine_c = f"clamp(int(u >> {fs}u) - {fbase - ncoarse}, {ncoarse}, {ncell - 1})"
+    if ncoarse:
+        cell = (f"{var} >= {_lit(split)} ? {fine_c} : clamp(int(u >> {cs}u) - {cbase}, 0, {ncoarse - 1})")
+    else:
+        cell = fine_c
+    code = (f"highp int {nm}_piece(highp float {var}) {{\n"
+            f"    highp uint u = floatBitsToUint({var});\n"
+            f"    highp int i = {nm}_cs[{cell}];\n"
+            + "".join(st + "\n" for st in steps) + "    return i;\n}\n")
     return arrays, code
+
+
+def _sup_below(lk, t32: float) -> float:
+    """The largest value of a level's bound (``pumpup.operators.pumping._Lookup.upper``) at float32 cosines in (0,
+    ``t32``): the power law below its first node at its larger end (float32's smallest cosine 2^-149 or the node), the
+    spline between the node and ``t32`` on 400 points, raised by 1e-9 of itself (that stretch is a relative 1e-12 of mu
+    wide: the spline moves by less), at most the cap.
+    """
+    x0 = math.exp(lk.logx[0])
+    lo = math.log(2.0**-149)
+    ends = [lk.v0 * math.exp(lk.slope0 * (z - lk.logx[0])) for z in (lo, min(math.log(t32), lk.logx[0]))]
+    sup = max(ends) + lk.margin_lo
+    if t32 > x0:
+        sup = max(sup, float(np.max(lk.upper(np.geomspace(x0, t32, 400), capped=False))))
+    return min(sup * (1.0 + 1e-9), lk.cap)
 
 
 class _LevelTable:
@@ -746,7 +1003,7 @@ class _LevelTable:
     def glsl(self) -> str:
         nm, d = self.name, self.deg
         arrays, search = _search(self.knots, nm, "mu")
-        out = [arrays, _array(f"{nm}_x", self.logx32), _array(f"{nm}_c", self.coef32.T.ravel())]
+        out = [arrays, search, _array(f"{nm}_x", self.logx32), _array(f"{nm}_c", self.coef32.T.ravel())]
         horner = f"{nm}_c[b]"
         for r in range(1, d + 1):
             horner = f"({horner}) * dd + {nm}_c[b + {r}]" if r > 1 else f"{nm}_c[b] * dd + {nm}_c[b + 1]"
@@ -765,8 +1022,9 @@ float {nm}_u(float mu, float lm) {{
         float u = {v0} * exp(x) * (1.0 + 2.0 * pumpup_exp_err(x, dx) + 4.0 * pumpup_U) + {mlo};
         return {cap};
     }}
-{search}    float dd = lm - {nm}_x[i];
-    int b = {d + 1} * i;
+    highp int i = {nm}_piece(mu);
+    float dd = lm - {nm}_x[i];
+    highp int b = {d + 1} * i;
     float u = {horner};
     return {cap};
 }}
@@ -774,68 +1032,157 @@ float {nm}_u(float mu, float lm) {{
         return "".join(out)
 
 
-class _ProductTable:
-    """A product table G(m) (:class:`pumpup.operators.pumping._Product`): the same pieces, each polynomial re-expanded
-    about its float32 centre (so that m - centre is exact in float32) and raised by twice its float32 error.
+class _Pieces:
+    """Polynomial pieces in m on one set of pieces, one or more functions per piece, as the shader reads them: a
+    product table G(m) (:class:`pumpup.operators.pumping._Product`, one function) or a level table
+    (:class:`pumpup.operators.pumping._LevelTable`, every level's bound U_j).  Each polynomial is re-expanded about
+    its piece's float32 centre (so that m - centre is exact in float32) and its constant term raised, in double
+    precision before the rounding to float32, by twice its float32 error (Horner's rule, the rounding of the
+    coefficients and of t) and by ``lift`` times its largest value on the piece.
+
+    The arrays: ``{name}_b`` the pieces' lower ends (rounded up to float32; padded), ``{name}_cs`` the cell index
+    (:func:`_search`), ``{name}_cen`` and ``{name}_ih`` each piece's float32 centre and inverse half-width, and
+    ``{name}_c`` per piece the functions' coefficients one after the other, highest power first (piece s, function j,
+    power r at ``(s * k + j) * (degree + 1) + r``): one piece search per cosine serves every function.
     """
 
-    def __init__(self, prod, name: str):
+    def __init__(self, lo, center, ihalf, coefs, lift, name: str, raise_: bool = True):
         self.name = name
-        lo = np.asarray(prod.lo[:-1], dtype=np.float64)
+        lo = np.asarray(lo, dtype=np.float64)
         hi = np.minimum(np.concatenate([lo[1:], [1.0]]), 1.0)
-        coef = np.asarray(prod.coef, dtype=np.float64)  # (deg + 1, pieces), highest power first, t = (m - c) ih
-        center, ihalf = np.asarray(prod.center, dtype=np.float64), np.asarray(prod.ihalf, dtype=np.float64)
+        center, ihalf = np.asarray(center, dtype=np.float64), np.asarray(ihalf, dtype=np.float64)
         c32 = center.astype(np.float32)
         ih32 = ihalf.astype(np.float32)
         alpha = ihalf / ih32.astype(np.float64)
         beta = (c32.astype(np.float64) - center) * ihalf
-        deg = coef.shape[0] - 1
-        # Q(s) = P(alpha s + beta): Horner on the coefficient arrays (low power first), all pieces at once
-        q = np.zeros((deg + 1, coef.shape[1]))
-        q[0] = coef[0]
-        for r in range(1, deg + 1):
-            nq = np.zeros_like(q)
-            nq[1:] += q[:-1] * alpha
-            nq += q * beta
-            nq[0] += coef[r]
-            q = nq
-        qh = q[::-1]  # highest power first
         smax = np.maximum(np.abs(lo - c32), np.abs(hi - c32)) * ih32.astype(np.float64) * (1.0 + 4 * U)
-        err = _poly_error(qh, smax, U * smax) + 1e-15 * np.sum(np.abs(qh) * smax ** np.arange(deg, -1, -1)[:, None],
-                                                               axis=0)
-        qh = qh.copy()
-        vals = np.min([np.polyval(coef, t) for t in np.linspace(-1.0, 1.0, 9)], axis=0)
-        #: the largest relative amount by which a piece was raised (half the piece's smallest sampled value)
-        self.rel = float(np.max(2.0 * err / np.maximum(0.5 * vals, 1e-300)))
-        qh[-1] += 2.0 * err
-        self.err = err
-        self.coef32 = qh.astype(np.float32)
-        self.coef32[-1] = _up32_array(qh[-1])
+        rows, errs, rels = [], [], []
+        for coef in coefs:
+            coef = np.asarray(coef, dtype=np.float64)  # (deg + 1, pieces), highest power first, t = (m - c) ih
+            deg = coef.shape[0] - 1
+            # Q(s) = P(alpha s + beta): Horner on the coefficient arrays (low power first), all pieces at once
+            q = np.zeros((deg + 1, coef.shape[1]))
+            q[0] = coef[0]
+            for r in range(1, deg + 1):
+                nq = np.zeros_like(q)
+                nq[1:] += q[:-1] * alpha
+                nq += q * beta
+                nq[0] += coef[r]
+                q = nq
+            qh = q[::-1].copy()  # highest power first
+            err = _poly_error(qh, smax, U * smax) + 1e-15 * np.sum(
+                np.abs(qh) * smax ** np.arange(deg, -1, -1)[:, None], axis=0)
+            samples = np.array([np.polyval(coef, t) for t in np.linspace(-1.0, 1.0, 9)])
+            vals, vmax = np.min(samples, axis=0), np.max(np.abs(samples), axis=0)
+            raise_by = 2.0 * err + np.asarray(lift) * 1.01 * vmax
+            #: the largest relative amount by which a piece was raised (against half its smallest sampled value)
+            rels.append(float(np.max(raise_by / np.maximum(0.5 * vals, 1e-300))))
+            c32 = qh.astype(np.float32)
+            if raise_:
+                qh[-1] += raise_by
+                c32[-1] = _up32_array(qh[-1])
+            rows.append(c32)
+            errs.append(err)
+        self.deg = rows[0].shape[0] - 1
+        self.nfun = len(rows)
+        #: (pieces, functions, degree + 1)
+        self.coef32 = np.stack(rows).transpose(2, 0, 1)
+        self.err = np.max(errs, axis=0)
+        self.rel = max(rels)
         self.lo32 = _up32_array(lo)  # m >= lo32[s]  <=>  m >= lo[s], for a float32 m
-        self.c32, self.ih32 = c32, ih32
-        self.deg = deg
-        self.mlo = float(prod.mlo)
-        self.mlo32 = _down32(self.mlo)  # m > mlo32  <=>  m > mlo, for a float32 m
+        self.c32, self.ih32 = center.astype(np.float32), ih32
         self.npieces = len(lo)
-        self.epsilon = float(getattr(prod, "epsilon", 0.0))
+
+    def values(self, m) -> np.ndarray:
+        """The plain numpy reference of the shader's look-up at float32 cosines ``m`` (>= the first lower end): every
+        function's value, (functions,) + m's shape, from the float32 coefficients in double precision.
+        """
+        m = np.asarray(m, dtype=np.float32)
+        s = np.clip(np.searchsorted(self.lo32, m, side="right") - 1, 0, self.npieces - 1)
+        t = (m.astype(np.float64) - self.c32[s].astype(np.float64)) * self.ih32[s].astype(np.float64)
+        out = []
+        for j in range(self.nfun):
+            v = np.zeros(m.shape)
+            for r in range(self.deg + 1):
+                v = v * t + self.coef32[s, j, r].astype(np.float64)
+            out.append(v)
+        return np.stack(out)
 
     def glsl(self) -> str:
-        nm, d = self.name, self.deg
+        """The arrays and ``int {name}_piece(float m)``; :meth:`value` writes a function's value from the piece."""
+        nm = self.name
         arrays, search = _search(self.lo32, nm, "m")
-        out = [arrays, _array(f"{nm}_cen", self.c32), _array(f"{nm}_ih", self.ih32),
-               _array(f"{nm}_c", self.coef32.T.ravel())]
-        horner = f"{nm}_c[b] * t + {nm}_c[b + 1]"
-        for r in range(2, d + 1):
-            horner = f"({horner}) * t + {nm}_c[b + {r}]"
-        out.append(f"""\
-// the product table at m (> its lower end): the polynomial piece that holds m (pumpup.physics.lookups.g_product)
-float {nm}_g(float m) {{
-{search}    float t = (m - {nm}_cen[i]) * {nm}_ih[i];
-    int b = {d + 1} * i;
-    return {horner};
-}}
-""")
-        return "".join(out)
+        return "".join([arrays, _array(f"{nm}_cen", self.c32), _array(f"{nm}_ih", self.ih32),
+                        _array(f"{nm}_c", self.coef32.ravel()), search])
+
+    def value(self, j: int, base: str, t: str) -> str:
+        """GLSL of function j's polynomial at ``t``, Horner's rule, the piece's coefficients from ``{name}_c[base +
+        ...]`` (``base`` = piece x functions x (degree + 1)).
+        """
+        nm, d = self.name, self.deg
+        o = j * (d + 1)
+        expr = f"{nm}_c[{base} + {o}]"
+        for r in range(1, d + 1):
+            head = expr if r == 1 else f"({expr})"
+            expr = f"{head} * {t} + {nm}_c[{base} + {o + r}]"
+        return expr
+
+    def locate(self, var: str, m: str, search: str | None = None) -> str:
+        """GLSL lines: the piece of ``m`` (>= the first lower end; found from ``search`` if given), ``t{var}`` and
+        ``b{var}`` for :meth:`value`.
+        """
+        nm = self.name
+        return (f"    highp int s{var} = {nm}_piece({search or m});\n"
+                f"    float t{var} = ({m} - {nm}_cen[s{var}]) * {nm}_ih[s{var}];\n"
+                f"    highp int b{var} = {self.nfun * (self.deg + 1)} * s{var};\n")
+
+
+#: the relative tolerance of the shader's own tables (:func:`_fit_table`): float32's resolution is 6e-8, so pumpup's
+#: tables, fitted to 1e-14 for double precision (hundreds of pieces per level), would only make the shader longer and
+#: slower to compile
+FIT_TOL = 1e-8
+
+
+def _kinks(looks, controlled, br: np.ndarray) -> np.ndarray:
+    """Values of m in the range of ``br`` where a level's g switches term (its uncapped bound crosses its cap, or, g2,
+    its bound crosses m: 001 eq. 21), from the sign changes on ``br`` and its geometric midpoints (brentq).
+    """
+    from scipy.optimize import brentq
+
+    grid = np.unique(np.concatenate([br, np.sqrt(br[:-1] * br[1:])]))
+    out = []
+    for lk, c in zip(looks, controlled):
+        fns = [] if not math.isfinite(lk.cap) else [lambda m, lk=lk: lk.upper(m, capped=False) - lk.cap]
+        if c:
+            fns.append(lambda m, lk=lk: lk.upper(m) - m)
+        for fn in fns:
+            v = fn(grid)
+            for i in np.nonzero(np.sign(v[:-1]) * np.sign(v[1:]) < 0)[0]:
+                out.append(brentq(lambda m, fn=fn: float(fn(np.array([m]))[0]), grid[i], grid[i + 1], xtol=1e-300,
+                                  rtol=1e-15))
+    return np.array(out)
+
+
+def _fit_table(functions, looks, controlled, mlo: float, lift: float, name: str) -> _Pieces:
+    """The shader's table of ``functions`` (each positive on [mlo, 1]) as :class:`_Pieces`: polynomials of degree 5 in m
+    on one set of pieces (:func:`pumpup.operators.pumping.fit_pieces`: at most an octave each, split where a level's g
+    switches term, bisected until each function is met to :data:`FIT_TOL` at the fit's test points), each raised by
+    twice its largest miss, at those points and at 33 more per piece, plus ``lift`` of itself (the amount by which
+    pumpup's own table may exceed the function) and its float32 error.
+    """
+    from .operators.pumping import fit_pieces
+
+    br = np.unique(np.concatenate([[mlo, 1.0], 2.0 ** np.arange(math.floor(math.log2(mlo)), 0.0)]))
+    br = br[(br >= mlo) & (br <= 1.0)]
+    br = np.unique(np.concatenate([br, _kinks(looks, controlled, br)]))
+    coefs, lo, hi, center, half, worst = fit_pieces(functions, br[:-1], br[1:], FIT_TOL, f"shader table {name}")
+    tt = np.linspace(-1.0, 1.0, 33)
+    m = np.clip(center[:, None] + half[:, None] * tt[None, :], lo[:, None], hi[:, None])
+    miss = np.array(worst)
+    for fn, coef in zip(functions, coefs):
+        approx = sum(coef[r][:, None] * tt[None, :] ** (coef.shape[0] - 1 - r) for r in range(coef.shape[0]))
+        miss = np.maximum(miss, np.max(np.abs(approx / fn(m) - 1.0), axis=1))
+    return _Pieces(lo, center, 1.0 / half, coefs, 2.0 * miss + lift, name)
 
 
 # ----------------------------------------------------------------------------------------
@@ -853,74 +1200,213 @@ def _param_decls(plan: _Plan) -> str:
     return "\n".join(lines) + ("\n" if lines else "")
 
 
-def _pumped_glsl(plan: _Plan) -> tuple[str, list[str], int]:
-    top = plan.levels[-1]
-    prod = top.product()
-    out, notes = [], []
-    levels = []
-    for j, lev in enumerate(plan.levels):
-        t = _LevelTable(lev.lookup(), f"pumpup_level{j + 1}")
-        levels.append((t, lev.controlled))
-        out.append(t.glsl())
-        notes.append(f"level {j + 1} ({lev.p['g']}): albedo bound of {json.dumps(lev.base.spec)}: {t.npieces} "
-                     f"pieces (degree {t.deg} in ln mu), table margin {t.margin:.3g}, float32 error <= "
-                     f"{float(np.max(t.err)):.3g} (added), cap {t.cap:g}")
-    cond = ""
-    if prod is not None:
-        p = _ProductTable(prod, "pumpup_product")
-        out.append(p.glsl())
-        notes.append(f"product table G(m) of all levels: {p.npieces} pieces (degree {p.deg} in m) for min(N.wi, "
-                     f"N.wo) > {p.mlo:.6g}, relative fit <= {p.epsilon:.3g} (added), float32 error <= "
-                     f"{float(np.max(p.err)):.3g} (added)")
-        cond = f"    if (mmin > {_lit(p.mlo32)}) return pumpup_product_g(mmax);\n"
-    body = []
-    for j, (t, controlled) in enumerate(levels):
-        nm = t.name
-        if t.increasing:
-            look = (f"mmin > {_lit(_down32(t.mu0))} ? {nm}_u(mmax, lmax) : max({nm}_u(mi, li), {nm}_u(mo, lo))")
+def _inf_below(lk, t32: float) -> float:
+    """The smallest value of a level's bound at float32 cosines in (0, ``t32``) (as :func:`_sup_below`, lowered by
+    1e-9 of itself).
+    """
+    x0 = math.exp(lk.logx[0])
+    lo = math.log(2.0**-149)
+    ends = [lk.v0 * math.exp(lk.slope0 * (z - lk.logx[0])) for z in (lo, min(math.log(t32), lk.logx[0]))]
+    inf = min(ends) + lk.margin_lo
+    if t32 > x0:
+        inf = min(inf, float(np.min(lk.upper(np.geomspace(x0, t32, 400), capped=False))))
+    return min(inf * (1.0 - 1e-9), lk.cap)
+
+
+class _PumpedTables:
+    """What a pumped chain's shader reads: the product table (every level's bound increases: G(m), m = max(N.wi,
+    N.wo)), else the level table (every level's bound on one set of pieces in m), else each level's spline in ln mu;
+    below the tables' lower end ``t32`` (1e-8 for pumpup's tables), each level's largest bound there (``sup``).
+    """
+
+    def __init__(self, plan: _Plan):
+        from .operators.pumping import _ProductError
+
+        levels = plan.levels
+        self.looks = [lev.lookup() for lev in levels]
+        self.controlled = [bool(lev.controlled) for lev in levels]
+        prod = levels[-1].product()
+        self.product = self.table = self.splines = None
+        self.t32 = 0.0
+        self.below = 0.0
+        self.k = 1.0
+        # above it every level is on its spline (as pumpup's tables: pumping._Product, pumping._LevelTable)
+        mlo = max(max(lk.mu0, math.exp(lk.logx[0])) for lk in self.looks) * (1.0 + 1e-12)
+        try:
+            if prod is not None:  # pumpup divides by its product table: G (1 + epsilon), its miss <= epsilon / 2
+                self.product = _fit_table([prod.exact], self.looks, self.controlled, prod.mlo,
+                                          2.0 * prod.epsilon + 4 * np.finfo(float).eps, "pumpup_product")
+                mlo = prod.mlo
+            else:  # pumpup divides by its level table (at most each U_j) or level by level (U_j)
+                self.table = _fit_table([lk.upper for lk in self.looks], self.looks, self.controlled, mlo, 0.0,
+                                        "pumpup_lt")
+        except _ProductError:
+            self.product = self.table = None
+        if self.product is None and self.table is None:
+            self.splines = [_LevelTable(lk, f"pumpup_level{j + 1}") for j, lk in enumerate(self.looks)]
+            self.rel = sum(t.rel for t in self.splines)
+            return
+        self.t32 = float(_up32(mlo))  # m >= t32  <=>  m >= mlo, for a float32 m
+        self.sup = [max(_sup_below(lk, self.t32), self.t32 if c else 0.0)
+                    for lk, c in zip(self.looks, self.controlled)]
+        inf = [_inf_below(lk, self.t32) for lk in self.looks]
+        at = [float(lk.upper(np.array([self.t32]))[0]) for lk in self.looks]
+        if self.product is not None:
+            # every U_j increases: for N.wi or N.wo below t32, g_j <= max(sup_j, g_j(max(m, t32))) <= K_j g_j(...)
+            self.k = math.prod(max(1.0, c / u) for c, u in zip(self.sup, at)) * (1.0 + 1e-9)
+            self.rel = self.product.rel
+            worst = self.k * max(1.0, math.prod(at) / math.prod(inf))
         else:
-            look = f"max({nm}_u(mi, li), {nm}_u(mo, lo))"
-        body.append(f"    float g{j + 1} = {look};  // 001 eq. 20")
-        if controlled:
-            body.append(f"    g{j + 1} = max(g{j + 1}, mmax);  // 001 eq. 21")
-    prod_expr = " * ".join(f"g{j + 1}" for j in range(len(levels)))
-    out.append(f"""\
-// the product of all levels' g at the cosines mi, mo > 0 (001 eq. 16, 20, 21), at least pumpup's
+            self.rel = len(levels) * self.table.rel
+            worst = math.prod(max(c / i, 1.0) for c, i in zip(self.sup, inf))
+        #: how much lower than pumpup's value (relative) the constant bounds below t32 may make the shader there
+        self.below = worst - 1.0
+
+
+def _pumped_glsl(plan: _Plan) -> tuple[str, list[str], int]:
+    tabs = _PumpedTables(plan)
+    out, notes = [], []
+    nlev = len(plan.levels)
+    for j, lev in enumerate(plan.levels):
+        lk = tabs.looks[j]
+        notes.append(f"level {j + 1} ({lev.p['g']}): albedo bound of {json.dumps(lev.base.spec)}: table margin "
+                     f"{lk.margin:.3g}, cap {lk.cap:g}")
+    if tabs.splines is not None:
+        body = []
+        for j, (t, controlled) in enumerate(zip(tabs.splines, tabs.controlled)):
+            out.append(t.glsl())
+            notes.append(f"level {j + 1}: {t.npieces} pieces (degree {t.deg} in ln mu), float32 error <= "
+                         f"{float(np.max(t.err)):.3g} (added)")
+            nm = t.name
+            if t.increasing:
+                look = (f"mmin > {_lit(_down32(t.mu0))} ? {nm}_u(mmax, lmax) : max({nm}_u(mi, li), {nm}_u(mo, lo))")
+            else:
+                look = f"max({nm}_u(mi, li), {nm}_u(mo, lo))"
+            body.append(f"    float g{j + 1} = {look};  // 001 eq. 20")
+            if controlled:
+                body.append(f"    g{j + 1} = max(g{j + 1}, mmax);  // 001 eq. 21")
+        prod_expr = " * ".join(f"g{j + 1}" for j in range(nlev))
+        out.append(f"""\
+// the product of all levels' g at the cosines mi, mo > 0 (001 eq. 16, 20, 21), at least pumpup's: each level's
+// spline in ln mu
 float pumpup_g(float mi, float mo) {{
     float mmax = max(mi, mo);
     float mmin = min(mi, mo);
-{cond}    float li = log(mi);
+    float li = log(mi);
     float lo = log(mo);
     float lmax = mi >= mo ? li : lo;
 {chr(10).join(body)}
     return {prod_expr};
 }}
 """)
-    return "".join(out), notes, len(levels)
+        return "".join(out), notes, nlev
+    t = _lit(tabs.t32)
+    if tabs.product is not None:
+        p = tabs.product
+        out.append(p.glsl())
+        notes.append(f"product table G(m) of all levels, m = max(N.wi, N.wo): {p.npieces} pieces (degree {p.deg} in m) "
+                     f"for m >= {tabs.t32:.9g}, fitted to {FIT_TOL:g}, raised by twice its fit and float32 errors "
+                     f"(<= {p.rel:.3g} relative); where N.wi or N.wo < {tabs.t32:.9g}, times {tabs.k:.9g}")
+        out.append(f"""\
+// the product of all levels' g at the cosines mi, mo > 0 (001 eq. 16, 20, 21), at least pumpup's: one piece of the
+// product table G(m), m = max(mi, mo); where a cosine is below the table's lower end, G times the constant K =
+// prod_j max(1, sup_j / U_j(lower end)) (sup_j: the level's largest bound below it)
+float pumpup_g(float mi, float mo) {{
+    float m = max(max(mi, mo), {t});
+{p.locate("", "m")}    float g = {p.value(0, "b", "t")};
+    return min(mi, mo) < {t} ? g * {_lit(_up32(tabs.k))} : g;
+}}
+""")
+        return "".join(out), notes, nlev
+    q = tabs.table
+    out.append(q.glsl())
+    notes.append(f"level table: every level's bound U_j(m) on one set of {q.npieces} pieces (degree {q.deg} in m) for "
+                 f"m >= {tabs.t32:.9g}, fitted to {FIT_TOL:g}, raised by twice its fit and float32 errors (<= "
+                 f"{q.rel:.3g} relative); below it each level's largest bound there: "
+                 + ", ".join(f"{c:.9g}" for c in tabs.sup))
+    body = []
+    for j, controlled in enumerate(tabs.controlled):
+        c = _lit(_up32(tabs.sup[j]))
+        body.append(f"    float g{j + 1} = max(mi < {t} ? {c} : {q.value(j, 'bi', 'ti')},\n"
+                    f"        mo < {t} ? {c} : {q.value(j, 'bo', 'to')});  // 001 eq. 20")
+        if controlled:
+            body.append(f"    g{j + 1} = max(g{j + 1}, max(mi, mo));  // 001 eq. 21")
+    prod_expr = " * ".join(f"g{j + 1}" for j in range(nlev))
+    out.append(f"""\
+// the product of all levels' g at the cosines mi, mo > 0 (001 eq. 16, 20, 21), at least pumpup's: one piece of the
+// level table per cosine, every level's bound U_j read from it; below the table's lower end, the level's largest
+// bound there
+float pumpup_g(float mi, float mo) {{
+{q.locate("i", f"max(mi, {t})")}{q.locate("o", f"max(mo, {t})")}{chr(10).join(body)}
+    return {prod_expr};
+}}
+""")
+    return "".join(out), notes, nlev
+
+
+class _CompTables:
+    """What a compensation's shader reads for U >= E: the product table of U in m (:class:`_Pieces`) above its lower
+    end ``t32``, U's largest value below it (``sup``); or, without a product table, the spline in ln mu.
+    """
+
+    def __init__(self, plan: _Plan):
+        bound = plan.comp.bound
+        self.lookup = bound.lookup
+        self.product = None
+        self.spline = None
+        self.below = 0.0
+        self.t32 = 0.0
+        table = None
+        if bound.product is not None:
+            from .operators.pumping import _ProductError
+
+            try:
+                table = _fit_table([bound.product.exact], [self.lookup], [False], bound.product.mlo,
+                                   2.0 * bound.product.epsilon + 4 * np.finfo(float).eps, "pumpup_eprod")
+            except _ProductError:
+                table = None
+        if table is not None:
+            self.product = table
+            self.t32 = float(_up32(bound.product.mlo))
+            self.sup = _sup_below(self.lookup, self.t32)
+            self.below = self.sup - _inf_below(self.lookup, self.t32)  # (absolute)
+            self.err = float(np.max(self.product.err))
+            self.rel = self.product.rel
+        else:
+            self.spline = _LevelTable(self.lookup, "pumpup_e")
+            self.err = float(np.max(self.spline.err))
+            self.rel = self.spline.rel
 
 
 def _comp_glsl(plan: _Plan) -> tuple[str, list[str]]:
     c = plan.comp
-    bound = c.bound
-    lvl = _LevelTable(bound.lookup, "pumpup_e")
-    out = [lvl.glsl()]
-    notes = [f"compensation bound U >= E of {json.dumps(c.white.spec)}: {lvl.npieces} pieces (degree {lvl.deg} in ln "
-             f"mu), table margin {lvl.margin:.3g}, float32 error <= {float(np.max(lvl.err)):.3g} (added), cap "
-             f"{lvl.cap:g}"]
-    if bound.product is not None:
-        p = _ProductTable(bound.product, "pumpup_eprod")
-        out.append(p.glsl())
-        notes.append(f"product table of U in m: {p.npieces} pieces (degree {p.deg}) for m > {p.mlo:.6g}, relative fit "
-                     f"<= {p.epsilon:.3g} (added), float32 error <= {float(np.max(p.err)):.3g} (added)")
-        look = f"m > {_lit(p.mlo32)} ? pumpup_eprod_g(m) : pumpup_e_u(m, log(m))"
-    else:
-        look = "pumpup_e_u(m, log(m))"
-    out.append(f"""\
-// U(m) >= E(m), at least pumpup's bound (pumpup.physics.lookups.scale_bound)
+    tabs = _CompTables(plan)
+    lk = tabs.lookup
+    notes = [f"compensation bound U >= E of {json.dumps(c.white.spec)}: table margin {lk.margin:.3g}, cap {lk.cap:g}"]
+    if tabs.product is not None:
+        p = tabs.product
+        t = _lit(tabs.t32)
+        notes.append(f"table of U in m: {p.npieces} pieces (degree {p.deg}) for m >= {tabs.t32:.9g}, fitted to "
+                     f"{FIT_TOL:g}, raised by twice its fit and float32 errors (<= {p.rel:.3g} relative); below it "
+                     f"U's largest value there, {tabs.sup:.9g}")
+        out = [p.glsl(), f"""\
+// U(m) >= E(m), at least pumpup's bound (pumpup.physics.lookups.scale_bound): one piece of the product table; below
+// its lower end, U's largest value there
 float pumpup_upper(float m) {{
-    return {look};
+{p.locate("", f"max(m, {t})")}    float u = {p.value(0, "b", "t")};
+    return m < {t} ? {_lit(_up32(tabs.sup))} : u;
 }}
-""")
+"""]
+        return "".join(out), notes
+    lvl = tabs.spline
+    notes.append(f"spline of U: {lvl.npieces} pieces (degree {lvl.deg} in ln mu), float32 error <= {tabs.err:.3g} "
+                 "(added)")
+    out = [lvl.glsl(), """\
+// U(m) >= E(m), at least pumpup's bound (pumpup.physics.lookups.scale_bound)
+float pumpup_upper(float m) {
+    return pumpup_e_u(m, log(m));
+}
+"""]
     return "".join(out), notes
 
 
@@ -937,33 +1423,24 @@ def table_error(spec: Any) -> dict[str, float]:
     Returns
     -------
     dict
-        ``{"relative": r, "absolute": a}``: a pumped value is at least pumpup's x (1 - 3 B - r); a ``scaled`` one too;
-        a ``kulla_conty`` one at least pumpup's base x (1 - 3 B - r) + its lobe - scale x 2 a (a: the largest amount by
-        which the shader's U exceeds pumpup's).  Both 0 for a closed-form model.
+        ``{"relative": r, "absolute": a, "below": m, "below_relative": rb}``: where N.wi and N.wo are both at least
+        ``m`` (the tables' lower end, 1e-8 for pumpup's tables; 0 without one), a pumped value is at least pumpup's x
+        (1 - 3 B - r); a ``scaled`` one too; a ``kulla_conty`` one at least pumpup's base x (1 - 3 B - r) + its lobe -
+        scale x 2 a (a: the largest amount by which the shader's U exceeds pumpup's).  Where a cosine is below ``m``
+        the shader divides by each level's largest bound below ``m`` (U's largest value below it for a compensation),
+        which may take a pumped or scaled value lower by a further relative ``rb`` (``rb`` absolute in U for
+        ``kulla_conty``).  All 0 for a closed-form model.
     """
     plan = _Plan(spec if isinstance(spec, BRDF) else load(spec))
     if plan.levels:
-        rel = 0.0
-        for lev in plan.levels:
-            lk = lev.lookup()
-            t = _LevelTable(lk, "x")
-            rel += t.rel
-        prod = plan.levels[-1].product()
-        if prod is not None:
-            p = _ProductTable(prod, "x")
-            rel += p.rel
-        return {"relative": rel + 4.0 * (len(plan.levels) + 9) * U, "absolute": 0.0}
+        tabs = _PumpedTables(plan)
+        return {"relative": tabs.rel + 4.0 * (len(plan.levels) + 9) * U, "absolute": 0.0, "below": tabs.t32,
+                "below_relative": tabs.below}
     if plan.comp is not None:
-        bound = plan.comp.bound
-        t = _LevelTable(bound.lookup, "x")
-        a = 2.0 * float(np.max(t.err)) + 4.0 * U
-        rel = t.rel
-        if bound.product is not None:
-            p = _ProductTable(bound.product, "x")
-            a = max(a, 2.0 * float(np.max(p.err)) + 4.0 * U)
-            rel = max(rel, p.rel)
-        return {"relative": rel + 32.0 * U, "absolute": a}
-    return {"relative": 0.0, "absolute": 0.0}
+        tabs = _CompTables(plan)
+        return {"relative": tabs.rel + 32.0 * U, "absolute": 2.0 * tabs.err + 4.0 * U, "below": tabs.t32,
+                "below_relative": tabs.below}
+    return {"relative": 0.0, "absolute": 0.0, "below": 0.0, "below_relative": 0.0}
 
 
 def _library(plan: _Plan) -> tuple[str, list[str]]:
@@ -977,6 +1454,8 @@ def _library(plan: _Plan) -> tuple[str, list[str]]:
         parts.append(_FRESNEL_CONDUCTOR)
     if "pumpup_erf" in code:
         parts.append(_ERF)
+    if "pumpup_atan" in code:
+        parts.append(_ATAN)
     parts.append(_param_decls(plan))
     parts.append(f"// the base model {b.type}: (f_r, a bound of its relative float32 error) for N.wi, N.wo > 0\n")
     if plan.fresnel is not None:
@@ -1080,6 +1559,10 @@ def _header(plan: _Plan, target: str, notes: list[str], command: str | None, com
     else:
         lines.append("uniforms: " + (", ".join(f"float pumpup_{k} (= {v:.9g} for this spec)"
                                                 for k, v in plan.params.items()) or "none"))
+    fixed = [k for k in _BAKED.get(plan.base.type, ()) if plan.base.p.get(k) is not None]
+    if fixed:
+        lines.append("baked into the code (it chooses the code or changes a table in it): "
+                     + ", ".join(f"{k} = {plan.base.p[k]}" for k in fixed))
         lines.append("float32: pumpup_brdf_error(wi, wo) bounds the relative difference from pumpup's double precision")
     for n in notes:
         lines.append("table: " + n)

@@ -1,15 +1,19 @@
 """Benchmark of pumpup.shader: generation time, and the GLSL's evaluation cost on Mesa's llvmpipe (pumped and
 compensated against their base, measured in the same run).
 
-    python scripts/bench/bench_shader.py [--pairs 1048576] [--repeat 5]
+    python scripts/bench/bench_shader.py [--pairs 1048576] [--repeat 5] [--against OLD_SHADERS_PY]
 
 Needs moderngl and an EGL driver (Debian: libegl1, libgl1-mesa-dri).  The evaluation renders one float32 value per
-pixel (directions from two float32 textures) and times the draws after a first, compiling one.
+pixel (directions from two float32 textures) and times the draws after a first, compiling one.  With ``--against`` (a
+file holding another version of pumpup/shaders.py, e.g. ``<(git show main:pumpup/shaders.py)``) each case's shader
+from that version is timed too, the two draws alternating, and the table gives both.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import tempfile
 import time
 
 import numpy as np
@@ -19,6 +23,7 @@ from pumpup.shaders import shader, uniforms
 
 GGX = {"type": "ggx", "alpha": 0.3}
 PHONG = {"type": "phong", "n": 20}
+BASES = ("ggx", "phong")
 CASES = [
     ("ggx", GGX, None),
     ("ggx pumped g1 x3", {"type": "pumped", "base": GGX, "g": "g1", "levels": 3}, "ggx"),
@@ -60,12 +65,32 @@ def generation_times() -> None:
               f"(again: {again:.3f} s), {len(src) / 1e3:.0f} kB of GLSL ES")
 
 
-def evaluation_times(pairs: int, repeat: int) -> None:
-    """Print the cost per pair of each case's GLSL on llvmpipe, and its ratio to its base's."""
+def load_other(path: str):
+    """Another version of pumpup/shaders.py, imported as a module of the installed pumpup package."""
+    import importlib.util
+    import sys
+
+    with open(path) as fh:
+        text = fh.read()
+    with tempfile.NamedTemporaryFile("w", suffix=".py", delete=False) as tmp:
+        tmp.write(text)
+    spec = importlib.util.spec_from_file_location("pumpup._shaders_other", tmp.name)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules["pumpup._shaders_other"] = mod
+    spec.loader.exec_module(mod)
+    os.unlink(tmp.name)
+    return mod
+
+
+def evaluation_times(pairs: int, repeat: int, other=None) -> None:
+    """Print the cost per pair of each case's GLSL on llvmpipe, and its ratio to its base's (and, with ``other``, the
+    same for that module's shaders, the draws alternating).
+    """
     import moderngl
 
     ctx = moderngl.create_standalone_context(backend="egl", require=430)
-    print(f"evaluation on {ctx.info['GL_RENDERER']}, {pairs} pairs per draw, best of {repeat}:")
+    print(f"evaluation on {ctx.info['GL_RENDERER']}, {pairs} pairs per draw, best of {repeat} rounds (each round draws "
+          "every shader once), load average before: " + " ".join(f"{x:.2f}" for x in os.getloadavg()) + ":")
     width = 1024
     h = pairs // width
     rng = np.random.default_rng(1)
@@ -85,12 +110,13 @@ def evaluation_times(pairs: int, repeat: int) -> None:
     out = ctx.texture((width, h), 4, dtype="f4")
     fbo = ctx.framebuffer([out])
     vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], "f4").tobytes())
-    seconds = {}
-    for name, spec, base in CASES:
-        lib = shader(spec, target="glsl")
+    modules = [("this", shader, uniforms)] + ([("other", other.shader, other.uniforms)] if other else [])
+
+    def prepare(make, unif, spec):
+        lib = make(spec, target="glsl")
         t = time.perf_counter()
         prog = ctx.program(vertex_shader=VS, fragment_shader="#version 430 core\n" + lib + FS)
-        for k, v in uniforms(spec).items():
+        for k, v in unif(spec).items():
             if k in prog:
                 prog[k].value = v
         prog["bench_wi"].value = 0
@@ -101,17 +127,33 @@ def evaluation_times(pairs: int, repeat: int) -> None:
         two.use(1)
         vao.render(moderngl.TRIANGLES)
         ctx.finish()
-        compile_s = time.perf_counter() - t
-        best = np.inf
-        for _ in range(repeat):
+        return prog, vao, time.perf_counter() - t
+
+    runs = {}
+    for name, spec, _ in CASES:
+        for label, make, unif in modules:
+            if label == "other" and name in BASES:
+                continue  # the same base shader
+            runs[label, name] = prepare(make, unif, spec)
+    best = dict.fromkeys(runs, np.inf)
+    for _ in range(repeat):  # every shader once per round: all of them under the same load
+        for key, (_, vao, _) in runs.items():
             t = time.perf_counter()
             vao.render(moderngl.TRIANGLES)
             ctx.finish()
-            best = min(best, time.perf_counter() - t)
-        seconds[name] = best
-        ratio = f", {best / seconds[base]:.2f} x {base}" if base else ""
-        print(f"  {name:22s} {best * 1e9 / (width * h):7.1f} ns per pair{ratio}  (compile + first draw "
-              f"{compile_s:.2f} s)")
+            best[key] = min(best[key], time.perf_counter() - t)
+    for name, _, base in CASES:
+        cols = []
+        for label, _, _ in modules:
+            key = (label, name) if (label, name) in best else ("this", name)
+            if label == "other" and key[0] == "this":
+                continue
+            ns = best[key] * 1e9 / (width * h)
+            ratio = f" ({best[key] / best['this', base]:.2f} x {base})" if base else ""
+            cols.append(f"{label} {ns:6.1f} ns{ratio}")
+        compile_s = ", ".join(f"{runs[k][2]:.2f}" for k in runs if k[1] == name)
+        print(f"  {name:20s} " + ", ".join(cols) + f"  (compile + first draw {compile_s} s)")
+    for prog, vao, _ in runs.values():
         vao.release()
         prog.release()
 
@@ -121,9 +163,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--pairs", type=int, default=1 << 20)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--against", help="another version of pumpup/shaders.py to time alternately")
+    ap.add_argument("--no-generation", action="store_true", help="skip the generation times")
     args = ap.parse_args()
-    generation_times()
-    evaluation_times(args.pairs, args.repeat)
+    if not args.no_generation:
+        generation_times()
+    evaluation_times(args.pairs, args.repeat, load_other(args.against) if args.against else None)
 
 
 if __name__ == "__main__":
