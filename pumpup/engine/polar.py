@@ -124,7 +124,8 @@ too, but its arc is a polynomial in 1 - c = g + 2 b sin^2(beta / 2) (g = 1 - cos
 :func:`~pumpup.engine.half_arc._k_ashikhmin` integrates in closed form from the moments W_k of sin^(2k)(beta / 2),
 sums of terms >= 0; the band below the kink N.wo = mu is a difference of two arcs' moments, whose rounding bound
 (64 eps times every term) is the node's error, and where that exceeds half the node's tolerance (near grazing
-incidence) the rule below takes the node instead.  A 257-point table at rtol 1e-10 takes about 9 ms instead of 30.
+incidence) the rule below takes the node instead (``python scripts/bench/bench_polar.py`` times a 257-point table
+at rtol 1e-10 with and without the closed form).
 The rule is globally adaptive 7/15 Gauss-Kronrod in delta = beta0 - beta from the arc's end (where d = c - c0 =
 2 e0 sin^2(delta / 2) + b sin(beta0) sin(delta), no cancellation), cut at the kinks and jumps (the V-cavity's
 crossings, Walter's G1 switch) and, where a factor has a singularity near the arc's small end (P(N.wo) at N.wo ~ +-i
