@@ -104,7 +104,7 @@ _mf_scalar = njit(cache=True, nogil=True, inline="always")(_mf_value)
 @njit(cache=True, nogil=True)
 def _mf_divided(wi, wo, out, dist, alpha, shadowing, g1, ior, eta, k, offsets, logx, coef, v0, slope0, margin_lo, cap,
                 controlled, increasing, mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo,
-                qshift, qcbase, qcell, qlo, qrow, rcells, rpattern, rshift, rcbase,
+                qshift, qcbase, qcell, qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase,
                 rcell, rlo, rcoef):  # pragma: no cover - compiled
     """f_r / (g_1 ... g_k) (001 eq. 16) over the rows of (N, 3) arrays into ``out``: the kernel's value and the pumped
     chain's division in one pass, the same operations as the kernel followed by the chain kernel
@@ -122,7 +122,7 @@ def _mf_divided(wi, wo, out, dist, alpha, shadowing, g1, ior, eta, k, offsets, l
         elif mmin > qmlo:
             g = 0.0
             if rcells > 0:  # the split table: one product F(mmin) H(mmax), 0 where the cell has no pattern
-                g = g_split(mmin, mmax, rcells, rpattern, rshift, rcbase, rcell, rlo,
+                g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
                             rcoef)
             if g == 0.0:
                 g = g_pair(lz, vz, controlled, qshift, qcbase, qcell, qlo, qrow)

@@ -111,7 +111,7 @@ def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compi
 @njit(cache=True, nogil=True)
 def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
                    index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell, qlo,
-                   qrow, rcells, rpattern, rshift, rcbase, rcell, rlo,
+                   qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
                    rcoef):  # pragma: no cover - compiled
     """f_r / (g_1 ... g_k) (001 eq. 16) over the rows of C-contiguous (N, 3) arrays into ``out`` in one pass: each
     block of _BLOCK rows as :func:`_phong_rows` (without the check), then divided by the pumped chain's g while it is
@@ -147,7 +147,7 @@ def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo
             elif mmin > qmlo:
                 g = 0.0
                 if rcells > 0:  # the split table: one product F(mmin) H(mmax), 0 where the cell has no pattern
-                    g = g_split(mmin, mmax, rcells, rpattern, rshift, rcbase, rcell,
+                    g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell,
                                 rlo, rcoef)
                 if g == 0.0:
                     g = g_pair(lz, vz, controlled, qshift, qcbase, qcell, qlo, qrow)
@@ -160,7 +160,7 @@ def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo
 @njit(cache=True, nogil=True)
 def _phong_divided_every_row(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
                              increasing, mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo,
-                             qshift, qcbase, qcell, qlo, qrow, rcells, rpattern, rshift, rcbase, rcell,
+                             qshift, qcbase, qcell, qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell,
                              rlo, rcoef):  # pragma: no cover - compiled
     """:func:`_phong_divided` dividing every row of a block by g, the dark ones (0 / g) too: the baseline of
     scripts/bench/bench_eval.py (``Phong._eval_divided_every_row``); the same values.
@@ -193,7 +193,7 @@ def _phong_divided_every_row(wi, wo, out, n, c, offsets, logx, coef, v0, slope0,
             elif mmin > qmlo:
                 g = 0.0
                 if rcells > 0:  # the split table: one product F(mmin) H(mmax), 0 where the cell has no pattern
-                    g = g_split(mmin, mmax, rcells, rpattern, rshift, rcbase, rcell,
+                    g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell,
                                 rlo, rcoef)
                 if g == 0.0:
                     g = g_pair(lz, vz, controlled, qshift, qcbase, qcell, qlo, qrow)

@@ -179,7 +179,7 @@ def _uses_file_tables(brdf: BRDF) -> bool:
 @njit(cache=True, nogil=True)
 def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
                   index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell,
-                  qlo, qrow, rcells, rpattern, rshift, rcbase, rcell, rlo,
+                  qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
                   rcoef):  # pragma: no cover - compiled
     """All levels of a pumped chain in one pass: f / (g_1 g_2 ... g_k) (001 eq. 16), in place.
 
@@ -210,7 +210,7 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
         elif mmin > qmlo:  # one piece per direction for all levels (0 / g = 0)
             g = 0.0
             if rcells > 0:  # one product F(mmin) H(mmax), 0 where the cell has no pattern
-                g = g_split(mmin, mmax, rcells, rpattern, rshift, rcbase, rcell, rlo,
+                g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
                             rcoef)
             if g == 0.0:
                 g = g_pair(mi, mo, controlled, qshift, qcbase, qcell, qlo, qrow)
@@ -592,9 +592,9 @@ class _SplitTable:
     ``epsilon``), as the level table's.  The cells where every level takes m hold -1: there the ideal operator's g is
     m^k itself, with no room below it for a scaled table. ``coef[f, s]`` holds function f's coefficients on piece s
     (highest power first), the piece's centre and inverse half-width: one cache line per look-up.  ``pattern[i, k]``
-    (int8) is the pattern of the cell i = floor(l CELLS), k = floor(m CELLS) (-1: none), ``fid[p]`` and ``hid[p]`` the
-    rows of ``coef`` that hold its F_A and H_B; the kernel reads ``packed``, the cells with i <= k holding fid + 256 hid
-    of their pattern (int16, 64 kB: one load gives both rows).  :meth:`g` is the plain numpy version of the kernel.
+    (int8) is the pattern of the cell i = floor(l CELLS), k = floor(m CELLS) (-1: none; the kernel reads ``packed``, its
+    cells with i <= k, 32 kB), ``fid[p]`` and ``hid[p]`` the rows of ``coef`` that hold its F_A and H_B. :meth:`g` is
+    the plain numpy version of the kernel.
     """
 
     #: the fit's relative tolerance (a product of k bounds is itself only good to a few k ulp: at 1e-15 the
@@ -623,7 +623,8 @@ class _SplitTable:
         self.pattern = np.full((n, n), -1, dtype=np.int8)
         self.pattern[ok] = inverse.ravel().astype(np.int8)
         k_, i_ = np.tril_indices(n)  # (k >= i: the cells with l <= m, row by row of k)
-        packed = self.pattern[i_, k_]
+        #: ``pattern``'s cells with i <= k packed as the kernel reads them: cell (i, k) at k (k + 1) / 2 + i
+        self.packed = np.ascontiguousarray(self.pattern[i_, k_])
         #: the term of every level in each pattern (0: U_j(l), 1: U_j(m), 2: m)
         self.patterns = keys.astype(np.int8)
         if len(keys) == 0:  # (no cell certified: a table of nothing; the chain keeps the level table alone)
@@ -636,10 +637,6 @@ class _SplitTable:
         self.fid = np.array([self.functions.index((tuple(np.nonzero(k == 0)[0]), 0)) for k in keys], dtype=np.int64)
         self.hid = np.array([self.functions.index((tuple(np.nonzero(k == 1)[0]), int(np.count_nonzero(k == 2))))
                              for k in keys], dtype=np.int64)
-        #: ``pattern``'s cells with i <= k packed as the kernel reads them: cell (i, k) at k (k + 1) / 2 + i holds
-        #: its pattern's rows of ``coef``, fid + 256 hid (-1: none), so that one load gives both
-        code = np.concatenate([self.fid + 256 * self.hid, [-1]]).astype(np.int16)
-        self.packed = np.ascontiguousarray(code[packed])  # (pattern -1: the last, -1)
         br = _level_breaks(self.looks, self.mlo)
         fns = [self._function(fn) for fn in self.functions[1:]]
         coefs, lo, hi, center, half, worst = fit_pieces(fns, br[:-1], br[1:], self.TOL, "split table")
@@ -653,8 +650,6 @@ class _SplitTable:
         self.center, self.ihalf = center, 1.0 / half
         self.lo = np.concatenate([lo, [math.inf]])  # a sentinel ends the search
         self.shift, self.cbase, self.cstart, self.entries = _piece_cells(lo, self.mlo, self.CELLS_MAX_BITS)
-        self._code_pattern = np.full(256 * len(self.functions), -1, dtype=np.int64)
-        self._code_pattern[self.fid + 256 * self.hid] = np.arange(len(keys))  # (fid, hid) -> pattern
         self._check([self._function(fn) for fn in self.functions])
 
     def _function(self, fn):
@@ -745,11 +740,7 @@ class _SplitTable:
         lo, hi = np.minimum(mu_i, mu_o), np.maximum(mu_i, mu_o)
         n = self.ncell
         i, k = np.minimum((lo * n).astype(np.int64), n - 1), np.minimum((hi * n).astype(np.int64), n - 1)
-        v = self.packed[k * (k + 1) // 2 + i].astype(np.int64)
-        p = np.full(v.shape, -1, dtype=np.int64)
-        on = v >= 0
-        p[on] = self._code_pattern[v[on]]
-        return p
+        return self.packed[k * (k + 1) // 2 + i]
 
     def g(self, mu_i, mu_o) -> np.ndarray:
         """g_1 ... g_k at (mu_i, mu_o), both > mlo: the plain numpy reference of :func:`g_split` followed, in the cells
@@ -802,8 +793,8 @@ def _unique_rows(rows: np.ndarray):
 
 
 #: the split table's arguments of the kernels when there is none (:meth:`Pumped._split_args`)
-_SPLIT_OFF = (0, np.full(1, -1, dtype=np.int16), CELL_SHIFT, 0, np.zeros(1, np.int64), np.full(2, math.inf),
-              np.zeros((1, 1, PRODUCT_DEGREE + 3)))
+_SPLIT_OFF = (0, np.full(1, -1, dtype=np.int8), np.zeros(1, np.int64), np.zeros(1, np.int64), CELL_SHIFT, 0,
+              np.zeros(1, np.int64), np.full(2, math.inf), np.zeros((1, 1, PRODUCT_DEGREE + 3)))
 
 
 class _Lookup:
@@ -1138,7 +1129,7 @@ class Pumped(BRDF):
         r = self.split_table()
         if r is None:  # off: split_cells = 0
             return _SPLIT_OFF
-        return r.ncell, r.packed, r.shift, r.cbase, r.entries, r.lo, r.coef
+        return r.ncell, r.packed, r.fid, r.hid, r.shift, r.cbase, r.entries, r.lo, r.coef
 
     def _level_args(self):
         q = self.level_table()
