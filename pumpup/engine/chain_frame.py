@@ -216,7 +216,7 @@ def _x_rule(n, p, mu, s, lo, hi, chain, kb, kc, keps, nodes, wk, wg, buf, ibuf, 
         g = 1.0  # (no chain: a metal's lobe)
         if chain is not None:
             if min(mu, t) > chain.product_mlo:
-                g = g_product(max(mu, t), chain.product_cbase, chain.product_cstart, chain.product_lo,
+                g = g_product(max(mu, t), chain.product_cbase, chain.product_cell, chain.product_lo,
                               chain.product_rows)
             else:
                 g = g_levels(max(mu, t), min(mu, t), chain.offsets, chain.logx, chain.coef, chain.v0, chain.slope0,

@@ -395,7 +395,7 @@ def _n_chain_g(chain, mu, t):  # pragma: no cover - compiled
     (``pumpup.physics.lookups.g_product``, ``g_levels``; 001 eq. 16).
     """
     if min(mu, t) > chain.product_mlo:
-        return g_product(max(mu, t), chain.product_cbase, chain.product_cstart, chain.product_lo, chain.product_rows)
+        return g_product(max(mu, t), chain.product_cbase, chain.product_cell, chain.product_lo, chain.product_rows)
     return g_levels(max(mu, t), min(mu, t), chain.offsets, chain.logx, chain.coef, chain.v0, chain.slope0,
                     chain.margin_lo, chain.cap, chain.controlled, chain.increasing, chain.mu0, chain.index,
                     chain.index_lo, chain.index_h_inv)

@@ -110,8 +110,8 @@ def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compi
 
 @njit(cache=True, nogil=True)
 def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
-                   index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow, qmlo, qshift, qcbase, qcstart, qlo,
-                   qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcstart, rlo,
+                   index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell, qlo,
+                   qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
                    rcoef):  # pragma: no cover - compiled
     """f_r / (g_1 ... g_k) (001 eq. 16) over the rows of C-contiguous (N, 3) arrays into ``out`` in one pass: each
     block of _BLOCK rows as :func:`_phong_rows` (without the check), then divided by the pumped chain's g while it is
@@ -143,14 +143,14 @@ def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo
                 continue
             mmax, mmin = max(lz, vz), min(lz, vz)
             if mmin > pmlo:  # (pumpup.physics.lookups.g_levels_call says why this is written out)
-                f[r] = f[r] / g_product(mmax, pcbase, pcstart, plo, prow)  # 001 eq. 16, all levels
+                f[r] = f[r] / g_product(mmax, pcbase, pcell, plo, prow)  # 001 eq. 16, all levels
             elif mmin > qmlo:
                 g = 0.0
                 if rcells > 0:  # the split table: one product F(mmin) H(mmax), 0 where the cell has no pattern
-                    g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcstart,
+                    g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell,
                                 rlo, rcoef)
                 if g == 0.0:
-                    g = g_pair(lz, vz, controlled, qshift, qcbase, qcstart, qlo, qrow)
+                    g = g_pair(lz, vz, controlled, qshift, qcbase, qcell, qlo, qrow)
                 f[r] = f[r] / g  # 001 eq. 16, all levels
             elif f[r] != 0.0:
                 f[r] = f[r] / g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
@@ -159,8 +159,8 @@ def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo
 
 @njit(cache=True, nogil=True)
 def _phong_divided_every_row(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
-                             increasing, mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow, qmlo,
-                             qshift, qcbase, qcstart, qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcstart,
+                             increasing, mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo,
+                             qshift, qcbase, qcell, qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell,
                              rlo, rcoef):  # pragma: no cover - compiled
     """:func:`_phong_divided` dividing every row of a block by g, the dark ones (0 / g) too: the baseline of
     scripts/bench/bench_eval.py (``Phong._eval_divided_every_row``); the same values.
@@ -189,14 +189,14 @@ def _phong_divided_every_row(wi, wo, out, n, c, offsets, logx, coef, v0, slope0,
                 continue  # (0 already)
             mmax, mmin = max(lz, vz), min(lz, vz)
             if mmin > pmlo:  # (pumpup.physics.lookups.g_levels_call says why this is written out)
-                f[r] = f[r] / g_product(mmax, pcbase, pcstart, plo, prow)  # 001 eq. 16, all levels
+                f[r] = f[r] / g_product(mmax, pcbase, pcell, plo, prow)  # 001 eq. 16, all levels
             elif mmin > qmlo:
                 g = 0.0
                 if rcells > 0:  # the split table: one product F(mmin) H(mmax), 0 where the cell has no pattern
-                    g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcstart,
+                    g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell,
                                 rlo, rcoef)
                 if g == 0.0:
-                    g = g_pair(lz, vz, controlled, qshift, qcbase, qcstart, qlo, qrow)
+                    g = g_pair(lz, vz, controlled, qshift, qcbase, qcell, qlo, qrow)
                 f[r] = f[r] / g  # 001 eq. 16, all levels
             elif f[r] != 0.0:
                 f[r] = f[r] / g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,

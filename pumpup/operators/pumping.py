@@ -33,6 +33,8 @@ from ..physics.lookups import (
     INDEX_CELLS,
     PRODUCT_DEGREE,
     GChain,
+    cell_entries,
+    cell_piece_reference,
     float_bits_reference,
     g_levels,
     g_levels_call,
@@ -176,8 +178,8 @@ def _uses_file_tables(brdf: BRDF) -> bool:
 
 @njit(cache=True, nogil=True)
 def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
-                  index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow, qmlo, qshift, qcbase, qcstart,
-                  qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcstart, rlo,
+                  index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell,
+                  qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
                   rcoef):  # pragma: no cover - compiled
     """All levels of a pumped chain in one pass: f / (g_1 g_2 ... g_k) (001 eq. 16), in place.
 
@@ -204,14 +206,14 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
             continue
         mmax, mmin = max(mi, mo), min(mi, mo)
         if mmin > pmlo:  # the fast path: one look-up for all levels (no branch on f = 0: 0 / g = 0)
-            f[k] = f[k] / g_product(mmax, pcbase, pcstart, plo, prow)  # 001 eq. 16, all levels
+            f[k] = f[k] / g_product(mmax, pcbase, pcell, plo, prow)  # 001 eq. 16, all levels
         elif mmin > qmlo:  # one piece per direction for all levels (0 / g = 0)
             g = 0.0
             if rcells > 0:  # one product F(mmin) H(mmax), 0 where the cell has no pattern
-                g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcstart, rlo,
+                g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
                             rcoef)
             if g == 0.0:
-                g = g_pair(mi, mo, controlled, qshift, qcbase, qcstart, qlo, qrow)
+                g = g_pair(mi, mo, controlled, qshift, qcbase, qcell, qlo, qrow)
             f[k] = f[k] / g  # 001 eq. 16, all levels
         elif f[k] != 0.0:
             f[k] = f[k] / g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
@@ -220,7 +222,7 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
 
 @njit(cache=True, nogil=True)
 def _chain_kernel_levelwise(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
-                            index, index_lo, index_h_inv, pmlo, pcbase, pcstart, plo, prow):  # pragma: no cover
+                            index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow):  # pragma: no cover
     """:func:`_chain_kernel` without the level table, as it was before it (the product table's path, else every level
     looked up level by level, :func:`g_levels` inlined): the baseline :meth:`Pumped._eval_levelwise` runs, for the
     tests of the level table and scripts/bench/bench_eval.py.
@@ -232,7 +234,7 @@ def _chain_kernel_levelwise(f, wi, wo, offsets, logx, coef, v0, slope0, margin_l
             continue
         mmax, mmin = max(mi, mo), min(mi, mo)
         if mmin > pmlo:
-            f[k] = f[k] / g_product(mmax, pcbase, pcstart, plo, prow)  # 001 eq. 16, all levels
+            f[k] = f[k] / g_product(mmax, pcbase, pcell, plo, prow)  # 001 eq. 16, all levels
             continue
         if f[k] == 0.0:
             continue
@@ -353,7 +355,8 @@ class _Product:
     at most 2 ``epsilon`` (relative).
     The kernel finds the piece from the bits of m: cell c = (bits(m) >> CELL_SHIFT) - cbase,
     2^CELL_BITS cells per octave, ``cstart[c]`` the piece where the cell starts (most cells
-    hold one piece).  :meth:`__call__` is the plain numpy version of that look-up.
+    hold one piece); the kernel reads ``entries[c]``, that piece and where the next starts in one int64.
+    :meth:`__call__` is the plain numpy version of that look-up.
     """
 
     TOL = 1e-14
@@ -382,6 +385,9 @@ class _Product:
         self.lo = np.concatenate([lo, [math.inf]])  # a sentinel ends the search
         # cell c = (bits(m) >> CELL_SHIFT) - cbase starts at bounds[c]; the last starts at m = 1
         self.cstart = np.clip(np.searchsorted(lo, bounds, side="right") - 1, 0, len(lo) - 1).astype(np.int32)
+        #: the cells as the kernel reads them: each cell's first piece and where the next starts, one int64
+        #: (:func:`pumpup.physics.lookups.cell_entries`)
+        self.entries = cell_entries(self.lo, self.cstart)
 
     def _g(self, j, m):
         g = self.looks[j].upper(m)  # already at most the cap
@@ -413,17 +419,10 @@ class _Product:
         return np.array(out)
 
     def piece(self, m):
-        """The piece that holds m (> mlo), found as the kernel finds it: the cell from the bits of
-        m, then forward.
+        """The piece that holds m (> mlo), found as the kernel finds it: the cell's entry from the bits of m, then
+        forward (:func:`pumpup.physics.lookups.cell_piece_reference`).
         """
-        m = np.asarray(m, dtype=np.float64)
-        c = np.minimum((float_bits_reference(m) >> CELL_SHIFT) - self.cbase, len(self.cstart) - 1)
-        s = self.cstart[c]
-        while True:
-            step = m >= self.lo[s + 1]
-            if not np.any(step):
-                return s
-            s = s + step
+        return cell_piece_reference(m, CELL_SHIFT, self.cbase, self.entries, self.lo)
 
     def __call__(self, m):
         """The kernel's G(m) in plain numpy (m > mlo): the reference of the fast path."""
@@ -462,11 +461,11 @@ def _level_breaks(looks, mlo: float) -> np.ndarray:
     return np.unique(np.concatenate([br, _cap_kinks(looks, br)]))
 
 
-def _piece_cells(lo: np.ndarray, mlo: float, max_bits: int) -> tuple[int, int, np.ndarray]:
+def _piece_cells(lo: np.ndarray, mlo: float, max_bits: int) -> tuple[int, int, np.ndarray, np.ndarray]:
     """The cell index of pieces that start at ``lo`` (sorted, the first at ``mlo``): 2^bits cells per octave, cell
     c = (bits(m) >> shift) - cbase starting at piece cstart[c], with bits from CELL_BITS up until no cell of the top
     two octaves, where most cosines lie, holds more than two piece starts, at most ``max_bits``.  Returns (shift,
-    cbase, cstart).
+    cbase, cstart, entries), the cells' entries the kernels read (:func:`pumpup.physics.lookups.cell_entries`).
     """
     for bits in range(52 - CELL_SHIFT, max_bits + 1):
         shift = 52 - bits
@@ -478,7 +477,7 @@ def _piece_cells(lo: np.ndarray, mlo: float, max_bits: int) -> tuple[int, int, n
     b1 = int(float_bits_reference(1.0)) >> shift
     bounds = (np.arange(b0, b1 + 1, dtype=np.int64) << shift).view(np.float64)
     cstart = np.clip(np.searchsorted(lo, bounds, side="right") - 1, 0, len(lo) - 1).astype(np.int32)
-    return shift, b0, cstart
+    return shift, b0, cstart, cell_entries(np.concatenate([lo, [math.inf]]), cstart)
 
 
 class _LevelTable:
@@ -530,7 +529,7 @@ class _LevelTable:
         more than two piece starts (3-level g2 pumped GGX alpha 0.3: 462 pieces in [0.5, 1], up to 41 forward steps
         with 256 cells per octave), at most CELLS_MAX_BITS (:func:`_piece_cells`).
         """
-        self.shift, self.cbase, self.cstart = _piece_cells(lo, self.mlo, self.CELLS_MAX_BITS)
+        self.shift, self.cbase, self.cstart, self.entries = _piece_cells(lo, self.mlo, self.CELLS_MAX_BITS)
 
     def _check(self, tt) -> None:
         """Refuse the table (:class:`_ProductError`) unless every piece is at most its level's bound at the fit's test
@@ -546,14 +545,7 @@ class _LevelTable:
 
     def piece(self, m):
         """The piece that holds m (> mlo), found as the kernel finds it (:meth:`_Product.piece`)."""
-        m = np.asarray(m, dtype=np.float64)
-        c = np.minimum((float_bits_reference(m) >> self.shift) - self.cbase, len(self.cstart) - 1)
-        s = self.cstart[c]
-        while True:
-            step = m >= self.lo[s + 1]
-            if not np.any(step):
-                return s
-            s = s + step
+        return cell_piece_reference(m, self.shift, self.cbase, self.entries, self.lo)
 
     def levels(self, m) -> np.ndarray:
         """Every level's U_j(m) (m > mlo) as the kernel computes it: an array (levels,) + m's shape."""
@@ -657,7 +649,7 @@ class _SplitTable:
              np.broadcast_to(1.0 / half[None, :, None], (len(coef), len(lo), 1))], axis=2))
         self.center, self.ihalf = center, 1.0 / half
         self.lo = np.concatenate([lo, [math.inf]])  # a sentinel ends the search
-        self.shift, self.cbase, self.cstart = _piece_cells(lo, self.mlo, self.CELLS_MAX_BITS)
+        self.shift, self.cbase, self.cstart, self.entries = _piece_cells(lo, self.mlo, self.CELLS_MAX_BITS)
         self._check([self._function(fn) for fn in self.functions])
 
     def _function(self, fn):
@@ -734,14 +726,7 @@ class _SplitTable:
 
     def piece(self, m):
         """The piece that holds m (> mlo), found as the kernel finds it (:meth:`_Product.piece`)."""
-        m = np.asarray(m, dtype=np.float64)
-        c = np.minimum((float_bits_reference(m) >> self.shift) - self.cbase, len(self.cstart) - 1)
-        s = self.cstart[c]
-        while True:
-            step = m >= self.lo[s + 1]
-            if not np.any(step):
-                return s
-            s = s + step
+        return cell_piece_reference(m, self.shift, self.cbase, self.entries, self.lo)
 
     def function(self, f, m) -> np.ndarray:
         """Tabulated function ``f`` (a row of ``coef``) at m (> mlo), as the kernel computes it."""
@@ -809,7 +794,7 @@ def _unique_rows(rows: np.ndarray):
 
 #: the split table's arguments of the kernels when there is none (:meth:`Pumped._split_args`)
 _SPLIT_OFF = (0, np.full(1, -1, dtype=np.int8), np.zeros(1, np.int64), np.zeros(1, np.int64), CELL_SHIFT, 0,
-              np.zeros(1, np.int32), np.full(2, math.inf), np.zeros((1, 1, PRODUCT_DEGREE + 3)))
+              np.zeros(1, np.int64), np.full(2, math.inf), np.zeros((1, 1, PRODUCT_DEGREE + 3)))
 
 
 class _Lookup:
@@ -1144,20 +1129,20 @@ class Pumped(BRDF):
         r = self.split_table()
         if r is None:  # off: split_cells = 0
             return _SPLIT_OFF
-        return r.ncell, r.packed, r.fid, r.hid, r.shift, r.cbase, r.cstart, r.lo, r.coef
+        return r.ncell, r.packed, r.fid, r.hid, r.shift, r.cbase, r.entries, r.lo, r.coef
 
     def _level_args(self):
         q = self.level_table()
         if q is None:  # off: qmlo = inf
-            return (math.inf, CELL_SHIFT, 0, np.zeros(1, np.int32), np.full(2, math.inf),
+            return (math.inf, CELL_SHIFT, 0, np.zeros(1, np.int64), np.full(2, math.inf),
                     np.zeros((1, 2 + PRODUCT_DEGREE + 1)))
-        return q.mlo, q.shift, q.cbase, q.cstart, q.lo, q.rows
+        return q.mlo, q.shift, q.cbase, q.entries, q.lo, q.rows
 
     def _product_args(self):
         p = self.product()
         if p is None:  # off: pmlo = inf
-            return math.inf, 0, np.zeros(1, np.int32), np.full(2, math.inf), np.zeros((1, PRODUCT_DEGREE + 3))
-        return p.mlo, p.cbase, p.cstart, p.lo, p.rows
+            return math.inf, 0, np.zeros(1, np.int64), np.full(2, math.inf), np.zeros((1, PRODUCT_DEGREE + 3))
+        return p.mlo, p.cbase, p.entries, p.lo, p.rows
 
     #: pairs per pass when many are evaluated at once: the base's values and the directions are
     #: still in the cache when the chain kernel reads them (2e6 pairs, 3-level Phong: 26 -> 21 ns

@@ -160,19 +160,67 @@ def float_bits_reference(x) -> np.ndarray:
     return np.asarray(x, dtype=np.float64).view(np.int64)
 
 
-@njit(cache=True, nogil=True, inline="always")
-def g_product(mmax, pcbase, pcstart, plo, prow):  # pragma: no cover - compiled
-    """The chain kernel's fast path: g_1 g_2 ... g_k as one function of mmax = max(N.wi, N.wo)
-    (:class:`_Product`; mmax above its ``mlo``): the piece found from the bits of mmax (no logarithm),
-    evaluated by Horner's rule; ``prow[s]`` holds the piece's coefficients, centre and inverse
-    half-width (one cache line).  Inlined where it is called.
+#: the high half of a cell entry (:func:`cell_entries`): the bits of m at and above which the cell's second piece starts
+CELL_HIGH = -(1 << 32)
+
+
+#: the low half of a cell entry: the cell's first piece
+CELL_LOW = (1 << 32) - 1
+
+
+def cell_entries(lo: np.ndarray, cstart: np.ndarray) -> np.ndarray:
+    """The cells of a table of pieces as the kernels read them, one int64 per cell: in the low 32 bits the piece where
+    the cell starts (``cstart[c]``), in the high 32 bits the top 32 bits of the next piece's start ``lo[cstart[c] + 1]``
+    rounded up (``lo`` ends with its sentinel, inf).  One load then gives both the piece and where the next begins:
+    m is in a later piece when bits(m) >= (entry & CELL_HIGH) (never wrongly: the bound is rounded up; m in the
+    2^-20 relative sliver below it, or in a third piece of the cell, is found by the forward search that follows,
+    :func:`cell_piece`).
     """
-    last_cell = pcstart.shape[0] - 1
-    deg = prow.shape[1] - 3
-    s = pcstart[min((float_bits(mmax) >> CELL_SHIFT) - pcbase, last_cell)]
-    s += mmax >= plo[s + 1]  # most cells hold one or two pieces: a branch-free step,
-    while mmax >= plo[s + 1]:  # then a loop that is rarely entered
+    nxt = float_bits_reference(np.asarray(lo, dtype=np.float64)[np.asarray(cstart, dtype=np.int64) + 1])
+    top = (nxt >> 32) + ((nxt & CELL_LOW) != 0)  # rounded up
+    return np.ascontiguousarray((top << 32) | np.asarray(cstart, dtype=np.int64))
+
+
+def cell_piece_reference(m, shift: int, cbase: int, cell: np.ndarray, lo: np.ndarray) -> np.ndarray:
+    """The numpy reference of :func:`cell_piece`: the piece of each m (> the table's ``mlo``), found as the kernel
+    finds it.
+    """
+    m = np.asarray(m, dtype=np.float64)
+    mb = float_bits_reference(m)
+    e = cell[np.minimum((mb >> shift) - cbase, len(cell) - 1)]
+    s = (e & CELL_LOW) + (mb >= (e & CELL_HIGH))
+    while True:
+        step = m >= lo[s + 1]
+        if not np.any(step):
+            return s
+        s = s + step
+
+
+@njit(cache=True, nogil=True, inline="always")
+def cell_piece(m, shift, cbase, cell, plo):  # pragma: no cover - compiled
+    """The piece of a table in m (> its ``mlo``) that holds m: the cell from the bits of m (2^(52 - ``shift``) cells
+    per octave), whose entry (:func:`cell_entries`) gives the cell's first piece and, in the same load, whether m lies
+    in the next (a branch-free step); then a forward search that is rarely entered (a third piece in the cell).  One
+    load before the piece's coefficients, where a cell index, then the pieces' starts, took two.  Inlined where it is
+    called; its numpy reference is :func:`cell_piece_reference`.
+    """
+    mb = float_bits(m)
+    e = cell[min((mb >> shift) - cbase, cell.shape[0] - 1)]
+    s = (e & CELL_LOW) + (mb >= (e & CELL_HIGH))
+    while m >= plo[s + 1]:
         s += 1
+    return s
+
+
+@njit(cache=True, nogil=True, inline="always")
+def g_product(mmax, pcbase, pcell, plo, prow):  # pragma: no cover - compiled
+    """The chain kernel's fast path: g_1 g_2 ... g_k as one function of mmax = max(N.wi, N.wo)
+    (:class:`_Product`; mmax above its ``mlo``): the piece found from the bits of mmax (no logarithm;
+    :func:`cell_piece`, ``pcell`` the cells' entries), evaluated by Horner's rule; ``prow[s]`` holds the piece's
+    coefficients, centre and inverse half-width (one cache line).  Inlined where it is called.
+    """
+    deg = prow.shape[1] - 3
+    s = cell_piece(mmax, CELL_SHIFT, pcbase, pcell, plo)
     t = (mmax - prow[s, deg + 1]) * prow[s, deg + 2]
     if deg == 5:  # written out (Horner, the order of horner)
         return (((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t
@@ -229,19 +277,7 @@ def g_levels(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, contro
 
 
 @njit(cache=True, nogil=True, inline="always")
-def pair_piece(m, shift, pcbase, pcstart, plo):  # pragma: no cover - compiled
-    """The piece of a table in m (:func:`g_pair`'s) that holds m (> its ``mlo``): the cell from the bits of m (2^(52 -
-    ``shift``) cells per octave), then forward.
-    """
-    s = pcstart[min((float_bits(m) >> shift) - pcbase, pcstart.shape[0] - 1)]
-    s += m >= plo[s + 1]  # most cells hold one or two pieces: a branch-free step,
-    while m >= plo[s + 1]:  # then a loop that is rarely entered
-        s += 1
-    return s
-
-
-@njit(cache=True, nogil=True, inline="always")
-def g_pair(mi, mo, controlled, shift, pcbase, pcstart, plo, prow):  # pragma: no cover - compiled
+def g_pair(mi, mo, controlled, shift, pcbase, pcell, plo, prow):  # pragma: no cover - compiled
     """g_1 g_2 ... g_k at N.wi = ``mi``, N.wo = ``mo`` (both above the table's ``mlo``) from the level table in m: every
     level's bound U_j as a polynomial piece in m, all levels on one set of pieces, so one piece per direction serves
     every level (:class:`pumpup.operators.pumping._LevelTable`; no logarithm; its cells are ``shift``'s, finer than
@@ -250,8 +286,8 @@ def g_pair(mi, mo, controlled, shift, pcbase, pcstart, plo, prow):  # pragma: no
     g_j = max(U_j(mi), U_j(mo)) (001 eq. 20), and max(., mi, mo) where ``controlled[j]`` (001 eq. 21).  Inlined where
     it is called.  Its numpy reference is :meth:`pumpup.operators.pumping._LevelTable.g`.
     """
-    si = pair_piece(mi, shift, pcbase, pcstart, plo)
-    so = pair_piece(mo, shift, pcbase, pcstart, plo)
+    si = cell_piece(mi, shift, pcbase, pcell, plo)
+    so = cell_piece(mo, shift, pcbase, pcell, plo)
     ti = (mi - prow[si, 0]) * prow[si, 1]
     to = (mo - prow[so, 0]) * prow[so, 1]
     mmax = max(mi, mo)
@@ -281,15 +317,16 @@ def g_pair(mi, mo, controlled, shift, pcbase, pcstart, plo, prow):  # pragma: no
 
 
 @njit(cache=True, nogil=True, inline="always")
-def g_split(mmin, mmax, ncell, pattern, fid, hid, shift, pcbase, pcstart, plo,  # pragma: no cover
-            pcoef):
+def g_split(mmin, mmax, ncell, pattern, fid, hid, shift, pcbase, pcell, plo, pcoef):  # pragma: no cover - compiled
     """g_1 g_2 ... g_k at min(N.wi, N.wo) = ``mmin`` and max = ``mmax`` (both above the table's ``mlo``) as ONE product
     F(mmin) H(mmax) of two tabulated functions, whatever the number of levels, or 0.0 where the cell of (mmin, mmax)
     has no pattern (the caller then takes :func:`g_pair`): the cell i = floor(mmin ``ncell``), k = floor(mmax
-    ``ncell``) gives the pattern p = ``pattern[k (k + 1) / 2 + i]`` (the cells with i <= k, packed), whose functions
-    are rows ``fid[p]`` and ``hid[p]`` of ``pcoef`` (:class:`pumpup.operators.pumping._SplitTable`; 001 eq. 20, 21
-    with every level's term fixed in the cell).  ``pcoef[f, s]``: piece s's PRODUCT_DEGREE + 1 coefficients, highest
-    power first, its centre and inverse half-width.  Inlined where it is called.  Its numpy reference is
+    ``ncell``) gives the pattern p = ``pattern[k (k + 1) / 2 + i]`` (the cells with i <= k, packed; int8, -1 none),
+    whose functions are rows ``fid[p]`` and ``hid[p]`` of ``pcoef`` (int8 patterns: a packing of both rows in an int16
+    cost 1.5 ns more per pair, measured) (:class:`pumpup.operators.pumping._SplitTable`; 001 eq. 20, 21
+    with every level's term fixed in the cell); each function's piece found by :func:`cell_piece` (``pcell`` the
+    cells' entries).  ``pcoef[f, s]``: piece s's PRODUCT_DEGREE + 1 coefficients, highest power first, its centre and
+    inverse half-width.  Inlined where it is called.  Its numpy reference is
     :meth:`pumpup.operators.pumping._SplitTable.g`.
     """
     i = min(int(mmin * ncell), ncell - 1)
@@ -298,8 +335,8 @@ def g_split(mmin, mmax, ncell, pattern, fid, hid, shift, pcbase, pcstart, plo,  
     if p < 0:
         return 0.0
     a, b = fid[p], hid[p]
-    si = pair_piece(mmin, shift, pcbase, pcstart, plo)
-    so = pair_piece(mmax, shift, pcbase, pcstart, plo)
+    si = cell_piece(mmin, shift, pcbase, pcell, plo)
+    so = cell_piece(mmax, shift, pcbase, pcell, plo)
     ti = (mmin - pcoef[a, si, 6]) * pcoef[a, si, 7]
     to = (mmax - pcoef[b, so, 6]) * pcoef[b, so, 7]
     # the quintics, written out (Horner, the order of horner; PRODUCT_DEGREE = 5)
@@ -357,9 +394,9 @@ def scale_bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, mar
 #: with one product of two look-ups (:func:`g_split`'s; ``split_cells`` 0 when there is none)
 GChain = namedtuple("GChain", [
     "offsets", "logx", "coef", "v0", "slope0", "margin_lo", "cap", "controlled", "increasing", "mu0", "index",
-    "index_lo", "index_h_inv", "product_mlo", "product_cbase", "product_cstart", "product_lo", "product_rows",
-    "pair_mlo", "pair_shift", "pair_cbase", "pair_cstart", "pair_lo", "pair_rows",
-    "split_cells", "split_pattern", "split_fid", "split_hid", "split_shift", "split_cbase",
-    "split_cstart", "split_lo", "split_coef",
+    "index_lo", "index_h_inv", "product_mlo", "product_cbase", "product_cell", "product_lo", "product_rows",
+    "pair_mlo", "pair_shift", "pair_cbase", "pair_cell", "pair_lo", "pair_rows",
+    "split_cells", "split_pattern", "split_fid", "split_hid", "split_shift", "split_cbase", "split_cell", "split_lo",
+    "split_coef",
 ])
 

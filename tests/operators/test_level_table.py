@@ -13,9 +13,11 @@ import math
 import numpy as np
 import pytest
 from helpers import random_directions
+from numba import njit
 
 import pumpup
 from pumpup.operators.pumping import _LevelTable, _SplitTable
+from pumpup.physics.lookups import cell_piece
 
 
 @pytest.fixture(scope="module")
@@ -240,8 +242,46 @@ def test_split_table_layout_and_switch(ggx3, ggx2):
     assert np.all(np.tril(r.pattern + 1) == 0)  # only cells with min < max hold a pattern
     i, k = np.triu_indices(r.ncell)
     assert args.split_pattern is r.packed and np.array_equal(r.packed[k * (k + 1) // 2 + i], r.pattern[i, k])
+    assert args.split_cell is r.entries and args.pair_cell is ggx3.level_table().entries
     assert r.share() > 0.85  # most uniform pairs take one product
     off = ggx3._level_table_args()
     assert off.split_cells == 0 and off.pair_rows is args.pair_rows
     assert pumpup.pump({"type": "ggx", "alpha": 0.3}, g="g2", levels=1).split_table() is None
     assert ggx2.split_table().looks is ggx2.level_table().looks
+
+
+@njit(cache=True)
+def _cell_pieces(m, shift, cbase, cell, lo):  # pragma: no cover - compiled
+    out = np.empty(m.shape[0], dtype=np.int64)
+    for q in range(m.shape[0]):
+        out[q] = cell_piece(m[q], shift, cbase, cell, lo)
+    return out
+
+
+@pytest.mark.parametrize("name", ["ggx2", "ggx3", "phong3"])
+def test_cell_entries_find_every_piece(name, request, rng):
+    """The cells' entries (one int64: a cell's first piece and where the next starts, rounded up) land on the piece
+    that holds m, never past it, at random m, at every piece's start and just below it, and at the ends of cells; the
+    compiled look-up equals its numpy reference."""
+    from pumpup.physics.lookups import CELL_HIGH, CELL_LOW, CELL_SHIFT, float_bits_reference
+
+    f = pumpup.pump({"type": "phong", "n": 20}, g="g2", levels=3) if name == "phong3" else request.getfixturevalue(name)
+    tables = [f.product()] if name == "phong3" else [f.level_table(), f.split_table()]
+    for t in tables:
+        if t is None:
+            continue
+        shift = CELL_SHIFT if t is f.product() else t.shift
+        starts = t.lo[1:-1]
+        edges = (np.arange(t.cbase, t.cbase + len(t.entries), dtype=np.int64) << shift).view(np.float64)
+        m = np.concatenate([np.exp(rng.uniform(np.log(t.mlo), 0, 100_000)), starts, np.nextafter(starts, 0),
+                            edges, np.nextafter(edges, 0), [1.0]])
+        m = m[(m > t.mlo) & (m <= 1.0)]
+        s = t.piece(m)
+        assert np.all((t.lo[s] <= m) & (m < t.lo[s + 1]))
+        first = t.entries & CELL_LOW
+        assert np.array_equal(first, t.cstart)
+        # the bound in the high half is at least the next piece's start: the branch-free step never overshoots
+        assert np.all((t.entries & CELL_HIGH) >= float_bits_reference(t.lo[first + 1]))
+        c = np.minimum((float_bits_reference(m) >> shift) - t.cbase, len(t.entries) - 1)
+        assert np.all(first[c] <= s)
+        assert np.array_equal(_cell_pieces(m, shift, t.cbase, t.entries, t.lo), s)

@@ -249,6 +249,7 @@ def test_product_table_of_a_monotone_chain(rng, spec, g):
     s = p.piece(m)
     assert np.all((p.lo[s] <= m) & (m < p.lo[s + 1]))
     assert np.all(p.cstart[np.minimum((_bits(m) >> _CELL_SHIFT) - p.cbase, len(p.cstart) - 1)] <= s)  # forward only
+    assert np.array_equal(p.entries & 0xFFFFFFFF, p.cstart)  # the kernel's cells: the same first pieces
     # the kernel: pairs with both cosines above mlo take the fast path, G(max)
     wi = random_directions(rng, 5000)
     wo = random_directions(rng, 5000)[::-1]
