@@ -953,19 +953,30 @@ def _search(bounds32: np.ndarray, nm: str, var: str = "m") -> tuple[str, str]:
     return arrays, code
 
 
-def _sup_below(lk, t32: float) -> float:
-    """The largest value of a level's bound (``pumpup.operators.pumping._Lookup.upper``) at float32 cosines in (0,
-    ``t32``): the power law below its first node at its larger end (float32's smallest cosine 2^-149 or the node), the
-    spline between the node and ``t32`` on 400 points, raised by 1e-9 of itself (that stretch is a relative 1e-12 of mu
-    wide: the spline moves by less), at most the cap.
+def _range_below(lk, t32: float) -> tuple[float, float]:
+    """The smallest and the largest value of a level's bound (``pumpup.operators.pumping._Lookup.upper``) at float32
+    cosines in (0, ``t32``): the power law below its first node at its two ends (float32's smallest cosine 2^-149 and
+    the node), the spline between the node and ``t32`` on 400 points; lowered and raised by 1e-9 of themselves (that
+    stretch is a relative 1e-12 of mu wide: the spline moves by less), at most the cap.
     """
     x0 = math.exp(lk.logx[0])
     lo = math.log(2.0**-149)
     ends = [lk.v0 * math.exp(lk.slope0 * (z - lk.logx[0])) for z in (lo, min(math.log(t32), lk.logx[0]))]
-    sup = max(ends) + lk.margin_lo
+    inf, sup = min(ends) + lk.margin_lo, max(ends) + lk.margin_lo
     if t32 > x0:
-        sup = max(sup, float(np.max(lk.upper(np.geomspace(x0, t32, 400), capped=False))))
-    return min(sup * (1.0 + 1e-9), lk.cap)
+        spline = lk.upper(np.geomspace(x0, t32, 400), capped=False)
+        inf, sup = min(inf, float(np.min(spline))), max(sup, float(np.max(spline)))
+    return min(inf * (1.0 - 1e-9), lk.cap), min(sup * (1.0 + 1e-9), lk.cap)
+
+
+def _sup_below(lk, t32: float) -> float:
+    """The largest value of a level's bound at float32 cosines in (0, ``t32``) (:func:`_range_below`)."""
+    return _range_below(lk, t32)[1]
+
+
+def _inf_below(lk, t32: float) -> float:
+    """The smallest value of a level's bound at float32 cosines in (0, ``t32``) (:func:`_range_below`)."""
+    return _range_below(lk, t32)[0]
 
 
 class _LevelTable:
@@ -1198,19 +1209,6 @@ def _param_decls(plan: _Plan) -> str:
         else:
             lines.append(f"uniform float pumpup_{k};")
     return "\n".join(lines) + ("\n" if lines else "")
-
-
-def _inf_below(lk, t32: float) -> float:
-    """The smallest value of a level's bound at float32 cosines in (0, ``t32``) (as :func:`_sup_below`, lowered by
-    1e-9 of itself).
-    """
-    x0 = math.exp(lk.logx[0])
-    lo = math.log(2.0**-149)
-    ends = [lk.v0 * math.exp(lk.slope0 * (z - lk.logx[0])) for z in (lo, min(math.log(t32), lk.logx[0]))]
-    inf = min(ends) + lk.margin_lo
-    if t32 > x0:
-        inf = min(inf, float(np.min(lk.upper(np.geomspace(x0, t32, 400), capped=False))))
-    return min(inf * (1.0 - 1e-9), lk.cap)
 
 
 class _PumpedTables:

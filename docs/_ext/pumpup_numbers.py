@@ -79,24 +79,24 @@ def _open(name: str):
         return ds.load()
 
 
-def stored(table: str, row: str, column: str) -> float:
-    """The ``computed`` value of one entry of a ``pumpup reproduce`` table (``tables/<table>.nc``)."""
+def _entry(table: str, row: str, column: str, variable: str) -> float:
+    """``variable`` of one entry of a ``pumpup reproduce`` table (``tables/<table>.nc``)."""
     ds = _open(f"{table}.nc")
     for i in range(ds.sizes["entry"]):
         e = ds.isel(entry=i)
         if str(e.row.values) == row and str(e.column.values) == column:
-            return float(e.computed)
+            return float(e[variable])
     raise KeyError(f"tables/{table}.nc has no entry row={row!r} column={column!r}")
+
+
+def stored(table: str, row: str, column: str) -> float:
+    """The ``computed`` value of one entry of a ``pumpup reproduce`` table (``tables/<table>.nc``)."""
+    return _entry(table, row, column, "computed")
 
 
 def published(table: str, row: str, column: str) -> float:
     """The paper's printed value of one entry of a ``pumpup reproduce`` table (``tables/<table>.nc``)."""
-    ds = _open(f"{table}.nc")
-    for i in range(ds.sizes["entry"]):
-        e = ds.isel(entry=i)
-        if str(e.row.values) == row and str(e.column.values) == column:
-            return float(e.published_value)
-    raise KeyError(f"tables/{table}.nc has no entry row={row!r} column={column!r}")
+    return _entry(table, row, column, "published_value")
 
 
 def reproduce_agreement() -> str:

@@ -157,52 +157,6 @@ def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo
                                             increasing, mu0, index, index_lo, index_h_inv)
 
 
-@njit(cache=True, nogil=True)
-def _phong_divided_every_row(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
-                             increasing, mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo,
-                             qshift, qcbase, qcell, qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell,
-                             rlo, rcoef):  # pragma: no cover - compiled
-    """:func:`_phong_divided` dividing every row of a block by g, the dark ones (0 / g) too: the baseline of
-    scripts/bench/bench_eval.py (``Phong._eval_divided_every_row``); the same values.
-    """
-    N = out.shape[0]
-    x = np.empty(_BLOCK)
-    lit = np.empty(_BLOCK, dtype=np.int64)
-    for s in range(0, N, _BLOCK):
-        m = min(N - s, _BLOCK)
-        a = wi[s : s + m]
-        b = wo[s : s + m]
-        f = out[s : s + m]
-        for r in range(m):
-            x[r] = _lit_cos(a[r, 0], a[r, 1], a[r, 2], b[r, 0], b[r, 1], b[r, 2])
-            f[r] = 0.0
-        q = 0
-        for r in range(m):
-            lit[q] = r
-            q += (x[r] > 0.0) | (x[r] != x[r])
-        for j in range(q):
-            r = lit[j]
-            f[r] = c * x[r] ** n  # 000 eq. 5
-        for r in range(m):
-            lz, vz = a[r, 2], b[r, 2]
-            if lz <= 0.0 or vz <= 0.0:
-                continue  # (0 already)
-            mmax, mmin = max(lz, vz), min(lz, vz)
-            if mmin > pmlo:  # (pumpup.physics.lookups.g_levels_call says why this is written out)
-                f[r] = f[r] / g_product(mmax, pcbase, pcell, plo, prow)  # 001 eq. 16, all levels
-            elif mmin > qmlo:
-                g = 0.0
-                if rcells > 0:  # the split table: one product F(mmin) H(mmax), 0 where the cell has no pattern
-                    g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell,
-                                rlo, rcoef)
-                if g == 0.0:
-                    g = g_pair(lz, vz, controlled, qshift, qcbase, qcell, qlo, qrow)
-                f[r] = f[r] / g  # 001 eq. 16, all levels
-            elif f[r] != 0.0:
-                f[r] = f[r] / g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
-                                            increasing, mu0, index, index_lo, index_h_inv)
-
-
 def _phong_reference(wi, wo, n, c):
     rv = np.maximum(_cos_alpha(wi, wo), 0.0)
     return np.where(_up(wi, wo) & (rv > 0), c * rv**n, 0.0)  # 000 eq. 5
@@ -243,15 +197,6 @@ class Phong(BRDF):
         _phong_divided(wi.reshape(-1, 3), wo.reshape(-1, 3), out.reshape(-1), *self.kernel_args(), *chain)
         return out
 
-    def _eval_divided_every_row(self, wi, wo, chain):
-        """:meth:`eval_divided` dividing every row, the dark ones too (:func:`_phong_divided_every_row`): the
-        baseline of scripts/bench/bench_eval.py.
-        """
-        if self._rows(wi, wo) is None:
-            return None
-        out = np.empty(wi.shape[:-1])
-        _phong_divided_every_row(wi.reshape(-1, 3), wo.reshape(-1, 3), out.reshape(-1), *self.kernel_args(), *chain)
-        return out
     rows_kernel = staticmethod(_phong_rows)
     reference_fn = staticmethod(_phong_reference)
 

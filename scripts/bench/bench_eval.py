@@ -136,7 +136,7 @@ def issue55_rows(repeat=9, n=1 << 20):
     for levels in (1, 3, 5):
         pp = pumpup.pump({"type": "phong", "n": 20}, g="g2", levels=levels)
         rows.append((f"pumped Phong n 20, g2, {levels} level{'s' * (levels > 1)}", phong,
-                     {"levelwise": pp._eval_levelwise, "level table": _every_row(pp), "new": pp._eval}, 1.3))
+                     {"levelwise": pp._eval_levelwise, "level table": pp._eval_level_table, "new": pp._eval}, 1.3))
     kc = pumpup.compensate({"type": "ggx", "alpha": 0.3}, method="kulla_conty")
     rows.append(("GGX alpha 0.3 + Kulla-Conty lobe", ggx, {"levelwise": kc._eval_two_passes,
                                                           "level table": kc._eval_two_passes, "new": kc._eval}, 1.3))
@@ -158,7 +158,7 @@ def issue55_rows(repeat=9, n=1 << 20):
     print(f"issue 55, eval against the base, {n} pairs, best of {repeat} (load {os.getloadavg()[0]:.1f}):")
     print("  levelwise: every level's bound looked up level by level (Pumped._eval_levelwise; Kulla-Conty: two "
           "passes)\n  level table: every level's bound from one polynomial piece per direction "
-          "(Pumped._eval_level_table; Phong: its previous fused kernel, which divided every row)\n"
+          "(Pumped._eval_level_table, the split table off)\n"
           "  new: Pumped._eval (the split table, one product of two look-ups; Phong: only the lit rows divided)")
     print(f"{'':40s} {'target':>7s} {'levelwise':>10s} {'lvl table':>10s} {'new':>7s} {'base ns':>8s} {'new ns':>7s}")
     for label, base, _, target in rows:
@@ -171,16 +171,6 @@ def issue55_rows(repeat=9, n=1 << 20):
     for levels, secs, kb, share in built:
         print(f"  {levels} level{'s' * (levels > 1)}: product/level/split tables {secs * 1e3:7.1f} ms, {kb:8.1f} kB; "
               f"the split table serves {share:.1%} of uniform (N.wi, N.wo)")
-
-
-def _every_row(p):
-    """The previous fused Phong kernel of pumped chain ``p`` (every row of a block divided by g, the dark ones too,
-    ``Phong._eval_divided_every_row``) with the split table off: the baseline of the "level table" column.
-    """
-    def run(wi, wo):
-        return p.chain()[0].base._eval_divided_every_row(wi, wo, p._level_table_args())
-
-    return run
 
 
 def table_cost(p):
