@@ -1264,7 +1264,9 @@ def _redeliver_interrupts(hook):
     """An unraisable-exception hook that sends a KeyboardInterrupt on again instead of printing it: Ctrl-C that lands
     in a callback from C (llvmlite's, while numba compiles) cannot propagate there, and Python would print it as
     "Exception ignored" and go on.  The interrupt is sent again 10 ms later, from a timer thread, so that it arrives
-    in ordinary Python code (and again, should it land in a callback once more).
+    in ordinary Python code (and again, should it land in a callback once more).  Once a Ctrl-C has arrived, other
+    unraisable errors are not printed either: they come from finalizers of objects the interrupt left half-built
+    (llvmlite's ``ObjectRef.__del__`` of an object whose constructor it broke off), and the command ends as interrupted.
     """
 
     def unraisable(args) -> None:
@@ -1273,6 +1275,8 @@ def _redeliver_interrupts(hook):
             timer = threading.Timer(0.01, _thread.interrupt_main)
             timer.daemon = True
             timer.start()
+            return
+        if _PENDING_INTERRUPT:  # the interrupt's fallout: a finalizer of an object it broke off half-built (llvmlite's)
             return
         hook(args)
 

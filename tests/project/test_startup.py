@@ -276,3 +276,23 @@ def test_ctrl_c_that_a_c_extension_turns_into_an_unchained_import_error_is_still
                        preexec_fn=default_sigint, timeout=60)
     assert p.returncode == 130, (p.returncode, p.stderr)
     assert p.stderr.strip() == "pumpup: interrupted", p.stderr
+
+
+def test_ctrl_c_hides_the_finalizer_errors_of_what_it_broke_off():
+    """An object whose constructor the interrupt broke off fails in its finalizer (llvmlite's ObjectRef.__del__ when
+    Ctrl-C lands while numba compiles): the command still prints only its one line."""
+    code = ("import gc, os, signal, time, pumpup.cli as cli\n"
+            "class HalfBuilt:\n"
+            "    def __init__(self):\n"
+            "        os.kill(os.getpid(), signal.SIGINT)\n"
+            "        time.sleep(5)\n"
+            "        self.handle = 1\n"
+            "    def __del__(self):\n"
+            "        del self.handle\n"
+            "def main(*a, **k):\n"
+            "    HalfBuilt()\n"
+            "cli.main = main\ncli.console_main()\n")
+    p = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=_env(), capture_output=True, text=True,
+                       preexec_fn=default_sigint, timeout=60)
+    assert p.returncode == 130, (p.returncode, p.stderr)
+    assert p.stderr.strip() == "pumpup: interrupted", p.stderr
