@@ -371,8 +371,9 @@ def _revolve(r, y, n_phi):
 
 
 def _tube(path, radius, n_phi):
-    """A tube of radius ``radius[k]`` along a curve ``path`` (k, 3) in the x-y plane, open at both ends: vertices and
-    faces, counter-clockwise seen from outside.
+    """A tube of radius ``radius[k]`` along a curve ``path`` (k, 3) in the x-y plane, closed by a flat disc at each
+    end (an open end would show the tube's inside, black under a one-sided BSDF): vertices and faces,
+    counter-clockwise seen from outside.
     """
     t = np.gradient(path, axis=0)
     t /= np.linalg.norm(t, axis=1, keepdims=True)
@@ -387,7 +388,11 @@ def _tube(path, radius, n_phi):
     for k in range(len(path) - 1):
         a, b = k * n_phi + i, k * n_phi + j
         f += [np.stack([a, b + n_phi, b], axis=1), np.stack([a, a + n_phi, b + n_phi], axis=1)]
-    return v.reshape(-1, 3), np.concatenate(f)
+    k_last = (len(path) - 1) * n_phi
+    first, last = len(path) * n_phi, len(path) * n_phi + 1  # the discs' centres: the path's ends
+    f += [np.stack([np.full(n_phi, first), i, j], axis=1),  # facing back along the path at its start
+          np.stack([np.full(n_phi, last), k_last + j, k_last + i], axis=1)]  # facing forward at its end
+    return np.concatenate([v.reshape(-1, 3), path[[0, -1]]]), np.concatenate(f)
 
 
 def teapot_mesh(n=48) -> tuple[np.ndarray, np.ndarray]:

@@ -81,17 +81,23 @@ def _signed_volume(v, f):
 
 def test_teapot_mesh_faces_point_outwards():
     """The body of revolution of a unit sphere's profile encloses 4 pi / 3 with outward faces (positive signed
-    volume); every face of a tube faces away from its axis; the teapot's indices are valid and its faces not
-    degenerate."""
+    volume); every side face of a tube faces away from its axis and its end discs close it; the teapot's indices
+    are valid and its faces not degenerate."""
     s = np.linspace(0.0, math.pi, 64)
     v, f = S._revolve(np.sin(s), -np.cos(s), 128)
     assert _signed_volume(v, f) == pytest.approx(4 * math.pi / 3, rel=2e-3)
     t = np.linspace(0.0, 1.0, 20)
     path = np.stack([t, t ** 2, 0 * t], axis=1)
     v, f = S._tube(path, np.full(20, 0.1), 12)
-    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
-    out = np.einsum("ij,ij->i", np.cross(b - a, c - a), (a + b + c) / 3 - path[f[:, 0] // 12])
+    side = f[:-24]  # (the last 2 x 12 faces are the end discs)
+    a, b, c = v[side[:, 0]], v[side[:, 1]], v[side[:, 2]]
+    out = np.einsum("ij,ij->i", np.cross(b - a, c - a), (a + b + c) / 3 - path[side[:, 0] // 12])
     assert np.all(out > 0)
+    # closed by its discs, faces outward: the signed volume is the 12-gon's area 3 r^2 times the path's length
+    # (Pappus), whatever the origin
+    length = np.linalg.norm(np.diff(path, axis=0), axis=1).sum()
+    for shift in ([0.0, 0.0, 0.0], [5.0, -3.0, 2.0]):
+        assert _signed_volume(v + np.array(shift), f) == pytest.approx(3 * 0.1**2 * length, rel=2e-3)
     v, f = S.teapot_mesh()
     assert f.min() == 0 and f.max() == len(v) - 1 and np.all(np.isfinite(v))
     area = np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
