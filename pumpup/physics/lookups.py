@@ -201,8 +201,8 @@ def cell_piece(m, shift, cbase, cell, plo):  # pragma: no cover - compiled
     """The piece of a table in m (> its ``mlo``) that holds m: the cell from the bits of m (2^(52 - ``shift``) cells
     per octave), whose entry (:func:`cell_entries`) gives the cell's first piece and, in the same load, whether m lies
     in the next (a branch-free step); then a forward search that is rarely entered (a third piece in the cell).  One
-    load before the piece's coefficients, where a cell index, then the pieces' starts, took two.  Inlined where it is
-    called; its numpy reference is :func:`cell_piece_reference`.
+    load before the piece's coefficients (a cell index and then the pieces' starts would take two dependent loads).
+    Inlined where it is called; its numpy reference is :func:`cell_piece_reference`.
     """
     mb = float_bits(m)
     e = cell[min((mb >> shift) - cbase, cell.shape[0] - 1)]
