@@ -175,9 +175,9 @@ def _fig8_rate() -> float:
     return e["size"] ** 2 * e["spp"] * len(e["panels"]) / sum(e["seconds"])
 
 
-def _script(name: str):
-    """A module of ``scripts/make/`` (not a package), imported by path."""
-    path = os.path.join(ROOT, "scripts", "make", f"{name}.py")
+def _script(name: str, folder: str = "make"):
+    """A module of ``scripts/<folder>/`` (not a package), imported by path."""
+    path = os.path.join(ROOT, "scripts", folder, f"{name}.py")
     spec = importlib.util.spec_from_file_location(f"_pumpup_docs_{name}", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -253,12 +253,24 @@ def sampling_table() -> str:
     return "\n".join(lines)
 
 
+@functools.cache
+def lut_warps() -> dict:
+    """The warp search of the renderer-tables page (``scripts/make/lut_warps.py`` writes ``tables/lut_warps.json``)."""
+    with open(os.path.join(TABLES_DIR, "lut_warps.json")) as fh:
+        return json.load(fh)
+
+
+def _warp_domain(mu_min: float) -> dict:
+    return next(d for d in lut_warps()["domains"] if abs(d["mu_min"] / mu_min - 1) < 1e-9)
+
+
 #: generated tables: name -> function returning Markdown
 TABLES: dict[str, Callable[[], str]] = {
     "fitting-study": fitting_tables,
     "compensation-study": compensation_table,
     "compensation-metalness": compensation_metalness,
     "sampling-efficiency": sampling_table,
+    "lut-warps": lambda: _script("lut_warps").markdown(lut_warps()),
 }
 
 
@@ -335,6 +347,11 @@ VALUES: dict[str, Value] = {
         noise("fireflies_by_spp").items(), key=lambda item: int(item[0]))), ""),
     "noise-variants": Value(lambda: ", ".join(f"{noise('fireflies_128_64spp', how)} {how}"
                                               for how in ("as it is", "without point lights", "Lambert plate")), ""),
+    # the warp search of docs/user-guide/luts.md (tables/lut_warps.json)
+    "lut-warps-searched": Value(lambda: _script("lut_warps").searched(lut_warps()), ""),
+    "lut-warps-best-where": Value(lambda: tuple(_warp_domain(1e-4)["candidates"][0]["where"]), ".2g",
+                                  sep=", rough = "),
+    "lut-warps-gain-0.01": Value(lambda: _script("lut_warps").gain(_warp_domain(0.01)), ".0f"),
     "phong-c": Value(lambda: _open("pumping_figures.nc").attrs["phong_c"], ".2f"),
     "g1-g2-phong": Value(lambda: float(abs(_open("pumping_figures.nc").albedo.sel(model="phong", g="g1")
                                            - _open("pumping_figures.nc").albedo.sel(model="phong", g="g2")).max()),
@@ -488,6 +505,26 @@ QUOTES: list[Quote] = [
     # the compensation study: prose read from tables/compensation.nc
     Quote("docs/user-guide/compensation.md", "1.6e-5 for Blinn n = 100",
           lambda: (_comp("blinn n=100", "scale", "furnace_residual"), 100)),
+    Quote("docs/user-guide/compensation.md", "at 89 deg by 1.04-1.66 x on GGX and\nBeckmann but 5-82 x on Phong "
+          "and Blinn, whose albedo falls towards grazing (g2 caps the gain at\n1/mu: 2 at 60 deg, 57 at 89 deg); "
+          "Kulla-Conty adds only the small lobe there, 1.00-1.26 x on the\nmicrofacet models and 1.05-2.3 x on Phong "
+          "and Blinn", lambda: (89, *_mirror(_MICROFACET, ("scale", "g1", "g2"), 89),
+                                *_mirror(_PHONG_BLINN, ("scale",), 89), 1,
+                                1 / math.cos(math.radians(60)), 60, 1 / math.cos(math.radians(89)), 89,
+                                *_mirror(_MICROFACET, ("kulla_conty",), 89), *_mirror(_PHONG_BLINN, ("kulla_conty",), 89))),
+    Quote("docs/user-guide/compensation.md", "at 85 deg tells the\nsame (scale up to 91 x on Blinn n = 100, g1 41 x, g2 "
+          "11 x, Kulla-Conty 1.15 x)",
+          lambda: (85, _comp("blinn n=100", "scale", "peak_ratio"), 100, _comp("blinn n=100", "g1", "peak_ratio"),
+                   _comp("blinn n=100", "g2", "peak_ratio"), _comp("blinn n=100", "kulla_conty", "peak_ratio"))),
+    Quote("docs/user-guide/luts.md", "# Cycles' own look-up errs by 0.102", lambda: _cycles_audit().lookup["max_abs"],
+          slow=True),
+    # Filament's row offset (scripts/studies/filament_rows.py)
+    Quote("docs/user-guide/luts.md", "up to 0.0107 in E (NoV = 0.94, roughness 0.754), median 0.0039, 44 x\n"
+          "the half-float rounding (2.4e-4)",
+          lambda: (_filament()["max"], _filament()["nov"], _filament()["read"], _filament()["median"],
+                   _filament()["max"] / _script("filament_rows", "studies").HALF_ROUNDING,
+                   _script("filament_rows", "studies").HALF_ROUNDING), slow=True),
+    Quote("README.md", "computed one texel higher: up to 0.0107 in E", lambda: _filament()["max"], slow=True),
     # the papers
     *[Quote("docs/studies/papers.md", row, lambda level=level: (level, *_eq22_row(level)), slow=True)
       for level, row in enumerate(("| 0 (Phong) | 0.97 | 0.21 | 0.48 |", "| 1 | 0.67 | 3.1e-7 | 0.11 |",
@@ -496,6 +533,24 @@ QUOTES: list[Quote] = [
     Quote("docs/studies/he-torrance.md", "# its share: 0.0054, 0.27, 0.82",
           lambda: _he_torrance().specular_weight([1.0, 0.5, 0.17])),
 ]
+
+
+_MICROFACET = tuple(f"{m} alpha={a:g}" for m in ("ggx", "beckmann") for a in (0.05, 0.1, 0.3, 0.6, 1))
+_PHONG_BLINN = tuple(f"{m} n={n}" for m in ("phong", "blinn") for n in (5, 20, 100))
+
+
+def _mirror(models, methods, theta_i) -> tuple[float, float]:
+    """The smallest and largest mirror ratio f_c(wi, R) / f(wi, R) of ``methods`` on ``models`` at ``theta_i``
+    (``tables/compensation.nc``).
+    """
+    v = [_comp(m, k, "mirror_ratio", theta_i) for m in models for k in methods]
+    return min(v), max(v)
+
+
+@functools.cache
+def _filament() -> dict:
+    """What Filament's one-texel row offset costs (``python scripts/studies/filament_rows.py``)."""
+    return _script("filament_rows", "studies").offset_cost()
 
 
 @functools.cache

@@ -125,3 +125,16 @@ def test_the_check_rejects_a_wrong_number():
     q = N.Quote("README.md", "| 3.8 | 3.7098", lambda: (3.8, 3.7093))
     with pytest.raises(AssertionError, match="3.7098 typed"):
         _check_quote(q)
+
+
+@pytest.mark.slow
+def test_the_stored_warp_search_is_what_the_code_finds():
+    """``tables/lut_warps.json`` (the renderer-tables page's warp table) is what ``scripts/make/lut_warps.py``
+    computes now: the same candidates, their worst look-up errors to 1e-6 relative."""
+    fresh = N._script("lut_warps").run()
+    stored = N.lut_warps()
+    assert [d["mu_min"] for d in fresh["domains"]] == [d["mu_min"] for d in stored["domains"]]
+    for f, s in zip(fresh["domains"], stored["domains"]):
+        assert [(c["p"], c["q"]) for c in f["candidates"]] == [(c["p"], c["q"]) for c in s["candidates"]]
+        np.testing.assert_allclose([c["max_abs"] for c in f["candidates"]], [c["max_abs"] for c in s["candidates"]],
+                                   rtol=1e-6)
