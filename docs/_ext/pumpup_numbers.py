@@ -511,9 +511,10 @@ QUOTES: list[Quote] = [
           "and Blinn", lambda: (89, *_mirror(_MICROFACET, ("scale", "g1", "g2"), 89),
                                 *_mirror(_PHONG_BLINN, ("scale",), 89), 1,
                                 1 / math.cos(math.radians(60)), 60, 1 / math.cos(math.radians(89)), 89,
-                                *_mirror(_MICROFACET, ("kulla_conty",), 89), *_mirror(_PHONG_BLINN, ("kulla_conty",), 89))),
-    Quote("docs/user-guide/compensation.md", "at 85 deg tells the\nsame (scale up to 91 x on Blinn n = 100, g1 41 x, g2 "
-          "11 x, Kulla-Conty 1.15 x)",
+                                *_mirror(_MICROFACET, ("kulla_conty",), 89),
+                                *_mirror(_PHONG_BLINN, ("kulla_conty",), 89))),
+    Quote("docs/user-guide/compensation.md", "at 85 deg tells the\nsame (scale up to 91 x on Blinn n = 100, "
+          "g1 41 x, g2 11 x, Kulla-Conty 1.15 x)",
           lambda: (85, _comp("blinn n=100", "scale", "peak_ratio"), 100, _comp("blinn n=100", "g1", "peak_ratio"),
                    _comp("blinn n=100", "g2", "peak_ratio"), _comp("blinn n=100", "kulla_conty", "peak_ratio"))),
     Quote("docs/user-guide/luts.md", "# Cycles' own look-up errs by 0.102", lambda: _cycles_audit().lookup["max_abs"],

@@ -100,6 +100,7 @@ def markdown(data: dict) -> str:
 
 
 def main() -> int:
+    """Run the command line; return its exit status."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
         os.path.abspath(__file__)))), "tables"))

@@ -25,7 +25,6 @@ import numpy as np  # noqa: E402
 
 from pumpup import luts  # noqa: E402
 
-
 #: the largest rounding error of a half float in [0.5, 1), where E lies at these texels: half its spacing 2^-11
 HALF_ROUNDING = 2.0 ** -12
 
@@ -52,6 +51,7 @@ def offset_cost(every: int = 8) -> dict:
 
 
 def main() -> int:
+    """Run the command line; return its exit status."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--every", type=int, default=8)
     args = ap.parse_args()
