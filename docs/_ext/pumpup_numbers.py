@@ -465,6 +465,26 @@ QUOTES: list[Quote] = [
     Quote("docs/user-guide/images.md", "(alpha = 0.3) and Cook-Torrance (m = 0.3) lose energy to shadowing (0.88 and "
           "0.996 at the\ncentre)", lambda: (0.3, 0.3, _furnace_centre({"type": "ggx", "alpha": 0.3}),
                                             _furnace_centre({"type": "cook_torrance", "m": 0.3})), slow=True),
+    # Lewis's shaders of docs/user-guide/images.md, as pumpup.plots draws them (160 x 160, his units)
+    Quote("docs/user-guide/images.md", "(peak 0.94 of 0.99 at 80 degrees for beta = 10 degrees,\nk_s = 0.75)",
+          lambda: (_lewis("phong_shader", 10, 0.75, 80), _lewis("phong_shader", 10, 0.75, 0), 80, 10, 0.75),
+          slow=True),
+    Quote("docs/user-guide/images.md", "its peak radiance is 6.5-17.9 (in his\nunits, L_d = 1) for beta = 10 degrees",
+          lambda: (min(_lewis("lewis_phong", 10, ks, phi) for ks in (0.25, 0.75) for phi in _LEWIS_LIGHTS),
+                   max(_lewis("lewis_phong", 10, ks, phi) for ks in (0.25, 0.75) for phi in _LEWIS_LIGHTS), 1, 10),
+          slow=True),
+    Quote("docs/user-guide/images.md", "at 80 degrees the\npeak is 0.79, 0.77, 0.82 against 0.83, 0.94, 0.94 in three "
+          "of the four rows; in the fourth (beta = 30\ndegrees, k_s = 0.25) it is 0.88 against 0.85",
+          lambda: (80, *(_lewis("phong_blinn", b, ks, 80) for b, ks in _LEWIS_ROWS if (b, ks) != (30, 0.25)),
+                   *(_lewis("phong_shader", b, ks, 80) for b, ks in _LEWIS_ROWS if (b, ks) != (30, 0.25)), 30, 0.25,
+                   _lewis("phong_blinn", 30, 0.25, 80), _lewis("phong_shader", 30, 0.25, 80)), slow=True),
+    Quote("docs/user-guide/images.md", "Phong's highlight dims to\n0.77-0.78 at Phi_L = 80 degrees for both widths, "
+          "the stretched and the pumped ones stay at 1.00 (within\n0.5 %",
+          lambda: (min(_lobe(s, b, 80) for s, b in _LOBES if s == "phong"),
+                   max(_lobe(s, b, 80) for s, b in _LOBES if s == "phong"), 80,
+                   max((_lobe(s, b, 80) for s, b in _LOBES if s != "phong"), key=lambda v: abs(v - 1)),
+                   100 * max(abs(_lobe(s, b, phi) - 1) for s, b in _LOBES if s != "phong" for phi in _LEWIS_LIGHTS)),
+          slow=True),
     # the pumped spheres of docs/user-guide/images.md: peak radiance at 160 x 160, as pumpup.plots draws them
     Quote("docs/user-guide/images.md", "Phong's highlight fades from 3.49 to 0.95 at Phi_L = 150",
           lambda: (_peak(_PHONG, 0), _peak(_PHONG, 150), 150), slow=True),
@@ -597,6 +617,40 @@ def _peak(spec, phi) -> float:
     from pumpup import render
 
     return float(render.sphere(spec, phi, 160, irradiance=1.0).radiance.max())
+
+
+_LEWIS_LIGHTS = (0.0, 30.0, 60.0, 80.0)  # pumpup.plots.LIGHTS
+_LEWIS_ROWS = ((10.0, 0.25), (10.0, 0.75), (30.0, 0.25), (30.0, 0.75))  # (beta, k_s), as pumpup.plots draws them
+_LOBES = tuple((s, b) for b in (10.0, 30.0) for s in ("phong", "stretched_phong", "pumped"))
+
+
+@functools.cache
+def _lewis(shader: str, beta: float, ks: float, phi: float) -> float:
+    """The brightest pixel of Lewis's sphere (160 x 160, irradiance pi) for ``shader`` at half-angle ``beta``
+    and specular share ``ks``, as ``pumpup.plots.lewis_fig3`` / ``lewis_fig6`` / ``lewis_fig10`` draw it.
+    """
+    from pumpup import render
+
+    n = render.lewis_exponent(beta)
+    spec = ({"type": "lewis_phong", "n": n, "k_rho": 1.0, "k_sigma": ks} if shader == "lewis_phong"
+            else {"type": shader, "n": n, "ks": ks / math.pi, "kd": (1 - ks) / math.pi})
+    return float(render.sphere(spec, phi, 160, irradiance=math.pi).radiance.max())
+
+
+@functools.cache
+def _lobe(kind: str, beta: float, phi: float) -> float:
+    """The brightest pixel of ``pumpup.plots.lobes``'s sphere (Phong, stretched or once-pumped Phong at half-angle
+    ``beta``, 160 x 160), lit so that its peak at Phi_L = 0 is 1.
+    """
+    from pumpup import render
+    from pumpup.operators.pumping import pump
+
+    n = render.lewis_exponent(beta)
+    base = {"type": "phong", "n": n}
+    spec = {"phong": base, "stretched_phong": {"type": "stretched_phong", "n": n},
+            "pumped": pump(base, g="g1").spec}[kind]
+    e = 1.0 / float(render.sphere(spec, 0.0, 160).radiance.max())
+    return float(render.sphere(spec, phi, 160, irradiance=e).radiance.max())
 
 
 def _rim_mu(size: int) -> float:
