@@ -264,6 +264,24 @@ def _warp_domain(mu_min: float) -> dict:
     return next(d for d in lut_warps()["domains"] if abs(d["mu_min"] / mu_min - 1) < 1e-9)
 
 
+@functools.cache
+def _json(name: str) -> dict:
+    with open(os.path.join(TABLES_DIR, name)) as fh:
+        return json.load(fh)
+
+
+def he_torrance(lam: float) -> dict:
+    """One wavelength of 000 Fig. 5's He-Torrance curve (``scripts/make/he_torrance_fig5.py`` writes
+    ``tables/he_torrance_fig5.json``).
+    """
+    return _script("he_torrance_fig5").entry(_json("he_torrance_fig5.json"), lam)
+
+
+def _ht_albedo(lam: float, theta: float) -> float:
+    data = _json("he_torrance_fig5.json")
+    return he_torrance(lam)["albedo"][data["theta_deg"].index(theta)]
+
+
 #: generated tables: name -> function returning Markdown
 TABLES: dict[str, Callable[[], str]] = {
     "fitting-study": fitting_tables,
@@ -271,6 +289,8 @@ TABLES: dict[str, Callable[[], str]] = {
     "compensation-metalness": compensation_metalness,
     "sampling-efficiency": sampling_table,
     "lut-warps": lambda: _script("lut_warps").markdown(lut_warps()),
+    "he-torrance-fig5": lambda: _script("he_torrance_fig5").markdown(_json("he_torrance_fig5.json")),
+    "metal-colours": lambda: _script("metal_colours").markdown(_json("metal_colours.json")),
 }
 
 
@@ -352,6 +372,30 @@ VALUES: dict[str, Value] = {
     "lut-warps-best-where": Value(lambda: tuple(_warp_domain(1e-4)["candidates"][0]["where"]), ".2g",
                                   sep=", rough = "),
     "lut-warps-gain-0.01": Value(lambda: _script("lut_warps").gain(_warp_domain(0.01)), ".0f"),
+    # 000 Fig. 5's He-Torrance curve (tables/he_torrance_fig5.json)
+    "ht-max-0.4": Value(lambda: f"{he_torrance(0.4)['max_albedo']:.5f} at {he_torrance(0.4)['max_theta_deg']:.2f} deg",
+                        ""),
+    "ht-max-0.55": Value(lambda: f"{he_torrance(0.55)['max_albedo']:.5f} at "
+                                 f"{he_torrance(0.55)['max_theta_deg']:.2f} deg", ""),
+    "ht-mean-0.4": Value(lambda: he_torrance(0.4)["mean_albedo"], ".5f"),
+    "ht-mean-0.55": Value(lambda: he_torrance(0.55)["mean_albedo"], ".5f"),
+    "ht-error": Value(lambda: max(max(w["error"]) for w in _json("he_torrance_fig5.json")["wavelengths"]), ".0e"),
+    "ht-grazing": Value(lambda: _ht_albedo(0.55, 89.9), ".3f"),
+    "ht-excess": Value(lambda: 100 * max(w["max_albedo"] - 1 for w in _json("he_torrance_fig5.json")["wavelengths"]
+                                         if w["wavelength"] in (0.4, 0.55, 0.7)), ".0f"),
+    "ht-excess-normal": Value(lambda: f"{max(_ht_albedo(lam, 0) - 1 for lam in (0.4, 0.55, 0.7)):.0e}".replace("e-0",
+                                                                                                            "e-"), ""),
+    "ht-pairs": Value(lambda: he_torrance(0.55)["pairs"], ".0f"),
+    "ht-asymmetry": Value(lambda: max(w["reciprocity"] for w in _json("he_torrance_fig5.json")["wavelengths"]), "g"),
+    # the metals' colours of docs/user-guide/spectral.md (tables/metal_colours.json)
+    "metal-8-vs-dense": Value(lambda: _script("metal_colours").gap(_json("metal_colours.json"), "f0_8", "f0_dense"),
+                              ".2g"),
+    "metal-published-close": Value(lambda: _script("metal_colours").gap(
+        _json("metal_colours.json"), "f0_8", "published", ["Au", "Cu", "Al", "Cr", "Ni", "Pt"]), ".1g"),
+    "metal-published-ti-fe": Value(lambda: _script("metal_colours").gap(
+        _json("metal_colours.json"), "f0_8", "published", ["Ti", "Fe"]), ".1g"),
+    "metal-ag-blue": Value(lambda: (_json("metal_colours.json")["metals"]["Ag"]["f0_8"][2],
+                                    _json("metal_colours.json")["metals"]["Ag"]["published"][2]), ".3f", sep=" vs "),
     "phong-c": Value(lambda: _open("pumping_figures.nc").attrs["phong_c"], ".2f"),
     "g1-g2-phong": Value(lambda: float(abs(_open("pumping_figures.nc").albedo.sel(model="phong", g="g1")
                                            - _open("pumping_figures.nc").albedo.sel(model="phong", g="g2")).max()),

@@ -69,7 +69,7 @@ def markdown(data: dict) -> str:
     for lam in SHOWN:
         lines.append(f"| lambda = {lam:.2f} um | " + " | ".join(f"{v:.5f}" for v in entry(data, lam)["albedo"]) + " |")
     share = entry(data, SHARE)["specular_share"]
-    lines.append(f"| specular share, {SHARE:.2f} um | " + " | ".join(f"{v:.2g}" for v in share) + " |")
+    lines.append(f"| specular share, {SHARE:.2f} um | " + " | ".join(f"{v:#.2g}" for v in share) + " |")
     return "\n".join(lines)
 
 
