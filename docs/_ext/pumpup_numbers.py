@@ -578,6 +578,22 @@ QUOTES: list[Quote] = [
     # the compensation study: prose read from tables/compensation.nc
     Quote("docs/user-guide/compensation.md", "1.6e-5 for Blinn n = 100",
           lambda: (_comp("blinn n=100", "scale", "furnace_residual"), 100)),
+    Quote("docs/user-guide/compensation.md", "whose albedo falls to 0.01",
+          lambda: _comp("blinn n=100", "base", "min_albedo")),
+    Quote("docs/user-guide/compensation.md", "g1 leaves 9-89 % of the base's loss, g2 38-100 % (on the\n"
+          "energy-losing bases). Only `scale` is non-reciprocal: asymmetry 0.08-0.5 on the microfacet models,\n"
+          "0.8-1 on Phong, Blinn and Ward",
+          lambda: (*_loss_left("g1"), *_loss_left("g2"),
+                   *_span(_comp(m, "scale", "asymmetry") for m in _MICROFACET),
+                   *_span(_comp(m, "scale", "asymmetry") for m in _PHONG_BLINN + _WARD))),
+    Quote("docs/user-guide/compensation.md", "the lobe of the sharp models, alpha <= 0.1, it varies by 0.6-11 %)",
+          lambda: (0.1, *_span(100 * _comp(m, k, "shape_change") for m in _MICROFACET if float(m.split("=")[1]) <= 0.1
+                               for k in ("scale", "g1", "g2")))),
+    Quote("docs/user-guide/compensation.md", "(shape 4e-4 on GGX 0.05, 0.4-3 on GGX alpha >= 0.3, Beckmann alpha >= "
+          "0.6 and the other Phong\nand Blinn bases, 5.2 on Blinn n = 5)",
+          lambda: (_comp("ggx alpha=0.05", "kulla_conty", "shape_change"), 0.05,
+                   *_span(_comp(m, "kulla_conty", "shape_change") for m in _ROUGH_AND_PHONG), 0.3, 0.6,
+                   _comp("blinn n=5", "kulla_conty", "shape_change"), 5)),
     Quote("docs/user-guide/compensation.md", "at 89 deg by 1.04-1.66 x on GGX and\nBeckmann but 5-82 x on Phong "
           "and Blinn, whose albedo falls towards grazing (g2 caps the gain at\n1/mu: 2 at 60 deg, 57 at 89 deg); "
           "Kulla-Conty adds only the small lobe there, 1.00-1.26 x on the\nmicrofacet models and 1.05-2.3 x on Phong "
@@ -611,6 +627,25 @@ QUOTES: list[Quote] = [
 
 _MICROFACET = tuple(f"{m} alpha={a:g}" for m in ("ggx", "beckmann") for a in (0.05, 0.1, 0.3, 0.6, 1))
 _PHONG_BLINN = tuple(f"{m} n={n}" for m in ("phong", "blinn") for n in (5, 20, 100))
+
+
+_WARD = ("ward m=0.1", "ward m=0.3")
+#: the rough microfacet bases and the Phong and Blinn bases but Blinn n = 5, which the page quotes apart
+_ROUGH_AND_PHONG = ("ggx alpha=0.3", "ggx alpha=0.6", "ggx alpha=1", "beckmann alpha=0.6", "beckmann alpha=1",
+                    *(m for m in _PHONG_BLINN if m != "blinn n=5"))
+
+
+def _span(values) -> tuple[float, float]:
+    v = list(values)
+    return min(v), max(v)
+
+
+def _loss_left(method: str) -> tuple[float, float]:
+    """The smallest and largest share (%) of the base's furnace loss that ``method`` leaves, over the bases that
+    lose energy (all but Ward's, whose albedo exceeds 1), ``tables/compensation.nc``.
+    """
+    return _span(100 * _comp(m, method, "furnace_residual") / _comp(m, "base", "furnace_residual")
+                 for m in _MICROFACET + _PHONG_BLINN)
 
 
 def _mirror(models, methods, theta_i) -> tuple[float, float]:
