@@ -620,6 +620,8 @@ QUOTES: list[Quote] = [
       for level, row in enumerate(("| 0 (Phong) | 0.97 | 0.21 | 0.48 |", "| 1 | 0.67 | 3.1e-7 | 0.11 |",
                                    "| 2 | 0.36 | 0.048 | 0.19 |", "| 3 | 0.61 | 0.057 | 0.28 |",
                                    "| 4 | 0.78 | 0.058 | 0.33 |", "| 5 | 0.91 | 0.058 | 0.36 |"))],
+    Quote("docs/studies/he-torrance.md", "with g1 and n = 1.5, 0.997 at\nmu = 0.2, of which 0.85 is the delta",
+          lambda: (1.5, _ht_pumped(0.2)[0], 0.2, _ht_pumped(0.2)[1]), slow=True),
     Quote("docs/studies/he-torrance.md", "# its share: 0.0054, 0.27, 0.82",
           lambda: _he_torrance().specular_weight([1.0, 0.5, 0.17])),
 ]
@@ -788,6 +790,15 @@ def _blinn() -> dict:
 
 def _pumped(base, g, levels) -> dict:
     return {"type": "pumped", "base": base, "g": g, "levels": levels}
+
+
+@functools.cache
+def _ht_pumped(mu: float) -> tuple[float, float]:
+    """The albedo of He-Torrance (000 Fig. 5, n = 1.5) pumped once with g1 at ``mu``, and the delta's share of it."""
+    import pumpup
+
+    p = pumpup.pump(pumpup.load({"type": "he_torrance", "sigma_0": 0.1, "tau": 1.7, "n": 1.5}), g="g1")
+    return float(pumpup.albedo(p, [mu])[0]), float(p.delta_albedo([mu])[0])
 
 
 def _he_torrance():
