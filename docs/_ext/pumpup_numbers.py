@@ -175,9 +175,9 @@ def _fig8_rate() -> float:
     return e["size"] ** 2 * e["spp"] * len(e["panels"]) / sum(e["seconds"])
 
 
-def _script(name: str):
-    """A module of ``scripts/make/`` (not a package), imported by path."""
-    path = os.path.join(ROOT, "scripts", "make", f"{name}.py")
+def _script(name: str, folder: str = "make"):
+    """A module of ``scripts/<folder>/`` (not a package), imported by path."""
+    path = os.path.join(ROOT, "scripts", folder, f"{name}.py")
     spec = importlib.util.spec_from_file_location(f"_pumpup_docs_{name}", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -253,12 +253,44 @@ def sampling_table() -> str:
     return "\n".join(lines)
 
 
+@functools.cache
+def lut_warps() -> dict:
+    """The warp search of the renderer-tables page (``scripts/make/lut_warps.py`` writes ``tables/lut_warps.json``)."""
+    with open(os.path.join(TABLES_DIR, "lut_warps.json")) as fh:
+        return json.load(fh)
+
+
+def _warp_domain(mu_min: float) -> dict:
+    return next(d for d in lut_warps()["domains"] if abs(d["mu_min"] / mu_min - 1) < 1e-9)
+
+
+@functools.cache
+def _json(name: str) -> dict:
+    with open(os.path.join(TABLES_DIR, name)) as fh:
+        return json.load(fh)
+
+
+def he_torrance(lam: float) -> dict:
+    """One wavelength of 000 Fig. 5's He-Torrance curve (``scripts/make/he_torrance_fig5.py`` writes
+    ``tables/he_torrance_fig5.json``).
+    """
+    return _script("he_torrance_fig5").entry(_json("he_torrance_fig5.json"), lam)
+
+
+def _ht_albedo(lam: float, theta: float) -> float:
+    data = _json("he_torrance_fig5.json")
+    return he_torrance(lam)["albedo"][data["theta_deg"].index(theta)]
+
+
 #: generated tables: name -> function returning Markdown
 TABLES: dict[str, Callable[[], str]] = {
     "fitting-study": fitting_tables,
     "compensation-study": compensation_table,
     "compensation-metalness": compensation_metalness,
     "sampling-efficiency": sampling_table,
+    "lut-warps": lambda: _script("lut_warps").markdown(lut_warps()),
+    "he-torrance-fig5": lambda: _script("he_torrance_fig5").markdown(_json("he_torrance_fig5.json")),
+    "metal-colours": lambda: _script("metal_colours").markdown(_json("metal_colours.json")),
 }
 
 
@@ -335,6 +367,35 @@ VALUES: dict[str, Value] = {
         noise("fireflies_by_spp").items(), key=lambda item: int(item[0]))), ""),
     "noise-variants": Value(lambda: ", ".join(f"{noise('fireflies_128_64spp', how)} {how}"
                                               for how in ("as it is", "without point lights", "Lambert plate")), ""),
+    # the warp search of docs/user-guide/luts.md (tables/lut_warps.json)
+    "lut-warps-searched": Value(lambda: _script("lut_warps").searched(lut_warps()), ""),
+    "lut-warps-best-where": Value(lambda: tuple(_warp_domain(1e-4)["candidates"][0]["where"]), ".2g",
+                                  sep=", rough = "),
+    "lut-warps-gain-0.01": Value(lambda: _script("lut_warps").gain(_warp_domain(0.01)), ".0f"),
+    # 000 Fig. 5's He-Torrance curve (tables/he_torrance_fig5.json)
+    "ht-max-0.4": Value(lambda: f"{he_torrance(0.4)['max_albedo']:.5f} at {he_torrance(0.4)['max_theta_deg']:.2f} deg",
+                        ""),
+    "ht-max-0.55": Value(lambda: f"{he_torrance(0.55)['max_albedo']:.5f} at "
+                                 f"{he_torrance(0.55)['max_theta_deg']:.2f} deg", ""),
+    "ht-mean-0.4": Value(lambda: he_torrance(0.4)["mean_albedo"], ".5f"),
+    "ht-mean-0.55": Value(lambda: he_torrance(0.55)["mean_albedo"], ".5f"),
+    "ht-error": Value(lambda: max(max(w["error"]) for w in _json("he_torrance_fig5.json")["wavelengths"]), ".0e"),
+    "ht-grazing": Value(lambda: _ht_albedo(0.55, 89.9), ".3f"),
+    "ht-excess": Value(lambda: 100 * max(w["max_albedo"] - 1 for w in _json("he_torrance_fig5.json")["wavelengths"]
+                                         if w["wavelength"] in (0.4, 0.55, 0.7)), ".0f"),
+    "ht-excess-normal": Value(lambda: f"{max(_ht_albedo(lam, 0) - 1 for lam in (0.4, 0.55, 0.7)):.0e}".replace("e-0",
+                                                                                                            "e-"), ""),
+    "ht-pairs": Value(lambda: he_torrance(0.55)["pairs"], ".0f"),
+    "ht-asymmetry": Value(lambda: max(w["reciprocity"] for w in _json("he_torrance_fig5.json")["wavelengths"]), "g"),
+    # the metals' colours of docs/user-guide/spectral.md (tables/metal_colours.json)
+    "metal-8-vs-dense": Value(lambda: _script("metal_colours").gap(_json("metal_colours.json"), "f0_8", "f0_dense"),
+                              ".2g"),
+    "metal-published-close": Value(lambda: _script("metal_colours").gap(
+        _json("metal_colours.json"), "f0_8", "published", ["Au", "Cu", "Al", "Cr", "Ni", "Pt"]), ".1g"),
+    "metal-published-ti-fe": Value(lambda: _script("metal_colours").gap(
+        _json("metal_colours.json"), "f0_8", "published", ["Ti", "Fe"]), ".1g"),
+    "metal-ag-blue": Value(lambda: (_json("metal_colours.json")["metals"]["Ag"]["f0_8"][2],
+                                    _json("metal_colours.json")["metals"]["Ag"]["published"][2]), ".3f", sep=" vs "),
     "phong-c": Value(lambda: _open("pumping_figures.nc").attrs["phong_c"], ".2f"),
     "g1-g2-phong": Value(lambda: float(abs(_open("pumping_figures.nc").albedo.sel(model="phong", g="g1")
                                            - _open("pumping_figures.nc").albedo.sel(model="phong", g="g2")).max()),
@@ -390,9 +451,18 @@ QUOTES: list[Quote] = [
     Quote("docs/user-guide/luts.md", "| max \\|table - E\\| at the 1024 nodes | 9.7e-7 | mu = 20/31, rough = 5/31",
           lambda: (1024, _cycles_audit().max_abs, 31 * _cycles_audit().where_abs[0], 31,
                    31 * _cycles_audit().where_abs[1], 31), slow=True),
-    Quote("docs/user-guide/luts.md", "| max relative error | 1.7e-6 | mu = 27/31, rough = 30/31",
+    Quote("docs/user-guide/luts.md", "| max relative error | 1.7e-6 | mu = 27/31, rough = 30/31 (E = 0.366) |",
           lambda: (_cycles_audit().max_rel, 31 * _cycles_audit().where_rel[0], 31, 31 * _cycles_audit().where_rel[1],
-                   31), slow=True),
+                   31, _cycles_node(_cycles_audit().truth, *_cycles_audit().where_rel)), slow=True),
+    Quote("docs/user-guide/luts.md", "| mean and rms of table - E | +2.2e-7 and 3.7e-7 | the 6-decimal rounding alone: "
+          "0 and 2.9e-7 |", lambda: (_cycles_errors()["mean"], _cycles_errors()["rms"], 6, 0,
+                                     1e-6 / math.sqrt(12)), slow=True),  # rounding to 1e-6: uniform, sd 1e-6/sqrt(12)
+    Quote("docs/user-guide/luts.md", "| cells off by more than the rounding (5e-7) | 21.6 % |",
+          lambda: (5e-7, 100 * _cycles_errors()["above_rounding"]), slow=True),
+    Quote("docs/user-guide/luts.md", "| E > 1, monotonicity violations | 0, 0 |",
+          lambda: (1, _cycles_audit().above_one, len(_cycles_audit().monotonicity)), slow=True),
+    Quote("docs/user-guide/luts.md", "(2.2e-7 on average, 9.7e-7 at most;",
+          lambda: (_cycles_errors()["mean"], _cycles_audit().max_abs), slow=True),
     Quote("docs/user-guide/luts.md", "| `table_ggx_Eavg` against the true E_avg | 6.2e-7 | rough = 20/31 |",
           lambda: (_cycles_audit().eavg["vs_truth"], 31 * _cycles_audit().eavg["vs_truth_where"], 31), slow=True),
     Quote("docs/user-guide/luts.md", "against 2 int E mu dmu of the table's own (linearly interpolated) E | 8.9e-5 | "
@@ -448,6 +518,26 @@ QUOTES: list[Quote] = [
     Quote("docs/user-guide/images.md", "(alpha = 0.3) and Cook-Torrance (m = 0.3) lose energy to shadowing (0.88 and "
           "0.996 at the\ncentre)", lambda: (0.3, 0.3, _furnace_centre({"type": "ggx", "alpha": 0.3}),
                                             _furnace_centre({"type": "cook_torrance", "m": 0.3})), slow=True),
+    # Lewis's shaders of docs/user-guide/images.md, as pumpup.plots draws them (160 x 160, his units)
+    Quote("docs/user-guide/images.md", "(peak 0.94 of 0.99 at 80 degrees for beta = 10 degrees,\nk_s = 0.75)",
+          lambda: (_lewis("phong_shader", 10, 0.75, 80), _lewis("phong_shader", 10, 0.75, 0), 80, 10, 0.75),
+          slow=True),
+    Quote("docs/user-guide/images.md", "its peak radiance is 6.5-17.9 (in his\nunits, L_d = 1) for beta = 10 degrees",
+          lambda: (min(_lewis("lewis_phong", 10, ks, phi) for ks in (0.25, 0.75) for phi in _LEWIS_LIGHTS),
+                   max(_lewis("lewis_phong", 10, ks, phi) for ks in (0.25, 0.75) for phi in _LEWIS_LIGHTS), 1, 10),
+          slow=True),
+    Quote("docs/user-guide/images.md", "at 80 degrees the\npeak is 0.79, 0.77, 0.82 against 0.83, 0.94, 0.94 in three "
+          "of the four rows; in the fourth (beta = 30\ndegrees, k_s = 0.25) it is 0.88 against 0.85",
+          lambda: (80, *(_lewis("phong_blinn", b, ks, 80) for b, ks in _LEWIS_ROWS if (b, ks) != (30, 0.25)),
+                   *(_lewis("phong_shader", b, ks, 80) for b, ks in _LEWIS_ROWS if (b, ks) != (30, 0.25)), 30, 0.25,
+                   _lewis("phong_blinn", 30, 0.25, 80), _lewis("phong_shader", 30, 0.25, 80)), slow=True),
+    Quote("docs/user-guide/images.md", "Phong's highlight dims to\n0.77-0.78 at Phi_L = 80 degrees for both widths, "
+          "the stretched and the pumped ones stay at 1.00 (within\n0.5 %",
+          lambda: (min(_lobe(s, b, 80) for s, b in _LOBES if s == "phong"),
+                   max(_lobe(s, b, 80) for s, b in _LOBES if s == "phong"), 80,
+                   max((_lobe(s, b, 80) for s, b in _LOBES if s != "phong"), key=lambda v: abs(v - 1)),
+                   100 * max(abs(_lobe(s, b, phi) - 1) for s, b in _LOBES if s != "phong" for phi in _LEWIS_LIGHTS)),
+          slow=True),
     # the pumped spheres of docs/user-guide/images.md: peak radiance at 160 x 160, as pumpup.plots draws them
     Quote("docs/user-guide/images.md", "Phong's highlight fades from 3.49 to 0.95 at Phi_L = 150",
           lambda: (_peak(_PHONG, 0), _peak(_PHONG, 150), 150), slow=True),
@@ -488,14 +578,106 @@ QUOTES: list[Quote] = [
     # the compensation study: prose read from tables/compensation.nc
     Quote("docs/user-guide/compensation.md", "1.6e-5 for Blinn n = 100",
           lambda: (_comp("blinn n=100", "scale", "furnace_residual"), 100)),
+    Quote("docs/user-guide/compensation.md", "whose albedo falls to 0.01",
+          lambda: _comp("blinn n=100", "base", "min_albedo")),
+    Quote("docs/user-guide/compensation.md", "g1 leaves 9-89 % of the base's loss, g2 38-100 % (on the\n"
+          "energy-losing bases). Only `scale` is non-reciprocal: asymmetry 0.08-0.5 on the microfacet models,\n"
+          "0.8-1 on Phong, Blinn and Ward",
+          lambda: (*_loss_left("g1"), *_loss_left("g2"),
+                   *_span(_comp(m, "scale", "asymmetry") for m in _MICROFACET),
+                   *_span(_comp(m, "scale", "asymmetry") for m in _PHONG_BLINN + _WARD))),
+    Quote("docs/user-guide/compensation.md", "the lobe of the sharp models, alpha <= 0.1, it varies by 0.6-11 %)",
+          lambda: (0.1, *_span(100 * _comp(m, k, "shape_change") for m in _MICROFACET if float(m.split("=")[1]) <= 0.1
+                               for k in ("scale", "g1", "g2")))),
+    Quote("docs/user-guide/compensation.md", "(shape 4e-4 on GGX 0.05, 0.4-3 on GGX alpha >= 0.3, Beckmann alpha >= "
+          "0.6 and the other Phong\nand Blinn bases, 5.2 on Blinn n = 5)",
+          lambda: (_comp("ggx alpha=0.05", "kulla_conty", "shape_change"), 0.05,
+                   *_span(_comp(m, "kulla_conty", "shape_change") for m in _ROUGH_AND_PHONG), 0.3, 0.6,
+                   _comp("blinn n=5", "kulla_conty", "shape_change"), 5)),
+    Quote("docs/user-guide/compensation.md", "at 89 deg by 1.04-1.66 x on GGX and\nBeckmann but 5-82 x on Phong "
+          "and Blinn, whose albedo falls towards grazing (g2 caps the gain at\n1/mu: 2 at 60 deg, 57 at 89 deg); "
+          "Kulla-Conty adds only the small lobe there, 1.00-1.26 x on the\nmicrofacet models and 1.05-2.3 x on Phong "
+          "and Blinn", lambda: (89, *_mirror(_MICROFACET, ("scale", "g1", "g2"), 89),
+                                *_mirror(_PHONG_BLINN, ("scale",), 89), 1,
+                                1 / math.cos(math.radians(60)), 60, 1 / math.cos(math.radians(89)), 89,
+                                *_mirror(_MICROFACET, ("kulla_conty",), 89),
+                                *_mirror(_PHONG_BLINN, ("kulla_conty",), 89))),
+    Quote("docs/user-guide/compensation.md", "at 85 deg tells the\nsame (scale up to 91 x on Blinn n = 100, "
+          "g1 41 x, g2 11 x, Kulla-Conty 1.15 x)",
+          lambda: (85, _comp("blinn n=100", "scale", "peak_ratio"), 100, _comp("blinn n=100", "g1", "peak_ratio"),
+                   _comp("blinn n=100", "g2", "peak_ratio"), _comp("blinn n=100", "kulla_conty", "peak_ratio"))),
+    Quote("docs/user-guide/luts.md", "# Cycles' own look-up errs by 0.102", lambda: _cycles_audit().lookup["max_abs"],
+          slow=True),
+    # Filament's row offset (scripts/studies/filament_rows.py)
+    Quote("docs/user-guide/luts.md", "up to 0.0107 in E (NoV = 0.94, roughness 0.754), median 0.0039, 44 x\n"
+          "the half-float rounding (2.4e-4)",
+          lambda: (_filament()["max"], _filament()["nov"], _filament()["read"], _filament()["median"],
+                   _filament()["max"] / _script("filament_rows", "studies").HALF_ROUNDING,
+                   _script("filament_rows", "studies").HALF_ROUNDING), slow=True),
+    Quote("README.md", "computed one texel higher: up to 0.0107 in E", lambda: _filament()["max"], slow=True),
     # the papers
     *[Quote("docs/studies/papers.md", row, lambda level=level: (level, *_eq22_row(level)), slow=True)
       for level, row in enumerate(("| 0 (Phong) | 0.97 | 0.21 | 0.48 |", "| 1 | 0.67 | 3.1e-7 | 0.11 |",
                                    "| 2 | 0.36 | 0.048 | 0.19 |", "| 3 | 0.61 | 0.057 | 0.28 |",
                                    "| 4 | 0.78 | 0.058 | 0.33 |", "| 5 | 0.91 | 0.058 | 0.36 |"))],
+    Quote("docs/studies/he-torrance.md", "with g1 and n = 1.5, 0.997 at\nmu = 0.2, of which 0.85 is the delta",
+          lambda: (1.5, _ht_pumped(0.2)[0], 0.2, _ht_pumped(0.2)[1]), slow=True),
     Quote("docs/studies/he-torrance.md", "# its share: 0.0054, 0.27, 0.82",
           lambda: _he_torrance().specular_weight([1.0, 0.5, 0.17])),
 ]
+
+
+_MICROFACET = tuple(f"{m} alpha={a:g}" for m in ("ggx", "beckmann") for a in (0.05, 0.1, 0.3, 0.6, 1))
+_PHONG_BLINN = tuple(f"{m} n={n}" for m in ("phong", "blinn") for n in (5, 20, 100))
+
+
+_WARD = ("ward m=0.1", "ward m=0.3")
+#: the rough microfacet bases and the Phong and Blinn bases but Blinn n = 5, which the page quotes apart
+_ROUGH_AND_PHONG = ("ggx alpha=0.3", "ggx alpha=0.6", "ggx alpha=1", "beckmann alpha=0.6", "beckmann alpha=1",
+                    *(m for m in _PHONG_BLINN if m != "blinn n=5"))
+
+
+def _span(values) -> tuple[float, float]:
+    v = list(values)
+    return min(v), max(v)
+
+
+def _loss_left(method: str) -> tuple[float, float]:
+    """The smallest and largest share (%) of the base's furnace loss that ``method`` leaves, over the bases that
+    lose energy (all but Ward's, whose albedo exceeds 1), ``tables/compensation.nc``.
+    """
+    return _span(100 * _comp(m, method, "furnace_residual") / _comp(m, "base", "furnace_residual")
+                 for m in _MICROFACET + _PHONG_BLINN)
+
+
+def _mirror(models, methods, theta_i) -> tuple[float, float]:
+    """The smallest and largest mirror ratio f_c(wi, R) / f(wi, R) of ``methods`` on ``models`` at ``theta_i``
+    (``tables/compensation.nc``).
+    """
+    v = [_comp(m, k, "mirror_ratio", theta_i) for m in models for k in methods]
+    return min(v), max(v)
+
+
+@functools.cache
+def _filament() -> dict:
+    """What Filament's one-texel row offset costs (``python scripts/studies/filament_rows.py``)."""
+    return _script("filament_rows", "studies").offset_cost()
+
+
+def _cycles_node(values, mu: float, rough: float) -> float:
+    """The entry of a 32 x 32 Cycles array (rows mu = y/31, columns rough = x/31) at the node (mu, rough)."""
+    return float(values[int(round(mu * 31)), int(round(rough * 31))])
+
+
+def _cycles_errors() -> dict:
+    """Mean and rms of table - E over Cycles' 1024 nodes, and the share of nodes off by more than the rounding of
+    6 printed decimals (5e-7).
+    """
+    import numpy as np
+
+    d = _cycles_audit().error_map
+    return {"mean": float(d.mean()), "rms": float(np.sqrt(np.mean(d * d))),
+            "above_rounding": float(np.mean(np.abs(d) > 5e-7))}
 
 
 @functools.cache
@@ -543,6 +725,40 @@ def _peak(spec, phi) -> float:
     return float(render.sphere(spec, phi, 160, irradiance=1.0).radiance.max())
 
 
+_LEWIS_LIGHTS = (0.0, 30.0, 60.0, 80.0)  # pumpup.plots.LIGHTS
+_LEWIS_ROWS = ((10.0, 0.25), (10.0, 0.75), (30.0, 0.25), (30.0, 0.75))  # (beta, k_s), as pumpup.plots draws them
+_LOBES = tuple((s, b) for b in (10.0, 30.0) for s in ("phong", "stretched_phong", "pumped"))
+
+
+@functools.cache
+def _lewis(shader: str, beta: float, ks: float, phi: float) -> float:
+    """The brightest pixel of Lewis's sphere (160 x 160, irradiance pi) for ``shader`` at half-angle ``beta``
+    and specular share ``ks``, as ``pumpup.plots.lewis_fig3`` / ``lewis_fig6`` / ``lewis_fig10`` draw it.
+    """
+    from pumpup import render
+
+    n = render.lewis_exponent(beta)
+    spec = ({"type": "lewis_phong", "n": n, "k_rho": 1.0, "k_sigma": ks} if shader == "lewis_phong"
+            else {"type": shader, "n": n, "ks": ks / math.pi, "kd": (1 - ks) / math.pi})
+    return float(render.sphere(spec, phi, 160, irradiance=math.pi).radiance.max())
+
+
+@functools.cache
+def _lobe(kind: str, beta: float, phi: float) -> float:
+    """The brightest pixel of ``pumpup.plots.lobes``'s sphere (Phong, stretched or once-pumped Phong at half-angle
+    ``beta``, 160 x 160), lit so that its peak at Phi_L = 0 is 1.
+    """
+    from pumpup import render
+    from pumpup.operators.pumping import pump
+
+    n = render.lewis_exponent(beta)
+    base = {"type": "phong", "n": n}
+    spec = {"phong": base, "stretched_phong": {"type": "stretched_phong", "n": n},
+            "pumped": pump(base, g="g1").spec}[kind]
+    e = 1.0 / float(render.sphere(spec, 0.0, 160).radiance.max())
+    return float(render.sphere(spec, phi, 160, irradiance=e).radiance.max())
+
+
 def _rim_mu(size: int) -> float:
     """mu_V of the outermost pixel centre inside the unit disc of a size x size image of [-1, 1]^2."""
     import numpy as np
@@ -574,6 +790,15 @@ def _blinn() -> dict:
 
 def _pumped(base, g, levels) -> dict:
     return {"type": "pumped", "base": base, "g": g, "levels": levels}
+
+
+@functools.cache
+def _ht_pumped(mu: float) -> tuple[float, float]:
+    """The albedo of He-Torrance (000 Fig. 5, n = 1.5) pumped once with g1 at ``mu``, and the delta's share of it."""
+    import pumpup
+
+    p = pumpup.pump(pumpup.load({"type": "he_torrance", "sigma_0": 0.1, "tau": 1.7, "n": 1.5}), g="g1")
+    return float(pumpup.albedo(p, [mu])[0]), float(p.delta_albedo([mu])[0])
 
 
 def _he_torrance():

@@ -125,3 +125,44 @@ def test_the_check_rejects_a_wrong_number():
     q = N.Quote("README.md", "| 3.8 | 3.7098", lambda: (3.8, 3.7093))
     with pytest.raises(AssertionError, match="3.7098 typed"):
         _check_quote(q)
+
+
+@pytest.mark.slow
+def test_the_stored_warp_search_is_what_the_code_finds():
+    """``tables/lut_warps.json`` (the renderer-tables page's warp table) is what ``scripts/make/lut_warps.py``
+    computes now: the same candidates, their worst look-up errors to 1e-6 relative."""
+    fresh = N._script("lut_warps").run()
+    stored = N.lut_warps()
+    assert [d["mu_min"] for d in fresh["domains"]] == [d["mu_min"] for d in stored["domains"]]
+    for f, s in zip(fresh["domains"], stored["domains"]):
+        assert [(c["p"], c["q"]) for c in f["candidates"]] == [(c["p"], c["q"]) for c in s["candidates"]]
+        np.testing.assert_allclose([c["max_abs"] for c in f["candidates"]], [c["max_abs"] for c in s["candidates"]],
+                                   rtol=1e-6)
+
+
+#: the generated sections of docs/user-guide/renderer-tables.md (scripts/studies/renderer_tables_doc.py); the
+#: audit and the energy study take seconds, so they run under -m slow
+_RT_SECTIONS = [("presets", False), ("furnace", False), ("cycles-audit", True), ("energy", True)]
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if slow else n for n, slow in _RT_SECTIONS])
+def test_renderer_tables_sections_are_what_the_script_writes(name):
+    """Each ``<!-- generated:NAME -->`` section of the renderer-tables page is what ``renderer_tables_doc.py``
+    writes now (the furnace section: the summary ``furnace_cycles.py`` stored beside the page)."""
+    doc = N._script("renderer_tables_doc", "studies")
+    text = open(doc.PAGE).read()
+    body = {"presets": doc.presets_section, "furnace": lambda: doc.furnace_section(doc.PAGE),
+            "cycles-audit": doc.audit_section, "energy": doc.energy_section}[name]()
+    assert body is not None, f"{name}: nothing to compare with"
+    assert doc.replace(text, name, body) == text, \
+        f"the {name} section of {doc.PAGE} is stale: run python scripts/studies/renderer_tables_doc.py --only {name}"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("script, stored", [("he_torrance_fig5", "he_torrance_fig5.json"),
+                                            ("metal_colours", "metal_colours.json")])
+def test_the_stored_study_is_what_the_code_computes(script, stored):
+    """The stored results the He-Torrance and spectral pages' tables are generated from are what their scripts
+    compute now (a minute or two each): the same tables, to the digits they print."""
+    module = N._script(script)
+    assert module.markdown(module.run()) == module.markdown(N._json(stored))
