@@ -16,18 +16,17 @@ Writes every number to ``OUT/he_torrance_fig5.json``, which the He-Torrance page
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
 import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))  # this checkout
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # stored_json, beside this script
 
 import numpy as np  # noqa: E402
+from stored_json import computed_or_stored  # noqa: E402
 
 import pumpup  # noqa: E402
-from pumpup.tables import atomic_path  # noqa: E402
 from pumpup.tables.provenance import source_commit  # noqa: E402
 
 THETA = [0, 30, 45, 60, 70, 75, 80, 85, 88, 89.9]
@@ -75,20 +74,9 @@ def markdown(data: dict) -> str:
 
 def main() -> int:
     """Run the command line; return its exit status."""
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
-        os.path.abspath(__file__)))), "tables"))
-    ap.add_argument("--read", action="store_true", help="print the table of the stored file instead of computing")
-    a = ap.parse_args()
-    path = os.path.join(a.out, "he_torrance_fig5.json")
-    if a.read:
-        with open(path) as fh:
-            data = json.load(fh)
-    else:
-        data = run()
-        with atomic_path(path) as tmp, open(tmp, "w") as fh:
-            json.dump(data, fh, indent=1, sort_keys=True)
-        print("wrote", path)
+    data, wrote = computed_or_stored("he_torrance_fig5.json", run, __doc__.splitlines()[0], sort_keys=True)
+    if wrote:
+        print("wrote", wrote)
     print(markdown(data))
     for w in data["wavelengths"]:
         print(f"lambda = {w['wavelength']:g} um: max a = {w['max_albedo']:.8f} +- {w['max_albedo_error']:.1e} at "

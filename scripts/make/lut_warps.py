@@ -11,17 +11,17 @@ exponents p (mu axis) and q (roughness axis); p = q = 1 is the uniform grid.  Se
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
-import json
 import os
 import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))  # this checkout
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # stored_json, beside this script
+
+from stored_json import computed_or_stored  # noqa: E402
 
 from pumpup import luts  # noqa: E402
-from pumpup.tables import atomic_path  # noqa: E402
 from pumpup.tables.provenance import source_commit  # noqa: E402
 
 #: (smallest mu of the look-up domain, p grid, q grid) of each search
@@ -101,24 +101,11 @@ def markdown(data: dict) -> str:
 
 def main() -> int:
     """Run the command line; return its exit status."""
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
-        os.path.abspath(__file__)))), "tables"))
-    ap.add_argument("--read", action="store_true", help="print the table of the stored file instead of computing")
-    a = ap.parse_args()
-    path = os.path.join(a.out, "lut_warps.json")
-    if a.read:
-        with open(path) as fh:
-            print(markdown(json.load(fh)))
-        return 0
-    data = run()
-    with atomic_path(path) as tmp:
-        with open(tmp, "w") as fh:
-            json.dump(data, fh, indent=1, sort_keys=True)
+    data, wrote = computed_or_stored("lut_warps.json", run, __doc__.splitlines()[0], sort_keys=True)
     print(markdown(data))
-    print("wrote", path)
+    if wrote:
+        print("wrote", wrote)
     return 0
-
 
 if __name__ == "__main__":
     sys.exit(main())

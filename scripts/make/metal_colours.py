@@ -16,18 +16,17 @@ prints the page's Markdown table (:func:`markdown`); ``--read`` prints the table
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))  # this checkout
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # stored_json, beside this script
 
 import numpy as np  # noqa: E402
+from stored_json import computed_or_stored  # noqa: E402
 
 from pumpup import spectral  # noqa: E402
 from pumpup.spectral import optical  # noqa: E402
-from pumpup.tables import atomic_path  # noqa: E402
 from pumpup.tables.provenance import source_commit  # noqa: E402
 
 PUBLISHED = {  # Unreal Engine 4 documentation, "Physically Based Materials", linear sRGB
@@ -82,24 +81,11 @@ def gap(data: dict, a: str, b: str, metals=None) -> float:
 
 def main() -> int:
     """Run the command line; return its exit status."""
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
-        os.path.abspath(__file__)))), "tables"))
-    ap.add_argument("--read", action="store_true", help="print the table of the stored file instead of computing")
-    a = ap.parse_args()
-    path = os.path.join(a.out, "metal_colours.json")
-    if a.read:
-        with open(path) as fh:
-            data = json.load(fh)
-    else:
-        data = run()
-        with atomic_path(path) as tmp, open(tmp, "w") as fh:
-            json.dump(data, fh, indent=1)
+    data, wrote = computed_or_stored("metal_colours.json", run, __doc__.splitlines()[0])
     print(markdown(data))
-    if not a.read:
-        print("wrote", path)
+    if wrote:
+        print("wrote", wrote)
     return 0
-
 
 if __name__ == "__main__":
     sys.exit(main())

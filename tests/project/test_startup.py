@@ -272,10 +272,7 @@ def test_ctrl_c_that_a_c_extension_turns_into_an_unchained_import_error_is_still
             "    if lost:\n"
             "        raise ImportError('PyCapsule_Import could not import module \"datetime\"')\n"
             "cli.main = main\ncli.console_main()\n")
-    p = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=_env(), capture_output=True, text=True,
-                       preexec_fn=default_sigint, timeout=60)
-    assert p.returncode == 130, (p.returncode, p.stderr)
-    assert p.stderr.strip() == "pumpup: interrupted", p.stderr
+    _ends_as_interrupted(code)
 
 
 def test_ctrl_c_hides_the_finalizer_errors_of_what_it_broke_off():
@@ -292,6 +289,12 @@ def test_ctrl_c_hides_the_finalizer_errors_of_what_it_broke_off():
             "def main(*a, **k):\n"
             "    HalfBuilt()\n"
             "cli.main = main\ncli.console_main()\n")
+    _ends_as_interrupted(code)
+
+
+def _ends_as_interrupted(code: str) -> None:
+    """Run ``code`` (which replaces pumpup.cli.main and calls console_main) in a process: status 130 and the one
+    line ``pumpup: interrupted`` on stderr."""
     p = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=_env(), capture_output=True, text=True,
                        preexec_fn=default_sigint, timeout=60)
     assert p.returncode == 130, (p.returncode, p.stderr)
