@@ -45,7 +45,7 @@ import numpy as np
 from numba import njit, vectorize
 
 from ..core import BRDF, MAX_INDEX, MAX_WIDTH, MIN_ALPHA, MIN_INDEX, Lobe, Param, SpecError, register
-from ..physics.lookups import CELL_SHIFT, float_bits, g_levels_call, g_pair, g_product, g_split, upper_scalar
+from ..physics.lookups import g_levels_call, g_pair, g_product, g_split, upper_scalar
 from ..physics.microfacet import projected, projected_reference, walter_level
 from ._half import tan2_half
 from .cook_torrance import _IOR, _fresnel, _fresnel_reference
@@ -312,36 +312,22 @@ def wih_kinks(brdf, eta, k):
 
 
 @njit(cache=True, nogil=True)
-def _mf_kc(wi, wo, out, dist, alpha, shadowing, g1, ior, eta, k, scale, pmlo, pcbase, pcstart, plo, prow, logx, coef,
+def _mf_kc(wi, wo, out, dist, alpha, shadowing, g1, ior, eta, k, scale, pmlo, pcbase, pcell, plo, prow, logx, coef,
            v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
     """f_r + scale D(mu_i) D(mu_o) (KC eq. 1) over the rows of (N, 3) arrays into ``out`` in one pass: the kernel's
     value and the Kulla-Conty lobe (``pumpup.operators.compensate._kc_kernel``'s operations; ``BRDF.eval_plus_lobe``).
     """
-    last = pcstart.shape[0] - 1
     for r in range(out.shape[0]):
         lz, vz = wi[r, 2], wo[r, 2]
         if lz <= 0.0 or vz <= 0.0:
             out[r] = 0.0
             continue
         f = _mf_scalar(wi[r, 0], wi[r, 1], lz, wo[r, 0], wo[r, 1], vz, dist, alpha, shadowing, g1, ior, eta, k)
-        # U(mu_i), U(mu_o): physics.lookups.scale_bound's look-up written out, as _kc_kernel (an inlined helper
-        # taking the look-up's arrays cost 2 x: numba counts references of array arguments per call)
-        if lz > pmlo:
-            s = pcstart[min((float_bits(lz) >> CELL_SHIFT) - pcbase, last)]
-            while lz >= plo[s + 1]:
-                s += 1
-            t = (lz - prow[s, 6]) * prow[s, 7]
-            ui = ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
-        else:
-            ui = upper_scalar(lz, logx, coef, v0, slope0, margin_lo, margin, cap)
-        if vz > pmlo:
-            s = pcstart[min((float_bits(vz) >> CELL_SHIFT) - pcbase, last)]
-            while vz >= plo[s + 1]:
-                s += 1
-            t = (vz - prow[s, 6]) * prow[s, 7]
-            uo = ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
-        else:
-            uo = upper_scalar(vz, logx, coef, v0, slope0, margin_lo, margin, cap)
+        # U(mu_i), U(mu_o) (KC eq. 1)
+        ui = (g_product(lz, pcbase, pcell, plo, prow) if lz > pmlo
+              else upper_scalar(lz, logx, coef, v0, slope0, margin_lo, margin, cap))  # scale_bound
+        uo = (g_product(vz, pcbase, pcell, plo, prow) if vz > pmlo
+              else upper_scalar(vz, logx, coef, v0, slope0, margin_lo, margin, cap))  # scale_bound
         di, do = 1.0 - ui, 1.0 - uo
         if di > 0.0 and do > 0.0:
             f += scale * (di * do)  # KC eq. 1

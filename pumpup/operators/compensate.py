@@ -65,7 +65,7 @@ from numba import njit
 
 from ..core import BRDF, Lobe, Param, SpecError, check_reciprocity, load, register
 from ..core.budget import check_max_seconds, time_budget
-from ..physics.lookups import CELL_SHIFT, float_bits, scale_bound, upper_scalar
+from ..physics.lookups import g_product, scale_bound, upper_scalar
 from .pumping import (
     TABLE_DECADES,
     Pumped,
@@ -117,58 +117,38 @@ def compensation_table(white: BRDF, progress: bool | None = None):
 
 
 @njit(cache=True, nogil=True)
-def _kc_kernel(f, wi, wo, scale, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin,
+def _kc_kernel(f, wi, wo, scale, pmlo, pcbase, pcell, plo, prow, logx, coef, v0, slope0, margin_lo, margin,
                cap):  # pragma: no cover - compiled
-    """Compute f += scale D(mu_i) D(mu_o) in place, D = max(0, 1 - U) (KC eq. 1; see the module docstring).
-    The look-up of :func:`scale_bound`, written out.  Tested against :meth:`KullaConty.reference`.
+    """Compute f += scale D(mu_i) D(mu_o) in place, D = max(0, 1 - U) (KC eq. 1; see the module docstring), U by
+    :func:`scale_bound`.  Tested against :meth:`KullaConty.reference`.
     """
-    last = pcstart.shape[0] - 1
     for k in range(f.shape[0]):
         mi, mo = wi[k, 2], wo[k, 2]
         if mi <= 0.0 or mo <= 0.0:
             f[k] = 0.0
             continue
-        if mi > pmlo:
-            s = pcstart[min((float_bits(mi) >> CELL_SHIFT) - pcbase, last)]
-            while mi >= plo[s + 1]:
-                s += 1
-            t = (mi - prow[s, 6]) * prow[s, 7]
-            ui = ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
-        else:
-            ui = upper_scalar(mi, logx, coef, v0, slope0, margin_lo, margin, cap)
-        if mo > pmlo:
-            s = pcstart[min((float_bits(mo) >> CELL_SHIFT) - pcbase, last)]
-            while mo >= plo[s + 1]:
-                s += 1
-            t = (mo - prow[s, 6]) * prow[s, 7]
-            uo = ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
-        else:
-            uo = upper_scalar(mo, logx, coef, v0, slope0, margin_lo, margin, cap)
+        ui = (g_product(mi, pcbase, pcell, plo, prow) if mi > pmlo
+              else upper_scalar(mi, logx, coef, v0, slope0, margin_lo, margin, cap))  # scale_bound
+        uo = (g_product(mo, pcbase, pcell, plo, prow) if mo > pmlo
+              else upper_scalar(mo, logx, coef, v0, slope0, margin_lo, margin, cap))  # scale_bound
         di, do = 1.0 - ui, 1.0 - uo
         if di > 0.0 and do > 0.0:
             f[k] += scale * (di * do)  # KC eq. 1 (di * do: the same bits for (wi, wo) and (wo, wi))
 
 
 @njit(cache=True, nogil=True)
-def _scale_kernel(f, wi, wo, f0, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin,
+def _scale_kernel(f, wi, wo, f0, pmlo, pcbase, pcell, plo, prow, logx, coef, v0, slope0, margin_lo, margin,
                   cap):  # pragma: no cover - compiled
-    """Compute f *= 1 + F0 (1 / U(mu_o) - 1) in place (Turquin eq. 6), the look-up of :func:`scale_bound` written
-    out.  Tested against :meth:`Scaled.reference`.
+    """Compute f *= 1 + F0 (1 / U(mu_o) - 1) in place (Turquin eq. 6), U by :func:`scale_bound`.  Tested against
+    :meth:`Scaled.reference`.
     """
-    last = pcstart.shape[0] - 1
     for k in range(f.shape[0]):
         mi, mo = wi[k, 2], wo[k, 2]
         if mi <= 0.0 or mo <= 0.0:
             f[k] = 0.0
             continue
-        if mo > pmlo:
-            s = pcstart[min((float_bits(mo) >> CELL_SHIFT) - pcbase, last)]
-            while mo >= plo[s + 1]:
-                s += 1
-            t = (mo - prow[s, 6]) * prow[s, 7]
-            u = ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
-        else:
-            u = upper_scalar(mo, logx, coef, v0, slope0, margin_lo, margin, cap)
+        u = (g_product(mo, pcbase, pcell, plo, prow) if mo > pmlo
+              else upper_scalar(mo, logx, coef, v0, slope0, margin_lo, margin, cap))  # scale_bound
         if f0 == 1.0:
             f[k] = f[k] / u  # Turquin eq. 6 with F0 = 1: f / E(mu_o)
         else:
@@ -190,10 +170,10 @@ class _Bound:
             raise AssertionError("the kernels are written for a product table of degree 5 "
                                  "(pumpup.physics.lookups.PRODUCT_DEGREE)")
         if self.product is None:
-            pargs = (math.inf, 0, np.zeros(1, np.int32), np.full(2, math.inf), np.zeros((1, 8)))
+            pargs = (math.inf, 0, np.zeros(1, np.int64), np.full(2, math.inf), np.zeros((1, 8)))
         else:
             p = self.product
-            pargs = (p.mlo, p.cbase, p.cstart, p.lo, p.rows)
+            pargs = (p.mlo, p.cbase, p.entries, p.lo, p.rows)
         self.args = pargs + lk.args()
         self.deficit_integral, kinks = self._integral()
         #: the kinks of D in (0, 1): where U reaches 1, and the table's breaks
@@ -285,11 +265,11 @@ class _Bound:
 
 
 @njit(cache=True, nogil=True)
-def _uppers(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover
+def _uppers(m, pmlo, pcbase, pcell, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover
     """U(m) at every m (``m`` > 0) by :func:`scale_bound`: the kernels' own look-up, value for value."""
     out = np.empty(m.shape[0])
     for i in range(m.shape[0]):
-        out[i] = scale_bound(m[i], pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap)
+        out[i] = scale_bound(m[i], pmlo, pcbase, pcell, plo, prow, logx, coef, v0, slope0, margin_lo, margin, cap)
     return out
 
 

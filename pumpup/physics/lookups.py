@@ -369,20 +369,16 @@ def horner(coef, t):
 
 
 @njit(cache=True, nogil=True)
-def scale_bound(m, pmlo, pcbase, pcstart, plo, prow, logx, coef, v0, slope0, margin_lo, margin,  # pragma: no cover
+def scale_bound(m, pmlo, pcbase, pcell, plo, prow, logx, coef, v0, slope0, margin_lo, margin,  # pragma: no cover
                 cap):
-    """U(m) >= E(m): above ``pmlo`` the polynomial piece of the product table found from the bits
-    of m (pump._Product, scaled up by its 1 + epsilon); below it the table's spline look-up.  The
-    kernels below write it out (a call per look-up cost 20 x the look-up; with numba's
-    ``inline="always"`` Kulla-Conty evaluated at 3.5 x its base against 1.35 x written out, measured
-    with scripts/bench/bench_compensate.py in one sitting).
+    """U(m) >= E(m): above ``pmlo`` the polynomial piece of the product table (pump._Product, scaled up by its
+    1 + epsilon) by :func:`g_product`; below it the table's spline look-up (:func:`upper_scalar`).  The compensation
+    kernels write this branch out with :func:`g_product` inlined and the spline called, its rare path (with this
+    function inlined whole, Kulla-Conty cost 2.1 x GGX against 1.16 x, ``python scripts/bench/bench_eval.py
+    --issue55``).
     """
     if m > pmlo:
-        s = pcstart[min((float_bits(m) >> CELL_SHIFT) - pcbase, pcstart.shape[0] - 1)]
-        while m >= plo[s + 1]:
-            s += 1
-        t = (m - prow[s, 6]) * prow[s, 7]
-        return ((((prow[s, 0] * t + prow[s, 1]) * t + prow[s, 2]) * t + prow[s, 3]) * t + prow[s, 4]) * t + prow[s, 5]
+        return g_product(m, pcbase, pcell, plo, prow)
     return upper_scalar(m, logx, coef, v0, slope0, margin_lo, margin, cap)
 
 
