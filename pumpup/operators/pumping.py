@@ -1077,53 +1077,49 @@ class Pumped(BRDF):
         """The fast path's table of the product of all levels' g (None unless every level's bound
         increases and the table reaches its tolerance; the kernel then looks up level by level).
         """
-        if not hasattr(self, "_product"):
-            with self._init_lock:  # another thread must not see a half-decided None (a race once
-                if not hasattr(self, "_product"):  # made threaded values differ by 3e-14)
-                    product = None
-                    if all(lev.lookup().increasing for lev in self.chain()):
-                        try:
-                            product = _Product([lev.lookup() for lev in self.chain()],
-                                               [lev.controlled for lev in self.chain()])
-                        except _ProductError:
-                            pass
-                    self._product = product
-        return self._product
+        def build():
+            if not all(lev.lookup().increasing for lev in self.chain()):
+                return None
+            return _Product([lev.lookup() for lev in self.chain()], [lev.controlled for lev in self.chain()])
+
+        return self._built_once("_product", build)
 
     def level_table(self) -> _LevelTable | None:
         """The level table of the chain (:class:`_LevelTable`), where it has no product table (None where it has one,
         or where the level table cannot reach its tolerance: the kernel then looks up level by level).
         """
-        if not hasattr(self, "_levels_table"):
-            with self._init_lock:
-                if not hasattr(self, "_levels_table"):
-                    table = None
-                    if self.product() is None:
-                        try:
-                            table = _LevelTable([lev.lookup() for lev in self.chain()],
-                                                [lev.controlled for lev in self.chain()])
-                        except _ProductError:
-                            pass
-                    self._levels_table = table
-        return self._levels_table
+        def build():
+            if self.product() is not None:
+                return None
+            return _LevelTable([lev.lookup() for lev in self.chain()], [lev.controlled for lev in self.chain()])
+
+        return self._built_once("_levels_table", build)
 
     def split_table(self) -> _SplitTable | None:
         """The split table of the chain (:class:`_SplitTable`) where it has a level table of at least two levels (None
         otherwise, or where the split table cannot reach its tolerance: the kernel then takes the level table).  With
         one level the level table already takes one polynomial per direction.
         """
-        if not hasattr(self, "_split_table"):
+        def build():
+            q = self.level_table()
+            return _SplitTable(q) if q is not None and len(q.looks) >= 2 else None
+
+        return self._built_once("_split_table", build)
+
+    def _built_once(self, name: str, build):
+        """The table ``build()`` returns (None where it raises _ProductError: the kernel then takes a slower path),
+        built once and kept as attribute ``name``: another thread never sees a half-decided None (a race once made
+        threaded values differ by 3e-14).
+        """
+        if not hasattr(self, name):
             with self._init_lock:
-                if not hasattr(self, "_split_table"):
-                    table = None
-                    q = self.level_table()
-                    if q is not None and len(q.looks) >= 2:
-                        try:
-                            table = _SplitTable(q)
-                        except _ProductError:
-                            pass
-                    self._split_table = table
-        return self._split_table
+                if not hasattr(self, name):
+                    try:
+                        table = build()
+                    except _ProductError:
+                        table = None
+                    setattr(self, name, table)
+        return getattr(self, name)
 
     def _split_args(self):
         r = self.split_table()
