@@ -429,14 +429,19 @@ def _range(v: Any, what: str) -> tuple:
     return lo, hi
 
 
+def _no_unknown_fields(d: dict, known, where: str = "") -> None:
+    """One line naming the first field of ``d`` (a table at ``where``, e.g. "axes[0].") that is not ``known``."""
+    unknown = set(d) - set(known)
+    if unknown:
+        raise ConventionsError(f"conventions: unknown field '{where}{sorted(unknown)[0]}' (known: "
+                               f"{', '.join(sorted(known))})")
+
+
 def _axis(d: Any, k: int, n: int) -> Axis:
     where = f"axes[{k}]."
     if not isinstance(d, dict):
         raise ConventionsError(f"conventions: axes[{k}] must be a table of axis, nodes, map, range; got {d!r}")
-    unknown = set(d) - AXIS_FIELDS
-    if unknown:
-        raise ConventionsError(f"conventions: unknown field {where}{sorted(unknown)[0]!r} (known: "
-                               f"{', '.join(sorted(AXIS_FIELDS))})")
+    _no_unknown_fields(d, AXIS_FIELDS, where)
     if d.get("axis") == "f0" or d.get("axis") == "eta":
         raise ConventionsError(f"conventions: field {where}'axis' = {d['axis']!r}: tables over a Fresnel parameter "
                                f"are not supported yet (axes: mu, roughness, alpha)")
@@ -468,10 +473,7 @@ def _axis(d: Any, k: int, n: int) -> Axis:
 def _parse(d: dict) -> Conventions:
     if not isinstance(d, dict):
         raise ConventionsError(f"conventions must be a table of fields; got {type(d).__name__}")
-    unknown = set(d) - TOP_FIELDS
-    if unknown:
-        raise ConventionsError(f"conventions: unknown field {sorted(unknown)[0]!r} (known: "
-                               f"{', '.join(sorted(TOP_FIELDS))})")
+    _no_unknown_fields(d, TOP_FIELDS)
     if "model" not in d:
         raise ConventionsError("conventions: field 'model' is missing (a pumpup spec such as "
                                "\"ggx:shadowing=correlated\")")
@@ -542,10 +544,7 @@ def _parse(d: dict) -> Conventions:
     e_avg = d.get("e_avg", {})
     if not isinstance(e_avg, dict):
         raise ConventionsError(f"conventions: field 'e_avg' must be a table; got {e_avg!r}")
-    unknown = set(e_avg) - EAVG_FIELDS
-    if unknown:
-        raise ConventionsError(f"conventions: unknown field 'e_avg.{sorted(unknown)[0]}' (known: "
-                               f"{', '.join(sorted(EAVG_FIELDS))})")
+    _no_unknown_fields(e_avg, EAVG_FIELDS, "e_avg.")
     if len(e_avg) > 1:
         raise ConventionsError(f"conventions: field 'e_avg' takes one of array, follows, channel, variable; got "
                                f"{', '.join(e_avg)}")
