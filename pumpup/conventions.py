@@ -54,6 +54,7 @@ from .luts import (
     AuditResult,
     LutError,
     check_npy_size,
+    eavg_grades,
     exr_channels,
     grade,
     lookup_error_on,
@@ -976,11 +977,7 @@ def audit_conventions(path, conventions, *, model=None, rtol: float = 1e-7, look
             own = c.own_average(tab["E"])
             true_avg, true_err = mean_albedo_grid(spec, param, r, rtol=rtol, threads=threads,
                                                   max_regions=max_regions)
-            d_own = np.abs(tab["E_avg"] - own)
-            d_true = np.abs(tab["E_avg"] - true_avg)
-            res.eavg = {"vs_own": float(d_own.max()), "vs_own_where": float(x[np.argmax(d_own)]),
-                        "vs_truth": float(d_true.max()), "vs_truth_where": float(x[np.argmax(d_true)]),
-                        "truth_error": float(true_err.max()), "own": own, "true": true_avg, "stored": tab["E_avg"]}
+            res.eavg = eavg_grades(tab["E_avg"], own, true_avg, true_err, x)
         if lookup_check:
             big = max(c.shape) > 64
             st = stride or (4 if big else 1)

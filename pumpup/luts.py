@@ -1122,6 +1122,17 @@ def grade(E: np.ndarray, truth: np.ndarray, truth_error: np.ndarray, bound: floa
         labels=tuple(labels), error_map=diff, truth=truth, table=E, mu=np.asarray(mu), rough=np.asarray(rough))
 
 
+def eavg_grades(stored, own, true_avg, true_err, x) -> dict:
+    """How a table's stored E_avg column differs from its own average of its E (``own``) and from the true mean
+    albedo ``true_avg`` (error ``true_err``), over the roughness axis ``x``: the largest differences and where.
+    """
+    d_own = np.abs(stored - own)
+    d_true = np.abs(stored - true_avg)
+    return {"vs_own": float(d_own.max()), "vs_own_where": float(x[np.argmax(d_own)]),
+            "vs_truth": float(d_true.max()), "vs_truth_where": float(x[np.argmax(d_true)]),
+            "truth_error": float(true_err.max()), "own": own, "true": true_avg, "stored": stored}
+
+
 def audit(path: str | os.PathLike[str], preset: str | None = None, model: str | dict | BRDF | None = None, *,
           conventions=None, rtol: float = 1e-7, lookup_check: bool = True, eavg: bool = True, per_cell: int = 1,
           stride: int | None = None, png: str | None = None, threads: int | None = None,
@@ -1166,11 +1177,7 @@ def audit(path: str | os.PathLike[str], preset: str | None = None, model: str | 
     if eavg and "E_avg" in tab:
         own = _own_eavg(E, p)
         true_avg, true_err = mean_albedo_grid(spec, param, rough, rtol=rtol, threads=threads, max_regions=max_regions)
-        d_own = np.abs(tab["E_avg"] - own)
-        d_true = np.abs(tab["E_avg"] - true_avg)
-        res.eavg = {"vs_own": float(d_own.max()), "vs_own_where": float(rough[np.argmax(d_own)]),
-                    "vs_truth": float(d_true.max()), "vs_truth_where": float(rough[np.argmax(d_true)]),
-                    "truth_error": float(true_err.max()), "own": own, "true": true_avg, "stored": tab["E_avg"]}
+        res.eavg = eavg_grades(tab["E_avg"], own, true_avg, true_err, rough)
     if lookup_check:
         big = max(p.n_mu, p.n_rough) > 64
         res.lookup = lookup_error(E, spec, param, p, per_cell=per_cell, stride=stride or (4 if big else 1),
