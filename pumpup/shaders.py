@@ -1154,6 +1154,15 @@ class _Pieces:
 FIT_TOL = 1e-8
 
 
+#: the degree of the product tables' polynomials (:class:`_PumpedTables`, :class:`_CompTables`)
+PRODUCT_DEGREE = 5
+#: the degree of the level table's polynomials (:class:`_PumpedTables`): every level's coefficients are read at both
+#: cosines, and on llvmpipe a read from a constant array at a computed index costs about ten arithmetic operations, so
+#: cubics (83 pieces for a 3-level g1 pumped GGX alpha 0.3, 150 for g2, against 48 and 95 quintics) read 24 values per
+#: pair instead of 36 (scripts/bench/bench_shader.py)
+LEVEL_DEGREE = 3
+
+
 def _kinks(looks, controlled, br: np.ndarray) -> np.ndarray:
     """Values of m in the range of ``br`` where a level's g switches term (its uncapped bound crosses its cap, or, g2,
     its bound crosses m: 001 eq. 21), from the sign changes on ``br`` and its geometric midpoints (brentq).
@@ -1174,19 +1183,21 @@ def _kinks(looks, controlled, br: np.ndarray) -> np.ndarray:
     return np.array(out)
 
 
-def _fit_table(functions, looks, controlled, mlo: float, lift: float, name: str) -> _Pieces:
-    """The shader's table of ``functions`` (each positive on [mlo, 1]) as :class:`_Pieces`: polynomials of degree 5 in m
-    on one set of pieces (:func:`pumpup.operators.pumping.fit_pieces`: at most an octave each, split where a level's g
-    switches term, bisected until each function is met to :data:`FIT_TOL` at the fit's test points), each raised by
-    twice its largest miss, at those points and at 33 more per piece, plus ``lift`` of itself (the amount by which
-    pumpup's own table may exceed the function) and its float32 error.
+def _fit_table(functions, looks, controlled, mlo: float, lift: float, name: str,
+               degree: int = PRODUCT_DEGREE) -> _Pieces:
+    """The shader's table of ``functions`` (each positive on [mlo, 1]) as :class:`_Pieces`: polynomials of ``degree``
+    in m on one set of pieces (:func:`pumpup.operators.pumping.fit_pieces`: at most an octave each, split where a
+    level's g switches term, bisected until each function is met to :data:`FIT_TOL` at the fit's test points), each
+    raised by twice its largest miss, at those points and at 33 more per piece, plus ``lift`` of itself (the amount by
+    which pumpup's own table may exceed the function) and its float32 error.
     """
     from .operators.pumping import fit_pieces
 
     br = np.unique(np.concatenate([[mlo, 1.0], 2.0 ** np.arange(math.floor(math.log2(mlo)), 0.0)]))
     br = br[(br >= mlo) & (br <= 1.0)]
     br = np.unique(np.concatenate([br, _kinks(looks, controlled, br)]))
-    coefs, lo, hi, center, half, worst = fit_pieces(functions, br[:-1], br[1:], FIT_TOL, f"shader table {name}")
+    coefs, lo, hi, center, half, worst = fit_pieces(functions, br[:-1], br[1:], FIT_TOL, f"shader table {name}",
+                                                    degree=degree)
     tt = np.linspace(-1.0, 1.0, 33)
     m = np.clip(center[:, None] + half[:, None] * tt[None, :], lo[:, None], hi[:, None])
     miss = np.array(worst)
@@ -1237,7 +1248,7 @@ class _PumpedTables:
                 mlo = prod.mlo
             else:  # pumpup divides by its level table (at most each U_j) or level by level (U_j)
                 self.table = _fit_table([lk.upper for lk in self.looks], self.looks, self.controlled, mlo, 0.0,
-                                        "pumpup_lt")
+                                        "pumpup_lt", degree=LEVEL_DEGREE)
         except _ProductError:
             self.product = self.table = None
         if self.product is None and self.table is None:

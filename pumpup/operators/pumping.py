@@ -300,21 +300,22 @@ def _monotone_envelope(spline, margin: float):
 FIT_TEST_POINTS = np.linspace(-1.0, 1.0, 4 * (PRODUCT_DEGREE + 1) + 1)
 
 
-def fit_pieces(functions, lo: np.ndarray, hi: np.ndarray, tol: float, what: str):
-    """Polynomial pieces of degree :data:`PRODUCT_DEGREE` on the intervals [lo, hi) for each of ``functions``
-    (positive, of an array of m): each interpolated at the Chebyshev points of every piece, the pieces bisected until
-    every function's relative miss at :data:`FIT_TEST_POINTS` is at most ``tol``, unless a piece is already
-    narrower than 1e-9 m (then the miss is the rounding of the function itself).  Returns (coefficients, one
-    (degree + 1, pieces) array per function with the highest power first, lo, hi, centres, half-widths, the largest
-    miss of each piece); :class:`_ProductError` (naming ``what``) beyond 100000 pieces or 64 rounds.
+def fit_pieces(functions, lo: np.ndarray, hi: np.ndarray, tol: float, what: str, degree: int = PRODUCT_DEGREE):
+    """Polynomial pieces of degree ``degree`` (:data:`PRODUCT_DEGREE` unless given) on the intervals [lo, hi) for
+    each of ``functions`` (positive, of an array of m): each interpolated at the Chebyshev points of every piece, the
+    pieces bisected until every function's relative miss at :data:`FIT_TEST_POINTS` (4 (degree + 1) + 1 points) is at
+    most ``tol``, unless a piece is already narrower than 1e-9 m (then the miss is the rounding of the function
+    itself).  Returns (coefficients, one (degree + 1, pieces) array per function with the highest power first, lo, hi,
+    centres, half-widths, the largest miss of each piece); :class:`_ProductError` (naming ``what``) beyond 100000
+    pieces or 64 rounds.
     """
-    deg = PRODUCT_DEGREE
+    deg = degree
     xk = np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))  # Chebyshev points
     vand = np.polynomial.chebyshev.chebvander(xk, deg)
     to_mono = np.array([np.pad(np.polynomial.chebyshev.cheb2poly(np.eye(deg + 1)[k]), (0, deg - k))
                         for k in range(deg + 1)])  # row k: monomial coefficients of T_k (low first)
     fit = np.linalg.solve(vand, np.eye(deg + 1)).T @ to_mono  # values at xk -> monomial (low first)
-    tt = FIT_TEST_POINTS
+    tt = FIT_TEST_POINTS if deg == PRODUCT_DEGREE else np.linspace(-1.0, 1.0, 4 * (deg + 1) + 1)
     for _ in range(64):
         center, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
         coefs, worst = [], np.zeros(len(lo))
