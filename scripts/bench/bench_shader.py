@@ -1,12 +1,14 @@
 """Benchmark of pumpup.shader: generation time, and the GLSL's evaluation cost on Mesa's llvmpipe (pumped and
 compensated against their base, measured in the same run).
 
-    python scripts/bench/bench_shader.py [--pairs 1048576] [--repeat 5] [--against OLD_SHADERS_PY]
+    python scripts/bench/bench_shader.py [--pairs 1048576] [--repeat 5] [--against OLD_SHADERS_PY] [--cpu]
 
 Needs moderngl and an EGL driver (Debian: libegl1, libgl1-mesa-dri).  The evaluation renders one float32 value per
 pixel (directions from two float32 textures) and times the draws after a first, compiling one.  With ``--against`` (a
 file holding another version of pumpup/shaders.py, e.g. ``<(git show main:pumpup/shaders.py)``) each case's shader
-from that version is timed too, the two draws alternating, and the table gives both.
+from that version is timed too, the two draws alternating, and the table gives both.  With ``--cpu`` llvmpipe
+rasterizes in the calling thread (``LP_NUM_THREADS=0``) and each draw is timed by that thread's CPU time, which a
+loaded machine disturbs less than the wall-clock time of llvmpipe's worker threads.
 """
 
 from __future__ import annotations
@@ -82,15 +84,19 @@ def load_other(path: str):
     return mod
 
 
-def evaluation_times(pairs: int, repeat: int, other=None) -> None:
+def evaluation_times(pairs: int, repeat: int, other=None, cpu: bool = False) -> None:
     """Print the cost per pair of each case's GLSL on llvmpipe, and its ratio to its base's (and, with ``other``, the
-    same for that module's shaders, the draws alternating).
+    same for that module's shaders, the draws alternating; with ``cpu``, in the calling thread, timed by its CPU time).
     """
+    if cpu:
+        os.environ["LP_NUM_THREADS"] = "0"  # (read when the driver starts: before the context)
     import moderngl
 
+    clock = time.thread_time if cpu else time.perf_counter
     ctx = moderngl.create_standalone_context(backend="egl", require=430)
     print(f"evaluation on {ctx.info['GL_RENDERER']}, {pairs} pairs per draw, best of {repeat} rounds (each round draws "
-          "every shader once), load average before: " + " ".join(f"{x:.2f}" for x in os.getloadavg()) + ":")
+          f"every shader once{', thread CPU time, no worker threads' if cpu else ''}), load average before: "
+          + " ".join(f"{x:.2f}" for x in os.getloadavg()) + ":")
     width = 1024
     h = pairs // width
     rng = np.random.default_rng(1)
@@ -138,10 +144,10 @@ def evaluation_times(pairs: int, repeat: int, other=None) -> None:
     best = dict.fromkeys(runs, np.inf)
     for _ in range(repeat):  # every shader once per round: all of them under the same load
         for key, (_, vao, _) in runs.items():
-            t = time.perf_counter()
+            t = clock()
             vao.render(moderngl.TRIANGLES)
             ctx.finish()
-            best[key] = min(best[key], time.perf_counter() - t)
+            best[key] = min(best[key], clock() - t)
     for name, _, base in CASES:
         cols = []
         for label, _, _ in modules:
@@ -165,10 +171,11 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--against", help="another version of pumpup/shaders.py to time alternately")
     ap.add_argument("--no-generation", action="store_true", help="skip the generation times")
+    ap.add_argument("--cpu", action="store_true", help="rasterize in this thread and time its CPU time")
     args = ap.parse_args()
     if not args.no_generation:
         generation_times()
-    evaluation_times(args.pairs, args.repeat, load_other(args.against) if args.against else None)
+    evaluation_times(args.pairs, args.repeat, load_other(args.against) if args.against else None, cpu=args.cpu)
 
 
 if __name__ == "__main__":
