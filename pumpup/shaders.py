@@ -909,48 +909,143 @@ def _choose_cells(b: np.ndarray, start: float, end: float, most: int, bits: int 
     return got
 
 
-def _search(bounds32: np.ndarray, nm: str, var: str = "m") -> tuple[str, str]:
-    """GLSL of ``int {nm}_piece(float var)``: the largest s with ``{nm}_b[s] <= var`` (``var`` >= the first bound, a
-    float32 > 0): the cell of ``var`` from its float32 bits (2^bits cells per octave, as
-    :func:`pumpup.physics.lookups.g_product` finds a piece from the float64 bits; below _FINE_FROM and above it bits
-    each from _CELL_BITS up until a cell holds at most two piece starts, within _CELLS_MAX cells in all), the first
-    candidate piece of the cell, then a binary search of fixed length over the cell's pieces, without branches (the
-    bounds array is padded with float32's largest value, so the steps need no range check).  (arrays, code).
+#: the most bits of a crowded cell's sub-cells (:class:`_Index`)
+_SUB_BITS_MAX = 8
+
+
+def _span(b: np.ndarray, lo_bits: np.ndarray, width: int, start: float, end: float) -> tuple[np.ndarray, np.ndarray]:
+    """The first and the last piece (lower ends ``b``) that may hold a float32 in each range of bits [lo_bits, lo_bits
+    + width) within [``start``, ``end``].
     """
-    b = np.asarray(bounds32, dtype=np.float32)
-    lo = float(b[0])
-    split = max(_FINE_FROM, lo)
-    fine = _choose_cells(b, split, 1.0, _CELLS_MAX // 2)
-    fs, fbase, nfine, ffirst, fcount = fine
-    if lo < split:
-        coarse = _choose_cells(b, lo, split, _CELLS_MAX // 2, bits=1)  # (few pieces per octave down there)
-        cs, cbase, ncoarse, cfirst, ccount = coarse
-    else:
-        cs, cbase, ncoarse, cfirst, ccount = 19, 0, 0, np.zeros(0, np.int64), 1
-    count = max(fcount, ccount)
-    k = 1
-    while k < count:
-        k *= 2
-    pad = np.full(k, np.finfo(np.float32).max, dtype=np.float32)
-    steps = []
-    k //= 2
-    while k >= 1:
-        steps.append(f"    i += {nm}_b[i + {k}] <= {var} ? {k} : 0;")
-        k //= 2
-    first = np.concatenate([cfirst, ffirst])
-    ncell = len(first)
-    vals = ", ".join(str(int(x)) for x in first)
-    arrays = _array(f"{nm}_b", np.concatenate([b, pad])) + f"const highp int {nm}_cs[{ncell}] = int[{ncell}]({vals});\n"
-    fine_c = f"clamp(int(u >> {fs}u) - {fbase - ncoarse}, {ncoarse}, {ncell - 1})"
-    if ncoarse:
-        cell = (f"{var} >= {_lit(split)} ? {fine_c} : clamp(int(u >> {cs}u) - {cbase}, 0, {ncoarse - 1})")
-    else:
-        cell = fine_c
-    code = (f"highp int {nm}_piece(highp float {var}) {{\n"
-            f"    highp uint u = floatBitsToUint({var});\n"
-            f"    highp int i = {nm}_cs[{cell}];\n"
-            + "".join(st + "\n" for st in steps) + "    return i;\n}\n")
-    return arrays, code
+    n = len(b)
+    starts = np.maximum(lo_bits.astype(np.uint32).view(np.float32), np.float32(start))
+    ends = np.minimum((lo_bits + width).astype(np.uint32).view(np.float32),
+                      np.float32(np.nextafter(np.float32(end), np.float32(np.inf))))
+    first = np.clip(np.searchsorted(b, starts, side="right") - 1, 0, n - 1)
+    last = np.clip(np.searchsorted(b, ends, side="left") - 1, 0, n - 1)
+    return first, last
+
+
+class _Index:
+    """How the shader finds the piece of a float32 ``var`` >= the first lower end (``bounds32``, sorted): the largest s
+    with ``{nm}_b[s] <= var``, without branches.
+
+    The cell of ``var`` from its float32 bits (2^bits cells per octave, as :func:`pumpup.physics.lookups.g_product`
+    finds a piece from the float64 bits; below _FINE_FROM and above it, bits each from _CELL_BITS up until a cell
+    holds at most two piece starts, within _CELLS_MAX cells in all) gives ``{nm}_cs[cell]``: the first candidate
+    piece, or, for a cell that still holds more than two piece starts (pieces crowd where a bound is barely smooth:
+    3-level g2 pumped GGX near m = 0.97), -1 - the offset of its 2^``sub`` sub-cells (the next ``sub`` bits of
+    ``var``) in ``{nm}_sub``, each holding its first candidate piece; then a binary search of fixed length over the
+    candidates (the bounds array is padded with float32's largest value, so the steps need no range check).  Both
+    reads are made for every ``var`` (a GPU runs both sides of a select): two dependent reads and one step instead of
+    one read and up to four steps.  :meth:`piece` is the plain numpy reference of the GLSL.
+    """
+
+    def __init__(self, bounds32: np.ndarray):
+        b = np.asarray(bounds32, dtype=np.float32)
+        self.b = b
+        lo = float(b[0])
+        self.split = float(np.float32(max(_FINE_FROM, lo)))
+        regions = [_choose_cells(b, self.split, 1.0, _CELLS_MAX // 2)]
+        if lo < self.split:
+            regions.insert(0, _choose_cells(b, lo, self.split, _CELLS_MAX // 2, bits=1))  # (few pieces down there)
+            self.coarse = regions[0][:3]
+        else:
+            self.coarse = (19, 0, 0)
+        self.fine = regions[-1][:3]
+        ends = [(lo, self.split), (self.split, 1.0)][-len(regions):]
+        cells, counts = [], []
+        for (shift, cbase, ncell, _, _), (a, z) in zip(regions, ends):
+            bits = (np.arange(ncell, dtype=np.int64) + cbase) << shift
+            first, last = _span(b, bits, 1 << shift, a, z)
+            cells.append((shift, bits, first, last, a, z))
+            counts.append(last - first + 1)
+        count = int(max(int(np.max(c)) for c in counts))
+        #: the sub-cells' bits (0: none) and entries
+        self.sub, subs = 0, []
+        cs = np.concatenate([c[2] for c in cells]).astype(np.int64)
+        if count > 2:
+            top = min(_SUB_BITS_MAX, min(c[0] for c in cells))
+            for k in range(1, top + 1):
+                worst, entries = 1, []
+                for shift, bits, first, last, a, z in cells:
+                    for c in np.nonzero(last - first + 1 > 2)[0]:
+                        sb = bits[c] + (np.arange(1 << k, dtype=np.int64) << (shift - k))
+                        f2, l2 = _span(b, sb, 1 << (shift - k), a, z)
+                        worst = max(worst, int(np.max(l2 - f2)) + 1)
+                        entries.append(f2)
+                if worst < count and (worst <= 2 or k == top):
+                    self.sub, subs, count = k, entries, worst
+                    break
+            if self.sub:
+                off = at = 0
+                for shift, bits, first, last, a, z in cells:
+                    for c in np.nonzero(last - first + 1 > 2)[0]:
+                        cs[at + c] = -1 - off
+                        off += 1 << self.sub
+                    at += len(bits)
+        self.cs = cs
+        self.subtable = np.concatenate(subs).astype(np.int64) if subs else np.zeros(0, np.int64)
+        k = 1
+        while k < count:
+            k *= 2
+        self.width = k  # candidates per cell (a power of two): steps k/2, k/4, ..., 1
+
+    def piece(self, m) -> np.ndarray:
+        """The piece the GLSL finds for float32 values ``m`` (each >= the first lower end): the numpy reference."""
+        m = np.asarray(m, dtype=np.float32)
+        u = m.view(np.uint32).astype(np.int64)
+        fs, fbase, nfine = self.fine
+        cs_, cbase, ncoarse = self.coarse
+        ncell = len(self.cs)
+        fine = np.clip((u >> fs) - (fbase - ncoarse), ncoarse, ncell - 1)
+        if ncoarse:
+            cell = np.where(m >= np.float32(self.split), fine, np.clip((u >> cs_) - cbase, 0, ncoarse - 1))
+        else:
+            cell = fine
+        i = self.cs[cell]
+        if self.sub:
+            sh = np.where(m >= np.float32(self.split), fs, cs_) - self.sub if ncoarse else fs - self.sub
+            j = np.maximum(-1 - i, 0) + ((u >> sh) & ((1 << self.sub) - 1))
+            i = np.where(i >= 0, i, self.subtable[np.minimum(j, len(self.subtable) - 1)])
+        bp = np.concatenate([self.b, np.full(self.width, np.finfo(np.float32).max, np.float32)])
+        k = self.width // 2
+        while k >= 1:
+            i = i + np.where(bp[i + k] <= m, k, 0)
+            k //= 2
+        return i
+
+    def glsl(self, nm: str, var: str) -> tuple[str, str]:
+        """(arrays, code) of ``int {nm}_piece(float var)``."""
+        pad = np.full(self.width, np.finfo(np.float32).max, dtype=np.float32)
+        fs, fbase, nfine = self.fine
+        cs_, cbase, ncoarse = self.coarse
+        ncell = len(self.cs)
+        vals = ", ".join(str(int(x)) for x in self.cs)
+        arrays = (_array(f"{nm}_b", np.concatenate([self.b, pad]))
+                  + f"const highp int {nm}_cs[{ncell}] = int[{ncell}]({vals});\n")
+        fine_c = f"clamp(int(u >> {fs}u) - {fbase - ncoarse}, {ncoarse}, {ncell - 1})"
+        split = _lit(self.split)
+        cell = (f"{var} >= {split} ? {fine_c} : clamp(int(u >> {cs_}u) - {cbase}, 0, {ncoarse - 1})" if ncoarse
+                else fine_c)
+        lines = [f"    highp uint u = floatBitsToUint({var});", f"    highp int i = {nm}_cs[{cell}];"]
+        if self.sub:
+            nsub = len(self.subtable)
+            arrays += (f"const highp int {nm}_sub[{nsub}] = int[{nsub}]("
+                       + ", ".join(str(int(x)) for x in self.subtable) + ");\n")
+            sh = f"({var} >= {split} ? {fs - self.sub}u : {cs_ - self.sub}u)" if ncoarse else f"{fs - self.sub}u"
+            lines.append(f"    i = i >= 0 ? i : {nm}_sub[max(-1 - i, 0) + int((u >> {sh}) & {(1 << self.sub) - 1}u)];")
+        k = self.width // 2
+        while k >= 1:
+            lines.append(f"    i += {nm}_b[i + {k}] <= {var} ? {k} : 0;")
+            k //= 2
+        code = f"highp int {nm}_piece(highp float {var}) {{\n" + "\n".join(lines) + "\n    return i;\n}\n"
+        return arrays, code
+
+
+def _search(bounds32: np.ndarray, nm: str, var: str = "m") -> tuple[str, str]:
+    """GLSL of ``int {nm}_piece(float var)`` (:class:`_Index`): (arrays, code)."""
+    return _Index(bounds32).glsl(nm, var)
 
 
 def _range_below(lk, t32: float) -> tuple[float, float]:

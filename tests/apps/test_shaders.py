@@ -403,3 +403,46 @@ def test_shader_tables_are_at_least_pumpups_bounds():
         below = below[below > 0]
         for lk, sup in zip(tabs.looks, tabs.sup):
             assert np.all(lk.upper(below.astype(np.float64)) <= sup)
+
+
+# --- the piece index: the GLSL against its numpy reference, the reference against a search ---------------------------
+
+
+def _index_cases():
+    """(name, _Index, float32 values to look up) for a level table whose pieces crowd (3-level g2 pumped GGX: the
+    sub-cells), one whose do not (g1) and a product table (Phong)."""
+    from pumpup.shaders import _Index, _Plan, _PumpedTables
+
+    rng = np.random.default_rng(5)
+    out = []
+    for name, spec in (("g2", {"type": "pumped", "base": GGX, "g": "g2", "levels": 3}),
+                       ("g1", {"type": "pumped", "base": GGX, "g": "g1", "levels": 3}),
+                       ("phong", {"type": "pumped", "base": PHONG, "g": "g1", "levels": 3})):
+        tabs = _PumpedTables(_Plan(pumpup.load(spec)))
+        lo = (tabs.table or tabs.product).lo32
+        m = np.concatenate([lo, np.nextafter(lo, np.float32(0)), np.nextafter(lo, np.float32(2)),
+                            (10.0 ** rng.uniform(np.log10(lo[0]), 0.0, 20000)).astype(np.float32),
+                            rng.uniform(0.9, 1.0, 20000).astype(np.float32), [np.float32(1.0)]]).astype(np.float32)
+        out.append((name, _Index(lo), np.unique(m[(m >= lo[0]) & (m <= 1.0)])))
+    return out
+
+
+def test_piece_index_reference_is_the_search():
+    cases = _index_cases()
+    assert cases[0][1].sub > 0 and cases[1][1].sub == 0  # (g2's crowded cells take sub-cells; g1's need none)
+    for name, ix, m in cases:
+        want = np.clip(np.searchsorted(ix.b, m, side="right") - 1, 0, len(ix.b) - 1)
+        assert np.array_equal(ix.piece(m), want), name
+
+
+@pytest.mark.parametrize("es", [False, True])
+def test_piece_index_glsl_matches_its_reference(ctx, es):
+    for name, ix, m in _index_cases():
+        arrays, code = ix.glsl("pumpup_t", "m")
+        # (wo read too, so that the program keeps its sampler)
+        lib = arrays + code + ("float pumpup_brdf(vec3 wi, vec3 wo) { return float(pumpup_t_piece(wi.z))"
+                               " + min(wo.z, 0.0); }\n")
+        wi = np.zeros((len(m), 3), np.float32)
+        wi[:, 2] = m
+        got, _ = run(ctx, [lib], wi, wi, es=es, with_error=False)
+        assert np.array_equal(got[0], ix.piece(m).astype(np.float64)), (name, es)
