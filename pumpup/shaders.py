@@ -1252,7 +1252,7 @@ FIT_TOL = 1e-8
 #: the degree of the product tables' polynomials (:class:`_PumpedTables`, :class:`_CompTables`)
 PRODUCT_DEGREE = 5
 #: the degree of the level table's polynomials (:class:`_PumpedTables`): every level's coefficients are read at both
-#: cosines, and on llvmpipe a read from a constant array at a computed index costs about ten arithmetic operations, so
+#: cosines, and on llvmpipe a read from a constant array at a computed index costs several arithmetic operations, so
 #: cubics (83 pieces for a 3-level g1 pumped GGX alpha 0.3, 150 for g2, against 48 and 95 quintics) read 24 values per
 #: pair instead of 36 (scripts/bench/bench_shader.py)
 LEVEL_DEGREE = 3
