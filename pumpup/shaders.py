@@ -1150,18 +1150,41 @@ class _Pieces:
     (:func:`_search`), ``{name}_cen`` and ``{name}_ih`` each piece's float32 centre and inverse half-width, and
     ``{name}_c`` per piece the functions' coefficients one after the other, highest power first (piece s, function j,
     power r at ``(s * k + j) * (degree + 1) + r``): one piece search per cosine serves every function.
+
+    With ``octave``, the polynomials are in t = (m - centre) 2^-e instead, e the exponent of m (of min(m, 1 - 2^-24),
+    so that m = 1 shares the exponent of its piece, which lies in [1/2, 1]), computed from the bits of m: exact,
+    since every piece lies within an octave, and one read fewer per look-up (no ``{name}_ih``).  (Not for degree 5:
+    t^5's coefficient, (half-width 2^-e)^-5 times the fit's, could leave float32's range on the narrowest pieces.)
     """
 
-    def __init__(self, lo, center, ihalf, coefs, lift, name: str, raise_: bool = True):
+    #: GLSL of 2^-e for a float32 m in (0, 1] from its bits (e its exponent; 1 - 2^-24's for m = 1)
+    OCTAVE = "uintBitsToFloat(0x7F000000u - (floatBitsToUint(min({m}, 0.99999994)) & 0x7F800000u))"
+
+    @staticmethod
+    def octave_scale(m) -> np.ndarray:
+        """2^-e of float32 values m in (0, 1] as :attr:`OCTAVE` computes it (float64)."""
+        e = np.frexp(np.minimum(np.asarray(m, np.float32), np.float32(1.0 - 2.0**-24)).astype(np.float64))[1] - 1
+        return np.ldexp(1.0, -e)
+
+    def __init__(self, lo, center, ihalf, coefs, lift, name: str, raise_: bool = True, octave: bool = False):
         self.name = name
         lo = np.asarray(lo, dtype=np.float64)
         hi = np.minimum(np.concatenate([lo[1:], [1.0]]), 1.0)
         center, ihalf = np.asarray(center, dtype=np.float64), np.asarray(ihalf, dtype=np.float64)
         c32 = center.astype(np.float32)
         ih32 = ihalf.astype(np.float32)
-        alpha = ihalf / ih32.astype(np.float64)
+        self.octave = octave
+        # the variable the shader computes: (m - c32) times ih32, or times 2^-e (the octave of the piece, exactly)
+        lo32 = _up32_array(lo)  # a float32 m is in piece s when lo32[s] <= m < lo32[s + 1]
+        scale = self.octave_scale(lo32) if octave else ih32.astype(np.float64)
+        if octave:  # (every piece within an octave: the last float32 of each has the exponent of its first)
+            top = np.concatenate([np.nextafter(lo32[1:], np.float32(0)), [np.float32(1.0)]])
+            held = np.concatenate([lo32[1:] > lo32[:-1], [True]])
+            if not np.all((self.octave_scale(top) == scale) | ~held):
+                raise ValueError("a piece of the shader's table spans more than an octave")
+        alpha = ihalf / scale
         beta = (c32.astype(np.float64) - center) * ihalf
-        smax = np.maximum(np.abs(lo - c32), np.abs(hi - c32)) * ih32.astype(np.float64) * (1.0 + 4 * U)
+        smax = np.maximum(np.abs(lo - c32), np.abs(hi - c32)) * scale * (1.0 + 4 * U)
         rows, errs, rels = [], [], []
         for coef in coefs:
             coef = np.asarray(coef, dtype=np.float64)  # (deg + 1, pieces), highest power first, t = (m - c) ih
@@ -1205,7 +1228,8 @@ class _Pieces:
         """
         m = np.asarray(m, dtype=np.float32)
         s = np.clip(np.searchsorted(self.lo32, m, side="right") - 1, 0, self.npieces - 1)
-        t = (m.astype(np.float64) - self.c32[s].astype(np.float64)) * self.ih32[s].astype(np.float64)
+        scale = self.octave_scale(m) if self.octave else self.ih32[s].astype(np.float64)
+        t = (m.astype(np.float64) - self.c32[s].astype(np.float64)) * scale
         out = []
         for j in range(self.nfun):
             v = np.zeros(m.shape)
@@ -1218,7 +1242,8 @@ class _Pieces:
         """The arrays and ``int {name}_piece(float m)``; :meth:`value` writes a function's value from the piece."""
         nm = self.name
         arrays, search = _search(self.lo32, nm, "m")
-        return "".join([arrays, _array(f"{nm}_cen", self.c32), _array(f"{nm}_ih", self.ih32),
+        ih = "" if self.octave else _array(f"{nm}_ih", self.ih32)
+        return "".join([arrays, _array(f"{nm}_cen", self.c32), ih,
                         _array(f"{nm}_c", self.coef32.ravel()), search])
 
     def value(self, j: int, base: str, t: str) -> str:
@@ -1238,8 +1263,9 @@ class _Pieces:
         ``b{var}`` for :meth:`value`.
         """
         nm = self.name
+        scale = self.OCTAVE.format(m=m) if self.octave else f"{nm}_ih[s{var}]"
         return (f"    highp int s{var} = {nm}_piece({search or m});\n"
-                f"    float t{var} = ({m} - {nm}_cen[s{var}]) * {nm}_ih[s{var}];\n"
+                f"    float t{var} = ({m} - {nm}_cen[s{var}]) * {scale};\n"
                 f"    highp int b{var} = {self.nfun * (self.deg + 1)} * s{var};\n")
 
 
@@ -1279,7 +1305,7 @@ def _kinks(looks, controlled, br: np.ndarray) -> np.ndarray:
 
 
 def _fit_table(functions, looks, controlled, mlo: float, lift: float, name: str,
-               degree: int = PRODUCT_DEGREE) -> _Pieces:
+               degree: int = PRODUCT_DEGREE, octave: bool = False) -> _Pieces:
     """The shader's table of ``functions`` (each positive on [mlo, 1]) as :class:`_Pieces`: polynomials of ``degree``
     in m on one set of pieces (:func:`pumpup.operators.pumping.fit_pieces`: at most an octave each, split where a
     level's g switches term, bisected until each function is met to :data:`FIT_TOL` at the fit's test points), each
@@ -1299,7 +1325,7 @@ def _fit_table(functions, looks, controlled, mlo: float, lift: float, name: str,
     for fn, coef in zip(functions, coefs):
         approx = sum(coef[r][:, None] * tt[None, :] ** (coef.shape[0] - 1 - r) for r in range(coef.shape[0]))
         miss = np.maximum(miss, np.max(np.abs(approx / fn(m) - 1.0), axis=1))
-    return _Pieces(lo, center, 1.0 / half, coefs, 2.0 * miss + lift, name)
+    return _Pieces(lo, center, 1.0 / half, coefs, 2.0 * miss + lift, name, octave=octave)
 
 
 # ----------------------------------------------------------------------------------------
@@ -1343,7 +1369,7 @@ class _PumpedTables:
                 mlo = prod.mlo
             else:  # pumpup divides by its level table (at most each U_j) or level by level (U_j)
                 self.table = _fit_table([lk.upper for lk in self.looks], self.looks, self.controlled, mlo, 0.0,
-                                        "pumpup_lt", degree=LEVEL_DEGREE)
+                                        "pumpup_lt", degree=LEVEL_DEGREE, octave=True)
         except _ProductError:
             self.product = self.table = None
         if self.product is None and self.table is None:

@@ -446,3 +446,29 @@ def test_piece_index_glsl_matches_its_reference(ctx, es):
         wi[:, 2] = m
         got, _ = run(ctx, [lib], wi, wi, es=es, with_error=False)
         assert np.array_equal(got[0], ix.piece(m).astype(np.float64)), (name, es)
+
+
+@pytest.mark.parametrize("es", [False, True])
+def test_level_table_glsl_matches_its_reference(ctx, es):
+    """Every level's bound as the GLSL computes it (piece, t = (m - centre) 2^-e from the bits of m, Horner) against
+    _Pieces.values, the numpy reference (float64 on the float32 coefficients): within the float32 error bound of the
+    piece (``err``, which the table's constant terms were raised by twice)."""
+    from pumpup.shaders import _Plan, _PumpedTables
+
+    rng = np.random.default_rng(8)
+    for g in ("g1", "g2"):
+        q = _PumpedTables(_Plan(pumpup.load({"type": "pumped", "base": GGX, "g": g, "levels": 3}))).table
+        assert q.octave and "pumpup_lt_ih" not in q.glsl()
+        m = np.unique(np.concatenate([q.lo32, np.nextafter(q.lo32, np.float32(2)),
+                                      (10.0 ** rng.uniform(np.log10(q.lo32[0]), 0.0, 20000)).astype(np.float32),
+                                      [np.float32(1.0)]]).astype(np.float32))
+        m = m[(m >= q.lo32[0]) & (m <= 1.0)]
+        wi = np.zeros((len(m), 3), np.float32)
+        wi[:, 2] = m
+        s = np.clip(np.searchsorted(q.lo32, m, side="right") - 1, 0, q.npieces - 1)
+        want = q.values(m)
+        for j in range(q.nfun):
+            lib = (q.glsl() + "float pumpup_brdf(vec3 wi, vec3 wo) {\n" + q.locate("", "wi.z")
+                   + f"    return {q.value(j, 'b', 't')} + min(wo.z, 0.0);\n}}\n")
+            got, _ = run(ctx, [lib], wi, wi, es=es, with_error=False)
+            assert np.all(np.abs(got[0] - want[j]) <= q.err[s] + 1e-300), (g, j, es)

@@ -1,0 +1,148 @@
+"""Where a pumped GGX shader's time goes on Mesa's llvmpipe: the shader of pumpup.shader timed beside variants of it
+with one part of its look-up taken out (the results of those variants are wrong; only their cost matters).
+
+    python scripts/bench/bench_shader_parts.py [--pairs 524288] [--repeat 9] [--g g1 g2]
+
+Needs moderngl and an EGL driver.  llvmpipe rasterizes in this thread (``LP_NUM_THREADS=0``) and each draw is timed
+by the thread's CPU time, every variant drawn once per round, best of the rounds; each line gives ns per pair and the
+ratio to the base GGX shader measured in the same run.  The variants of the 3-level pumped GGX (alpha 0.3):
+
+- ``g = 1``: the base, its bound and the final division, without the table;
+- ``no search steps``: the piece is the cell's first candidate (the binary search's reads left out);
+- ``no sub-cells``: the crowded cells' second read left out;
+- ``no centre, half-width``: t computed from m alone (two reads per cosine left out);
+- ``no coefficients``: every coefficient read replaced by arithmetic on the piece number;
+- ``branch never taken``: the whole look-up inside an ``if`` that no pair takes (llvmpipe runs it anyway);
+- ``N reads``: the base GGX plus N reads from a constant array of 1,000 floats at an index computed from N.wi.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import time
+
+import numpy as np
+
+import pumpup
+from pumpup.shaders import shader
+
+GGX = {"type": "ggx", "alpha": 0.3}
+VS = "#version 430 core\nin vec2 p;\nvoid main() { gl_Position = vec4(p, 0.0, 1.0); }\n"
+FS = """
+uniform highp sampler2D bench_wi;
+uniform highp sampler2D bench_wo;
+out vec4 bench_out;
+void main() {
+    ivec2 q = ivec2(gl_FragCoord.xy);
+    bench_out = vec4(pumpup_brdf(texelFetch(bench_wi, q, 0).xyz, texelFetch(bench_wo, q, 0).xyz));
+}
+"""
+
+
+def _function(src: str, name: str) -> tuple[int, int]:
+    """The start and end of a GLSL function's definition in ``src``."""
+    i = src.index(f"float {name}(float mi, float mo) {{")
+    return i, src.index("\n}\n", i) + 3
+
+
+def variants(lib: str) -> dict[str, str]:
+    """The pumped shader ``lib`` and its variants (see the module's docstring)."""
+    out = {"full": lib}
+    i, j = _function(lib, "pumpup_g")
+    out["g = 1"] = lib[:i] + "float pumpup_g(float mi, float mo) { return 1.0; }\n" + lib[j:]
+    out["no search steps"] = re.sub(r"    i \+= pumpup_lt_b\[i \+ \d+\] <= m \? \d+ : 0;\n", "", lib)
+    if "pumpup_lt_sub[" in lib:
+        out["no sub-cells"] = re.sub(r"    i = i >= 0 \? i : pumpup_lt_sub\[.*\n", "", lib)
+    centred = r"\((max\(m[io], [^)]*\)) - pumpup_lt_cen\[s[io]\]\) \* pumpup_lt_ih\[s[io]\]"
+    out["no centre, half-width"] = re.sub(centred, r"(\1 * 3.0 - 1.0)", lib)
+    out["no coefficients"] = re.sub(r"pumpup_lt_c\[b([io]) \+ (\d+)\]",
+                                    lambda mm: f"(float(b{mm.group(1)}) * {0.001 * (int(mm.group(2)) + 1):.3f})", lib)
+    body = lib[i:j].replace("float pumpup_g(float mi, float mo) {", "float pumpup_gfull(float mi, float mo) {")
+    out["branch never taken"] = (lib[:i] + body + "float pumpup_g(float mi, float mo) {\n    float g = 1.0;\n"
+                                 "    if (mi < -1.0) {\n        g = pumpup_gfull(mi, mo);\n    }\n    return g;\n}\n"
+                                 + lib[j:])
+    return out
+
+
+def reads(base: str, n: int) -> str:
+    """The base GGX library, divided by a sum of ``n`` reads from a constant array at an index computed from N.wi."""
+    rng = np.random.default_rng(0)
+    vals = ", ".join(f"{x:.6f}" for x in rng.uniform(0.5, 1.0, 1000))
+    terms = " + ".join(f"pumpup_a[s + {r}]" for r in range(n)) or "1.0"
+    i = base.index("float pumpup_brdf")
+    return (base[:i] + f"const float pumpup_a[1000] = float[1000]({vals});\n"
+            f"float pumpup_sum(float mi) {{\n    highp int s = int(mi * 900.0);\n    return {terms};\n}}\n"
+            + base[i:].replace("return pumpup_base(wi, wo).x", "return pumpup_base(wi, wo).x / pumpup_sum(wi.z)"))
+
+
+def main() -> None:
+    """Time the variants and print where the time goes."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--pairs", type=int, default=1 << 19)
+    ap.add_argument("--repeat", type=int, default=9)
+    ap.add_argument("--g", nargs="+", default=["g1", "g2"])
+    args = ap.parse_args()
+    libs = {"ggx": shader(GGX, target="glsl")}
+    for n in (6, 12, 24):
+        libs[f"ggx + {n} reads"] = reads(libs["ggx"], n)
+    for g in args.g:
+        f = pumpup.load({"type": "pumped", "base": GGX, "g": g, "levels": 3})
+        for name, src in variants(shader(f, target="glsl")).items():
+            libs[f"{g} x3: {name}"] = src
+
+    os.environ["LP_NUM_THREADS"] = "0"  # (read when the driver starts: before the context)
+    import moderngl
+
+    ctx = moderngl.create_standalone_context(backend="egl", require=430)
+    width = 1024
+    h = args.pairs // width
+    rng = np.random.default_rng(1)
+
+    def hemi(n):
+        z = rng.uniform(0, 1, n)
+        phi = rng.uniform(0, 2 * np.pi, n)
+        s = np.sqrt(1 - z * z)
+        a = np.zeros((n, 4), np.float32)
+        a[:, 0], a[:, 1], a[:, 2] = s * np.cos(phi), s * np.sin(phi), z
+        return a
+
+    twi = ctx.texture((width, h), 4, hemi(width * h).tobytes(), dtype="f4")
+    two = ctx.texture((width, h), 4, hemi(width * h).tobytes(), dtype="f4")
+    for t in (twi, two):
+        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    out = ctx.texture((width, h), 4, dtype="f4")
+    fbo = ctx.framebuffer([out])
+    vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], "f4").tobytes())
+    runs = {}
+    for name, lib in libs.items():
+        prog = ctx.program(vertex_shader=VS, fragment_shader="#version 430 core\n" + lib + FS)
+        if "pumpup_alpha" in prog:
+            prog["pumpup_alpha"].value = 0.3
+        prog["bench_wi"].value = 0
+        prog["bench_wo"].value = 1
+        vao = ctx.vertex_array(prog, [(vbo, "2f", "p")])
+        fbo.use()
+        twi.use(0)
+        two.use(1)
+        vao.render(moderngl.TRIANGLES)
+        ctx.finish()
+        runs[name] = vao
+    print(f"{ctx.info['GL_RENDERER']}, {width * h} pairs per draw, in this thread (thread CPU time), best of "
+          f"{args.repeat} rounds, load average before: " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
+    best = dict.fromkeys(runs, np.inf)
+    for _ in range(args.repeat):
+        for name, vao in runs.items():
+            t = time.thread_time()
+            vao.render(moderngl.TRIANGLES)
+            ctx.finish()
+            best[name] = min(best[name], time.thread_time() - t)
+    base = best["ggx"]
+    for name, t in best.items():
+        print(f"  {name:40s} {t * 1e9 / (width * h):6.1f} ns  {t / base:5.2f} x ggx")
+    print("load average after: " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
+
+
+if __name__ == "__main__":
+    main()
