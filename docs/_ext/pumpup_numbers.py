@@ -467,6 +467,18 @@ QUOTES: list[Quote] = [
           lambda: (_cycles_audit().eavg["vs_truth"], 31 * _cycles_audit().eavg["vs_truth_where"], 31), slow=True),
     Quote("docs/user-guide/luts.md", "against 2 int E mu dmu of the table's own (linearly interpolated) E | 8.9e-5 | "
           "rough = 1 |", lambda: (2, _cycles_audit().eavg["vs_own"], _cycles_audit().eavg["vs_own_where"]), slow=True),
+    Quote("docs/engine/accuracy.md", "(84 values: Phong, Blinn, their stretched forms, Ward, modified Ward, "
+          "Cook-Torrance, mu down to 1e-06) | every estimate bounds the true error; the largest relative difference "
+          "is 9.6e-12 |", lambda: _independent_reference(), slow=True),
+    Quote("docs/engine/accuracy.md", "at alpha = mu = 1/32 it returns 0.877 where the albedo\nis 0.915",
+          lambda: (1, 32, _script("bench_peers", "bench").dblquad_albedo("beckmann", 1 / 32, 1 / 32)[0],
+                   _albedo(_script("bench_peers", "bench").spec("beckmann", 1 / 32), 1 / 32)[0]), slow=True),
+    Quote("docs/engine/accuracy.md", "its rational fit jumps by 5.7e-5 at a = 1.6", lambda: _walter_jump()),
+    Quote("docs/user-guide/luts.md", "| pumpup (rtol 1e-9) against the independent quadrature, at the 12 worst cells "
+          "| <= 1e-13 |", lambda: (1e-9, len(_cycles_check()["cells"]), _power_of_ten_above(_cycles_check()["gap"])),
+          slow=True),
+    Quote("docs/user-guide/luts.md", "at rtol 1e-9 the truth's own error estimate is at most 9.3e-10 at every\nnode",
+          lambda: (1e-9, _cycles_check()["node_error"]), slow=True),
     Quote("docs/user-guide/luts.md", "| 0.102 (rms 0.005) | mu = 1.1e-4, rough = 0.01:",
           lambda: (_cycles_audit().lookup["max_abs"], _cycles_audit().lookup["rms"], *_cycles_audit().lookup["where"]),
           slow=True),
@@ -686,6 +698,53 @@ def _cycles_audit():
     import pumpup
 
     return pumpup.audit(os.path.join(ROOT, "tests", "data", "cycles_shader.tables"), preset="cycles")
+
+
+@functools.cache
+def _cycles_check() -> dict:
+    """``python scripts/studies/audit_cycles.py``: pumpup's truth (rtol 1e-9) at the audit's worst cells against the
+    independent quadrature, and the truth's largest error estimate at the nodes.
+    """
+    import pumpup
+
+    script = _script("audit_cycles", "studies")
+    r = pumpup.audit(script.DEFAULT_TABLE, preset="cycles", rtol=1e-9)
+    return {**script.independent_check(r), "node_error": script.node_error(r, 1e-9)}
+
+
+def _independent_reference() -> tuple[float, float, float]:
+    """How many values of ``tests/data/independent_reference.json`` pumpup can be compared with (the output of
+    ``tests/reference/independent_reference.py``, which never imports pumpup), the smallest mu among them, and the
+    largest relative difference of pumpup's albedo and mean albedo from them.
+    """
+    import pumpup
+
+    with open(os.path.join(ROOT, "tests", "data", "independent_reference.json")) as fh:
+        entries = [e for e in json.load(fh)["entries"] if e["quantity"] == "mean_albedo" or e["mu"] > 0]
+    worst = 0.0
+    for e in entries:
+        brdf = pumpup.load({"type": e["model"], **e["params"]})
+        if e["quantity"] == "mean_albedo":
+            value = pumpup.mean_albedo(brdf)
+        else:
+            value = float(pumpup.albedo(brdf, e["mu"]))
+        worst = max(worst, abs(value - e["value"]) / abs(e["value"]))
+    return len(entries), min(e["mu"] for e in entries if e["mu"]), worst
+
+
+def _walter_jump() -> tuple[float, float]:
+    """The jump of Walter's rational G1 for Beckmann (Walter et al. 2007 eq. 27) at its cut a = 1.6, where it
+    switches to 1.
+    """
+    from pumpup.physics.microfacet import W_A1, W_A2, W_B1, W_B2, W_CUT
+
+    a = W_CUT
+    return (W_A1 * a + W_A2 * a * a) / (1 + W_B1 * a + W_B2 * a * a) - 1, a
+
+
+def _power_of_ten_above(x: float) -> float:
+    """The smallest power of ten >= x: a bound quoted as "<= 1e-N"."""
+    return 10.0 ** math.ceil(math.log10(x))
 
 
 def _plastic_max_s() -> float:
