@@ -160,7 +160,8 @@ def test_renderer_tables_sections_are_what_the_script_writes(name):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("script, stored", [("he_torrance_fig5", "he_torrance_fig5.json"),
-                                            ("metal_colours", "metal_colours.json")])
+                                            ("metal_colours", "metal_colours.json"),
+                                            ("pumped_colours", "pumped_colours.json")])
 def test_the_stored_study_is_what_the_code_computes(script, stored):
     """The stored results the He-Torrance and spectral pages' tables are generated from are what their scripts
     compute now (a minute or two each): the same tables, to the digits they print."""
