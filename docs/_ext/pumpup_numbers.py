@@ -277,6 +277,18 @@ def he_torrance(lam: float) -> dict:
     return _script("he_torrance_fig5").entry(_json("he_torrance_fig5.json"), lam)
 
 
+def pumping_tolerances() -> str:
+    """The level-3 albedo at mu = 0.5 of a 3-level g2 pumped Phong n = 20 built with each tolerance setting of
+    ``python scripts/bench/bench_eval.py --tolerances``.
+    """
+    bench = _script("bench_eval", "bench")
+    lines = ["| TABLE_RTOL, TABLE_INTERP_TOL | level-3 albedo at mu = 0.5 |", "|---|---|"]
+    for i, r in enumerate(bench.tolerance_rows(repeat=1)):
+        lines.append(f"| {r['rtol']:.0e}, {r['interp_tol']:.0e}{' (default)' if i == 0 else ''} | "
+                     f"{r['albedo']:.8f} |".replace("e-0", "e-"))
+    return "\n".join(lines)
+
+
 #: short citations of the dielectrics' datasets (``optical.reference(name)`` gives the full ones)
 _DIELECTRIC_CITATIONS = {"PMMA": "Zhang et al., Appl. Opt. 59, 2337 (2020)", "polycarbonate": "Zhang et al. 2020",
                          "polystyrene": "Zhang et al. 2020", "BK7": "SCHOTT Zemax catalog 2017-01-20b",
@@ -347,6 +359,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "he-torrance-fig5": lambda: _script("he_torrance_fig5").markdown(_json("he_torrance_fig5.json")),
     "pumped-colours": lambda: _script("pumped_colours").markdown(_json("pumped_colours.json")),
     "dielectrics": lambda: dielectrics_table(),
+    "pumping-tolerances": lambda: pumping_tolerances(),
     "metal-colours": lambda: _script("metal_colours").markdown(_json("metal_colours.json")),
 }
 
@@ -586,6 +599,11 @@ QUOTES: list[Quote] = [
           lambda: (_furnace_centre({"type": "phong", "n": 20}), _furnace_centre(_blinn()),
                    _furnace_min({"type": "phong", "n": 20}), _furnace_min(_blinn()), _rim_mu(160), 160, 160),
           slow=True),
+    Quote("docs/user-guide/images.md", "(1.0476 = (n+2)/(n+1) in the middle, magenta)",
+          lambda: (_furnace_centre({"type": "phong_shader", "n": 20}), 2, 1), slow=True),
+    Quote("docs/user-guide/images.md", "(0.999998 to 1.0000000 over the sphere at 160 x 160; the 2e-6 left by `scale`\n"
+          "of Phong", lambda: (*_compensated_furnace_range(), 160, 160,
+                               1 - _furnace_min(_compensated({"type": "phong", "n": 20}, "scale"))), slow=True),
     Quote("docs/user-guide/images.md", "(Phong 0.42, 0.66, 0.79 after one to three levels, Blinn\n0.18 and 0.48 after "
           "one and three g1 levels)",
           lambda: (*(_furnace_min(_pumped({"type": "phong", "n": 20}, "g1", k)) for k in (1, 2, 3)),
@@ -841,6 +859,23 @@ def _furnace(spec_json: str):
 def _furnace_min(spec) -> float:
     im = _furnace(json.dumps(spec, sort_keys=True))
     return float(im.radiance[im.mask].min())
+
+
+def _compensated(base: dict, method: str) -> dict:
+    import pumpup
+
+    return pumpup.compensate(pumpup.load(base), method=method).spec
+
+
+def _compensated_furnace_range() -> tuple[float, float]:
+    """The smallest and largest pixel of the compensated row of ``figures/render_furnace.png`` (``pumpup.plots``)."""
+    lo, hi = [], []
+    for base in ({"type": "phong", "n": 20}, {"type": "ggx", "alpha": 0.3}):
+        for method in ("kulla_conty", "scale"):
+            im = _furnace(json.dumps(_compensated(base, method), sort_keys=True))
+            lo.append(float(im.radiance[im.mask].min()))
+            hi.append(float(im.radiance[im.mask].max()))
+    return min(lo), max(hi)
 
 
 def _furnace_centre(spec) -> float:
