@@ -599,6 +599,9 @@ QUOTES: list[Quote] = [
           lambda: (_furnace_centre({"type": "phong", "n": 20}), _furnace_centre(_blinn()),
                    _furnace_min({"type": "phong", "n": 20}), _furnace_min(_blinn()), _rim_mu(160), 160, 160),
           slow=True),
+    Quote("docs/user-guide/compensation.md", "`TABLE_RTOL` = 1e-8 and `TABLE_INTERP_TOL` = 1e-7 in "
+          "`pumpup/operators/compensate.py`: the same 54 nodes and 1.6e-7\nmargin as the pumping tables' 1e-9 on GGX "
+          "alpha = 0.3", lambda: _compensation_grid()),
     Quote("docs/user-guide/images.md", "(1.0476 = (n+2)/(n+1) in the middle, magenta)",
           lambda: (_furnace_centre({"type": "phong_shader", "n": 20}), 2, 1), slow=True),
     Quote("docs/user-guide/images.md", "(0.999998 to 1.0000000 over the sphere at 160 x 160; the 2e-6 left by `scale`\n"
@@ -859,6 +862,22 @@ def _furnace(spec_json: str):
 def _furnace_min(spec) -> float:
     im = _furnace(json.dumps(spec, sort_keys=True))
     return float(im.radiance[im.mask].min())
+
+
+def _compensation_grid() -> tuple:
+    """The E table of GGX alpha = 0.3 at the compensation tables' tolerances: its node count and margin (twice its
+    interpolation error), checked to equal those at the pumping tables' quadrature tolerance.
+    """
+    import pumpup
+    from pumpup.operators import compensate, pumping
+
+    ggx = pumpup.load({"type": "ggx", "alpha": 0.3})
+    grids = [pumpup.tabulate(ggx, rtol=rtol, interp_tol=compensate.TABLE_INTERP_TOL, progress=False)
+             for rtol in (compensate.TABLE_RTOL, pumping.TABLE_RTOL)]
+    (nodes, margin), other = [(g.sizes["mu"], 2 * g.attrs["interpolation_error"]) for g in grids]
+    if (nodes, margin) != other:
+        raise ValueError(f"the compensation table ({nodes}, {margin}) differs from the pumping one {other}")
+    return (compensate.TABLE_RTOL, compensate.TABLE_INTERP_TOL, nodes, margin, pumping.TABLE_RTOL, 0.3)
 
 
 def _compensated(base: dict, method: str) -> dict:
