@@ -570,6 +570,41 @@ QUOTES: list[Quote] = [
       for m, pub, val in (("0.4", "1.63", "1.6205"), ("0.2", "1.16", "1.1576"), ("0.1", "1.04", "1.0398"),
                           ("0.05", "1.011", "1.00999"), ("0.02", "1.005", "1.0016"), ("0.01", "1.002", "1.0004"),
                           ("0.005", "1.002", "1.0001"))],
+    Quote("docs/notes_on_published_tables.md", "- **n = 128: 5.334, not 5.34 (both columns).**",
+          lambda: (128, stored("table2", "128", "blinn"), published("table2", "128", "blinn"))),
+    Quote("docs/notes_on_published_tables.md", "For n = 128 this gives C = 1/a(1) = 5.3341774,\n  which rounds to 5.33.",
+          lambda: (128, 1, 1, stored("table2", "128", "blinn"), stored("table2", "128", "blinn"))),
+    Quote("docs/notes_on_published_tables.md", "- **Stretched Blinn n = 2: 0.3638, not 0.368.**",
+          lambda: (2, stored("table2", "2", "stretched_blinn"), published("table2", "2", "stretched_blinn"))),
+    Quote("docs/notes_on_published_tables.md", "at theta = 41.41 deg (mu = 0.75), where a = 2.7488936 = 7 pi / 8 to 1e-15",
+          lambda: (_entry("table2", "2", "stretched_blinn", "theta_deg"),
+                   math.cos(math.radians(_entry("table2", "2", "stretched_blinn", "theta_deg"))),
+                   1 / stored("table2", "2", "stretched_blinn"), 7, 8,
+                   _at_most(abs(1 / stored("table2", "2", "stretched_blinn") - 7 * math.pi / 8), 1e-15))),
+    Quote("docs/notes_on_published_tables.md", "so C = 8 / (7 pi) = 0.36378. 0.368",
+          lambda: (8, 7, stored("table2", "2", "stretched_blinn"), published("table2", "2", "stretched_blinn"))),
+    Quote("docs/notes_on_published_tables.md", "-> **2/3**, not the printed 0.5.\n    The printed column itself reaches "
+          "0.667 from n = 64 on; we compute 0.66667 at n = 1e4.",
+          lambda: (2, 3, published("table3", "inf", "phong"), published("table3", "64", "phong"), 64,
+                   _entry("table3", "inf", "phong", "check_large_n"), 1e4)),
+    Quote("docs/notes_on_published_tables.md", "(printed 1: agrees). The approach is slow, like\n    n^(-1/2) (the "
+          "grazing region where a < 1 has a width of order n^(-1/2)): 0.9938 at n = 1e4.",
+          lambda: (published("table3", "inf", "stretched_phong"), -1, 2, 1, -1, 2,
+                   _entry("table3", "inf", "stretched_phong", "check_large_n"), 1e4)),
+    Quote("docs/notes_on_published_tables.md", "(printed 0.5: agrees; 0.5001 at n = 1e4)",
+          lambda: (published("table3", "inf", "blinn"), _entry("table3", "inf", "blinn", "check_large_n"), 1e4)),
+    Quote("docs/notes_on_published_tables.md", "not the printed 1 (0.6616 at n = 1e4; the column\n    0.640, 0.644, 0.649 "
+          "for n = 128 ... 512 creeps up towards it)",
+          lambda: (published("table3", "inf", "stretched_blinn"), _entry("table3", "inf", "stretched_blinn",
+                                                                         "check_large_n"), 1e4,
+                   *(published("table3", n, "stretched_blinn") for n in ("128", "256", "512")), 128, 512)),
+    Quote("docs/notes_on_published_tables.md", "- **Stretched Blinn n = 128, 256, 512: 0.6395, 0.6435, 0.6482** with the "
+          "exact maximum\n  constants (printed 0.640, 0.644, 0.649).",
+          lambda: (128, 256, 512, *(stored("table3", n, "stretched_blinn") for n in ("128", "256", "512")),
+                   *(published("table3", n, "stretched_blinn") for n in ("128", "256", "512")))),
+    Quote("docs/notes_on_published_tables.md", "The printed values are high by\n  0.0007 to 0.0013.",
+          lambda: _span(published("table3", n, "stretched_phong") - stored("table3", n, "stretched_phong")
+                        for n in ("128", "256", "512"))),
     Quote("docs/notes_on_published_tables.md", "n = 256 and 512 (10.426, 20.611) agree with the printed 10.4, 20.6",
           lambda: (256, 512, stored("table2", "256", "blinn"), stored("table2", "512", "blinn"),
                    published("table2", "256", "blinn"), published("table2", "512", "blinn"))),
@@ -836,6 +871,11 @@ def _walter_jump() -> tuple[float, float]:
 
     a = W_CUT
     return (W_A1 * a + W_A2 * a * a) / (1 + W_B1 * a + W_B2 * a * a) - 1, a
+
+
+def _at_most(x: float, bound: float) -> float:
+    """``bound`` when x <= bound, else x: a quoted bound "to 1e-15" checks as a number that must equal ``bound``."""
+    return bound if x <= bound else x
 
 
 def _power_of_ten_above(x: float) -> float:

@@ -21,7 +21,7 @@ sys.path.insert(0, os.path.join(DOCS, "_ext"))
 import pumpup_numbers as N  # noqa: E402
 
 #: a number as the pages print it: 0.0642, 1e-8, 3.2e-7, 670,000 is not one (no thousands separators are checked)
-NUMBER = re.compile(r"(?<![\w.])-?\d+(?:\.\d+)?(?:e[+-]?\d+)?(?![\w.])")
+NUMBER = re.compile(r"(?<![\w.])-?\d+(?:\.\d+)?(?:e[+-]?\d+)?(?!\w|\.\d)")
 
 
 def _pages() -> list[str]:
