@@ -605,6 +605,25 @@ QUOTES: list[Quote] = [
     Quote("docs/notes_on_published_tables.md", "The printed values are high by\n  0.0007 to 0.0013.",
           lambda: _span(published("table3", n, "stretched_phong") - stored("table3", n, "stretched_phong")
                         for n in ("128", "256", "512"))),
+    Quote("docs/notes_on_published_tables.md", "The printed 2.14 and 0.72 look truncated (0.21 is rounded correctly);\n"
+          "  the printed 0.042 for r = 0.001", lambda: (*(published("text", r, "schlick C_max")
+                                                          for r in ("r = 0.5", "r = 0.1", "r = 0.01", "r = 0.001")),
+                                                        0.001)),
+    Quote("docs/notes_on_published_tables.md", "no angle gives a constant below 0.06416",
+          lambda: stored("text", "r = 0.001", "schlick C_max")),
+    Quote("docs/notes_on_published_tables.md", "at 89.9995 deg we find **3.7098**, not 3.8. a sqrt(mu) = 0.01096-0.01097 "
+          "at\n  all three angles", lambda: (89.9995, stored("text", "89.9995", "ward m=0.1 a(theta)"),
+                                            published("text", "89.9995", "ward m=0.1 a(theta)"), *_ward_sqrt_mu())),
+    Quote("docs/notes_on_published_tables.md", "With the maximum constant (5.334), Blinn gives\n  7.81e-3 (printed "
+          "7.8e-3) and stretched Blinn **3.63e-2** (printed 3.7e-2; with 5.34 it is\n  still 3.63e-2). The mean "
+          "albedos 0.508 and 0.640 agree",
+          lambda: (_entry("text", "n = 128", "blinn a(90 deg)", "c"), stored("text", "n = 128", "blinn a(90 deg)"),
+                   published("text", "n = 128", "blinn a(90 deg)"), stored("text", "n = 128", "stretched_blinn a(90 deg)"),
+                   published("text", "n = 128", "stretched_blinn a(90 deg)"), 5.34,
+                   stored("text", "n = 128", "stretched_blinn a(90 deg)") * 5.34
+                   / _entry("text", "n = 128", "stretched_blinn a(90 deg)", "c"),
+                   published("text", "n = 128", "blinn mean albedo"),
+                   published("text", "n = 128", "stretched_blinn mean albedo"))),
     Quote("docs/notes_on_published_tables.md", "n = 256 and 512 (10.426, 20.611) agree with the printed 10.4, 20.6",
           lambda: (256, 512, stored("table2", "256", "blinn"), stored("table2", "512", "blinn"),
                    published("table2", "256", "blinn"), published("table2", "512", "blinn"))),
@@ -871,6 +890,14 @@ def _walter_jump() -> tuple[float, float]:
 
     a = W_CUT
     return (W_A1 * a + W_A2 * a * a) / (1 + W_B1 * a + W_B2 * a * a) - 1, a
+
+
+def _ward_sqrt_mu() -> tuple[float, float]:
+    """The smallest and largest a(mu) sqrt(mu) of Ward m = 0.1 at 89.995, 89.999 and 89.9995 deg
+    (``tables/text.nc``).
+    """
+    return _span(stored("text", t, "ward m=0.1 a(theta)") * math.sqrt(_entry("text", t, "ward m=0.1 a(theta)", "mu"))
+                 for t in ("89.995", "89.999", "89.9995"))
 
 
 def _at_most(x: float, bound: float) -> float:
