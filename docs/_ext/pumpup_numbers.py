@@ -624,6 +624,8 @@ QUOTES: list[Quote] = [
                    / _entry("text", "n = 128", "stretched_blinn a(90 deg)", "c"),
                    published("text", "n = 128", "blinn mean albedo"),
                    published("text", "n = 128", "stretched_blinn mean albedo"))),
+    Quote("docs/studies/papers.md", "(measured: 1.0e-8, 1.0e-12, 1.0e-16 sr at N.L = 1e-4, 1e-6,\n  1e-8 for m = 0.1)",
+          lambda: (*(_ct_region(mu) for mu in (1e-4, 1e-6, 1e-8)), 1e-4, 1e-6, 1e-8, 0.1)),
     Quote("docs/notes_on_published_tables.md", "n = 256 and 512 (10.426, 20.611) agree with the printed 10.4, 20.6",
           lambda: (256, 512, stored("table2", "256", "blinn"), stored("table2", "512", "blinn"),
                    published("table2", "256", "blinn"), published("table2", "512", "blinn"))),
@@ -890,6 +892,15 @@ def _walter_jump() -> tuple[float, float]:
 
     a = W_CUT
     return (W_A1 * a + W_A2 * a * a) / (1 + W_B1 * a + W_B2 * a * a) - 1, a
+
+
+def _ct_region(mu: float) -> float:
+    """The solid angle where Cook-Torrance's G = 1 inside the cap of 001 eq. 15's best bound, m = 0.1, at N.L = mu
+    (``pumpup.divergence.cook_torrance_bound``).
+    """
+    import importlib
+
+    return float(importlib.import_module("pumpup.divergence").cook_torrance_bound(0.1, mu)[2])
 
 
 def _ward_sqrt_mu() -> tuple[float, float]:
