@@ -1176,6 +1176,14 @@ VALUES.update({
     "mitsuba-asymmetry-ratio": Value(_m_asymmetry_ratio, ""),
     "mitsuba-asymmetry-grazing": Value(_m_grazing, ""),
     "mitsuba-inner-cos": Value(lambda: _mitsuba()["inner_cos"], "g"),
+    "mitsuba-chi2-verdicts": Value(lambda: ", ".join(f"{'passes' if ok else 'fails'} with ires = {ires}" for ires, ok
+                                                     in sorted(_mitsuba()["chi2_horizon"]["passes"].items(),
+                                                               key=lambda item: int(item[0]))), ""),
+    "mitsuba-chi2-at-least": Value(lambda: _mitsuba()["chi2_horizon"]["at_least"], "g"),
+    "mitsuba-chi2-cell": Value(lambda: f"{_mitsuba()['chi2_horizon']['default_count']:.0f} samples where a "
+                                       f"{_mitsuba()['chi2_horizon']['fine_points']} x "
+                                       f"{_mitsuba()['chi2_horizon']['fine_points']}-point integral of the pdf gives "
+                                       f"{_mitsuba()['chi2_horizon']['fine_count']:.0f}", ""),
 })
 
 TABLES.update({
