@@ -1235,6 +1235,36 @@ def _complete_targets(mu_min: float) -> int:
 
 _F = "docs/user-guide/fitting.md"
 
+
+def _scene_f0(colour: str) -> list[float]:
+    """F0 per RGB channel of a scene metal: the conductor Fresnel factor at normal incidence of its measured index
+    at ``spectral.RGB_WAVELENGTHS`` (``pumpup.scenes.metal_index``).
+    """
+    from pumpup import scenes
+    from pumpup.physics.fresnel import fresnel_conductor
+
+    eta, k = scenes.metal_index(colour)
+    return [float(fresnel_conductor(1.0, e, kk)) for e, kk in zip(eta, k)]
+
+
+def _scene_f0_vs_spectrum() -> tuple:
+    """Gold's red of the 8-wavelength spectrum (``tables/metal_colours.json``), gold's F0 per channel against the
+    spectrum's sRGB, and the largest gap of the other scene metals.
+    """
+    from pumpup import scenes
+
+    colours = _json("metal_colours.json")["metals"]
+    spectrum = colours["Au"]["f0_8"]
+    gap = max(abs(a - b) for c, m in scenes.METALS.items() if c != "gold"
+              for a, b in zip(_scene_f0(c), colours[m]["f0_8"]))
+    return (spectrum[0], *_scene_f0("gold"), *spectrum, gap)
+
+
+def _sky_luminance() -> float:
+    from pumpup.scenes import SKY
+
+    return 0.2126 * SKY[0] + 0.7152 * SKY[1] + 0.0722 * SKY[2]  # linear sRGB luminance (Rec. 709 weights)
+
 QUOTES += [
     # docs/user-guide/fitting.md: every number of the prose after the figure, from the study's records
     Quote(_F, "the ratio fit / target over the lobe region lies in [0.66, 0.96] at\ntheta_V = 0, [0.43, 1.51] at 44 "
@@ -1299,4 +1329,10 @@ QUOTES += [
     Quote(_F, "The energy-constrained fits (`--plausible`) ran on 4",
           lambda: len({r["target_name"] for r in _fits(plausible=True)})),
     Quote(_F, "variant on 2 targets and a half", lambda: _complete_targets(0.26)),
+    # docs/user-guide/mitsuba.md: the scenes' metals and sky (pumpup.scenes, tables/metal_colours.json)
+    Quote("docs/user-guide/mitsuba.md", "gold's red there is 1.032, which no Fresnel factor reaches:\ngold's F0 per "
+          "channel is (0.942, 0.704, 0.404) against (1.032, 0.732, 0.362) from the spectrum\n(silver, copper, "
+          "aluminium agree to 0.03)", _scene_f0_vs_spectrum),
+    Quote("docs/user-guide/mitsuba.md", "the sky's luminance is 0.61 and measured silver's F0 0.98-0.99 per channel",
+          lambda: (_sky_luminance(), *_span(_scene_f0("silver")))),
 ]
