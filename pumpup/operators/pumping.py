@@ -449,6 +449,22 @@ def _cap_kinks(looks, br) -> np.ndarray:
     return np.array(out)
 
 
+def _meet_kinks(looks, br) -> np.ndarray:
+    """Values of m in the range of ``br`` (sorted) where a level's bound meets m (U_j(m) = m: a kink of
+    max(U_j(m), m), 001 eq. 21), by bisection of the sign changes on ``br`` and its geometric midpoints.
+    """
+    from scipy.optimize import brentq
+
+    grid = np.unique(np.concatenate([br, np.sqrt(br[:-1] * br[1:])]))
+    out = []
+    for lk in looks:
+        v = lk.upper(grid) - grid
+        for i in np.nonzero(np.sign(v[:-1]) * np.sign(v[1:]) < 0)[0]:
+            out.append(brentq(lambda m, lk=lk: float(lk.upper(np.array([m]))[0]) - m, grid[i], grid[i + 1],
+                              xtol=1e-300, rtol=1e-15))
+    return np.array(out)
+
+
 def _level_breaks(looks, mlo: float) -> np.ndarray:
     """The first breakpoints in m of a table of the levels' bounds on [mlo, 1] (:class:`_LevelTable`,
     :class:`_PairTable`): at most an eighth of an octave apart, at every breakpoint of every level's spline and where a
@@ -616,7 +632,8 @@ class _SplitTable:
         rlo, rhi = self._ranges(lo_e, hi_e)  # (levels, n)
         codes = self._codes(rlo[:, :, None], rhi[:, :, None], rlo[:, None, :], rhi[:, None, :],
                             lo_e[None, :], hi_e[None, :])  # (levels, n, n)
-        ok = self._certified(codes) & np.triu(np.ones((n, n), dtype=bool), 1) & (hi_e > self.mlo)[:, None]
+        ok = (self._certified(codes) & self._slack(codes, rhi[:, :, None], rhi[:, None, :])
+              & np.triu(np.ones((n, n), dtype=bool), 1) & (hi_e > self.mlo)[:, None])
         keys, inverse = _unique_rows(codes[:, ok].T)
         if len(keys) > 127:
             raise _ProductError("the split table needs more than 127 patterns")
@@ -625,19 +642,21 @@ class _SplitTable:
         k_, i_ = np.tril_indices(n)  # (k >= i: the cells with l <= m, row by row of k)
         #: ``pattern``'s cells with i <= k packed as the kernel reads them: cell (i, k) at k (k + 1) / 2 + i
         self.packed = np.ascontiguousarray(self.pattern[i_, k_])
-        #: the term of every level in each pattern (0: U_j(l), 1: U_j(m), 2: m)
+        #: the term of every level in each pattern (0: U_j(l), 1: U_j(m), 2: m, 3: max(U_j(m), m))
         self.patterns = keys.astype(np.int8)
         if len(keys) == 0:  # (no cell certified: a table of nothing; the chain keeps the level table alone)
             raise _ProductError("no cell of the split table has one term per level")
-        fkeys = {(tuple(np.nonzero(k == 0)[0]), 0) for k in keys}
-        hkeys = {(tuple(np.nonzero(k == 1)[0]), int(np.count_nonzero(k == 2))) for k in keys}
-        #: the functions tabulated, each (levels, c): the product of those levels' bounds times m^c; row 0 the empty
-        #: product, exactly 1
-        self.functions = [((), 0)] + sorted((fkeys | hkeys) - {((), 0)}, key=lambda a: (len(a[0]), a))
-        self.fid = np.array([self.functions.index((tuple(np.nonzero(k == 0)[0]), 0)) for k in keys], dtype=np.int64)
-        self.hid = np.array([self.functions.index((tuple(np.nonzero(k == 1)[0]), int(np.count_nonzero(k == 2))))
-                             for k in keys], dtype=np.int64)
+        fkeys = {self._f_key(k) for k in keys}
+        hkeys = {self._h_key(k) for k in keys}
+        #: the functions tabulated, each (levels, c, wlevels): the product of the bounds of ``levels`` times m^c times
+        #: max(U_j(m), m) for j in ``wlevels``; row 0 the empty product, exactly 1
+        self.functions = [((), 0, ())] + sorted((fkeys | hkeys) - {((), 0, ())},
+                                                key=lambda a: (len(a[0]) + len(a[2]), a))
+        self.fid = np.array([self.functions.index(self._f_key(k)) for k in keys], dtype=np.int64)
+        self.hid = np.array([self.functions.index(self._h_key(k)) for k in keys], dtype=np.int64)
+        wlevels = sorted({j for fn in self.functions for j in fn[2]})
         br = _level_breaks(self.looks, self.mlo)
+        br = np.unique(np.concatenate([br, _meet_kinks([self.looks[j] for j in wlevels], br)]))
         fns = [self._function(fn) for fn in self.functions[1:]]
         coefs, lo, hi, center, half, worst = fit_pieces(fns, br[:-1], br[1:], self.TOL, "split table")
         self.epsilon = 2.0 * float(worst.max()) + 16 * np.finfo(float).eps
@@ -652,8 +671,21 @@ class _SplitTable:
         self.shift, self.cbase, self.cstart, self.entries = _piece_cells(lo, self.mlo, self.CELLS_MAX_BITS)
         self._check([self._function(fn) for fn in self.functions])
 
+    @staticmethod
+    def _f_key(k) -> tuple:
+        """The function F of pattern ``k`` (a level's term per level): the product of the U_j(l) it takes."""
+        return tuple(int(j) for j in np.nonzero(k == 0)[0]), 0, ()
+
+    @staticmethod
+    def _h_key(k) -> tuple:
+        """The function H of pattern ``k``: the U_j(m), the m and the max(U_j(m), m) it takes."""
+        return (tuple(int(j) for j in np.nonzero(k == 1)[0]), int(np.count_nonzero(k == 2)),
+                tuple(int(j) for j in np.nonzero(k == 3)[0]))
+
     def _function(self, fn):
-        """The exact function of one of :attr:`functions`, of an array of m: a product of levels' bounds times m^c."""
+        """The exact function of one of :attr:`functions`, of an array of m: a product of levels' bounds times m^c
+        times max(U_j(m), m) of the levels ``fn[2]``.
+        """
         looks = self.looks
 
         def f(m):
@@ -663,6 +695,8 @@ class _SplitTable:
                 out = out * looks[j].upper(m)
             for _ in range(fn[1]):
                 out = out * m  # 001 eq. 21: g_j = m
+            for j in fn[2]:
+                out = out * np.maximum(looks[j].upper(m), m)  # 001 eq. 21: g_j = max(U_j(m), m)
             return out
 
         return f
@@ -701,8 +735,22 @@ class _SplitTable:
             c0 = ll[j] >= top * s  # U_j(l) above U_j(m) and m throughout
             c1 = (ml[j] >= lh[j] * s) & ((ml[j] >= m1 * s) if ctl else True)
             c2 = (m0 >= np.maximum(lh[j], mh[j]) * s) if ctl else False
-            out[j] = np.where(c0, 0, np.where(c1, 1, np.where(c2, 2, -1)))
+            # max(U_j(m), m) above U_j(l) throughout (U_j(m) and m too close to tell apart over the cell: both are
+            # functions of m, so their max is one)
+            c3 = (np.maximum(ml[j], m0) >= lh[j] * s) if ctl else False
+            out[j] = np.where(c0, 0, np.where(c1, 1, np.where(c2, 2, np.where(c3, 3, -1))))
         return out
+
+    def _slack(self, codes, lh, mh) -> np.ndarray:
+        """Cells where a term max(U_j(m), m) (code 3) is used only beside a level whose certified term is its bound
+        U_j below its cap throughout the cell (code 0 with U_j(l) < cap, or 1 with U_j(m) < cap; ``lh``, ``mh`` the
+        largest U_j over the cell's intervals of l and m).  Where max(U_j(m), m) = m, that level's g is the ideal
+        operator's itself; the level with its bound below the cap keeps the room (its table's margin) that the fit's
+        scaling down by 1 - epsilon takes.
+        """
+        cap = np.array([lk.cap for lk in self.looks])[:, None, None]
+        room = ((codes == 0) & (lh < cap)) | ((codes == 1) & (mh < cap))
+        return ~np.any(codes == 3, axis=0) | np.any(room, axis=0)
 
     @staticmethod
     def _certified(codes) -> np.ndarray:
@@ -780,15 +828,15 @@ def _aligned(a: np.ndarray, line: int = 64) -> np.ndarray:
 
 
 def _unique_rows(rows: np.ndarray):
-    """np.unique(rows, axis=0, return_inverse=True) for rows of digits 0-2 (each row read as a number in base 3: the
+    """np.unique(rows, axis=0, return_inverse=True) for rows of digits 0-3 (each row read as a number in base 4: the
     sort of rows as records took 0.14 s of a 3-level split table's 0.4 s).
     """
-    if rows.shape[1] > 39:  # (beyond int64)
+    if rows.shape[1] > 31:  # (beyond int64)
         keys, inverse = np.unique(rows, axis=0, return_inverse=True)
         return keys, inverse.ravel()
-    weight = 3 ** np.arange(rows.shape[1] - 1, -1, -1, dtype=np.int64)  # (the first digit the most significant)
+    weight = 4 ** np.arange(rows.shape[1] - 1, -1, -1, dtype=np.int64)  # (the first digit the most significant)
     u, inverse = np.unique(rows.astype(np.int64) @ weight, return_inverse=True)
-    keys = (u[:, None] // weight[None, :]) % 3
+    keys = (u[:, None] // weight[None, :]) % 4
     return keys.astype(rows.dtype), inverse.ravel()
 
 
