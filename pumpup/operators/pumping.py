@@ -592,21 +592,24 @@ class _SplitTable:
     Each level's g_j = max(U_j(l), U_j(m)[, m]) (001 eq. 20, 21) takes one of its two or three terms throughout most
     cells of a grid of CELLS x CELLS cells in (l, m) (l < m: the cells above the diagonal): the term is certified when
     its smallest value over the cell exceeds the other terms' largest by the relative SAFETY, each U_j's range over a
-    cell's interval taken from its values at the ends and at the zeros of its spline's derivative inside.  A cell whose
-    levels all have a certified term holds a pattern (the term of every level); then
-    g_1 ... g_k = F_A(l) H_B(m) with F_A the product of the U_j of the levels A that take U_j(l), and H_B the product
-    of the U_j of the levels B that take U_j(m) times m^c, c the number of levels that take m (001 eq. 21).  The
-    other cells (the diagonal ones, and those a kink crosses: U_j(l) = U_j(m), U_j = m, U_j = cap) hold -1, and the
-    kernel takes the level table there.
+    cell's interval taken from its values at the ends and at the zeros of its spline's derivative inside.  Where
+    neither U_j(m) nor m is certified but both exceed U_j(l) (g2, U_j within the cell's variation of m: Phong's albedo),
+    the level's term is W_j(m) = max(U_j(m), m), one function of m (code 3; kept only in cells where another level's
+    term is its bound below its cap, :meth:`_slack`).  A cell whose levels all have a certified term holds a pattern
+    (the term of every level); then g_1 ... g_k = F_A(l) H_B(m) with F_A the product of the U_j of the levels A that
+    take U_j(l), and H_B the product of the U_j of the levels B that take U_j(m) times m^c, c the number of levels that
+    take m (001 eq. 21), times the W_j of the levels that take it.  The other cells (the diagonal ones, and those a
+    kink crosses: U_j(l) = U_j(m), U_j = m, U_j = cap) hold -1, and the kernel takes the level table there.
 
     Every product of bounds used (:attr:`functions`; row 0, the empty product, is exactly 1) is tabulated on one set of
-    pieces in m, as the level table tabulates the U_j (pieces split at every breakpoint of every level's spline and
-    where a level's bound reaches its cap; a Chebyshev interpolant of degree PRODUCT_DEGREE on each, bisected until it
-    matches its function to ``TOL``, relative, at 4 (degree + 1) + 1 test points), scaled by 1 - ``epsilon`` (twice the
-    largest miss plus 16 ulp) and checked never to exceed its function: the product the kernel divides by is at most the
-    level-by-level product of g (the pumped BRDF at least the level-by-level one) and at least that product times (1 - 2
-    ``epsilon``), as the level table's.  The cells where every level takes m hold -1: there the ideal operator's g is
-    m^k itself, with no room below it for a scaled table. ``coef[f, s]`` holds function f's coefficients on piece s
+    pieces in m, as the level table tabulates the U_j (pieces split at every breakpoint of every level's spline, where
+    a level's bound reaches its cap and, for a W_j, where U_j meets m; a Chebyshev interpolant of degree
+    PRODUCT_DEGREE on each, bisected until it matches its function to ``TOL``, relative, at 4 (degree + 1) + 1 test
+    points), scaled by 1 - ``epsilon`` (twice the largest miss plus 16 ulp) and checked never to exceed its function:
+    the product the kernel divides by is at most the level-by-level product of g (the pumped BRDF at least the
+    level-by-level one) and at least that product times (1 - 2 ``epsilon``), as the level table's.  The cells where
+    every level takes m hold -1: there the ideal operator's g is m^k itself, with no room below it for a scaled table.
+    ``coef[f, s]`` holds function f's coefficients on piece s
     (highest power first), the piece's centre and inverse half-width: one cache line per look-up.  ``pattern[i, k]``
     (int8) is the pattern of the cell i = floor(l CELLS), k = floor(m CELLS) (-1: none; the kernel reads ``packed``, its
     cells with i <= k, 32 kB), ``fid[p]`` and ``hid[p]`` the rows of ``coef`` that hold its F_A and H_B. :meth:`g` is
@@ -622,6 +625,8 @@ class _SplitTable:
     SAFETY = 1e-12
     #: the most cells per octave of the piece index (2^CELLS_MAX_BITS, :func:`_piece_cells`)
     CELLS_MAX_BITS = 12
+    #: the share of served cells with an empty F (all levels' terms functions of m) from which the kernel skips F there
+    SKIP_SHARE = 0.8
 
     def __init__(self, levels: _LevelTable):
         self.levels_table = levels
@@ -654,15 +659,24 @@ class _SplitTable:
                                                 key=lambda a: (len(a[0]) + len(a[2]), a))
         self.fid = np.array([self.functions.index(self._f_key(k)) for k in keys], dtype=np.int64)
         self.hid = np.array([self.functions.index(self._h_key(k)) for k in keys], dtype=np.int64)
+        #: whether the kernel skips F where it is the empty product (fid 0, :func:`g_split`): where fewer than
+        #: SKIP_SHARE of the served cells have an empty F, their patterns read a copy of row 0 instead (the last
+        #: row, the same exact 1), so that the kernel's branch on fid 0 is never taken and never mispredicted
+        cells = np.bincount(inverse, minlength=len(keys))
+        self.skips = bool(np.sum(cells[self.fid == 0]) >= self.SKIP_SHARE * np.sum(cells))
+        if not self.skips and np.any(self.fid == 0):
+            self.fid[self.fid == 0] = len(self.functions)
+            self.functions.append(((), 0, ()))
         wlevels = sorted({j for fn in self.functions for j in fn[2]})
         br = _level_breaks(self.looks, self.mlo)
         br = np.unique(np.concatenate([br, _meet_kinks([self.looks[j] for j in wlevels], br)]))
-        fns = [self._function(fn) for fn in self.functions[1:]]
+        fns = [self._function(fn) for fn in self.functions[1:] if fn != ((), 0, ())]
         coefs, lo, hi, center, half, worst = fit_pieces(fns, br[:-1], br[1:], self.TOL, "split table")
         self.epsilon = 2.0 * float(worst.max()) + 16 * np.finfo(float).eps
         one = np.zeros((1, PRODUCT_DEGREE + 1, len(lo)))
         one[0, -1] = 1.0  # the empty product: Horner's rule gives exactly 1
-        coef = np.concatenate([one, np.stack(coefs) * (1.0 - self.epsilon)])  # (functions, degree + 1, pieces)
+        copy = [one] if self.functions[-1] == ((), 0, ()) and len(self.functions) > 1 else []
+        coef = np.concatenate([one, np.stack(coefs) * (1.0 - self.epsilon)] + copy)  # (functions, degree + 1, pieces)
         self.coef = _aligned(np.concatenate(
             [coef.transpose(0, 2, 1), np.broadcast_to(center[None, :, None], (len(coef), len(lo), 1)),
              np.broadcast_to(1.0 / half[None, :, None], (len(coef), len(lo), 1))], axis=2))

@@ -251,6 +251,10 @@ def test_split_table_layout_and_switch(ggx3, ggx2):
     assert args.split_pattern is r.packed and np.array_equal(r.packed[k * (k + 1) // 2 + i], r.pattern[i, k])
     assert args.split_cell is r.entries and args.pair_cell is ggx3.level_table().entries
     assert r.share() > 0.85  # most uniform pairs take one product
+    # F is empty in too few cells to skip its look-up: those patterns read a copy of row 0 (the kernel's branch on
+    # row 0 is never taken)
+    assert not r.skips and np.all(r.fid > 0) and r.functions[-1] == ((), 0, ())
+    assert np.array_equal(r.coef[-1], r.coef[0]) and np.count_nonzero(r.fid == len(r.functions) - 1) > 0
     off = ggx3._level_table_args()
     assert off.split_cells == 0 and off.pair_rows is args.pair_rows
     assert pumpup.pump({"type": "ggx", "alpha": 0.3}, g="g2", levels=1).split_table() is None
@@ -264,6 +268,7 @@ def test_split_table_takes_max_of_bound_and_cosine(phong5):
     r = phong5.split_table()
     with3 = np.any(r.patterns == 3, axis=1)
     assert np.any(with3) and r.share() > 0.9
+    assert r.skips and np.any(r.fid == 0)  # F is empty (exactly 1) in most cells: the kernel skips its look-up
     assert np.all(np.any((r.patterns[with3] == 0) | (r.patterns[with3] == 1), axis=1))
     assert all(fn[2] == tuple(np.nonzero(r.patterns[p] == 3)[0]) for p, fn in
                ((p, r.functions[h]) for p, h in enumerate(r.hid)))
