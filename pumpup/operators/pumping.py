@@ -623,8 +623,10 @@ class _SplitTable:
     CELLS = 256
     #: how far (relative) a level's certified term stays above its others throughout a cell
     SAFETY = 1e-12
-    #: the most cells per octave of the piece index (2^CELLS_MAX_BITS, :func:`_piece_cells`)
-    CELLS_MAX_BITS = 12
+    #: the most cells per octave of the piece index (2^CELLS_MAX_BITS, :func:`_piece_cells`): 1024 int64, 8 kB per
+    #: octave (4096 cells, 32 kB, left less of the cache to the rest: 3- and 5-level GGX and 5-level Phong took 4 to
+    #: 13 % longer per pair, measured in one run with scripts/bench/bench_eval.py's pairs)
+    CELLS_MAX_BITS = 10
     #: the share of served cells with an empty F (all levels' terms functions of m) from which the kernel skips F there
     SKIP_SHARE = 0.8
 
