@@ -227,15 +227,17 @@ from .half_arc import numeric_params
 from .hint_view import kernel_view
 from .lobe_frame import _NO_JACOBI, N_INIT, ROUNDING, jacobi_rules
 from .normal_frame import _integrate_n, n_params
-from .outer_rule import _RADIAL, _RULES, RULE, _integrate
+from .outer_rule import _RADIAL, _RULES, DECAY_MODE, RULE, _integrate
 
 __all__ = ["albedo_1d", "axis_albedo", "run"]
 
 
 def run(route: str, hint: AzimuthHint, mu: np.ndarray, rtol: float, atol: float, max_regions: int,
-        lobe_fresnel_gauss: bool = True):
+        lobe_fresnel_gauss: bool = True, decay_estimate: bool = True):
     """(value, error, converged, evaluations) of the albedo of ``hint`` at every mu (a 1-D float array) by the 1-D
-    ``route`` the routing table chose for it (:mod:`pumpup.engine.routes`).
+    ``route`` the routing table chose for it (:mod:`pumpup.engine.routes`).  ``decay_estimate``: the ``lobe`` route's
+    closed forms (p in {0, 1}) take the sharper of QUADPACK's estimate and the one from the decay of the rule's
+    coefficients (:data:`pumpup.engine.outer_rule.DECAY_ROWS`); else QUADPACK's alone.
     """
     hint = kernel_view(hint)
     mu = np.ascontiguousarray(mu, dtype=np.float64)
@@ -285,6 +287,8 @@ def run(route: str, hint: AzimuthHint, mu: np.ndarray, rtol: float, atol: float,
         # 0.11 of it (7 m x 63 mu x rtol 1e-6 .. 1e-12 against the nested engine at 1e-13): Ward keeps the raw one
         frame = _FRAMES[route]
         mode = 0 if hint.sqrt_cos else mode_code()
+        if decay_estimate and frame == 0 and mode == 1 and hint.p in (0.0, 1.0):
+            mode = DECAY_MODE
         mp = numeric_params(hint, lobe_fresnel_gauss)
         mp[12] = rtol
         _integrate(frame, _RADIAL[hint.radial], float(hint.n), float(hint.p), mu, float(rtol), atol_q, budget,
@@ -296,7 +300,8 @@ def run(route: str, hint: AzimuthHint, mu: np.ndarray, rtol: float, atol: float,
 _FRAMES = {"lobe": 0, "half": 1, "ward": 2, "vcavity": 3, "half_arc": 4, "lobe_fresnel": 5}
 
 
-def axis_albedo(n: float, nu: np.ndarray, scale: np.ndarray, rtol: float, atol: float, max_regions: int):
+def axis_albedo(n: float, nu: np.ndarray, scale: np.ndarray, rtol: float, atol: float, max_regions: int,
+                decay_estimate: bool = True):
     """(value, error, converged, evaluations) of a power lobe scale (A.wo)_+^n about an axis A at elevation nu = N.A
     (:meth:`pumpup.core.BRDF.lobe_axis`: Lafortune's lobe, 000 eq. 14, at any azimuth of wi).  Without max(N.L, N.V)
     the integrand depends on wi only through A, so the albedo is the ``lobe`` route's p = 0 lobe about R with mu = nu
@@ -304,7 +309,7 @@ def axis_albedo(n: float, nu: np.ndarray, scale: np.ndarray, rtol: float, atol: 
     few roundings, (4 n + 16) eps relative.
     """
     hint = AzimuthHint(PowerLobe(n=float(n), p=0.0), scale=lambda m: scale)
-    val, err, conv, evals = run("lobe", hint, nu, rtol, atol, max_regions)
+    val, err, conv, evals = run("lobe", hint, nu, rtol, atol, max_regions, decay_estimate=decay_estimate)
     return val, err + (4.0 * n + 16.0) * EPS * np.abs(val), conv, evals
 
 
