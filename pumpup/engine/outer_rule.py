@@ -167,14 +167,29 @@ def _decay_ratio(f, rows):  # pragma: no cover - compiled; see decay_error_refer
     return last, r
 
 
-@njit(cache=True, nogil=True)
-def _rho_ratio(x, sm, t0, t1):  # pragma: no cover - compiled; see decay_error_reference
-    """rho^-2 for the singular point x (complex, in the piece's variable before the smoothing ``sm``, the piece [0, 1])
-    seen from the interval [t0, t1] of tau: rho is the Bernstein ellipse's parameter through the nearest preimage of x
-    under the smoothing (:func:`_smoothing`; 1.0 for sm = 3, whose preimages are not computed: no sharper estimate).
+@njit(cache=True, nogil=True, inline="always")
+def _rho_ratio(xr, xi, sm, t0, t1, reach):  # pragma: no cover - compiled; see decay_error_reference
+    """rho^-2 for the singular point x = xr + i xi (in the piece's variable before the smoothing ``sm``, the piece
+    [0, 1]) seen from the interval [t0, t1] of tau: rho is the Bernstein ellipse's parameter through the nearest
+    preimage of x under the smoothing (:func:`_smoothing`; 1.0 for sm = 3, whose preimages are not computed: no sharper
+    estimate).  0.0 where every preimage lies farther than ``reach`` half-lengths from the interval's centre (outside
+    the ellipse whose rho^-2 the caller already has), found without a square root.
     """
     if sm == 3:
         return 1.0
+    c = 0.5 * (t0 + t1)
+    hl = 0.5 * (t1 - t0)
+    lim = reach * hl
+    # |preimage - c| >= (the preimages' common distance from the smoothed end) - (c's distance from it)
+    if sm == 0:
+        far = (xr - c) * (xr - c) + xi * xi > lim * lim
+    elif sm == 1:
+        far = xr * xr + xi * xi > (lim + c) ** 4
+    else:
+        far = (1.0 - xr) * (1.0 - xr) + xi * xi > (lim + 1.0 - c) ** 4
+    if far:
+        return 0.0
+    x = complex(xr, xi)
     out = 0.0
     for branch in range(1 if sm == 0 else 2):
         if sm == 0:
@@ -183,45 +198,58 @@ def _rho_ratio(x, sm, t0, t1):  # pragma: no cover - compiled; see decay_error_r
             tau = cmath.sqrt(x) * (1.0 if branch == 0 else -1.0)
         else:
             tau = 1.0 - cmath.sqrt(1.0 - x) * (1.0 if branch == 0 else -1.0)
-        y = (2.0 * tau - t0 - t1) / (t1 - t0)
+        y = (tau - c) / hl
         rho = abs(y + cmath.sqrt(y - 1.0) * cmath.sqrt(y + 1.0))
         out = max(out, 1.0 / (rho * rho) if rho > 1.0 else 1.0)
     return out
 
 
 @njit(cache=True, nogil=True)
-def _singular_ratio(kind, sm, n, p, mu, c2, v0, w, t0, t1):  # pragma: no cover - compiled; see decay_error_reference
-    """The largest rho^-2 (:func:`_rho_ratio`) over the points where frame 0's closed form K(u) (:func:`_k_closed`) or
-    the weight is singular, u = +-s (the horizon), +-1, c2 = cos(2 theta_i) (p = 1: the level N.wo = mu) and 0 (u^n,
-    n not an integer), in the piece's variable: u (kind 0) or z = -(n + 1) ln u (kind 1; for u < 0 at -(n + 1)
-    (ln|u| +- i pi), for u > 0 at the real z and its images +- 2 pi i (n + 1)).  Points on the piece's closed range
-    [0, 1] are its own ends: the singular side of a break there is the other piece's (or smoothed away).
+def _singular_points(n, p, mu, c2, sing):  # pragma: no cover - compiled; see decay_error_reference
+    """Fill ``sing`` (4 x 6) with the points where frame 0's closed form K(u) (:func:`_k_closed`) or the weight is
+    singular: u = +-s (the horizon), +-1, c2 = cos(2 theta_i) (p = 1: the level N.wo = mu) and 0 (u^n, n not an
+    integer), row 0 (NaN where unused); rows 1-3 the same in z = -(n + 1) ln u: the real part, the imaginary step
+    (pi (n + 1) for u < 0, the points -(n + 1) (ln|u| +- i pi); 2 pi (n + 1) for u > 0, the images of the real z) and
+    1.0 where the real z itself is one (u > 0).
     """
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
-    worst = 0.0
     for j in range(6):
-        if j == 4 and p != 1.0:
+        u = s if j == 0 else (-s if j == 1 else (1.0 if j == 2 else (-1.0 if j == 3 else (c2 if j == 4 else 0.0))))
+        if (j == 4 and p != 1.0) or (j == 5 and n == math.floor(n)):
+            u = math.nan
+        sing[0, j] = u
+        if u == 0.0 or u != u:
+            sing[1, j], sing[2, j], sing[3, j] = math.nan, 0.0, 0.0
             continue
-        if j == 5 and (kind != 0 or n == math.floor(n)):
-            continue
-        u = (s, -s, 1.0, -1.0, c2, 0.0)[j]
+        sing[1, j] = -(n + 1.0) * math.log(abs(u))
+        sing[2, j] = (n + 1.0) * math.pi * (2.0 if u > 0.0 else 1.0)
+        sing[3, j] = 1.0 if u > 0.0 else 0.0
+
+
+@njit(cache=True, nogil=True)
+def _singular_ratio(kind, sm, v0, w, t0, t1, r0, sing):  # pragma: no cover - compiled; see decay_error_reference
+    """The largest rho^-2 (:func:`_rho_ratio`) above ``r0`` (else ``r0``) over the singular points ``sing``
+    (:func:`_singular_points`) in the piece's variable: u (kind 0) or z (kind 1).  Points on the piece's closed range
+    [0, 1] are its own ends: the singular side of a break there is the other piece's (or smoothed away).
+    """
+    worst = r0
+    for j in range(sing.shape[1]):
+        big = 1.0 / math.sqrt(worst) if worst > 0.0 else math.inf  # the ellipse of rho^-2 = worst
+        reach = 0.5 * (big + 1.0 / big)
         if kind == 0:
-            x = (u - v0) / w
-            if 0.0 <= x <= 1.0:
-                continue
-            worst = max(worst, _rho_ratio(complex(x, 0.0), sm, t0, t1))
+            if sing[0, j] == sing[0, j]:
+                x = (sing[0, j] - v0) / w
+                if not 0.0 <= x <= 1.0:
+                    worst = max(worst, _rho_ratio(x, 0.0, sm, t0, t1, reach))
             continue
-        if u == 0.0:
+        if sing[1, j] != sing[1, j]:
             continue
-        lu = math.log(abs(u))
-        for k in range(3):
-            if u < 0.0 and k == 0:
-                continue
-            im = (0.0, math.pi, -math.pi)[k] * (1.0 if u < 0.0 else 2.0)
-            x = complex(-(n + 1.0) * lu - v0, -(n + 1.0) * im) / w
-            if x.imag == 0.0 and 0.0 <= x.real <= 1.0:
-                continue
-            worst = max(worst, _rho_ratio(x, sm, t0, t1))
+        xr = (sing[1, j] - v0) / w
+        step = sing[2, j] / w
+        if sing[3, j] > 0.0 and not 0.0 <= xr <= 1.0:
+            worst = max(worst, _rho_ratio(xr, 0.0, sm, t0, t1, reach))
+        worst = max(worst, _rho_ratio(xr, step, sm, t0, t1, reach))
+        worst = max(worst, _rho_ratio(xr, -step, sm, t0, t1, reach))
     return worst
 
 
@@ -241,7 +269,7 @@ def decay_error_reference(f: np.ndarray, rho_ratio: float = 0.0) -> float:
 
 @njit(cache=True, nogil=True)
 def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes,  # pragma: no cover
-        iwk, iwg, ibuf, iwork, jac, mp, iacc):
+        iwk, iwg, ibuf, iwork, jac, mp, iacc, sing):
     """(K, error) of the rule on [t0, t1]; the error is :func:`pumpup.physics.quadrature.calibrated` of
     |K - G| (``mode`` 1) or |K - G| itself (0), plus for p in (0, 1) and frame 4 the inner errors of the
     integrand's values (the inner rule ``inodes``, ``iwk``, ``iwg`` at relative tolerance
@@ -327,7 +355,7 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
             top, r = _decay_ratio(buf, DECAY_ROWS)
             if r <= DECAY_RCRIT and DECAY_SAFETY * top * r**DECAY_STEPS * h < err:
                 # no faster than the nearest singular point lets the coefficients decay
-                r = max(r, _singular_ratio(kind, sm, n, p, mu, c2, v0, w, t0, t1))
+                r = _singular_ratio(kind, sm, v0, w, t0, t1, r, sing)
                 if r <= DECAY_RCRIT:
                     err = min(err, max(low, DECAY_SAFETY * top * r**DECAY_STEPS * h))
         return k * h, err
@@ -812,6 +840,7 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
     v0 = np.empty(PIECES_CAP)
     w = np.empty(PIECES_CAP)
     cv1 = np.empty(PIECES_CAP)
+    sing = np.empty((4, 6))
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -820,6 +849,8 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
         elif frame == 5:  # F(mu) and the arcs' cuts
             _lobe_f_prepare(mp, mu)
         npieces, c2, left_out = _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, cv1, mp)
+        if mode == DECAY_MODE:
+            _singular_points(n, p, mu, c2, sing)
         # frame 4's inner rule may leave an absolute error iacc / (the node's factor) in K, iacc = itol times a lower
         # bound of the integral so far over the pieces' total length in tau: its share of the sum is then at most
         # itol times that bound (the integrand is >= 0; the errors are added to the estimate either way)
@@ -837,7 +868,7 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
                 t0[m] = j / n_init
                 t1[m] = (j + 1.0) / n_init
                 kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk,
-                                   wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
+                                   wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc, sing)
                 acc += max(kv[m] - ke[m], 0.0)
                 m += 1
         start = m
@@ -848,9 +879,9 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
             iacc = itol * max(tot - e, 0.0) / live
             kv[worst], ke[worst] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk,
-                                       wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
+                                       wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc, sing)
             kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode,
-                               buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
+                               buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc, sing)
             m += 1
         val[q] = tot
         err[q] = e + r
