@@ -144,7 +144,7 @@ def _decay_rows(nodes: np.ndarray, wk: np.ndarray, low: int) -> np.ndarray:
 DECAY_ROWS = _decay_rows(NODES21, WK21, DECAY_LOW)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _decay_ratio(f, rows):  # pragma: no cover - compiled; see decay_error_reference
     """(E_top, r) of the rule's values ``f`` (:data:`DECAY_ROWS`): the last pair's size and the largest ratio of
     consecutive pairs (inf where a pair follows one that is 0).
@@ -269,7 +269,7 @@ def decay_error_reference(f: np.ndarray, rho_ratio: float = 0.0) -> float:
 
 @njit(cache=True, nogil=True)
 def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes,  # pragma: no cover
-        iwk, iwg, ibuf, iwork, jac, mp, iacc, sing):
+        iwk, iwg, ibuf, iwork, jac, mp, iacc):
     """(K, error) of the rule on [t0, t1]; the error is :func:`pumpup.physics.quadrature.calibrated` of
     |K - G| (``mode`` 1) or |K - G| itself (0), plus for p in (0, 1) and frame 4 the inner errors of the
     integrand's values (the inner rule ``inodes``, ``iwk``, ``iwg`` at relative tolerance
@@ -347,23 +347,47 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
                 k = _k_vcavity(mu, s, psi, u, sa) / (u * u * u * u if kind >= 2 else 1.0)
             buf[j] = k * fac
     k, diff, asc, ab = rule_sums(buf, wk, wg)
-    if mode == DECAY_MODE and frame == 0 and (p == 0.0 or p == 1.0) and nodes.shape[0] == DECAY_ROWS.shape[1]:
-        # the closed forms' sharper estimate (:func:`_decay_ratio`, :func:`_singular_ratio`), where QUADPACK's is above its floor
-        err = calibrated(diff * h, asc * h, ab * h, 1)
-        low = FLOOR * EPS * ab * h
-        if err > low:
-            top, r = _decay_ratio(buf, DECAY_ROWS)
-            if r <= DECAY_RCRIT and DECAY_SAFETY * top * r**DECAY_STEPS * h < err:
-                # no faster than the nearest singular point lets the coefficients decay
-                r = _singular_ratio(kind, sm, v0, w, t0, t1, r, sing)
-                if r <= DECAY_RCRIT:
-                    err = min(err, max(low, DECAY_SAFETY * top * r**DECAY_STEPS * h))
-        return k * h, err
     # (frame 5: at most the raw |K - G| raised by the noise, QUADPACK's "min" mode: where the values' errors dominate
     # |K - G| on a small interval, the calibration's (200 |K - G| / resasc)^1.5 grows as resasc shrinks, and bisecting
     # raised the total: fresnel over stretched Phong n = 0, eta 0.999, k 0.001 at mu = 1e-3 and rtol 1e-6 went from
     # 4.1e-8 to 3.0e-7 in 1000 bisections)
     return k * h, calibrated((diff + noise) * h, asc * h, ab * h, 2 if frame == 5 and mode == 1 else mode) + ie * h
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _gk_closed(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, buf, sing):  # pragma: no cover - compiled
+    """(K, error) of the 10/21 rule on [t0, t1] for frame 0's closed forms (p in {0, 1}, :func:`_k_closed`), the error
+    the smaller of QUADPACK's calibrated one and the one from the decay of the rule's coefficients
+    (:data:`DECAY_ROWS`, :func:`_decay_ratio`, :func:`_singular_ratio`; ``mode`` :data:`DECAY_MODE` of
+    :func:`_integrate`).  Inlined, with the rule's arrays as constants: :func:`_gk`'s call passes a dozen arrays, whose
+    reference counts cost about as much per interval as the sharper estimate saves.
+    """
+    h = t1 - t0
+    for j in range(21):
+        u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * NODES21[j])
+        buf[j] = _k_closed(p, mu, c2, u, um, sa)[0] * fac
+    k = 0.0
+    g = 0.0
+    ab = 0.0
+    for j in range(21):
+        k += WK21[j] * buf[j]
+        g += WG21[j] * buf[j]
+        ab += WK21[j] * abs(buf[j])
+    asc = 0.0
+    for j in range(21):
+        asc += WK21[j] * abs(buf[j] - k)
+    err = calibrated(abs(k - g) * h, asc * h, ab * h, 1)
+    low = FLOOR * EPS * ab * h
+    if err > low:
+        top, r = _decay_ratio(buf, DECAY_ROWS)
+        if r <= DECAY_RCRIT and DECAY_SAFETY * top * r**DECAY_STEPS * h < err:
+            # no faster than the nearest singular point lets the coefficients decay
+            if sing[0, 0] != sing[0, 0]:  # (the points of this mu, once: row 0 starts as NaN)
+                _singular_points(n, p, mu, c2, sing)
+            r = _singular_ratio(kind, sm, v0, w, t0, t1, r, sing)
+            if r <= DECAY_RCRIT:
+                err = min(err, max(low, DECAY_SAFETY * top * r**DECAY_STEPS * h))
+    return k * h, err
 
 
 #: the peak variable z = -(n + 1) ln u runs at most to Z_MAX: below u = exp(-Z_MAX / (n + 1)) the
@@ -849,8 +873,7 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
         elif frame == 5:  # F(mu) and the arcs' cuts
             _lobe_f_prepare(mp, mu)
         npieces, c2, left_out = _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, cv1, mp)
-        if mode == DECAY_MODE:
-            _singular_points(n, p, mu, c2, sing)
+        sing[0, 0] = math.nan  # (:func:`_gk_closed` fills it where it needs it)
         # frame 4's inner rule may leave an absolute error iacc / (the node's factor) in K, iacc = itol times a lower
         # bound of the integral so far over the pieces' total length in tau: its share of the sum is then at most
         # itol times that bound (the integrand is >= 0; the errors are added to the estimate either way)
@@ -867,8 +890,12 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
                 pk[m] = i
                 t0[m] = j / n_init
                 t1[m] = (j + 1.0) / n_init
-                kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk,
-                                   wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc, sing)
+                if mode == DECAY_MODE:
+                    kv[m], ke[m] = _gk_closed(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], buf,
+                                              sing)
+                else:
+                    kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes,
+                                       wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
                 acc += max(kv[m] - ke[m], 0.0)
                 m += 1
         start = m
@@ -878,10 +905,15 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
             iacc = itol * max(tot - e, 0.0) / live
-            kv[worst], ke[worst] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk,
-                                       wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc, sing)
-            kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode,
-                               buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc, sing)
+            if mode == DECAY_MODE:
+                kv[worst], ke[worst] = _gk_closed(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, buf,
+                                                  sing)
+                kv[m], ke[m] = _gk_closed(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, buf, sing)
+            else:
+                kv[worst], ke[worst] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes,
+                                           wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
+                kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg,
+                                   mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
             m += 1
         val[q] = tot
         err[q] = e + r

@@ -287,7 +287,7 @@ def run(route: str, hint: AzimuthHint, mu: np.ndarray, rtol: float, atol: float,
         # 0.11 of it (7 m x 63 mu x rtol 1e-6 .. 1e-12 against the nested engine at 1e-13): Ward keeps the raw one
         frame = _FRAMES[route]
         mode = 0 if hint.sqrt_cos else mode_code()
-        if decay_estimate and frame == 0 and mode == 1 and hint.p in (0.0, 1.0):
+        if decay_estimate and frame == 0 and mode == 1 and hint.p in (0.0, 1.0) and RULE == "gk21":
             mode = DECAY_MODE
         mp = numeric_params(hint, lobe_fresnel_gauss)
         mp[12] = rtol
