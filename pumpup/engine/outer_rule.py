@@ -116,11 +116,13 @@ RULE = "gk21"
 #: to degree 20, decay no faster than that (retro n = 10 at mu = 0.864, the level's break 3 % of the piece beyond its
 #: end: the coefficients' ratios 0.03, 0.09, 0.10 gave 1.6e-14 against a true 2.4e-14).  The smaller of the two
 #: estimates is taken, never below QUADPACK's floor 50 eps resabs.
-DECAY_LOW = 13
+DECAY_LOW = 13  # (odd: :func:`_decay_ratio` pairs an odd degree with the next)
 DECAY_RCRIT = 0.5
 DECAY_STEPS = 6
 DECAY_SAFETY = 10.0
-#: the ``mode`` that asks :func:`_gk` for the sharper estimate (QUADPACK's otherwise, :func:`calibrated`'s mode 1)
+#: QUADPACK's error of an interval at most DECAY_SHARE x rtol x (the integral's lower bound so far) is kept as it is
+DECAY_SHARE = 1e-3
+#: the ``mode`` that asks :func:`_integrate` for the sharper estimate (QUADPACK's otherwise, :func:`calibrated`'s mode 1)
 DECAY_MODE = 3
 
 
@@ -145,18 +147,24 @@ DECAY_ROWS = _decay_rows(NODES21, WK21, DECAY_LOW)
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _decay_ratio(f, rows):  # pragma: no cover - compiled; see decay_error_reference
-    """(E_top, r) of the rule's values ``f`` (:data:`DECAY_ROWS`): the last pair's size and the largest ratio of
-    consecutive pairs (inf where a pair follows one that is 0).
+def _decay_ratio(f, rows, half):  # pragma: no cover - compiled; see decay_error_reference
+    """(E_top, r) of the 21-point rule's values ``f`` (:data:`DECAY_ROWS`): the last pair's size and the largest ratio
+    of consecutive pairs (inf where a pair follows one that is 0).  The rule is symmetric, so a polynomial of odd degree
+    is odd about the middle and one of even degree even: the coefficients are sums over the 10 differences and the 11
+    sums f_j -+ f_(20-j) (``half``, 2 x 11, work space).
     """
+    for j in range(10):
+        half[0, j] = f[j] - f[20 - j]
+        half[1, j] = f[j] + f[20 - j]
+    half[1, 10] = f[10]
     r = 0.0
     last = 0.0
     for pair in range(rows.shape[0] // 2):
-        a = 0.0
-        b = 0.0
-        for j in range(f.shape[0]):
-            a += rows[2 * pair, j] * f[j]
-            b += rows[2 * pair + 1, j] * f[j]
+        a = 0.0  # degree DECAY_LOW + 2 pair: odd
+        b = rows[2 * pair + 1, 10] * half[1, 10]
+        for j in range(10):
+            a += rows[2 * pair, j] * half[0, j]
+            b += rows[2 * pair + 1, j] * half[1, j]
         e = math.sqrt(a * a + b * b)
         if pair > 0:
             if last > 0.0:
@@ -355,12 +363,13 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _gk_closed(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, buf, sing):  # pragma: no cover - compiled
+def _gk_closed(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, buf, sing, half, dtol):  # pragma: no cover - compiled
     """(K, error) of the 10/21 rule on [t0, t1] for frame 0's closed forms (p in {0, 1}, :func:`_k_closed`), the error
     the smaller of QUADPACK's calibrated one and the one from the decay of the rule's coefficients
     (:data:`DECAY_ROWS`, :func:`_decay_ratio`, :func:`_singular_ratio`; ``mode`` :data:`DECAY_MODE` of
     :func:`_integrate`).  Inlined, with the rule's arrays as constants: :func:`_gk`'s call passes a dozen arrays, whose
-    reference counts cost about as much per interval as the sharper estimate saves.
+    reference counts cost about as much per interval as the sharper estimate saves.  Where QUADPACK's error is at most
+    ``dtol`` (a small share of the tolerance) the sharper one is not sought.
     """
     h = t1 - t0
     for j in range(21):
@@ -378,8 +387,8 @@ def _gk_closed(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, buf, sing):  # pragma
         asc += WK21[j] * abs(buf[j] - k)
     err = calibrated(abs(k - g) * h, asc * h, ab * h, 1)
     low = FLOOR * EPS * ab * h
-    if err > low:
-        top, r = _decay_ratio(buf, DECAY_ROWS)
+    if err > low and err > dtol:
+        top, r = _decay_ratio(buf, DECAY_ROWS, half)
         if r <= DECAY_RCRIT and DECAY_SAFETY * top * r**DECAY_STEPS * h < err:
             # no faster than the nearest singular point lets the coefficients decay
             if sing[0, 0] != sing[0, 0]:  # (the points of this mu, once: row 0 starts as NaN)
@@ -865,6 +874,7 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
     w = np.empty(PIECES_CAP)
     cv1 = np.empty(PIECES_CAP)
     sing = np.empty((4, 6))
+    half = np.empty((2, 11))
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -882,7 +892,11 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
             live += n_init if w[i] > 0.0 else 0
         acc = 0.0
         m = 0
-        for i in range(npieces):
+        ev = 0
+        for ii in range(npieces):
+            # (the closed forms' sharper estimate: the peak's pieces first, so that the tail's, a small share of the
+            # integral, see the lower bound that decides whether they need it)
+            i = npieces - 1 - ii if mode == DECAY_MODE else ii
             if w[i] <= 0.0:
                 continue
             for j in range(n_init):
@@ -891,9 +905,11 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
                 t0[m] = j / n_init
                 t1[m] = (j + 1.0) / n_init
                 if mode == DECAY_MODE:
+                    ev += 21
                     kv[m], ke[m] = _gk_closed(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], buf,
-                                              sing)
+                                              sing, half, DECAY_SHARE * rtol * acc)
                 else:
+                    ev += nodes.shape[0]
                     kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes,
                                        wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
                 acc += max(kv[m] - ke[m], 0.0)
@@ -904,11 +920,14 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
             if ok or m - start >= max_intervals or m >= cap:
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
+            ev += 2 * nodes.shape[0]
             iacc = itol * max(tot - e, 0.0) / live
             if mode == DECAY_MODE:
+                dtol = DECAY_SHARE * rtol * max(tot - e, 0.0)
                 kv[worst], ke[worst] = _gk_closed(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, buf,
-                                                  sing)
-                kv[m], ke[m] = _gk_closed(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, buf, sing)
+                                                  sing, half, dtol)
+                kv[m], ke[m] = _gk_closed(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, buf, sing, half,
+                                          dtol)
             else:
                 kv[worst], ke[worst] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes,
                                            wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
@@ -918,7 +937,7 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
         val[q] = tot
         err[q] = e + r
         conv[q] = ok
-        evals[q] = nodes.shape[0] * (m + (m - start))  # every split evaluates two halves
+        evals[q] = ev  # (every split evaluates two halves)
 
 _RULES = {"gk15": (_NODES, _WK, _WG), "gk21": (NODES21, WK21, WG21)}
 
