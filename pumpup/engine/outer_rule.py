@@ -120,8 +120,8 @@ DECAY_LOW = 13  # (odd: :func:`_decay_ratio` pairs an odd degree with the next)
 DECAY_RCRIT = 0.5
 DECAY_STEPS = 6
 DECAY_SAFETY = 10.0
-#: QUADPACK's error of an interval at most DECAY_SHARE x rtol x (the integral's lower bound so far) is kept as it is
-DECAY_SHARE = 1e-3
+#: QUADPACK's error of an interval at most DECAY_SHARE x rtol x (a lower bound of the integral) is kept as it is
+DECAY_SHARE = 1e-2
 #: the ``mode`` that asks :func:`_integrate` for the sharper estimate (QUADPACK's otherwise, :func:`calibrated`'s mode 1)
 DECAY_MODE = 3
 
@@ -221,6 +221,7 @@ def _singular_points(n, p, mu, c2, sing):  # pragma: no cover - compiled; see de
     1.0 where the real z itself is one (u > 0).
     """
     s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    ls = math.log(s) if s > 0.0 else -math.inf  # (one logarithm for +-s, none for +-1)
     for j in range(6):
         u = s if j == 0 else (-s if j == 1 else (1.0 if j == 2 else (-1.0 if j == 3 else (c2 if j == 4 else 0.0))))
         if (j == 4 and p != 1.0) or (j == 5 and n == math.floor(n)):
@@ -229,7 +230,8 @@ def _singular_points(n, p, mu, c2, sing):  # pragma: no cover - compiled; see de
         if u == 0.0 or u != u:
             sing[1, j], sing[2, j], sing[3, j] = math.nan, 0.0, 0.0
             continue
-        sing[1, j] = -(n + 1.0) * math.log(abs(u))
+        lu = ls if j < 2 else (0.0 if j < 4 else math.log(abs(u)))
+        sing[1, j] = -(n + 1.0) * lu
         sing[2, j] = (n + 1.0) * math.pi * (2.0 if u > 0.0 else 1.0)
         sing[3, j] = 1.0 if u > 0.0 else 0.0
 
@@ -241,14 +243,19 @@ def _singular_ratio(kind, sm, v0, w, t0, t1, r0, sing):  # pragma: no cover - co
     [0, 1] are its own ends: the singular side of a break there is the other piece's (or smoothed away).
     """
     worst = r0
+    reach = -1.0
     for j in range(sing.shape[1]):
-        big = 1.0 / math.sqrt(worst) if worst > 0.0 else math.inf  # the ellipse of rho^-2 = worst
-        reach = 0.5 * (big + 1.0 / big)
+        if reach < 0.0:  # the ellipse of rho^-2 = worst (again after worst grew)
+            big = 1.0 / math.sqrt(worst) if worst > 0.0 else math.inf
+            reach = 0.5 * (big + 1.0 / big)
+        last = worst
         if kind == 0:
             if sing[0, j] == sing[0, j]:
                 x = (sing[0, j] - v0) / w
                 if not 0.0 <= x <= 1.0:
                     worst = max(worst, _rho_ratio(x, 0.0, sm, t0, t1, reach))
+            if worst > last:
+                reach = -1.0
             continue
         if sing[1, j] != sing[1, j]:
             continue
@@ -258,6 +265,8 @@ def _singular_ratio(kind, sm, v0, w, t0, t1, r0, sing):  # pragma: no cover - co
             worst = max(worst, _rho_ratio(xr, 0.0, sm, t0, t1, reach))
         worst = max(worst, _rho_ratio(xr, step, sm, t0, t1, reach))
         worst = max(worst, _rho_ratio(xr, -step, sm, t0, t1, reach))
+        if worst > last:
+            reach = -1.0
     return worst
 
 
@@ -363,13 +372,14 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _gk_closed(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, buf, sing, half, dtol):  # pragma: no cover - compiled
+def _gk_closed(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, buf, sing, half, drel, low_sum):  # pragma: no cover
     """(K, error) of the 10/21 rule on [t0, t1] for frame 0's closed forms (p in {0, 1}, :func:`_k_closed`), the error
     the smaller of QUADPACK's calibrated one and the one from the decay of the rule's coefficients
     (:data:`DECAY_ROWS`, :func:`_decay_ratio`, :func:`_singular_ratio`; ``mode`` :data:`DECAY_MODE` of
     :func:`_integrate`).  Inlined, with the rule's arrays as constants: :func:`_gk`'s call passes a dozen arrays, whose
     reference counts cost about as much per interval as the sharper estimate saves.  Where QUADPACK's error is at most
-    ``dtol`` (a small share of the tolerance) the sharper one is not sought.
+    ``drel`` times a lower bound of the integral (``low_sum``, the intervals' so far, or this one's value less its error:
+    the integrand is >= 0) the sharper one is not sought.
     """
     h = t1 - t0
     for j in range(21):
@@ -385,9 +395,15 @@ def _gk_closed(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, buf, sing, half, dtol
     asc = 0.0
     for j in range(21):
         asc += WK21[j] * abs(buf[j] - k)
-    err = calibrated(abs(k - g) * h, asc * h, ab * h, 1)
+    # QUADPACK's calibration (:func:`calibrated`, mode 1; t^1.5 as t sqrt(t))
+    diff = abs(k - g) * h
+    err = diff
+    if asc != 0.0 and diff != 0.0:
+        t = min(1.0, 200.0 * diff / (asc * h))
+        err = asc * h * t * math.sqrt(t)
     low = FLOOR * EPS * ab * h
-    if err > low and err > dtol:
+    err = max(low, err)
+    if err > low and err > drel * max(low_sum, k * h - err):
         top, r = _decay_ratio(buf, DECAY_ROWS, half)
         if r <= DECAY_RCRIT and DECAY_SAFETY * top * r**DECAY_STEPS * h < err:
             # no faster than the nearest singular point lets the coefficients decay
@@ -893,11 +909,12 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
         acc = 0.0
         m = 0
         ev = 0
-        for ii in range(npieces):
-            # (the closed forms' sharper estimate: the peak's pieces first, so that the tail's, a small share of the
-            # integral, see the lower bound that decides whether they need it)
-            i = npieces - 1 - ii if mode == DECAY_MODE else ii
-            if w[i] <= 0.0:
+        for ii in range(2 * npieces if mode == DECAY_MODE else npieces):
+            # (the closed forms' sharper estimate: the peak's pieces (kind 1) first, from u = 1 down, then the tail's,
+            # so that the pieces of a small share of the integral see the lower bound that decides whether they need
+            # it)
+            i = ii % npieces
+            if w[i] <= 0.0 or (mode == DECAY_MODE and (kinds[i] == 0) != (ii >= npieces)):
                 continue
             for j in range(n_init):
                 iacc = itol * acc / live
@@ -907,7 +924,7 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
                 if mode == DECAY_MODE:
                     ev += 21
                     kv[m], ke[m] = _gk_closed(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], buf,
-                                              sing, half, DECAY_SHARE * rtol * acc)
+                                              sing, half, DECAY_SHARE * rtol, acc)
                 else:
                     ev += nodes.shape[0]
                     kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes,
@@ -923,11 +940,11 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
             ev += 2 * nodes.shape[0]
             iacc = itol * max(tot - e, 0.0) / live
             if mode == DECAY_MODE:
-                dtol = DECAY_SHARE * rtol * max(tot - e, 0.0)
+                low_sum = max(tot - e, 0.0)
                 kv[worst], ke[worst] = _gk_closed(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, buf,
-                                                  sing, half, dtol)
+                                                  sing, half, DECAY_SHARE * rtol, low_sum)
                 kv[m], ke[m] = _gk_closed(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, buf, sing, half,
-                                          dtol)
+                                          DECAY_SHARE * rtol, low_sum)
             else:
                 kv[worst], ke[worst] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes,
                                            wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)

@@ -223,7 +223,7 @@ import numpy as np
 from ..core.hints import AzimuthHint, PowerLobe
 from ..physics.quadrature import EPS, mode_code
 from .chain_frame import CHAIN_RULE, N_INIT_CHAIN, _integrate_chain, chain_cut_matrix, ring_table
-from .half_arc import numeric_params
+from .half_arc import MP_SIZE, numeric_params
 from .hint_view import kernel_view
 from .lobe_frame import _NO_JACOBI, N_INIT, ROUNDING, jacobi_rules
 from .normal_frame import _integrate_n, n_params
@@ -289,7 +289,8 @@ def run(route: str, hint: AzimuthHint, mu: np.ndarray, rtol: float, atol: float,
         mode = 0 if hint.sqrt_cos else mode_code()
         if decay_estimate and frame == 0 and mode == 1 and hint.p in (0.0, 1.0) and RULE == "gk21":
             mode = DECAY_MODE
-        mp = numeric_params(hint, lobe_fresnel_gauss)
+        # (frame 0 reads no parameter: a blank array there)
+        mp = np.zeros(MP_SIZE) if frame == 0 else numeric_params(hint, lobe_fresnel_gauss)
         mp[12] = rtol
         _integrate(frame, _RADIAL[hint.radial], float(hint.n), float(hint.p), mu, float(rtol), atol_q, budget,
                    ROUNDING, *(_RULES[RULE]), mode, N_INIT, *_RULES["gk15"], jac, mp, val, err, conv, evals)
