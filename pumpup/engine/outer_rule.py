@@ -197,6 +197,18 @@ def _rho_ratio(xr, xi, sm, t0, t1, reach):  # pragma: no cover - compiled; see d
         far = (1.0 - xr) * (1.0 - xr) + xi * xi > (lim + 1.0 - c) ** 4
     if far:
         return 0.0
+    if xi == 0.0 and (sm == 0 or (sm == 1 and xr > 0.0) or (sm == 2 and xr < 1.0)):
+        # real preimages: rho = |y| + sqrt(y^2 - 1) for the nearer one (|y| > 1: the point is outside the interval)
+        if sm == 0:
+            y = abs(xr - c) / hl
+        elif sm == 1:
+            y = min(abs(math.sqrt(xr) - c), math.sqrt(xr) + c) / hl
+        else:
+            y = min(abs(1.0 - math.sqrt(1.0 - xr) - c), abs(1.0 + math.sqrt(1.0 - xr) - c)) / hl
+        if y <= 1.0:
+            return 1.0
+        rho = y + math.sqrt((y - 1.0) * (y + 1.0))
+        return 1.0 / (rho * rho)
     x = complex(xr, xi)
     out = 0.0
     for branch in range(1 if sm == 0 else 2):
