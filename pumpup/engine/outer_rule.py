@@ -282,6 +282,35 @@ def _singular_ratio(kind, sm, v0, w, t0, t1, r0, sing):  # pragma: no cover - co
     return worst
 
 
+def singular_ratio_reference(kind: int, sm: int, n: float, p: float, mu: float, c2: float, v0: float, w: float,
+                             t0: float, t1: float) -> float:
+    """Plain Python twin of :func:`_singular_points` and :func:`_singular_ratio` (from r0 = 0): every point and every
+    preimage in complex arithmetic, none skipped.
+    """
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    us = [s, -s, 1.0, -1.0] + ([c2] if p == 1.0 else []) + ([0.0] if kind == 0 and n != math.floor(n) else [])
+    points = []
+    for u in us:
+        if kind == 0:
+            points.append(complex((u - v0) / w, 0.0))
+        elif u != 0.0:
+            z = -(n + 1.0) * math.log(abs(u))
+            ims = [0.0, 2.0 * math.pi, -2.0 * math.pi] if u > 0.0 else [math.pi, -math.pi]
+            points += [complex(z - v0, -(n + 1.0) * im) / w for im in ims]
+    worst = 0.0
+    for x in points:
+        if x.imag == 0.0 and 0.0 <= x.real <= 1.0:
+            continue
+        if sm == 3:
+            return 1.0
+        taus = {0: [x], 1: [cmath.sqrt(x), -cmath.sqrt(x)], 2: [1.0 - cmath.sqrt(1.0 - x), 1.0 + cmath.sqrt(1.0 - x)]}[sm]
+        for tau in taus:
+            y = (2.0 * tau - t0 - t1) / (t1 - t0)
+            rho = max(abs(y + cmath.sqrt(y - 1.0) * cmath.sqrt(y + 1.0)), abs(y - cmath.sqrt(y - 1.0) * cmath.sqrt(y + 1.0)))
+            worst = max(worst, 1.0 / rho**2 if rho > 1.0 else 1.0)
+    return worst
+
+
 def decay_error_reference(f: np.ndarray, rho_ratio: float = 0.0) -> float:
     """Plain numpy twin of the sharper estimate (:func:`_decay_ratio`, per unit length) of the 21-point rule's values
     ``f``, with rho^-2 = ``rho_ratio`` from the singular points (:func:`_singular_ratio`): inf where it does not apply.
