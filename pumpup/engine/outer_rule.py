@@ -109,20 +109,20 @@ RULE = "gk21"
 #: of consecutive degrees, E_j = sqrt(c_(2j-1)^2 + c_(2j)^2) (so that an even or odd integrand's zeros do not read as
 #: convergence).  Where their largest ratio r = max E_(j+1) / E_j is at most DECAY_RCRIT (geometric or faster decay),
 #: the Kronrod rule's error, the coefficients from degree 32 on (it integrates degree 31 exactly), is estimated as
-#: DECAY_SAFETY E_top r^DECAY_STEPS: the last pair's size carried the six pairs from degree 20 to 32 at the slowest ratio
-#: seen, times a safety factor; else (slower decay: a singularity near the interval, a kink, rounding noise) QUADPACK's
-#: estimate stands.  r is never taken below rho^-2, rho the Bernstein ellipse through the nearest point where K or the
-#: weight is singular (:func:`_singular_ratio`): a small singular term's coefficients, hidden by faster-decaying ones up
-#: to degree 20, decay no faster than that (retro n = 10 at mu = 0.864, the level's break 3 % of the piece beyond its
-#: end: the coefficients' ratios 0.03, 0.09, 0.10 gave 1.6e-14 against a true 2.4e-14).  The smaller of the two
-#: estimates is taken, never below QUADPACK's floor 50 eps resabs.
+#: DECAY_SAFETY E_top r^DECAY_STEPS: the last pair's size carried the six pairs from degree 20 to 32 at the slowest
+#: ratio seen, times a safety factor; else (slower decay: a singularity near the interval, a kink, rounding noise)
+#: QUADPACK's estimate stands.  r is never taken below rho^-2, rho the Bernstein ellipse through the nearest point where
+#: K or the weight is singular (:func:`_singular_ratio`): a small singular term's coefficients, hidden by
+#: faster-decaying ones up to degree 20, decay no faster than that (retro n = 10 at mu = 0.864, the level's break 3 % of
+#: the piece beyond its end: the coefficients' ratios 0.03, 0.09, 0.10 gave 1.6e-14 against a true 2.4e-14).  The
+#: smaller of the two estimates is taken, never below QUADPACK's floor 50 eps resabs.
 DECAY_LOW = 13  # (odd: :func:`_decay_ratio` pairs an odd degree with the next)
 DECAY_RCRIT = 0.5
 DECAY_STEPS = 6
 DECAY_SAFETY = 10.0
 #: QUADPACK's error of an interval at most DECAY_SHARE x rtol x (a lower bound of the integral) is kept as it is
 DECAY_SHARE = 1e-2
-#: the ``mode`` that asks :func:`_integrate` for the sharper estimate (QUADPACK's otherwise, :func:`calibrated`'s mode 1)
+#: the ``mode`` that asks :func:`_integrate` for the sharper estimate (else QUADPACK's, :func:`calibrated`'s mode 1)
 DECAY_MODE = 3
 
 
@@ -303,10 +303,12 @@ def singular_ratio_reference(kind: int, sm: int, n: float, p: float, mu: float, 
             continue
         if sm == 3:
             return 1.0
-        taus = {0: [x], 1: [cmath.sqrt(x), -cmath.sqrt(x)], 2: [1.0 - cmath.sqrt(1.0 - x), 1.0 + cmath.sqrt(1.0 - x)]}[sm]
+        root = cmath.sqrt(x) if sm == 1 else cmath.sqrt(1.0 - x)
+        taus = {0: [x], 1: [root, -root], 2: [1.0 - root, 1.0 + root]}[sm]
         for tau in taus:
             y = (2.0 * tau - t0 - t1) / (t1 - t0)
-            rho = max(abs(y + cmath.sqrt(y - 1.0) * cmath.sqrt(y + 1.0)), abs(y - cmath.sqrt(y - 1.0) * cmath.sqrt(y + 1.0)))
+            q = cmath.sqrt(y - 1.0) * cmath.sqrt(y + 1.0)
+            rho = max(abs(y + q), abs(y - q))
             worst = max(worst, 1.0 / rho**2 if rho > 1.0 else 1.0)
     return worst
 
@@ -419,8 +421,8 @@ def _gk_closed(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, buf, sing, half, drel
     (:data:`DECAY_ROWS`, :func:`_decay_ratio`, :func:`_singular_ratio`; ``mode`` :data:`DECAY_MODE` of
     :func:`_integrate`).  Inlined, with the rule's arrays as constants: :func:`_gk`'s call passes a dozen arrays, whose
     reference counts cost about as much per interval as the sharper estimate saves.  Where QUADPACK's error is at most
-    ``drel`` times a lower bound of the integral (``low_sum``, the intervals' so far, or this one's value less its error:
-    the integrand is >= 0) the sharper one is not sought.
+    ``drel`` times a lower bound of the integral (``low_sum``, the intervals' so far, or this one's value less its
+    error: the integrand is >= 0) the sharper one is not sought.
     """
     h = t1 - t0
     for j in range(21):

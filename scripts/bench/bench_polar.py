@@ -113,7 +113,8 @@ def main():
             continue
         route = parts[0][0]
         paths = {
-            "old": lambda: _polar.run(route, hint, MU, RTOL, 0.0, 10000, lobe_fresnel_gauss=False, decay_estimate=False),
+            "old": lambda: _polar.run(route, hint, MU, RTOL, 0.0, 10000, lobe_fresnel_gauss=False,
+                                      decay_estimate=False),
             "new": lambda: _polar.run(route, hint, MU, RTOL, 0.0, 10000),
         }
         floor_order = None

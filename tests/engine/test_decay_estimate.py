@@ -79,7 +79,7 @@ def test_singular_ratio_matches_its_twin(rng, kind, n, p):
             _outer._singular_points(n, p, mu, c2, sing)
             got = _outer._singular_ratio(kind, sm, v0, w, t0, t1, 0.0, sing)
             want = _outer.singular_ratio_reference(kind, sm, n, p, mu, c2, v0, w, t0, t1)
-            assert got == pytest.approx(want, rel=1e-6, abs=1e-300)  # (r^6 carries the sums' rounding), (kind, sm, n, p, mu, v0, w, t0, t1)
+            assert got == pytest.approx(want, rel=1e-9, abs=1e-300), (kind, sm, n, p, mu, v0, w, t0, t1)
             # from a floor r0: the largest of r0 and the points' (points below r0 are skipped, the result is the same)
             r0 = 0.1
             assert _outer._singular_ratio(kind, sm, v0, w, t0, t1, r0, sing) == pytest.approx(max(r0, want), rel=1e-9)
