@@ -125,6 +125,9 @@ def _phong(n, c=None):
     return s
 
 
+#: the radiance of the scenes' constant sky (linear sRGB)
+SKY = (0.55, 0.62, 0.75)
+
 #: the scenes' metals: colour name -> :mod:`pumpup.spectral.optical` material
 METALS = {"gold": "Au", "silver": "Ag", "copper": "Cu", "aluminium": "Al"}
 
@@ -327,7 +330,7 @@ def _scene_dict(name, mats, size, spp):
                     "film": {"type": "hdrfilm", "width": size, "height": size, "pixel_format": "rgb",
                              "rfilter": {"type": "box"}},
                     "sampler": {"type": "independent", "sample_count": spp}},
-         "sky": {"type": "constant", "radiance": {"type": "rgb", "value": [0.55, 0.62, 0.75]}},
+         "sky": {"type": "constant", "radiance": {"type": "rgb", "value": list(SKY)}},
          "key": {"type": "point", "position": [3.0, 5.0, 4.0], "intensity": {"type": "rgb", "value": 40.0}},
          "fill": {"type": "point", "position": [-4.0, 3.5, 1.5], "intensity": {"type": "rgb", "value": 14.0}},
          "plate": {"type": "rectangle", "bsdf": _bsdf(mats["plate"]),

@@ -89,8 +89,8 @@ __all__ = ["compensate", "KullaConty", "Scaled", "save_compensated", "load_compe
 METHODS = ("kulla_conty", "scale", "g1", "g2")
 
 #: quadrature and interpolation tolerance of the E tables (rtol 1e-8 gives the same grid and
-#: margin as the pumping tables' 1e-9 on GGX alpha = 0.3, 54 nodes, margin 1.6e-7, in a third
-#: of the time; the margin is set by the interpolation, 2 x 8e-8)
+#: margin as the pumping tables' 1e-9 on GGX alpha = 0.3, for fewer integrand evaluations; the margin is set by the
+#: interpolation, 2 x its error)
 TABLE_RTOL = 1e-8
 TABLE_INTERP_TOL = 1e-7
 

@@ -449,6 +449,22 @@ def _cap_kinks(looks, br) -> np.ndarray:
     return np.array(out)
 
 
+def _meet_kinks(looks, br) -> np.ndarray:
+    """Values of m in the range of ``br`` (sorted) where a level's bound meets m (U_j(m) = m: a kink of
+    max(U_j(m), m), 001 eq. 21), by bisection of the sign changes on ``br`` and its geometric midpoints.
+    """
+    from scipy.optimize import brentq
+
+    grid = np.unique(np.concatenate([br, np.sqrt(br[:-1] * br[1:])]))
+    out = []
+    for lk in looks:
+        v = lk.upper(grid) - grid
+        for i in np.nonzero(np.sign(v[:-1]) * np.sign(v[1:]) < 0)[0]:
+            out.append(brentq(lambda m, lk=lk: float(lk.upper(np.array([m]))[0]) - m, grid[i], grid[i + 1],
+                              xtol=1e-300, rtol=1e-15))
+    return np.array(out)
+
+
 def _level_breaks(looks, mlo: float) -> np.ndarray:
     """The first breakpoints in m of a table of the levels' bounds on [mlo, 1] (:class:`_LevelTable`,
     :class:`_PairTable`): at most an eighth of an octave apart, at every breakpoint of every level's spline and where a
@@ -576,21 +592,24 @@ class _SplitTable:
     Each level's g_j = max(U_j(l), U_j(m)[, m]) (001 eq. 20, 21) takes one of its two or three terms throughout most
     cells of a grid of CELLS x CELLS cells in (l, m) (l < m: the cells above the diagonal): the term is certified when
     its smallest value over the cell exceeds the other terms' largest by the relative SAFETY, each U_j's range over a
-    cell's interval taken from its values at the ends and at the zeros of its spline's derivative inside.  A cell whose
-    levels all have a certified term holds a pattern (the term of every level); then
-    g_1 ... g_k = F_A(l) H_B(m) with F_A the product of the U_j of the levels A that take U_j(l), and H_B the product
-    of the U_j of the levels B that take U_j(m) times m^c, c the number of levels that take m (001 eq. 21).  The
-    other cells (the diagonal ones, and those a kink crosses: U_j(l) = U_j(m), U_j = m, U_j = cap) hold -1, and the
-    kernel takes the level table there.
+    cell's interval taken from its values at the ends and at the zeros of its spline's derivative inside.  Where
+    neither U_j(m) nor m is certified but both exceed U_j(l) (g2, U_j within the cell's variation of m: Phong's albedo),
+    the level's term is W_j(m) = max(U_j(m), m), one function of m (code 3; kept only in cells where another level's
+    term is its bound below its cap, :meth:`_slack`).  A cell whose levels all have a certified term holds a pattern
+    (the term of every level); then g_1 ... g_k = F_A(l) H_B(m) with F_A the product of the U_j of the levels A that
+    take U_j(l), and H_B the product of the U_j of the levels B that take U_j(m) times m^c, c the number of levels that
+    take m (001 eq. 21), times the W_j of the levels that take it.  The other cells (the diagonal ones, and those a
+    kink crosses: U_j(l) = U_j(m), U_j = m, U_j = cap) hold -1, and the kernel takes the level table there.
 
     Every product of bounds used (:attr:`functions`; row 0, the empty product, is exactly 1) is tabulated on one set of
-    pieces in m, as the level table tabulates the U_j (pieces split at every breakpoint of every level's spline and
-    where a level's bound reaches its cap; a Chebyshev interpolant of degree PRODUCT_DEGREE on each, bisected until it
-    matches its function to ``TOL``, relative, at 4 (degree + 1) + 1 test points), scaled by 1 - ``epsilon`` (twice the
-    largest miss plus 16 ulp) and checked never to exceed its function: the product the kernel divides by is at most the
-    level-by-level product of g (the pumped BRDF at least the level-by-level one) and at least that product times (1 - 2
-    ``epsilon``), as the level table's.  The cells where every level takes m hold -1: there the ideal operator's g is
-    m^k itself, with no room below it for a scaled table. ``coef[f, s]`` holds function f's coefficients on piece s
+    pieces in m, as the level table tabulates the U_j (pieces split at every breakpoint of every level's spline, where
+    a level's bound reaches its cap and, for a W_j, where U_j meets m; a Chebyshev interpolant of degree
+    PRODUCT_DEGREE on each, bisected until it matches its function to ``TOL``, relative, at 4 (degree + 1) + 1 test
+    points), scaled by 1 - ``epsilon`` (twice the largest miss plus 16 ulp) and checked never to exceed its function:
+    the product the kernel divides by is at most the level-by-level product of g (the pumped BRDF at least the
+    level-by-level one) and at least that product times (1 - 2 ``epsilon``), as the level table's.  The cells where
+    every level takes m hold -1: there the ideal operator's g is m^k itself, with no room below it for a scaled table.
+    ``coef[f, s]`` holds function f's coefficients on piece s
     (highest power first), the piece's centre and inverse half-width: one cache line per look-up.  ``pattern[i, k]``
     (int8) is the pattern of the cell i = floor(l CELLS), k = floor(m CELLS) (-1: none; the kernel reads ``packed``, its
     cells with i <= k, 32 kB), ``fid[p]`` and ``hid[p]`` the rows of ``coef`` that hold its F_A and H_B. :meth:`g` is
@@ -604,8 +623,12 @@ class _SplitTable:
     CELLS = 256
     #: how far (relative) a level's certified term stays above its others throughout a cell
     SAFETY = 1e-12
-    #: the most cells per octave of the piece index (2^CELLS_MAX_BITS, :func:`_piece_cells`)
-    CELLS_MAX_BITS = 12
+    #: the most cells per octave of the piece index (2^CELLS_MAX_BITS, :func:`_piece_cells`): 1024 int64, 8 kB per
+    #: octave (4096 cells, 32 kB, left less of the cache to the rest: 3- and 5-level GGX and 5-level Phong took 4 to
+    #: 13 % longer per pair, measured in one run with scripts/bench/bench_eval.py's pairs)
+    CELLS_MAX_BITS = 10
+    #: the share of served cells with an empty F (all levels' terms functions of m) from which the kernel skips F there
+    SKIP_SHARE = 0.8
 
     def __init__(self, levels: _LevelTable):
         self.levels_table = levels
@@ -616,7 +639,8 @@ class _SplitTable:
         rlo, rhi = self._ranges(lo_e, hi_e)  # (levels, n)
         codes = self._codes(rlo[:, :, None], rhi[:, :, None], rlo[:, None, :], rhi[:, None, :],
                             lo_e[None, :], hi_e[None, :])  # (levels, n, n)
-        ok = self._certified(codes) & np.triu(np.ones((n, n), dtype=bool), 1) & (hi_e > self.mlo)[:, None]
+        ok = (self._certified(codes) & self._slack(codes, rhi[:, :, None], rhi[:, None, :])
+              & np.triu(np.ones((n, n), dtype=bool), 1) & (hi_e > self.mlo)[:, None])
         keys, inverse = _unique_rows(codes[:, ok].T)
         if len(keys) > 127:
             raise _ProductError("the split table needs more than 127 patterns")
@@ -625,25 +649,36 @@ class _SplitTable:
         k_, i_ = np.tril_indices(n)  # (k >= i: the cells with l <= m, row by row of k)
         #: ``pattern``'s cells with i <= k packed as the kernel reads them: cell (i, k) at k (k + 1) / 2 + i
         self.packed = np.ascontiguousarray(self.pattern[i_, k_])
-        #: the term of every level in each pattern (0: U_j(l), 1: U_j(m), 2: m)
+        #: the term of every level in each pattern (0: U_j(l), 1: U_j(m), 2: m, 3: max(U_j(m), m))
         self.patterns = keys.astype(np.int8)
         if len(keys) == 0:  # (no cell certified: a table of nothing; the chain keeps the level table alone)
             raise _ProductError("no cell of the split table has one term per level")
-        fkeys = {(tuple(np.nonzero(k == 0)[0]), 0) for k in keys}
-        hkeys = {(tuple(np.nonzero(k == 1)[0]), int(np.count_nonzero(k == 2))) for k in keys}
-        #: the functions tabulated, each (levels, c): the product of those levels' bounds times m^c; row 0 the empty
-        #: product, exactly 1
-        self.functions = [((), 0)] + sorted((fkeys | hkeys) - {((), 0)}, key=lambda a: (len(a[0]), a))
-        self.fid = np.array([self.functions.index((tuple(np.nonzero(k == 0)[0]), 0)) for k in keys], dtype=np.int64)
-        self.hid = np.array([self.functions.index((tuple(np.nonzero(k == 1)[0]), int(np.count_nonzero(k == 2))))
-                             for k in keys], dtype=np.int64)
+        fkeys = {self._f_key(k) for k in keys}
+        hkeys = {self._h_key(k) for k in keys}
+        #: the functions tabulated, each (levels, c, wlevels): the product of the bounds of ``levels`` times m^c times
+        #: max(U_j(m), m) for j in ``wlevels``; row 0 the empty product, exactly 1
+        self.functions = [((), 0, ())] + sorted((fkeys | hkeys) - {((), 0, ())},
+                                                key=lambda a: (len(a[0]) + len(a[2]), a))
+        self.fid = np.array([self.functions.index(self._f_key(k)) for k in keys], dtype=np.int64)
+        self.hid = np.array([self.functions.index(self._h_key(k)) for k in keys], dtype=np.int64)
+        #: whether the kernel skips F where it is the empty product (fid 0, :func:`g_split`): where fewer than
+        #: SKIP_SHARE of the served cells have an empty F, their patterns read a copy of row 0 instead (the last
+        #: row, the same exact 1), so that the kernel's branch on fid 0 is never taken and never mispredicted
+        cells = np.bincount(inverse, minlength=len(keys))
+        self.skips = bool(np.sum(cells[self.fid == 0]) >= self.SKIP_SHARE * np.sum(cells))
+        if not self.skips and np.any(self.fid == 0):
+            self.fid[self.fid == 0] = len(self.functions)
+            self.functions.append(((), 0, ()))
+        wlevels = sorted({j for fn in self.functions for j in fn[2]})
         br = _level_breaks(self.looks, self.mlo)
-        fns = [self._function(fn) for fn in self.functions[1:]]
+        br = np.unique(np.concatenate([br, _meet_kinks([self.looks[j] for j in wlevels], br)]))
+        fns = [self._function(fn) for fn in self.functions[1:] if fn != ((), 0, ())]
         coefs, lo, hi, center, half, worst = fit_pieces(fns, br[:-1], br[1:], self.TOL, "split table")
         self.epsilon = 2.0 * float(worst.max()) + 16 * np.finfo(float).eps
         one = np.zeros((1, PRODUCT_DEGREE + 1, len(lo)))
         one[0, -1] = 1.0  # the empty product: Horner's rule gives exactly 1
-        coef = np.concatenate([one, np.stack(coefs) * (1.0 - self.epsilon)])  # (functions, degree + 1, pieces)
+        copy = [one] if self.functions[-1] == ((), 0, ()) and len(self.functions) > 1 else []
+        coef = np.concatenate([one, np.stack(coefs) * (1.0 - self.epsilon)] + copy)  # (functions, degree + 1, pieces)
         self.coef = _aligned(np.concatenate(
             [coef.transpose(0, 2, 1), np.broadcast_to(center[None, :, None], (len(coef), len(lo), 1)),
              np.broadcast_to(1.0 / half[None, :, None], (len(coef), len(lo), 1))], axis=2))
@@ -652,8 +687,21 @@ class _SplitTable:
         self.shift, self.cbase, self.cstart, self.entries = _piece_cells(lo, self.mlo, self.CELLS_MAX_BITS)
         self._check([self._function(fn) for fn in self.functions])
 
+    @staticmethod
+    def _f_key(k) -> tuple:
+        """The function F of pattern ``k`` (a level's term per level): the product of the U_j(l) it takes."""
+        return tuple(int(j) for j in np.nonzero(k == 0)[0]), 0, ()
+
+    @staticmethod
+    def _h_key(k) -> tuple:
+        """The function H of pattern ``k``: the U_j(m), the m and the max(U_j(m), m) it takes."""
+        return (tuple(int(j) for j in np.nonzero(k == 1)[0]), int(np.count_nonzero(k == 2)),
+                tuple(int(j) for j in np.nonzero(k == 3)[0]))
+
     def _function(self, fn):
-        """The exact function of one of :attr:`functions`, of an array of m: a product of levels' bounds times m^c."""
+        """The exact function of one of :attr:`functions`, of an array of m: a product of levels' bounds times m^c
+        times max(U_j(m), m) of the levels ``fn[2]``.
+        """
         looks = self.looks
 
         def f(m):
@@ -663,6 +711,8 @@ class _SplitTable:
                 out = out * looks[j].upper(m)
             for _ in range(fn[1]):
                 out = out * m  # 001 eq. 21: g_j = m
+            for j in fn[2]:
+                out = out * np.maximum(looks[j].upper(m), m)  # 001 eq. 21: g_j = max(U_j(m), m)
             return out
 
         return f
@@ -701,8 +751,22 @@ class _SplitTable:
             c0 = ll[j] >= top * s  # U_j(l) above U_j(m) and m throughout
             c1 = (ml[j] >= lh[j] * s) & ((ml[j] >= m1 * s) if ctl else True)
             c2 = (m0 >= np.maximum(lh[j], mh[j]) * s) if ctl else False
-            out[j] = np.where(c0, 0, np.where(c1, 1, np.where(c2, 2, -1)))
+            # max(U_j(m), m) above U_j(l) throughout (U_j(m) and m too close to tell apart over the cell: both are
+            # functions of m, so their max is one)
+            c3 = (np.maximum(ml[j], m0) >= lh[j] * s) if ctl else False
+            out[j] = np.where(c0, 0, np.where(c1, 1, np.where(c2, 2, np.where(c3, 3, -1))))
         return out
+
+    def _slack(self, codes, lh, mh) -> np.ndarray:
+        """Cells where a term max(U_j(m), m) (code 3) is used only beside a level whose certified term is its bound
+        U_j below its cap throughout the cell (code 0 with U_j(l) < cap, or 1 with U_j(m) < cap; ``lh``, ``mh`` the
+        largest U_j over the cell's intervals of l and m).  Where max(U_j(m), m) = m, that level's g is the ideal
+        operator's itself; the level with its bound below the cap keeps the room (its table's margin) that the fit's
+        scaling down by 1 - epsilon takes.
+        """
+        cap = np.array([lk.cap for lk in self.looks])[:, None, None]
+        room = ((codes == 0) & (lh < cap)) | ((codes == 1) & (mh < cap))
+        return ~np.any(codes == 3, axis=0) | np.any(room, axis=0)
 
     @staticmethod
     def _certified(codes) -> np.ndarray:
@@ -780,15 +844,15 @@ def _aligned(a: np.ndarray, line: int = 64) -> np.ndarray:
 
 
 def _unique_rows(rows: np.ndarray):
-    """np.unique(rows, axis=0, return_inverse=True) for rows of digits 0-2 (each row read as a number in base 3: the
+    """np.unique(rows, axis=0, return_inverse=True) for rows of digits 0-3 (each row read as a number in base 4: the
     sort of rows as records took 0.14 s of a 3-level split table's 0.4 s).
     """
-    if rows.shape[1] > 39:  # (beyond int64)
+    if rows.shape[1] > 31:  # (beyond int64)
         keys, inverse = np.unique(rows, axis=0, return_inverse=True)
         return keys, inverse.ravel()
-    weight = 3 ** np.arange(rows.shape[1] - 1, -1, -1, dtype=np.int64)  # (the first digit the most significant)
+    weight = 4 ** np.arange(rows.shape[1] - 1, -1, -1, dtype=np.int64)  # (the first digit the most significant)
     u, inverse = np.unique(rows.astype(np.int64) @ weight, return_inverse=True)
-    keys = (u[:, None] // weight[None, :]) % 3
+    keys = (u[:, None] // weight[None, :]) % 4
     return keys.astype(rows.dtype), inverse.ravel()
 
 

@@ -325,8 +325,10 @@ def g_split(mmin, mmax, ncell, pattern, fid, hid, shift, pcbase, pcell, plo, pco
     whose functions are rows ``fid[p]`` and ``hid[p]`` of ``pcoef`` (int8 patterns: a packing of both rows in an int16
     cost 1.5 ns more per pair, measured) (:class:`pumpup.operators.pumping._SplitTable`; 001 eq. 20, 21
     with every level's term fixed in the cell); each function's piece found by :func:`cell_piece` (``pcell`` the
-    cells' entries).  ``pcoef[f, s]``: piece s's PRODUCT_DEGREE + 1 coefficients, highest power first, its centre and
-    inverse half-width.  Inlined where it is called.  Its numpy reference is
+    cells' entries); F's look-up is skipped where it is row 0, the empty product (exactly 1: a table whose patterns
+    rarely have an empty F points them to a copy of row 0 instead, so this branch stays predictable,
+    :attr:`pumpup.operators.pumping._SplitTable.skips`).  ``pcoef[f, s]``: piece s's PRODUCT_DEGREE + 1 coefficients,
+    highest power first, its centre and inverse half-width.  Inlined where it is called.  Its numpy reference is
     :meth:`pumpup.operators.pumping._SplitTable.g`.
     """
     i = min(int(mmin * ncell), ncell - 1)
@@ -335,15 +337,17 @@ def g_split(mmin, mmax, ncell, pattern, fid, hid, shift, pcbase, pcell, plo, pco
     if p < 0:
         return 0.0
     a, b = fid[p], hid[p]
-    si = cell_piece(mmin, shift, pcbase, pcell, plo)
     so = cell_piece(mmax, shift, pcbase, pcell, plo)
-    ti = (mmin - pcoef[a, si, 6]) * pcoef[a, si, 7]
     to = (mmax - pcoef[b, so, 6]) * pcoef[b, so, 7]
     # the quintics, written out (Horner, the order of horner; PRODUCT_DEGREE = 5)
-    gi = ((((pcoef[a, si, 0] * ti + pcoef[a, si, 1]) * ti + pcoef[a, si, 2]) * ti + pcoef[a, si, 3]) * ti
-          + pcoef[a, si, 4]) * ti + pcoef[a, si, 5]
     go = ((((pcoef[b, so, 0] * to + pcoef[b, so, 1]) * to + pcoef[b, so, 2]) * to + pcoef[b, so, 3]) * to
           + pcoef[b, so, 4]) * to + pcoef[b, so, 5]
+    if a == 0:  # F is row 0, the empty product: exactly 1 (1 * go = go), its look-up skipped
+        return go
+    si = cell_piece(mmin, shift, pcbase, pcell, plo)
+    ti = (mmin - pcoef[a, si, 6]) * pcoef[a, si, 7]
+    gi = ((((pcoef[a, si, 0] * ti + pcoef[a, si, 1]) * ti + pcoef[a, si, 2]) * ti + pcoef[a, si, 3]) * ti
+          + pcoef[a, si, 4]) * ti + pcoef[a, si, 5]
     return gi * go
 
 

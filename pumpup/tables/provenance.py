@@ -19,7 +19,7 @@ __all__ = ["PROVENANCE_ATTRS", "source_commit", "same_data", "write_generated"]
 #: attributes that record where and when a file was made, not what it holds
 PROVENANCE_ATTRS = ("pumpup_commit", "pumpup_version", "pumpup_digest")
 
-_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # the checkout, above pumpup/
 
 
 def _git(*args: str) -> str | None:

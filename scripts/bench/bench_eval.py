@@ -5,7 +5,7 @@ Phong).  One core, 2e6 random direction pairs in the upper hemisphere, best of 5
 a warm-up call (so numba compilation is not timed).  The baseline (reciprocal Phong) is
 measured in the same run.
 
-    python scripts/bench/bench_eval.py [--pumped] [--spectral] [--issue55]
+    python scripts/bench/bench_eval.py [--pumped] [--spectral] [--issue55] [--tolerances]
 
 (These are the kernels, ``_eval``.  The cost of ``BRDF.eval``'s input checks, and eval against a
 fused numpy expression, is ``python scripts/bench/bench_albedo.py --eval``.)
@@ -15,6 +15,10 @@ with its target and the old and new path measured alternating in one run (old: t
 ``Pumped._eval_levelwise``, and the compensated model's two passes, ``KullaConty._eval_two_passes``; new: ``_eval``,
 the level table where the chain has no product table, and the base's fused kernel where it has one); 2^20 pairs, best
 of 9 in this thread's CPU time (``time.thread_time``: on a shared machine the time spent waiting for a core is out).
+
+``--tolerances`` builds the 3-level g2 pumped Phong n = 20 with three settings of the pumping tables' tolerances
+(``pumpup.operators.pumping.TABLE_RTOL`` and ``TABLE_INTERP_TOL``) and prints each build's time relative to the
+default's, measured in the same run, and the level-3 albedo at mu = 0.5 (:func:`tolerance_rows`).
 
 ``--spectral`` also times the spectral gold of 000 sec. 5 (8 wavelengths, n = 20) against one
 wavelength (the scalar ``metal``), with input checks on both: 000 eq. 27/28 with the Fresnel factor
@@ -88,6 +92,44 @@ def main():
               f"its 3 albedo tables took {warm:.2f} s to build ({cold:.2f} s for n = 21, the first in the process)")
     if "--spectral" in sys.argv:
         spectral_rows(wi, wo)
+    if "--tolerances" in sys.argv:
+        rows = tolerance_rows()
+        print("\n3-level g2 pumped Phong n = 20, the pumping tables' tolerances (best of 3 builds each):")
+        print(f"  {'TABLE_RTOL':>10s} {'TABLE_INTERP_TOL':>16s} {'build time / default':>20s} {'a_3(0.5)':>12s}")
+        for r in rows:
+            print(f"  {r['rtol']:10.0e} {r['interp_tol']:16.0e} {r['seconds'] / rows[0]['seconds']:20.2f} "
+                  f"{r['albedo']:12.8f}")
+
+
+#: the tolerance settings of ``--tolerances`` (the first is pumpup's default)
+TOLERANCES = ((1e-9, 1e-7), (1e-8, 1e-6), (1e-7, 1e-5))
+
+
+def tolerance_rows(settings=TOLERANCES, repeat: int = 3, mu: float = 0.5) -> list[dict]:
+    """Build a 3-level g2 pumped Phong n = 20 with each (TABLE_RTOL, TABLE_INTERP_TOL) of ``settings``, each
+    from empty table caches; return each setting's best build time of ``repeat`` and its level-3 albedo at ``mu``.
+    The module constants and caches are restored afterwards.
+    """
+    from pumpup.operators import pumping
+
+    saved = pumping.TABLE_RTOL, pumping.TABLE_INTERP_TOL, pumping._TABLES
+    out = []
+    try:
+        for rtol, interp_tol in settings:
+            pumping.TABLE_RTOL, pumping.TABLE_INTERP_TOL = rtol, interp_tol
+            best, f = float("inf"), None
+            for _ in range(repeat):
+                pumping._TABLES = {}
+                t = time.perf_counter()
+                f = pumpup.pump({"type": "phong", "n": 20}, g="g2", levels=3)
+                for lev in f.chain():
+                    lev.lookup()
+                best = min(best, time.perf_counter() - t)
+            out.append({"rtol": rtol, "interp_tol": interp_tol, "seconds": best,
+                        "albedo": float(pumpup.albedo(f, mu))})
+    finally:
+        pumping.TABLE_RTOL, pumping.TABLE_INTERP_TOL, pumping._TABLES = saved
+    return out
 
 
 def spectral_rows(wi, wo, repeat=5):

@@ -15,7 +15,7 @@ Contestants, measured in one run on the same machine:
 * Mitsuba 3 Monte Carlo: the mean of ``bsdf.sample`` weights (f cos / pdf,
   ``sample_visible: False``) with ``--samples`` samples per cell, in the ``scalar_rgb``
   variant (a Python loop; ``--variant llvm_ad_rgb`` samples all at once where Dr.Jit's LLVM
-  back end works -- on this machine's libLLVM 15 it aborts).  Optional: skipped with a
+  back end works: libLLVM 17 or newer).  Optional: skipped with a
   message when ``mitsuba`` is not installed (``pip install -e ".[bench]"``).
 
 Accuracy is measured against a reference: pumpup at rtol 1e-12, itself cross-checked against

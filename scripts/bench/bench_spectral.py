@@ -98,7 +98,10 @@ class count_values:
         sys.modules["pumpup.engine.cubature"].albedo = sys.modules["pumpup.tables"].albedo = self.orig
 
 
-def bench_counts(n):
+def value_counts(n) -> dict:
+    """How many albedo values Au at exponent ``n`` costs: each wavelength's own ``pumpup.tabulate`` (``own``, in
+    the order of the wavelengths) and ``Spectral.tabulate`` of all (``spectral``, on ``grid`` mu).
+    """
     s = spectral.SpectralMetal("Au", n=n)
     own = []
     for m in s.models:
@@ -107,9 +110,15 @@ def bench_counts(n):
         own.append(c.n)
     with count_values() as c:
         ds = spectral.SpectralMetal("Au", n=n).tabulate(threads=1)
+    return {"own": own, "spectral": c.n, "grid": ds.sizes["mu"], "wavelengths": [float(w) for w in s.wavelengths]}
+
+
+def bench_counts(n):
+    r = value_counts(n)
+    own, c, i520 = r["own"], r["spectral"], r["wavelengths"].index(520.0)
     print(f"albedo values computed, Au n = {n:g}: one wavelength's own adaptive table {min(own)} to {max(own)} "
-          f"(520 nm: {own[3]}, sum of the 8: {sum(own)}); Spectral.tabulate (one shared grid, {ds.sizes['mu']} mu) "
-          f"{c.n} = {c.n / own[3]:.2f} x the 520 nm one, {c.n / (sum(own) / 8):.2f} x the mean one")
+          f"(520 nm: {own[i520]}, sum of the 8: {sum(own)}); Spectral.tabulate (one shared grid, {r['grid']} mu) "
+          f"{c} = {c / own[i520]:.2f} x the 520 nm one, {c / (sum(own) / 8):.2f} x the mean one")
 
 
 def bench_tabulate(n):

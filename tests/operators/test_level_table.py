@@ -39,6 +39,13 @@ def ggx2_g1():
 
 
 @pytest.fixture(scope="module")
+def phong5():
+    """5-level g2 pumped Phong n = 20: the top level's bound falls near mu = 1 (no product table), and the base's bound
+    is within 1e-6 of mu, so its split table takes max(U_1(m), m) as one term."""
+    return pumpup.pump({"type": "phong", "n": 20}, g="g2", levels=5)
+
+
+@pytest.fixture(scope="module")
 def ggx1_g1():
     return pumpup.pump({"type": "ggx", "alpha": 0.3, "shadowing": "correlated"}, g="g1", levels=1)
 
@@ -59,7 +66,7 @@ def _pairs(rng, n=300):
     return np.concatenate([wi, a, a, graze]), np.concatenate([wo, mirror, graze, wo])
 
 
-@pytest.mark.parametrize("name", ["ggx2", "ggx3", "ggx2_g1", "ggx1_g1"])
+@pytest.mark.parametrize("name", ["ggx2", "ggx3", "ggx2_g1", "ggx1_g1", "phong5"])
 @pytest.mark.parametrize("path", ["new", "level table"])
 def test_level_table_between_the_levelwise_and_the_ideal_operator(name, path, request, rng):
     """Both the level table alone and with the split table (``_eval``) are pointwise between the level-by-level path
@@ -187,10 +194,11 @@ def _cell_pairs(r, rng, per=3):
     return np.where(swap, hi, lo), np.where(swap, lo, hi)
 
 
-@pytest.mark.parametrize("name", ["ggx2", "ggx3", "ggx2_g1"])
+@pytest.mark.parametrize("name", ["ggx2", "ggx3", "ggx2_g1", "phong5"])
 def test_split_table_patterns_hold_in_their_cells(name, request, rng):
     """In a cell with a pattern, every level's g takes the pattern's term: that term is the largest of U_j(l), U_j(m)
-    and (g2) m at every pair tried there, so F(l) H(m) is the product of the levels' g."""
+    and (g2) m, or is max(U_j(m), m) and at least U_j(l), at every pair tried there, so F(l) H(m) is the product of the
+    levels' g."""
     f = request.getfixturevalue(name)
     r = f.split_table()
     mi, mo = _cell_pairs(r, rng, per=20)
@@ -200,6 +208,7 @@ def test_split_table_patterns_hold_in_their_cells(name, request, rng):
     lo, hi, codes = np.minimum(mi, mo)[on], np.maximum(mi, mo)[on], r.patterns[p[on]]
     for j, lk in enumerate(r.looks):
         terms = np.stack([lk.upper(lo), lk.upper(hi), hi if r.controlled[j] else np.zeros_like(hi)])
+        terms = np.concatenate([terms, np.maximum(terms[1], terms[2])[None]])  # code 3: max(U_j(m), m)
         chosen = terms[codes[:, j], np.arange(len(lo))]
         assert np.all(chosen >= terms.max(axis=0))  # 001 eq. 20, 21: the max is the pattern's term
     # and the tabulated functions are at most their products of bounds, within 2 epsilon below them
@@ -210,7 +219,7 @@ def test_split_table_patterns_hold_in_their_cells(name, request, rng):
         assert np.all(got <= exact) and np.all(got >= exact * (1 - 2 * r.epsilon - 1e-15))
 
 
-@pytest.mark.parametrize("name", ["ggx2", "ggx3", "ggx2_g1"])
+@pytest.mark.parametrize("name", ["ggx2", "ggx3", "ggx2_g1", "phong5"])
 def test_split_kernel_against_its_numpy_reference(name, request, rng):
     """The compiled chain kernel (f = 1, so it returns 1 / g) against :meth:`_SplitTable.g`, on both of its paths."""
     from pumpup.operators.pumping import _chain_kernel
@@ -234,7 +243,7 @@ def test_split_table_layout_and_switch(ggx3, ggx2):
     args = ggx3._chain_args()
     assert args.split_cells == r.ncell == _SplitTable.CELLS and args.split_coef is r.coef
     assert r.coef.shape == (len(r.functions), len(r.lo) - 1, PRODUCT_DEGREE + 3)
-    assert r.functions[0] == ((), 0) and np.all(r.coef[0, :, :PRODUCT_DEGREE + 1] == np.eye(PRODUCT_DEGREE + 1)[-1])
+    assert r.functions[0] == ((), 0, ()) and np.all(r.coef[0, :, :PRODUCT_DEGREE + 1] == np.eye(PRODUCT_DEGREE + 1)[-1])
     assert not np.any(np.all(r.patterns == 2, axis=1))  # where every level takes m, the level table serves
     assert r.pattern.shape == (r.ncell, r.ncell) and r.pattern.dtype == np.int8
     assert np.all(np.tril(r.pattern + 1) == 0)  # only cells with min < max hold a pattern
@@ -242,10 +251,27 @@ def test_split_table_layout_and_switch(ggx3, ggx2):
     assert args.split_pattern is r.packed and np.array_equal(r.packed[k * (k + 1) // 2 + i], r.pattern[i, k])
     assert args.split_cell is r.entries and args.pair_cell is ggx3.level_table().entries
     assert r.share() > 0.85  # most uniform pairs take one product
+    # F is empty in too few cells to skip its look-up: those patterns read a copy of row 0 (the kernel's branch on
+    # row 0 is never taken)
+    assert not r.skips and np.all(r.fid > 0) and r.functions[-1] == ((), 0, ())
+    assert np.array_equal(r.coef[-1], r.coef[0]) and np.count_nonzero(r.fid == len(r.functions) - 1) > 0
     off = ggx3._level_table_args()
     assert off.split_cells == 0 and off.pair_rows is args.pair_rows
     assert pumpup.pump({"type": "ggx", "alpha": 0.3}, g="g2", levels=1).split_table() is None
     assert ggx2.split_table().looks is ggx2.level_table().looks
+
+
+def test_split_table_takes_max_of_bound_and_cosine(phong5):
+    """Where a level's bound and m are too close to tell apart over a cell (Phong's albedo is within 1e-6 of mu), the
+    split table takes their max as one term of H (code 3), and most pairs take one product; each such pattern has a
+    level whose term is its bound below the cap (the room the fit's scaling down takes)."""
+    r = phong5.split_table()
+    with3 = np.any(r.patterns == 3, axis=1)
+    assert np.any(with3) and r.share() > 0.9
+    assert r.skips and np.any(r.fid == 0)  # F is empty (exactly 1) in most cells: the kernel skips its look-up
+    assert np.all(np.any((r.patterns[with3] == 0) | (r.patterns[with3] == 1), axis=1))
+    assert all(fn[2] == tuple(np.nonzero(r.patterns[p] == 3)[0]) for p, fn in
+               ((p, r.functions[h]) for p, h in enumerate(r.hid)))
 
 
 @njit(cache=True)
