@@ -121,7 +121,7 @@ DECAY_RCRIT = 0.5
 DECAY_STEPS = 6
 DECAY_SAFETY = 10.0
 #: QUADPACK's error of an interval at most DECAY_SHARE x rtol x (a lower bound of the integral) is kept as it is
-DECAY_SHARE = 1e-2
+DECAY_SHARE = 0.1
 #: the ``mode`` that asks :func:`_integrate` for the sharper estimate (else QUADPACK's, :func:`calibrated`'s mode 1)
 DECAY_MODE = 3
 
