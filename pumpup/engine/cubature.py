@@ -694,14 +694,16 @@ def albedo(brdf: BRDF, mu: ArrayLike, return_error: bool = False, rtol: float = 
             elif route == "lobe_axis":  # a power lobe about its own axis (Lafortune's, p = 0), at every azimuth of wi
                 n, nu, scale = payload
                 v, e, conv, _ = polar.axis_albedo(n, np.broadcast_to(nu, flat.shape)[idx],
-                                                  np.broadcast_to(scale, flat.shape)[idx], rtol, atol, max_regions)
+                                                  np.broadcast_to(scale, flat.shape)[idx], rtol, atol, max_regions,
+                                                  choice.decay_estimate)
             elif route == "nested":
                 v, e, conv = nested.integrate(term, payload, rtol, atol, max_regions)
             elif route == "cubature":
                 v, e, conv = _integrate_group(term, payload, rtol, atol, max_regions,
                                               generic_check=choice.generic_check)
             else:  # the 1-D routes of the model's azimuth hint (pumpup.engine.polar)
-                v, e, conv, _ = polar.run(route, payload, flat[idx], rtol, atol, max_regions, choice.lobe_fresnel_gauss)
+                v, e, conv, _ = polar.run(route, payload, flat[idx], rtol, atol, max_regions, choice.lobe_fresnel_gauss,
+                                          choice.decay_estimate)
             value[idx] += w * v
             error[idx] += abs(w) * e
             ok[idx] &= conv

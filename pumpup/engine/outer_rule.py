@@ -4,13 +4,14 @@ the globally adaptive rule (:func:`_integrate`); :mod:`pumpup.engine.polar` desc
 
 from __future__ import annotations
 
+import cmath
 import math
 
 import numpy as np
 from numba import njit
 
 from ..physics.microfacet import projected as _projected
-from ..physics.quadrature import calibrated, rule_sums
+from ..physics.quadrature import EPS, FLOOR, calibrated, rule_sums
 from .cubature import NODES as _NODES
 from .cubature import WG as _WG
 from .cubature import WK as _WK
@@ -103,6 +104,228 @@ WG21[11::2] = 0.5 * _WG10[::-1]
 #: Phong family at rtol 1e-10)
 RULE = "gk21"
 
+#: the sharper estimate of the closed forms of frame 0 (``mode`` :data:`DECAY_MODE`, :func:`_decay_ratio`): the 21
+#: values' coefficients of degree DECAY_LOW .. 20 in the polynomials orthonormal for the Kronrod weights, taken in pairs
+#: of consecutive degrees, E_j = sqrt(c_(2j-1)^2 + c_(2j)^2) (so that an even or odd integrand's zeros do not read as
+#: convergence).  Where their largest ratio r = max E_(j+1) / E_j is at most DECAY_RCRIT (geometric or faster decay),
+#: the Kronrod rule's error, the coefficients from degree 32 on (it integrates degree 31 exactly), is estimated as
+#: DECAY_SAFETY E_top r^DECAY_STEPS: the last pair's size carried the six pairs from degree 20 to 32 at the slowest
+#: ratio seen, times a safety factor; else (slower decay: a singularity near the interval, a kink, rounding noise)
+#: QUADPACK's estimate stands.  r is never taken below rho^-2, rho the Bernstein ellipse through the nearest point where
+#: K or the weight is singular (:func:`_singular_ratio`): a small singular term's coefficients, hidden by
+#: faster-decaying ones up to degree 20, decay no faster than that (retro n = 10 at mu = 0.864, the level's break 3 % of
+#: the piece beyond its end: the coefficients' ratios 0.03, 0.09, 0.10 gave 1.6e-14 against a true 2.4e-14).  The
+#: smaller of the two estimates is taken, never below QUADPACK's floor 50 eps resabs.
+DECAY_LOW = 13  # (odd: :func:`_decay_ratio` pairs an odd degree with the next)
+DECAY_RCRIT = 0.5
+DECAY_STEPS = 6
+DECAY_SAFETY = 10.0
+#: QUADPACK's error of an interval at most DECAY_SHARE x rtol x (a lower bound of the integral) is kept as it is
+DECAY_SHARE = 0.1
+#: the ``mode`` that asks :func:`_integrate` for the sharper estimate (else QUADPACK's, :func:`calibrated`'s mode 1)
+DECAY_MODE = 3
+
+
+def _decay_rows(nodes: np.ndarray, wk: np.ndarray, low: int) -> np.ndarray:
+    """Rows low .. len(nodes) - 1 of the matrix taking a rule's values to their coefficients in the polynomials
+    orthonormal on [0, 1] for the discrete inner product sum_j wk_j f_j g_j (Legendre's, orthonormalised by a QR
+    factorisation: up to degree 15 they are the Legendre polynomials themselves, which the Kronrod rule integrates
+    exactly in pairs).
+    """
+    top = nodes.shape[0] - 1
+    vander = np.polynomial.legendre.legvander(2.0 * nodes - 1.0, top)
+    root = np.sqrt(wk)[:, None]
+    q, r = np.linalg.qr(root * vander)
+    q = q * np.sign(np.diag(r))
+    rows = np.ascontiguousarray((q * root).T[low:])
+    rows.flags.writeable = False
+    return rows
+
+
+#: :func:`_decay_rows` of the 21-point rule (8 x 21: degrees 13 .. 20)
+DECAY_ROWS = _decay_rows(NODES21, WK21, DECAY_LOW)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _decay_ratio(f, rows, half):  # pragma: no cover - compiled; see decay_error_reference
+    """(E_top, r) of the 21-point rule's values ``f`` (:data:`DECAY_ROWS`): the last pair's size and the largest ratio
+    of consecutive pairs (inf where a pair follows one that is 0).  The rule is symmetric, so a polynomial of odd degree
+    is odd about the middle and one of even degree even: the coefficients are sums over the 10 differences and the 11
+    sums f_j -+ f_(20-j) (``half``, 2 x 11, work space).
+    """
+    for j in range(10):
+        half[0, j] = f[j] - f[20 - j]
+        half[1, j] = f[j] + f[20 - j]
+    half[1, 10] = f[10]
+    r = 0.0
+    last = 0.0
+    for pair in range(rows.shape[0] // 2):
+        a = 0.0  # degree DECAY_LOW + 2 pair: odd
+        b = rows[2 * pair + 1, 10] * half[1, 10]
+        for j in range(10):
+            a += rows[2 * pair, j] * half[0, j]
+            b += rows[2 * pair + 1, j] * half[1, j]
+        e = math.sqrt(a * a + b * b)
+        if pair > 0:
+            if last > 0.0:
+                r = max(r, e / last)
+            elif e > 0.0:
+                r = math.inf
+        last = e
+    return last, r
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _rho_ratio(xr, xi, sm, t0, t1, reach):  # pragma: no cover - compiled; see decay_error_reference
+    """rho^-2 for the singular point x = xr + i xi (in the piece's variable before the smoothing ``sm``, the piece
+    [0, 1]) seen from the interval [t0, t1] of tau: rho is the Bernstein ellipse's parameter through the nearest
+    preimage of x under the smoothing (:func:`_smoothing`; 1.0 for sm = 3, whose preimages are not computed: no sharper
+    estimate).  0.0 where every preimage lies farther than ``reach`` half-lengths from the interval's centre (outside
+    the ellipse whose rho^-2 the caller already has), found without a square root.
+    """
+    if sm == 3:
+        return 1.0
+    c = 0.5 * (t0 + t1)
+    hl = 0.5 * (t1 - t0)
+    lim = reach * hl
+    # |preimage - c| >= (the preimages' common distance from the smoothed end) - (c's distance from it)
+    if sm == 0:
+        far = (xr - c) * (xr - c) + xi * xi > lim * lim
+    elif sm == 1:
+        far = xr * xr + xi * xi > (lim + c) ** 4
+    else:
+        far = (1.0 - xr) * (1.0 - xr) + xi * xi > (lim + 1.0 - c) ** 4
+    if far:
+        return 0.0
+    if xi == 0.0 and (sm == 0 or (sm == 1 and xr > 0.0) or (sm == 2 and xr < 1.0)):
+        # real preimages: rho = |y| + sqrt(y^2 - 1) for the nearer one (|y| > 1: the point is outside the interval)
+        if sm == 0:
+            y = abs(xr - c) / hl
+        elif sm == 1:
+            y = min(abs(math.sqrt(xr) - c), math.sqrt(xr) + c) / hl
+        else:
+            y = min(abs(1.0 - math.sqrt(1.0 - xr) - c), abs(1.0 + math.sqrt(1.0 - xr) - c)) / hl
+        if y <= 1.0:
+            return 1.0
+        rho = y + math.sqrt((y - 1.0) * (y + 1.0))
+        return 1.0 / (rho * rho)
+    x = complex(xr, xi)
+    out = 0.0
+    for branch in range(1 if sm == 0 else 2):
+        if sm == 0:
+            tau = x
+        elif sm == 1:
+            tau = cmath.sqrt(x) * (1.0 if branch == 0 else -1.0)
+        else:
+            tau = 1.0 - cmath.sqrt(1.0 - x) * (1.0 if branch == 0 else -1.0)
+        y = (tau - c) / hl
+        rho = abs(y + cmath.sqrt(y - 1.0) * cmath.sqrt(y + 1.0))
+        out = max(out, 1.0 / (rho * rho) if rho > 1.0 else 1.0)
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _singular_points(n, p, mu, c2, sing):  # pragma: no cover - compiled; see decay_error_reference
+    """Fill ``sing`` (4 x 6) with the points where frame 0's closed form K(u) (:func:`_k_closed`) or the weight is
+    singular: u = +-s (the horizon), +-1, c2 = cos(2 theta_i) (p = 1: the level N.wo = mu) and 0 (u^n, n not an
+    integer), row 0 (NaN where unused); rows 1-3 the same in z = -(n + 1) ln u: the real part, the imaginary step
+    (pi (n + 1) for u < 0, the points -(n + 1) (ln|u| +- i pi); 2 pi (n + 1) for u > 0, the images of the real z) and
+    1.0 where the real z itself is one (u > 0).
+    """
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    ls = math.log(s) if s > 0.0 else -math.inf  # (one logarithm for +-s, none for +-1)
+    for j in range(6):
+        u = s if j == 0 else (-s if j == 1 else (1.0 if j == 2 else (-1.0 if j == 3 else (c2 if j == 4 else 0.0))))
+        if (j == 4 and p != 1.0) or (j == 5 and n == math.floor(n)):
+            u = math.nan
+        sing[0, j] = u
+        if u == 0.0 or u != u:
+            sing[1, j], sing[2, j], sing[3, j] = math.nan, 0.0, 0.0
+            continue
+        lu = ls if j < 2 else (0.0 if j < 4 else math.log(abs(u)))
+        sing[1, j] = -(n + 1.0) * lu
+        sing[2, j] = (n + 1.0) * math.pi * (2.0 if u > 0.0 else 1.0)
+        sing[3, j] = 1.0 if u > 0.0 else 0.0
+
+
+@njit(cache=True, nogil=True)
+def _singular_ratio(kind, sm, v0, w, t0, t1, r0, sing):  # pragma: no cover - compiled; see decay_error_reference
+    """The largest rho^-2 (:func:`_rho_ratio`) above ``r0`` (else ``r0``) over the singular points ``sing``
+    (:func:`_singular_points`) in the piece's variable: u (kind 0) or z (kind 1).  Points on the piece's closed range
+    [0, 1] are its own ends: the singular side of a break there is the other piece's (or smoothed away).
+    """
+    worst = r0
+    reach = -1.0
+    for j in range(sing.shape[1]):
+        if reach < 0.0:  # the ellipse of rho^-2 = worst (again after worst grew)
+            big = 1.0 / math.sqrt(worst) if worst > 0.0 else math.inf
+            reach = 0.5 * (big + 1.0 / big)
+        last = worst
+        if kind == 0:
+            if sing[0, j] == sing[0, j]:
+                x = (sing[0, j] - v0) / w
+                if not 0.0 <= x <= 1.0:
+                    worst = max(worst, _rho_ratio(x, 0.0, sm, t0, t1, reach))
+            if worst > last:
+                reach = -1.0
+            continue
+        if sing[1, j] != sing[1, j]:
+            continue
+        xr = (sing[1, j] - v0) / w
+        step = sing[2, j] / w
+        if sing[3, j] > 0.0 and not 0.0 <= xr <= 1.0:
+            worst = max(worst, _rho_ratio(xr, 0.0, sm, t0, t1, reach))
+        worst = max(worst, _rho_ratio(xr, step, sm, t0, t1, reach))
+        worst = max(worst, _rho_ratio(xr, -step, sm, t0, t1, reach))
+        if worst > last:
+            reach = -1.0
+    return worst
+
+
+def singular_ratio_reference(kind: int, sm: int, n: float, p: float, mu: float, c2: float, v0: float, w: float,
+                             t0: float, t1: float) -> float:
+    """Plain Python twin of :func:`_singular_points` and :func:`_singular_ratio` (from r0 = 0): every point and every
+    preimage in complex arithmetic, none skipped.
+    """
+    s = math.sqrt((1.0 - mu) * (1.0 + mu))
+    us = [s, -s, 1.0, -1.0] + ([c2] if p == 1.0 else []) + ([0.0] if kind == 0 and n != math.floor(n) else [])
+    points = []
+    for u in us:
+        if kind == 0:
+            points.append(complex((u - v0) / w, 0.0))
+        elif u != 0.0:
+            z = -(n + 1.0) * math.log(abs(u))
+            ims = [0.0, 2.0 * math.pi, -2.0 * math.pi] if u > 0.0 else [math.pi, -math.pi]
+            points += [complex(z - v0, -(n + 1.0) * im) / w for im in ims]
+    worst = 0.0
+    for x in points:
+        if x.imag == 0.0 and 0.0 <= x.real <= 1.0:
+            continue
+        if sm == 3:
+            return 1.0
+        root = cmath.sqrt(x) if sm == 1 else cmath.sqrt(1.0 - x)
+        taus = {0: [x], 1: [root, -root], 2: [1.0 - root, 1.0 + root]}[sm]
+        for tau in taus:
+            y = (2.0 * tau - t0 - t1) / (t1 - t0)
+            q = cmath.sqrt(y - 1.0) * cmath.sqrt(y + 1.0)
+            rho = max(abs(y + q), abs(y - q))
+            worst = max(worst, 1.0 / rho**2 if rho > 1.0 else 1.0)
+    return worst
+
+
+def decay_error_reference(f: np.ndarray, rho_ratio: float = 0.0) -> float:
+    """Plain numpy twin of the sharper estimate (:func:`_decay_ratio`, per unit length) of the 21-point rule's values
+    ``f``, with rho^-2 = ``rho_ratio`` from the singular points (:func:`_singular_ratio`): inf where it does not apply.
+    """
+    c = DECAY_ROWS @ np.asarray(f, dtype=np.float64)
+    pairs = np.hypot(c[0::2], c[1::2])
+    r = rho_ratio
+    for lo, hi in zip(pairs[:-1], pairs[1:]):
+        if lo == 0.0 and hi > 0.0:
+            return math.inf
+        r = max(r, hi / lo if lo > 0.0 else 0.0)
+    return math.inf if r > DECAY_RCRIT else float(DECAY_SAFETY * pairs[-1] * r**DECAY_STEPS)
+
 
 @njit(cache=True, nogil=True)
 def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, buf, itol, inodes,  # pragma: no cover
@@ -189,6 +412,50 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
     # raised the total: fresnel over stretched Phong n = 0, eta 0.999, k 0.001 at mu = 1e-3 and rtol 1e-6 went from
     # 4.1e-8 to 3.0e-7 in 1000 bisections)
     return k * h, calibrated((diff + noise) * h, asc * h, ab * h, 2 if frame == 5 and mode == 1 else mode) + ie * h
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _gk_closed(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, buf, sing, half, drel, low_sum):  # pragma: no cover
+    """(K, error) of the 10/21 rule on [t0, t1] for frame 0's closed forms (p in {0, 1}, :func:`_k_closed`), the error
+    the smaller of QUADPACK's calibrated one and the one from the decay of the rule's coefficients
+    (:data:`DECAY_ROWS`, :func:`_decay_ratio`, :func:`_singular_ratio`; ``mode`` :data:`DECAY_MODE` of
+    :func:`_integrate`).  Inlined, with the rule's arrays as constants: :func:`_gk`'s call passes a dozen arrays, whose
+    reference counts cost about as much per interval as the sharper estimate saves.  Where QUADPACK's error is at most
+    ``drel`` times a lower bound of the integral (``low_sum``, the intervals' so far, or this one's value less its
+    error: the integrand is >= 0) the sharper one is not sought.
+    """
+    h = t1 - t0
+    for j in range(21):
+        u, um, sa, fac = _u_at(kind, sm, n, v0, w, cv1, t0 + h * NODES21[j])
+        buf[j] = _k_closed(p, mu, c2, u, um, sa)[0] * fac
+    k = 0.0
+    g = 0.0
+    ab = 0.0
+    for j in range(21):
+        k += WK21[j] * buf[j]
+        g += WG21[j] * buf[j]
+        ab += WK21[j] * abs(buf[j])
+    asc = 0.0
+    for j in range(21):
+        asc += WK21[j] * abs(buf[j] - k)
+    # QUADPACK's calibration (:func:`calibrated`, mode 1; t^1.5 as t sqrt(t))
+    diff = abs(k - g) * h
+    err = diff
+    if asc != 0.0 and diff != 0.0:
+        t = min(1.0, 200.0 * diff / (asc * h))
+        err = asc * h * t * math.sqrt(t)
+    low = FLOOR * EPS * ab * h
+    err = max(low, err)
+    if err > low and err > drel * max(low_sum, k * h - err):
+        top, r = _decay_ratio(buf, DECAY_ROWS, half)
+        if r <= DECAY_RCRIT and DECAY_SAFETY * top * r**DECAY_STEPS * h < err:
+            # no faster than the nearest singular point lets the coefficients decay
+            if sing[0, 0] != sing[0, 0]:  # (the points of this mu, once: row 0 starts as NaN)
+                _singular_points(n, p, mu, c2, sing)
+            r = _singular_ratio(kind, sm, v0, w, t0, t1, r, sing)
+            if r <= DECAY_RCRIT:
+                err = min(err, max(low, DECAY_SAFETY * top * r**DECAY_STEPS * h))
+    return k * h, err
 
 
 #: the peak variable z = -(n + 1) ln u runs at most to Z_MAX: below u = exp(-Z_MAX / (n + 1)) the
@@ -665,6 +932,8 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
     v0 = np.empty(PIECES_CAP)
     w = np.empty(PIECES_CAP)
     cv1 = np.empty(PIECES_CAP)
+    sing = np.empty((4, 6))
+    half = np.empty((2, 11))
     for q in range(mu_arr.shape[0]):
         mu = mu_arr[q]
         s = math.sqrt((1.0 - mu) * (1.0 + mu))
@@ -673,6 +942,7 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
         elif frame == 5:  # F(mu) and the arcs' cuts
             _lobe_f_prepare(mp, mu)
         npieces, c2, left_out = _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, cv1, mp)
+        sing[0, 0] = math.nan  # (:func:`_gk_closed` fills it where it needs it)
         # frame 4's inner rule may leave an absolute error iacc / (the node's factor) in K, iacc = itol times a lower
         # bound of the integral so far over the pieces' total length in tau: its share of the sum is then at most
         # itol times that bound (the integrand is >= 0; the errors are added to the estimate either way)
@@ -681,16 +951,27 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
             live += n_init if w[i] > 0.0 else 0
         acc = 0.0
         m = 0
-        for i in range(npieces):
-            if w[i] <= 0.0:
+        ev = 0
+        for ii in range(2 * npieces if mode == DECAY_MODE else npieces):
+            # (the closed forms' sharper estimate: the peak's pieces (kind 1) first, from u = 1 down, then the tail's,
+            # so that the pieces of a small share of the integral see the lower bound that decides whether they need
+            # it)
+            i = ii % npieces
+            if w[i] <= 0.0 or (mode == DECAY_MODE and (kinds[i] == 0) != (ii >= npieces)):
                 continue
             for j in range(n_init):
                 iacc = itol * acc / live
                 pk[m] = i
                 t0[m] = j / n_init
                 t1[m] = (j + 1.0) / n_init
-                kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes, wk,
-                                   wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
+                if mode == DECAY_MODE:
+                    ev += 21
+                    kv[m], ke[m] = _gk_closed(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], buf,
+                                              sing, half, DECAY_SHARE * rtol, acc)
+                else:
+                    ev += nodes.shape[0]
+                    kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], t0[m], t1[m], nodes,
+                                       wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
                 acc += max(kv[m] - ke[m], 0.0)
                 m += 1
         start = m
@@ -699,16 +980,24 @@ def _integrate(frame, radial, n, p, mu_arr, rtol, atol_arr, max_intervals, round
             if ok or m - start >= max_intervals or m >= cap:
                 break
             i, a_, mid, b_ = _bisect(pk, t0, t1, worst, m)
+            ev += 2 * nodes.shape[0]
             iacc = itol * max(tot - e, 0.0) / live
-            kv[worst], ke[worst] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes, wk,
-                                       wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
-            kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg, mode,
-                               buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
+            if mode == DECAY_MODE:
+                low_sum = max(tot - e, 0.0)
+                kv[worst], ke[worst] = _gk_closed(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, buf,
+                                                  sing, half, DECAY_SHARE * rtol, low_sum)
+                kv[m], ke[m] = _gk_closed(kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, buf, sing, half,
+                                          DECAY_SHARE * rtol, low_sum)
+            else:
+                kv[worst], ke[worst] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], a_, mid, nodes,
+                                           wk, wg, mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
+                kv[m], ke[m] = _gk(frame, kinds[i], sms[i], n, p, mu, c2, v0[i], w[i], cv1[i], mid, b_, nodes, wk, wg,
+                                   mode, buf, itol, inodes, iwk, iwg, ibuf, iwork, jac, mp, iacc)
             m += 1
         val[q] = tot
         err[q] = e + r
         conv[q] = ok
-        evals[q] = nodes.shape[0] * (m + (m - start))  # every split evaluates two halves
+        evals[q] = ev  # (every split evaluates two halves)
 
 _RULES = {"gk15": (_NODES, _WK, _WG), "gk21": (NODES21, WK21, WG21)}
 

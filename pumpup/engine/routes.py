@@ -66,13 +66,15 @@ class Choice:
     """Which routes the engine may take: ``engine`` one of :data:`ENGINES`; ``without``, route names left out (the
     tests' and calibrations' second route for a model); ``lobe_fresnel_gauss``: the ``lobe_fresnel`` route's arcs by
     Gauss-Legendre pieces with an a-priori bound, and Ashikhmin-Shirley's arcs on the ``half_arc`` route in closed form
-    (else both by the adaptive 7/15 rule); ``generic_check``: the 2-D cubature
-    checks a user function's kinks on a grid first.
+    (else both by the adaptive 7/15 rule); ``decay_estimate``: the ``lobe`` route's closed forms also estimate their
+    error from the decay of the rule's coefficients (:func:`pumpup.engine.polar.run`; else by QUADPACK's calibration
+    alone); ``generic_check``: the 2-D cubature checks a user function's kinks on a grid first.
     """
 
     engine: str = "auto"
     without: frozenset = frozenset()
     lobe_fresnel_gauss: bool = True
+    decay_estimate: bool = True
     generic_check: bool = True
 
     def allows(self, route: str) -> bool:
@@ -114,6 +116,7 @@ def using(engine: str | None = None, without=(), **options):
     new = Choice(engine=check_engine("using", engine) if engine is not None else old.engine,
                  without=old.without | frozenset(without),
                  lobe_fresnel_gauss=options.pop("lobe_fresnel_gauss", old.lobe_fresnel_gauss),
+                 decay_estimate=options.pop("decay_estimate", old.decay_estimate),
                  generic_check=options.pop("generic_check", old.generic_check))
     if options:
         raise TypeError(f"using: unknown options {sorted(options)}")

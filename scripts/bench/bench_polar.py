@@ -11,9 +11,9 @@ rounds in which every path runs once, alternating, so that they share the machin
 * the other models of frames 0-5 in ``scripts/bench/bench_revisions.py``.
 
 "old" is the same code with ``lobe_fresnel_gauss=False`` (Ashikhmin-Shirley's arcs by the adaptive 7/15 rule instead
-of their closed form, frame 5's arcs by that rule instead of Gauss-Legendre pieces), the path before issue 49's speed
-item; the other rows show that nothing else moved.  The values of old and new must agree within their summed
-estimates.
+of their closed form, frame 5's arcs by that rule instead of Gauss-Legendre pieces) and ``decay_estimate=False`` (the
+``lobe`` route's closed forms by QUADPACK's estimate alone, without the one from the decay of the rule's coefficients);
+the other rows show that nothing else moved.  The values of old and new must agree within their summed estimates.
 
     PYTHONPATH=. python scripts/bench/bench_polar.py [--rounds 15]
 """
@@ -113,7 +113,8 @@ def main():
             continue
         route = parts[0][0]
         paths = {
-            "old": lambda: _polar.run(route, hint, MU, RTOL, 0.0, 10000, lobe_fresnel_gauss=False),
+            "old": lambda: _polar.run(route, hint, MU, RTOL, 0.0, 10000, lobe_fresnel_gauss=False,
+                                      decay_estimate=False),
             "new": lambda: _polar.run(route, hint, MU, RTOL, 0.0, 10000),
         }
         floor_order = None
