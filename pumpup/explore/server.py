@@ -61,6 +61,40 @@ def plotly_js_path() -> str:
     return path
 
 
+def load_numba_registries() -> None:
+    """Load numba's CPU lowering registries (what its first compile or cache load does) without importing
+    ``scipy.linalg``.
+
+    numba.np.arraymath, one of those registries, checks at import that BLAS is there by importing
+    ``scipy.linalg.cython_blas``, which imports all of ``scipy.linalg`` (0.3 to 0.5 s, most of it scipy's array-API
+    layer importing ``numpy.f2py``).  pumpup's kernels call no BLAS.  Where scipy ships ``cython_blas`` (the check
+    would pass), the check is answered by an empty placeholder module for the time of that one import, and the
+    placeholder is removed before anything else can see it; numba imports the real module when a kernel that uses BLAS
+    is compiled or run.  Call it before any numba kernel runs and while no other thread imports scipy (the explorer
+    calls it first thing in its first computation); once the registries are loaded it does nothing.
+    """
+    import sys
+    import types
+
+    name = "scipy.linalg.cython_blas"
+    if "numba.np.arraymath" in sys.modules or name in sys.modules:
+        return
+    spec = importlib.util.find_spec("scipy")
+    if spec is None or not spec.submodule_search_locations:
+        return
+    folders = [os.path.join(p, "linalg") for p in spec.submodule_search_locations]
+    if not any(f.startswith("cython_blas.") and f.endswith((".so", ".pyd"))
+               for d in folders if os.path.isdir(d) for f in os.listdir(d)):
+        return  # no BLAS from scipy: numba's own check says so
+    placeholder = types.ModuleType(name)
+    sys.modules[name] = placeholder
+    try:
+        import numba.np.arraymath  # noqa: F401
+    finally:
+        if sys.modules.get(name) is placeholder:
+            del sys.modules[name]
+
+
 class Session:
     """One tab's connection: the generation of its newest request (nothing else is kept between requests)."""
 
@@ -119,6 +153,7 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
     def prefetch() -> None:
         with compute_lock:
             try:
+                load_numba_registries()
                 prefetched[state_key(first_state)] = C.compute(first_state, deadline=time.monotonic() + time_limit)
             except Exception:  # noqa: BLE001 - the page's own request reports any error
                 pass
