@@ -21,7 +21,7 @@ _GOLDEN = 0.5 * (3.0 - math.sqrt(5.0))
 
 
 def _sign(x: float) -> float:
-    """numpy's sign: -1, 0 or 1 (NaN for NaN)."""
+    """The sign as numpy gives it: -1, 0 or 1 (NaN for NaN)."""
     if x != x:
         return x
     return float(x > 0) - float(x < 0)

@@ -1,4 +1,4 @@
-"""pumpup.tables.brent.bounded_minimum takes scipy's bounded-Brent steps: the same point, value and calls, bit for bit."""
+"""pumpup.tables.brent.bounded_minimum takes scipy's bounded-Brent steps: the same point, value and calls."""
 
 from __future__ import annotations
 
