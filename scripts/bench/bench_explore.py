@@ -95,14 +95,19 @@ def start(root: str, browser, env: dict) -> tuple:
     context = browser.new_context(viewport={"width": 1400, "height": 1000})
     page = context.new_page()
     t0 = time.perf_counter()
+    # run in the checkout: ``python -m`` puts the working directory first on sys.path, before PYTHONPATH
     proc = subprocess.Popen([sys.executable, "-m", "pumpup.cli", "explore", "phong:n=20", "--port", "0",
-                             "--no-browser"], stdout=subprocess.PIPE, text=True, env=env)
+                             "--no-browser"], stdout=subprocess.PIPE, text=True, env=env, cwd=root)
     line = proc.stdout.readline()
     url = line.split()[2]
     t_listen = time.perf_counter() - t0
     page.goto(url)
     page.wait_for_function("window.explore && window.explore.ready", timeout=120_000)
-    return proc, url, page, t_listen, time.perf_counter() - t0
+    ready = time.perf_counter() - t0
+    with open(os.path.join(root, "pumpup", "explore", "static", "app.js"), encoding="utf-8") as fh:
+        if page.request.get(url + "static/app.js").text() != fh.read():
+            raise SystemExit(f"the explorer started for {root} serves another checkout's page")
+    return proc, url, page, t_listen, ready
 
 
 def open_case(page, url: str, query: str) -> None:
@@ -141,7 +146,7 @@ def main(argv=None) -> int:
         roots["old"] = os.path.abspath(args.baseline)
     # warm numba's cache for the cases (the target is for a warm kernel cache)
     for root in roots.values():
-        subprocess.run([sys.executable, "-m", "pumpup.cli", "warmup", "--quiet"], check=True,
+        subprocess.run([sys.executable, "-m", "pumpup.cli", "warmup", "--quiet"], check=True, cwd=root,
                        env=dict(os.environ, PYTHONPATH=root + os.pathsep + os.environ.get("PYTHONPATH", "")))
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=shutil.which("chromium"),

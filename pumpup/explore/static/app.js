@@ -97,7 +97,7 @@ function connect() {
   socket = new WebSocket(`${proto}//${location.host}/ws`);
   socket.onopen = () => { setStatus("connected"); if (pending) { socket.send(pending); pending = null; } };
   socket.onclose = () => { setStatus("disconnected: restart pumpup explore and reload"); };
-  socket.onmessage = (ev) => onAnswer(JSON.parse(ev.data));
+  socket.onmessage = (ev) => { explore.receivedAt = performance.now(); onAnswer(JSON.parse(ev.data)); };
 }
 
 function request() {
@@ -108,9 +108,10 @@ function request() {
     specs: st.specs, theta_i: st.theta_i, phi: st.phi, pump: st.pump, kulla_conty: st.kulla_conty,
     scaled: st.scaled, light: st.light, light_azimuth: st.light_azimuth, lobe3d: st.lobe3d}});
   if (socket && socket.readyState === WebSocket.OPEN) socket.send(msg); else pending = msg;
-  // the page's own bookkeeping runs while the server computes
+  // the page's own bookkeeping runs while the server computes; the status says "computing" only when the answer
+  // takes longer than a glance (a quick answer then changes the page once: one frame to draw, not two)
   writeURL();
-  setStatus("computing…");
+  setTimeout(() => { if (explore.drawnId < id && explore.sent === id) setStatus("computing…"); }, 250);
   return id;
 }
 
@@ -167,6 +168,8 @@ function onAnswer(ans) {
   explore.drawnId = ans.id;
   explore.drawn += 1;
   explore.lastMs = ms;
+  // when the request left, its answer arrived and the views were drawn (performance.now(), for the benchmark)
+  explore.timing = {sent: sentAt[ans.id], received: explore.receivedAt, drawn: performance.now()};
   explore.serverMs = ans.ms;
   document.body.dataset.drawn = String(explore.drawn);
   // the controls, links and URL in the same task as the views, so that one frame shows them all (only what
@@ -673,22 +676,37 @@ function drawAlbedo(r, table = true) {
 
 function drawNumbers(r) {
   const body = $("numbers").querySelector("tbody");
-  body.innerHTML = "";
+  const old = body.children;
+  let at = 0;  // rows are rewritten in place (only the text that changed), so the table is laid out only as needed
+  const row = (cls) => {
+    let tr = old[at];
+    if (!tr || tr.className !== cls) {
+      const fresh = document.createElement("tr");
+      fresh.className = cls;
+      if (tr) body.replaceChild(fresh, tr); else body.appendChild(fresh);
+      tr = fresh;
+    }
+    at += 1;
+    return tr;
+  };
   const rows = [];
   r.models.forEach((m, i) => {
     rows.push([label(m, i), m, COLOURS[i]]);
     for (const [k, o] of Object.entries(m.overlays || {})) rows.push([`${i + 1}: ${OVERLAY_NAME[k]}`, o, COLOURS[i]]);
   });
   rows.forEach(([name, m], k) => {
-    const tr = document.createElement("tr");
-    tr.dataset.row = k;
+    const tr = row(m.error ? "model error" : "model");
+    if (tr.dataset.row !== String(k)) tr.dataset.row = k;
+    let c = 0;
     const cell = (cls, text, value) => {
-      const td = document.createElement("td"); td.className = cls; td.textContent = text;
-      if (value !== undefined) td.dataset.value = String(value);
-      tr.appendChild(td);
+      let td = tr.children[c++];
+      if (!td) { td = document.createElement("td"); tr.appendChild(td); }
+      setIf(td, "className", cls); setIf(td, "textContent", text);
+      if (value !== undefined) { if (td.dataset.value !== String(value)) td.dataset.value = String(value); }
+      else delete td.dataset.value;
     };
     cell("name", name);
-    if (m.error) { cell("error", m.error); body.appendChild(tr); return; }
+    if (m.error) { cell("error", m.error); while (tr.children.length > c) tr.removeChild(tr.lastChild); return; }
     cell("mean-albedo", m.mean_albedo !== undefined ? m.mean_albedo.toPrecision(10) : "—", m.mean_albedo);
     const mc = m.max_constant;
     cell("max-constant", mc ? `${mc.name} ≤ ${mc.value.toPrecision(8)} (max a at ${mc.theta.toFixed(2)}°)` : "—",
@@ -696,15 +714,14 @@ function drawNumbers(r) {
     cell("max-albedo", m.albedo && !m.albedo.error ? m.albedo.max.toPrecision(10) : "—", m.albedo ? m.albedo.max : undefined);
     const spans = m.albedo && m.albedo.above_one ? m.albedo.above_one : [];
     cell("above-one", spans.length ? spans.map(([a, b]) => `${a.toFixed(1)}–${b.toFixed(1)}°`).join(", ") : "nowhere");
-    body.appendChild(tr);
+    while (tr.children.length > c) tr.removeChild(tr.lastChild);
     for (const note of m.notes || []) {
-      const nr = document.createElement("tr");
-      nr.className = "note";
-      const td = document.createElement("td");
-      td.colSpan = 5; td.textContent = "note: " + note;
-      nr.appendChild(td); body.appendChild(nr);
+      const nr = row("note");
+      if (!nr.firstChild) { const td = document.createElement("td"); td.colSpan = 5; nr.appendChild(td); }
+      setIf(nr.firstChild, "textContent", "note: " + note);
     }
   });
+  while (body.children.length > at) body.removeChild(body.lastChild);
 }
 
 function decode64(text) {
