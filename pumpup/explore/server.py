@@ -3,8 +3,9 @@
 Routes
 ------
 ``GET /``
-    The page (``static/index.html``), its script and style (``/static/...``) and plotly.js, served from the
-    installed ``plotly`` package (``plotly/package_data/plotly.min.js``): nothing is fetched from elsewhere.
+    The page (``static/index.html``), its script and style (``/static/...``) and plotly.js (which the page loads
+    for the 3-D lobe only), served from the installed ``plotly`` package (``plotly/package_data/plotly.min.js``):
+    nothing is fetched from elsewhere.
 ``GET /api/models``
     The registered models and their parameters (:func:`pumpup.explore.compute.model_catalog`).
 ``WS /ws``
@@ -139,8 +140,8 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
 
     lock = threading.Lock()
     compute_lock = threading.Lock()
-    # the page's first request, computed while the page loads plotly.js (numba's kernels load from its cache on
-    # first use): the answer waits here for the page's identical first request
+    # the page's first request, computed while the page loads (numba's kernels load from its cache on first use):
+    # the answer waits here for the page's identical first request
     first_state = {"specs": initial or [DEFAULT_SPEC]}
     prefetched: dict[str, Any] = {}
 
