@@ -133,8 +133,8 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
         initial.append(C.short_spec(C.check_spec(s).spec))
     if len(initial) > C.MAX_COMPARE:
         raise SpecError(f"pumpup explore: at most {C.MAX_COMPARE} specs, got {len(initial)}")
-    with open(plotly_js_path(), "rb") as fh:  # sent in one piece: no file reads that wait for the GIL
-        plotly_js = fh.read()
+    plotly_path = plotly_js_path()  # (an ImportError before the server starts if plotly is missing)
+    plotly_js: list[bytes] = []  # read on its first request (the 3-D lobe), then sent in one piece from memory
     pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="pumpup-explore")
     catalog: dict[str, Any] = {}
 
@@ -174,7 +174,10 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
     async def static(request):
         name = request.path_params["name"]
         if name == "plotly.min.js":  # 4.8 MB that never changes while the server runs: the browser keeps it
-            return Response(plotly_js, media_type="text/javascript",
+            if not plotly_js:
+                with open(plotly_path, "rb") as fh:
+                    plotly_js.append(fh.read())
+            return Response(plotly_js[0], media_type="text/javascript",
                             headers={"Cache-Control": "max-age=86400, immutable"})
         if name not in ("app.js", "app.css"):
             return PlainTextResponse("not found", status_code=404)
