@@ -669,7 +669,7 @@ function drawAlbedo(r, table = true) {
     let best = 0;
     for (let k = 1; k < a0.theta.length; k++) if (Math.abs(a0.theta[k] - t) < Math.abs(a0.theta[best] - t)) best = k;
     return `θi ${a0.theta[best].toFixed(2)}°: ` + curves.map(([a], c) =>
-      `${entries[c][0].split(":")[0]}: a = ${a.a[best].toPrecision(10)}` + (a.err ? ` ± ${a.err[best].toPrecision(2)}` : "")).join(" · ");
+      `${entries[c][0]}: a = ${a.a[best].toPrecision(10)}` + (a.err ? ` ± ${a.err[best].toPrecision(2)}` : "")).join(" · ");
   };
   if (table) drawNumbers(r);
 }
