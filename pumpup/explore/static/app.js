@@ -790,7 +790,6 @@ function drawSlice(r) {
   images.forEach((im) => { if (im) for (const v of im) if (v > zmax) zmax = v; });
   const cmin = st.log ? Math.log10(Math.max(zmax, 1e-30)) - 4 : 0;
   const cmax = st.log ? Math.log10(Math.max(zmax, 1e-30)) : zmax;
-  explore.sliceScale = {cmin, cmax, log: st.log};
   r.models.forEach((m, i) => {
     let panel = box.children[i];
     if (!panel) {
