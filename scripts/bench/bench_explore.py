@@ -1,7 +1,7 @@
 """Benchmark of ``pumpup explore`` in headless chromium: slider release to every view redrawn, and page-ready time.
 
     python scripts/bench/bench_explore.py [--moves 20] [--cases phong,ggx,...] [--baseline DIR] [--ready-runs N]
-                                          [--no-bytecode]
+                                          [--no-bytecode] [--software-compositing]
 
 Targets (issue 54): from a slider release to every view redrawn (lobe, albedo with its table, spheres, slice), over
 20 moves: the Phong family under 100 ms, every other built-in model under 300 ms, a 3-level pumped model under
@@ -18,6 +18,11 @@ playwright and Debian's chromium.  The load average is printed first.
 The views are the lobe, the albedo plot with its table of numbers, the spheres and the image slice (and the 3-D lobe
 when it is on); the page updates its status line, URL, download links and code lines in the same task, so the same
 frame shows them.
+
+The browser is headless chromium with WebGL on SwiftShader (``--use-angle=swiftshader``), which also composites the
+page through SwiftShader's GL: on a loaded CPU that costs tens of milliseconds per frame, which a GPU does in one or
+two.  ``--software-compositing`` adds ``--disable-gpu-compositing`` (chromium's software compositor, as on a machine
+without a usable GPU; WebGL still runs on SwiftShader), which shows the page's own part of a move.
 
 Before measuring, each checkout's kernels are compiled (``pumpup warmup``) and its Python modules byte-compiled
 (``compileall``), as an installed or once-run pumpup has them; ``--no-bytecode`` removes the bytecode instead and sets
@@ -145,6 +150,10 @@ def main(argv=None) -> int:
     ap.add_argument("--no-bytecode", action="store_true",
                     help="remove pumpup's cached bytecode (__pycache__/*.pyc) of each checkout first and write none, "
                          "so that every start compiles pumpup's modules from source")
+    ap.add_argument("--software-compositing", action="store_true",
+                    help="chromium composites the page in software (--disable-gpu-compositing), as it does on a "
+                         "machine without a usable GPU, instead of through SwiftShader's GL (WebGL still runs on "
+                         "SwiftShader)")
     args = ap.parse_args(argv)
     if args.no_bytecode:
         os.environ["PYTHONDONTWRITEBYTECODE"] = "1"
@@ -170,8 +179,11 @@ def main(argv=None) -> int:
     print(f"Python bytecode: {'compiled from source at every start (--no-bytecode)' if args.no_bytecode else 'cached'}"
           f"{' (PYTHONDONTWRITEBYTECODE is set)' if os.environ.get('PYTHONDONTWRITEBYTECODE') else ''}")
     with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=shutil.which("chromium"),
-                                    args=["--use-angle=swiftshader", "--enable-unsafe-swiftshader"])
+        flags = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+        if args.software_compositing:
+            flags.append("--disable-gpu-compositing")
+        print(f"chromium: {' '.join(flags)}")
+        browser = p.chromium.launch(executable_path=shutil.which("chromium"), args=flags)
         running: dict[str, tuple] = {}
         try:
             ready: dict[str, list] = {k: [] for k in roots}
