@@ -341,7 +341,9 @@ def _anisotropy(f) -> float:
     from .core import direction_set
 
     d = direction_set(8, 8)
-    wi, wo = d[:, None, :], d[None, :, :]
+    # every pair spelled out (arrays of one shape): the model's row kernel, not its broadcasting ufunc, whose first
+    # call builds a wrapper (the values are the same)
+    wi, wo = (np.ascontiguousarray(a) for a in np.broadcast_arrays(d[:, None, :], d[None, :, :]))
     f0 = np.asarray(f._eval(wi, wo), dtype=np.float64)
     worst = 0.0
     for psi in (0.7, 2.1, 4.0):

@@ -803,7 +803,9 @@ class _Plan:
             raise _unsupported(b, f"inside {brdf.type!r}: one operator over a closed-form model is supported")
         if b.type not in _MODELS or not isinstance(b, BRDF) or getattr(b, "fn", None) is not None:
             raise _unsupported(b)
-        if np.ndim(b.eval(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0]))) != 0:
+        # (1, 3) arrays, not single vectors: the model's row kernel, which is loaded anyway, rather than its
+        # broadcasting ufunc, whose first call builds a wrapper (0.15 s)
+        if np.shape(b.eval(np.array([[0.0, 0.0, 1.0]]), np.array([[0.0, 0.0, 1.0]]))) != (1,):
             raise _unsupported(b, "spectral or multi-channel")
         self.base = b
         self.baked = bool(self.levels) or self.comp is not None

@@ -87,18 +87,21 @@ def _phi_numeric(mp, mu, u, c0, d):  # pragma: no cover - compiled; see numeric_
 
 
 def _w_series(kmax: int = 6, terms: int = 24) -> np.ndarray:
-    """Row k: the Taylor coefficients of (sin(y) / y)^(2k) in y^(2m), m < ``terms`` (exact rationals, then floats), for
-    :func:`_w_moments`' series.
-    """
-    from fractions import Fraction
+    """Row k: the Taylor coefficients of (sin(y) / y)^(2k) in y^(2m), m < ``terms`` (exact, then each rounded once to
+    a float), for :func:`_w_moments`' series.
 
-    sinc = [Fraction((-1) ** m, math.factorial(2 * m + 1)) for m in range(terms)]  # sin(y) / y in y^(2m)
+    The series are multiplied in integers: with D = (2 terms - 1)!, D (sin(y) / y) has integer coefficients
+    (-1)^m D / (2m + 1)!, so row k is an integer series over D^(2k); Python's int / int rounds correctly.
+    """
+    d = math.factorial(2 * terms - 1)
+    sinc = [(-1) ** m * (d // math.factorial(2 * m + 1)) for m in range(terms)]  # D sin(y) / y in y^(2m)
     out = np.zeros((kmax + 1, terms))
-    power = [Fraction(1)] + [Fraction(0)] * (terms - 1)
+    power, scale = [1] + [0] * (terms - 1), 1
     for k in range(kmax + 1):
-        out[k] = [float(x) for x in power]
+        out[k] = [x / scale for x in power]
         for _ in range(2):  # times (sin(y) / y)^2
             power = [sum(power[i] * sinc[m - i] for i in range(m + 1)) for m in range(terms)]
+            scale *= d
     return out
 
 

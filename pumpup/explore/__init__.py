@@ -1,7 +1,8 @@
 """``pumpup explore``: look at a BRDF, its albedo, and what pumping and compensation do to it, live in the browser.
 
-A local web application (Starlette served by uvicorn; plotly.js from the installed ``plotly`` package; the lit sphere
-in WebGL 2): nothing is fetched from the network at run time.  Needs the ``explore`` extra
+A local web application (Starlette served by uvicorn; the plots drawn on the page's own canvases; plotly.js from the
+installed ``plotly`` package for the 3-D lobe; the lit sphere in WebGL 2): nothing is fetched from the network at run
+time.  Needs the ``explore`` extra
 (``pip install 'pumpup[explore]'``).
 
 >>> from pumpup.explore import compute

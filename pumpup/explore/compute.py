@@ -282,7 +282,9 @@ def lobe_curve(f: BRDF, theta_i: float, phi: float = 0.0) -> dict:
     t = lobe_angles(theta_i)
     tr, p = np.radians(t), math.radians(phi)
     wo = np.stack([-np.sin(tr) * math.cos(p), -np.sin(tr) * math.sin(p), np.cos(tr)], axis=-1)
-    wi = incidence(theta_i, phi)
+    # wi repeated on every row: the model's row kernel, not its broadcasting ufunc (whose first call builds a
+    # wrapper; the values are the same)
+    wi = np.ascontiguousarray(np.broadcast_to(incidence(theta_i, phi), wo.shape))
     fr = np.asarray(f.eval(wi, wo), dtype=np.float64)
     return {"theta_o": _floats(t), "value": _floats(fr * np.cos(tr))}  # f_r cos(theta_o), 000 eq. 2's integrand
 

@@ -3,8 +3,9 @@
 Routes
 ------
 ``GET /``
-    The page (``static/index.html``), its script and style (``/static/...``) and plotly.js, served from the
-    installed ``plotly`` package (``plotly/package_data/plotly.min.js``): nothing is fetched from elsewhere.
+    The page (``static/index.html``), its script and style (``/static/...``) and plotly.js (which the page loads
+    for the 3-D lobe only), served from the installed ``plotly`` package (``plotly/package_data/plotly.min.js``):
+    nothing is fetched from elsewhere.
 ``GET /api/models``
     The registered models and their parameters (:func:`pumpup.explore.compute.model_catalog`).
 ``WS /ws``
@@ -61,6 +62,40 @@ def plotly_js_path() -> str:
     return path
 
 
+def load_numba_registries() -> None:
+    """Load numba's CPU lowering registries (what its first compile or cache load does) without importing
+    ``scipy.linalg``.
+
+    numba.np.arraymath, one of those registries, checks at import that BLAS is there by importing
+    ``scipy.linalg.cython_blas``, which imports all of ``scipy.linalg`` (0.3 to 0.5 s, most of it scipy's array-API
+    layer importing ``numpy.f2py``).  pumpup's kernels call no BLAS.  Where scipy ships ``cython_blas`` (the check
+    would pass), the check is answered by an empty placeholder module for the time of that one import, and the
+    placeholder is removed before anything else can see it; numba imports the real module when a kernel that uses BLAS
+    is compiled or run.  Call it before any numba kernel runs and while no other thread imports scipy (the explorer
+    calls it first thing in its first computation); once the registries are loaded it does nothing.
+    """
+    import sys
+    import types
+
+    name = "scipy.linalg.cython_blas"
+    if "numba.np.arraymath" in sys.modules or name in sys.modules:
+        return
+    spec = importlib.util.find_spec("scipy")
+    if spec is None or not spec.submodule_search_locations:
+        return
+    folders = [os.path.join(p, "linalg") for p in spec.submodule_search_locations]
+    if not any(f.startswith("cython_blas.") and f.endswith((".so", ".pyd"))
+               for d in folders if os.path.isdir(d) for f in os.listdir(d)):
+        return  # no BLAS from scipy: numba's own check says so
+    placeholder = types.ModuleType(name)
+    sys.modules[name] = placeholder
+    try:
+        import numba.np.arraymath  # noqa: F401
+    finally:
+        if sys.modules.get(name) is placeholder:
+            del sys.modules[name]
+
+
 class Session:
     """One tab's connection: the generation of its newest request (nothing else is kept between requests)."""
 
@@ -98,15 +133,15 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
         initial.append(C.short_spec(C.check_spec(s).spec))
     if len(initial) > C.MAX_COMPARE:
         raise SpecError(f"pumpup explore: at most {C.MAX_COMPARE} specs, got {len(initial)}")
-    with open(plotly_js_path(), "rb") as fh:  # sent in one piece: no file reads that wait for the GIL
-        plotly_js = fh.read()
+    plotly_path = plotly_js_path()  # (an ImportError before the server starts if plotly is missing)
+    plotly_js: list[bytes] = []  # read on its first request (the 3-D lobe), then sent in one piece from memory
     pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="pumpup-explore")
     catalog: dict[str, Any] = {}
 
     lock = threading.Lock()
     compute_lock = threading.Lock()
-    # the page's first request, computed while the page loads plotly.js (numba's kernels load from its cache on
-    # first use): the answer waits here for the page's identical first request
+    # the page's first request, computed while the page loads (numba's kernels load from its cache on first use):
+    # the answer waits here for the page's identical first request
     first_state = {"specs": initial or [DEFAULT_SPEC]}
     prefetched: dict[str, Any] = {}
 
@@ -119,6 +154,7 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
     def prefetch() -> None:
         with compute_lock:
             try:
+                load_numba_registries()
                 prefetched[state_key(first_state)] = C.compute(first_state, deadline=time.monotonic() + time_limit)
             except Exception:  # noqa: BLE001 - the page's own request reports any error
                 pass
@@ -138,7 +174,10 @@ def create_app(initial_specs: list[str] | None = None, *, time_limit: float = TI
     async def static(request):
         name = request.path_params["name"]
         if name == "plotly.min.js":  # 4.8 MB that never changes while the server runs: the browser keeps it
-            return Response(plotly_js, media_type="text/javascript",
+            if not plotly_js:
+                with open(plotly_path, "rb") as fh:
+                    plotly_js.append(fh.read())
+            return Response(plotly_js[0], media_type="text/javascript",
                             headers={"Cache-Control": "max-age=86400, immutable"})
         if name not in ("app.js", "app.css"):
             return PlainTextResponse("not found", status_code=404)

@@ -31,6 +31,7 @@ from ..core.budget import current as current_budget
 from ..core.budget import time_budget
 from ..engine.cubature import DEFAULT_ATOL, DEFAULT_RTOL, albedo, check_mu
 from . import reuse as _reuse
+from .brent import bounded_minimum
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -1064,7 +1065,8 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
     """Locate the maximum of a(mu) over [mu_min, 1] with the model's constant set to 1.
 
     A scan uniform in theta (plus decades of mu down to ``mu_min``) finds the best node;
-    a bounded Brent search (scipy ``minimize_scalar``) between its neighbours refines it.
+    a bounded Brent search between its neighbours refines it (:func:`pumpup.tables.brent.bounded_minimum`, the
+    steps of scipy's ``minimize_scalar(method="bounded")``).
 
     Where the albedo peaks at ``mu_min``, four more decades below it are probed: an albedo that keeps growing there
     as a power of mu (Ward's, a ~ mu^-0.5) has no maximum, and the result says so (``diverges``, with the exponent;
@@ -1078,8 +1080,6 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
     >>> m.diverges, m.constant, round(m.exponent, 3)
     (True, 0.0, 0.5)
     """
-    from scipy.optimize import minimize_scalar
-
     _check_brdf("max_albedo", brdf)
     mu_min = check_open_unit("max_albedo", "mu_min", mu_min)
     n_scan = check_count("max_albedo", "n_scan", n_scan, 3, 10**6)
@@ -1102,9 +1102,9 @@ def max_albedo(brdf: BRDF, *, mu_min: float = 1e-6, n_scan: int = 91, rtol: floa
         def neg(m):
             return -float(albedo(f, m, rtol=rtol))
 
-        res = minimize_scalar(neg, bounds=(lo, hi), method="bounded", options={"xatol": 1e-9 * hi})
-        if -res.fun > best_a:
-            best_mu = float(res.x)
+        x, fx, _ = bounded_minimum(neg, lo, hi, xatol=1e-9 * hi)
+        if -fx > best_a:
+            best_mu = float(x)
             best_a, best_e = (float(v) for v in albedo(f, best_mu, return_error=True, rtol=rtol))
         elif scan is not None:  # the table's value was computed at its own tolerance
             best_a, best_e = (float(v) for v in albedo(f, best_mu, return_error=True, rtol=rtol))

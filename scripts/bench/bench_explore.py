@@ -1,6 +1,7 @@
 """Benchmark of ``pumpup explore`` in headless chromium: slider release to every view redrawn, and page-ready time.
 
     python scripts/bench/bench_explore.py [--moves 20] [--cases phong,ggx,...] [--baseline DIR] [--ready-runs N]
+                                          [--no-bytecode] [--software-compositing]
 
 Targets (issue 54): from a slider release to every view redrawn (lobe, albedo with its table, spheres, slice), over
 20 moves: the Phong family under 100 ms, every other built-in model under 300 ms, a 3-level pumped model under
@@ -17,6 +18,15 @@ playwright and Debian's chromium.  The load average is printed first.
 The views are the lobe, the albedo plot with its table of numbers, the spheres and the image slice (and the 3-D lobe
 when it is on); the page updates its status line, URL, download links and code lines in the same task, so the same
 frame shows them.
+
+The browser is headless chromium with WebGL on SwiftShader (``--use-angle=swiftshader``), which also composites the
+page through SwiftShader's GL: on a loaded CPU that costs tens of milliseconds per frame, which a GPU does in one or
+two.  ``--software-compositing`` adds ``--disable-gpu-compositing`` (chromium's software compositor, as on a machine
+without a usable GPU; WebGL still runs on SwiftShader), which shows the page's own part of a move.
+
+Before measuring, each checkout's kernels are compiled (``pumpup warmup``) and its Python modules byte-compiled
+(``compileall``), as an installed or once-run pumpup has them; ``--no-bytecode`` removes the bytecode instead and sets
+PYTHONDONTWRITEBYTECODE, so that every start compiles pumpup's modules from source (about 0.5 s of CPU).
 
 ``--baseline DIR`` runs a second explorer from another checkout (``git archive main | tar -x -C DIR``) in the same
 browser and alternates the two move by move and start by start, so that both see the same load; the last columns are
@@ -95,14 +105,19 @@ def start(root: str, browser, env: dict) -> tuple:
     context = browser.new_context(viewport={"width": 1400, "height": 1000})
     page = context.new_page()
     t0 = time.perf_counter()
+    # run in the checkout: ``python -m`` puts the working directory first on sys.path, before PYTHONPATH
     proc = subprocess.Popen([sys.executable, "-m", "pumpup.cli", "explore", "phong:n=20", "--port", "0",
-                             "--no-browser"], stdout=subprocess.PIPE, text=True, env=env)
+                             "--no-browser"], stdout=subprocess.PIPE, text=True, env=env, cwd=root)
     line = proc.stdout.readline()
     url = line.split()[2]
     t_listen = time.perf_counter() - t0
     page.goto(url)
     page.wait_for_function("window.explore && window.explore.ready", timeout=120_000)
-    return proc, url, page, t_listen, time.perf_counter() - t0
+    ready = time.perf_counter() - t0
+    with open(os.path.join(root, "pumpup", "explore", "static", "app.js"), encoding="utf-8") as fh:
+        if page.request.get(url + "static/app.js").text() != fh.read():
+            raise SystemExit(f"the explorer started for {root} serves another checkout's page")
+    return proc, url, page, t_listen, ready
 
 
 def open_case(page, url: str, query: str) -> None:
@@ -132,20 +147,43 @@ def main(argv=None) -> int:
                          "-C DIR): its explorer is measured too, alternating with this one's, move by move")
     ap.add_argument("--ready-runs", type=int, default=1,
                     help="page-ready measurements per checkout (alternating with --baseline); the median is printed")
+    ap.add_argument("--no-bytecode", action="store_true",
+                    help="remove pumpup's cached bytecode (__pycache__/*.pyc) of each checkout first and write none, "
+                         "so that every start compiles pumpup's modules from source")
+    ap.add_argument("--software-compositing", action="store_true",
+                    help="chromium composites the page in software (--disable-gpu-compositing), as it does on a "
+                         "machine without a usable GPU, instead of through SwiftShader's GL (WebGL still runs on "
+                         "SwiftShader)")
     args = ap.parse_args(argv)
+    if args.no_bytecode:
+        os.environ["PYTHONDONTWRITEBYTECODE"] = "1"
     from playwright.sync_api import sync_playwright
 
     print(f"load average: {os.getloadavg()[0]:.2f} (1 min), {os.cpu_count()} cores")
     roots = {"new": ROOT}
     if args.baseline:
         roots["old"] = os.path.abspath(args.baseline)
-    # warm numba's cache for the cases (the target is for a warm kernel cache)
+    # warm numba's cache for the cases (the target is for a warm kernel cache), and Python's bytecode cache, which an
+    # installed or once-imported pumpup has (unless PYTHONDONTWRITEBYTECODE is set, when every start compiles
+    # pumpup's modules from source: --no-bytecode measures that)
     for root in roots.values():
-        subprocess.run([sys.executable, "-m", "pumpup.cli", "warmup", "--quiet"], check=True,
+        if args.no_bytecode:
+            for folder, _, files in os.walk(os.path.join(root, "pumpup")):
+                for name in files:
+                    if name.endswith(".pyc"):
+                        os.remove(os.path.join(folder, name))
+        subprocess.run([sys.executable, "-m", "pumpup.cli", "warmup", "--quiet"], check=True, cwd=root,
                        env=dict(os.environ, PYTHONPATH=root + os.pathsep + os.environ.get("PYTHONPATH", "")))
+        if not args.no_bytecode:
+            subprocess.run([sys.executable, "-m", "compileall", "-q", os.path.join(root, "pumpup")], check=True)
+    print(f"Python bytecode: {'compiled from source at every start (--no-bytecode)' if args.no_bytecode else 'cached'}"
+          f"{' (PYTHONDONTWRITEBYTECODE is set)' if os.environ.get('PYTHONDONTWRITEBYTECODE') else ''}")
     with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=shutil.which("chromium"),
-                                    args=["--use-angle=swiftshader", "--enable-unsafe-swiftshader"])
+        flags = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+        if args.software_compositing:
+            flags.append("--disable-gpu-compositing")
+        print(f"chromium: {' '.join(flags)}")
+        browser = p.chromium.launch(executable_path=shutil.which("chromium"), args=flags)
         running: dict[str, tuple] = {}
         try:
             ready: dict[str, list] = {k: [] for k in roots}

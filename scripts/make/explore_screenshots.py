@@ -30,7 +30,7 @@ SHOTS = {
     "albedo": ({"s": ["phong:n=20", "ggx:alpha=0.5"], "pump": "g2:3", "kc": "1"}, "#albedo"),
     "spheres": ({"s": ["phong:n=20", "ggx:alpha=0.3", '{"type": "phong", "n": 20, "c": 6}'], "light": "40",
                  "laz": "30"}, "#spheres"),
-    "slice": ({"s": ["phong:n=20", "ggx:alpha=0.3"], "log": "1"}, "#slice"),
+    "slice": ({"s": ["phong:n=20", "ggx:alpha=0.3"], "log": "1"}, ".slice-row"),
 }
 
 

@@ -219,3 +219,24 @@ def test_lobe_surface_is_f_cos_over_the_hemisphere():
     wi = np.array([np.sin(np.radians(35.0)), 0.0, np.cos(np.radians(35.0))])
     assert v[7, 40] == float(f.eval(wi, wo)) * np.cos(t)
     assert "lobe3d" not in C.compute({"specs": ["ward:m=0.2"]})["models"][0]
+
+
+def test_first_answer_imports_neither_scipy_linalg_nor_scipy_optimize():
+    """The server's first answer loads numba's registries without scipy.linalg (load_numba_registries) and computes
+    max_constant without scipy.optimize; afterwards a kernel that calls BLAS still compiles and runs, through the real
+    scipy.linalg.cython_blas."""
+    pytest.importorskip("starlette")
+    code = """
+import sys
+from pumpup.explore import compute as C, server
+server.load_numba_registries()
+r = C.compute({"specs": ["phong:n=20"]})
+assert r["models"][0]["max_constant"]["value"] > 0
+print([m for m in ("scipy.linalg", "scipy.optimize") if m in sys.modules])
+import numba, numpy as np
+dot = numba.njit(lambda a, b: np.dot(a, b))
+print(dot(np.arange(3.0), np.arange(3.0)), hasattr(sys.modules["scipy.linalg.cython_blas"], "__pyx_capi__"))
+"""
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.split("\n")[:2] == ["[]", "5.0 True"], r.stdout

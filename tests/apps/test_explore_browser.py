@@ -209,8 +209,21 @@ def test_compare_shares_axes_and_downloads(chromium, server):
     r = p.result()
     assert [m["input"]["type"] for m in r["models"]] == ["phong", "stretched_phong", "ggx"]
     assert p.page.locator("#spheres .sphere-pair").count() == 3
-    # the three image slices share one colour axis
-    assert p.page.evaluate("document.getElementById('slice').data.every(t => t.coloraxis === 'coloraxis')")
+    # the three image slices share one colour axis: each panel's pixels are its values on the scale from 0 to the
+    # largest value of all three, which the colour bar shows (a panel on a scale of its own would reach the top
+    # colour at its own maximum, which is below half the shared one for at least one of them)
+    datas = [np.frombuffer(base64.b64decode(m["slice"]["data"]), "<f8") for m in r["models"]]
+    top = max(float(d.max()) for d in datas)
+    assert min(float(d.max()) for d in datas) < 0.5 * top
+    assert float(p.page.get_attribute("#slice-scale", "data-cmax")) == top
+    assert float(p.page.get_attribute("#slice-scale", "data-cmin")) == 0.0
+    for i, d in enumerate(datas):
+        n = r["models"][i]["slice"]["n"]
+        px = np.array(p.page.evaluate(f"""() => Array.from(document.getElementById('slice-{i}').getContext('2d')
+            .getImageData(0, 0, {n}, {n}).data)""")).reshape(n, n, 4)[::-1]  # canvas rows from the top: theta_d up
+        want = p.page.evaluate("([v, top]) => v.map((x) => window.explore.viridis(x, 0, top))", [d.tolist(), top])
+        np.testing.assert_array_equal(px[..., :3].reshape(-1, 3), np.array(want), err_msg=f"panel {i}")
+        assert (px[..., 3] == 255).all()
     spec = json.dumps({"type": "ggx", "alpha": 0.3})
     got = p.page.request.get(server + "download/spec.json", params={"spec": spec})
     assert got.ok and json.loads(got.body()) == pumpup.load(spec).spec

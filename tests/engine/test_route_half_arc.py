@@ -244,6 +244,21 @@ def _as_samples(rng, n):
             yield float(mu), rs, float(rng.uniform(1e-3, 1.0))
 
 
+def test_w_series_is_the_exact_series_rounded_once():
+    """_w_series (integer arithmetic) equals the Taylor coefficients of (sin(y) / y)^(2k) computed in exact rationals
+    term by term, each rounded once to a float."""
+    from fractions import Fraction
+
+    kmax, terms = 6, _half_arc.W_TERMS
+    sinc = [Fraction((-1) ** m, math.factorial(2 * m + 1)) for m in range(terms)]
+    power = [Fraction(1)] + [Fraction(0)] * (terms - 1)
+    got = _half_arc._w_series(kmax, terms)
+    for k in range(kmax + 1):
+        assert got[k].tolist() == [float(x) for x in power], k
+        for _ in range(2):
+            power = [sum(power[i] * sinc[m - i] for i in range(m + 1)) for m in range(terms)]
+
+
 def test_w_moments_against_mpmath():
     """W_k(x) = integral_0^x sin^(2k)(t / 2) dt (the series, the Fourier form and the downward recurrence of
     _w_moments) against 150-digit mpmath's Fourier form (which cancels by x^-12 at small x), from x = 1e-6 to pi and

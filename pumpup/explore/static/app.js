@@ -97,7 +97,7 @@ function connect() {
   socket = new WebSocket(`${proto}//${location.host}/ws`);
   socket.onopen = () => { setStatus("connected"); if (pending) { socket.send(pending); pending = null; } };
   socket.onclose = () => { setStatus("disconnected: restart pumpup explore and reload"); };
-  socket.onmessage = (ev) => onAnswer(JSON.parse(ev.data));
+  socket.onmessage = (ev) => { explore.receivedAt = performance.now(); onAnswer(JSON.parse(ev.data)); };
 }
 
 function request() {
@@ -108,22 +108,31 @@ function request() {
     specs: st.specs, theta_i: st.theta_i, phi: st.phi, pump: st.pump, kulla_conty: st.kulla_conty,
     scaled: st.scaled, light: st.light, light_azimuth: st.light_azimuth, lobe3d: st.lobe3d}});
   if (socket && socket.readyState === WebSocket.OPEN) socket.send(msg); else pending = msg;
-  // the page's own bookkeeping runs while the server computes
+  // the page's own bookkeeping runs while the server computes; the status says "computing" only when the answer
+  // takes longer than a glance (a quick answer then changes the page once: one frame to draw, not two)
   writeURL();
-  setStatus("computing…");
+  setTimeout(() => { if (explore.drawnId < id && explore.sent === id) setStatus("computing…"); }, 250);
   return id;
 }
 
-// plotly.js (4.6 MB) loads while the first views are computed; drawing waits for it
-const plotlyReady = new Promise((resolve) => {
-  if (window.Plotly) { resolve(); return; }
-  const tag = document.getElementById("plotly-js");
-  tag.addEventListener("load", () => resolve());
-  tag.addEventListener("error", () => showMessage("plotly.js did not load from the server"));
-});
+// plotly.js (4.8 MB, served by pumpup from the installed plotly package) draws the 3-D lobe only: it is loaded the
+// first time that view is turned on
+let plotlyLoading = null;
+
+function loadPlotly() {
+  if (!plotlyLoading) {
+    plotlyLoading = new Promise((resolve, reject) => {
+      const tag = document.createElement("script");
+      tag.src = "/static/plotly.min.js";
+      tag.onload = () => resolve();
+      tag.onerror = () => { showMessage("plotly.js did not load from the server"); reject(new Error("plotly.js")); };
+      document.head.appendChild(tag);
+    });
+  }
+  return plotlyLoading;
+}
 
 function onAnswer(ans) {
-  if (!window.Plotly) { plotlyReady.then(() => onAnswer(ans)); return; }
   if (ans.cancelled) return;
   if (ans.id !== null && ans.id !== explore.sent) return;  // an older answer: a newer request is on its way
   if (!ans.ok) {
@@ -159,6 +168,8 @@ function onAnswer(ans) {
   explore.drawnId = ans.id;
   explore.drawn += 1;
   explore.lastMs = ms;
+  // when the request left, its answer arrived and the views were drawn (performance.now(), for the benchmark)
+  explore.timing = {sent: sentAt[ans.id], received: explore.receivedAt, drawn: performance.now()};
   explore.serverMs = ans.ms;
   document.body.dataset.drawn = String(explore.drawn);
   // the controls, links and URL in the same task as the views, so that one frame shows them all (only what
@@ -407,87 +418,295 @@ function lightMoved() {
 }
 
 // ---------------------------------------------------------------------------------------------------------------
-// Plots
+// Plots: the lobe, the albedo and the image slice are drawn on the page's own canvases (a redraw is a few
+// milliseconds of 2-D drawing, and no plotting library has to load before the page is ready); plotly.js is loaded
+// only for the 3-D lobe
 // ---------------------------------------------------------------------------------------------------------------
-
-const PLOT_CONFIG = {displaylogo: false, responsive: true};
 
 function label(m, i) {
   const text = m.short.length > 44 ? m.short.slice(0, 42) + "…" : m.short;
   return `${i + 1}: ${text}`;
 }
 
-function drawLobe(r) {
-  const st = explore.state;
-  const traces = [];
-  let rmax = 0;
-  const clean = (v) => (st.log ? v.map((x) => (x > 0 ? x : null)) : v);
-  r.models.forEach((m, i) => {
-    if (m.lobe.error) return;
-    rmax = Math.max(rmax, ...m.lobe.value);
-    traces.push({type: "scatterpolar", mode: "lines", theta: m.lobe.theta_o, r: clean(m.lobe.value),
-                 name: label(m, i), line: {color: COLOURS[i], width: 2}});
-    for (const [k, o] of Object.entries(m.overlays || {})) {
-      if (!o.lobe || o.lobe.error) continue;
-      rmax = Math.max(rmax, ...o.lobe.value);
-      traces.push({type: "scatterpolar", mode: "lines", theta: o.lobe.theta_o, r: clean(o.lobe.value),
-                   name: `${i + 1}: ${OVERLAY_NAME[k]}`, line: {color: COLOURS[i], width: 1.5, dash: OVERLAY_DASH[k]}});
-    }
-  });
-  traces.push({type: "scatterpolar", mode: "lines", theta: [-st.theta_i, -st.theta_i], r: [st.log ? rmax * 1e-6 : 0, rmax || 1],
-               name: "light", line: {color: "#888", dash: "dot"}, hoverinfo: "skip"});
-  const layout = {margin: {l: 30, r: 30, t: 20, b: 20}, showlegend: true, legend: {orientation: "h"},
-                  polar: {sector: [0, 180], angularaxis: {rotation: 90, direction: "clockwise", dtick: 15},
-                          radialaxis: {type: st.log ? "log" : "linear", exponentformat: "power",
-                                       // log: four decades below the largest value
-                                       range: st.log && rmax > 0 ? [Math.log10(rmax) - 4, Math.log10(rmax) + 0.05] : undefined}}};
-  Plotly.react("lobe", traces, layout, PLOT_CONFIG);
+const DASH = {solid: [], dash: [7, 4], dot: [2, 3], dashdot: [7, 3, 2, 3]};
+const FONT = "11px system-ui, sans-serif";
+
+// the CSS size of each plot box, kept by a ResizeObserver (a redraw does not read the layout)
+const boxSize = {};
+const resized = new ResizeObserver((entries) => {
+  let changed = false;
+  for (const e of entries) {
+    const w = Math.round(e.contentRect.width), h = Math.round(e.contentRect.height);
+    const old = boxSize[e.target.id];
+    if (!old || old[0] !== w || old[1] !== h) { boxSize[e.target.id] = [w, h]; changed = true; }
+  }
+  if (changed) {
+    const r = explore.result || {models: []};
+    drawLobe(r); drawAlbedo(r, false);
+  }
+});
+
+// the plot box's canvas, sized to the box (device pixels), cleared, with a context in CSS pixels
+function plotCanvas(id) {
+  const box = $(id);
+  let c = box.firstElementChild;
+  if (!c) {
+    c = document.createElement("canvas");
+    box.appendChild(c);
+    resized.observe(box);
+    hover(box, c);
+  }
+  if (!boxSize[id]) boxSize[id] = [box.clientWidth, box.clientHeight];
+  const [w, h] = boxSize[id];
+  const dpr = window.devicePixelRatio || 1;
+  const W = Math.max(1, Math.round(w * dpr)), H = Math.max(1, Math.round(h * dpr));
+  if (c.width !== W || c.height !== H) { c.width = W; c.height = H; c.style.width = `${w}px`; c.style.height = `${h}px`; }
+  const ctx = c.getContext("2d");
+  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  ctx.clearRect(0, 0, w, h);
+  ctx.font = FONT;
+  return {ctx, w, h, canvas: c};
 }
 
-function drawAlbedo(r) {
+// about n round numbers from lo to hi (steps of 1, 2 or 5 times a power of ten)
+function niceTicks(lo, hi, n) {
+  const span = hi - lo;
+  if (!(span > 0) || !isFinite(span)) return [lo];
+  const raw = span / n, mag = Math.pow(10, Math.floor(Math.log10(raw))), f = raw / mag;
+  const step = (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * mag;
+  const out = [];
+  for (let k = Math.ceil(lo / step - 1e-9); k * step <= hi + 1e-9 * step; k++) out.push(k * step);
+  return out;
+}
+
+function tickText(v) {
+  if (v === 0) return "0";
+  const a = Math.abs(v);
+  return a >= 1e4 || a < 1e-3 ? v.toExponential(0).replace("e+", "e") : String(parseFloat(v.toPrecision(6)));
+}
+
+function strokePath(ctx, pts, colour, width, dash) {
+  ctx.strokeStyle = colour; ctx.lineWidth = width; ctx.setLineDash(DASH[dash || "solid"]);
+  ctx.beginPath();
+  let pen = false;
+  for (const p of pts) {
+    if (p === null) { pen = false; continue; }
+    if (pen) ctx.lineTo(p[0], p[1]); else { ctx.moveTo(p[0], p[1]); pen = true; }
+  }
+  ctx.stroke();
+  ctx.setLineDash([]);
+}
+
+// a legend in rows across the top of a plot: [name, colour, width, dash]
+function drawLegend(ctx, entries, x0, y0, w) {
+  let x = x0, y = y0;
+  ctx.textAlign = "left"; ctx.textBaseline = "middle";
+  for (const [name, colour, width, dash] of entries) {
+    const tw = 26 + ctx.measureText(name).width + 14;
+    if (x + tw > x0 + w && x > x0) { x = x0; y += 15; }
+    strokePath(ctx, [[x, y], [x + 20, y]], colour, width, dash);
+    ctx.fillStyle = "#333"; ctx.fillText(name, x + 25, y);
+    x += tw;
+  }
+  return y + 10;
+}
+
+// what the page shows under the pointer: each plot sets plotHover[id] = (x, y) -> text or null
+const plotHover = {};
+
+function hover(box, canvas) {
+  const tip = document.createElement("div");
+  tip.className = "tip"; tip.hidden = true;
+  box.appendChild(tip);
+  canvas.addEventListener("mousemove", (ev) => {
+    const f = plotHover[box.id];
+    const rect = canvas.getBoundingClientRect();
+    const x = ev.clientX - rect.left, y = ev.clientY - rect.top;
+    const text = f ? f(x, y) : null;
+    if (!text) { tip.hidden = true; return; }
+    tip.textContent = text; tip.hidden = false;
+    tip.style.left = `${Math.min(x + 12, rect.width - 200)}px`; tip.style.top = `${y + 12}px`;
+  });
+  canvas.addEventListener("mouseleave", () => { tip.hidden = true; });
+}
+
+// the lobe in the plane of incidence, f_r cos(theta_o): a half disc, theta_o = 0 (the normal) up, the mirror side
+// (theta_o > 0) right, the light (-theta_i) a grey dotted spoke
+function drawLobe(r) {
   const st = explore.state;
-  const traces = [], shapes = [];
+  const {ctx, w, h} = plotCanvas("lobe");
+  const curves = [];
+  r.models.forEach((m, i) => {
+    if (m.lobe && !m.lobe.error) curves.push([label(m, i), m.lobe, COLOURS[i], 2, "solid"]);
+    for (const [k, o] of Object.entries(m.overlays || {})) {
+      if (o.lobe && !o.lobe.error) curves.push([`${i + 1}: ${OVERLAY_NAME[k]}`, o.lobe, COLOURS[i], 1.5, OVERLAY_DASH[k]]);
+    }
+  });
+  let rmax = 0;
+  for (const c of curves) for (const v of c[1].value) if (v > rmax) rmax = v;
+  const legend = curves.map(([name, , colour, width, dash]) => [name, colour, width, dash]);
+  const top = drawLegend(ctx, legend.concat([["light", "#888", 1, "dot"]]), 10, 10, w - 20);
+  const cx = w / 2, cy = h - 22;
+  const R = Math.max(10, Math.min(w / 2 - 34, cy - top - 14));
+  // the radial scale: linear from 0 to a round number >= the largest value, or four decades below it (log)
+  let toR, ticks, lo = 0, hi = 1;
+  if (st.log) {
+    hi = rmax > 0 ? Math.log10(rmax) + 0.05 : 0; lo = hi - 4.05;
+    toR = (v) => (v > 0 ? R * Math.max(0, (Math.log10(v) - lo) / (hi - lo)) : null);
+    ticks = [];
+    for (let k = Math.ceil(lo); k <= hi; k++) ticks.push(Math.pow(10, k));
+  } else {
+    const t = niceTicks(0, rmax > 0 ? rmax : 1, 4);
+    hi = t[t.length - 1] < rmax ? t[t.length - 1] + (t[1] - t[0]) : t[t.length - 1];
+    if (hi < rmax || !(hi > 0)) hi = rmax > 0 ? rmax : 1;
+    toR = (v) => R * Math.max(0, v) / hi;
+    ticks = niceTicks(0, hi, 4).filter((v) => v > 0);
+  }
+  const at = (deg, rad) => [cx + rad * Math.sin(deg * Math.PI / 180), cy - rad * Math.cos(deg * Math.PI / 180)];
+  // grid: half circles at the radial ticks, spokes every 15 degrees
+  ctx.strokeStyle = "#e2e4ea"; ctx.lineWidth = 1;
+  for (const v of ticks) { const rr = toR(v); ctx.beginPath(); ctx.arc(cx, cy, rr, Math.PI, 2 * Math.PI); ctx.stroke(); }
+  ctx.fillStyle = "#555"; ctx.textAlign = "center"; ctx.textBaseline = "middle";
+  for (let d = -90; d <= 90; d += 15) {
+    const [x, y] = at(d, R);
+    ctx.strokeStyle = d === 0 ? "#c8ccd6" : "#e2e4ea";
+    ctx.beginPath(); ctx.moveTo(cx, cy); ctx.lineTo(x, y); ctx.stroke();
+    const [lx, ly] = at(d, R + 14);
+    ctx.fillText(`${d}°`, lx, ly);
+  }
+  ctx.strokeStyle = "#9aa0ad"; ctx.beginPath(); ctx.arc(cx, cy, R, Math.PI, 2 * Math.PI); ctx.stroke();
+  ctx.textBaseline = "top";
+  for (const v of ticks) ctx.fillText(tickText(v), cx + toR(v), cy + 4);
+  // the light, then the curves
+  strokePath(ctx, [at(-st.theta_i, 0), at(-st.theta_i, R)], "#888", 1, "dot");
+  ctx.save();
+  ctx.beginPath(); ctx.rect(0, 0, w, cy + 1); ctx.clip();
+  for (const [, lobe, colour, width, dash] of curves) {
+    const pts = lobe.theta_o.map((t, k) => { const rr = toR(lobe.value[k]); return rr === null ? null : at(t, rr); });
+    strokePath(ctx, pts, colour, width, dash);
+  }
+  ctx.restore();
+  plotHover.lobe = (x, y) => {
+    if (!curves.length) return null;
+    const t = Math.atan2(x - cx, cy - y) * 180 / Math.PI;
+    if (!(Math.abs(t) < 90) || Math.hypot(x - cx, y - cy) > R + 8) return null;
+    return `θo ${t.toFixed(1)}°: ` + curves.map(([name, lobe]) => {
+      let best = 0;
+      for (let k = 1; k < lobe.theta_o.length; k++) if (Math.abs(lobe.theta_o[k] - t) < Math.abs(lobe.theta_o[best] - t)) best = k;
+      return `${name} ${lobe.value[best].toPrecision(4)}`;
+    }).join(" · ");
+  };
+}
+
+// the directional albedo a(theta_i) with its error band, the overlays, where a > 1 (red) and the line a = 1;
+// then the table of numbers (only when ``table``)
+function drawAlbedo(r, table = true) {
+  const st = explore.state;
+  const {ctx, w, h} = plotCanvas("albedo");
+  const entries = [], curves = [];
+  let ylo = Infinity, yhi = -Infinity;
   r.models.forEach((m, i) => {
     const a = m.albedo;
     if (!a || a.error) return;
-    const up = a.a.map((v, k) => v + a.err[k]), lo = a.a.map((v, k) => v - a.err[k]);
-    traces.push({x: a.theta, y: up, mode: "lines", line: {width: 0}, showlegend: false, hoverinfo: "skip"});
-    traces.push({x: a.theta, y: lo, mode: "lines", line: {width: 0}, fill: "tonexty",
-                 fillcolor: COLOURS[i] + "55", name: `${i + 1}: error band`, showlegend: false, hoverinfo: "skip"});
-    traces.push({x: a.theta, y: a.a, mode: "lines", name: label(m, i), line: {color: COLOURS[i], width: 2},
-                 customdata: a.err, hovertemplate: "θi %{x:.2f}°: a = %{y:.10g} ± %{customdata:.2g}<extra></extra>"});
+    a.a.forEach((v, k) => { ylo = Math.min(ylo, v - a.err[k]); yhi = Math.max(yhi, v + a.err[k]); });
+    entries.push([label(m, i), COLOURS[i], 2, "solid"]);
+    curves.push([a, COLOURS[i], 2, "solid", true]);
     for (const [k, o] of Object.entries(m.overlays || {})) {
       if (!o.albedo || o.albedo.error) continue;
-      traces.push({x: o.albedo.theta, y: o.albedo.a, mode: "lines", name: `${i + 1}: ${OVERLAY_NAME[k]}`,
-                   line: {color: COLOURS[i], width: 1.5, dash: OVERLAY_DASH[k]}});
-    }
-    for (const [t0, t1] of a.above_one) {
-      shapes.push({type: "rect", xref: "x", yref: "paper", x0: t0 - 0.5, x1: t1 + 0.5, y0: 0, y1: 1,
-                   fillcolor: "#ff000022", line: {width: 0}});
+      o.albedo.a.forEach((v) => { ylo = Math.min(ylo, v); yhi = Math.max(yhi, v); });
+      entries.push([`${i + 1}: ${OVERLAY_NAME[k]}`, COLOURS[i], 1.5, OVERLAY_DASH[k]]);
+      curves.push([o.albedo, COLOURS[i], 1.5, OVERLAY_DASH[k], false]);
     }
   });
-  shapes.push({type: "line", xref: "paper", x0: 0, x1: 1, y0: 1, y1: 1, line: {color: "#a00", dash: "dot", width: 1}});
-  shapes.push({type: "line", xref: "x", yref: "paper", x0: st.theta_i, x1: st.theta_i, y0: 0, y1: 1,
-               line: {color: "#888", dash: "dot", width: 1}});
-  Plotly.react("albedo", traces, {margin: {l: 50, r: 10, t: 10, b: 40}, shapes, legend: {orientation: "h"},
-    xaxis: {title: {text: "θi (degrees)"}, range: [0, 90]}, yaxis: {title: {text: "a(θi)"}}}, PLOT_CONFIG);
+  ylo = Math.min(ylo, 1); yhi = Math.max(yhi, 1);  // the line a = 1 is always in view
+  if (!isFinite(ylo)) { ylo = 0; yhi = 1; }
+  const pad = 0.05 * (yhi - ylo || 1);
+  ylo -= pad; yhi += pad;
+  const top = entries.length ? drawLegend(ctx, entries, 55, 10, w - 65) : 10;
+  const L = 55, Rr = w - 10, T = top + 4, B = h - 38;
+  const X = (t) => L + (Rr - L) * t / 90, Y = (v) => B - (B - T) * (v - ylo) / (yhi - ylo);
+  ctx.fillStyle = "#ff000022";
+  for (const m of r.models) {
+    if (!m.albedo || m.albedo.error) continue;
+    for (const [t0, t1] of m.albedo.above_one) ctx.fillRect(X(t0 - 0.5), T, X(t1 + 0.5) - X(t0 - 0.5), B - T);
+  }
+  // axes and grid
+  ctx.strokeStyle = "#e2e4ea"; ctx.lineWidth = 1; ctx.fillStyle = "#555";
+  ctx.textAlign = "center"; ctx.textBaseline = "top";
+  for (let t = 0; t <= 90; t += 15) {
+    ctx.beginPath(); ctx.moveTo(X(t), T); ctx.lineTo(X(t), B); ctx.stroke();
+    ctx.fillText(String(t), X(t), B + 4);
+  }
+  ctx.textAlign = "right"; ctx.textBaseline = "middle";
+  for (const v of niceTicks(ylo, yhi, 5)) {
+    ctx.beginPath(); ctx.moveTo(L, Y(v)); ctx.lineTo(Rr, Y(v)); ctx.stroke();
+    ctx.fillText(tickText(v), L - 5, Y(v));
+  }
+  ctx.strokeStyle = "#9aa0ad"; ctx.strokeRect(L, T, Rr - L, B - T);
+  ctx.textAlign = "center"; ctx.textBaseline = "bottom";
+  ctx.fillText("θi (degrees)", (L + Rr) / 2, h - 2);
+  ctx.save(); ctx.translate(12, (T + B) / 2); ctx.rotate(-Math.PI / 2); ctx.textBaseline = "middle";
+  ctx.fillText("a(θi)", 0, 0); ctx.restore();
+  strokePath(ctx, [[L, Y(1)], [Rr, Y(1)]], "#a00", 1, "dot");
+  strokePath(ctx, [[X(st.theta_i), T], [X(st.theta_i), B]], "#888", 1, "dot");
+  ctx.save();
+  ctx.beginPath(); ctx.rect(L, T, Rr - L, B - T); ctx.clip();
+  for (const [a, colour, width, dash, band] of curves) {
+    if (band) {  // the error band: a +- err
+      ctx.fillStyle = colour + "55";
+      ctx.beginPath();
+      a.theta.forEach((t, k) => ctx.lineTo(X(t), Y(a.a[k] + a.err[k])));
+      for (let k = a.theta.length - 1; k >= 0; k--) ctx.lineTo(X(a.theta[k]), Y(a.a[k] - a.err[k]));
+      ctx.closePath(); ctx.fill();
+    }
+    strokePath(ctx, a.theta.map((t, k) => [X(t), Y(a.a[k])]), colour, width, dash);
+  }
+  ctx.restore();
+  plotHover.albedo = (x, y) => {
+    if (!curves.length || x < L || x > Rr || y < T || y > B) return null;
+    const t = 90 * (x - L) / (Rr - L);
+    const a0 = curves[0][0];
+    let best = 0;
+    for (let k = 1; k < a0.theta.length; k++) if (Math.abs(a0.theta[k] - t) < Math.abs(a0.theta[best] - t)) best = k;
+    return `θi ${a0.theta[best].toFixed(2)}°: ` + curves.map(([a], c) =>
+      `${entries[c][0]}: a = ${a.a[best].toPrecision(10)}` + (a.err ? ` ± ${a.err[best].toPrecision(2)}` : "")).join(" · ");
+  };
+  if (table) drawNumbers(r);
+}
+
+function drawNumbers(r) {
   const body = $("numbers").querySelector("tbody");
-  body.innerHTML = "";
+  const old = body.children;
+  let at = 0;  // rows are rewritten in place (only the text that changed), so the table is laid out only as needed
+  const row = (cls) => {
+    let tr = old[at];
+    if (!tr || tr.className !== cls) {
+      const fresh = document.createElement("tr");
+      fresh.className = cls;
+      if (tr) body.replaceChild(fresh, tr); else body.appendChild(fresh);
+      tr = fresh;
+    }
+    at += 1;
+    return tr;
+  };
   const rows = [];
   r.models.forEach((m, i) => {
     rows.push([label(m, i), m, COLOURS[i]]);
     for (const [k, o] of Object.entries(m.overlays || {})) rows.push([`${i + 1}: ${OVERLAY_NAME[k]}`, o, COLOURS[i]]);
   });
   rows.forEach(([name, m], k) => {
-    const tr = document.createElement("tr");
-    tr.dataset.row = k;
+    const tr = row(m.error ? "model error" : "model");
+    if (tr.dataset.row !== String(k)) tr.dataset.row = k;
+    let c = 0;
     const cell = (cls, text, value) => {
-      const td = document.createElement("td"); td.className = cls; td.textContent = text;
-      if (value !== undefined) td.dataset.value = String(value);
-      tr.appendChild(td);
+      let td = tr.children[c++];
+      if (!td) { td = document.createElement("td"); tr.appendChild(td); }
+      setIf(td, "className", cls); setIf(td, "textContent", text);
+      if (value !== undefined) { if (td.dataset.value !== String(value)) td.dataset.value = String(value); }
+      else delete td.dataset.value;
     };
     cell("name", name);
-    if (m.error) { cell("error", m.error); body.appendChild(tr); return; }
+    if (m.error) { cell("error", m.error); while (tr.children.length > c) tr.removeChild(tr.lastChild); return; }
     cell("mean-albedo", m.mean_albedo !== undefined ? m.mean_albedo.toPrecision(10) : "—", m.mean_albedo);
     const mc = m.max_constant;
     cell("max-constant", mc ? `${mc.name} ≤ ${mc.value.toPrecision(8)} (max a at ${mc.theta.toFixed(2)}°)` : "—",
@@ -495,15 +714,14 @@ function drawAlbedo(r) {
     cell("max-albedo", m.albedo && !m.albedo.error ? m.albedo.max.toPrecision(10) : "—", m.albedo ? m.albedo.max : undefined);
     const spans = m.albedo && m.albedo.above_one ? m.albedo.above_one : [];
     cell("above-one", spans.length ? spans.map(([a, b]) => `${a.toFixed(1)}–${b.toFixed(1)}°`).join(", ") : "nowhere");
-    body.appendChild(tr);
+    while (tr.children.length > c) tr.removeChild(tr.lastChild);
     for (const note of m.notes || []) {
-      const nr = document.createElement("tr");
-      nr.className = "note";
-      const td = document.createElement("td");
-      td.colSpan = 5; td.textContent = "note: " + note;
-      nr.appendChild(td); body.appendChild(nr);
+      const nr = row("note");
+      if (!nr.firstChild) { const td = document.createElement("td"); td.colSpan = 5; nr.appendChild(td); }
+      setIf(nr.firstChild, "textContent", "note: " + note);
     }
   });
+  while (body.children.length > at) body.removeChild(body.lastChild);
 }
 
 function decode64(text) {
@@ -523,46 +741,6 @@ function sameInputs(view, key) {
   return old !== undefined && old.length === key.length && old.every((v, k) => v === key[k]);
 }
 
-function drawSlice(r) {
-  const st = explore.state;
-  if (sameInputs("slice", [st.log, ...r.models.map((m) => (m.slice ? m.slice.data || m.slice.error : null))])) return;
-  const traces = [];
-  const n = r.models.length;
-  let zmax = 0;
-  const images = r.models.map((m) => (m.slice && !m.slice.error ? decode64(m.slice.data) : null));
-  images.forEach((im) => { if (im) for (const v of im) if (v > zmax) zmax = v; });
-  r.models.forEach((m, i) => {
-    const im = images[i];
-    if (!im) return;
-    const k = m.slice.n, z = [];
-    for (let row = 0; row < k; row++) {
-      const line = im.subarray(row * k, row * k + k);
-      z.push(st.log ? Array.from(line, (v) => (v > 0 ? Math.log10(v) : null)) : line);
-    }
-    const ax = i === 0 ? "" : String(i + 1);
-    // pixel centres on a uniform grid (x0, dx): plotly draws one image of n x n pixels, scaled without smoothing
-    const a = m.slice.axis, d = a.length > 1 ? a[1] - a[0] : 90;
-    traces.push({type: "heatmap", x0: a[0], dx: d, y0: a[0], dy: d, z, zsmooth: "fast", coloraxis: "coloraxis",
-                 xaxis: "x" + ax, yaxis: "y" + ax, name: label(m, i),
-                 hovertemplate: "θh %{x:.1f}°, θd %{y:.1f}°: %{z:.4g}<extra>" + label(m, i) + "</extra>"});
-  });
-  const cmin = st.log ? Math.log10(Math.max(zmax, 1e-30)) - 4 : 0;
-  const cmax = st.log ? Math.log10(Math.max(zmax, 1e-30)) : zmax;
-  // the colour bar is drawn beside the plot (drawColourBar): plotly's own redraws its ticks and margins at every
-  // move, which costs more than the image
-  const layout = {margin: {l: 45, r: 10, t: 25, b: 40}, grid: {rows: 1, columns: n, pattern: "independent"},
-    coloraxis: {colorscale: VIRIDIS, cmin, cmax, showscale: false},
-    annotations: r.models.map((m, i) => ({text: n > 1 ? String(i + 1) : label(m, i), showarrow: false, xref: `x${i ? i + 1 : ""} domain`,
-                                         yref: `y${i ? i + 1 : ""} domain`, x: 0.5, y: 1.08, font: {color: COLOURS[i]}}))};
-  for (let i = 0; i < n; i++) {
-    const ax = i === 0 ? "" : String(i + 1);
-    layout["xaxis" + ax] = {title: {text: "θh (°)"}, range: [0, 90]};
-    layout["yaxis" + ax] = {title: {text: i === 0 ? "θd (°)" : ""}, range: [0, 90], matches: i ? "y" : undefined};
-  }
-  Plotly.react("slice", traces, layout, PLOT_CONFIG);
-  drawColourBar($("slice-scale"), cmin, cmax, st.log ? "log10 fr" : "fr");
-}
-
 // plotly's Viridis
 const VIRIDIS = [[0, "#440154"], [0.06274509803921569, "#48186a"], [0.12549019607843137, "#472d7b"],
   [0.18823529411764706, "#424086"], [0.25098039215686274, "#3b528b"], [0.3137254901960784, "#33638d"],
@@ -570,6 +748,95 @@ const VIRIDIS = [[0, "#440154"], [0.06274509803921569, "#48186a"], [0.1254901960
   [0.5647058823529412, "#1fa088"], [0.6274509803921569, "#28ae80"], [0.6901960784313725, "#3fbc73"],
   [0.7529411764705882, "#5ec962"], [0.8156862745098039, "#84d44b"], [0.8784313725490196, "#addc30"],
   [0.9411764705882353, "#d8e219"], [1, "#fde725"]];
+
+// Viridis in 256 steps: entry k is the colour of t = k / 255, interpolated linearly in RGB between the stops
+const VIRIDIS_LUT = (() => {
+  const rgb = VIRIDIS.map(([t, c]) => [t, [1, 3, 5].map((o) => parseInt(c.slice(o, o + 2), 16))]);
+  const out = [];
+  for (let k = 0; k < 256; k++) {
+    const t = k / 255;
+    let j = 0;
+    while (j < rgb.length - 2 && rgb[j + 1][0] < t) j++;
+    const [t0, c0] = rgb[j], [t1, c1] = rgb[j + 1];
+    const u = Math.min(1, Math.max(0, (t - t0) / (t1 - t0)));
+    out.push(c0.map((v, q) => Math.round(v + u * (c1[q] - v))));
+  }
+  return out;
+})();
+
+// the colour of z on the scale [cmin, cmax] (null: no value, drawn transparent)
+function viridis(z, cmin, cmax) {
+  if (z === null || !isFinite(z)) return null;
+  const t = cmax > cmin ? (z - cmin) / (cmax - cmin) : 0;
+  return VIRIDIS_LUT[Math.round(255 * Math.min(1, Math.max(0, t)))];
+}
+explore.viridis = viridis;
+
+// the colour bar spans the height of the first panel's image
+const sliceResized = new ResizeObserver((entries) => {
+  for (const e of entries) setIf($("slice-scale").style, "height", `${Math.round(e.contentRect.height) + 60}px`);
+});
+
+// the image slice f_r(theta_h, theta_d): one panel per model, every panel on one colour scale (the bar beside
+// them); a panel is an n x n canvas, one pixel per value (theta_d up, theta_h right), scaled without smoothing
+function drawSlice(r) {
+  const st = explore.state;
+  if (sameInputs("slice", [st.log, ...r.models.map((m) => (m.slice ? m.slice.data || m.slice.error : null))])) return;
+  const box = $("slice");
+  const n = r.models.length;
+  while (box.children.length > n) box.removeChild(box.lastChild);
+  let zmax = 0;
+  const images = r.models.map((m) => (m.slice && !m.slice.error ? decode64(m.slice.data) : null));
+  images.forEach((im) => { if (im) for (const v of im) if (v > zmax) zmax = v; });
+  const cmin = st.log ? Math.log10(Math.max(zmax, 1e-30)) - 4 : 0;
+  const cmax = st.log ? Math.log10(Math.max(zmax, 1e-30)) : zmax;
+  r.models.forEach((m, i) => {
+    let panel = box.children[i];
+    if (!panel) {
+      panel = document.createElement("div");
+      panel.className = "slice-panel";
+      const ticks = (cls) => `<div class="${cls}">` + [0, 30, 60, 90].map((t) => `<span style="--at:${t / 90}">${t}</span>`).join("") + "</div>";
+      panel.innerHTML = `<div class="slice-title"></div><div class="slice-y">θd (°)</div>${ticks("slice-yticks")}` +
+        `<canvas class="slice-img" id="slice-${i}"></canvas>${ticks("slice-xticks")}<div class="slice-x">θh (°)</div>` +
+        `<div class="slice-err"></div>`;
+      box.appendChild(panel);
+      const canvas = panel.querySelector("canvas");
+      if (i === 0) sliceResized.observe(canvas);
+      canvas.addEventListener("mousemove", (ev) => {
+        const im = canvas._values, k = canvas.width;
+        if (!im) return;
+        const rect = canvas.getBoundingClientRect();
+        const col = Math.min(k - 1, Math.floor(k * (ev.clientX - rect.left) / rect.width));
+        const row = Math.min(k - 1, Math.floor(k * (rect.bottom - ev.clientY) / rect.height));
+        const a = canvas._axis;
+        canvas.title = `θh ${a[col].toFixed(1)}°, θd ${a[row].toFixed(1)}°: ${im[row * k + col].toPrecision(4)}`;
+      });
+    }
+    const title = panel.querySelector(".slice-title");
+    setIf(title, "textContent", n > 1 ? String(i + 1) : label(m, i));
+    title.style.color = COLOURS[i];
+    const canvas = panel.querySelector("canvas"), im = images[i];
+    setIf(panel.querySelector(".slice-err"), "textContent", m.slice && m.slice.error ? "slice: " + m.slice.error : "");
+    canvas.hidden = !im;
+    if (!im) { canvas._values = null; return; }
+    const k = m.slice.n;
+    if (canvas.width !== k) { canvas.width = k; canvas.height = k; }
+    const ctx = canvas.getContext("2d");
+    const data = ctx.createImageData(k, k);
+    for (let row = 0; row < k; row++) {
+      for (let col = 0; col < k; col++) {
+        const v = im[row * k + col];
+        const c = viridis(st.log ? (v > 0 ? Math.log10(v) : null) : v, cmin, cmax);
+        const o = ((k - 1 - row) * k + col) * 4;  // canvas rows from the top: theta_d grows upwards
+        if (c) { data.data[o] = c[0]; data.data[o + 1] = c[1]; data.data[o + 2] = c[2]; data.data[o + 3] = 255; }
+      }
+    }
+    ctx.putImageData(data, 0, 0);
+    canvas._values = im; canvas._axis = m.slice.axis;
+    canvas.dataset.cmin = String(cmin); canvas.dataset.cmax = String(cmax);
+  });
+  drawColourBar($("slice-scale"), cmin, cmax, st.log ? "log10 fr" : "fr");
+}
 
 // a vertical colour bar: the colour scale from cmin (bottom) to cmax (top), five labelled ticks and a title
 function drawColourBar(box, cmin, cmax, title) {
@@ -584,12 +851,12 @@ function drawColourBar(box, cmin, cmax, title) {
       ticks.appendChild(t);
     }
   }
-  box.querySelector(".cb-title").textContent = title;
+  setIf(box.querySelector(".cb-title"), "textContent", title);
   box.dataset.cmin = String(cmin);
   box.dataset.cmax = String(cmax);
   box.querySelectorAll(".cb-ticks span").forEach((t, k) => {
     const v = cmin + (k / 4) * (cmax - cmin);
-    t.textContent = Math.abs(v) >= 1e4 || (v !== 0 && Math.abs(v) < 1e-2) ? v.toExponential(1) : String(parseFloat(v.toPrecision(3)));
+    setIf(t, "textContent", Math.abs(v) >= 1e4 || (v !== 0 && Math.abs(v) < 1e-2) ? v.toExponential(1) : String(parseFloat(v.toPrecision(3))));
   });
 }
 
@@ -819,8 +1086,12 @@ function drawSpheres(r) {
 function drawLobe3d(r) {
   const view = $("lobe3d-view");
   const on = r.models.some((m) => m.lobe3d && !m.lobe3d.error);
-  view.hidden = !on;
-  if (!on) { if ($("lobe3d").data) Plotly.purge("lobe3d"); return; }
+  setIf(view, "hidden", !on);
+  if (!on) { if (window.Plotly && $("lobe3d").data) Plotly.purge("lobe3d"); return; }
+  if (!window.Plotly) {  // drawn once plotly.js has loaded, if this answer is still the newest
+    loadPlotly().then(() => { if (explore.result === r) drawLobe3d(r); }).catch(() => {});
+    return;
+  }
   const traces = [];
   r.models.forEach((m, i) => {
     if (!m.lobe3d || m.lobe3d.error) return;
@@ -840,7 +1111,7 @@ function drawLobe3d(r) {
   });
   Plotly.react("lobe3d", traces, {margin: {l: 0, r: 0, t: 0, b: 0},
     scene: {aspectmode: "data", xaxis: {title: {text: "x"}}, yaxis: {title: {text: "y"}}, zaxis: {title: {text: "N"}}}},
-    PLOT_CONFIG);
+    {displaylogo: false, responsive: true});
 }
 
 function draw(r) {
@@ -856,11 +1127,10 @@ function draw(r) {
 
 async function start() {
   explore.state = stateFromURL();
-  // while the server computes the first answer, plotly draws the empty lobe and albedo axes (its first drawing of
-  // each kind of plot is the slow one)
-  plotlyReady.then(() => { if (!explore.result) { drawLobe({models: []}); drawAlbedo({models: []}); } });
   connect();
   request();  // the views are computed while the model list loads
+  // empty axes while the server computes the first answer
+  if (!explore.result) { drawLobe({models: []}); drawAlbedo({models: []}, false); }
   const res = await fetch("/api/models");
   explore.catalog = await res.json();
   initControls();
