@@ -266,3 +266,18 @@ def takes_normal(f) -> bool:
 def takes_lobe_normal(f) -> bool:
     """Whether the routing table gives ``f`` (a BRDF or a hint) the lobe's frame of N, ``lobe_normal``, at some mu."""
     return "lobe_normal" in hint_routes(f)
+
+
+class BareLobe:
+    """A bare lobe c u^n / max(mu, N.wo)^p with c = (n + 2) / (2 pi), as the mpmath reference has it: only the
+    azimuth hint the 1-D engine reads.
+    """
+
+    def __init__(self, n, p):
+        self.n, self.p = n, p
+
+    def azimuth_hint(self):
+        from pumpup.core.hints import AzimuthHint, PowerLobe
+
+        c = (self.n + 2) / (2 * math.pi)
+        return AzimuthHint(PowerLobe(n=self.n, p=self.p), scale=lambda mu: np.full(np.shape(mu), c))

@@ -84,55 +84,81 @@ def load_other(path: str):
     return mod
 
 
+class Draws:
+    """A standalone EGL context (llvmpipe here) holding ``pairs`` random direction pairs of the upper hemisphere in
+    two float textures, and a full-screen triangle whose fragment shader evaluates a library's ``pumpup_brdf`` at
+    each pixel's pair (``FS``): :meth:`program` compiles one, :meth:`draw` evaluates every pair once.
+    """
+
+    def __init__(self, pairs: int, seed: int = 1):
+        import moderngl
+
+        self.moderngl = moderngl
+        self.ctx = moderngl.create_standalone_context(backend="egl", require=430)
+        self.width, self.height = 1024, pairs // 1024
+        rng = np.random.default_rng(seed)
+
+        def hemi(n):
+            z = rng.uniform(0, 1, n)
+            phi = rng.uniform(0, 2 * np.pi, n)
+            s = np.sqrt(1 - z * z)
+            a = np.zeros((n, 4), np.float32)
+            a[:, 0], a[:, 1], a[:, 2] = s * np.cos(phi), s * np.sin(phi), z
+            return a
+
+        size = (self.width, self.height)
+        self.wi = self.ctx.texture(size, 4, hemi(self.pairs).tobytes(), dtype="f4")
+        self.wo = self.ctx.texture(size, 4, hemi(self.pairs).tobytes(), dtype="f4")
+        for t in (self.wi, self.wo):
+            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self.fbo = self.ctx.framebuffer([self.ctx.texture(size, 4, dtype="f4")])
+        self.vbo = self.ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], "f4").tobytes())
+
+    @property
+    def pairs(self) -> int:
+        """The number of direction pairs one draw evaluates."""
+        return self.width * self.height
+
+    def program(self, lib: str, values: dict[str, float]):
+        """Compile ``lib`` (a GLSL library snippet) with its uniforms set to ``values`` and draw it once; return the
+        program and its vertex array.
+        """
+        prog = self.ctx.program(vertex_shader=VS, fragment_shader="#version 430 core\n" + lib + FS)
+        for k, v in values.items():
+            if k in prog:
+                prog[k].value = v
+        prog["bench_wi"].value = 0
+        prog["bench_wo"].value = 1
+        vao = self.ctx.vertex_array(prog, [(self.vbo, "2f", "p")])
+        self.draw(vao)
+        return prog, vao
+
+    def draw(self, vao) -> None:
+        """Evaluate every pair once with ``vao``'s program, and wait until it is done."""
+        self.fbo.use()
+        self.wi.use(0)
+        self.wo.use(1)
+        vao.render(self.moderngl.TRIANGLES)
+        self.ctx.finish()
+
+
 def evaluation_times(pairs: int, repeat: int, other=None, cpu: bool = False) -> None:
     """Print the cost per pair of each case's GLSL on llvmpipe, and its ratio to its base's (and, with ``other``, the
     same for that module's shaders, the draws alternating; with ``cpu``, in the calling thread, timed by its CPU time).
     """
     if cpu:
         os.environ["LP_NUM_THREADS"] = "0"  # (read when the driver starts: before the context)
-    import moderngl
-
     clock = time.thread_time if cpu else time.perf_counter
-    ctx = moderngl.create_standalone_context(backend="egl", require=430)
-    print(f"evaluation on {ctx.info['GL_RENDERER']}, {pairs} pairs per draw, best of {repeat} rounds (each round draws "
-          f"every shader once{', thread CPU time, no worker threads' if cpu else ''}), load average before: "
-          + " ".join(f"{x:.2f}" for x in os.getloadavg()) + ":")
-    width = 1024
-    h = pairs // width
-    rng = np.random.default_rng(1)
-
-    def hemi(n):
-        z = rng.uniform(0, 1, n)
-        phi = rng.uniform(0, 2 * np.pi, n)
-        s = np.sqrt(1 - z * z)
-        a = np.zeros((n, 4), np.float32)
-        a[:, 0], a[:, 1], a[:, 2] = s * np.cos(phi), s * np.sin(phi), z
-        return a
-
-    twi = ctx.texture((width, h), 4, hemi(width * h).tobytes(), dtype="f4")
-    two = ctx.texture((width, h), 4, hemi(width * h).tobytes(), dtype="f4")
-    for t in (twi, two):
-        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
-    out = ctx.texture((width, h), 4, dtype="f4")
-    fbo = ctx.framebuffer([out])
-    vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], "f4").tobytes())
+    draws = Draws(pairs)
+    print(f"evaluation on {draws.ctx.info['GL_RENDERER']}, {draws.pairs} pairs per draw, best of {repeat} rounds "
+          f"(each round draws every shader once{', thread CPU time, no worker threads' if cpu else ''}), load average "
+          "before: " + " ".join(f"{x:.2f}" for x in os.getloadavg()) + ":")
     modules = [("this", shader, uniforms)] + ([("other", other.shader, other.uniforms)] if other else [])
 
     def prepare(make, unif, spec):
         lib = make(spec, target="glsl")
         t = time.perf_counter()
-        prog = ctx.program(vertex_shader=VS, fragment_shader="#version 430 core\n" + lib + FS)
-        for k, v in unif(spec).items():
-            if k in prog:
-                prog[k].value = v
-        prog["bench_wi"].value = 0
-        prog["bench_wo"].value = 1
-        vao = ctx.vertex_array(prog, [(vbo, "2f", "p")])
-        fbo.use()
-        twi.use(0)
-        two.use(1)
-        vao.render(moderngl.TRIANGLES)
-        ctx.finish()
+        prog, vao = draws.program(lib, unif(spec))
         return prog, vao, time.perf_counter() - t
 
     runs = {}
@@ -145,8 +171,7 @@ def evaluation_times(pairs: int, repeat: int, other=None, cpu: bool = False) -> 
     for _ in range(repeat):  # every shader once per round: all of them under the same load
         for key, (_, vao, _) in runs.items():
             t = clock()
-            vao.render(moderngl.TRIANGLES)
-            ctx.finish()
+            draws.draw(vao)
             best[key] = min(best[key], clock() - t)
     for name, _, base in CASES:
         cols = []
@@ -154,7 +179,7 @@ def evaluation_times(pairs: int, repeat: int, other=None, cpu: bool = False) -> 
             key = (label, name) if (label, name) in best else ("this", name)
             if label == "other" and key[0] == "this":
                 continue
-            ns = best[key] * 1e9 / (width * h)
+            ns = best[key] * 1e9 / draws.pairs
             ratio = f" ({best[key] / best['this', base]:.2f} x {base})" if base else ""
             cols.append(f"{label} {ns:6.1f} ns{ratio}")
         compile_s = ", ".join(f"{runs[k][2]:.2f}" for k in runs if k[1] == name)

@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import sys
 import time
 
 import numpy as np
@@ -28,19 +29,10 @@ import numpy as np
 import pumpup
 from pumpup.shaders import shader
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # bench_shader, beside this script
+from bench_shader import Draws  # noqa: E402
+
 GGX = {"type": "ggx", "alpha": 0.3}
-VS = "#version 430 core\nin vec2 p;\nvoid main() { gl_Position = vec4(p, 0.0, 1.0); }\n"
-FS = """
-uniform highp sampler2D bench_wi;
-uniform highp sampler2D bench_wo;
-out vec4 bench_out;
-void main() {
-    ivec2 q = ivec2(gl_FragCoord.xy);
-    bench_out = vec4(pumpup_brdf(texelFetch(bench_wi, q, 0).xyz, texelFetch(bench_wo, q, 0).xyz));
-}
-"""
-
-
 def _function(src: str, name: str) -> tuple[int, int]:
     """The start and end of a GLSL function's definition in ``src``."""
     i = src.index(f"float {name}(float mi, float mo) {{")
@@ -93,54 +85,19 @@ def main() -> None:
             libs[f"{g} x3: {name}"] = src
 
     os.environ["LP_NUM_THREADS"] = "0"  # (read when the driver starts: before the context)
-    import moderngl
-
-    ctx = moderngl.create_standalone_context(backend="egl", require=430)
-    width = 1024
-    h = args.pairs // width
-    rng = np.random.default_rng(1)
-
-    def hemi(n):
-        z = rng.uniform(0, 1, n)
-        phi = rng.uniform(0, 2 * np.pi, n)
-        s = np.sqrt(1 - z * z)
-        a = np.zeros((n, 4), np.float32)
-        a[:, 0], a[:, 1], a[:, 2] = s * np.cos(phi), s * np.sin(phi), z
-        return a
-
-    twi = ctx.texture((width, h), 4, hemi(width * h).tobytes(), dtype="f4")
-    two = ctx.texture((width, h), 4, hemi(width * h).tobytes(), dtype="f4")
-    for t in (twi, two):
-        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
-    out = ctx.texture((width, h), 4, dtype="f4")
-    fbo = ctx.framebuffer([out])
-    vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], "f4").tobytes())
-    runs = {}
-    for name, lib in libs.items():
-        prog = ctx.program(vertex_shader=VS, fragment_shader="#version 430 core\n" + lib + FS)
-        if "pumpup_alpha" in prog:
-            prog["pumpup_alpha"].value = 0.3
-        prog["bench_wi"].value = 0
-        prog["bench_wo"].value = 1
-        vao = ctx.vertex_array(prog, [(vbo, "2f", "p")])
-        fbo.use()
-        twi.use(0)
-        two.use(1)
-        vao.render(moderngl.TRIANGLES)
-        ctx.finish()
-        runs[name] = vao
-    print(f"{ctx.info['GL_RENDERER']}, {width * h} pairs per draw, in this thread (thread CPU time), best of "
+    draws = Draws(args.pairs)
+    runs = {name: draws.program(lib, {"pumpup_alpha": 0.3})[1] for name, lib in libs.items()}
+    print(f"{draws.ctx.info['GL_RENDERER']}, {draws.pairs} pairs per draw, in this thread (thread CPU time), best of "
           f"{args.repeat} rounds, load average before: " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
     best = dict.fromkeys(runs, np.inf)
     for _ in range(args.repeat):
         for name, vao in runs.items():
             t = time.thread_time()
-            vao.render(moderngl.TRIANGLES)
-            ctx.finish()
+            draws.draw(vao)
             best[name] = min(best[name], time.thread_time() - t)
     base = best["ggx"]
     for name, t in best.items():
-        print(f"  {name:40s} {t * 1e9 / (width * h):6.1f} ns  {t / base:5.2f} x ggx")
+        print(f"  {name:40s} {t * 1e9 / draws.pairs:6.1f} ns  {t / base:5.2f} x ggx")
     print("load average after: " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
 
 

@@ -8,26 +8,14 @@ import math
 
 import numpy as np
 import pytest
-from helpers import phong_albedo_1d
+from helpers import BareLobe, phong_albedo_1d
 
 import pumpup
-from pumpup.core.hints import AzimuthHint, PowerLobe
 from pumpup.engine import outer_rule as _outer
 from pumpup.engine import polar as _polar
 from pumpup.physics.quadrature import calibrated_reference
 
 TABLE_MU = np.sin(np.radians(90.0 - np.linspace(0.0, 89.99, 257)))  # (scripts/bench/bench_polar.py's table)
-
-
-class _Lobe:
-    """A bare lobe c u^n / max(mu, N.wo)^p with c = (n + 2) / (2 pi), as the mpmath reference has it."""
-
-    def __init__(self, n, p):
-        self.n, self.p = n, p
-
-    def azimuth_hint(self):
-        c = (self.n + 2) / (2 * math.pi)
-        return AzimuthHint(PowerLobe(n=self.n, p=self.p), scale=lambda mu: np.full(np.shape(mu), c))
 
 
 def _compiled_estimate(f):
@@ -129,7 +117,7 @@ def test_nearly_coinciding_breaks_of_the_table():
     mu = np.array([TABLE_MU[86], TABLE_MU[85], TABLE_MU[87]])
     refs = [phong_albedo_1d(10, m, stretched=True) for m in mu]
     for rtol in (1e-8, 1e-10, 1e-12):
-        a, e, conv, _ = _polar.albedo_1d(_Lobe(10, 1.0), mu, rtol, 0.0, 20000)
+        a, e, conv, _ = _polar.albedo_1d(BareLobe(10, 1.0), mu, rtol, 0.0, 20000)
         assert conv.all()
         for m, v, err, (ref, ref_err) in zip(mu, a, e, refs):
             assert abs(v - ref) <= err + ref_err, (m, rtol, v - ref, err)
@@ -141,7 +129,7 @@ def test_against_mpmath_on_the_table(n, p):
     mu = TABLE_MU[::16]
     refs = [phong_albedo_1d(n, m, stretched=bool(p)) for m in mu]
     for rtol in (1e-6, 1e-10):
-        a, e, conv, _ = _polar.albedo_1d(_Lobe(n, p), mu, rtol, 0.0, 20000)
+        a, e, conv, _ = _polar.albedo_1d(BareLobe(n, p), mu, rtol, 0.0, 20000)
         assert conv.all()
         for m, v, err, (ref, ref_err) in zip(mu, a, e, refs):
             assert abs(v - ref) <= err + ref_err, (n, p, m, rtol, v - ref, err)

@@ -11,27 +11,15 @@ import warnings
 import helpers
 import numpy as np
 import pytest
-from helpers import phong_albedo_1d
+from helpers import BareLobe, phong_albedo_1d
 
 import pumpup
-from pumpup.core.hints import AzimuthHint, PowerLobe
 from pumpup.engine import lobe_frame as _lobe_frame
 from pumpup.engine import polar as _polar
 
 # grazing, the breakpoints' special cases (mu = 1/2: s = cos 30 deg; 1/sqrt(2): cos 2 theta = 0;
 # sqrt(3)/2: s = 1/2, the split of the tail), and ordinary angles
 MU = [1.0, 0.99, 0.9, math.sqrt(3) / 2, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 1e-6, 1e-8]
-
-
-class _Lobe:
-    """A bare lobe c u^n / max(mu, N.wo)^p with c = (n + 2) / (2 pi), as the mpmath reference has it."""
-
-    def __init__(self, n, p):
-        self.n, self.p = n, p
-
-    def azimuth_hint(self):
-        c = (self.n + 2) / (2 * math.pi)
-        return AzimuthHint(PowerLobe(n=self.n, p=self.p), scale=lambda mu: np.full(np.shape(mu), c))
 
 
 @pytest.mark.parametrize("p", [0.0, 0.3, 0.5, 0.9, 1.0])
@@ -129,7 +117,7 @@ def test_arc_power_beyond_the_rules_falls_back_to_the_adaptive_rule():
 def test_against_mpmath_with_honest_error(n, p):
     mu = np.array(MU)
     for rtol in (1e-10, 1e-6):
-        a, e, conv, evals = _polar.albedo_1d(_Lobe(n, p), mu, rtol, 1e-14, 20000)
+        a, e, conv, evals = _polar.albedo_1d(BareLobe(n, p), mu, rtol, 1e-14, 20000)
         assert conv.all()
         for m, v, err in zip(MU, a, e):
             ref, ref_err = phong_albedo_1d(n, m, stretched=bool(p))
@@ -150,7 +138,7 @@ def test_nearly_coinciding_breaks_against_mpmath(n):
     mu = m0 * (1.0 + np.array([0.0, -1e-14, 1e-12, -1e-9, 1e-9, -1e-6, 1e-6, -1e-4, 1e-4]))
     refs = [phong_albedo_1d(n, m, stretched=True) for m in mu]
     for rtol in (1e-8, 1e-10, 1e-12):
-        a, e, conv, _ = _polar.albedo_1d(_Lobe(n, 1.0), mu, rtol, 0.0, 20000)
+        a, e, conv, _ = _polar.albedo_1d(BareLobe(n, 1.0), mu, rtol, 0.0, 20000)
         assert conv.all()
         for m, v, err, (ref, ref_err) in zip(mu, a, e, refs):
             assert abs(v - ref) <= err + ref_err, (n, m, rtol, v - ref, err)
@@ -159,7 +147,7 @@ def test_nearly_coinciding_breaks_against_mpmath(n):
 def test_evaluations_per_mu_are_a_few_hundred():
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     for n, p in [(20, 0), (20, 1), (5000, 1), (1, 0)]:
-        _, _, conv, evals = _polar.albedo_1d(_Lobe(n, p), mu, 1e-10, 1e-14, 20000)
+        _, _, conv, evals = _polar.albedo_1d(BareLobe(n, p), mu, 1e-10, 1e-14, 20000)
         assert conv.all() and evals.mean() < 300 and evals.max() < 1000, (n, p, evals.mean(), evals.max())
 
 
@@ -282,8 +270,9 @@ def test_general_p_evaluations():
     fifteenth session; p = 1 also has the sharper estimate of the closed forms, test_decay_estimate.py)."""
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     for n in (1.0, 20.0, 1000.0):
-        _, _, conv, evals = _polar.albedo_1d(_Lobe(n, 0.5), mu, 1e-10, 1e-14, 20000)
-        _, _, _, evals1 = _polar.run("lobe", _Lobe(n, 1).azimuth_hint(), mu, 1e-10, 1e-14, 20000, decay_estimate=False)
+        _, _, conv, evals = _polar.albedo_1d(BareLobe(n, 0.5), mu, 1e-10, 1e-14, 20000)
+        _, _, _, evals1 = _polar.run("lobe", BareLobe(n, 1).azimuth_hint(), mu, 1e-10, 1e-14, 20000,
+                                     decay_estimate=False)
         assert conv.all() and evals.mean() < 1.2 * evals1.mean(), (n, evals.mean(), evals1.mean())
 
 
