@@ -19,7 +19,7 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))  # this checkout
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # stored_json, beside this script
 
-from stored_json import computed_or_stored  # noqa: E402
+import stored_json  # noqa: E402
 
 from pumpup import luts  # noqa: E402
 from pumpup.tables.provenance import source_commit  # noqa: E402
@@ -99,13 +99,5 @@ def markdown(data: dict) -> str:
     return "\n".join(lines)
 
 
-def main() -> int:
-    """Run the command line; return its exit status."""
-    data, wrote = computed_or_stored("lut_warps.json", run, __doc__.splitlines()[0], sort_keys=True)
-    print(markdown(data))
-    if wrote:
-        print("wrote", wrote)
-    return 0
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(stored_json.main("lut_warps.json", run, markdown, __doc__.splitlines()[0], sort_keys=True))

@@ -23,7 +23,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspa
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # stored_json, beside this script
 
 import numpy as np  # noqa: E402
-from stored_json import computed_or_stored  # noqa: E402
+import stored_json  # noqa: E402
 
 from pumpup import spectral  # noqa: E402
 from pumpup.spectral import optical  # noqa: E402
@@ -79,13 +79,5 @@ def gap(data: dict, a: str, b: str, metals=None) -> float:
     return max(abs(x - y) for m in ms for x, y in zip(data["metals"][m][a], data["metals"][m][b]))
 
 
-def main() -> int:
-    """Run the command line; return its exit status."""
-    data, wrote = computed_or_stored("metal_colours.json", run, __doc__.splitlines()[0])
-    print(markdown(data))
-    if wrote:
-        print("wrote", wrote)
-    return 0
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(stored_json.main("metal_colours.json", run, markdown, __doc__.splitlines()[0]))

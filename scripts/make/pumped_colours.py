@@ -23,7 +23,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))  # this checkout
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # stored_json, beside this script
 
-from stored_json import computed_or_stored  # noqa: E402
+import stored_json  # noqa: E402
 
 from pumpup import spectral  # noqa: E402
 from pumpup.tables.provenance import source_commit  # noqa: E402
@@ -74,14 +74,5 @@ def brightening(data: dict, n: float = 20.0) -> tuple[float, float]:
     return min(gains), max(gains)
 
 
-def main() -> int:
-    """Run the command line; return its exit status."""
-    data, wrote = computed_or_stored("pumped_colours.json", run, __doc__.splitlines()[0])
-    print(markdown(data))
-    if wrote:
-        print("wrote", wrote)
-    return 0
-
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(stored_json.main("pumped_colours.json", run, markdown, __doc__.splitlines()[0]))

@@ -35,3 +35,15 @@ def computed_or_stored(filename: str, run: Callable[[], dict], description: str,
     with atomic_path(path) as tmp, open(tmp, "w") as fh:
         json.dump(data, fh, indent=1, sort_keys=sort_keys)
     return data, path
+
+
+def main(filename: str, run: Callable[[], dict], markdown: Callable[[dict], str], description: str,
+         sort_keys: bool = False) -> int:
+    """The whole command line of a script whose output is its page's table: :func:`computed_or_stored`, then print
+    ``markdown(data)`` and the path written; return the exit status.
+    """
+    data, wrote = computed_or_stored(filename, run, description, sort_keys=sort_keys)
+    print(markdown(data))
+    if wrote:
+        print("wrote", wrote)
+    return 0
