@@ -438,7 +438,8 @@ def _gk_closed(kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, buf, sing, half, drel
     asc = 0.0
     for j in range(21):
         asc += WK21[j] * abs(buf[j] - k)
-    # QUADPACK's calibration (:func:`calibrated`, mode 1; t^1.5 as t sqrt(t))
+    # QUADPACK's calibration (:func:`calibrated`, mode 1) written out with t^1.5 as t sqrt(t): calling it, with its
+    # pow, made Phong n = 20's table 5-10 % slower (python scripts/bench/bench_polar.py, alternating)
     diff = abs(k - g) * h
     err = diff
     if asc != 0.0 and diff != 0.0:
