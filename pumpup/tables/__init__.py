@@ -83,19 +83,33 @@ ADAPTIVE_FACTOR = 3.0
 
 
 @contextlib.contextmanager
-def _long_work_bar(bar, brdf, seconds: float, done: int):
-    """``bar`` itself, or, where it is silent and the first ``done`` values took ``seconds`` so that the whole table
-    will take longer than :data:`LONG_WORK_SECONDS` (``ADAPTIVE_FACTOR`` times as many values), one line on stderr
-    with the estimate and a progress bar there with the remaining time.
+def _compile_seconds():
+    """A list whose first item, after the block, is the wall time numba spent compiling kernels in it (any thread; a
+    kernel loaded from numba's cache is not compiled).
     """
-    estimate = seconds * ADAPTIVE_FACTOR
+    from numba.core import event
+
+    spent = [0.0]
+    with event.install_timer("numba:compile", lambda seconds: spent.__setitem__(0, seconds)):
+        yield spent
+
+
+@contextlib.contextmanager
+def _long_work_bar(bar, brdf, seconds: float, done: int, compiling: float = 0.0):
+    """``bar`` itself, or, where it is silent and the first ``done`` values took ``seconds`` (of which ``compiling``
+    went to compiling kernels, which the rest of the table does not repeat) so that the whole table will take longer
+    than :data:`LONG_WORK_SECONDS` (``ADAPTIVE_FACTOR`` times as many values), one line on stderr with the estimate
+    and a progress bar there with the remaining time.
+    """
+    estimate = max(seconds - compiling, 0.0) * ADAPTIVE_FACTOR
     if not bar.disable or estimate < LONG_WORK_SECONDS:
         yield bar
         return
     from tqdm.auto import tqdm
 
+    spent = f"{seconds:.1f} s" if compiling < 0.05 else f"{seconds:.1f} s, {compiling:.1f} s of it compiling kernels"
     print(f"pumpup: the albedo table of {brdf!r} will take about {estimate:.0f} s (its first {done} values took "
-          f"{seconds:.1f} s); progress follows on stderr", file=sys.stderr, flush=True)
+          f"{spent}); progress follows on stderr", file=sys.stderr, flush=True)
     with tqdm(total=done, initial=done, desc=f"albedo {brdf.type}", unit="mu", leave=True, file=sys.stderr,
               mininterval=5.0) as loud:
         yield loud
@@ -515,9 +529,10 @@ def _tabulate(brdf, mu, *, rtol, atol, interp_tol, mu_min, max_points, progress,
     with contextlib.ExitStack() as stack:
         bar = stack.enter_context(_progress(len(grid), f"albedo {brdf.type}", progress))
         start = time.monotonic()
-        val, err = values(grid, bar)
+        with _compile_seconds() as compiling:
+            val, err = values(grid, bar)
         if progress is None:  # a long table says so, and shows its progress, even where stderr is no terminal
-            bar = stack.enter_context(_long_work_bar(bar, brdf, time.monotonic() - start, len(grid)))
+            bar = stack.enter_context(_long_work_bar(bar, brdf, time.monotonic() - start, len(grid), compiling[0]))
         grid, val, err, interp = adaptive_grid(grid, val, err, lambda m: values(m, bar), interp_tol, max_points,
                                                () if breaks is None else breaks, bar, built_on_tables(brdf.spec))
         interp_error = float(interp.max())

@@ -79,6 +79,36 @@ def test_command_line_budget_names_its_option(capsys):
         main(["table", "phong:n=3", "--out", "x.nc", "--max-seconds", "-2"])
 
 
+def test_long_work_estimate_leaves_out_compiling(capsys):
+    """The first values' time minus numba's compiling (which the rest of a table does not repeat) makes the estimate:
+    the compiling is measured (a fresh kernel compiled in the block), and 40 s of values of which 39.5 s compiled
+    announce nothing, while 40 s of values alone do, and the line names the compiling when there was some."""
+    import time
+
+    import numba
+    from tqdm.auto import tqdm
+
+    from pumpup import tables
+
+    t0 = time.monotonic()
+    with tables._compile_seconds() as compiling:
+        numba.njit(cache=False)(lambda x: x * 2.5 + 1.0)(3.0)
+    assert 0.0 < compiling[0] <= time.monotonic() - t0
+    f = pumpup.load("ggx:alpha=0.2")
+    silent = tqdm(total=1, disable=True)
+    with tables._long_work_bar(silent, f, 40.0, 45, compiling=39.5) as bar:
+        assert bar is silent
+    assert capsys.readouterr().err == ""
+    with tables._long_work_bar(silent, f, 40.0, 45) as bar:
+        assert bar is not silent
+    err = capsys.readouterr().err
+    assert "will take about 120 s (its first 45 values took 40.0 s)" in err
+    with tables._long_work_bar(silent, f, 40.0, 45, compiling=20.0):
+        pass
+    assert "will take about 60 s (its first 45 values took 40.0 s, 20.0 s of it compiling kernels)" in \
+        capsys.readouterr().err
+
+
 def test_long_table_announces_its_estimate_and_progress(monkeypatch, capsys):
     """A table estimated (from its first values) above LONG_WORK_SECONDS says so in one line on stderr, with a
     progress bar there, though stderr is no terminal; below it, nothing."""
