@@ -438,8 +438,9 @@ VALUES: dict[str, Value] = {
     "noise-run": Value(lambda: f"{noise('seconds'):.0f} s at load {noise('load'):.1f}", ""),
     "noise-by-spp": Value(lambda: ", ".join(f"{c} at {n} spp" for n, c in sorted(
         noise("fireflies_by_spp").items(), key=lambda item: int(item[0]))), ""),
-    "noise-variants": Value(lambda: ", ".join(f"{noise('fireflies_128_64spp', how)} {how}"
-                                              for how in ("as it is", "without point lights", "Lambert plate")), ""),
+    "noise-variants": Value(lambda: ", ".join(
+        f"{noise('fireflies_128_64spp', how)} {how}"
+        for how in ("as it is", "without point lights", "Lambert plate", "light tracing (ptracer)")), ""),
     # the warp search of docs/user-guide/luts.md (tables/lut_warps.json)
     "lut-warps-searched": Value(lambda: _script("lut_warps").searched(lut_warps()), ""),
     "lut-warps-best-where": Value(lambda: tuple(_warp_domain(1e-4)["candidates"][0]["where"]), ".2g",

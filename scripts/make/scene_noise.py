@@ -7,9 +7,9 @@ Renders the left panel of ``--scene`` ``--passes`` times with ``--spp`` samples 
 per pixel, the standard deviation of one sample's luminance (linear sRGB).  Prints its percentiles over the
 pixels, the samples per pixel a standard error of 0.01 would need at the 99th percentile, the fireflies
 (``make_scenes.fireflies``) of the average of the first 1, 2, 4, ... passes, and the fireflies of the same panel
-at 128 x 128 and 64 spp as it is, without its point lights, and with a Lambert plate (which of them makes the
-fireflies).  Writes the numbers to ``OUT/scene_noise.json``; docs/user-guide/mitsuba.md quotes them.  About a
-minute on a free 2-core machine.
+at 128 x 128 and 64 spp as it is, without its point lights, with a Lambert plate (which of them makes the
+fireflies), and rendered by Mitsuba's light tracer ``ptracer`` instead of its path tracer.  Writes the numbers to
+``OUT/scene_noise.json``; docs/user-guide/mitsuba.md quotes them.  About a minute on a free 2-core machine.
 """
 
 from __future__ import annotations
@@ -28,6 +28,10 @@ from make_scenes import LUMINANCE, fireflies  # noqa: E402
 
 import pumpup.scenes as S  # noqa: E402
 from pumpup.tables import atomic_path  # noqa: E402
+
+#: the panel at 128 x 128 and 64 spp: as it is, without its point lights, with a Lambert plate, and rendered by
+#: Mitsuba's light tracer instead of its path tracer
+VARIANTS = ("as it is", "without point lights", "Lambert plate", "light tracing (ptracer)")
 
 
 def _render(d, seed=0):
@@ -65,12 +69,14 @@ def main(argv=None) -> int:
         counts[k * a.spp] = fireflies(y[:k].mean(axis=0))
         k *= 2
     variants = {}
-    for how in ("as it is", "without point lights", "Lambert plate"):
+    for how in VARIANTS:
         d = S._scene_dict(a.scene, mats, 128, 64)
         if how == "without point lights":
             del d["key"], d["fill"]
         elif how == "Lambert plate":
             d["plate"]["bsdf"] = S._bsdf([((0.5, 0.5, 0.5), {"type": "lambert", "albedo": 1.0})])
+        elif how == "light tracing (ptracer)":
+            d["integrator"] = {"type": "ptracer", "max_depth": d["integrator"]["max_depth"]}
         variants[how] = fireflies(_render(d))
     out = {"scene": a.scene, "panel": label, "variant": variant, "size": a.size, "spp": a.spp, "passes": a.passes,
            "sample_sd_percentiles": {str(q): v for q, v in pct.items()}, "spp_for_0.01_at_p99": need,
