@@ -223,6 +223,9 @@ def _mitsuba(variant="auto"):
     if not v.endswith("_rgb"):  # an earlier mi.set_variant of a mono or spectral variant
         v = pm.register("llvm_ad_rgb")
     _register_mix(pm)
+    from . import caustics
+
+    caustics.register()
     return pm, v
 
 

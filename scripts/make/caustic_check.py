@@ -1,0 +1,139 @@
+"""Check that pumpup's caustic integrator is unbiased, and measure what it does to the fireflies.
+
+    python scripts/make/caustic_check.py [--scene 000-fig8] [--size 64] [--spp 64] [--passes 16] [--out figures]
+                                         [--fireflies-size 256] [--fireflies-spp 64]
+
+Renders the left panel of ``--scene`` with Mitsuba's ``path`` (max_depth 6), with ``pumpup_caustic`` without
+its mirror-image technique (the plain path tracer) and with it, ``--passes`` times each at ``--spp`` samples per
+pixel and independent seeds.  Per region of the image (the pixels whose centre sees the sky, each object, the
+plate; all pixels; the 2 % of pixels where the path tracer's passes spread most: the caustics' fireflies) it
+prints the mean luminance of each integrator with its standard error (from the spread of the passes) and the
+z-score of each difference.  Then it renders the panel at ``--fireflies-size`` and ``--fireflies-spp`` with
+``path`` and with ``pumpup_caustic`` (each panel of the scene) and prints the fireflies
+(``make_scenes.fireflies``) and the render times.  Writes ``OUT/caustic_check.json``; the documentation quotes
+it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))  # this checkout
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import numpy as np  # noqa: E402
+from make_scenes import LUMINANCE, fireflies  # noqa: E402
+
+import pumpup.scenes as S  # noqa: E402
+from pumpup.tables import atomic_path  # noqa: E402
+
+#: the integrators compared: Mitsuba's path tracer, pumpup_caustic without and with its mirror-image technique
+INTEGRATORS = {"path": {"type": "path", "max_depth": 6},
+               "caustic, B off": {"type": "pumpup_caustic", "max_depth": 6, "technique_b": False},
+               "caustic": {"type": "pumpup_caustic", "max_depth": 6}}
+
+
+def regions(scene: str, mats: dict, size: int) -> dict:
+    """Boolean masks (size, size) of the pixels whose centre sees the sky or each shape (by its id), and all."""
+    import mitsuba as mi
+
+    sc = mi.load_dict(S._scene_dict(scene, mats, size, 1))
+    sensor = sc.sensors()[0]
+    j, i = np.meshgrid(np.arange(size), np.arange(size))  # row i, column j
+    pos = mi.Point2f((j.ravel() + 0.5) / size, (i.ravel() + 0.5) / size)
+    ray, _ = sensor.sample_ray(0.0, 0.5, pos, mi.Point2f(0.5, 0.5))
+    si = sc.ray_intersect(ray)
+    out = {"all": np.ones((size, size), bool), "sky": ~np.array(si.is_valid()).reshape(size, size)}
+    for shape in sc.shapes():
+        out[shape.id()] = np.array((si.shape == mi.ShapePtr(shape)) & si.is_valid()).reshape(size, size)
+    return out
+
+
+def passes(scene: str, mats: dict, integrator: dict, size: int, spp: int, n: int, seed0: int):
+    """(n, size, size) luminance of n independent renders, and the seconds they took."""
+    import mitsuba as mi
+
+    d = S._scene_dict(scene, mats, size, spp)
+    d["integrator"] = dict(integrator)
+    sc = mi.load_dict(d)
+    t = time.perf_counter()
+    y = np.stack([np.array(mi.render(sc, seed=seed0 + k), dtype=np.float64)[..., :3] @ LUMINANCE for k in range(n)])
+    return y, time.perf_counter() - t
+
+
+def compare(ys: dict, masks: dict) -> dict:
+    """Per region: each integrator's mean and standard error over its passes, and the z-scores of the
+    differences (each pair)."""
+    out = {}
+    keys = list(ys)
+    for rn, m in masks.items():
+        r = {}
+        stats = {}
+        for k in keys:
+            per = ys[k][:, m].mean(axis=1)
+            stats[k] = (float(per.mean()), float(per.std(ddof=1) / np.sqrt(len(per))))
+            r[k] = {"mean": stats[k][0], "se": stats[k][1]}
+        z = {}
+        for i, a in enumerate(keys):
+            for b in keys[i + 1:]:
+                (ma, sa), (mb, sb) = stats[a], stats[b]
+                z[f"{a} vs {b}"] = (ma - mb) / max(np.hypot(sa, sb), 1e-300)
+        r["z"] = z
+        r["pixels"] = int(m.sum())
+        out[rn] = r
+    return out
+
+
+def main(argv=None) -> int:
+    """Measure, print and write ``caustic_check.json``; returns the exit status."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scene", default="000-fig8", choices=["000-fig8"])
+    ap.add_argument("--size", type=int, default=64)
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--passes", type=int, default=16)
+    ap.add_argument("--fireflies-size", type=int, default=256)
+    ap.add_argument("--fireflies-spp", type=int, default=64)
+    ap.add_argument("--out", default="figures")
+    a = ap.parse_args(argv)
+    S.check_args(a.scene, a.spp, a.size, "auto")
+    S.check_args(a.scene, a.fireflies_spp, a.fireflies_size, "auto")
+    if a.passes < 2:
+        raise SystemExit("--passes must be >= 2 (the standard errors come from the spread of the passes)")
+    _, variant = S._mitsuba("auto")
+    label, mats = S.panels(a.scene)[0][0]
+    masks = regions(a.scene, mats, a.size)
+    ys, secs = {}, {}
+    for j, (k, integ) in enumerate(INTEGRATORS.items()):
+        ys[k], secs[k] = passes(a.scene, mats, integ, a.size, a.spp, a.passes, 1000 * j)
+    sd = ys["path"].std(axis=0, ddof=1)
+    masks["path's fireflies"] = sd >= np.percentile(sd, 98)
+    cmp = compare(ys, masks)
+    for rn, r in cmp.items():
+        print(f"{rn:18s} ({r['pixels']:5d} px) " + "; ".join(f"{k} {r[k]['mean']:.5f} +- {r[k]['se']:.5f}"
+                                                          for k in INTEGRATORS)
+              + " | z " + ", ".join(f"{v:+.2f}" for v in r["z"].values()), flush=True)
+    ff = {}
+    for plabel, pmats in S.panels(a.scene)[0]:
+        ff[plabel] = {}
+        for k in ("path", "caustic"):
+            y, s = passes(a.scene, pmats, INTEGRATORS[k], a.fireflies_size, a.fireflies_spp, 1, 7)
+            y2, s2 = passes(a.scene, pmats, INTEGRATORS[k], a.fireflies_size, a.fireflies_spp, 1, 8)
+            ff[plabel][k] = {"fireflies": [fireflies(y[0]), fireflies(y2[0])], "seconds": [s, s2]}
+            print(f"{plabel}: {k}: fireflies {ff[plabel][k]['fireflies']} in {s:.1f}, {s2:.1f} s", flush=True)
+    out = {"scene": a.scene, "panel": label, "variant": variant, "size": a.size, "spp": a.spp, "passes": a.passes,
+           "seconds": secs, "regions": cmp, "fireflies_size": a.fireflies_size, "fireflies_spp": a.fireflies_spp,
+           "fireflies": ff, "load": os.getloadavg()[0]}
+    path = os.path.join(a.out, "caustic_check.json")
+    with atomic_path(path) as tmp:
+        with open(tmp, "w") as fh:
+            json.dump(out, fh, indent=1, sort_keys=True)
+    print("wrote", path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
