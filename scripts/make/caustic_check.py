@@ -7,7 +7,8 @@ Renders the left panel of ``--scene`` with Mitsuba's ``path`` (max_depth 6), wit
 its mirror-image technique (the plain path tracer) and with it, ``--passes`` times each at ``--spp`` samples per
 pixel and independent seeds.  Per region of the image (the pixels whose centre sees the sky, each object, the
 plate; all pixels; the 2 % of pixels where the path tracer's passes spread most: the caustics' fireflies) it
-prints the mean luminance of each integrator with its standard error (from the spread of the passes) and the
+prints the mean luminance of each integrator (also ``pumpup_caustic`` with its lobe's exponent k divided and
+multiplied by 16: the weights of the two techniques change, an unbiased combination keeps the mean) with its standard error (from the spread of the passes) and the
 z-score of each difference.  Then it renders the panel at ``--fireflies-size`` and ``--fireflies-spp`` with
 ``path`` and with ``pumpup_caustic`` (each panel of the scene) and prints the fireflies
 (``make_scenes.fireflies``) and the render times.  Writes ``OUT/caustic_check.json``; the documentation quotes
@@ -31,10 +32,14 @@ from make_scenes import LUMINANCE, fireflies  # noqa: E402
 import pumpup.scenes as S  # noqa: E402
 from pumpup.tables import atomic_path  # noqa: E402
 
-#: the integrators compared: Mitsuba's path tracer, pumpup_caustic without and with its mirror-image technique
+#: the integrators compared: Mitsuba's path tracer, pumpup_caustic without and with its mirror-image technique,
+#: and with the technique's lobe 16 x wider and narrower (k / 16, k x 16; the MIS weights change, the
+#: expectation must not)
 INTEGRATORS = {"path": {"type": "path", "max_depth": 6},
                "caustic, B off": {"type": "pumpup_caustic", "max_depth": 6, "technique_b": False},
-               "caustic": {"type": "pumpup_caustic", "max_depth": 6}}
+               "caustic": {"type": "pumpup_caustic", "max_depth": 6},
+               "caustic, k / 16": {"type": "pumpup_caustic", "max_depth": 6, "k_scale": 0.25 / 16},
+               "caustic, k x 16": {"type": "pumpup_caustic", "max_depth": 6, "k_scale": 0.25 * 16}}
 
 
 def regions(scene: str, mats: dict, size: int) -> dict:
