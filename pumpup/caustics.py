@@ -109,7 +109,7 @@ def _integrator_class():
 
         @staticmethod
         def _lobe_sample(d0, k, u):
-            """cos = u0^(1 / (k + 1)): 1 - cos computed as -expm1(log(u0) / (k + 1))."""
+            """A direction of the lobe: cos = u0^(1 / (k + 1)), 1 - cos computed as -expm1(log(u0) / (k + 1))."""
             e = dr.log(dr.maximum(u.x, 1e-30)) / (k + 1.0)
             om = dr.select(e > -1e-3, -e * (1.0 + 0.5 * e), 1.0 - dr.exp(e))  # 1 - cos = -expm1(e)
             cos = 1.0 - om
@@ -119,7 +119,7 @@ def _integrator_class():
             return mi.Frame3f(d0).to_world(local)
 
         def _nee(self, scene, ctx, si, bsdf, em, active):
-            """f cos * I / r^2 * V towards a point light (Spectrum, 0 where occluded or inactive)."""
+            """Next-event estimate f cos I / r^2 V towards a point light (Spectrum, 0 where occluded or inactive)."""
             ds, le = em.sample_direction(si, mi.Point2f(0.5, 0.5), active)
             vis = active & (ds.pdf > 0.0) & ~scene.ray_test(si.spawn_ray_to(ds.p), active)
             f = bsdf.eval(mi.BSDFContext(), si, si.to_local(ds.d), vis)

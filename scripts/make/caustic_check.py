@@ -8,11 +8,11 @@ its mirror-image technique (the plain path tracer) and with it, ``--passes`` tim
 pixel and independent seeds.  Per region of the image (the pixels whose centre sees the sky, each object, the
 plate; all pixels; the 2 % of pixels where the path tracer's passes spread most: the caustics' fireflies) it
 prints the mean luminance of each integrator (also ``pumpup_caustic`` with its lobe's exponent k divided and
-multiplied by 16: the weights of the two techniques change, an unbiased combination keeps the mean) with its standard error (from the spread of the passes) and the
-z-score of each difference.  Then it renders the panel at ``--fireflies-size`` and ``--fireflies-spp`` with
-``path`` and with ``pumpup_caustic`` (each panel of the scene) and prints the fireflies
-(``make_scenes.fireflies``) and the render times.  Writes ``OUT/caustic_check.json``; the documentation quotes
-it.
+multiplied by 16: the weights of the two techniques change, an unbiased combination keeps the mean) with its
+standard error (from the spread of the passes) and the z-score of each difference.  Then it renders each panel
+of the scene at ``--fireflies-size`` and ``--fireflies-spp`` with ``path`` and with ``pumpup_caustic`` (two
+seeds each) and prints the fireflies (``make_scenes.fireflies``) and the render times.  Writes
+``OUT/caustic_check.json``; the documentation quotes it.
 """
 
 from __future__ import annotations
@@ -72,7 +72,8 @@ def passes(scene: str, mats: dict, integrator: dict, size: int, spp: int, n: int
 
 def compare(ys: dict, masks: dict) -> dict:
     """Per region: each integrator's mean and standard error over its passes, and the z-scores of the
-    differences (each pair)."""
+    differences (each pair).
+    """
     out = {}
     keys = list(ys)
     for rn, m in masks.items():
