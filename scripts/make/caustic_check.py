@@ -1,7 +1,8 @@
 """Check that pumpup's caustic integrator is unbiased, and measure what it does to the fireflies.
 
-    python scripts/make/caustic_check.py [--scene 000-fig8] [--size 64] [--spp 64] [--passes 16] [--out figures]
-                                         [--fireflies-size 256] [--fireflies-spp 64]
+    python scripts/make/caustic_check.py [--scene 000-fig8] [--size 64] [--spp 256] [--passes 32]
+                                         [--fireflies-size 256] [--fireflies-spp 64 256]
+                                         [--reference-spp 1024] [--rough-plate 300] [--out figures]
 
 Renders the left panel of ``--scene`` with Mitsuba's ``path`` (max_depth 6), with ``pumpup_caustic`` without
 its mirror-image technique (the plain path tracer) and with it, ``--passes`` times each at ``--spp`` samples per
@@ -9,10 +10,13 @@ pixel and independent seeds.  Per region of the image (the pixels whose centre s
 plate; all pixels; the 2 % of pixels where the path tracer's passes spread most: the caustics' fireflies) it
 prints the mean luminance of each integrator (also ``pumpup_caustic`` with its lobe's exponent k divided and
 multiplied by 16: the weights of the two techniques change, an unbiased combination keeps the mean) with its
-standard error (from the spread of the passes) and the z-score of each difference.  Then it renders each panel
-of the scene at ``--fireflies-size`` and ``--fireflies-spp`` with ``path`` and with ``pumpup_caustic`` (two
-seeds each) and prints the fireflies (``make_scenes.fireflies``) and the render times.  Writes
-``OUT/caustic_check.json``; the documentation quotes it.
+standard error (from the spread of the passes) and the z-score of each difference.  The same again with a
+rougher plate (``--rough-plate``, n = 300), where ``path`` makes no caustic fireflies and the comparison is
+tight.  Then it renders each panel of the scene at ``--fireflies-size`` and each of ``--fireflies-spp`` with
+``path`` and with ``pumpup_caustic`` (two seeds each) and prints the fireflies (``make_scenes.fireflies``),
+those of them that are not fireflies of a ``pumpup_caustic`` render at ``--reference-spp`` (noise, not bright
+features of the converged image), and the render times.  Writes ``OUT/caustic_check.json``; the documentation
+quotes it.  About 5 minutes on a free 2-core machine.
 """
 
 from __future__ import annotations
@@ -40,6 +44,15 @@ INTEGRATORS = {"path": {"type": "path", "max_depth": 6},
                "caustic": {"type": "pumpup_caustic", "max_depth": 6},
                "caustic, k / 16": {"type": "pumpup_caustic", "max_depth": 6, "k_scale": 0.25 / 16},
                "caustic, k x 16": {"type": "pumpup_caustic", "max_depth": 6, "k_scale": 0.25 * 16}}
+
+
+def firefly_mask(y: np.ndarray) -> np.ndarray:
+    """The pixels that ``make_scenes.fireflies`` counts."""
+    from scipy.ndimage import median_filter
+
+    mask = y > 1.5 * median_filter(y, 3) + 0.1
+    assert int(mask.sum()) == fireflies(y)
+    return mask
 
 
 def regions(scene: str, mats: dict, size: int) -> dict:
@@ -99,40 +112,63 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scene", default="000-fig8", choices=["000-fig8"])
     ap.add_argument("--size", type=int, default=64)
-    ap.add_argument("--spp", type=int, default=64)
-    ap.add_argument("--passes", type=int, default=16)
+    ap.add_argument("--spp", type=int, default=256)
+    ap.add_argument("--passes", type=int, default=32)
     ap.add_argument("--fireflies-size", type=int, default=256)
-    ap.add_argument("--fireflies-spp", type=int, default=64)
+    ap.add_argument("--fireflies-spp", type=int, nargs="+", default=[64, 256])
+    ap.add_argument("--reference-spp", type=int, default=1024)
+    ap.add_argument("--rough-plate", type=int, default=300)
     ap.add_argument("--out", default="figures")
     a = ap.parse_args(argv)
     S.check_args(a.scene, a.spp, a.size, "auto")
-    S.check_args(a.scene, a.fireflies_spp, a.fireflies_size, "auto")
+    for spp in a.fireflies_spp:
+        S.check_args(a.scene, spp, a.fireflies_size, "auto")
+    S.check_args(a.scene, a.reference_spp, a.fireflies_size, "auto")
     if a.passes < 2:
         raise SystemExit("--passes must be >= 2 (the standard errors come from the spread of the passes)")
     _, variant = S._mitsuba("auto")
     label, mats = S.panels(a.scene)[0][0]
     masks = regions(a.scene, mats, a.size)
-    ys, secs = {}, {}
-    for j, (k, integ) in enumerate(INTEGRATORS.items()):
-        ys[k], secs[k] = passes(a.scene, mats, integ, a.size, a.spp, a.passes, 1000 * j)
-    sd = ys["path"].std(axis=0, ddof=1)
-    masks["path's fireflies"] = sd >= np.percentile(sd, 98)
-    cmp = compare(ys, masks)
-    for rn, r in cmp.items():
-        print(f"{rn:18s} ({r['pixels']:5d} px) " + "; ".join(f"{k} {r[k]['mean']:.5f} +- {r[k]['se']:.5f}"
-                                                          for k in INTEGRATORS)
-              + " | z " + ", ".join(f"{v:+.2f}" for v in r["z"].values()), flush=True)
+    cmp = {}
+    for plate_n in (5000, a.rough_plate):  # the scene's plate, and a rougher one where path converges too
+        pm = mats if plate_n == 5000 else dict(mats, plate=S.metal("silver", plate_n, "phong"))
+        ys, secs = {}, {}
+        for j, (k, integ) in enumerate(INTEGRATORS.items()):
+            integ = dict(integ, mirror_n=float(plate_n)) if integ["type"] == "pumpup_caustic" else integ
+            ys[k], secs[k] = passes(a.scene, pm, integ, a.size, a.spp, a.passes, 1000 * j)
+        m = dict(masks)
+        sd = ys["path"].std(axis=0, ddof=1)
+        m["path's fireflies"] = sd >= np.percentile(sd, 98)
+        cmp[plate_n] = compare(ys, m)
+        print(f"plate n = {plate_n}: seconds " + ", ".join(f"{k} {v:.1f}" for k, v in secs.items()))
+        for rn, r in cmp[plate_n].items():
+            print(f"{rn:18s} ({r['pixels']:5d} px) " + "; ".join(f"{k} {r[k]['mean']:.5f} +- {r[k]['se']:.5f}"
+                                                              for k in INTEGRATORS)
+                  + " | z " + ", ".join(f"{v:+.2f}" for v in r["z"].values()), flush=True)
     ff = {}
     for plabel, pmats in S.panels(a.scene)[0]:
-        ff[plabel] = {}
-        for k in ("path", "caustic"):
-            y, s = passes(a.scene, pmats, INTEGRATORS[k], a.fireflies_size, a.fireflies_spp, 1, 7)
-            y2, s2 = passes(a.scene, pmats, INTEGRATORS[k], a.fireflies_size, a.fireflies_spp, 1, 8)
-            ff[plabel][k] = {"fireflies": [fireflies(y[0]), fireflies(y2[0])], "seconds": [s, s2]}
-            print(f"{plabel}: {k}: fireflies {ff[plabel][k]['fireflies']} in {s:.1f}, {s2:.1f} s", flush=True)
+        ref, s_ref = passes(a.scene, pmats, INTEGRATORS["caustic"], a.fireflies_size, a.reference_spp, 1, 11)
+        ref_mask = firefly_mask(ref[0])
+        ff[plabel] = {"reference": {"spp": a.reference_spp, "fireflies": int(ref_mask.sum()), "seconds": s_ref}}
+        print(f"{plabel}: caustic at {a.reference_spp} spp: fireflies {int(ref_mask.sum())} in {s_ref:.1f} s",
+              flush=True)
+        for spp in a.fireflies_spp:
+            for k in ("path", "caustic"):
+                r = {"fireflies": [], "noise": [], "seconds": []}
+                for seed in (7, 8):
+                    y, sec = passes(a.scene, pmats, INTEGRATORS[k], a.fireflies_size, spp, 1, seed)
+                    m = firefly_mask(y[0])
+                    r["fireflies"].append(int(m.sum()))
+                    r["noise"].append(int((m & ~ref_mask).sum()))
+                    r["seconds"].append(sec)
+                ff[plabel][f"{k}, {spp} spp"] = r
+                print(f"{plabel}: {k}, {spp} spp: fireflies {r['fireflies']} (not at {a.reference_spp} spp: "
+                      f"{r['noise']}) in " + ", ".join(f"{x:.1f}" for x in r["seconds"]) + " s", flush=True)
     out = {"scene": a.scene, "panel": label, "variant": variant, "size": a.size, "spp": a.spp, "passes": a.passes,
-           "seconds": secs, "regions": cmp, "fireflies_size": a.fireflies_size, "fireflies_spp": a.fireflies_spp,
-           "fireflies": ff, "load": os.getloadavg()[0]}
+           "rough_plate": a.rough_plate,
+           "regions": cmp[5000], "regions_rough_plate": cmp[a.rough_plate],
+           "fireflies_size": a.fireflies_size, "fireflies_spp": a.fireflies_spp,
+           "reference_spp": a.reference_spp, "fireflies": ff, "load": os.getloadavg()[0]}
     path = os.path.join(a.out, "caustic_check.json")
     with atomic_path(path) as tmp:
         with open(tmp, "w") as fh:
