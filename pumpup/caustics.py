@@ -12,12 +12,12 @@ ray or a BSDF-sampled ray escapes.  No Russian roulette.
 
 Technique B, at every vertex x above the mirror and not on it, for every point light l: the mirror image l' of
 l across the mirror's plane; the specular point s where the segment x -> l' crosses the plane (skipped if s is
-off the mirror); a direction w sampled from the lobe
+off the mirror); a direction w sampled from the lobe::
 
     q_l(w; x) = (k + 1) / (2 pi) cos^k(w, d0),    d0 = (s - x) / |s - x|,    k = c n (1 + |x - s| / |s - l|)^2,
 
 (the mirror lobe's angular width seen from x, widened by ``k_scale`` = c), traced from x; if its first hit p
-is on the mirror, the path x -> p -> l contributes
+is on the mirror, the path x -> p -> l contributes::
 
     beta f_x(w) cos_x / q_l(w) * w_B * f_p(p -> l) cos_p V(p, l) I / |p - l|^2,
     w_B = q_l(w) / (q_l(w) + p_x(w)),
@@ -39,6 +39,8 @@ Registered by :func:`register` (``pumpup.scenes`` calls it); Mitsuba is imported
 from __future__ import annotations
 
 import math
+
+__all__ = ["register"]
 
 _CLASSES: dict = {}
 
