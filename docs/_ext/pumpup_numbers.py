@@ -482,8 +482,9 @@ VALUES: dict[str, Value] = {
     "caustic-se-fireflies": Value(lambda: _caustic_se("path's fireflies"), ""),
     "caustic-fireflies-64": Value(lambda: _caustic_fireflies(64), ""),
     "caustic-fireflies-256": Value(lambda: _caustic_fireflies(256), ""),
-    "caustic-reference": Value(lambda: ", ".join(f"{p['reference']['fireflies']} ({label.split(' (')[0]})"
-                                                 for label, p in caustic()["fireflies"].items()), ""),
+    "caustic-rough": Value(lambda: f"n = {caustic()['rough_plate']}", ""),
+    "caustic-reference": Value(lambda: f"{caustic()['reference_spp']} spp still has " + ", ".join(
+        f"{p['reference']['fireflies']} ({label.split(' (')[0]})" for label, p in caustic()["fireflies"].items()), ""),
     # the warp search of docs/user-guide/luts.md (tables/lut_warps.json)
     "lut-warps-searched": Value(lambda: _script("lut_warps").searched(lut_warps()), ""),
     "lut-warps-best-where": Value(lambda: tuple(_warp_domain(1e-4)["candidates"][0]["where"]), ".2g",
