@@ -171,7 +171,8 @@ def _scene_names() -> list[str]:
 
 def _fig8_rate() -> float:
     """Samples per second of Mitsuba's path tracer on 000-fig8's panels at the smallest sample count of
-    ``scripts/make/caustic_check.py`` (``figures/caustic_check.json``; every render of both panels)."""
+    ``scripts/make/caustic_check.py`` (``figures/caustic_check.json``; every render of both panels).
+    """
     e = caustic()
     spp = min(e["fireflies_spp"])
     secs = [x for p in e["fireflies"].values() for x in p[f"path, {spp} spp"]["seconds"]]
