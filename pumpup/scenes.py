@@ -360,10 +360,12 @@ def _scene_dict(name, mats, size, spp):
 
 #: Mitsuba's path tracer, the integrator of the scenes without a near-mirror plate
 PATH = {"type": "path", "max_depth": 6}
-#: the scenes rendered otherwise: 000 Fig. 8 by ``pumpup_caustic`` (:mod:`pumpup.caustics`), the same path
-#: tracer plus next-event estimation through the planar silver plate (n = 5000), combined by MIS: unbiased, and
-#: without the caustics' fireflies of ``path``
-INTEGRATOR = {"000-fig8": {"type": "pumpup_caustic", "max_depth": 6, "mirror": "plate", "mirror_n": 5000.0}}
+#: the scenes rendered otherwise: 000 Fig. 8 and 001 Fig. 8 by ``pumpup_caustic`` (:mod:`pumpup.caustics`), the
+#: same path tracer plus next-event estimation through the planar near-mirrors (000: the silver plate, n = 5000;
+#: 001: the faces of the cubes, n = 5000 in two of its panels), combined by MIS: unbiased, and without the
+#: caustics' fireflies of ``path``
+INTEGRATOR = {"000-fig8": {"type": "pumpup_caustic", "max_depth": 6, "mirror": "plate", "mirror_n": 5000.0},
+              "001-fig8": {"type": "pumpup_caustic", "max_depth": 6, "mirror": "*,-plate", "mirror_n": 5000.0}}
 
 
 def integrator_name(name) -> str:

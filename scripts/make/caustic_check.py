@@ -4,19 +4,21 @@
                                          [--fireflies-size 256] [--fireflies-spp 64 256]
                                          [--reference-spp 1024] [--rough-plate 300] [--out figures]
 
-Renders the left panel of ``--scene`` with Mitsuba's ``path`` (max_depth 6), with ``pumpup_caustic`` without
-its mirror-image technique (the plain path tracer) and with it, ``--passes`` times each at ``--spp`` samples per
-pixel and independent seeds.  Per region of the image (the pixels whose centre sees the sky, each object, the
-plate; all pixels; the 2 % of pixels where the path tracer's passes spread most: the caustics' fireflies) it
-prints the mean luminance of each integrator (also ``pumpup_caustic`` with its lobe's exponent k divided and
-multiplied by 16: the weights of the two techniques change, an unbiased combination keeps the mean) with its
-standard error (from the spread of the passes) and the z-score of each difference.  The same again with a
-rougher plate (``--rough-plate``, n = 300), where ``path`` makes no caustic fireflies and the comparison is
-tight.  Then it renders each panel of the scene at ``--fireflies-size`` and each of ``--fireflies-spp`` with
-``path`` and with ``pumpup_caustic`` (two seeds each) and prints the fireflies (``make_scenes.fireflies``),
-those of them that are not fireflies of a ``pumpup_caustic`` render at ``--reference-spp`` (noise, not bright
-features of the converged image), and the render times.  Writes ``OUT/caustic_check.json``; the documentation
-quotes it.  About 5 minutes on a free 2-core machine.
+Renders a panel of ``--scene`` (000 Fig. 8: the reciprocal Phong one; 001 Fig. 8: reciprocal Phong, n = 5000;
+:data:`SETUP`) with Mitsuba's ``path`` (max_depth 6), with ``pumpup_caustic`` without its mirror-image technique
+(the plain path tracer) and with it, ``--passes`` times each at ``--spp`` samples per pixel and independent
+seeds.  Per region of the image (the pixels whose centre sees the sky, each shape, all pixels, and the 2 % of
+pixels where the path tracer's passes spread most: the caustics' fireflies) it prints the mean luminance of
+each integrator (also ``pumpup_caustic`` with its lobe's exponent k divided and multiplied by 16: the weights of
+the two techniques change, an unbiased combination keeps the mean) with its standard error (from the spread of
+the passes) and the z-score of each difference.  The same again with rougher mirrors (``--rough-plate``,
+n = 300), where ``path`` makes no caustic fireflies and the comparison is tight.  Then it renders the scene's
+near-mirror panels (n = 5000) at ``--fireflies-size`` and each of ``--fireflies-spp`` with ``path`` and with
+``pumpup_caustic`` (two seeds each) and prints the fireflies (``make_scenes.fireflies``), those of them that
+are not fireflies of a ``pumpup_caustic`` render at ``--reference-spp`` (noise, not bright features of the
+converged image), and the render times.  Writes ``OUT/caustic_check.json`` (000 Fig. 8) or
+``OUT/caustic_check_SCENE.json``; the documentation quotes them.  About 5 minutes for 000 Fig. 8 on a free
+2-core machine, more for 001 Fig. 8.
 """
 
 from __future__ import annotations
@@ -39,6 +41,11 @@ from pumpup.tables import atomic_path  # noqa: E402
 #: the integrators compared: Mitsuba's path tracer, pumpup_caustic without and with its mirror-image technique,
 #: and with the technique's lobe 16 x wider and narrower (k / 16, k x 16; the MIS weights change, the
 #: expectation must not)
+#: per scene: the panels checked (row, column; the first is compared per region), the integrator's ``mirror``,
+#: and the near-mirrors' metals (made rougher for the second comparison)
+SETUP = {"000-fig8": {"panels": [(0, 0), (0, 1)], "mirror": "plate", "metals": {"plate": "silver"}},
+         "001-fig8": {"panels": [(0, 1), (1, 1)], "mirror": "*,-plate",
+                      "metals": {"tank": "gold", "p0": "aluminium", "p1": "silver", "p2": "copper", "p3": "gold"}}}
 INTEGRATORS = {"path": {"type": "path", "max_depth": 6},
                "caustic, B off": {"type": "pumpup_caustic", "max_depth": 6, "technique_b": False},
                "caustic": {"type": "pumpup_caustic", "max_depth": 6},
@@ -110,7 +117,7 @@ def compare(ys: dict, masks: dict) -> dict:
 def main(argv=None) -> int:
     """Measure, print and write ``caustic_check.json``; returns the exit status."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--scene", default="000-fig8", choices=["000-fig8"])
+    ap.add_argument("--scene", default="000-fig8", choices=sorted(SETUP))
     ap.add_argument("--size", type=int, default=64)
     ap.add_argument("--spp", type=int, default=256)
     ap.add_argument("--passes", type=int, default=32)
@@ -127,15 +134,25 @@ def main(argv=None) -> int:
     if a.passes < 2:
         raise SystemExit("--passes must be >= 2 (the standard errors come from the spread of the passes)")
     _, variant = S._mitsuba("auto")
-    label, mats = S.panels(a.scene)[0][0]
+    setup = SETUP[a.scene]
+    rows = S.panels(a.scene)
+    chosen = [rows[i][j] for i, j in setup["panels"]]
+    label, mats = chosen[0]
+
+    def integrator(k, n=5000.0):
+        integ = dict(INTEGRATORS[k])
+        if integ["type"] == "pumpup_caustic":
+            integ.update(mirror=setup["mirror"], mirror_n=float(n))
+        return integ
+
     masks = regions(a.scene, mats, a.size)
     cmp = {}
     for plate_n in (5000, a.rough_plate):  # the scene's plate, and a rougher one where path converges too
-        pm = mats if plate_n == 5000 else dict(mats, plate=S.metal("silver", plate_n, "phong"))
+        pm = mats if plate_n == 5000 else dict(mats, **{o: S.metal(metal, plate_n, "phong")
+                                                        for o, metal in setup["metals"].items()})
         ys, secs = {}, {}
-        for j, (k, integ) in enumerate(INTEGRATORS.items()):
-            integ = dict(integ, mirror_n=float(plate_n)) if integ["type"] == "pumpup_caustic" else integ
-            ys[k], secs[k] = passes(a.scene, pm, integ, a.size, a.spp, a.passes, 1000 * j)
+        for j, k in enumerate(INTEGRATORS):
+            ys[k], secs[k] = passes(a.scene, pm, integrator(k, plate_n), a.size, a.spp, a.passes, 1000 * j)
         m = dict(masks)
         sd = ys["path"].std(axis=0, ddof=1)
         m["path's fireflies"] = sd >= np.percentile(sd, 98)
@@ -146,8 +163,8 @@ def main(argv=None) -> int:
                                                               for k in INTEGRATORS)
                   + " | z " + ", ".join(f"{v:+.2f}" for v in r["z"].values()), flush=True)
     ff = {}
-    for plabel, pmats in S.panels(a.scene)[0]:
-        ref, s_ref = passes(a.scene, pmats, INTEGRATORS["caustic"], a.fireflies_size, a.reference_spp, 1, 11)
+    for plabel, pmats in chosen:
+        ref, s_ref = passes(a.scene, pmats, integrator("caustic"), a.fireflies_size, a.reference_spp, 1, 11)
         ref_mask = firefly_mask(ref[0])
         ff[plabel] = {"reference": {"spp": a.reference_spp, "fireflies": int(ref_mask.sum()), "seconds": s_ref}}
         print(f"{plabel}: caustic at {a.reference_spp} spp: fireflies {int(ref_mask.sum())} in {s_ref:.1f} s",
@@ -156,7 +173,7 @@ def main(argv=None) -> int:
             for k in ("path", "caustic"):
                 r = {"fireflies": [], "noise": [], "seconds": []}
                 for seed in (7, 8):
-                    y, sec = passes(a.scene, pmats, INTEGRATORS[k], a.fireflies_size, spp, 1, seed)
+                    y, sec = passes(a.scene, pmats, integrator(k), a.fireflies_size, spp, 1, seed)
                     m = firefly_mask(y[0])
                     r["fireflies"].append(int(m.sum()))
                     r["noise"].append(int((m & ~ref_mask).sum()))
@@ -169,7 +186,7 @@ def main(argv=None) -> int:
            "regions": cmp[5000], "regions_rough_plate": cmp[a.rough_plate],
            "fireflies_size": a.fireflies_size, "fireflies_spp": a.fireflies_spp,
            "reference_spp": a.reference_spp, "fireflies": ff, "load": os.getloadavg()[0]}
-    path = os.path.join(a.out, "caustic_check.json")
+    path = os.path.join(a.out, "caustic_check.json" if a.scene == "000-fig8" else f"caustic_check_{a.scene}.json")
     with atomic_path(path) as tmp:
         with open(tmp, "w") as fh:
             json.dump(out, fh, indent=1, sort_keys=True)
