@@ -46,8 +46,8 @@ indices give F0 = (0.942, 0.704, 0.404) for gold against (1.032, 0.732, 0.362) f
 :data:`F0` (Hoffman 2010) is kept for reference only; the scenes do not use it.
 
 Lights: a constant sky (Mitsuba ``constant`` emitter; the papers' "sky-light") plus point lights,
-path tracing (``path``, max_depth 6) with Mitsuba's MIS (000 Fig. 8: ``pumpup_caustic``, the same
-path tracer plus next-event estimation through the near-mirror plate, :data:`INTEGRATOR`); the plugin
+path tracing (``path``, max_depth 6) with Mitsuba's MIS (000 Fig. 8 and 001 Fig. 8: ``pumpup_caustic``,
+the same path tracer plus next-event estimation through the near-mirrors, :data:`INTEGRATOR`); the plugin
 samples each lobe with pumpup's strategies.  A colour factor or a sum of pumpup models (Lambert + Phong lobe) is the
 small BSDF plugin ``pumpup_mix`` defined here: f = sum_i w_i f_i (w_i RGB), sampled by choosing
 component i with probability proportional to the mean of w_i and evaluating the mixture pdf.
