@@ -46,8 +46,9 @@ indices give F0 = (0.942, 0.704, 0.404) for gold against (1.032, 0.732, 0.362) f
 :data:`F0` (Hoffman 2010) is kept for reference only; the scenes do not use it.
 
 Lights: a constant sky (Mitsuba ``constant`` emitter; the papers' "sky-light") plus point lights,
-path tracing (``path``, max_depth 6) with Mitsuba's MIS; the plugin samples each lobe with
-pumpup's strategies.  A colour factor or a sum of pumpup models (Lambert + Phong lobe) is the
+path tracing (``path``, max_depth 6) with Mitsuba's MIS (000 Fig. 8 and 001 Fig. 8: ``pumpup_caustic``,
+the same path tracer plus next-event estimation through the near-mirrors, :data:`INTEGRATOR`); the plugin
+samples each lobe with pumpup's strategies.  A colour factor or a sum of pumpup models (Lambert + Phong lobe) is the
 small BSDF plugin ``pumpup_mix`` defined here: f = sum_i w_i f_i (w_i RGB), sampled by choosing
 component i with probability proportional to the mean of w_i and evaluating the mixture pdf.
 
@@ -66,7 +67,7 @@ import time
 import numpy as np
 
 __all__ = ["SCENES", "F0", "METALS", "metal_index", "check_scene", "panels", "render_scene", "render_panel",
-           "write_scene", "teapot_mesh", "TEAPOTS"]
+           "integrator_name", "write_scene", "teapot_mesh", "TEAPOTS"]
 
 #: normal-incidence reflectance of metals, linear RGB (Hoffman 2010 / Real-Time Rendering 3rd ed., Table 7.3);
 #: the scenes used it before the measured metals (:data:`METALS`); kept for comparison only
@@ -223,6 +224,9 @@ def _mitsuba(variant="auto"):
     if not v.endswith("_rgb"):  # an earlier mi.set_variant of a mono or spectral variant
         v = pm.register("llvm_ad_rgb")
     _register_mix(pm)
+    from . import caustics
+
+    caustics.register()
     return pm, v
 
 
@@ -324,7 +328,7 @@ def _scene_dict(name, mats, size, spp):
                 "to_world": T().translate([x, h, z]) @ T().rotate([0, 1, 0], turn) @ T().scale(h)}
 
     d = {"type": "scene",
-         "integrator": {"type": "path", "max_depth": 6},
+         "integrator": dict(INTEGRATOR.get(name, PATH)),
          "sensor": {"type": "perspective", "fov": 32,
                     "to_world": T().look_at(origin=[0, 2.4, 7.0], target=[0, 0.45, 0], up=[0, 1, 0]),
                     "film": {"type": "hdrfilm", "width": size, "height": size, "pixel_format": "rgb",
@@ -352,6 +356,21 @@ def _scene_dict(name, mats, size, spp):
         for i, (x, z) in enumerate(((-1.45, 0.9), (-0.5, 1.5), (0.5, 1.5), (1.45, 0.9))):
             d[f"p{i}"] = cube(mats[f"p{i}"], x, z, 0.3, 45)
     return d
+
+
+#: Mitsuba's path tracer, the integrator of the scenes without a near-mirror plate
+PATH = {"type": "path", "max_depth": 6}
+#: the scenes rendered otherwise: 000 Fig. 8 and 001 Fig. 8 by ``pumpup_caustic`` (:mod:`pumpup.caustics`), the
+#: same path tracer plus next-event estimation through the planar near-mirrors (000: the silver plate, n = 5000;
+#: 001: the faces of the cubes, n = 5000 in two of its panels), combined by MIS: unbiased, and without the
+#: caustics' fireflies of ``path``
+INTEGRATOR = {"000-fig8": {"type": "pumpup_caustic", "max_depth": 6, "mirror": "plate", "mirror_n": 5000.0},
+              "001-fig8": {"type": "pumpup_caustic", "max_depth": 6, "mirror": "*,-plate", "mirror_n": 5000.0}}
+
+
+def integrator_name(name) -> str:
+    """The Mitsuba integrator a scene renders with (``path`` or ``pumpup_caustic``)."""
+    return INTEGRATOR.get(check_scene(name), PATH)["type"]
 
 
 def _revolve(r, y, n_phi):
@@ -556,8 +575,8 @@ def write_scene(name, rows, out_dir, *, exposure=0.0, variant="", spp=0, exr=Tru
             ax.set_yticks([])
             ax.set_title(label, fontsize=8)
     fig.suptitle(SCENES[name], fontsize=7.5)
-    fig.text(0.5, 0.005, f"Mitsuba 3 {variant}, {spp} spp; tone map: radiance x 2^{exposure:g}, sRGB transfer, "
-             "clipped at 1", ha="center", va="bottom", fontsize=6.5)
+    fig.text(0.5, 0.005, f"Mitsuba 3 {variant}, {integrator_name(name)}, {spp} spp; tone map: radiance x "
+             f"2^{exposure:g}, sRGB transfer, clipped at 1", ha="center", va="bottom", fontsize=6.5)
     p = os.path.join(out_dir, f"{name}.png")
     with _atomic(p) as tmp:
         fig.savefig(tmp, dpi=100, format="png")

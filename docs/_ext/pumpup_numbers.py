@@ -170,9 +170,53 @@ def _scene_names() -> list[str]:
 
 
 def _fig8_rate() -> float:
-    """Samples per second of the last 000-fig8 render of ``make_scenes.py`` (both panels, 256 x 256 or as run)."""
-    e = _scenes()["000-fig8"]
-    return e["size"] ** 2 * e["spp"] * len(e["panels"]) / sum(e["seconds"])
+    """Samples per second of Mitsuba's path tracer on 000-fig8's panels at the smallest sample count of
+    ``scripts/make/caustic_check.py`` (``figures/caustic_check.json``; every render of both panels).
+    """
+    e = caustic()
+    spp = min(e["fireflies_spp"])
+    secs = [x for p in e["fireflies"].values() for x in p[f"path, {spp} spp"]["seconds"]]
+    return e["fireflies_size"] ** 2 * spp * len(secs) / sum(secs)
+
+
+@functools.cache
+def caustic(scene: str = "000-fig8") -> dict:
+    """``figures/caustic_check.json`` or ``figures/caustic_check_SCENE.json`` (``scripts/make/caustic_check.py``)."""
+    name = "caustic_check.json" if scene == "000-fig8" else f"caustic_check_{scene}.json"
+    with open(os.path.join(ROOT, "figures", name)) as fh:
+        return json.load(fh)
+
+
+def _short(label: str) -> str:
+    return label.split(" (")[0].split(",")[0]
+
+
+def _caustic_z(key: str = "regions", scene: str = "000-fig8") -> str:
+    zs = [abs(z) for r in caustic(scene)[key].values() for z in r["z"].values()]
+    return f"{len(zs)} z-scores, the largest {max(zs):.2f}, {sum(z > 2 for z in zs)} above 2"
+
+
+def _caustic_fireflies(spp: int, scene: str = "000-fig8") -> str:
+    e = caustic(scene)
+    out = []
+    for label, p in e["fireflies"].items():
+        a, b = p[f"path, {spp} spp"], p[f"caustic, {spp} spp"]
+        out.append(f"{_short(label)}: {' and '.join(map(str, a['fireflies']))} with `path` in "
+                   f"{min(a['seconds']):.1f} s, {' and '.join(map(str, b['fireflies']))} with `pumpup_caustic` "
+                   f"(of them not at {e['reference_spp']} spp: {' and '.join(map(str, b['noise']))}) in "
+                   f"{min(b['seconds']):.1f} s")
+    return "; ".join(out)
+
+
+def _caustic_reference(scene: str = "000-fig8") -> str:
+    e = caustic(scene)
+    return f"{e['reference_spp']} spp still has " + ", ".join(
+        f"{p['reference']['fireflies']} ({_short(label)})" for label, p in e["fireflies"].items())
+
+
+def _caustic_se(region: str) -> str:
+    r = caustic()["regions"][region]
+    return f"{r['path']['se'] / r['caustic']['se']:.0f}"
 
 
 def _script(name: str, folder: str = "make"):
@@ -441,6 +485,25 @@ VALUES: dict[str, Value] = {
     "noise-variants": Value(lambda: ", ".join(
         f"{noise('fireflies_128_64spp', how)} {how}"
         for how in ("as it is", "without point lights", "Lambert plate", "light tracing (ptracer)")), ""),
+    # pumpup_caustic against Mitsuba's path (figures/caustic_check.json)
+    "caustic-setup": Value(lambda: f"{caustic()['size']} x {caustic()['size']}, {caustic()['passes']} passes of "
+                                   f"{caustic()['spp']} spp each", ""),
+    "caustic-z": Value(_caustic_z, ""),
+    "caustic-z-rough": Value(lambda: _caustic_z("regions_rough_plate"), ""),
+    "caustic-se-plate": Value(lambda: _caustic_se("plate"), ""),
+    "caustic-se-fireflies": Value(lambda: _caustic_se("path's fireflies"), ""),
+    "caustic-fireflies-64": Value(lambda: _caustic_fireflies(64), ""),
+    "caustic-fireflies-256": Value(lambda: _caustic_fireflies(256), ""),
+    "caustic-rough": Value(lambda: f"n = {caustic()['rough_plate']}", ""),
+    "caustic-reference": Value(_caustic_reference, ""),
+    "caustic-001-setup": Value(lambda: f"{caustic('001-fig8')['size']} x {caustic('001-fig8')['size']}, "
+                                       f"{caustic('001-fig8')['passes']} passes of {caustic('001-fig8')['spp']} "
+                                       "spp each", ""),
+    "caustic-001-z": Value(lambda: _caustic_z("regions", "001-fig8"), ""),
+    "caustic-001-z-rough": Value(lambda: _caustic_z("regions_rough_plate", "001-fig8"), ""),
+    "caustic-001-fireflies-64": Value(lambda: _caustic_fireflies(64, "001-fig8"), ""),
+    "caustic-001-fireflies-256": Value(lambda: _caustic_fireflies(256, "001-fig8"), ""),
+    "caustic-001-reference": Value(lambda: _caustic_reference("001-fig8"), ""),
     # the warp search of docs/user-guide/luts.md (tables/lut_warps.json)
     "lut-warps-searched": Value(lambda: _script("lut_warps").searched(lut_warps()), ""),
     "lut-warps-best-where": Value(lambda: tuple(_warp_domain(1e-4)["candidates"][0]["where"]), ".2g",

@@ -5,8 +5,9 @@ Mitsuba's built-in BSDFs, measured in the same run.
 
 For each panel (reciprocal Phong, stretched Phong) and for the baseline (every material replaced by
 Mitsuba's ``roughconductor`` GGX alpha 0.1 with the same colour as its specular reflectance), it
-renders twice: "cold" includes Dr.Jit's kernel compilation, "warm" reuses the kernel cache.  Prints
-seconds, the ratio to the baseline, the variant and the load average (the machine is shared).
+renders twice with the scene's integrator (``pumpup.scenes.INTEGRATOR``: ``pumpup_caustic``): "cold"
+includes Dr.Jit's kernel compilation, "warm" reuses the kernel cache.  Prints seconds, the ratio to the
+baseline, the variant and the load average (the machine is shared).
 """
 
 from __future__ import annotations

@@ -3,10 +3,10 @@
     python scripts/make/make_scenes.py [--size 256] [--spp N] [--out figures] [--only 000-fig8 ...]
 
 Needs the render extra (mitsuba).  Each scene renders at its own sample count (:data:`SPP`) unless ``--spp`` is
-given.  Prints the variant, the time per panel (the first pass of a panel includes Dr.Jit's kernel compilation)
-and the load average, and, per panel, the mean luminance of the image, its 99th percentile, the mean of the
-bottom rows (the plate) and the number of fireflies (:func:`fireflies`); writes them to ``OUT/scenes.json``
-(one entry per scene, the others kept), which the documentation quotes.
+given.  Prints the variant, the integrator, the time per panel (the first pass of a panel includes Dr.Jit's
+kernel compilation) and the load average, and, per panel, the mean luminance of the image, its 99th
+percentile, the mean of the bottom rows (the plate) and the number of fireflies (:func:`fireflies`); writes
+them to ``OUT/scenes.json`` (one entry per scene, the others kept), which the documentation quotes.
 """
 
 from __future__ import annotations
@@ -26,10 +26,11 @@ import pumpup.scenes as S  # noqa: E402
 from pumpup.tables import atomic_path  # noqa: E402
 
 #: samples per pixel of each scene.  000 Fig. 9 and Fig. 10 (plastic plate, n <= 169) converge: at 2048 spp no
-#: pixel is a firefly.  000 Fig. 8 and 001 Fig. 8 keep 64: their fireflies are caustics, point light -> near mirror
-#: (n = 5000) -> a rougher surface, which a path tracer finds by chance; more samples make them dimmer and more
-#: numerous, not gone (docs/user-guide/mitsuba.md says what removing them would take).
-SPP = {"000-fig8": 64, "000-fig9": 2048, "001-fig8": 64, "000-fig10": 2048}
+#: pixel is a firefly.  000 Fig. 8 and 001 Fig. 8 render with ``pumpup_caustic`` (pumpup.scenes.INTEGRATOR),
+#: which reaches their caustics (point light -> near-mirror, n = 5000 -> a rougher surface) by next-event
+#: estimation through the mirrors' planes; at 256 spp no pixel of 000 Fig. 8 is noise, and 001 Fig. 8 keeps
+#: about 20 per n = 5000 panel, against about 500 with Mitsuba's path (scripts/make/caustic_check.py).
+SPP = {"000-fig8": 256, "000-fig9": 2048, "001-fig8": 256, "000-fig10": 2048}
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])  # linear sRGB
 
 
@@ -59,7 +60,7 @@ def main(argv=None) -> int:
         t = time.perf_counter()
         v, rows, times = S.render_scene(name, spp, args.size, args.variant)
         load = os.getloadavg()[0]
-        print(f"{name}: {v}, {args.size} x {args.size}, {spp} spp, panels "
+        print(f"{name}: {v}, {S.integrator_name(name)}, {args.size} x {args.size}, {spp} spp, panels "
               + ", ".join(f"{x:.1f}" for x in times) + f" s; load {load:.1f}")
         panels = {}
         for r in rows:
@@ -75,7 +76,8 @@ def main(argv=None) -> int:
         if os.path.exists(stats_path):
             with open(stats_path) as fh:
                 stats = json.load(fh)
-        stats[name] = {"spp": spp, "size": args.size, "variant": v, "seconds": [round(x, 1) for x in times],
+        stats[name] = {"spp": spp, "size": args.size, "variant": v, "integrator": S.integrator_name(name),
+                       "seconds": [round(x, 1) for x in times],
                        "load": round(load, 1), "panels": panels}
         with atomic_path(stats_path) as tmp:
             with open(tmp, "w") as fh:

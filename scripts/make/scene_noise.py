@@ -2,7 +2,8 @@
 
     python scripts/make/scene_noise.py [--scene 000-fig8] [--size 64] [--spp 256] [--passes 16] [--out figures]
 
-Renders the left panel of ``--scene`` ``--passes`` times with ``--spp`` samples per pixel and different seeds
+Renders the left panel of ``--scene`` with Mitsuba's path tracer ``path`` ``--passes`` times with ``--spp``
+samples per pixel and different seeds
 (Mitsuba 3, pumpup's plugin, the scene of :mod:`pumpup.scenes`), and from the spread of the passes estimates,
 per pixel, the standard deviation of one sample's luminance (linear sRGB).  Prints its percentiles over the
 pixels, the samples per pixel a standard error of 0.01 would need at the 99th percentile, the fireflies
@@ -54,7 +55,9 @@ def main(argv=None) -> int:
     import mitsuba as mi
 
     label, mats = S.panels(a.scene)[0][0]
-    scene = mi.load_dict(S._scene_dict(a.scene, mats, a.size, a.spp))
+    d = S._scene_dict(a.scene, mats, a.size, a.spp)
+    d["integrator"] = dict(S.PATH)  # the path tracer's noise (make_scenes renders 000 Fig. 8 otherwise)
+    scene = mi.load_dict(d)
     t = time.perf_counter()
     y = np.stack([np.array(mi.render(scene, seed=k), dtype=np.float64)[..., :3] @ LUMINANCE
                   for k in range(a.passes)])
@@ -71,6 +74,7 @@ def main(argv=None) -> int:
     variants = {}
     for how in VARIANTS:
         d = S._scene_dict(a.scene, mats, 128, 64)
+        d["integrator"] = dict(S.PATH)
         if how == "without point lights":
             del d["key"], d["fill"]
         elif how == "Lambert plate":

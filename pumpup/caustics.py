@@ -1,0 +1,303 @@
+"""An unbiased Mitsuba 3 path tracer that finds caustics through planar near-mirrors: ``pumpup_caustic``.
+
+A point light seen through a near-mirror (a Phong lobe of exponent n = 5000) from a rough surface is a caustic
+that a path tracer finds only by chance: the rough surface's BSDF sample must fall into the mirror's narrow
+lobe.  This integrator adds a second technique for exactly those paths and combines the two by one-sample
+multiple importance sampling (the balance heuristic, Veach 1997, sec. 9.2), so the image stays unbiased.
+
+The path tracer (technique A) is Mitsuba's ``path`` with ``max_depth`` (counting edges: next-event estimation
+at the i-th hit makes a path of i + 1 edges): at each vertex, next-event estimation to every point light
+(visibility by a shadow ray), BSDF sampling to continue; the environment (a constant sky) only where a camera
+ray or a BSDF-sampled ray escapes.  No Russian roulette.
+
+The mirrors are planar rectangles: a ``rectangle`` shape, or each planar face of a mesh made of rectangles (a
+``cube``).  Technique B, at every vertex x, for every point light l: the faces f in front of both x and l whose
+plane holds a specular point s, where the segment from x to l's mirror image l' in f's plane crosses f; their
+number N(x, l); one of them picked uniformly, and a direction w sampled from the lobe::
+
+    q_f(w; x) = (k + 1) / (2 pi) cos^k(w, d0),    d0 = (s - x) / |s - x|,    k = c n (1 + |x - s| / |s - l|)^2,
+
+(the mirror lobe's angular width seen from x, widened by ``k_scale`` = c), traced from x; if its first hit p
+is on f, the path x -> p -> l contributes::
+
+    beta f_x(w) cos_x / (q_f(w) / N) * w_B * f_p(p -> l) cos_p V(p, l) I / |p - l|^2,
+    w_B = (q_f(w) / N) / (q_f(w) / N + p_x(w)),
+
+with p_x the BSDF-sampling pdf at x.  The path tracer's own estimate of the same path (BSDF sample w from x
+hitting face f at p, then next-event estimation at p towards l) is weighted w_A = p_x(w) / (p_x(w) +
+q_f(w; x) / N(x, l)) (1 after a camera ray), so w_A + w_B = 1 for every such path: the sum is unbiased for any
+k.
+
+Properties: ``max_depth`` (int, default 6), ``mirror`` (the mirror shapes' ids, comma-separated, or ``*`` for
+every shape and ``-id`` to leave one out; default "plate"), ``mirror_n`` (the mirror lobe's exponent, default
+5000), ``k_scale`` (c above, default 0.25), ``technique_b`` (bool, default True: False gives the plain path
+tracer, equal to Mitsuba's ``path`` in expectation).
+
+Registered by :func:`register` (``pumpup.scenes`` calls it); Mitsuba is imported only inside functions.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["register"]
+
+_CLASSES: dict = {}
+
+
+def _integrator_class():
+    import drjit as dr
+    import mitsuba as mi
+
+    def _p3(a):
+        return mi.Point3f(*[float(z) for z in a])
+
+    def _v3(a):
+        return mi.Vector3f(*[float(z) for z in a])
+
+    class PumpupCaustic(mi.SamplingIntegrator):
+        """Path tracer plus mirror-image sampling through a planar near-mirror, one-sample MIS (module docstring)."""
+
+        def __init__(self, props):
+            mi.SamplingIntegrator.__init__(self, props)
+            self.max_depth = int(props.get("max_depth", 6))
+            self.mirror_id = str(props.get("mirror", "plate"))
+            self.mirror_n = float(props.get("mirror_n", 5000.0))
+            self.k_scale = float(props.get("k_scale", 0.25))
+            self.technique_b = bool(props.get("technique_b", True))
+            if self.max_depth < 1:
+                raise ValueError(f"pumpup_caustic: max_depth must be an integer >= 1, got {self.max_depth}")
+            if not (self.mirror_n > 0.0 and self.k_scale > 0.0):
+                raise ValueError("pumpup_caustic: mirror_n and k_scale must be > 0, got "
+                                 f"{self.mirror_n} and {self.k_scale}")
+
+        # ---- the scene's pieces (Python-side, once per render) ------------------------------------
+        def _mirror_shapes(self, scene):
+            want = [w.strip() for w in self.mirror_id.split(",") if w.strip()]
+            shapes = list(scene.shapes())
+            if "*" in want:
+                out = [s for s in shapes if "-" + s.id() not in want]
+            else:
+                out = [s for s in shapes if s.id() in want]
+                if len(out) != len(want):
+                    raise ValueError("pumpup_caustic: mirror must name shapes of the scene (comma-separated ids, "
+                                     f"or '*' and '-id' to exclude), got {self.mirror_id!r}")
+            return out
+
+        @staticmethod
+        def _faces(shape):
+            """The planar rectangles of a shape: a ``rectangle``, or a mesh's faces grouped by plane."""
+            params = mi.traverse(shape)
+
+            def vec(a):
+                return np.array([float(v) for v in a], dtype=np.float64)
+
+            if "vertex_positions" not in params:  # a rectangle: [-1, 1]^2 at z = 0, normal +z, then to_world
+                m = np.array(params["to_world"].matrix, dtype=np.float64).reshape(4, 4)
+                c = m[:3, 3]
+                u, v = m[:3, 0], m[:3, 1]
+                return [(c, u, v)]
+            pos = np.array(params["vertex_positions"], dtype=np.float64).reshape(-1, 3)
+            tri = np.array(params["faces"], dtype=np.int64).reshape(-1, 3)
+            nrm = np.cross(pos[tri[:, 1]] - pos[tri[:, 0]], pos[tri[:, 2]] - pos[tri[:, 0]])
+            nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+            off = np.einsum("ij,ij->i", nrm, pos[tri[:, 0]])
+            groups: list = []  # (plane key, vertex indices): triangles of one plane that share vertices
+            for i in range(len(tri)):
+                key = tuple(np.round(np.r_[nrm[i], off[i]], 4))
+                idx = set(tri[i].tolist())
+                for g in groups:
+                    if g[0] == key and g[1] & idx:
+                        g[1].update(idx)
+                        break
+                else:
+                    groups.append((key, idx))
+            out = []
+            for key, idx in groups:
+                pts = np.unique(np.round(pos[sorted(idx)], 5), axis=0)
+                if len(pts) != 4:
+                    raise ValueError("pumpup_caustic: a mirror mesh must be made of planar rectangles")
+                a = pts[0]
+                far = int(np.argmax(np.linalg.norm(pts - a, axis=1)))
+                b, e = [pts[j] for j in range(1, 4) if j != far]
+                u, v = (b - a) / 2.0, (e - a) / 2.0
+                if abs(u @ v) > 1e-4 * (u @ u + v @ v):
+                    raise ValueError("pumpup_caustic: a mirror mesh must be made of planar rectangles")
+                n = np.cross(u, v)
+                if n @ np.array(key[:3]) < 0:
+                    u, v = v, u
+                out.append(((a + pts[far]) / 2.0, u, v))
+            return out
+
+        def _setup(self, scene):
+            faces = []
+            for shape in self._mirror_shapes(scene):
+                for c, u, v in self._faces(shape):
+                    n = np.cross(u, v)
+                    n /= np.linalg.norm(n)
+                    faces.append((mi.ShapePtr(shape), c, n, u, v))
+            lights = []
+            for e in scene.emitters():
+                if e.is_environment():
+                    continue
+                if not mi.has_flag(e.flags(), mi.EmitterFlags.DeltaPosition):
+                    raise ValueError("pumpup_caustic: only point lights and one environment are supported")
+                pos = mi.traverse(e)["position"]
+                lpos = np.array([float(dr.slice(pos[i])) if dr.width(pos[i]) else float(pos[i]) for i in range(3)])
+                lights.append((e, lpos, [f for f in faces if (lpos - f[1]) @ f[2] > 1e-6]))
+            return lights
+
+        # ---- technique B's lobe about the specular direction towards a light's mirror image ------
+        def _lobe(self, x, light, face, active):
+            """d0, k and whether the lobe exists at vertex x for a light at ``light`` and a mirror ``face``."""
+            _, c, n, u, v = face
+            side_l = float((light - c) @ n)
+            side_x = dr.dot(x - _p3(c), _v3(n))
+            lp = light - 2.0 * side_l * n  # the light's mirror image
+            t = side_x / (side_x + side_l)
+            s = x + t * (_p3(lp) - x)  # where x -> l' crosses the face's plane
+            sc = s - _p3(c)
+            ok = (active & (side_x > 1e-4) & (dr.abs(dr.dot(sc, _v3(u))) <= float(u @ u))
+                  & (dr.abs(dr.dot(sc, _v3(v))) <= float(v @ v)))
+            d = s - x
+            dist_xs = dr.norm(d)
+            dist_sl = dr.norm(_p3(light) - s)
+            d0 = d / dr.maximum(dist_xs, 1e-12)
+            r = dist_xs / dr.maximum(dist_sl, 1e-12)
+            k = self.k_scale * self.mirror_n * dr.square(1.0 + r)
+            return d0, k, ok
+
+        @staticmethod
+        def _on_face(si, face):
+            """Whether the hit ``si`` lies on ``face`` (its shape, its plane, inside it)."""
+            ptr, c, n, u, v = face
+            pc = si.p - _p3(c)
+            size = math.sqrt(float(u @ u + v @ v))
+            return ((si.shape == ptr) & (dr.abs(dr.dot(pc, _v3(n))) < 1e-4 * size)
+                    & (dr.abs(dr.dot(pc, _v3(u))) <= 1.0001 * float(u @ u))
+                    & (dr.abs(dr.dot(pc, _v3(v))) <= 1.0001 * float(v @ v)))
+
+        @staticmethod
+        def _lobe_pdf(w, d0, k, ok):
+            """(k + 1) / (2 pi) cos^k with 1 - cos from |w - d0|^2 / 2 (accurate near the axis)."""
+            om = 0.5 * dr.squared_norm(w - d0)  # 1 - cos(w, d0)
+            val = (k + 1.0) / (2.0 * math.pi) * dr.exp(k * dr.log(dr.maximum(1.0 - om, 1e-30)))
+            return dr.select(ok & (om < 1.0), val, 0.0)
+
+        @staticmethod
+        def _lobe_sample(d0, k, u):
+            """A direction of the lobe: cos = u0^(1 / (k + 1)), 1 - cos computed as -expm1(log(u0) / (k + 1))."""
+            e = dr.log(dr.maximum(u.x, 1e-30)) / (k + 1.0)
+            om = dr.select(e > -1e-3, -e * (1.0 + 0.5 * e), 1.0 - dr.exp(e))  # 1 - cos = -expm1(e)
+            cos = 1.0 - om
+            sin = dr.safe_sqrt(om * (2.0 - om))
+            phi = 2.0 * math.pi * u.y
+            local = mi.Vector3f(sin * dr.cos(phi), sin * dr.sin(phi), cos)
+            return mi.Frame3f(d0).to_world(local)
+
+        def _nee(self, scene, ctx, si, bsdf, em, active):
+            """Next-event estimate f cos I / r^2 V towards a point light (Spectrum, 0 where occluded or inactive)."""
+            ds, le = em.sample_direction(si, mi.Point2f(0.5, 0.5), active)
+            vis = active & (ds.pdf > 0.0) & ~scene.ray_test(si.spawn_ray_to(ds.p), active)
+            f = bsdf.eval(mi.BSDFContext(), si, si.to_local(ds.d), vis)
+            return dr.select(vis, f * le, 0.0)
+
+        # ---- the estimator ------------------------------------------------------------------------
+        def sample(self, scene, sampler, ray, medium=None, active=True):
+            lights = self._setup(scene)
+            env = scene.environment()
+            ctx = mi.BSDFContext()
+            ray = mi.Ray3f(ray)
+            active = mi.Bool(active)
+            L = mi.Spectrum(0.0)
+            beta = mi.Spectrum(1.0)
+            prev_x = mi.Point3f(0.0)
+            prev_pdf = mi.Float(0.0)
+            prev_mis = mi.Bool(False)  # technique B ran at the previous vertex
+            for depth in range(self.max_depth):
+                si = scene.ray_intersect(ray, active)
+                escaped = active & ~si.is_valid()
+                if env is not None:
+                    L += dr.select(escaped, beta * env.eval(si, escaped), 0.0)
+                active &= si.is_valid()
+                if depth + 1 >= self.max_depth:
+                    break
+                bsdf = si.bsdf(ray)
+                # next-event estimation to each point light; at a mirror face reached by a BSDF sample from a
+                # vertex where technique B ran, weighted w_A = p_x / (p_x + q_f / N) (balance heuristic)
+                for em, pos, faces in lights:
+                    c = self._nee(scene, ctx, si, bsdf, em, active)
+                    if self.technique_b and faces:
+                        count, q_sel = mi.Float(0.0), mi.Float(0.0)
+                        for face in faces:
+                            d0, k, ok = self._lobe(prev_x, pos, face, prev_mis & active)
+                            count += dr.select(ok, 1.0, 0.0)
+                            hit = ok & self._on_face(si, face)
+                            q_sel += dr.select(hit, self._lobe_pdf(ray.d, d0, k, hit), 0.0)
+                        q = q_sel / dr.maximum(count, 1.0)
+                        c *= dr.select(q > 0.0, prev_pdf / dr.maximum(prev_pdf + q, 1e-30), 1.0)
+                    L += beta * c
+                # technique B: x -> p (a mirror face) -> light through the light's image in that face's plane
+                if self.technique_b and depth + 2 < self.max_depth:
+                    for em, pos, faces in lights:
+                        if not faces:
+                            continue
+                        lobes = [self._lobe(si.p, pos, face, active) for face in faces]
+                        count = mi.Float(0.0)
+                        for _, _, ok in lobes:
+                            count += dr.select(ok, 1.0, 0.0)
+                        pick = dr.floor(sampler.next_1d(active) * count)  # one valid face, uniformly
+                        run = mi.Float(0.0)
+                        d0, k, sel = mi.Vector3f(0.0, 0.0, 1.0), mi.Float(1.0), mi.Bool(False)
+                        chosen = []
+                        for (d0_f, k_f, ok), face in zip(lobes, faces):
+                            this = ok & (run == pick)
+                            run += dr.select(ok, 1.0, 0.0)
+                            d0 = dr.select(this, d0_f, d0)
+                            k = dr.select(this, k_f, k)
+                            sel |= this
+                            chosen.append((this, face))
+                        w = self._lobe_sample(d0, k, sampler.next_2d(sel))
+                        q = self._lobe_pdf(w, d0, k, sel) / dr.maximum(count, 1.0)
+                        fx, px = bsdf.eval_pdf(ctx, si, si.to_local(w), sel)
+                        ok = sel & (q > 0.0) & (dr.max(fx) > 0.0)
+                        ray_b = si.spawn_ray(w)
+                        sp = scene.ray_intersect(ray_b, ok)
+                        on = mi.Bool(False)
+                        for this, face in chosen:
+                            on |= this & self._on_face(sp, face)
+                        ok &= sp.is_valid() & on
+                        bsdf_p = sp.bsdf(ray_b)
+                        c = self._nee(scene, ctx, sp, bsdf_p, em, ok)
+                        L += dr.select(ok, beta * fx * c / dr.maximum(q + px, 1e-30), 0.0)  # f/q * q/(q+p_x)
+                # BSDF sampling to continue
+                bs, wt = bsdf.sample(ctx, si, sampler.next_1d(active), sampler.next_2d(active), active)
+                active &= bs.pdf > 0.0
+                beta *= dr.select(active, wt, 0.0)
+                prev_x = mi.Point3f(si.p)
+                prev_pdf = mi.Float(bs.pdf)
+                prev_mis = active & (depth + 2 < self.max_depth)
+                ray = si.spawn_ray(si.to_world(bs.wo))
+            return L, mi.Bool(True), []
+
+        def aov_names(self):
+            return []
+
+        def to_string(self):
+            return (f"PumpupCaustic[max_depth={self.max_depth}, mirror={self.mirror_id!r}, n={self.mirror_n}, "
+                    f"k_scale={self.k_scale}, technique_b={self.technique_b}]")
+
+    return PumpupCaustic
+
+
+def register() -> None:
+    """Register the ``pumpup_caustic`` integrator for the current Mitsuba variant (idempotent)."""
+    import mitsuba as mi
+
+    v = mi.variant()
+    if v not in _CLASSES:
+        _CLASSES[v] = _integrator_class()
+    cls = _CLASSES[v]
+    mi.register_integrator("pumpup_caustic", lambda props: cls(props))
