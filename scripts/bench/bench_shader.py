@@ -28,6 +28,8 @@ PHONG = {"type": "phong", "n": 20}
 BASES = ("ggx", "phong")
 CASES = [
     ("ggx", GGX, None),
+    ("ggx pumped g1 x1", {"type": "pumped", "base": GGX, "g": "g1"}, "ggx"),
+    ("ggx pumped g2 x1", {"type": "pumped", "base": GGX, "g": "g2"}, "ggx"),
     ("ggx pumped g1 x3", {"type": "pumped", "base": GGX, "g": "g1", "levels": 3}, "ggx"),
     ("ggx pumped g2 x3", {"type": "pumped", "base": GGX, "g": "g2", "levels": 3}, "ggx"),
     ("ggx kulla_conty", {"type": "kulla_conty", "base": GGX}, "ggx"),
