@@ -39,7 +39,7 @@ def agrees(computed: float, published: Published, error: float = 0.0) -> bool:
     """Whether ``computed`` (with its error estimate ``error``) matches the printed value to the printed rounding:
     whether some value within ``error`` of it rounds to the printed string, half a unit of the last printed digit
     either way (the ends included: 000 printed Phong n = 4's exact 0.6875 as 0.688, and a computed 0.6875 - 1e-16
-    rounds the other way; issue 14's twentieth session).
+    rounds the other way).
 
     "0.350" has 3 decimals; "20.6" has 1; "7.8e-3" has 2 significant digits.
     """

@@ -74,8 +74,7 @@ _END_GAP = 1e-10
 #: |u| of a level N.wo = u, |a0| + |b0| of the horizon) are one curve, computed twice: its "roots" are rounding noise.
 #: A pumped Cook-Torrance has the level N.wo = mu of g2 and g1 (:meth:`pumpup.operators.pumping.Pumped.kink_levels`) and
 #: the geometry factor's kink N.wo = mu (:func:`pumpup.models.cook_torrance._g_kinks`): 292 such breaks at mu = 0.5 gave
-#: the nested engine 448 first intervals where the base model has 25, 40-60 x its evaluations (issue 14's
-#: twenty-fourth session)
+#: the nested engine 448 first intervals where the base model has 25, 40-60 x its evaluations
 COINCIDENT = 64.0
 _EPS = float(np.finfo(float).eps)
 

@@ -141,7 +141,7 @@ def _complete_kd(y):  # pragma: no cover - compiled; tested against scipy.specia
     c_(n+1) = (a_n - g_n) / 2 = c_n^2 / (4 a_(n+1)) (c_1 = m / (2 (1 + sqrt(y))): no cancellation), K = pi / (2 AGM),
     K - E = K sum_(n>=0) 2^(n-1) c_n^2 with c_0^2 = m, so D = K (1/2 + sum_(n>=1) 2^(n-1) c_n^2 / m), a sum of
     positive terms.  Quadratic convergence: at most about 10 steps of one square root each for y down to 1e-300
-    (issue 14's fifteenth session: Carlson's duplication, 170 ns per pair, took most of Ward's K(u)).
+    (Carlson's duplication, 170 ns per pair, would take most of Ward's K(u)).
     """
     m = 1.0 - y
     kc = math.sqrt(y)

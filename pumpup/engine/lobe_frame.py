@@ -190,13 +190,12 @@ def _arc_power(q, mu, a, b, d1, beta1, rtol, rest, nodes, wk, wg, mode, ibuf, iw
     integral_0^(T/2) - integral_0^mu by the Gauss-Jacobi rule for the weight t^q (``jac``: nodes and
     weights of two orders): the rest of the integrand has its singularities at T and at L <= mu - (T - 2 mu) < -T / 2,
     at least T / 2 away, so the rules converge geometrically, and the shorter one is taken where its a-priori bound
-    (:func:`_jacobi_bound`) meets half the tolerance, the longer one else, the bound its error (until issue 14's
-    fifteenth session: both rules, their difference the error).  The rest,
+    (:func:`_jacobi_bound`) meets half the tolerance, the longer one else, the bound its error.  The rest,
     t from T - D c^2 (mu, or T / 2 beyond 4 mu) to T, is t = T - D s^2, s in [0, c] (D = T - mu = d1 / (b + mu - a),
     without cancellation): an even, analytic integrand in s (:func:`_arc_piece`), by the fewest Gauss-Legendre
     points whose a-priori error bound (:func:`_arc_bound`) meets ``rtol`` times a lower bound of K = ``rest`` + H
     (``rest`` >= 0, H >= beta1 mu^q), its rounding added; about 5 values of t^q per call where the 7/15 rule in beta
-    took 15 to 45 (issue 14's fifteenth session).  Should the bound want more than GL_MAX points, the piece is
+    takes 15 to 45.  Should the bound want more than GL_MAX points, the piece is
     the 7/15 rule in beta, globally adaptive on at most INNER_MAX intervals (``iwork``, 4 x INNER_MAX), until
     the summed calibrated error meets the same tolerance; the error is returned either way.
     """

@@ -344,7 +344,7 @@ def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol,  # pragma: no cover - compil
     branch point w = x0 - i y0 (``mp[13]``, ``mp[14]``, :func:`fresnel_branch`) and its pole near 0 (at distance rho,
     ``mp[15]``, :func:`fresnel_pole`): that arc is cut at t = x0 -+ y0 3^j and at t = rho 3^j from max(rho, 3 mu) (each
     piece then lies about its own length from them; computed once per mu, :func:`_lobe_f_prepare`) and its pieces taken
-    by Gauss-Legendre rules with an a-priori bound (:func:`_lobe_f_gauss`; issue 14's sixteenth session) at max(``itol``
+    by Gauss-Legendre rules with an a-priori bound (:func:`_lobe_f_gauss`) at max(``itol``
     times a guess of K's lower bound, ``tol_abs`` / 2).  Where a piece would want more than GL_MAX points (or with
     ``using(lobe_fresnel_gauss=False)``) the arc is the globally adaptive 7/15 rule in beta, from the same cuts, the
     interval with the largest error bisected until the summed error (QUADPACK's calibration) is at most max(``itol``
@@ -367,7 +367,7 @@ def _k_lobe_fresnel(mp, p, mu, c2, u, um, sa, itol,  # pragma: no cover - compil
     cut = mp[23 + i0:23 + nall]
     nc = nall - i0
     if mp[20] > 0.0:
-        # the Gauss-Legendre pieces with an a-priori bound (issue 14's sixteenth session), at the tolerance's target for
+        # the Gauss-Legendre pieces with an a-priori bound, at the tolerance's target for
         # H >= beta1 min(F) mu^q, min(F) guessed as half the smaller of F(mu), F(T)
         d = um * (u - c2) / (b + mu * um)  # T - mu = d1 / (b + mu - a), without cancellation
         h_low = 0.5 * beta1 * min(fm, _fresnel_real(top, mp[6], mp[7])) * (mu if q == 1.0 else 1.0)

@@ -236,7 +236,7 @@ def smooth_inverse(x: float, xc: float) -> float:
         # the series tau = t0 (1 + t0 / 3 + ...), t0 = sqrt(small / 3): the closed form below rounds 1 - 2 small, and
         # for small below about 1e-16 it started Newton at tau = 0 or 5.6e-17, whence three steps did not come back
         # (xc = 9.2e-18 gave 1 - tau = 6.8e-3 for 1.7e-9: GGX alpha = 1e-4's horizon break at mu = 6.05e-5, 6.8e-9
-        # off with an estimate of 2.8e-10, issue 14's twentieth session)
+        # off with an estimate of 2.8e-10)
         t0 = math.sqrt(small / 3.0)
         tau = t0 * (1.0 + t0 / 3.0)
     else:

@@ -53,10 +53,10 @@ where the hint is not even in beta), and two compiled passes (:func:`pumpup.engi
 compare with it.
 
 Groups with wi turned out of the xz-plane (``phi != 0``) are integrated in the frame of wi at phi = 0 and the points
-turned by phi about N before ``_eval``, as the 2-D engine does (issue 14, fourteenth session; before, they were left to
-the 2-D engine, whose first grid missed the visible tail of a ridge just past a break: ward_aniso ax = 1, ay = 0.001 at
-mu = 0.9877, phi = 0.4 was 1.3e-8 off with an estimate of 5e-14, where the outer substitution towards a break
-(``OUTER_SUB``) puts a node within 2e-6 of the interval of it).  Hint-less BRDFs (a :func:`pumpup.from_function`,
+turned by phi about N before ``_eval``, as the 2-D engine does.  Left to the 2-D engine, such groups lose the visible
+tail of a ridge just past a break from its first grid: ward_aniso ax = 1, ay = 0.001 at mu = 0.9877, phi = 0.4 was
+1.3e-8 off there with an estimate of 5e-14, where the outer substitution towards a break (``OUTER_SUB``) puts a node
+within 2e-6 of the interval of it.  Hint-less BRDFs (a :func:`pumpup.from_function`,
 integrated by the 2-D engine's generic path) are left to the 2-D engine.  ``engine="2d"`` leaves this path out (the 2-D
 engine stays the reference), as does ``pumpup.engine.routes.using(without={"nested"})``.
 """
@@ -466,7 +466,7 @@ def _evaluate(brdf, g, i_prob, i_x0, i_x1, seg_int, seg_piece, seg_t0, seg_t1, i
 
 #: segments per call of :func:`_evaluate`: its block arrays (a dozen of 8 bytes per segment and outer node, more where
 #: the ends are graded) grow with the segments a refinement round adds.  Found by
-#: ``scripts/studies/fuzz_engines.py --fmax 22`` (issue 14's twenty-second session): a nested reference at max_regions
+#: ``scripts/studies/fuzz_engines.py --fmax 22``: a nested reference at max_regions
 #: 200000 grew past 23 GB and the kernel killed it.  Each segment's values do not depend on the others in its call, so
 #: the chunks change no bit
 SEG_CHUNK = 100_000
@@ -524,8 +524,8 @@ def _alpha_grading(lobe, mu: float) -> np.ndarray:
     which is (a / 2) in alpha_h from a break; away from normal incidence the arc's integral over beta spreads that over
     theta_i, but near it the outer integrand has the whole feature next to the break, where the grading towards the
     break (on the scale of its distance to the end of the range) did not see it: GGX alpha = 1.4e-3 at mu = 1 was 6.4 x
-    its estimate at rtol 1e-10, alpha = 3e-4 at mu = 1 - 1e-9 26 x at 1e-12 (issue 14's twentieth session,
-    ``scripts/studies/fuzz_engines.py``).
+    its estimate at rtol 1e-10, alpha = 3e-4 at mu = 1 - 1e-9 26 x at 1e-12
+    (``scripts/studies/fuzz_engines.py``).
     """
     if lobe.axis != "half" or lobe.radial not in ("ggx", "beckmann"):
         return np.array([])

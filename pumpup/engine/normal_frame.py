@@ -60,8 +60,8 @@ RING_F_NMAX = 128
 #: scripts/calibration/ring_fresnel_calibration.py)
 RING_F_RATIO = 0.5
 #: :func:`_ring_f_sums` sums term by term where nn |1 - z| is below this (at most the sample n = 0, where 1 - rho < 2 /
-#: nn: n >= 1 has |1 - z| >= rho sin(pi / nn)); until issue 14's twenty-third session, where |1 - z| < 0.25, up to ~nn /
-#: 12 samples of nn + 1 terms each, a quarter of GGX alpha 0.02 with ior 1.5's table time
+#: nn: n >= 1 has |1 - z| >= rho sin(pi / nn)); summing term by term wherever |1 - z| < 0.25, up to ~nn / 12 samples
+#: of nn + 1 terms each, took a quarter of GGX alpha 0.02 with ior 1.5's table time
 RING_F_DIRECT = 2.0
 #: sin^2(psi / 2) at psi = j pi / RING_F_NMAX (the finest level's samples; a coarser level takes every stride-th)
 _RING_F_SIN2 = np.sin(0.5 * np.pi * np.arange(RING_F_NMAX + 1) / RING_F_NMAX) ** 2
@@ -534,8 +534,8 @@ N_LOG_GRADE = 27.0
 #: ... on the side short of the peak only for |d| <= this times x_mu: towards x = 0, P(t)'s singularity (or Schlick's
 #: pole) lies near d = -x_mu, ln 8 = 2.1 from u = ln(x_mu / 8) (at 1/2 a piece came within 0.23 of its length in u of
 #: it, on the cuts at mu = 1; tests/engine/test_route_normal.py checks every piece in the variable it is integrated in)
-#: ... and from x = 0 up to this times x_mu, by N_LOG_GRADE in u = ln x (:func:`_n_kind` 3; issue 14's eighteenth
-#: session): P(t)'s singularities at x = +- i atanh(alpha) lie pi / 2 from the real u axis whatever x (Schlick's pole at
+#: ... and from x = 0 up to this times x_mu, by N_LOG_GRADE in u = ln x (:func:`_n_kind` 3):
+#: P(t)'s singularities at x = +- i atanh(alpha) lie pi / 2 from the real u axis whatever x (Schlick's pole at
 #: x ~ -r / (1 - r), pi), the peak's ln 8 beyond the last piece (GGX alpha = 1e-8 had 17 pieces graded by 3 in x there,
 #: now 6)
 N_LOG_SIDE = 0.125

@@ -363,7 +363,7 @@ def _gk(frame, kind, sm, n, p, mu, c2, v0, w, cv1, t0, t1, nodes, wk, wg, mode, 
                 continue
             if kind >= 2:
                 # (u^4 underflows below u ~ 1e-81, near grazing incidence, mu < 1e-80: GGX alpha = 1e-8 with an ior at
-                # mu = 1e-100 divided by 0 (the ninth session).  Where u^3 underflows too, below 1e-108, the weight's
+                # mu = 1e-100 divided by 0).  Where u^3 underflows too, below 1e-108, the weight's
                 # value there is below 1e-96 K (GGX's e^-z (m^2 / 2) / u ~ m^4 u / 2, Beckmann's e^-t = 0): left out)
                 u3 = u * u * u
                 fac = fac / (u3 * u) if u3 * u > 0.0 else (fac / u3 / u if u3 > 0.0 else 0.0)
@@ -473,7 +473,7 @@ MAX_BREAKS = 96
 MAX_PIECES = 128
 #: the size of :func:`_pieces`'s arrays: MAX_PIECES graded ones and the pieces between every two breaks of the tail and
 #: the peak, which come after them (with 128 slots in all, a narrow GGX lobe at grazing incidence, alpha = 1e-8 at mu =
-#: 1e-100 and rtol 1e-13 on frame 4, wrote past the end: found in the ninth session by NUMBA_BOUNDSCHECK=1)
+#: 1e-100 and rtol 1e-13 on frame 4, wrote past the end: found by NUMBA_BOUNDSCHECK=1)
 #: the most cuts :func:`_foreign_roots` adds to the tail's or the peak's breaks
 FOREIGN_CUTS = 64
 #: a piece is graded where a break's root lies beyond its end closer than this fraction of its length
@@ -725,8 +725,7 @@ def _pieces(frame, radial, n, p, mu, s, kinds, sms, v0, w, v1, mp):  # pragma: n
             # |theta_i -+ theta_0|, on the scale y0 / sin(theta_0) in alpha; near normal incidence c hardly varies on
             # the circle and the whole near-kink is K's.  Cuts there and at -+ (that scale / 2) 4^j, not smoothed
             # (code 3), as frame 5's in the lobe frame.  Without them GGX alpha = 0.003 with eta 0.271, k 0.0605 at mu =
-            # 1 was 2.4e-11 off with an estimate of 3.5e-12 (rtol 1e-10; issue 14's twentieth session,
-            # scripts/studies/fuzz_engines.py)
+            # 1 was 2.4e-11 off with an estimate of 3.5e-12 (rtol 1e-10; scripts/studies/fuzz_engines.py)
             x0, y0 = mp[13], mp[14]
             st0 = math.sqrt((1.0 - x0) * (1.0 + x0)) if 0.0 < x0 < 1.0 else 0.0
             if st0 > 0.0 and y0 < x0 and y0 < LOBE_F_WIDE * st0:

@@ -36,7 +36,7 @@ cut by the horizon (u = s) and where the level N.wo = mu leaves the circle (u = 
 p > 0 only): these, and u = 1/2 (or the nearest of 0.45, 0.55, 0.4, 0.6 at least 0.02 from every break,
 :data:`SPLITS`), are breakpoints.  A break's square root reaches across the breaks next to it: where two nearly
 coincide (s and cos 2 theta_i near mu = sqrt(3) / 2) the piece beyond the other is graded towards it
-(:func:`_foreign_roots`; found in issue 14's twelfth session: stretched Phong n = 10 at mu = 0.866025 was 3.2e-12 off
+(:func:`_foreign_roots`; without it, stretched Phong n = 10 at mu = 0.866025 was 3.2e-12 off
 at rtol 1e-12 with an estimate of 6.6e-13).  On [0, 1/2] the variable is u itself; above
 it is z = -(n + 1) ln u, i.e. y = u^(n+1) = e^-z, which absorbs the u^n peak exactly
 (u^n du = e^-z dz / (n + 1); the engine's "power" map, 000 eq. 20, graded logarithmically); z
@@ -96,9 +96,9 @@ at the levels of g (``Pumped.lobe(mu).levels``), at N.wo = mu and s (V's kappa =
 theta_i +- 3, 8 and 13 / sqrt(n), at N.wo = 2^-(1 + 2k) (g's tables are splines in ln N.wo), every pi / 16, and
 for n < 8 graded towards x_s (:func:`chain_cuts`).  g's splines have breakpoints no cut marks, so the estimate
 per interval is ``CHAIN_SAFETY`` (3) times the raw |K - G| (measured: true error at most 0.49 of it over 15
-chains, 351 mu from 1e-10 to 1, rtol 1e-6 ... 1e-12).  Until issue 14's fifth session the lobe frame served
-pumped lobes too, with an adaptive rule on the arc for every outer node: g was looked up ~50 000 times per mu
-instead of ~400, and the three tables of 3-level g2 pumped Phong n = 20 took 180-230 ms instead of 58-83.
+chains, 351 mu from 1e-10 to 1, rtol 1e-6 ... 1e-12).  The lobe frame, with an adaptive rule on the arc for every
+outer node, would look g up ~50 000 times per mu instead of ~400: the three tables of 3-level g2 pumped Phong n = 20
+take 58-83 ms here against 180-230 ms there.
 Checked in ``tests/engine/test_route_pumped_lobe.py`` against an independent quadrature about N (numpy's
 level-by-level reference), the nested engine at rtol 1e-13 and the 2-D engine, and the ring table against
 40-digit mpmath.
@@ -160,7 +160,7 @@ Torrance-Sparrow's D2 stay on the nested engine.
 lobe with p in {0, 1}; ``PowerLobe`` with ``FresnelAtMax``) takes the lobe frame with a rule on the arc (frame 5,
 :func:`_k_lobe_fresnel`): where N.wo < mu the factor is the constant F(mu) / mu^p, so that part is the closed form's;
 where N.wo = t >= mu the integrand F(t) t^(1 - p) is integrated by Gauss-Legendre rules with an a-priori bound on
-Bernstein ellipses (:func:`_lobe_f_gauss`, since issue 14's sixteenth session; the adaptive 7/15 rule in beta where they
+Bernstein ellipses (:func:`_lobe_f_gauss`; the adaptive 7/15 rule in beta where they
 would want too many points), cut at t = x0 -+
 y0 3^j about F's branch point w = sqrt(1 - (eta + i k)^2) = x0 - i y0 (:func:`fresnel_branch`) and at t = rho 3^j
 towards the pole of its parallel reflectance near c = 0 (rho = 1 / |sqrt((eta + i k)^2 + 1)|, :func:`fresnel_pole`: a
@@ -168,7 +168,7 @@ strong absorber's, eta 1.1, k 30, sits at -0.0012 + 0.033 i); the outer variable
 points (features narrower than :data:`LOBE_F_WIDE`).  A near-kink (Im w < :data:`LOBE_F_Y0_MIN`, or w real in (0, 1): a
 dielectric's total reflection below eta = 1) stays on the nested engine.  A pumped metal, and the fresnel wrapper of a
 pumped lobe, multiply the pumped lobe's frame of N by F(max(mu, N.wo)) (:func:`_x_rule`, cut likewise by
-:func:`chain_cuts`; Im w >= :data:`CHAIN_F_Y0_MIN` there).  Since issue 14's twelfth session a lobe with n >=
+:func:`chain_cuts`; Im w >= :data:`CHAIN_F_Y0_MIN` there).  A lobe with n >=
 :data:`LOBE_N_MIN` takes that frame too, with g = 1 (:func:`takes_lobe_n_frame`; its cuts :func:`chain_cut_matrix`,
 compiled, and QUADPACK's calibration instead of CHAIN_SAFETY |K - G|): F is then one factor per node of the elevation
 instead of a rule on every arc, 60-400 evaluations per mu instead of 15 per arc times ~110 arcs (metal n = 20, eta 0.2,
@@ -187,10 +187,10 @@ below z = 200).  What is left is one integral over x of analytic pieces, graded 
 axis: the peak's (x_mu +- 2 i atanh(alpha) for GGX; Beckmann's Gaussian 2 alpha wide; the variable is d = x - x_mu,
 exact where the peak is narrow), P(t)'s at +- i atanh(alpha) (GGX) or its turn on the scale alpha (Beckmann), Schlick's
 pole at sin x = -r / (1 - r), the pole at x = -x_mu of the height-correlated G and of Beckmann's kappa, Walter's switch
-(:func:`_n_cuts`); 10/21 Gauss-Kronrod with QUADPACK's calibration.  Since issue 14's thirteenth session GGX's and
+(:func:`_n_cuts`); 10/21 Gauss-Kronrod with QUADPACK's calibration.  GGX's and
 Schlick's pieces off the peak are integrated in u = ln |d| and graded by 27 instead of 3 (:data:`N_LOG_GRADE`: the
-peak's singularities lie pi / 2 from the real u axis whatever |d|; GGX alpha = 1e-8 took 1099 evaluations per mu, then
-803), and since its eighteenth the pieces from x = 0 up to x_mu / 8 in u = ln x, graded by 27 too (P(t)'s singularities
+peak's singularities lie pi / 2 from the real u axis whatever |d|; GGX alpha = 1e-8: 803 evaluations per mu instead
+of 1099), and the pieces from x = 0 up to x_mu / 8 in u = ln x, graded by 27 too (P(t)'s singularities
 lie pi / 2 from that axis; alpha = 1e-8: 608 evaluations per mu, a 257-point table in 15 ms instead of 19-23).
 No inner rule: 41-184 evaluations per mu for alpha
 >= 0.1, a 257-point table in 0.7-2.6 ms for GGX and Schlick (frame 4 took 20-70 ms), 4-12 ms for Beckmann (frame 4:
@@ -198,7 +198,7 @@ No inner rule: 41-184 evaluations per mu for alpha
 frame 4 (``using(without={"normal", "lobe_normal"})``, :mod:`pumpup.engine.routes`) at rtol 1e-13 over 45 models, 64 mu
 and rtol 1e-6 ... 1e-12: at most 4e-5 of the estimate beyond that reference's own error.
 
-GGX with a Fresnel factor takes frame 6 too since issue 14's thirteenth session (:func:`_ggx_ring_f`).  On the ring
+GGX with a Fresnel factor takes frame 6 too (:func:`_ggx_ring_f`).  On the ring
 F(wi.h) depends on the azimuth, through c = wi.h = sqrt(S^2 + s cos(x) sin^2(psi / 2)) (psi from the mirror side, S =
 sin((x + x_mu) / 2) the ring's smallest c), and has no closed form against D; but D's Fourier cosine coefficients do,
 M_k = 2 a2 (delta_k0 + rho^k (2 k1 + t2 + k k1^2)) (the terms of :func:`_ggx_ring`, rho = (a' - R) / Q), so F's cosine
@@ -221,7 +221,7 @@ F (the nested engine, as before: frame 4 below 0.248 has no chain); Beckmann wit
 coefficients are Bessel functions e^-kappa I_k(kappa), not attempted).
 
 The ``fresnel`` wrapper's F(max(N.L, N.V)) (000 eq. 28) over GGX, Beckmann (F = 1) or Schlick's model, pumped or not,
-takes frame 6 since issue 14's twenty-second session (``FresnelAtMax`` on a frame 6 family): for a fixed wi it depends
+takes frame 6 (``FresnelAtMax`` on a frame 6 family): for a fixed wi it depends
 on N.wo alone, so it is one factor per ring, as a pumped chain's g is; its kink N.wo = mu is the cut d = 0, and the
 elevation is cut about F's branch point and pole as a pumped metal's (:func:`chain_cuts`).  A near-kink (branch point
 within :data:`LOBE_F_Y0_MIN` of the real axis, :data:`CHAIN_F_Y0_MIN` with a chain) stays on the nested engine.  A

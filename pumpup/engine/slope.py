@@ -272,7 +272,7 @@ def _slope_one(mu, phi, ax, ay, rtol, atol, max_intervals, rounding, tnodes, twk
     # direction of the smaller slope's axis (pi / 2 and 3 pi / 2 where a_y < a_x): |e| J(theta) has a branch point that
     # close to the real axis.  The rule's 7 and 15 points on an interval ending near theta_a agreed while both missed:
     # a_x = 0.743, a_y = 0.0149 at mu = 1 (phi = 5.898) was 8.0e-10 off with an estimate of 4.7e-11 at rtol 1e-8, 72 x
-    # at mu = 1 - 1e-9 and rtol 1e-10 (scripts/studies/fuzz_engines.py --registry 47; issue 14's twenty-fourth session).
+    # at mu = 1 - 1e-9 and rtol 1e-10 (scripts/studies/fuzz_engines.py --registry 47).
     # Cuts at theta_a and graded by EDGE_FACTOR from the branch point's distance on both sides
     if ax != ay:
         dist = math.atanh(min(ax, ay) / max(ax, ay))

@@ -42,7 +42,7 @@ from ._half import tan2_half
 #: and 2.68 for Torrance-Sparrow D1 e = 2.  A table's spline went across it, its knots bunched there, and an engine
 #: integrating 1 / U(N.wo) of a 1/E scaling across those knots under-reported: scaled Cook-Torrance m = 0.538 at mu =
 #: 0.9999 was 4.4e-10 off with an estimate of 8.2e-11 at rtol 1e-8 and 1e-10 (scripts/studies/fuzz_engines.py --registry
-#: 49 found m = 0.428 at mu = 1, 1.04 x; issue 14's twenty-fifth session)
+#: 49 found m = 0.428 at mu = 1, 1.04 x)
 RETRO_BREAK = math.sqrt(0.5)
 
 

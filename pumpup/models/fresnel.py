@@ -101,7 +101,7 @@ class FresnelWeighted(BRDF):
         1.88, ad 0.33) had the specular lobe's hint (the power map about the mirror, n = 34) for its Lambert part too,
         and the engines lost part of it with estimates of 1e-9 (0.2908 for 0.4060 at mu = 0.306, eta 0.232), and over a
         2-level pumped plastic half of it (0.468 for 0.959 at mu = 1; scripts/studies/fuzz_engines.py --registry 47 and
-        48; issue 14's twenty-fourth session).
+        48).
         """
         terms = self.base.albedo_terms()
         if len(terms) == 1 and terms[0][1] is self.base:

@@ -80,7 +80,7 @@ def _isotropic_lobe(n, cx, cy, cz, p, mu):
     # cos(alpha) - cx s sin(alpha) cos(beta) = 0 is a kink (a jump of the n-th derivative) that meets the horizon at
     # beta = pi/2, a boundary of the engines' dyadic pieces: unmarked, the thin sliver of lobe between it and pi/2 fell
     # between the last node and the boundary (n = 2, cx = 3, cz = 0.3 at mu = 0.2: 1.0e-7 missed with an estimate of
-    # 2e-11; found in issue 14's fifteenth session, traced by a second session).  With wi turned out of the xz-plane the
+    # 2e-11).  With wi turned out of the xz-plane the
     # zero set is cos(beta - beta*) = ..., which this form does not hold: there the cut is an extra one, not the kink's
     return Lobe(axis="normal", radial="cosine", levels=levels, kinks=_zero_set_kinks(cx, cz), symmetric=True)
 
@@ -179,7 +179,7 @@ class Lafortune(BRDF):
 
     def lobe_axis(self, mu, phi):
         """For p = 0 (000 eq. 14): (R.V)_M = v.wo with v = (-cx Lx, -cy Ly, cz Lz), so f = c |v|^n (v^.wo)_+^n, a
-        Phong power lobe about v^ at elevation nu = cz mu / |v|, scaled by c |v|^n (issue 14's fifteenth session: the
+        Phong power lobe about v^ at elevation nu = cz mu / |v|, scaled by c |v|^n (the
         1-D path about v^ at every azimuth of wi, :func:`pumpup.engine.polar.axis_albedo`).  None for p > 0
         (max(N.L, N.V) depends on mu itself), for cz <= 0 (v^ on or below the horizon), where :meth:`polar` applies, and
         where nu or the scale is not a positive finite number.  With cx = cy, |v| is taken without phi

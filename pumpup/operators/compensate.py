@@ -568,8 +568,8 @@ class _MsLobe(BRDF):
     def azimuth_hint(self):
         """The lobe's albedo in closed form (:class:`~pumpup.core.hints.ClosedForm`): D(mu) 2 pi integral_0^1 D(t) t
         dt = D(mu) pi I, D the kernels' own (:func:`_deficits`), I by :meth:`_Bound.deficit_moment` (exact on the
-        product table's polynomial pieces); the relative error I's, plus 8 ulps for D(mu) pi I itself.  Until issue 14's
-        twelfth session the nested engine integrated it (80 ms for 257 mu, GGX alpha = 0.3).
+        product table's polynomial pieces); the relative error I's, plus 8 ulps for D(mu) pi I itself.  Without
+        it the nested engine integrates the lobe (80 ms for 257 mu, GGX alpha = 0.3).
         """
         from ..core.hints import AzimuthHint, ClosedForm
 
@@ -788,7 +788,7 @@ class _Transposed(BRDF):
         f_r(wi, wo) s(N.wo) with f_r reciprocal, so f(wo, wi) = s(N.wi) f_r(wi, wo) and its albedo at mu is s(mu) times
         f_r's (000 eq. 2; s = 1 + F0 (1 / U - 1), Turquin eq. 6): f_r's own hint with its scale times s (as the kernel
         forms it, :meth:`Scaled.kernel_factor`).  None for anything else (the nested engine), or a base forced in
-        without reciprocity.  Until issue 14's twelfth session the nested engine integrated it.
+        without reciprocity.
         """
         import dataclasses
 

@@ -928,7 +928,7 @@ class _Lookup:
 #: Lafortune n = 148 (cx = cy = -1, cz = 1) at rtol 1e-6 was 1.14-1.56 x its estimate at every mu from 0.01 down to
 #: 2.6e-6, the Kulla-Conty lobe of Phong n = 987 (f_avg 0.69) at rtol 1e-12 3.4 x on the 2-D engine, the fuzz's
 #: reference (scripts/studies/fuzz_engines.py --registry 47), and g2 pumped Minnaert k = 0.31 at mu = 0.88 4.1 x at
-#: every rtol from 1e-6 to 1e-12 (issue 14's twenty-fourth session).  A lobe about another axis has N.wo vary along its
+#: every rtol from 1e-6 to 1e-12.  A lobe about another axis has N.wo vary along its
 #: arcs, where the estimate held (levels there cut every arc: 1.2-2.5 x the time)
 TABLE_DECADES = tuple(10.0 ** -k for k in range(1, 9))
 
@@ -1340,7 +1340,7 @@ class Pumped(BRDF):
         exceeds u(v) (g1: where g = u(N.wo)) is born at the normal or vanishes, so this level's albedo has a near-kink
         at v (a jump of its second derivative) although no cut of g sits there for a wo (g2: only where u(1) > 1,
         below).  Only a bound that is not monotone has one (rough Ward's albedo falls from mu = 1 and rises again at
-        grazing; a metal's has a minimum).  Issue 14's twentieth session: a 2-level g1 pumped Ward m = 0.885 had its
+        grazing; a metal's has a minimum).  Without the break, a 2-level g1 pumped Ward m = 0.885 had its
         level-2 table bunch 37 nodes between v = 0.05 and 0.07 (4 with the break) and round the kink at 0.0605 off,
         and the nested engine was 1.6e-12 off at mu = 1 with an estimate of 8.1e-13.
         """
@@ -1446,7 +1446,7 @@ class Pumped(BRDF):
                 out.append(q)
         # the table's breaks (its spline's split points: the base's albedo_breaks, Cook-Torrance's
         # pumpup.models.cook_torrance.RETRO_BREAK, and a lower level's kinks) are kinks of u(v), so of g where u(v) is
-        # its largest term (issue 14's twenty-fifth session)
+        # its largest term
         for v in lk.table.breaks:
             uv = float(up(v))
             if uv >= am * (1 - 1e-12) and (not self.controlled or uv >= max(mu, v) * (1 - 1e-12)):

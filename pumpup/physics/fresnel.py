@@ -132,8 +132,8 @@ def fresnel_levels(eta: float, k: float, y0_max: float | None = None) -> tuple:
     reflection, with a square-root kink there; a small k makes it a near-kink, the branch point sqrt(1 -
     (eta + i k)^2) = x0 - i y0 (:func:`fresnel_branch`) y0 off the axis.  The 1-D path declines such a factor
     (``pumpup.engine.lobe_fresnel.lobe_fresnel_ok``) and the nested engine, blind to the kink, bisected towards it:
-    fresnel over Blinn n = 5, eta = 0.551, k = 0 took 0.25-0.41 s per value at rtol 1e-10 (issue 14's twenty-first
-    session, ``scripts/studies/fuzz_engines.py --registry``).
+    fresnel over Blinn n = 5, eta = 0.551, k = 0 took 0.25-0.41 s per value at rtol 1e-10
+    (``scripts/studies/fuzz_engines.py --registry``).
     """
     x0, y0 = fresnel_branch(float(eta), float(k))
     return (x0,) if 0.0 < x0 < 1.0 and y0 < (FRESNEL_LEVEL_Y0 if y0_max is None else y0_max) else ()

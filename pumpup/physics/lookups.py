@@ -63,9 +63,9 @@ def upper_array(mu, logx, coef, v0, slope0, margin_lo, margin, cap, out):  # pra
 def upper_root(lo, hi, kind, target, logx, coef, v0, slope0, margin_lo, margin, cap):  # pragma: no cover - compiled
     """The u in [lo, hi] where the bound U(u) (:func:`upper_scalar`) meets ``target`` (``kind`` 0 or 2) or u itself (1),
     given a change of sign of the difference at the ends: bisection until the bracket is at most 1e-15 + 4 eps u wide
-    (where scipy's brentq at xtol 1e-15, which :meth:`Pumped._kink_levels` called from Python, stops too); its midpoint.
-    Compiled (issue 14's eighteenth session): the brentq calls took ~60 us each in cProfile, and the per-mu kink search
-    two thirds of a first 2-level pumped GGX table.
+    (where scipy's brentq at xtol 1e-15 stops too); its midpoint.  Compiled: called from Python in
+    :meth:`Pumped._kink_levels`, brentq takes ~60 us per call in cProfile, and the per-mu kink search two thirds of a
+    first 2-level pumped GGX table.
     """
     flo = upper_scalar(lo, logx, coef, v0, slope0, margin_lo, margin, cap) - (lo if kind == 1 else target)
     while hi - lo > 1e-15 + 8.9e-16 * hi:

@@ -371,8 +371,8 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
         miss = misses(grid, V, E, mids, mv)
         # an interval whose midpoint is not a new value of log(mu) is not split: its miss counts as an accepted one.
         # The bisection reaches one where the values' own noise exceeds interp_tol (a divergent albedo, 3.5e6 at mu =
-        # 1.08e-8 with errors of 1e-5: interp_tol 1e-7 is 3e-14 of it), or at a jump of the albedo.  It split such an
-        # interval into two nodes of one log(mu) before (ValueError from scipy; issue 14's twenty-third session)
+        # 1.08e-8 with errors of 1e-5: interp_tol 1e-7 is 3e-14 of it), or at a jump of the albedo.  Splitting such an
+        # interval would give two nodes of one log(mu) (ValueError from scipy)
         split = _splittable(grid)[todo]
         bad = (miss > interp_tol).any(axis=1) & split
         # (within such an interval the spline takes one end's value at every mu: its ends' spread counts too)
@@ -398,15 +398,15 @@ def adaptive_grid(grid, val, err, values, interp_tol, max_points, breaks=(), bar
     # theta ~ its width: pumped plastic n = 5284 was 3.1e-7 off at mu = 0.99995 with a margin of 2.0e-7, found by
     # scripts/studies/fuzz_engines.py --tables 43), and so does a g2 level whose bound crosses the diagonal within it (a
     # kink the table's one spline goes across: Pumped.albedo_kinks).  It is checked at 1 - mu = (1 - a) 2^-k too, down
-    # to NEAR_ONE_MIN, and the largest miss there counts (issue 14's twenty-third session)
+    # to NEAR_ONE_MIN, and the largest miss there counts
     pts = _near_one(grid[-2])
     if off_grid:
         # a model that reads pumpup's own tables (a pumped level's g, a compensation's E) inherits their interpolation
         # error between their nodes, and those nodes are this grid's and its midpoints: a check there is blind to it.
         # Kulla-Conty over Torrance-Sparrow D1 (s 844, ior 1.53) was exact at its nodes and midpoints and 6.0e-8 off at
-        # mu = 0.039 with a margin of 5.9e-9 (scripts/studies/fuzz_engines.py --tables 44; issue 14's twenty-third
-        # session).  The thirds of each interval in log(mu) are no nodes of a dyadic refinement; one third alone left it
-        # 1.24 x its margin (the interval held two of E's pieces), both 0.58 x
+        # mu = 0.039 with a margin of 5.9e-9 (scripts/studies/fuzz_engines.py --tables 44).  The thirds of each
+        # interval in log(mu) are no nodes of a dyadic refinement; one third alone left it 1.24 x its margin (the
+        # interval held two of E's pieces), both 0.58 x
         lx = np.log(grid)
         thirds = np.concatenate([np.exp((2.0 * lx[:-1] + lx[1:]) / 3.0), np.exp((lx[:-1] + 2.0 * lx[1:]) / 3.0)])
         inside = (np.log(thirds) > np.tile(lx[:-1], 2)) & (np.log(thirds) < np.tile(lx[1:], 2))
@@ -500,7 +500,7 @@ def _tabulate(brdf, mu, *, rtol, atol, interp_tol, mu_min, max_points, progress,
 
     if breaks is None and mu is None and (phi is None or isinstance(phi, str) and phi == "sup"):
         # the model's own kinks (BRDF.albedo_breaks: a Fresnel factor's total reflection): metal n = 5, eta = 0.551 took
-        # 748 nodes and 15 s without them, 322 and 7.3 s with them (issue 14's twenty-first session)
+        # 748 nodes and 15 s without them, 322 and 7.3 s with them
         own = [b for b in brdf.albedo_breaks() if mu_min < b < 1.0]
         breaks = own or None
     if breaks is not None:
@@ -576,7 +576,7 @@ def _chunked(brdf, mu, rtol, atol, bar, threads: int | None = None, chunk: int =
 
     if one_d_everywhere(brdf, mu):
         # its values cost microseconds: one call for them all (chunks of 32 cost Phong n = 20's 257-point table
-        # 1.8 ms against 1.4 ms, issue 14's twenty-third session); the values do not depend on the batch
+        # 1.8 ms against 1.4 ms); the values do not depend on the batch
         chunk = max(chunk, len(mu))
         if threads is None and THREADS is None:
             threads = 1
@@ -984,7 +984,7 @@ def mean_albedo(brdf: BRDF, *, rtol: float = 1e-9, return_error: bool = False,
 
     # a pumped level's albedo has kinks (BRDF.albedo_kinks): first intervals end there.  Without them a 2-level g1
     # pumped stretched Phong (n = 0.127, p = 1: kinks at mu = 0.309, 0.345, 0.741, 0.745) had a mean 1.05e-9 off with an
-    # estimate of 1.0e-10 (issue 14's twentieth session, scripts/studies/fuzz_engines.py --mean)
+    # estimate of 1.0e-10 (scripts/studies/fuzz_engines.py --mean)
     from ..engine.lobe_geometry import smooth_inverse
 
     # and two more towards grazing incidence, tau = 1/16 and 1/32 (mu = 0.011, 0.0029): the albedo there turns on the
