@@ -22,35 +22,35 @@ pumped Phong n = 20, new against previous.  Best of 3 (1-D) or 1 (2-D) runs afte
     python scripts/bench/bench_albedo.py --cells    # only the sweep cells and the pumped tables
     python scripts/bench/bench_albedo.py --eval     # only BRDF.eval's overhead (the input checks) and numpy
     python scripts/bench/bench_albedo.py --phong    # only the Phong family's rows (1-D path), no dblquad
-    python scripts/bench/bench_albedo.py --slope    # only anisotropic Ward: the slope path (issue 14's fourteenth session)
+    python scripts/bench/bench_albedo.py --slope    # only anisotropic Ward: the slope path
                                               # against the nested engine
     python scripts/bench/bench_albedo.py --p        # only the p-model with p in (0, 1): 1-D path against the nested engine
-    python scripts/bench/bench_albedo.py --half     # only the models put on the 1-D path in issue 14's sixth session
-                                              # (half vector, closed forms) against the nested engine
-    python scripts/bench/bench_albedo.py --arc      # only the models put on the 1-D path in issue 14's seventh session
-                                              # (a rule on the half vector's arc) against the nested engine
-    python scripts/bench/bench_albedo.py --fresnel  # only the models put on the 1-D path in issue 14's eighth session
-                                              # (the lobe frame with F(Theta_min)) against the nested engine
-    python scripts/bench/bench_albedo.py --nframe   # only GGX, Beckmann (F = 1) and Schlick, about N in closed form since issue
-                                              # 14's ninth session, against the rule on h's arc and the nested engine
-    python scripts/bench/bench_albedo.py --nframe-f # only GGX with a Fresnel factor, about N since issue 14's thirteenth session,
+    python scripts/bench/bench_albedo.py --half     # only the models on the 1-D path by the half vector's azimuth
+                                              # in closed form against the nested engine
+    python scripts/bench/bench_albedo.py --arc      # only the models on the 1-D path by a rule on the half vector's
+                                              # arc against the nested engine
+    python scripts/bench/bench_albedo.py --fresnel  # only the models on the 1-D path by the lobe frame with
+                                              # F(Theta_min) against the nested engine
+    python scripts/bench/bench_albedo.py --nframe   # only GGX, Beckmann (F = 1) and Schlick, about N in closed form,
                                               # against the rule on h's arc and the nested engine
-    python scripts/bench/bench_albedo.py --lobe-n   # only lobes with F(Theta_min), n >= 8, about N since issue 14's twelfth
-                                              # session, against frame 5 and the nested engine
+    python scripts/bench/bench_albedo.py --nframe-f # only GGX with a Fresnel factor, about N,
+                                              # against the rule on h's arc and the nested engine
+    python scripts/bench/bench_albedo.py --lobe-n   # only lobes with F(Theta_min), n >= 8, about N,
+                                              # against frame 5 and the nested engine
     python scripts/bench/bench_albedo.py --fmax     # only the fresnel wrapper over GGX, Beckmann, Schlick (pumped or not), frame
-                                              # 6 with F(Theta_min) per node since issue 14's twenty-second session,
+                                              # 6 with F(Theta_min) per node,
                                               # against the nested engine
-    python scripts/bench/bench_albedo.py --pumped-f # only pumped GGX with F(wi.h): frame 6 at mu >= 0.248 since issue 14's
-                                              # twenty-second session, against the nested engine
+    python scripts/bench/bench_albedo.py --pumped-f # only pumped GGX with F(wi.h): frame 6 at mu >= 0.248,
+                                              # against the nested engine
     python scripts/bench/bench_albedo.py --pumped   # only pumped chains (Phong family; GGX, Beckmann, Schlick in frame 6):
                                               # 1-D path against the nested engine
     python scripts/bench/bench_albedo.py --scaled   # only 1/E-scaled GGX, Beckmann, Schlick (frame 6 times Turquin's factor)
                                               # against the nested engine
-    python scripts/bench/bench_albedo.py --lafortune  # only Lafortune lobes with p = 0 about their own axis (issue 14's
-                                              # fifteenth session) against the nested engine / the 2-D cubature
+    python scripts/bench/bench_albedo.py --lafortune  # only Lafortune lobes with p = 0 about their own axis
+                                              # against the nested engine / the 2-D cubature
     python scripts/bench/bench_albedo.py --lobe-f   # only frame 5's lobes with n < 8 (metal, plastic, the fresnel wrapper):
-                                              # Gauss-Legendre pieces with an a-priori bound (issue 14's sixteenth
-                                              # session) against the adaptive 7/15 rule they had before
+                                              # Gauss-Legendre pieces with an a-priori bound against the adaptive
+                                              # 7/15 rule (``using(lobe_fresnel_gauss=False)``)
     python scripts/bench/bench_albedo.py --breaks   # only the nested families with kinks or levels: the compiled break
                                               # finding against its numpy reference (issue 14 item 3)
 """
@@ -236,7 +236,7 @@ def families(rtol=1e-10, specs=None, dblquad=True):
 
 
 def against_nested(specs, label, rtol=1e-10, repeat=3):
-    """Models on the 1-D path against the nested engine they had before (the 1-D path switched off alone,
+    """Models on the 1-D path against the nested engine they take without it (the 1-D path switched off alone,
     ``using(engine="nested")``; ``engine="2d"`` would switch off the nested engine too), same run, same rtol: a
     257-point table (mu uniform in theta) and a sweep cell (257 mu of ``default_mu`` + mean albedo + maximum
     constant), one thread, best of ``repeat``."""
@@ -289,8 +289,8 @@ def _against_second_path(specs, title, first, second, width, rtol, repeat, lobe=
 
 
 def n_frame(rtol=1e-10, repeat=3):
-    """GGX and Beckmann with F = 1 and Schlick's model, about N with the weight's azimuth in closed form (frame 6, issue 14's
-    ninth session) against frame 4, the rule on h's arc they took before, and the nested engine
+    """GGX and Beckmann with F = 1 and Schlick's model, about N with the weight's azimuth in closed form (frame 6)
+    against frame 4, the rule on h's arc (their route without frame 6), and the nested engine
     (:func:`_against_second_path`)."""
     specs = [{"type": "ggx", "alpha": a} for a in (0.001, 0.1, 0.5)] + [
         {"type": "ggx", "alpha": 0.3, "shadowing": "correlated"}, {"type": "schlick", "r": 0.2}, {"type": "schlick", "r": 0.001}] + [
@@ -299,8 +299,8 @@ def n_frame(rtol=1e-10, repeat=3):
 
 
 def n_frame_fresnel(rtol=1e-10, repeat=3):
-    """GGX with a Fresnel factor about N (frame 6 with the ring's product rule, pumpup.engine.normal_frame._ggx_ring_f; issue 14's
-    thirteenth session; frame 4 below mu = N_FRESNEL_MU_MIN) against frame 4, the rule on h's arc they took before, and the
+    """GGX with a Fresnel factor about N (frame 6 with the ring's product rule, pumpup.engine.normal_frame._ggx_ring_f;
+    frame 4 below mu = N_FRESNEL_MU_MIN) against frame 4, the rule on h's arc (their route without frame 6), and the
     nested engine (:func:`_against_second_path`)."""
     specs = [{"type": "ggx", "alpha": 0.3, "eta": 0.2, "k": 3.0}, {"type": "ggx", "alpha": 0.02, "ior": 1.5},
              {"type": "ggx", "alpha": 0.5, "shadowing": "correlated", "eta": 1.1, "k": 6.0},
@@ -311,7 +311,7 @@ def n_frame_fresnel(rtol=1e-10, repeat=3):
 
 def lobe_n_frame(rtol=1e-10, repeat=3):
     """Lobes with 000 eq. 28's F(Theta_min) (metal, plastic with an index, the fresnel wrapper; n >= 8) about N with the ring
-    table and g = 1 (issue 14's twelfth session) against frame 5, the lobe frame with a rule on the arc they took before,
+    table and g = 1 against frame 5, the lobe frame with a rule on the arc (their route without the ring table),
     and the nested engine (:func:`_against_second_path`)."""
     specs = [{"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, {"type": "metal", "n": 8, "eta": 1.5},
              {"type": "metal", "n": 500, "eta": 1.1, "k": 6.0}, {"type": "metal", "n": 10, "eta": 0.6, "k": 0.3},
@@ -332,10 +332,10 @@ def p_model(rtol=1e-10, repeat=3):
 
 
 def half_and_closed(rtol=1e-10, repeat=3):
-    """The models issue 14's sixth session put on the 1-D path (the half vector's azimuth about N in closed form:
+    """The models on the 1-D path by the half vector's azimuth about N in closed form (
     the Blinn family, 000 eq. 31, 32 and 002 eq. 24; Ward and modified Ward, 000 eq. 34, 35; Cook-Torrance and
     Torrance-Sparrow with F = 1, 001 eq. 9-10 and 002 eq. 10; plastic without Fresnel, 000 eq. 30; and the closed
-    forms of Oren-Nayar, Minnaert and the lacquer) against the nested engine they had before (:func:`against_nested`)."""
+    forms of Oren-Nayar, Minnaert and the lacquer) against the nested engine (:func:`against_nested`)."""
     against_nested([{"type": "blinn", "n": 16}, {"type": "blinn", "n": 512, "c": 20.6}, {"type": "stretched_blinn", "n": 8},
                     {"type": "phong_blinn", "n": 20}, {"type": "ward", "m": 0.1}, {"type": "ward", "m": 0.4},
                     {"type": "modified_ward", "m": 0.1}, {"type": "cook_torrance", "m": 0.3},
@@ -345,10 +345,10 @@ def half_and_closed(rtol=1e-10, repeat=3):
 
 
 def on_the_arc(rtol=1e-10, repeat=3):
-    """The models issue 14's seventh session put on the 1-D path: the half vector's azimuth by a rule on its arc
+    """The models on the 1-D path by the half vector's azimuth by a rule on its arc
     (pumpup.engine.half_arc._k_numeric: GGX and Beckmann with Smith G, with and without a Fresnel factor; Cook-Torrance and
     Torrance-Sparrow with one; Schlick, 000 eq. 36) and Torrance-Sparrow D3 in closed form under the GGX weight,
-    against the nested engine they had before (:func:`against_nested`)."""
+    against the nested engine (:func:`against_nested`)."""
     against_nested([{"type": "ggx", "alpha": 0.1}, {"type": "ggx", "alpha": 0.5, "shadowing": "correlated"},
                     {"type": "ggx", "alpha": 0.02, "ior": 1.5}, {"type": "ggx", "alpha": 0.001},
                     {"type": "beckmann", "alpha": 0.1}, {"type": "beckmann", "alpha": 0.3, "g1": "walter"},
@@ -359,10 +359,10 @@ def on_the_arc(rtol=1e-10, repeat=3):
 
 
 def lobe_fresnel(rtol=1e-10, repeat=3):
-    """The models issue 14's eighth session put on the 1-D path: the lobe frame with 000 eq. 28's F(Theta_min) by a rule
+    """The models on the 1-D path by the lobe frame with 000 eq. 28's F(Theta_min) by a rule
     on the arc where N.V >= N.L (pumpup.engine.lobe_fresnel._k_lobe_fresnel: metal, plastic with an index, the fresnel wrapper of a
     Phong-family lobe) and the pumped lobe's frame of N with it (a pumped metal, the fresnel wrapper of a pumped lobe),
-    against the nested engine they had before (:func:`against_nested`)."""
+    against the nested engine (:func:`against_nested`)."""
     against_nested([{"type": "metal", "n": 20, "eta": 0.2, "k": 3.0}, {"type": "metal", "n": 1, "eta": 1.5},
                     {"type": "metal", "n": 500, "eta": 1.1, "k": 6.0}, {"type": "metal", "n": 7.5, "eta": 0.6, "k": 0.3},
                     {"type": "metal", "n": 20, "eta": 0.5, "k": 0.002}, {"type": "plastic", "n": 20, "eta": 1.5, "ad": 0.3},
@@ -376,7 +376,7 @@ def lobe_fresnel(rtol=1e-10, repeat=3):
 
 def scaled(rtol=1e-10, repeat=3):
     """1/E-scaled GGX, Beckmann and Schlick models (Turquin eq. 6, ``pumpup.compensate(..., method="scale")``; frame 6
-    times the factor since issue 14's eleventh session) against the nested engine they had before (:func:`against_nested`)."""
+    times the factor) against the nested engine (:func:`against_nested`)."""
     against_nested([{"type": "scaled", "base": b, "f0": f0} for b, f0 in [
         ({"type": "ggx", "alpha": 0.3}, 1.0), ({"type": "ggx", "alpha": 0.05}, 1.0), ({"type": "ggx", "alpha": 1.0}, 0.5),
         ({"type": "beckmann", "alpha": 0.1}, 1.0), ({"type": "schlick", "r": 0.2}, 1.0)]],
@@ -385,8 +385,7 @@ def scaled(rtol=1e-10, repeat=3):
 
 def fresnel_max(rtol=1e-10, repeat=3):
     """The fresnel wrapper (000 eq. 28's F(max(N.L, N.V))) over GGX, Beckmann and Schlick's model, pumped or not: frame 6
-    with F a factor of each node since issue 14's twenty-second session (``Polar.fmax``), against the nested engine they
-    had before (:func:`against_nested`)."""
+    with F a factor of each node (``Polar.fmax``), against the nested engine (:func:`against_nested`)."""
     ggx = {"type": "fresnel", "base": {"type": "ggx", "alpha": 0.1}, "eta": 0.2, "k": 3.0}
     against_nested([{"type": "fresnel", "base": {"type": "ggx", "alpha": 0.3}, "eta": 0.2, "k": 3.0}, ggx,
                     {"type": "fresnel", "base": {"type": "ggx", "alpha": 0.02, "shadowing": "correlated"}, "eta": 1.5},
@@ -399,8 +398,8 @@ def fresnel_max(rtol=1e-10, repeat=3):
 
 
 def pumped_fresnel(rtol=1e-10, repeat=3):
-    """Pumped GGX with a Fresnel factor F(wi.h): frame 6 divided by g at mu >= N_FRESNEL_MU_MIN since issue 14's
-    twenty-second session, the nested engine below (``pumpup.engine.routes``), against the nested engine at every mu as before
+    """Pumped GGX with a Fresnel factor F(wi.h): frame 6 divided by g at mu >= N_FRESNEL_MU_MIN,
+    the nested engine below (``pumpup.engine.routes``), against the nested engine at every mu
     (:func:`against_nested`)."""
     against_nested([{"type": "pumped", "base": {"type": "ggx", "alpha": 0.1, "eta": 0.2, "k": 3.0}, "g": "g2"},
                     {"type": "pumped", "base": {"type": "ggx", "alpha": 0.3, "ior": 1.5}, "g": "g1", "levels": 2},
@@ -409,8 +408,8 @@ def pumped_fresnel(rtol=1e-10, repeat=3):
 
 
 def pumped_chains(rtol=1e-10, repeat=3):
-    """Pumped Phong-family BRDFs (001 eq. 16; the 1-D path since issue 14's fourth session) and pumped GGX, Beckmann
-    and Schlick models (frame 6 divided by g since the tenth) against the nested engine that had them (``Pumped.polar``
+    """Pumped Phong-family BRDFs (001 eq. 16; the 1-D path) and pumped GGX, Beckmann
+    and Schlick models (frame 6 divided by g) against the nested engine (``Pumped.polar``
     switched off: the base keeps its 1-D path), same run: a 257-point table at rtol ``rtol`` (mu uniform in theta,
     the chain's tables built first), one thread, best of ``repeat``; then the three tables of a 3-level g2 pumped
     Phong n = 20 and GGX alpha = 0.3 as ``pumpup.pump`` builds them (``tabulate``'s threads, rtol 1e-9, adaptive
@@ -425,7 +424,7 @@ def pumped_chains(rtol=1e-10, repeat=3):
     for spec, g, levels in [({"type": "phong", "n": 20}, "g2", 1), ({"type": "phong", "n": 20}, "g2", 2),
                             ({"type": "phong", "n": 20}, "g2", 3), ({"type": "stretched_phong", "n": 20}, "g1", 2),
                             ({"type": "phong", "n": 200}, "g2", 2),
-                            # frame 6 divided by g (issue 14's tenth and eleventh sessions)
+                            # frame 6 divided by g
                             ({"type": "ggx", "alpha": 0.3}, "g2", 1), ({"type": "ggx", "alpha": 0.1, "shadowing": "correlated"}, "g2", 2),
                             ({"type": "beckmann", "alpha": 0.3}, "g1", 2), ({"type": "schlick", "r": 0.2}, "g1", 1)]:
         f = pumpup.pump(spec, g=g, levels=levels)
@@ -642,8 +641,8 @@ def eval_overhead(n=1_000_000, repeat=15):
 
 
 def slope(rtol=1e-10, repeat=3):
-    """Anisotropic Ward in slope space (pumpup.engine.slope, issue 14's fourteenth session) against the nested engine it took
-    before (``using(engine="nested")`` leaves both out), same run: a 257-point table (mu uniform in theta) at phi = 0 and at
+    """Anisotropic Ward in slope space (pumpup.engine.slope) against the nested engine
+    (``using(engine="nested")`` leaves both out), same run: a 257-point table (mu uniform in theta) at phi = 0 and at
     phi = 0.7, one thread, best of ``repeat`` (nested: 1), with the slope path's evaluations per mu."""
 
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
@@ -668,8 +667,8 @@ def slope(rtol=1e-10, repeat=3):
 
 def lobe_f_gauss(rtol=1e-10, repeat=3):
     """Frame 5's lobes with F(Theta_min) and n < LOBE_N_MIN (metal, plastic, the fresnel wrapper) with the arcs by
-    Gauss-Legendre pieces and their a-priori bound (``pumpup.engine.lobe_fresnel._lobe_f_gauss``; issue 14's sixteenth session)
-    against the adaptive 7/15 rule they had before (``using(lobe_fresnel_gauss=False)``), same run: a 257-point table (mu
+    Gauss-Legendre pieces and their a-priori bound (``pumpup.engine.lobe_fresnel._lobe_f_gauss``)
+    against the adaptive 7/15 rule (``using(lobe_fresnel_gauss=False)``), same run: a 257-point table (mu
     uniform in theta) at ``rtol`` and a sweep cell (257 mu + mean albedo + maximum constant), one thread, best of
     ``repeat`` each, alternating."""
     from pumpup.engine import chain_frame as _chain_frame
@@ -708,8 +707,8 @@ def lobe_f_gauss(rtol=1e-10, repeat=3):
 
 
 def lafortune_axis(rtol=1e-10, repeat=3):
-    """Lafortune lobes with p = 0 about their own axis v^ (``BRDF.lobe_axis``, ``pumpup.engine.polar.axis_albedo``; issue 14's
-    fifteenth session) against the engine they took before (``lobe_axis`` switched off: the nested engine at phi = 0, the
+    """Lafortune lobes with p = 0 about their own axis v^ (``BRDF.lobe_axis``, ``pumpup.engine.polar.axis_albedo``)
+    against the engine they take without it (``lobe_axis`` switched off: the nested engine at phi = 0, the
     2-D cubature at phi != 0), same run: a 257-point table (mu uniform in theta) at rtol 1e-10 by the axis path, one
     thread, best of ``repeat``; the engine before on every 16th of those mu (17 values, once; the 2-D cubature takes
     seconds per value), compared per value of mu."""

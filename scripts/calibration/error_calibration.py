@@ -83,8 +83,8 @@ def _without_1d():
 def _nested_applies(f) -> bool:
     """The nested quadrature (pumpup.engine.nested) integrates f: every term with a lobe hint (a
     from_function BRDF stays on the 2-D engine).  It is judged with the 1-D path off (``_without_1d``),
-    so also on the models that path takes (the Phong family, and since issue 14's sixth session the half
-    vector's models: the nested engine integrated those before, and is their second engine in the tests)."""
+    so also on the models that path takes (the Phong family, and the half
+    vector's models: the nested engine is their second engine in the tests)."""
     for _, t in f.albedo_terms():
         lobe = t.lobe(0.5)
         if lobe.generic:

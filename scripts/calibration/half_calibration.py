@@ -1,4 +1,4 @@
-"""How honest is the half-vector 1-D path's error estimate?  (issue 14, sixth session)
+"""How honest is the half-vector 1-D path's error estimate?
 
 For the models whose albedo the 1-D path integrates about N for the half vector (pumpup.engine.polar,
 Polar kind "half": the Blinn family, Ward, modified Ward, Cook-Torrance and Torrance-Sparrow D1, D3, D4 with
@@ -28,7 +28,7 @@ FAMILIES = {
     "modified_ward": [{"type": "modified_ward", "m": m} for m in (0.02, 0.05, 0.1, 0.2, 0.3, 0.5, 1.0)],
     "cook_torrance": [{"type": "cook_torrance", "m": m} for m in (0.02, 0.1, 0.3, 0.6, 1.0, 3.0)],
     "torrance_sparrow D1": [{"type": "torrance_sparrow", "d": "D1", "s": e} for e in (0, 1, 5, 20, 200)],
-    # the seventh session: D3 in closed form (the GGX weight), and the rule on h's arc (Polar smith / fresnel)
+    # D3 in closed form (the GGX weight), and the rule on h's arc (Polar smith / fresnel)
     "torrance_sparrow D3": [{"type": "torrance_sparrow", "d": "D3", "s": c} for c in (0.01, 0.1, 0.3, 1.0, 2.0, 10.0)],
     "ggx": [{"type": "ggx", "alpha": a} for a in (1e-5, 0.001, 0.02, 0.1, 0.5, 1.0)],
     "ggx correlated, F": [{"type": "ggx", "alpha": a, "shadowing": "correlated", **fr}

@@ -1,4 +1,4 @@
-"""How honest is the error estimate of the 1-D path with 000 eq. 28's Fresnel factor?  (issue 14, eighth session)
+"""How honest is the error estimate of the 1-D path with 000 eq. 28's Fresnel factor?
 
 The lobe frame with F(Theta_min) (pumpup.engine.polar frame 5, _k_lobe_fresnel: metal, plastic with an index, the fresnel
 wrapper of a Phong-family lobe) and the pumped lobe's frame of N with it (a pumped metal, the fresnel wrapper of a

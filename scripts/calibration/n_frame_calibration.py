@@ -1,4 +1,4 @@
-"""How honest is frame 6's error estimate?  (issue 14, ninth session)
+"""How honest is frame 6's error estimate?
 
 Frame 6 (pumpup.engine.normal_frame._integrate_n) integrates GGX and Beckmann with F = 1 (both Smith G, exact or Walter's G1) and
 Schlick's model about N, with the weight's azimuth in closed form.  Its reference here is frame 4, the rule on h's arc these models took before

@@ -11,12 +11,12 @@ miss of one of the two.
     python scripts/calibration/pumped_calibration.py              # every third theta of the figures (a few minutes)
     python scripts/calibration/pumped_calibration.py --stride 1   # all of them
     python scripts/calibration/pumped_calibration.py --nframe     # pumped GGX, Beckmann and Schlick models instead (frame 6 about
-                                                      # N divided by g, pumpup.engine.normal_frame._integrate_n; issue 14's tenth
-                                                      # session): their estimate is the larger of QUADPACK's calibration
+                                                      # N divided by g, pumpup.engine.normal_frame._integrate_n):
+                                                      # their estimate is the larger of QUADPACK's calibration
                                                       # and CHAIN_SAFETY |K - G|
     python scripts/calibration/pumped_calibration.py --scaled     # 1/E-scaled GGX, Beckmann and Schlick models (frame 6 times
-                                                      # Turquin's factor 1 + F0 (1 / U(N.wo) - 1); issue 14's eleventh
-                                                      # session), the same estimate
+                                                      # Turquin's factor 1 + F0 (1 / U(N.wo) - 1)), the
+                                                      # same estimate
 """
 
 import argparse

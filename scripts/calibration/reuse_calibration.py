@@ -1,4 +1,4 @@
-"""Calibration of the mean albedo taken from a table (pumpup/tables/reuse.py, issue 14's item 5; nineteenth session).
+"""Calibration of the mean albedo taken from a table (pumpup/tables/reuse.py).
 
 For built-in models from wide to very narrow lobes, Ward's divergent grazing albedo and sharp Fresnel features, on the
 sweep's grid (``pumpup.sweeps.default_mu(257)``): the table, then ``pumpup.mean_albedo`` at rtol 1e-9 (from the table,
@@ -6,7 +6,7 @@ the table cut short, or afresh), against ``pumpup.mean_albedo`` on a fresh objec
 Gauss-Kronrod in mu over fresh values), its own error counted in the reused value's favour.  Prints, per model, which way
 the mean was taken, the true error / the estimate, and the time of the mean; then the worst ratio.
 
-Until this session the spline's estimate was |quintic - cubic| alone: Phong n = 20000 was 1.1e-9 off with an estimate of
+The spline's estimate is not |quintic - cubic| alone: with that, Phong n = 20000 was 1.1e-9 off with an estimate of
 3.5e-10 (ratio 3.2): the grid barely resolves a feature there, and both splines are off alike.
 
     PYTHONPATH=. python scripts/calibration/reuse_calibration.py

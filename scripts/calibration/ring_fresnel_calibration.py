@@ -1,4 +1,4 @@
-"""Calibration of frame 6 with a Fresnel factor (pumpup.engine.normal_frame._ggx_ring_f; issue 14, thirteenth session).
+"""Calibration of frame 6 with a Fresnel factor (pumpup.engine.normal_frame._ggx_ring_f).
 
 1. The ring: GGX's D times F(wi.h) over the azimuth of wo, for 7 indices (a dielectric near 1 and at 1.5 and 3; a metal, a
    strong absorber whose pole lies near c = 0, a weak absorber, a conductor with eta < 1), 6 alpha from 1e-4 to 1, 9 mu from

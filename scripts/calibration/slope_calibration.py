@@ -1,4 +1,4 @@
-"""Calibration of the slope path (anisotropic Ward, pumpup.engine.slope; issue 14, fourteenth session).
+"""Calibration of the slope path (anisotropic Ward, pumpup.engine.slope).
 
 For 9 pairs of slopes (anisotropy 1 ... 1000, widths 1e-3 ... 3, both orders), 14 mu (MU_MIN, 1e-8, 1e-4, 0.003 and 10
 uniform in theta) and 4 azimuths of wi (0, 0.4, pi / 4 + 0.1, pi / 2), at rtol 1e-6, 1e-8, 1e-10 and 1e-12: the true error

@@ -1,4 +1,4 @@
-"""Is the 1-D path's estimate honest next to the mu where two of its breaks coincide?  (issue 14, twelfth session)
+"""Is the 1-D path's estimate honest next to the mu where two of its breaks coincide?
 
 In the lobe frame the level's break (u = cos 2 theta_i) and the horizon's (u = s) meet at mu = sqrt(3)/2; in the half
 frame the level (u = mu) meets the split of tail and peak at mu = 1/2 and the horizon's break at sqrt(3)/2.  For 22
@@ -6,8 +6,8 @@ models of frames 0-5 (Phong family with p in {0.5, 1}, Blinn family, Cook-Torran
 Ward, metal n < 8, GGX and Cook-Torrance with a Fresnel factor), at 180 mu (150 random in theta, 15 on each side of
 sqrt(3)/2 and of 1/2 at relative distances 1e-14 ... 1e-3) and rtol 1e-10 and 1e-12, prints the worst ratio
 max(|a - ref| - ref_err, 0) / estimate against the nested engine at rtol 1e-13 (``using(engine="nested")``), where
-it lies, and the evaluations per mu.  A ratio above 1 is a dishonest estimate (the previous session's code: 4.69 for
-stretched Phong and retro n = 10 at mu = sqrt(3)/2 (1 - 1e-6)).
+it lies, and the evaluations per mu.  A ratio above 1 is a dishonest estimate (without
+``pumpup.engine.outer_rule._foreign_roots``: 4.69 for stretched Phong and retro n = 10 at mu = sqrt(3)/2 (1 - 1e-6)).
 
     PYTHONPATH=. python scripts/studies/breaks_scan.py     # about 30 s
 """

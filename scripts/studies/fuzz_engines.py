@@ -1,4 +1,4 @@
-"""Random probe of the albedo engines' honesty (issue 14, nineteenth session).
+"""Random probe of the albedo engines' honesty.
 
 Draws built-in models with extreme parameters (lobe exponents 0.1-1e4, roughness 1e-4-1, Fresnel factors with eta
 0.1-3 and k 0.01-16, Schlick r down to 1e-6, p-models), three incidences (mu log-uniform down to 1e-6, uniform, 1) and
@@ -11,12 +11,12 @@ culprit: decide it with a third method (``tests/reference/independent_microfacet
 Found this way: GGX alpha 1.3e-4 at mu = 6.05e-5.  The 1-D path (0.8967913960373392, estimate 2.3e-14) agrees with
 the independent script (0.8967913960367667 +- 1.9e-8); the nested engine was 9e-9 off with estimates of 2e-10 to 3e-9
 at every rtol (36-42 x at alpha 1e-4, mu 6e-5 and 1e-4; 1.3 x at alpha 1e-3, mu 1e-5), and at alpha 1e-4 the 2-D
-engine too (4.7e-9 off, estimate 2.5e-9).  The cause, found in the twentieth session: ``albedo.smooth_inverse`` put
+engine too (4.7e-9 off, estimate 2.5e-9).  The cause: ``albedo.smooth_inverse`` put
 the far horizon break (1 - tau_x = 1.7e-9) at 6.8e-3 (Newton from a start that rounds 1 - 2 (1 - x)); mended, both
 engines agree with a half-vector quadrature to 5e-13 (``tests/engine/test_cubature.py``).  The nested engine is not
 GGX's path (frame 6 is); it is the tests' second engine and the path of models without a 1-D path.
 
-Found in the twentieth session (each mended, with a test): a pumped level's albedo kinked where its bound equals its value
+Found the same way (each mended, with a test): a pumped level's albedo kinked where its bound equals its value
 at the normal (--two-d; ``Pumped._kink_normal``); a (mu, phi) dataset crashing ``AlbedoTable.from_dataset`` (--tables);
 frame 4 blind to a near-real branch point of F at normal incidence (GGX alpha .003, eta .271, k .0605 at mu = 1: 6.9 x);
 the nested engine blind to G1's fall at the horizon near normal incidence for alpha < 1.5e-3 (up to 26 x;
@@ -24,18 +24,18 @@ the nested engine blind to G1's fall at the horizon near normal incidence for al
 ``mean_albedo``'s first intervals end at them now), and across mu ~ alpha near grazing (2.6 x; two more first
 intervals there).
 
-Found in the twenty-first session (each mended, with a test): the 2-D engine blind to G1's fall at the horizon near normal
+Also found (each mended, with a test): the 2-D engine blind to G1's fall at the horizon near normal
 incidence (GGX alpha 2.7e-4 at mu = 1: 62 x; it is now graded as the nested engine); the power map wrong at its split
 x = 1/2 for n > 52, so the kink scan missed a cut of Torrance-Sparrow's G entering the arc (--two-d: the 2-D engine 1.77e-7
 off, 1270 x); a Fresnel factor's total reflection (eta < 1, k = 0) unknown to the hints (--registry: correct, but 0.3 s
 per value and minutes per table on the nested engine).
 
-Found in the twenty-third session by --tables (each mended, with a test in tests/tables/test_tables.py): a divergent albedo bisected
-down to two nodes of one log(mu) (scipy's ValueError); a table across a jump (Beckmann with Walter's G1) whose margin hid it;
+Found by --tables (each mended, with a test in tests/tables/test_tables.py): a divergent albedo bisected down to
+ two nodes of one log(mu) (scipy's ValueError); a table across a jump (Beckmann with Walter's G1) whose margin hid it;
 pumped plastic n = 5284 turning inside the interval at the normal, which only its midpoint checked (1.55 x its margin); and
 Kulla-Conty over Torrance-Sparrow, exact at the very points the grid checks because it reads a table built on them (8.6 x).
 
-Found in the twenty-fourth session by --registry 47 (each mended, with a test): lobes about the normal that carry a table in
+Found by --registry 47 (each mended, with a test): lobes about the normal that carry a table in
 log(N.wo) (a scaled model's 1 / U, the Kulla-Conty lobe's D, a pumped level's g) on the nested and 2-D engines, whose
 features on every scale of N.wo lay in one first interval (scaled Lafortune 1.56 x, scaled lacquer 2.5 x, the Kulla-Conty
 lobe of Phong n = 987 3.4 x on the 2-D engine, g2 pumped Minnaert 4.1 x: ``pumping.TABLE_DECADES``); the slope path near
@@ -44,7 +44,7 @@ engine unconverged on fresnel (eta 0.232) over plastic (n 34.4, eta 1.88, ad 0.3
 engine was wrong there (0.2908 for 0.4060, with estimates of 1e-9): the fresnel wrapper was one albedo term with plastic's
 specular hint for its Lambert part too (``FresnelWeighted.albedo_terms`` now splits it over the base's terms).
 
-Found in the twenty-fifth session by --registry 49 (mended, with tests): scaled Cook-Torrance near the normal, 1.04 x
+Found by --registry 49 (mended, with tests): scaled Cook-Torrance near the normal, 1.04 x
 (up to 5.3 x in a scan around it), whose E table's spline went across the jump of a'' at mu = 1 / sqrt(2) of 001 eq.
 10's geometry factor (``pumpup.models.cook_torrance.RETRO_BREAK``, now an albedo break); following it, a 1/E scaling
 of Beckmann with Walter's G1 in frame 6 (94 x; the nested engine takes it now).  Its other disagreement is the 2-D
@@ -98,8 +98,8 @@ def rand_spec(rng):
 
 def rand_spec_fmax(rng):
     """The fresnel wrapper (F(max(N.L, N.V))) over GGX, Beckmann (F = 1) or Schlick's model, some pumped (either order),
-    and pumped GGX with F(wi.h): frame 6 with F per node, and with g above mu = 0.248, since issue 14's twenty-second
-    session (``--fmax``: the default mode's comparison with the nested engine, on these only; seed 21's 372 cases, 0
+    and pumped GGX with F(wi.h): frame 6 with F per node, and with g above mu = 0.248
+    (``--fmax``: the default mode's comparison with the nested engine, on these only; seed 21's 372 cases, 0
     disagreements, drew the first three kinds only, at 95ad034)."""
     base = {"type": "schlick", "r": float(10 ** rng.uniform(-4, 0))} if rng.random() < 0.2 else {
         "type": str(rng.choice(["ggx", "beckmann"])), "alpha": float(10 ** rng.uniform(-3, 0)),
