@@ -43,8 +43,8 @@ def test_narrowest_microfacet_lobe_is_a_mirror(spec):
         # near grazing the mirror limit with Smith shadowing: E = G(wi, mirror) + O((alpha / mu)^3) (the lobe's
         # width over the grazing angle; measured: the deviation grows as mu^-3 from 6.7e-13 at mu = 1e-4 to 7.6e-7
         # at 1e-6); separable G = G1^2, correlated 1 / (1 + 2 Lambda), Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2.
-        # (Until issue 14's seventh session the engine's error here was 5e-5, and this test asked 1e-10 of the
-        # limit itself; with an error of 4e-14 the O((alpha / mu)^3) term shows.)
+        # (With an engine error of 4e-14 rather than 5e-5 the O((alpha / mu)^3) term shows: this test cannot ask
+        # 1e-10 of the limit itself.)
         mu = np.array([1e-4, 1e-6])
         a, e = pumpup.albedo(pumpup.load(spec), mu, return_error=True)
         lam = (np.sqrt(1 + (spec["alpha"] * np.sqrt(1 - mu**2) / mu) ** 2) - 1) / 2

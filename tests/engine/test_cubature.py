@@ -387,8 +387,8 @@ def test_kink_breaks_touching_pairs_match_the_reference():
 def test_engines_near_normal_incidence_see_the_shadowing_at_the_horizon(alpha, mu, rtol, engine):
     """G1(wo) falls to 0 within alpha of the horizon; near normal incidence the arc's integral no longer spreads that
     over theta_i, and the engines' grids, graded towards the horizon break on the scale of its distance to the end of
-    the range, did not see it: the nested engine was 1.3-26 x its estimate on the first four cases (issue 14's twentieth
-    session), the 2-D engine 3.3-62 x on five of the six (twenty-first; 2.7e-4 at mu = 1: 2.6e-11 off, estimate
+    the range, did not see it: the nested engine was 1.3-26 x its estimate on the first four cases,
+    the 2-D engine 3.3-62 x on five of the six (2.7e-4 at mu = 1: 2.6e-11 off, estimate
     4.1e-13), both found by ``scripts/studies/fuzz_engines.py``.  Both grids are now also graded on alpha's scale
     (``_nested._alpha_grading``). Reference: the 1-D path (frame 6), which agrees with 30-digit mpmath at mu = 1
     (checked here)."""

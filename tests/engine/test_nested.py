@@ -20,9 +20,8 @@ from pumpup.engine.routes import using
 
 @pytest.fixture(autouse=True)
 def _nested_for_the_blinn_family_too():
-    """These tests use the Blinn family as the nested engine's examples; since issue 14's sixth session
-    its azimuth about N is closed-form (pumpup.engine.polar, kind "half"), so the 1-D path is switched off here
-    and the nested engine integrates it, as before."""
+    """These tests use the Blinn family as the nested engine's examples; its azimuth about N is closed-form
+    (pumpup.engine.polar, kind "half"), so the 1-D path is switched off here and the nested engine integrates it."""
     with helpers.without_1d():
         yield
 
@@ -236,7 +235,7 @@ def test_two_d_only_and_disabled_switch_the_nested_path_off(monkeypatch):
     pumpup.albedo(f, 0.5, phi=0.3)  # isotropic: phi ignored, nested
     assert calls == [1, 1]
     aniso = pumpup.load({"type": "ward_aniso", "ax": 0.1, "ay": 0.3})
-    pumpup.albedo(aniso, 0.5, phi=0.3)  # wi out of the xz-plane: nested too, turned (issue 14, fourteenth session)
+    pumpup.albedo(aniso, 0.5, phi=0.3)  # wi out of the xz-plane: nested too, turned
     assert calls == [1, 1, 1]
     user = pumpup.from_function(lambda wi, wo: np.full(wi.shape[:-1], 1 / np.pi), name="flat")
     pumpup.albedo(user, 0.5)  # no hint: the 2-D engine's generic path
@@ -351,9 +350,9 @@ def test_graded_breaks_on_an_end_terminate():
 
 
 def test_segments_in_chunks_change_no_bit(monkeypatch):
-    """``_evaluate`` in calls of at most SEG_CHUNK segments (issue 14's twenty-second session: a nested reference at
-    max_regions 200000 grew past 23 GB, and a case of it peaked at 2.8 GB before, 0.81 GB after): each segment's values
-    do not depend on the others in its call, so 7 segments per call give the same bits as one call."""
+    """``_evaluate`` in calls of at most SEG_CHUNK segments (a nested reference at max_regions 200000 grew past
+    23 GB without them, and a case of it peaks at 0.81 GB with them, 2.8 GB without): each segment's values do not
+    depend on the others in its call, so 7 segments per call give the same bits as one call."""
     mu = np.array([1e-4, 0.03, 0.4, 0.8, 1.0])
     for spec in ({"type": "ward_aniso", "ax": 0.05, "ay": 0.3},
                  {"type": "pumped", "base": {"type": "blinn", "n": 30}, "g": "g2", "levels": 2}):

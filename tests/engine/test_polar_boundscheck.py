@@ -4,7 +4,7 @@ numba does not check indices by default: a write past an array's end corrupts me
 as an abort.  test_properties.py's slow hypothesis test aborted the process that way (in numpy, under the nested
 engine); rerun with bounds checking it named the cause, the 1-D path's first intervals overflowing their buffer (one
 per piece, up to MAX_PIECES = 128, in room for max_regions + 64): Blinn n = 0 at mu = 1.3e-47 with max_regions = 50.
-The ninth session found frame 4's pieces themselves overflowing their 128 slots (GGX alpha = 1e-8 at mu = 1e-100, rtol
+It also found frame 4's pieces themselves overflowing their 128 slots (GGX alpha = 1e-8 at mu = 1e-100, rtol
 1e-13: a heap corruption that aborted the process), and frame 6 (GGX, Schlick) runs here too, down to mu = 1e-300.
 """
 

@@ -1,5 +1,5 @@
 """The half vector's azimuth by a rule on its arc (pumpup.engine.polar frame 4,
-:func:`pumpup.engine.half_arc._k_numeric`; issue 14, seventh session): the Smith microfacet models (GGX, Beckmann;
+:func:`pumpup.engine.half_arc._k_numeric`): the Smith microfacet models (GGX, Beckmann;
 separable or height-correlated G, exact or Walter's G1, with or without a Fresnel factor), the V-cavity models with a
 Fresnel factor (Cook-Torrance, Torrance-Sparrow with ``ior``) and Schlick's model; and Torrance-Sparrow's D3, whose
 azimuth is closed-form, under the GGX weight."""
@@ -28,8 +28,8 @@ MU = [1.0, 0.99, 0.9, math.sqrt(3) / 2, 1 / math.sqrt(2), 0.5, 0.2, 0.05, 1e-3, 
 KERNEL_SPECS = [{"type": "ggx", "alpha": 0.1}, {"type": "ggx", "alpha": 0.003},
                 {"type": "ggx", "alpha": 0.5, "shadowing": "correlated", "eta": 0.2, "k": 3.0},
                 {"type": "beckmann", "alpha": 0.1}, {"type": "beckmann", "alpha": 0.3, "g1": "walter", "ior": 1.5},
-                # (Walter's G1 in the correlated G with a Fresnel factor left the 1-D path in issue 14's twenty-first
-                # session: frame 4 was up to 7 x its estimate; tests/models/test_fresnel_total_reflection.py)
+                # (Walter's G1 in the correlated G with a Fresnel factor is off the 1-D path: frame 4 was up to 7 x its
+                # estimate; tests/models/test_fresnel_total_reflection.py)
                 {"type": "beckmann", "alpha": 1.0, "g1": "walter", "eta": 1.02, "k": 0.01},
                 {"type": "cook_torrance", "m": 0.3, "ior": 1.5},
                 {"type": "torrance_sparrow", "d": "D1", "s": 20, "ior": 1.001},

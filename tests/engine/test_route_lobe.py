@@ -53,7 +53,7 @@ def _arc_cases():
 
 
 def test_arc_piece_and_its_bound_against_mpmath():
-    """issue 14's fifteenth session: the arc where N.wo >= mu (p in (0, 1)) by the fewest Gauss-Legendre points in
+    """The arc where N.wo >= mu (p in (0, 1)) by the fewest Gauss-Legendre points in
     s whose Bernstein-ellipse bound meets the tolerance (``_lobe_frame._arc_power``).  Against 24-digit mpmath at rtol
     1e-6 .. 1e-14, the returned error bounds the true error, and the piece matches its numpy twin (200 points)."""
     import mpmath
@@ -130,10 +130,9 @@ def test_against_mpmath_with_honest_error(n, p):
 @pytest.mark.parametrize("n", [3, 10, 20])
 def test_nearly_coinciding_breaks_against_mpmath(n):
     """Near mu = sqrt(3) / 2 the level's break (u = cos 2 theta_i) and the horizon's (u = s) nearly coincide, and each
-    one's square root reaches across the other's (stretched Phong n = 10 at mu = 0.866025 was 3.2e-12 off at rtol 1e-12
-    with an estimate of 6.6e-13 until issue 14's twelfth session: ``_outer_rule._foreign_roots`` grades the piece next
-    to such a root): against the 30-digit mpmath reference, at rtol 1e-8, 1e-10 and 1e-12, the estimate bounds the
-    error."""
+    one's square root reaches across the other's (``_outer_rule._foreign_roots`` grades the piece next to such a root;
+    without it, stretched Phong n = 10 at mu = 0.866025 was 3.2e-12 off at rtol 1e-12 with an estimate of 6.6e-13):
+    against the 30-digit mpmath reference, at rtol 1e-8, 1e-10 and 1e-12, the estimate bounds the error."""
     m0 = math.sqrt(3) / 2
     mu = m0 * (1.0 + np.array([0.0, -1e-14, 1e-12, -1e-9, 1e-9, -1e-6, 1e-6, -1e-4, 1e-4]))
     refs = [phong_albedo_1d(n, m, stretched=True) for m in mu]
@@ -166,7 +165,7 @@ SPECS = [
     {"type": "stretched_phong", "n": 8, "p": 0.5},  # p in (0, 1): the inner rule on one arc
     {"type": "retro", "n": 10, "p": 0.3},
     {"type": "lafortune", "n": 20, "cx": 1.1, "cy": 1.1, "cz": 1.1, "p": 0.7},
-    # issue 14's sixth session: 000 eq. 30's plastic (stretched Phong's lobe), and closed forms
+    # 000 eq. 30's plastic (stretched Phong's lobe), and closed forms
     {"type": "plastic", "n": 20}, {"type": "plastic", "n": 5, "ad": 0.2, "a_s": 0.7},
     {"type": "oren_nayar", "albedo": 0.7, "sigma": 0.5}, {"type": "minnaert", "k": 1.37, "b": 0.1},
     {"type": "lacquer", "s": 0.3},
@@ -266,8 +265,8 @@ def test_retro_and_stretched_phong_have_the_same_albedo():
 
 def test_general_p_evaluations():
     """A 257-point table of stretched Phong p = 0.5 at rtol 1e-10 takes as many outer nodes as p = 1 with the same
-    estimate, QUADPACK's (the inner rule's work is per outer node: about 5 values of (N.wo)^(1 - p) since issue 14's
-    fifteenth session; p = 1 also has the sharper estimate of the closed forms, test_decay_estimate.py)."""
+    estimate, QUADPACK's (the inner rule's work is per outer node: about 5 values of (N.wo)^(1 - p);
+    p = 1 also has the sharper estimate of the closed forms, test_decay_estimate.py)."""
     mu = np.cos(np.linspace(0, np.pi / 2, 258)[:-1])
     for n in (1.0, 20.0, 1000.0):
         _, _, conv, evals = _polar.albedo_1d(BareLobe(n, 0.5), mu, 1e-10, 1e-14, 20000)
@@ -318,8 +317,8 @@ def test_budget_warns_and_keeps_an_honest_error():
 
 def test_jacobi_bound_against_mpmath():
     """The a-priori bound of the Gauss-Jacobi rules at the arc's end near grazing incidence
-    (``_lobe_frame._jacobi_bound``, issue 14's fifteenth session: it replaced the difference of the two rules as the
-    error) bounds the true error of each rule, against 30-digit mpmath, over q 0.01 .. 0.99, T / mu from 4 to 1e8 and L
+    (``_lobe_frame._jacobi_bound``, the error the engine states rather than the difference of the two rules)
+    bounds the true error of each rule, against 30-digit mpmath, over q 0.01 .. 0.99, T / mu from 4 to 1e8 and L
     from -T / 2 down to -1."""
     import mpmath
 

@@ -1,5 +1,5 @@
 """The lobe frame with 000 eq. 28's Fresnel factor F(Theta_min) (pumpup.engine.polar frame 5,
-:func:`pumpup.engine.lobe_fresnel._k_lobe_fresnel`; issue 14, eighth session): ``metal``, ``plastic`` with an index, and
+:func:`pumpup.engine.lobe_fresnel._k_lobe_fresnel`): ``metal``, ``plastic`` with an index, and
 the ``fresnel`` wrapper over a lobe with p in {0, 1} (Phong, stretched Phong, Lafortune, retro, Phong's shader), whose
 F(max(N.L, N.V)) the rule integrates on the arc where N.V >= N.L."""
 
@@ -78,7 +78,7 @@ def test_against_the_nested_and_two_d_engines(spec):
                               if s.get("n", s.get("base", {}).get("n", 0)) >= _chain_frame.LOBE_N_MIN])
 def test_lobe_about_n_against_frame_5(spec):
     """A lobe with n >= LOBE_N_MIN takes the frame of N (the pumped lobe's, g = 1: the ring table and F(max(mu, N.wo))
-    per node, issue 14's twelfth session) instead of frame 5 (the lobe frame with a rule on the arc): the two agree
+    per node) instead of frame 5 (the lobe frame with a rule on the arc): the two agree
     within their estimates at rtol 1e-12, and at rtol 1e-6, 1e-8, 1e-10 the frame of N's estimate bounds its distance
     from frame 5 at 1e-12 (less frame 5's own estimate) and meets the tolerance."""
     f = _lobe(spec)
@@ -193,7 +193,7 @@ def test_colour_keeping_pumped_metal_channels():
     assert np.all(np.abs(a - b) <= e + eb) and np.all(e <= 1e-10 * a * 1.0001)
 
 
-# --- frame 5's Gauss-Legendre pieces with an a-priori bound (issue 14, sixteenth session) ----------------------------
+# --- frame 5's Gauss-Legendre pieces with an a-priori bound -------------------------------------------------------
 
 #: (eta, k): dielectrics (Brewster's zero on the real axis), conductors, a strong absorber (F's pole near c = 0), F's
 #: branch point near the real axis (x0 0.87, y0 1.2e-3; x0 0.049, y0 0.02), eta near 1
@@ -297,8 +297,8 @@ def test_gauss_piece_and_its_bound_against_mpmath(rng, eta, k):
 
 @pytest.mark.parametrize("spec", SPECS, ids=IDS)
 def test_gauss_pieces_against_the_adaptive_rule(spec):
-    """Frame 5 with the Gauss-Legendre pieces against frame 5 with the adaptive 7/15 rule alone (the rule before issue
-    14's sixteenth session, ``without_lobe_f_gauss``) at rtol 1e-12: at rtol 1e-6, 1e-8, 1e-10 and 1e-12 the estimate
+    """Frame 5 with the Gauss-Legendre pieces against frame 5 with the adaptive 7/15 rule alone
+    (``without_lobe_f_gauss``) at rtol 1e-12: at rtol 1e-6, 1e-8, 1e-10 and 1e-12 the estimate
     bounds the distance (less the other's estimate), and up to 1e-10 it meets the tolerance (at 1e-12 the engine's
     rounding allowance, 64 eps, may take it a little beyond)."""
     f = _lobe(spec)

@@ -1,4 +1,4 @@
-"""Frame 6 (issue 14, ninth session): GGX and Beckmann with F = 1 (either Smith G, exact or Walter's G1) and Schlick's
+"""Frame 6: GGX and Beckmann with F = 1 (either Smith G, exact or Walter's G1) and Schlick's
 model about N, the weight's azimuth in closed form (:func:`pumpup.engine.normal_frame._ggx_ring`, :func:`_beckmann_ring`
 with :func:`_kummer_fast`), one rule over the elevation of wo (:func:`_integrate_n`).
 
@@ -168,8 +168,8 @@ def test_against_frame_4_and_the_nested_engine(spec, rtol):
 
 
 def test_which_models_take_frame_6():
-    """GGX and Beckmann with F = 1 and alpha <= 1, and Schlick's model (and GGX with a Fresnel factor since the
-    thirteenth session: tests/engine/test_route_normal_fresnel.py); not Beckmann with a Fresnel factor (frame 4) or
+    """GGX and Beckmann with F = 1 and alpha <= 1, and Schlick's model (and GGX with a Fresnel factor:
+    tests/engine/test_route_normal_fresnel.py); not Beckmann with a Fresnel factor (frame 4) or
     alpha > 1 (the nested engine), not the V-cavity models."""
     takes = [{"type": "ggx", "alpha": 0.2}, {"type": "ggx", "alpha": 1.0, "shadowing": "correlated"},
              {"type": "schlick", "r": 0.3}]
@@ -220,7 +220,7 @@ def test_cuts_keep_every_piece_off_the_singularities(spec):
 
 def test_frame_4_at_a_grazing_narrow_lobe_with_a_fresnel_factor():
     """Frame 4 (GGX with an ior keeps it) at mu = 1e-100, alpha = 1e-8: u^4 underflowed there and the weight divided by
-    0 (ZeroDivisionError out of pumpup.albedo before the ninth session); and its pieces overflowed their arrays at rtol
+    0 (ZeroDivisionError out of pumpup.albedo); and its pieces overflowed their arrays at rtol
     1e-13 (tests/engine/test_polar_boundscheck.py runs that under bounds checking).  The albedo is flat to ~mu near
     grazing incidence."""
     f = pumpup.load({"type": "ggx", "alpha": 1e-8, "ior": 1.5})

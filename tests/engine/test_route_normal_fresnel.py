@@ -1,4 +1,4 @@
-"""Frame 6 with a Fresnel factor (issue 14, thirteenth session): GGX's D times F(wi.h) integrated over the azimuth of wo
+"""Frame 6 with a Fresnel factor: GGX's D times F(wi.h) integrated over the azimuth of wo
 by a product rule whose weights are D's Fourier coefficients in closed form (pumpup.engine.normal_frame._ggx_ring_f),
 against scipy's quadrature of D F on the ring, 40-digit mpmath sums, frame 4 (the rule on h's arc) and the nested
 engine."""
@@ -178,8 +178,8 @@ def test_near_kink_conductor_at_normal_incidence(shadowing):
 
 
 def test_the_frame_4_split_is_per_thread():
-    """GGX with F below N_FRESNEL_MU_MIN takes frame 4 by switching frame 6 off for that call: per thread since issue
-    14's twenty-second session.  A global switch raced under threads: another thread's mu above it took frame 4 while
+    """GGX with F below N_FRESNEL_MU_MIN takes frame 4 by switching frame 6 off for that call, per thread.
+    A global switch raced under threads: another thread's mu above it took frame 4 while
     one had it off (right values, other bits: this test failed 4 times in 4 on 316b97c), and two calls restoring each
     other's old value could leave it off for good.  Values from three threads at once equal one thread's, bit for
     bit."""

@@ -1,6 +1,6 @@
 """The ``fresnel`` wrapper (000 eq. 28's F(max(N.L, N.V)) of a conductor) over GGX, Beckmann (F = 1) and Schlick's
 model, pumped or not, on the 1-D path (pumpup/engine/polar.py, frame 6 about N with F(max(mu, N.wo)) a factor of each
-node, ``Polar.fmax``; issue 14's twenty-second session).  Before it these took the nested engine: GGX alpha 1.6e-4 with
+node, ``Polar.fmax``).  The nested engine, their route without it, takes long: GGX alpha 1.6e-4 with
 eta 0.497, k 3.15 at mu = 7.3e-6 took it 14.6 s at rtol 1e-10, and 2-level g1 pumping of it over 20 minutes for a table
 with fresh values at rtol 1e-12 (``scripts/studies/fuzz_engines.py --tables 7``).
 

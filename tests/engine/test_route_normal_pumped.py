@@ -34,8 +34,8 @@ def test_pumped_microfacet_models_take_frame_6():
         assert hint.chain is not None and helpers.takes_normal(f), spec
         with helpers.without_normal_frames():  # off frame 6 a pumped half-vector model goes to the nested engine
             assert _polar.albedo_1d(f, np.array([0.5]), 1e-8, 0.0, 1000) is None
-    # alpha > 1: the nested engine, as before; with Fresnel at mu >= N_FRESNEL_MU_MIN only since issue 14's
-    # twenty-second session (tests/engine/test_route_normal_pumped_fresnel.py)
+    # alpha > 1: the nested engine; with Fresnel: frame 6 at mu >= N_FRESNEL_MU_MIN only
+    # (tests/engine/test_route_normal_pumped_fresnel.py)
     assert not helpers.hint_routes(pumpup.pump({"type": "ggx", "alpha": 1.5}, g="g1"))
     f = pumpup.pump({"type": "ggx", "alpha": 0.3, "ior": 1.5}, g="g1")
     assert helpers.view(f).chain is not None and not helpers.takes_1d(f)
@@ -62,8 +62,8 @@ def test_near_kinks_of_the_levels_tables():
     """A 2-level g2 pumped GGX (alpha 0.1, height-correlated): level 2's table has a kink at v = 0.98814, where level
     1's bound crosses the diagonal (u(v) = v); before ``table_kinks`` the 1-D path was 5e-7 off at mu = 0.993068 with an
     estimate of 1.6e-7.  Beckmann alpha 0.3, g2 x 2: with the kink cut but not the knots bunched around it, 2.1e-12 off
-    at mu = 0.99888 with an estimate 4.8 x smaller.  Since issue 14's nineteenth session the table is split at the kink
-    (AlbedoTable's breaks) and its grid no longer bunches towards it; the cuts hold the kink; the estimates bound the
+    at mu = 0.99888 with an estimate 4.8 x smaller.  The table is split at the kink
+    (AlbedoTable's breaks) and its grid does not bunch towards it; the cuts hold the kink; the estimates bound the
     truth."""
     f = pumpup.pump({"type": "ggx", "alpha": 0.1, "shadowing": "correlated"}, g="g2", levels=2)
     kinks = np.array(f.table_kinks())

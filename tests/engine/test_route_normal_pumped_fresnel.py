@@ -1,8 +1,8 @@
-"""Pumped GGX with a Fresnel factor F(wi.h) (issue 14's twenty-second session): frame 6 (the product rule of D and F on
+"""Pumped GGX with a Fresnel factor F(wi.h): frame 6 (the product rule of D and F on
 each ring, pumpup.engine.normal_frame._ggx_ring_f) divided by the chain's g at each node, at mu >= N_FRESNEL_MU_MIN; the
-nested engine below (frame 4, which takes GGX with F there, has no chain; ``pumpup.engine.polar.one_d_part``).  Before,
-the nested engine took every mu: a 257-point table of 1-level g2 pumped GGX 0.1 with eta 0.2, k 3 took 0.70 s, now
-0.28 s (``scripts/bench/bench_albedo.py --pumped-f``).
+nested engine below (frame 4, which takes GGX with F there, has no chain; ``pumpup.engine.polar.one_d_part``).  A
+257-point table of 1-level g2 pumped GGX 0.1 with eta 0.2, k 3 takes 0.28 s, 0.70 s on the nested engine at every mu
+(``scripts/bench/bench_albedo.py --pumped-f``).
 
 Checked against the model's own ``eval`` integrated over the azimuth by scipy (the integrand, g included) and the nested
 engine at rtol 1e-13, the estimate bounding the difference at every rtol; the ring's error is divided by g as the node
@@ -97,7 +97,7 @@ def test_the_rings_error_is_divided_by_g():
     """A node's ring error (:func:`pumpup.engine.normal_frame._ggx_ring_f`) enters the rule's error divided by g, as the
     node's value is: one node at a time (as ``_n_values`` calls the rule), the pumped node's value and error are the
     plain node's divided by g.  g is below 1: without the division a pumped node's ring error was under-reported by the
-    factor g (issue 14's twenty-second session; the values' tests above do not see a factor of 0.5-1 at their
+    factor g (the values' tests above do not see a factor of 0.5-1 at their
     tolerances)."""
     import math
 

@@ -150,7 +150,7 @@ def test_grazing_narrow_lobe_against_a_long_double_reference(mu, value):
     # tests/reference/independent_ward_aniso_grazing.py: two cancellation-free methods in long double, written without
     # pumpup, agreeing to 1e-19 (phi the double below: 5e-17 relative under the values at pi/4 + 0.1, allowed as 1e-16).
     # At mu = 1e-8 the nested and 2-D engines (wi turned by phi) give 1.2078149107921772 +- 1.3e-12 and
-    # 1.20781491079219 +- 7.5e-13: 2e-12 off, left open (the closing note of issue 14's fourteenth session)
+    # 1.20781491079219 +- 7.5e-13: 2e-12 off, not resolved
     f = pumpup.load({"type": "ward_aniso", "ax": 0.002, "ay": 0.006})
     for rtol in (1e-10, 1e-12, 1e-13):
         a, e = pumpup.albedo(f, mu, phi=math.pi / 4 + 0.1, rtol=rtol, return_error=True)

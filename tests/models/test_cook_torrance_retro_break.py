@@ -1,6 +1,6 @@
 """The albedo of the models with 001 eq. 10's geometry factor has a jump in its second derivative at mu = 1 / sqrt(2)
 (``pumpup.models.cook_torrance.RETRO_BREAK``), and the lobes that carry a table of it in N.wo (a 1/E scaling's U, a
-pumped level's g) have a level there (issue 14's twenty-fifth session)."""
+pumped level's g) have a level there."""
 
 import contextlib
 import math

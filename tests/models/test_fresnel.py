@@ -1,5 +1,5 @@
-"""The ``fresnel`` wrapper over a sum: F(Theta_min) sum w_k f_k = sum w_k F f_k, each term with its own hint (issue 14's
-twenty-fourth session).  As one term, fresnel over plastic had the specular lobe's hint (the power map about the mirror)
+"""The ``fresnel`` wrapper over a sum: F(Theta_min) sum w_k f_k = sum w_k F f_k, each term with its own hint.
+As one term, fresnel over plastic had the specular lobe's hint (the power map about the mirror)
 for its Lambert part too, and the engines lost part of it with estimates of 1e-10: 0.2908 for 0.4060 at mu = 0.306
 (eta 0.232), 0.0294 for 0.0396 (eta 1.5); over a pumped plastic half of it.  Checked against the rings of
 :func:`helpers.rings` (scipy's quad in N.wo, Gauss-Legendre in phi_o), and at the normal against Gauss-Legendre in

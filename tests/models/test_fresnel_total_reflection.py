@@ -1,8 +1,8 @@
 """A Fresnel factor F(eta + i k, max(N.wi, N.wo)) with eta < 1 and k = 0 (a dielectric seen from its denser side) is 1
 up to cos = x0 = sqrt(1 - eta^2), total reflection, and has a square-root kink there; a small k makes it a near-kink.
 The 1-D path declines such a factor and the nested engine, blind to the kink, bisected towards it: fresnel over Blinn
-n = 5, eta = 0.551 took 0.25-0.41 s per value at rtol 1e-10, a pumped one's base table minutes (issue 14's twenty-first
-session, ``scripts/studies/fuzz_engines.py --registry``).  The hints now carry the level N.wo = x0
+n = 5, eta = 0.551 took 0.25-0.41 s per value at rtol 1e-10, a pumped one's base table minutes
+(``scripts/studies/fuzz_engines.py --registry``).  The hints carry the level N.wo = x0
 (:func:`pumpup.models.metal.fresnel_levels`) and the albedo's kink at mu = x0 (``BRDF.albedo_breaks``).  The values are
 checked against an independent quadrature in spherical coordinates about N split at the kink."""
 

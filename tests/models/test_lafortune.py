@@ -148,7 +148,7 @@ AXIS_CASES = [  # (spec, mu, phi)
 
 @pytest.mark.parametrize("spec,mu,phi", AXIS_CASES)
 def test_p0_lobe_about_its_own_axis_against_mpmath(spec, mu, phi):
-    """Issue 14's fifteenth session: a p = 0 lobe is c |v|^n (v^.wo)_+^n, a Phong lobe about v^ = M R / |M R|, so its
+    """A p = 0 lobe is c |v|^n (v^.wo)_+^n, a Phong lobe about v^ = M R / |M R|, so its
     albedo is the 1-D path's about an axis at elevation nu = cz mu / |v| (``Lafortune.lobe_axis``,
     ``pumpup.engine.polar.axis_albedo``), at every azimuth of wi.  Against the independent mpmath reference at rtol
     1e-6, 1e-9 and 1e-12 the estimate bounds the error.  (The first two cases are ~1e-7 off by the nested and 2-D

@@ -94,7 +94,7 @@ def test_deficit_integral_bounds_an_independent_quadrature():
                                   {"type": "lambert", "albedo": 0.5}],
                          ids=lambda s: f"{s['type']}-{s.get('alpha', s.get('n'))}")
 def test_kulla_conty_lobe_in_closed_form(spec):
-    """The lobe's albedo is D(mu) pi I (issue 14, twelfth session; ``_MsLobe.polar``, a constant hint): I against
+    """The lobe's albedo is D(mu) pi I (``_MsLobe.polar``, a constant hint): I against
     scipy's adaptive quad of the kernels' own 2 D(m) m (an independent method, split at the product table's pieces and
     D's kinks), within I's error and below the upper bound I_hi; the lobe's albedo against the nested engine at rtol
     1e-12 within the summed estimates, from mu = 1 to 1e-8 and between the table's nodes."""
@@ -212,7 +212,7 @@ def test_scale_with_f0():
                          ids=["ggx", "beckmann-f0.5", "phong", "schlick", "mix"])
 def test_scaled_furnace_toward_the_viewer_in_closed_form(spec, f0):
     """The furnace toward the viewer of a scaled model (and of each term of a scaled sum) is s(mu) times the base's
-    albedo (000 eq. 2 for the reciprocal base; issue 14's twelfth session, ``_Transposed.polar``): on the 1-D path, and
+    albedo (000 eq. 2 for the reciprocal base; ``_Transposed.polar``): on the 1-D path, and
     against the nested engine at rtol 1e-12 within the summed estimates, from mu = 1 to 1e-8 and between the nodes."""
 
     s = pumpup.compensate(spec, method="scale", f0=f0)
@@ -468,7 +468,7 @@ def test_scaled_beckmann_with_walters_g1_takes_the_nested_engine():
     """Beckmann with Walter's G1: its albedo jumps at the switch level (5.7e-5 relative), and its E table's spline rings
     across the jump among hundreds of knots (614 nodes, margin 1.1e-4 for alpha 0.19).  Frame 6 times 1 / U(N.wo) did
     not see it: alpha 0.19 (F0 0.11) at mu = 0.9999 was 2.9e-12 off with an estimate of 3.1e-14 (94 x), alpha 0.091
-    (F0 0.96) at mu = 0.324 37 x at rtol 1e-10 (issue 14's twenty-fifth session).  The nested engine takes it; the
+    (F0 0.96) at mu = 0.324 37 x at rtol 1e-10.  The nested engine takes it; the
     reference: rings (quad in N.wo between the table's knots and the switch level, Gauss-Legendre in the azimuth graded
     towards the mirror side, where D peaks; 2 minutes, most of it the rings)."""
     from helpers import rings

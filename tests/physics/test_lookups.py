@@ -1,5 +1,5 @@
-"""The compiled kink search of a pumped BRDF (pumpup.physics.lookups.kink_roots, _upper_root; issue 14, eighteenth
-session) against the numpy and scipy search it replaced (np.insert, np.sign and brentq on the bound)."""
+"""The compiled kink search of a pumped BRDF (pumpup.physics.lookups.kink_roots, _upper_root) against a numpy and
+scipy search (np.insert, np.sign and brentq on the bound)."""
 
 import numpy as np
 import pytest

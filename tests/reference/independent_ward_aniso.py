@@ -1,9 +1,8 @@
 #!/usr/bin/env python
-"""Independent reference albedos of anisotropic Ward (Ward 1992) to ~1e-13, for the slope path (issue 14, fourteenth
-session).
+"""Independent reference albedos of anisotropic Ward (Ward 1992) to ~1e-13, for the slope path.
 
-Written from scratch with numpy and scipy by a separate session that was given only the BRDF's definition and the cases,
-and told not to read or import pumpup (the code these numbers check).
+Written from scratch with numpy and scipy from the BRDF's definition and the cases only, without reading or importing
+pumpup (the code these numbers check).
 
 f(wi,wo) = exp(-((hx/hz)/ax)^2 - ((hy/hz)/ay)^2) / (4 pi ax ay sqrt(mu wo_z)),  h = wi + wo,
 wi = (s cos(phi), s sin(phi), mu);  a(mu,phi) = int_{H+} f wo_z domega_o.
@@ -15,12 +14,11 @@ Method B: half-vector coordinates (t, p), nested quad (outer p, inner t); for fi
 last segment in t = t_c - u^2; breakpoints graded at the lobe's width along p and about p = phi +- pi/2 at scale mu/s.
 
 The stored value is A; its error is max(|A - B|, both quad estimates (the outer one plus the largest inner relative
-estimate times the value), 1e-15).  Four cases were added afterwards (by the session that wrote the slope path, running
-these methods unchanged), where the slope path and the nested engine disagreed.  The session that wrote the methods also
-reran every case with the smallest breakpoint spacing x 0.4 and x 2: the values moved by at most 1.3e-13 relative (ax
-0.3, ay 0.0003), 2.2e-15 in 10 of the 12 cases.  The last two cases were added by issue 14's twenty-fourth session (near
-normal incidence, a_x / a_y = 50), where the slope path was far off its estimate; the first 16 rows were unchanged in
-the rerun.
+estimate times the value), 1e-15).  Four of the cases (the same methods, unchanged) are where the slope path and the
+nested engine disagreed.  The first 12 cases, rerun with the smallest breakpoint spacing x 0.4 and x 2, moved by at
+most 1.3e-13 relative (ax 0.3, ay 0.0003), 2.2e-15 in 10 of the 12.  The last two cases (near normal incidence,
+a_x / a_y = 50) are where the slope path was far off its estimate; the first 16 rows were unchanged in the run that
+added them.
 
 Run: ``python tests/reference/independent_ward_aniso.py`` (about a minute on 2 cores) writes
 ``tests/data/independent_ward_aniso.json``.
@@ -290,11 +288,10 @@ def albedo_A(ax, ay, mu, phi, epsrel_in=1e-13, epsrel_out=1e-13, dfac=0.25):
 CASES = [(0.1, 0.3, 0.5, 0.0), (0.1, 0.3, 0.2, math.pi / 2), (0.1, 0.3, 0.02, 0.0), (0.1, 0.3, 0.02, 0.9),
          (0.05, 0.5, 0.9, 0.0), (0.05, 0.5, 0.1, 1.2), (0.4, 0.02, 0.5, math.pi / 3), (0.001, 0.3, 0.7, 0.4),
          (0.3, 0.0003, 0.3, 0.25), (2.0, 0.5, 0.3, 0.2), (0.2, 0.2, 0.001, 0.0), (0.01, 0.03, 0.999, 2.0),
-         # added by the fourteenth session, where the slope path and the nested engine disagreed (same methods, run
-         # here)
+         # where the slope path and the nested engine disagreed (same methods, run here)
          (0.001, 1.0, 0.7071067811865476, math.pi / 2), (1.0, 0.001, 0.9876883405951378, 0.4),
          (0.05, 0.5, 0.003, math.pi / 4 + 0.1), (0.001, 1.0, 1e-4, 0.4),
-         # added by issue 14's twenty-fourth session, where the fuzz found the slope path 17-72 x off its estimate near
+         # where the fuzz found the slope path 17-72 x off its estimate near
          # normal incidence (same methods, run here)
          (0.7425871721374118, 0.014944728805878636, 1.0, 5.898172449376829),
          (0.7425871721374118, 0.014944728805878636, 1.0 - 1e-9, 5.898172449376829)]

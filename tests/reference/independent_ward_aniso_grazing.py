@@ -1,8 +1,8 @@
 #!/usr/bin/env python
-"""Independent long-double reference albedos of anisotropic Ward at grazing incidence (issue 14, fourteenth session).
+"""Independent long-double reference albedos of anisotropic Ward at grazing incidence.
 
-Written by a separate session from the BRDF's definition only, without reading or importing pumpup, when the slope path
-(pumpup.engine.slope) and the nested and 2-D engines disagreed by 2e-12 at ax = 0.002, ay = 0.006, mu = 1e-8,
+Written from the BRDF's definition only, without reading or importing pumpup, for the case where the slope path
+(pumpup.engine.slope) and the nested and 2-D engines disagree by 2e-12 at ax = 0.002, ay = 0.006, mu = 1e-8,
 phi = pi/4 + 0.1.  Two methods in 80-bit long double, composite Gauss-Legendre with Newton-refined nodes:
 
 1. the half vector's slopes m, rotated so t is along (cos phi, sin phi): wo_z = mu (t - t0)(t1 - t) / (1 + |m|^2) with

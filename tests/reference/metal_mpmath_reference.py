@@ -24,7 +24,7 @@ Method B (spherical coordinates about N): t = cos(theta_o), phi_o.
 Usage: python tests/reference/metal_mpmath_reference.py [dps]    (76 s at dps 30, 141 s at 40; both methods agree to
 1e-41 at 40)
 
-Written for issue 14 (eighth session) without pumpup: tests/engine/test_route_lobe_fresnel.py holds the 1-D path to
+Written without pumpup: tests/engine/test_route_lobe_fresnel.py holds the 1-D path to
 these values.
 """
 import sys

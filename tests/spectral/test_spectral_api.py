@@ -289,9 +289,8 @@ def test_cli_spectral_errors_one_line_status_2(argv, match, capsys, tmp_path, mo
 
 def test_spectral_tables_share_tabulates_adaptive_grid():
     """The spectral table's adaptive grid is pumpup.tabulate's (pumpup.tables.adaptive_grid): with max_points below the
-    first grid's size it measures that grid's misses per wavelength, where its own copy of the loop reported 0 (issue
-    14's twenty-third session); and each wavelength's column agrees with tabulate of that wavelength's model on the
-    same grid."""
+    first grid's size it measures that grid's misses per wavelength (not 0); and each wavelength's column agrees with
+    tabulate of that wavelength's model on the same grid."""
     s = pumpup.load({"type": "plastic", "material": "BK7", "n": 40, "wavelengths": "rgb"})
     ds = s.tabulate(max_points=10)
     assert np.all(ds["interpolation_error"].values > 1e-7)

@@ -1,5 +1,5 @@
 """An albedo table split at the kinks of the albedo (AlbedoTable's breaks, tabulate(breaks=...)): a pumped level's table
-has them where a level below changes its g's form (Pumped.albedo_kinks; issue 14's nineteenth session)."""
+has them where a level below changes its g's form (Pumped.albedo_kinks)."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""mean_albedo of pumped levels (issue 14's twentieth session, found by scripts/studies/fuzz_engines.py --mean):
+"""mean_albedo of pumped levels (cases found by scripts/studies/fuzz_engines.py --mean):
 
 * a pumped level's albedo has kinks (Pumped.albedo_kinks): the first intervals end at them.  Without that, a 2-level g1
   pumped stretched Phong (n = 0.127, p = 1) had a mean 1.05e-9 off with an estimate of 1.0e-10;

@@ -64,9 +64,9 @@ def _fake_values(monkeypatch, fn):
 def test_adaptive_grid_splits_no_interval_below_the_doubles_of_log_mu(monkeypatch):
     """A jump the grid does not know of, at mu = 1.1e-8 (where log(mu)'s doubles are 25 times coarser than mu's): the
     bisection closes in on it, splits no interval whose midpoint is not a new value of log(mu), and counts the last
-    one's spread, the jump, as interpolation error: the spline takes one end's value at every mu within it.  Before
-    issue 14's twenty-third session it split down to two nodes of one log(mu) (scipy's ValueError; a divergent albedo
-    did it under its own noise)."""
+    one's spread, the jump, as interpolation error: the spline takes one end's value at every mu within it.  Splitting
+    down to two nodes of one log(mu) would raise scipy's ValueError (a divergent albedo does it under its own
+    noise)."""
     from pumpup import tables
 
     _fake_values(monkeypatch, lambda mu: np.where(mu > 1.1e-8, 2.0, 1.0) + mu)
@@ -82,7 +82,7 @@ def test_adaptive_grid_splits_no_interval_below_the_doubles_of_log_mu(monkeypatc
 def test_a_jump_of_the_albedo_counts_in_the_margin():
     """Beckmann alpha 0.0052 with Walter's G1, whose switch level mu = 0.0083 is a jump of 5.3e-5 in the albedo: the
     grid closes in on it to an interval 5 doubles wide whose midpoint is no new log(mu), and at the 4 doubles inside it
-    the table is off by the jump.  Its margin covers them (it was 2e-7 before issue 14's twenty-third session)."""
+    the table is off by the jump.  Its margin covers them (a margin of 2e-7 would not)."""
     from pumpup.models.microfacet import walter_level
 
     alpha = 0.005184313347496449
@@ -130,7 +130,7 @@ def test_a_model_that_reads_tables_is_checked_off_the_dyadic_points():
 
 def test_max_points_below_the_first_grid_measures_its_misses(monkeypatch):
     """max_points below the first grid's 45 nodes: that grid, with its misses at the midpoints measured once as the
-    interpolation error (an UnboundLocalError before issue 14's twenty-third session)."""
+    interpolation error."""
     f = pumpup.load({"type": "phong", "n": 20})
     ds = pumpup.tabulate(f, max_points=10, progress=False)
     assert ds.sizes["mu"] == len(pumpup.tables.default_grid())
