@@ -12,13 +12,16 @@ ray or a BSDF-sampled ray escapes.  No Russian roulette.
 
 The mirrors are planar rectangles: a ``rectangle`` shape, or each planar face of a mesh made of rectangles (a
 ``cube``).  Technique B, at every vertex x, for every point light l: the faces f in front of both x and l whose
-plane holds a specular point s, where the segment from x to l's mirror image l' in f's plane crosses f; their
-number N(x, l); one of them picked uniformly, and a direction w sampled from the lobe::
+plane holds a specular point s (where the segment from x to l's mirror image l' in f's plane crosses that plane)
+on f or within a margin of it; their number N(x, l); one of them picked uniformly, and a direction w sampled from
+the lobe::
 
     q_f(w; x) = (k + 1) / (2 pi) cos^k(w, d0),    d0 = (s - x) / |s - x|,    k = c n (1 + |x - s| / |s - l|)^2,
 
-(the mirror lobe's angular width seen from x, widened by ``k_scale`` = c), traced from x; if its first hit p
-is on f, the path x -> p -> l contributes::
+(the mirror lobe's angular width seen from x, widened by ``k_scale`` = c), traced from x.  The margin is
+m |x - s| sqrt(2 / k) / max(cos, 0.05) (cos between d0 and f's normal): the lobe's footprint on f's plane, m
+times, so that points near a face's edge, which reflect l towards x although s is just outside f, are sampled
+too.  If w's first hit p is on f, the path x -> p -> l contributes::
 
     beta f_x(w) cos_x / (q_f(w) / N) * w_B * f_p(p -> l) cos_p V(p, l) I / |p - l|^2,
     w_B = (q_f(w) / N) / (q_f(w) / N + p_x(w)),
@@ -31,7 +34,9 @@ k.
 Properties: ``max_depth`` (int, default 6), ``mirror`` (the mirror shapes' ids, comma-separated, or ``*`` for
 every shape and ``-id`` to leave one out; default "plate"), ``mirror_n`` (the mirror lobe's exponent, default
 5000), ``k_scale`` (c above, default 0.25), ``technique_b`` (bool, default True: False gives the plain path
-tracer, equal to Mitsuba's ``path`` in expectation).
+tracer, equal to Mitsuba's ``path`` in expectation), ``margin`` (m above, default 3; 0 takes only specular
+points on the face).  The set of faces, N and q depend on x and l only, and both weights use the same ones, so
+the image is unbiased for any k and m.
 
 Registered by :func:`register` (``pumpup.scenes`` calls it); Mitsuba is imported only inside functions.
 """
@@ -67,8 +72,11 @@ def _integrator_class():
             self.mirror_n = float(props.get("mirror_n", 5000.0))
             self.k_scale = float(props.get("k_scale", 0.25))
             self.technique_b = bool(props.get("technique_b", True))
+            self.margin = float(props.get("margin", 3.0))
             if self.max_depth < 1:
                 raise ValueError(f"pumpup_caustic: max_depth must be an integer >= 1, got {self.max_depth}")
+            if not self.margin >= 0.0:
+                raise ValueError(f"pumpup_caustic: margin must be >= 0, got {self.margin}")
             if not (self.mirror_n > 0.0 and self.k_scale > 0.0):
                 raise ValueError("pumpup_caustic: mirror_n and k_scale must be > 0, got "
                                  f"{self.mirror_n} and {self.k_scale}")
@@ -159,14 +167,19 @@ def _integrator_class():
             t = side_x / (side_x + side_l)
             s = x + t * (_p3(lp) - x)  # where x -> l' crosses the face's plane
             sc = s - _p3(c)
-            ok = (active & (side_x > 1e-4) & (dr.abs(dr.dot(sc, _v3(u))) <= float(u @ u))
-                  & (dr.abs(dr.dot(sc, _v3(v))) <= float(v @ v)))
             d = s - x
             dist_xs = dr.norm(d)
             dist_sl = dr.norm(_p3(light) - s)
             d0 = d / dr.maximum(dist_xs, 1e-12)
             r = dist_xs / dr.maximum(dist_sl, 1e-12)
             k = self.k_scale * self.mirror_n * dr.square(1.0 + r)
+            # s may lie just outside the face while the lobe still reaches it: accept s within the margin
+            # m = margin |x - s| sqrt(2 / k) / cos (the lobe's footprint on the plane, module docstring)
+            cos_s = dr.abs(dr.dot(d0, _v3(n)))
+            m = self.margin * dist_xs * dr.sqrt(2.0 / k) / dr.maximum(cos_s, 0.05)
+            lu, lv = float(np.linalg.norm(u)), float(np.linalg.norm(v))
+            ok = (active & (side_x > 1e-4) & (dr.abs(dr.dot(sc, _v3(u / lu))) <= lu + m)
+                  & (dr.abs(dr.dot(sc, _v3(v / lv))) <= lv + m))
             return d0, k, ok
 
         @staticmethod
@@ -287,7 +300,7 @@ def _integrator_class():
 
         def to_string(self):
             return (f"PumpupCaustic[max_depth={self.max_depth}, mirror={self.mirror_id!r}, n={self.mirror_n}, "
-                    f"k_scale={self.k_scale}, technique_b={self.technique_b}]")
+                    f"k_scale={self.k_scale}, technique_b={self.technique_b}, margin={self.margin}]")
 
     return PumpupCaustic
 
