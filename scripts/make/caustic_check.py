@@ -24,7 +24,6 @@ converged image), and the render times.  Writes ``OUT/caustic_check.json`` (000 
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 import time
@@ -34,9 +33,9 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import numpy as np  # noqa: E402
 from make_scenes import LUMINANCE, fireflies  # noqa: E402
+from stored_json import write  # noqa: E402
 
 import pumpup.scenes as S  # noqa: E402
-from pumpup.tables import atomic_path  # noqa: E402
 
 #: the integrators compared: Mitsuba's path tracer, pumpup_caustic without and with its mirror-image technique,
 #: and with the technique's lobe 16 x wider and narrower (k / 16, k x 16; the MIS weights change, the
@@ -188,9 +187,7 @@ def main(argv=None) -> int:
            "fireflies_size": a.fireflies_size, "fireflies_spp": a.fireflies_spp,
            "reference_spp": a.reference_spp, "fireflies": ff, "load": os.getloadavg()[0]}
     path = os.path.join(a.out, "caustic_check.json" if a.scene == "000-fig8" else f"caustic_check_{a.scene}.json")
-    with atomic_path(path) as tmp:
-        with open(tmp, "w") as fh:
-            json.dump(out, fh, indent=1, sort_keys=True)
+    write(path, out, sort_keys=True)
     print("wrote", path)
     return 0
 

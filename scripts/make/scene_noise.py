@@ -26,9 +26,9 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import numpy as np  # noqa: E402
 from make_scenes import LUMINANCE, fireflies  # noqa: E402
+from stored_json import write  # noqa: E402
 
 import pumpup.scenes as S  # noqa: E402
-from pumpup.tables import atomic_path  # noqa: E402
 
 #: the panel at 128 x 128 and 64 spp: as it is, without its point lights, with a Lambert plate, and rendered by
 #: Mitsuba's light tracer instead of its path tracer
@@ -88,9 +88,7 @@ def main(argv=None) -> int:
            "fireflies_by_spp": {str(n): c for n, c in counts.items()}, "fireflies_128_64spp": variants}
     print(json.dumps(out, indent=1))
     path = os.path.join(a.out, "scene_noise.json")
-    with atomic_path(path) as tmp:
-        with open(tmp, "w") as fh:
-            json.dump(out, fh, indent=1, sort_keys=True)
+    write(path, out, sort_keys=True)
     print("wrote", path)
     return 0
 

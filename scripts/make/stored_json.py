@@ -22,7 +22,8 @@ TABLES = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.ab
 def computed_or_stored(filename: str, run: Callable[[], dict], description: str,
                        sort_keys: bool = False) -> tuple[dict, str | None]:
     """Parse ``--out DIR`` (default tables/) and ``--read``; return the data (``run()``'s, written atomically to
-    DIR/``filename``, or the stored file's with ``--read``) and the path written (None when read)."""
+    DIR/``filename``, or the stored file's with ``--read``) and the path written (None when read).
+    """
     ap = argparse.ArgumentParser(description=description)
     ap.add_argument("--out", default=TABLES)
     ap.add_argument("--read", action="store_true", help="print the table of the stored file instead of computing")
@@ -32,9 +33,14 @@ def computed_or_stored(filename: str, run: Callable[[], dict], description: str,
         with open(path) as fh:
             return json.load(fh), None
     data = run()
+    write(path, data, sort_keys)
+    return data, path
+
+
+def write(path: str, data: dict, sort_keys: bool = False) -> None:
+    """Write ``data`` to ``path`` as indented JSON, atomically (the file is whole or absent)."""
     with atomic_path(path) as tmp, open(tmp, "w") as fh:
         json.dump(data, fh, indent=1, sort_keys=sort_keys)
-    return data, path
 
 
 def main(filename: str, run: Callable[[], dict], markdown: Callable[[dict], str], description: str,
