@@ -201,8 +201,8 @@ def _caustic_fireflies(spp: int, scene: str = "000-fig8") -> str:
     out = []
     for label, p in e["fireflies"].items():
         a, b = p[f"path, {spp} spp"], p[f"caustic, {spp} spp"]
-        out.append(f"{_short(label)}: {' and '.join(map(str, a['fireflies']))} with `path` in "
-                   f"{min(a['seconds']):.1f} s, {' and '.join(map(str, b['fireflies']))} with `pumpup_caustic` "
+        out.append(f"{_short(label)}: {' and '.join(map(str, a['fireflies']))} with path in "
+                   f"{min(a['seconds']):.1f} s, {' and '.join(map(str, b['fireflies']))} with pumpup_caustic "
                    f"(of them not at {e['reference_spp']} spp: {' and '.join(map(str, b['noise']))}) in "
                    f"{min(b['seconds']):.1f} s")
     return "; ".join(out)
