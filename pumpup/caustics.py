@@ -214,7 +214,7 @@ def _integrator_class():
             """Next-event estimate f cos I / r^2 V towards a point light (Spectrum, 0 where occluded or inactive)."""
             ds, le = em.sample_direction(si, mi.Point2f(0.5, 0.5), active)
             vis = active & (ds.pdf > 0.0) & ~scene.ray_test(si.spawn_ray_to(ds.p), active)
-            f = bsdf.eval(mi.BSDFContext(), si, si.to_local(ds.d), vis)
+            f = bsdf.eval(ctx, si, si.to_local(ds.d), vis)
             return dr.select(vis, f * le, 0.0)
 
         # ---- the estimator ------------------------------------------------------------------------
@@ -226,9 +226,9 @@ def _integrator_class():
             active = mi.Bool(active)
             L = mi.Spectrum(0.0)
             beta = mi.Spectrum(1.0)
-            prev_x = mi.Point3f(0.0)
             prev_pdf = mi.Float(0.0)
             prev_mis = mi.Bool(False)  # technique B ran at the previous vertex
+            prev_lobes: dict = {}  # technique B's lobes there, per light: (d0, k, ok) per face
             for depth in range(self.max_depth):
                 si = scene.ray_intersect(ray, active)
                 escaped = active & ~si.is_valid()
@@ -240,12 +240,12 @@ def _integrator_class():
                 bsdf = si.bsdf(ray)
                 # next-event estimation to each point light; at a mirror face reached by a BSDF sample from a
                 # vertex where technique B ran, weighted w_A = p_x / (p_x + q_f / N) (balance heuristic)
-                for em, pos, faces in lights:
+                for li, (em, pos, faces) in enumerate(lights):
                     c = self._nee(scene, ctx, si, bsdf, em, active)
-                    if self.technique_b and faces:
+                    if li in prev_lobes:  # (absent where B did not run at the previous vertex: w_A = 1)
                         count, q_sel = mi.Float(0.0), mi.Float(0.0)
-                        for face in faces:
-                            d0, k, ok = self._lobe(prev_x, pos, face, prev_mis & active)
+                        for (d0, k, ok), face in zip(prev_lobes[li], faces):
+                            ok = ok & prev_mis & active
                             count += dr.select(ok, 1.0, 0.0)
                             hit = ok & self._on_face(si, face)
                             q_sel += dr.select(hit, self._lobe_pdf(ray.d, d0, k, hit), 0.0)
@@ -253,11 +253,12 @@ def _integrator_class():
                         c *= dr.select(q > 0.0, prev_pdf / dr.maximum(prev_pdf + q, 1e-30), 1.0)
                     L += beta * c
                 # technique B: x -> p (a mirror face) -> light through the light's image in that face's plane
+                lobes_here = {}
                 if self.technique_b and depth + 2 < self.max_depth:
-                    for em, pos, faces in lights:
+                    for li, (em, pos, faces) in enumerate(lights):
                         if not faces:
                             continue
-                        lobes = [self._lobe(si.p, pos, face, active) for face in faces]
+                        lobes = lobes_here[li] = [self._lobe(si.p, pos, face, active) for face in faces]
                         count = mi.Float(0.0)
                         for _, _, ok in lobes:
                             count += dr.select(ok, 1.0, 0.0)
@@ -289,9 +290,9 @@ def _integrator_class():
                 bs, wt = bsdf.sample(ctx, si, sampler.next_1d(active), sampler.next_2d(active), active)
                 active &= bs.pdf > 0.0
                 beta *= dr.select(active, wt, 0.0)
-                prev_x = mi.Point3f(si.p)
                 prev_pdf = mi.Float(bs.pdf)
                 prev_mis = active & (depth + 2 < self.max_depth)
+                prev_lobes = lobes_here
                 ray = si.spawn_ray(si.to_world(bs.wo))
             return L, mi.Bool(True), []
 
