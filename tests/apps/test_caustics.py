@@ -93,7 +93,6 @@ def test_mirror_faces_of_rectangles_and_cubes(S):
 def test_bad_mirror_is_one_line(S):
     label, mats = S.panels("000-fig8")[0][0]
     d = S._scene_dict("000-fig8", mats, 8, 1)
-    d["integrator"] = {"type": "pumpup_caustic", "mirror": "nope"}
     for integ, words in (({"type": "pumpup_caustic", "mirror": "nope"},
                           "mirror must name shapes of the scene (comma-separated ids, or '*' and '-id' to "
                           "exclude), got 'nope'"),
@@ -132,23 +131,24 @@ def _check(size, spp, passes, pairs, zmax, rough=None, scene="000-fig8"):
     return res
 
 
+#: the pairs of integrators (scripts/make/caustic_check.py's INTEGRATORS) whose means the small renders compare
+PAIRS = ["path vs caustic, B off", "path vs caustic", "caustic, B off vs caustic", "caustic vs caustic, k / 16",
+         "caustic vs caustic, k x 16"]
+
+
 def test_means_agree_small_render(S):
     """000 Fig. 8 with a plate of n = 300 (not 5000: there Mitsuba's path needs far more samples to converge),
     24 x 24, 6 passes x 64 spp of each integrator: per region (all, sky, each object, plate), pumpup_caustic
     with its mirror-image technique agrees with its lobe 16 x wider and narrower, with technique B off and
     with Mitsuba's path, and B off with path, within 4 combined standard errors."""
-    pairs = ["path vs caustic, B off", "path vs caustic", "caustic, B off vs caustic",
-             "caustic vs caustic, k / 16", "caustic vs caustic, k x 16"]
-    res = _check(24, 64, 6, pairs, 4.0, rough=300)
+    res = _check(24, 64, 6, PAIRS, 4.0, rough=300)
     assert res["all"]["caustic"]["se"] < res["all"]["caustic, B off"]["se"]  # and it is less noisy
 
 
 def test_means_agree_small_render_cubes(S):
     """001 Fig. 8's reciprocal Phong panel with its five cubes at n = 300 (the near-mirrors are the cubes'
     faces), 20 x 20, 5 passes x 48 spp: the same agreement per region."""
-    pairs = ["path vs caustic, B off", "path vs caustic", "caustic, B off vs caustic",
-             "caustic vs caustic, k / 16", "caustic vs caustic, k x 16"]
-    _check(20, 48, 5, pairs, 4.0, rough=300, scene="001-fig8")
+    _check(20, 48, 5, PAIRS, 4.0, rough=300, scene="001-fig8")
 
 
 def test_margin_keeps_the_mean(S):
