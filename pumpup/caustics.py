@@ -47,7 +47,10 @@ import math
 
 import numpy as np
 
-__all__ = ["register"]
+__all__ = ["register", "K_SCALE"]
+
+#: the default widening c of technique B's lobe (``k_scale``)
+K_SCALE = 0.25
 
 _CLASSES: dict = {}
 
@@ -70,7 +73,7 @@ def _integrator_class():
             self.max_depth = int(props.get("max_depth", 6))
             self.mirror_id = str(props.get("mirror", "plate"))
             self.mirror_n = float(props.get("mirror_n", 5000.0))
-            self.k_scale = float(props.get("k_scale", 0.25))
+            self.k_scale = float(props.get("k_scale", K_SCALE))
             self.technique_b = bool(props.get("technique_b", True))
             self.margin = float(props.get("margin", 3.0))
             if self.max_depth < 1:

@@ -32,33 +32,25 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspa
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import numpy as np  # noqa: E402
-from make_scenes import LUMINANCE, fireflies  # noqa: E402
+from make_scenes import LUMINANCE, firefly_mask  # noqa: E402
 from stored_json import write  # noqa: E402
 
 import pumpup.scenes as S  # noqa: E402
+from pumpup.caustics import K_SCALE  # noqa: E402
 
-#: the integrators compared: Mitsuba's path tracer, pumpup_caustic without and with its mirror-image technique,
-#: and with the technique's lobe 16 x wider and narrower (k / 16, k x 16; the MIS weights change, the
-#: expectation must not)
 #: per scene: the panels checked (row, column; the first is compared per region), the integrator's ``mirror``,
 #: and the near-mirrors' metals (made rougher for the second comparison)
 SETUP = {"000-fig8": {"panels": [(0, 0), (0, 1)], "mirror": "plate", "metals": {"plate": "silver"}},
          "001-fig8": {"panels": [(0, 1), (1, 1)], "mirror": "*,-plate",
                       "metals": {"tank": "gold", "p0": "aluminium", "p1": "silver", "p2": "copper", "p3": "gold"}}}
+#: the integrators compared: Mitsuba's path tracer, pumpup_caustic without and with its mirror-image technique,
+#: and with the technique's lobe 16 x wider and narrower (k / 16, k x 16; the MIS weights change, the
+#: expectation must not)
 INTEGRATORS = {"path": {"type": "path", "max_depth": 6},
                "caustic, B off": {"type": "pumpup_caustic", "max_depth": 6, "technique_b": False},
                "caustic": {"type": "pumpup_caustic", "max_depth": 6},
-               "caustic, k / 16": {"type": "pumpup_caustic", "max_depth": 6, "k_scale": 0.25 / 16},
-               "caustic, k x 16": {"type": "pumpup_caustic", "max_depth": 6, "k_scale": 0.25 * 16}}
-
-
-def firefly_mask(y: np.ndarray) -> np.ndarray:
-    """The pixels that ``make_scenes.fireflies`` counts."""
-    from scipy.ndimage import median_filter
-
-    mask = y > 1.5 * median_filter(y, 3) + 0.1
-    assert int(mask.sum()) == fireflies(y)
-    return mask
+               "caustic, k / 16": {"type": "pumpup_caustic", "max_depth": 6, "k_scale": K_SCALE / 16},
+               "caustic, k x 16": {"type": "pumpup_caustic", "max_depth": 6, "k_scale": K_SCALE * 16}}
 
 
 def regions(scene: str, mats: dict, size: int) -> dict:

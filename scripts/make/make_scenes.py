@@ -34,14 +34,19 @@ SPP = {"000-fig8": 256, "000-fig9": 2048, "001-fig8": 256, "000-fig10": 2048}
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])  # linear sRGB
 
 
-def fireflies(y: np.ndarray) -> int:
-    """Pixels brighter than 1.5 x the median of their 3 x 3 neighbourhood plus 0.1 (linear luminance ``y``): the
-    isolated bright pixels of a Monte Carlo image; 0 for a converged one (edges of highlights are not that abrupt
+def firefly_mask(y: np.ndarray) -> np.ndarray:
+    """The pixels brighter than 1.5 x the median of their 3 x 3 neighbourhood plus 0.1 (linear luminance ``y``): the
+    isolated bright pixels of a Monte Carlo image; none in a converged one (edges of highlights are not that abrupt
     at 256 x 256).
     """
     from scipy.ndimage import median_filter
 
-    return int((y > 1.5 * median_filter(y, 3) + 0.1).sum())
+    return y > 1.5 * median_filter(y, 3) + 0.1
+
+
+def fireflies(y: np.ndarray) -> int:
+    """The number of pixels :func:`firefly_mask` marks."""
+    return int(firefly_mask(y).sum())
 
 
 def main(argv=None) -> int:
