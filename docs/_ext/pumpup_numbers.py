@@ -221,7 +221,11 @@ def _caustic_se(region: str) -> str:
 
 def _script(name: str, folder: str = "make"):
     """A module of ``scripts/<folder>/`` (not a package), imported by path."""
-    path = os.path.join(ROOT, "scripts", folder, f"{name}.py")
+    return _by_path(os.path.join(ROOT, "scripts", folder, f"{name}.py"), name)
+
+
+def _by_path(path: str, name: str):
+    """The module at ``path`` (a file of the repository outside the package), imported under a private name."""
     spec = importlib.util.spec_from_file_location(f"_pumpup_docs_{name}", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -1526,10 +1530,7 @@ def _furnace_zscores() -> dict:
     """The end-to-end furnace check of tests/apps/test_render_mitsuba.py at its default size and samples: per model,
     the pixels tested, those beyond its Z_MAX sigma, the largest |z|, the mean and standard deviation of z.
     """
-    path = os.path.join(ROOT, "tests", "apps", "test_render_mitsuba.py")
-    spec = importlib.util.spec_from_file_location("_pumpup_docs_render_mitsuba", path)
-    check = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(check)
+    check = _by_path(os.path.join(ROOT, "tests", "apps", "test_render_mitsuba.py"), "render_mitsuba")
     out = {"z_max": check.Z_MAX}
     for name, model in check.MODELS.items():
         z, _ = check.check_furnace(model, *check.FAST)
