@@ -64,6 +64,13 @@ def _load_baseline(path):
     return mod
 
 
+def hemisphere(rng, n: int) -> np.ndarray:
+    """``n`` directions uniform on the upper hemisphere, (n, 3): where eval() looks, as towards a light."""
+    d = rng.normal(size=(n, 3))
+    d[:, 2] = np.abs(d[:, 2])
+    return d / np.linalg.norm(d, axis=1)[:, None]
+
+
 def _bsdf(pm, spec, plugin="pumpup"):
     import json
 
@@ -101,10 +108,7 @@ def _rounds(pm, models, n, rounds, baseline, eval_at="light"):
     s1, s2 = mi.Float(u[0]), mi.Point2f(mi.Float(u[1]), mi.Float(u[2]))
     light = None
     if eval_at == "light":  # directions uniform on the upper hemisphere
-        d = rng.normal(size=(3, n))
-        d[2] = np.abs(d[2])
-        d /= np.linalg.norm(d, axis=0)
-        light = mi.Vector3f(*[mi.Float(x.astype(np.float32)) for x in d])
+        light = mi.Vector3f(*[mi.Float(x.astype(np.float32)) for x in hemisphere(rng, n).T])
     dr.eval(s1, s2, si)
     runs = [("roughconductor", _bsdf(pm, BASELINE[1]))]
     for key, _, spec, _ in models:
@@ -155,9 +159,7 @@ def bench_scalar(pm, models, n):
 
     rng = np.random.default_rng(1)
     u = rng.random((n, 3))
-    light = rng.normal(size=(n, 3))  # eval() towards other directions, uniform on the upper hemisphere
-    light[:, 2] = np.abs(light[:, 2])
-    light /= np.linalg.norm(light, axis=1)[:, None]
+    light = hemisphere(rng, n)  # eval() towards other directions
     out = []
     for label, spec in [("roughconductor GGX 0.3 (built-in)", BASELINE[1])] + [(m[1], m[2]) for m in models]:
         b = _bsdf(pm, spec)
