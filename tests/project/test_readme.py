@@ -202,9 +202,57 @@ def test_commands_by_document_keeps_every_command():
     assert "README.md" in by_doc and "docs/user-guide/files.md" in by_doc
 
 
+#: runs one document's commands in order in one Python process (argv[1]: a JSON list of [command, line]): a plain
+#: ``pumpup ARGS`` (no shell syntax) as ``pumpup.cli.main(ARGS)``, what the ``pumpup`` script runs, so that the
+#: interpreter and pumpup's imports start once per document; any other command through bash.  Prints the first
+#: failure as JSON on the last line of stdout, or null.
+DOCUMENT_RUNNER = r"""
+import contextlib, io, json, shlex, subprocess, sys
+
+def run(cmd):
+    argv = shlex.split(cmd)
+    plain = argv and argv[0] == "pumpup" and not any(c in cmd for c in "|&;<>$`()")
+    if not plain:
+        r = subprocess.run(["bash", "-c", cmd], capture_output=True, text=True, timeout=900)
+        return r.returncode, r.stderr
+    from pumpup.cli import main
+    err = io.StringIO()
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+        try:
+            code = main(argv[1:])
+        except SystemExit as exc:
+            code = exc.code if isinstance(exc.code, int) or exc.code is None else (print(exc.code, file=err) or 1)
+    return code or 0, err.getvalue()
+
+failure = None
+for cmd, line in json.loads(sys.argv[1]):
+    code, err = run(cmd)
+    if code != 0:
+        failure = f"{line}: {cmd} (exit {code})\n{err[-2000:]}"
+        break
+print(json.dumps(failure))
+"""
+
+
+def test_document_runner_reports_a_failing_command(tmp_path):
+    """The runner of test_bash_blocks_run fails on a pumpup command that fails, and on a bash command that does."""
+    import json
+
+    work, env = make_workspace(tmp_path)
+    for cmds, expect in ([["pumpup models", "a 1"], ["pumpup albedo phong:n=-1 --mu 1", "a 2"]], "a 2"), \
+                        ([["pumpup models", "b 1"], ["true && false", "b 2"]], "b 2"), \
+                        ([["pumpup models", "c 1"], ["ls > /dev/null", "c 2"]], None):
+        r = subprocess.run([sys.executable, "-c", DOCUMENT_RUNNER, json.dumps(cmds)], cwd=work, env=env,
+                           capture_output=True, text=True, timeout=300)
+        failure = json.loads(r.stdout.splitlines()[-1])
+        assert (failure is None) if expect is None else failure.startswith(expect + ": "), (failure, r.stderr)
+
+
 def test_bash_blocks_run(tmp_path):
     """Each document's commands run in order in a workspace of the document's own (a command may read what an
-    earlier one of its page wrote); the documents run side by side, one per core."""
+    earlier one of its page wrote), in one process per document (DOCUMENT_RUNNER); the documents run side by side,
+    one per core."""
+    import json
     from concurrent.futures import ThreadPoolExecutor
 
     by_doc = commands_by_document()
@@ -212,13 +260,13 @@ def test_bash_blocks_run(tmp_path):
     def run_document(index_and_doc):
         index, doc = index_and_doc
         work, env = make_workspace(tmp_path / f"doc{index}")
-        failures = []
-        for cmd, line in by_doc[doc]:
-            r = subprocess.run(["bash", "-c", cmd], cwd=work, env=env, capture_output=True, text=True, timeout=900)
-            if r.returncode != 0:
-                failures.append(f"{line}: {cmd}\n{r.stderr[-2000:]}")
-                break
-        return failures
+        r = subprocess.run([sys.executable, "-c", DOCUMENT_RUNNER, json.dumps(by_doc[doc])], cwd=work, env=env,
+                           capture_output=True, text=True, timeout=1800)
+        lines = r.stdout.splitlines()
+        if r.returncode != 0 or not lines:
+            return [f"{doc}: the runner failed\n{r.stderr[-2000:]}"]
+        failure = json.loads(lines[-1])
+        return [failure] if failure else []
 
     with ThreadPoolExecutor(max(1, min(2, os.cpu_count() or 1))) as pool:
         failures = [f for fs in pool.map(run_document, enumerate(by_doc)) for f in fs]
