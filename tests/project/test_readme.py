@@ -3,7 +3,8 @@
 The python blocks of one document run in order as ONE script (a file, as a user would save them; the
 processes scheduler of the sweep example then needs its main guard) in a fresh process: every page
 stands on its own, as a reader who opens it sees it.  The bash blocks of one document
-run line by line, in order, with ``pumpup`` meaning this checkout's command line.  Both run in a scratch
+run line by line, in order, in one process of their own: each ``pumpup ARGS`` line as this checkout's
+``pumpup.cli.main(ARGS)``, the others through bash (``DOCUMENT_RUNNER``).  Both run in a scratch
 directory that mirrors the repository root (a symlink to every top-level entry but .git), so
 the examples read what they would read from the root while the files they write (tables,
 sweeps) do not land in the checkout.
