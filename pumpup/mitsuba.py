@@ -549,52 +549,86 @@ class _Cells:
     found from the float64 bits of m as :meth:`pumpup.operators.pumping._LevelTable.piece` finds it, without a branch:
     cell c = (bits(m) >> ``shift``) - ``cbase`` holds a packet (s0, b_1, ..., b_(w-1)), s0 the piece where the cell
     starts and b_i the start of piece s0 + i where it lies inside the cell (else inf); the piece is s0 + the number of
-    b_i <= m, read with one gather.  2^bits cells per octave and w in {2, 4, 8}: the fewest bits from CELL_BITS to
-    ``MAX_BITS`` at which no cell holds more than 3 piece starts (w = 2 or 4), else than 7 (w = 8); where even
-    ``MAX_BITS`` leaves K > 7 starts in a cell, the starts of pieces s0 + 8 ... s0 + K are read too, for every m
-    (``extra``).
+    b_i <= m, read with one gather.  2^bits cells per octave and w in {2, 4}: the fewest bits from CELL_BITS to
+    ``MAX_BITS`` at which no cell holds more than 3 piece starts.
+
+    Where even ``MAX_BITS`` leaves more than 3 starts in some cell (the pieces crowd about a few points, as a 3-level
+    pumped GGX's level table does near m = 0.97), the cells are two-level (``fine``): a coarse cell at CELL_BITS holds
+    e_c and the index of its first fine cell (one UInt32, ``(index << 5) | e_c``), e_c the fewest extra bits that
+    leave at most 3 starts in each of its 2^e_c fine cells; the fine cells are packets of width 4 as above.  Two small
+    dependent gathers, where one level of cells would need a large table of wide packets.
     """
 
     MAX_BITS = 12
+    #: the most extra bits of a fine cell (two-level cells)
+    MAX_FINE_BITS = 26
 
     def __init__(self, lo, mlo: float):
         from .physics.lookups import CELL_BITS, float_bits_reference
 
+        self._bits = float_bits_reference
         self.lo_np = np.asarray(lo, dtype=np.float64)
         starts = self.lo_np[:-1]
+        b0 = int(float_bits_reference(mlo))
+        top = int(float_bits_reference(1.0))
+        for bits in range(CELL_BITS, self.MAX_BITS + 1):
+            most = self._most(starts, self._edges(b0, top, 52 - bits))
+            if most <= 3:
+                break
+        self.shift = shift = 52 - (bits if most <= 3 else CELL_BITS)
+        self.cbase = b0 >> shift
+        edges = self._edges(b0, top, shift)
+        self.ncell = len(edges) - 1
+        self.fine = None
+        if most <= 3:
+            self.width = 2 if most <= 1 else 4
+            self.np = self._packets(starts, edges[:-1], edges[1:])
+        else:
+            self.width = 4
+            entries, packets, first = [], [], 0
+            for c in range(self.ncell):
+                for e in range(self.MAX_FINE_BITS + 1):
+                    sub = edges[c] + (np.arange(2**e + 1, dtype=np.int64) << (shift - e))
+                    if self._most(starts, sub) <= 3:
+                        break
+                else:
+                    raise ValueError("pumpup.mitsuba: a table's pieces are too crowded for its cells")
+                packets.append(self._packets(starts, sub[:-1], sub[1:]))
+                entries.append((first << 5) | e)
+                first += 2**e
+            self.fine = np.concatenate(packets)
+            self.coarse = np.array(entries, dtype=np.uint32)
+            self.np = self._packets(starts, edges[:-1], edges[1:])  # the scalar path: s0, then a search
+        if _jit():
+            self.dr = _aligned_f64(self.np if self.fine is None else self.fine)
+            if self.fine is not None:
+                self.coarse_dr = mi.UInt32(self.coarse)
 
-        def most(bits):  # the most piece starts inside one cell (after its first piece's)
-            shift = 52 - bits
-            b0 = int(float_bits_reference(mlo)) >> shift
-            top = int(float_bits_reference(1.0)) >> shift
-            bounds = (np.arange(b0, top + 2, dtype=np.int64) << shift).view(np.float64)
-            inside = (np.searchsorted(starts, bounds[1:], side="left")
-                      - np.searchsorted(starts, bounds[:-1], side="right"))
-            return int(inside.max())
+    @staticmethod
+    def _edges(b0, top, shift):
+        """The edges (float64 bits) of the cells from the one of bits ``b0`` to the one of ``top``, 2^(52 - shift)
+        cells per octave.
+        """
+        return np.arange(b0 >> shift, (top >> shift) + 2, dtype=np.int64) << shift
 
-        counts = {bits: most(bits) for bits in range(CELL_BITS, self.MAX_BITS + 1)}
-        few = [b for b in counts if counts[b] <= 3]
-        some = [b for b in counts if counts[b] <= 7]
-        bits = few[0] if few else (some[0] if some else self.MAX_BITS)
-        k = counts[bits]
-        self.width = 2 if k <= 1 else (4 if k <= 3 else 8)
-        self.extra = max(0, k - 7)
-        self.shift = shift = 52 - bits
-        self.cbase = int(float_bits_reference(mlo)) >> shift
-        top = int(float_bits_reference(1.0)) >> shift
-        bounds = (np.arange(self.cbase, top + 2, dtype=np.int64) << shift).view(np.float64)
-        s0 = np.clip(np.searchsorted(starts, bounds[:-1], side="right") - 1, 0, len(starts) - 1)
+    @staticmethod
+    def _most(starts, edges):
+        """The most piece starts inside one of the cells with these edges (after the cell's first piece's)."""
+        bounds = np.asarray(edges, dtype=np.int64).view(np.float64)
+        inside = np.searchsorted(starts, bounds[1:], side="left") - np.searchsorted(starts, bounds[:-1], side="right")
+        return int(inside.max())
+
+    def _packets(self, starts, lo_bits, hi_bits):
+        """The packets (s0, b_1, ..., b_(w-1)) of the cells [lo_bits[i], hi_bits[i]) (float64 bits)."""
+        lo_m = np.asarray(lo_bits, dtype=np.int64).view(np.float64)
+        hi_m = np.asarray(hi_bits, dtype=np.int64).view(np.float64)
+        s0 = np.clip(np.searchsorted(starts, lo_m, side="right") - 1, 0, len(starts) - 1)
         table = np.full((len(s0), self.width), math.inf)
         table[:, 0] = s0
         for i in range(1, self.width):
             nxt = self.lo_np[np.minimum(s0 + i, len(self.lo_np) - 1)]
-            table[:, i] = np.where(nxt < bounds[1:], nxt, math.inf)  # a start inside the cell, else never reached
-        self.np = table
-        self.ncell = len(s0)
-        if _jit():
-            self.dr = _aligned_f64(table)
-            self.lo = mi.Float64(self.lo_np)
-        self._bits = float_bits_reference
+            table[:, i] = np.where(nxt < hi_m, nxt, math.inf)  # a start inside the cell, else never reached
+        return table
 
     def __call__(self, m):
         """The piece that holds m (m > mlo; other m give some valid piece index)."""
@@ -604,18 +638,18 @@ class _Cells:
             while m >= self.lo_np[s + 1]:
                 s += 1
             return s
-        bits = dr.reinterpret_array(mi.UInt64, m) >> self.shift
+        mb = dr.reinterpret_array(mi.UInt64, m)
+        bits = mb >> self.shift
         c = mi.UInt32(dr.minimum(dr.maximum(bits, self.cbase) - self.cbase, self.ncell - 1))
+        if self.fine is not None:  # two-level: the coarse cell's entry, then its fine cell (class docstring)
+            entry = dr.gather(mi.UInt32, self.coarse_dr, c)
+            e = mi.UInt64(entry & 31)
+            c = (entry >> 5) + mi.UInt32((mb >> (self.shift - e)) & ((mi.UInt64(1) << e) - 1))
         cell = dr.gather(_array_xf64(), self.dr, c, shape=(self.width, dr.width(c)))
         one, zero = mi.UInt32(1), mi.UInt32(0)
-        s0 = mi.UInt32(cell[0])
-        s = s0
+        s = mi.UInt32(cell[0])
         for i in range(1, self.width):
             s = s + dr.select(m >= cell[i], one, zero)
-        end = len(self.lo_np) - 1  # the sentinel
-        for i in range(self.width, self.width + self.extra):  # a cell with more starts than its packet: the starts
-            # after them, each read from s0 (independent reads; lo increases, so those beyond m count nothing)
-            s = s + dr.select(m >= dr.gather(mi.Float64, self.lo, dr.minimum(s0 + i, end)), one, zero)
         return s
 
 
