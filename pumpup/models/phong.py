@@ -189,10 +189,10 @@ def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo
 
 
 @njit(cache=True, nogil=True)
-def _phong_divided_lit(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
-                   index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell, qlo,
-                   qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
-                   rcoef):  # pragma: no cover - compiled
+def _phong_divided_lit(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing,
+                       mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell,
+                       qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
+                       rcoef):  # pragma: no cover - compiled
     """:func:`_phong_divided` in blocks of _BLOCK rows, every lit row divided in place through its row index, the
     path chosen row by row as ``pumpup.operators.pumping._chain_kernel`` chooses it: the same operations, the same
     values.  The baseline :meth:`Phong._eval_divided_lit` runs, for the tests of :func:`_phong_divided` and
