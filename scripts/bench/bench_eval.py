@@ -13,8 +13,10 @@ fused numpy expression, is ``python scripts/bench/bench_albedo.py --eval``.)
 ``--issue55`` prints only the eval rows of issue 55's table (pumped and compensated models against their base), each
 with its target and the old and new path measured alternating in one run (old: the chain kernel level by level,
 ``Pumped._eval_levelwise``, and the compensated model's two passes, ``KullaConty._eval_two_passes``; new: ``_eval``,
-the level table where the chain has no product table, and the base's fused kernel where it has one); 2^20 pairs, best
-of 9 in this thread's CPU time (``time.thread_time``: on a shared machine the time spent waiting for a core is out).
+the level table where the chain has no product table, and the base's fused kernel where it has one; for pumped Phong
+also "lit rows", its fused kernel dividing every lit row in place row by row, ``Phong._eval_divided_lit``, against
+"new", which gathers the product table's rows into contiguous arrays first); 2^20 pairs, best of 9 in this thread's CPU
+time (``time.thread_time``: on a shared machine the time spent waiting for a core is out).
 
 ``--tolerances`` builds the 3-level g2 pumped Phong n = 20 with three settings of the pumping tables' tolerances
 (``pumpup.operators.pumping.TABLE_RTOL`` and ``TABLE_INTERP_TOL``) and prints each build's time relative to the
@@ -178,15 +180,18 @@ def issue55_rows(repeat=9, n=1 << 20):
     for levels in (1, 3, 5):
         pp = pumpup.pump({"type": "phong", "n": 20}, g="g2", levels=levels)
         rows.append((f"pumped Phong n 20, g2, {levels} level{'s' * (levels > 1)}", phong,
-                     {"levelwise": pp._eval_levelwise, "level table": pp._eval_level_table, "new": pp._eval}, 1.3))
+                     {"levelwise": pp._eval_levelwise, "level table": pp._eval_level_table,
+                      "lit rows": lambda wi, wo, pp=pp: phong._eval_divided_lit(wi, wo, pp._chain_args()),
+                      "new": pp._eval}, 1.3))
     kc = pumpup.compensate({"type": "ggx", "alpha": 0.3}, method="kulla_conty")
     rows.append(("GGX alpha 0.3 + Kulla-Conty lobe", ggx, {"levelwise": kc._eval_two_passes,
                                                           "level table": kc._eval_two_passes, "new": kc._eval}, 1.3))
-    paths = ("levelwise", "level table", "new")
+    paths = ("levelwise", "level table", "lit rows", "new")
     fns = {"ggx": ggx._eval, "phong": phong._eval}
     for label, _, fn, _ in rows:
         for path in paths:
-            fns[label + " " + path] = fn[path]
+            if path in fn:
+                fns[label + " " + path] = fn[path]
     for fn in fns.values():
         fn(wi[:10], wo[:10])
         fn(wi, wo)
@@ -201,14 +206,18 @@ def issue55_rows(repeat=9, n=1 << 20):
     print("  levelwise: every level's bound looked up level by level (Pumped._eval_levelwise; Kulla-Conty: two "
           "passes)\n  level table: every level's bound from one polynomial piece per direction "
           "(Pumped._eval_level_table, the split table off)\n"
-          "  new: Pumped._eval (the split table, one product of two look-ups; Phong: only the lit rows divided)")
-    print(f"{'':40s} {'target':>7s} {'levelwise':>10s} {'lvl table':>10s} {'new':>7s} {'base ns':>8s} {'new ns':>7s}")
+          "  new: Pumped._eval (the split table, one product of two look-ups; Phong: only the lit rows divided)\n"
+          "  lit rows (Phong): its fused kernel dividing each lit row in place (Phong._eval_divided_lit); new gathers "
+          "the product table's rows first")
+    print(f"{'':40s} {'target':>7s} {'levelwise':>10s} {'lvl table':>10s} {'lit rows':>9s} {'new':>7s} {'base ns':>8s} "
+          f"{'new ns':>7s}")
     for label, base, _, target in rows:
         b = best["ggx" if base is ggx else "phong"]
-        r = [best[label + " " + path] / b for path in paths]
-        met = "met" if r[2] <= target else "missed"
-        print(f"{label:40s} {target:6.1f}x {r[0]:9.2f}x {r[1]:9.2f}x {r[2]:6.2f}x {b / n * 1e9:8.1f} "
-              f"{best[label + ' new'] / n * 1e9:7.1f}  {met}")
+        r = {path: best[label + " " + path] / b for path in paths if label + " " + path in best}
+        met = "met" if r["new"] <= target else "missed"
+        lit = f"{r['lit rows']:8.2f}x" if "lit rows" in r else f"{'-':>9s}"
+        print(f"{label:40s} {target:6.1f}x {r['levelwise']:9.2f}x {r['level table']:9.2f}x {lit} {r['new']:6.2f}x "
+              f"{b / n * 1e9:8.1f} {best[label + ' new'] / n * 1e9:7.1f}  {met}")
     print("\ntables of the pumped GGX chains (built again from the levels' albedo tables, which are cached):")
     for levels, secs, kb, share in built:
         print(f"  {levels} level{'s' * (levels > 1)}: product/level/split tables {secs * 1e3:7.1f} ms, {kb:8.1f} kB; "
