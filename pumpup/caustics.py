@@ -321,6 +321,11 @@ def _integrator_class():
                     & (dr.abs(dr.dot(pc, _v3(v))) <= 1.0001 * float(v @ v)))
 
         @staticmethod
+        def _mix_pdf(a, p_bsdf, q_c):
+            """The continuation's pdf a p_bsdf + (1 - a) q_C (module docstring)."""
+            return a * p_bsdf + (1.0 - a) * q_c
+
+        @staticmethod
         def _lobe_pdf(w, d0, k, ok):
             """(k + 1) / (2 pi) cos^k with 1 - cos from |w - d0|^2 / 2 (accurate near the axis)."""
             om = 0.5 * dr.squared_norm(w - d0)  # 1 - cos(w, d0)
@@ -428,7 +433,7 @@ def _integrator_class():
                         q = self._lobe_pdf(w, d0, k, sel) / dr.maximum(count, 1.0)
                         fx, px = bsdf.eval_pdf(ctx, si, si.to_local(w), sel)
                         if c_lobes:  # the continuation's pdf p_x = a p_bsdf + (1 - a) q_C
-                            px = a * px + (1.0 - a) * q_c(w)
+                            px = self._mix_pdf(a, px, q_c(w))
                         ok = sel & (q > 0.0) & (dr.max(fx) > 0.0)
                         ray_b = si.spawn_ray(w)
                         sp = scene.ray_intersect(ray_b, ok)
@@ -457,7 +462,7 @@ def _integrator_class():
                     wo = dr.select(take_c, w_c, wo)
                     f_cos = dr.select(take_c, fc, wt * bs.pdf)  # Mitsuba's weight is f cos / p_bsdf
                     p_bsdf = dr.select(take_c, pc, bs.pdf)
-                    p_mix = a * p_bsdf + (1.0 - a) * q_c(wo)  # exact for either component's w
+                    p_mix = self._mix_pdf(a, p_bsdf, q_c(wo))  # exact for either component's w
                     active &= (p_mix > 0.0) & (p_bsdf > 0.0)
                     beta *= dr.select(active, f_cos / dr.maximum(p_mix, 1e-30), 0.0)
                     prev_pdf = mi.Float(p_mix)

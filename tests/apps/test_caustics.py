@@ -133,7 +133,7 @@ def _check(size, spp, passes, pairs, zmax, rough=None, scene="000-fig8"):
 
 #: the pairs of integrators (scripts/make/caustic_check.py's INTEGRATORS) whose means the small renders compare
 PAIRS = ["path vs caustic, B off", "path vs caustic", "caustic, B off vs caustic", "caustic vs caustic, k / 16",
-         "caustic vs caustic, k x 16"]
+         "caustic vs caustic, k x 16", "caustic, C off vs caustic", "path vs caustic, C off"]
 
 
 def test_means_agree_small_render(S):
