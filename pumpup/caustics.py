@@ -83,24 +83,27 @@ def _lobe_np(x, light, face, kn, margin):
 def mirror_pairs(faces, light, points, kn, margin) -> list:
     """Technique C's ordered face pairs (i1, i2) for a point light at ``light``, pruned (numpy, once per render).
 
-    ``faces`` is a list of (shape index, c, n, u, v): the mirror faces (centre, unit normal, half-edge vectors);
-    ``points`` (P, 3) are points where a vertex may use technique C (a grid over the shapes that are not
-    mirrors).  A pair is kept if the light is in front of f2, f1 and f2 lie on different shapes, each is partly
-    in front of the other's plane, the light's image l' in f2's plane is in front of f1, and at one of the points
-    at least the path x -> f1 -> f2 -> l passes the integrator's test with twice its margin (q_C is a valid pdf
-    for any set of pairs: the pruning changes the noise, not the mean).
+    ``faces`` is a list of (shape index, c, n, u, v) (the index is not used): the mirror faces (centre, unit normal,
+    half-edge vectors); ``points`` (P, 3) are points where a vertex may use technique C (a grid over the shapes that
+    are not mirrors). A pair is kept if the light is in front of f2, f1 != f2, each is partly in front of the
+    other's plane (two faces of one cube never are, nor of two cubes merged into one mesh), the light's image l' in
+    f2's plane is in front of f1, and at one of the points at least the path x -> f1 -> f2 -> l passes the
+    integrator's test with twice its margin (q_C is a valid pdf for any set of pairs: the pruning changes the noise,
+    not the mean).
     """
     points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     corners = [np.array([c + a * u + b * v for a in (-1, 1) for b in (-1, 1)]) for _, c, _, u, v in faces]
+    tol = [1e-5 * float(np.linalg.norm(u) + np.linalg.norm(v)) for _, _, _, u, v in faces]
     out = []
-    for i2, (sh2, c2, n2, u2, v2) in enumerate(faces):
+    for i2, (_, c2, n2, u2, v2) in enumerate(faces):
         side_l2 = float((light - c2) @ n2)
         if side_l2 <= 1e-6:
             continue
         lp = light - 2.0 * side_l2 * n2  # the light's image in f2's plane
-        for i1, (sh1, c1, n1, u1, v1) in enumerate(faces):
-            if sh1 == sh2 or not (np.any((corners[i1] - c2) @ n2 > 1e-6)
-                                  and np.any((corners[i2] - c1) @ n1 > 1e-6) and (lp - c1) @ n1 > 1e-6):
+        for i1, (_, c1, n1, u1, v1) in enumerate(faces):
+            # (two faces of one convex shape fail the first two tests: each lies behind the other's plane)
+            if i1 == i2 or not (np.any((corners[i1] - c2) @ n2 > tol[i1])
+                                and np.any((corners[i2] - c1) @ n1 > tol[i2]) and (lp - c1) @ n1 > 1e-6):
                 continue
             if not len(points):
                 continue
