@@ -53,7 +53,7 @@ __all__ = ["register", "K_SCALE"]
 K_SCALE = 0.25
 
 #: the share 1 - a of technique C's lobes in the continuation mixture where they apply
-C_SHARE = 0.5
+C_SHARE = 0.1
 
 _CLASSES: dict = {}
 
