@@ -2,13 +2,16 @@
 
 A point light seen through a near-mirror (a Phong lobe of exponent n = 5000) from a rough surface is a caustic
 that a path tracer finds only by chance: the rough surface's BSDF sample must fall into the mirror's narrow
-lobe.  This integrator adds a second technique for exactly those paths and combines the two by one-sample
-multiple importance sampling (the balance heuristic, Veach 1997, sec. 9.2), so the image stays unbiased.
+lobe.  This integrator adds a technique for the paths that reach a light through one mirror (B) and a
+continuation that aims at a light seen through two mirrors (C), and combines them with the path tracer by
+one-sample multiple importance sampling (the balance heuristic, Veach 1997, sec. 9.2), so the image stays
+unbiased.
 
 The path tracer (technique A) is Mitsuba's ``path`` with ``max_depth`` (counting edges: next-event estimation
 at the i-th hit makes a path of i + 1 edges): at each vertex, next-event estimation to every point light
-(visibility by a shadow ray), BSDF sampling to continue; the environment (a constant sky) only where a camera
-ray or a BSDF-sampled ray escapes.  No Russian roulette.
+(visibility by a shadow ray), a sampled direction to continue (the BSDF's, or technique C's where it applies,
+below); the environment (a constant sky) only where a camera ray or a continuation escapes.  No Russian
+roulette.
 
 The mirrors are planar rectangles: a ``rectangle`` shape, or each planar face of a mesh made of rectangles (a
 ``cube``).  Technique B, at every vertex x, for every point light l: the faces f in front of both x and l whose
@@ -26,17 +29,36 @@ too.  If w's first hit p is on f, the path x -> p -> l contributes::
     beta f_x(w) cos_x / (q_f(w) / N) * w_B * f_p(p -> l) cos_p V(p, l) I / |p - l|^2,
     w_B = (q_f(w) / N) / (q_f(w) / N + p_x(w)),
 
-with p_x the BSDF-sampling pdf at x.  The path tracer's own estimate of the same path (BSDF sample w from x
-hitting face f at p, then next-event estimation at p towards l) is weighted w_A = p_x(w) / (p_x(w) +
+with p_x the continuation's pdf at x (below).  The path tracer's own estimate of the same path (a continuation
+w from x hitting face f at p, then next-event estimation at p towards l) is weighted w_A = p_x(w) / (p_x(w) +
 q_f(w; x) / N(x, l)) (1 after a camera ray), so w_A + w_B = 1 for every such path: the sum is unbiased for any
 k.
 
+Technique C reaches a light through two mirror faces, x -> p1 (on f1) -> p2 (on f2) -> l.  Unfolded, p1 -> p2
+-> l is a straight line from p1 to l's image l' in f2's plane, so x -> p1 is B's lobe for a light at l' and the
+face f1: about x -> s1 (s1 where x -> l'' crosses f1's plane, l'' the image of l' in it), k = c n (1 + |x - s1| /
+|s1 - l'|)^2, valid where s1 is on f1 within B's margin and the segment s1 -> l' crosses f2's plane at s2 on f2
+within m (|x - s1| + |s1 - s2|) sqrt(2 / k) / max(cos2, 0.05) (cos2 between s1 -> l' and f2's normal).  The
+ordered pairs (f1, f2) are pruned once per render (:func:`mirror_pairs`: l in front of f2, each face partly in
+front of the other's plane, l' in front of f1, and the lobe valid somewhere on the shapes that are not mirrors).
+q_C(w; x) is the uniform mixture of the M(x) valid lobes over all point lights and pairs, and the continuation
+at x samples::
+
+    p_x(w) = a p_bsdf(w) + (1 - a) q_C(w; x),    beta *= f_x(w) cos_x / p_x(w),
+
+whichever of the two produced w; 1 - a = ``C_SHARE`` (1/10) where M(x) > 0 and x is on no mirror shape, its BSDF
+has no delta component and the path has room for both bounces and the next-event estimate (depth + 3 <
+``max_depth``); a = 1 (BSDF sampling alone) elsewhere.  q_C is a pdf over all directions (no test whether w hits
+f1), so p_x is exact for every w, and a depends on x only: the continuation is unbiased for any lobes.  At p1,
+technique B samples the second bounce p1 -> p2 -> l.  p_x enters both weights w_A and w_B above.
+
 Properties: ``max_depth`` (int, default 6), ``mirror`` (the mirror shapes' ids, comma-separated, or ``*`` for
 every shape and ``-id`` to leave one out; default "plate"), ``mirror_n`` (the mirror lobe's exponent, default
-5000), ``k_scale`` (c above, default 0.25), ``technique_b`` (bool, default True: False gives the plain path
-tracer, equal to Mitsuba's ``path`` in expectation), ``margin`` (m above, default 3; 0 takes only specular
-points on the face).  The set of faces, N and q depend on x and l only, and both weights use the same ones, so
-the image is unbiased for any k and m.
+5000), ``k_scale`` (c above, default 0.25), ``technique_b`` (bool, default True: False gives the path tracer
+without B), ``technique_c`` (bool, default True: False samples every continuation from the BSDF; both False give
+the plain path tracer, equal to Mitsuba's ``path`` in expectation), ``margin`` (m above, default 3; 0 takes only
+specular points on the face).  The set of faces and pairs, N, M and the lobes depend on x and l only, and every
+weight uses the same ones, so the image is unbiased for any k and m.
 
 Registered by :func:`register` (``pumpup.scenes`` calls it); Mitsuba is imported only inside functions.
 """
@@ -47,12 +69,12 @@ import math
 
 import numpy as np
 
-__all__ = ["register", "K_SCALE"]
+__all__ = ["register", "mirror_pairs", "K_SCALE", "C_SHARE"]
 
 #: the default widening c of technique B's lobe (``k_scale``)
 K_SCALE = 0.25
 
-#: the share 1 - a of technique C's lobes in the continuation mixture where they apply
+#: technique C's share 1 - a of the continuation where its lobes apply (module docstring)
 C_SHARE = 0.1
 
 _CLASSES: dict = {}
@@ -466,7 +488,7 @@ def _integrator_class():
                     f_cos = dr.select(take_c, fc, wt * bs.pdf)  # Mitsuba's weight is f cos / p_bsdf
                     p_bsdf = dr.select(take_c, pc, bs.pdf)
                     p_mix = self._mix_pdf(a, p_bsdf, q_c(wo))  # exact for either component's w
-                    active &= (p_mix > 0.0) & (p_bsdf > 0.0)
+                    active &= p_mix > 0.0
                     beta *= dr.select(active, f_cos / dr.maximum(p_mix, 1e-30), 0.0)
                     prev_pdf = mi.Float(p_mix)
                 else:

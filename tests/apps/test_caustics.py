@@ -1,6 +1,7 @@
 """pumpup.caustics (the ``pumpup_caustic`` Mitsuba integrator): its lobe samples what its pdf says, bad input,
-and renders of 000 Fig. 8 whose means agree with Mitsuba's ``path`` and with the integrator's own variants
-(technique B off, its lobe 16 x wider or narrower) within their standard errors."""
+technique C's face pairs, and renders of 000 Fig. 8 and 001 Fig. 8 whose means agree with Mitsuba's ``path`` and
+with the integrator's own variants (techniques B and C off, C off, the lobes 16 x wider or narrower) within their
+standard errors, and a wrong weight that the comparison catches."""
 
 from __future__ import annotations
 
@@ -249,7 +250,9 @@ def test_margin_keeps_the_mean(S):
 @pytest.mark.slow
 def test_means_agree_and_fireflies_drop(S):
     """64 x 64, 16 passes x 256 spp: every pair of integrators agrees within 4 combined standard errors per
-    region; at 256 x 256 and 64 spp the fireflies of 000 Fig. 8's left panel drop at least 10 x."""
+    region; at 256 x 256 and 64 spp the fireflies of 000 Fig. 8's left panel drop at least 10 x; at 256 x 256
+    and 256 spp, 001 Fig. 8's pumped n = 5000 panel keeps at most 5 fireflies with technique C, at least 4 x
+    fewer than without it (the paths through two cube faces)."""
     import caustic_check as C
 
     res = _check(64, 256, 16, [], 4.0)
@@ -261,3 +264,10 @@ def test_means_agree_and_fireflies_drop(S):
     y_path = C.passes("000-fig8", mats, C.INTEGRATORS["path"], 256, 64, 1, 7)[0][0]
     y_new = C.passes("000-fig8", mats, C.INTEGRATORS["caustic"], 256, 64, 1, 7)[0][0]
     assert fireflies(y_new) * 10 <= fireflies(y_path)
+    i, j = C.SETUP["001-fig8"]["panels"][1]
+    label, mats = C.S.panels("001-fig8")[i][j]
+    count = {}
+    for k in ("caustic, C off", "caustic"):
+        integ = dict(C.INTEGRATORS[k], mirror=C.SETUP["001-fig8"]["mirror"], mirror_n=5000.0)
+        count[k] = fireflies(C.passes("001-fig8", mats, integ, 256, 256, 1, 7)[0][0])
+    assert count["caustic"] <= 5 and count["caustic"] * 4 <= count["caustic, C off"], (label, count)
