@@ -192,8 +192,11 @@ def _short(label: str) -> str:
 
 
 def _caustic_z(key: str = "regions", scene: str = "000-fig8") -> str:
-    zs = [abs(z) for r in caustic(scene)[key].values() for z in r["z"].values()]
-    return f"{len(zs)} z-scores, the largest {max(zs):.2f}, {sum(z > 2 for z in zs)} above 2"
+    zs = [(abs(z), pair, region or "the merged cubes") for region, r in caustic(scene)[key].items()
+          for pair, z in r["z"].items()]
+    top = max(zs)
+    return (f"{len(zs)} z-scores, the largest {top[0]:.2f} ({top[1]}, {top[2]}), "
+            f"{sum(z > 2 for z, _, _ in zs)} above 2")
 
 
 def _caustic_fireflies(spp: int, scene: str = "000-fig8") -> str:
