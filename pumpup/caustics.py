@@ -240,10 +240,11 @@ def _integrator_class():
 
         def _setup(self, scene):
             """Per point light: (emitter, position, faces in front of it, technique C's pairs (f1, f2, l')),
-            and the mirror shapes; cached per scene (the scalar variants call ``sample`` per ray).
+            and the mirror shapes; kept for the scene's next call in the scalar variants (which call ``sample``
+            per ray; the JIT variants trace it once per render).
             """
-            key = id(scene)
-            if getattr(self, "_cache", (None,))[0] == key:
+            scalar = mi.variant().startswith("scalar")
+            if scalar and getattr(self, "_cache", (None,))[0] is scene:
                 return self._cache[1]
             mirrors = self._mirror_shapes(scene)
             faces, plain = [], []
@@ -268,8 +269,10 @@ def _integrator_class():
                         c2, n2 = plain[i2][1], plain[i2][2]
                         pairs.append((faces[i1], faces[i2], lpos - 2.0 * float((lpos - c2) @ n2) * n2))
                 lights.append((e, lpos, [f for f in faces if (lpos - f[1]) @ f[2] > 1e-6], pairs))
-            self._cache = (key, (lights, [mi.ShapePtr(m) for m in mirrors]))
-            return self._cache[1]
+            out = (lights, [mi.ShapePtr(m) for m in mirrors])
+            if scalar:
+                self._cache = (scene, out)
+            return out
 
         @staticmethod
         def _points(shapes, grid=48):
