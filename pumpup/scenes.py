@@ -47,10 +47,11 @@ indices give F0 = (0.942, 0.704, 0.404) for gold against (1.032, 0.732, 0.362) f
 
 Lights: a constant sky (Mitsuba ``constant`` emitter; the papers' "sky-light") plus point lights,
 path tracing (``path``, max_depth 6) with Mitsuba's MIS (000 Fig. 8 and 001 Fig. 8: ``pumpup_caustic``,
-the same path tracer plus next-event estimation through the near-mirrors, :data:`INTEGRATOR`); the plugin
-samples each lobe with pumpup's strategies.  A colour factor or a sum of pumpup models (Lambert + Phong lobe) is the
-small BSDF plugin ``pumpup_mix`` defined here: f = sum_i w_i f_i (w_i RGB), sampled by choosing
-component i with probability proportional to the mean of w_i and evaluating the mixture pdf.
+the same path tracer plus sampling towards point lights seen through one or two near-mirrors,
+:data:`INTEGRATOR`); the plugin samples each lobe with pumpup's strategies.  A colour factor or a sum of
+pumpup models (Lambert + Phong lobe) is the small BSDF plugin ``pumpup_mix`` defined here: f = sum_i w_i f_i
+(w_i RGB), sampled by choosing component i with probability proportional to the mean of w_i and evaluating the
+mixture pdf.
 
 Imports Mitsuba only inside functions: ``import pumpup.scenes`` works without it, and
 :func:`render_scene` then raises ImportError naming the ``render`` extra.
@@ -361,9 +362,9 @@ def _scene_dict(name, mats, size, spp):
 #: Mitsuba's path tracer, the integrator of the scenes without a near-mirror plate
 PATH = {"type": "path", "max_depth": 6}
 #: the scenes rendered otherwise: 000 Fig. 8 and 001 Fig. 8 by ``pumpup_caustic`` (:mod:`pumpup.caustics`), the
-#: same path tracer plus next-event estimation through the planar near-mirrors (000: the silver plate, n = 5000;
-#: 001: the faces of the cubes, n = 5000 in two of its panels), combined by MIS: unbiased, and without the
-#: caustics' fireflies of ``path``
+#: same path tracer plus sampling towards point lights seen through one or two planar near-mirrors (000: the
+#: silver plate, n = 5000; 001: the faces of the cubes, n = 5000 in two of its panels), combined by MIS:
+#: unbiased, and without the caustics' fireflies of ``path``
 INTEGRATOR = {"000-fig8": {"type": "pumpup_caustic", "max_depth": 6, "mirror": "plate", "mirror_n": 5000.0},
               "001-fig8": {"type": "pumpup_caustic", "max_depth": 6, "mirror": "*,-plate", "mirror_n": 5000.0}}
 

@@ -192,8 +192,11 @@ def _short(label: str) -> str:
 
 
 def _caustic_z(key: str = "regions", scene: str = "000-fig8") -> str:
-    zs = [abs(z) for r in caustic(scene)[key].values() for z in r["z"].values()]
-    return f"{len(zs)} z-scores, the largest {max(zs):.2f}, {sum(z > 2 for z in zs)} above 2"
+    zs = [(abs(z), pair, region or "the merged cubes") for region, r in caustic(scene)[key].items()
+          for pair, z in r["z"].items()]
+    top = max(zs)
+    return (f"{len(zs)} z-scores, the largest {top[0]:.2f} ({top[1]}, {top[2]}), "
+            f"{sum(z > 2 for z, _, _ in zs)} above 2")
 
 
 def _caustic_fireflies(spp: int, scene: str = "000-fig8") -> str:
@@ -201,9 +204,12 @@ def _caustic_fireflies(spp: int, scene: str = "000-fig8") -> str:
     out = []
     for label, p in e["fireflies"].items():
         a, b = p[f"path, {spp} spp"], p[f"caustic, {spp} spp"]
+        c = p.get(f"caustic, C off, {spp} spp")  # pumpup_caustic without technique C (001 Fig. 8)
+        without_c = "" if c is None else (f"{' and '.join(map(str, c['fireflies']))} without technique C in "
+                                          f"{min(c['seconds']):.1f} s, ")
         out.append(f"{_short(label)}: {' and '.join(map(str, a['fireflies']))} with path in "
-                   f"{min(a['seconds']):.1f} s, {' and '.join(map(str, b['fireflies']))} with pumpup_caustic "
-                   f"(of them not at {e['reference_spp']} spp: {' and '.join(map(str, b['noise']))}) in "
+                   f"{min(a['seconds']):.1f} s, {without_c}{' and '.join(map(str, b['fireflies']))} with "
+                   f"pumpup_caustic (of them not at {e['reference_spp']} spp: {' and '.join(map(str, b['noise']))}) in "
                    f"{min(b['seconds']):.1f} s")
     return "; ".join(out)
 

@@ -5,20 +5,20 @@
                                          [--reference-spp 1024] [--rough-plate 300] [--out figures]
 
 Renders a panel of ``--scene`` (000 Fig. 8: the reciprocal Phong one; 001 Fig. 8: reciprocal Phong, n = 5000;
-:data:`SETUP`) with Mitsuba's ``path`` (max_depth 6), with ``pumpup_caustic`` without its mirror-image technique
-(the plain path tracer) and with it, ``--passes`` times each at ``--spp`` samples per pixel and independent
-seeds.  Per region of the image (the pixels whose centre sees the sky, each shape, all pixels, and the 2 % of
-pixels where 8 more passes of the path tracer spread most: the caustics' fireflies) it prints the mean luminance of
-each integrator (also ``pumpup_caustic`` with its lobe's exponent k divided and multiplied by 16: the weights of
-the two techniques change, an unbiased combination keeps the mean) with its standard error (from the spread of
-the passes) and the z-score of each difference.  The same again with rougher mirrors (``--rough-plate``,
-n = 300), where ``path`` makes no caustic fireflies and the comparison is tight.  Then it renders the scene's
-near-mirror panels (n = 5000) at ``--fireflies-size`` and each of ``--fireflies-spp`` with ``path`` and with
-``pumpup_caustic`` (two seeds each) and prints the fireflies (``make_scenes.fireflies``), those of them that
-are not fireflies of a ``pumpup_caustic`` render at ``--reference-spp`` (noise, not bright features of the
-converged image), and the render times.  Writes ``OUT/caustic_check.json`` (000 Fig. 8) or
-``OUT/caustic_check_SCENE.json``; the documentation quotes them.  About 5 minutes for 000 Fig. 8 on a free
-2-core machine, more for 001 Fig. 8.
+:data:`SETUP`) with Mitsuba's ``path`` (max_depth 6), with ``pumpup_caustic`` without its mirror-image techniques
+(the plain path tracer), without its two-mirror technique C and with both (:data:`INTEGRATORS`), ``--passes`` times
+each at ``--spp`` samples per pixel and independent seeds. Per region of the image (the pixels whose centre sees the
+sky, each shape, all pixels, and the 2 % of pixels where 8 more passes of the path tracer spread most: the caustics'
+fireflies) it prints the mean luminance of each integrator (also ``pumpup_caustic`` with its lobes' exponent k
+divided and multiplied by 16: the weights of the techniques change, an unbiased combination keeps the mean) with its
+standard error (from the spread of the passes) and the z-score of each difference. The same again with rougher
+mirrors (``--rough-plate``, n = 300), where ``path`` makes no caustic fireflies and the comparison is tight. Then it
+renders the scene's near-mirror panels (n = 5000) at ``--fireflies-size`` and each of ``--fireflies-spp`` with
+``path`` and with ``pumpup_caustic`` (for 001 Fig. 8 also without technique C; two seeds each) and prints the
+fireflies (``make_scenes.fireflies``), those of them that are not fireflies of a ``pumpup_caustic`` render at
+``--reference-spp`` (noise, not bright features of the converged image), and the render times. Writes
+``OUT/caustic_check.json`` (000 Fig. 8) or ``OUT/caustic_check_SCENE.json``; the documentation quotes them. About 5
+minutes for 000 Fig. 8 on a free 2-core machine, more for 001 Fig. 8.
 """
 
 from __future__ import annotations
@@ -39,15 +39,20 @@ import pumpup.scenes as S  # noqa: E402
 from pumpup.caustics import K_SCALE  # noqa: E402
 
 #: per scene: the panels checked (row, column; the first is compared per region), the integrator's ``mirror``,
-#: and the near-mirrors' metals (made rougher for the second comparison)
-SETUP = {"000-fig8": {"panels": [(0, 0), (0, 1)], "mirror": "plate", "metals": {"plate": "silver"}},
+#: the near-mirrors' metals (made rougher for the second comparison), and whether paths reflect a light through
+#: two mirrors of different shapes (technique C applies: its fireflies are counted with C off too)
+SETUP = {"000-fig8": {"panels": [(0, 0), (0, 1)], "mirror": "plate", "metals": {"plate": "silver"},
+                     "two_mirror": False},
          "001-fig8": {"panels": [(0, 1), (1, 1)], "mirror": "*,-plate",
-                      "metals": {"tank": "gold", "p0": "aluminium", "p1": "silver", "p2": "copper", "p3": "gold"}}}
-#: the integrators compared: Mitsuba's path tracer, pumpup_caustic without and with its mirror-image technique,
-#: and with the technique's lobe 16 x wider and narrower (k / 16, k x 16; the MIS weights change, the
-#: expectation must not)
+                      "metals": {"tank": "gold", "p0": "aluminium", "p1": "silver", "p2": "copper", "p3": "gold"},
+                     "two_mirror": True}}
+#: the integrators compared: Mitsuba's path tracer, pumpup_caustic without its mirror-image techniques (B and
+#: C: the plain path tracer), without the two-mirror technique C, with both, and with the techniques' lobes 16 x
+#: wider and narrower (k / 16, k x 16; the MIS weights and the continuation's pdf change, the expectation must not)
 INTEGRATORS = {"path": {"type": "path", "max_depth": 6},
-               "caustic, B off": {"type": "pumpup_caustic", "max_depth": 6, "technique_b": False},
+               "caustic, B off": {"type": "pumpup_caustic", "max_depth": 6, "technique_b": False,
+                                  "technique_c": False},
+               "caustic, C off": {"type": "pumpup_caustic", "max_depth": 6, "technique_c": False},
                "caustic": {"type": "pumpup_caustic", "max_depth": 6},
                "caustic, k / 16": {"type": "pumpup_caustic", "max_depth": 6, "k_scale": K_SCALE / 16},
                "caustic, k x 16": {"type": "pumpup_caustic", "max_depth": 6, "k_scale": K_SCALE * 16}}
@@ -162,7 +167,7 @@ def main(argv=None) -> int:
         print(f"{plabel}: caustic at {a.reference_spp} spp: fireflies {int(ref_mask.sum())} in {s_ref:.1f} s",
               flush=True)
         for spp in a.fireflies_spp:
-            for k in ("path", "caustic"):
+            for k in ("path", "caustic, C off", "caustic") if setup["two_mirror"] else ("path", "caustic"):
                 r = {"fireflies": [], "noise": [], "seconds": []}
                 for seed in (7, 8):
                     y, sec = passes(a.scene, pmats, integrator(k), a.fireflies_size, spp, 1, seed)

@@ -27,9 +27,9 @@ from pumpup.tables import atomic_path  # noqa: E402
 
 #: samples per pixel of each scene.  000 Fig. 9 and Fig. 10 (plastic plate, n <= 169) converge: at 2048 spp no
 #: pixel is a firefly.  000 Fig. 8 and 001 Fig. 8 render with ``pumpup_caustic`` (pumpup.scenes.INTEGRATOR),
-#: which reaches their caustics (point light -> near-mirror, n = 5000 -> a rougher surface) by next-event
-#: estimation through the mirrors' planes; at 256 spp no pixel of 000 Fig. 8 is noise, and 001 Fig. 8 keeps
-#: about 20 per n = 5000 panel, against about 500 with Mitsuba's path (scripts/make/caustic_check.py).
+#: which reaches their caustics (point light -> one or two near-mirrors, n = 5000 -> a rougher surface) through
+#: the mirrors' planes; at 256 spp no pixel of 000 Fig. 8 or of 001 Fig. 8's n = 5000 panels is noise, against
+#: about 500 per panel with Mitsuba's path (scripts/make/caustic_check.py).
 SPP = {"000-fig8": 256, "000-fig9": 2048, "001-fig8": 256, "000-fig10": 2048}
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])  # linear sRGB
 
