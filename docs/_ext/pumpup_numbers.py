@@ -1352,6 +1352,43 @@ def _pumped_minutes() -> tuple[float, float, float, float]:
             *_span(r["load"] for r in rs))
 
 
+#: the pumped shaders whose table errors docs/user-guide/shaders.md quotes: 1 and 3 levels, g1 and g2
+_SHADER_SPECS = [{"type": "pumped", "base": b, "g": g, "levels": lv}
+                 for b in ({"type": "ggx", "alpha": 0.3}, {"type": "phong", "n": 20})
+                 for lv in (1, 3) for g in ("g1", "g2")]
+
+
+@functools.cache
+def _shader_table_errors() -> list[dict]:
+    from pumpup.shaders import table_error
+
+    return [table_error(spec) for spec in _SHADER_SPECS]
+
+
+def _shader_error_range(key: str) -> str:
+    vals = [e[key] for e in _shader_table_errors()]
+    return f"{_sci(min(vals))} to {_sci(max(vals))}"
+
+
+def _shader_pieces() -> str:
+    """The pieces of a 3-level g2 pumped GGX's level table: the shader's, and pumpup's own."""
+    import pumpup
+    from pumpup.shaders import _Plan, _PumpedTables
+
+    f = pumpup.load({"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 3})
+    mine, theirs = _PumpedTables(_Plan(f)).table, f.level_table()
+    return (f"{mine.npieces} pieces of degree {mine.deg} in the shader, {len(theirs.lo) - 1} of degree "
+            f"{theirs.coef.shape[1] - 1} in pumpup's level table")
+
+
+VALUES.update({
+    # docs/user-guide/shaders.md: pumpup.shaders.table_error of 1- and 3-level g1 and g2 pumped GGX and Phong
+    "shader-pieces": Value(_shader_pieces, ""),
+    "shader-table-error": Value(lambda: _shader_error_range("relative"), ""),
+    "shader-table-error-below": Value(lambda: _shader_error_range("below_relative"), ""),
+})
+
+
 VALUES.update({
     # docs/user-guide/mitsuba.md: tables/mitsuba_measurements.json (scripts/make/mitsuba_measurements.py)
     "mitsuba-setup": Value(lambda: f"{_mitsuba()['variant']}, channel {_mitsuba()['channel']} (green), "
