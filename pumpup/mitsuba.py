@@ -585,19 +585,20 @@ class _Cells:
             self.np = self._packets(starts, edges[:-1], edges[1:])
         else:
             self.width = 4
-            entries, packets, first = [], [], 0
-            for c in range(self.ncell):
-                for e in range(self.MAX_FINE_BITS + 1):
-                    sub = edges[c] + (np.arange(2**e + 1, dtype=np.int64) << (shift - e))
-                    if self._most(starts, sub) <= 3:
-                        break
-                else:
-                    raise ValueError("pumpup.mitsuba: a table's pieces are too crowded for its cells")
-                packets.append(self._packets(starts, sub[:-1], sub[1:]))
-                entries.append((first << 5) | e)
-                first += 2**e
-            self.fine = np.concatenate(packets)
-            self.coarse = np.array(entries, dtype=np.uint32)
+            e = np.zeros(self.ncell, dtype=np.int64)  # each coarse cell's extra bits: 0 where it holds <= 3 starts
+            for c in np.nonzero(self._inside(starts, edges) > 3)[0]:
+                while self._most(starts, edges[c] + (np.arange(2 ** e[c] + 1, dtype=np.int64) << (shift - e[c]))) > 3:
+                    e[c] += 1
+                    if e[c] > self.MAX_FINE_BITS:
+                        raise ValueError("pumpup.mitsuba: a table's pieces are too crowded for its cells")
+            nfine = 2**e
+            first = np.concatenate([[0], np.cumsum(nfine)[:-1]])
+            # the fine cells' lower edges: cell c's, plus j << (shift - e_c) for its j-th fine cell
+            j = np.arange(int(nfine.sum()), dtype=np.int64) - np.repeat(first, nfine)
+            step = np.repeat(np.int64(1) << (shift - e), nfine)
+            lo_bits = np.repeat(edges[:-1], nfine) + j * step
+            self.fine = self._packets(starts, lo_bits, lo_bits + step)
+            self.coarse = ((first << 5) | e).astype(np.uint32)
             self.np = self._packets(starts, edges[:-1], edges[1:])  # the scalar path: s0, then a search
         if _jit():
             self.dr = _aligned_f64(self.np if self.fine is None else self.fine)
@@ -612,11 +613,15 @@ class _Cells:
         return np.arange(b0 >> shift, (top >> shift) + 2, dtype=np.int64) << shift
 
     @staticmethod
-    def _most(starts, edges):
-        """The most piece starts inside one of the cells with these edges (after the cell's first piece's)."""
+    def _inside(starts, edges):
+        """The piece starts inside each of the cells with these edges (after the cell's first piece's)."""
         bounds = np.asarray(edges, dtype=np.int64).view(np.float64)
-        inside = np.searchsorted(starts, bounds[1:], side="left") - np.searchsorted(starts, bounds[:-1], side="right")
-        return int(inside.max())
+        return np.searchsorted(starts, bounds[1:], side="left") - np.searchsorted(starts, bounds[:-1], side="right")
+
+    @classmethod
+    def _most(cls, starts, edges):
+        """The most piece starts inside one of the cells with these edges."""
+        return int(cls._inside(starts, edges).max())
 
     def _packets(self, starts, lo_bits, hi_bits):
         """The packets (s0, b_1, ..., b_(w-1)) of the cells [lo_bits[i], hi_bits[i]) (float64 bits)."""
