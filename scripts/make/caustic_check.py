@@ -110,6 +110,21 @@ def compare(ys: dict, masks: dict) -> dict:
     return out
 
 
+def scene_integrator(scene: str, key: str, n: float = 5000.0) -> dict:
+    """The integrator ``key`` of :data:`INTEGRATORS` for ``scene``: pumpup_caustic with the scene's mirrors, of
+    exponent ``n``.
+    """
+    integ = dict(INTEGRATORS[key])
+    if integ["type"] == "pumpup_caustic":
+        integ.update(mirror=SETUP[scene]["mirror"], mirror_n=float(n))
+    return integ
+
+
+def rougher(scene: str, mats: dict, n: float) -> dict:
+    """A panel's materials with the scene's near-mirrors made Phong metals of exponent ``n``."""
+    return dict(mats, **{o: S.metal(metal, n, "phong") for o, metal in SETUP[scene]["metals"].items()})
+
+
 def main(argv=None) -> int:
     """Measure, print and write ``caustic_check.json``; returns the exit status."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -136,16 +151,12 @@ def main(argv=None) -> int:
     label, mats = chosen[0]
 
     def integrator(k, n=5000.0):
-        integ = dict(INTEGRATORS[k])
-        if integ["type"] == "pumpup_caustic":
-            integ.update(mirror=setup["mirror"], mirror_n=float(n))
-        return integ
+        return scene_integrator(a.scene, k, n)
 
     masks = regions(a.scene, mats, a.size)
     cmp = {}
     for plate_n in (5000, a.rough_plate):  # the scene's plate, and a rougher one where path converges too
-        pm = mats if plate_n == 5000 else dict(mats, **{o: S.metal(metal, plate_n, "phong")
-                                                        for o, metal in setup["metals"].items()})
+        pm = mats if plate_n == 5000 else rougher(a.scene, mats, plate_n)
         ys, secs = {}, {}
         for j, k in enumerate(INTEGRATORS):
             ys[k], secs[k] = passes(a.scene, pm, integrator(k, plate_n), a.size, a.spp, a.passes, 1000 * j)

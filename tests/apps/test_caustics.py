@@ -116,12 +116,9 @@ def _check(size, spp, passes, pairs, zmax, rough=None, scene="000-fig8", names=N
     setup = C.SETUP[scene]
     i, j = setup["panels"][0]
     label, mats = S.panels(scene)[i][j]
-    integ = {k: dict(v) for k, v in C.INTEGRATORS.items() if names is None or k in names}
-    for v in integ.values():
-        if v["type"] == "pumpup_caustic":
-            v.update(mirror=setup["mirror"], mirror_n=float(rough or 5000))
+    integ = {k: C.scene_integrator(scene, k, rough or 5000) for k in C.INTEGRATORS if names is None or k in names}
     if rough is not None:  # rougher mirrors: Mitsuba's path converges too, the comparison is tight
-        mats = dict(mats, **{o: S.metal(metal, rough, "phong") for o, metal in setup["metals"].items()})
+        mats = C.rougher(scene, mats, rough)
     masks = C.regions(scene, mats, size)
     assert masks["plate"].sum() > 0.2 * size * size and masks["sky"].sum() > 0.2 * size * size
     ys = {k: C.passes(scene, mats, integ[k], size, spp, passes, 1000 * j)[0] for j, k in enumerate(C.INTEGRATORS)
@@ -250,12 +247,11 @@ def test_margin_keeps_the_mean(S):
     setup = C.SETUP["001-fig8"]
     i, j = setup["panels"][0]
     label, mats = C.S.panels("001-fig8")[i][j]
-    mats = dict(mats, **{o: C.S.metal(metal, 300, "phong") for o, metal in setup["metals"].items()})
+    mats = C.rougher("001-fig8", mats, 300)
     masks = C.regions("001-fig8", mats, 20)
     ys = {}
     for k, m in enumerate((0.0, 12.0)):
-        integ = {"type": "pumpup_caustic", "max_depth": 6, "mirror": setup["mirror"], "mirror_n": 300.0,
-                 "margin": m, "technique_c": False}
+        integ = dict(C.scene_integrator("001-fig8", "caustic, C off", 300), margin=m)
         ys[m] = C.passes("001-fig8", mats, integ, 20, 48, 5, 500 * k)[0]
     res = C.compare(ys, {k: m for k, m in masks.items() if m.sum() >= 4})
     for region, r in res.items():
