@@ -99,17 +99,14 @@ _TABLES: dict[str, object] = {}  # cache key of the white base -> AlbedoTable (w
 
 def compensation_table(white: BRDF, progress: bool | None = None):
     """The albedo table E of ``white`` used by the compensation operators (cached per session)."""
-    from ..tables import AlbedoTable, tabulate
+    from ..tables import albedo_table
 
     key = _key(white)
     own = from_file("compensate", key)  # a file being loaded: its table serves only its objects
     if own is not None:
         return own
     if key not in _TABLES:
-        ds = tabulate(white, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress)
-        t = AlbedoTable.from_dataset(ds)
-        t.dataset = ds
-        _TABLES[key] = t
+        _TABLES[key] = albedo_table(white, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress)
     return _TABLES[key]
 
 

@@ -104,7 +104,7 @@ def from_file(kind: str, key: str):
 
 def base_table(base: BRDF, progress: bool | None = None):
     """The albedo table of ``base`` used by the pumping operator (cached per session)."""
-    from ..tables import AlbedoTable, tabulate
+    from ..tables import albedo_table
 
     own = from_file("pump", _key(base))
     if own is not None:
@@ -112,10 +112,8 @@ def base_table(base: BRDF, progress: bool | None = None):
     if _uses_file_tables(base):  # computed from a file's tables: serves this object only
         with _lock_for(f"derived#{id(base)}"):
             if getattr(base, "_derived_table", None) is None:
-                ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress,
-                              breaks=base.albedo_kinks(*grid_interior()))
-                base._derived_table = AlbedoTable.from_dataset(ds)
-                base._derived_table.dataset = ds
+                base._derived_table = albedo_table(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL,
+                                                   progress=progress, breaks=base.albedo_kinks(*grid_interior()))
         return base._derived_table
     key = _key(base)
     if key not in _TABLES:
@@ -124,11 +122,8 @@ def base_table(base: BRDF, progress: bool | None = None):
                 # an anisotropic base: the table bounds the supremum over the azimuth of wi (001 eq. 17
                 # needs g >= a(L) for every L, not only for L in the xz-plane; pumpup.tables.azimuth)
                 phi = None if base.azimuth_range() is None else "sup"
-                ds = tabulate(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress, phi=phi,
-                              breaks=base.albedo_kinks(*grid_interior()))
-                t = AlbedoTable.from_dataset(ds)
-                t.dataset = ds
-                _TABLES[key] = t
+                _TABLES[key] = albedo_table(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress,
+                                            phi=phi, breaks=base.albedo_kinks(*grid_interior()))
     return _TABLES[key]
 
 

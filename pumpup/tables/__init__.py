@@ -20,7 +20,7 @@ import tempfile
 import time
 import weakref
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -222,6 +222,22 @@ class AlbedoTable:
         if degree not in (3, 5):
             raise ValueError(f"an albedo table interpolates with degree 3 or 5, got {degree}")
         return 5 if degree == 5 and n >= 6 else 3
+
+    #: the :func:`tabulate` Dataset this table was made from, or a function that makes it (:func:`albedo_table`)
+    _dataset_or_maker: object = None
+
+    @property
+    def dataset(self):
+        """The xarray Dataset of this table as :func:`tabulate` returns it (what a file stores), or None for a table
+        made from arrays alone.  A table from :func:`albedo_table` makes it when it is first read.
+        """
+        if callable(self._dataset_or_maker):
+            self._dataset_or_maker = self._dataset_or_maker()
+        return self._dataset_or_maker
+
+    @dataset.setter
+    def dataset(self, ds) -> None:
+        self._dataset_or_maker = ds
 
     @classmethod
     def from_dataset(cls, ds) -> AlbedoTable:
@@ -478,12 +494,54 @@ def tabulate(brdf: BRDF, mu: ArrayLike | None = None, *, rtol: float = DEFAULT_R
     [0.5, 0.5, 0.5]
     """
     with time_budget("tabulate", max_seconds):
-        return _tabulate(brdf, mu, rtol=rtol, atol=atol, interp_tol=interp_tol, mu_min=mu_min, max_points=max_points,
+        made = _tabulate(brdf, mu, rtol=rtol, atol=atol, interp_tol=interp_tol, mu_min=mu_min, max_points=max_points,
                          progress=progress, threads=threads, phi=phi, breaks=breaks)
+    return made.dataset() if isinstance(made, _Tabulated) else made
+
+
+def albedo_table(brdf: BRDF, *, rtol: float, interp_tol: float, progress: bool | None = None,
+                 phi: str | None = None, breaks: ArrayLike | None = None) -> AlbedoTable:
+    """The :class:`AlbedoTable` of :func:`tabulate`'s adaptive table over mu (``phi`` None or ``"sup"``), without
+    building its xarray Dataset: the table's :attr:`AlbedoTable.dataset` (the Dataset :func:`tabulate` returns, bit for
+    bit) is made when it is first read, e.g. when the table is saved.  The operators' session tables use this: xarray's
+    import and the Dataset cost a new process about half a second.
+    """
+    made = _tabulate(brdf, None, rtol=rtol, atol=DEFAULT_ATOL, interp_tol=interp_tol, mu_min=1e-8, max_points=2049,
+                     progress=progress, threads=None, phi=phi, breaks=breaks)  # (tabulate's defaults)
+    if not isinstance(made, _Tabulated) or made.phis is not None:  # (a spectral model, or a table over (mu, phi))
+        ds = made if not isinstance(made, _Tabulated) else made.dataset()
+        table = AlbedoTable.from_dataset(ds)
+        table.dataset = ds
+        return table
+    spec = json.loads(json.dumps(brdf.spec, sort_keys=True))  # (as from_dataset reads the Dataset's)
+    table = AlbedoTable(made.mu, made.val, made.err, made.interp_error, spec,
+                        degree=AlbedoTable.degree_for(len(made.mu)), breaks=() if made.breaks is None else made.breaks)
+    table.dataset = made.dataset
+    return table
+
+
+class _Tabulated(NamedTuple):
+    """What :func:`_tabulate` computed: the arguments of :func:`_dataset`."""
+
+    brdf: BRDF
+    mu: np.ndarray
+    val: np.ndarray
+    err: np.ndarray
+    rtol: float
+    atol: float
+    interp_error: float
+    grid_kind: str
+    phis: np.ndarray | None = None
+    phi_kind: str | None = None
+    breaks: np.ndarray | None = None
+
+    def dataset(self) -> xr.Dataset:
+        """The table as :func:`tabulate` returns it."""
+        return _dataset(*self)
 
 
 def _tabulate(brdf, mu, *, rtol, atol, interp_tol, mu_min, max_points, progress, threads, phi, breaks):
-    """:func:`tabulate`, within its time budget."""
+    """:func:`tabulate`'s work (within its time budget): a spectral model's Dataset, else a :class:`_Tabulated`."""
     if threads is not None and (isinstance(threads, bool) or not isinstance(threads, (int, np.integer))
                                 or not 1 <= threads <= MAX_THREADS):
         raise ValueError(f"tabulate: threads must be an integer in [1, {MAX_THREADS}], got {reprlib.repr(threads)}")
@@ -521,7 +579,7 @@ def _tabulate(brdf, mu, *, rtol, atol, interp_tol, mu_min, max_points, progress,
             val, err = values(grid, bar)
         if reusable:
             _reuse.remember(brdf, grid, val, err, rtol)
-        return _dataset(brdf, grid, val, err, rtol, atol, 0.0, "given", phis, phi_kind)
+        return _Tabulated(brdf, grid, val, err, rtol, atol, 0.0, "given", phis, phi_kind)
     check_mu(mu_min)
     grid = default_grid(mu_min=mu_min)
     if breaks is not None:
@@ -538,7 +596,7 @@ def _tabulate(brdf, mu, *, rtol, atol, interp_tol, mu_min, max_points, progress,
         interp_error = float(interp.max())
     if reusable:
         _reuse.remember(brdf, grid, val, err, rtol)
-    return _dataset(brdf, grid, val, err, rtol, atol, interp_error, "adaptive", phis, phi_kind, breaks)
+    return _Tabulated(brdf, grid, val, err, rtol, atol, interp_error, "adaptive", phis, phi_kind, breaks)
 
 
 #: threads that compute the albedos of a table (None: one per core, or one for a BRDF on the 1-D path,

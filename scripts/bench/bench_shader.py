@@ -50,23 +50,56 @@ void main() {
 """
 
 
-def generation_times() -> None:
-    """Print the time to build a 3-level pumped GGX's tables and to generate its shader."""
-    print("generation (pumpup.shader, target glsl-es):")
+#: a fresh process that makes the shader of a 3-level pumped GGX (GGX_G in the environment: g1 or g2), timing its parts
+_COLD = """
+import os, time
+t0 = time.perf_counter()
+import numpy as np
+import pumpup
+spec = {"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": os.environ["GGX_G"], "levels": 3}
+pumpup.registry()
+t1 = time.perf_counter()
+f = pumpup.load(spec)
+t2 = time.perf_counter()
+f.eval(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0]))
+t3 = time.perf_counter()
+pumpup.shader(f, target="glsl-es")
+t4 = time.perf_counter()
+print(t1 - t0, t2 - t1, t3 - t2, t4 - t3, t4 - t0)
+"""
+
+
+def generation_times(runs: int = 3) -> None:
+    """Print the time to generate a 3-level pumped GGX's shader with its tables (target: under 1 s): in a process that
+    has made one before (for another alpha: its kernels loaded), and in a fresh process, split into its parts.
+    """
+    import subprocess
+    import sys
+
+    print("generation of a 3-level pumped GGX's shader, tables included (pumpup.shader, target glsl-es; target 1 s):")
     for g in ("g1", "g2"):
-        spec = {"type": "pumped", "base": GGX, "g": g, "levels": 3}
-        t = time.perf_counter()
-        f = pumpup.load(spec)
-        f.eval(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0]))  # builds the three levels' tables
-        tables = time.perf_counter() - t
-        t = time.perf_counter()
-        src = shader(f, target="glsl-es")
-        gen = time.perf_counter() - t
-        t = time.perf_counter()
-        shader(f, target="glsl")
-        again = time.perf_counter() - t
-        print(f"  3-level pumped GGX {g}: tables {tables:.2f} s (once per session), shader {gen:.3f} s "
-              f"(again: {again:.3f} s), {len(src) / 1e3:.0f} kB of GLSL ES")
+        f = pumpup.load({"type": "pumped", "base": {"type": "ggx", "alpha": 0.5}, "g": g, "levels": 3})
+        shader(f, target="glsl-es")  # (the kernels of a 3-level chain loaded in this process)
+        times, tables = [], []
+        for k in range(runs):
+            alpha = 0.3 + 0.01 * k  # (a new chain each time: its tables are made anew)
+            t = time.perf_counter()
+            f = pumpup.load({"type": "pumped", "base": {"type": "ggx", "alpha": alpha}, "g": g, "levels": 3})
+            f.eval(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.0, 1.0]))  # builds the three levels' tables
+            tables.append(time.perf_counter() - t)
+            shader(f, target="glsl-es")
+            times.append(time.perf_counter() - t)
+        print(f"  {g}, in a process that made one before: {np.median(times):.2f} s (median of {runs}; tables "
+              f"{np.median(tables):.2f} s)")
+        cold = []
+        for _ in range(runs):
+            out = subprocess.run([sys.executable, "-c", _COLD], capture_output=True, text=True, check=True,
+                                 env={**os.environ, "GGX_G": g})
+            cold.append([float(v) for v in out.stdout.split()])
+        imports, load, tables, text, total = np.median(np.array(cold), axis=0)
+        print(f"  {g}, in a fresh process: {total:.2f} s (median of {runs}): importing pumpup, numba and the models "
+              f"{imports:.2f} s, load {load:.2f} s (numba's first call), tables {tables:.2f} s (kernels loaded from "
+              f"numba's cache, then computed), shader {text:.3f} s")
 
 
 def load_other(path: str):
