@@ -3,6 +3,7 @@
 
     python scripts/bench/bench_mitsuba.py [--n 1048576] [--rounds 9] [--threads 0] [--eval-at light|sample]
                                           [--scalar-n 20000] [--baseline OLD_MITSUBA_PY] [--models ggx,...]
+                                          [--parts]
 
 llvm: per round, every model in turn (alternating, so that the shared machine's load hits all alike): one wide call of
 sample() and one of eval(), evaluated together (kernels compiled in a warm-up round, not timed).  eval() runs at other
@@ -20,6 +21,10 @@ within 1.3 x of roughconductor, a pumped model within 1.5 x).  ``--baseline`` lo
 ``pumpup/mitsuba.py`` (e.g. ``git show main:pumpup/mitsuba.py > /tmp/old.py``) as a second plugin and prints its
 ratios beside, measured in the same rounds.  scalar: a Python loop of single calls (both sides pay Python's per-call
 cost).  The load average is printed with the numbers.
+
+``--parts`` shows where a pumped model's time goes: for each of :data:`PARTS`, a copy of ``pumpup/mitsuba.py`` with one
+part of the look-up taken out is measured beside the plugin, as ``--baseline`` measures a file (the values of those
+copies are wrong; only their cost matters).
 """
 
 from __future__ import annotations
@@ -50,9 +55,51 @@ MODELS = [
 ]
 
 
+#: ``--parts``: (label, [(text of pumpup/mitsuba.py, what replaces it), ...]) -- the pumped value without g (the base,
+#: its rounding down and the mask: what the look-up adds to is left); the tables' cells and rows read (the level
+#: table's for both cosines, the product table's for the larger) with only a sum of what was read in place of the
+#: polynomials, power laws and maxima; and the level-by-level path (a product table's pairs with a cosine at or below
+#: its mlo) left out
+PARTS = [
+    ("g = 1", [("val = _div(val, self.g(wl[2], v[2])) * self.ROUND_DOWN", "val = val * self.ROUND_DOWN")]),
+    ("table reads only", [
+        ("        ri, ro = self.rows(self.cells(mi_)), self.rows(self.cells(mo))\n",
+         "        ri, ro = self.rows(self.cells(mi_)), self.rows(self.cells(mo))\n"
+         "        acc = ri[0] + ro[0]\n"
+         "        for x in ri[1:] + ro[1:]:\n"
+         "            acc = acc + x\n"
+         "        return 1.0 + 1e-30 * acc\n"),
+        ("        return _horner(row, 0, d, (m - row[d + 1]) * row[d + 2])\n",
+         "        acc = row[0]\n"
+         "        for x in row[1:]:\n"
+         "            acc = acc + x\n"
+         "        return 1.0 + 1e-30 * acc\n")]),
+    ("no level-by-level path", [
+        ("        return dr.if_stmt((mi_, mo, g), slow, lambda a, b, g: by_levels(a, b), lambda a, b, g: g)\n",
+         "        return g\n")]),
+]
+
+
+def _part_file(label: str, changes) -> str:
+    """A copy of pumpup/mitsuba.py with each (old, new) of ``changes`` made (a temporary file's path)."""
+    import tempfile
+
+    import pumpup.mitsuba as pm
+
+    with open(pm.__file__) as fh:
+        text = fh.read()
+    for old, new in changes:
+        if old not in text:
+            raise SystemExit(f"bench_mitsuba --parts: {label!r}: pumpup/mitsuba.py no longer holds {old.strip()!r}")
+        text = text.replace(old, new, 1)
+    with tempfile.NamedTemporaryFile("w", suffix=".py", delete=False) as tmp:
+        tmp.write(text)
+    return tmp.name
+
+
 def _load_baseline(path):
     """Another copy of pumpup/mitsuba.py as a module of the pumpup package, its plugin registered as
-    ``pumpup_baseline`` (for the current variant).
+    ``pumpup_baseline`` (for the current variant; a later call registers its own in its place).
     """
     import mitsuba as mi
 
@@ -130,12 +177,12 @@ def _rounds(pm, models, n, rounds, baseline, eval_at="light"):
     return cpu, wall
 
 
-def _report_llvm(models, cpu, wall, n, baseline):
+def _report_llvm(models, cpu, wall, n, baseline, label="baseline"):
     rc_cpu, rc_wall = cpu["roughconductor"], wall["roughconductor"]
     head = ("| model | ns CPU per sample (median of rounds) | ratio to roughconductor (CPU, median of rounds) "
             "| wall ratio | target |")
     if baseline:
-        head += " baseline ratio (CPU) | this / baseline (CPU) |"
+        head += f" {label} ratio (CPU) | this / {label} (CPU) |"
     print(head)
     print("|---" * (head.count("|") - 1) + "|")
     print(f"| roughconductor GGX 0.3 (built-in) | {1e9 * statistics.median(rc_cpu) / n:.2f} | 1 | 1 | |"
@@ -190,6 +237,8 @@ def main(argv=None):
                          "the sampled ones (then Dr.Jit shares their work in one kernel)")
     ap.add_argument("--scalar-n", type=int, default=20000, help="samples in the scalar loop (0: skip scalar)")
     ap.add_argument("--baseline", help="another copy of pumpup/mitsuba.py to measure beside (llvm)")
+    ap.add_argument("--parts", action="store_true", help="measure copies of the plugin with parts of the look-up "
+                    "taken out (PARTS), each beside the plugin in a run of its own")
     ap.add_argument("--models", help="comma-separated keys of the models to run (default all): "
                     + ", ".join(m[0] for m in MODELS))
     args = ap.parse_args(argv)
@@ -210,12 +259,16 @@ def main(argv=None):
     ok, why = pm.probe("llvm_ad_rgb")
     if ok:
         pm.register("llvm_ad_rgb")
-        if args.baseline:
-            _load_baseline(args.baseline)
-        print(f"\nllvm_ad_rgb, {args.n} samples per call, {args.rounds} rounds, {args.threads} Dr.Jit worker threads, "
-              f"eval() at {'other directions (as towards a light)' if args.eval_at == 'light' else 'the sampled ones'}")
-        cpu, wall = bench_llvm(pm, models, args.n, args.rounds, bool(args.baseline), args.threads, args.eval_at)
-        _report_llvm(models, cpu, wall, args.n, bool(args.baseline))
+        where = 'other directions (as towards a light)' if args.eval_at == 'light' else 'the sampled ones'
+        runs = [(args.baseline, "baseline")] if not args.parts else \
+            [(_part_file(label, changes), label) for label, changes in PARTS]
+        for path, label in runs:
+            if path:
+                _load_baseline(path)
+            print(f"\nllvm_ad_rgb, {args.n} samples per call, {args.rounds} rounds, {args.threads} Dr.Jit worker "
+                  f"threads, eval() at {where}" + (f"; beside: {label}" if path else ""))
+            cpu, wall = bench_llvm(pm, models, args.n, args.rounds, bool(path), args.threads, args.eval_at)
+            _report_llvm(models, cpu, wall, args.n, bool(path), label)
     else:
         print(f"llvm_ad_rgb skipped: {why}")
     if args.scalar_n > 0:
