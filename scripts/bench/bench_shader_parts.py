@@ -13,12 +13,16 @@ ratio to the base GGX shader measured in the same run.  The variants of the 3-le
 - ``no centre``: the piece's centre read left out (t from m and the octave alone);
 - ``no coefficients``: every coefficient read replaced by arithmetic on the piece number;
 - ``branch never taken``: the whole look-up inside an ``if`` that no pair takes (llvmpipe runs it anyway);
+- ``coefficients from a texture`` / ``from a uniform buffer``: the same shader with the level table's coefficients read
+  as 3 RGBA32F texels (``texelFetch``) or 3 vec4 of a std140 uniform block per cosine instead of 12 constant-array
+  reads (the same values: checked equal to the full shader's, pair by pair);
 - ``N reads``: the base GGX plus N reads from a constant array of 1,000 floats at an index computed from N.wi.
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import os
 import re
 import sys
@@ -60,6 +64,32 @@ def variants(lib: str) -> dict[str, str]:
     return out
 
 
+def vec4_variants(lib: str) -> dict[str, tuple[str, np.ndarray]]:
+    """The full shader with the level table's coefficients (``pumpup_lt_c``, 12 per piece) read as 3 vec4 per cosine
+    from a texture or a uniform block, and those coefficients as (3 x pieces, 4) float32 rows.
+    """
+    m = re.search(r"const float pumpup_lt_c\[(\d+)\] = float\[\d+\]\((.*?)\);\n", lib, re.S)
+    rows = np.array([float(x) for x in m.group(2).split(",")], np.float32).reshape(-1, 4)
+    out = {}
+    for name, decl, fetch in (
+            ("coefficients from a texture", "uniform highp sampler2D pumpup_lt_tex;\n",
+             "texelFetch(pumpup_lt_tex, ivec2(3 * s{side} + {k}, 0), 0)"),
+            ("coefficients from a uniform buffer",
+             f"layout(std140) uniform pumpup_lt_block {{ vec4 pumpup_lt_v[{len(rows)}]; }};\n",
+             "pumpup_lt_v[3 * s{side} + {k}]")):
+        src = lib[:m.start()] + decl + lib[m.end():]
+        for side, b in (("i", "bi"), ("o", "bo")):
+            line = f"    highp int {b} = 12 * s{side};\n"
+            src = src.replace(line, line + "".join(f"    vec4 c{side}{k} = {fetch.format(side=side, k=k)};\n"
+                                                   for k in range(3)))
+            for k in range(12):
+                src = src.replace(f"pumpup_lt_c[{b} + {k}]", f"c{side}{k // 4}.{'xyzw'[k % 4]}")
+        if "pumpup_lt_c[" in src:
+            raise SystemExit(f"bench_shader_parts: the variant {name!r} no longer replaces every coefficient read")
+        out[name] = (src, rows)
+    return out
+
+
 def reads(base: str, n: int) -> str:
     """The base GGX library, divided by a sum of ``n`` reads from a constant array at an index computed from N.wi."""
     rng = np.random.default_rng(0)
@@ -81,25 +111,59 @@ def main() -> None:
     libs = {"ggx": shader(GGX, target="glsl")}
     for n in (6, 12, 24):
         libs[f"ggx + {n} reads"] = reads(libs["ggx"], n)
+    tables = {}  # the variants that read a texture or a uniform block: their data
     for g in args.g:
         f = pumpup.load({"type": "pumped", "base": GGX, "g": g, "levels": 3})
-        for name, src in variants(shader(f, target="glsl")).items():
+        lib = shader(f, target="glsl")
+        for name, src in variants(lib).items():
             libs[f"{g} x3: {name}"] = src
+        for name, (src, rows) in vec4_variants(lib).items():
+            libs[f"{g} x3: {name}"] = src
+            tables[f"{g} x3: {name}"] = rows
 
     os.environ["LP_NUM_THREADS"] = "0"  # (read when the driver starts: before the context)
     draws = Draws(args.pairs)
-    runs = {name: draws.program(lib, {"pumpup_alpha": 0.3})[1] for name, lib in libs.items()}
+    runs = {}
+    for name, lib in libs.items():
+        bind = None
+        if name in tables and "texture" in name:
+            tex = draws.ctx.texture((len(tables[name]), 1), 4, tables[name].tobytes(), dtype="f4")
+            tex.filter = (draws.moderngl.NEAREST, draws.moderngl.NEAREST)
+            bind = functools.partial(tex.use, 2)
+        elif name in tables:
+            buf = draws.ctx.buffer(tables[name].tobytes())
+            bind = functools.partial(buf.bind_to_uniform_block, 2)
+        if bind is not None:
+            bind()
+        prog, vao = draws.program(lib, {"pumpup_alpha": 0.3, "pumpup_lt_tex": 2})
+        if "pumpup_lt_block" in prog:
+            prog["pumpup_lt_block"].binding = 2
+        runs[name] = (vao, bind)
+
+    def values(name):
+        vao, bind = runs[name]
+        if bind is not None:
+            bind()
+        draws.draw(vao)
+        return np.frombuffer(draws.fbo.color_attachments[0].read(), np.float32)[::4].copy()
+
+    for name in tables:  # the same numbers as the full shader's, or the comparison would say nothing
+        full = values(name.split(": ")[0] + ": full")
+        if not np.array_equal(values(name), full):
+            raise SystemExit(f"bench_shader_parts: {name!r} does not give the full shader's values")
     print(f"{draws.ctx.info['GL_RENDERER']}, {draws.pairs} pairs per draw, in this thread (thread CPU time), best of "
           f"{args.repeat} rounds, load average before: " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
     best = dict.fromkeys(runs, np.inf)
     for _ in range(args.repeat):
-        for name, vao in runs.items():
+        for name, (vao, bind) in runs.items():
+            if bind is not None:
+                bind()
             t = time.thread_time()
             draws.draw(vao)
             best[name] = min(best[name], time.thread_time() - t)
     base = best["ggx"]
     for name, t in best.items():
-        print(f"  {name:40s} {t * 1e9 / draws.pairs:6.1f} ns  {t / base:5.2f} x ggx")
+        print(f"  {name:44s} {t * 1e9 / draws.pairs:6.1f} ns  {t / base:5.2f} x ggx")
     print("load average after: " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
 
 
