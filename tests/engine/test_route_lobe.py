@@ -185,15 +185,17 @@ def test_one_d_agrees_with_the_two_d_engine(spec):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("spec", [dict(type=m.type, **ex) for m in pumpup.registry().values() for ex in m.examples
-                                  if helpers.hint_routes(m(**ex))
-                                  or m.type in ("lafortune_sum", "lewis_phong", "phong_shader")],
+@pytest.mark.parametrize("spec", [dict(type=m.type, **ex) for m in pumpup.registry().values() for ex in m.examples],
                          ids=lambda s: s["type"])
 def test_one_d_agrees_with_the_two_d_engine_on_every_example(spec):
     # the models on the rule on h's arc (frame 4) against the nested engine: the 2-D engine misses GGX alpha = 0.5,
     # correlated, at mu = 1e-8 by 6.7e-11 with an estimate of 5.5e-11 (30-digit mpmath,
     # tests/engine/test_route_half_arc.py)
     f = pumpup.load(spec)
+    if not (helpers.hint_routes(f) or spec["type"] in ("lafortune_sum", "lewis_phong", "phong_shader")):
+        # (decided here, not when the tests are collected: a pumped example's hint needs its level tables, whose
+        # albedos compile the engine's kernels in every process that collects this file)
+        pytest.skip("no 1-D route for this example")
     mu = np.array(MU)
     a, e = pumpup.albedo(f, mu, return_error=True)
     hint = helpers.view(f)
