@@ -108,6 +108,35 @@ def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compi
     return bad_i, bad_o
 
 
+@njit(cache=True, nogil=True)
+def _divide_rows(f, a, b, rows, count, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
+                 index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell, qlo, qrow,
+                 rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo, rcoef):  # pragma: no cover - compiled
+    """f[r] / (g_1 ... g_k) in place for the rows r = ``rows[:count]`` of a block (``a``, ``b`` its rows of wi and wo),
+    the path of each chosen as ``pumpup.operators.pumping._chain_kernel`` chooses it; rows with a cosine <= 0 are left
+    as they are.  Called once per block by :func:`_phong_divided` and :func:`_phong_divided_lit` (a call per row
+    would cost more than the look-up: ``pumpup.physics.lookups.g_levels_call``).
+    """
+    for j in range(count):  # (a loop without pow's call)
+        r = rows[j]
+        lz, vz = a[r, 2], b[r, 2]
+        if lz <= 0.0 or vz <= 0.0:
+            continue
+        mmax, mmin = max(lz, vz), min(lz, vz)
+        if mmin > pmlo:  # (pumpup.physics.lookups.g_levels_call says why the paths are written out)
+            f[r] = f[r] / g_product(mmax, pcbase, pcell, plo, prow)  # 001 eq. 16, all levels
+        elif mmin > qmlo:
+            g = 0.0
+            if rcells > 0:  # the split table: one product F(mmin) H(mmax), 0 where the cell has no pattern
+                g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo, rcoef)
+            if g == 0.0:
+                g = g_pair(lz, vz, controlled, qshift, qcbase, qcell, qlo, qrow)
+            f[r] = f[r] / g  # 001 eq. 16, all levels
+        elif f[r] != 0.0:
+            f[r] = f[r] / g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
+                                        increasing, mu0, index, index_lo, index_h_inv)
+
+
 #: rows per block of _phong_divided (measured on 3-level g2 pumped Phong n = 20: 1.40 x Phong with blocks of 4096 rows,
 #: 1.51 x with 256, 1.43 x with 2048; 1 level: 1.37, 1.51 and 1.38 x)
 _DIVIDED_BLOCK = 4096
@@ -126,7 +155,7 @@ def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo
     N.wo) and whether the product table serves the row.  The lit rows it serves (a third of random pairs are dark) are
     then gathered without branches into contiguous arrays of R.V and max cosine; the product table's look-ups run over
     them in a loop of their own, then pow and the division, each value written to its row.  The other lit rows (a
-    cosine at or below the table's ``mlo``, a NaN cosine) take the row-by-row paths of :func:`_phong_divided_lit`.
+    cosine at or below the table's ``mlo``, a NaN cosine) take the row-by-row paths of :func:`_divide_rows`.
     A chain without a product table takes :func:`_phong_divided_lit` (:meth:`Phong.eval_divided`).
     """
     N = out.shape[0]
@@ -167,25 +196,9 @@ def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo
         for j in range(k):  # the other lit rows, as _phong_divided_lit
             r = rest[j]
             f[r] = c * x[r] ** n  # 000 eq. 5
-        for j in range(k):  # (a loop without pow's call)
-            r = rest[j]
-            lz, vz = a[r, 2], b[r, 2]
-            if lz <= 0.0 or vz <= 0.0:
-                continue
-            mmax, mmin = max(lz, vz), min(lz, vz)
-            if mmin > pmlo:  # (pumpup.physics.lookups.g_levels_call says why this is written out)
-                f[r] = f[r] / g_product(mmax, pcbase, pcell, plo, prow)  # 001 eq. 16, all levels
-            elif mmin > qmlo:
-                g = 0.0
-                if rcells > 0:  # the split table: one product F(mmin) H(mmax), 0 where the cell has no pattern
-                    g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell,
-                                rlo, rcoef)
-                if g == 0.0:
-                    g = g_pair(lz, vz, controlled, qshift, qcbase, qcell, qlo, qrow)
-                f[r] = f[r] / g  # 001 eq. 16, all levels
-            elif f[r] != 0.0:
-                f[r] = f[r] / g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
-                                            increasing, mu0, index, index_lo, index_h_inv)
+        _divide_rows(f, a, b, rest, k, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing,
+                     mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell,
+                     qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo, rcoef)
 
 
 @njit(cache=True, nogil=True)
@@ -193,16 +206,16 @@ def _phong_divided_lit(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margi
                        mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell,
                        qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
                        rcoef):  # pragma: no cover - compiled
-    """:func:`_phong_divided` in blocks of _BLOCK rows, every lit row divided in place through its row index, the
-    path chosen row by row as ``pumpup.operators.pumping._chain_kernel`` chooses it: the same operations, the same
-    values.  The baseline :meth:`Phong._eval_divided_lit` runs, for the tests of :func:`_phong_divided` and
-    scripts/bench/bench_eval.py.
+    """:func:`_phong_divided` in blocks of _DIVIDED_BLOCK rows, every lit row divided in place through its row index
+    (:func:`_divide_rows`, the path chosen row by row as ``pumpup.operators.pumping._chain_kernel`` chooses it): the
+    same operations, the same values.  The baseline :meth:`Phong._eval_divided_lit` runs, for the tests of
+    :func:`_phong_divided` and scripts/bench/bench_eval.py.
     """
     N = out.shape[0]
-    x = np.empty(_BLOCK)
-    lit = np.empty(_BLOCK, dtype=np.int64)
-    for s in range(0, N, _BLOCK):
-        m = min(N - s, _BLOCK)
+    x = np.empty(_DIVIDED_BLOCK)
+    lit = np.empty(_DIVIDED_BLOCK, dtype=np.int64)
+    for s in range(0, N, _DIVIDED_BLOCK):
+        m = min(N - s, _DIVIDED_BLOCK)
         a = wi[s : s + m]
         b = wo[s : s + m]
         f = out[s : s + m]
@@ -216,25 +229,10 @@ def _phong_divided_lit(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margi
         for j in range(q):
             r = lit[j]
             f[r] = c * x[r] ** n  # 000 eq. 5
-        for j in range(q):  # only the lit rows (a dark row's value is 0 / g = 0 already), in a loop without pow's call
-            r = lit[j]
-            lz, vz = a[r, 2], b[r, 2]
-            if lz <= 0.0 or vz <= 0.0:
-                continue
-            mmax, mmin = max(lz, vz), min(lz, vz)
-            if mmin > pmlo:  # (pumpup.physics.lookups.g_levels_call says why this is written out)
-                f[r] = f[r] / g_product(mmax, pcbase, pcell, plo, prow)  # 001 eq. 16, all levels
-            elif mmin > qmlo:
-                g = 0.0
-                if rcells > 0:  # the split table: one product F(mmin) H(mmax), 0 where the cell has no pattern
-                    g = g_split(mmin, mmax, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell,
-                                rlo, rcoef)
-                if g == 0.0:
-                    g = g_pair(lz, vz, controlled, qshift, qcbase, qcell, qlo, qrow)
-                f[r] = f[r] / g  # 001 eq. 16, all levels
-            elif f[r] != 0.0:
-                f[r] = f[r] / g_levels_call(mmax, mmin, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled,
-                                            increasing, mu0, index, index_lo, index_h_inv)
+        # only the lit rows (a dark row's value is 0 / g = 0 already)
+        _divide_rows(f, a, b, lit, q, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing,
+                     mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell,
+                     qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo, rcoef)
 
 
 def _phong_reference(wi, wo, n, c):
@@ -274,8 +272,8 @@ class Phong(BRDF):
         if self._rows(wi, wo) is None:
             return None
         out = np.empty(wi.shape[:-1])
-        # a chain without a product table (pmlo = inf): the row-by-row kernel, whose blocks of _BLOCK rows suit the
-        # split and level tables' paths (5-level g2 pumped Phong n = 20: 1.98 x Phong, 2.06 x by _phong_divided)
+        # a chain without a product table (pmlo = inf): the row-by-row kernel, which suits the split and level tables'
+        # paths (5-level g2 pumped Phong n = 20: 1.90-1.94 x Phong, 2.06-2.11 x by _phong_divided)
         kernel = _phong_divided if chain.product_mlo < math.inf else _phong_divided_lit
         kernel(wi.reshape(-1, 3), wo.reshape(-1, 3), out.reshape(-1), *self.kernel_args(), *chain)
         return out
