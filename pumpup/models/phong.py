@@ -155,8 +155,8 @@ def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo
     N.wo) and whether the product table serves the row.  The lit rows it serves (a third of random pairs are dark) are
     then gathered without branches into contiguous arrays of R.V and max cosine; the product table's look-ups run over
     them in a loop of their own, then pow and the division, each value written to its row.  The other lit rows (a
-    cosine at or below the table's ``mlo``, a NaN cosine) take the row-by-row paths of :func:`_divide_rows`.
-    A chain without a product table takes :func:`_phong_divided_lit` (:meth:`Phong.eval_divided`).
+    cosine at or below the table's ``mlo``, a NaN cosine), counted in the first loop and gathered only in a block that
+    has some, take the row-by-row paths of :func:`_divide_rows`.  A chain without a product table takes :func:`_phong_divided_lit` (:meth:`Phong.eval_divided`).
     """
     N = out.shape[0]
     x = np.empty(_DIVIDED_BLOCK)  # R.V where lit, else 0
@@ -172,22 +172,27 @@ def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo
         a = wi[s : s + m]
         b = wo[s : s + m]
         f = out[s : s + m]
+        slow = 0  # lit rows the product table does not serve
         for r in range(m):
             lz, vz = a[r, 2], b[r, 2]
-            x[r] = _lit_cos(a[r, 0], a[r, 1], lz, b[r, 0], b[r, 1], vz)
+            xr = _lit_cos(a[r, 0], a[r, 1], lz, b[r, 0], b[r, 1], vz)
+            fr = (lz > 0.0) & (vz > 0.0) & (min(lz, vz) > pmlo)  # (as _phong_divided_lit's tests)
+            x[r] = xr
             mm[r] = max(lz, vz)
-            fast[r] = (lz > 0.0) & (vz > 0.0) & (min(lz, vz) > pmlo)  # (as _phong_divided_lit's tests)
+            fast[r] = fr
+            slow += ((xr > 0.0) | (xr != xr)) & (not fr)  # lit (a NaN too, as _phong_rows)
             f[r] = 0.0
         q = 0
-        k = 0
         for r in range(m):
-            on = (x[r] > 0.0) | (x[r] != x[r])  # lit (a NaN too, as _phong_rows)
             rows[q] = r
             y[q] = x[r]
             mc[q] = mm[r]
-            q += on & fast[r]
-            rest[k] = r
-            k += on & (not fast[r])
+            q += ((x[r] > 0.0) | (x[r] != x[r])) & fast[r]
+        k = 0
+        if slow > 0:  # most blocks have none: their gathering would cost about 0.05 x Phong
+            for r in range(m):
+                rest[k] = r
+                k += ((x[r] > 0.0) | (x[r] != x[r])) & (not fast[r])
         for j in range(q):  # the look-ups first, in a loop without pow's call
             gk[j] = g_product(mc[j], pcbase, pcell, plo, prow)
         for j in range(q):
@@ -196,9 +201,10 @@ def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo
         for j in range(k):  # the other lit rows, as _phong_divided_lit
             r = rest[j]
             f[r] = c * x[r] ** n  # 000 eq. 5
-        _divide_rows(f, a, b, rest, k, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing,
-                     mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell,
-                     qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo, rcoef)
+        if k > 0:
+            _divide_rows(f, a, b, rest, k, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing,
+                         mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase,
+                         qcell, qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo, rcoef)
 
 
 @njit(cache=True, nogil=True)

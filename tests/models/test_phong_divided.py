@@ -66,6 +66,28 @@ def test_fused_kernel_at_block_edges(pumped, rng, rows):
     np.testing.assert_array_equal(_fused(base, wi, wo, chain), base._eval_divided_lit(wi, wo, chain))
 
 
+def test_fused_kernel_blocks_with_and_without_rows_below_the_product_table(pumped, rng):
+    """A block whose lit rows the product table all serves (the other rows are then not gathered) beside blocks with
+    one such row each, at its first and at its last place (N.wi = 1e-9, below the table's lower end): the same bits as
+    the row-by-row kernel."""
+    n = 3 * _DIVIDED_BLOCK
+    wi, wo = _many_pairs(rng, n)
+    wi, wo = wi[:n].copy(), wo[:n].copy()
+    for w in (wi, wo):
+        w[:, 2] = np.maximum(w[:, 2], 0.05)  # every cosine above the table's mlo
+        w /= np.linalg.norm(w, axis=-1, keepdims=True)
+    wo[: _DIVIDED_BLOCK] = wi[: _DIVIDED_BLOCK] * np.array([-1.0, -1.0, 1.0])  # lit: mirror pairs
+    low = [_DIVIDED_BLOCK, n - 1]
+    wo[low] = wi[low] * np.array([-1.0, -1.0, 1.0])
+    wi[low] = np.array([np.sqrt(1 - 1e-18), 0.0, 1e-9])
+    wo[low] = np.array([-np.sqrt(1 - 1e-18), 0.0, 1e-9])  # the mirror pair at grazing: lit, R.V = 1
+    base = pumped.chain()[0].base
+    chain = pumped._chain_args()
+    new = _fused(base, wi, wo, chain)
+    np.testing.assert_array_equal(new, base._eval_divided_lit(wi, wo, chain))
+    assert np.all(new[low] > 0) and np.all(new[: _DIVIDED_BLOCK] > 0)
+
+
 def test_fused_kernel_non_finite_rows(pumped, rng):
     """NaN and inf in the tangent components (R.V NaN or infinite, which the kernel's lit test lets through; the
     cosines stay finite, as BRDF.eval's input check ensures) give what the row-by-row kernel gives."""
