@@ -103,7 +103,7 @@ _mf_scalar = njit(cache=True, nogil=True, inline="always")(_mf_value)
 
 @njit(cache=True, nogil=True)
 def _mf_divided(wi, wo, out, dist, alpha, shadowing, g1, ior, eta, k, offsets, logx, coef, v0, slope0, margin_lo, cap,
-                controlled, increasing, mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo,
+                controlled, increasing, mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, pinv, qmlo,
                 qshift, qcbase, qcell, qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase,
                 rcell, rlo, rcoef):  # pragma: no cover - compiled
     """f_r / (g_1 ... g_k) (001 eq. 16) over the rows of (N, 3) arrays into ``out``: the kernel's value and the pumped
@@ -118,7 +118,7 @@ def _mf_divided(wi, wo, out, dist, alpha, shadowing, g1, ior, eta, k, offsets, l
         f = _mf_scalar(wi[r, 0], wi[r, 1], lz, wo[r, 0], wo[r, 1], vz, dist, alpha, shadowing, g1, ior, eta, k)
         mmax, mmin = max(lz, vz), min(lz, vz)
         if mmin > pmlo:  # as pumpup.operators.pumping._chain_kernel chooses (physics.lookups.g_levels_call says why)
-            out[r] = f / g_product(mmax, pcbase, pcell, plo, prow)  # 001 eq. 16, all levels
+            out[r] = f * g_product(mmax, pcbase, pcell, plo, pinv)  # 001 eq. 16, all levels (times 1 / G)
         elif mmin > qmlo:
             g = 0.0
             if rcells > 0:  # the split table: one product F(mmin) H(mmax), 0 where the cell has no pattern

@@ -110,8 +110,8 @@ def _phong_rows(wi, wo, out, check, lo2, hi2, n, c):  # pragma: no cover - compi
 
 @njit(cache=True, nogil=True)
 def _divide_rows(f, a, b, rows, count, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
-                 index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell, qlo, qrow,
-                 rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo, rcoef):  # pragma: no cover - compiled
+                 index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, pinv, qmlo, qshift, qcbase, qcell, qlo,
+                 qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo, rcoef):  # pragma: no cover - compiled
     """f[r] / (g_1 ... g_k) in place for the rows r = ``rows[:count]`` of a block (``a``, ``b`` its rows of wi and wo),
     the path of each chosen as ``pumpup.operators.pumping._chain_kernel`` chooses it; rows with a cosine <= 0 are left
     as they are.  Called once per block by :func:`_phong_divided` and :func:`_phong_divided_lit` (a call per row
@@ -124,7 +124,7 @@ def _divide_rows(f, a, b, rows, count, offsets, logx, coef, v0, slope0, margin_l
             continue
         mmax, mmin = max(lz, vz), min(lz, vz)
         if mmin > pmlo:  # (pumpup.physics.lookups.g_levels_call says why the paths are written out)
-            f[r] = f[r] / g_product(mmax, pcbase, pcell, plo, prow)  # 001 eq. 16, all levels
+            f[r] = f[r] * g_product(mmax, pcbase, pcell, plo, pinv)  # 001 eq. 16, all levels (times 1 / G)
         elif mmin > qmlo:
             g = 0.0
             if rcells > 0:  # the split table: one product F(mmin) H(mmax), 0 where the cell has no pattern
@@ -144,7 +144,7 @@ _DIVIDED_BLOCK = 4096
 
 @njit(cache=True, nogil=True)
 def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
-                   index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell, qlo,
+                   index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, pinv, qmlo, qshift, qcbase, qcell, qlo,
                    qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
                    rcoef):  # pragma: no cover - compiled
     """f_r / (g_1 ... g_k) (001 eq. 16) over the rows of C-contiguous (N, 3) arrays into ``out`` in one pass, the path
@@ -152,65 +152,68 @@ def _phong_divided(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo
     operations, the same values (:func:`_phong_divided_lit`, tested bit for bit).
 
     Blocks of _DIVIDED_BLOCK rows.  A first loop without branches: R.V (0 where dark, :func:`_lit_cos`), max(N.wi,
-    N.wo) and whether the product table serves the row.  The lit rows it serves (a third of random pairs are dark) are
-    then gathered without branches into contiguous arrays of R.V and max cosine; the product table's look-ups run over
-    them in a loop of their own, then pow and the division, each value written to its row.  The other lit rows (a
-    cosine at or below the table's ``mlo``, a NaN cosine), counted in the first loop and gathered only in a block that
-    has some, take the row-by-row paths of :func:`_divide_rows`.  A chain without a product table takes :func:`_phong_divided_lit` (:meth:`Phong.eval_divided`).
+    N.wo) and the number of rows with a cosine at or below the product table's ``mlo`` (or NaN).  In a block that has
+    some (a direction below the horizon counts), the lit rows among them that the table does not serve are set aside
+    for the row-by-row paths of :func:`_divide_rows`.  The other lit rows (a third of random pairs are dark) are then
+    gathered without branches into contiguous arrays of R.V and max cosine; the product table's look-ups run over them
+    in a loop of their own (1 / G, the table's inverse rows: a product costs less than a division), then pow and the
+    product, each value written to its row.  A chain without a product table takes :func:`_phong_divided_lit`
+    (:meth:`Phong.eval_divided`).
     """
     N = out.shape[0]
-    x = np.empty(_DIVIDED_BLOCK)  # R.V where lit, else 0
+    x = np.empty(_DIVIDED_BLOCK)  # R.V where lit and the product table serves the row, else 0
     mm = np.empty(_DIVIDED_BLOCK)  # max(N.wi, N.wo)
-    fast = np.empty(_DIVIDED_BLOCK, dtype=np.bool_)  # the product table serves the row
     rows = np.empty(_DIVIDED_BLOCK, dtype=np.int64)  # the lit rows the product table serves
     y = np.empty(_DIVIDED_BLOCK)  # their R.V
     mc = np.empty(_DIVIDED_BLOCK)  # their max(N.wi, N.wo)
-    gk = np.empty(_DIVIDED_BLOCK)  # their g_1 ... g_k
+    hk = np.empty(_DIVIDED_BLOCK)  # their 1 / (g_1 ... g_k)
     rest = np.empty(_DIVIDED_BLOCK, dtype=np.int64)  # the other lit rows
+    y_rest = np.empty(_DIVIDED_BLOCK)  # their R.V
     for s in range(0, N, _DIVIDED_BLOCK):
         m = min(N - s, _DIVIDED_BLOCK)
         a = wi[s : s + m]
         b = wo[s : s + m]
         f = out[s : s + m]
-        slow = 0  # lit rows the product table does not serve
+        low = 0  # rows with a cosine at or below the table's mlo (or NaN)
         for r in range(m):
             lz, vz = a[r, 2], b[r, 2]
-            xr = _lit_cos(a[r, 0], a[r, 1], lz, b[r, 0], b[r, 1], vz)
-            fr = (lz > 0.0) & (vz > 0.0) & (min(lz, vz) > pmlo)  # (as _phong_divided_lit's tests)
-            x[r] = xr
+            x[r] = _lit_cos(a[r, 0], a[r, 1], lz, b[r, 0], b[r, 1], vz)
             mm[r] = max(lz, vz)
-            fast[r] = fr
-            slow += ((xr > 0.0) | (xr != xr)) & (not fr)  # lit (a NaN too, as _phong_rows)
+            low += not (min(lz, vz) > pmlo)
             f[r] = 0.0
+        k = 0
+        if low > 0:  # (most blocks of directions above the horizon have none: the test per row would cost 0.03 x)
+            for r in range(m):  # the lit rows the table does not serve leave x for rest
+                lz, vz = a[r, 2], b[r, 2]
+                xr = x[r]
+                rest[k] = r
+                y_rest[k] = xr
+                other = ((xr > 0.0) | (xr != xr)) & (not ((lz > 0.0) & (vz > 0.0) & (min(lz, vz) > pmlo)))
+                k += other
+                x[r] = 0.0 if other else xr
         q = 0
         for r in range(m):
             rows[q] = r
             y[q] = x[r]
             mc[q] = mm[r]
-            q += ((x[r] > 0.0) | (x[r] != x[r])) & fast[r]
-        k = 0
-        if slow > 0:  # most blocks have none: their gathering would cost about 0.05 x Phong
-            for r in range(m):
-                rest[k] = r
-                k += ((x[r] > 0.0) | (x[r] != x[r])) & (not fast[r])
+            q += (x[r] > 0.0) | (x[r] != x[r])  # lit (a NaN too, as _phong_rows)
         for j in range(q):  # the look-ups first, in a loop without pow's call
-            gk[j] = g_product(mc[j], pcbase, pcell, plo, prow)
+            hk[j] = g_product(mc[j], pcbase, pcell, plo, pinv)
         for j in range(q):
             fr = c * y[j] ** n  # 000 eq. 5
-            f[rows[j]] = fr / gk[j]  # 001 eq. 16, all levels
+            f[rows[j]] = fr * hk[j]  # 001 eq. 16, all levels (times 1 / G)
         for j in range(k):  # the other lit rows, as _phong_divided_lit
-            r = rest[j]
-            f[r] = c * x[r] ** n  # 000 eq. 5
+            f[rest[j]] = c * y_rest[j] ** n  # 000 eq. 5
         if k > 0:
             _divide_rows(f, a, b, rest, k, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing,
-                         mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase,
+                         mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, pinv, qmlo, qshift, qcbase,
                          qcell, qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo, rcoef)
 
 
 @njit(cache=True, nogil=True)
 def _phong_divided_lit(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing,
-                       mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell,
-                       qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
+                       mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, pinv, qmlo, qshift, qcbase,
+                       qcell, qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
                        rcoef):  # pragma: no cover - compiled
     """:func:`_phong_divided` in blocks of _DIVIDED_BLOCK rows, every lit row divided in place through its row index
     (:func:`_divide_rows`, the path chosen row by row as ``pumpup.operators.pumping._chain_kernel`` chooses it): the
@@ -237,8 +240,8 @@ def _phong_divided_lit(wi, wo, out, n, c, offsets, logx, coef, v0, slope0, margi
             f[r] = c * x[r] ** n  # 000 eq. 5
         # only the lit rows (a dark row's value is 0 / g = 0 already)
         _divide_rows(f, a, b, lit, q, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing,
-                     mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell,
-                     qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo, rcoef)
+                     mu0, index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, pinv, qmlo, qshift, qcbase,
+                     qcell, qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo, rcoef)
 
 
 def _phong_reference(wi, wo, n, c):

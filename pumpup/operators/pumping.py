@@ -173,7 +173,7 @@ def _uses_file_tables(brdf: BRDF) -> bool:
 
 @njit(cache=True, nogil=True)
 def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, controlled, increasing, mu0,
-                  index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, qmlo, qshift, qcbase, qcell,
+                  index, index_lo, index_h_inv, pmlo, pcbase, pcell, plo, prow, pinv, qmlo, qshift, qcbase, qcell,
                   qlo, qrow, rcells, rpattern, rfid, rhid, rshift, rcbase, rcell, rlo,
                   rcoef):  # pragma: no cover - compiled
     """All levels of a pumped chain in one pass: f / (g_1 g_2 ... g_k) (001 eq. 16), in place.
@@ -201,7 +201,7 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
             continue
         mmax, mmin = max(mi, mo), min(mi, mo)
         if mmin > pmlo:  # the fast path: one look-up for all levels (no branch on f = 0: 0 / g = 0)
-            f[k] = f[k] / g_product(mmax, pcbase, pcell, plo, prow)  # 001 eq. 16, all levels
+            f[k] = f[k] * g_product(mmax, pcbase, pcell, plo, pinv)  # 001 eq. 16, all levels (times 1 / G)
         elif mmin > qmlo:  # one piece per direction for all levels (0 / g = 0)
             g = 0.0
             if rcells > 0:  # one product F(mmin) H(mmax), 0 where the cell has no pattern
@@ -346,9 +346,12 @@ class _Product:
     interpolant of degree PRODUCT_DEGREE, bisected until it matches G to ``TOL`` (relative) at
     4 (degree + 1) + 1 test points (G itself is computed to about 1e-14: the levels' splines are
     polynomials in log m).  The coefficients are then scaled by 1 + ``epsilon`` (twice the
-    largest miss, plus 4 ulp; about 2e-14), so the kernel divides by at least G and at most
-    G (1 + 2 ``epsilon``): the pumped BRDF comes out lower than the level-by-level reference by
-    at most 2 ``epsilon`` (relative).
+    largest miss, plus 4 ulp; about 2e-14), so the albedo engine divides by at least G and at most
+    G (1 + 2 ``epsilon``): the pumped BRDF it integrates is lower than the level-by-level reference by
+    at most 2 ``epsilon`` (relative).  The eval kernels multiply by 1 / G instead, which costs less than a
+    division: ``inverse_rows``, the interpolant of 1 / G on the same pieces (bisected until both G and 1 / G meet
+    ``TOL``), scaled by 1 - ``epsilon`` and checked never to exceed 1 / G, so the value eval gives is at most the
+    level-by-level reference and lower by at most 2 ``epsilon``, as the value the engine integrates.
     The kernel finds the piece from the bits of m: cell c = (bits(m) >> CELL_SHIFT) - cbase,
     2^CELL_BITS cells per octave, ``cstart[c]`` the piece where the cell starts (most cells
     hold one piece); the kernel reads ``entries[c]``, that piece and where the next starts in one int64.
@@ -372,18 +375,38 @@ class _Product:
         br = br[(br >= self.mlo) & (br <= 1.0)]
         br = np.unique(np.concatenate([br, self._kinks(br)]))
         lo, hi = br[:-1], br[1:]
-        (coef,), lo, hi, center, half, worst = fit_pieces([self.exact], lo, hi, self.TOL, "product table")
+        # G and 1 / G on one set of pieces (bisected until both meet TOL: 1 / G needs about a fifth more pieces)
+        (coef, icoef), lo, hi, center, half, worst = fit_pieces([self.exact, self.inverse_exact], lo, hi, self.TOL,
+                                                                "product table")
         self.epsilon = 2.0 * float(worst.max()) + 4 * np.finfo(float).eps
         self.coef = np.ascontiguousarray(coef * (1.0 + self.epsilon))
         self.center, self.ihalf = center, 1.0 / half
-        #: what the kernel reads for piece s: coefficients, centre, inverse half-width
+        #: what the albedo engine reads for piece s: coefficients, centre, inverse half-width
         self.rows = np.ascontiguousarray(np.concatenate([self.coef, center[None], self.ihalf[None]]).T)
+        self.inverse_coef = np.ascontiguousarray(icoef * (1.0 - self.epsilon))
+        #: what the eval kernels read for piece s to multiply by 1 / G, in the layout of ``rows``
+        self.inverse_rows = np.ascontiguousarray(np.concatenate([self.inverse_coef, center[None], self.ihalf[None]]).T)
+        tt = np.linspace(-1.0, 1.0, 8 * (PRODUCT_DEGREE + 1) + 1)
+        m = np.clip(center[:, None] + half[:, None] * tt, lo[:, None], hi[:, None])
+        if not np.all(horner(self.inverse_coef[:, :, None], (m - center[:, None]) * self.ihalf[:, None])
+                      <= self.inverse_exact(m)):  # pragma: no cover - the scaling leaves 2 ulp at least
+            raise _ProductError("the product table's inverse exceeds 1 / G")
         self.lo = np.concatenate([lo, [math.inf]])  # a sentinel ends the search
         # cell c = (bits(m) >> CELL_SHIFT) - cbase starts at bounds[c]; the last starts at m = 1
         self.cstart = np.clip(np.searchsorted(lo, bounds, side="right") - 1, 0, len(lo) - 1).astype(np.int32)
         #: the cells as the kernel reads them: each cell's first piece and where the next starts, one int64
         #: (:func:`pumpup.physics.lookups.cell_entries`)
         self.entries = cell_entries(self.lo, self.cstart)
+
+    def inverse_exact(self, m):
+        """1 / G(m) (:meth:`exact`)."""
+        return 1.0 / self.exact(m)
+
+    def inverse(self, m):
+        """The eval kernels' 1 / G(m) in plain numpy (m > mlo): the reference of their fast path."""
+        m = np.asarray(m, dtype=np.float64)
+        s = self.piece(m)
+        return horner(self.inverse_coef[:, s], (m - self.center[s]) * self.ihalf[s])
 
     def _g(self, j, m):
         g = self.looks[j].upper(m)  # already at most the cap
@@ -1197,8 +1220,9 @@ class Pumped(BRDF):
     def _product_args(self):
         p = self.product()
         if p is None:  # off: pmlo = inf
-            return math.inf, 0, np.zeros(1, np.int64), np.full(2, math.inf), np.zeros((1, PRODUCT_DEGREE + 3))
-        return p.mlo, p.cbase, p.entries, p.lo, p.rows
+            empty = np.zeros((1, PRODUCT_DEGREE + 3))
+            return math.inf, 0, np.zeros(1, np.int64), np.full(2, math.inf), empty, empty
+        return p.mlo, p.cbase, p.entries, p.lo, p.rows, p.inverse_rows
 
     #: pairs per pass when many are evaluated at once: the base's values and the directions are
     #: still in the cache when the chain kernel reads them (2e6 pairs, 3-level Phong: 26 -> 21 ns
@@ -1244,7 +1268,7 @@ class Pumped(BRDF):
         # (n, 3) views of the directions when their strides allow it (the engine's do): no copies
         if levelwise:
             _chain_kernel_levelwise(f.reshape(-1), wi.reshape(-1, 3), wo.reshape(-1, 3),
-                                    *self._chain_args()[:GChain._fields.index("pair_mlo")])
+                                    *self._chain_args()[:GChain._fields.index("product_inverse_rows")])
         else:
             _chain_kernel(f.reshape(-1), wi.reshape(-1, 3), wo.reshape(-1, 3), *self._chain_args())
         return f

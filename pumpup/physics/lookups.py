@@ -388,14 +388,15 @@ def scale_bound(m, pmlo, pcbase, pcell, plo, prow, logx, coef, v0, slope0, margi
 
 #: a pumped chain's look-ups, as the compiled kernels read them (:meth:`pumpup.operators.pumping.Pumped._chain_args`):
 #: every level's upper bound (:func:`g_levels`' arguments), the product table of all levels (:func:`g_product`'s,
-#: with the N.wo above which it applies, ``product_mlo``; inf when there is none) and, where there is no product table
-#: (a level's bound falls somewhere), the level table (:func:`g_pair`'s, with the smaller cosine above which it applies,
-#: ``pair_mlo``; inf when there is none) and, above the same ``pair_mlo``, the split table that serves most pairs
-#: with one product of two look-ups (:func:`g_split`'s; ``split_cells`` 0 when there is none)
+#: with the N.wo above which it applies, ``product_mlo``; inf when there is none; the albedo engine divides by it, and
+#: the eval kernels multiply by its inverse, ``product_inverse_rows``, rows of the same layout) and, where there is no
+#: product table (a level's bound falls somewhere), the level table (:func:`g_pair`'s, with the smaller cosine above
+#: which it applies, ``pair_mlo``; inf when there is none) and, above the same ``pair_mlo``, the split table that serves
+#: most pairs with one product of two look-ups (:func:`g_split`'s; ``split_cells`` 0 when there is none)
 GChain = namedtuple("GChain", [
     "offsets", "logx", "coef", "v0", "slope0", "margin_lo", "cap", "controlled", "increasing", "mu0", "index",
     "index_lo", "index_h_inv", "product_mlo", "product_cbase", "product_cell", "product_lo", "product_rows",
-    "pair_mlo", "pair_shift", "pair_cbase", "pair_cell", "pair_lo", "pair_rows",
+    "product_inverse_rows", "pair_mlo", "pair_shift", "pair_cbase", "pair_cell", "pair_lo", "pair_rows",
     "split_cells", "split_pattern", "split_fid", "split_hid", "split_shift", "split_cbase", "split_cell", "split_lo",
     "split_coef",
 ])

@@ -232,9 +232,10 @@ def test_bad_input():
 
 @pytest.mark.parametrize("spec, g", [(BASES["phong"], "g2"), (BASES["blinn"], "g1")])
 def test_product_table_of_a_monotone_chain(rng, spec, g):
-    """The kernel's fast path divides by G(m), one function of m = max(N.wi, N.wo) for all
-    levels: never below the product of the levels' g, above it by at most twice its epsilon (checked
-    at 2e5 random m and at every piece's ends), and the kernel evaluates exactly that G."""
+    """The fast path's G(m), one function of m = max(N.wi, N.wo) for all levels, which the albedo engine divides by:
+    never below the product of the levels' g, above it by at most twice its epsilon; and its inverse, which the eval
+    kernel multiplies by: never above 1 / G, below it by at most twice epsilon (both checked at 2e5 random m and at
+    every piece's ends); the kernel evaluates exactly that inverse."""
     from pumpup.physics.lookups import CELL_SHIFT as _CELL_SHIFT
     from pumpup.physics.lookups import float_bits_reference as _bits
 
@@ -245,6 +246,8 @@ def test_product_table_of_a_monotone_chain(rng, spec, g):
     m = m[m > p.mlo]
     ratio = p(m) / p.exact(m)
     assert ratio.min() >= 1.0 and ratio.max() <= 1.0 + 2 * p.epsilon
+    ratio = p.inverse(m) * p.exact(m)
+    assert ratio.max() <= 1.0 and ratio.min() >= 1.0 - 2 * p.epsilon
     # the look-up: the cell from the float's bits, then forward, lands on the piece that holds m
     s = p.piece(m)
     assert np.all((p.lo[s] <= m) & (m < p.lo[s + 1]))
@@ -254,7 +257,7 @@ def test_product_table_of_a_monotone_chain(rng, spec, g):
     wi = random_directions(rng, 5000)
     wo = random_directions(rng, 5000)[::-1]
     up = (wi[:, 2] > p.mlo) & (wo[:, 2] > p.mlo)
-    expect = f.chain()[0].base.eval(wi[up], wo[up]) / p(np.maximum(wi[up, 2], wo[up, 2]))
+    expect = f.chain()[0].base.eval(wi[up], wo[up]) * p.inverse(np.maximum(wi[up, 2], wo[up, 2]))
     np.testing.assert_allclose(f.eval(wi[up], wo[up]), expect, rtol=1e-15, atol=0)
     # and the level-by-level reference agrees to 2 epsilon (the fast path is never larger)
     ref = f.reference(wi[up], wo[up])
@@ -264,7 +267,7 @@ def test_product_table_of_a_monotone_chain(rng, spec, g):
     z = np.concatenate([p.lo[1:-1:7], np.nextafter(p.lo[1:-1:7], 0), [1.0]])
     li = np.stack([np.sqrt(1 - z**2), np.zeros_like(z), z], axis=-1)
     lo = li * np.array([-1.0, 1.0, 1.0])  # the mirror direction: f is at its peak
-    expect = f.chain()[0].base.eval(li, lo) / p(z)
+    expect = f.chain()[0].base.eval(li, lo) * p.inverse(z)
     assert np.all(expect > 0)
     np.testing.assert_allclose(f.eval(li, lo), expect, rtol=1e-15, atol=0)
 
