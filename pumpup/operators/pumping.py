@@ -349,9 +349,10 @@ class _Product:
     largest miss, plus 4 ulp; about 2e-14), so the albedo engine divides by at least G and at most
     G (1 + 2 ``epsilon``): the pumped BRDF it integrates is lower than the level-by-level reference by
     at most 2 ``epsilon`` (relative).  The eval kernels multiply by 1 / G instead, which costs less than a
-    division: ``inverse_rows``, the interpolant of 1 / G on the same pieces (bisected until both G and 1 / G meet
-    ``TOL``), scaled by 1 - ``epsilon`` and checked never to exceed 1 / G, so the value eval gives is at most the
-    level-by-level reference and lower by at most 2 ``epsilon``, as the value the engine integrates.
+    division: with ``inverse`` (a pumped chain's table; the compensations' one-level tables do without),
+    ``inverse_rows``, the interpolant of 1 / G on the same pieces (bisected until both G and 1 / G meet ``TOL``),
+    scaled by 1 - ``epsilon`` and checked never to exceed 1 / G, so the value eval gives is at most the level-by-level
+    reference and lower by at most 2 ``epsilon``, as the value the engine integrates.
     The kernel finds the piece from the bits of m: cell c = (bits(m) >> CELL_SHIFT) - cbase,
     2^CELL_BITS cells per octave, ``cstart[c]`` the piece where the cell starts (most cells
     hold one piece); the kernel reads ``entries[c]``, that piece and where the next starts in one int64.
@@ -360,7 +361,7 @@ class _Product:
 
     TOL = 1e-14
 
-    def __init__(self, looks, controlled):
+    def __init__(self, looks, controlled, inverse: bool = False):
         self.looks, self.controlled = looks, controlled
         # above mlo every level is on its spline (not the power law below its first node; the
         # 1e-12 keeps log(m) clear of the first breakpoint's rounding)
@@ -375,22 +376,27 @@ class _Product:
         br = br[(br >= self.mlo) & (br <= 1.0)]
         br = np.unique(np.concatenate([br, self._kinks(br)]))
         lo, hi = br[:-1], br[1:]
-        # G and 1 / G on one set of pieces (bisected until both meet TOL: 1 / G needs about a fifth more pieces)
-        (coef, icoef), lo, hi, center, half, worst = fit_pieces([self.exact, self.inverse_exact], lo, hi, self.TOL,
-                                                                "product table")
+        # G, and with ``inverse`` 1 / G, on one set of pieces (bisected until both meet TOL: 1 / G needs about a
+        # fifth more pieces)
+        fns = [self.exact, self.inverse_exact] if inverse else [self.exact]
+        coefs, lo, hi, center, half, worst = fit_pieces(fns, lo, hi, self.TOL, "product table")
         self.epsilon = 2.0 * float(worst.max()) + 4 * np.finfo(float).eps
-        self.coef = np.ascontiguousarray(coef * (1.0 + self.epsilon))
+        self.coef = np.ascontiguousarray(coefs[0] * (1.0 + self.epsilon))
         self.center, self.ihalf = center, 1.0 / half
         #: what the albedo engine reads for piece s: coefficients, centre, inverse half-width
         self.rows = np.ascontiguousarray(np.concatenate([self.coef, center[None], self.ihalf[None]]).T)
-        self.inverse_coef = np.ascontiguousarray(icoef * (1.0 - self.epsilon))
-        #: what the eval kernels read for piece s to multiply by 1 / G, in the layout of ``rows``
-        self.inverse_rows = np.ascontiguousarray(np.concatenate([self.inverse_coef, center[None], self.ihalf[None]]).T)
-        tt = np.linspace(-1.0, 1.0, 8 * (PRODUCT_DEGREE + 1) + 1)
-        m = np.clip(center[:, None] + half[:, None] * tt, lo[:, None], hi[:, None])
-        if not np.all(horner(self.inverse_coef[:, :, None], (m - center[:, None]) * self.ihalf[:, None])
-                      <= self.inverse_exact(m)):  # pragma: no cover - the scaling leaves 2 ulp at least
-            raise _ProductError("the product table's inverse exceeds 1 / G")
+        #: what the eval kernels read for piece s to multiply by 1 / G, in the layout of ``rows`` (None without
+        #: ``inverse``)
+        self.inverse_coef = self.inverse_rows = None
+        if inverse:
+            self.inverse_coef = np.ascontiguousarray(coefs[1] * (1.0 - self.epsilon))
+            self.inverse_rows = np.ascontiguousarray(
+                np.concatenate([self.inverse_coef, center[None], self.ihalf[None]]).T)
+            tt = np.linspace(-1.0, 1.0, 8 * (PRODUCT_DEGREE + 1) + 1)
+            m = np.clip(center[:, None] + half[:, None] * tt, lo[:, None], hi[:, None])
+            if not np.all(horner(self.inverse_coef[:, :, None], (m - center[:, None]) * self.ihalf[:, None])
+                          <= self.inverse_exact(m)):  # pragma: no cover - the scaling leaves 2 ulp at least
+                raise _ProductError("the product table's inverse exceeds 1 / G")
         self.lo = np.concatenate([lo, [math.inf]])  # a sentinel ends the search
         # cell c = (bits(m) >> CELL_SHIFT) - cbase starts at bounds[c]; the last starts at m = 1
         self.cstart = np.clip(np.searchsorted(lo, bounds, side="right") - 1, 0, len(lo) - 1).astype(np.int32)
@@ -1163,7 +1169,8 @@ class Pumped(BRDF):
         def build():
             if not all(lev.lookup().increasing for lev in self.chain()):
                 return None
-            return _Product([lev.lookup() for lev in self.chain()], [lev.controlled for lev in self.chain()])
+            return _Product([lev.lookup() for lev in self.chain()], [lev.controlled for lev in self.chain()],
+                            inverse=True)
 
         return self._built_once("_product", build)
 
