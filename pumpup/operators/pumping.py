@@ -187,8 +187,9 @@ def _chain_kernel(f, wi, wo, offsets, logx, coef, v0, slope0, margin_lo, cap, co
     against the plain numpy reference, :meth:`Pumped.reference`, which pumps level by level.
 
     Fast path: where every level's bound increases, the product of all levels' g is one function
-    of mmax (:class:`_Product`, :func:`g_product`; ``pmlo`` = inf turns it off).  Tested against
-    :meth:`_Product.__call__` and the reference.  Otherwise, where both cosines exceed ``qmlo``, every level's bound
+    of mmax, and the kernel multiplies by its tabulated inverse (:class:`_Product`, :func:`g_product` on its
+    ``inverse_rows``; ``pmlo`` = inf turns it off).  Tested against :meth:`_Product.inverse` and the reference.
+    Otherwise, where both cosines exceed ``qmlo``, every level's bound
     from the level table, one piece per direction (:class:`_LevelTable`, :func:`g_pair`; ``qmlo`` = inf turns it
     off, :meth:`Pumped._eval_levelwise`); there, first, the split table (:class:`_SplitTable`, :func:`g_split`: one
     product of two look-ups whatever the number of levels, in the cells where every level's term is fixed;
