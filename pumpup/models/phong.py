@@ -137,8 +137,9 @@ def _divide_rows(f, a, b, rows, count, offsets, logx, coef, v0, slope0, margin_l
                                         increasing, mu0, index, index_lo, index_h_inv)
 
 
-#: rows per block of _phong_divided (measured on 3-level g2 pumped Phong n = 20: 1.40 x Phong with blocks of 4096 rows,
-#: 1.51 x with 256, 1.43 x with 2048; 1 level: 1.37, 1.51 and 1.38 x)
+#: rows per block of _phong_divided and _phong_divided_lit (measured on 3-level g2 pumped Phong n = 20, when the kernel
+#: still divided by G: 1.40 x Phong with blocks of 4096 rows, 1.51 x with 256, 1.43 x with 2048; 1 level: 1.37, 1.51
+#: and 1.38 x)
 _DIVIDED_BLOCK = 4096
 
 

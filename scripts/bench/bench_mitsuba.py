@@ -265,6 +265,8 @@ def main(argv=None):
         for path, label in runs:
             if path:
                 _load_baseline(path)
+                if args.parts:  # (a temporary copy: loaded, it is no longer needed)
+                    os.unlink(path)
             print(f"\nllvm_ad_rgb, {args.n} samples per call, {args.rounds} rounds, {args.threads} Dr.Jit worker "
                   f"threads, eval() at {where}" + (f"; beside: {label}" if path else ""))
             cpu, wall = bench_llvm(pm, models, args.n, args.rounds, bool(path), args.threads, args.eval_at)
