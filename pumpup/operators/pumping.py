@@ -296,14 +296,21 @@ def _monotone_envelope(spline, margin: float):
 FIT_TEST_POINTS = np.linspace(-1.0, 1.0, 4 * (PRODUCT_DEGREE + 1) + 1)
 
 
+#: :func:`fit_pieces`: a miss of at most this many ulps (of 1) that bisection did not halve is the rounding of the
+#: functions themselves, which no narrower piece removes (5-level g2 pumped Phong's power laws below its splines miss
+#: by up to 8 ulps on some machines, at every width)
+ROUNDING_ULPS = 16
+
+
 def fit_pieces(functions, lo: np.ndarray, hi: np.ndarray, tol: float, what: str, degree: int = PRODUCT_DEGREE):
     """Polynomial pieces of degree ``degree`` (:data:`PRODUCT_DEGREE` unless given) on the intervals [lo, hi) for
     each of ``functions`` (positive, of an array of m): each interpolated at the Chebyshev points of every piece, the
     pieces bisected until every function's relative miss at :data:`FIT_TEST_POINTS` (4 (degree + 1) + 1 points) is at
-    most ``tol``, unless a piece is already narrower than 1e-9 m (then the miss is the rounding of the function
-    itself).  Returns (coefficients, one (degree + 1, pieces) array per function with the highest power first, lo, hi,
-    centres, half-widths, the largest miss of each piece); :class:`_ProductError` (naming ``what``) beyond 100000
-    pieces or 64 rounds.
+    most ``tol``, unless the miss is the rounding of the functions themselves: a piece already narrower than 1e-9 m,
+    or one whose miss is at most :data:`ROUNDING_ULPS` ulps and at least half its parent's (bisection, which cuts an
+    interpolant's miss by about 2^(degree + 1), did not halve it).  Returns (coefficients, one (degree + 1, pieces)
+    array per function with the highest power first, lo, hi, centres, half-widths, the largest miss of each piece);
+    :class:`_ProductError` (naming ``what``) beyond 100000 pieces or 64 rounds.
     """
     deg = degree
     xk = np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))  # Chebyshev points
@@ -312,6 +319,7 @@ def fit_pieces(functions, lo: np.ndarray, hi: np.ndarray, tol: float, what: str,
                         for k in range(deg + 1)])  # row k: monomial coefficients of T_k (low first)
     fit = np.linalg.solve(vand, np.eye(deg + 1)).T @ to_mono  # values at xk -> monomial (low first)
     tt = FIT_TEST_POINTS if deg == PRODUCT_DEGREE else np.linspace(-1.0, 1.0, 4 * (deg + 1) + 1)
+    parent = np.full(len(lo), np.inf)  # the miss of each piece's parent (inf: not made by bisection)
     for _ in range(64):
         center, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
         coefs, worst = [], np.zeros(len(lo))
@@ -320,14 +328,18 @@ def fit_pieces(functions, lo: np.ndarray, hi: np.ndarray, tol: float, what: str,
             miss = np.abs(horner(coef[..., None], tt) / fn(center[:, None] + half[:, None] * tt) - 1.0)
             coefs.append(coef)
             worst = np.maximum(worst, miss.max(axis=1))
-        bad = (worst > tol) & (hi - lo > 1e-9 * hi)
+        rounding = (worst <= ROUNDING_ULPS * np.finfo(np.float64).eps) & (worst >= 0.5 * parent)
+        bad = (worst > tol) & (hi - lo > 1e-9 * hi) & ~rounding
         if not bad.any():
             return coefs, lo, hi, center, half, worst
         if len(lo) + bad.sum() > 100_000:
             raise _ProductError(f"the {what} needs more than 100000 pieces to reach {tol:g}")
         mid = 0.5 * (lo[bad] + hi[bad])
+        old_lo, old_worst, old_bad = lo, worst, bad
         lo = np.sort(np.concatenate([lo, mid]))
         hi = np.sort(np.concatenate([hi, mid]))
+        old = np.searchsorted(old_lo, lo, side="right") - 1  # the piece each new one lies in
+        parent = np.where(old_bad[old], old_worst[old], np.inf)
     raise _ProductError(f"the {what} did not reach {tol:g} (worst {worst.max():.3g})")
 
 

@@ -334,3 +334,36 @@ def test_cell_entries_find_every_piece(name, request, rng):
         c = np.minimum((float_bits_reference(m) >> shift) - t.cbase, len(t.entries) - 1)
         assert np.all(first[c] <= s)
         assert np.array_equal(_cell_pieces(m, shift, t.cbase, t.entries, t.lo), s)
+
+
+def _noisy(m):
+    """1 + m / 3 with a deterministic relative error of up to 6 ulps, as a function rounded on some machine."""
+    m = np.asarray(m, dtype=np.float64)
+    bits = m.view(np.int64)
+    wobble = ((bits * 2654435761) >> 7) % 13 - 6  # -6 ... 6, from m's bits
+    return (1.0 + m / 3.0) * (1.0 + wobble * np.finfo(np.float64).eps)
+
+
+def test_fit_pieces_stops_at_the_rounding_of_the_functions():
+    """A function that misses its interpolant by its own rounding (a few ulps at every width) is fitted without running
+    into the piece limit; the miss it reports is that rounding (at most ROUNDING_ULPS ulps), not below it."""
+    from pumpup.operators.pumping import ROUNDING_ULPS, fit_pieces
+
+    lo, hi = np.array([0.1, 0.5]), np.array([0.5, 1.0])
+    _, plo, _, _, _, worst = fit_pieces([_noisy], lo, hi, 1e-15, "noise test")
+    assert len(plo) < 1000
+    assert 1e-15 < worst.max() <= ROUNDING_ULPS * np.finfo(np.float64).eps
+
+
+def test_fit_pieces_still_bisects_a_kink_to_its_tolerance():
+    """A kink inside a piece (a miss that halves at each bisection, as a rounding floor does not) is bisected until
+    the miss meets the tolerance or the piece is 1e-9 m wide: the rounding rule does not stop it early."""
+    from pumpup.operators.pumping import fit_pieces
+
+    def kink(m):
+        return 1.0 + np.abs(np.asarray(m) - 0.3 - 1e-3 * math.pi)
+
+    _, plo, phi, _, _, worst = fit_pieces([kink], np.array([0.1]), np.array([1.0]), 1e-15, "kink test")
+    assert np.all((worst <= 1e-15) | (phi - plo <= 1e-9 * phi))
+    inside = (plo <= 0.3 + 1e-3 * math.pi) & (0.3 + 1e-3 * math.pi < phi)
+    assert (phi - plo)[inside].max() <= 1e-9
