@@ -356,8 +356,8 @@ def test_fit_pieces_stops_at_the_rounding_of_the_functions():
 
 
 def test_fit_pieces_still_bisects_a_kink_to_its_tolerance():
-    """A kink inside a piece (a miss that halves at each bisection, as a rounding floor does not) is bisected until
-    the miss meets the tolerance or the piece is 1e-9 m wide: the rounding rule does not stop it early."""
+    """A kink inside a piece is bisected until the miss meets the tolerance or the piece is 1e-9 m wide: its miss, about
+    the piece's width, stays far above the rounding rule's few ulps, so the rule does not stop it early."""
     from pumpup.operators.pumping import fit_pieces
 
     def kink(m):
