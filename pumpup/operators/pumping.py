@@ -335,11 +335,10 @@ def fit_pieces(functions, lo: np.ndarray, hi: np.ndarray, tol: float, what: str,
         if len(lo) + bad.sum() > 100_000:
             raise _ProductError(f"the {what} needs more than 100000 pieces to reach {tol:g}")
         mid = 0.5 * (lo[bad] + hi[bad])
-        old_lo, old_worst, old_bad = lo, worst, bad
-        lo = np.sort(np.concatenate([lo, mid]))
-        hi = np.sort(np.concatenate([hi, mid]))
-        old = np.searchsorted(old_lo, lo, side="right") - 1  # the piece each new one lies in
-        parent = np.where(old_bad[old], old_worst[old], np.inf)
+        new_lo = np.sort(np.concatenate([lo, mid]))
+        old = np.searchsorted(lo, new_lo, side="right") - 1  # the piece each new one lies in
+        parent = np.where(bad[old], worst[old], np.inf)
+        lo, hi = new_lo, np.sort(np.concatenate([hi, mid]))
     raise _ProductError(f"the {what} did not reach {tol:g} (worst {worst.max():.3g})")
 
 
