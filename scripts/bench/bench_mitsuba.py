@@ -78,6 +78,18 @@ PARTS = [
         ("        return dr.if_stmt((mi_, mo, g), slow, lambda a, b, g: by_levels(a, b), lambda a, b, g: g)\n",
          "        return g\n")]),
 ]
+#: the floor of a look-up by rows of pieces: the table reads with the cell's read left out (the piece index computed
+#: from the cosine's bits alone), and with only the first 64-byte packet of each row read (as if every level's
+#: coefficients fitted in one packet)
+PARTS += [
+    ("row reads, no cell read", PARTS[1][1] + [
+        ("        if self.fine is not None:  # two-level",
+         "        return dr.minimum(c, len(self.lo_np) - 2)\n        if self.fine is not None:  # two-level")]),
+    ("one packet per row, no cell read", PARTS[1][1] + [
+        ("        if self.fine is not None:  # two-level",
+         "        return dr.minimum(c, len(self.lo_np) - 2)\n        if self.fine is not None:  # two-level"),
+        ("        for j in range(self.packets):\n", "        for j in range(1):\n")]),
+]
 
 
 def _part_file(label: str, changes) -> str:
