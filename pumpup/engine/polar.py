@@ -89,7 +89,8 @@ g is looked up once per node of x (the albedo engine divides by it: ``pumpup.phy
 ``g_levels``), and W, the lobe on the circle N.wo = t, is (A + B)^n V(kappa) with kappa = 2B / (A + B) in
 [0, 2], u = (A + B)(1 - kappa sin^2(phi / 2)): V depends on n and kappa only, so it is tabulated once per n
 (:func:`ring_table`: Chebyshev pieces to 1e-14, their errors carried; pieces next to kappa = 1, where V has a
-term |kappa - 1|^(n + 1/2), computed by quadrature when they cannot be fitted), and A + B = cos(x - x_mu)
+term |kappa - 1|^(n + 1/2), computed by quadrature when they cannot be fitted; for n < 1 the quadrature takes
+the arc's end, where the integrand's derivative is unbounded, in s = cos(phi / 2) = s0 + e^u), and A + B = cos(x - x_mu)
 keeps (A + B)^n = exp(n log1p(-2 sin^2((x - x_mu) / 2))) accurate for any n (a plain power of A + B cos(phi)
 lost n ulp: 2.2e-13 for n = 2000, measured).  The x integral (:func:`_integrate_chain`, adaptive 10/21) is cut
 at the levels of g (``Pumped.lobe(mu).levels``), at N.wo = mu and s (V's kappa = 1), around the lobe's peak
