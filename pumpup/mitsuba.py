@@ -766,6 +766,187 @@ class _PairG:
         return g_all
 
 
+class _CellQuintics:
+    """Functions F_j of the cosine m (a pumped chain's level bounds or the product of its g, :class:`_CellG`) as
+    quintics in fixed cells of m: 2^``bits`` cells per octave from 2^lo_oct (the first power of two above every level's
+    first node ``mu0``, below which a level's bound is a power law) up to 1, cell c = (bits(m) >> shift) - cbase, t =
+    m's bits below the shift / 2^shift in [0, 1) (the position in the cell, exact), and a cell of its own holding
+    F_j(1).  A look-up computes its cell from the bits of m and reads its coefficients, one gather each, with no search
+    and no index table: on Mitsuba's llvm variants that costs less than finding a piece of the level table
+    (:class:`_PairG`).  Each F_j is taken at most its cap.
+
+    Each cell's quintic interpolates F_j at the Chebyshev points of the cell and is lifted by three times its largest
+    miss at 65 points of the cell, plus 8 ulps of the sum of its coefficients' magnitudes (Horner's rounding): it is at
+    least F_j on the cell, so the plugin divides by at least pumpup's levelwise g and never returns more than pumpup.
+    A cell whose lift exceeds :data:`LIFT` of its smallest value (a kink of F_j in it) is ``bad``: the plugin looks
+    pairs with a cosine there up level by level.  The fewest bits of :data:`BITS` with the fewest bad cells; refused
+    (``ValueError``: the plugin then takes pumpup's product or level table) beyond :data:`MAX_BAD` of them.
+    ``reference`` is the plain numpy version of the look-up, the same operations in the same order.
+    """
+
+    #: the relative lift a cell may need (the plugin's values may lie this much further below pumpup's, per function)
+    LIFT = 1e-13
+    #: the cells per octave tried, 2^bits
+    BITS = (8, 9, 10)
+    #: the quintic
+    DEGREE = 5
+    #: the most cells that may miss (:attr:`bad`)
+    MAX_BAD = 4
+
+    def __init__(self, functions, caps, mu0: float):
+        self.lo_oct = math.floor(math.log2(mu0)) + 1
+        self.mlo = 2.0 ** self.lo_oct  # (the cells start here; the plugin looks smaller cosines up level by level)
+        self.caps = [float(c) for c in caps]
+        self.nfun = len(functions)
+        best = None
+        for bits in self.BITS:
+            coef, bad = self._fit(functions, bits)
+            if best is None or len(bad) < len(best[2]):
+                best = bits, coef, bad
+            if len(bad) == 0:
+                break
+        bits, coef, bad = best
+        if len(bad) > self.MAX_BAD:
+            raise ValueError(f"pumpup.mitsuba: {len(bad)} cells of a level's bound are not within its lift of "
+                             "quintics")
+        #: the cells whose quintics miss (a kink of a level's bound): pairs with a cosine there are looked up level by
+        #: level
+        self.bad = [int(c) for c in bad]
+        self.shift = 52 - bits
+        self.cbase = (1023 + self.lo_oct) << bits
+        self.ncell = coef.shape[0]
+        self.np = np.ascontiguousarray(coef.reshape(self.ncell, -1))  # row c: level 0's 6 coefficients, level 1's, ...
+        self.dr = _aligned_f64(self.np) if _jit() else None
+
+    def _fit(self, functions, bits):
+        """(the coefficients (cell, level, 6), highest power first, lifted; the cells whose lift exceeds LIFT)."""
+        from .physics.lookups import horner
+
+        deg = self.DEGREE
+        ncell = (-self.lo_oct << bits) + 1
+        c = np.arange(ncell - 1)
+        width = 2.0 ** (self.lo_oct + (c >> bits) - bits)
+        left = 2.0 ** (self.lo_oct + (c >> bits)) + (c & ((1 << bits) - 1)) * width
+        tk = 0.5 - 0.5 * np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
+        tt = np.linspace(0.0, 1.0, 65)
+        vander = np.vander(tk, deg + 1)  # coefficients (highest power first) -> values at tk
+        coef = np.zeros((ncell, len(functions), deg + 1))
+        bad = np.zeros(ncell - 1, dtype=bool)
+        for j, fn in enumerate(functions):
+            vk = fn(left[:, None] + width[:, None] * tk[None, :])
+            a = np.linalg.solve(vander, vk.T).T  # (solve: inverting the matrix first cost 1e-14)
+            vt = fn(left[:, None] + width[:, None] * tt[None, :])
+            pt = horner(a.T[:, :, None], tt[None, :])
+            lift = 3.0 * np.max(np.abs(vt - pt), axis=1) + 8.0 * np.finfo(float).eps * np.sum(np.abs(a), axis=1)
+            bad |= ~(lift <= self.LIFT * np.min(vt, axis=1))
+            a[:, -1] += lift
+            coef[:-1, j] = a
+            coef[-1, j, -1] = float(fn(np.array([1.0]))[0])  # the cell of m = 1: the function's value there
+        return coef, np.nonzero(bad)[0]
+
+    def _cell(self, bits):
+        """(cell, t) of the float64 bits of m >= mlo (numpy)."""
+        c = np.minimum((bits >> self.shift) - self.cbase, self.ncell - 1)
+        return c, (bits & ((1 << self.shift) - 1)).astype(np.float64) * 2.0**-self.shift
+
+    def in_bad(self, m):
+        """Whether m >= mlo lies in a cell of :attr:`bad` (numpy, Dr.Jit or a float)."""
+        if isinstance(m, (np.ndarray, float)):  # (numpy's float64 is a float)
+            c = self._cell(np.asarray(m, dtype=np.float64).view(np.int64))[0]
+            return np.isin(c, self.bad) if isinstance(m, np.ndarray) else bool(np.isin(c, self.bad))
+        c = (dr.reinterpret_array(mi.UInt64, m) >> self.shift) - self.cbase
+        out = dr.full(mi.Bool, False, dr.width(m))
+        for b in self.bad:
+            out |= c == b
+        return out
+
+    def reference(self, m):
+        """[F_1(m), ..., F_k(m)], each at most its cap, as the Dr.Jit look-up computes them (numpy; m >= mlo)."""
+        m = np.asarray(m, dtype=np.float64)
+        c, t = self._cell(m.view(np.int64))
+        rows = self.np[c]
+        deg = self.DEGREE
+        out = []
+        for j, cap in enumerate(self.caps):
+            u = _horner([rows[..., j * (deg + 1) + r] for r in range(deg + 1)], 0, deg, t)
+            out.append(np.minimum(u, cap) if math.isfinite(cap) else u)
+        return out
+
+    def __call__(self, m):
+        """:meth:`reference` in Dr.Jit (Float64 cosines; below mlo some valid cell's values)."""
+        if not _jit():
+            return [float(u) for u in self.reference(np.float64(m))]
+        mb = dr.reinterpret_array(mi.UInt64, m)
+        c = mi.UInt32(dr.minimum(dr.maximum(mb >> self.shift, self.cbase) - self.cbase, self.ncell - 1))
+        t = mi.Float64(mb & ((1 << self.shift) - 1)) * 2.0**-self.shift
+        deg = self.DEGREE
+        base = c * (self.nfun * (deg + 1))
+        out = []
+        for j, cap in enumerate(self.caps):
+            row = [dr.gather(mi.Float64, self.dr, base + (j * (deg + 1) + r)) for r in range(deg + 1)]
+            u = _horner(row, 0, deg, t)
+            out.append(dr.minimum(u, cap) if math.isfinite(cap) else u)
+        return out
+
+
+class _CellG:
+    """g_1 ... g_k of a pumped chain from :class:`_CellQuintics`.  Where every level's bound increases, one function of
+    m = max(N.wi, N.wo): G(m) = prod_j max(min(U_j(m), cap_j), m where controlled) (001 eq. 20, 21; pumpup's product
+    table), looked up once per pair.  Else each level's uncapped bound U_j, looked up at both cosines, and g_j =
+    max(min(U_j, cap_j) at N.wi, at N.wo), at least max(N.wi, N.wo) where controlled.  Both cosines above ``mlo``, and
+    not in a cell whose quintics miss (:meth:`in_bad`); the plugin looks the others up level by level.
+    """
+
+    def __init__(self, looks, controlled):
+        self.controlled = [bool(c) for c in controlled]
+        self.increasing = all(lk.increasing for lk in looks)
+        mu0 = max(float(lk.mu0) for lk in looks)
+        if self.increasing:
+            self.cells = _CellQuintics([self._product_of(looks)], [math.inf], mu0)
+        else:
+            self.cells = _CellQuintics([lambda m, lk=lk: lk.upper(m, capped=False) for lk in looks],
+                                       [lk.cap for lk in looks], mu0)
+        self.mlo = self.cells.mlo
+
+    def _product_of(self, looks):
+        def product(m):
+            g = np.ones_like(m)
+            for lk, controlled in zip(looks, self.controlled):
+                g = g * (np.maximum(lk.upper(m), m) if controlled else lk.upper(m))  # 001 eq. 20, 21
+            return g
+        return product
+
+    def _levels(self, ui, uo, mmax, maximum):
+        g_all = None
+        for j, controlled in enumerate(self.controlled):
+            g = maximum(ui[j], uo[j])  # 001 eq. 20
+            if controlled:
+                g = maximum(g, mmax)  # 001 eq. 21
+            g_all = g if g_all is None else g_all * g
+        return g_all
+
+    def in_bad(self, mi_, mo):
+        """Whether the pair looks a cosine up in a cell whose quintics miss (:attr:`_CellQuintics.bad`)."""
+        if self.increasing:
+            return self.cells.in_bad(dr.maximum(mi_, mo) if isinstance(mi_, mi.Float64) else np.maximum(mi_, mo))
+        return self.cells.in_bad(mi_) | self.cells.in_bad(mo)
+
+    def reference(self, mi_, mo):
+        """The plain numpy version (both cosines >= mlo)."""
+        mi_, mo = np.asarray(mi_, dtype=np.float64), np.asarray(mo, dtype=np.float64)
+        mmax = np.maximum(mi_, mo)
+        if self.increasing:
+            return self.cells.reference(mmax)[0]
+        return self._levels(self.cells.reference(mi_), self.cells.reference(mo), mmax, np.maximum)
+
+    def __call__(self, mi_, mo):
+        if not _jit():
+            return float(self.reference(mi_, mo))
+        mmax = dr.maximum(mi_, mo)
+        if self.increasing:
+            return self.cells(mmax)[0]
+        return self._levels(self.cells(mi_), self.cells(mo), mmax, dr.maximum)
+
 #: the largest float32, the type Mitsuba's JIT variants evaluate in
 FLOAT32_MAX = float(np.finfo(np.float32).max)
 
@@ -808,11 +989,14 @@ class _DrModel:
 
         #: one table for all levels where the chain has one: the product table G(max(N.wi, N.wo)) where every level's
         #: bound increases, else the level table (as pumpup's chain kernel chooses); None: level by level
-        self.fast: _ProductG | _PairG | None = None
+        self.fast: _CellG | _ProductG | _PairG | None = None
         if isinstance(base, Pumped):
-            prod = base.product()
-            table = base.level_table() if prod is None else None
-            self.fast = _ProductG(prod) if prod is not None else (_PairG(table) if table is not None else None)
+            try:  # every level's bound in fixed cells of the cosine, where quintics fit them
+                self.fast = _CellG([lev.lookup() for lev in base.chain()], [lev.controlled for lev in base.chain()])
+            except ValueError:
+                prod = base.product()
+                table = base.level_table() if prod is None else None
+                self.fast = _ProductG(prod) if prod is not None else (_PairG(table) if table is not None else None)
         while isinstance(base, Pumped):
             self.levels.append(_Level(base.lookup(), base.controlled))
             base = base.base
@@ -849,6 +1033,8 @@ class _DrModel:
             return self.fast(mi_, mo) if _jit() or dr.minimum(mi_, mo) > 0.0 else 1.0
         mmin = dr.minimum(mi_, mo)
         slow = (mmin <= self.fast.mlo) & (mmin > 0.0)
+        if getattr(getattr(self.fast, "cells", None), "bad", None):  # (and where a cell's quintics miss)
+            slow = slow | (self.fast.in_bad(mi_, mo) & (mmin > self.fast.mlo))
         if not _jit():
             return by_levels(mi_, mo) if (slow or mmin <= 0.0) else self.fast(mi_, mo)
         # the table's value outside the conditional, so that Dr.Jit shares it between sample() and eval() at the same

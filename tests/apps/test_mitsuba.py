@@ -155,17 +155,19 @@ def test_eval_agrees_with_pumpup_llvm(spec, rng):
     _check_agreement(spec, LLVM, 2000, rng)
 
 
-#: pumped chains whose levels' bounds are not all monotone (GGX's albedo falls, then rises): the plugin divides by
-#: the level table (one piece per cosine for every level), as pumpup's chain kernel does
+#: pumped chains whose levels' bounds are not all monotone (GGX's albedo falls, then rises), so that g depends on both
+#: cosines: the plugin looks every level's bound up in fixed cells of each cosine where quintics fit them
+#: (:class:`pumpup.mitsuba._CellG`; 2 levels: one cell misses, at a kink), else in the level table (one piece per
+#: cosine for every level), as pumpup's chain kernel does (3 levels: too many cells miss)
 LEVEL_TABLE = [{"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 2},
                {"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 3}]
 
 
 @needs_llvm
-@pytest.mark.parametrize("spec", LEVEL_TABLE, ids=_ids(LEVEL_TABLE))
-def test_level_table_chains_agree_with_pumpup_llvm(spec, rng):
+@pytest.mark.parametrize("spec,look_up", zip(LEVEL_TABLE, ["_CellG", "_PairG"]), ids=_ids(LEVEL_TABLE))
+def test_level_table_chains_agree_with_pumpup_llvm(spec, look_up, rng):
     pm.register(LLVM)
-    assert pm._DrModel(pumpup.load(spec)).fast.__class__.__name__ == "_PairG"
+    assert pm._DrModel(pumpup.load(spec)).fast.__class__.__name__ == look_up
     _check_agreement(spec, LLVM, 2000, rng)
 
 
@@ -183,18 +185,24 @@ def _table_points(t, rng):
     return x[x > t.mlo]
 
 
+def _table_g(f):
+    """The Dr.Jit look-up of pumpup's own table of a chain (the product table where it has one, else the level table)
+    and that table."""
+    t = f.product() if f.product() is not None else f.level_table()
+    return (pm._ProductG(t) if f.product() is not None else pm._PairG(t)), t
+
+
 @needs_llvm
 @pytest.mark.parametrize("spec", [PUMPED[0], LEVEL_TABLE[1], {**PUMPED[0], "levels": 3}],
                          ids=["product-2", "level-table-3", "product-3"])
 def test_table_kernels_equal_their_numpy_references(spec, rng):
     """The Dr.Jit look-ups of the product table and the level table (a cell gather, two-level cells where the pieces
-    crowd, one row per piece in 64-byte packets, Horner) against their plain numpy references, _Product.__call__ and
-    _LevelTable.g: the same pieces, the same value to the last bit, at random cosines and at both sides of every piece
-    start (crowded cells included)."""
+    crowd, one row per piece in 64-byte packets, Horner; the plugin's path where the cells of _CellG do not fit) against
+    their plain numpy references, _Product.__call__ and _LevelTable.g: the same pieces, the same value to the last bit,
+    at random cosines and at both sides of every piece start (crowded cells included)."""
     pm.register(LLVM)
     f = pumpup.load(spec)
-    fast = pm._DrModel(f).fast
-    t = f.product() if f.product() is not None else f.level_table()
+    fast, t = _table_g(f)
     x = _table_points(t, rng)
     y = rng.permutation(x)
     got = np.array(fast(mi.Float64(x), mi.Float64(y)), dtype=np.float64)
@@ -208,6 +216,97 @@ def test_table_kernels_equal_their_numpy_references(spec, rng):
         assert np.asarray(table).__array_interface__["data"][0] % 64 == 0
 
 
+#: chains whose g the plugin takes from fixed cells (:class:`pumpup.mitsuba._CellG`): each level's bound at both
+#: cosines (1-level and 2-level GGX, a 2-level Beckmann), the product of every level's g at the larger cosine where
+#: every level's bound increases (2- and 3-level Phong)
+CELL_CHAINS = [{"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 1}, LEVEL_TABLE[0],
+               {"type": "pumped", "base": {"type": "beckmann", "alpha": 0.05}, "g": "g1", "levels": 2},
+               PUMPED[0], {**PUMPED[0], "levels": 3}]
+
+
+def _cell_points(cells, rng):
+    """Cosines from a cell table's mlo to 1: uniform, log-uniform, the edges of every 7th cell and the floats below
+    them, 1, and the table's mlo."""
+    nc = cells.ncell - 1
+    c = np.arange(0, nc, 7) + cells.cbase
+    edges = (c << cells.shift).view(np.float64)
+    x = np.concatenate([rng.uniform(cells.mlo, 1.0, 4000), np.exp(rng.uniform(math.log(cells.mlo), 0.0, 4000)),
+                        edges, np.nextafter(edges, 0.0), [1.0, np.nextafter(1.0, 0.0), cells.mlo]])
+    return x[x >= cells.mlo]
+
+
+@needs_llvm
+@pytest.mark.parametrize("spec", CELL_CHAINS, ids=_ids(CELL_CHAINS))
+def test_cell_quintics_equal_their_numpy_reference_and_bound_pumpups_g(spec, rng):
+    """g from fixed cells (:class:`pumpup.mitsuba._CellG`): the Dr.Jit look-up equals its plain numpy reference to the
+    last bit (random and log-uniform cosines, both sides of cell edges, 1); outside the cells that miss (``bad``, where
+    the plugin looks pairs up level by level) it is at least pumpup's levelwise g (each level's Pumped.g), so the
+    plugin never exceeds pumpup, and at most LIFT (1e-13) per function above it."""
+    pm.register(LLVM)
+    f = pumpup.load(spec)
+    fast = pm._DrModel(f).fast
+    assert isinstance(fast, pm._CellG) and fast.increasing == (f.product() is not None)
+    cells = fast.cells
+    assert len(cells.bad) <= cells.MAX_BAD and cells.nfun == (1 if fast.increasing else spec.get("levels", 1))
+    x = _cell_points(cells, rng)
+    y = rng.permutation(x)
+    got = np.array(fast(mi.Float64(x), mi.Float64(y)), dtype=np.float64)
+    ref = fast.reference(x, y)
+    assert np.array_equal(got, ref)
+    assert np.array_equal(np.array(fast.in_bad(mi.Float64(x), mi.Float64(y))), fast.in_bad(x, y))
+    good = ~fast.in_bad(x, y)
+    assert good.mean() > 0.95
+    levelwise = np.ones(len(x))
+    for lev in f.chain():
+        levelwise = levelwise * lev.g(x, y)
+    assert np.all(ref[good] >= levelwise[good])
+    assert np.all(ref[good] <= levelwise[good] * (1.0 + cells.LIFT) ** cells.nfun * (1.0 + 1e-15))
+
+
+def test_cell_quintics_mark_a_kink_as_bad():
+    """A function with a kink inside one cell: that cell's quintic cannot come within LIFT of it, so it is bad, and the
+    others are not; beyond MAX_BAD such cells the table is refused."""
+    kink = 0.6 + 1e-4
+
+    def fn(m):
+        return 0.5 + np.abs(m - kink)
+
+    cells = pm._CellQuintics([fn], [math.inf], 1e-8)
+    assert len(cells.bad) == 1
+    c = (np.float64(kink).view(np.int64) >> cells.shift) - cells.cbase
+    assert cells.bad == [int(c)]
+    kinks = 0.6 + 0.01 * np.arange(cells.MAX_BAD + 1)
+    with pytest.raises(ValueError, match="not within its lift"):
+        pm._CellQuintics([lambda m: 0.5 + np.min(np.abs(m[..., None] - kinks), axis=-1)], [math.inf], 1e-8)
+
+
+@needs_llvm
+@pytest.mark.parametrize("spec", [CELL_CHAINS[1], PUMPED[0]], ids=["levels-2", "product-2"])
+def test_pairs_in_cells_that_miss_agree_with_pumpup(spec, rng):
+    """Pairs whose cosines lie in the cells whose quintics miss (and just outside them): the plugin looks them up
+    level by level, within one rounding of pumpup's eval and never above it."""
+    pm.register(LLVM)
+    f = pumpup.load(spec)
+    cells = pm._DrModel(f).fast.cells
+    assert cells.bad
+    lo = ((np.array(cells.bad) + cells.cbase) << cells.shift).view(np.float64)
+    hi = ((np.array(cells.bad) + cells.cbase + 1) << cells.shift).view(np.float64)
+    z = np.concatenate([rng.uniform(lo[:, None], hi[:, None], (len(lo), 200)).ravel(), lo, np.nextafter(lo, 0.0)])
+    z = z[z < 1.0].astype(np.float32).astype(np.float64)
+    ph = rng.uniform(0, 2 * np.pi, len(z))
+    s = np.sqrt(1 - z * z)
+    wi = np.stack([s * np.cos(ph), s * np.sin(ph), z], -1).astype(np.float32).astype(np.float64)
+    wo = np.stack([-wi[:, 0], -wi[:, 1], rng.uniform(0.05, 1.0, len(z))], -1)  # near the mirror for half the pairs
+    wo[::2] = wi[::2] * np.array([-1.0, -1.0, 1.0])
+    wo = (wo / np.linalg.norm(wo, axis=1)[:, None]).astype(np.float32).astype(np.float64)
+    b = pm.load_dict({"type": "pumpup", "spec": spec})
+    got, _ = _plugin_eval(b, wi, wo)
+    ref = f.eval(wi, wo) * wi[:, 2]
+    assert np.all(got <= ref * (1 + 1e-12))
+    assert np.all(np.abs(got - ref) <= (2.0**-23 + F32) * ref + np.finfo(np.float32).tiny)
+    assert np.sum(ref > 0) > len(z) // 2
+
+
 @needs_llvm
 def test_level_table_below_mlo_is_the_level_by_level_power_law(rng):
     """Float32 cosines at or below the level table's mlo (down to the smallest float32), paired with any cosine: the
@@ -215,7 +314,7 @@ def test_level_table_below_mlo_is_the_level_by_level_power_law(rng):
     error it allows itself (1e-13 per level from the float32 logarithm of the mantissa)."""
     pm.register(LLVM)
     f = pumpup.load(LEVEL_TABLE[1])
-    fast = pm._DrModel(f).fast
+    fast = _table_g(f)[0]
     assert fast.below is not None and fast.cheap_log
     low = np.exp(rng.uniform(math.log(1.5e-45), math.log(fast.mlo), 3000)).astype(np.float32).astype(np.float64)
     low = np.concatenate([low[low > 0], [float(np.float32(1e-8)), float(np.finfo(np.float32).smallest_subnormal)]])
@@ -233,12 +332,17 @@ def test_table_kernels_scalar_equal_their_numpy_references(rng):
     pm.register("scalar_rgb")
     for spec in (PUMPED[0], LEVEL_TABLE[0]):
         f = pumpup.load(spec)
-        fast = pm._DrModel(f).fast
-        t = f.product() if f.product() is not None else f.level_table()
+        fast, t = _table_g(f)
         x = _table_points(t, rng)[::40]
         y = rng.permutation(x)
         ref = t(np.maximum(x, y)) if f.product() is not None else t.g(x, y)
         assert [fast(float(a), float(b)) for a, b in zip(x, y)] == list(ref)
+        cell = pm._DrModel(f).fast  # the fixed cells, in scalar variants through their numpy reference
+        assert isinstance(cell, pm._CellG)
+        x = _cell_points(cell.cells, rng)[::40]
+        y = rng.permutation(x)
+        assert [cell(float(a), float(b)) for a, b in zip(x, y)] == list(cell.reference(x, y))
+        assert [cell.in_bad(float(a), float(b)) for a, b in zip(x, y)] == list(cell.in_bad(x, y))
 
 
 @needs_llvm
