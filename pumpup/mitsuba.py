@@ -48,8 +48,11 @@ The BSDF
     the result rounded once to Mitsuba's float32; only the sampler's azimuth sine and cosine are float32, of the
     float32 sample), so in ``llvm_*`` variants it is traced into Mitsuba's kernels; in ``scalar_*`` variants the
     same code runs on Python floats.  A pumped model divides by the same upper bounds of the albedo tables as
-    pumpup's compiled kernel (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`), through the
-    same table of all levels: the product table G(m) where every level's bound increases
+    pumpup's compiled kernel (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`): from quintics
+    in fixed cells of the cosine, each at least the bound and within 1e-13 of it (:class:`_CellG`, its cell and the
+    position in it from the cosine's bits, no search), with pairs in the few cells where a bound has a kink and below
+    the cells level by level; where the quintics miss in more cells, through pumpup's table of all levels: the
+    product table G(m) where every level's bound increases
     (:class:`pumpup.operators.pumping._Product`, m = max(N.wi, N.wo)), else the level table
     (:class:`pumpup.operators.pumping._LevelTable`: every level's bound on one set of pieces, one piece per cosine
     for all levels), else level by level.  A piece is found from the float64 bits of the cosine with one read of a
