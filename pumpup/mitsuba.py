@@ -48,10 +48,10 @@ The BSDF
     the result rounded once to Mitsuba's float32; only the sampler's azimuth sine and cosine are float32, of the
     float32 sample), so in ``llvm_*`` variants it is traced into Mitsuba's kernels; in ``scalar_*`` variants the
     same code runs on Python floats.  A pumped model divides by the same upper bounds of the albedo tables as
-    pumpup's compiled kernel (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`): from quintics
+    pumpup's compiled kernel (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`): from quartics
     in fixed cells of the cosine, each at least the bound and within 1e-13 of it (:class:`_CellG`, its cell and the
     position in it from the cosine's bits, no search), with pairs in the few cells where a bound has a kink and below
-    the cells level by level; where the quintics miss in more cells, through pumpup's table of all levels: the
+    the cells level by level; where the quartics miss in more cells, through pumpup's table of all levels: the
     product table G(m) where every level's bound increases
     (:class:`pumpup.operators.pumping._Product`, m = max(N.wi, N.wo)), else the level table
     (:class:`pumpup.operators.pumping._LevelTable`: every level's bound on one set of pieces, one piece per cosine
@@ -769,21 +769,27 @@ class _PairG:
         return g_all
 
 
-class _CellQuintics:
+class _CellsMiss(ValueError):
+    """Raised by :class:`_CellPolynomials` where more than MAX_BAD cells miss: the plugin takes pumpup's tables."""
+
+
+class _CellPolynomials:
     """Functions F_j of the cosine m (a pumped chain's level bounds or the product of its g, :class:`_CellG`) as
-    quintics in fixed cells of m: 2^``bits`` cells per octave from 2^lo_oct (the first power of two above every level's
+    quartics in fixed cells of m: 2^``bits`` cells per octave from 2^lo_oct (the first power of two above every level's
     first node ``mu0``, below which a level's bound is a power law) up to 1, cell c = (bits(m) >> shift) - cbase, t =
     m's bits below the shift / 2^shift in [0, 1) (the position in the cell, exact), and a cell of its own holding
     F_j(1).  A look-up computes its cell from the bits of m and reads its coefficients, one gather each, with no search
     and no index table: on Mitsuba's llvm variants that costs less than finding a piece of the level table
     (:class:`_PairG`).  Each F_j is taken at most its cap.
 
-    Each cell's quintic interpolates F_j at the Chebyshev points of the cell and is lifted by three times its largest
+    Each cell's quartic interpolates F_j at the Chebyshev points of the cell and is lifted by three times its largest
     miss at 65 points of the cell, plus 8 ulps of the sum of its coefficients' magnitudes (Horner's rounding): it is at
     least F_j on the cell, so the plugin divides by at least pumpup's levelwise g and never returns more than pumpup.
-    A cell whose lift exceeds :data:`LIFT` of its smallest value (a kink of F_j in it) is ``bad``: the plugin looks
-    pairs with a cosine there up level by level.  The fewest bits of :data:`BITS` with the fewest bad cells; refused
-    (``ValueError``: the plugin then takes pumpup's product or level table) beyond :data:`MAX_BAD` of them.
+    A cell whose quartic, lifted, may lie more than :data:`LIFT` of its smallest value above F_j (a kink of F_j in it:
+    the lift plus the miss) is split at the kink where the chain knows of one, else ``bad``: the plugin looks
+    pairs with a cosine there up level by level.  The fewest bits of :data:`BITS` with the fewest bad cells, then the
+    fewest split cells; refused (:class:`_CellsMiss`: the plugin then takes pumpup's product or level table) beyond
+    :data:`MAX_BAD` bad or :data:`MAX_SPLITS` split cells.
     ``reference`` is the plain numpy version of the look-up, the same operations in the same order.
     """
 
@@ -791,66 +797,123 @@ class _CellQuintics:
     LIFT = 1e-13
     #: the cells per octave tried, 2^bits
     BITS = (8, 9, 10)
-    #: the quintic
-    DEGREE = 5
+    #: the quartic (five reads per look-up; quintics fit with fewer cells but cost one more read, 3-5 % of a
+    #: sample and an eval of pumped GGX or Phong)
+    DEGREE = 4
     #: the most cells that may miss (:attr:`bad`)
     MAX_BAD = 4
+    #: the most kinks at which one cell is split, and the most split cells (each costs a few selects per look-up)
+    MAX_KINKS = 3
+    MAX_SPLITS = 4
 
-    def __init__(self, functions, caps, mu0: float):
+    def __init__(self, functions, caps, mu0: float, kinks=()):
         self.lo_oct = math.floor(math.log2(mu0)) + 1
         self.mlo = 2.0 ** self.lo_oct  # (the cells start here; the plugin looks smaller cosines up level by level)
         self.caps = [float(c) for c in caps]
         self.nfun = len(functions)
+        kinks = np.sort(np.asarray(kinks, dtype=np.float64))
         best = None
-        for bits in self.BITS:
-            coef, bad = self._fit(functions, bits)
-            if best is None or len(bad) < len(best[2]):
-                best = bits, coef, bad
-            if len(bad) == 0:
+        for bits in self.BITS:  # (the fewest cells that miss, then the fewest split cells, then the fewest bits)
+            fit = self._fit(functions, bits, kinks)
+            if best is None or (len(fit[2]), len(fit[1])) < (len(best[3]), len(best[2])):
+                best = (bits, *fit)
+            if len(fit[1]) + len(fit[2]) == 0:
                 break
-        bits, coef, bad = best
-        if len(bad) > self.MAX_BAD:
-            raise ValueError(f"pumpup.mitsuba: {len(bad)} cells of a level's bound are not within its lift of "
-                             "quintics")
-        #: the cells whose quintics miss (a kink of a level's bound): pairs with a cosine there are looked up level by
-        #: level
+        bits, coef, splits, bad = best
+        if len(bad) > self.MAX_BAD or len(splits) > self.MAX_SPLITS:
+            raise _CellsMiss(f"pumpup.mitsuba: {len(bad)} cells of a level's bound are not within its lift of "
+                             f"quartics and {len(splits)} are split at kinks")
+        #: the cells split at kinks of a function, (cell, [t of each kink], the row of its first piece): their pieces'
+        #: rows follow the cells'
+        self.splits = []
+        row = coef.shape[0] - sum(len(tk) + 1 for _, tk in splits)
+        for c, tk in splits:
+            self.splits.append((int(c), tk, row))
+            row += len(tk) + 1
+        #: the cells whose quartics miss even so: pairs with a cosine there are looked up level by level
         self.bad = [int(c) for c in bad]
         self.shift = 52 - bits
         self.cbase = (1023 + self.lo_oct) << bits
-        self.ncell = coef.shape[0]
-        self.np = np.ascontiguousarray(coef.reshape(self.ncell, -1))  # row c: level 0's 6 coefficients, level 1's, ...
+        self.ncell = coef.shape[0] - sum(len(tk) + 1 for _, tk in splits)
+        self.np = np.ascontiguousarray(coef.reshape(coef.shape[0], -1))  # row c: F_1's 5 coefficients, F_2's, ...
         self.dr = _aligned_f64(self.np) if _jit() else None
 
-    def _fit(self, functions, bits):
-        """(the coefficients (cell, level, 6), highest power first, lifted; the cells whose lift exceeds LIFT)."""
-        from .physics.lookups import horner
-
-        deg = self.DEGREE
+    def _fit(self, functions, bits, kinks):
+        """(the coefficients (row, function, 5), highest power first, lifted: the cells', then one row per piece of
+        each split cell; the splits [(cell, [t of each kink])]; the cells that still miss).  A cell whose lift exceeds
+        LIFT is split at all the ``kinks`` inside it (at most MAX_KINKS), else at the first one, where every piece is
+        within LIFT.
+        """
         ncell = (-self.lo_oct << bits) + 1
         c = np.arange(ncell - 1)
         width = 2.0 ** (self.lo_oct + (c >> bits) - bits)
         left = 2.0 ** (self.lo_oct + (c >> bits)) + (c & ((1 << bits) - 1)) * width
+        coef, ok = self._pieces(functions, left, width, 0.0)
+        coef = np.concatenate([coef, np.zeros((1, *coef.shape[1:]))])
+        for j, fn in enumerate(functions):
+            coef[-1, j, -1] = float(fn(np.array([1.0]))[0])  # the cell of m = 1: the function's value there
+        rows, splits, bad = [coef], [], []
+        for i in np.nonzero(~ok)[0]:
+            inside = np.unique(kinks[(kinks > left[i]) & (kinks < left[i] + width[i])])
+            tries = ([inside] if 1 < len(inside) <= self.MAX_KINKS else []) + [inside[k:k + 1] for k in
+                                                                               range(len(inside))]
+            for x in tries:
+                ends = np.concatenate([[0.0], (x - left[i]) / width[i], [1.0]])
+                pieces, fits = self._pieces(functions, left[i] + width[i] * ends[:-1], width[i] * np.diff(ends), 1e-14)
+                if np.all(fits):
+                    rows.append(pieces)
+                    splits.append((i, [float(v) for v in ends[1:-1]]))
+                    break
+            else:
+                bad.append(i)
+        return np.concatenate(rows), splits, bad
+
+    def _pieces(self, functions, left, width, margin):
+        """(the lifted quartics (piece, function, 5) of every function on the pieces [left, left + width], in t in
+        [0, 1]; whether each piece's lift is within LIFT).  ``margin``: a further lift, relative to the function's
+        largest value on the piece (a split cell's halves: the kink's position is known to a few ulps).
+        """
+        from .physics.lookups import horner
+
+        deg = self.DEGREE
         tk = 0.5 - 0.5 * np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
         tt = np.linspace(0.0, 1.0, 65)
         vander = np.vander(tk, deg + 1)  # coefficients (highest power first) -> values at tk
-        coef = np.zeros((ncell, len(functions), deg + 1))
-        bad = np.zeros(ncell - 1, dtype=bool)
+        coef = np.zeros((len(left), len(functions), deg + 1))
+        ok = np.ones(len(left), dtype=bool)
         for j, fn in enumerate(functions):
             vk = fn(left[:, None] + width[:, None] * tk[None, :])
             a = np.linalg.solve(vander, vk.T).T  # (solve: inverting the matrix first cost 1e-14)
             vt = fn(left[:, None] + width[:, None] * tt[None, :])
             pt = horner(a.T[:, :, None], tt[None, :])
-            lift = 3.0 * np.max(np.abs(vt - pt), axis=1) + 8.0 * np.finfo(float).eps * np.sum(np.abs(a), axis=1)
-            bad |= ~(lift <= self.LIFT * np.min(vt, axis=1))
+            miss = np.max(np.abs(vt - pt), axis=1)
+            lift = (3.0 * miss + 8.0 * np.finfo(float).eps * np.sum(np.abs(a), axis=1)
+                    + margin * np.max(np.abs(vt), axis=1))
+            ok &= lift + miss <= self.LIFT * np.min(vt, axis=1)  # (the most the lifted quartic lies above)
             a[:, -1] += lift
-            coef[:-1, j] = a
-            coef[-1, j, -1] = float(fn(np.array([1.0]))[0])  # the cell of m = 1: the function's value there
-        return coef, np.nonzero(bad)[0]
+            coef[:, j] = a
+        return coef, ok
 
     def _cell(self, bits):
         """(cell, t) of the float64 bits of m >= mlo (numpy)."""
         c = np.minimum((bits >> self.shift) - self.cbase, self.ncell - 1)
         return c, (bits & ((1 << self.shift) - 1)).astype(np.float64) * 2.0**-self.shift
+
+    def _halves(self, c, t, select):
+        """(row, t) after the splits: in a split cell, the row of the piece that holds t and t's position in that
+        piece, (t - t_i) / (t_(i+1) - t_i) between its kinks t_i (``select``: numpy's where or Dr.Jit's select).
+        """
+        for cell, kinks, first in self.splits:
+            ends = [0.0, *kinks, 1.0]
+            row, start, scale = c * 0 + first, t * 0.0, t * 0.0 + 1.0 / ends[1]
+            for i, tk in enumerate(kinks):
+                right = t >= tk
+                row = select(right, first + i + 1, row)
+                start = select(right, tk, start)
+                scale = select(right, 1.0 / (ends[i + 2] - tk), scale)
+            hit = c == cell
+            c, t = select(hit, row, c), select(hit, (t - start) * scale, t)
+        return c, t
 
     def in_bad(self, m):
         """Whether m >= mlo lies in a cell of :attr:`bad` (numpy, Dr.Jit or a float)."""
@@ -866,7 +929,7 @@ class _CellQuintics:
     def reference(self, m):
         """[F_1(m), ..., F_k(m)], each at most its cap, as the Dr.Jit look-up computes them (numpy; m >= mlo)."""
         m = np.asarray(m, dtype=np.float64)
-        c, t = self._cell(m.view(np.int64))
+        c, t = self._halves(*self._cell(m.view(np.int64)), np.where)
         rows = self.np[c]
         deg = self.DEGREE
         out = []
@@ -882,6 +945,7 @@ class _CellQuintics:
         mb = dr.reinterpret_array(mi.UInt64, m)
         c = mi.UInt32(dr.minimum(dr.maximum(mb >> self.shift, self.cbase) - self.cbase, self.ncell - 1))
         t = mi.Float64(mb & ((1 << self.shift) - 1)) * 2.0**-self.shift
+        c, t = self._halves(c, t, dr.select)
         deg = self.DEGREE
         base = c * (self.nfun * (deg + 1))
         out = []
@@ -893,23 +957,36 @@ class _CellQuintics:
 
 
 class _CellG:
-    """g_1 ... g_k of a pumped chain from :class:`_CellQuintics`.  Where every level's bound increases, one function of
-    m = max(N.wi, N.wo): G(m) = prod_j max(min(U_j(m), cap_j), m where controlled) (001 eq. 20, 21; pumpup's product
+    """g_1 ... g_k of a pumped chain from :class:`_CellPolynomials`.  Where every level's bound increases, one function
+    of m = max(N.wi, N.wo): G(m) = prod_j max(min(U_j(m), cap_j), m where controlled) (001 eq. 20, 21; pumpup's product
     table), looked up once per pair.  Else each level's uncapped bound U_j, looked up at both cosines, and g_j =
     max(min(U_j, cap_j) at N.wi, at N.wo), at least max(N.wi, N.wo) where controlled.  Both cosines above ``mlo``, and
-    not in a cell whose quintics miss (:meth:`in_bad`); the plugin looks the others up level by level.
+    not in a cell whose quartics miss (:meth:`in_bad`); the plugin looks the others up level by level.
     """
 
     def __init__(self, looks, controlled):
         self.controlled = [bool(c) for c in controlled]
         self.increasing = all(lk.increasing for lk in looks)
         mu0 = max(float(lk.mu0) for lk in looks)
+        kinks = self._kinks(looks, mu0)
         if self.increasing:
-            self.cells = _CellQuintics([self._product_of(looks)], [math.inf], mu0)
+            self.cells = _CellPolynomials([self._product_of(looks)], [math.inf], mu0, kinks)
         else:
-            self.cells = _CellQuintics([lambda m, lk=lk: lk.upper(m, capped=False) for lk in looks],
-                                       [lk.cap for lk in looks], mu0)
+            self.cells = _CellPolynomials([lambda m, lk=lk: lk.upper(m, capped=False) for lk in looks],
+                                       [lk.cap for lk in looks], mu0, kinks)
         self.mlo = self.cells.mlo
+
+    def _kinks(self, looks, mu0):
+        """Where a function of the cells may have a kink: the levels' spline breakpoints (pumpup's albedo kinks among
+        them) and flat pieces' ends, where a bound crosses its cap, and, for the product, where a controlled level's
+        bound meets m (001 eq. 21).
+        """
+        from .operators.pumping import _level_breaks, _meet_kinks
+
+        br = _level_breaks(looks, mu0)  # (the knots, every eighth of an octave and the cap crossings)
+        flats = [x for lk in looks for a, b, _ in lk.flats for x in (a, b)]
+        meets = _meet_kinks([lk for lk, c in zip(looks, self.controlled) if c], br) if self.increasing else []
+        return np.concatenate([br, flats, meets])
 
     def _product_of(self, looks):
         def product(m):
@@ -929,7 +1006,7 @@ class _CellG:
         return g_all
 
     def in_bad(self, mi_, mo):
-        """Whether the pair looks a cosine up in a cell whose quintics miss (:attr:`_CellQuintics.bad`)."""
+        """Whether the pair looks a cosine up in a cell whose quartics miss (:attr:`_CellPolynomials.bad`)."""
         if self.increasing:
             return self.cells.in_bad(dr.maximum(mi_, mo) if isinstance(mi_, mi.Float64) else np.maximum(mi_, mo))
         return self.cells.in_bad(mi_) | self.cells.in_bad(mo)
@@ -994,9 +1071,9 @@ class _DrModel:
         #: bound increases, else the level table (as pumpup's chain kernel chooses); None: level by level
         self.fast: _CellG | _ProductG | _PairG | None = None
         if isinstance(base, Pumped):
-            try:  # every level's bound in fixed cells of the cosine, where quintics fit them
+            try:  # every level's bound in fixed cells of the cosine, where quartics fit them
                 self.fast = _CellG([lev.lookup() for lev in base.chain()], [lev.controlled for lev in base.chain()])
-            except ValueError:
+            except _CellsMiss:
                 prod = base.product()
                 table = base.level_table() if prod is None else None
                 self.fast = _ProductG(prod) if prod is not None else (_PairG(table) if table is not None else None)
@@ -1036,7 +1113,7 @@ class _DrModel:
             return self.fast(mi_, mo) if _jit() or dr.minimum(mi_, mo) > 0.0 else 1.0
         mmin = dr.minimum(mi_, mo)
         slow = (mmin <= self.fast.mlo) & (mmin > 0.0)
-        if getattr(getattr(self.fast, "cells", None), "bad", None):  # (and where a cell's quintics miss)
+        if getattr(getattr(self.fast, "cells", None), "bad", None):  # (and where a cell's quartics miss)
             slow = slow | (self.fast.in_bad(mi_, mo) & (mmin > self.fast.mlo))
         if not _jit():
             return by_levels(mi_, mo) if (slow or mmin <= 0.0) else self.fast(mi_, mo)

@@ -57,9 +57,9 @@ MODELS = [
 
 #: ``--parts``: (label, [(text of pumpup/mitsuba.py, what replaces it), ...]) -- the pumped value without g (the base,
 #: its rounding down and the mask: what the look-up adds to is left); the tables' cells and rows read (the level
-#: table's for both cosines, the product table's for the larger, the fixed cells' coefficients of _CellQuintics) with
+#: table's for both cosines, the product table's for the larger, the fixed cells' coefficients of _CellPolynomials) with
 #: only a sum of what was read in place of the polynomials, power laws and maxima; and the level-by-level path (pairs
-#: with a cosine at or below the table's mlo, or in a fixed cell whose quintic misses) left out
+#: with a cosine at or below the table's mlo, or in a fixed cell whose quartic misses) left out
 PARTS = [
     ("g = 1", [("val = _div(val, self.g(wl[2], v[2])) * self.ROUND_DOWN", "val = val * self.ROUND_DOWN")]),
     ("table reads only", [
@@ -75,7 +75,7 @@ PARTS = [
          "            acc = acc + x\n"
          "        return 1.0 + 1e-30 * acc\n"),
         ("            u = _horner(row, 0, deg, t)\n",
-         "            u = 1.0 + 1e-30 * (row[0] + row[1] + row[2] + row[3] + row[4] + row[5])\n")]),
+         "            u = 1.0 + 1e-30 * sum(row[1:], row[0])\n")]),
     ("no level-by-level path", [
         ("        return dr.if_stmt((mi_, mo, g), slow, lambda a, b, g: by_levels(a, b), lambda a, b, g: g)\n",
          "        return g\n")]),

@@ -156,7 +156,7 @@ def test_eval_agrees_with_pumpup_llvm(spec, rng):
 
 
 #: pumped chains whose levels' bounds are not all monotone (GGX's albedo falls, then rises), so that g depends on both
-#: cosines: the plugin looks every level's bound up in fixed cells of each cosine where quintics fit them
+#: cosines: the plugin looks every level's bound up in fixed cells of each cosine where quartics fit them
 #: (:class:`pumpup.mitsuba._CellG`; 2 levels: one cell misses, at a kink), else in the level table (one piece per
 #: cosine for every level), as pumpup's chain kernel does (3 levels: too many cells miss)
 LEVEL_TABLE = [{"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 2},
@@ -218,36 +218,53 @@ def test_table_kernels_equal_their_numpy_references(spec, rng):
 
 #: chains whose g the plugin takes from fixed cells (:class:`pumpup.mitsuba._CellG`): each level's bound at both
 #: cosines (1-level and 2-level GGX, a 2-level Beckmann), the product of every level's g at the larger cosine where
-#: every level's bound increases (2- and 3-level Phong)
+#: every level's bound increases (2-level Phong)
 CELL_CHAINS = [{"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 1}, LEVEL_TABLE[0],
-               {"type": "pumped", "base": {"type": "beckmann", "alpha": 0.05}, "g": "g1", "levels": 2},
-               PUMPED[0], {**PUMPED[0], "levels": 3}]
+               {"type": "pumped", "base": {"type": "beckmann", "alpha": 0.05}, "g": "g1", "levels": 2}, PUMPED[0]]
+
+
+def _cell_range(cells, c):
+    """The cosines [lo, hi) of cells ``c`` of a cell table."""
+    c = np.asarray(c, dtype=np.int64) + cells.cbase
+    return (c << cells.shift).view(np.float64), ((c + 1) << cells.shift).view(np.float64)
+
+
+def _kink_points(cells, rng):
+    """Cosines in the cells split at kinks and in the cells that miss: 50 random ones in each, and every kink with
+    the floats on both sides of it."""
+    split = [c for c, _, _ in cells.splits]
+    lo, hi = _cell_range(cells, split + cells.bad)
+    x = [rng.uniform(lo[:, None], hi[:, None], (len(lo), 50)).ravel(), lo]
+    for (c, kinks, _), a, b in zip(cells.splits, lo, hi):
+        k = a + (b - a) * np.array(kinks)
+        x += [k, np.nextafter(k, 0.0), np.nextafter(k, 2.0)]
+    return np.concatenate(x)
 
 
 def _cell_points(cells, rng):
     """Cosines from a cell table's mlo to 1: uniform, log-uniform, the edges of every 7th cell and the floats below
-    them, 1, and the table's mlo."""
-    nc = cells.ncell - 1
-    c = np.arange(0, nc, 7) + cells.cbase
-    edges = (c << cells.shift).view(np.float64)
+    them, 1, the table's mlo, and those of :func:`_kink_points`."""
+    lo, _ = _cell_range(cells, np.arange(0, cells.ncell - 1, 7))
     x = np.concatenate([rng.uniform(cells.mlo, 1.0, 4000), np.exp(rng.uniform(math.log(cells.mlo), 0.0, 4000)),
-                        edges, np.nextafter(edges, 0.0), [1.0, np.nextafter(1.0, 0.0), cells.mlo]])
-    return x[x >= cells.mlo]
+                        lo, np.nextafter(lo, 0.0), [1.0, np.nextafter(1.0, 0.0), cells.mlo], _kink_points(cells, rng)])
+    return x[(x >= cells.mlo) & (x <= 1.0)]
 
 
 @needs_llvm
 @pytest.mark.parametrize("spec", CELL_CHAINS, ids=_ids(CELL_CHAINS))
-def test_cell_quintics_equal_their_numpy_reference_and_bound_pumpups_g(spec, rng):
+def test_cell_polynomials_equal_their_numpy_reference_and_bound_pumpups_g(spec, rng):
     """g from fixed cells (:class:`pumpup.mitsuba._CellG`): the Dr.Jit look-up equals its plain numpy reference to the
-    last bit (random and log-uniform cosines, both sides of cell edges, 1); outside the cells that miss (``bad``, where
-    the plugin looks pairs up level by level) it is at least pumpup's levelwise g (each level's Pumped.g), so the
-    plugin never exceeds pumpup, and at most LIFT (1e-13) per function above it."""
+    last bit (random and log-uniform cosines, both sides of cell edges, in and about the cells split at kinks, 1);
+    outside the cells that miss (``bad``, where the plugin looks pairs up level by level) it is at least pumpup's
+    levelwise g (from each level's look-up, as pumpup's kernels divide by it), so the plugin never exceeds pumpup, and
+    at most LIFT (1e-13) per function above it."""
     pm.register(LLVM)
     f = pumpup.load(spec)
     fast = pm._DrModel(f).fast
     assert isinstance(fast, pm._CellG) and fast.increasing == (f.product() is not None)
     cells = fast.cells
-    assert len(cells.bad) <= cells.MAX_BAD and cells.nfun == (1 if fast.increasing else spec.get("levels", 1))
+    assert len(cells.bad) <= cells.MAX_BAD and len(cells.splits) <= cells.MAX_SPLITS
+    assert cells.nfun == (1 if fast.increasing else spec.get("levels", 1))
     x = _cell_points(cells, rng)
     y = rng.permutation(x)
     got = np.array(fast(mi.Float64(x), mi.Float64(y)), dtype=np.float64)
@@ -257,42 +274,51 @@ def test_cell_quintics_equal_their_numpy_reference_and_bound_pumpups_g(spec, rng
     good = ~fast.in_bad(x, y)
     assert good.mean() > 0.95
     levelwise = np.ones(len(x))
-    for lev in f.chain():
-        levelwise = levelwise * lev.g(x, y)
+    for lev in f.chain():  # as pumpup's kernels compute it, from each level's look-up (where a level's bound dips
+        lk = lev.lookup()  # within its margin, the look-up takes its running maximum)
+        g = np.maximum(lk.upper(x), lk.upper(y))  # 001 eq. 20
+        levelwise = levelwise * (np.maximum(g, np.maximum(x, y)) if lev.controlled else g)  # 001 eq. 21
     assert np.all(ref[good] >= levelwise[good])
     assert np.all(ref[good] <= levelwise[good] * (1.0 + cells.LIFT) ** cells.nfun * (1.0 + 1e-15))
 
 
-def test_cell_quintics_mark_a_kink_as_bad():
-    """A function with a kink inside one cell: that cell's quintic cannot come within LIFT of it, so it is bad, and the
-    others are not; beyond MAX_BAD such cells the table is refused."""
+def test_cell_polynomials_split_a_cell_at_a_kink_or_mark_it():
+    """A function with a kink inside one cell: no quartic comes within LIFT of it there.  Told where the kink is, the
+    table splits that cell there (two quartics, each within LIFT, at least the function on either side); not told, it
+    marks the cell as missing.  Beyond MAX_BAD such cells the table is refused."""
     kink = 0.6 + 1e-4
 
     def fn(m):
         return 0.5 + np.abs(m - kink)
 
-    cells = pm._CellQuintics([fn], [math.inf], 1e-8)
-    assert len(cells.bad) == 1
-    c = (np.float64(kink).view(np.int64) >> cells.shift) - cells.cbase
-    assert cells.bad == [int(c)]
-    kinks = 0.6 + 0.01 * np.arange(cells.MAX_BAD + 1)
-    with pytest.raises(ValueError, match="not within its lift"):
-        pm._CellQuintics([lambda m: 0.5 + np.min(np.abs(m[..., None] - kinks), axis=-1)], [math.inf], 1e-8)
+    marked = pm._CellPolynomials([fn], [math.inf], 1e-8)
+    c = (np.float64(kink).view(np.int64) >> marked.shift) - marked.cbase
+    assert marked.bad == [int(c)] and marked.splits == []
+    split = pm._CellPolynomials([fn], [math.inf], 1e-8, kinks=[0.3, kink])
+    assert split.bad == [] and [(a, len(b)) for a, b, _ in split.splits] == [(int(c), 1)]
+    m = np.concatenate([np.linspace(*_cell_range(split, [c]), 2001)[:, 0], [kink, np.nextafter(kink, 0.0)]])
+    got = split.reference(m)[0]
+    assert np.all(got >= fn(m)) and np.all(got <= fn(m) * (1 + split.LIFT))
+    kinks = 0.6 + 0.01 * np.arange(split.MAX_BAD + 1)
+    with pytest.raises(pm._CellsMiss, match="not within its lift"):
+        pm._CellPolynomials([lambda m: 0.5 + np.min(np.abs(m[..., None] - kinks), axis=-1)], [math.inf], 1e-8)
 
 
 @needs_llvm
-@pytest.mark.parametrize("spec", [CELL_CHAINS[1], PUMPED[0]], ids=["levels-2", "product-2"])
-def test_pairs_in_cells_that_miss_agree_with_pumpup(spec, rng):
-    """Pairs whose cosines lie in the cells whose quintics miss (and just outside them): the plugin looks them up
-    level by level, within one rounding of pumpup's eval and never above it."""
+@pytest.mark.parametrize("spec,hide_kinks", [(CELL_CHAINS[1], False), (PUMPED[0], False), (CELL_CHAINS[1], True)],
+                         ids=["levels-2", "product-2", "levels-2-kinks-hidden"])
+def test_pairs_in_split_and_missing_cells_agree_with_pumpup(spec, hide_kinks, rng, monkeypatch):
+    """Pairs whose cosines lie in the cells split at a kink (about the kinks too), or, with the kinks hidden from the
+    table, in the cells whose quartics then miss (looked up level by level): through the plugin, within one rounding
+    of pumpup's eval and never above it."""
     pm.register(LLVM)
+    if hide_kinks:
+        monkeypatch.setattr(pm._CellG, "_kinks", lambda self, looks, mu0: np.zeros(0))
     f = pumpup.load(spec)
     cells = pm._DrModel(f).fast.cells
-    assert cells.bad
-    lo = ((np.array(cells.bad) + cells.cbase) << cells.shift).view(np.float64)
-    hi = ((np.array(cells.bad) + cells.cbase + 1) << cells.shift).view(np.float64)
-    z = np.concatenate([rng.uniform(lo[:, None], hi[:, None], (len(lo), 200)).ravel(), lo, np.nextafter(lo, 0.0)])
-    z = z[z < 1.0].astype(np.float32).astype(np.float64)
+    assert (cells.bad and not cells.splits) if hide_kinks else (cells.splits and not cells.bad)
+    z = _kink_points(cells, rng)
+    z = z[(z < 1.0) & (z > 0.0)].astype(np.float32).astype(np.float64)
     ph = rng.uniform(0, 2 * np.pi, len(z))
     s = np.sqrt(1 - z * z)
     wi = np.stack([s * np.cos(ph), s * np.sin(ph), z], -1).astype(np.float32).astype(np.float64)
