@@ -157,8 +157,8 @@ def test_eval_agrees_with_pumpup_llvm(spec, rng):
 
 #: pumped chains whose levels' bounds are not all monotone (GGX's albedo falls, then rises), so that g depends on both
 #: cosines: the plugin looks every level's bound up in fixed cells of each cosine where quartics fit them
-#: (:class:`pumpup.mitsuba._CellG`; 2 levels: one cell misses, at a kink), else in the level table (one piece per
-#: cosine for every level), as pumpup's chain kernel does (3 levels: too many cells miss)
+#: (:class:`pumpup.mitsuba._CellG`; 2 levels: one cell split at a kink), else in the level table (one piece per
+#: cosine for every level), as pumpup's chain kernel does (3 levels: too many cells miss or need splitting)
 LEVEL_TABLE = [{"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 2},
                {"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 3}]
 
