@@ -50,9 +50,10 @@ The BSDF
     same code runs on Python floats.  A pumped model divides by the same upper bounds of the albedo tables as
     pumpup's compiled kernel (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`): from quartics
     in fixed cells of the cosine, each at least the bound and within 1e-13 of it (:class:`_CellG`, its cell and the
-    position in it from the cosine's bits, no search), with pairs in the few cells where a bound has a kink and below
-    the cells level by level; where the quartics miss in more cells, through pumpup's table of all levels: the
-    product table G(m) where every level's bound increases
+    position in it from the cosine's bits, no search; a cell with a kink split there), with pairs in the few cells
+    that still miss and below the cells level by level, and the levels whose bounds the cells do not fit from a level
+    table of those levels; else (no level fits, or the product of a chain whose bounds all increase does not) through
+    pumpup's table of all levels: the product table G(m) where every level's bound increases
     (:class:`pumpup.operators.pumping._Product`, m = max(N.wi, N.wo)), else the level table
     (:class:`pumpup.operators.pumping._LevelTable`: every level's bound on one set of pieces, one piece per cosine
     for all levels), else level by level.  A piece is found from the float64 bits of the cosine with one read of a
@@ -960,21 +961,58 @@ class _CellG:
     """g_1 ... g_k of a pumped chain from :class:`_CellPolynomials`.  Where every level's bound increases, one function
     of m = max(N.wi, N.wo): G(m) = prod_j max(min(U_j(m), cap_j), m where controlled) (001 eq. 20, 21; pumpup's product
     table), looked up once per pair.  Else each level's uncapped bound U_j, looked up at both cosines, and g_j =
-    max(min(U_j, cap_j) at N.wi, at N.wo), at least max(N.wi, N.wo) where controlled.  Both cosines above ``mlo``, and
-    not in a cell whose quartics miss (:meth:`in_bad`); the plugin looks the others up level by level.
+    max(min(U_j, cap_j) at N.wi, at N.wo), at least max(N.wi, N.wo) where controlled; where some levels' bounds do not
+    fit the cells (crowded features), only the others, times those levels' g from a level table of their own
+    (:class:`_PairG`: one piece per cosine).  Both cosines above ``mlo``, and not in a cell whose quartics miss
+    (:meth:`in_bad`); the plugin looks the others up level by level.
     """
 
     def __init__(self, looks, controlled):
-        self.controlled = [bool(c) for c in controlled]
         self.increasing = all(lk.increasing for lk in looks)
         mu0 = max(float(lk.mu0) for lk in looks)
+        self.controlled = [bool(c) for c in controlled]
         kinks = self._kinks(looks, mu0)
+        #: the levels that are not in the cells, and their level table (None: every level is in the cells)
+        self.rest, self.rest_table = [], None
         if self.increasing:
             self.cells = _CellPolynomials([self._product_of(looks)], [math.inf], mu0, kinks)
         else:
-            self.cells = _CellPolynomials([lambda m, lk=lk: lk.upper(m, capped=False) for lk in looks],
-                                       [lk.cap for lk in looks], mu0, kinks)
+            try:
+                self.cells = self._levels_in_cells(looks, range(len(looks)), mu0, kinks)
+            except _CellsMiss:
+                fit = [j for j in range(len(looks)) if self._fits(looks[j], mu0, kinks)]
+                if not fit:
+                    raise
+                self.cells = self._levels_in_cells(looks, fit, mu0, kinks)
+                self.rest = [j for j in range(len(looks)) if j not in fit]
+                self._rest_pair(looks)
+            self.controlled = [self.controlled[j] for j in range(len(looks)) if j not in self.rest]
         self.mlo = self.cells.mlo
+
+    @staticmethod
+    def _levels_in_cells(looks, levels, mu0, kinks):
+        return _CellPolynomials([lambda m, lk=looks[j]: lk.upper(m, capped=False) for j in levels],
+                                [looks[j].cap for j in levels], mu0, kinks)
+
+    def _fits(self, lk, mu0, kinks) -> bool:
+        try:
+            self._levels_in_cells([lk], [0], mu0, kinks)
+        except _CellsMiss:
+            return False
+        return True
+
+    def _rest_pair(self, looks):
+        """The level table of the levels not in the cells (:class:`_CellsMiss` where it cannot be built)."""
+        from .operators.pumping import _LevelTable, _ProductError
+
+        try:
+            self.rest_table = _LevelTable([looks[j] for j in self.rest], [self.controlled[j] for j in self.rest])
+        except _ProductError as e:
+            raise _CellsMiss(f"pumpup.mitsuba: no level table of the levels beyond the cells: {e}") from None
+        if not self.rest_table.mlo <= self.cells.mlo:  # (pairs below the cells go level by level)
+            raise _CellsMiss("pumpup.mitsuba: the levels' table starts above the cells")
+        self.rest_g = _PairG(self.rest_table)
+        self.rest_g.below = None  # (cosines below the cells are looked up level by level: no power laws here)
 
     def _kinks(self, looks, mu0):
         """Where a function of the cells may have a kink: the levels' spline breakpoints (pumpup's albedo kinks among
@@ -1017,7 +1055,8 @@ class _CellG:
         mmax = np.maximum(mi_, mo)
         if self.increasing:
             return self.cells.reference(mmax)[0]
-        return self._levels(self.cells.reference(mi_), self.cells.reference(mo), mmax, np.maximum)
+        g = self._levels(self.cells.reference(mi_), self.cells.reference(mo), mmax, np.maximum)
+        return g if self.rest_table is None else g * self.rest_table.g(mi_, mo)
 
     def __call__(self, mi_, mo):
         if not _jit():
@@ -1025,7 +1064,8 @@ class _CellG:
         mmax = dr.maximum(mi_, mo)
         if self.increasing:
             return self.cells(mmax)[0]
-        return self._levels(self.cells(mi_), self.cells(mo), mmax, dr.maximum)
+        g = self._levels(self.cells(mi_), self.cells(mo), mmax, dr.maximum)
+        return g if self.rest_table is None else g * self.rest_g(mi_, mo)
 
 #: the largest float32, the type Mitsuba's JIT variants evaluate in
 FLOAT32_MAX = float(np.finfo(np.float32).max)
