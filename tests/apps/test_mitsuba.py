@@ -172,6 +172,24 @@ def test_level_table_chains_agree_with_pumpup_llvm(spec, rest, rng):
     _check_agreement(spec, LLVM, 2000, rng)
 
 
+#: pumped chains of many bases, g1 and g2, 1 to 3 levels: the plugin's look-up takes every path on them (fixed cells,
+#: cells split at kinks, levels in a level table of their own, pumpup's product table)
+MANY_PUMPED = [{"type": "pumped", "base": base, "g": g, "levels": levels}
+               for base in ({"type": "ggx", "alpha": 0.02}, {"type": "ggx", "alpha": 1.0},
+                            {"type": "beckmann", "alpha": 0.4}, {"type": "phong", "n": 1}, {"type": "phong", "n": 5000},
+                            {"type": "blinn", "n": 30}, {"type": "ward", "m": 0.3}, {"type": "schlick", "r": 0.1},
+                            {"type": "cook_torrance", "m": 0.3, "ior": 1.5},
+                            {"type": "ggx", "alpha": 0.3, "eta": 0.2, "k": 3.0})
+               for g in ("g1", "g2") for levels in (1, 3)]
+
+
+@needs_llvm
+@pytest.mark.slow
+@pytest.mark.parametrize("spec", MANY_PUMPED, ids=_ids(MANY_PUMPED))
+def test_many_pumped_chains_agree_with_pumpup_llvm(spec, rng):
+    _check_agreement(spec, LLVM, 1000, rng)
+
+
 @needs_llvm
 def test_levels_the_cells_do_not_fit_come_from_a_level_table_of_their_own(rng):
     """3-level g2 GGX alpha 0.3: the third level's bound crowds with features that no quartic in the cells fits, so
