@@ -991,10 +991,12 @@ class _CellG:
 
     @staticmethod
     def _levels_in_cells(looks, levels, mu0, kinks):
+        """The cells of the uncapped bounds of ``levels`` (:class:`_CellsMiss` where they do not fit)."""
         return _CellPolynomials([lambda m, lk=looks[j]: lk.upper(m, capped=False) for j in levels],
                                 [looks[j].cap for j in levels], mu0, kinks)
 
     def _fits(self, lk, mu0, kinks) -> bool:
+        """Whether the cells fit the bound of look-up ``lk`` alone."""
         try:
             self._levels_in_cells([lk], [0], mu0, kinks)
         except _CellsMiss:
@@ -1027,6 +1029,7 @@ class _CellG:
         return np.concatenate([br, flats, meets])
 
     def _product_of(self, looks):
+        """G(m), the product of every level's g at N.wi = N.wo = m, from the levels' look-ups."""
         def product(m):
             g = np.ones_like(m)
             for lk, controlled in zip(looks, self.controlled):
@@ -1066,6 +1069,7 @@ class _CellG:
             return self.cells(mmax)[0]
         g = self._levels(self.cells(mi_), self.cells(mo), mmax, dr.maximum)
         return g if self.rest_table is None else g * self.rest_g(mi_, mo)
+
 
 #: the largest float32, the type Mitsuba's JIT variants evaluate in
 FLOAT32_MAX = float(np.finfo(np.float32).max)
