@@ -700,10 +700,11 @@ class _PairG:
     cosine m <= mlo lies below every level's spline, where pumpup's level-by-level path (:func:`g_levels`) takes the
     power law v0 exp(slope0 (log m - log x0)) + margin_lo (at most the cap): this class then computes it too, without a
     branch (the exponential as a Taylor polynomial where |slope0 (log m - log x0)| <= 1e-3, to 1e-18), and the pair
-    needs no level-by-level path at all.
+    needs no level-by-level path at all.  ``power_laws=False``: no power laws (its caller looks those cosines up level
+    by level).
     """
 
-    def __init__(self, table):
+    def __init__(self, table, power_laws: bool = True):
         self.mlo = float(table.mlo)
         self.deg = table.coef.shape[1] - 1
         self.controlled = [bool(c) for c in table.controlled]
@@ -716,7 +717,7 @@ class _PairG:
         looks = table.looks
         span = math.log(self.mlo) - math.log(float(np.finfo(np.float32).smallest_subnormal)) + 1.0
         self.below = None
-        if all(top < math.exp(lk.logx[0]) * (1.0 - 1e-12) and top <= lk.mu0 for lk in looks):
+        if power_laws and all(top < math.exp(lk.logx[0]) * (1.0 - 1e-12) and top <= lk.mu0 for lk in looks):
             self.below = []
             for lk in looks:
                 ymax = abs(float(lk.slope0)) * span  # |slope0 (log m - log x0)| for every float32 m in (0, mlo]
@@ -824,10 +825,11 @@ class _CellPolynomials:
         if len(bad) > self.MAX_BAD or len(splits) > self.MAX_SPLITS:
             raise _CellsMiss(f"pumpup.mitsuba: {len(bad)} cells of a level's bound are not within its lift of "
                              f"quartics and {len(splits)} are split at kinks")
+        self.ncell = coef.shape[0] - sum(len(tk) + 1 for _, tk in splits)
         #: the cells split at kinks of a function, (cell, [t of each kink], the row of its first piece): their pieces'
         #: rows follow the cells'
         self.splits = []
-        row = coef.shape[0] - sum(len(tk) + 1 for _, tk in splits)
+        row = self.ncell
         for c, tk in splits:
             self.splits.append((int(c), tk, row))
             row += len(tk) + 1
@@ -835,7 +837,6 @@ class _CellPolynomials:
         self.bad = [int(c) for c in bad]
         self.shift = 52 - bits
         self.cbase = (1023 + self.lo_oct) << bits
-        self.ncell = coef.shape[0] - sum(len(tk) + 1 for _, tk in splits)
         self.np = np.ascontiguousarray(coef.reshape(coef.shape[0], -1))  # row c: F_1's 5 coefficients, F_2's, ...
         self.dr = _aligned_f64(self.np) if _jit() else None
 
@@ -940,9 +941,9 @@ class _CellPolynomials:
         return out
 
     def __call__(self, m):
-        """:meth:`reference` in Dr.Jit (Float64 cosines; below mlo some valid cell's values)."""
-        if not _jit():
-            return [float(u) for u in self.reference(np.float64(m))]
+        """:meth:`reference` in Dr.Jit (Float64 cosines; below mlo some valid cell's values; scalar variants call
+        :meth:`reference`).
+        """
         mb = dr.reinterpret_array(mi.UInt64, m)
         c = mi.UInt32(dr.minimum(dr.maximum(mb >> self.shift, self.cbase) - self.cbase, self.ncell - 1))
         t = mi.Float64(mb & ((1 << self.shift) - 1)) * 2.0**-self.shift
@@ -1013,8 +1014,7 @@ class _CellG:
             raise _CellsMiss(f"pumpup.mitsuba: no level table of the levels beyond the cells: {e}") from None
         if not self.rest_table.mlo <= self.cells.mlo:  # (pairs below the cells go level by level)
             raise _CellsMiss("pumpup.mitsuba: the levels' table starts above the cells")
-        self.rest_g = _PairG(self.rest_table)
-        self.rest_g.below = None  # (cosines below the cells are looked up level by level: no power laws here)
+        self.rest_g = _PairG(self.rest_table, power_laws=False)  # (cosines below the cells go level by level)
 
     def _kinks(self, looks, mu0):
         """Where a function of the cells may have a kink: the levels' spline breakpoints (pumpup's albedo kinks among
@@ -1157,7 +1157,7 @@ class _DrModel:
             return self.fast(mi_, mo) if _jit() or dr.minimum(mi_, mo) > 0.0 else 1.0
         mmin = dr.minimum(mi_, mo)
         slow = (mmin <= self.fast.mlo) & (mmin > 0.0)
-        if getattr(getattr(self.fast, "cells", None), "bad", None):  # (and where a cell's quartics miss)
+        if isinstance(self.fast, _CellG) and self.fast.cells.bad:  # (and where a cell's quartics miss)
             slow = slow | (self.fast.in_bad(mi_, mo) & (mmin > self.fast.mlo))
         if not _jit():
             return by_levels(mi_, mo) if (slow or mmin <= 0.0) else self.fast(mi_, mo)
