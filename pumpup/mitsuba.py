@@ -50,10 +50,11 @@ The BSDF
     same code runs on Python floats.  A pumped model divides by the same upper bounds of the albedo tables as
     pumpup's compiled kernel (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`): from quartics
     in fixed cells of the cosine, each at least the bound and within 1e-13 of it (:class:`_CellG`, its cell and the
-    position in it from the cosine's bits, no search; a cell with a kink split there), with pairs in the few cells
-    that still miss and below the cells level by level, and the levels whose bounds the cells do not fit from a level
-    table of those levels; else (no level fits, or the product of a chain whose bounds all increase does not) through
-    pumpup's table of all levels: the product table G(m) where every level's bound increases
+    position in it from the cosine's bits, no search; a cell with a kink split there; below the levels' tables, where
+    the bounds are power laws, coarser cells down to float32's smallest subnormal where they fit), with pairs in the
+    few cells that still miss and below the cells level by level, and the levels whose bounds the cells do not fit
+    from a level table of those levels; else (no level fits, or the product of a chain whose bounds all increase does
+    not) through pumpup's table of all levels: the product table G(m) where every level's bound increases
     (:class:`pumpup.operators.pumping._Product`, m = max(N.wi, N.wo)), else the level table
     (:class:`pumpup.operators.pumping._LevelTable`: every level's bound on one set of pieces, one piece per cosine
     for all levels), else level by level.  A piece is found from the float64 bits of the cosine with one read of a
@@ -777,22 +778,26 @@ class _CellsMiss(ValueError):
 
 class _CellPolynomials:
     """Functions F_j of the cosine m (a pumped chain's level bounds or the product of its g, :class:`_CellG`) as
-    quartics in fixed cells of m: 2^``bits`` cells per octave from 2^lo_oct (the first power of two above every level's
-    first node ``mu0``, below which a level's bound is a power law) up to 1, cell c = (bits(m) >> shift) - cbase, t =
-    m's bits below the shift / 2^shift in [0, 1) (the position in the cell, exact), and a cell of its own holding
-    F_j(1).  A look-up computes its cell from the bits of m and reads its coefficients, one gather each, with no search
-    and no index table: on Mitsuba's llvm variants that costs less than finding a piece of the level table
+    quartics in fixed cells of m.  The fine cells: 2^``bits`` cells per octave from the one holding ``start`` (mlo,
+    where every level's spline begins) up to 1, cell c = (bits(m) >> shift) - cbase, t = m's bits below the shift /
+    2^shift in [0, 1) (the position in the cell, exact), and a cell of its own holding F_j(1).  With ``low``, below
+    mlo, where every level's bound is a power law: 2^low_bits cells per octave down to float32's smallest subnormal
+    (:data:`LOW_EXP`), found the same way, where their quartics fit (``nlow`` > 0); then the cells hold every float32
+    cosine > 0.  A look-up computes its cell from the bits of m and reads its coefficients, one gather each, with no
+    search and no index table: on Mitsuba's llvm variants that costs less than finding a piece of the level table
     (:class:`_PairG`).  Each F_j is taken at most its cap.
 
-    Each cell's quartic interpolates F_j at the Chebyshev points of the cell and is lifted by three times its largest
-    miss at 65 points of the cell, plus 8 ulps of the sum of its coefficients' magnitudes (Horner's rounding): it is at
-    least F_j on the cell, so the plugin divides by at least pumpup's levelwise g and never returns more than pumpup.
-    A cell whose quartic, lifted, may lie more than :data:`LIFT` of its smallest value above F_j (a kink of F_j in it:
-    the lift plus the miss) is split at the kink where the chain knows of one, else ``bad``: the plugin looks
-    pairs with a cosine there up level by level.  The fewest bits of :data:`BITS` with the fewest bad cells, then the
-    fewest split cells; refused (:class:`_CellsMiss`: the plugin then takes pumpup's product or level table) beyond
-    :data:`MAX_BAD` bad or :data:`MAX_SPLITS` split cells.
-    ``reference`` is the plain numpy version of the look-up, the same operations in the same order.
+    Each cell's quartic interpolates F_j at the Chebyshev points of the cell (of the part of it on its side of mlo)
+    and is lifted by three times its largest miss at 65 points there, plus 8 ulps of the sum of its coefficients'
+    magnitudes (Horner's rounding): it is at least F_j on the cell, so the plugin divides by at least pumpup's
+    levelwise g and never returns more than pumpup.  A cell whose quartic, lifted, may lie more than :data:`LIFT` of
+    its smallest value above F_j (a kink or a jump of F_j in it: the lift plus the miss) is split at the kinks where
+    the chain knows of them: its first piece keeps the cell's row, each further piece, from kink t_i, has a row of its
+    own, a quartic in t - t_i.  Else the cell is ``bad``: the plugin looks pairs with a cosine there up level by level.
+    The fewest bits of :data:`BITS` with the fewest bad cells, then the fewest split cells; refused
+    (:class:`_CellsMiss`: the plugin then takes pumpup's product or level table) beyond :data:`MAX_BAD` bad or
+    :data:`MAX_SPLITS` split cells.  ``reference`` is the plain numpy version of the look-up, the same operations in
+    the same order.
     """
 
     #: the relative lift a cell may need (the plugin's values may lie this much further below pumpup's, per function)
@@ -807,16 +812,22 @@ class _CellPolynomials:
     #: the most kinks at which one cell is split, and the most split cells (each costs a few selects per look-up)
     MAX_KINKS = 3
     MAX_SPLITS = 4
+    #: the lowest octave of the low cells, as a float64 exponent (biased): 2^-149, float32's smallest subnormal
+    LOW_EXP = 1023 - 149
+    #: the cells per octave below mlo tried, 2^low_bits
+    LOW_BITS = (0, 1, 2, 3)
+    #: the float64 bits of 1
+    ONE = int(np.float64(1.0).view(np.int64))
 
-    def __init__(self, functions, caps, mu0: float, kinks=()):
-        self.lo_oct = math.floor(math.log2(mu0)) + 1
-        self.mlo = 2.0 ** self.lo_oct  # (the cells start here; the plugin looks smaller cosines up level by level)
+    def __init__(self, functions, caps, start: float, kinks=(), low: bool = False):
+        self.mlo = float(start)
+        self.mlo_bits = int(np.float64(start).view(np.int64))
         self.caps = [float(c) for c in caps]
         self.nfun = len(functions)
         kinks = np.sort(np.asarray(kinks, dtype=np.float64))
         best = None
         for bits in self.BITS:  # (the fewest cells that miss, then the fewest split cells, then the fewest bits)
-            fit = self._fit(functions, bits, kinks)
+            fit = self._fine(functions, bits, kinks)
             if best is None or (len(fit[2]), len(fit[1])) < (len(best[3]), len(best[2])):
                 best = (bits, *fit)
             if len(fit[1]) + len(fit[2]) == 0:
@@ -825,68 +836,128 @@ class _CellPolynomials:
         if len(bad) > self.MAX_BAD or len(splits) > self.MAX_SPLITS:
             raise _CellsMiss(f"pumpup.mitsuba: {len(bad)} cells of a level's bound are not within its lift of "
                              f"quartics and {len(splits)} are split at kinks")
-        self.ncell = coef.shape[0] - sum(len(tk) + 1 for _, tk in splits)
-        #: the cells split at kinks of a function, (cell, [t of each kink], the row of its first piece): their pieces'
-        #: rows follow the cells'
+        self.shift = 52 - bits
+        self.cbase = self.mlo_bits >> self.shift
+        self.nfine = coef.shape[0]
+        lows, low_bits = None, 0
+        for low_bits in self.LOW_BITS if low else ():
+            lows = self._low(functions, kinks, low_bits, self.MAX_SPLITS - len(splits))
+            if lows is not None:
+                break
+        #: the low cells' rows follow the fine cells' (none where they do not fit or were not asked for)
+        self.nlow = 0 if lows is None else lows[0].shape[0]
+        self.low_shift = 52 - low_bits
+        self.low_base = self.LOW_EXP << low_bits
+        if lows is not None:
+            coef = np.concatenate([coef, lows[0]])
+            splits = splits + [(self.nfine + c, *rest) for c, *rest in lows[1]]
+        self.ncell = coef.shape[0]
+        #: the cells split at kinks, (cell, [t of each kink], the row of the piece from the first kink): the further
+        #: pieces' rows follow the cells'
         self.splits = []
-        row = self.ncell
-        for c, tk in splits:
-            self.splits.append((int(c), tk, row))
-            row += len(tk) + 1
+        rows = [coef]
+        for c, own, pieces, tk in splits:
+            coef[c] = own
+            self.splits.append((int(c), tk, sum(r.shape[0] for r in rows)))
+            rows.append(pieces)
+        coef = np.concatenate(rows)
         #: the cells whose quartics miss even so: pairs with a cosine there are looked up level by level
         self.bad = [int(c) for c in bad]
-        self.shift = 52 - bits
-        self.cbase = (1023 + self.lo_oct) << bits
         self.np = np.ascontiguousarray(coef.reshape(coef.shape[0], -1))  # row c: F_1's 5 coefficients, F_2's, ...
         self.dr = _aligned_f64(self.np) if _jit() else None
 
-    def _fit(self, functions, bits, kinks):
-        """(the coefficients (row, function, 5), highest power first, lifted: the cells', then one row per piece of
-        each split cell; the splits [(cell, [t of each kink])]; the cells that still miss).  A cell whose lift exceeds
-        LIFT is split at all the ``kinks`` inside it (at most MAX_KINKS), else at the first one, where every piece is
-        within LIFT.
+    @staticmethod
+    def _grid(first: int, last: int, shift: int):
+        """(left, width) of the cells ``first`` ... ``last``, cell c holding the floats whose bits >> shift are c."""
+        c = np.arange(first, last + 1, dtype=np.int64)
+        left = (c << shift).view(np.float64)
+        return left, ((c + 1) << shift).view(np.float64) - left
+
+    def _fine(self, functions, bits, kinks):
+        """(the fine cells' coefficients (cell, function, 5), highest power first, lifted, and one more row for m = 1;
+        the cells split at kinks, as :meth:`_split`; the cells that still miss).
         """
-        ncell = (-self.lo_oct << bits) + 1
-        c = np.arange(ncell - 1)
-        width = 2.0 ** (self.lo_oct + (c >> bits) - bits)
-        left = 2.0 ** (self.lo_oct + (c >> bits)) + (c & ((1 << bits) - 1)) * width
+        shift = 52 - bits
+        left, width = self._grid(self.mlo_bits >> shift, (self.ONE >> shift) - 1, shift)
+        lo_t = np.zeros(len(left))
+        lo_t[0] = (self.mlo - left[0]) / width[0]  # (the first cell holds m >= mlo only; exact)
         coef, ok = self._pieces(functions, left, width, 0.0)
+        if lo_t[0] > 0.0:
+            coef[:1], ok[:1] = self._pieces(functions, left[:1], width[:1], 0.0, lo_t[0])
         coef = np.concatenate([coef, np.zeros((1, *coef.shape[1:]))])
         for j, fn in enumerate(functions):
             coef[-1, j, -1] = float(fn(np.array([1.0]))[0])  # the cell of m = 1: the function's value there
-        rows, splits, bad = [coef], [], []
+        splits, bad = self._split(functions, left, width, ok, kinks, lo_t, np.ones(len(left)))
+        return coef, splits, bad
+
+    def _low(self, functions, kinks, bits: int, nsplit: int):
+        """(the coefficients of 2^``bits`` cells per octave from 2^(LOW_EXP - 1023) up to mlo, the cells split at
+        kinks) where their quartics, split at no more than ``nsplit`` cells, fit every function; else None.
+        """
+        shift = 52 - bits
+        left, width = self._grid(self.LOW_EXP << bits, (self.mlo_bits - 1) >> shift, shift)
+        hi_t = np.ones(len(left))
+        hi_t[-1] = (self.mlo - left[-1]) / width[-1]  # (the last cell holds m < mlo only; exact)
+        with np.errstate(all="ignore"):
+            coef, ok = self._pieces(functions, left, width, 0.0)
+            if hi_t[-1] < 1.0:
+                coef[-1:], ok[-1:] = self._pieces(functions, left[-1:], width[-1:], 0.0, 0.0, hi_t[-1])
+            splits, bad = self._split(functions, left, width, ok, kinks, np.zeros(len(left)), hi_t)
+        if bad or len(splits) > nsplit or not np.all(np.isfinite(coef)):
+            return None
+        return coef, splits
+
+    def _split(self, functions, left, width, ok, kinks, lo_t, hi_t):
+        """(the cells that miss (``~ok``, each holding t in [lo_t, hi_t)) split at kinks, [(cell, its first piece's
+        coefficients, the further pieces', [t of each kink])]; the cells that still miss).  A cell is split at one of
+        the ``kinks`` inside it, else at all of them (at most MAX_KINKS), where every piece is within LIFT.
+        """
+        splits, bad = [], []
         for i in np.nonzero(~ok)[0]:
-            inside = np.unique(kinks[(kinks > left[i]) & (kinks < left[i] + width[i])])
-            tries = ([inside] if 1 < len(inside) <= self.MAX_KINKS else []) + [inside[k:k + 1] for k in
-                                                                               range(len(inside))]
-            for x in tries:
-                ends = np.concatenate([[0.0], (x - left[i]) / width[i], [1.0]])
-                pieces, fits = self._pieces(functions, left[i] + width[i] * ends[:-1], width[i] * np.diff(ends), 1e-14)
+            x = kinks[(kinks > left[i]) & (kinks < left[i] + width[i])]
+            inside = np.unique((x - left[i]) / width[i])  # (t of each kink, exact)
+            inside = inside[(inside > lo_t[i]) & (inside < hi_t[i])]
+            tries = [inside[k:k + 1] for k in range(len(inside))] + ([inside] if 1 < len(inside) <= self.MAX_KINKS
+                                                                     else [])
+            for tk in tries:
+                ends = np.concatenate([[lo_t[i]], tk, [hi_t[i]]])
+                own, fits = self._pieces(functions, left[i:i + 1], width[i:i + 1], 1e-14, ends[0], ends[1])
+                pieces = []
+                for a, b in zip(ends[1:-1], ends[2:]):  # (a piece from kink a: a quartic in t - a)
+                    p, f = self._pieces(functions, left[i:i + 1] + width[i:i + 1] * a, width[i:i + 1], 1e-14, 0.0,
+                                        b - a)
+                    pieces.append(p)
+                    fits = fits & f
                 if np.all(fits):
-                    rows.append(pieces)
-                    splits.append((i, [float(v) for v in ends[1:-1]]))
+                    splits.append((i, own[0], np.concatenate(pieces), [float(v) for v in tk]))
                     break
             else:
                 bad.append(i)
-        return np.concatenate(rows), splits, bad
+        return splits, bad
 
-    def _pieces(self, functions, left, width, margin):
-        """(the lifted quartics (piece, function, 5) of every function on the pieces [left, left + width], in t in
-        [0, 1]; whether each piece's lift is within LIFT).  ``margin``: a further lift, relative to the function's
-        largest value on the piece (a split cell's halves: the kink's position is known to a few ulps).
+    def _pieces(self, functions, left, width, margin, t0: float = 0.0, t1: float = 1.0):
+        """(the lifted quartics (piece, function, 5) in t of every function at m = left + width t, t in [t0, t1);
+        whether each piece's lift is within LIFT).  ``margin``: a further lift, relative to the function's largest
+        value on the piece (a split cell's pieces: the kink's position is known to a few ulps).
         """
         from .physics.lookups import horner
 
         deg = self.DEGREE
-        tk = 0.5 - 0.5 * np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
-        tt = np.linspace(0.0, 1.0, 65)
-        vander = np.vander(tk, deg + 1)  # coefficients (highest power first) -> values at tk
+        cheb = 0.5 - 0.5 * np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
+        tk = t0 + (t1 - t0) * cheb
+        tt = t0 + (t1 - t0) * np.linspace(0.0, 1.0, 65)
+        power = np.arange(deg, -1, -1)
         coef = np.zeros((len(left), len(functions), deg + 1))
         ok = np.ones(len(left), dtype=bool)
         for j, fn in enumerate(functions):
             vk = fn(left[:, None] + width[:, None] * tk[None, :])
-            a = np.linalg.solve(vander, vk.T).T  # (solve: inverting the matrix first cost 1e-14)
-            vt = fn(left[:, None] + width[:, None] * tt[None, :])
+            if t0 == 0.0:  # in u = t / t1 on [0, 1], then in t (solve: inverting the matrix first cost 1e-14)
+                a = np.linalg.solve(np.vander(cheb, deg + 1), vk.T).T / t1 ** power
+            else:
+                a = np.linalg.solve(np.vander(tk, deg + 1), vk.T).T
+            mt = left[:, None] + width[:, None] * tt[None, :]
+            mt[:, -1] = np.nextafter(mt[:, -1], 0.0)  # (a piece holds [t0, t1): a jump at its end)
+            vt = fn(mt)
             pt = horner(a.T[:, :, None], tt[None, :])
             miss = np.max(np.abs(vt - pt), axis=1)
             lift = (3.0 * miss + 8.0 * np.finfo(float).eps * np.sum(np.abs(a), axis=1)
@@ -897,39 +968,56 @@ class _CellPolynomials:
         return coef, ok
 
     def _cell(self, bits):
-        """(cell, t) of the float64 bits of m >= mlo (numpy)."""
-        c = np.minimum((bits >> self.shift) - self.cbase, self.ncell - 1)
-        return c, (bits & ((1 << self.shift) - 1)).astype(np.float64) * 2.0**-self.shift
+        """(cell, t) of the float64 bits of m > 0 (numpy): a fine cell from m's bits above the shift, t those below
+        it / 2^shift (exact); below mlo, where the low cells hold every float32, its low cell and t likewise.
+        """
+        c = np.minimum(np.maximum(bits >> self.shift, self.cbase) - self.cbase, self.nfine - 1)
+        t = (bits & ((1 << self.shift) - 1)).astype(np.float64) * 2.0**-self.shift
+        if self.nlow:
+            low = bits < self.mlo_bits
+            c = np.where(low, self.nfine + np.maximum(bits >> self.low_shift, self.low_base) - self.low_base, c)
+            t = np.where(low, (bits & ((1 << self.low_shift) - 1)).astype(np.float64) * 2.0**-self.low_shift, t)
+        return c, t
 
     def _halves(self, c, t, select):
-        """(row, t) after the splits: in a split cell, the row of the piece that holds t and t's position in that
-        piece, (t - t_i) / (t_(i+1) - t_i) between its kinks t_i (``select``: numpy's where or Dr.Jit's select).
+        """(row, t) after the splits: in a split cell, from its kink t_i on, the row of the piece from t_i and t - t_i
+        (``select``: numpy's where or Dr.Jit's select).
         """
+        row, start = c, t * 0.0
         for cell, kinks, first in self.splits:
-            ends = [0.0, *kinks, 1.0]
-            row, start, scale = c * 0 + first, t * 0.0, t * 0.0 + 1.0 / ends[1]
-            for i, tk in enumerate(kinks):
-                right = t >= tk
-                row = select(right, first + i + 1, row)
-                start = select(right, tk, start)
-                scale = select(right, 1.0 / (ends[i + 2] - tk), scale)
             hit = c == cell
-            c, t = select(hit, row, c), select(hit, (t - start) * scale, t)
-        return c, t
+            for i, tk in enumerate(kinks):
+                right = hit & (t >= tk)
+                row = select(right, first + i, row)
+                start = select(right, tk, start)
+        return row, t - start
 
     def in_bad(self, m):
         """Whether m >= mlo lies in a cell of :attr:`bad` (numpy, Dr.Jit or a float)."""
         if isinstance(m, (np.ndarray, float)):  # (numpy's float64 is a float)
             c = self._cell(np.asarray(m, dtype=np.float64).view(np.int64))[0]
             return np.isin(c, self.bad) if isinstance(m, np.ndarray) else bool(np.isin(c, self.bad))
-        c = (dr.reinterpret_array(mi.UInt64, m) >> self.shift) - self.cbase
+        c = self._cell_dr(m)[0]
         out = dr.full(mi.Bool, False, dr.width(m))
         for b in self.bad:
             out |= c == b
         return out
 
+    def _cell_dr(self, m):
+        """:meth:`_cell` in Dr.Jit, of the Float64 cosines m (m <= 0: some valid cell)."""
+        mb = dr.reinterpret_array(mi.UInt64, m)
+        c = mi.UInt32(dr.minimum(dr.maximum(mb >> self.shift, self.cbase) - self.cbase, self.nfine - 1))
+        if not self.nlow:
+            return c, mi.Float64(mb & ((1 << self.shift) - 1)) * 2.0**-self.shift
+        low = mb < self.mlo_bits
+        c = dr.select(low, mi.UInt32(dr.maximum(mb >> self.low_shift, self.low_base) - self.low_base) + self.nfine, c)
+        mask = dr.select(low, mi.UInt64((1 << self.low_shift) - 1), mi.UInt64((1 << self.shift) - 1))
+        return c, mi.Float64(mb & mask) * dr.select(low, 2.0**-self.low_shift, 2.0**-self.shift)
+
     def reference(self, m):
-        """[F_1(m), ..., F_k(m)], each at most its cap, as the Dr.Jit look-up computes them (numpy; m >= mlo)."""
+        """[F_1(m), ..., F_k(m)], each at most its cap, as the Dr.Jit look-up computes them (numpy; m >= mlo, or
+        m > 0 where the low cells hold every float32).
+        """
         m = np.asarray(m, dtype=np.float64)
         c, t = self._halves(*self._cell(m.view(np.int64)), np.where)
         rows = self.np[c]
@@ -944,10 +1032,7 @@ class _CellPolynomials:
         """:meth:`reference` in Dr.Jit (Float64 cosines; below mlo some valid cell's values; scalar variants call
         :meth:`reference`).
         """
-        mb = dr.reinterpret_array(mi.UInt64, m)
-        c = mi.UInt32(dr.minimum(dr.maximum(mb >> self.shift, self.cbase) - self.cbase, self.ncell - 1))
-        t = mi.Float64(mb & ((1 << self.shift) - 1)) * 2.0**-self.shift
-        c, t = self._halves(c, t, dr.select)
+        c, t = self._halves(*self._cell_dr(m), dr.select)
         deg = self.DEGREE
         base = c * (self.nfun * (deg + 1))
         out = []
@@ -970,36 +1055,45 @@ class _CellG:
 
     def __init__(self, looks, controlled):
         self.increasing = all(lk.increasing for lk in looks)
-        mu0 = max(float(lk.mu0) for lk in looks)
+        # the fine cells' start: where every level's spline has begun (below it a level's bound is a power law, with a
+        # jump of its margin), and for the product, above every level's mu0 (pumpup's product table's mlo)
+        start = max(self._spline_start(float(lk.logx[0])) for lk in looks)
+        if self.increasing:
+            start = max([start] + [float(lk.mu0) for lk in looks])
         self.controlled = [bool(c) for c in controlled]
-        kinks = self._kinks(looks, mu0)
+        kinks = self._kinks(looks, start)
         #: the levels that are not in the cells, and their level table (None: every level is in the cells)
         self.rest, self.rest_table = [], None
         if self.increasing:
-            self.cells = _CellPolynomials([self._product_of(looks)], [math.inf], mu0, kinks)
-        else:
+            self.cells = _CellPolynomials([self._product_of(looks)], [math.inf], start, kinks)
+        else:  # (each level's bound at both cosines, as pumpup's level-by-level path: the low cells serve)
             try:
-                self.cells = self._levels_in_cells(looks, range(len(looks)), mu0, kinks)
+                self.cells = self._levels_in_cells(looks, range(len(looks)), start, kinks)
             except _CellsMiss:
-                fit = [j for j in range(len(looks)) if self._fits(looks[j], mu0, kinks)]
+                fit = [j for j in range(len(looks)) if self._fits(looks[j], start, kinks)]
                 if not fit:
                     raise
-                self.cells = self._levels_in_cells(looks, fit, mu0, kinks)
+                self.cells = self._levels_in_cells(looks, fit, start, kinks)
                 self.rest = [j for j in range(len(looks)) if j not in fit]
                 self._rest_pair(looks)
             self.controlled = [self.controlled[j] for j in range(len(looks)) if j not in self.rest]
-        self.mlo = self.cells.mlo
+        #: pairs with a cosine at or below mlo go level by level, unless the cells hold every float32 cosine > 0
+        #: (``whole``: the low cells fit, and no level is left out); then only pairs in a cell that misses do
+        self.mlo = self.cells.mlo if self.rest_table is None else max(self.cells.mlo, self.rest_table.mlo)
+        self.whole = bool(self.cells.nlow) and self.rest_table is None
 
     @staticmethod
-    def _levels_in_cells(looks, levels, mu0, kinks):
-        """The cells of the uncapped bounds of ``levels`` (:class:`_CellsMiss` where they do not fit)."""
+    def _levels_in_cells(looks, levels, start, kinks):
+        """The cells of the uncapped bounds of ``levels``, with low cells where they fit (:class:`_CellsMiss` where
+        the fine cells do not fit).
+        """
         return _CellPolynomials([lambda m, lk=looks[j]: lk.upper(m, capped=False) for j in levels],
-                                [looks[j].cap for j in levels], mu0, kinks)
+                                [looks[j].cap for j in levels], start, kinks, low=True)
 
-    def _fits(self, lk, mu0, kinks) -> bool:
+    def _fits(self, lk, start, kinks) -> bool:
         """Whether the cells fit the bound of look-up ``lk`` alone."""
         try:
-            self._levels_in_cells([lk], [0], mu0, kinks)
+            self._levels_in_cells([lk], [0], start, kinks)
         except _CellsMiss:
             return False
         return True
@@ -1012,21 +1106,32 @@ class _CellG:
             self.rest_table = _LevelTable([looks[j] for j in self.rest], [self.controlled[j] for j in self.rest])
         except _ProductError as e:
             raise _CellsMiss(f"pumpup.mitsuba: no level table of the levels beyond the cells: {e}") from None
-        if not self.rest_table.mlo <= self.cells.mlo:  # (pairs below the cells go level by level)
-            raise _CellsMiss("pumpup.mitsuba: the levels' table starts above the cells")
-        self.rest_g = _PairG(self.rest_table, power_laws=False)  # (cosines below the cells go level by level)
+        self.rest_g = _PairG(self.rest_table, power_laws=False)  # (cosines below its mlo go level by level)
 
-    def _kinks(self, looks, mu0):
+    def _kinks(self, looks, start):
         """Where a function of the cells may have a kink: the levels' spline breakpoints (pumpup's albedo kinks among
         them) and flat pieces' ends, where a bound crosses its cap, and, for the product, where a controlled level's
         bound meets m (001 eq. 21).
         """
         from .operators.pumping import _level_breaks, _meet_kinks
 
-        br = _level_breaks(looks, mu0)  # (the knots, every eighth of an octave and the cap crossings)
+        br = _level_breaks(looks, start)  # (the knots, every eighth of an octave and the cap crossings)
         flats = [x for lk in looks for a, b, _ in lk.flats for x in (a, b)]
+        flats += [self._spline_start(float(lk.logx[0])) for lk in looks]  # (a jump of its margin: low cells)
         meets = _meet_kinks([lk for lk, c in zip(looks, self.controlled) if c], br) if self.increasing else []
         return np.concatenate([br, flats, meets])
+
+    @staticmethod
+    def _spline_start(logx0: float) -> float:
+        """The smallest float m with log(m) >= logx0: where a level's bound leaves its power law for its spline (a
+        jump of its margins; pumpup.physics.lookups.upper_log tests log(m) < logx0 in the same libm logarithm).
+        """
+        m = math.exp(logx0)
+        while math.log(m) >= logx0:
+            m = math.nextafter(m, 0.0)
+        while math.log(m) < logx0:
+            m = math.nextafter(m, math.inf)
+        return m
 
     def _product_of(self, looks):
         """G(m), the product of every level's g at N.wi = N.wo = m, from the levels' look-ups."""
@@ -1156,9 +1261,14 @@ class _DrModel:
         if getattr(self.fast, "below", None) is not None:  # the table holds every float32 cosine > 0
             return self.fast(mi_, mo) if _jit() or dr.minimum(mi_, mo) > 0.0 else 1.0
         mmin = dr.minimum(mi_, mo)
-        slow = (mmin <= self.fast.mlo) & (mmin > 0.0)
-        if isinstance(self.fast, _CellG) and self.fast.cells.bad:  # (and where a cell's quartics miss)
-            slow = slow | (self.fast.in_bad(mi_, mo) & (mmin > self.fast.mlo))
+        if isinstance(self.fast, _CellG) and self.fast.whole:  # (every cosine > 0 in the cells)
+            if not self.fast.cells.bad:
+                return self.fast(mi_, mo) if _jit() or mmin > 0.0 else 1.0
+            slow = self.fast.in_bad(mi_, mo) & (mmin > 0.0)
+        else:
+            slow = (mmin <= self.fast.mlo) & (mmin > 0.0)
+            if isinstance(self.fast, _CellG) and self.fast.cells.bad:  # (and where a cell's quartics miss)
+                slow = slow | (self.fast.in_bad(mi_, mo) & (mmin > self.fast.mlo))
         if not _jit():
             return by_levels(mi_, mo) if (slow or mmin <= 0.0) else self.fast(mi_, mo)
         # the table's value outside the conditional, so that Dr.Jit shares it between sample() and eval() at the same

@@ -200,8 +200,9 @@ def test_levels_the_cells_do_not_fit_come_from_a_level_table_of_their_own(rng):
     pm.register(LLVM)
     f = pumpup.load(LEVEL_TABLE[1])
     fast = pm._DrModel(f).fast
-    assert fast.rest == [2] and fast.cells.nfun == 2 and fast.rest_table.mlo <= fast.mlo
+    assert fast.rest == [2] and fast.cells.nfun == 2 and fast.rest_table.mlo <= fast.mlo and not fast.whole
     x = _cell_points(fast.cells, rng)
+    x = x[x > fast.mlo]  # (below it the plugin looks pairs up level by level)
     y = rng.permutation(x)
     got = np.array(fast(mi.Float64(x), mi.Float64(y)), dtype=np.float64)
     ref = fast.reference(x, y)
@@ -283,19 +284,33 @@ def _kink_points(cells, rng):
 
 
 def _cell_points(cells, rng):
-    """Cosines from a cell table's mlo to 1: uniform, log-uniform, the edges of every 7th cell and the floats below
-    them, 1, the table's mlo, and those of :func:`_kink_points`."""
-    lo, _ = _cell_range(cells, np.arange(0, cells.ncell - 1, 7))
+    """Cosines from a cell table's mlo to 1: uniform, log-uniform, the edges of every 7th fine cell and the floats below
+    them, 1, the table's mlo, and those of :func:`_kink_points`; where the table has low cells, those of
+    :func:`_low_points` too."""
+    lo, _ = _cell_range(cells, np.arange(0, cells.nfine - 1, 7))
     x = np.concatenate([rng.uniform(cells.mlo, 1.0, 4000), np.exp(rng.uniform(math.log(cells.mlo), 0.0, 4000)),
                         lo, np.nextafter(lo, 0.0), [1.0, np.nextafter(1.0, 0.0), cells.mlo], _kink_points(cells, rng)])
-    return x[(x >= cells.mlo) & (x <= 1.0)]
+    x = x[(x >= cells.mlo) & (x <= 1.0)]
+    return np.concatenate([x, _low_points(cells, rng)]) if cells.nlow else x
+
+
+def _low_points(cells, rng):
+    """Float32 cosines below a cell table's mlo, where its low cells hold them: log-uniform down to float32's smallest
+    subnormal, the low cells' edges, the float64 and the float32 below mlo."""
+    edges = (np.arange(cells.low_base, cells.low_base + cells.nlow, dtype=np.int64) << cells.low_shift).view(np.float64)
+    f32 = np.float32(cells.mlo)
+    f32 = f32 if f32 < cells.mlo else np.nextafter(f32, np.float32(0.0))
+    x = np.concatenate([np.exp(rng.uniform(math.log(1.4e-45), math.log(cells.mlo), 4000)), edges[edges > 1.4e-45],
+                        [np.finfo(np.float32).smallest_subnormal, f32]]).astype(np.float32).astype(np.float64)
+    return np.concatenate([x[(x > 0) & (x < cells.mlo)], [np.nextafter(cells.mlo, 0.0)]])
 
 
 @needs_llvm
 @pytest.mark.parametrize("spec", CELL_CHAINS, ids=_ids(CELL_CHAINS))
 def test_cell_polynomials_equal_their_numpy_reference_and_bound_pumpups_g(spec, rng):
     """g from fixed cells (:class:`pumpup.mitsuba._CellG`): the Dr.Jit look-up equals its plain numpy reference to the
-    last bit (random and log-uniform cosines, both sides of cell edges, in and about the cells split at kinks, 1);
+    last bit (random and log-uniform cosines, both sides of cell edges, in and about the cells split at kinks, 1, and
+    for the chains looked up level by level, float32 cosines in the low cells, down to the smallest subnormal);
     outside the cells that miss (``bad``, where the plugin looks pairs up level by level) it is at least pumpup's
     levelwise g (from each level's look-up, as pumpup's kernels divide by it), so the plugin never exceeds pumpup, and
     at most LIFT (1e-13) per function above it."""
@@ -306,6 +321,8 @@ def test_cell_polynomials_equal_their_numpy_reference_and_bound_pumpups_g(spec, 
     cells = fast.cells
     assert len(cells.bad) <= cells.MAX_BAD and len(cells.splits) <= cells.MAX_SPLITS
     assert cells.nfun == (1 if fast.increasing else spec.get("levels", 1))
+    assert fast.whole == (not fast.increasing) and (cells.nlow > 0) == fast.whole  # (the product: pairs below mlo
+    # take both cosines' bounds, level by level)
     x = _cell_points(cells, rng)
     y = rng.permutation(x)
     got = np.array(fast(mi.Float64(x), mi.Float64(y)), dtype=np.float64)
@@ -321,6 +338,37 @@ def test_cell_polynomials_equal_their_numpy_reference_and_bound_pumpups_g(spec, 
         levelwise = levelwise * (np.maximum(g, np.maximum(x, y)) if lev.controlled else g)  # 001 eq. 21
     assert np.all(ref[good] >= levelwise[good])
     assert np.all(ref[good] <= levelwise[good] * (1.0 + cells.LIFT) ** cells.nfun * (1.0 + 1e-15))
+
+
+@needs_llvm
+@pytest.mark.parametrize("spec", CELL_CHAINS[:3], ids=_ids(CELL_CHAINS[:3]))
+def test_cosines_in_the_low_cells_agree_with_pumpup(spec, rng):
+    """Pairs with a cosine below the levels' splines (float32 cosines from the smallest normal float32 up to mlo, where
+    each level's bound is a power law and the cells hold them without a level-by-level path): through the plugin,
+    within one rounding of pumpup's eval and never above it.  (Dr.Jit's llvm kernels wider than 16 lanes flush a
+    subnormal float32 to 0, so there the plugin gives 0, as Mitsuba's roughconductor does.)"""
+    pm.register(LLVM)
+    f = pumpup.load(spec)
+    fast = pm._DrModel(f).fast
+    assert fast.whole and not fast.cells.bad
+    z = _low_points(fast.cells, rng)
+    z = z[z >= np.finfo(np.float32).tiny]
+    ph = rng.uniform(0, 2 * np.pi, len(z))
+    s = np.sqrt(1 - z * z)
+    wo = np.stack([s * np.cos(ph), s * np.sin(ph), z], -1).astype(np.float32).astype(np.float64)
+    wi = rng.normal(size=wo.shape)
+    wi[:, 2] = np.abs(wi[:, 2])
+    wi[::2] = -wo[::2] * np.array([1.0, 1.0, -1.0]) + 0.01 * wi[::2]  # near the mirror for half the pairs
+    wi[:, 2] = np.abs(wi[:, 2])
+    wi = (wi / np.linalg.norm(wi, axis=1)[:, None]).astype(np.float32).astype(np.float64)
+    b = pm.load_dict({"type": "pumpup", "spec": spec})
+    for a, c in ((wi, wo), (wo, wi)):  # (the low cosine on either side)
+        got, _ = _plugin_eval(b, a, c)
+        ref = f.eval(a, c) * a[:, 2]
+        tiny = np.finfo(np.float32).tiny
+        assert np.all(got <= ref * (1 + 1e-12) + tiny)
+        assert np.all(np.abs(got - ref) <= np.maximum((2.0**-23 + F32) * ref, tiny))
+        assert np.sum(ref > 1e-30) > len(z) // 10 or a is wo  # (times the low cosine, most values are below 1e-30)
 
 
 def test_cell_polynomials_split_a_cell_at_a_kink_or_mark_it():
