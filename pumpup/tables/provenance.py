@@ -44,21 +44,42 @@ def source_commit() -> str:
     return head + ("-dirty" if dirty else "")
 
 
+#: how close two error estimates (variables named ``*_error``) must be, relative to themselves, to be the same data:
+#: an estimate is a difference of nearly equal sums, whose last digits carry the rounding of the machine's math
+#: library (on an AMD EPYC, 49 of the 160 albedo errors of tables/sampling_efficiency.nc differed from those made on
+#: an Intel Xeon, by at most 7.6e-9 of themselves)
+ERROR_RTOL = 1e-7
+
+
 def same_data(a, b) -> bool:
-    """True if two Datasets hold the same variables, coordinates, values (bit for bit) and
-    attributes, apart from :data:`PROVENANCE_ATTRS`.
+    """True if two Datasets hold the same variables, coordinates, values and attributes, apart from
+    :data:`PROVENANCE_ATTRS`: the values bit for bit, except error estimates (variables named ``*_error``), which
+    agree to :data:`ERROR_RTOL` of themselves.
     """
+    import numpy as np
     import xarray as xr
 
-    def strip(ds):
-        ds = ds.copy()
+    def strip(ds, errors):
+        ds = ds.drop_vars(errors)
         ds.attrs = {k: v for k, v in ds.attrs.items() if k not in PROVENANCE_ATTRS}
         return ds
 
-    try:
-        xr.testing.assert_identical(strip(a), strip(b))
-    except AssertionError:
+    errors = sorted(v for v in a.data_vars if str(v).endswith("_error"))
+    if errors != sorted(v for v in b.data_vars if str(v).endswith("_error")):
         return False
+    try:
+        xr.testing.assert_identical(strip(a, errors), strip(b, errors))
+        for v in errors:
+            xr.testing.assert_identical(a[v].copy(data=np.zeros(a[v].shape)), b[v].copy(data=np.zeros(b[v].shape)))
+    except (AssertionError, ValueError):
+        return False
+    for v in errors:
+        if a[v].dtype != b[v].dtype:
+            return False
+        x, y = np.asarray(a[v].values, dtype=np.float64), np.asarray(b[v].values, dtype=np.float64)
+        same = (x == y) | (np.isnan(x) & np.isnan(y)) | (np.abs(x - y) <= ERROR_RTOL * np.maximum(np.abs(x), np.abs(y)))
+        if not np.all(same):
+            return False
     return True
 
 

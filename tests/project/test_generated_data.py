@@ -58,6 +58,34 @@ def test_source_commit_and_same_data():
     assert not same_data(ds, other)
 
 
+def test_same_data_takes_error_estimates_to_their_own_precision():
+    """Error estimates (``*_error`` variables) are the same data within ERROR_RTOL of themselves, so that `pumpup
+    reproduce` on another machine keeps a file whose estimates differ only in the digits its math library rounds; a
+    value one ulp off, an estimate further off, or an estimate's attribute, dtype or presence changed is not."""
+    import numpy as np
+
+    from pumpup.tables.provenance import ERROR_RTOL
+
+    ds = pumpup.open_table(os.path.join(TABLES, "sampling_efficiency.nc"))
+    errors = [v for v in ds.data_vars if v.endswith("_error")]
+    assert errors
+    near = ds.copy(deep=True)
+    for v in errors:
+        near[v].values[...] = near[v].values * (1.0 + 0.5 * ERROR_RTOL)
+    assert same_data(ds, near) and same_data(near, ds)
+    far = ds.copy(deep=True)
+    far[errors[0]].values.flat[7] *= 1.0 + 2.0 * ERROR_RTOL
+    assert not same_data(ds, far)
+    value = near.copy(deep=True)
+    value["albedo"].values.flat[7] = np.nextafter(value["albedo"].values.flat[7], np.inf)
+    assert not same_data(ds, value)
+    attr = ds.copy(deep=True)
+    attr[errors[0]].attrs["units"] = "other"
+    assert not same_data(ds, attr)
+    assert not same_data(ds, ds.drop_vars(errors[0])) and not same_data(ds.drop_vars(errors[0]), ds)
+    assert not same_data(ds, ds.assign({errors[0]: ds[errors[0]].astype(np.float32)}))
+
+
 def test_reproduce_of_the_cheap_tables_changes_no_byte(tmp_path):
     """table4 and text regenerated into a copy of the committed files: bit for bit the same data,
     so the files are not even rewritten."""
