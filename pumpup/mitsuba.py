@@ -50,9 +50,10 @@ The BSDF
     same code runs on Python floats.  A pumped model divides by the same upper bounds of the albedo tables as
     pumpup's compiled kernel (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`): from quartics
     in fixed cells of the cosine, each at least the bound and within 1e-13 of it (:class:`_CellG`, its cell and the
-    position in it from the cosine's bits, no search; a cell with a kink split there; below the levels' tables, where
-    the bounds are power laws, coarser cells down to float32's smallest subnormal where they fit), with pairs in the
-    few cells that still miss and below the cells level by level, and the levels whose bounds the cells do not fit
+    position in it from the cosine's bits, no search; a cell with a kink split there, or where a fixed grid does not
+    fit, refined cells, a coarse cell cut into finer ones; below the levels' tables, where the bounds are power laws,
+    coarser cells down to float32's smallest subnormal where they fit), with pairs in the few cells that still miss
+    and below the cells level by level, and the levels whose bounds the cells do not fit
     from a level table of those levels; else (no level fits, or the product of a chain whose bounds all increase does
     not) through pumpup's table of all levels: the product table G(m) where every level's bound increases
     (:class:`pumpup.operators.pumping._Product`, m = max(N.wi, N.wo)), else the level table
@@ -794,10 +795,12 @@ class _CellPolynomials:
     its smallest value above F_j (a kink or a jump of F_j in it: the lift plus the miss) is split at the kinks where
     the chain knows of them: its first piece keeps the cell's row, each further piece, from kink t_i, has a row of its
     own, a quartic in t - t_i.  Else the cell is ``bad``: the plugin looks pairs with a cosine there up level by level.
-    The fewest bits of :data:`BITS` with the fewest bad cells, then the fewest split cells; refused
-    (:class:`_CellsMiss`: the plugin then takes pumpup's product or level table) beyond :data:`MAX_BAD` bad or
-    :data:`MAX_SPLITS` split cells.  ``reference`` is the plain numpy version of the look-up, the same operations in
-    the same order.
+    The fewest bits of :data:`BITS` with the fewest bad cells, then the fewest split cells.  Beyond :data:`MAX_BAD` bad
+    or :data:`MAX_SPLITS` split cells, refined cells (``coarse``): 2^REFINE_BITS coarse cells per octave, each cut into
+    the fewest 2^e fine cells (e <= MAX_EXTRA_BITS) that all fit, with no splits; a look-up reads its coarse cell's
+    entry (first fine cell << 5 | e), then its fine cell's coefficients.  Refused (:class:`_CellsMiss`: the plugin then
+    leaves levels out of the cells, or takes pumpup's product or level table) where more than MAX_BAD fine cells miss
+    even so.  ``reference`` is the plain numpy version of the look-up, the same operations in the same order.
     """
 
     #: the relative lift a cell may need (the plugin's values may lie this much further below pumpup's, per function)
@@ -818,8 +821,12 @@ class _CellPolynomials:
     LOW_BITS = (0, 1, 2, 3)
     #: the float64 bits of 1
     ONE = int(np.float64(1.0).view(np.int64))
+    #: refined cells, where no fixed grid of :data:`BITS` fits: 2^REFINE_BITS coarse cells per octave, each cut into
+    #: 2^e fine cells, e from 0 to MAX_EXTRA_BITS, the fewest where all fit
+    REFINE_BITS = 9
+    MAX_EXTRA_BITS = 10
 
-    def __init__(self, functions, caps, start: float, kinks=(), low: bool = False):
+    def __init__(self, functions, caps, start: float, kinks=(), low: bool = False, refine: bool = True):
         self.mlo = float(start)
         self.mlo_bits = int(np.float64(start).view(np.int64))
         self.caps = [float(c) for c in caps]
@@ -833,6 +840,11 @@ class _CellPolynomials:
             if len(fit[1]) + len(fit[2]) == 0:
                 break
         bits, coef, splits, bad = best
+        #: refined cells: each coarse cell's entry (its first fine cell << 5 | its extra bits e), else None
+        self.coarse = None
+        if (len(bad) > self.MAX_BAD or len(splits) > self.MAX_SPLITS) and refine:
+            bits = self.REFINE_BITS
+            coef, self.coarse, splits, bad = self._refined(functions, kinks)
         if len(bad) > self.MAX_BAD or len(splits) > self.MAX_SPLITS:
             raise _CellsMiss(f"pumpup.mitsuba: {len(bad)} cells of a level's bound are not within its lift of "
                              f"quartics and {len(splits)} are split at kinks")
@@ -865,6 +877,7 @@ class _CellPolynomials:
         self.bad = [int(c) for c in bad]
         self.np = np.ascontiguousarray(coef.reshape(coef.shape[0], -1))  # row c: F_1's 5 coefficients, F_2's, ...
         self.dr = _aligned_f64(self.np) if _jit() else None
+        self.coarse_dr = mi.UInt32(self.coarse) if _jit() and self.coarse is not None else None
 
     @staticmethod
     def _grid(first: int, last: int, shift: int):
@@ -889,6 +902,51 @@ class _CellPolynomials:
             coef[-1, j, -1] = float(fn(np.array([1.0]))[0])  # the cell of m = 1: the function's value there
         splits, bad = self._split(functions, left, width, ok, kinks, lo_t, np.ones(len(left)))
         return coef, splits, bad
+
+    def _refined(self, functions, kinks):
+        """(the fine cells' coefficients, in the order of their coarse cells, and one more row for m = 1; the coarse
+        cells' entries (first fine cell << 5 | e); the fine cells split at kinks, as :meth:`_split`; the fine cells
+        that still miss) of refined cells: each coarse cell that misses cut into 2^e fine cells, the fewest with all
+        within LIFT, at most 2^MAX_EXTRA_BITS; fine cells that miss even so are split at a kink where they can be (at
+        most MAX_SPLITS in all).
+        """
+        shift = 52 - self.REFINE_BITS
+        left, width = self._grid(self.mlo_bits >> shift, (self.ONE >> shift) - 1, shift)
+        coef, ok = self._pieces(functions, left, width, 0.0)
+
+        def cut(i, e):  # the 2^e fine cells of coarse cell i (the first holds m >= mlo only: below it never read)
+            n = 2**e
+            sub_left, sub_width = left[i] + width[i] * np.arange(n) / n, np.full(n, width[i] / n)  # (exact)
+            lo_t = np.zeros(n)
+            c, fits = self._pieces(functions, sub_left, sub_width, 0.0)
+            fits |= sub_left + sub_width <= self.mlo
+            for k in np.nonzero((sub_left < self.mlo) & (sub_left + sub_width > self.mlo))[0]:
+                lo_t[k] = (self.mlo - sub_left[k]) / sub_width[k]
+                c[k:k + 1], fits[k:k + 1] = self._pieces(functions, sub_left[k:k + 1], sub_width[k:k + 1], 0.0,
+                                                         lo_t[k])
+            split, miss = self._split(functions, sub_left, sub_width, fits, kinks, lo_t, np.ones(n))
+            return c, split, miss
+
+        rows, entries, splits, bad = [], [], [], []
+        first = 0
+        for i in range(len(left)):
+            e = 0
+            c, split, miss = (coef[i:i + 1], [], []) if ok[i] else cut(i, 0)
+            while (miss or split) and e < self.MAX_EXTRA_BITS:  # (finer cells cost memory, splits a few selects)
+                e += 1
+                c, split, miss = cut(i, e)
+            if len(splits) + len(split) > self.MAX_SPLITS:  # (the cells to split beyond MAX_SPLITS miss)
+                miss, split = miss + [k for k, *_ in split], []
+            rows.append(c)
+            entries.append((first << 5) | e)
+            splits += [(first + k, *rest) for k, *rest in split]
+            bad += [first + k for k in miss]
+            first += len(c)
+        last = np.zeros((1, *coef.shape[1:]))
+        for j, fn in enumerate(functions):
+            last[0, j, -1] = float(fn(np.array([1.0]))[0])  # the cell of m = 1: the function's value there
+        entries.append(first << 5)
+        return np.concatenate(rows + [last]), np.array(entries, dtype=np.uint32), splits, sorted(bad)
 
     def _low(self, functions, kinks, bits: int, nsplit: int):
         """(the coefficients of 2^``bits`` cells per octave from 2^(LOW_EXP - 1023) up to mlo, the cells split at
@@ -973,6 +1031,11 @@ class _CellPolynomials:
         """
         c = np.minimum(np.maximum(bits >> self.shift, self.cbase) - self.cbase, self.nfine - 1)
         t = (bits & ((1 << self.shift) - 1)).astype(np.float64) * 2.0**-self.shift
+        if self.coarse is not None:  # the coarse cell's entry, then its fine cell
+            entry = self.coarse[np.minimum(c, len(self.coarse) - 1)].astype(np.int64)
+            sub = self.shift - (entry & 31)
+            c = (entry >> 5) + ((bits >> sub) & ((1 << (entry & 31)) - 1))
+            t = (bits & ((1 << sub) - 1)).astype(np.float64) * np.ldexp(1.0, -sub)
         if self.nlow:
             low = bits < self.mlo_bits
             c = np.where(low, self.nfine + np.maximum(bits >> self.low_shift, self.low_base) - self.low_base, c)
@@ -1006,13 +1069,21 @@ class _CellPolynomials:
     def _cell_dr(self, m):
         """:meth:`_cell` in Dr.Jit, of the Float64 cosines m (m <= 0: some valid cell)."""
         mb = dr.reinterpret_array(mi.UInt64, m)
-        c = mi.UInt32(dr.minimum(dr.maximum(mb >> self.shift, self.cbase) - self.cbase, self.nfine - 1))
+        if self.coarse is not None:  # the coarse cell's entry, then its fine cell
+            cc = mi.UInt32(dr.minimum(dr.maximum(mb >> self.shift, self.cbase) - self.cbase, len(self.coarse) - 1))
+            entry = dr.gather(mi.UInt32, self.coarse_dr, cc)
+            e = mi.UInt64(entry & 31)
+            sub = self.shift - e
+            c = (entry >> 5) + mi.UInt32((mb >> sub) & ((mi.UInt64(1) << e) - 1))
+            t = mi.Float64(mb & ((mi.UInt64(1) << sub) - 1)) * dr.reinterpret_array(mi.Float64, (1023 - sub) << 52)
+        else:
+            c = mi.UInt32(dr.minimum(dr.maximum(mb >> self.shift, self.cbase) - self.cbase, self.nfine - 1))
+            t = mi.Float64(mb & ((1 << self.shift) - 1)) * 2.0**-self.shift
         if not self.nlow:
-            return c, mi.Float64(mb & ((1 << self.shift) - 1)) * 2.0**-self.shift
+            return c, t
         low = mb < self.mlo_bits
         c = dr.select(low, mi.UInt32(dr.maximum(mb >> self.low_shift, self.low_base) - self.low_base) + self.nfine, c)
-        mask = dr.select(low, mi.UInt64((1 << self.low_shift) - 1), mi.UInt64((1 << self.shift) - 1))
-        return c, mi.Float64(mb & mask) * dr.select(low, 2.0**-self.low_shift, 2.0**-self.shift)
+        return c, dr.select(low, mi.Float64(mb & ((1 << self.low_shift) - 1)) * 2.0**-self.low_shift, t)
 
     def reference(self, m):
         """[F_1(m), ..., F_k(m)], each at most its cap, as the Dr.Jit look-up computes them (numpy; m >= mlo, or
@@ -1048,9 +1119,10 @@ class _CellG:
     of m = max(N.wi, N.wo): G(m) = prod_j max(min(U_j(m), cap_j), m where controlled) (001 eq. 20, 21; pumpup's product
     table), looked up once per pair.  Else each level's uncapped bound U_j, looked up at both cosines, and g_j =
     max(min(U_j, cap_j) at N.wi, at N.wo), at least max(N.wi, N.wo) where controlled; where some levels' bounds do not
-    fit the cells (crowded features), only the others, times those levels' g from a level table of their own
-    (:class:`_PairG`: one piece per cosine).  Both cosines above ``mlo``, and not in a cell whose quartics miss
-    (:meth:`in_bad`); the plugin looks the others up level by level.
+    fit a fixed grid (crowded features), only the others, times those levels' g from refined cells of their own
+    (``rest_cells``: a refined look-up's coarse read delays only those levels' reads), else from a level table of
+    their own (:class:`_PairG`: one piece per cosine).  Both cosines above ``mlo`` (any cosine > 0 where ``whole``),
+    and not in a cell whose quartics miss (:meth:`in_bad`); the plugin looks the others up level by level.
     """
 
     def __init__(self, looks, controlled):
@@ -1062,38 +1134,47 @@ class _CellG:
             start = max([start] + [float(lk.mu0) for lk in looks])
         self.controlled = [bool(c) for c in controlled]
         kinks = self._kinks(looks, start)
-        #: the levels that are not in the cells, and their level table (None: every level is in the cells)
-        self.rest, self.rest_table = [], None
+        #: the levels that are not in the fixed cells, and their refined cells or level table (None: none)
+        self.rest, self.rest_cells, self.rest_table = [], None, None
+        self.rest_controlled = []
         if self.increasing:
             self.cells = _CellPolynomials([self._product_of(looks)], [math.inf], start, kinks)
         else:  # (each level's bound at both cosines, as pumpup's level-by-level path: the low cells serve)
             try:
-                self.cells = self._levels_in_cells(looks, range(len(looks)), start, kinks)
+                self.cells = self._levels_in_cells(looks, range(len(looks)), start, kinks, refine=False)
             except _CellsMiss:
                 fit = [j for j in range(len(looks)) if self._fits(looks[j], start, kinks)]
-                if not fit:
-                    raise
-                self.cells = self._levels_in_cells(looks, fit, start, kinks)
-                self.rest = [j for j in range(len(looks)) if j not in fit]
-                self._rest_pair(looks)
+                if not fit:  # (refined cells of every level, else pumpup's tables)
+                    self.cells = self._levels_in_cells(looks, range(len(looks)), start, kinks)
+                else:
+                    self.cells = self._levels_in_cells(looks, fit, start, kinks, refine=False)
+                    self.rest = [j for j in range(len(looks)) if j not in fit]
+                    try:
+                        self.rest_cells = self._levels_in_cells(looks, self.rest, start, kinks)
+                    except _CellsMiss:
+                        self._rest_pair(looks)
+            self.rest_controlled = [self.controlled[j] for j in self.rest]
             self.controlled = [self.controlled[j] for j in range(len(looks)) if j not in self.rest]
         #: pairs with a cosine at or below mlo go level by level, unless the cells hold every float32 cosine > 0
-        #: (``whole``: the low cells fit, and no level is left out); then only pairs in a cell that misses do
+        #: (``whole``: the low cells fit, and no level is in a level table); then only pairs in a cell that misses do
         self.mlo = self.cells.mlo if self.rest_table is None else max(self.cells.mlo, self.rest_table.mlo)
-        self.whole = bool(self.cells.nlow) and self.rest_table is None
+        self.whole = (bool(self.cells.nlow) and self.rest_table is None
+                      and (self.rest_cells is None or bool(self.rest_cells.nlow)))
+        #: the cells whose quartics miss, of the fixed cells and of the refined ones
+        self.bad = self.cells.bad + ([] if self.rest_cells is None else self.rest_cells.bad)
 
     @staticmethod
-    def _levels_in_cells(looks, levels, start, kinks):
-        """The cells of the uncapped bounds of ``levels``, with low cells where they fit (:class:`_CellsMiss` where
-        the fine cells do not fit).
+    def _levels_in_cells(looks, levels, start, kinks, refine: bool = True):
+        """The cells of the uncapped bounds of ``levels``, with low cells where they fit, refined where ``refine`` and
+        a fixed grid does not fit (:class:`_CellsMiss` where the cells do not fit).
         """
         return _CellPolynomials([lambda m, lk=looks[j]: lk.upper(m, capped=False) for j in levels],
-                                [looks[j].cap for j in levels], start, kinks, low=True)
+                                [looks[j].cap for j in levels], start, kinks, low=True, refine=refine)
 
     def _fits(self, lk, start, kinks) -> bool:
-        """Whether the cells fit the bound of look-up ``lk`` alone."""
+        """Whether a fixed grid of cells fits the bound of look-up ``lk`` alone."""
         try:
-            self._levels_in_cells([lk], [0], start, kinks)
+            self._levels_in_cells([lk], [0], start, kinks, refine=False)
         except _CellsMiss:
             return False
         return True
@@ -1142,9 +1223,10 @@ class _CellG:
             return g
         return product
 
-    def _levels(self, ui, uo, mmax, maximum):
+    @staticmethod
+    def _levels(ui, uo, mmax, maximum, controlled_levels):
         g_all = None
-        for j, controlled in enumerate(self.controlled):
+        for j, controlled in enumerate(controlled_levels):
             g = maximum(ui[j], uo[j])  # 001 eq. 20
             if controlled:
                 g = maximum(g, mmax)  # 001 eq. 21
@@ -1155,7 +1237,8 @@ class _CellG:
         """Whether the pair looks a cosine up in a cell whose quartics miss (:attr:`_CellPolynomials.bad`)."""
         if self.increasing:
             return self.cells.in_bad(dr.maximum(mi_, mo) if isinstance(mi_, mi.Float64) else np.maximum(mi_, mo))
-        return self.cells.in_bad(mi_) | self.cells.in_bad(mo)
+        out = self.cells.in_bad(mi_) | self.cells.in_bad(mo)
+        return out if self.rest_cells is None else out | self.rest_cells.in_bad(mi_) | self.rest_cells.in_bad(mo)
 
     def reference(self, mi_, mo):
         """The plain numpy version (both cosines >= mlo)."""
@@ -1163,7 +1246,10 @@ class _CellG:
         mmax = np.maximum(mi_, mo)
         if self.increasing:
             return self.cells.reference(mmax)[0]
-        g = self._levels(self.cells.reference(mi_), self.cells.reference(mo), mmax, np.maximum)
+        g = self._levels(self.cells.reference(mi_), self.cells.reference(mo), mmax, np.maximum, self.controlled)
+        if self.rest_cells is not None:
+            return g * self._levels(self.rest_cells.reference(mi_), self.rest_cells.reference(mo), mmax, np.maximum,
+                                    self.rest_controlled)
         return g if self.rest_table is None else g * self.rest_table.g(mi_, mo)
 
     def __call__(self, mi_, mo):
@@ -1172,7 +1258,10 @@ class _CellG:
         mmax = dr.maximum(mi_, mo)
         if self.increasing:
             return self.cells(mmax)[0]
-        g = self._levels(self.cells(mi_), self.cells(mo), mmax, dr.maximum)
+        g = self._levels(self.cells(mi_), self.cells(mo), mmax, dr.maximum, self.controlled)
+        if self.rest_cells is not None:
+            return g * self._levels(self.rest_cells(mi_), self.rest_cells(mo), mmax, dr.maximum,
+                                    self.rest_controlled)
         return g if self.rest_table is None else g * self.rest_g(mi_, mo)
 
 
@@ -1262,12 +1351,12 @@ class _DrModel:
             return self.fast(mi_, mo) if _jit() or dr.minimum(mi_, mo) > 0.0 else 1.0
         mmin = dr.minimum(mi_, mo)
         if isinstance(self.fast, _CellG) and self.fast.whole:  # (every cosine > 0 in the cells)
-            if not self.fast.cells.bad:
+            if not self.fast.bad:
                 return self.fast(mi_, mo) if _jit() or mmin > 0.0 else 1.0
             slow = self.fast.in_bad(mi_, mo) & (mmin > 0.0)
         else:
             slow = (mmin <= self.fast.mlo) & (mmin > 0.0)
-            if isinstance(self.fast, _CellG) and self.fast.cells.bad:  # (and where a cell's quartics miss)
+            if isinstance(self.fast, _CellG) and self.fast.bad:  # (and where a cell's quartics miss)
                 slow = slow | (self.fast.in_bad(mi_, mo) & (mmin > self.fast.mlo))
         if not _jit():
             return by_levels(mi_, mo) if (slow or mmin <= 0.0) else self.fast(mi_, mo)

@@ -46,6 +46,8 @@ MODELS = [
     ("phong", "Phong n 20", {"type": "phong", "n": 20}, 1.3),
     ("pumped-phong-2", "2-level g2 pumped Phong n 20",
      {"type": "pumped", "base": {"type": "phong", "n": 20}, "g": "g2", "levels": 2}, 1.5),
+    ("pumped-phong-3", "3-level g2 pumped Phong n 20",
+     {"type": "pumped", "base": {"type": "phong", "n": 20}, "g": "g2", "levels": 3}, 1.5),
     ("pumped-ggx-1", "1-level g2 pumped GGX alpha 0.3",
      {"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 1}, 1.5),
     ("pumped-ggx-2", "2-level g2 pumped GGX alpha 0.3",

@@ -12,6 +12,7 @@ import math
 import os
 import subprocess
 import sys
+import types
 
 import helpers
 import numpy as np
@@ -157,18 +158,20 @@ def test_eval_agrees_with_pumpup_llvm(spec, rng):
 
 #: pumped chains whose levels' bounds are not all monotone (GGX's albedo falls, then rises), so that g depends on both
 #: cosines: the plugin looks every level's bound up in fixed cells of each cosine where quartics fit them
-#: (:class:`pumpup.mitsuba._CellG`; 2 levels: one cell split at a kink), the levels they do not fit in a level table of
-#: their own (one piece per cosine for those levels; 3 levels: the third)
+#: (:class:`pumpup.mitsuba._CellG`; 2 levels: one cell split at a kink; 3 levels: refined cells, the third level's
+#: bound crowding with features)
 LEVEL_TABLE = [{"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 2},
                {"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 3}]
 
 
 @needs_llvm
-@pytest.mark.parametrize("spec,rest", zip(LEVEL_TABLE, [[], [2]]), ids=_ids(LEVEL_TABLE))
-def test_level_table_chains_agree_with_pumpup_llvm(spec, rest, rng):
+@pytest.mark.parametrize("spec,refined", zip(LEVEL_TABLE, [False, True]), ids=_ids(LEVEL_TABLE))
+def test_level_table_chains_agree_with_pumpup_llvm(spec, refined, rng):
     pm.register(LLVM)
     fast = pm._DrModel(pumpup.load(spec)).fast
-    assert isinstance(fast, pm._CellG) and fast.rest == rest
+    assert isinstance(fast, pm._CellG) and fast.rest_table is None and fast.cells.coarse is None
+    assert fast.rest == ([2] if refined else []) and (fast.rest_cells is not None) == refined
+    assert not refined or fast.rest_cells.coarse is not None
     _check_agreement(spec, LLVM, 2000, rng)
 
 
@@ -191,13 +194,15 @@ def test_many_pumped_chains_agree_with_pumpup_llvm(spec, rng):
 
 
 @needs_llvm
-def test_levels_the_cells_do_not_fit_come_from_a_level_table_of_their_own(rng):
-    """3-level g2 GGX alpha 0.3: the third level's bound crowds with features that no quartic in the cells fits, so
-    the plugin keeps the first two levels in the cells and takes the third from a level table of that level alone
-    (:class:`pumpup.mitsuba._PairG`).  The Dr.Jit look-up equals its numpy reference to the last bit, and lies within
-    1e-14 below and 2 x 1e-13 above pumpup's level table of all three levels (both tables fit each bound to 1e-15 from
-    below; the cells lift theirs by at most 1e-13)."""
+def test_levels_the_cells_do_not_fit_come_from_a_level_table_of_their_own(rng, monkeypatch):
+    """3-level g2 GGX alpha 0.3 without refined cells: the third level's bound crowds with features that no quartic in
+    the fixed cells fits, so the plugin keeps the first two levels in the cells and takes the third from a level table
+    of that level alone (:class:`pumpup.mitsuba._PairG`).  The Dr.Jit look-up equals its numpy reference to the last
+    bit, and lies within 1e-14 below and 2 x 1e-13 above pumpup's level table of all three levels (both tables fit
+    each bound to 1e-15 from below; the cells lift theirs by at most 1e-13); through the plugin it agrees with
+    pumpup."""
     pm.register(LLVM)
+    monkeypatch.setattr(pm._CellPolynomials, "MAX_EXTRA_BITS", 0)
     f = pumpup.load(LEVEL_TABLE[1])
     fast = pm._DrModel(f).fast
     assert fast.rest == [2] and fast.cells.nfun == 2 and fast.rest_table.mlo <= fast.mlo and not fast.whole
@@ -211,6 +216,7 @@ def test_levels_the_cells_do_not_fit_come_from_a_level_table_of_their_own(rng):
     table = f.level_table().g(x, y)
     assert np.all(ref[good] >= table[good] * (1.0 - 1e-14))
     assert np.all(ref[good] <= table[good] * (1.0 + 2e-13))
+    _check_agreement(LEVEL_TABLE[1], LLVM, 1000, rng)
 
 
 @pytest.mark.parametrize("spec", SPECS[:: 3] + PUMPED[:1] + LEVEL_TABLE[:1],
@@ -260,15 +266,23 @@ def test_table_kernels_equal_their_numpy_references(spec, rng):
 
 #: chains whose g the plugin takes from fixed cells (:class:`pumpup.mitsuba._CellG`): each level's bound at both
 #: cosines (1-level and 2-level GGX, a 2-level Beckmann), the product of every level's g at the larger cosine where
-#: every level's bound increases (2-level Phong)
+#: every level's bound increases (2-level Phong), and 3-level GGX in refined cells
 CELL_CHAINS = [{"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 1}, LEVEL_TABLE[0],
-               {"type": "pumped", "base": {"type": "beckmann", "alpha": 0.05}, "g": "g1", "levels": 2}, PUMPED[0]]
+               {"type": "pumped", "base": {"type": "beckmann", "alpha": 0.05}, "g": "g1", "levels": 2}, PUMPED[0],
+               LEVEL_TABLE[1]]
 
 
 def _cell_range(cells, c):
-    """The cosines [lo, hi) of cells ``c`` of a cell table."""
-    c = np.asarray(c, dtype=np.int64) + cells.cbase
-    return (c << cells.shift).view(np.float64), ((c + 1) << cells.shift).view(np.float64)
+    """The cosines [lo, hi) of fine cells ``c`` of a cell table (of refined cells: in their coarse cells)."""
+    c = np.asarray(c, dtype=np.int64)
+    if cells.coarse is None:
+        c = c + cells.cbase
+        return (c << cells.shift).view(np.float64), ((c + 1) << cells.shift).view(np.float64)
+    first, e = (cells.coarse >> 5).astype(np.int64), (cells.coarse & 31).astype(np.int64)
+    k = np.searchsorted(first, c, side="right") - 1
+    lo, hi = _cell_range(types.SimpleNamespace(coarse=None, cbase=cells.cbase, shift=cells.shift), k)
+    w = (hi - lo) / 2.0 ** e[k]
+    return lo + w * (c - first[k]), lo + w * (c - first[k] + 1)
 
 
 def _kink_points(cells, rng):
@@ -309,8 +323,9 @@ def _low_points(cells, rng):
 @pytest.mark.parametrize("spec", CELL_CHAINS, ids=_ids(CELL_CHAINS))
 def test_cell_polynomials_equal_their_numpy_reference_and_bound_pumpups_g(spec, rng):
     """g from fixed cells (:class:`pumpup.mitsuba._CellG`): the Dr.Jit look-up equals its plain numpy reference to the
-    last bit (random and log-uniform cosines, both sides of cell edges, in and about the cells split at kinks, 1, and
-    for the chains looked up level by level, float32 cosines in the low cells, down to the smallest subnormal);
+    last bit (random and log-uniform cosines, both sides of cell edges, refined cells' too, in and about the cells
+    split at kinks, 1, and for the chains looked up level by level, float32 cosines in the low cells, down to the
+    smallest subnormal);
     outside the cells that miss (``bad``, where the plugin looks pairs up level by level) it is at least pumpup's
     levelwise g (from each level's look-up, as pumpup's kernels divide by it), so the plugin never exceeds pumpup, and
     at most LIFT (1e-13) per function above it."""
@@ -320,10 +335,13 @@ def test_cell_polynomials_equal_their_numpy_reference_and_bound_pumpups_g(spec, 
     assert isinstance(fast, pm._CellG) and fast.increasing == (f.product() is not None)
     cells = fast.cells
     assert len(cells.bad) <= cells.MAX_BAD and len(cells.splits) <= cells.MAX_SPLITS
-    assert cells.nfun == (1 if fast.increasing else spec.get("levels", 1))
+    nfun = cells.nfun + (0 if fast.rest_cells is None else fast.rest_cells.nfun)
+    assert nfun == (1 if fast.increasing else spec.get("levels", 1))
     assert fast.whole == (not fast.increasing) and (cells.nlow > 0) == fast.whole  # (the product: pairs below mlo
     # take both cosines' bounds, level by level)
     x = _cell_points(cells, rng)
+    if fast.rest_cells is not None:  # (and the refined cells' edges, fine cells and cells that miss)
+        x = np.concatenate([x, _cell_points(fast.rest_cells, rng)])
     y = rng.permutation(x)
     got = np.array(fast(mi.Float64(x), mi.Float64(y)), dtype=np.float64)
     ref = fast.reference(x, y)
@@ -337,7 +355,7 @@ def test_cell_polynomials_equal_their_numpy_reference_and_bound_pumpups_g(spec, 
         g = np.maximum(lk.upper(x), lk.upper(y))  # 001 eq. 20
         levelwise = levelwise * (np.maximum(g, np.maximum(x, y)) if lev.controlled else g)  # 001 eq. 21
     assert np.all(ref[good] >= levelwise[good])
-    assert np.all(ref[good] <= levelwise[good] * (1.0 + cells.LIFT) ** cells.nfun * (1.0 + 1e-15))
+    assert np.all(ref[good] <= levelwise[good] * (1.0 + cells.LIFT) ** nfun * (1.0 + 1e-15))
 
 
 @needs_llvm
