@@ -797,10 +797,11 @@ class _CellPolynomials:
     own, a quartic in t - t_i.  Else the cell is ``bad``: the plugin looks pairs with a cosine there up level by level.
     The fewest bits of :data:`BITS` with the fewest bad cells, then the fewest split cells.  Beyond :data:`MAX_BAD` bad
     or :data:`MAX_SPLITS` split cells, refined cells (``coarse``): 2^REFINE_BITS coarse cells per octave, each cut into
-    the fewest 2^e fine cells (e <= MAX_EXTRA_BITS) that all fit, with no splits; a look-up reads its coarse cell's
-    entry (first fine cell << 5 | e), then its fine cell's coefficients.  Refused (:class:`_CellsMiss`: the plugin then
-    leaves levels out of the cells, or takes pumpup's product or level table) where more than MAX_BAD fine cells miss
-    even so.  ``reference`` is the plain numpy version of the look-up, the same operations in the same order.
+    the fewest 2^e fine cells (e <= MAX_EXTRA_BITS) that all fit, a fine cell that misses even so split at a kink
+    where it can be; a look-up reads its coarse cell's entry (first fine cell << 5 | e), then its fine cell's
+    coefficients.  Refused (:class:`_CellsMiss`: the plugin then leaves levels out of the cells, or takes pumpup's
+    product or level table) beyond MAX_BAD fine cells that miss or MAX_SPLITS split ones.  ``reference`` is the plain
+    numpy version of the look-up, the same operations in the same order.
     """
 
     #: the relative lift a cell may need (the plugin's values may lie this much further below pumpup's, per function)
