@@ -1017,7 +1017,7 @@ class _CellPolynomials:
             mt = left[:, None] + width[:, None] * tt[None, :]
             mt[:, -1] = np.nextafter(mt[:, -1], 0.0)  # (a piece holds [t0, t1): a jump at its end)
             vt = fn(mt)
-            pt = horner(a.T[:, :, None], tt[None, :])
+            pt = horner(a.T[:, :, None], (mt - left[:, None]) / width[:, None])  # (at the t of the float m, exact)
             miss = np.max(np.abs(vt - pt), axis=1)
             lift = (3.0 * miss + 8.0 * np.finfo(float).eps * np.sum(np.abs(a), axis=1)
                     + margin * np.max(np.abs(vt), axis=1))

@@ -412,6 +412,30 @@ def test_cell_polynomials_split_a_cell_at_a_kink_or_mark_it():
 
 
 @needs_llvm
+def test_refined_cells_cut_the_cells_a_fixed_grid_misses(rng):
+    """A function with six steep (smooth) steps, 1e-3 wide: no fixed grid of quartics comes within LIFT of it in at
+    most MAX_BAD cells, so the table refines: the coarse cells about the steps are cut into 2^e finer ones, and the
+    look-up lies within [F, F (1 + LIFT)] on and about the steps, its Dr.Jit version equal to its numpy reference.
+    Without refinement the table is refused."""
+    pm.register(LLVM)
+    centres = 0.6 + 0.01 * np.arange(6)
+
+    def fn(m):
+        return 2.5 + 0.3 * np.sum(np.tanh((m[..., None] - centres) / 1e-3), axis=-1)
+
+    with pytest.raises(pm._CellsMiss, match="not within its lift"):
+        pm._CellPolynomials([fn], [math.inf], 1e-8, refine=False)
+    cells = pm._CellPolynomials([fn], [math.inf], 1e-8)
+    e = cells.coarse & 31
+    assert not cells.bad and not cells.splits and 0 < np.count_nonzero(e) <= 20 * len(centres)
+    assert e.max() <= cells.MAX_EXTRA_BITS
+    m = np.concatenate([(centres + np.linspace(-5e-3, 5e-3, 2001)[:, None]).ravel(), rng.uniform(1e-8, 1.0, 4000)])
+    got = cells.reference(m)[0]
+    assert np.all(got >= fn(m)) and np.all(got <= fn(m) * (1 + cells.LIFT))
+    assert np.array_equal(np.array(cells(mi.Float64(m))[0], dtype=np.float64), got)
+
+
+@needs_llvm
 @pytest.mark.parametrize("spec,hide_kinks", [(CELL_CHAINS[1], False), (PUMPED[0], False), (CELL_CHAINS[1], True)],
                          ids=["levels-2", "product-2", "levels-2-kinks-hidden"])
 def test_pairs_in_split_and_missing_cells_agree_with_pumpup(spec, hide_kinks, rng, monkeypatch):
