@@ -901,6 +901,8 @@ class _CellPolynomials:
         coef = np.concatenate([coef, np.zeros((1, *coef.shape[1:]))])
         for j, fn in enumerate(functions):
             coef[-1, j, -1] = float(fn(np.array([1.0]))[0])  # the cell of m = 1: the function's value there
+        if np.count_nonzero(~ok) > self.MAX_SPLITS + self.MAX_BAD:  # (refused however they split: not tried)
+            return coef, [], list(np.nonzero(~ok)[0])
         splits, bad = self._split(functions, left, width, ok, kinks, lo_t, np.ones(len(left)))
         return coef, splits, bad
 
@@ -1165,17 +1167,17 @@ class _CellG:
         self.bad = self.cells.bad + ([] if self.rest_cells is None else self.rest_cells.bad)
 
     @staticmethod
-    def _levels_in_cells(looks, levels, start, kinks, refine: bool = True):
-        """The cells of the uncapped bounds of ``levels``, with low cells where they fit, refined where ``refine`` and
-        a fixed grid does not fit (:class:`_CellsMiss` where the cells do not fit).
+    def _levels_in_cells(looks, levels, start, kinks, refine: bool = True, low: bool = True):
+        """The cells of the uncapped bounds of ``levels``, with low cells where ``low`` and they fit, refined where
+        ``refine`` and a fixed grid does not fit (:class:`_CellsMiss` where the cells do not fit).
         """
         return _CellPolynomials([lambda m, lk=looks[j]: lk.upper(m, capped=False) for j in levels],
-                                [looks[j].cap for j in levels], start, kinks, low=True, refine=refine)
+                                [looks[j].cap for j in levels], start, kinks, low=low, refine=refine)
 
     def _fits(self, lk, start, kinks) -> bool:
         """Whether a fixed grid of cells fits the bound of look-up ``lk`` alone."""
         try:
-            self._levels_in_cells([lk], [0], start, kinks, refine=False)
+            self._levels_in_cells([lk], [0], start, kinks, refine=False, low=False)
         except _CellsMiss:
             return False
         return True
