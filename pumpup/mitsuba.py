@@ -50,12 +50,12 @@ The BSDF
     same code runs on Python floats.  A pumped model divides by the same upper bounds of the albedo tables as
     pumpup's compiled kernel (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`): from quartics
     in fixed cells of the cosine, each at least the bound and within 1e-13 of it (:class:`_CellG`, its cell and the
-    position in it from the cosine's bits, no search; a cell with a kink split there, or where a fixed grid does not
-    fit, refined cells, a coarse cell cut into finer ones; below the levels' tables, where the bounds are power laws,
-    coarser cells down to float32's smallest subnormal where they fit), with pairs in the few cells that still miss
-    and below the cells level by level, and the levels whose bounds the cells do not fit
-    from a level table of those levels; else (no level fits, or the product of a chain whose bounds all increase does
-    not) through pumpup's table of all levels: the product table G(m) where every level's bound increases
+    position in it from the cosine's bits, no search; a cell with a kink split there; below the levels' tables, where
+    the bounds are power laws, coarser cells down to float32's smallest subnormal where they fit), with pairs in the
+    few cells that still miss and below the cells level by level; the levels whose bounds a fixed grid does not fit
+    from refined cells of their own (a coarse cell cut into finer ones), else from a level table of those levels;
+    else (no level fits, or the product of a chain whose bounds all increase does not) through pumpup's table of all
+    levels: the product table G(m) where every level's bound increases
     (:class:`pumpup.operators.pumping._Product`, m = max(N.wi, N.wo)), else the level table
     (:class:`pumpup.operators.pumping._LevelTable`: every level's bound on one set of pieces, one piece per cosine
     for all levels), else level by level.  A piece is found from the float64 bits of the cosine with one read of a
@@ -774,7 +774,9 @@ class _PairG:
 
 
 class _CellsMiss(ValueError):
-    """Raised by :class:`_CellPolynomials` where more than MAX_BAD cells miss: the plugin takes pumpup's tables."""
+    """Raised by :class:`_CellPolynomials` where more than MAX_BAD cells miss or more than MAX_SPLITS are split: the
+    plugin leaves levels out of the cells or takes pumpup's tables.
+    """
 
 
 class _CellPolynomials:
@@ -864,7 +866,6 @@ class _CellPolynomials:
         if lows is not None:
             coef = np.concatenate([coef, lows[0]])
             splits = splits + [(self.nfine + c, *rest) for c, *rest in lows[1]]
-        self.ncell = coef.shape[0]
         #: the cells split at kinks, (cell, [t of each kink], the row of the piece from the first kink): the further
         #: pieces' rows follow the cells'
         self.splits = []
@@ -893,17 +894,12 @@ class _CellPolynomials:
         """
         shift = 52 - bits
         left, width = self._grid(self.mlo_bits >> shift, (self.ONE >> shift) - 1, shift)
-        lo_t = np.zeros(len(left))
-        lo_t[0] = (self.mlo - left[0]) / width[0]  # (the first cell holds m >= mlo only; exact)
-        coef, ok = self._pieces(functions, left, width, 0.0)
-        if lo_t[0] > 0.0:
-            coef[:1], ok[:1] = self._pieces(functions, left[:1], width[:1], 0.0, lo_t[0])
-        coef = np.concatenate([coef, np.zeros((1, *coef.shape[1:]))])
-        for j, fn in enumerate(functions):
-            coef[-1, j, -1] = float(fn(np.array([1.0]))[0])  # the cell of m = 1: the function's value there
+        lo_t, hi_t = self._side(left, width, below=False)
+        coef, ok = self._fit(functions, left, width, lo_t, hi_t)
+        coef = np.concatenate([coef, self._row_of_one(functions)])
         if np.count_nonzero(~ok) > self.MAX_SPLITS + self.MAX_BAD:  # (refused however they split: not tried)
             return coef, [], list(np.nonzero(~ok)[0])
-        splits, bad = self._split(functions, left, width, ok, kinks, lo_t, np.ones(len(left)))
+        splits, bad = self._split(functions, left, width, ok, kinks, lo_t, hi_t)
         return coef, splits, bad
 
     def _refined(self, functions, kinks):
@@ -915,19 +911,14 @@ class _CellPolynomials:
         """
         shift = 52 - self.REFINE_BITS
         left, width = self._grid(self.mlo_bits >> shift, (self.ONE >> shift) - 1, shift)
-        coef, ok = self._pieces(functions, left, width, 0.0)
+        coef, ok = self._fit(functions, left, width, *self._side(left, width, below=False))
 
-        def cut(i, e):  # the 2^e fine cells of coarse cell i (the first holds m >= mlo only: below it never read)
+        def cut(i, e):  # the 2^e fine cells of coarse cell i
             n = 2**e
             sub_left, sub_width = left[i] + width[i] * np.arange(n) / n, np.full(n, width[i] / n)  # (exact)
-            lo_t = np.zeros(n)
-            c, fits = self._pieces(functions, sub_left, sub_width, 0.0)
-            fits |= sub_left + sub_width <= self.mlo
-            for k in np.nonzero((sub_left < self.mlo) & (sub_left + sub_width > self.mlo))[0]:
-                lo_t[k] = (self.mlo - sub_left[k]) / sub_width[k]
-                c[k:k + 1], fits[k:k + 1] = self._pieces(functions, sub_left[k:k + 1], sub_width[k:k + 1], 0.0,
-                                                         lo_t[k])
-            split, miss = self._split(functions, sub_left, sub_width, fits, kinks, lo_t, np.ones(n))
+            lo_t, hi_t = self._side(sub_left, sub_width, below=False)
+            c, fits = self._fit(functions, sub_left, sub_width, lo_t, hi_t)
+            split, miss = self._split(functions, sub_left, sub_width, fits, kinks, lo_t, hi_t)
             return c, split, miss
 
         rows, entries, splits, bad = [], [], [], []
@@ -945,11 +936,9 @@ class _CellPolynomials:
             splits += [(first + k, *rest) for k, *rest in split]
             bad += [first + k for k in miss]
             first += len(c)
-        last = np.zeros((1, *coef.shape[1:]))
-        for j, fn in enumerate(functions):
-            last[0, j, -1] = float(fn(np.array([1.0]))[0])  # the cell of m = 1: the function's value there
         entries.append(first << 5)
-        return np.concatenate(rows + [last]), np.array(entries, dtype=np.uint32), splits, sorted(bad)
+        return (np.concatenate(rows + [self._row_of_one(functions)]), np.array(entries, dtype=np.uint32), splits,
+                sorted(bad))
 
     def _low(self, functions, kinks, bits: int, nsplit: int):
         """(the coefficients of 2^``bits`` cells per octave from 2^(LOW_EXP - 1023) up to mlo, the cells split at
@@ -957,16 +946,38 @@ class _CellPolynomials:
         """
         shift = 52 - bits
         left, width = self._grid(self.LOW_EXP << bits, (self.mlo_bits - 1) >> shift, shift)
-        hi_t = np.ones(len(left))
-        hi_t[-1] = (self.mlo - left[-1]) / width[-1]  # (the last cell holds m < mlo only; exact)
+        lo_t, hi_t = self._side(left, width, below=True)
         with np.errstate(all="ignore"):
-            coef, ok = self._pieces(functions, left, width, 0.0)
-            if hi_t[-1] < 1.0:
-                coef[-1:], ok[-1:] = self._pieces(functions, left[-1:], width[-1:], 0.0, 0.0, hi_t[-1])
-            splits, bad = self._split(functions, left, width, ok, kinks, np.zeros(len(left)), hi_t)
+            coef, ok = self._fit(functions, left, width, lo_t, hi_t)
+            splits, bad = self._split(functions, left, width, ok, kinks, lo_t, hi_t)
         if bad or len(splits) > nsplit or not np.all(np.isfinite(coef)):
             return None
         return coef, splits
+
+    def _side(self, left, width, below: bool):
+        """(lo_t, hi_t): the part in t of each cell [left, left + width) that holds m >= mlo (``below``: m < mlo),
+        exact where the cell holds mlo; empty (lo_t = hi_t) where no part does.
+        """
+        t = np.clip((self.mlo - left) / width, 0.0, 1.0)
+        return (np.zeros_like(t), t) if below else (t, np.ones_like(t))
+
+    def _fit(self, functions, left, width, lo_t, hi_t):
+        """:meth:`_pieces` of each cell on its part [lo_t, hi_t) (a cell cut at mlo: fitted alone there); a cell with
+        no part is never read: fitted whole and taken as fitting.
+        """
+        empty = lo_t >= hi_t
+        coef, ok = self._pieces(functions, left, width, 0.0)
+        ok |= empty
+        for k in np.nonzero(~empty & ((lo_t > 0.0) | (hi_t < 1.0)))[0]:
+            coef[k:k + 1], ok[k:k + 1] = self._pieces(functions, left[k:k + 1], width[k:k + 1], 0.0, lo_t[k],
+                                                      hi_t[k])
+        return coef, ok
+
+    def _row_of_one(self, functions):
+        """The row of the cell of m = 1, (1, function, 5): each function's value there, a constant."""
+        row = np.zeros((1, len(functions), self.DEGREE + 1))
+        row[0, :, -1] = [float(fn(np.array([1.0]))[0]) for fn in functions]
+        return row
 
     def _split(self, functions, left, width, ok, kinks, lo_t, hi_t):
         """(the cells that miss (``~ok``, each holding t in [lo_t, hi_t)) split at kinks, [(cell, its first piece's

@@ -12,7 +12,6 @@ import math
 import os
 import subprocess
 import sys
-import types
 
 import helpers
 import numpy as np
@@ -176,7 +175,8 @@ def test_level_table_chains_agree_with_pumpup_llvm(spec, refined, rng):
 
 
 #: pumped chains of many bases, g1 and g2, 1 to 3 levels: the plugin's look-up takes every path on them (fixed cells,
-#: cells split at kinks, levels in a level table of their own, pumpup's product table)
+#: with and without low cells, cells split at kinks, levels in refined cells or a level table of their own, pumpup's
+#: product table)
 MANY_PUMPED = [{"type": "pumped", "base": base, "g": g, "levels": levels}
                for base in ({"type": "ggx", "alpha": 0.02}, {"type": "ggx", "alpha": 1.0},
                             {"type": "beckmann", "alpha": 0.4}, {"type": "phong", "n": 1}, {"type": "phong", "n": 5000},
@@ -205,7 +205,7 @@ def test_levels_the_cells_do_not_fit_come_from_a_level_table_of_their_own(rng, m
     monkeypatch.setattr(pm._CellPolynomials, "MAX_EXTRA_BITS", 0)
     f = pumpup.load(LEVEL_TABLE[1])
     fast = pm._DrModel(f).fast
-    assert fast.rest == [2] and fast.cells.nfun == 2 and fast.rest_table.mlo <= fast.mlo and not fast.whole
+    assert fast.rest == [2] and fast.cells.nfun == 2 and fast.rest_cells is None and not fast.whole
     x = _cell_points(fast.cells, rng)
     x = x[x > fast.mlo]  # (below it the plugin looks pairs up level by level)
     y = rng.permutation(x)
@@ -273,16 +273,17 @@ CELL_CHAINS = [{"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g
 
 
 def _cell_range(cells, c):
-    """The cosines [lo, hi) of fine cells ``c`` of a cell table (of refined cells: in their coarse cells)."""
+    """The cosines [lo, hi) of fine cells ``c`` of a cell table (of refined cells: fine cell c - first of coarse cell
+    k, one of its 2^e)."""
     c = np.asarray(c, dtype=np.int64)
-    if cells.coarse is None:
-        c = c + cells.cbase
-        return (c << cells.shift).view(np.float64), ((c + 1) << cells.shift).view(np.float64)
-    first, e = (cells.coarse >> 5).astype(np.int64), (cells.coarse & 31).astype(np.int64)
-    k = np.searchsorted(first, c, side="right") - 1
-    lo, hi = _cell_range(types.SimpleNamespace(coarse=None, cbase=cells.cbase, shift=cells.shift), k)
-    w = (hi - lo) / 2.0 ** e[k]
-    return lo + w * (c - first[k]), lo + w * (c - first[k] + 1)
+    k, sub, e = c, 0, 0
+    if cells.coarse is not None:
+        first = (cells.coarse >> 5).astype(np.int64)
+        k = np.searchsorted(first, c, side="right") - 1
+        sub, e = c - first[k], (cells.coarse[k] & 31).astype(np.int64)
+    lo = ((k + cells.cbase) << cells.shift).view(np.float64)
+    w = (((k + cells.cbase + 1) << cells.shift).view(np.float64) - lo) / 2.0**e
+    return lo + w * sub, lo + w * (sub + 1)
 
 
 def _kink_points(cells, rng):
