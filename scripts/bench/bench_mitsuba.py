@@ -24,7 +24,8 @@ cost).  The load average is printed with the numbers.
 
 ``--parts`` shows where a pumped model's time goes: for each of :data:`PARTS`, a copy of ``pumpup/mitsuba.py`` with one
 part of the look-up taken out is measured beside the plugin, as ``--baseline`` measures a file (the values of those
-copies are wrong; only their cost matters).
+copies are wrong; only their cost matters).  ``--cost-models`` measures, the same way, copies that look g up as the
+plugin does not (:data:`COST_MODELS`): the cost of other designs, for the chains looked up level by level in cells.
 """
 
 from __future__ import annotations
@@ -95,6 +96,37 @@ PARTS += [
         ("        for j in range(self.packets):\n", "        for j in range(1):\n")]),
 ]
 
+#: ``--cost-models``: (label, changes) -- look-ups of g by level-by-level cells (pumped GGX) that the plugin does not
+#: take, their cost measured with random or truncated values: each function read as a quadratic (three coefficients
+#: per function and cosine in place of five, from the same cells: the reads a looser bound than LIFT would need), and
+#: a split table as pumpup's numpy path has it (g = F(mmin) H(mmax) whatever the number of levels: one pattern read
+#: per pair from a 256 x 256 grid of (mmin, mmax), then two functions of the pair's pattern from the cells: 4 look-ups
+#: per sample and eval() in place of 3 per level; the cells of pairs whose pattern changes inside, which would need
+#: more, left out)
+COST_MODELS = [
+    ("three reads per function", [
+        ("            row = [dr.gather(mi.Float64, self.dr, base + (j * (deg + 1) + r)) for r in range(deg + 1)]\n"
+         "            u = _horner(row, 0, deg, t)\n",
+         "            row = [dr.gather(mi.Float64, self.dr, base + (j * (deg + 1) + r)) for r in range(3)]\n"
+         "            u = _horner(row, 0, 2, t)\n")]),
+    ("split table: a pattern, then F(mmin) H(mmax)", [
+        ("        g = self._levels(self.cells(mi_), self.cells(mo), mmax, dr.maximum, self.controlled)\n",
+         "        if not hasattr(self, '_pattern'):\n"
+         "            rng = np.random.default_rng(1)\n"
+         "            self._pattern = mi.UInt32(rng.integers(0, 4, 256 * 257 // 2).astype(np.uint32))\n"
+         "        mmin = dr.minimum(mi_, mo)\n"
+         "        i = mi.UInt32(dr.minimum(mi.Int32(mmin * 256.0), 255))\n"
+         "        k = mi.UInt32(dr.minimum(mi.Int32(mmax * 256.0), 255))\n"
+         "        p = dr.gather(mi.UInt32, self._pattern, ((k * (k + 1)) >> 1) + i)\n"
+         "        (ca, ta), (cb, tb) = self.cells._cell_dr(mmin), self.cells._cell_dr(mmax)\n"
+         "        width = self.cells.nfun * 5\n"
+         "        fa = ca * width + ((p & 1) * 5 if width > 5 else 0)\n"
+         "        fb = cb * width + ((p >> 1) * 5 if width > 5 else 0)\n"
+         "        ra = [dr.gather(mi.Float64, self.cells.dr, fa + r) for r in range(5)]\n"
+         "        rb = [dr.gather(mi.Float64, self.cells.dr, fb + r) for r in range(5)]\n"
+         "        return _horner(ra, 0, 4, ta) * _horner(rb, 0, 4, tb)\n")]),
+]
+
 
 def _part_file(label: str, changes) -> str:
     """A copy of pumpup/mitsuba.py with each (old, new) of ``changes`` made (a temporary file's path)."""
@@ -106,7 +138,7 @@ def _part_file(label: str, changes) -> str:
         text = fh.read()
     for old, new in changes:
         if old not in text:
-            raise SystemExit(f"bench_mitsuba --parts: {label!r}: pumpup/mitsuba.py no longer holds {old.strip()!r}")
+            raise SystemExit(f"bench_mitsuba: {label!r}: pumpup/mitsuba.py no longer holds {old.strip()!r}")
         text = text.replace(old, new, 1)
     with tempfile.NamedTemporaryFile("w", suffix=".py", delete=False) as tmp:
         tmp.write(text)
@@ -255,6 +287,8 @@ def main(argv=None):
     ap.add_argument("--baseline", help="another copy of pumpup/mitsuba.py to measure beside (llvm)")
     ap.add_argument("--parts", action="store_true", help="measure copies of the plugin with parts of the look-up "
                     "taken out (PARTS), each beside the plugin in a run of its own")
+    ap.add_argument("--cost-models", action="store_true", help="measure copies of the plugin that look g up in "
+                    "other ways (COST_MODELS), each beside the plugin in a run of its own")
     ap.add_argument("--models", help="comma-separated keys of the models to run (default all): "
                     + ", ".join(m[0] for m in MODELS))
     args = ap.parse_args(argv)
@@ -276,12 +310,13 @@ def main(argv=None):
     if ok:
         pm.register("llvm_ad_rgb")
         where = 'other directions (as towards a light)' if args.eval_at == 'light' else 'the sampled ones'
-        runs = [(args.baseline, "baseline")] if not args.parts else \
-            [(_part_file(label, changes), label) for label, changes in PARTS]
+        copies = (PARTS if args.parts else []) + (COST_MODELS if args.cost_models else [])
+        runs = [(_part_file(label, changes), label) for label, changes in copies] if copies else \
+            [(args.baseline, "baseline")]
         for path, label in runs:
             if path:
                 _load_baseline(path)
-                if args.parts:  # (a temporary copy: loaded, it is no longer needed)
+                if copies:  # (a temporary copy: loaded, it is no longer needed)
                     os.unlink(path)
             print(f"\nllvm_ad_rgb, {args.n} samples per call, {args.rounds} rounds, {args.threads} Dr.Jit worker "
                   f"threads, eval() at {where}" + (f"; beside: {label}" if path else ""))
