@@ -51,8 +51,8 @@ The BSDF
     pumpup's compiled kernel (spline + margin, capped at 1; :class:`pumpup.operators.pumping._Lookup`): from quartics
     in fixed cells of the cosine, each at least the bound and within 1e-13 of it (:class:`_CellG`, its cell and the
     position in it from the cosine's bits, no search; a cell with a kink split there; below the levels' tables, where
-    the bounds are power laws, coarser cells down to float32's smallest subnormal where they fit), with pairs in the
-    few cells that still miss and below the cells level by level; the levels whose bounds a fixed grid does not fit
+    the bounds are power laws, coarser cells down to float32's smallest subnormal where they fit; finer cells from
+    where features crowd up to 1), with pairs in the few cells that still miss and below the cells level by level; the levels whose bounds a fixed grid does not fit
     from refined cells of their own (a coarse cell cut into finer ones), else from a level table of those levels;
     else (no level fits, or the product of a chain whose bounds all increase does not) through pumpup's table of all
     levels: the product table G(m) where every level's bound increases
@@ -798,7 +798,10 @@ class _CellPolynomials:
     the chain knows of them: its first piece keeps the cell's row, each further piece, from kink t_i, has a row of its
     own, a quartic in t - t_i.  Else the cell is ``bad``: the plugin looks pairs with a cosine there up level by level.
     The fewest bits of :data:`BITS` with the fewest bad cells, then the fewest split cells.  Beyond :data:`MAX_BAD` bad
-    or :data:`MAX_SPLITS` split cells, refined cells (``coarse``): 2^REFINE_BITS coarse cells per octave, each cut into
+    cells, top cells: from the lowest bad cell up to 1, the fewest 2^top_bits cells per octave of which at most MAX_BAD
+    miss (those are bad, not split), found from the bits of m as the fine cells are, with one comparison and one
+    select more (``ntop``; a chain whose features crowd near m = 1).  Beyond MAX_BAD bad cells even so, or
+    :data:`MAX_SPLITS` split cells, refined cells (``coarse``): 2^REFINE_BITS coarse cells per octave, each cut into
     the fewest 2^e fine cells (e <= MAX_EXTRA_BITS) that all fit, a fine cell that misses even so split at a kink
     where it can be; a look-up reads its coarse cell's entry (first fine cell << 5 | e), then its fine cell's
     coefficients.  Refused (:class:`_CellsMiss`: the plugin then leaves levels out of the cells, or takes pumpup's
@@ -824,6 +827,12 @@ class _CellPolynomials:
     LOW_BITS = (0, 1, 2, 3)
     #: the float64 bits of 1
     ONE = int(np.float64(1.0).view(np.int64))
+    #: top cells, where a fixed grid of :data:`BITS` misses in more than MAX_BAD cells: from the lowest of them up to
+    #: 1, 2^top_bits cells per octave, the fewest (at most MAX_TOP_BITS, in at most MAX_TOP_ROWS rows) where at most
+    #: MAX_BAD miss; those are not split (a split there measured slower than a cell that misses, so small that few
+    #: pairs take the level-by-level path)
+    MAX_TOP_BITS = 20
+    MAX_TOP_ROWS = 2**13
     #: refined cells, where no fixed grid of :data:`BITS` fits: 2^REFINE_BITS coarse cells per octave, each cut into
     #: 2^e fine cells, e from 0 to MAX_EXTRA_BITS, the fewest where all fit
     REFINE_BITS = 9
@@ -843,10 +852,15 @@ class _CellPolynomials:
             if len(fit[1]) + len(fit[2]) == 0:
                 break
         bits, coef, splits, bad = best
+        #: top cells: (the bits of their first cell's left edge, their shift, their coefficients with a row for m = 1,
+        #: those that miss), else None
+        top = self._top(functions, bits, bad) if len(bad) > self.MAX_BAD else None
+        if top is not None:  # (the fine cells end where the top cells begin)
+            coef, splits, bad = coef[:min(bad)], [s for s in splits if s[0] < min(bad)], []
         #: refined cells: each coarse cell's entry (its first fine cell << 5 | its extra bits e), else None
         self.coarse = None
         if (len(bad) > self.MAX_BAD or len(splits) > self.MAX_SPLITS) and refine:
-            bits = self.REFINE_BITS
+            bits, top = self.REFINE_BITS, None
             coef, self.coarse, splits, bad = self._refined(functions, kinks)
         if len(bad) > self.MAX_BAD or len(splits) > self.MAX_SPLITS:
             raise _CellsMiss(f"pumpup.mitsuba: {len(bad)} cells of a level's bound are not within its lift of "
@@ -866,6 +880,15 @@ class _CellPolynomials:
         if lows is not None:
             coef = np.concatenate([coef, lows[0]])
             splits = splits + [(self.nfine + c, *rest) for c, *rest in lows[1]]
+        #: the top cells' rows follow the low cells' (none where the fine cells fit up to 1): 2^(52 - top_shift) cells
+        #: per octave from the float whose bits are top_bits up to 1, the last holding m = 1
+        self.ntop, self.top_bits, self.top_shift = 0, self.ONE + 1, 0
+        if top is not None:
+            self.top_bits, self.top_shift, top_coef, top_bad = top
+            self.ntop = top_coef.shape[0]
+            bad = bad + [coef.shape[0] + int(c) for c in top_bad]
+            coef = np.concatenate([coef, top_coef])
+        self.top_base = self.top_bits >> self.top_shift
         #: the cells split at kinks, (cell, [t of each kink], the row of the piece from the first kink): the further
         #: pieces' rows follow the cells'
         self.splits = []
@@ -939,6 +962,24 @@ class _CellPolynomials:
         entries.append(first << 5)
         return (np.concatenate(rows + [self._row_of_one(functions)]), np.array(entries, dtype=np.uint32), splits,
                 sorted(bad))
+
+    def _top(self, functions, bits: int, bad):
+        """(the bits of the left edge of the lowest fine cell of ``bad``, the top cells' shift, their coefficients with
+        one more row for m = 1, the top cells that miss) of the fewest top cells per octave from that edge up to 1 of
+        which at most MAX_BAD miss, in at most MAX_TOP_ROWS rows; else None.
+        """
+        shift = 52 - bits
+        top_bits = ((self.mlo_bits >> shift) + min(bad)) << shift
+        for top in range(bits + 1, self.MAX_TOP_BITS + 1):
+            top_shift = 52 - top
+            first, last = top_bits >> top_shift, (self.ONE >> top_shift) - 1
+            if last - first + 2 > self.MAX_TOP_ROWS:
+                return None
+            left, width = self._grid(first, last, top_shift)
+            coef, ok = self._fit(functions, left, width, *self._side(left, width, below=False))
+            if np.count_nonzero(~ok) <= self.MAX_BAD:
+                return top_bits, top_shift, np.concatenate([coef, self._row_of_one(functions)]), np.nonzero(~ok)[0]
+        return None
 
     def _low(self, functions, kinks, bits: int, nsplit: int):
         """(the coefficients of 2^``bits`` cells per octave from 2^(LOW_EXP - 1023) up to mlo, the cells split at
@@ -1041,7 +1082,8 @@ class _CellPolynomials:
 
     def _cell(self, bits):
         """(cell, t) of the float64 bits of m > 0 (numpy): a fine cell from m's bits above the shift, t those below
-        it / 2^shift (exact); below mlo, where the low cells hold every float32, its low cell and t likewise.
+        it / 2^shift (exact); from the top cells' first edge up, its top cell and t likewise, and below mlo, where the
+        low cells hold every float32, its low cell.
         """
         c = np.minimum(np.maximum(bits >> self.shift, self.cbase) - self.cbase, self.nfine - 1)
         t = (bits & ((1 << self.shift) - 1)).astype(np.float64) * 2.0**-self.shift
@@ -1050,6 +1092,11 @@ class _CellPolynomials:
             sub = self.shift - (entry & 31)
             c = (entry >> 5) + ((bits >> sub) & ((1 << (entry & 31)) - 1))
             t = (bits & ((1 << sub) - 1)).astype(np.float64) * np.ldexp(1.0, -sub)
+        if self.ntop:
+            top = bits >= self.top_bits
+            c = np.where(top, self.nfine + self.nlow + np.minimum((bits >> self.top_shift) - self.top_base,
+                                                                  self.ntop - 1), c)
+            t = np.where(top, (bits & ((1 << self.top_shift) - 1)).astype(np.float64) * 2.0**-self.top_shift, t)
         if self.nlow:
             low = bits < self.mlo_bits
             c = np.where(low, self.nfine + np.maximum(bits >> self.low_shift, self.low_base) - self.low_base, c)
@@ -1093,11 +1140,17 @@ class _CellPolynomials:
         else:
             c = mi.UInt32(dr.minimum(dr.maximum(mb >> self.shift, self.cbase) - self.cbase, self.nfine - 1))
             t = mi.Float64(mb & ((1 << self.shift) - 1)) * 2.0**-self.shift
-        if not self.nlow:
-            return c, t
-        low = mb < self.mlo_bits
-        c = dr.select(low, mi.UInt32(dr.maximum(mb >> self.low_shift, self.low_base) - self.low_base) + self.nfine, c)
-        return c, dr.select(low, mi.Float64(mb & ((1 << self.low_shift) - 1)) * 2.0**-self.low_shift, t)
+        if self.ntop:
+            top = mb >= self.top_bits
+            c = dr.select(top, mi.UInt32(dr.minimum((mb >> self.top_shift) - self.top_base, self.ntop - 1))
+                          + (self.nfine + self.nlow), c)
+            t = dr.select(top, mi.Float64(mb & ((1 << self.top_shift) - 1)) * 2.0**-self.top_shift, t)
+        if self.nlow:
+            low = mb < self.mlo_bits
+            c = dr.select(low, mi.UInt32(dr.maximum(mb >> self.low_shift, self.low_base) - self.low_base) + self.nfine,
+                          c)
+            t = dr.select(low, mi.Float64(mb & ((1 << self.low_shift) - 1)) * 2.0**-self.low_shift, t)
+        return c, t
 
     def reference(self, m):
         """[F_1(m), ..., F_k(m)], each at most its cap, as the Dr.Jit look-up computes them (numpy; m >= mlo, or

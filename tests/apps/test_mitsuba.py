@@ -266,23 +266,29 @@ def test_table_kernels_equal_their_numpy_references(spec, rng):
 
 #: chains whose g the plugin takes from fixed cells (:class:`pumpup.mitsuba._CellG`): each level's bound at both
 #: cosines (1-level and 2-level GGX, a 2-level Beckmann), the product of every level's g at the larger cosine where
-#: every level's bound increases (2-level Phong), and 3-level GGX in refined cells
+#: every level's bound increases (2-level Phong; 3-level Phong, whose product crowds with features near m = 1, in top
+#: cells there), and 3-level GGX in refined cells
+PHONG_TOP = {"type": "pumped", "base": {"type": "phong", "n": 20}, "g": "g2", "levels": 3}
 CELL_CHAINS = [{"type": "pumped", "base": {"type": "ggx", "alpha": 0.3}, "g": "g2", "levels": 1}, LEVEL_TABLE[0],
                {"type": "pumped", "base": {"type": "beckmann", "alpha": 0.05}, "g": "g1", "levels": 2}, PUMPED[0],
-               LEVEL_TABLE[1]]
+               LEVEL_TABLE[1], PHONG_TOP]
 
 
 def _cell_range(cells, c):
-    """The cosines [lo, hi) of fine cells ``c`` of a cell table (of refined cells: fine cell c - first of coarse cell
-    k, one of its 2^e)."""
+    """The cosines [lo, hi) of fine or top cells ``c`` of a cell table (of refined cells: fine cell c - first of
+    coarse cell k, one of its 2^e)."""
     c = np.asarray(c, dtype=np.int64)
-    k, sub, e = c, 0, 0
+    k, sub, e, base, shift = c, 0, 0, cells.cbase, cells.shift
     if cells.coarse is not None:
         first = (cells.coarse >> 5).astype(np.int64)
         k = np.searchsorted(first, c, side="right") - 1
         sub, e = c - first[k], (cells.coarse[k] & 31).astype(np.int64)
-    lo = ((k + cells.cbase) << cells.shift).view(np.float64)
-    w = (((k + cells.cbase + 1) << cells.shift).view(np.float64) - lo) / 2.0**e
+    if cells.ntop:
+        top = c >= cells.nfine + cells.nlow
+        k = np.where(top, c - cells.nfine - cells.nlow, k)
+        base, shift = np.where(top, cells.top_base, base), np.where(top, cells.top_shift, shift)
+    lo = ((k + base) << shift).view(np.float64)
+    w = (((k + base + 1) << shift).view(np.float64) - lo) / 2.0**e
     return lo + w * sub, lo + w * (sub + 1)
 
 
@@ -299,10 +305,11 @@ def _kink_points(cells, rng):
 
 
 def _cell_points(cells, rng):
-    """Cosines from a cell table's mlo to 1: uniform, log-uniform, the edges of every 7th fine cell and the floats below
-    them, 1, the table's mlo, and those of :func:`_kink_points`; where the table has low cells, those of
-    :func:`_low_points` too."""
-    lo, _ = _cell_range(cells, np.arange(0, cells.nfine - 1, 7))
+    """Cosines from a cell table's mlo to 1: uniform, log-uniform, the edges of every 7th fine cell and of every 7th
+    top cell and the floats below them, 1, the table's mlo, and those of :func:`_kink_points`; where the table has low
+    cells, those of :func:`_low_points` too."""
+    top = cells.nfine + cells.nlow
+    lo, _ = _cell_range(cells, np.concatenate([np.arange(0, cells.nfine - 1, 7), np.arange(top, top + cells.ntop, 7)]))
     x = np.concatenate([rng.uniform(cells.mlo, 1.0, 4000), np.exp(rng.uniform(math.log(cells.mlo), 0.0, 4000)),
                         lo, np.nextafter(lo, 0.0), [1.0, np.nextafter(1.0, 0.0), cells.mlo], _kink_points(cells, rng)])
     x = x[(x >= cells.mlo) & (x <= 1.0)]
@@ -437,18 +444,48 @@ def test_refined_cells_cut_the_cells_a_fixed_grid_misses(rng):
 
 
 @needs_llvm
-@pytest.mark.parametrize("spec,hide_kinks", [(CELL_CHAINS[1], False), (PUMPED[0], False), (CELL_CHAINS[1], True)],
-                         ids=["levels-2", "product-2", "levels-2-kinks-hidden"])
+def test_top_cells_hold_features_that_crowd_near_1(rng, monkeypatch):
+    """Three steep (smooth) steps 1e-3 wide near m = 1: a fixed grid of quartics misses in more than MAX_BAD cells
+    there, so the table takes top cells, finer, from the lowest of those cells up to 1, where all fit, without refined
+    cells; the look-up lies within [F, F (1 + LIFT)] on and about the steps and about the top cells' first edge, its
+    Dr.Jit version equal to its numpy reference.  Without top cells (MAX_TOP_ROWS = 0) the table is refused."""
+    pm.register(LLVM)
+    centres = 0.990 + 0.004 * np.arange(3)
+
+    def fn(m):
+        return 2.5 + 0.3 * np.sum(np.tanh((m[..., None] - centres) / 1e-3), axis=-1)
+
+    cells = pm._CellPolynomials([fn], [math.inf], 1e-8, refine=False)
+    assert cells.ntop > 0 and cells.coarse is None and not cells.bad and not cells.splits
+    top = float(np.int64(cells.top_bits).view(np.float64))
+    assert 0.95 < top < centres[0] - 3e-3 and 52 - cells.top_shift > 52 - cells.shift
+    m = np.concatenate([(centres + np.linspace(-5e-3, 5e-3, 2001)[:, None]).ravel(), rng.uniform(1e-8, 1.0, 4000),
+                        top + np.linspace(-1e-4, 1e-4, 201), [top, np.nextafter(top, 0.0), 1.0]])
+    m = m[m <= 1.0]
+    got = cells.reference(m)[0]
+    assert np.all(got >= fn(m)) and np.all(got <= fn(m) * (1 + cells.LIFT))
+    assert np.array_equal(np.array(cells(mi.Float64(m))[0], dtype=np.float64), got)
+    monkeypatch.setattr(pm._CellPolynomials, "MAX_TOP_ROWS", 0)
+    with pytest.raises(pm._CellsMiss, match="not within its lift"):
+        pm._CellPolynomials([fn], [math.inf], 1e-8, refine=False)
+
+
+@needs_llvm
+@pytest.mark.parametrize("spec,hide_kinks", [(CELL_CHAINS[1], False), (PUMPED[0], False), (CELL_CHAINS[1], True),
+                                             (PHONG_TOP, False)],
+                         ids=["levels-2", "product-2", "levels-2-kinks-hidden", "product-3-top"])
 def test_pairs_in_split_and_missing_cells_agree_with_pumpup(spec, hide_kinks, rng, monkeypatch):
     """Pairs whose cosines lie in the cells split at a kink (about the kinks too), or, with the kinks hidden from the
-    table, in the cells whose quartics then miss (looked up level by level): through the plugin, within one rounding
-    of pumpup's eval and never above it."""
+    table or in top cells (not split), in the cells whose quartics then miss (looked up level by level): through the
+    plugin, within one rounding of pumpup's eval and never above it."""
     pm.register(LLVM)
     if hide_kinks:
         monkeypatch.setattr(pm._CellG, "_kinks", lambda self, looks, mu0: np.zeros(0))
     f = pumpup.load(spec)
     cells = pm._DrModel(f).fast.cells
-    assert (cells.bad and not cells.splits) if hide_kinks else (cells.splits and not cells.bad)
+    missing = hide_kinks or cells.ntop > 0
+    assert (cells.bad and not cells.splits) if missing else (cells.splits and not cells.bad)
+    assert (cells.ntop > 0) == (spec is PHONG_TOP)
     z = _kink_points(cells, rng)
     z = z[(z < 1.0) & (z > 0.0)].astype(np.float32).astype(np.float64)
     ph = rng.uniform(0, 2 * np.pi, len(z))
