@@ -52,8 +52,9 @@ The BSDF
     in fixed cells of the cosine, each at least the bound and within 1e-13 of it (:class:`_CellG`, its cell and the
     position in it from the cosine's bits, no search; a cell with a kink split there; below the levels' tables, where
     the bounds are power laws, coarser cells down to float32's smallest subnormal where they fit; finer cells from
-    where features crowd up to 1), with pairs in the few cells that still miss and below the cells level by level; the levels whose bounds a fixed grid does not fit
-    from refined cells of their own (a coarse cell cut into finer ones), else from a level table of those levels;
+    where features crowd up to 1), with pairs in the few cells that still miss and below the cells level by level;
+    the levels whose bounds a fixed grid does not fit from refined cells of their own (a coarse cell cut into finer
+    ones), else from a level table of those levels;
     else (no level fits, or the product of a chain whose bounds all increase does not) through pumpup's table of all
     levels: the product table G(m) where every level's bound increases
     (:class:`pumpup.operators.pumping._Product`, m = max(N.wi, N.wo)), else the level table
