@@ -853,8 +853,8 @@ class _CellPolynomials:
             if len(fit[1]) + len(fit[2]) == 0:
                 break
         bits, coef, splits, bad = best
-        #: top cells: (the bits of their first cell's left edge, their shift, their coefficients with a row for m = 1,
-        #: those that miss), else None
+        # top cells: (the bits of their first cell's left edge, their shift, their coefficients with a row for m = 1,
+        # those that miss), else None
         top = self._top(functions, bits, bad) if len(bad) > self.MAX_BAD else None
         if top is not None:  # (the fine cells end where the top cells begin)
             coef, splits, bad = coef[:min(bad)], [s for s in splits if s[0] < min(bad)], []
@@ -967,8 +967,11 @@ class _CellPolynomials:
     def _top(self, functions, bits: int, bad):
         """(the bits of the left edge of the lowest fine cell of ``bad``, the top cells' shift, their coefficients with
         one more row for m = 1, the top cells that miss) of the fewest top cells per octave from that edge up to 1 of
-        which at most MAX_BAD miss, in at most MAX_TOP_ROWS rows; else None.
+        which at most MAX_BAD miss, in at most MAX_TOP_ROWS rows; else None (and where the lowest is the first fine
+        cell: some fine cell stays below the top cells, so that every cosine's fine cell is a row).
         """
+        if min(bad) == 0:
+            return None
         shift = 52 - bits
         top_bits = ((self.mlo_bits >> shift) + min(bad)) << shift
         for top in range(bits + 1, self.MAX_TOP_BITS + 1):
