@@ -107,7 +107,8 @@ def current() -> Choice:
 def using(engine: str | None = None, without=(), **options):
     """Within the block (in this thread or task only), :func:`pumpup.albedo` and everything built on it (tables,
     pumping, compensation) route by ``engine`` and leave out the routes ``without``; ``options`` set
-    :class:`Choice`'s other fields.  Blocks nest: the inner one adds to the outer one's ``without``.
+    :class:`Choice`'s other fields.  Blocks nest: the inner one adds to the outer one's ``without``.  The pumping and
+    compensation operators keep the tables they cache for the session per choice.
     """
     old = _CHOICE.get()
     bad = set(without) - set(ROUTES)

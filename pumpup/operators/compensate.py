@@ -76,6 +76,7 @@ from .pumping import (
     file_tables,
     from_file,
     prepare,
+    session_key,
     table_decades,
 )
 
@@ -101,10 +102,10 @@ def compensation_table(white: BRDF, progress: bool | None = None):
     """The albedo table E of ``white`` used by the compensation operators (cached per session)."""
     from ..tables import albedo_table
 
-    key = _key(white)
-    own = from_file("compensate", key)  # a file being loaded: its table serves only its objects
+    own = from_file("compensate", _key(white))  # a file being loaded: its table serves only its objects
     if own is not None:
         return own
+    key = session_key(white)
     if key not in _TABLES:
         _TABLES[key] = albedo_table(white, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress)
     return _TABLES[key]
@@ -927,7 +928,6 @@ def save_compensated(f: BRDF, path: str | os.PathLike[str]) -> str:
 
     from .._version import __version__
     from ..tables import write_groups
-    from .pumping import _TABLES as PUMP_TABLES
     from .pumping import base_table
 
     if not isinstance(f, BRDF):
@@ -944,8 +944,7 @@ def save_compensated(f: BRDF, path: str | os.PathLike[str]) -> str:
         if kind == "compensate":
             ds = compensation_table(g).dataset
         else:
-            base_table(g)
-            ds = PUMP_TABLES[_key(g)].dataset
+            ds = base_table(g).dataset
         groups.append(ds.assign_attrs(cache=kind))
     root = xr.Dataset(attrs={"pumpup_kind": "pumpup compensated BRDF", "spec": json.dumps(f.spec, sort_keys=True),
                              "tables": len(groups), "pumpup_version": __version__})

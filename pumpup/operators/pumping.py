@@ -73,6 +73,17 @@ def _key(brdf: BRDF) -> str:
     return key if fn is None else f"{key}#{id(fn)}"
 
 
+def session_key(brdf: BRDF) -> str:
+    """Key of a base's table in the session's cache: :func:`_key`, and the routing in force where it is not the
+    default (:func:`pumpup.engine.routes.using`): a table that other routes computed differs within its error from the
+    default's, so it serves only code under the same routing.
+    """
+    from ..engine.routes import Choice, current
+
+    choice = current()
+    return _key(brdf) if choice == Choice() else f"{_key(brdf)}#{choice}"
+
+
 #: tables read from a file while that file's BRDF is being built (``file_tables``): (kind, key) -> AlbedoTable
 _FILE = threading.local()
 
@@ -115,7 +126,7 @@ def base_table(base: BRDF, progress: bool | None = None):
                 base._derived_table = albedo_table(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL,
                                                    progress=progress, breaks=base.albedo_kinks(*grid_interior()))
         return base._derived_table
-    key = _key(base)
+    key = session_key(base)
     if key not in _TABLES:
         with _lock_for(key):  # one thread computes a base's table; the others wait for it
             if key not in _TABLES:
