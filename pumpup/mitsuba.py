@@ -799,11 +799,11 @@ class _CellPolynomials:
     the chain knows of them: its first piece keeps the cell's row, each further piece, from kink t_i, has a row of its
     own, a quartic in t - t_i.  Else the cell is ``bad``: the plugin looks pairs with a cosine there up level by level.
     The fewest bits of :data:`BITS` with the fewest bad cells, then the fewest split cells.  Beyond :data:`MAX_BAD` bad
-    cells, top cells: from the lowest bad cell up to 1, the fewest 2^top_bits cells per octave of which at most MAX_BAD
-    miss (those are bad, not split), found from the bits of m as the fine cells are, with one comparison and one
-    select more (``ntop``; a chain whose features crowd near m = 1).  Beyond MAX_BAD bad cells even so, or
-    :data:`MAX_SPLITS` split cells, refined cells (``coarse``): 2^REFINE_BITS coarse cells per octave, each cut into
-    the fewest 2^e fine cells (e <= MAX_EXTRA_BITS) that all fit, a fine cell that misses even so split at a kink
+    cells, top cells: from the lowest bad cell up to 1, the fewest 2^top_bits cells per octave of which at most
+    :data:`MAX_TOP_BAD` miss (those are bad, not split), found from the bits of m as the fine cells are, with one
+    comparison and one select more (``ntop``; a chain whose features crowd near m = 1).  Beyond MAX_BAD bad cells even
+    so, or :data:`MAX_SPLITS` split cells, refined cells (``coarse``): 2^REFINE_BITS coarse cells per octave, each cut
+    into the fewest 2^e fine cells (e <= MAX_EXTRA_BITS) that all fit, a fine cell that misses even so split at a kink
     where it can be; a look-up reads its coarse cell's entry (first fine cell << 5 | e), then its fine cell's
     coefficients.  Refused (:class:`_CellsMiss`: the plugin then leaves levels out of the cells, or takes pumpup's
     product or level table) beyond MAX_BAD fine cells that miss or MAX_SPLITS split ones.  ``reference`` is the plain
@@ -830,10 +830,13 @@ class _CellPolynomials:
     ONE = int(np.float64(1.0).view(np.int64))
     #: top cells, where a fixed grid of :data:`BITS` misses in more than MAX_BAD cells: from the lowest of them up to
     #: 1, 2^top_bits cells per octave, the fewest (at most MAX_TOP_BITS, in at most MAX_TOP_ROWS rows) where at most
-    #: MAX_BAD miss; those are not split (a split there measured slower than a cell that misses, so small that few
-    #: pairs take the level-by-level path)
+    #: MAX_TOP_BAD miss, together at most MAX_TOP_BAD_WIDTH wide; those are not split (splits there measured slower
+    #: than cells that miss, so small that few pairs take the level-by-level path).  More than MAX_BAD: 3-level g2
+    #: Phong's product has 5 at 2^14, whatever engine built its tables, where 4 at 2^18 needed tables from the default
     MAX_TOP_BITS = 20
     MAX_TOP_ROWS = 2**13
+    MAX_TOP_BAD = 8
+    MAX_TOP_BAD_WIDTH = 2.0**-12
     #: refined cells, where no fixed grid of :data:`BITS` fits: 2^REFINE_BITS coarse cells per octave, each cut into
     #: 2^e fine cells, e from 0 to MAX_EXTRA_BITS, the fewest where all fit
     REFINE_BITS = 9
@@ -967,8 +970,9 @@ class _CellPolynomials:
     def _top(self, functions, bits: int, bad):
         """(the bits of the left edge of the lowest fine cell of ``bad``, the top cells' shift, their coefficients with
         one more row for m = 1, the top cells that miss) of the fewest top cells per octave from that edge up to 1 of
-        which at most MAX_BAD miss, in at most MAX_TOP_ROWS rows; else None (and where the lowest is the first fine
-        cell: some fine cell stays below the top cells, so that every cosine's fine cell is a row).
+        which at most MAX_TOP_BAD miss, at most MAX_TOP_BAD_WIDTH wide together, in at most MAX_TOP_ROWS rows; else
+        None (and where the lowest is the first fine cell: some fine cell stays below the top cells, so that every
+        cosine's fine cell is a row).
         """
         if min(bad) == 0:
             return None
@@ -981,7 +985,7 @@ class _CellPolynomials:
                 return None
             left, width = self._grid(first, last, top_shift)
             coef, ok = self._fit(functions, left, width, *self._side(left, width, below=False))
-            if np.count_nonzero(~ok) <= self.MAX_BAD:
+            if np.count_nonzero(~ok) <= self.MAX_TOP_BAD and np.sum(width[~ok]) <= self.MAX_TOP_BAD_WIDTH:
                 return top_bits, top_shift, np.concatenate([coef, self._row_of_one(functions)]), np.nonzero(~ok)[0]
         return None
 

@@ -342,7 +342,8 @@ def test_cell_polynomials_equal_their_numpy_reference_and_bound_pumpups_g(spec, 
     fast = pm._DrModel(f).fast
     assert isinstance(fast, pm._CellG) and fast.increasing == (f.product() is not None)
     cells = fast.cells
-    assert len(cells.bad) <= cells.MAX_BAD and len(cells.splits) <= cells.MAX_SPLITS
+    assert len(cells.bad) <= (cells.MAX_TOP_BAD if cells.ntop else cells.MAX_BAD)
+    assert len(cells.splits) <= cells.MAX_SPLITS
     nfun = cells.nfun + (0 if fast.rest_cells is None else fast.rest_cells.nfun)
     assert nfun == (1 if fast.increasing else spec.get("levels", 1))
     assert fast.whole == (not fast.increasing) and (cells.nlow > 0) == fast.whole  # (the product: pairs below mlo
