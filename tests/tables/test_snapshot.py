@@ -30,8 +30,8 @@ def _levels(f):
 
 
 def test_loads_racing_saves_give_one_writers_object(tmp_path, monkeypatch):
-    monkeypatch.setattr(pumping, "_TABLES", {})  # (tables of this test only: those on the other grid must not serve
-    # later tests of the same process)
+    monkeypatch.setattr(pumping, "_TABLES", {})  # (tables of this test only: it clears them, and builds some on
+    # another grid)
     a_path, b_path = str(tmp_path / "a.nc"), str(tmp_path / "b.nc")
     pumpup.save_pumped(pumpup.load(SPEC), a_path)
     pumping._TABLES.clear()
