@@ -170,7 +170,7 @@ def cell_model(spec: dict, pump: dict | None) -> BRDF:
 
 def _cell(spec: dict, pump: dict | None, mu: np.ndarray, opts: dict) -> dict[str, Any]:
     """Everything the sweep stores for one cell: a pure function of its arguments."""
-    from .operators.pumping import _TABLES, Pumped, session_key
+    from .operators.pumping import _TABLES, Pumped, _key
     from .tables import max_albedo, mean_albedo, tabulate
 
     f = cell_model(spec, pump)
@@ -187,7 +187,7 @@ def _cell(spec: dict, pump: dict | None, mu: np.ndarray, opts: dict) -> dict[str
     # the levels of f keep their own references while f lives)
     cur = f
     while isinstance(cur, Pumped):
-        _TABLES.pop(session_key(cur.base), None)
+        _TABLES.pop(_key(cur.base), None)
         cur = cur.base
     return out
 

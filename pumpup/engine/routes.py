@@ -104,11 +104,24 @@ def current() -> Choice:
 
 
 @contextlib.contextmanager
+def default_routes():
+    """Within the block, every route, as by default, whatever :func:`using` block encloses it: the pumping and
+    compensation operators build their tables, which define their BRDFs, in it, so that a BRDF is the same whichever
+    routes compute its albedo (a table by other routes differs within its error).
+    """
+    token = _CHOICE.set(Choice())
+    try:
+        yield
+    finally:
+        _CHOICE.reset(token)
+
+
+@contextlib.contextmanager
 def using(engine: str | None = None, without=(), **options):
     """Within the block (in this thread or task only), :func:`pumpup.albedo` and everything built on it (tables,
     pumping, compensation) route by ``engine`` and leave out the routes ``without``; ``options`` set
-    :class:`Choice`'s other fields.  Blocks nest: the inner one adds to the outer one's ``without``.  The pumping and
-    compensation operators keep the tables they cache for the session per choice.
+    :class:`Choice`'s other fields.  Blocks nest: the inner one adds to the outer one's ``without``.  What defines a
+    BRDF is computed as by default within it (:func:`default_routes`).
     """
     old = _CHOICE.get()
     bad = set(without) - set(ROUTES)

@@ -76,7 +76,6 @@ from .pumping import (
     file_tables,
     from_file,
     prepare,
-    session_key,
     table_decades,
 )
 
@@ -99,15 +98,19 @@ _TABLES: dict[str, object] = {}  # cache key of the white base -> AlbedoTable (w
 
 
 def compensation_table(white: BRDF, progress: bool | None = None):
-    """The albedo table E of ``white`` used by the compensation operators (cached per session)."""
+    """The albedo table E of ``white`` used by the compensation operators (cached per session), built with every route
+    whatever :func:`pumpup.engine.routes.using` block encloses the call (:func:`pumpup.engine.routes.default_routes`).
+    """
+    from ..engine.routes import default_routes
     from ..tables import albedo_table
 
-    own = from_file("compensate", _key(white))  # a file being loaded: its table serves only its objects
+    key = _key(white)
+    own = from_file("compensate", key)  # a file being loaded: its table serves only its objects
     if own is not None:
         return own
-    key = session_key(white)
     if key not in _TABLES:
-        _TABLES[key] = albedo_table(white, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress)
+        with default_routes():
+            _TABLES[key] = albedo_table(white, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress)
     return _TABLES[key]
 
 

@@ -73,17 +73,6 @@ def _key(brdf: BRDF) -> str:
     return key if fn is None else f"{key}#{id(fn)}"
 
 
-def session_key(brdf: BRDF) -> str:
-    """Key of a base's table in the session's cache: :func:`_key`, and the routing in force where it is not the
-    default (:func:`pumpup.engine.routes.using`): a table that other routes computed differs within its error from the
-    default's, so it serves only code under the same routing.
-    """
-    from ..engine.routes import Choice, current
-
-    choice = current()
-    return _key(brdf) if choice == Choice() else f"{_key(brdf)}#{choice}"
-
-
 #: tables read from a file while that file's BRDF is being built (``file_tables``): (kind, key) -> AlbedoTable
 _FILE = threading.local()
 
@@ -114,7 +103,10 @@ def from_file(kind: str, key: str):
 
 
 def base_table(base: BRDF, progress: bool | None = None):
-    """The albedo table of ``base`` used by the pumping operator (cached per session)."""
+    """The albedo table of ``base`` used by the pumping operator (cached per session), built with every route whatever
+    :func:`pumpup.engine.routes.using` block encloses the call (:func:`pumpup.engine.routes.default_routes`).
+    """
+    from ..engine.routes import default_routes
     from ..tables import albedo_table
 
     own = from_file("pump", _key(base))
@@ -123,18 +115,20 @@ def base_table(base: BRDF, progress: bool | None = None):
     if _uses_file_tables(base):  # computed from a file's tables: serves this object only
         with _lock_for(f"derived#{id(base)}"):
             if getattr(base, "_derived_table", None) is None:
-                base._derived_table = albedo_table(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL,
-                                                   progress=progress, breaks=base.albedo_kinks(*grid_interior()))
+                with default_routes():
+                    base._derived_table = albedo_table(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL,
+                                                       progress=progress, breaks=base.albedo_kinks(*grid_interior()))
         return base._derived_table
-    key = session_key(base)
+    key = _key(base)
     if key not in _TABLES:
         with _lock_for(key):  # one thread computes a base's table; the others wait for it
             if key not in _TABLES:
                 # an anisotropic base: the table bounds the supremum over the azimuth of wi (001 eq. 17
                 # needs g >= a(L) for every L, not only for L in the xz-plane; pumpup.tables.azimuth)
                 phi = None if base.azimuth_range() is None else "sup"
-                _TABLES[key] = albedo_table(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL, progress=progress,
-                                            phi=phi, breaks=base.albedo_kinks(*grid_interior()))
+                with default_routes():
+                    _TABLES[key] = albedo_table(base, rtol=TABLE_RTOL, interp_tol=TABLE_INTERP_TOL,
+                                                progress=progress, phi=phi, breaks=base.albedo_kinks(*grid_interior()))
     return _TABLES[key]
 
 

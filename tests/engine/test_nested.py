@@ -115,7 +115,7 @@ BASES = {"phong": {"type": "phong", "n": 20}, "blinn": {"type": "blinn", "n": 20
                                                         "cook_torrance-g2-2"])
 def test_pumped_nested_and_2d_agree(base, g, levels, no_1d):
     f = pumpup.pump(BASES[base], g=g, levels=levels)
-    f.lookup()  # the tables of the levels below, built once (with the nested engine)
+    f.lookup()  # the tables of the levels below, built once (with every route: they define f)
     mu = np.array([1.0, 0.7, 0.2, 1e-3, 1e-6]) if base != "cook_torrance" else np.array([0.8, 0.1, 1e-4])
     a, e, used = _by_engine(f, mu, nested=True)
     b, eb, _ = _by_engine(f, mu, nested=False)

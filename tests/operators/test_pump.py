@@ -394,22 +394,20 @@ def test_saved_file_carries_the_top_levels_albedo(tmp_path):
     np.testing.assert_array_equal(g._derived_table.dataset.albedo.values, top.albedo.values)
 
 
-def test_a_table_built_under_other_routes_serves_only_that_routing(monkeypatch):
-    """A base's table built under other routes (``using(engine="2d")``: the 2-D cubature alone) may differ from the
-    default's within its error: the session's cache keeps it for that routing only, so code outside the block builds
-    and gets the default's, and the block its own again; the compensation's tables likewise."""
+def test_tables_that_define_a_brdf_are_built_with_every_route_within_using(monkeypatch):
+    """A base's table built within ``using(engine="2d")`` (the 2-D cubature alone) is the one built with every route:
+    it defines the pumped (or compensated) BRDF, which must be the same whichever routes compute its albedo, and
+    whichever of them came first in the session; the compensation's tables likewise."""
     from pumpup.engine.routes import using
 
     pumping = sys.modules["pumpup.operators.pumping"]
     compensate = sys.modules["pumpup.operators.compensate"]
-    monkeypatch.setattr(pumping, "_TABLES", {})  # (tables of this test only)
-    monkeypatch.setattr(compensate, "_TABLES", {})
     base = pumpup.load({"type": "phong", "n": 20})
-    for table in (pumping.base_table, compensate.compensation_table):
+    for module, table in ((pumping, pumping.base_table), (compensate, compensate.compensation_table)):
+        monkeypatch.setattr(module, "_TABLES", {})  # (tables of this test only)
         with using(engine="2d"):
             inner = table(base)
-            assert table(base) is inner
+        assert table(base) is inner
+        monkeypatch.setattr(module, "_TABLES", {})
         outer = table(base)
-        assert outer is not inner and table(base) is outer
-        with using(engine="2d"):
-            assert table(base) is inner
+        assert outer is not inner and np.array_equal(outer.dataset["albedo"].values, inner.dataset["albedo"].values)
