@@ -1088,27 +1088,40 @@ class _CellPolynomials:
             coef[:, j] = a
         return coef, ok
 
+    @staticmethod
+    def _in_grid(bits, shift: int, base: int, n: int | None, xp=np):
+        """(cell, t) of float64 bits in a grid of ``n`` cells, cell c holding the floats whose bits >> shift are
+        base + c, t the bits below the shift / 2^shift (exact); bits below the grid in its first cell, bits above it in
+        its last, but for ``n`` None: the low cells, which end where the comparison that selects them does (a clamp
+        there cost 3 % of a 1-level pumped GGX sample, measured).  ``xp``: numpy, or Dr.Jit (bits a UInt64 array).
+        """
+        if xp is np:
+            c = np.maximum(bits >> shift, base) - base
+            t = (bits & ((1 << shift) - 1)).astype(np.float64) * 2.0**-shift
+            return (c if n is None else np.minimum(c, n - 1)), t
+        c = dr.maximum(bits >> shift, base) - base
+        t = mi.Float64(bits & ((1 << shift) - 1)) * 2.0**-shift
+        return mi.UInt32(c if n is None else dr.minimum(c, n - 1)), t
+
     def _cell(self, bits):
         """(cell, t) of the float64 bits of m > 0 (numpy): a fine cell from m's bits above the shift, t those below
         it / 2^shift (exact); from the top cells' first edge up, its top cell and t likewise, and below mlo, where the
         low cells hold every float32, its low cell.
         """
-        c = np.minimum(np.maximum(bits >> self.shift, self.cbase) - self.cbase, self.nfine - 1)
-        t = (bits & ((1 << self.shift) - 1)).astype(np.float64) * 2.0**-self.shift
+        c, t = self._in_grid(bits, self.shift, self.cbase, self.nfine)
         if self.coarse is not None:  # the coarse cell's entry, then its fine cell
-            entry = self.coarse[np.minimum(c, len(self.coarse) - 1)].astype(np.int64)
+            entry = self.coarse[self._in_grid(bits, self.shift, self.cbase, len(self.coarse))[0]].astype(np.int64)
             sub = self.shift - (entry & 31)
             c = (entry >> 5) + ((bits >> sub) & ((1 << (entry & 31)) - 1))
             t = (bits & ((1 << sub) - 1)).astype(np.float64) * np.ldexp(1.0, -sub)
         if self.ntop:
             top = bits >= self.top_bits
-            c = np.where(top, self.nfine + self.nlow + np.minimum((bits >> self.top_shift) - self.top_base,
-                                                                  self.ntop - 1), c)
-            t = np.where(top, (bits & ((1 << self.top_shift) - 1)).astype(np.float64) * 2.0**-self.top_shift, t)
+            ct, tt = self._in_grid(bits, self.top_shift, self.top_base, self.ntop)
+            c, t = np.where(top, ct + (self.nfine + self.nlow), c), np.where(top, tt, t)
         if self.nlow:
             low = bits < self.mlo_bits
-            c = np.where(low, self.nfine + np.maximum(bits >> self.low_shift, self.low_base) - self.low_base, c)
-            t = np.where(low, (bits & ((1 << self.low_shift) - 1)).astype(np.float64) * 2.0**-self.low_shift, t)
+            cl, tl = self._in_grid(bits, self.low_shift, self.low_base, None)
+            c, t = np.where(low, cl + self.nfine, c), np.where(low, tl, t)
         return c, t
 
     def _halves(self, c, t, select):
@@ -1139,25 +1152,22 @@ class _CellPolynomials:
         """:meth:`_cell` in Dr.Jit, of the Float64 cosines m (m <= 0: some valid cell)."""
         mb = dr.reinterpret_array(mi.UInt64, m)
         if self.coarse is not None:  # the coarse cell's entry, then its fine cell
-            cc = mi.UInt32(dr.minimum(dr.maximum(mb >> self.shift, self.cbase) - self.cbase, len(self.coarse) - 1))
-            entry = dr.gather(mi.UInt32, self.coarse_dr, cc)
+            coarse_cell = self._in_grid(mb, self.shift, self.cbase, len(self.coarse), xp=dr)[0]
+            entry = dr.gather(mi.UInt32, self.coarse_dr, coarse_cell)
             e = mi.UInt64(entry & 31)
             sub = self.shift - e
             c = (entry >> 5) + mi.UInt32((mb >> sub) & ((mi.UInt64(1) << e) - 1))
             t = mi.Float64(mb & ((mi.UInt64(1) << sub) - 1)) * dr.reinterpret_array(mi.Float64, (1023 - sub) << 52)
         else:
-            c = mi.UInt32(dr.minimum(dr.maximum(mb >> self.shift, self.cbase) - self.cbase, self.nfine - 1))
-            t = mi.Float64(mb & ((1 << self.shift) - 1)) * 2.0**-self.shift
+            c, t = self._in_grid(mb, self.shift, self.cbase, self.nfine, xp=dr)
         if self.ntop:
             top = mb >= self.top_bits
-            c = dr.select(top, mi.UInt32(dr.minimum((mb >> self.top_shift) - self.top_base, self.ntop - 1))
-                          + (self.nfine + self.nlow), c)
-            t = dr.select(top, mi.Float64(mb & ((1 << self.top_shift) - 1)) * 2.0**-self.top_shift, t)
+            ct, tt = self._in_grid(mb, self.top_shift, self.top_base, self.ntop, xp=dr)
+            c, t = dr.select(top, ct + (self.nfine + self.nlow), c), dr.select(top, tt, t)
         if self.nlow:
             low = mb < self.mlo_bits
-            c = dr.select(low, mi.UInt32(dr.maximum(mb >> self.low_shift, self.low_base) - self.low_base) + self.nfine,
-                          c)
-            t = dr.select(low, mi.Float64(mb & ((1 << self.low_shift) - 1)) * 2.0**-self.low_shift, t)
+            cl, tl = self._in_grid(mb, self.low_shift, self.low_base, None, xp=dr)
+            c, t = dr.select(low, cl + self.nfine, c), dr.select(low, tl, t)
         return c, t
 
     def reference(self, m):
